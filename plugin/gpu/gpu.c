@@ -1,0 +1,248 @@
+/* gpu.c — program cache over the embedded shaders, timestamp ring, debug groups. */
+#include "gpu/gpu.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "vfx_shaders.h"
+#include "shader_text.h"
+
+#define GPU_MAX_PROGRAMS 64
+#define GPU_RING 4          /* frames in flight before a timer result is read */
+#define GPU_MAX_PASSES 32   /* timed passes per frame */
+#define GPU_PASS_DEPTH 8    /* nesting */
+
+typedef struct program_entry {
+    char key[256];
+    GLuint program;
+} program_entry;
+
+typedef struct timer_frame {
+    GLuint queries[GPU_MAX_PASSES * 2];
+    char names[GPU_MAX_PASSES][40];
+    uint32_t count;
+} timer_frame;
+
+struct vfx_gpu {
+    program_entry programs[GPU_MAX_PROGRAMS];
+    uint32_t program_count;
+    GLuint empty_vao;
+    timer_frame ring[GPU_RING];
+    uint32_t frame;                     /* ring slot being recorded */
+    uint32_t open[GPU_PASS_DEPTH];      /* open pass slots */
+    uint32_t open_count;
+    bool has_debug;
+};
+
+const char *vfx_gpu_error_string(void)
+{
+    switch (glGetError()) {
+    case GL_NO_ERROR: return NULL;
+    case GL_INVALID_ENUM: return "GL_INVALID_ENUM";
+    case GL_INVALID_VALUE: return "GL_INVALID_VALUE";
+    case GL_INVALID_OPERATION: return "GL_INVALID_OPERATION";
+    case GL_INVALID_FRAMEBUFFER_OPERATION: return "GL_INVALID_FRAMEBUFFER_OPERATION";
+    case GL_OUT_OF_MEMORY: return "GL_OUT_OF_MEMORY";
+    default: return "GL error";
+    }
+}
+
+vfx_result vfx_gpu_create(vfx_context *ctx, vfx_gpu **out)
+{
+    *out = NULL;
+    const GLubyte *version = glGetString(GL_VERSION);
+    if (!version)
+        return vfx_fail(ctx, VFX_ERR_GL, "volfx needs a current GL context on the calling thread");
+    int ver = epoxy_gl_version();
+    if (ver < 45 || !epoxy_is_desktop_gl())
+        return vfx_fail(ctx, VFX_ERR_GL_UNSUPPORTED,
+                        "volfx needs desktop GL 4.5, the current context is %s", (const char *)version);
+    vfx_gpu *g = vfx_alloc(ctx, sizeof *g);
+    if (!g)
+        return VFX_ERR_OUT_OF_MEMORY;
+    glCreateVertexArrays(1, &g->empty_vao);
+    vfx_gpu_label(GL_VERTEX_ARRAY, g->empty_vao, "volfx.fullscreen_vao");
+    for (int f = 0; f < GPU_RING; ++f)
+        glCreateQueries(GL_TIMESTAMP, GPU_MAX_PASSES * 2, g->ring[f].queries);
+    g->has_debug = true; /* KHR_debug is core in 4.3 */
+    const char *err = vfx_gpu_error_string();
+    if (err) {
+        vfx_gpu_destroy(ctx, g);
+        return vfx_fail(ctx, VFX_ERR_GL, "volfx gpu setup: %s", err);
+    }
+    *out = g;
+    return VFX_OK;
+}
+
+void vfx_gpu_destroy(vfx_context *ctx, vfx_gpu *g)
+{
+    if (!g)
+        return;
+    for (uint32_t i = 0; i < g->program_count; ++i)
+        glDeleteProgram(g->programs[i].program);
+    for (int f = 0; f < GPU_RING; ++f)
+        glDeleteQueries(GPU_MAX_PASSES * 2, g->ring[f].queries);
+    glDeleteVertexArrays(1, &g->empty_vao);
+    vfx_free(ctx, g);
+}
+
+void vfx_gpu_label(GLenum kind, GLuint object, const char *label)
+{
+    if (object)
+        glObjectLabel(kind, object, -1, label);
+}
+
+GLuint vfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *stages,
+                            const char *const *sources, const char *const *names)
+{
+    GLuint prog = glCreateProgram();
+    GLuint shaders[3] = {0};
+    char log[4096], pretty[8192];
+    bool ok = true;
+    for (int i = 0; i < stage_count && ok; ++i) {
+        shaders[i] = glCreateShader(stages[i]);
+        glShaderSource(shaders[i], 1, &sources[i], NULL);
+        glCompileShader(shaders[i]);
+        GLint status = 0;
+        glGetShaderiv(shaders[i], GL_COMPILE_STATUS, &status);
+        if (!status) {
+            glGetShaderInfoLog(shaders[i], sizeof log, NULL, log);
+            vfx_shader_rewrite_log(log, pretty, sizeof pretty, names[i]);
+            vfx_fail(ctx, VFX_ERR_GL, "shader compile failed: %s", pretty);
+            ok = false;
+        } else {
+            glAttachShader(prog, shaders[i]);
+        }
+    }
+    if (ok) {
+        glLinkProgram(prog);
+        GLint status = 0;
+        glGetProgramiv(prog, GL_LINK_STATUS, &status);
+        if (!status) {
+            glGetProgramInfoLog(prog, sizeof log, NULL, log);
+            vfx_fail(ctx, VFX_ERR_GL, "program link failed (%s%s%s): %s", names[0],
+                     stage_count > 1 ? " + " : "", stage_count > 1 ? names[1] : "", log);
+            ok = false;
+        }
+    }
+    for (int i = 0; i < stage_count; ++i)
+        if (shaders[i])
+            glDeleteShader(shaders[i]);
+    if (!ok) {
+        glDeleteProgram(prog);
+        return 0;
+    }
+    return prog;
+}
+
+static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const char *const *paths,
+                          const char *defines)
+{
+    vfx_gpu *g = ctx->gpu;
+    char key[256];
+    snprintf(key, sizeof key, "%s|%s|%s", paths[0], n > 1 ? paths[1] : "", defines ? defines : "");
+    for (uint32_t i = 0; i < g->program_count; ++i)
+        if (strcmp(g->programs[i].key, key) == 0)
+            return g->programs[i].program;
+    if (g->program_count >= GPU_MAX_PROGRAMS) {
+        vfx_fail(ctx, VFX_ERR_GL, "program cache full (%d programs)", GPU_MAX_PROGRAMS);
+        return 0;
+    }
+    char *bufs[2] = {NULL, NULL};
+    char err[256];
+    GLuint prog = 0;
+    bool ok = true;
+    for (int i = 0; i < n && ok; ++i)
+        if (!(bufs[i] = vfx_shader_expand(paths[i], defines, err, sizeof err))) {
+            vfx_fail(ctx, VFX_ERR_GL, "%s", err);
+            ok = false;
+        }
+    if (ok)
+        prog = vfx_gpu_link_sources(ctx, n, stages, (const char *const *)bufs, paths);
+    for (int i = 0; i < n; ++i)
+        free(bufs[i]);
+    if (!prog)
+        return 0;
+    program_entry *e = &g->programs[g->program_count++];
+    snprintf(e->key, sizeof e->key, "%s", key);
+    e->program = prog;
+    char label[96];
+    snprintf(label, sizeof label, "volfx.%s", n > 1 ? paths[1] : paths[0]);
+    vfx_gpu_label(GL_PROGRAM, prog, label);
+    return prog;
+}
+
+GLuint vfx_gpu_program(vfx_context *ctx, const char *vert, const char *frag, const char *defines)
+{
+    const GLenum stages[2] = {GL_VERTEX_SHADER, GL_FRAGMENT_SHADER};
+    const char *paths[2] = {vert, frag};
+    return get_program(ctx, 2, stages, paths, defines);
+}
+
+GLuint vfx_gpu_compute(vfx_context *ctx, const char *comp, const char *defines)
+{
+    const GLenum stages[1] = {GL_COMPUTE_SHADER};
+    const char *paths[1] = {comp};
+    return get_program(ctx, 1, stages, paths, defines);
+}
+
+/* ------------------------------------------------------------------------ timers */
+
+void vfx_gpu_pass_begin(vfx_context *ctx, const char *name)
+{
+    vfx_gpu *g = ctx->gpu;
+    glPushDebugGroup(GL_DEBUG_SOURCE_APPLICATION, 0, -1, name);
+    timer_frame *f = &g->ring[g->frame];
+    if (f->count >= GPU_MAX_PASSES || g->open_count >= GPU_PASS_DEPTH) {
+        if (g->open_count < GPU_PASS_DEPTH)
+            g->open[g->open_count++] = UINT32_MAX; /* untimed */
+        return;
+    }
+    uint32_t slot = f->count++;
+    snprintf(f->names[slot], sizeof f->names[slot], "%s", name);
+    glQueryCounter(f->queries[slot * 2], GL_TIMESTAMP);
+    g->open[g->open_count++] = slot;
+}
+
+void vfx_gpu_pass_end(vfx_context *ctx)
+{
+    vfx_gpu *g = ctx->gpu;
+    if (g->open_count == 0)
+        return;
+    uint32_t slot = g->open[--g->open_count];
+    if (slot != UINT32_MAX)
+        glQueryCounter(g->ring[g->frame].queries[slot * 2 + 1], GL_TIMESTAMP);
+    glPopDebugGroup();
+}
+
+void vfx_gpu_frame_end(vfx_context *ctx)
+{
+    vfx_gpu *g = ctx->gpu;
+    while (g->open_count)
+        vfx_gpu_pass_end(ctx);
+    /* The oldest slot was recorded GPU_RING-1 frames ago: read it only if it is ready. */
+    uint32_t oldest = (g->frame + 1) % GPU_RING;
+    timer_frame *f = &g->ring[oldest];
+    for (uint32_t i = 0; i < f->count; ++i) {
+        GLint ready = 0;
+        glGetQueryObjectiv(f->queries[i * 2 + 1], GL_QUERY_RESULT_AVAILABLE, &ready);
+        if (!ready)
+            continue;
+        GLuint64 t0 = 0, t1 = 0;
+        glGetQueryObjectui64v(f->queries[i * 2], GL_QUERY_RESULT, &t0);
+        glGetQueryObjectui64v(f->queries[i * 2 + 1], GL_QUERY_RESULT, &t1);
+        char name[48];
+        snprintf(name, sizeof name, "%s.gpu_ms", f->names[i]);
+        vfx_stat_set(ctx, name, t1 > t0 ? (double)(t1 - t0) * 1e-6 : 0.0);
+    }
+    f->count = 0;
+    g->frame = oldest;
+}
+
+void vfx_gpu_fullscreen(vfx_context *ctx)
+{
+    glBindVertexArray(ctx->gpu->empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+}

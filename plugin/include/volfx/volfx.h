@@ -1,0 +1,285 @@
+/* volfx.h — the whole plugin ABI. A host needs this header and nothing else of ours.
+ *
+ * Rules (they keep old hosts and new plugins, or the reverse, safe together):
+ *  - every struct that crosses the boundary begins with `size` and `version`; the writer fills
+ *    them, the reader refuses a version it does not know and never reads past `size`;
+ *  - a published struct is never edited: a new field means a new struct version;
+ *  - zero means "default" in every parameter struct (sokol style), so `{0}` plus size/version
+ *    is always valid;
+ *  - nothing here owns global state: every call goes through a context made by create().
+ *
+ * Threading: every plugin call is made on the thread where the host's GL context is current.
+ * Matrices are column-major float[16] (OpenGL/cglm layout). Depth is window depth in [0,1].
+ */
+#ifndef VOLFX_VOLFX_H
+#define VOLFX_VOLFX_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define VFX_ABI_VERSION 1u
+#define VFX_ENTRY_SYMBOL "vfx_plugin_entry"
+
+#if defined(_WIN32)
+#define VFX_EXPORT __declspec(dllexport)
+#else
+#define VFX_EXPORT __attribute__((visibility("default")))
+#endif
+
+typedef enum vfx_result {
+    VFX_OK = 0,
+    VFX_ERR_INVALID_ARGUMENT = 1, /* a NULL, NaN, out-of-range value or bad count */
+    VFX_ERR_ABI = 2,              /* version or size mismatch between host and plugin */
+    VFX_ERR_GL = 3,               /* GL call, shader compile/link or framebuffer failure */
+    VFX_ERR_GL_UNSUPPORTED = 4,   /* missing GL version or extension */
+    VFX_ERR_OUT_OF_MEMORY = 5,
+    VFX_ERR_IO = 6,               /* file cannot be opened or read */
+    VFX_ERR_FORMAT = 7,           /* file read but malformed */
+    VFX_ERR_NOT_FOUND = 8,        /* asked-for item absent (also: effect not in this world) */
+    VFX_ERR_NUMERIC = 9,          /* NaN/Inf or blow-up that could not be recovered */
+    VFX_ERR_UNSUPPORTED = 10,     /* feature not built in or not implemented */
+} vfx_result;
+
+/* Returns a static, human-readable name of a result code (never NULL). */
+static inline const char *vfx_result_name(vfx_result r)
+{
+    switch (r) {
+    case VFX_OK: return "ok";
+    case VFX_ERR_INVALID_ARGUMENT: return "invalid argument";
+    case VFX_ERR_ABI: return "ABI mismatch";
+    case VFX_ERR_GL: return "GL error";
+    case VFX_ERR_GL_UNSUPPORTED: return "GL feature unsupported";
+    case VFX_ERR_OUT_OF_MEMORY: return "out of memory";
+    case VFX_ERR_IO: return "I/O error";
+    case VFX_ERR_FORMAT: return "malformed input";
+    case VFX_ERR_NOT_FOUND: return "not found";
+    case VFX_ERR_NUMERIC: return "numerical failure";
+    case VFX_ERR_UNSUPPORTED: return "unsupported";
+    }
+    return "unknown result";
+}
+
+typedef enum vfx_log_level {
+    VFX_LOG_DEBUG = 0,
+    VFX_LOG_INFO = 1,
+    VFX_LOG_WARN = 2,
+    VFX_LOG_ERROR = 3,
+} vfx_log_level;
+
+typedef enum vfx_effect_kind {
+    VFX_EFFECT_WATER = 0,  /* seed 000: metaball ray casting of particles */
+    VFX_EFFECT_BEAMS = 1,  /* seed 003: closed-form line integrals of beam densities */
+    VFX_EFFECT_VOLUME = 2, /* seed 002: cell projection of tetrahedral volumes */
+    VFX_EFFECT_COUNT = 3,
+} vfx_effect_kind;
+
+#define VFX_EFFECT_BIT(k) (1u << (k))
+
+/* ---------------------------------------------------------------- data the host hands over */
+
+/* One chunk of particles as SoA columns, straight from the host's storage (no copy).
+ * pos[] is required; the other columns may be NULL. `revision` changes whenever the content
+ * changes, so the plugin may skip an upload when it has not. */
+#define VFX_PARTICLE_VIEW_VERSION 1u
+typedef struct vfx_particle_view {
+    uint32_t size, version;
+    uint32_t count;
+    uint32_t _reserved;
+    const float *pos[3];  /* x[], y[], z[] */
+    const float *vel[3];  /* optional */
+    const float *density; /* optional */
+    const float *radius;  /* optional: per-particle scale of h (1 = h) */
+    uint64_t revision;
+} vfx_particle_view;
+
+/* Bits of vfx_water_params.disable: each switches one technique of seed 000 off (ablation). */
+enum {
+    VFX_WATER_NO_BILLBOARD_INIT = 1u << 0, /* technique 1: start every ray at the near plane */
+    VFX_WATER_NO_SKIP = 1u << 1,           /* technique 2: fixed steps, no gap jumping */
+    VFX_WATER_NO_BLEND = 1u << 2,          /* technique 3: compute-shader sum instead of blending */
+    VFX_WATER_NO_PACK4 = 1u << 3,          /* technique 4: one sample per texel, not four */
+    VFX_WATER_NO_PYRAMID = 1u << 4,        /* technique 5: no min/max pyramid culling */
+    VFX_WATER_NO_REFINE = 1u << 5,         /* technique 6: linear interpolation only */
+    VFX_WATER_NO_SHADING = 1u << 6,        /* flat colour: for tests that compare coverage */
+};
+
+typedef enum vfx_water_method {
+    VFX_WATER_METHOD_PAPER = 0,     /* billboards + blending, seed 000 (default) */
+    VFX_WATER_METHOD_BRUTE = 1,     /* baseline: per-pixel march over all particles (compute) */
+    VFX_WATER_METHOD_GRID = 2,      /* baseline: per-pixel march over a uniform grid (compute) */
+} vfx_water_method;
+
+#define VFX_WATER_PARAMS_VERSION 1u
+typedef struct vfx_water_params {
+    uint32_t size, version;
+    float h;               /* kernel radius; 0 -> 0.61 */
+    float threshold;       /* T in I = sqrt(sum P) - T; 0 -> 0.765625 */
+    uint32_t max_samples;  /* cap per pixel; 0 -> 64 */
+    float step;            /* sample spacing; 0 -> h/8 */
+    uint32_t refine_iters; /* regula falsi iterations; 0 -> 3 */
+    uint32_t pyramid_level;/* min/max pyramid level used for culling; 0 -> 3 */
+    uint32_t disable;      /* VFX_WATER_NO_* bits; 0 = every technique on */
+    uint32_t method;       /* vfx_water_method */
+    float color[3];        /* absorption tint; all 0 -> sea water */
+    float absorption;      /* per unit length; 0 -> 0.6 */
+    float ior;             /* 0 -> 1.333 */
+    float _reserved[3];
+} vfx_water_params;
+
+/* One beam; the field is defined exactly in docs/beams.md (issue 5):
+ * head rho_h = a / sqrt(|P-M|^2 + eps^2) inside radius R, trail rho_t = b / sqrt(r^2 + eps^2)
+ * around the segment M..M+L*D inside radius R. */
+typedef struct vfx_beam {
+    float head[3];   /* M */
+    float length;    /* L >= 0 */
+    float dir[3];    /* D, normalised by the plugin; zero vector is refused */
+    float radius;    /* R > 0 */
+    float a, b;      /* head and trail strengths >= 0 */
+    float eps;       /* softening >= 0 */
+    float _pad;
+    float color[4];  /* tint multiplied into the ramp; all 0 -> white */
+} vfx_beam;
+
+typedef enum vfx_saturation { VFX_SATURATE_CLAMP = 0, VFX_SATURATE_SMOOTH = 1 } vfx_saturation;
+
+#define VFX_BEAMS_VIEW_VERSION 1u
+typedef struct vfx_beams_view {
+    uint32_t size, version;
+    uint32_t count;
+    uint32_t saturation;   /* vfx_saturation */
+    const vfx_beam *beams;
+    float saturate_c;      /* H mapped to full intensity; 0 -> 1 */
+    float far_distance;    /* integrate to here where no surface; 0 -> camera far plane */
+    uint32_t method;       /* 0 closed form (default), 1 ray marching (baseline) */
+    uint32_t march_samples;/* ray-marching baseline samples; 0 -> 32 */
+} vfx_beams_view;
+
+/* Bits of vfx_volume_view.disable. */
+enum {
+    VFX_VOLUME_NO_ERT = 1u << 0,   /* no early ray termination at all */
+    VFX_VOLUME_NO_SHARE = 1u << 1, /* workers do not share ERT tables */
+    VFX_VOLUME_NO_DLB = 1u << 2,   /* no dynamic load balancing */
+};
+
+#define VFX_VOLUME_VIEW_VERSION 1u
+typedef struct vfx_volume_view {
+    uint32_t size, version;
+    uint32_t point_count, tet_count;
+    const float *points;          /* xyz per point */
+    const uint32_t *tets;         /* 4 point indices per tetrahedron */
+    const float *scalar;          /* one value per point */
+    float scalar_min, scalar_max; /* transfer function domain; equal -> data range */
+    const float *transfer_rgba;   /* transfer_count RGBA entries over the domain; alpha is
+                                     opacity per unit length; NULL -> a default ramp */
+    uint32_t transfer_count;
+    float ert_threshold;          /* opacity that terminates a ray; 0 -> 0.9 */
+    uint32_t tiles;               /* D of the DxD termination table; 0 -> 16 */
+    uint32_t update_c;            /* table updated every remaining/C cells; 0 -> 16 */
+    uint32_t workers;             /* threads; 0 -> number of cores */
+    uint32_t disable;             /* VFX_VOLUME_NO_* bits */
+    float model[16];              /* model matrix; all zero -> identity */
+    uint64_t revision;            /* changes when the mesh or scalars change */
+} vfx_volume_view;
+
+/* -------------------------------------------------------------------------- host api */
+
+#define VFX_HOST_API_VERSION 1u
+typedef struct vfx_host_api {
+    uint32_t size, version;
+    void *user; /* passed back to every callback */
+    /* GL entry points of the current context (eglGetProcAddress/glfwGetProcAddress). */
+    void *(*gl_get_proc_address)(void *user, const char *name);
+    /* Logger: every message the plugin has for the user comes through here. */
+    void (*log)(void *user, vfx_log_level level, const char *message);
+    /* Allocator: NULL alloc/free -> the C library's. alloc returns NULL on failure. */
+    void *(*alloc)(void *user, size_t size, size_t align);
+    void (*free)(void *user, void *ptr);
+    /* Particles (water). count 0 -> no water: the plugin allocates nothing for it. */
+    uint32_t (*particle_chunk_count)(void *user);
+    vfx_result (*particle_chunk)(void *user, uint32_t index, vfx_particle_view *out);
+    /* Water parameters; VFX_ERR_NOT_FOUND -> defaults. NULL callback -> defaults. */
+    vfx_result (*water_params)(void *user, vfx_water_params *out);
+    /* Beams; count 0 or VFX_ERR_NOT_FOUND -> no beams pass. */
+    vfx_result (*beams)(void *user, vfx_beams_view *out);
+    /* Tetrahedral volumes. */
+    uint32_t (*volume_count)(void *user);
+    vfx_result (*volume)(void *user, uint32_t index, vfx_volume_view *out);
+} vfx_host_api;
+
+/* ------------------------------------------------------------------------ per frame */
+
+#define VFX_FRAME_VIEW_VERSION 1u
+typedef struct vfx_frame_view {
+    uint32_t size, version;
+    uint32_t framebuffer;   /* GL framebuffer the plugin draws its result into */
+    uint32_t color_texture; /* opaque scene colour (RGBA), NOT attached to `framebuffer` */
+    uint32_t depth_texture; /* opaque scene depth, NOT attached to `framebuffer` */
+    uint32_t width, height;
+    float view[16], proj[16];
+    float eye[3];
+    float near_plane, far_plane;
+    float fov_y;            /* radians */
+    uint32_t effects;       /* VFX_EFFECT_BIT mask to draw; 0 -> all present */
+    uint32_t _reserved;
+} vfx_frame_view;
+
+#define VFX_STATS_MAX 64
+typedef struct vfx_stat {
+    char name[40];  /* "water.gpu_ms.accumulate", "beams.tiles_culled", ... */
+    double value;
+} vfx_stat;
+
+#define VFX_STATS_VERSION 1u
+typedef struct vfx_stats {
+    uint32_t size, version;
+    uint32_t count;
+    uint32_t _reserved;
+    vfx_stat entries[VFX_STATS_MAX];
+} vfx_stats;
+
+/* ---------------------------------------------------------------------- plugin api */
+
+typedef struct vfx_context vfx_context;
+
+#define VFX_PLUGIN_API_VERSION 1u
+typedef struct vfx_plugin_api {
+    uint32_t size, version;
+    const char *name;        /* "volfx" */
+    uint32_t effects_built;  /* VFX_EFFECT_BIT mask compiled into this plugin */
+    uint32_t _reserved;
+    /* Creates a context on the current GL context; allocates nothing per effect yet. */
+    vfx_result (*create)(const vfx_host_api *host, vfx_context **out);
+    /* Destroys the context and every GL object it made. NULL is allowed. */
+    void (*destroy)(vfx_context *ctx);
+    /* Reallocates size-dependent targets of the effects that exist. */
+    vfx_result (*resize)(vfx_context *ctx, uint32_t width, uint32_t height);
+    /* Pulls the host's data (particles, beams, volumes); creates or frees effect state as
+     * effects appear or vanish. */
+    vfx_result (*update)(vfx_context *ctx, double time, float dt);
+    /* Draws every present effect into frame->framebuffer, depth-tested against the host. */
+    vfx_result (*render)(vfx_context *ctx, const vfx_frame_view *frame);
+    /* Copies timings (GPU ms per pass, never stalling) and counters of the last frame. */
+    vfx_result (*get_stats)(vfx_context *ctx, vfx_stats *out);
+    /* Text of the last error on this context ("" when none). */
+    const char *(*last_error)(vfx_context *ctx);
+    /* Reads back an effect's raw quantity of the last render (width*height floats, top row
+     * first): water ray distance (-1 = miss), beams H, volume accumulated opacity. */
+    vfx_result (*read_raw)(vfx_context *ctx, vfx_effect_kind effect, float *out, size_t count);
+} vfx_plugin_api;
+
+/* The one exported symbol. The host passes its ABI version; out->size must be set by the host
+ * to sizeof(vfx_plugin_api) it knows. A different ABI version is refused (VFX_ERR_ABI) with a
+ * message naming both versions through host->log. */
+typedef vfx_result (*vfx_plugin_entry_fn)(uint32_t abi_version, const vfx_host_api *host,
+                                          vfx_plugin_api *out);
+VFX_EXPORT vfx_result vfx_plugin_entry(uint32_t abi_version, const vfx_host_api *host,
+                                       vfx_plugin_api *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

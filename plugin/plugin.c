@@ -1,0 +1,367 @@
+/* plugin.c — the exported entry point and the context lifecycle. Effects are created the
+ * first frame the host's world holds them and destroyed when it no longer does, so an absent
+ * effect costs no shader, no buffer and no pass. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gpu/gpu.h"
+#include "plugin_internal.h"
+
+/* ------------------------------------------------------------ logging, errors, memory */
+
+void vfx_log(vfx_context *ctx, vfx_log_level level, const char *fmt, ...)
+{
+    char buf[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    if (ctx && ctx->host.log)
+        ctx->host.log(ctx->host.user, level, buf);
+}
+
+vfx_result vfx_fail(vfx_context *ctx, vfx_result code, const char *fmt, ...)
+{
+    char buf[sizeof ctx->last_error];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    if (ctx) {
+        memcpy(ctx->last_error, buf, sizeof buf);
+        if (ctx->host.log)
+            ctx->host.log(ctx->host.user, VFX_LOG_ERROR, buf);
+    }
+    return code;
+}
+
+/* Header in front of each block so free() finds the original pointer whatever the host's
+ * allocator aligned. */
+typedef struct alloc_header {
+    void *base;
+    size_t size;
+} alloc_header;
+
+void *vfx_alloc(vfx_context *ctx, size_t size)
+{
+    const size_t align = 64;
+    if (size > SIZE_MAX - align - sizeof(alloc_header)) {
+        vfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "allocation of %zu bytes is too large", size);
+        return NULL;
+    }
+    size_t total = size + align + sizeof(alloc_header);
+    void *base = ctx->host.alloc ? ctx->host.alloc(ctx->host.user, total, 16) : malloc(total);
+    if (!base) {
+        vfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "out of memory allocating %zu bytes", size);
+        return NULL;
+    }
+    uintptr_t p = ((uintptr_t)base + sizeof(alloc_header) + align - 1) & ~(uintptr_t)(align - 1);
+    alloc_header *h = (alloc_header *)p - 1;
+    h->base = base;
+    h->size = size;
+    memset((void *)p, 0, size);
+    return (void *)p;
+}
+
+void vfx_free(vfx_context *ctx, void *ptr)
+{
+    if (!ptr)
+        return;
+    alloc_header *h = (alloc_header *)ptr - 1;
+    if (ctx->host.free)
+        ctx->host.free(ctx->host.user, h->base);
+    else
+        free(h->base);
+}
+
+static vfx_stat *stat_slot(vfx_context *ctx, const char *name)
+{
+    vfx_stats *s = &ctx->stats;
+    for (uint32_t i = 0; i < s->count; ++i)
+        if (strncmp(s->entries[i].name, name, sizeof s->entries[i].name - 1) == 0)
+            return &s->entries[i];
+    if (s->count >= VFX_STATS_MAX)
+        return NULL;
+    vfx_stat *e = &s->entries[s->count++];
+    snprintf(e->name, sizeof e->name, "%s", name);
+    e->value = 0;
+    return e;
+}
+
+void vfx_stat_set(vfx_context *ctx, const char *name, double value)
+{
+    vfx_stat *e = stat_slot(ctx, name);
+    if (e)
+        e->value = value;
+}
+
+void vfx_stat_add(vfx_context *ctx, const char *name, double value)
+{
+    vfx_stat *e = stat_slot(ctx, name);
+    if (e)
+        e->value += value;
+}
+
+/* --------------------------------------------------------------------- lifecycle */
+
+static void register_effects(vfx_context *ctx)
+{
+#if VFX_WITH_WATER
+    ctx->effect_ops[VFX_EFFECT_WATER] = &vfx_water_ops;
+#endif
+#if VFX_WITH_BEAMS
+    ctx->effect_ops[VFX_EFFECT_BEAMS] = &vfx_beams_ops;
+#endif
+#if VFX_WITH_TETVOL
+    ctx->effect_ops[VFX_EFFECT_VOLUME] = &vfx_volume_ops;
+#endif
+    (void)ctx;
+}
+
+static void plugin_destroy(vfx_context *ctx)
+{
+    if (!ctx)
+        return;
+    for (int k = 0; k < VFX_EFFECT_COUNT; ++k)
+        if (ctx->effect_state[k] && ctx->effect_ops[k]) {
+            ctx->effect_ops[k]->destroy(ctx, ctx->effect_state[k]);
+            ctx->effect_state[k] = NULL;
+        }
+    vfx_gpu_destroy(ctx, ctx->gpu);
+    vfx_host_api host = ctx->host;
+    if (host.free)
+        host.free(host.user, ctx);
+    else
+        free(ctx);
+}
+
+static vfx_result plugin_create(const vfx_host_api *host, vfx_context **out)
+{
+    if (!out)
+        return VFX_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    if (!host || host->size < sizeof(vfx_host_api) || host->version != VFX_HOST_API_VERSION) {
+        if (host && host->log)
+            host->log(host->user, VFX_LOG_ERROR, "volfx create: host api is NULL or of another version");
+        return VFX_ERR_ABI;
+    }
+    vfx_context *ctx = host->alloc ? host->alloc(host->user, sizeof *ctx, 64) : malloc(sizeof *ctx);
+    if (!ctx)
+        return VFX_ERR_OUT_OF_MEMORY;
+    memset(ctx, 0, sizeof *ctx);
+    ctx->host = *host;
+    ctx->stats.size = ctx->last_stats.size = sizeof(vfx_stats);
+    ctx->stats.version = ctx->last_stats.version = VFX_STATS_VERSION;
+    register_effects(ctx);
+    vfx_result r = vfx_gpu_create(ctx, &ctx->gpu);
+    if (r != VFX_OK) {
+        /* keep the message: the caller has no context to ask */
+        plugin_destroy(ctx);
+        return r;
+    }
+    *out = ctx;
+    return VFX_OK;
+}
+
+static vfx_result plugin_resize(vfx_context *ctx, uint32_t width, uint32_t height)
+{
+    if (!ctx)
+        return VFX_ERR_INVALID_ARGUMENT;
+    if (width == 0 || height == 0 || width > 16384 || height > 16384)
+        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                        "resize: %ux%u outside 1..16384 in each direction", width, height);
+    ctx->width = width;
+    ctx->height = height;
+    for (int k = 0; k < VFX_EFFECT_COUNT; ++k)
+        if (ctx->effect_state[k] && ctx->effect_ops[k]->resize) {
+            vfx_result r = ctx->effect_ops[k]->resize(ctx, ctx->effect_state[k], width, height);
+            if (r)
+                return r;
+        }
+    return VFX_OK;
+}
+
+static vfx_result plugin_update(vfx_context *ctx, double time, float dt)
+{
+    if (!ctx)
+        return VFX_ERR_INVALID_ARGUMENT;
+    if (!isfinite(time) || !isfinite(dt))
+        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "update: time %g or dt %g is not finite",
+                        time, (double)dt);
+    for (int k = 0; k < VFX_EFFECT_COUNT; ++k) {
+        const vfx_effect_ops *ops = ctx->effect_ops[k];
+        if (!ops)
+            continue;
+        bool present = ops->present(ctx);
+        if (present && !ctx->effect_state[k]) {
+            vfx_result r = ops->create(ctx, &ctx->effect_state[k]);
+            if (r)
+                return r;
+            vfx_log(ctx, VFX_LOG_DEBUG, "effect %s created", ops->name);
+            if (ctx->width && ops->resize
+                && (r = ops->resize(ctx, ctx->effect_state[k], ctx->width, ctx->height)))
+                return r;
+        } else if (!present && ctx->effect_state[k]) {
+            ops->destroy(ctx, ctx->effect_state[k]);
+            ctx->effect_state[k] = NULL;
+            vfx_log(ctx, VFX_LOG_DEBUG, "effect %s destroyed (absent from the world)", ops->name);
+        }
+        if (ctx->effect_state[k]) {
+            vfx_result r = ops->update(ctx, ctx->effect_state[k], time, dt);
+            if (r)
+                return r;
+        }
+    }
+    return VFX_OK;
+}
+
+/* Column-major 4x4 inverse by cofactors, in double so near-singular projections keep digits. */
+static bool invert4(const float m[16], float out[16])
+{
+    double a[16], inv[16];
+    for (int i = 0; i < 16; ++i)
+        a[i] = m[i];
+    inv[0] = a[5]*a[10]*a[15] - a[5]*a[11]*a[14] - a[9]*a[6]*a[15] + a[9]*a[7]*a[14] + a[13]*a[6]*a[11] - a[13]*a[7]*a[10];
+    inv[4] = -a[4]*a[10]*a[15] + a[4]*a[11]*a[14] + a[8]*a[6]*a[15] - a[8]*a[7]*a[14] - a[12]*a[6]*a[11] + a[12]*a[7]*a[10];
+    inv[8] = a[4]*a[9]*a[15] - a[4]*a[11]*a[13] - a[8]*a[5]*a[15] + a[8]*a[7]*a[13] + a[12]*a[5]*a[11] - a[12]*a[7]*a[9];
+    inv[12] = -a[4]*a[9]*a[14] + a[4]*a[10]*a[13] + a[8]*a[5]*a[14] - a[8]*a[6]*a[13] - a[12]*a[5]*a[10] + a[12]*a[6]*a[9];
+    inv[1] = -a[1]*a[10]*a[15] + a[1]*a[11]*a[14] + a[9]*a[2]*a[15] - a[9]*a[3]*a[14] - a[13]*a[2]*a[11] + a[13]*a[3]*a[10];
+    inv[5] = a[0]*a[10]*a[15] - a[0]*a[11]*a[14] - a[8]*a[2]*a[15] + a[8]*a[3]*a[14] + a[12]*a[2]*a[11] - a[12]*a[3]*a[10];
+    inv[9] = -a[0]*a[9]*a[15] + a[0]*a[11]*a[13] + a[8]*a[1]*a[15] - a[8]*a[3]*a[13] - a[12]*a[1]*a[11] + a[12]*a[3]*a[9];
+    inv[13] = a[0]*a[9]*a[14] - a[0]*a[10]*a[13] - a[8]*a[1]*a[14] + a[8]*a[2]*a[13] + a[12]*a[1]*a[10] - a[12]*a[2]*a[9];
+    inv[2] = a[1]*a[6]*a[15] - a[1]*a[7]*a[14] - a[5]*a[2]*a[15] + a[5]*a[3]*a[14] + a[13]*a[2]*a[7] - a[13]*a[3]*a[6];
+    inv[6] = -a[0]*a[6]*a[15] + a[0]*a[7]*a[14] + a[4]*a[2]*a[15] - a[4]*a[3]*a[14] - a[12]*a[2]*a[7] + a[12]*a[3]*a[6];
+    inv[10] = a[0]*a[5]*a[15] - a[0]*a[7]*a[13] - a[4]*a[1]*a[15] + a[4]*a[3]*a[13] + a[12]*a[1]*a[7] - a[12]*a[3]*a[5];
+    inv[14] = -a[0]*a[5]*a[14] + a[0]*a[6]*a[13] + a[4]*a[1]*a[14] - a[4]*a[2]*a[13] - a[12]*a[1]*a[6] + a[12]*a[2]*a[5];
+    inv[3] = -a[1]*a[6]*a[11] + a[1]*a[7]*a[10] + a[5]*a[2]*a[11] - a[5]*a[3]*a[10] - a[9]*a[2]*a[7] + a[9]*a[3]*a[6];
+    inv[7] = a[0]*a[6]*a[11] - a[0]*a[7]*a[10] - a[4]*a[2]*a[11] + a[4]*a[3]*a[10] + a[8]*a[2]*a[7] - a[8]*a[3]*a[6];
+    inv[11] = -a[0]*a[5]*a[11] + a[0]*a[7]*a[9] + a[4]*a[1]*a[11] - a[4]*a[3]*a[9] - a[8]*a[1]*a[7] + a[8]*a[3]*a[5];
+    inv[15] = a[0]*a[5]*a[10] - a[0]*a[6]*a[9] - a[4]*a[1]*a[10] + a[4]*a[2]*a[9] + a[8]*a[1]*a[6] - a[8]*a[2]*a[5];
+    double det = a[0] * inv[0] + a[1] * inv[4] + a[2] * inv[8] + a[3] * inv[12];
+    if (!(fabs(det) > 1e-300) || !isfinite(det))
+        return false;
+    for (int i = 0; i < 16; ++i)
+        out[i] = (float)(inv[i] / det);
+    return true;
+}
+
+static void mul4(const float a[16], const float b[16], float out[16])
+{
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) {
+            float s = 0;
+            for (int k = 0; k < 4; ++k)
+                s += a[k * 4 + r] * b[c * 4 + k];
+            out[c * 4 + r] = s;
+        }
+}
+
+static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
+{
+    if (!ctx)
+        return VFX_ERR_INVALID_ARGUMENT;
+    if (!frame || frame->size < sizeof(vfx_frame_view) || frame->version != VFX_FRAME_VIEW_VERSION)
+        return vfx_fail(ctx, VFX_ERR_ABI, "render: frame view missing or of version %u (need %u)",
+                        frame ? frame->version : 0, VFX_FRAME_VIEW_VERSION);
+    if (frame->width == 0 || frame->height == 0)
+        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame is %ux%u", frame->width,
+                        frame->height);
+    for (int i = 0; i < 16; ++i)
+        if (!isfinite(frame->view[i]) || !isfinite(frame->proj[i]))
+            return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: camera matrix element %d is not finite", i);
+    if (frame->width != ctx->width || frame->height != ctx->height) {
+        vfx_result r = plugin_resize(ctx, frame->width, frame->height);
+        if (r)
+            return r;
+    }
+    vfx_frame_targets targets;
+    memset(&targets, 0, sizeof targets);
+    targets.scene_depth = frame->depth_texture;
+    targets.scene_color = frame->color_texture;
+    float vp[16];
+    mul4(frame->proj, frame->view, vp);
+    if (!invert4(vp, targets.inv_view_proj))
+        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: view*projection is singular");
+
+    ctx->stats.count = 0;
+    uint32_t mask = frame->effects ? frame->effects : 0xffffffffu;
+    static const vfx_effect_kind order[VFX_EFFECT_COUNT] = {VFX_EFFECT_WATER, VFX_EFFECT_VOLUME,
+                                                            VFX_EFFECT_BEAMS};
+    vfx_result result = VFX_OK;
+    for (int i = 0; i < VFX_EFFECT_COUNT && result == VFX_OK; ++i) {
+        vfx_effect_kind k = order[i];
+        if (!ctx->effect_state[k] || !(mask & VFX_EFFECT_BIT(k)))
+            continue;
+        result = ctx->effect_ops[k]->render(ctx, ctx->effect_state[k], frame, &targets);
+    }
+    vfx_gpu_frame_end(ctx);
+    ctx->last_stats = ctx->stats;
+    return result;
+}
+
+static vfx_result plugin_get_stats(vfx_context *ctx, vfx_stats *out)
+{
+    if (!ctx || !out)
+        return VFX_ERR_INVALID_ARGUMENT;
+    if (out->size < sizeof(vfx_stats))
+        return vfx_fail(ctx, VFX_ERR_ABI, "get_stats: stats struct size %u < %zu", out->size,
+                        sizeof(vfx_stats));
+    *out = ctx->last_stats;
+    return VFX_OK;
+}
+
+static const char *plugin_last_error(vfx_context *ctx) { return ctx ? ctx->last_error : "no context"; }
+
+static vfx_result plugin_read_raw(vfx_context *ctx, vfx_effect_kind effect, float *out, size_t count)
+{
+    if (!ctx || !out)
+        return VFX_ERR_INVALID_ARGUMENT;
+    if ((unsigned)effect >= VFX_EFFECT_COUNT)
+        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "read_raw: effect %d out of range", (int)effect);
+    if (!ctx->effect_ops[effect])
+        return vfx_fail(ctx, VFX_ERR_UNSUPPORTED, "read_raw: effect %d is not built in", (int)effect);
+    if (!ctx->effect_state[effect])
+        return vfx_fail(ctx, VFX_ERR_NOT_FOUND, "read_raw: effect %s is absent from the world",
+                        ctx->effect_ops[effect]->name);
+    if (count < (size_t)ctx->width * ctx->height)
+        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "read_raw: buffer of %zu floats, need %ux%u",
+                        count, ctx->width, ctx->height);
+    return ctx->effect_ops[effect]->read_raw(ctx, ctx->effect_state[effect], out, count);
+}
+
+VFX_EXPORT vfx_result vfx_plugin_entry(uint32_t abi_version, const vfx_host_api *host,
+                                       vfx_plugin_api *out)
+{
+    if (abi_version != VFX_ABI_VERSION) {
+        if (host && host->log) {
+            char msg[160];
+            snprintf(msg, sizeof msg, "volfx: host ABI version %u, plugin ABI version %u: refused",
+                     abi_version, VFX_ABI_VERSION);
+            host->log(host->user, VFX_LOG_ERROR, msg);
+        }
+        return VFX_ERR_ABI;
+    }
+    if (!out || out->size < sizeof(vfx_plugin_api)) {
+        if (host && host->log)
+            host->log(host->user, VFX_LOG_ERROR, "volfx: plugin api struct too small or NULL");
+        return VFX_ERR_ABI;
+    }
+    memset(out, 0, sizeof *out);
+    out->size = sizeof *out;
+    out->version = VFX_PLUGIN_API_VERSION;
+    out->name = "volfx";
+    out->effects_built = (VFX_WITH_WATER ? VFX_EFFECT_BIT(VFX_EFFECT_WATER) : 0)
+                         | (VFX_WITH_BEAMS ? VFX_EFFECT_BIT(VFX_EFFECT_BEAMS) : 0)
+                         | (VFX_WITH_TETVOL ? VFX_EFFECT_BIT(VFX_EFFECT_VOLUME) : 0);
+    out->create = plugin_create;
+    out->destroy = plugin_destroy;
+    out->resize = plugin_resize;
+    out->update = plugin_update;
+    out->render = plugin_render;
+    out->get_stats = plugin_get_stats;
+    out->last_error = plugin_last_error;
+    out->read_raw = plugin_read_raw;
+    return VFX_OK;
+}

@@ -1,0 +1,228 @@
+/* renderer.c — host scene target (RGBA8 + DEPTH32F textures) and output target. The plugin
+ * samples the scene textures while drawing into the output, so it never reads what it writes. */
+#include "gfx/renderer.h"
+
+#include <epoxy/gl.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "shader_text.h"
+
+struct vfx_renderer {
+    vfx_logger log;
+    GLuint mesh_prog;
+    GLint u_model, u_view_proj, u_color, u_light;
+    GLuint scene_fbo, scene_color, scene_depth;
+    GLuint out_fbo, out_color, out_depth;
+    uint32_t width, height;
+    float view[16], proj[16];
+};
+
+static GLuint compile(const vfx_logger *log, GLenum stage, const char *path)
+{
+    char err[256], raw[4096], pretty[8192];
+    char *src = vfx_shader_expand(path, NULL, err, sizeof err);
+    if (!src) {
+        vfx_logf(log, VFX_LOG_ERROR, "host shader: %s", err);
+        return 0;
+    }
+    GLuint s = glCreateShader(stage);
+    glShaderSource(s, 1, (const char *const *)&src, NULL);
+    glCompileShader(s);
+    free(src);
+    GLint ok = 0;
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        glGetShaderInfoLog(s, sizeof raw, NULL, raw);
+        vfx_shader_rewrite_log(raw, pretty, sizeof pretty, path);
+        vfx_logf(log, VFX_LOG_ERROR, "host shader compile failed: %s", pretty);
+        glDeleteShader(s);
+        return 0;
+    }
+    return s;
+}
+
+vfx_result vfx_renderer_create(const vfx_logger *logger, vfx_renderer **out)
+{
+    vfx_renderer *r = calloc(1, sizeof *r);
+    if (!r)
+        return VFX_ERR_OUT_OF_MEMORY;
+    if (logger)
+        r->log = *logger;
+    GLuint vs = compile(&r->log, GL_VERTEX_SHADER, "host/mesh.vert");
+    GLuint fs = compile(&r->log, GL_FRAGMENT_SHADER, "host/mesh.frag");
+    if (!vs || !fs) {
+        glDeleteShader(vs);
+        glDeleteShader(fs);
+        free(r);
+        return VFX_ERR_GL;
+    }
+    r->mesh_prog = glCreateProgram();
+    glAttachShader(r->mesh_prog, vs);
+    glAttachShader(r->mesh_prog, fs);
+    glLinkProgram(r->mesh_prog);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint ok = 0;
+    glGetProgramiv(r->mesh_prog, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char log[2048];
+        glGetProgramInfoLog(r->mesh_prog, sizeof log, NULL, log);
+        vfx_logf(&r->log, VFX_LOG_ERROR, "host mesh program link failed: %s", log);
+        glDeleteProgram(r->mesh_prog);
+        free(r);
+        return VFX_ERR_GL;
+    }
+    glObjectLabel(GL_PROGRAM, r->mesh_prog, -1, "host.mesh");
+    r->u_model = glGetUniformLocation(r->mesh_prog, "u_model");
+    r->u_view_proj = glGetUniformLocation(r->mesh_prog, "u_view_proj");
+    r->u_color = glGetUniformLocation(r->mesh_prog, "u_color");
+    r->u_light = glGetUniformLocation(r->mesh_prog, "u_light_dir");
+    *out = r;
+    return VFX_OK;
+}
+
+static void free_targets(vfx_renderer *r)
+{
+    GLuint tex[4] = {r->scene_color, r->scene_depth, r->out_color, r->out_depth};
+    glDeleteTextures(4, tex);
+    GLuint fbo[2] = {r->scene_fbo, r->out_fbo};
+    glDeleteFramebuffers(2, fbo);
+    r->scene_color = r->scene_depth = r->out_color = r->out_depth = 0;
+    r->scene_fbo = r->out_fbo = 0;
+}
+
+void vfx_renderer_destroy(vfx_renderer *r)
+{
+    if (!r)
+        return;
+    free_targets(r);
+    glDeleteProgram(r->mesh_prog);
+    free(r);
+}
+
+static GLuint make_tex(GLenum fmt, uint32_t w, uint32_t h, const char *label)
+{
+    GLuint t;
+    glCreateTextures(GL_TEXTURE_2D, 1, &t);
+    glTextureStorage2D(t, 1, fmt, (GLsizei)w, (GLsizei)h);
+    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glObjectLabel(GL_TEXTURE, t, -1, label);
+    return t;
+}
+
+static GLuint make_fbo(GLuint color, GLuint depth, const char *label)
+{
+    GLuint f;
+    glCreateFramebuffers(1, &f);
+    glNamedFramebufferTexture(f, GL_COLOR_ATTACHMENT0, color, 0);
+    glNamedFramebufferTexture(f, GL_DEPTH_ATTACHMENT, depth, 0);
+    glObjectLabel(GL_FRAMEBUFFER, f, -1, label);
+    return f;
+}
+
+vfx_result vfx_renderer_resize(vfx_renderer *r, uint32_t w, uint32_t h)
+{
+    if (!r || w == 0 || h == 0 || w > 16384 || h > 16384)
+        return VFX_ERR_INVALID_ARGUMENT;
+    if (w == r->width && h == r->height && r->scene_fbo)
+        return VFX_OK;
+    free_targets(r);
+    r->scene_color = make_tex(GL_RGBA8, w, h, "host.scene_color");
+    r->scene_depth = make_tex(GL_DEPTH_COMPONENT32F, w, h, "host.scene_depth");
+    r->out_color = make_tex(GL_RGBA8, w, h, "host.out_color");
+    r->out_depth = make_tex(GL_DEPTH_COMPONENT32F, w, h, "host.out_depth");
+    r->scene_fbo = make_fbo(r->scene_color, r->scene_depth, "host.scene");
+    r->out_fbo = make_fbo(r->out_color, r->out_depth, "host.out");
+    r->width = w;
+    r->height = h;
+    if (glCheckNamedFramebufferStatus(r->scene_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE
+        || glCheckNamedFramebufferStatus(r->out_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        vfx_logf(&r->log, VFX_LOG_ERROR, "host targets %ux%u incomplete", w, h);
+        return VFX_ERR_GL;
+    }
+    return VFX_OK;
+}
+
+void vfx_renderer_begin_scene(vfx_renderer *r, const float view[16], const float proj[16],
+                              const float clear_rgb[3])
+{
+    memcpy(r->view, view, sizeof r->view);
+    memcpy(r->proj, proj, sizeof r->proj);
+    glPushDebugGroup(GL_DEBUG_SOURCE_APPLICATION, 0, -1, "host.scene");
+    glBindFramebuffer(GL_FRAMEBUFFER, r->scene_fbo);
+    glViewport(0, 0, (GLsizei)r->width, (GLsizei)r->height);
+    glClearColor(clear_rgb[0], clear_rgb[1], clear_rgb[2], 1.f);
+    glClearDepth(1.0);
+    glDepthMask(GL_TRUE);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+}
+
+void vfx_renderer_draw_mesh(vfx_renderer *r, const vfx_mesh_gpu *mesh, const float model[16],
+                            const float rgb[3])
+{
+    float vp[16];
+    for (int c = 0; c < 4; ++c)
+        for (int row = 0; row < 4; ++row) {
+            float s = 0;
+            for (int k = 0; k < 4; ++k)
+                s += r->proj[k * 4 + row] * r->view[c * 4 + k];
+            vp[c * 4 + row] = s;
+        }
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(r->mesh_prog);
+    glUniformMatrix4fv(r->u_model, 1, GL_FALSE, model);
+    glUniformMatrix4fv(r->u_view_proj, 1, GL_FALSE, vp);
+    glUniform3fv(r->u_color, 1, rgb);
+    glUniform3f(r->u_light, 0.4f, 0.8f, 0.45f);
+    glBindVertexArray(mesh->vao);
+    glDrawElements(GL_TRIANGLES, (GLsizei)mesh->index_count, GL_UNSIGNED_INT, NULL);
+    glBindVertexArray(0);
+}
+
+void vfx_renderer_end_scene(vfx_renderer *r, vfx_frame_view *frame)
+{
+    glPopDebugGroup();
+    glBlitNamedFramebuffer(r->scene_fbo, r->out_fbo, 0, 0, (GLint)r->width, (GLint)r->height, 0, 0,
+                           (GLint)r->width, (GLint)r->height, GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT,
+                           GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
+    glDisable(GL_DEPTH_TEST);
+    glUseProgram(0);
+    memset(frame, 0, sizeof *frame);
+    frame->size = sizeof *frame;
+    frame->version = VFX_FRAME_VIEW_VERSION;
+    frame->framebuffer = r->out_fbo;
+    frame->color_texture = r->scene_color;
+    frame->depth_texture = r->scene_depth;
+    frame->width = r->width;
+    frame->height = r->height;
+    memcpy(frame->view, r->view, sizeof frame->view);
+    memcpy(frame->proj, r->proj, sizeof frame->proj);
+}
+
+vfx_result vfx_renderer_read_rgba(vfx_renderer *r, uint8_t *rgba)
+{
+    if (!r || !rgba)
+        return VFX_ERR_INVALID_ARGUMENT;
+    size_t row = (size_t)r->width * 4;
+    uint8_t *tmp = malloc(row * r->height);
+    if (!tmp)
+        return VFX_ERR_OUT_OF_MEMORY;
+    glGetTextureImage(r->out_color, 0, GL_RGBA, GL_UNSIGNED_BYTE, (GLsizei)(row * r->height), tmp);
+    for (uint32_t y = 0; y < r->height; ++y) /* GL rows are bottom-up */
+        memcpy(rgba + y * row, tmp + (r->height - 1 - y) * row, row);
+    free(tmp);
+    return glGetError() == GL_NO_ERROR ? VFX_OK : VFX_ERR_GL;
+}
+
+void vfx_renderer_present(vfx_renderer *r, uint32_t ww, uint32_t wh)
+{
+    glBlitNamedFramebuffer(r->out_fbo, 0, 0, 0, (GLint)r->width, (GLint)r->height, 0, 0, (GLint)ww,
+                           (GLint)wh, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+}

@@ -1,0 +1,78 @@
+/* bench.c — volfx-bench: one headless benchmark program; each effect adds its subcommand
+ * (sample_game/<effect>/bench_*.c). Prints one JSON object per configuration. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "app.h"
+#include "demo_scene.h"
+
+/* Weak: an effect left out of the build (or not written yet) leaves its entry NULL. */
+int vfx_bench_sim(int argc, char **argv) __attribute__((weak));
+int vfx_bench_metaballs(int argc, char **argv) __attribute__((weak));
+int vfx_bench_beams(int argc, char **argv) __attribute__((weak));
+int vfx_bench_tetvol(int argc, char **argv) __attribute__((weak));
+
+/* `frame`: the sample game's default scene, headless, N frames. */
+static int bench_frame(int argc, char **argv)
+{
+    uint32_t frames = 60, w = 640, h = 360;
+    for (int i = 1; i < argc; ++i) {
+        if (!strcmp(argv[i], "--frames") && i + 1 < argc) frames = (uint32_t)strtoul(argv[++i], NULL, 10);
+        else if (!strcmp(argv[i], "--size") && i + 1 < argc) {
+            if (sscanf(argv[++i], "%ux%u", &w, &h) != 2) { fprintf(stderr, "--size wants WxH\n"); return 2; }
+        } else if (!strcmp(argv[i], "--json")) {
+        } else { fprintf(stderr, "volfx-bench frame: unknown option '%s'\n", argv[i]); return 2; }
+    }
+    vfx_app_desc d = {.mode = VFX_GL_HEADLESS, .width = w, .height = h};
+    vfx_app *app;
+    if (vfx_app_create(&d, &app))
+        return 1;
+    vfx_demo demo;
+    if (vfx_demo_load(app, &demo, NULL, 0)) {
+        vfx_app_destroy(app);
+        return 1;
+    }
+    int rc = 0;
+    for (uint32_t f = 0; f < frames && rc == 0; ++f) {
+        vfx_demo_animate(app, &demo, 1.f / 60.f);
+        rc = vfx_app_frame(app, 1.f / 60.f) ? 1 : 0;
+    }
+    vfx_frame_summary s = vfx_profiler_summary(app->profiler, frames > 10 ? 5 : 0);
+    printf("{\"effect\":\"frame\",\"width\":%u,\"height\":%u,\"frames\":%u,\"gl_renderer\":\"%s\","
+           "\"frame_ms\":{\"p50\":%.4f,\"p95\":%.4f,\"p99\":%.4f},\"mean_fps\":%.3f,\"stats\":{",
+           w, h, s.frames, vfx_gl_context_renderer(app->gl), s.p50_ms, s.p95_ms, s.p99_ms, s.mean_fps);
+    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+    app->api->get_stats(app->ctx, &st);
+    for (uint32_t i = 0; i < st.count; ++i)
+        printf("%s\"%s\":%.6g", i ? "," : "", st.entries[i].name, st.entries[i].value);
+    printf("}}\n");
+    vfx_demo_free(app, &demo);
+    vfx_app_destroy(app);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2 || !strcmp(argv[1], "--help")) {
+        puts("usage: volfx-bench <sim|metaballs|beams|tetvol|frame> [options] [--json]\n"
+             "each subcommand prints one JSON object per configuration; --help after it lists its options");
+        return argc < 2 ? 2 : 0;
+    }
+    const char *sub = argv[1];
+    struct { const char *name; int (*fn)(int, char **); } subs[] = {
+        {"sim", vfx_bench_sim}, {"metaballs", vfx_bench_metaballs}, {"beams", vfx_bench_beams},
+        {"tetvol", vfx_bench_tetvol}, {"frame", bench_frame}};
+    for (size_t i = 0; i < sizeof subs / sizeof subs[0]; ++i) {
+        if (strcmp(sub, subs[i].name) != 0)
+            continue;
+        if (!subs[i].fn) {
+            fprintf(stderr, "volfx-bench: '%s' is not built into this binary\n", sub);
+            return 2;
+        }
+        return subs[i].fn(argc - 1, argv + 1);
+    }
+    fprintf(stderr, "volfx-bench: unknown subcommand '%s'\n", sub);
+    return 2;
+}

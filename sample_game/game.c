@@ -1,0 +1,185 @@
+/* game.c — volfx-game: a GLFW game loop (or headless EGL run) over the built-in default
+ * scene, printing fps and frame-time statistics and writing a PNG screenshot. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+
+#include "app.h"
+#include "demo_scene.h"
+
+typedef struct game_options {
+    uint32_t frames;
+    double seconds;
+    uint32_t width, height;
+    const char *png, *csv, *trace, *plugin, *scene;
+    vfx_gl_mode mode;
+    bool debug;
+    uint32_t effects_off;
+} game_options;
+
+static void usage(void)
+{
+    puts("usage: volfx-game [--headless|--window] [--frames N] [--seconds S] [--size WxH]\n"
+         "                  [--png FILE] [--csv FILE] [--trace FILE] [--plugin libvolfx.so]\n"
+         "                  [--scene FILE.json] [--no-water] [--no-beams] [--no-volume] [--debug-gl]\n"
+         "Without a display it runs headless (EGL) for 120 frames and writes volfx-game.png.\n"
+         "Window keys: WASD/QE fly, mouse drag orbit, 1/2/3 toggle water/beams/volume,\n"
+         "             P pause, N single step, Esc quit.");
+}
+
+static bool parse(int argc, char **argv, game_options *o)
+{
+    memset(o, 0, sizeof *o);
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+#define NEED_ARG() do { if (!v) { fprintf(stderr, "volfx-game: %s needs a value\n", a); return false; } ++i; } while (0)
+        if (!strcmp(a, "--headless")) o->mode = VFX_GL_HEADLESS;
+        else if (!strcmp(a, "--window")) o->mode = VFX_GL_WINDOW;
+        else if (!strcmp(a, "--frames")) { NEED_ARG(); o->frames = (uint32_t)strtoul(v, NULL, 10); }
+        else if (!strcmp(a, "--seconds")) { NEED_ARG(); o->seconds = strtod(v, NULL); }
+        else if (!strcmp(a, "--size")) {
+            NEED_ARG();
+            if (sscanf(v, "%ux%u", &o->width, &o->height) != 2 || !o->width || !o->height) {
+                fprintf(stderr, "volfx-game: --size wants WxH, got '%s'\n", v);
+                return false;
+            }
+        }
+        else if (!strcmp(a, "--png")) { NEED_ARG(); o->png = v; }
+        else if (!strcmp(a, "--csv")) { NEED_ARG(); o->csv = v; }
+        else if (!strcmp(a, "--trace")) { NEED_ARG(); o->trace = v; }
+        else if (!strcmp(a, "--plugin")) { NEED_ARG(); o->plugin = v; }
+        else if (!strcmp(a, "--scene")) { NEED_ARG(); o->scene = v; }
+        else if (!strcmp(a, "--no-water")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_WATER);
+        else if (!strcmp(a, "--no-beams")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_BEAMS);
+        else if (!strcmp(a, "--no-volume")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_VOLUME);
+        else if (!strcmp(a, "--debug-gl")) o->debug = true;
+        else if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(); exit(0); }
+        else { fprintf(stderr, "volfx-game: unknown option '%s'\n", a); usage(); return false; }
+#undef NEED_ARG
+    }
+    return true;
+}
+
+/* Orbit camera and toggles for the window mode. */
+static void handle_input(vfx_app *app, vfx_demo *demo, bool *paused, bool *step, double dt)
+{
+    GLFWwindow *w = vfx_gl_context_window(app->gl);
+    if (!w)
+        return;
+    if (glfwGetKey(w, GLFW_KEY_ESCAPE) == GLFW_PRESS)
+        glfwSetWindowShouldClose(w, 1);
+    static const int keys[3] = {GLFW_KEY_1, GLFW_KEY_2, GLFW_KEY_3};
+    static const vfx_effect_kind kinds[3] = {VFX_EFFECT_WATER, VFX_EFFECT_BEAMS, VFX_EFFECT_VOLUME};
+    for (int k = 0; k < 3; ++k) {
+        bool down = glfwGetKey(w, keys[k]) == GLFW_PRESS;
+        if (down && !demo->key_latch[k])
+            vfx_demo_toggle(app, demo, kinds[k]);
+        demo->key_latch[k] = down;
+    }
+    bool p = glfwGetKey(w, GLFW_KEY_P) == GLFW_PRESS, n = glfwGetKey(w, GLFW_KEY_N) == GLFW_PRESS;
+    if (p && !demo->key_latch[3]) *paused = !*paused;
+    if (n && !demo->key_latch[4]) *step = true;
+    demo->key_latch[3] = p, demo->key_latch[4] = n;
+    double f[3], r[3], u[3];
+    vfx_ref_camera_basis(&app->camera, f, r, u);
+    double speed = 3.0 * dt, move[3] = {0, 0, 0};
+    if (glfwGetKey(w, GLFW_KEY_W) == GLFW_PRESS) for (int k = 0; k < 3; ++k) move[k] += f[k] * speed;
+    if (glfwGetKey(w, GLFW_KEY_S) == GLFW_PRESS) for (int k = 0; k < 3; ++k) move[k] -= f[k] * speed;
+    if (glfwGetKey(w, GLFW_KEY_D) == GLFW_PRESS) for (int k = 0; k < 3; ++k) move[k] += r[k] * speed;
+    if (glfwGetKey(w, GLFW_KEY_A) == GLFW_PRESS) for (int k = 0; k < 3; ++k) move[k] -= r[k] * speed;
+    if (glfwGetKey(w, GLFW_KEY_E) == GLFW_PRESS) move[1] += speed;
+    if (glfwGetKey(w, GLFW_KEY_Q) == GLFW_PRESS) move[1] -= speed;
+    for (int k = 0; k < 3; ++k) {
+        app->camera.eye[k] += move[k];
+        app->camera.target[k] += move[k];
+    }
+    double mx, my;
+    glfwGetCursorPos(w, &mx, &my);
+    if (glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS && demo->mouse_down) {
+        double yaw = -(mx - demo->mouse_x) * 0.005;
+        double off[3];
+        for (int k = 0; k < 3; ++k) off[k] = app->camera.eye[k] - app->camera.target[k];
+        double c = cos(yaw), s = sin(yaw);
+        double x = off[0] * c - off[2] * s, z = off[0] * s + off[2] * c;
+        off[0] = x, off[2] = z;
+        off[1] += (my - demo->mouse_y) * 0.01;
+        for (int k = 0; k < 3; ++k) app->camera.eye[k] = app->camera.target[k] + off[k];
+    }
+    demo->mouse_down = glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+    demo->mouse_x = mx, demo->mouse_y = my;
+}
+
+int main(int argc, char **argv)
+{
+    game_options o;
+    if (!parse(argc, argv, &o))
+        return 2;
+    vfx_app_desc d = {.mode = o.mode, .width = o.width, .height = o.height, .debug_gl = o.debug,
+                      .plugin_path = o.plugin};
+    vfx_app *app;
+    if (vfx_app_create(&d, &app)) {
+        fprintf(stderr, "volfx-game: could not start (see the messages above)\n");
+        return 1;
+    }
+    vfx_demo demo;
+    if (vfx_demo_load(app, &demo, o.scene, o.effects_off)) {
+        vfx_app_destroy(app);
+        return 1;
+    }
+    bool headless = !vfx_gl_context_has_window(app->gl);
+    uint32_t frames = o.frames ? o.frames : (headless && o.seconds <= 0 ? 120 : UINT32_MAX);
+    printf("volfx-game: %s, %ux%u, %s, %s\n", vfx_gl_context_renderer(app->gl), app->camera.width,
+           app->camera.height, headless ? "headless" : "window", demo.description);
+    const float dt = 1.0f / 60.0f; /* fixed simulation step: runs are repeatable */
+    bool paused = false, step = false;
+    double start = vfx_now_ms();
+    int rc = 0;
+    for (uint32_t f = 0; f < frames; ++f) {
+        if (o.seconds > 0 && (vfx_now_ms() - start) > o.seconds * 1000.0)
+            break;
+        if (vfx_gl_context_should_close(app->gl))
+            break;
+        handle_input(app, &demo, &paused, &step, dt);
+        float frame_dt = (paused && !step) ? 0.f : dt;
+        step = false;
+        vfx_demo_animate(app, &demo, frame_dt);
+        if (vfx_app_frame(app, frame_dt)) {
+            fprintf(stderr, "volfx-game: frame %u failed\n", f);
+            rc = 1;
+            break;
+        }
+        if (!headless && (f % 30) == 0) {
+            vfx_frame_summary s = vfx_profiler_summary(app->profiler, app->frame > 60 ? (uint32_t)app->frame - 60 : 0);
+            char title[128];
+            snprintf(title, sizeof title, "volfx  %.1f fps  %.2f ms (p95 %.2f)", s.mean_fps, s.p50_ms, s.p95_ms);
+            glfwSetWindowTitle(vfx_gl_context_window(app->gl), title);
+        }
+    }
+    uint32_t warm = app->frame > 10 ? 5 : 0;
+    vfx_frame_summary s = vfx_profiler_summary(app->profiler, warm);
+    printf("frames %u (after %u warm-up), mean %.2f fps, frame ms p50 %.3f p95 %.3f p99 %.3f max %.3f\n",
+           s.frames, warm, s.mean_fps, s.p50_ms, s.p95_ms, s.p99_ms, s.max_ms);
+    vfx_demo_print_profile(app, stdout);
+    const char *png = o.png ? o.png : (headless ? "volfx-game.png" : NULL);
+    if (png && rc == 0) {
+        if (vfx_app_screenshot(app, png) == VFX_OK)
+            printf("screenshot: %s\n", png);
+        else
+            rc = 1;
+    }
+    if (o.csv && vfx_profiler_write_csv(app->profiler, o.csv)) {
+        fprintf(stderr, "volfx-game: cannot write %s\n", o.csv);
+        rc = 1;
+    }
+    if (o.trace && vfx_profiler_write_trace(app->profiler, o.trace)) {
+        fprintf(stderr, "volfx-game: cannot write %s\n", o.trace);
+        rc = 1;
+    }
+    vfx_demo_free(app, &demo);
+    vfx_app_destroy(app);
+    return rc;
+}

@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Installs what volfx needs on Debian 12, idempotently: packages already present are not
+# fetched again, and apt-get update runs only when something is missing.
+# Usage: scripts/install-deps.sh [extra-package ...]
+set -euo pipefail
+pkgs=(
+  build-essential meson ninja-build pkg-config
+  libglfw3-dev libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri mesa-utils
+  libcglm-dev libassimp-dev libcjson-dev zlib1g-dev libexpat1-dev libcmocka-dev
+  libopenmpi-dev openmpi-bin
+  assimp-testmodels tetgen
+  xvfb xauth
+  "$@"
+)
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#pkgs[@]} packages present"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; else SUDO=; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

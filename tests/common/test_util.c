@@ -1,0 +1,42 @@
+/* test_util.c — see test_util.h. */
+#include "test_util.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+vfx_gl_context *vfx_test_gl_or_skip(void)
+{
+    vfx_gl_context *gl = NULL;
+    vfx_gl_context_desc d = {.mode = VFX_GL_HEADLESS, .width = 64, .height = 64};
+    if (vfx_gl_context_create(&d, &gl) != VFX_OK) {
+        fprintf(stderr, "no headless GL 4.5 context: skipping\n");
+        exit(VFX_TEST_SKIP);
+    }
+    return gl;
+}
+
+const char *vfx_test_shared_data_or_skip(const char *rel, char *buf, unsigned buflen)
+{
+    const char *dir = getenv("VFX_SHARED_DATA");
+    if (!dir)
+        dir = "../shared/data";
+    snprintf(buf, buflen, "%s/%s", dir, rel);
+    FILE *f = fopen(buf, "rb");
+    if (!f) {
+        fprintf(stderr, "shared data %s absent: skipping\n", buf);
+        exit(VFX_TEST_SKIP);
+    }
+    fclose(f);
+    return buf;
+}
+
+void vfx_test_log_fn(void *user, vfx_log_level level, const char *message)
+{
+    vfx_test_log *l = user;
+    snprintf(l->last, sizeof l->last, "%s", message);
+    if (level == VFX_LOG_ERROR)
+        l->errors++;
+    else if (level == VFX_LOG_WARN)
+        l->warnings++;
+}
