@@ -1,0 +1,217 @@
+/* Headless GL on the real driver (llvmpipe in CI): render and read back, timestamp queries
+ * through the plugin's pass timers, shader errors as file:line, plugin lifecycle with nothing
+ * in the world (no effect state, no pass, no stat). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <epoxy/gl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "app.h"
+#include "gpu/gpu.h"
+#include "plugin_internal.h"
+#include "test_util.h"
+
+static vfx_gl_context *g_gl;
+
+static vfx_host_api empty_host(vfx_test_log *log)
+{
+    return (vfx_host_api){.size = sizeof(vfx_host_api), .version = VFX_HOST_API_VERSION,
+                          .user = log, .log = vfx_test_log_fn};
+}
+
+static const vfx_plugin_api *plugin_api(void)
+{
+    static vfx_plugin_api api; /* test-local table; the plugin itself holds no globals */
+    api.size = sizeof api;
+    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
+    return &api;
+}
+
+static void test_render_readback(void **state)
+{
+    (void)state;
+    vfx_renderer *r;
+    vfx_logger lg = {0};
+    assert_int_equal(vfx_renderer_create(&lg, &r), VFX_OK);
+    assert_int_equal(vfx_renderer_resize(r, 64, 48), VFX_OK);
+    vfx_ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8, 64, 48, 0.1, 100};
+    float view[16], proj[16];
+    vfx_ref_camera_matrices(&cam, view, proj);
+    vfx_mesh_data box;
+    assert_int_equal(vfx_mesh_make_box((float[3]){-1, -1, -1}, (float[3]){1, 1, 1}, &box), VFX_OK);
+    vfx_mesh_gpu gpu;
+    assert_int_equal(vfx_mesh_upload(&box, &gpu), VFX_OK);
+    vfx_mesh_data_free(&box);
+    static const float clear[3] = {0, 0, 1}, red[3] = {1, 0, 0};
+    static const float id[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    vfx_renderer_begin_scene(r, view, proj, clear);
+    vfx_renderer_draw_mesh(r, &gpu, id, red);
+    vfx_frame_view fv;
+    vfx_renderer_end_scene(r, &fv);
+    assert_int_equal(fv.width, 64);
+    assert_int_not_equal(fv.depth_texture, 0);
+    uint8_t *px = malloc(64 * 48 * 4);
+    assert_int_equal(vfx_renderer_read_rgba(r, px), VFX_OK);
+    const uint8_t *centre = px + (24 * 64 + 32) * 4, *corner = px;
+    assert_true(centre[0] > 60 && centre[2] < 10);   /* the box, lit red */
+    assert_true(corner[2] == 255 && corner[0] == 0); /* the clear colour */
+    /* the depth the plugin will read: the box front face at z = 1 is 4 units from the eye */
+    float *depth = malloc(64 * 48 * sizeof(float));
+    glGetTextureImage(fv.depth_texture, 0, GL_DEPTH_COMPONENT, GL_FLOAT, 64 * 48 * 4, depth);
+    double n = 0.1, f = 100, d = depth[24 * 64 + 32];
+    double z_eye = 2.0 * n * f / (f + n - (2.0 * d - 1.0) * (f - n));
+    assert_true(fabs(z_eye - 4.0) < 1e-3); /* depth32F keeps this to ~1e-5 relative */
+    free(depth);
+    free(px);
+    vfx_mesh_gpu_destroy(&gpu);
+    vfx_renderer_destroy(r);
+    assert_null(vfx_gpu_error_string());
+}
+
+static void test_timestamps_and_empty_world(void **state)
+{
+    (void)state;
+    vfx_test_log log = {0};
+    vfx_host_api host = empty_host(&log);
+    const vfx_plugin_api *api = plugin_api();
+    vfx_context *ctx;
+    assert_int_equal(api->create(&host, &ctx), VFX_OK);
+    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .width = 32, .height = 32};
+    vfx_ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8, 32, 32, 0.1, 100};
+    vfx_ref_camera_matrices(&cam, fv.view, fv.proj);
+    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+    /* nothing in the world: no effect state is made, no pass runs, no stat appears */
+    for (int i = 0; i < 6; ++i) {
+        assert_int_equal(api->update(ctx, i / 60.0, 1.f / 60.f), VFX_OK);
+        assert_int_equal(api->render(ctx, &fv), VFX_OK);
+    }
+    for (int k = 0; k < VFX_EFFECT_COUNT; ++k)
+        assert_null(ctx->effect_state[k]);
+    assert_int_equal(api->get_stats(ctx, &st), VFX_OK);
+    assert_int_equal(st.count, 0);
+    float raw[32 * 32];
+    assert_int_not_equal(api->read_raw(ctx, VFX_EFFECT_BEAMS, raw, 32 * 32), VFX_OK);
+    /* a timed pass: its GPU ms reach the stats a few frames later, without a stall */
+    GLuint fbo, tex;
+    glCreateTextures(GL_TEXTURE_2D, 1, &tex);
+    glTextureStorage2D(tex, 1, GL_RGBA8, 256, 256);
+    glCreateFramebuffers(1, &fbo);
+    glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, tex, 0);
+    bool seen = false;
+    for (int frame = 0; frame < 12 && !seen; ++frame) {
+        ctx->stats.count = 0;
+        vfx_gpu_pass_begin(ctx, "test.clear");
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glClearColor(0.1f * frame, 0, 0, 1);
+        glClear(GL_COLOR_BUFFER_BIT);
+        vfx_gpu_pass_end(ctx);
+        glFinish();
+        vfx_gpu_frame_end(ctx);
+        for (uint32_t i = 0; i < ctx->stats.count; ++i)
+            if (!strcmp(ctx->stats.entries[i].name, "test.clear.gpu_ms")) {
+                seen = true;
+                assert_true(ctx->stats.entries[i].value >= 0 && ctx->stats.entries[i].value < 1000);
+            }
+    }
+    assert_true(seen);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteTextures(1, &tex);
+    /* bad frames are refused with a message, not drawn */
+    fv.proj[5] = NAN;
+    assert_int_equal(api->render(ctx, &fv), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(api->last_error(ctx), "not finite"));
+    fv.proj[5] = 1;
+    fv.version = 9;
+    assert_int_equal(api->render(ctx, &fv), VFX_ERR_ABI);
+    assert_int_equal(api->resize(ctx, 0, 10), VFX_ERR_INVALID_ARGUMENT);
+    api->destroy(ctx);
+}
+
+static void test_shader_error_names_file_line(void **state)
+{
+    (void)state;
+    vfx_test_log log = {0};
+    vfx_host_api host = empty_host(&log);
+    const vfx_plugin_api *api = plugin_api();
+    vfx_context *ctx;
+    assert_int_equal(api->create(&host, &ctx), VFX_OK);
+    char src[256];
+    extern int vfx_shader_index(const char *path);
+    int idx = vfx_shader_index("common/depth.glsl");
+    assert_true(idx >= 0);
+    /* line 3 of the named file has the error */
+    snprintf(src, sizeof src, "#version 450 core\n#line 1 %d\nvoid f() {}\n\nvoid main() { undefined_thing = 1; }\n", idx);
+    const char *srcs[1] = {src}, *names[1] = {"common/depth.glsl"};
+    GLenum stage = GL_FRAGMENT_SHADER;
+    assert_int_equal(vfx_gpu_link_sources(ctx, 1, &stage, srcs, names), 0);
+    assert_non_null(strstr(api->last_error(ctx), "common/depth.glsl:3:"));
+    /* a shader that is not embedded is named */
+    assert_int_equal(vfx_gpu_program(ctx, "common/fullscreen.vert", "nope/none.frag", NULL), 0);
+    assert_non_null(strstr(api->last_error(ctx), "nope/none.frag"));
+    /* the real embedded program links */
+    assert_int_not_equal(vfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", NULL), 0);
+    api->destroy(ctx);
+}
+
+static void test_lifecycle_many(void **state)
+{
+    (void)state;
+    vfx_test_log log = {0};
+    vfx_host_api host = empty_host(&log);
+    const vfx_plugin_api *api = plugin_api();
+    /* create, resize, destroy and re-create; run under valgrind/LSan this proves no leak */
+    for (int i = 0; i < 1000; ++i) {
+        vfx_context *ctx;
+        assert_int_equal(api->create(&host, &ctx), VFX_OK);
+        assert_int_equal(api->resize(ctx, 64 + (uint32_t)i % 7, 32), VFX_OK);
+        api->destroy(ctx);
+    }
+    assert_int_equal(log.errors, 0);
+    assert_null(vfx_gpu_error_string());
+}
+
+static void test_app_frame(void **state)
+{
+    (void)state;
+    /* the full host path: world, scene, plugin, screenshot */
+    vfx_gl_context_destroy(g_gl);
+    g_gl = NULL;
+    vfx_test_log log = {0};
+    vfx_app_desc d = {.mode = VFX_GL_HEADLESS, .width = 48, .height = 32, .logger = {vfx_test_log_fn, &log}};
+    vfx_app *app;
+    assert_int_equal(vfx_app_create(&d, &app), VFX_OK);
+    assert_int_equal(vfx_app_add_box(app, (float[3]){-1, -1, -1}, (float[3]){1, 1, 1}, (float[3]){0, 1, 0}), VFX_OK);
+    for (int i = 0; i < 3; ++i)
+        assert_int_equal(vfx_app_frame(app, 1.f / 60.f), VFX_OK);
+    assert_int_equal(vfx_app_screenshot(app, "app_frame.png"), VFX_OK);
+    FILE *f = fopen("app_frame.png", "rb");
+    assert_non_null(f);
+    fclose(f);
+    vfx_frame_summary s = vfx_profiler_summary(app->profiler, 0);
+    assert_int_equal(s.frames, 3);
+    assert_true(s.p50_ms > 0 && s.p99_ms >= s.p50_ms);
+    assert_int_equal(vfx_app_dump_raw(app, VFX_EFFECT_WATER, "none.pfm") == VFX_OK, 0);
+    vfx_app_destroy(app);
+}
+
+int main(void)
+{
+    g_gl = vfx_test_gl_or_skip();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_render_readback),
+        cmocka_unit_test(test_timestamps_and_empty_world),
+        cmocka_unit_test(test_shader_error_names_file_line),
+        cmocka_unit_test(test_lifecycle_many),
+        cmocka_unit_test(test_app_frame),
+    };
+    int rc = cmocka_run_group_tests(tests, NULL, NULL);
+    vfx_gl_context_destroy(g_gl);
+    return rc;
+}
