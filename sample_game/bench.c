@@ -13,6 +13,7 @@ int vfx_bench_sim(int argc, char **argv) __attribute__((weak));
 int vfx_bench_metaballs(int argc, char **argv) __attribute__((weak));
 int vfx_bench_beams(int argc, char **argv) __attribute__((weak));
 int vfx_bench_tetvol(int argc, char **argv) __attribute__((weak));
+int vfx_bench_ecs(int argc, char **argv);
 
 /* `frame`: the sample game's default scene, headless, N frames. */
 static int bench_frame(int argc, char **argv)
@@ -56,14 +57,14 @@ static int bench_frame(int argc, char **argv)
 int main(int argc, char **argv)
 {
     if (argc < 2 || !strcmp(argv[1], "--help")) {
-        puts("usage: volfx-bench <sim|metaballs|beams|tetvol|frame> [options] [--json]\n"
+        puts("usage: volfx-bench <sim|metaballs|beams|tetvol|ecs|frame> [options] [--json]\n"
              "each subcommand prints one JSON object per configuration; --help after it lists its options");
         return argc < 2 ? 2 : 0;
     }
     const char *sub = argv[1];
     struct { const char *name; int (*fn)(int, char **); } subs[] = {
         {"sim", vfx_bench_sim}, {"metaballs", vfx_bench_metaballs}, {"beams", vfx_bench_beams},
-        {"tetvol", vfx_bench_tetvol}, {"frame", bench_frame}};
+        {"tetvol", vfx_bench_tetvol}, {"ecs", vfx_bench_ecs}, {"frame", bench_frame}};
     for (size_t i = 0; i < sizeof subs / sizeof subs[0]; ++i) {
         if (strcmp(sub, subs[i].name) != 0)
             continue;
