@@ -9,6 +9,16 @@
 #include "gpu/gpu.h"
 #include "plugin_internal.h"
 
+#ifndef VFX_HAS_WATER_OPS
+#define VFX_HAS_WATER_OPS 0
+#endif
+#ifndef VFX_HAS_BEAMS_OPS
+#define VFX_HAS_BEAMS_OPS 0
+#endif
+#ifndef VFX_HAS_VOLUME_OPS
+#define VFX_HAS_VOLUME_OPS 0
+#endif
+
 /* ------------------------------------------------------------ logging, errors, memory */
 
 void vfx_log(vfx_context *ctx, vfx_log_level level, const char *fmt, ...)
@@ -108,13 +118,13 @@ void vfx_stat_add(vfx_context *ctx, const char *name, double value)
 
 static void register_effects(vfx_context *ctx)
 {
-#if VFX_WITH_WATER
+#if VFX_WITH_WATER && VFX_HAS_WATER_OPS
     ctx->effect_ops[VFX_EFFECT_WATER] = &vfx_water_ops;
 #endif
-#if VFX_WITH_BEAMS
+#if VFX_WITH_BEAMS && VFX_HAS_BEAMS_OPS
     ctx->effect_ops[VFX_EFFECT_BEAMS] = &vfx_beams_ops;
 #endif
-#if VFX_WITH_TETVOL
+#if VFX_WITH_TETVOL && VFX_HAS_VOLUME_OPS
     ctx->effect_ops[VFX_EFFECT_VOLUME] = &vfx_volume_ops;
 #endif
     (void)ctx;
@@ -352,9 +362,9 @@ VFX_EXPORT vfx_result vfx_plugin_entry(uint32_t abi_version, const vfx_host_api 
     out->size = sizeof *out;
     out->version = VFX_PLUGIN_API_VERSION;
     out->name = "volfx";
-    out->effects_built = (VFX_WITH_WATER ? VFX_EFFECT_BIT(VFX_EFFECT_WATER) : 0)
-                         | (VFX_WITH_BEAMS ? VFX_EFFECT_BIT(VFX_EFFECT_BEAMS) : 0)
-                         | (VFX_WITH_TETVOL ? VFX_EFFECT_BIT(VFX_EFFECT_VOLUME) : 0);
+    out->effects_built = (VFX_WITH_WATER && VFX_HAS_WATER_OPS ? VFX_EFFECT_BIT(VFX_EFFECT_WATER) : 0)
+                         | (VFX_WITH_BEAMS && VFX_HAS_BEAMS_OPS ? VFX_EFFECT_BIT(VFX_EFFECT_BEAMS) : 0)
+                         | (VFX_WITH_TETVOL && VFX_HAS_VOLUME_OPS ? VFX_EFFECT_BIT(VFX_EFFECT_VOLUME) : 0);
     out->create = plugin_create;
     out->destroy = plugin_destroy;
     out->resize = plugin_resize;
