@@ -130,8 +130,11 @@ vfx_result vfx_app_create(const vfx_app_desc *desc, vfx_app **out)
         app->desc = *desc;
     app->log = app->desc.logger;
     uint32_t w = app->desc.width ? app->desc.width : 640, h = app->desc.height ? app->desc.height : 360;
+#ifndef VFX_GL_DEBUG_DEFAULT
+#define VFX_GL_DEBUG_DEFAULT 0
+#endif
     vfx_gl_context_desc gd = {.mode = app->desc.mode, .width = w, .height = h, .title = "volfx",
-                              .debug = app->desc.debug_gl, .logger = app->log};
+                              .debug = app->desc.debug_gl || VFX_GL_DEBUG_DEFAULT, .logger = app->log};
     vfx_result r = vfx_gl_context_create(&gd, &app->gl);
     if (r)
         goto fail;
@@ -144,6 +147,9 @@ vfx_result vfx_app_create(const vfx_app_desc *desc, vfx_app **out)
         goto fail;
     }
     if ((r = vfx_particles_register(app->world, &app->particles)))
+        goto fail;
+    if ((r = vfx_world_register(app->world, &(vfx_component_desc){"vfx.mesh", sizeof(vfx_app_mesh), 8, 1}, &app->mesh_comp))
+        || (r = vfx_world_register(app->world, &(vfx_component_desc){"vfx.transform", 64, 16, 1}, &app->transform_comp)))
         goto fail;
     if ((r = vfx_renderer_create(&app->log, &app->renderer)))
         goto fail;
@@ -181,8 +187,14 @@ void vfx_app_destroy(vfx_app *app)
     if (app->ctx)
         app->api->destroy(app->ctx);
     vfx_plugin_host_unload(app->plugin);
-    for (uint32_t i = 0; i < app->mesh_count; ++i)
-        vfx_mesh_gpu_destroy(&app->meshes[i].gpu);
+    if (app->world) {
+        vfx_query_iter it = vfx_query_begin(app->world, &app->mesh_comp, 1);
+        while (vfx_query_next(&it)) {
+            vfx_app_mesh *m = vfx_query_column(&it, app->mesh_comp, 0);
+            for (uint32_t i = 0; i < it.rows; ++i)
+                vfx_mesh_gpu_destroy(&m[i].gpu);
+        }
+    }
     vfx_renderer_destroy(app->renderer);
     vfx_world_destroy(app->world);
     vfx_profiler_destroy(app->profiler);
@@ -190,28 +202,35 @@ void vfx_app_destroy(vfx_app *app)
     free(app);
 }
 
-static vfx_result add_mesh(vfx_app *app, vfx_mesh_data *data, const float model[16], const float rgb[3])
+static vfx_result add_mesh(vfx_app *app, vfx_mesh_data *data, const float model[16],
+                           const float rgb[3], vfx_entity *out)
 {
-    if (app->mesh_count >= VFX_APP_MAX_MESHES) {
-        vfx_mesh_data_free(data);
-        vfx_logf(&app->log, VFX_LOG_ERROR, "app: more than %d meshes", VFX_APP_MAX_MESHES);
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
-    vfx_app_mesh *m = &app->meshes[app->mesh_count];
-    vfx_result r = vfx_mesh_upload(data, &m->gpu);
-    memcpy(m->bounds_min, data->bounds_min, sizeof m->bounds_min);
-    memcpy(m->bounds_max, data->bounds_max, sizeof m->bounds_max);
+    vfx_app_mesh m;
+    memset(&m, 0, sizeof m);
+    vfx_result r = vfx_mesh_upload(data, &m.gpu);
+    memcpy(m.bounds_min, data->bounds_min, sizeof m.bounds_min);
+    memcpy(m.bounds_max, data->bounds_max, sizeof m.bounds_max);
     vfx_mesh_data_free(data);
     if (r)
         return r;
+    memcpy(m.color, rgb, sizeof m.color);
+    vfx_component comps[2] = {app->mesh_comp, app->transform_comp};
+    vfx_entity e;
+    if ((r = vfx_world_spawn(app->world, 1, comps, 2, &e))) {
+        vfx_mesh_gpu_destroy(&m.gpu);
+        return r;
+    }
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    memcpy(m->model, model ? model : identity, sizeof m->model);
-    memcpy(m->color, rgb, sizeof m->color);
+    memcpy(vfx_world_get(app->world, e, app->mesh_comp, 0), &m, sizeof m);
+    memcpy(vfx_world_get(app->world, e, app->transform_comp, 0), model ? model : identity, 64);
     app->mesh_count++;
+    if (out)
+        *out = e;
     return VFX_OK;
 }
 
-vfx_result vfx_app_add_mesh_file(vfx_app *app, const char *path, const float model[16], const float rgb[3])
+vfx_result vfx_app_add_mesh_file(vfx_app *app, const char *path, const float model[16],
+                                 const float rgb[3], vfx_entity *out)
 {
     vfx_mesh_data data;
     char err[512];
@@ -220,14 +239,15 @@ vfx_result vfx_app_add_mesh_file(vfx_app *app, const char *path, const float mod
         vfx_logf(&app->log, VFX_LOG_ERROR, "%s", err);
         return r;
     }
-    return add_mesh(app, &data, model, rgb);
+    return add_mesh(app, &data, model, rgb, out);
 }
 
-vfx_result vfx_app_add_box(vfx_app *app, const float mn[3], const float mx[3], const float rgb[3])
+vfx_result vfx_app_add_box(vfx_app *app, const float mn[3], const float mx[3], const float rgb[3],
+                           vfx_entity *out)
 {
     vfx_mesh_data data;
     vfx_result r = vfx_mesh_make_box(mn, mx, &data);
-    return r ? r : add_mesh(app, &data, NULL, rgb);
+    return r ? r : add_mesh(app, &data, NULL, rgb, out);
 }
 
 vfx_result vfx_app_frame(vfx_app *app, float dt)
@@ -249,8 +269,14 @@ vfx_result vfx_app_frame(vfx_app *app, float dt)
     vfx_ref_camera_matrices(&app->camera, view, proj);
     t0 = vfx_now_ms();
     vfx_renderer_begin_scene(app->renderer, view, proj, app->clear_color);
-    for (uint32_t i = 0; i < app->mesh_count; ++i)
-        vfx_renderer_draw_mesh(app->renderer, &app->meshes[i].gpu, app->meshes[i].model, app->meshes[i].color);
+    vfx_component draw_terms[2] = {app->mesh_comp, app->transform_comp};
+    vfx_query_iter it = vfx_query_begin(app->world, draw_terms, 2);
+    while (vfx_query_next(&it)) {
+        const vfx_app_mesh *m = vfx_query_column(&it, app->mesh_comp, 0);
+        const float *xf = vfx_query_column(&it, app->transform_comp, 0);
+        for (uint32_t i = 0; i < it.rows; ++i)
+            vfx_renderer_draw_mesh(app->renderer, &m[i].gpu, xf + 16 * (size_t)i, m[i].color);
+    }
     vfx_frame_view frame;
     vfx_renderer_end_scene(app->renderer, &frame);
     for (int k = 0; k < 3; ++k)

@@ -16,7 +16,6 @@
 #include "profile/profiler.h"
 #include "reference/reference.h"
 
-#define VFX_APP_MAX_MESHES 32
 #define VFX_APP_MAX_BEAMS 1024
 #define VFX_APP_MAX_VOLUMES 4
 
@@ -29,9 +28,10 @@ typedef struct vfx_app_desc {
     vfx_logger logger;
 } vfx_app_desc;
 
+/* Component "vfx.mesh": a drawable mesh with its colour and model-space bounds. The transform
+ * is the separate component "vfx.transform" (float[16], column-major). */
 typedef struct vfx_app_mesh {
     vfx_mesh_gpu gpu;
-    float model[16];
     float color[3];
     float bounds_min[3], bounds_max[3];
 } vfx_app_mesh;
@@ -50,7 +50,7 @@ typedef struct vfx_app {
     vfx_host_api host;
     vfx_ref_camera camera;
     float clear_color[3];
-    vfx_app_mesh meshes[VFX_APP_MAX_MESHES];
+    vfx_component mesh_comp, transform_comp; /* scene meshes are entities of the world */
     uint32_t mesh_count;
     bool water_enabled;        /* particles are drawn as water when true */
     vfx_water_params water;
@@ -67,11 +67,12 @@ typedef struct vfx_app {
 vfx_result vfx_app_create(const vfx_app_desc *desc, vfx_app **out);
 /* Destroys everything in reverse order. NULL allowed. */
 void vfx_app_destroy(vfx_app *app);
-/* Imports a mesh file (Assimp) and adds it to the scene with a model matrix and colour. */
+/* Imports a mesh file (Assimp) as an entity (mesh, transform); `out` may be NULL. */
 vfx_result vfx_app_add_mesh_file(vfx_app *app, const char *path, const float model[16],
-                                 const float rgb[3]);
-/* Adds an axis-aligned box to the scene. */
-vfx_result vfx_app_add_box(vfx_app *app, const float min[3], const float max[3], const float rgb[3]);
+                                 const float rgb[3], vfx_entity *out);
+/* Adds an axis-aligned box entity to the scene; `out` may be NULL. */
+vfx_result vfx_app_add_box(vfx_app *app, const float min[3], const float max[3], const float rgb[3],
+                           vfx_entity *out);
 /* One frame: world systems (dt), plugin update, host scene, plugin render, present. */
 vfx_result vfx_app_frame(vfx_app *app, float dt);
 /* Writes the last frame's colour as a PNG. */

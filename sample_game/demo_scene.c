@@ -43,10 +43,10 @@ vfx_result vfx_demo_load(vfx_app *app, vfx_demo *demo, const char *scene_path, u
         return VFX_ERR_UNSUPPORTED;
     }
     static const float floor_c[3] = {0.55f, 0.5f, 0.45f}, wall_c[3] = {0.35f, 0.4f, 0.5f};
-    vfx_result r = vfx_app_add_box(app, (float[3]){-4, -0.2f, -4}, (float[3]){4, 0, 4}, floor_c);
-    if (!r) r = vfx_app_add_box(app, (float[3]){-4, 0, -4}, (float[3]){4, 2, -3.8f}, wall_c);
-    if (!r) r = vfx_app_add_box(app, (float[3]){-1.7f, 0, -1.2f}, (float[3]){-1.6f, 0.7f, 1.2f}, wall_c);
-    if (!r) r = vfx_app_add_box(app, (float[3]){1.6f, 0, -1.2f}, (float[3]){1.7f, 0.7f, 1.2f}, wall_c);
+    vfx_result r = vfx_app_add_box(app, (float[3]){-4, -0.2f, -4}, (float[3]){4, 0, 4}, floor_c, NULL);
+    if (!r) r = vfx_app_add_box(app, (float[3]){-4, 0, -4}, (float[3]){4, 2, -3.8f}, wall_c, NULL);
+    if (!r) r = vfx_app_add_box(app, (float[3]){-1.7f, 0, -1.2f}, (float[3]){-1.6f, 0.7f, 1.2f}, wall_c, NULL);
+    if (!r) r = vfx_app_add_box(app, (float[3]){1.6f, 0, -1.2f}, (float[3]){1.7f, 0.7f, 1.2f}, wall_c, NULL);
     if (r)
         return r;
     FILE *f = fopen(ARENA_MODEL, "rb");
@@ -54,7 +54,7 @@ vfx_result vfx_demo_load(vfx_app *app, vfx_demo *demo, const char *scene_path, u
         fclose(f);
         float model[16] = {0.02f, 0, 0, 0, 0, 0.02f, 0, 0, 0, 0, 0.02f, 0, 2.6f, 0.4f, -2.2f, 1};
         static const float c[3] = {0.7f, 0.35f, 0.3f};
-        if (vfx_app_add_mesh_file(app, ARENA_MODEL, model, c))
+        if (vfx_app_add_mesh_file(app, ARENA_MODEL, model, c, NULL))
             vfx_logf(&app->log, VFX_LOG_WARN, "arena model skipped");
     }
     /* Water: a block of particles in the pool between the two low walls. */

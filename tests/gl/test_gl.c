@@ -187,7 +187,7 @@ static void test_app_frame(void **state)
     vfx_app_desc d = {.mode = VFX_GL_HEADLESS, .width = 48, .height = 32, .logger = {vfx_test_log_fn, &log}};
     vfx_app *app;
     assert_int_equal(vfx_app_create(&d, &app), VFX_OK);
-    assert_int_equal(vfx_app_add_box(app, (float[3]){-1, -1, -1}, (float[3]){1, 1, 1}, (float[3]){0, 1, 0}), VFX_OK);
+    assert_int_equal(vfx_app_add_box(app, (float[3]){-1, -1, -1}, (float[3]){1, 1, 1}, (float[3]){0, 1, 0}, NULL), VFX_OK);
     for (int i = 0; i < 3; ++i)
         assert_int_equal(vfx_app_frame(app, 1.f / 60.f), VFX_OK);
     assert_int_equal(vfx_app_screenshot(app, "app_frame.png"), VFX_OK);
