@@ -9,6 +9,7 @@
 
 #include "app.h"
 #include "demo_scene.h"
+#include "profile/resources.h"
 
 typedef struct game_options {
     uint32_t frames;
@@ -18,6 +19,8 @@ typedef struct game_options {
     vfx_gl_mode mode;
     bool debug;
     uint32_t effects_off;
+    uint32_t mem_every;        /* print RSS and GL object counts every N frames (0 = never) */
+    const char *raw_effect, *raw_path;
 } game_options;
 
 static void usage(void)
@@ -25,9 +28,10 @@ static void usage(void)
     puts("usage: volfx-game [--headless|--window] [--frames N] [--seconds S] [--size WxH]\n"
          "                  [--png FILE] [--csv FILE] [--trace FILE] [--plugin libvolfx.so]\n"
          "                  [--scene FILE.json] [--no-water] [--no-beams] [--no-volume] [--debug-gl]\n"
+         "                  [--mem-every N] [--dump-raw water|beams|volume FILE.pfm]\n"
          "Without a display it runs headless (EGL) for 120 frames and writes volfx-game.png.\n"
          "Window keys: WASD/QE fly, mouse drag orbit, 1/2/3 toggle water/beams/volume,\n"
-         "             P pause, N single step, Esc quit.");
+         "             Tab cycle water quality (16/32/54/64 samples), P pause, N single step, Esc quit.");
 }
 
 static bool parse(int argc, char **argv, game_options *o)
@@ -57,6 +61,13 @@ static bool parse(int argc, char **argv, game_options *o)
         else if (!strcmp(a, "--no-beams")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_BEAMS);
         else if (!strcmp(a, "--no-volume")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_VOLUME);
         else if (!strcmp(a, "--debug-gl")) o->debug = true;
+        else if (!strcmp(a, "--mem-every")) { NEED_ARG(); o->mem_every = (uint32_t)strtoul(v, NULL, 10); }
+        else if (!strcmp(a, "--dump-raw")) {
+            NEED_ARG();
+            o->raw_effect = v;
+            if (i + 1 >= argc) { fprintf(stderr, "volfx-game: --dump-raw needs EFFECT FILE\n"); return false; }
+            o->raw_path = argv[++i];
+        }
         else if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(); exit(0); }
         else { fprintf(stderr, "volfx-game: unknown option '%s'\n", a); usage(); return false; }
 #undef NEED_ARG
@@ -80,6 +91,17 @@ static void handle_input(vfx_app *app, vfx_demo *demo, bool *paused, bool *step,
             vfx_demo_toggle(app, demo, kinds[k]);
         demo->key_latch[k] = down;
     }
+    bool tab = glfwGetKey(w, GLFW_KEY_TAB) == GLFW_PRESS;
+    if (tab && !demo->key_latch[5]) {
+        static const uint32_t presets[4] = {16, 32, 54, 64}; /* the paper's sample caps */
+        uint32_t cur = app->water.max_samples, next = presets[0];
+        for (int k = 0; k < 4; ++k)
+            if (presets[k] == cur)
+                next = presets[(k + 1) % 4];
+        app->water.max_samples = next;
+        printf("water quality: %u samples per pixel\n", next);
+    }
+    demo->key_latch[5] = tab;
     bool p = glfwGetKey(w, GLFW_KEY_P) == GLFW_PRESS, n = glfwGetKey(w, GLFW_KEY_N) == GLFW_PRESS;
     if (p && !demo->key_latch[3]) *paused = !*paused;
     if (n && !demo->key_latch[4]) *step = true;
@@ -152,6 +174,13 @@ int main(int argc, char **argv)
             rc = 1;
             break;
         }
+        if (o.mem_every && (f % o.mem_every) == 0) {
+            vfx_gl_object_counts c = vfx_gl_count_objects(4096);
+            printf("mem frame %u rss_kb %llu gl_objects %u (buffers %u textures %u programs %u queries %u)\n", f,
+                   (unsigned long long)(vfx_resident_bytes() / 1024), c.total, c.buffers, c.textures,
+                   c.programs, c.queries);
+            fflush(stdout);
+        }
         if (!headless && (f % 30) == 0) {
             vfx_frame_summary s = vfx_profiler_summary(app->profiler, app->frame > 60 ? (uint32_t)app->frame - 60 : 0);
             char title[128];
@@ -170,6 +199,17 @@ int main(int argc, char **argv)
             printf("screenshot: %s\n", png);
         else
             rc = 1;
+    }
+    if (o.raw_effect && rc == 0) {
+        vfx_effect_kind k = !strcmp(o.raw_effect, "water") ? VFX_EFFECT_WATER
+                            : !strcmp(o.raw_effect, "beams") ? VFX_EFFECT_BEAMS
+                            : !strcmp(o.raw_effect, "volume") ? VFX_EFFECT_VOLUME : VFX_EFFECT_COUNT;
+        if (k == VFX_EFFECT_COUNT || vfx_app_dump_raw(app, k, o.raw_path) != VFX_OK) {
+            fprintf(stderr, "volfx-game: cannot dump '%s' to %s\n", o.raw_effect, o.raw_path);
+            rc = 1;
+        } else {
+            printf("raw %s: %s\n", o.raw_effect, o.raw_path);
+        }
     }
     if (o.csv && vfx_profiler_write_csv(app->profiler, o.csv)) {
         fprintf(stderr, "volfx-game: cannot write %s\n", o.csv);
