@@ -1,0 +1,1254 @@
+/* sph.c — weakly compressible SPH: see sph.h and docs/simulation.md. */
+#include "sim/sph.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define SPH_CHUNK 1024u          /* particles per work item: fixed, so sums do not depend on threads */
+#define SPH_MAX_COLLIDERS 64u
+#define SPH_MAX_EMITTERS 16u
+#define SPH_MAX_CELLS (1u << 26)
+#define SPH_PI 3.14159265358979323846
+
+typedef struct sph_chunk_out {
+    float v2_max, a2_max, c2_max;
+    float rho_err_max;
+    double rho_err_sum, ke, pe;
+    uint64_t pairs;
+    uint32_t bad;      /* first failing row in the chunk, UINT32_MAX when none */
+    int bad_kind;      /* 1 non-finite, 2 speed, 3 density change */
+    float bad_value;
+} sph_chunk_out;
+
+typedef struct sph_collider_state {
+    vfx_sph_collider c;
+    float pos[3], vel[3]; /* at the current substep */
+} sph_collider_state;
+
+typedef struct sph_emitter_state {
+    vfx_sph_emitter e;
+    float u[3], w[3];     /* basis of the nozzle plane */
+    double travelled;     /* distance moved by the last layer */
+    uint32_t emitted;
+    bool started;
+} sph_emitter_state;
+
+typedef void (*sph_chunk_fn)(vfx_sph *s, uint32_t chunk);
+
+struct vfx_sph {
+    vfx_sph_desc p;
+    float mass, H, H2, h, inv_cell;
+    float k_poly6, k_spiky;          /* W = k_poly6 (H^2-r^2)^3, |grad W| = k_spiky (H-r)^2 */
+    float wall_scale;                /* lattice calibration of the wall density fraction */
+    float B, c0;
+    double time;
+    uint32_t n, cap, next_id, clamped_on_add;
+    /* columns */
+    float *x, *y, *z, *vx, *vy, *vz, *rho, *pr, *ax, *ay, *az, *drho;
+    float *xn, *yn, *zn, *vxn, *vyn, *vzn, *tmp;
+    uint32_t *id, *idtmp, *key, *perm;
+    /* grid */
+    int nx, ny, nz;
+    uint32_t ncells;
+    uint32_t *cell_start; /* ncells + 1 */
+    /* boundaries */
+    sph_collider_state col[SPH_MAX_COLLIDERS];
+    uint32_t ncol;
+    sph_emitter_state em[SPH_MAX_EMITTERS];
+    uint32_t nem;
+    /* per-chunk reductions */
+    sph_chunk_out *out;
+    uint32_t out_cap;
+    float dt_try;
+    /* thread pool */
+    pthread_t *threads;
+    uint32_t nthreads; /* workers besides the caller */
+    pthread_mutex_t mu;
+    pthread_cond_t cv_start, cv_done;
+    uint64_t gen;
+    uint32_t busy;
+    bool quit;
+    sph_chunk_fn job;
+    atomic_uint next_chunk;
+    uint32_t nchunks;
+    char err[512];
+};
+
+static void set_err(vfx_sph *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void set_err(vfx_sph *s, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(s->err, sizeof s->err, fmt, ap);
+    va_end(ap);
+}
+
+/* ---- closed-form wall integrals ------------------------------------------------------------ */
+
+double vfx_sph_wall_density_fraction(double d, double H)
+{
+    if (d >= H)
+        return 0.0;
+    if (d < 0.0)
+        d = 0.0; /* inside the wall: the clamp puts it back; use the half-space value */
+    /* int_{z>d} int_plane W_poly6 = (pi k/4) int_d^H (H^2-z^2)^4 dz, k = 315/(64 pi H^9) */
+    double H2 = H * H, H4 = H2 * H2, H6 = H4 * H2, H8 = H4 * H4;
+#define P9(z) (H8 * (z) - 4.0 * H6 * pow((z), 3) / 3.0 + 6.0 * H4 * pow((z), 5) / 5.0 \
+               - 4.0 * H2 * pow((z), 7) / 7.0 + pow((z), 9) / 9.0)
+    double k = 315.0 / (64.0 * SPH_PI * pow(H, 9));
+    double v = SPH_PI * k / 4.0 * (P9(H) - P9(d));
+#undef P9
+    return v;
+}
+
+double vfx_sph_wall_density_gradient(double d, double H)
+{
+    if (d >= H)
+        return 0.0;
+    if (d < 0.0)
+        d = 0.0;
+    /* -d/dd of vfx_sph_wall_density_fraction = (pi k/4) (H^2-d^2)^4 */
+    double k = 315.0 / (64.0 * SPH_PI * pow(H, 9)), q = H * H - d * d;
+    return SPH_PI * k / 4.0 * q * q * q * q;
+}
+
+/* ---- thread pool --------------------------------------------------------------------------- */
+
+static void run_chunks(vfx_sph *s)
+{
+    for (;;) {
+        uint32_t c = atomic_fetch_add(&s->next_chunk, 1u);
+        if (c >= s->nchunks)
+            break;
+        s->job(s, c);
+    }
+}
+
+static void *worker_main(void *arg)
+{
+    vfx_sph *s = arg;
+    uint64_t seen = 0;
+    for (;;) {
+        pthread_mutex_lock(&s->mu);
+        while (!s->quit && s->gen == seen)
+            pthread_cond_wait(&s->cv_start, &s->mu);
+        if (s->quit) {
+            pthread_mutex_unlock(&s->mu);
+            return NULL;
+        }
+        seen = s->gen;
+        pthread_mutex_unlock(&s->mu);
+        run_chunks(s);
+        pthread_mutex_lock(&s->mu);
+        if (--s->busy == 0)
+            pthread_cond_signal(&s->cv_done);
+        pthread_mutex_unlock(&s->mu);
+    }
+}
+
+/* Runs fn over every chunk on all threads. The density pass starts the chunk reductions
+ * afresh; later passes of the same substep add to them and only reset the failure slot. */
+static void parallel(vfx_sph *s, sph_chunk_fn fn, bool fresh)
+{
+    uint32_t nchunks = (s->n + SPH_CHUNK - 1) / SPH_CHUNK;
+    for (uint32_t c = 0; c < nchunks; ++c) {
+        if (fresh) {
+            s->out[c] = (sph_chunk_out){.bad = UINT32_MAX};
+        } else {
+            s->out[c].bad = UINT32_MAX;
+            s->out[c].ke = s->out[c].pe = 0.0;
+        }
+    }
+    s->job = fn;
+    s->nchunks = nchunks;
+    atomic_store(&s->next_chunk, 0u);
+    if (s->nthreads == 0 || nchunks < 2) {
+        run_chunks(s);
+        return;
+    }
+    pthread_mutex_lock(&s->mu);
+    s->busy = s->nthreads;
+    s->gen++;
+    pthread_cond_broadcast(&s->cv_start);
+    pthread_mutex_unlock(&s->mu);
+    run_chunks(s);
+    pthread_mutex_lock(&s->mu);
+    while (s->busy > 0)
+        pthread_cond_wait(&s->cv_done, &s->mu);
+    pthread_mutex_unlock(&s->mu);
+}
+
+/* ---- creation ------------------------------------------------------------------------------ */
+
+static float def(float v, float d) { return v != 0.f ? v : d; }
+
+static vfx_result fill_params(vfx_sph_desc *p, char *err, size_t err_len)
+{
+    p->spacing = def(p->spacing, 0.02f);
+    p->support_ratio = def(p->support_ratio, 2.0f);
+    p->rest_density = def(p->rest_density, 1000.f);
+    p->gamma = def(p->gamma, 7.f);
+    p->cfl = def(p->cfl, 0.4f);
+    if (p->flags & VFX_SPH_NO_VISCOSITY)
+        p->viscosity = 0.f;
+    else
+        p->viscosity = def(p->viscosity, 0.05f);
+    if (p->flags & VFX_SPH_NO_GRAVITY) {
+        p->gravity[0] = p->gravity[1] = p->gravity[2] = 0.f;
+    } else if (p->gravity[0] == 0.f && p->gravity[1] == 0.f && p->gravity[2] == 0.f) {
+        p->gravity[1] = -9.81f;
+    }
+    bool dom_set = false;
+    for (int a = 0; a < 3; ++a)
+        dom_set |= p->domain_min[a] != p->domain_max[a];
+    if (!dom_set)
+        for (int a = 0; a < 3; ++a)
+            p->domain_min[a] = 0.f, p->domain_max[a] = 1.f;
+    if (!p->max_substeps) p->max_substeps = 256;
+    if (!p->max_redo) p->max_redo = 10;
+    if (!p->max_particles) p->max_particles = 1u << 27;
+    if (!p->threads) {
+        long nc = sysconf(_SC_NPROCESSORS_ONLN);
+        p->threads = nc > 0 ? (uint32_t)nc : 1u;
+    }
+    p->density_change_limit = def(p->density_change_limit, 0.05f);
+
+    const float *fields[] = {&p->spacing, &p->support_ratio, &p->rest_density, &p->sound_speed,
+                             &p->stiffness, &p->gamma, &p->viscosity, &p->cfl, &p->velocity_limit,
+                             &p->density_change_limit, &p->gravity[0], &p->gravity[1], &p->gravity[2],
+                             &p->domain_min[0], &p->domain_min[1], &p->domain_min[2],
+                             &p->domain_max[0], &p->domain_max[1], &p->domain_max[2]};
+    static const char *names[] = {"spacing", "support_ratio", "rest_density", "sound_speed",
+                                  "stiffness", "gamma", "viscosity", "cfl", "velocity_limit",
+                                  "density_change_limit", "gravity[0]", "gravity[1]", "gravity[2]",
+                                  "domain_min[0]", "domain_min[1]", "domain_min[2]",
+                                  "domain_max[0]", "domain_max[1]", "domain_max[2]"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
+        if (!isfinite(*fields[i])) {
+            snprintf(err, err_len, "vfx_sph_create: desc.%s is not finite", names[i]);
+            return VFX_ERR_INVALID_ARGUMENT;
+        }
+    }
+    if (p->spacing < 0.f || p->support_ratio < 1.f || p->rest_density < 0.f || p->gamma < 1.f ||
+        p->viscosity < 0.f || p->cfl <= 0.f || p->cfl > 1.f || p->sound_speed < 0.f ||
+        p->stiffness < 0.f || p->velocity_limit < 0.f || p->density_change_limit < 0.f) {
+        snprintf(err, err_len, "vfx_sph_create: a parameter is out of range (spacing>0, "
+                 "support_ratio>=1, rest_density>0, gamma>=1, 0<cfl<=1, others >= 0)");
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    for (int a = 0; a < 3; ++a) {
+        if (!(p->domain_max[a] - p->domain_min[a] >= 2.f * p->spacing)) {
+            snprintf(err, err_len, "vfx_sph_create: domain axis %d is thinner than 2 spacings "
+                     "(%g..%g)", a, p->domain_min[a], p->domain_max[a]);
+            return VFX_ERR_INVALID_ARGUMENT;
+        }
+    }
+    if (p->threads > 256)
+        p->threads = 256;
+    return VFX_OK;
+}
+
+vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, size_t err_len)
+{
+    char dummy[8];
+    if (!err || err_len == 0)
+        err = dummy, err_len = sizeof dummy;
+    err[0] = 0;
+    if (!out) {
+        snprintf(err, err_len, "vfx_sph_create: out is NULL");
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    *out = NULL;
+    vfx_sph_desc p = desc ? *desc : (vfx_sph_desc){0};
+    vfx_result r = fill_params(&p, err, err_len);
+    if (r)
+        return r;
+    vfx_sph *s = calloc(1, sizeof *s);
+    if (!s) {
+        snprintf(err, err_len, "vfx_sph_create: out of memory");
+        return VFX_ERR_OUT_OF_MEMORY;
+    }
+    s->H = p.spacing * p.support_ratio;
+    s->H2 = s->H * s->H;
+    s->h = 0.5f * s->H;
+    s->k_poly6 = (float)(315.0 / (64.0 * SPH_PI * pow(s->H, 9)));
+    s->k_spiky = (float)(45.0 / (SPH_PI * pow(s->H, 6)));
+    /* Mass calibrated on the lattice the solver fills blocks with, so a block starts at rho0
+     * exactly instead of at the kernel's lattice bias (a few % for poly6 at H = 2 dx). */
+    double sum = 0.0;
+    int R = (int)ceil(p.support_ratio) + 1;
+    for (int i = -R; i <= R; ++i)
+        for (int j = -R; j <= R; ++j)
+            for (int k = -R; k <= R; ++k) {
+                double r2 = ((double)i * i + (double)j * j + (double)k * k) * p.spacing * p.spacing;
+                double q = (double)s->H2 - r2;
+                if (q > 0)
+                    sum += (double)s->k_poly6 * q * q * q;
+            }
+    s->mass = (float)(p.rest_density / sum);
+    /* The wall term is the continuum integral; a lattice particle half a spacing from a wall
+     * misses the lattice layers beyond it, which is not quite the same number. Scale the wall
+     * fraction so that the first lattice layer sits exactly at rho0. */
+    double beyond = 0.0;
+    for (int i = -R; i <= R; ++i)
+        for (int j = -R; j <= R; ++j)
+            for (int k = -R; k <= -1; ++k) {
+                double r2 = ((double)i * i + (double)j * j + (double)k * k) * p.spacing * p.spacing;
+                double q = (double)s->H2 - r2;
+                if (q > 0)
+                    beyond += (double)s->k_poly6 * q * q * q;
+            }
+    s->wall_scale = (float)(beyond / sum / vfx_sph_wall_density_fraction(0.5 * p.spacing, s->H));
+    float height = 0.f, g = sqrtf(p.gravity[0] * p.gravity[0] + p.gravity[1] * p.gravity[1] +
+                                  p.gravity[2] * p.gravity[2]);
+    for (int a = 0; a < 3; ++a)
+        if (fabsf(p.domain_max[a] - p.domain_min[a]) > height)
+            height = p.domain_max[a] - p.domain_min[a];
+    if (p.stiffness > 0.f) {
+        p.sound_speed = sqrtf(p.gamma * p.stiffness / p.rest_density);
+    } else {
+        if (p.sound_speed == 0.f)
+            p.sound_speed = g > 0.f ? 10.f * sqrtf(2.f * g * height) : 10.f;
+        p.stiffness = p.rest_density * p.sound_speed * p.sound_speed / p.gamma;
+    }
+    p.velocity_limit = def(p.velocity_limit, 20.f * p.sound_speed);
+    s->B = p.stiffness;
+    s->c0 = p.sound_speed;
+    s->p = p;
+    s->inv_cell = 1.f / s->H;
+    double dims[3];
+    for (int a = 0; a < 3; ++a)
+        dims[a] = ceil((p.domain_max[a] - p.domain_min[a]) / s->H);
+    if (dims[0] * dims[1] * dims[2] > SPH_MAX_CELLS) {
+        snprintf(err, err_len, "vfx_sph_create: domain/support gives %.0f grid cells (max %u): "
+                 "shrink the domain or grow the spacing", dims[0] * dims[1] * dims[2], SPH_MAX_CELLS);
+        free(s);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    s->nx = (int)dims[0], s->ny = (int)dims[1], s->nz = (int)dims[2];
+    s->ncells = (uint32_t)(s->nx * s->ny * s->nz);
+    s->cell_start = calloc((size_t)s->ncells + 1, sizeof *s->cell_start);
+    if (!s->cell_start) {
+        snprintf(err, err_len, "vfx_sph_create: out of memory for %u grid cells", s->ncells);
+        free(s);
+        return VFX_ERR_OUT_OF_MEMORY;
+    }
+    pthread_mutex_init(&s->mu, NULL);
+    pthread_cond_init(&s->cv_start, NULL);
+    pthread_cond_init(&s->cv_done, NULL);
+    atomic_init(&s->next_chunk, 0u);
+    uint32_t workers = p.threads - 1;
+    if (workers) {
+        s->threads = calloc(workers, sizeof *s->threads);
+        if (!s->threads) {
+            vfx_sph_destroy(s);
+            snprintf(err, err_len, "vfx_sph_create: out of memory");
+            return VFX_ERR_OUT_OF_MEMORY;
+        }
+        for (uint32_t i = 0; i < workers; ++i) {
+            if (pthread_create(&s->threads[i], NULL, worker_main, s) != 0) {
+                s->p.threads = 1 + i; /* run with the ones we have */
+                break;
+            }
+            s->nthreads++;
+        }
+    }
+    *out = s;
+    return VFX_OK;
+}
+
+static void free_columns(vfx_sph *s)
+{
+    float **f[] = {&s->x, &s->y, &s->z, &s->vx, &s->vy, &s->vz, &s->rho, &s->pr, &s->ax, &s->ay,
+                   &s->az, &s->drho, &s->xn, &s->yn, &s->zn, &s->vxn, &s->vyn, &s->vzn, &s->tmp};
+    for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) {
+        free(*f[i]);
+        *f[i] = NULL;
+    }
+    free(s->id), free(s->idtmp), free(s->key), free(s->perm);
+    s->id = s->idtmp = s->key = s->perm = NULL;
+}
+
+void vfx_sph_destroy(vfx_sph *s)
+{
+    if (!s)
+        return;
+    pthread_mutex_lock(&s->mu);
+    s->quit = true;
+    pthread_cond_broadcast(&s->cv_start);
+    pthread_mutex_unlock(&s->mu);
+    for (uint32_t i = 0; i < s->nthreads; ++i)
+        pthread_join(s->threads[i], NULL);
+    free(s->threads);
+    pthread_mutex_destroy(&s->mu);
+    pthread_cond_destroy(&s->cv_start);
+    pthread_cond_destroy(&s->cv_done);
+    free_columns(s);
+    free(s->cell_start);
+    free(s->out);
+    free(s);
+}
+
+const char *vfx_sph_last_error(const vfx_sph *s) { return s ? s->err : "vfx_sph is NULL"; }
+const vfx_sph_desc *vfx_sph_params(const vfx_sph *s) { return s ? &s->p : NULL; }
+float vfx_sph_particle_mass(const vfx_sph *s) { return s ? s->mass : 0.f; }
+float vfx_sph_support(const vfx_sph *s) { return s ? s->H : 0.f; }
+uint32_t vfx_sph_clamped_on_add(const vfx_sph *s) { return s ? s->clamped_on_add : 0; }
+double vfx_sph_time(const vfx_sph *s) { return s ? s->time : 0.0; }
+uint32_t vfx_sph_thread_count(const vfx_sph *s) { return s ? s->nthreads + 1 : 0; }
+
+size_t vfx_sph_memory_bytes(const vfx_sph *s)
+{
+    if (!s)
+        return 0;
+    return sizeof *s + (size_t)s->cap * (19 * sizeof(float) + 4 * sizeof(uint32_t)) +
+           ((size_t)s->ncells + 1) * sizeof(uint32_t) + (size_t)s->out_cap * sizeof(sph_chunk_out);
+}
+
+float vfx_sph_pressure(const vfx_sph *s, uint32_t i)
+{
+    if (!s || i >= s->n)
+        return 0.f;
+    return s->pr[i] * s->rho[i] * s->rho[i];
+}
+
+vfx_sph_columns vfx_sph_get_columns(vfx_sph *s)
+{
+    if (!s)
+        return (vfx_sph_columns){0};
+    return (vfx_sph_columns){s->n, s->x, s->y, s->z, s->vx, s->vy, s->vz, s->rho, s->id};
+}
+
+static vfx_result reserve(vfx_sph *s, uint64_t want)
+{
+    if (want > s->p.max_particles) {
+        set_err(s, "vfx_sph: %llu particles requested, capacity bound is %u (desc.max_particles)",
+                (unsigned long long)want, s->p.max_particles);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    if (want <= s->cap)
+        return VFX_OK;
+    uint64_t cap = s->cap ? s->cap : 1024;
+    while (cap < want)
+        cap *= 2;
+    if (cap > s->p.max_particles)
+        cap = s->p.max_particles;
+    float **f[] = {&s->x, &s->y, &s->z, &s->vx, &s->vy, &s->vz, &s->rho, &s->pr, &s->ax, &s->ay,
+                   &s->az, &s->drho, &s->xn, &s->yn, &s->zn, &s->vxn, &s->vyn, &s->vzn, &s->tmp};
+    for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) {
+        float *np = realloc(*f[i], (size_t)cap * sizeof(float));
+        if (!np)
+            goto oom;
+        *f[i] = np;
+    }
+    uint32_t **u[] = {&s->id, &s->idtmp, &s->key, &s->perm};
+    for (size_t i = 0; i < sizeof u / sizeof u[0]; ++i) {
+        uint32_t *np = realloc(*u[i], (size_t)cap * sizeof(uint32_t));
+        if (!np)
+            goto oom;
+        *u[i] = np;
+    }
+    uint32_t chunks = (uint32_t)((cap + SPH_CHUNK - 1) / SPH_CHUNK);
+    sph_chunk_out *no = realloc(s->out, (size_t)chunks * sizeof *no);
+    if (!no)
+        goto oom;
+    s->out = no;
+    s->out_cap = chunks;
+    s->cap = (uint32_t)cap;
+    return VFX_OK;
+oom:
+    set_err(s, "vfx_sph: out of memory growing to %llu particles", (unsigned long long)cap);
+    return VFX_ERR_OUT_OF_MEMORY;
+}
+
+static float clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+
+vfx_result vfx_sph_add_particles(vfx_sph *s, uint32_t n, const float *x, const float *y,
+                                 const float *z, const float *vx, const float *vy, const float *vz)
+{
+    if (!s)
+        return VFX_ERR_INVALID_ARGUMENT;
+    s->err[0] = 0;
+    if (n == 0)
+        return VFX_OK;
+    if (!x || !y || !z) {
+        set_err(s, "vfx_sph_add_particles: position array is NULL for %u particles", n);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    const float *arr[6] = {x, y, z, vx, vy, vz};
+    static const char *nm[6] = {"x", "y", "z", "vx", "vy", "vz"};
+    for (uint32_t i = 0; i < n; ++i)
+        for (int a = 0; a < 6; ++a)
+            if (arr[a] && !isfinite(arr[a][i])) {
+                set_err(s, "vfx_sph_add_particles: particle %u (of %u in this batch) has a "
+                        "non-finite %s (%g); batch refused", i, n, nm[a], (double)arr[a][i]);
+                return VFX_ERR_INVALID_ARGUMENT;
+            }
+    vfx_result r = reserve(s, (uint64_t)s->n + n);
+    if (r)
+        return r;
+    /* keep fresh particles a quarter spacing inside the walls, where the clamp would put them */
+    float m = 0.25f * s->p.spacing;
+    for (uint32_t i = 0; i < n; ++i) {
+        uint32_t k = s->n + i;
+        float px = clampf(x[i], s->p.domain_min[0] + m, s->p.domain_max[0] - m);
+        float py = clampf(y[i], s->p.domain_min[1] + m, s->p.domain_max[1] - m);
+        float pz = clampf(z[i], s->p.domain_min[2] + m, s->p.domain_max[2] - m);
+        if (px != x[i] || py != y[i] || pz != z[i])
+            s->clamped_on_add++;
+        s->x[k] = px, s->y[k] = py, s->z[k] = pz;
+        s->vx[k] = vx ? vx[i] : 0.f;
+        s->vy[k] = vy ? vy[i] : 0.f;
+        s->vz[k] = vz ? vz[i] : 0.f;
+        s->rho[k] = s->p.rest_density;
+        s->pr[k] = 0.f;
+        s->id[k] = s->next_id++;
+    }
+    s->n += n;
+    return VFX_OK;
+}
+
+vfx_result vfx_sph_add_block(vfx_sph *s, const float lo[3], const float hi[3], uint32_t *added)
+{
+    if (added)
+        *added = 0;
+    if (!s || !lo || !hi)
+        return VFX_ERR_INVALID_ARGUMENT;
+    float dx = s->p.spacing;
+    uint64_t c[3];
+    for (int a = 0; a < 3; ++a) {
+        if (!isfinite(lo[a]) || !isfinite(hi[a]) || hi[a] < lo[a]) {
+            set_err(s, "vfx_sph_add_block: bad bounds on axis %d (%g..%g)", a, (double)lo[a], (double)hi[a]);
+            return VFX_ERR_INVALID_ARGUMENT;
+        }
+        c[a] = (uint64_t)floor((hi[a] - lo[a]) / dx + 1e-4);
+    }
+    uint64_t total = c[0] * c[1] * c[2];
+    if (total == 0)
+        return VFX_OK;
+    vfx_result r = reserve(s, s->n + total);
+    if (r)
+        return r;
+    uint32_t base = s->n;
+    for (uint64_t k = 0; k < c[2]; ++k)
+        for (uint64_t j = 0; j < c[1]; ++j)
+            for (uint64_t i = 0; i < c[0]; ++i) {
+                uint32_t q = s->n++;
+                s->x[q] = lo[0] + ((float)i + 0.5f) * dx;
+                s->y[q] = lo[1] + ((float)j + 0.5f) * dx;
+                s->z[q] = lo[2] + ((float)k + 0.5f) * dx;
+                s->vx[q] = s->vy[q] = s->vz[q] = 0.f;
+                s->rho[q] = s->p.rest_density;
+                s->pr[q] = 0.f;
+                s->id[q] = s->next_id++;
+            }
+    /* out-of-domain lattice points are clamped like any other input */
+    float m = 0.25f * dx;
+    for (uint32_t q = base; q < s->n; ++q) {
+        float px = clampf(s->x[q], s->p.domain_min[0] + m, s->p.domain_max[0] - m);
+        float py = clampf(s->y[q], s->p.domain_min[1] + m, s->p.domain_max[1] - m);
+        float pz = clampf(s->z[q], s->p.domain_min[2] + m, s->p.domain_max[2] - m);
+        if (px != s->x[q] || py != s->y[q] || pz != s->z[q])
+            s->clamped_on_add++;
+        s->x[q] = px, s->y[q] = py, s->z[q] = pz;
+    }
+    if (added)
+        *added = (uint32_t)total;
+    return VFX_OK;
+}
+
+static bool finite3(const float *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
+vfx_result vfx_sph_add_collider(vfx_sph *s, const vfx_sph_collider *c, uint32_t *index)
+{
+    if (!s || !c)
+        return VFX_ERR_INVALID_ARGUMENT;
+    if (s->ncol >= SPH_MAX_COLLIDERS) {
+        set_err(s, "vfx_sph_add_collider: at most %u colliders", SPH_MAX_COLLIDERS);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    vfx_sph_collider k = *c;
+    if (!finite3(k.center) || !finite3(k.normal) || !finite3(k.half) || !finite3(k.motion_axis) ||
+        !isfinite(k.radius) || !isfinite(k.motion_amplitude) || !isfinite(k.motion_frequency)) {
+        set_err(s, "vfx_sph_add_collider: collider %u has a non-finite field", s->ncol);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    if (k.kind == VFX_SPH_PLANE) {
+        float l = sqrtf(k.normal[0] * k.normal[0] + k.normal[1] * k.normal[1] + k.normal[2] * k.normal[2]);
+        if (!(l > 1e-6f)) {
+            set_err(s, "vfx_sph_add_collider: plane %u has a zero normal", s->ncol);
+            return VFX_ERR_INVALID_ARGUMENT;
+        }
+        for (int a = 0; a < 3; ++a)
+            k.normal[a] /= l;
+    } else if (k.kind == VFX_SPH_SPHERE) {
+        if (!(k.radius > 0.f)) {
+            set_err(s, "vfx_sph_add_collider: sphere %u needs radius > 0 (got %g)", s->ncol, (double)k.radius);
+            return VFX_ERR_INVALID_ARGUMENT;
+        }
+    } else if (k.kind == VFX_SPH_BOX) {
+        if (!(k.half[0] > 0.f && k.half[1] > 0.f && k.half[2] > 0.f)) {
+            set_err(s, "vfx_sph_add_collider: box %u needs half extents > 0", s->ncol);
+            return VFX_ERR_INVALID_ARGUMENT;
+        }
+    } else {
+        set_err(s, "vfx_sph_add_collider: unknown kind %d", (int)k.kind);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    float al = sqrtf(k.motion_axis[0] * k.motion_axis[0] + k.motion_axis[1] * k.motion_axis[1] +
+                     k.motion_axis[2] * k.motion_axis[2]);
+    if (al > 0.f)
+        for (int a = 0; a < 3; ++a)
+            k.motion_axis[a] /= al;
+    else
+        k.motion_amplitude = 0.f;
+    sph_collider_state *st = &s->col[s->ncol];
+    st->c = k;
+    memcpy(st->pos, k.center, sizeof st->pos);
+    memset(st->vel, 0, sizeof st->vel);
+    if (index)
+        *index = s->ncol;
+    s->ncol++;
+    return VFX_OK;
+}
+
+vfx_result vfx_sph_add_emitter(vfx_sph *s, const vfx_sph_emitter *e)
+{
+    if (!s || !e)
+        return VFX_ERR_INVALID_ARGUMENT;
+    if (s->nem >= SPH_MAX_EMITTERS) {
+        set_err(s, "vfx_sph_add_emitter: at most %u emitters", SPH_MAX_EMITTERS);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    vfx_sph_emitter k = *e;
+    float l = sqrtf(k.direction[0] * k.direction[0] + k.direction[1] * k.direction[1] +
+                    k.direction[2] * k.direction[2]);
+    if (!finite3(k.center) || !(l > 1e-6f) || !isfinite(l) || !(k.speed > 0.f) || !isfinite(k.speed) ||
+        !(k.radius >= 0.5f * s->p.spacing) || !isfinite(k.radius)) {
+        set_err(s, "vfx_sph_add_emitter: emitter %u needs finite centre, non-zero direction, "
+                "speed > 0 and radius >= spacing/2", s->nem);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    sph_emitter_state *st = &s->em[s->nem++];
+    memset(st, 0, sizeof *st);
+    for (int a = 0; a < 3; ++a)
+        k.direction[a] /= l;
+    st->e = k;
+    /* nozzle plane basis: any vector not parallel to the direction, orthogonalised */
+    const float *d = k.direction;
+    float t[3] = {1.f, 0.f, 0.f};
+    if (fabsf(d[0]) > 0.9f)
+        t[0] = 0.f, t[1] = 1.f;
+    float u[3] = {d[1] * t[2] - d[2] * t[1], d[2] * t[0] - d[0] * t[2], d[0] * t[1] - d[1] * t[0]};
+    float ul = sqrtf(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (int a = 0; a < 3; ++a)
+        u[a] /= ul;
+    float w[3] = {d[1] * u[2] - d[2] * u[1], d[2] * u[0] - d[0] * u[2], d[0] * u[1] - d[1] * u[0]};
+    memcpy(st->u, u, sizeof u);
+    memcpy(st->w, w, sizeof w);
+    return VFX_OK;
+}
+
+/* ---- boundaries ---------------------------------------------------------------------------- */
+
+/* Signed distance of p to collider surface (positive on the fluid side) and outward normal. */
+static float collider_distance(const sph_collider_state *st, float px, float py, float pz, float n[3])
+{
+    const vfx_sph_collider *c = &st->c;
+    float dx = px - st->pos[0], dy = py - st->pos[1], dz = pz - st->pos[2];
+    if (c->kind == VFX_SPH_PLANE) {
+        n[0] = c->normal[0], n[1] = c->normal[1], n[2] = c->normal[2];
+        return dx * n[0] + dy * n[1] + dz * n[2];
+    }
+    if (c->kind == VFX_SPH_SPHERE) {
+        float l = sqrtf(dx * dx + dy * dy + dz * dz);
+        if (l < 1e-12f) {
+            n[0] = 0.f, n[1] = 1.f, n[2] = 0.f;
+        } else {
+            n[0] = dx / l, n[1] = dy / l, n[2] = dz / l;
+        }
+        return l - c->radius;
+    }
+    float d[3] = {dx, dy, dz}, q[3], o[3], ol2 = 0.f, qmax = -INFINITY;
+    int amax = 0;
+    for (int a = 0; a < 3; ++a) {
+        q[a] = fabsf(d[a]) - c->half[a];
+        o[a] = q[a] > 0.f ? q[a] : 0.f;
+        ol2 += o[a] * o[a];
+        if (q[a] > qmax)
+            qmax = q[a], amax = a;
+    }
+    if (ol2 > 0.f) {
+        float ol = sqrtf(ol2);
+        for (int a = 0; a < 3; ++a)
+            n[a] = (d[a] < 0.f ? -o[a] : o[a]) / ol;
+        return ol;
+    }
+    n[0] = n[1] = n[2] = 0.f;
+    n[amax] = d[amax] < 0.f ? -1.f : 1.f;
+    return qmax;
+}
+
+static void update_colliders(vfx_sph *s, double t)
+{
+    for (uint32_t i = 0; i < s->ncol; ++i) {
+        sph_collider_state *st = &s->col[i];
+        const vfx_sph_collider *c = &st->c;
+        double w = 2.0 * SPH_PI * c->motion_frequency;
+        double off = c->motion_amplitude * sin(w * t), vel = c->motion_amplitude * w * cos(w * t);
+        for (int a = 0; a < 3; ++a) {
+            st->pos[a] = c->center[a] + (float)(off * c->motion_axis[a]);
+            st->vel[a] = (float)(vel * c->motion_axis[a]);
+        }
+    }
+}
+
+/* ---- neighbour grid ------------------------------------------------------------------------ */
+
+static inline int cell_coord(float v, float lo, float inv, int n)
+{
+    int c = (int)((v - lo) * inv);
+    return c < 0 ? 0 : (c >= n ? n - 1 : c);
+}
+
+/* Counting sort of the particles by cell, then every per-particle column permuted so that a
+ * cell's particles are contiguous (and a row of 3 x-adjacent cells is one range). Stable, so
+ * the order — and every sum over neighbours — does not depend on the thread count. */
+static void build_grid(vfx_sph *s)
+{
+    const float *lo = s->p.domain_min;
+    uint32_t n = s->n;
+    memset(s->cell_start, 0, ((size_t)s->ncells + 1) * sizeof *s->cell_start);
+    for (uint32_t i = 0; i < n; ++i) {
+        int cx = cell_coord(s->x[i], lo[0], s->inv_cell, s->nx);
+        int cy = cell_coord(s->y[i], lo[1], s->inv_cell, s->ny);
+        int cz = cell_coord(s->z[i], lo[2], s->inv_cell, s->nz);
+        uint32_t k = (uint32_t)((cz * s->ny + cy) * s->nx + cx);
+        s->key[i] = k;
+        s->cell_start[k + 1]++;
+    }
+    for (uint32_t c = 0; c < s->ncells; ++c)
+        s->cell_start[c + 1] += s->cell_start[c];
+    /* scatter using cell_start as running cursors, then restore it */
+    for (uint32_t i = 0; i < n; ++i)
+        s->perm[s->cell_start[s->key[i]]++] = i;
+    for (uint32_t c = s->ncells; c > 0; --c)
+        s->cell_start[c] = s->cell_start[c - 1];
+    s->cell_start[0] = 0;
+    float **cols[] = {&s->x, &s->y, &s->z, &s->vx, &s->vy, &s->vz};
+    for (size_t c = 0; c < 6; ++c) {
+        float *src = *cols[c], *dst = s->tmp;
+        for (uint32_t i = 0; i < n; ++i)
+            dst[i] = src[s->perm[i]];
+        s->tmp = src;
+        *cols[c] = dst;
+    }
+    for (uint32_t i = 0; i < n; ++i)
+        s->idtmp[i] = s->id[s->perm[i]];
+    uint32_t *t = s->id;
+    s->id = s->idtmp;
+    s->idtmp = t;
+}
+
+typedef struct sph_ranges {
+    uint32_t lo[9], hi[9];
+    int count;
+} sph_ranges;
+
+static inline void neighbor_ranges(const vfx_sph *s, float px, float py, float pz, sph_ranges *r)
+{
+    const float *lo = s->p.domain_min;
+    int cx = cell_coord(px, lo[0], s->inv_cell, s->nx);
+    int cy = cell_coord(py, lo[1], s->inv_cell, s->ny);
+    int cz = cell_coord(pz, lo[2], s->inv_cell, s->nz);
+    int x0 = cx > 0 ? cx - 1 : 0, x1 = cx + 1 < s->nx ? cx + 1 : cx;
+    r->count = 0;
+    for (int z = cz - 1; z <= cz + 1; ++z) {
+        if (z < 0 || z >= s->nz)
+            continue;
+        for (int y = cy - 1; y <= cy + 1; ++y) {
+            if (y < 0 || y >= s->ny)
+                continue;
+            uint32_t row = (uint32_t)((z * s->ny + y) * s->nx);
+            uint32_t a = s->cell_start[row + (uint32_t)x0], b = s->cell_start[row + (uint32_t)x1 + 1];
+            if (b > a) {
+                r->lo[r->count] = a;
+                r->hi[r->count] = b;
+                r->count++;
+            }
+        }
+    }
+}
+
+/* Walls of the domain box and every collider: density fraction and force integral. */
+typedef struct sph_wall_hit {
+    float n[3], d, vel[3];
+    bool is_box;
+} sph_wall_hit;
+
+static int gather_walls(const vfx_sph *s, float px, float py, float pz, sph_wall_hit *w, int max)
+{
+    int k = 0;
+    const float *lo = s->p.domain_min, *hi = s->p.domain_max;
+    float pp[3] = {px, py, pz};
+    for (int a = 0; a < 3; ++a) {
+        float d0 = pp[a] - lo[a], d1 = hi[a] - pp[a];
+        if (d0 < s->H && k < max) {
+            w[k] = (sph_wall_hit){{0}, d0, {0}, true};
+            w[k].n[a] = 1.f;
+            k++;
+        }
+        if (d1 < s->H && k < max) {
+            w[k] = (sph_wall_hit){{0}, d1, {0}, true};
+            w[k].n[a] = -1.f;
+            k++;
+        }
+    }
+    for (uint32_t c = 0; c < s->ncol && k < max; ++c) {
+        float n[3];
+        float d = collider_distance(&s->col[c], px, py, pz, n);
+        if (d < s->H) {
+            w[k] = (sph_wall_hit){{n[0], n[1], n[2]}, d, {s->col[c].vel[0], s->col[c].vel[1], s->col[c].vel[2]}, false};
+            k++;
+        }
+    }
+    return k;
+}
+
+#define SPH_MAX_WALLS (6 + SPH_MAX_COLLIDERS)
+
+/* Number of leading box walls in a gather_walls list (they come before the colliders). */
+static inline int walls_box(const sph_wall_hit *w, int nw)
+{
+    int k = 0;
+    while (k < nw && w[k].is_box)
+        k++;
+    return k;
+}
+
+/* ---- passes -------------------------------------------------------------------------------- */
+
+static void density_chunk(vfx_sph *s, uint32_t chunk)
+{
+    uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
+    const float H2 = s->H2, kp = s->k_poly6, m = s->mass, rho0 = s->p.rest_density;
+    const double H = s->H;
+    const float gam = s->p.gamma, B = s->B, c2_0 = s->c0 * s->c0;
+    sph_chunk_out *o = &s->out[chunk];
+    const float *X = s->x, *Y = s->y, *Z = s->z;
+    sph_wall_hit walls[SPH_MAX_WALLS];
+    for (uint32_t i = b; i < e; ++i) {
+        float px = X[i], py = Y[i], pz = Z[i];
+        sph_ranges r;
+        neighbor_ranges(s, px, py, pz, &r);
+        float sum = 0.f;
+        uint32_t pairs = 0;
+        for (int q = 0; q < r.count; ++q) {
+            for (uint32_t j = r.lo[q]; j < r.hi[q]; ++j) {
+                float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
+                float r2 = dx * dx + dy * dy + dz * dz;
+                if (r2 < H2) {
+                    float t = H2 - r2;
+                    sum += t * t * t;
+                    pairs++;
+                }
+            }
+        }
+        float rho = m * kp * sum;
+        int nw = gather_walls(s, px, py, pz, walls, SPH_MAX_WALLS);
+        /* The box walls are perpendicular: the region beyond them is a union of half-spaces,
+         * counted as 1 - prod(1 - f) (exact for a separable kernel, close for poly6) so the
+         * edges and corners are not compressed by double counting. Colliders just add. */
+        float inside = 1.f, extra = 0.f;
+        for (int w = 0; w < nw; ++w) {
+            float f = s->wall_scale * (float)vfx_sph_wall_density_fraction(walls[w].d, H);
+            if (w < walls_box(walls, nw))
+                inside *= 1.f - f;
+            else
+                extra += f;
+        }
+        rho += rho0 * (1.f - inside + extra);
+        s->rho[i] = rho;
+        /* EOS on the clamped ratio: p >= 0 (no tensile attraction at the free surface) and
+         * ratio <= 2 (p <= 127 B) so a collapsed input cannot produce an unbounded force. */
+        float ratio = clampf(rho / rho0, 1.f, 2.f);
+        float rg1 = powf(ratio, gam - 1.f);
+        float p = B * (rg1 * ratio - 1.f);
+        s->pr[i] = p / (rho * rho);
+        float c2 = c2_0 * rg1;
+        if (c2 > o->c2_max)
+            o->c2_max = c2;
+        float err = (rho - rho0) / rho0;
+        if (err > o->rho_err_max)
+            o->rho_err_max = err;
+        if (err > 0.f)
+            o->rho_err_sum += err;
+        o->pairs += pairs - 1; /* minus self */
+        if (!isfinite(rho) && o->bad == UINT32_MAX)
+            o->bad = i, o->bad_kind = 1, o->bad_value = rho;
+    }
+}
+
+/* Deterministic, antisymmetric unit direction for exactly coincident particles. */
+static void coincident_dir(uint32_t a, uint32_t b, float out[3])
+{
+    uint32_t lo = a < b ? a : b, hi = a < b ? b : a;
+    uint64_t h = ((uint64_t)lo * 0x9E3779B97F4A7C15ull) ^ ((uint64_t)hi * 0xC2B2AE3D27D4EB4Full);
+    h ^= h >> 29;
+    h *= 0xBF58476D1CE4E5B9ull;
+    h ^= h >> 32;
+    float th = (float)((h & 0xFFFF) / 65536.0 * 2.0 * SPH_PI);
+    float cz = (float)(((h >> 16) & 0xFFFF) / 65536.0 * 2.0 - 1.0);
+    float sz = sqrtf(1.f - cz * cz), sg = a < b ? 1.f : -1.f;
+    out[0] = sg * sz * cosf(th), out[1] = sg * sz * sinf(th), out[2] = sg * cz;
+}
+
+static void force_chunk(vfx_sph *s, uint32_t chunk)
+{
+    uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
+    const float H = s->H, H2 = s->H2, ks = s->k_spiky, m = s->mass, h = s->h;
+    const float alpha = s->p.viscosity, c0 = s->c0, rho0 = s->p.rest_density;
+    const float eps2 = 1e-12f * H2;
+    const float *g = s->p.gravity;
+    const float *X = s->x, *Y = s->y, *Z = s->z, *VX = s->vx, *VY = s->vy, *VZ = s->vz;
+    const float *R = s->rho, *P = s->pr;
+    sph_chunk_out *o = &s->out[chunk];
+    sph_wall_hit walls[SPH_MAX_WALLS];
+    for (uint32_t i = b; i < e; ++i) {
+        float px = X[i], py = Y[i], pz = Z[i], vxi = VX[i], vyi = VY[i], vzi = VZ[i];
+        float pri = P[i], rhoi = R[i];
+        float ax = 0.f, ay = 0.f, az = 0.f, dr = 0.f;
+        sph_ranges r;
+        neighbor_ranges(s, px, py, pz, &r);
+        for (int q = 0; q < r.count; ++q) {
+            for (uint32_t j = r.lo[q]; j < r.hi[q]; ++j) {
+                float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
+                float r2 = dx * dx + dy * dy + dz * dz;
+                if (r2 >= H2 || j == i)
+                    continue;
+                float rl, ux, uy, uz;
+                if (r2 > eps2) {
+                    rl = sqrtf(r2);
+                    float inv = 1.f / rl;
+                    ux = dx * inv, uy = dy * inv, uz = dz * inv;
+                } else {
+                    float u[3];
+                    coincident_dir(s->id[i], s->id[j], u);
+                    rl = 0.f, ux = u[0], uy = u[1], uz = u[2];
+                }
+                float hr = H - rl;
+                float gw = -ks * hr * hr; /* dW/dr of the spiky kernel, grad_i W = gw * u */
+                float dvx = vxi - VX[j], dvy = vyi - VY[j], dvz = vzi - VZ[j];
+                float vdotu = dvx * ux + dvy * uy + dvz * uz;
+                float coef = pri + P[j];
+                if (vdotu < 0.f && alpha > 0.f) {
+                    /* Monaghan (1992) artificial viscosity, mu = h v.r/(r^2 + 0.01 h^2) */
+                    float mu = h * vdotu * rl / (r2 + 0.01f * h * h);
+                    coef += -alpha * c0 * mu / (0.5f * (rhoi + R[j]));
+                }
+                float f = -m * coef * gw;
+                ax += f * ux, ay += f * uy, az += f * uz;
+                dr += m * vdotu * gw;
+            }
+        }
+        /* walls: -(p_i/rho_i^2) grad rho_wall, the gradient of the same wall density the
+         * density pass added (box walls through the product), so the wall force derives from
+         * the EOS energy and does no net work on a resting fluid. A mirrored-particle force
+         * (2 p_i/rho_i^2) is twice this, not an energy gradient, and pumps energy in. */
+        int nw = gather_walls(s, px, py, pz, walls, SPH_MAX_WALLS);
+        int nb = walls_box(walls, nw);
+        float fr[SPH_MAX_WALLS];
+        for (int w = 0; w < nw; ++w)
+            fr[w] = s->wall_scale * (float)vfx_sph_wall_density_fraction(walls[w].d, H);
+        for (int w = 0; w < nw; ++w) {
+            float others = 1.f;
+            if (w < nb)
+                for (int v = 0; v < nb; ++v)
+                    if (v != w)
+                        others *= 1.f - fr[v];
+            float f = pri * rho0 * s->wall_scale * others *
+                      (float)vfx_sph_wall_density_gradient(walls[w].d, H);
+            ax += f * walls[w].n[0], ay += f * walls[w].n[1], az += f * walls[w].n[2];
+        }
+        ax += g[0], ay += g[1], az += g[2];
+        s->ax[i] = ax, s->ay[i] = ay, s->az[i] = az;
+        s->drho[i] = dr; /* continuity: d rho_i/dt = sum_j m v_ij . grad_i W_ij */
+        float a2 = ax * ax + ay * ay + az * az, v2 = vxi * vxi + vyi * vyi + vzi * vzi;
+        if (a2 > o->a2_max)
+            o->a2_max = a2;
+        if (v2 > o->v2_max)
+            o->v2_max = v2;
+        if (!isfinite(a2) && o->bad == UINT32_MAX)
+            o->bad = i, o->bad_kind = 1, o->bad_value = a2;
+    }
+}
+
+static void integrate_chunk(vfx_sph *s, uint32_t chunk)
+{
+    uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
+    const float dt = s->dt_try, margin = 0.25f * s->p.spacing;
+    const float vlim2 = s->p.velocity_limit * s->p.velocity_limit, dlim = s->p.density_change_limit;
+    const float *lo = s->p.domain_min, *hi = s->p.domain_max;
+    const float m = s->mass;
+    const float *g = s->p.gravity;
+    sph_chunk_out *o = &s->out[chunk];
+    for (uint32_t i = b; i < e; ++i) {
+        float v[3] = {s->vx[i] + dt * s->ax[i], s->vy[i] + dt * s->ay[i], s->vz[i] + dt * s->az[i]};
+        float p[3] = {s->x[i] + dt * v[0], s->y[i] + dt * v[1], s->z[i] + dt * v[2]};
+        /* colliders: push back to the margin, remove the velocity into the solid (relative) */
+        for (uint32_t c = 0; c < s->ncol; ++c) {
+            float n[3];
+            float d = collider_distance(&s->col[c], p[0], p[1], p[2], n);
+            if (d < margin) {
+                for (int a = 0; a < 3; ++a)
+                    p[a] += (margin - d) * n[a];
+                const float *cv = s->col[c].vel;
+                float vn = (v[0] - cv[0]) * n[0] + (v[1] - cv[1]) * n[1] + (v[2] - cv[2]) * n[2];
+                if (vn < 0.f)
+                    for (int a = 0; a < 3; ++a)
+                        v[a] -= vn * n[a];
+            }
+        }
+        /* domain box last: nothing leaves it whatever the colliders did */
+        for (int a = 0; a < 3; ++a) {
+            if (p[a] < lo[a] + margin) {
+                p[a] = lo[a] + margin;
+                if (v[a] < 0.f)
+                    v[a] = 0.f;
+            } else if (p[a] > hi[a] - margin) {
+                p[a] = hi[a] - margin;
+                if (v[a] > 0.f)
+                    v[a] = 0.f;
+            }
+        }
+        float v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        float drel = fabsf(dt * s->drho[i] / s->rho[i]);
+        if (o->bad == UINT32_MAX) {
+            if (!isfinite(v2) || !finite3(p))
+                o->bad = i, o->bad_kind = 1, o->bad_value = v2;
+            else if (v2 > vlim2)
+                o->bad = i, o->bad_kind = 2, o->bad_value = sqrtf(v2);
+            else if (!(drel <= dlim))
+                o->bad = i, o->bad_kind = 3, o->bad_value = drel;
+        }
+        s->xn[i] = p[0], s->yn[i] = p[1], s->zn[i] = p[2];
+        s->vxn[i] = v[0], s->vyn[i] = v[1], s->vzn[i] = v[2];
+        o->ke += 0.5 * (double)m * v2;
+        o->pe -= (double)m * (g[0] * (p[0] - lo[0]) + g[1] * (p[1] - lo[1]) + g[2] * (p[2] - lo[2]));
+    }
+}
+
+/* ---- emitters ------------------------------------------------------------------------------ */
+
+static vfx_result emit(vfx_sph *s, double dt, uint32_t *emitted)
+{
+    float dx = s->p.spacing;
+    for (uint32_t k = 0; k < s->nem; ++k) {
+        sph_emitter_state *st = &s->em[k];
+        const vfx_sph_emitter *e = &st->e;
+        if (!st->started) {
+            st->started = true;
+            st->travelled = dx; /* first layer at once */
+        } else {
+            st->travelled += e->speed * dt;
+        }
+        while (st->travelled >= dx) {
+            st->travelled -= dx;
+            int R = (int)floorf(e->radius / dx);
+            float off = (float)st->travelled; /* the layer has already moved this far */
+            for (int a = -R; a <= R; ++a)
+                for (int b = -R; b <= R; ++b) {
+                    if (((float)(a * a + b * b)) * dx * dx > e->radius * e->radius)
+                        continue;
+                    if (e->max_emit && st->emitted >= e->max_emit)
+                        return VFX_OK;
+                    if (s->n >= s->p.max_particles)
+                        return VFX_OK; /* capacity reached: the emitter just stops */
+                    float p[3], v[3];
+                    for (int c = 0; c < 3; ++c) {
+                        p[c] = e->center[c] + (float)a * dx * st->u[c] + (float)b * dx * st->w[c] +
+                               off * e->direction[c];
+                        v[c] = e->speed * e->direction[c];
+                    }
+                    vfx_result r = vfx_sph_add_particles(s, 1, &p[0], &p[1], &p[2], &v[0], &v[1], &v[2]);
+                    if (r)
+                        return r;
+                    st->emitted++;
+                    (*emitted)++;
+                }
+        }
+    }
+    return VFX_OK;
+}
+
+/* ---- step ---------------------------------------------------------------------------------- */
+
+static void swap_state(vfx_sph *s)
+{
+    float *t;
+#define SW(a, b) (t = s->a, s->a = s->b, s->b = t)
+    SW(x, xn);
+    SW(y, yn);
+    SW(z, zn);
+    SW(vx, vxn);
+    SW(vy, vyn);
+    SW(vz, vzn);
+#undef SW
+}
+
+static uint32_t first_bad(const vfx_sph *s, uint32_t nchunks, const sph_chunk_out **which)
+{
+    for (uint32_t c = 0; c < nchunks; ++c)
+        if (s->out[c].bad != UINT32_MAX) {
+            *which = &s->out[c];
+            return s->out[c].bad;
+        }
+    return UINT32_MAX;
+}
+
+static void finish_report(vfx_sph *s, vfx_sph_report *rep)
+{
+    uint32_t nchunks = (s->n + SPH_CHUNK - 1) / SPH_CHUNK;
+    float emax = 0.f, v2 = 0.f;
+    double esum = 0.0, ke = 0.0, pe = 0.0;
+    const float m = s->mass;
+    const float *g = s->p.gravity, *lo = s->p.domain_min;
+    if (s->n) {
+        build_grid(s);
+        parallel(s, density_chunk, true);
+        for (uint32_t c = 0; c < nchunks; ++c) {
+            if (s->out[c].rho_err_max > emax)
+                emax = s->out[c].rho_err_max;
+            esum += s->out[c].rho_err_sum;
+        }
+    }
+    for (uint32_t i = 0; i < s->n; ++i) {
+        float w = s->vx[i] * s->vx[i] + s->vy[i] * s->vy[i] + s->vz[i] * s->vz[i];
+        if (w > v2)
+            v2 = w;
+        ke += 0.5 * m * w;
+        pe -= (double)m * (g[0] * (s->x[i] - lo[0]) + g[1] * (s->y[i] - lo[1]) + g[2] * (s->z[i] - lo[2]));
+    }
+    rep->max_density_error = emax;
+    rep->mean_density_error = s->n ? (float)(esum / s->n) : 0.f;
+    rep->max_speed = sqrtf(v2);
+    rep->kinetic_energy = ke;
+    rep->potential_energy = pe;
+}
+
+vfx_result vfx_sph_step(vfx_sph *s, float frame_dt, vfx_sph_report *report)
+{
+    vfx_sph_report rep = {0};
+    if (report)
+        *report = rep;
+    if (!s)
+        return VFX_ERR_INVALID_ARGUMENT;
+    s->err[0] = 0;
+    if (!isfinite(frame_dt) || frame_dt < 0.f) {
+        set_err(s, "vfx_sph_step: frame_dt %g must be finite and >= 0", (double)frame_dt);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    const double h = s->h, lam = s->p.cfl;
+    double t = 0.0;
+    rep.dt_min = INFINITY;
+    vfx_result res = VFX_OK;
+    while (t < (double)frame_dt * (1.0 - 1e-9)) {
+        if (rep.substeps >= s->p.max_substeps) {
+            rep.cap_hit = true;
+            break;
+        }
+        if (s->nem) {
+            res = emit(s, rep.substeps ? rep.dt_last : 0.0, &rep.emitted);
+            if (res)
+                break;
+        }
+        update_colliders(s, s->time);
+        double remaining = (double)frame_dt - t;
+        double dt = remaining;
+        vfx_sph_dt_limit lim = VFX_SPH_DT_FRAME;
+        uint32_t nchunks = (s->n + SPH_CHUNK - 1) / SPH_CHUNK;
+        if (s->n) {
+            build_grid(s);
+            parallel(s, density_chunk, true);
+            parallel(s, force_chunk, false);
+            float v2 = 0.f, a2 = 0.f, c2 = 0.f;
+            const sph_chunk_out *bo = NULL;
+            uint32_t bad = first_bad(s, nchunks, &bo);
+            if (bad != UINT32_MAX) {
+                set_err(s, "vfx_sph_step: particle %u (row %u) has a non-finite density or "
+                        "force (%g) at t=%.6g s; state left at the last good substep",
+                        s->id[bad], bad, (double)bo->bad_value, s->time);
+                res = VFX_ERR_NUMERIC;
+                break;
+            }
+            for (uint32_t c = 0; c < nchunks; ++c) {
+                const sph_chunk_out *o = &s->out[c];
+                v2 = o->v2_max > v2 ? o->v2_max : v2;
+                a2 = o->a2_max > a2 ? o->a2_max : a2;
+                c2 = o->c2_max > c2 ? o->c2_max : c2;
+                rep.neighbor_pairs += o->pairs;
+            }
+            double vmax = sqrt(v2), amax = sqrt(a2), cmax = sqrt(c2);
+            double nu = s->p.viscosity * h * s->c0 / 10.0; /* artificial viscosity as nu, 3D */
+            if (vmax > 0 && lam * h / vmax < dt)
+                dt = lam * h / vmax, lim = VFX_SPH_DT_CFL;
+            if (cmax > 0 && lam * h / cmax < dt)
+                dt = lam * h / cmax, lim = VFX_SPH_DT_ACOUSTIC;
+            if (amax > 0 && 0.25 * sqrt(h / amax) < dt)
+                dt = 0.25 * sqrt(h / amax), lim = VFX_SPH_DT_FORCE;
+            if (nu > 0 && 0.125 * h * h / nu < dt)
+                dt = 0.125 * h * h / nu, lim = VFX_SPH_DT_VISCOUS;
+            /* avoid a sliver substep at the end of the frame */
+            if (lim != VFX_SPH_DT_FRAME && remaining < 1.5 * dt && remaining > dt)
+                dt = 0.5 * remaining;
+            uint32_t tries = 0;
+            for (;;) {
+                s->dt_try = (float)dt;
+                parallel(s, integrate_chunk, false);
+                bad = first_bad(s, nchunks, &bo);
+                if (bad == UINT32_MAX)
+                    break;
+                if (bo->bad_kind == 1 || tries >= s->p.max_redo) {
+                    static const char *what[] = {"", "non-finite state", "speed", "density change"};
+                    set_err(s, "vfx_sph_step: particle %u (row %u) blew up: %s %g (limit %g) "
+                            "after %u dt halvings (dt %.3g s) at t=%.6g s; state left at the "
+                            "last good substep", s->id[bad], bad, what[bo->bad_kind],
+                            (double)bo->bad_value,
+                            bo->bad_kind == 2 ? (double)s->p.velocity_limit
+                                              : (double)s->p.density_change_limit,
+                            tries, dt, s->time);
+                    res = VFX_ERR_NUMERIC;
+                    break;
+                }
+                dt *= 0.5;
+                tries++;
+                rep.redo_count++;
+            }
+            if (res)
+                break;
+            swap_state(s);
+        }
+        t += dt;
+        s->time += dt;
+        rep.substeps++;
+        rep.dt_last = dt;
+        rep.dt_limit = lim;
+        if (dt < rep.dt_min)
+            rep.dt_min = dt;
+        if (dt > rep.dt_max)
+            rep.dt_max = dt;
+    }
+    if (rep.substeps == 0)
+        rep.dt_min = 0.0;
+    rep.simulated_time = t;
+    finish_report(s, &rep);
+    if (report)
+        *report = rep;
+    return res;
+}

@@ -1,0 +1,158 @@
+/* sph.h — weakly compressible SPH fluid (Tait EOS, Becker & Teschner 2007) on SoA float
+ * columns, independent of the ECS (runtime/sim/sim_system.h adapts it).
+ *
+ * Kernels (support radius H = support_ratio * spacing): Mueller et al. 2003 poly6 for density,
+ * spiky gradient for pressure and viscosity forces (its gradient does not vanish at r = 0, so
+ * coincident particles are pushed apart). Walls (domain box, planes, sphere and box colliders,
+ * moving paddles) are semi-analytic: the density and pressure force of the missing fluid beyond
+ * a wall are integrated in closed form over the half-space, plus a hard non-penetration clamp.
+ * Time step: min of CFL, acoustic, force and viscosity conditions, substeps per frame with a
+ * cap; a substep whose result blows up (NaN/Inf, speed or density change beyond bounds) is
+ * redone with half the dt, and fails with a message naming the particle if that keeps failing.
+ * The columns never hold NaN: a failed substep leaves the previous state in place.
+ *
+ * Column pointers returned by vfx_sph_columns stay valid until the next add or step (particles
+ * are reordered by grid cell every substep for locality; `id` says which input particle a row
+ * is). No global state; one vfx_sph is not thread-safe, it uses its own worker threads. */
+#ifndef VFX_SIM_SPH_H
+#define VFX_SIM_SPH_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <volfx/volfx.h>
+
+enum {
+    VFX_SPH_NO_GRAVITY = 1u << 0,   /* gravity = 0 (a zero gravity field otherwise means default) */
+    VFX_SPH_NO_VISCOSITY = 1u << 1, /* artificial viscosity alpha = 0 */
+};
+
+/* Zero in any field means its default (listed). */
+typedef struct vfx_sph_desc {
+    float spacing;              /* particle spacing dx [m]; 0.02 */
+    float support_ratio;        /* kernel support H / dx; 2.0 */
+    float rest_density;         /* rho0 [kg/m^3]; 1000 */
+    float sound_speed;          /* c0 [m/s]; 10*sqrt(2*|g|*domain height) (~1% compression) */
+    float stiffness;            /* Tait B [Pa]; rho0*c0^2/gamma. Setting it sets c0 from it */
+    float gamma;                /* Tait exponent; 7 */
+    float viscosity;            /* Monaghan artificial viscosity alpha; 0.05 */
+    float gravity[3];           /* [m/s^2]; (0,-9.81,0) */
+    float domain_min[3];        /* solid box walls; [0,1]^3 when min == max */
+    float domain_max[3];
+    float cfl;                  /* lambda of the CFL and acoustic conditions; 0.4 */
+    uint32_t max_substeps;      /* per vfx_sph_step; 256 */
+    uint32_t max_redo;          /* dt halvings per substep before giving up; 10 */
+    float velocity_limit;       /* blow-up bound on |v| [m/s]; 20*c0 */
+    float density_change_limit; /* blow-up bound on |d rho|/rho per substep; 0.05 */
+    uint32_t max_particles;     /* capacity bound (adds and emitters); 1<<27 */
+    uint32_t threads;           /* worker threads; all online cores */
+    uint32_t flags;             /* VFX_SPH_* */
+} vfx_sph_desc;
+
+typedef enum vfx_sph_dt_limit {
+    VFX_SPH_DT_FRAME = 0,    /* the rest of the frame was shorter than every condition */
+    VFX_SPH_DT_CFL = 1,      /* lambda*h/v_max */
+    VFX_SPH_DT_ACOUSTIC = 2, /* lambda*h/c_max */
+    VFX_SPH_DT_FORCE = 3,    /* 0.25*sqrt(h/a_max) */
+    VFX_SPH_DT_VISCOUS = 4,  /* 0.125*h^2/nu */
+} vfx_sph_dt_limit;
+
+typedef struct vfx_sph_report {
+    uint32_t substeps;
+    uint32_t redo_count;        /* substeps redone with a halved dt */
+    bool cap_hit;               /* max_substeps reached before the frame time was covered */
+    double simulated_time;      /* <= frame_dt; less when cap_hit */
+    double dt_min, dt_max, dt_last;
+    vfx_sph_dt_limit dt_limit;  /* what bounded the last dt */
+    float max_density_error;    /* max (rho - rho0)/rho0 over particles (compression), end state */
+    float mean_density_error;   /* mean of max(0, rho - rho0)/rho0, end state */
+    float max_speed;            /* end state [m/s] */
+    double kinetic_energy;      /* [J], end state */
+    double potential_energy;    /* [J], -sum m g.(x - domain_min), end state */
+    uint64_t neighbor_pairs;    /* ordered pairs (i != j) within H, summed over substeps (one pass) */
+    uint32_t emitted;           /* particles emitted during this step */
+} vfx_sph_report;
+
+typedef struct vfx_sph_columns {
+    uint32_t count;
+    float *x, *y, *z, *vx, *vy, *vz, *density;
+    const uint32_t *id; /* input index (order of addition/emission) of each row */
+} vfx_sph_columns;
+
+typedef enum vfx_sph_collider_kind {
+    VFX_SPH_PLANE = 0,  /* fluid on the side `normal` points to */
+    VFX_SPH_SPHERE = 1, /* solid ball */
+    VFX_SPH_BOX = 2,    /* solid axis-aligned box */
+} vfx_sph_collider_kind;
+
+typedef struct vfx_sph_collider {
+    vfx_sph_collider_kind kind;
+    float center[3];          /* plane: a point on it; sphere/box: centre at t = 0 */
+    float normal[3];          /* plane only, normalised on add */
+    float radius;             /* sphere */
+    float half[3];            /* box half extents */
+    /* Paddle motion: centre(t) = centre + axis*amplitude*sin(2*pi*frequency*t); 0 = static. */
+    float motion_axis[3];
+    float motion_amplitude;   /* [m] */
+    float motion_frequency;   /* [Hz] */
+} vfx_sph_collider;
+
+typedef struct vfx_sph_emitter {
+    float center[3];
+    float direction[3];       /* normalised on add */
+    float speed;              /* [m/s], > 0 */
+    float radius;             /* nozzle disc radius [m], >= spacing/2 */
+    uint32_t max_emit;        /* stop after this many particles; 0 = until capacity */
+} vfx_sph_emitter;
+
+typedef struct vfx_sph vfx_sph;
+
+/* Creates a solver; NULL desc = defaults. On failure returns an error and, when err is not
+ * NULL, a message in err (err_len bytes). */
+vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, size_t err_len);
+/* Stops the workers and frees everything. NULL allowed. */
+void vfx_sph_destroy(vfx_sph *sim);
+/* The last error message ("" when none). */
+const char *vfx_sph_last_error(const vfx_sph *sim);
+/* The resolved parameters (defaults filled in, c0 and B consistent). */
+const vfx_sph_desc *vfx_sph_params(const vfx_sph *sim);
+/* Particle mass [kg] (calibrated so a lattice of `spacing` has the rest density). */
+float vfx_sph_particle_mass(const vfx_sph *sim);
+/* Kernel support radius H [m]. */
+float vfx_sph_support(const vfx_sph *sim);
+
+/* Adds n particles (x,y,z required, v* NULL = 0). Refuses the whole batch, naming the first
+ * particle, when any value is NaN/Inf; positions outside the domain are moved inside (counted
+ * in vfx_sph_clamped_on_add). n = 0 is a no-op. */
+vfx_result vfx_sph_add_particles(vfx_sph *sim, uint32_t n, const float *x, const float *y,
+                                 const float *z, const float *vx, const float *vy, const float *vz);
+/* Adds a lattice of spacing dx filling [lo, hi] (cell centres), at rest; count in *added. */
+vfx_result vfx_sph_add_block(vfx_sph *sim, const float lo[3], const float hi[3], uint32_t *added);
+/* Number of particles that vfx_sph_add_particles had to move into the domain so far. */
+uint32_t vfx_sph_clamped_on_add(const vfx_sph *sim);
+/* Adds a static or moving collider; its index in *index when not NULL. */
+vfx_result vfx_sph_add_collider(vfx_sph *sim, const vfx_sph_collider *c, uint32_t *index);
+/* Adds an emitter that injects disc-shaped layers of particles each time they have moved dx. */
+vfx_result vfx_sph_add_emitter(vfx_sph *sim, const vfx_sph_emitter *e);
+
+/* Advances by frame_dt seconds in adaptive substeps (see the report). VFX_ERR_NUMERIC when a
+ * substep cannot be made stable (message names the particle); the state is then the last good
+ * one. frame_dt must be finite and >= 0. */
+vfx_result vfx_sph_step(vfx_sph *sim, float frame_dt, vfx_sph_report *report);
+/* The SoA columns (see the validity note above). */
+vfx_sph_columns vfx_sph_get_columns(vfx_sph *sim);
+/* Pressure [Pa] of row i from the last density pass (0 when i is out of range). */
+float vfx_sph_pressure(const vfx_sph *sim, uint32_t i);
+/* Simulated time since creation [s]. */
+double vfx_sph_time(const vfx_sph *sim);
+/* Bytes allocated by the solver (columns, grid, chunk reductions). */
+size_t vfx_sph_memory_bytes(const vfx_sph *sim);
+/* Number of worker threads in use (including the calling thread). */
+uint32_t vfx_sph_thread_count(const vfx_sph *sim);
+
+/* Closed-form wall integrals (exposed for tests): fraction of the poly6 kernel mass beyond a
+ * plane at distance d (0.5 at d = 0, 0 at d >= H), and minus its derivative in d [1/m]. */
+double vfx_sph_wall_density_fraction(double d, double H);
+double vfx_sph_wall_density_gradient(double d, double H);
+
+#endif
