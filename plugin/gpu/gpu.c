@@ -8,13 +8,13 @@
 #include "vfx_shaders.h"
 #include "shader_text.h"
 
-#define GPU_MAX_PROGRAMS 64
+#define GPU_MAX_PROGRAMS 256
 #define GPU_RING 4          /* frames in flight before a timer result is read */
 #define GPU_MAX_PASSES 32   /* timed passes per frame */
 #define GPU_PASS_DEPTH 8    /* nesting */
 
 typedef struct program_entry {
-    char key[256];
+    char *key; /* "vert|frag|defines", whole: ablation sweeps differ only late in the defines */
     GLuint program;
 } program_entry;
 
@@ -79,8 +79,10 @@ void vfx_gpu_destroy(vfx_context *ctx, vfx_gpu *g)
 {
     if (!g)
         return;
-    for (uint32_t i = 0; i < g->program_count; ++i)
+    for (uint32_t i = 0; i < g->program_count; ++i) {
         glDeleteProgram(g->programs[i].program);
+        free(g->programs[i].key);
+    }
     for (int f = 0; f < GPU_RING; ++f)
         glDeleteQueries(GPU_MAX_PASSES * 2, g->ring[f].queries);
     glDeleteVertexArrays(1, &g->empty_vao);
@@ -140,12 +142,20 @@ static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const c
                           const char *defines)
 {
     vfx_gpu *g = ctx->gpu;
-    char key[256];
-    snprintf(key, sizeof key, "%s|%s|%s", paths[0], n > 1 ? paths[1] : "", defines ? defines : "");
+    size_t klen = strlen(paths[0]) + (n > 1 ? strlen(paths[1]) : 0) + (defines ? strlen(defines) : 0) + 3;
+    char *key = malloc(klen);
+    if (!key) {
+        vfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "program cache: out of memory");
+        return 0;
+    }
+    snprintf(key, klen, "%s|%s|%s", paths[0], n > 1 ? paths[1] : "", defines ? defines : "");
     for (uint32_t i = 0; i < g->program_count; ++i)
-        if (strcmp(g->programs[i].key, key) == 0)
+        if (strcmp(g->programs[i].key, key) == 0) {
+            free(key);
             return g->programs[i].program;
+        }
     if (g->program_count >= GPU_MAX_PROGRAMS) {
+        free(key);
         vfx_fail(ctx, VFX_ERR_GL, "program cache full (%d programs)", GPU_MAX_PROGRAMS);
         return 0;
     }
@@ -162,10 +172,12 @@ static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const c
         prog = vfx_gpu_link_sources(ctx, n, stages, (const char *const *)bufs, paths);
     for (int i = 0; i < n; ++i)
         free(bufs[i]);
-    if (!prog)
+    if (!prog) {
+        free(key);
         return 0;
+    }
     program_entry *e = &g->programs[g->program_count++];
-    snprintf(e->key, sizeof e->key, "%s", key);
+    e->key = key;
     e->program = prog;
     char label[96];
     snprintf(label, sizeof label, "volfx.%s", n > 1 ? paths[1] : paths[0]);

@@ -155,8 +155,21 @@ static void test_shader_error_names_file_line(void **state)
     /* a shader that is not embedded is named */
     assert_int_equal(vfx_gpu_program(ctx, "common/fullscreen.vert", "nope/none.frag", NULL), 0);
     assert_non_null(strstr(api->last_error(ctx), "nope/none.frag"));
-    /* the real embedded program links */
-    assert_int_not_equal(vfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", NULL), 0);
+    /* the real embedded program links, and is cached */
+    GLuint p0 = vfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", NULL);
+    assert_int_not_equal(p0, 0);
+    assert_int_equal(vfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", NULL), p0);
+    /* define sets that differ only far into the string are different programs */
+    char d1[400], d2[400];
+    memset(d1, 0, sizeof d1);
+    strcpy(d1, "// ");
+    memset(d1 + 3, 'x', 330);
+    memcpy(d2, d1, sizeof d1);
+    strcat(d1, "\n#define VARIANT 1");
+    strcat(d2, "\n#define VARIANT 2");
+    GLuint p1 = vfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", d1);
+    GLuint p2 = vfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", d2);
+    assert_true(p1 != 0 && p2 != 0 && p1 != p2 && p1 != p0);
     api->destroy(ctx);
 }
 
