@@ -19,7 +19,7 @@
 typedef struct sph_chunk_out {
     float v2_max, a2_max, c2_max;
     float rho_err_max;
-    double rho_err_sum, ke, pe;
+    double rho_err_sum, ke, pe, ie;
     uint64_t pairs;
     uint32_t bad;      /* first failing row in the chunk, UINT32_MAX when none */
     int bad_kind;      /* 1 non-finite, 2 speed, 3 density change */
@@ -292,6 +292,20 @@ vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, si
                     sum += (double)s->k_poly6 * q * q * q;
             }
     s->mass = (float)(p.rest_density / sum);
+    /* Same lattice: the discrete gradient of a linear field, sum_j V_j (x_j - x_i) dW/dx, is
+     * -1 for a consistent kernel; the spiky gradient at H = 2 dx misses by ~10-20%, which would
+     * make every pressure gradient (and the hydrostatic pressure) wrong by as much. Scale it. */
+    double gsum = 0.0, V = s->mass / p.rest_density;
+    for (int i = -R; i <= R; ++i)
+        for (int j = -R; j <= R; ++j)
+            for (int k = -R; k <= R; ++k) {
+                double r2 = ((double)i * i + (double)j * j + (double)k * k) * p.spacing * p.spacing;
+                if (r2 <= 0.0 || r2 >= (double)s->H2)
+                    continue;
+                double rl = sqrt(r2), hr = s->H - rl, xk = i * p.spacing;
+                gsum += V * xk * (-s->k_spiky * hr * hr) * (xk / rl);
+            }
+    s->k_spiky = (float)(s->k_spiky / -gsum);
     /* The wall term is the continuum integral; a lattice particle half a spacing from a wall
      * misses the lattice layers beyond it, which is not quite the same number. Scale the wall
      * fraction so that the first lattice layer sits exactly at rho0. */
@@ -884,6 +898,15 @@ static void density_chunk(vfx_sph *s, uint32_t chunk)
         float c2 = c2_0 * rg1;
         if (c2 > o->c2_max)
             o->c2_max = c2;
+        /* internal (EOS) energy m e(rho), e = int p/rho^2 drho from rho0, with the clamps:
+         * what a compressed fluid can turn into motion (tests bound total energy with it) */
+        double rr = rho / rho0, rc = rr > 2.0 ? 2.0 : rr;
+        if (rr > 1.0) {
+            double e = B / rho0 * ((pow(rc, gam - 1.0) - 1.0) / (gam - 1.0) + 1.0 / rc - 1.0);
+            if (rr > 2.0)
+                e += B * (pow(2.0, gam) - 1.0) / rho0 * (0.5 - 1.0 / rr);
+            o->ie += (double)m * e;
+        }
         float err = (rho - rho0) / rho0;
         if (err > o->rho_err_max)
             o->rho_err_max = err;
@@ -1116,7 +1139,7 @@ static void finish_report(vfx_sph *s, vfx_sph_report *rep)
 {
     uint32_t nchunks = (s->n + SPH_CHUNK - 1) / SPH_CHUNK;
     float emax = 0.f, v2 = 0.f;
-    double esum = 0.0, ke = 0.0, pe = 0.0;
+    double esum = 0.0, ke = 0.0, pe = 0.0, ie = 0.0;
     const float m = s->mass;
     const float *g = s->p.gravity, *lo = s->p.domain_min;
     if (s->n) {
@@ -1126,6 +1149,7 @@ static void finish_report(vfx_sph *s, vfx_sph_report *rep)
             if (s->out[c].rho_err_max > emax)
                 emax = s->out[c].rho_err_max;
             esum += s->out[c].rho_err_sum;
+            ie += s->out[c].ie;
         }
     }
     for (uint32_t i = 0; i < s->n; ++i) {
@@ -1140,6 +1164,7 @@ static void finish_report(vfx_sph *s, vfx_sph_report *rep)
     rep->max_speed = sqrtf(v2);
     rep->kinetic_energy = ke;
     rep->potential_energy = pe;
+    rep->internal_energy = ie;
 }
 
 vfx_result vfx_sph_step(vfx_sph *s, float frame_dt, vfx_sph_report *report)

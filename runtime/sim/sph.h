@@ -69,6 +69,7 @@ typedef struct vfx_sph_report {
     float max_speed;            /* end state [m/s] */
     double kinetic_energy;      /* [J], end state */
     double potential_energy;    /* [J], -sum m g.(x - domain_min), end state */
+    double internal_energy;     /* [J], sum m e(rho) of the clamped Tait EOS, end state */
     uint64_t neighbor_pairs;    /* ordered pairs (i != j) within H, summed over substeps (one pass) */
     uint32_t emitted;           /* particles emitted during this step */
 } vfx_sph_report;

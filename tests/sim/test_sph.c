@@ -1,0 +1,587 @@
+/* SPH solver: stiff and degenerate inputs, refusals, boundaries, determinism, hydrostatics and
+ * a small dam break against Martin & Moyce (1952). Every case checks the same invariants:
+ * finite columns, every particle inside the domain, bounded energy, a stated density bound. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sim/sph.h"
+
+static vfx_sph *make(vfx_sph_desc d)
+{
+    vfx_sph *s = NULL;
+    char err[256];
+    vfx_result r = vfx_sph_create(&d, &s, err, sizeof err);
+    if (r)
+        fprintf(stderr, "create: %s\n", err);
+    assert_int_equal(r, VFX_OK);
+    return s;
+}
+
+/* Finite, inside the domain (walls are solid: nothing may leave). */
+static void check_state(vfx_sph *s)
+{
+    const vfx_sph_desc *p = vfx_sph_params(s);
+    vfx_sph_columns c = vfx_sph_get_columns(s);
+    for (uint32_t i = 0; i < c.count; ++i) {
+        float v[7] = {c.x[i], c.y[i], c.z[i], c.vx[i], c.vy[i], c.vz[i], c.density[i]};
+        for (int k = 0; k < 7; ++k)
+            assert_true(isfinite(v[k]));
+        assert_true(c.x[i] >= p->domain_min[0] && c.x[i] <= p->domain_max[0]);
+        assert_true(c.y[i] >= p->domain_min[1] && c.y[i] <= p->domain_max[1]);
+        assert_true(c.z[i] >= p->domain_min[2] && c.z[i] <= p->domain_max[2]);
+    }
+}
+
+/* Total energy: kinetic + gravity above the domain floor + EOS internal energy. Viscosity and
+ * the inelastic wall clamp only remove it; explicit time integration error may add a little. */
+static double energy(const vfx_sph_report *r)
+{
+    return r->kinetic_energy + r->potential_energy + r->internal_energy;
+}
+
+static vfx_sph_desc small_box(void)
+{
+    vfx_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.1f, 0.2f, 0.06f}, .threads = 2};
+    return d;
+}
+
+static void test_wall_integrals(void **state)
+{
+    (void)state;
+    const double H = 0.02;
+    /* closed forms against brute-force float64 quadrature of the poly6 kernel over the
+     * half-space beyond the plane (midpoint rule, 200^3 cells: error ~1e-4 of the value) */
+    assert_true(fabs(vfx_sph_wall_density_fraction(0.0, H) - 0.5) < 1e-12);
+    assert_true(vfx_sph_wall_density_fraction(H, H) == 0.0);
+    double k = 315.0 / (64.0 * M_PI * pow(H, 9));
+    const double ds[] = {0.0, 0.25 * H, 0.5 * H, 0.8 * H};
+    for (int t = 0; t < 4; ++t) {
+        double d = ds[t], sum = 0.0;
+        int n = 200;
+        double hx = 2 * H / n, hz = H / n;
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j)
+                for (int l = 0; l < n; ++l) {
+                    double x = -H + (i + 0.5) * hx, y = -H + (j + 0.5) * hx, z = d + (l + 0.5) * hz;
+                    double r2 = x * x + y * y + z * z;
+                    if (r2 < H * H)
+                        sum += k * pow(H * H - r2, 3) * hx * hx * hz;
+                }
+        double got = vfx_sph_wall_density_fraction(d, H);
+        assert_true(fabs(got - sum) < 2e-3 * 0.5);
+        /* the gradient is minus the derivative (central difference, O(e^2)) */
+        double e = 1e-6 * H;
+        if (d > e) {
+            double fd = -(vfx_sph_wall_density_fraction(d + e, H) - vfx_sph_wall_density_fraction(d - e, H)) / (2 * e);
+            assert_true(fabs(fd - vfx_sph_wall_density_gradient(d, H)) < 1e-5 * fabs(fd) + 1e-6);
+        }
+    }
+}
+
+static void test_bad_desc_and_input(void **state)
+{
+    (void)state;
+    vfx_sph *s = NULL;
+    char err[256];
+    vfx_sph_desc d = {.spacing = NAN};
+    assert_int_equal(vfx_sph_create(&d, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "spacing"));
+    assert_null(s);
+    d = (vfx_sph_desc){.spacing = 1e-5f, .domain_max = {10, 10, 10}};
+    assert_int_equal(vfx_sph_create(&d, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "grid cells"));
+
+    s = make(small_box());
+    float x[5] = {0.05f, 0.05f, 0.05f, 0.05f, 0.05f}, y[5] = {0.05f, 0.06f, 0.07f, NAN, 0.09f};
+    float z[5] = {0.03f, 0.03f, 0.03f, 0.03f, 0.03f};
+    assert_int_equal(vfx_sph_add_particles(s, 5, x, y, z, NULL, NULL, NULL), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(vfx_sph_last_error(s), "particle 3"));
+    assert_non_null(strstr(vfx_sph_last_error(s), "non-finite y"));
+    assert_int_equal(vfx_sph_get_columns(s).count, 0); /* whole batch refused */
+    y[3] = 0.08f;
+    float vz[5] = {0, 0, 0, 0, INFINITY};
+    assert_int_equal(vfx_sph_add_particles(s, 5, x, y, z, NULL, NULL, vz), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(vfx_sph_last_error(s), "particle 4"));
+    assert_non_null(strstr(vfx_sph_last_error(s), "vz"));
+    assert_int_equal(vfx_sph_add_particles(s, 5, NULL, y, z, NULL, NULL, NULL), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(vfx_sph_add_particles(s, 5, x, y, z, NULL, NULL, NULL), VFX_OK);
+    vfx_sph_report r;
+    assert_int_equal(vfx_sph_step(s, NAN, &r), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(vfx_sph_step(s, -1.f, &r), VFX_ERR_INVALID_ARGUMENT);
+    vfx_sph_collider c = {.kind = VFX_SPH_SPHERE, .radius = 0.f};
+    assert_int_equal(vfx_sph_add_collider(s, &c, NULL), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(vfx_sph_last_error(s), "radius"));
+    vfx_sph_emitter e = {.direction = {0, 0, 0}, .speed = 1, .radius = 0.02f};
+    assert_int_equal(vfx_sph_add_emitter(s, &e), VFX_ERR_INVALID_ARGUMENT);
+    check_state(s);
+    vfx_sph_destroy(s);
+}
+
+static void test_zero_particles(void **state)
+{
+    (void)state;
+    vfx_sph *s = make(small_box());
+    vfx_sph_report r;
+    assert_int_equal(vfx_sph_add_particles(s, 0, NULL, NULL, NULL, NULL, NULL, NULL), VFX_OK);
+    assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+    assert_int_equal(vfx_sph_get_columns(s).count, 0);
+    assert_true(fabs(r.simulated_time - 1.0 / 60.0) < 1e-9);
+    assert_false(r.cap_hit);
+    assert_true(r.kinetic_energy == 0.0);
+    vfx_sph_destroy(s);
+}
+
+static void test_single_particle(void **state)
+{
+    (void)state;
+    vfx_sph *s = make(small_box());
+    float x = 0.05f, y = 0.15f, z = 0.03f;
+    assert_int_equal(vfx_sph_add_particles(s, 1, &x, &y, &z, NULL, NULL, NULL), VFX_OK);
+    vfx_sph_report r;
+    double e0 = 0;
+    for (int f = 0; f < 30; ++f) {
+        assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        if (f == 0)
+            e0 = energy(&r) + 1e-12;
+        check_state(s);
+        /* free fall then rest: the floor removes energy, never adds (1% for the first
+         * substep's explicit Euler drift) */
+        assert_true(energy(&r) <= e0 * 1.01);
+    }
+    vfx_sph_columns c = vfx_sph_get_columns(s);
+    assert_true(c.y[0] < 0.02f); /* reached the floor after 0.5 s (free fall takes 0.17 s) */
+    /* alone it is far below rest density: max compression error must be <= 0 */
+    assert_true(r.max_density_error <= 0.f);
+    vfx_sph_destroy(s);
+}
+
+static void test_two_coincident(void **state)
+{
+    (void)state;
+    /* Alone: two coincident particles are far below rest density, so p = 0 (clamped EOS)
+     * and nothing moves them; the r = 0 pair must still give finite, symmetric results. */
+    vfx_sph_desc d = small_box();
+    d.flags = VFX_SPH_NO_GRAVITY;
+    vfx_sph *s = make(d);
+    float x[2] = {0.05f, 0.05f}, y[2] = {0.1f, 0.1f}, z[2] = {0.03f, 0.03f};
+    assert_int_equal(vfx_sph_add_particles(s, 2, x, y, z, NULL, NULL, NULL), VFX_OK);
+    vfx_sph_report r;
+    for (int f = 0; f < 10; ++f) {
+        assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        check_state(s);
+        assert_true(r.kinetic_energy == 0.0);
+        assert_true(r.max_density_error <= 0.f);
+    }
+    vfx_sph_destroy(s);
+    /* Inside a block: a duplicate of a bulk particle is compressed (rho ~ 1.2 rho0), and the
+     * spiky gradient (non-zero at r = 0, along a pseudo-random antisymmetric axis) separates
+     * the pair; momentum stays zero. */
+    s = make(d);
+    float lo[3] = {0.02f, 0.05f, 0.0f}, hi[3] = {0.08f, 0.11f, 0.06f};
+    assert_int_equal(vfx_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    float px = 0.055f, py = 0.085f, pz = 0.035f; /* exactly a lattice site */
+    assert_int_equal(vfx_sph_add_particles(s, 1, &px, &py, &pz, NULL, NULL, NULL), VFX_OK);
+    uint32_t dup = vfx_sph_get_columns(s).count - 1;
+    for (int f = 0; f < 3; ++f) {
+        assert_int_equal(vfx_sph_step(s, 1.f / 240.f, &r), VFX_OK);
+        check_state(s);
+    }
+    vfx_sph_columns c = vfx_sph_get_columns(s);
+    float best = 1e9f;
+    double mx = 0, my = 0, mz = 0;
+    for (uint32_t i = 0; i < c.count; ++i) {
+        mx += c.vx[i], my += c.vy[i], mz += c.vz[i];
+        if (c.id[i] == dup) {
+            for (uint32_t j = 0; j < c.count; ++j) {
+                if (j == i)
+                    continue;
+                float dx = c.x[i] - c.x[j], dy = c.y[i] - c.y[j], dz = c.z[i] - c.z[j];
+                float dd = sqrtf(dx * dx + dy * dy + dz * dz);
+                best = dd < best ? dd : best;
+            }
+        }
+    }
+    print_message("duplicate particle: nearest neighbour at %.4f m after 1/80 s\n", best);
+    assert_true(best > 0.1f * 0.01f);
+    /* the block is >= 2.5 cm (> H) from the x and y walls: x and y momentum are conserved
+     * (pairwise antisymmetric forces), up to float rounding of ~300 terms */
+    (void)mz; /* the block touches the z walls, which take z momentum */
+    assert_true(fabs(mx) < 1e-3 && fabs(my) < 1e-3);
+    vfx_sph_destroy(s);
+}
+
+/* Upper bound on the kinetic energy a clamped-EOS fluid can release: pressure is at most
+ * 127 B (rho clamped to 2 rho0, gamma 7), and a particle's volume can grow by at most m/rho0
+ * while it is positive, so the work is <= N * 127 B m/rho0; plus falling through the box. */
+static double release_bound(vfx_sph *s, uint32_t n)
+{
+    const vfx_sph_desc *p = vfx_sph_params(s);
+    double m = vfx_sph_particle_mass(s);
+    double pmax = p->stiffness * (pow(2.0, p->gamma) - 1.0);
+    double h = p->domain_max[1] - p->domain_min[1];
+    return n * (pmax * m / p->rest_density + m * 9.81 * h);
+}
+
+static void test_all_at_one_point(void **state)
+{
+    (void)state;
+    vfx_sph_desc d = small_box();
+    d.max_substeps = 400;
+    vfx_sph *s = make(d);
+    enum { N = 300 };
+    float x[N], y[N], z[N];
+    for (int i = 0; i < N; ++i)
+        x[i] = 0.05f, y[i] = 0.1f, z[i] = 0.03f;
+    assert_int_equal(vfx_sph_add_particles(s, N, x, y, z, NULL, NULL, NULL), VFX_OK);
+    vfx_sph_report r;
+    assert_int_equal(vfx_sph_step(s, 0.f, &r), VFX_OK);
+    float err0 = r.max_density_error;
+    assert_true(err0 > 10.f); /* 300 particles on one point: a huge compression */
+    double bound = release_bound(s, N);
+    for (int f = 0; f < 20; ++f) {
+        assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        check_state(s);
+        assert_true(r.kinetic_energy < bound);
+    }
+    /* the cloud has spread: the worst compression falls below 100% (from >1000%) */
+    assert_true(r.max_density_error < 1.0f);
+    vfx_sph_destroy(s);
+}
+
+/* A block resting in the small box; returns the solver after `frames` steps of frame_dt. */
+static void run_block(vfx_sph *s, int frames, float frame_dt, bool expect_cap, float max_err)
+{
+    float lo[3] = {0, 0, 0}, hi[3] = {0.1f, 0.08f, 0.06f};
+    uint32_t n;
+    assert_int_equal(vfx_sph_add_block(s, lo, hi, &n), VFX_OK);
+    assert_int_equal(n, 10 * 8 * 6);
+    vfx_sph_report r;
+    assert_int_equal(vfx_sph_step(s, 0.f, &r), VFX_OK);
+    double e0 = energy(&r);
+    for (int f = 0; f < frames; ++f) {
+        assert_int_equal(vfx_sph_step(s, frame_dt, &r), VFX_OK);
+        check_state(s);
+        if (expect_cap) {
+            assert_true(r.cap_hit);
+            assert_true(r.simulated_time < frame_dt);
+        }
+        /* a fluid at rest under gravity only loses energy to viscosity and walls; 2% covers
+         * the settling of the initially uncompressed column (its weight compresses it) */
+        if (!(energy(&r) <= e0 * 1.02))
+            print_message("energy %.6g > 1.02 * %.6g (ke %.3g), substeps %u\n", energy(&r), e0, r.kinetic_energy, r.substeps);
+        assert_true(energy(&r) <= e0 * 1.02);
+        assert_true(r.max_density_error < max_err);
+    }
+}
+
+static void test_stiffness_1000x(void **state)
+{
+    (void)state;
+    vfx_sph_desc d = small_box();
+    vfx_sph *s0 = make(d);
+    float B = vfx_sph_params(s0)->stiffness;
+    vfx_sph_destroy(s0);
+    d.stiffness = 1000.f * B;
+    d.max_substeps = 100;
+    vfx_sph *s = make(d);
+    /* c0 grows by sqrt(1000): the acoustic dt is ~32x smaller, a 60 Hz frame needs more than
+     * the cap: every frame must report cap_hit; compression stays under 0.1% */
+    assert_true(vfx_sph_params(s)->sound_speed > 30.f * 10.f);
+    run_block(s, 5, 1.f / 60.f, true, 0.001f);
+    vfx_sph_destroy(s);
+}
+
+static void test_dt_100x_too_large(void **state)
+{
+    (void)state;
+    vfx_sph_desc d = small_box();
+    d.max_substeps = 200;
+    vfx_sph *s = make(d);
+    /* 100 frames' worth in one call: substeps are bounded by the conditions, not by the
+     * request; the cap stops it and says so. Density error bound: 3% (c0 = 10 v gives ~1%) */
+    run_block(s, 3, 100.f / 60.f, true, 0.03f);
+    vfx_sph_destroy(s);
+}
+
+static void test_outside_domain(void **state)
+{
+    (void)state;
+    vfx_sph *s = make(small_box());
+    enum { N = 64 };
+    float x[N], y[N], z[N], vx[N];
+    for (int i = 0; i < N; ++i) {
+        x[i] = (i % 2 ? -1.f : 1.f) * (1.f + (float)i); /* far outside on both sides */
+        y[i] = 0.1f + 0.001f * (float)i;
+        z[i] = 5.f;
+        vx[i] = x[i] > 0 ? 3.f : -3.f; /* and moving further out */
+    }
+    assert_int_equal(vfx_sph_add_particles(s, N, x, y, z, vx, NULL, NULL), VFX_OK);
+    assert_int_equal(vfx_sph_clamped_on_add(s), N);
+    check_state(s);
+    vfx_sph_report r;
+    for (int f = 0; f < 20; ++f) {
+        assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        check_state(s);
+        /* clamped onto two edges 1 mm apart: the pile expands; bounded by the initial
+         * 0.5 N m 3^2 plus what the clamped EOS can release */
+        assert_true(r.kinetic_energy <= 0.5 * N * vfx_sph_particle_mass(s) * 9.0 + release_bound(s, N));
+    }
+    /* piled into two edges: compression stays bounded by the EOS clamp region (100%) */
+    assert_true(r.max_density_error < 1.0f);
+    vfx_sph_destroy(s);
+}
+
+static void test_blowup_reported(void **state)
+{
+    (void)state;
+    vfx_sph_desc d = small_box();
+    d.velocity_limit = 1.f;
+    vfx_sph *s = make(d);
+    float x[3] = {0.02f, 0.05f, 0.08f}, y[3] = {0.1f, 0.1f, 0.1f}, z[3] = {0.03f, 0.03f, 0.03f};
+    float vy[3] = {0.f, 0.f, -5.f}; /* particle 2 is already beyond the limit: no dt helps */
+    assert_int_equal(vfx_sph_add_particles(s, 3, x, y, z, NULL, vy, NULL), VFX_OK);
+    vfx_sph_report r;
+    assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_ERR_NUMERIC);
+    assert_non_null(strstr(vfx_sph_last_error(s), "particle 2"));
+    assert_non_null(strstr(vfx_sph_last_error(s), "speed"));
+    assert_int_equal(r.redo_count, vfx_sph_params(s)->max_redo);
+    /* the last good state stays: unchanged, finite */
+    check_state(s);
+    vfx_sph_columns c = vfx_sph_get_columns(s);
+    for (uint32_t i = 0; i < c.count; ++i)
+        if (c.id[i] == 2)
+            assert_true(c.vy[i] == -5.f && c.y[i] == 0.1f);
+    vfx_sph_destroy(s);
+}
+
+static void test_thread_count_determinism(void **state)
+{
+    (void)state;
+    vfx_sph_columns c[2];
+    vfx_sph *s[2];
+    for (int t = 0; t < 2; ++t) {
+        vfx_sph_desc d = small_box();
+        d.threads = (uint32_t)(t + 1);
+        s[t] = make(d);
+        float lo[3] = {0, 0, 0}, hi[3] = {0.05f, 0.15f, 0.06f};
+        assert_int_equal(vfx_sph_add_block(s[t], lo, hi, NULL), VFX_OK); /* 450 particles: 1 chunk */
+        float lo2[3] = {0.06f, 0.1f, 0}, hi2[3] = {0.1f, 0.2f, 0.06f};
+        assert_int_equal(vfx_sph_add_block(s[t], lo2, hi2, NULL), VFX_OK);
+        vfx_sph_report r;
+        for (int f = 0; f < 5; ++f)
+            assert_int_equal(vfx_sph_step(s[t], 1.f / 60.f, &r), VFX_OK);
+        c[t] = vfx_sph_get_columns(s[t]);
+    }
+    assert_int_equal(vfx_sph_thread_count(s[1]), 2);
+    assert_int_equal(c[0].count, c[1].count);
+    /* each particle sums its neighbours in the same order whatever thread runs it */
+    assert_memory_equal(c[0].x, c[1].x, c[0].count * sizeof(float));
+    assert_memory_equal(c[0].vy, c[1].vy, c[0].count * sizeof(float));
+    assert_memory_equal(c[0].id, c[1].id, c[0].count * sizeof(uint32_t));
+    vfx_sph_destroy(s[0]);
+    vfx_sph_destroy(s[1]);
+}
+
+static void test_colliders_emitter_paddle(void **state)
+{
+    (void)state;
+    vfx_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.3f, 0.2f, 0.06f}, .threads = 2};
+    vfx_sph *s = make(d);
+    vfx_sph_collider ball = {.kind = VFX_SPH_SPHERE, .center = {0.15f, 0.05f, 0.03f}, .radius = 0.03f};
+    vfx_sph_collider box = {.kind = VFX_SPH_BOX, .center = {0.22f, 0.03f, 0.03f}, .half = {0.02f, 0.03f, 0.1f}};
+    vfx_sph_collider paddle = {.kind = VFX_SPH_BOX, .center = {0.02f, 0.1f, 0.03f}, .half = {0.01f, 0.1f, 0.1f},
+                               .motion_axis = {1, 0, 0}, .motion_amplitude = 0.01f, .motion_frequency = 2.f};
+    vfx_sph_collider slope = {.kind = VFX_SPH_PLANE, .center = {0.28f, 0.0f, 0.f}, .normal = {-1, 1, 0}};
+    assert_int_equal(vfx_sph_add_collider(s, &ball, NULL), VFX_OK);
+    assert_int_equal(vfx_sph_add_collider(s, &box, NULL), VFX_OK);
+    assert_int_equal(vfx_sph_add_collider(s, &paddle, NULL), VFX_OK);
+    assert_int_equal(vfx_sph_add_collider(s, &slope, NULL), VFX_OK);
+    vfx_sph_emitter e = {.center = {0.15f, 0.17f, 0.03f}, .direction = {0, -1, 0}, .speed = 1.f,
+                         .radius = 0.015f, .max_emit = 400};
+    assert_int_equal(vfx_sph_add_emitter(s, &e), VFX_OK);
+    float lo[3] = {0.04f, 0, 0}, hi[3] = {0.1f, 0.06f, 0.06f};
+    assert_int_equal(vfx_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    vfx_sph_report r;
+    uint32_t emitted = 0;
+    for (int f = 0; f < 30; ++f) {
+        assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        emitted += r.emitted;
+        check_state(s);
+        assert_true(r.max_density_error < 0.1f); /* 10%: impacts of the jet on the ball */
+        double t = vfx_sph_time(s);
+        float px = 0.02f + 0.01f * (float)sin(2 * M_PI * 2.0 * t);
+        vfx_sph_columns c = vfx_sph_get_columns(s);
+        for (uint32_t i = 0; i < c.count; ++i) {
+            /* no particle inside a solid (the clamp keeps a quarter spacing; allow 1e-4 m
+             * for the paddle, which moved after the clamp within the last substep) */
+            float bx = c.x[i] - 0.15f, by = c.y[i] - 0.05f, bz = c.z[i] - 0.03f;
+            assert_true(sqrtf(bx * bx + by * by + bz * bz) >= 0.03f);
+            bool in_box = fabsf(c.x[i] - 0.22f) < 0.02f && c.y[i] < 0.06f;
+            assert_false(in_box);
+            assert_true(c.x[i] >= px + 0.01f - 1e-3f);
+            assert_true(c.y[i] - (c.x[i] - 0.28f) >= 0.f); /* fluid side of the slope plane */
+        }
+    }
+    assert_int_equal(emitted, 400); /* the emitter stops at max_emit */
+    vfx_sph_destroy(s);
+}
+
+static void test_hydrostatic(void **state)
+{
+    (void)state;
+    /* Column 0.06 x 0.15 x 0.06 m at rest, dx = 1 cm, released uncompressed. WCSPH pressure
+     * carries acoustic noise (gamma 7 turns 1% of density into 7% of B = 56 kPa, against a
+     * hydrostatic 1.5 kPa), so the pressure is averaged over particles in 2 cm depth bins and
+     * over 30 frames (0.5 s, ~3 periods of the slowest column mode) after 0.5 s of settling.
+     * Reference: p = rho0 g depth, depth below the mean free surface (float64). */
+    vfx_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.06f, 0.2f, 0.06f},
+                      .threads = 2, .viscosity = 0.1f};
+    vfx_sph *s = make(d);
+    float lo[3] = {0, 0, 0}, hi[3] = {0.06f, 0.15f, 0.06f};
+    assert_int_equal(vfx_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    vfx_sph_report r;
+    enum { BINS = 8 };
+    double psum[BINS] = {0}, dsum[BINS] = {0};
+    int cnt[BINS] = {0};
+    float max_err = 0.f, mean_err = 0.f;
+    for (int f = 0; f < 60; ++f) {
+        assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        check_state(s);
+        if (f < 30)
+            continue;
+        max_err = r.max_density_error > max_err ? r.max_density_error : max_err;
+        mean_err = r.mean_density_error > mean_err ? r.mean_density_error : mean_err;
+        vfx_sph_columns c = vfx_sph_get_columns(s);
+        double top = 0.0;
+        for (uint32_t i = 0; i < c.count; ++i)
+            top += c.y[i];
+        /* mean free surface: the column height from the mean particle height (uniform
+         * column: mean = H/2), robust to single particles hopping on the surface */
+        top = 2.0 * top / c.count;
+        for (uint32_t i = 0; i < c.count; ++i) {
+            int b = (int)((top - c.y[i]) / 0.02);
+            if (b < 0 || b >= BINS)
+                continue;
+            psum[b] += vfx_sph_pressure(s, i);
+            dsum[b] += top - c.y[i];
+            cnt[b]++;
+        }
+    }
+    /* density error bounds over the measured frames: max 3%, mean 0.5% */
+    print_message("hydrostatic density error: max %.4f, mean %.4f\n", max_err, mean_err);
+    assert_true(max_err < 0.03f);
+    assert_true(mean_err < 0.005f);
+    /* bins below the first (free surface) and above the floor layer. Pressure rises linearly
+     * with depth; the fitted slope is held to rho0 g within 35% and each bin to 50%. These
+     * bounds are loose on purpose and the measured bias (+20-35%, docs/simulation.md) is a
+     * known shortcoming: the clamped p >= 0 EOS truncates the negative half of the acoustic
+     * noise, and the energy-consistent single-sided wall force lets wall layers compress. */
+    int checked = 0;
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (int b = 1; b < 6; ++b) { /* bin 6 holds the floor layer */
+        if (cnt[b] < 30 * 20)
+            continue;
+        double dm = dsum[b] / cnt[b], pm = psum[b] / cnt[b], ref = 1000.0 * 9.81 * dm;
+        print_message("hydrostatic bin depth %.3f m: p %.1f Pa, rho0 g d %.1f Pa (%+.1f%%)\n",
+                      dm, pm, ref, 100.0 * (pm - ref) / ref);
+        assert_true(fabs(pm - ref) < 0.5 * ref);
+        sx += dm, sy += pm, sxx += dm * dm, sxy += dm * pm;
+        checked++;
+    }
+    assert_true(checked >= 4);
+    double slope = (checked * sxy - sx * sy) / (checked * sxx - sx * sx);
+    print_message("hydrostatic dp/ddepth %.0f Pa/m, rho0 g %.0f (%+.1f%%)\n", slope, 9810.0,
+                  100.0 * (slope - 9810.0) / 9810.0);
+    assert_true(fabs(slope - 9810.0) < 0.35 * 9810.0);
+    vfx_sph_destroy(s);
+}
+
+static void test_dam_break_small(void **state)
+{
+    (void)state;
+    /* Martin & Moyce (1952), n^2 = 2 (height 2a), a = 2.25 in: (T, Z) read from their
+     * Fig. 3 (digitised values as published in the PySPH example db_exp_data.py).
+     * Coarse run (a/dx = 10, 4 layers deep): the surge front within 15% of the data for
+     * T <= 2 (the finer bench run `volfx-bench sim --dam-break` is held to 10%). */
+    static const double T_mm[] = {0.832, 1.219, 1.997};
+    static const double Z_mm[] = {1.217, 1.474, 2.292};
+    const double a = 0.05715, g = 9.81;
+    float dx = (float)(a / 10);
+    vfx_sph_desc d = {.spacing = dx, .domain_min = {0, 0, 0},
+                      .domain_max = {(float)(6 * a), (float)(2.5 * a), 4 * dx}, .threads = 2,
+                      .max_substeps = 100000};
+    vfx_sph *s = make(d);
+    float lo[3] = {0, 0, 0}, hi[3] = {(float)a, (float)(2 * a), 4 * dx};
+    assert_int_equal(vfx_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    double Ts = sqrt(2 * g / a);
+    vfx_sph_report r;
+    assert_int_equal(vfx_sph_step(s, 0.f, &r), VFX_OK);
+    double e0 = energy(&r);
+    for (int k = 0; k < 3; ++k) {
+        double target = T_mm[k] / Ts;
+        assert_int_equal(vfx_sph_step(s, (float)(target - vfx_sph_time(s)), &r), VFX_OK);
+        assert_false(r.cap_hit);
+        check_state(s);
+        assert_true(energy(&r) <= e0 * 1.01);
+        assert_true(r.max_density_error < 0.1f);
+        vfx_sph_columns c = vfx_sph_get_columns(s);
+        float front = 0.f;
+        for (uint32_t i = 0; i < c.count; ++i)
+            front = c.x[i] > front ? c.x[i] : front;
+        double Z = (front + 0.5 * dx) / a;
+        print_message("dam break T=%.3f Z=%.3f (Martin & Moyce %.3f, %+.1f%%)\n", T_mm[k], Z,
+                      Z_mm[k], 100.0 * (Z - Z_mm[k]) / Z_mm[k]);
+        assert_true(fabs(Z - Z_mm[k]) < 0.15 * Z_mm[k]);
+    }
+    vfx_sph_destroy(s);
+}
+
+static void test_million_particles(void **state)
+{
+    (void)state;
+    /* 100^3 particles: allocate, one short step (1 substep + the closing density pass). */
+    vfx_sph_desc d = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {2.2f, 2.2f, 2.2f}};
+    vfx_sph *s = make(d);
+    float lo[3] = {0, 0, 0}, hi[3] = {2.0f, 2.0f, 2.0f};
+    uint32_t n;
+    assert_int_equal(vfx_sph_add_block(s, lo, hi, &n), VFX_OK);
+    assert_int_equal(n, 1000000);
+    vfx_sph_report r;
+    assert_int_equal(vfx_sph_step(s, 1e-5f, &r), VFX_OK);
+    assert_int_equal(r.substeps, 1);
+    print_message("1,000,000 particles: %.1f MiB in the solver, %llu neighbour pairs\n",
+                  vfx_sph_memory_bytes(s) / 1048576.0, (unsigned long long)r.neighbor_pairs);
+    assert_true(vfx_sph_memory_bytes(s) < 200u * 1024u * 1024u);
+    check_state(s);
+    assert_true(r.max_density_error < 0.01f); /* a fresh lattice is at rho0 (calibrated mass) */
+    vfx_sph_destroy(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_wall_integrals),
+        cmocka_unit_test(test_bad_desc_and_input),
+        cmocka_unit_test(test_zero_particles),
+        cmocka_unit_test(test_single_particle),
+        cmocka_unit_test(test_two_coincident),
+        cmocka_unit_test(test_all_at_one_point),
+        cmocka_unit_test(test_stiffness_1000x),
+        cmocka_unit_test(test_dt_100x_too_large),
+        cmocka_unit_test(test_outside_domain),
+        cmocka_unit_test(test_blowup_reported),
+        cmocka_unit_test(test_thread_count_determinism),
+        cmocka_unit_test(test_colliders_emitter_paddle),
+        cmocka_unit_test(test_hydrostatic),
+        cmocka_unit_test(test_dam_break_small),
+        cmocka_unit_test(test_million_particles),
+    };
+    return cmocka_run_group_tests_name("sim", tests, NULL, NULL);
+}
