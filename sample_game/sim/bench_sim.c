@@ -1,0 +1,233 @@
+/* bench_sim.c — `volfx-bench sim`: SPH throughput (particle-steps/s and neighbour
+ * interactions/s) at several particle counts and thread counts, and `--dam-break`: the surge
+ * front against Martin & Moyce (1952). One JSON object per line. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "sim/sph.h"
+
+int vfx_bench_sim(int argc, char **argv);
+
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static int cmp_d(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_d);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static void cpu_model(char *out, size_t len)
+{
+    snprintf(out, len, "unknown");
+    FILE *f = fopen("/proc/cpuinfo", "r");
+    if (!f)
+        return;
+    char line[512];
+    while (fgets(line, sizeof line, f)) {
+        if (strncmp(line, "model name", 10) == 0) {
+            char *c = strchr(line, ':');
+            if (c) {
+                c += 2;
+                c[strcspn(c, "\n\"\\")] = 0;
+                snprintf(out, len, "%s", c);
+            }
+            break;
+        }
+    }
+    fclose(f);
+}
+
+/* Block of n particles (dx = 2 cm) in the corner of a tank twice as long: a dam break, so
+ * the measured substeps are of a moving fluid with free surface and walls. */
+static int bench_size(uint32_t n_target, uint32_t threads, int substeps, int reps, const char *cpu)
+{
+    /* block of exactly n_target particles: kx = kz, the largest divisor pair with kx <= cbrt */
+    uint32_t kx = (uint32_t)floor(cbrt((double)n_target) + 1e-9);
+    while (kx > 1 && n_target % (kx * kx) != 0)
+        kx--;
+    uint32_t ky = n_target / (kx * kx);
+    const float dx = 0.02f;
+    float bx = (float)kx * dx, by = (float)ky * dx, bz = (float)kx * dx;
+    vfx_sph_desc d = {.spacing = dx, .domain_min = {0, 0, 0}, .domain_max = {3.f * bx, 1.2f * by, bz},
+                      .threads = threads, .max_substeps = (uint32_t)substeps};
+    vfx_sph *s;
+    char err[256];
+    if (vfx_sph_create(&d, &s, err, sizeof err)) {
+        fprintf(stderr, "volfx-bench sim: %s\n", err);
+        return 1;
+    }
+    float lo[3] = {0, 0, 0}, hi[3] = {bx, by, bz};
+    uint32_t n;
+    if (vfx_sph_add_block(s, lo, hi, &n)) {
+        fprintf(stderr, "volfx-bench sim: %s\n", vfx_sph_last_error(s));
+        vfx_sph_destroy(s);
+        return 1;
+    }
+    vfx_sph_report r;
+    vfx_sph_step(s, 1.f, &r); /* warm-up: the column starts to fall, pages touched */
+    double *ps = calloc((size_t)reps, sizeof *ps), *is = calloc((size_t)reps, sizeof *is);
+    double *ms = calloc((size_t)reps, sizeof *ms);
+    int rc = 0;
+    for (int i = 0; i < reps && ps && is && ms; ++i) {
+        double t0 = now_s();
+        /* frame_dt 1 s and a substep cap: exactly `substeps` substeps + one closing density pass */
+        vfx_result e = vfx_sph_step(s, 1.f, &r);
+        double t = now_s() - t0;
+        if (e) {
+            fprintf(stderr, "volfx-bench sim: %s\n", vfx_sph_last_error(s));
+            rc = 1;
+            break;
+        }
+        ps[i] = (double)n * r.substeps / t;
+        is[i] = 2.0 * (double)r.neighbor_pairs / t; /* density + force pass */
+        ms[i] = 1e3 * t / r.substeps;
+    }
+    if (!rc && ps && is && ms) {
+        double p = median(ps, reps), in = median(is, reps), m = median(ms, reps);
+        printf("{\"effect\":\"sim\",\"particles\":%u,\"threads\":%u,\"substeps_per_rep\":%d,\"reps\":%d,"
+               "\"particle_steps_per_s\":%.0f,\"particle_steps_per_s_per_thread\":%.0f,"
+               "\"neighbour_interactions_per_s\":%.0f,\"ms_per_substep\":%.3f,"
+               "\"neighbours_per_particle\":%.1f,\"memory_mb\":%.1f,\"cpu\":\"%s\"}\n",
+               n, vfx_sph_thread_count(s), substeps, reps, p, p / vfx_sph_thread_count(s), in, m,
+               r.substeps ? (double)r.neighbor_pairs / r.substeps / n : 0.0,
+               vfx_sph_memory_bytes(s) / 1048576.0, cpu);
+    }
+    free(ps), free(is), free(ms);
+    vfx_sph_destroy(s);
+    return rc;
+}
+
+/* Martin & Moyce (1952), n^2 = 2 (column height 2a), a = 2.25 in, read from their Fig. 3
+ * (digitised values as published in PySPH's examples/db_exp_data.py): T = t sqrt(2g/a),
+ * Z = surge front x / a. */
+static const double mm_T[] = {0.832, 1.219, 1.997, 2.547, 3.345, 4.034, 4.418, 5.091, 5.685};
+static const double mm_Z[] = {1.217, 1.474, 2.292, 2.995, 4.134, 4.944, 5.881, 6.980, 7.945};
+
+static int dam_break(int res, uint32_t threads, double t_max, const char *cpu)
+{
+    const double a = 0.05715, g = 9.81;
+    float dx = (float)(a / res);
+    vfx_sph_desc d = {.spacing = dx, .domain_min = {0, 0, 0},
+                      .domain_max = {(float)(10 * a), (float)(2.5 * a), 4 * dx},
+                      .threads = threads, .max_substeps = 1000000};
+    vfx_sph *s;
+    char err[256];
+    if (vfx_sph_create(&d, &s, err, sizeof err)) {
+        fprintf(stderr, "volfx-bench sim: %s\n", err);
+        return 1;
+    }
+    float lo[3] = {0, 0, 0}, hi[3] = {(float)a, (float)(2 * a), 4 * dx};
+    uint32_t n;
+    vfx_sph_add_block(s, lo, hi, &n);
+    double Ts = sqrt(2 * g / a), worst = 0.0, t0 = now_s();
+    uint64_t substeps = 0;
+    int rc = 0, used = 0;
+    for (size_t k = 0; k < sizeof mm_T / sizeof mm_T[0]; ++k) {
+        if (mm_T[k] > t_max)
+            break;
+        vfx_sph_report r;
+        if (vfx_sph_step(s, (float)(mm_T[k] / Ts - vfx_sph_time(s)), &r)) {
+            fprintf(stderr, "volfx-bench sim: %s\n", vfx_sph_last_error(s));
+            rc = 1;
+            break;
+        }
+        substeps += r.substeps;
+        vfx_sph_columns c = vfx_sph_get_columns(s);
+        float front = 0.f;
+        for (uint32_t i = 0; i < c.count; ++i)
+            front = c.x[i] > front ? c.x[i] : front;
+        /* the front is the fluid's edge: half a spacing beyond the last particle centre */
+        double Z = (front + 0.5 * dx) / a, e = (Z - mm_Z[k]) / mm_Z[k];
+        worst = fabs(e) > worst ? fabs(e) : worst;
+        used++;
+        printf("{\"effect\":\"sim\",\"case\":\"dam_break\",\"a_over_dx\":%d,\"particles\":%u,\"T\":%.3f,"
+               "\"Z\":%.4f,\"Z_martin_moyce\":%.3f,\"error_pct\":%.2f,\"max_density_error\":%.4f}\n",
+               res, n, mm_T[k], Z, mm_Z[k], 100.0 * e, r.max_density_error);
+    }
+    printf("{\"effect\":\"sim\",\"case\":\"dam_break_summary\",\"a_over_dx\":%d,\"particles\":%u,"
+           "\"points\":%d,\"max_abs_error_pct\":%.2f,\"substeps\":%llu,\"wall_s\":%.2f,\"cpu\":\"%s\"}\n",
+           res, n, used, 100.0 * worst, (unsigned long long)substeps, now_s() - t0, cpu);
+    vfx_sph_destroy(s);
+    return rc;
+}
+
+static int parse_list(const char *s, uint32_t *out, int max)
+{
+    int n = 0;
+    while (*s && n < max) {
+        char *end;
+        unsigned long v = strtoul(s, &end, 10);
+        if (end == s || v == 0 || v > (1ul << 27))
+            return -1;
+        out[n++] = (uint32_t)v;
+        s = *end == ',' ? end + 1 : end;
+        if (*end && *end != ',')
+            return -1;
+    }
+    return n;
+}
+
+int vfx_bench_sim(int argc, char **argv)
+{
+    uint32_t sizes[8] = {4096, 16384, 65536}, threads[8] = {1, 2};
+    int nsizes = 3, nthreads = 2, substeps = 20, reps = 5, res = 20;
+    bool dam = false;
+    double t_max = 6.0;
+    for (int i = 1; i < argc; ++i) {
+        if (!strcmp(argv[i], "--sizes") && i + 1 < argc) {
+            if ((nsizes = parse_list(argv[++i], sizes, 8)) <= 0) {
+                fprintf(stderr, "volfx-bench sim: --sizes wants a comma list of counts 1..2^27\n");
+                return 2;
+            }
+        } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
+            if ((nthreads = parse_list(argv[++i], threads, 8)) <= 0) {
+                fprintf(stderr, "volfx-bench sim: --threads wants a comma list\n");
+                return 2;
+            }
+        } else if (!strcmp(argv[i], "--substeps") && i + 1 < argc) {
+            substeps = atoi(argv[++i]);
+        } else if (!strcmp(argv[i], "--reps") && i + 1 < argc) {
+            reps = atoi(argv[++i]);
+        } else if (!strcmp(argv[i], "--dam-break")) {
+            dam = true;
+        } else if (!strcmp(argv[i], "--res") && i + 1 < argc) {
+            res = atoi(argv[++i]);
+        } else if (!strcmp(argv[i], "--t-max") && i + 1 < argc) {
+            t_max = atof(argv[++i]);
+        } else if (!strcmp(argv[i], "--help")) {
+            puts("volfx-bench sim [--sizes 4096,16384,65536] [--threads 1,2] [--substeps 20] [--reps 5]\n"
+                 "volfx-bench sim --dam-break [--res 20 (a/dx)] [--t-max 6 (last T)] [--threads 2]");
+            return 0;
+        } else if (strcmp(argv[i], "--json") != 0) {
+            fprintf(stderr, "volfx-bench sim: unknown option '%s'\n", argv[i]);
+            return 2;
+        }
+    }
+    if (substeps < 1 || substeps > 100000 || reps < 1 || reps > 1000 || res < 4 || res > 200) {
+        fprintf(stderr, "volfx-bench sim: need 1..100000 substeps, 1..1000 reps, 4..200 res\n");
+        return 2;
+    }
+    char cpu[256];
+    cpu_model(cpu, sizeof cpu);
+    if (dam)
+        return dam_break(res, threads[nthreads - 1], t_max, cpu);
+    for (int t = 0; t < nthreads; ++t)
+        for (int k = 0; k < nsizes; ++k)
+            if (bench_size(sizes[k], threads[t], substeps, reps, cpu))
+                return 1;
+    return 0;
+}
