@@ -528,6 +528,14 @@ vfx_result vfx_sph_add_particles(vfx_sph *s, uint32_t n, const float *x, const f
     return VFX_OK;
 }
 
+void vfx_sph_clear(vfx_sph *s)
+{
+    if (!s)
+        return;
+    s->n = 0;
+    s->next_id = 0;
+}
+
 vfx_result vfx_sph_add_block(vfx_sph *s, const float lo[3], const float hi[3], uint32_t *added)
 {
     if (added)

@@ -127,6 +127,8 @@ float vfx_sph_support(const vfx_sph *sim);
  * in vfx_sph_clamped_on_add). n = 0 is a no-op. */
 vfx_result vfx_sph_add_particles(vfx_sph *sim, uint32_t n, const float *x, const float *y,
                                  const float *z, const float *vx, const float *vy, const float *vz);
+/* Removes every particle (capacity, colliders, emitters and time are kept); ids restart at 0. */
+void vfx_sph_clear(vfx_sph *sim);
 /* Adds a lattice of spacing dx filling [lo, hi] (cell centres), at rest; count in *added. */
 vfx_result vfx_sph_add_block(vfx_sph *sim, const float lo[3], const float hi[3], uint32_t *added);
 /* Number of particles that vfx_sph_add_particles had to move into the domain so far. */
