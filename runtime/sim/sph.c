@@ -66,6 +66,7 @@ struct vfx_sph {
     sph_chunk_out *out;
     uint32_t out_cap;
     float dt_try;
+    bool want_energy; /* the closing density pass also sums the EOS internal energy */
     /* thread pool */
     pthread_t *threads;
     uint32_t nthreads; /* workers besides the caller */
@@ -97,13 +98,12 @@ double vfx_sph_wall_density_fraction(double d, double H)
         return 0.0;
     if (d < 0.0)
         d = 0.0; /* inside the wall: the clamp puts it back; use the half-space value */
-    /* int_{z>d} int_plane W_poly6 = (pi k/4) int_d^H (H^2-z^2)^4 dz, k = 315/(64 pi H^9) */
-    double H2 = H * H, H4 = H2 * H2, H6 = H4 * H2, H8 = H4 * H4;
-#define P9(z) (H8 * (z) - 4.0 * H6 * pow((z), 3) / 3.0 + 6.0 * H4 * pow((z), 5) / 5.0 \
-               - 4.0 * H2 * pow((z), 7) / 7.0 + pow((z), 9) / 9.0)
-    double k = 315.0 / (64.0 * SPH_PI * pow(H, 9));
-    double v = SPH_PI * k / 4.0 * (P9(H) - P9(d));
-#undef P9
+    /* int_{z>d} int_plane W_poly6 = (pi k/4) int_d^H (H^2-z^2)^4 dz, k = 315/(64 pi H^9);
+     * with u = d/H: (315/256) [P(1) - P(u)], P(u) = u - 4u^3/3 + 6u^5/5 - 4u^7/7 + u^9/9
+     * (Horner form: this runs per particle and wall in every pass) */
+    double u = d / H, u2 = u * u;
+    double Pu = u * (1.0 + u2 * (-4.0 / 3.0 + u2 * (6.0 / 5.0 + u2 * (-4.0 / 7.0 + u2 / 9.0))));
+    double v = 315.0 / 256.0 * (128.0 / 315.0 - Pu);
     return v;
 }
 
@@ -113,9 +113,9 @@ double vfx_sph_wall_density_gradient(double d, double H)
         return 0.0;
     if (d < 0.0)
         d = 0.0;
-    /* -d/dd of vfx_sph_wall_density_fraction = (pi k/4) (H^2-d^2)^4 */
-    double k = 315.0 / (64.0 * SPH_PI * pow(H, 9)), q = H * H - d * d;
-    return SPH_PI * k / 4.0 * q * q * q * q;
+    /* -d/dd of vfx_sph_wall_density_fraction = (pi k/4) (H^2-d^2)^4 = (315/256)(1-u^2)^4/H */
+    double u = d / H, q = 1.0 - u * u;
+    return 315.0 / 256.0 * q * q * q * q / H;
 }
 
 /* ---- thread pool --------------------------------------------------------------------------- */
@@ -335,10 +335,11 @@ vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, si
     s->B = p.stiffness;
     s->c0 = p.sound_speed;
     s->p = p;
-    s->inv_cell = 1.f / s->H;
+    /* cells of H/2 and a 5x5x5 stencil: 42% fewer candidate pairs than H cells and 3x3x3 */
+    s->inv_cell = 2.f / s->H;
     double dims[3];
     for (int a = 0; a < 3; ++a)
-        dims[a] = ceil((p.domain_max[a] - p.domain_min[a]) / s->H);
+        dims[a] = ceil((p.domain_max[a] - p.domain_min[a]) * s->inv_cell);
     if (dims[0] * dims[1] * dims[2] > SPH_MAX_CELLS) {
         snprintf(err, err_len, "vfx_sph_create: domain/support gives %.0f grid cells (max %u): "
                  "shrink the domain or grow the spacing", dims[0] * dims[1] * dims[2], SPH_MAX_CELLS);
@@ -779,7 +780,7 @@ static void build_grid(vfx_sph *s)
 }
 
 typedef struct sph_ranges {
-    uint32_t lo[9], hi[9];
+    uint32_t lo[25], hi[25];
     int count;
 } sph_ranges;
 
@@ -789,12 +790,12 @@ static inline void neighbor_ranges(const vfx_sph *s, float px, float py, float p
     int cx = cell_coord(px, lo[0], s->inv_cell, s->nx);
     int cy = cell_coord(py, lo[1], s->inv_cell, s->ny);
     int cz = cell_coord(pz, lo[2], s->inv_cell, s->nz);
-    int x0 = cx > 0 ? cx - 1 : 0, x1 = cx + 1 < s->nx ? cx + 1 : cx;
+    int x0 = cx > 1 ? cx - 2 : 0, x1 = cx + 2 < s->nx ? cx + 2 : s->nx - 1;
     r->count = 0;
-    for (int z = cz - 1; z <= cz + 1; ++z) {
+    for (int z = cz - 2; z <= cz + 2; ++z) {
         if (z < 0 || z >= s->nz)
             continue;
-        for (int y = cy - 1; y <= cy + 1; ++y) {
+        for (int y = cy - 2; y <= cy + 2; ++y) {
             if (y < 0 || y >= s->ny)
                 continue;
             uint32_t row = (uint32_t)((z * s->ny + y) * s->nx);
@@ -909,7 +910,7 @@ static void density_chunk(vfx_sph *s, uint32_t chunk)
         /* internal (EOS) energy m e(rho), e = int p/rho^2 drho from rho0, with the clamps:
          * what a compressed fluid can turn into motion (tests bound total energy with it) */
         double rr = rho / rho0, rc = rr > 2.0 ? 2.0 : rr;
-        if (rr > 1.0) {
+        if (s->want_energy && rr > 1.0) {
             double e = B / rho0 * ((pow(rc, gam - 1.0) - 1.0) / (gam - 1.0) + 1.0 / rc - 1.0);
             if (rr > 2.0)
                 e += B * (pow(2.0, gam) - 1.0) / rho0 * (0.5 - 1.0 / rr);
@@ -1152,7 +1153,9 @@ static void finish_report(vfx_sph *s, vfx_sph_report *rep)
     const float *g = s->p.gravity, *lo = s->p.domain_min;
     if (s->n) {
         build_grid(s);
+        s->want_energy = true;
         parallel(s, density_chunk, true);
+        s->want_energy = false;
         for (uint32_t c = 0; c < nchunks; ++c) {
             if (s->out[c].rho_err_max > emax)
                 emax = s->out[c].rho_err_max;
