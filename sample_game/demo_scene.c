@@ -8,31 +8,6 @@
 
 #define ARENA_MODEL "/usr/share/assimp/models/OBJ/spider.obj"
 
-static vfx_result wave_system(vfx_world *world, const vfx_system_ctx *ctx)
-{
-    vfx_app *app = ((void **)ctx->user)[0];
-    vfx_demo *demo = ((void **)ctx->user)[1];
-    vfx_component t = app->particles.position;
-    vfx_query_iter it = vfx_query_begin(world, &t, 1);
-    uint32_t base = 0;
-    double time = app->time;
-    while (vfx_query_next(&it)) {
-        float *x = vfx_query_column(&it, app->particles.position, 0);
-        float *y = vfx_query_column(&it, app->particles.position, 1);
-        float *z = vfx_query_column(&it, app->particles.position, 2);
-        for (uint32_t i = 0; i < it.rows && base + i < demo->particle_count; ++i) {
-            const float *r = &demo->rest[3 * (size_t)(base + i)];
-            /* a standing slosh: the surface tilts and a wave runs along x */
-            double h = r[1] * (1.0 + 0.25 * sin(time * 1.7 + r[0] * 2.0) * r[0] * 0.5);
-            x[i] = r[0] + 0.08f * (float)sin(time * 2.3 + r[1] * 3.0);
-            y[i] = (float)h;
-            z[i] = r[2] + 0.05f * (float)cos(time * 1.9 + r[0] * 2.5);
-        }
-        base += it.rows;
-    }
-    return VFX_OK;
-}
-
 vfx_result vfx_demo_load(vfx_app *app, vfx_demo *demo, const char *scene_path, uint32_t effects_off)
 {
     memset(demo, 0, sizeof *demo);
@@ -57,23 +32,38 @@ vfx_result vfx_demo_load(vfx_app *app, vfx_demo *demo, const char *scene_path, u
         if (vfx_app_add_mesh_file(app, ARENA_MODEL, model, c, NULL))
             vfx_logf(&app->log, VFX_LOG_WARN, "arena model skipped");
     }
-    /* Water: a block of particles in the pool between the two low walls. */
+    /* Water: an SPH pool between the two low walls, sloshed by a paddle; the simulation
+     * system writes the particle columns the plugin reads. */
     if (!(effects_off & VFX_EFFECT_BIT(VFX_EFFECT_WATER))) {
-        const int nx = 20, ny = 8, nz = 14;
-        const float s = 0.15f;
-        uint32_t n = (uint32_t)(nx * ny * nz);
+        const float spacing = 0.1f;
+        vfx_sph_desc sd = {.spacing = spacing, .domain_min = {-1.55f, 0.0f, -1.15f},
+                           .domain_max = {1.55f, 1.4f, 1.15f}, .max_substeps = 64,
+                           /* 0.6 m of water moves at ~3.4 m/s: c0 = 25 m/s keeps compression near
+                            * (3.4/25)^2 = 2% with half the substeps of the default */
+                           .sound_speed = 25.0f};
+        char err[256];
+        if ((r = vfx_sim_system_create(app->world, &sd, &demo->sim, err, sizeof err))) {
+            vfx_logf(&app->log, VFX_LOG_ERROR, "water simulation: %s", err);
+            return r;
+        }
+        vfx_sph_collider paddle = {.kind = VFX_SPH_BOX, .center = {-1.45f, 0.5f, 0}, .half = {0.05f, 0.5f, 1.1f},
+                                   .motion_axis = {1, 0, 0}, .motion_amplitude = 0.25f,
+                                   .motion_frequency = 0.45f};
+        if ((r = vfx_sph_add_collider(vfx_sim_system_solver(demo->sim), &paddle, NULL)))
+            return r;
+        const int nx = 14, ny = 6, nz = 22;
+        uint32_t n = (uint32_t)(nx * ny * nz), k = 0;
         float *px = malloc(n * sizeof(float)), *py = malloc(n * sizeof(float)), *pz = malloc(n * sizeof(float));
-        demo->rest = malloc(3 * (size_t)n * sizeof(float));
-        if (!px || !py || !pz || !demo->rest) {
+        if (!px || !py || !pz) {
             free(px), free(py), free(pz);
             return VFX_ERR_OUT_OF_MEMORY;
         }
-        uint32_t k = 0;
         for (int a = 0; a < nx; ++a)
             for (int b = 0; b < ny; ++b)
                 for (int c = 0; c < nz; ++c, ++k) {
-                    px[k] = -1.45f + a * s, py[k] = 0.1f + b * s, pz[k] = -1.0f + c * s;
-                    demo->rest[3 * k] = px[k], demo->rest[3 * k + 1] = py[k], demo->rest[3 * k + 2] = pz[k];
+                    px[k] = -1.2f + (a + 0.5f) * spacing;
+                    py[k] = (b + 0.5f) * spacing;
+                    pz[k] = -1.1f + (c + 0.5f) * spacing;
                 }
         r = vfx_particles_spawn(app->world, &app->particles, n, px, py, pz, false);
         free(px), free(py), free(pz);
@@ -82,13 +72,7 @@ vfx_result vfx_demo_load(vfx_app *app, vfx_demo *demo, const char *scene_path, u
         demo->particle_count = n;
         app->water_enabled = true;
         app->water = (vfx_water_params){.size = sizeof app->water, .version = VFX_WATER_PARAMS_VERSION,
-                                        .h = 0.3f};
-        demo->wave_user[0] = app, demo->wave_user[1] = demo;
-        vfx_component w = app->particles.position;
-        vfx_system_desc sd = {.name = "demo.slosh", .phase = VFX_PHASE_SIMULATE, .writes = &w,
-                              .write_count = 1, .fn = wave_system, .user = demo->wave_user};
-        if ((r = vfx_world_add_system(app->world, &sd)))
-            return r;
+                                        .h = 2.2f * spacing};
     }
     if (!(effects_off & VFX_EFFECT_BIT(VFX_EFFECT_BEAMS))) {
         static const vfx_beam base[3] = {
@@ -146,7 +130,7 @@ void vfx_demo_toggle(vfx_app *app, vfx_demo *demo, vfx_effect_kind kind)
 
 void vfx_demo_print_profile(vfx_app *app, FILE *out)
 {
-    static const char *series[] = {"demo.slosh", "plugin.update", "host.scene", "plugin.render"};
+    static const char *series[] = {"vfx.sim.sph", "plugin.update", "host.scene", "plugin.render"};
     fprintf(out, "cpu ms (median):");
     for (size_t i = 0; i < sizeof series / sizeof series[0]; ++i) {
         double m = vfx_profiler_series_median(app->profiler, series[i]);
@@ -166,6 +150,11 @@ void vfx_demo_print_profile(vfx_app *app, FILE *out)
 void vfx_demo_free(vfx_app *app, vfx_demo *demo)
 {
     (void)app;
-    free(demo->rest);
+    if (demo->sim) {
+        const vfx_sph_report *rep = vfx_sim_system_report(demo->sim);
+        if (rep->cap_hit)
+            vfx_logf(&app->log, VFX_LOG_WARN, "water simulation: substep cap hit in the last frame");
+    }
+    vfx_sim_system_destroy(demo->sim); /* the world is destroyed after: it must not run again */
     memset(demo, 0, sizeof *demo);
 }

@@ -5,18 +5,18 @@
 
 #include <stdio.h>
 #include "app.h"
+#include "sim/sim_system.h"
 
 typedef struct vfx_demo {
     char description[160];
     uint32_t effects_off;      /* VFX_EFFECT_BIT mask switched off by options or keys */
     uint32_t particle_count;
-    float *rest;               /* rest positions (x,y,z) of the animated particle block */
     vfx_beam beam_base[8];
     uint32_t beam_base_count;
     bool key_latch[8];
     bool mouse_down;
     double mouse_x, mouse_y;
-    void *wave_user[2];        /* {app, demo} for the slosh system */
+    vfx_sim_system *sim;       /* SPH writing the particle columns (NULL without water) */
 } vfx_demo;
 
 /* Loads `scene_path` (NULL -> the built-in default) into the app; effects in `effects_off`
