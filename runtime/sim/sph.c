@@ -978,12 +978,11 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
                 float gw = -ks * hr * hr; /* dW/dr of the spiky kernel, grad_i W = gw * u */
                 float dvx = vxi - VX[j], dvy = vyi - VY[j], dvz = vzi - VZ[j];
                 float vdotu = dvx * ux + dvy * uy + dvz * uz;
-                float coef = pri + P[j];
-                if (vdotu < 0.f && alpha > 0.f) {
-                    /* Monaghan (1992) artificial viscosity, mu = h v.r/(r^2 + 0.01 h^2) */
-                    float mu = h * vdotu * rl / (r2 + 0.01f * h * h);
-                    coef += -alpha * c0 * mu / (0.5f * (rhoi + R[j]));
-                }
+                /* Monaghan (1992) artificial viscosity, mu = h v.r/(r^2 + 0.01 h^2), approaching
+                 * pairs only; branch-free (the sign is a coin flip for the predictor) */
+                float vneg = vdotu < 0.f ? vdotu : 0.f;
+                float mu = h * vneg * rl / ((r2 + 0.01f * h * h) * (rhoi + R[j]));
+                float coef = pri + P[j] - 2.f * alpha * c0 * mu;
                 float f = -m * coef * gw;
                 ax += f * ux, ay += f * uy, az += f * uz;
                 dr += m * vdotu * gw;
