@@ -135,6 +135,16 @@ vfx_result vfx_sph_add_block(vfx_sph *sim, const float lo[3], const float hi[3],
 uint32_t vfx_sph_clamped_on_add(const vfx_sph *sim);
 /* Adds a static or moving collider; its index in *index when not NULL. */
 vfx_result vfx_sph_add_collider(vfx_sph *sim, const vfx_sph_collider *c, uint32_t *index);
+/* Adds a solid triangle mesh (closed, any winding; e.g. from vfx_mesh_import) as a collider:
+ * its signed distance is sampled once on a grid of ~H/2 (at most 64 nodes per axis, brute
+ * force over <= 20,000 triangles, inside by generalised winding number) and interpolated.
+ * motion (NULL = static) moves it rigidly: centre(t) - centre(0) is added to the mesh. */
+vfx_result vfx_sph_add_mesh_collider(vfx_sph *sim, const float *positions, uint32_t vertex_count,
+                                     const uint32_t *indices, uint32_t index_count,
+                                     const vfx_sph_collider *motion, uint32_t *index);
+/* Signed distance from p to collider `index` at the current time (positive on the fluid side;
+ * +Inf beyond a mesh's grid); NaN for a bad index. */
+float vfx_sph_collider_distance(const vfx_sph *sim, uint32_t index, const float p[3]);
 /* Adds an emitter that injects disc-shaped layers of particles each time they have moved dx. */
 vfx_result vfx_sph_add_emitter(vfx_sph *sim, const vfx_sph_emitter *e);
 
