@@ -73,6 +73,11 @@ struct vfx_sph {
     uint32_t out_cap;
     float dt_try;
     bool want_energy; /* the closing density pass also sums the EOS internal energy */
+    /* neighbour lists found by the density pass and reused by the force pass: one growing
+     * buffer per chunk (a chunk is only ever run by one thread), offsets per particle */
+    uint32_t **cnb, *cnb_cap, *nb_start, *nb_count;
+    uint32_t cnb_chunks;
+    atomic_bool nb_oom;
     /* thread pool */
     pthread_t *threads;
     uint32_t nthreads; /* workers besides the caller */
@@ -364,6 +369,7 @@ vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, si
     pthread_cond_init(&s->cv_start, NULL);
     pthread_cond_init(&s->cv_done, NULL);
     atomic_init(&s->next_chunk, 0u);
+    atomic_init(&s->nb_oom, false);
     uint32_t workers = p.threads - 1;
     if (workers) {
         s->threads = calloc(workers, sizeof *s->threads);
@@ -392,8 +398,12 @@ static void free_columns(vfx_sph *s)
         free(*f[i]);
         *f[i] = NULL;
     }
-    free(s->id), free(s->idtmp), free(s->key), free(s->perm);
-    s->id = s->idtmp = s->key = s->perm = NULL;
+    free(s->id), free(s->idtmp), free(s->key), free(s->perm), free(s->nb_start), free(s->nb_count);
+    s->id = s->idtmp = s->key = s->perm = s->nb_start = s->nb_count = NULL;
+    for (uint32_t c = 0; c < s->cnb_chunks; ++c)
+        free(s->cnb[c]);
+    free(s->cnb), free(s->cnb_cap);
+    s->cnb = NULL, s->cnb_cap = NULL, s->cnb_chunks = 0;
 }
 
 void vfx_sph_destroy(vfx_sph *s)
@@ -430,7 +440,10 @@ size_t vfx_sph_memory_bytes(const vfx_sph *s)
 {
     if (!s)
         return 0;
-    return sizeof *s + (size_t)s->cap * (19 * sizeof(float) + 4 * sizeof(uint32_t)) +
+    size_t lists = 0;
+    for (uint32_t c = 0; c < s->cnb_chunks; ++c)
+        lists += (size_t)s->cnb_cap[c] * sizeof(uint32_t);
+    return sizeof *s + lists + (size_t)s->cap * (19 * sizeof(float) + 6 * sizeof(uint32_t)) +
            ((size_t)s->ncells + 1) * sizeof(uint32_t) + (size_t)s->out_cap * sizeof(sph_chunk_out);
 }
 
@@ -470,7 +483,7 @@ static vfx_result reserve(vfx_sph *s, uint64_t want)
             goto oom;
         *f[i] = np;
     }
-    uint32_t **u[] = {&s->id, &s->idtmp, &s->key, &s->perm};
+    uint32_t **u[] = {&s->id, &s->idtmp, &s->key, &s->perm, &s->nb_start, &s->nb_count};
     for (size_t i = 0; i < sizeof u / sizeof u[0]; ++i) {
         uint32_t *np = realloc(*u[i], (size_t)cap * sizeof(uint32_t));
         if (!np)
@@ -483,6 +496,19 @@ static vfx_result reserve(vfx_sph *s, uint64_t want)
         goto oom;
     s->out = no;
     s->out_cap = chunks;
+    if (chunks > s->cnb_chunks) {
+        uint32_t **nl = realloc(s->cnb, (size_t)chunks * sizeof *nl);
+        if (!nl)
+            goto oom;
+        s->cnb = nl;
+        uint32_t *nc = realloc(s->cnb_cap, (size_t)chunks * sizeof *nc);
+        if (!nc)
+            goto oom;
+        s->cnb_cap = nc;
+        for (uint32_t c = s->cnb_chunks; c < chunks; ++c)
+            s->cnb[c] = NULL, s->cnb_cap[c] = 0;
+        s->cnb_chunks = chunks;
+    }
     s->cap = (uint32_t)cap;
     return VFX_OK;
 oom:
@@ -1097,12 +1123,29 @@ static void density_chunk(vfx_sph *s, uint32_t chunk)
     sph_chunk_out *o = &s->out[chunk];
     const float *X = s->x, *Y = s->y, *Z = s->z;
     sph_wall_hit walls[SPH_MAX_WALLS];
+    uint32_t used = 0;
     for (uint32_t i = b; i < e; ++i) {
         float px = X[i], py = Y[i], pz = Z[i];
         sph_ranges r;
         neighbor_ranges(s, px, py, pz, &r);
+        uint32_t cand = 0;
+        for (int q = 0; q < r.count; ++q)
+            cand += r.hi[q] - r.lo[q];
+        if (used + cand > s->cnb_cap[chunk]) {
+            uint32_t cap = s->cnb_cap[chunk] ? s->cnb_cap[chunk] : 4096;
+            while (cap < used + cand)
+                cap *= 2;
+            uint32_t *nl = realloc(s->cnb[chunk], (size_t)cap * sizeof *nl);
+            if (!nl) {
+                atomic_store(&s->nb_oom, true);
+                return;
+            }
+            s->cnb[chunk] = nl;
+            s->cnb_cap[chunk] = cap;
+        }
+        uint32_t *L = s->cnb[chunk] + used;
         float sum = 0.f;
-        uint32_t pairs = 0;
+        uint32_t nn = 0;
         for (int q = 0; q < r.count; ++q) {
             for (uint32_t j = r.lo[q]; j < r.hi[q]; ++j) {
                 float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
@@ -1110,10 +1153,15 @@ static void density_chunk(vfx_sph *s, uint32_t chunk)
                 if (r2 < H2) {
                     float t = H2 - r2;
                     sum += t * t * t;
-                    pairs++;
+                    L[nn] = j;
+                    nn += j != i;
                 }
             }
         }
+        s->nb_start[i] = used;
+        s->nb_count[i] = nn;
+        used += nn;
+        uint32_t pairs = nn + 1;
         float rho = m * kp * sum;
         int nw = gather_walls(s, px, py, pz, walls, SPH_MAX_WALLS);
         /* The box walls are perpendicular: the region beyond them is a union of half-spaces,
@@ -1187,14 +1235,13 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
         float px = X[i], py = Y[i], pz = Z[i], vxi = VX[i], vyi = VY[i], vzi = VZ[i];
         float pri = P[i], rhoi = R[i];
         float ax = 0.f, ay = 0.f, az = 0.f, dr = 0.f;
-        sph_ranges r;
-        neighbor_ranges(s, px, py, pz, &r);
-        for (int q = 0; q < r.count; ++q) {
-            for (uint32_t j = r.lo[q]; j < r.hi[q]; ++j) {
+        const uint32_t *L = s->cnb[chunk] + s->nb_start[i];
+        const uint32_t nn = s->nb_count[i];
+        {
+            for (uint32_t k = 0; k < nn; ++k) {
+                uint32_t j = L[k];
                 float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
                 float r2 = dx * dx + dy * dy + dz * dz;
-                if (r2 >= H2 || j == i)
-                    continue;
                 float rl, ux, uy, uz;
                 if (r2 > eps2) {
                     rl = sqrtf(r2);
@@ -1442,6 +1489,11 @@ vfx_result vfx_sph_step(vfx_sph *s, float frame_dt, vfx_sph_report *report)
         if (s->n) {
             build_grid(s);
             parallel(s, density_chunk, true);
+            if (atomic_exchange(&s->nb_oom, false)) {
+                set_err(s, "vfx_sph_step: out of memory for the neighbour lists of %u particles", s->n);
+                res = VFX_ERR_OUT_OF_MEMORY;
+                break;
+            }
             parallel(s, force_chunk, false);
             float v2 = 0.f, a2 = 0.f, c2 = 0.f;
             const sph_chunk_out *bo = NULL;

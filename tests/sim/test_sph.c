@@ -623,7 +623,9 @@ static void test_million_particles(void **state)
     assert_int_equal(r.substeps, 1);
     print_message("1,000,000 particles: %.1f MiB in the solver, %llu neighbour pairs\n",
                   vfx_sph_memory_bytes(s) / 1048576.0, (unsigned long long)r.neighbor_pairs);
-    assert_true(vfx_sph_memory_bytes(s) < 200u * 1024u * 1024u);
+    /* 19 float + 6 uint32 columns (100 B/particle, 95 MiB) + neighbour lists (4 B per pair,
+     * ~29 pairs/particle, in per-chunk buffers that grow by doubling: up to 2x) + grid */
+    assert_true(vfx_sph_memory_bytes(s) < 300u * 1024u * 1024u);
     check_state(s);
     assert_true(r.max_density_error < 0.01f); /* a fresh lattice is at rho0 (calibrated mass) */
     vfx_sph_destroy(s);
