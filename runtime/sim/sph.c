@@ -997,22 +997,45 @@ static inline int cell_coord(float v, float lo, float inv, int n)
     return c < 0 ? 0 : (c >= n ? n - 1 : c);
 }
 
-/* Counting sort of the particles by cell, then every per-particle column permuted so that a
- * cell's particles are contiguous (and a row of 3 x-adjacent cells is one range). Stable, so
- * the order — and every sum over neighbours — does not depend on the thread count. */
-static void build_grid(vfx_sph *s)
+static void key_chunk(vfx_sph *s, uint32_t chunk)
 {
+    uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
     const float *lo = s->p.domain_min;
-    uint32_t n = s->n;
-    memset(s->cell_start, 0, ((size_t)s->ncells + 1) * sizeof *s->cell_start);
-    for (uint32_t i = 0; i < n; ++i) {
+    for (uint32_t i = b; i < e; ++i) {
         int cx = cell_coord(s->x[i], lo[0], s->inv_cell, s->nx);
         int cy = cell_coord(s->y[i], lo[1], s->inv_cell, s->ny);
         int cz = cell_coord(s->z[i], lo[2], s->inv_cell, s->nz);
-        uint32_t k = (uint32_t)((cz * s->ny + cy) * s->nx + cx);
-        s->key[i] = k;
-        s->cell_start[k + 1]++;
+        s->key[i] = (uint32_t)((cz * s->ny + cy) * s->nx + cx);
     }
+}
+
+/* Gathers the state columns into the (free) integration buffers in sorted order. */
+static void permute_chunk(vfx_sph *s, uint32_t chunk)
+{
+    uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
+    const uint32_t *perm = s->perm;
+    for (uint32_t i = b; i < e; ++i) {
+        uint32_t k = perm[i];
+        s->xn[i] = s->x[k], s->yn[i] = s->y[k], s->zn[i] = s->z[k];
+        s->vxn[i] = s->vx[k], s->vyn[i] = s->vy[k], s->vzn[i] = s->vz[k];
+        s->idtmp[i] = s->id[k];
+    }
+}
+
+static void swap_state(vfx_sph *s);
+static void parallel(vfx_sph *s, sph_chunk_fn fn, bool fresh);
+
+/* Counting sort of the particles by cell, then every per-particle column permuted so that a
+ * cell's particles are contiguous (and a row of x-adjacent cells is one range). Stable, so
+ * the order — and every sum over neighbours — does not depend on the thread count. Keys and
+ * the permutation run on all threads; the histogram and the scatter are serial (O(n + cells)). */
+static void build_grid(vfx_sph *s)
+{
+    uint32_t n = s->n;
+    parallel(s, key_chunk, false);
+    memset(s->cell_start, 0, ((size_t)s->ncells + 1) * sizeof *s->cell_start);
+    for (uint32_t i = 0; i < n; ++i)
+        s->cell_start[s->key[i] + 1]++;
     for (uint32_t c = 0; c < s->ncells; ++c)
         s->cell_start[c + 1] += s->cell_start[c];
     /* scatter using cell_start as running cursors, then restore it */
@@ -1021,16 +1044,8 @@ static void build_grid(vfx_sph *s)
     for (uint32_t c = s->ncells; c > 0; --c)
         s->cell_start[c] = s->cell_start[c - 1];
     s->cell_start[0] = 0;
-    float **cols[] = {&s->x, &s->y, &s->z, &s->vx, &s->vy, &s->vz};
-    for (size_t c = 0; c < 6; ++c) {
-        float *src = *cols[c], *dst = s->tmp;
-        for (uint32_t i = 0; i < n; ++i)
-            dst[i] = src[s->perm[i]];
-        s->tmp = src;
-        *cols[c] = dst;
-    }
-    for (uint32_t i = 0; i < n; ++i)
-        s->idtmp[i] = s->id[s->perm[i]];
+    parallel(s, permute_chunk, false);
+    swap_state(s);
     uint32_t *t = s->id;
     s->id = s->idtmp;
     s->idtmp = t;
