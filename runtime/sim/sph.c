@@ -530,6 +530,11 @@ vfx_result vfx_sph_add_particles(vfx_sph *s, uint32_t n, const float *x, const f
         set_err(s, "vfx_sph_add_particles: position array is NULL for %u particles", n);
         return VFX_ERR_INVALID_ARGUMENT;
     }
+    if ((uint64_t)s->n + n > s->p.max_particles) {
+        set_err(s, "vfx_sph_add_particles: %u + %u particles exceed the capacity bound %u "
+                "(desc.max_particles)", s->n, n, s->p.max_particles);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
     const float *arr[6] = {x, y, z, vx, vy, vz};
     static const char *nm[6] = {"x", "y", "z", "vx", "vy", "vz"};
     for (uint32_t i = 0; i < n; ++i)

@@ -112,6 +112,9 @@ static void test_bad_desc_and_input(void **state)
     assert_non_null(strstr(vfx_sph_last_error(s), "particle 4"));
     assert_non_null(strstr(vfx_sph_last_error(s), "vz"));
     assert_int_equal(vfx_sph_add_particles(s, 5, NULL, y, z, NULL, NULL, NULL), VFX_ERR_INVALID_ARGUMENT);
+    /* a huge count is refused before any array is read */
+    assert_int_equal(vfx_sph_add_particles(s, UINT32_MAX, x, y, z, NULL, NULL, NULL), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(vfx_sph_last_error(s), "capacity"));
     assert_int_equal(vfx_sph_add_particles(s, 5, x, y, z, NULL, NULL, NULL), VFX_OK);
     vfx_sph_report r;
     assert_int_equal(vfx_sph_step(s, NAN, &r), VFX_ERR_INVALID_ARGUMENT);
