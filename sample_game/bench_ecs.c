@@ -13,18 +13,6 @@
 
 int vfx_bench_ecs(int argc, char **argv);
 
-static int cmp(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 int vfx_bench_ecs(int argc, char **argv)
 {
     uint32_t n = 1000000;
@@ -61,7 +49,7 @@ int vfx_bench_ecs(int argc, char **argv)
         }
         t[r] = vfx_now_ms() - t0;
     }
-    double iter_ns = median(t, reps) * 1e6 / n;
+    double iter_ns = vfx_median(t, (uint32_t)reps) * 1e6 / n;
     vfx_gl_context *gl = NULL;
     vfx_gl_context_desc gd = {.mode = VFX_GL_HEADLESS};
     double upload_mbs = NAN;
@@ -82,7 +70,7 @@ int vfx_bench_ecs(int argc, char **argv)
             glFinish();
             t[r] = vfx_now_ms() - t0;
         }
-        upload_mbs = 3.0 * bytes / (median(t, reps) * 1e-3) / 1e6;
+        upload_mbs = 3.0 * bytes / (vfx_median(t, (uint32_t)reps) * 1e-3) / 1e6;
         glDeleteBuffers(1, &buf);
     }
     printf("{\"effect\":\"ecs\",\"entities\":%u,\"reps\":%d,\"iterate_ns_per_entity\":%.4f,"

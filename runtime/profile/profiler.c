@@ -217,10 +217,17 @@ double vfx_profiler_series_median(const vfx_profiler *p, const char *name)
         if (!isnan(x))
             v[n++] = x;
     }
-    qsort(v, n, sizeof(double), cmp_double);
-    double m = n ? (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2])) : NAN;
+    double m = vfx_median(v, n);
     free(v);
     return m;
+}
+
+double vfx_median(double *v, uint32_t n)
+{
+    if (n == 0)
+        return NAN;
+    qsort(v, n, sizeof(double), cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 vfx_result vfx_profiler_write_csv(const vfx_profiler *p, const char *path)

@@ -41,6 +41,8 @@ double vfx_profiler_series_median(const vfx_profiler *p, const char *name);
 vfx_result vfx_profiler_write_csv(const vfx_profiler *p, const char *path);
 /* Writes Chrome trace-event JSON (complete events "ph":"X", pid 1, tid 1 CPU, tid 2 GPU). */
 vfx_result vfx_profiler_write_trace(const vfx_profiler *p, const char *path);
+/* Median of v[0..n) (sorts v in place); NAN when n is 0. */
+double vfx_median(double *v, uint32_t n);
 /* Monotonic clock in ms. */
 double vfx_now_ms(void);
 

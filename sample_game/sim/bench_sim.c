@@ -7,6 +7,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "profile/profiler.h"
 #include "sim/sph.h"
 
 int vfx_bench_sim(int argc, char **argv);
@@ -16,18 +17,6 @@ static double now_s(void)
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int cmp_d(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_d);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 static void cpu_model(char *out, size_t len)
@@ -97,7 +86,7 @@ static int bench_size(uint32_t n_target, uint32_t threads, int substeps, int rep
         ms[i] = 1e3 * t / r.substeps;
     }
     if (!rc && ps && is && ms) {
-        double p = median(ps, reps), in = median(is, reps), m = median(ms, reps);
+        double p = vfx_median(ps, (uint32_t)reps), in = vfx_median(is, (uint32_t)reps), m = vfx_median(ms, (uint32_t)reps);
         printf("{\"effect\":\"sim\",\"particles\":%u,\"threads\":%u,\"substeps_per_rep\":%d,\"reps\":%d,"
                "\"particle_steps_per_s\":%.0f,\"particle_steps_per_s_per_thread\":%.0f,"
                "\"neighbour_interactions_per_s\":%.0f,\"ms_per_substep\":%.3f,"
