@@ -9,14 +9,9 @@
  *    of its own inputs: a ray 1e6 units away from a beam of radius 1 moves by 0.1 when its
  *    direction moves by one ulp. Where the inputs are well conditioned (cond << 1e-5) this is
  *    the issue's 1e-5 target. The test also counts how many cases needed the cond term.
- *  - float64 closed form: 2e-5 + cond * (DBL_EPSILON / FLT_EPSILON). This is NOT the accuracy
- *    of the closed form: the adaptive quadrature, asked for 1e-12, still converges falsely on
- *    some random rays (its error fell from 6e-4 to below 1e-5 when a minimum of 2^8 pieces per
- *    breakpoint interval was forced, with float32 and float64 closed forms agreeing to 1e-7
- *    there), so the float64 check is bounded by the reference, not by the closed form.
- *  - Known open case "through M+L*D exactly, eps=0": the hand value is
- *    asinh(1/s)*(1/0.8 + 1) = 32.64 (s = 1e-6 R), the quadrature gives 32.598, float32 32.49
- *    and float64 32.38. It is reported, not counted, until it is understood (docs/beams.md).
+ *  - float64 closed form: 1e-8 + cond * (DBL_EPSILON / FLT_EPSILON). The quadrature is asked
+ *    for 1e-12 relative but near a 1/r peak at the 1e-6 R softening floor the density itself is
+ *    only good to ~eps*|t|/width (see beams_ref.c); 8.5e-10 was the largest difference seen.
  * Cases whose reference H is 0 must give 0 (outside the support nothing is added) unless the
  * ray grazes the support (cond-limited), where |H| <= 1e-6 * (a + b) is accepted. */
 #include <float.h>
@@ -94,8 +89,12 @@ typedef struct tally {
 
 static void check(tally *t, const tcase *c)
 {
-    int known_open = strcmp(c->name, "through M+L*D exactly, eps=0") == 0;
     double od[3] = {c->o[0], c->o[1], c->o[2]}, vd[3] = {c->v[0], c->v[1], c->v[2]};
+    /* The float direction is unit only to ~6e-8; the float64 paths take t as arc length, so
+     * they get the exactly normalised direction (else both would be off by |v| - 1). */
+    double vn = sqrt(vd[0] * vd[0] + vd[1] * vd[1] + vd[2] * vd[2]);
+    for (int k = 0; k < 3; ++k)
+        vd[k] /= vn;
     double ref = NAN;
     vfx_beam_d bd;
     char err[256];
@@ -128,7 +127,7 @@ static void check(tally *t, const tcase *c)
         return;
     }
     double ef = fabs(hf - ref) / ref, ed = fabs(hd - ref) / ref;
-    double tol_f = 1e-5 + cond, tol_d = 2e-5 + cond * (DBL_EPSILON / FLT_EPSILON);
+    double tol_f = 1e-5 + cond, tol_d = 1e-8 + cond * (DBL_EPSILON / FLT_EPSILON);
     if (ef > 1e-5)
         t->cond_limited++;
     if (ef > t->max_rel_f)
@@ -147,10 +146,6 @@ static void check(tally *t, const tcase *c)
             sum += vfx_beam_density_d(&bd, pp);
         }
         printf("  brute %.12g\n", sum * hstep);
-    }
-    if (known_open && (ef > tol_f || ed > tol_d)) {
-        printf("KNOWN OPEN %s: ref %.17g f32 %.9g f64 %.17g\n", c->name, ref, hf, hd);
-        return;
     }
     if (ef > tol_f || ed > tol_d) {
         printf("FAIL %s: ref %.17g f32 %.9g (rel %.3g, tol %.3g) f64 %.17g (rel %.3g, tol %.3g)\n",
