@@ -1,0 +1,153 @@
+/* bench_water.c — volfx-bench metaballs: frame time of the water effect on the paper's layout
+ * (24x24 square layers stacked, spacing 0.3), one JSON object per configuration. Only the
+ * brute-force baseline exists so far (docs/water.md), so that is what is timed.
+ * Options: --particles N (repeatable) --size S (repeatable) --frames F --reference. */
+#include <epoxy/gl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "gfx/gl_context.h"
+#include "plugin_internal.h"
+#include "profile/profiler.h"
+#include "reference/reference.h"
+#include "water/water_ref.h"
+
+typedef struct bench_scene {
+    float *x, *y, *z;
+    uint32_t n;
+} bench_scene;
+
+static uint32_t bench_chunks(void *user) { return ((bench_scene *)user)->n ? 1 : 0; }
+
+static vfx_result bench_chunk(void *user, uint32_t index, vfx_particle_view *out)
+{
+    (void)index;
+    bench_scene *s = user;
+    out->count = s->n;
+    out->pos[0] = s->x;
+    out->pos[1] = s->y;
+    out->pos[2] = s->z;
+    return VFX_OK;
+}
+
+static vfx_result bench_params(void *user, vfx_water_params *out)
+{
+    (void)user;
+    memset(out, 0, sizeof *out);
+    out->size = sizeof *out;
+    out->version = VFX_WATER_PARAMS_VERSION;
+    out->method = VFX_WATER_METHOD_BRUTE;
+    return VFX_OK;
+}
+
+static double now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+}
+
+static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference)
+{
+    bench_scene s = {malloc(n * 4), malloc(n * 4), malloc(n * 4), n};
+    vfx_water_ref_layers(n, 0.3, s.x, s.y, s.z);
+    double top = (double)((n - 1) / 576) * 0.3;
+    vfx_ref_camera cam = {{0, top + 4.0, 8.0}, {0, top * 0.5, 0}, {0, 1, 0}, 0.9, size, size, 0.1, 100};
+    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &s,
+                         .particle_chunk_count = bench_chunks, .particle_chunk = bench_chunk,
+                         .water_params = bench_params};
+    vfx_plugin_api api = {.size = sizeof api};
+    vfx_context *ctx = NULL;
+    if (vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api) != VFX_OK || api.create(&host, &ctx) != VFX_OK) {
+        fprintf(stderr, "metaballs: plugin create failed\n");
+        return 1;
+    }
+    GLuint fbo, col;
+    glCreateTextures(GL_TEXTURE_2D, 1, &col);
+    glTextureStorage2D(col, 1, GL_RGBA8, (GLsizei)size, (GLsizei)size);
+    glCreateFramebuffers(1, &fbo);
+    glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, col, 0);
+    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = fbo,
+                         .width = size, .height = size, .fov_y = 0.9f, .near_plane = 0.1f, .far_plane = 100.f};
+    for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam.eye[k];
+    vfx_ref_camera_matrices(&cam, fv.view, fv.proj);
+    double *ms = malloc(frames * sizeof *ms);
+    int rc = 0;
+    for (uint32_t f = 0; f < frames && rc == 0; ++f) {
+        double t0 = now_ms();
+        if (api.update(ctx, f / 60.0, 1.f / 60.f) != VFX_OK || api.render(ctx, &fv) != VFX_OK) {
+            fprintf(stderr, "metaballs: frame failed: %s\n", api.last_error(ctx));
+            rc = 1;
+        }
+        glFinish();
+        ms[f] = now_ms() - t0;
+    }
+    double p50 = vfx_median(ms, frames);
+    printf("{\"effect\":\"metaballs\",\"method\":\"brute\",\"particles\":%u,\"width\":%u,\"height\":%u,"
+           "\"frames\":%u,\"frame_ms\":{\"p50\":%.2f},\"gl_renderer\":\"%s\"",
+           n, size, size, frames, p50, (const char *)glGetString(GL_RENDERER));
+    if (reference && rc == 0) {
+        float *gpu = malloc((size_t)size * size * 4), *ref = malloc((size_t)size * size * 4);
+        api.read_raw(ctx, VFX_EFFECT_WATER, gpu, (size_t)size * size);
+        double fwd[3], right[3], up[3];
+        vfx_ref_camera_basis(&cam, fwd, right, up);
+        vfx_water_ref_camera rc2 = {{cam.eye[0], cam.eye[1], cam.eye[2]}, {fwd[0], fwd[1], fwd[2]},
+                                    {up[0], up[1], up[2]}, cam.fov_y, size, size};
+        vfx_water_ref_params rp = vfx_water_ref_default_params();
+        vfx_water_ref_error e;
+        char err[256];
+        double r0 = now_ms();
+        if (vfx_water_ref_render(&rc2, s.x, s.y, s.z, n, &rp, ref, NULL, NULL, err) == 0 &&
+            vfx_water_ref_compare(gpu, NULL, ref, NULL, (size_t)size * size, rp.h, &e) == 0)
+            printf(",\"reference_ms\":%.1f,\"ref_hits\":%u,\"hole_rate\":%.5f,\"false_hit_rate\":%.5f,"
+                   "\"dist_mean_rel_h\":%.2e,\"dist_p99_rel_h\":%.2e",
+                   now_ms() - r0, e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_mean_rel_h, e.dist_p99_rel_h);
+        free(gpu);
+        free(ref);
+    }
+    printf("}\n");
+    fflush(stdout);
+    free(ms);
+    api.destroy(ctx);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteTextures(1, &col);
+    free(s.x); free(s.y); free(s.z);
+    return rc;
+}
+
+int vfx_bench_metaballs(int argc, char **argv)
+{
+    uint32_t parts[8], sizes[8], np = 0, ns = 0, frames = 3;
+    int reference = 0;
+    for (int i = 1; i < argc; ++i) {
+        if (!strcmp(argv[i], "--particles") && i + 1 < argc && np < 8) parts[np++] = (uint32_t)atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--size") && i + 1 < argc && ns < 8) sizes[ns++] = (uint32_t)atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--frames") && i + 1 < argc) frames = (uint32_t)atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--reference")) reference = 1;
+        else if (!strcmp(argv[i], "--json")) continue;
+        else { fprintf(stderr, "metaballs: unknown option %s\n", argv[i]); return 2; }
+    }
+    if (!np) parts[np++] = 4096;
+    if (!ns) sizes[ns++] = 128;
+    if (frames == 0) frames = 1;
+    vfx_gl_context *gl = NULL;
+    vfx_gl_context_desc d = {.mode = VFX_GL_HEADLESS, .width = 64, .height = 64};
+    if (vfx_gl_context_create(&d, &gl) != VFX_OK) {
+        fprintf(stderr, "metaballs: no headless GL 4.5 context\n");
+        return 1;
+    }
+    int rc = 0;
+    for (uint32_t a = 0; a < np && !rc; ++a)
+        for (uint32_t b = 0; b < ns && !rc; ++b) {
+            if (parts[a] == 0 || sizes[b] == 0 || sizes[b] > 4096) {
+                fprintf(stderr, "metaballs: bad size %u or particle count %u\n", sizes[b], parts[a]);
+                rc = 2;
+                break;
+            }
+            rc = run_one(parts[a], sizes[b], frames, reference);
+        }
+    vfx_gl_context_destroy(gl);
+    return rc;
+}
