@@ -1,8 +1,11 @@
-/* water_effect.c — metaball water (seed 000). State of this file: the brute-force baseline
- * (per-pixel march over every particle, compute shader) is what runs; the paper's billboard /
- * blending pipeline and the grid baseline are not written yet, and asking for them falls back
- * to brute force with a counter (water.method_fallback) and a one-time warning. */
+/* water_effect.c — metaball water (seed 000, Mishima et al.). Method PAPER: billboard init by
+ * depth test (eq. 1), potentials by additive blending into RGBA16F at 4 samples per texel,
+ * sample update with two distance buffers and depth-tested gap jumping (eqs. 2-4), min/max
+ * pyramid culling, eq. 5 interpolation and eq. 6 regula falsi (each pass again by blending).
+ * Method BRUTE: per-pixel compute march over every particle. Method GRID is not written yet
+ * and falls back to BRUTE with a counter (water.method_fallback) and a one-time warning. */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "gpu/gpu.h"
@@ -16,7 +19,34 @@ typedef struct water_state {
     uint32_t width, height;
     vfx_water_params params;
     int warned_fallback;
+    float lo[3], hi[3];    /* box of the finite particles */
+    /* paper pipeline targets */
+    GLuint cur, next1, pot, st, br, reft, depth, pyr, fbo_dist, fbo_pot, counters;
+    int pyr_levels;
+    float view_proj[16];
+    GLuint vao; /* empty: billboards are built from gl_VertexID / gl_InstanceID */
 } water_state;
+
+static void paper_free(water_state *s)
+{
+    GLuint tex[] = {s->cur, s->next1, s->pot, s->st, s->br, s->reft, s->depth, s->pyr};
+    glDeleteTextures(8, tex);
+    GLuint fb[] = {s->fbo_dist, s->fbo_pot};
+    glDeleteFramebuffers(2, fb);
+    s->cur = s->next1 = s->pot = s->st = s->br = s->reft = s->depth = s->pyr = 0;
+    s->fbo_dist = s->fbo_pot = 0;
+}
+
+static GLuint make_tex(GLenum fmt, uint32_t w, uint32_t h, int levels, const char *label)
+{
+    GLuint t;
+    glCreateTextures(GL_TEXTURE_2D, 1, &t);
+    glTextureStorage2D(t, levels, fmt, (GLsizei)w, (GLsizei)h);
+    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    vfx_gpu_label(GL_TEXTURE, t, label);
+    return t;
+}
 
 static void water_defaults(vfx_water_params *p)
 {
@@ -43,6 +73,7 @@ static vfx_result water_create(vfx_context *ctx, void **out)
     water_state *s = vfx_alloc(ctx, sizeof *s);
     if (!s)
         return VFX_ERR_OUT_OF_MEMORY;
+    glCreateVertexArrays(1, &s->vao);
     *out = s;
     return VFX_OK;
 }
@@ -52,6 +83,10 @@ static void water_destroy(vfx_context *ctx, void *state)
     water_state *s = state;
     if (s->cols[0])
         glDeleteBuffers(3, s->cols);
+    paper_free(s);
+    glDeleteVertexArrays(1, &s->vao);
+    if (s->counters)
+        glDeleteBuffers(1, &s->counters);
     if (ctx->water_dist_tex) {
         glDeleteTextures(1, &ctx->water_dist_tex);
         ctx->water_dist_tex = 0;
@@ -71,6 +106,31 @@ static vfx_result water_resize(vfx_context *ctx, void *state, uint32_t width, ui
     vfx_gpu_label(GL_TEXTURE, ctx->water_dist_tex, "water.dist");
     s->width = width;
     s->height = height;
+    paper_free(s);
+    s->cur = make_tex(GL_R32F, width, height, 1, "water.dist_cur");
+    s->next1 = make_tex(GL_R32F, width, height, 1, "water.dist_next");
+    s->pot = make_tex(GL_RGBA16F, width, height, 1, "water.potential");
+    s->st = make_tex(GL_RGBA32F, width, height, 1, "water.state");
+    s->br = make_tex(GL_RGBA32F, width, height, 1, "water.bracket");
+    s->reft = make_tex(GL_R32F, width, height, 1, "water.refine_t");
+    s->depth = make_tex(GL_DEPTH_COMPONENT32F, width, height, 1, "water.depth");
+    int levels = 1;
+    while (levels < 8 && ((width >> levels) > 0 || (height >> levels) > 0))
+        ++levels;
+    s->pyr_levels = levels;
+    s->pyr = make_tex(GL_RG32F, width, height, levels, "water.minmax_pyramid");
+    glCreateFramebuffers(1, &s->fbo_dist);
+    glNamedFramebufferTexture(s->fbo_dist, GL_COLOR_ATTACHMENT0, s->cur, 0);
+    glNamedFramebufferTexture(s->fbo_dist, GL_DEPTH_ATTACHMENT, s->depth, 0);
+    glCreateFramebuffers(1, &s->fbo_pot);
+    glNamedFramebufferTexture(s->fbo_pot, GL_COLOR_ATTACHMENT0, s->pot, 0);
+    if (glCheckNamedFramebufferStatus(s->fbo_dist, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE ||
+        glCheckNamedFramebufferStatus(s->fbo_pot, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        return vfx_fail(ctx, VFX_ERR_GL, "water resize %ux%u: incomplete framebuffer", width, height);
+    if (!s->counters) {
+        glCreateBuffers(1, &s->counters);
+        glNamedBufferStorage(s->counters, 8 * sizeof(uint32_t), NULL, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
+    }
     const char *e = vfx_gpu_error_string();
     if (e)
         return vfx_fail(ctx, VFX_ERR_GL, "water resize %ux%u: %s", width, height, e);
@@ -116,6 +176,7 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
             glNamedBufferStorage(s->cols[k], (GLsizeiptr)s->capacity * 4, NULL, GL_DYNAMIC_STORAGE_BIT);
     }
     uint32_t off = 0, nan_count = 0;
+    int seen = 0;
     for (uint32_t c = 0; c < chunks; ++c) {
         vfx_particle_view v = {.size = sizeof v, .version = VFX_PARTICLE_VIEW_VERSION};
         ctx->host.particle_chunk(ctx->host.user, c, &v);
@@ -124,9 +185,18 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
                 glNamedBufferSubData(s->cols[k], (GLintptr)off * 4, (GLsizeiptr)v.count * 4, v.pos[k]);
         /* NaN/Inf positions are uploaded as they are and skipped by the shaders (a NaN
          * distance fails every `<` test); counted here so the host can see them. */
-        for (uint32_t i = 0; i < v.count; ++i)
-            if (!isfinite(v.pos[0][i]) || !isfinite(v.pos[1][i]) || !isfinite(v.pos[2][i]))
+        for (uint32_t i = 0; i < v.count; ++i) {
+            float q[3] = {v.pos[0][i], v.pos[1][i], v.pos[2][i]};
+            if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) {
                 ++nan_count;
+                continue;
+            }
+            for (int k = 0; k < 3; ++k) {
+                if (!seen || q[k] < s->lo[k]) s->lo[k] = q[k];
+                if (!seen || q[k] > s->hi[k]) s->hi[k] = q[k];
+            }
+            seen = 1;
+        }
         off += v.count;
     }
     s->count = off;
@@ -137,18 +207,50 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
     return VFX_OK;
 }
 
-static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
-                               vfx_frame_targets *targets)
+
+static void set_common(GLuint prog, const water_state *s, const vfx_frame_view *frame,
+                       const vfx_frame_targets *targets, float t_end)
 {
-    water_state *s = state;
     const vfx_water_params *p = &s->params;
-    targets->water_dist = ctx->water_dist_tex;
-    vfx_stat_set(ctx, "water.particles", s->count);
-    vfx_stat_set(ctx, "water.nan_skipped", s->nan_count);
+    glUniformMatrix4fv(glGetUniformLocation(prog, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
+    glUniform3fv(glGetUniformLocation(prog, "u_eye"), 1, frame->eye);
+    glUniform1f(glGetUniformLocation(prog, "u_h"), p->h);
+    glUniform1f(glGetUniformLocation(prog, "u_T"), p->threshold);
+    glUniform1f(glGetUniformLocation(prog, "u_step"), p->step);
+    glUniform1f(glGetUniformLocation(prog, "u_t_end"), t_end);
+    glUniform1f(glGetUniformLocation(prog, "u_near"), frame->near_plane > 0 ? frame->near_plane : 0.01f);
+    glUniform1ui(glGetUniformLocation(prog, "u_max_samples"), p->max_samples);
+    glUniform1ui(glGetUniformLocation(prog, "u_count"), s->count);
+    glUniform1i(glGetUniformLocation(prog, "u_has_depth"), frame->depth_texture != 0);
+    glUniform2i(glGetUniformLocation(prog, "u_size"), (GLint)s->width, (GLint)s->height);
+    glUniform2f(glGetUniformLocation(prog, "u_sizef"), (float)s->width, (float)s->height);
+    if (frame->depth_texture)
+        glBindTextureUnit(1, frame->depth_texture);
+}
+
+static void dispatch(const water_state *s)
+{
+    glDispatchCompute((s->width + 7) / 8, (s->height + 7) / 8, 1);
+    glMemoryBarrier(GL_ALL_BARRIER_BITS);
+}
+
+/* Draws every particle's billboard with `prog` (one instanced strip). */
+static void draw_billboards(vfx_context *ctx, const water_state *s)
+{
+    (void)ctx;
+    glBindVertexArray(s->vao);
+    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)s->count);
+    glMemoryBarrier(GL_ALL_BARRIER_BITS);
+}
+
+static vfx_result brute_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
+                              vfx_frame_targets *targets)
+{
+    const vfx_water_params *p = &s->params;
     if (p->method != VFX_WATER_METHOD_BRUTE) {
         vfx_stat_set(ctx, "water.method_fallback", 1);
         if (!s->warned_fallback) {
-            vfx_log(ctx, VFX_LOG_WARN, "water: method %u is not implemented yet; rendering with the brute-force baseline", p->method);
+            vfx_log(ctx, VFX_LOG_WARN, "water: method %u (grid) is not implemented yet; rendering with the brute-force baseline", p->method);
             s->warned_fallback = 1;
         }
     }
@@ -173,6 +275,249 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     glDispatchCompute((s->width + 7) / 8, (s->height + 7) / 8, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     vfx_gpu_pass_end(ctx);
+    return VFX_OK;
+}
+
+/* Potentials at the current samples (tex `at`, NS samples from it) into s->pot: additive
+ * blending of billboards (technique 3) or the compute-shader sum (VFX_WATER_NO_BLEND). */
+static vfx_result potential_pass(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
+                                 const vfx_frame_targets *targets, GLuint at, int ns, int cull,
+                                 float t_end)
+{
+    char defs[96];
+    if (s->params.disable & VFX_WATER_NO_BLEND) {
+        snprintf(defs, sizeof defs, "#define MODE_POTSUM\n#define NS %d\n", ns);
+        GLuint prog = vfx_gpu_compute(ctx, "water/march.comp", defs);
+        if (!prog)
+            return VFX_ERR_GL;
+        glUseProgram(prog);
+        set_common(prog, s, frame, targets, t_end);
+        glBindImageTexture(2, at, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
+        glBindImageTexture(5, s->pot, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+        dispatch(s);
+        return VFX_OK;
+    }
+    snprintf(defs, sizeof defs, "#define PASS_POT\n#define NS %d\n", ns);
+    GLuint prog = vfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", defs);
+    if (!prog)
+        return VFX_ERR_GL;
+    glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_pot);
+    glViewport(0, 0, (GLsizei)s->width, (GLsizei)s->height);
+    float zero[4] = {0, 0, 0, 0};
+    glClearNamedFramebufferfv(s->fbo_pot, GL_COLOR, 0, zero);
+    glDisable(GL_DEPTH_TEST);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glBlendEquation(GL_FUNC_ADD);
+    glUseProgram(prog);
+    set_common(prog, s, frame, targets, t_end);
+    glUniformMatrix4fv(glGetUniformLocation(prog, "u_view_proj"), 1, GL_FALSE, s->view_proj);
+    glBindTextureUnit(0, at);
+    glBindTextureUnit(1, s->pyr);
+    int level = (int)s->params.pyramid_level;
+    if (level >= s->pyr_levels)
+        level = s->pyr_levels - 1;
+    glUniform1i(glGetUniformLocation(prog, "u_pyr_level"), level);
+    glUniform1i(glGetUniformLocation(prog, "u_cull"), cull);
+    draw_billboards(ctx, s);
+    glDisable(GL_BLEND);
+    return VFX_OK;
+}
+
+static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
+                              vfx_frame_targets *targets)
+{
+    const vfx_water_params *p = &s->params;
+    const uint32_t dis = p->disable;
+    const int ns = (dis & VFX_WATER_NO_PACK4) ? 1 : 4;
+    const int cull = !(dis & VFX_WATER_NO_PYRAMID);
+    /* farthest point of the particles' box grown by h: beyond it no sample can be inside */
+    float t_end = 0;
+    for (int c = 0; c < 8; ++c) {
+        float d2 = 0;
+        for (int k = 0; k < 3; ++k) {
+            float v = ((c >> k) & 1 ? s->hi[k] + p->h : s->lo[k] - p->h) - frame->eye[k];
+            d2 += v * v;
+        }
+        if (d2 > t_end) t_end = d2;
+    }
+    t_end = sqrtf(t_end);
+    float vp[16];
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) {
+            float a = 0;
+            for (int k = 0; k < 4; ++k)
+                a += frame->proj[k * 4 + r] * frame->view[c * 4 + k];
+            vp[c * 4 + r] = a;
+        }
+    memcpy(s->view_proj, vp, sizeof vp);
+    for (int k = 0; k < 3; ++k)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, s->cols[k]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->counters);
+    glClearNamedBufferData(s->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
+    float zero[4] = {0, 0, 0, 0}, far4[4] = {1e30f, 1e30f, 1e30f, 1e30f};
+    glClearTexImage(s->st, 0, GL_RGBA, GL_FLOAT, zero);
+    glClearTexImage(s->br, 0, GL_RGBA, GL_FLOAT, zero);
+    char defs[96];
+
+    /* (1) initial sample: nearest cube front face per pixel by the depth test (eq. 1) */
+    vfx_gpu_pass_begin(ctx, "water.init");
+    if (dis & VFX_WATER_NO_BILLBOARD_INIT) {
+        float nearv[4] = {frame->near_plane, 0, 0, 0};
+        glClearTexImage(s->cur, 0, GL_RED, GL_FLOAT, nearv);
+    } else {
+        GLuint prog = vfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_INIT\n#define NS 1\n");
+        if (!prog)
+            return VFX_ERR_GL;
+        glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_dist);
+        glViewport(0, 0, (GLsizei)s->width, (GLsizei)s->height);
+        glClearNamedFramebufferfv(s->fbo_dist, GL_COLOR, 0, far4);
+        glClearNamedFramebufferfi(s->fbo_dist, GL_DEPTH_STENCIL, 0, 1.0f, 0);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glDepthMask(GL_TRUE);
+        glDisable(GL_BLEND);
+        glUseProgram(prog);
+        set_common(prog, s, frame, targets, t_end);
+        glUniformMatrix4fv(glGetUniformLocation(prog, "u_view_proj"), 1, GL_FALSE, vp);
+        draw_billboards(ctx, s);
+        glDisable(GL_DEPTH_TEST);
+    }
+    vfx_gpu_pass_end(ctx);
+
+    uint32_t iters = (p->max_samples + (uint32_t)ns - 1) / (uint32_t)ns;
+    snprintf(defs, sizeof defs, "#define MODE_UPDATE\n#define NS %d\n", ns);
+    GLuint upd = vfx_gpu_compute(ctx, "water/march.comp", defs);
+    snprintf(defs, sizeof defs, "#define MODE_PYR0\n#define NS %d\n", ns);
+    GLuint pyr0 = vfx_gpu_compute(ctx, "water/march.comp", defs);
+    GLuint pyrd = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_PYRDOWN\n#define NS 1\n");
+    GLuint skip = vfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_SKIP\n#define NS 1\n");
+    if (!upd || !pyr0 || !pyrd || !skip)
+        return VFX_ERR_GL;
+    int level = (int)p->pyramid_level;
+    if (level >= s->pyr_levels)
+        level = s->pyr_levels - 1;
+    for (uint32_t it = 0; it < iters; ++it) {
+        /* (5) min/max pyramid of the current samples, 2x2 reductions down to `level` */
+        if (cull) {
+            vfx_gpu_pass_begin(ctx, "water.pyramid");
+            glUseProgram(pyr0);
+            set_common(pyr0, s, frame, targets, t_end);
+            glBindImageTexture(2, s->cur, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
+            glBindImageTexture(5, s->pyr, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
+            dispatch(s);
+            glUseProgram(pyrd);
+            for (int l = 1; l <= level; ++l) {
+                glBindImageTexture(5, s->pyr, l, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
+                glBindImageTexture(6, s->pyr, l - 1, GL_FALSE, 0, GL_READ_ONLY, GL_RG32F);
+                uint32_t w = s->width >> l, h = s->height >> l;
+                glDispatchCompute(((w ? w : 1) + 7) / 8, ((h ? h : 1) + 7) / 8, 1);
+                glMemoryBarrier(GL_ALL_BARRIER_BITS);
+            }
+            vfx_gpu_pass_end(ctx);
+        }
+        /* (3)+(4) potentials at NS consecutive samples */
+        vfx_gpu_pass_begin(ctx, "water.potential");
+        vfx_result r = potential_pass(ctx, s, frame, targets, s->cur, ns, cull, t_end);
+        vfx_gpu_pass_end(ctx);
+        if (r)
+            return r;
+        /* inside/outside, stop flag, t'_next = t + NS w (eq. 2) into buffer 1 */
+        vfx_gpu_pass_begin(ctx, "water.update");
+        glUseProgram(upd);
+        set_common(upd, s, frame, targets, t_end);
+        glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+        glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+        glBindImageTexture(2, s->cur, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
+        glBindImageTexture(3, s->next1, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindTextureUnit(0, s->pot);
+        dispatch(s);
+        vfx_gpu_pass_end(ctx);
+        /* (2) jump over gaps: buffer 2 = nearest candidate region at or after t'_next
+         * (eqs. 3-4, depth test); without it the next sample is t'_next itself */
+        vfx_gpu_pass_begin(ctx, "water.skip");
+        if (dis & VFX_WATER_NO_SKIP) {
+            GLuint t = s->cur;
+            s->cur = s->next1;
+            s->next1 = t;
+            glNamedFramebufferTexture(s->fbo_dist, GL_COLOR_ATTACHMENT0, s->cur, 0);
+        } else {
+            glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_dist);
+            glViewport(0, 0, (GLsizei)s->width, (GLsizei)s->height);
+            glClearNamedFramebufferfv(s->fbo_dist, GL_COLOR, 0, far4);
+            glClearNamedFramebufferfi(s->fbo_dist, GL_DEPTH_STENCIL, 0, 1.0f, 0);
+            glEnable(GL_DEPTH_TEST);
+            glDepthFunc(GL_LESS);
+            glDepthMask(GL_TRUE);
+            glUseProgram(skip);
+            set_common(skip, s, frame, targets, t_end);
+            glUniformMatrix4fv(glGetUniformLocation(skip, "u_view_proj"), 1, GL_FALSE, vp);
+            glBindTextureUnit(0, s->next1);
+            draw_billboards(ctx, s);
+            glDisable(GL_DEPTH_TEST);
+        }
+        vfx_gpu_pass_end(ctx);
+    }
+
+    /* (6) eq. 5 then eq. 6 regula falsi, each iteration's potential again by blending */
+    vfx_gpu_pass_begin(ctx, "water.refine");
+    GLuint interp = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_INTERP\n#define NS 1\n");
+    GLuint refine = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_REFINE\n#define NS 1\n");
+    GLuint fin = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_FINAL\n#define NS 1\n");
+    if (!interp || !refine || !fin)
+        return VFX_ERR_GL;
+    glUseProgram(interp);
+    set_common(interp, s, frame, targets, t_end);
+    glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+    dispatch(s);
+    uint32_t riters = (dis & VFX_WATER_NO_REFINE) ? 0 : p->refine_iters;
+    for (uint32_t it = 0; it < riters; ++it) {
+        vfx_result r = potential_pass(ctx, s, frame, targets, s->reft, 1, 0, t_end);
+        if (r)
+            return r;
+        glUseProgram(refine);
+        set_common(refine, s, frame, targets, t_end);
+        glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+        glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+        glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+        glBindTextureUnit(0, s->pot);
+        dispatch(s);
+    }
+    glUseProgram(fin);
+    set_common(fin, s, frame, targets, t_end);
+    glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+    glBindImageTexture(3, ctx->water_dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    dispatch(s);
+    vfx_gpu_pass_end(ctx);
+
+    /* counters: read back after the frame's work (a stall; acceptable for measurement) */
+    uint32_t c[6];
+    glGetNamedBufferSubData(s->counters, 0, sizeof c, c);
+    vfx_stat_set(ctx, "water.fragments_culled", c[0]);
+    vfx_stat_set(ctx, "water.potential_fragments", c[1]);
+    vfx_stat_set(ctx, "water.samples", c[2]);
+    vfx_stat_set(ctx, "water.pixels_found", c[3]);
+    vfx_stat_set(ctx, "water.pixels_sample_cap", c[4]);
+    vfx_stat_set(ctx, "water.pixels_left", c[5]);
+    return VFX_OK;
+}
+
+static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
+                               vfx_frame_targets *targets)
+{
+    water_state *s = state;
+    const vfx_water_params *p = &s->params;
+    targets->water_dist = ctx->water_dist_tex;
+    vfx_stat_set(ctx, "water.particles", s->count);
+    vfx_stat_set(ctx, "water.nan_skipped", s->nan_count);
+    vfx_result r = p->method == VFX_WATER_METHOD_PAPER ? paper_march(ctx, s, frame, targets)
+                                                       : brute_march(ctx, s, frame, targets);
+    if (r != VFX_OK)
+        return r;
 
     GLuint shade = vfx_gpu_program(ctx, "common/fullscreen.vert", "water/shade.frag", NULL);
     if (!shade)

@@ -186,6 +186,27 @@ static void test_coincident_and_nan(void **state)
     free_scene(&s);
 }
 
+/* The paper's method (every technique on) on the blob scene against the reference. */
+static void test_paper_blobs_vs_reference(void **state)
+{
+    (void)state;
+    scene s = make_scene(300);
+    s.params.method = VFX_WATER_METHOD_PAPER;
+    vfx_water_ref_blobs(s.n, 4, 1.0, 0.35, 7, s.x, s.y, s.z);
+    vfx_ref_camera cam = {{0.5, 1.0, 5.0}, {0, 0, 0}, {0, 1, 0}, 0.8, 64, 64, 0.1, 100};
+    vfx_stats st;
+    vfx_water_ref_error e = render_and_compare(&s, &cam, &st);
+    print_message("paper blobs: ref hits %u holes %.4f false %.4f dist mean %.2e p99 %.2e (x h) samples %.0f culled %.0f\n",
+                  e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_mean_rel_h, e.dist_p99_rel_h,
+                  stat_of(&st, "water.samples"), stat_of(&st, "water.fragments_culled"));
+    assert_true(e.ref_hits > 400);
+    assert_true(e.hole_rate < 0.02);
+    assert_true(e.false_hit_rate < 0.01);
+    assert_true(e.dist_mean_rel_h < 1e-2);
+    assert_true(e.dist_p99_rel_h < 5e-2);
+    free_scene(&s);
+}
+
 /* Zero particles: the effect is absent, no state, no pass, no stat. */
 static void test_zero_particles(void **state)
 {
@@ -207,6 +228,7 @@ int main(void)
         cmocka_unit_test(test_one_particle_and_camera_inside),
         cmocka_unit_test(test_coincident_and_nan),
         cmocka_unit_test(test_zero_particles),
+        cmocka_unit_test(test_paper_blobs_vs_reference),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

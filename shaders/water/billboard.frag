@@ -1,0 +1,59 @@
+// Fragment stage of the three billboard passes, chosen by a define:
+//   PASS_INIT (eq. 1): t = D.(P - O) - h, nearest kept by the depth test.
+//   PASS_SKIP (eqs. 2-4): jump the next sample over gaps between candidate regions.
+//   PASS_POT: additive blending of this particle's potential at NS samples (RGBA = 4 samples).
+#include "common/depth.glsl"
+flat in vec3 v_p;
+uniform mat4 u_inv_view_proj;
+uniform vec3 u_eye;
+uniform float u_h, u_step;
+uniform vec2 u_sizef;
+layout(binding = 0) uniform sampler2D u_in;   // SKIP: t'_next; POT: current sample distance
+layout(binding = 1) uniform sampler2D u_pyr;  // POT: min/max pyramid (RG)
+uniform int u_pyr_level;
+uniform bool u_cull;
+layout(std430, binding = 4) buffer Counters { uint c_culled; uint c_frags; };
+out vec4 o_val;
+
+void main()
+{
+    ivec2 pix = ivec2(gl_FragCoord.xy);
+    vec2 ndc = gl_FragCoord.xy / u_sizef * 2.0 - 1.0;
+    vec3 dir = vfx_ray_dir(u_inv_view_proj, u_eye, ndc);
+    float tb = dot(dir, v_p - u_eye);
+#if defined(PASS_INIT)
+    float t = max(tb - u_h, 0.0);
+    if (tb < 0.0) discard; // candidate region wholly behind the eye
+    o_val = vec4(t);
+    gl_FragDepth = t / (t + 1.0);
+#elif defined(PASS_SKIP)
+    float tn = texelFetch(u_in, pix, 0).r;
+    if (tn >= 1.0e29) discard;          // stopped or finished ray
+    if (tb < tn) discard;               // eq. 3: region ends before the candidate sample
+    float tf = tb - u_h;
+    float nx = tf < tn ? tn : tf;       // eq. 4
+    o_val = vec4(nx);
+    gl_FragDepth = nx / (nx + 1.0);
+#else
+    float t = texelFetch(u_in, pix, 0).r;
+    if (t >= 1.0e29) discard;
+    float dc = length(v_p - u_eye);
+    if (u_cull) {
+        // Every sample x of the tile has |x - O| in [min, max]; |x - P| >= |dc - |x - O||.
+        vec2 mm = texelFetch(u_pyr, pix >> u_pyr_level, u_pyr_level).rg;
+        if (dc - u_h > mm.y || dc + u_h < mm.x) {
+            atomicAdd(c_culled, 1u);
+            discard;
+        }
+    }
+    atomicAdd(c_frags, 1u);
+    vec4 pot = vec4(0.0);
+    for (int s = 0; s < NS; ++s) {
+        vec3 x = u_eye + (t + float(s) * u_step) * dir;
+        float r = length(x - v_p);
+        float q = max(1.0 - r / u_h, 0.0);
+        pot[s] = q * q;
+    }
+    o_val = pot;
+#endif
+}
