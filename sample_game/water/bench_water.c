@@ -1,7 +1,7 @@
 /* bench_water.c — volfx-bench metaballs: frame time of the water effect on the paper's layout
- * (24x24 square layers stacked, spacing 0.3), one JSON object per configuration. Only the
- * brute-force baseline exists so far (docs/water.md), so that is what is timed.
- * Options: --particles N (repeatable) --size S (repeatable) --frames F --reference. */
+ * (24x24 square layers stacked, spacing 0.3), one JSON object per configuration.
+ * Options: --particles N (repeatable) --size S (repeatable) --frames F --reference
+ * --method paper|brute|grid --disable BITS (VFX_WATER_NO_*) --samples CAP. */
 #include <epoxy/gl.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,6 +17,7 @@
 typedef struct bench_scene {
     float *x, *y, *z;
     uint32_t n;
+    uint32_t method, disable, max_samples;
 } bench_scene;
 
 static uint32_t bench_chunks(void *user) { return ((bench_scene *)user)->n ? 1 : 0; }
@@ -34,11 +35,13 @@ static vfx_result bench_chunk(void *user, uint32_t index, vfx_particle_view *out
 
 static vfx_result bench_params(void *user, vfx_water_params *out)
 {
-    (void)user;
+    bench_scene *s = user;
     memset(out, 0, sizeof *out);
     out->size = sizeof *out;
     out->version = VFX_WATER_PARAMS_VERSION;
-    out->method = VFX_WATER_METHOD_BRUTE;
+    out->method = s->method;
+    out->disable = s->disable;
+    out->max_samples = s->max_samples;
     return VFX_OK;
 }
 
@@ -49,9 +52,12 @@ static double now_ms(void)
     return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
 }
 
-static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference)
+static const char *method_name(uint32_t m) { return m == 0 ? "paper" : m == 1 ? "brute" : "grid"; }
+
+static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, uint32_t method,
+                   uint32_t disable, uint32_t max_samples)
 {
-    bench_scene s = {malloc(n * 4), malloc(n * 4), malloc(n * 4), n};
+    bench_scene s = {malloc(n * 4), malloc(n * 4), malloc(n * 4), n, method, disable, max_samples};
     vfx_water_ref_layers(n, 0.3, s.x, s.y, s.z);
     double top = (double)((n - 1) / 576) * 0.3;
     vfx_ref_camera cam = {{0, top + 4.0, 8.0}, {0, top * 0.5, 0}, {0, 1, 0}, 0.9, size, size, 0.1, 100};
@@ -85,9 +91,17 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference)
         ms[f] = now_ms() - t0;
     }
     double p50 = vfx_median(ms, frames);
-    printf("{\"effect\":\"metaballs\",\"method\":\"brute\",\"particles\":%u,\"width\":%u,\"height\":%u,"
+    printf("{\"effect\":\"metaballs\",\"method\":\"%s\",\"disable\":%u,\"max_samples\":%u,\"particles\":%u,\"width\":%u,\"height\":%u,"
            "\"frames\":%u,\"frame_ms\":{\"p50\":%.2f},\"gl_renderer\":\"%s\"",
-           n, size, size, frames, p50, (const char *)glGetString(GL_RENDERER));
+           method_name(method), disable, max_samples ? max_samples : 64, n, size, size, frames, p50,
+           (const char *)glGetString(GL_RENDERER));
+    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+    if (api.get_stats(ctx, &st) == VFX_OK) {
+        printf(",\"counters\":{");
+        for (uint32_t k = 0; k < st.count; ++k)
+            printf("%s\"%s\":%.4g", k ? "," : "", st.entries[k].name, st.entries[k].value);
+        printf("}");
+    }
     if (reference && rc == 0) {
         float *gpu = malloc((size_t)size * size * 4), *ref = malloc((size_t)size * size * 4);
         api.read_raw(ctx, VFX_EFFECT_WATER, gpu, (size_t)size * size);
@@ -119,13 +133,20 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference)
 
 int vfx_bench_metaballs(int argc, char **argv)
 {
-    uint32_t parts[8], sizes[8], np = 0, ns = 0, frames = 3;
+    uint32_t parts[8], sizes[8], np = 0, ns = 0, frames = 3, method = 0, disable = 0, cap = 0;
     int reference = 0;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--particles") && i + 1 < argc && np < 8) parts[np++] = (uint32_t)atoi(argv[++i]);
         else if (!strcmp(argv[i], "--size") && i + 1 < argc && ns < 8) sizes[ns++] = (uint32_t)atoi(argv[++i]);
         else if (!strcmp(argv[i], "--frames") && i + 1 < argc) frames = (uint32_t)atoi(argv[++i]);
         else if (!strcmp(argv[i], "--reference")) reference = 1;
+        else if (!strcmp(argv[i], "--method") && i + 1 < argc) {
+            ++i;
+            method = !strcmp(argv[i], "brute") ? 1 : !strcmp(argv[i], "grid") ? 2 : !strcmp(argv[i], "paper") ? 0 : 99;
+            if (method == 99) { fprintf(stderr, "metaballs: --method paper|brute|grid, not %s\n", argv[i]); return 2; }
+        }
+        else if (!strcmp(argv[i], "--disable") && i + 1 < argc) disable = (uint32_t)strtoul(argv[++i], NULL, 0);
+        else if (!strcmp(argv[i], "--samples") && i + 1 < argc) cap = (uint32_t)atoi(argv[++i]);
         else if (!strcmp(argv[i], "--json")) continue;
         else { fprintf(stderr, "metaballs: unknown option %s\n", argv[i]); return 2; }
     }
@@ -146,7 +167,7 @@ int vfx_bench_metaballs(int argc, char **argv)
                 rc = 2;
                 break;
             }
-            rc = run_one(parts[a], sizes[b], frames, reference);
+            rc = run_one(parts[a], sizes[b], frames, reference, method, disable, cap);
         }
     vfx_gl_context_destroy(gl);
     return rc;
