@@ -1,0 +1,56 @@
+/* tet_render.h — CPU cell-projection renderer for tetrahedral meshes (seed 002): each tet is
+ * scan-converted into per-pixel ray segments kept in depth-ordered per-pixel lists with partial
+ * compositing on insert, with Conservative Subscreen Termination (DxD ERT table). */
+#ifndef VFX_TET_RENDER_H
+#define VFX_TET_RENDER_H
+
+#include <stdint.h>
+#include "tet_mesh.h"
+
+/* Perspective camera: column-major view and projection matrices (OpenGL/cglm convention). */
+typedef struct vfx_tet_camera {
+    float view[16];
+    float proj[16];
+    int width, height;
+} vfx_tet_camera;
+
+/* Linear transfer function over the normalised scalar u = (s - smin) / (smax - smin) clamped to
+ * [0,1]: extinction tau = tau_lo + (tau_hi - tau_lo) u per world unit, colour lerped. */
+typedef struct vfx_tet_tf {
+    float smin, smax;
+    float tau_lo, tau_hi;
+    float color_lo[3], color_hi[3];
+} vfx_tet_tf;
+
+typedef struct vfx_tet_options {
+    int ert;               /* 1: Conservative Subscreen Termination on */
+    float ert_threshold;   /* accumulated opacity at which a pixel counts as terminated */
+    int tiles_d;           /* D: the ERT table is D x D tiles */
+    int update_c;          /* C: table updated every (remaining cells)/C cells */
+    int partial_composite; /* 1: merge adjacent segments on insert */
+    const float *max_dist; /* optional width*height host depth as ray distance; NULL = none */
+} vfx_tet_options;
+
+typedef struct vfx_tet_counters {
+    uint64_t cells_scanned;      /* cells scan-converted */
+    uint64_t cells_skipped_ert;  /* N: cells skipped by subscreen termination */
+    uint64_t cells_behind;       /* cells wholly behind the near plane (skipped) */
+    uint64_t cells_near_crossing;/* cells crossing the near plane (ray-clipped at near) */
+    uint64_t cells_degenerate;   /* zero-volume cells (skipped) */
+    uint64_t cells_nan;          /* cells with a NaN scalar or coordinate (skipped) */
+    uint64_t segments_made;      /* ray segments produced by scan conversion */
+    uint64_t segments_merged;    /* of those, merged by partial compositing on insert */
+    uint64_t table_updates;
+    double t_sc_ms, t_update_ms, t_composite_ms;
+} vfx_tet_counters;
+
+/* Fills opts with the paper's defaults (ERT on, threshold 0.9, D = 20, C = 100, partial on). */
+void vfx_tet_options_default(vfx_tet_options *opts);
+
+/* Renders mesh (with its scalar) into rgba (width*height*4 floats, premultiplied, row 0 = bottom).
+ * Returns VFX_OK or an error code with a message in err; counters may be NULL. */
+int vfx_tet_render(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam, const vfx_tet_tf *tf,
+                   const vfx_tet_options *opts, float *rgba, vfx_tet_counters *counters,
+                   char err[256]);
+
+#endif
