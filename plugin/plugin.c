@@ -227,8 +227,8 @@ static vfx_result plugin_update(vfx_context *ctx, double time, float dt)
     return VFX_OK;
 }
 
-/* Column-major 4x4 inverse by cofactors, in double so near-singular projections keep digits. */
-static bool invert4(const float m[16], float out[16])
+/* Cofactors in double, so near-singular projections keep their digits. */
+bool vfx_mat4_invert(const float m[16], float out[16])
 {
     double a[16], inv[16];
     for (int i = 0; i < 16; ++i)
@@ -257,7 +257,7 @@ static bool invert4(const float m[16], float out[16])
     return true;
 }
 
-static void mul4(const float a[16], const float b[16], float out[16])
+void vfx_mat4_mul(const float a[16], const float b[16], float out[16])
 {
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r) {
@@ -291,8 +291,8 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
     targets.scene_depth = frame->depth_texture;
     targets.scene_color = frame->color_texture;
     float vp[16];
-    mul4(frame->proj, frame->view, vp);
-    if (!invert4(vp, targets.inv_view_proj))
+    vfx_mat4_mul(frame->proj, frame->view, vp);
+    if (!vfx_mat4_invert(vp, targets.inv_view_proj))
         return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: view*projection is singular");
 
     ctx->stats.count = 0;

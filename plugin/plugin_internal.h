@@ -75,5 +75,9 @@ void vfx_free(vfx_context *ctx, void *ptr);
 void vfx_stat_set(vfx_context *ctx, const char *name, double value);
 /* Adds to a named counter of the current frame. */
 void vfx_stat_add(vfx_context *ctx, const char *name, double value);
+/* Column-major 4x4 inverse (false when singular or not finite). */
+bool vfx_mat4_invert(const float m[16], float out[16]);
+/* out = a * b, column-major. */
+void vfx_mat4_mul(const float a[16], const float b[16], float out[16]);
 
 #endif
