@@ -71,7 +71,8 @@ static void over(seg *f, const seg *b)
 
 /* Inserts v into the pixel list at *head in order of zf; merges with the neighbours it touches
  * (the paper's partial compositing: a merged segment is again a segment). */
-static int insert_seg(seg_pool *p, int32_t *head, seg v, int partial, uint64_t *merged)
+static int insert_seg(seg_pool *p, int32_t *head, seg v, int partial, float stop,
+                      uint64_t *merged)
 {
     int32_t prev = -1, cur = *head;
     while (cur >= 0 && p->s[cur].zf < v.zf) {
@@ -80,20 +81,22 @@ static int insert_seg(seg_pool *p, int32_t *head, seg v, int partial, uint64_t *
     }
     if (partial) {
         float eps = TOUCH_EPS * (1.0f + fabsf(v.zf));
-        if (prev >= 0 && fabsf(p->s[prev].zb - v.zf) <= eps) {
+        /* never grow a segment that is already opaque past the ERT threshold: its z_back is
+         * where the pixel terminated, and growing it would push the termination depth back */
+        if (prev >= 0 && p->s[prev].a < stop && fabsf(p->s[prev].zb - v.zf) <= eps) {
             seg *ps = &p->s[prev];
             over(ps, &v);
             ps->zb = v.zb;
             (*merged)++;
             /* the grown segment may now touch its successor */
-            if (cur >= 0 && fabsf(ps->zb - p->s[cur].zf) <= eps) {
+            if (cur >= 0 && ps->a < stop && fabsf(ps->zb - p->s[cur].zf) <= eps) {
                 over(ps, &p->s[cur]);
                 ps->zb = p->s[cur].zb;
                 ps->next = p->s[cur].next;
             }
             return 0;
         }
-        if (cur >= 0 && fabsf(v.zb - p->s[cur].zf) <= eps) {
+        if (cur >= 0 && v.a < stop && fabsf(v.zb - p->s[cur].zf) <= eps) {
             seg *cs = &p->s[cur];
             seg m = v;
             over(&m, cs);
@@ -393,7 +396,7 @@ int vfx_tet_render(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam, const vf
                           (float)(rgb[1] * alpha), (float)(rgb[2] * alpha), (float)alpha, -1};
                 cnt.segments_made++;
                 if (insert_seg(&pool, &heads[pix], sg, opts->partial_composite,
-                               &cnt.segments_merged) != 0) {
+                               opts->ert_threshold, &cnt.segments_merged) != 0) {
                     snprintf(err, 256, "tet_render: out of memory at %zu segments", pool.n);
                     rc = VFX_ERR_OUT_OF_MEMORY;
                     goto done;
