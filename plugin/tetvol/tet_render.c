@@ -1,6 +1,8 @@
 /* tet_render.c — cell projection with per-pixel ray-segment lists, partial compositing and
  * Conservative Subscreen Termination (seed 002, sections 2.1 and 3.1). Single worker. */
+#if !defined(_POSIX_C_SOURCE) && !defined(_GNU_SOURCE)
 #define _POSIX_C_SOURCE 199309L
+#endif
 #include "tet_render.h"
 
 #include <math.h>
