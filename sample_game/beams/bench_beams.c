@@ -96,8 +96,13 @@ static int cmp_d(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+int vfx_bench_beams_gpu(int argc, char **argv);
+
 int vfx_bench_beams(int argc, char **argv)
 {
+    for (int i = 1; i < argc; ++i)
+        if (!strcmp(argv[i], "--gpu"))
+            return vfx_bench_beams_gpu(argc, argv);
     int reps = 5;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--reps") && i + 1 < argc) reps = atoi(argv[++i]);
