@@ -1,5 +1,5 @@
 /* tet_render.c — cell projection with per-pixel ray-segment lists, partial compositing and
- * Conservative Subscreen Termination (seed 002, sections 2.1 and 3.1). Single worker. */
+ * Conservative Subscreen Termination (seed 002, sections 2.1, 3.1, 3.2, 4.3.2), on N threads. */
 #if !defined(_POSIX_C_SOURCE) && !defined(_GNU_SOURCE)
 #define _POSIX_C_SOURCE 199309L
 #endif
@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <pthread.h>
 
 typedef struct seg {
     float zf, zb;        /* ray distance of entry and exit */
@@ -42,6 +43,9 @@ void vfx_tet_options_default(vfx_tet_options *o)
     o->tiles_d = 20;
     o->update_c = 100;
     o->partial_composite = 1;
+    o->workers = 1;
+    o->share = 1;
+    o->dlb = 1;
 }
 
 /* Segments closer than this (relative to depth) count as touching for partial compositing. */
@@ -158,12 +162,349 @@ static int cmp_key(const void *a, const void *b)
     return (x->id > y->id) - (x->id < y->id);
 }
 
+typedef struct scan_ctx {
+    const vfx_tet_mesh *mesh;
+    const vfx_tet_tf *tf;
+    const vfx_tet_options *opts;
+    const double *vp;
+    const float *P;
+    double near_d;
+    int W, H, D;
+} scan_ctx;
+
+typedef struct worker {
+    seg_pool pool;
+    int32_t *heads;
+    tile *tiles;            /* local ERT table */
+    vfx_tet_counters cnt;
+    uint32_t next, end;     /* remaining cells: keys[next..end), guarded by lock */
+    pthread_mutex_t lock;
+    int failed;
+    struct shared *sh;
+} worker;
+
+typedef struct shared {
+    const scan_ctx *X;
+    const cellkey *keys;
+    worker *w;
+    int nw;
+    tile *table;            /* the shared ERT table (weak sharing) */
+    pthread_mutex_t lock;
+} shared;
+
+/* Scan-converts one cell into the worker's lists unless CST proves it hidden.
+ * Returns 0, or -1 when out of memory. */
+static int scan_cell(const scan_ctx *X, worker *w, const cellkey *key)
+{
+    const vfx_tet_mesh *mesh = X->mesh;
+    const vfx_tet_tf *tf = X->tf;
+    const vfx_tet_options *opts = X->opts;
+    const double *vp = X->vp;
+    const float *P = X->P;
+    const double near_d = X->near_d, ix0 = P[8], iy0 = P[9];
+    const int W = X->W, H = X->H, D = X->D, ert = opts->ert;
+    uint32_t c = key->id;
+    const uint32_t *t = &mesh->tets[4 * c];
+    double v[4][3], s[4];
+    int behind = 0;
+    for (int j = 0; j < 4; j++) {
+        memcpy(v[j], &vp[3 * t[j]], sizeof v[j]);
+        s[j] = mesh->scalar[t[j]];
+        if (-v[j][2] <= near_d)
+            behind++;
+    }
+    if (behind == 4) {
+        w->cnt.cells_behind++;
+        return 0;
+    }
+    /* screen bounding box; a cell crossing the near plane may cover anything */
+    int bx0 = 0, by0 = 0, bx1 = W - 1, by1 = H - 1;
+    if (behind) {
+        w->cnt.cells_near_crossing++;
+    } else {
+        double mnx = INFINITY, mxx = -INFINITY, mny = INFINITY, mxy = -INFINITY;
+        for (int j = 0; j < 4; j++) {
+            double w = -v[j][2];
+            double nx = (P[0] * v[j][0] + P[8] * v[j][2]) / w;
+            double ny = (P[5] * v[j][1] + P[9] * v[j][2]) / w;
+            double px = (nx + 1) * 0.5 * W - 0.5, py = (ny + 1) * 0.5 * H - 0.5;
+            if (px < mnx) mnx = px;
+            if (px > mxx) mxx = px;
+            if (py < mny) mny = py;
+            if (py > mxy) mxy = py;
+        }
+        if (mxx < 0 || mxy < 0 || mnx > W - 1 || mny > H - 1)
+            return 0; /* off screen */
+        bx0 = mnx < 0 ? 0 : (int)ceil(mnx);
+        by0 = mny < 0 ? 0 : (int)ceil(mny);
+        bx1 = mxx > W - 1 ? W - 1 : (int)floor(mxx);
+        by1 = mxy > H - 1 ? H - 1 : (int)floor(mxy);
+        if (bx1 < bx0 || by1 < by0)
+            return 0; /* falls between pixel centres */
+        if (ert) {
+            /* CST: every tile the bbox touches is terminated in front of the cell */
+            int tx0 = bx0 * D / W, tx1 = bx1 * D / W, ty0 = by0 * D / H, ty1 = by1 * D / H;
+            int skip = 1;
+            for (int ty = ty0; ty <= ty1 && skip; ty++)
+                for (int tx = tx0; tx <= tx1; tx++) {
+                    const tile *tl = &w->tiles[ty * D + tx];
+                    if (!tl->terminated || !(tl->deepest < key->nearest)) {
+                        skip = 0;
+                        break;
+                    }
+                }
+            if (skip) {
+                w->cnt.cells_skipped_ert++;
+                return 0;
+            }
+        }
+    }
+    /* barycentric coordinates as affine functions of the ray parameter */
+    double e[3][3];
+    for (int j = 0; j < 3; j++)
+        for (int r = 0; r < 3; r++)
+            e[r][j] = v[j][r] - v[3][r];
+    double det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+                 e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                 e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+    double scale = 0;
+    for (int r = 0; r < 3; r++)
+        for (int j = 0; j < 3; j++)
+            scale = fmax(scale, fabs(e[r][j]));
+    if (!(fabs(det) > 1e-12 * scale * scale * scale)) {
+        w->cnt.cells_degenerate++;
+        return 0;
+    }
+    double inv[3][3];
+    inv[0][0] = (e[1][1] * e[2][2] - e[1][2] * e[2][1]) / det;
+    inv[0][1] = (e[0][2] * e[2][1] - e[0][1] * e[2][2]) / det;
+    inv[0][2] = (e[0][1] * e[1][2] - e[0][2] * e[1][1]) / det;
+    inv[1][0] = (e[1][2] * e[2][0] - e[1][0] * e[2][2]) / det;
+    inv[1][1] = (e[0][0] * e[2][2] - e[0][2] * e[2][0]) / det;
+    inv[1][2] = (e[0][2] * e[1][0] - e[0][0] * e[1][2]) / det;
+    inv[2][0] = (e[1][0] * e[2][1] - e[1][1] * e[2][0]) / det;
+    inv[2][1] = (e[0][1] * e[2][0] - e[0][0] * e[2][1]) / det;
+    inv[2][2] = (e[0][0] * e[1][1] - e[0][1] * e[1][0]) / det;
+    double a0[4]; /* lambda at the eye (t = 0) */
+    for (int j = 0; j < 3; j++)
+        a0[j] = -(inv[j][0] * v[3][0] + inv[j][1] * v[3][1] + inv[j][2] * v[3][2]);
+    a0[3] = 1 - a0[0] - a0[1] - a0[2];
+    w->cnt.cells_scanned++;
+    for (int y = by0; y <= by1; y++) {
+        double dy = (((y + 0.5) / H) * 2 - 1 + iy0) / P[5];
+        for (int x = bx0; x <= bx1; x++) {
+            double dx = (((x + 0.5) / W) * 2 - 1 + ix0) / P[0];
+            double inl = 1.0 / sqrt(dx * dx + dy * dy + 1.0);
+            double d[3] = {dx * inl, dy * inl, -inl};
+            double b[4];
+            for (int j = 0; j < 3; j++)
+                b[j] = inv[j][0] * d[0] + inv[j][1] * d[1] + inv[j][2] * d[2];
+            b[3] = -b[0] - b[1] - b[2];
+            double tin = near_d / inl, tout = INFINITY; /* near plane as ray distance */
+            int empty = 0;
+            for (int j = 0; j < 4 && !empty; j++) {
+                if (b[j] > 0) {
+                    double tt = -a0[j] / b[j];
+                    if (tt > tin) tin = tt;
+                } else if (b[j] < 0) {
+                    double tt = -a0[j] / b[j];
+                    if (tt < tout) tout = tt;
+                } else if (a0[j] < 0) {
+                    empty = 1;
+                }
+            }
+            size_t pix = (size_t)y * W + x;
+            if (opts->max_dist && opts->max_dist[pix] < tout)
+                tout = opts->max_dist[pix];
+            if (empty || !(tout > tin))
+                continue;
+            double sf = 0, sb = 0;
+            for (int j = 0; j < 4; j++) {
+                sf += (a0[j] + b[j] * tin) * s[j];
+                sb += (a0[j] + b[j] * tout) * s[j];
+            }
+            /* colour and extinction at the segment midpoint scalar; the opacity is
+             * corrected for the segment's thickness: alpha = 1 - exp(-tau * length) */
+            double tau, rgb[3];
+            tf_eval(tf, 0.5 * (sf + sb), &tau, rgb);
+            double alpha = 1.0 - exp(-tau * (tout - tin));
+            seg sg = {(float)tin, (float)tout, (float)(rgb[0] * alpha),
+                      (float)(rgb[1] * alpha), (float)(rgb[2] * alpha), (float)alpha, -1};
+            w->cnt.segments_made++;
+            if (insert_seg(&w->pool, &w->heads[pix], sg, opts->partial_composite,
+                           opts->ert_threshold, &w->cnt.segments_merged) != 0) {
+                return -1;
+            }
+        }
+    }
+    return 0;
+}
+
+/* Rebuilds the worker's table from its own lists (paper 3.1.1), then, with sharing on, merges
+ * it with the shared one entry by entry: the terminated entry with the smallest deepest wins
+ * (paper 3.2). Another worker's termination is valid here: our segments only add opacity. */
+static void update_table(shared *sh, worker *w)
+{
+    const scan_ctx *X = sh->X;
+    const int W = X->W, H = X->H, D = X->D;
+    double tu = now_ms();
+    for (int ty = 0; ty < D; ty++)
+        for (int tx = 0; tx < D; tx++) {
+            int x0 = tx * W / D, x1 = (tx + 1) * W / D;
+            int y0 = ty * H / D, y1 = (ty + 1) * H / D;
+            int term = 1;
+            float deep = 0;
+            for (int y = y0; y < y1 && term; y++)
+                for (int x = x0; x < x1; x++) {
+                    float z = pixel_termination(&w->pool, w->heads[(size_t)y * W + x],
+                                                X->opts->ert_threshold);
+                    if (z < 0) { term = 0; break; }
+                    if (z > deep) deep = z;
+                }
+            w->tiles[ty * D + tx].terminated = term && x1 > x0 && y1 > y0;
+            w->tiles[ty * D + tx].deepest = deep;
+        }
+    if (X->opts->share && sh->nw > 1) {
+        pthread_mutex_lock(&sh->lock);
+        for (int i = 0; i < D * D; i++) {
+            tile *l = &w->tiles[i], *s = &sh->table[i];
+            if (s->terminated && (!l->terminated || s->deepest < l->deepest))
+                *l = *s;
+            else if (l->terminated)
+                *s = *l;
+        }
+        pthread_mutex_unlock(&sh->lock);
+    }
+    w->cnt.table_updates++;
+    w->cnt.t_update_ms += now_ms() - tu;
+}
+
+/* Dynamic load balancing (paper 4.3.2): take 1/3 of the remaining cells of the most loaded
+ * worker, from the back of its (front-to-back sorted) range. Returns 1 when work was taken. */
+static int steal(shared *sh, worker *self)
+{
+    for (;;) {
+        int best = -1;
+        uint32_t most = 0;
+        for (int i = 0; i < sh->nw; i++) {
+            worker *v = &sh->w[i];
+            if (v == self) continue;
+            pthread_mutex_lock(&v->lock);
+            uint32_t rem = v->end - v->next;
+            pthread_mutex_unlock(&v->lock);
+            if (rem > most) { most = rem; best = i; }
+        }
+        if (best < 0 || most < 2)
+            return 0;
+        worker *v = &sh->w[best];
+        pthread_mutex_lock(&v->lock);
+        uint32_t rem = v->end - v->next;
+        uint32_t n = rem / 3 ? rem / 3 : (rem >= 2 ? 1 : 0);
+        if (n == 0) { pthread_mutex_unlock(&v->lock); continue; }
+        uint32_t e = v->end;
+        v->end -= n;
+        pthread_mutex_unlock(&v->lock);
+        pthread_mutex_lock(&self->lock);
+        self->next = e - n;
+        self->end = e;
+        pthread_mutex_unlock(&self->lock);
+        return 1;
+    }
+}
+
+static void *worker_main(void *arg)
+{
+    worker *w = arg;
+    shared *sh = w->sh;
+    const scan_ctx *X = sh->X;
+    const int ert = X->opts->ert;
+    const uint32_t C = X->opts->update_c > 0 ? (uint32_t)X->opts->update_c : 1;
+    double t0 = now_ms();
+    pthread_mutex_lock(&w->lock);
+    uint32_t rem0 = w->end - w->next;
+    pthread_mutex_unlock(&w->lock);
+    uint32_t next_update = ert ? (rem0 / C > 0 ? rem0 / C : 1) : UINT32_MAX, since = 0;
+    for (;;) {
+        pthread_mutex_lock(&w->lock);
+        if (w->next >= w->end) {
+            pthread_mutex_unlock(&w->lock);
+            if (X->opts->dlb && sh->nw > 1 && steal(sh, w))
+                continue;
+            break;
+        }
+        uint32_t k = w->next++;
+        uint32_t rem = w->end - w->next;
+        pthread_mutex_unlock(&w->lock);
+        if (ert && since >= next_update) {
+            update_table(sh, w);
+            next_update = rem / C > 0 ? rem / C : 1;
+            since = 0;
+        }
+        since++;
+        if (scan_cell(X, w, &sh->keys[k]) != 0) {
+            w->failed = 1;
+            break;
+        }
+    }
+    w->cnt.t_sc_ms = now_ms() - t0 - w->cnt.t_update_ms;
+    return NULL;
+}
+
+typedef struct comp_job {
+    const shared *sh;
+    float *rgba;
+    int y0, y1;
+} comp_job;
+
+/* Final composition (paper fig. 4): per pixel, the workers' lists are merged in depth order
+ * and composited front to back; screen rows are split between threads. */
+static void *composite_main(void *arg)
+{
+    comp_job *j = arg;
+    const shared *sh = j->sh;
+    const int W = sh->X->W, nw = sh->nw;
+    int32_t cur[64];
+    for (int y = j->y0; y < j->y1; y++)
+        for (int x = 0; x < W; x++) {
+            size_t pix = (size_t)y * W + x;
+            for (int i = 0; i < nw; i++)
+                cur[i] = sh->w[i].heads[pix];
+            seg acc = {0, 0, 0, 0, 0, 0, -1};
+            for (;;) {
+                int bi = -1;
+                float bz = INFINITY;
+                for (int i = 0; i < nw; i++)
+                    if (cur[i] >= 0 && sh->w[i].pool.s[cur[i]].zf < bz) {
+                        bz = sh->w[i].pool.s[cur[i]].zf;
+                        bi = i;
+                    }
+                if (bi < 0) break;
+                over(&acc, &sh->w[bi].pool.s[cur[bi]]);
+                cur[bi] = sh->w[bi].pool.s[cur[bi]].next;
+            }
+            j->rgba[4 * pix + 0] = acc.r;
+            j->rgba[4 * pix + 1] = acc.g;
+            j->rgba[4 * pix + 2] = acc.b;
+            j->rgba[4 * pix + 3] = acc.a;
+        }
+    return NULL;
+}
+
 int vfx_tet_render(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam, const vfx_tet_tf *tf,
                    const vfx_tet_options *opts, float *rgba, vfx_tet_counters *counters,
                    char err[256])
 {
+    return vfx_tet_render_workers(mesh, cam, tf, opts, rgba, counters, NULL, err);
+}
+
+int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
+                           const vfx_tet_tf *tf, const vfx_tet_options *opts, float *rgba,
+                           vfx_tet_counters *counters, vfx_tet_counters *per_worker,
+                           char err[256])
+{
     vfx_tet_counters cnt;
     memset(&cnt, 0, sizeof cnt);
+    if (counters) *counters = cnt;
     if (!mesh || !cam || !tf || !opts || !rgba) {
         snprintf(err, 256, "tet_render: NULL argument");
         return VFX_ERR_INVALID_ARGUMENT;
@@ -171,6 +512,11 @@ int vfx_tet_render(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam, const vf
     const int W = cam->width, H = cam->height;
     if (W <= 0 || H <= 0 || W > 16384 || H > 16384) {
         snprintf(err, 256, "tet_render: image size %dx%d out of range", W, H);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    const int nw = opts->workers <= 0 ? 1 : opts->workers;
+    if (nw > 64) {
+        snprintf(err, 256, "tet_render: %d workers requested, at most 64", nw);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     if (!mesh->scalar) {
@@ -188,243 +534,148 @@ int vfx_tet_render(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam, const vf
     if (!(near_d > 0)) near_d = 1e-4;
 
     const uint32_t np = mesh->point_count, nt = mesh->tet_count;
-    double *vp = malloc((size_t)np * 3 * sizeof *vp);
-    int32_t *heads = malloc((size_t)W * H * sizeof *heads);
+    const int D = opts->tiles_d > 0 ? opts->tiles_d : 1;
+    double *vp = malloc((size_t)np * 3 * sizeof *vp + 1);
     cellkey *keys = malloc((size_t)(nt ? nt : 1) * sizeof *keys);
-    int D = opts->tiles_d > 0 ? opts->tiles_d : 1;
-    tile *tiles = calloc((size_t)D * D, sizeof *tiles);
-    seg_pool pool = {0};
-    int rc = VFX_OK;
-    if (!vp || !heads || !keys || !tiles) {
+    worker *ws = calloc((size_t)nw, sizeof *ws);
+    tile *table = calloc((size_t)D * D, sizeof *table);
+    uint32_t *bounds = calloc((size_t)nw + 1, sizeof *bounds);
+    int rc = VFX_OK, nthreads = 0;
+    pthread_t th[64];
+    shared sh;
+    memset(&sh, 0, sizeof sh);
+    pthread_mutex_init(&sh.lock, NULL);
+    if (!vp || !keys || !ws || !table || !bounds) {
         snprintf(err, 256, "tet_render: out of memory (%u points, %u tets)", np, nt);
         rc = VFX_ERR_OUT_OF_MEMORY;
         goto done;
     }
-    for (size_t i = 0; i < (size_t)W * H; i++)
-        heads[i] = -1;
+    for (int i = 0; i < nw; i++) {
+        pthread_mutex_init(&ws[i].lock, NULL);
+        ws[i].heads = malloc((size_t)W * H * sizeof *ws[i].heads);
+        ws[i].tiles = calloc((size_t)D * D, sizeof *ws[i].tiles);
+        if (!ws[i].heads || !ws[i].tiles) {
+            snprintf(err, 256, "tet_render: out of memory for worker %d (%dx%d)", i, W, H);
+            rc = VFX_ERR_OUT_OF_MEMORY;
+            goto done;
+        }
+        for (size_t p = 0; p < (size_t)W * H; p++)
+            ws[i].heads[p] = -1;
+    }
     for (uint32_t i = 0; i < np; i++) {
         const float *x = &mesh->points[3 * i];
         for (int r = 0; r < 3; r++)
             vp[3 * i + r] = (double)V[r] * x[0] + (double)V[4 + r] * x[1] +
                             (double)V[8 + r] * x[2] + V[12 + r];
     }
-    /* front-to-back order by the nearest view depth of each cell (visibility cycles do no harm:
-     * the per-pixel lists are sorted by depth anyway; the order only feeds ERT) */
+    /* Initial assignment: contiguous ranges of the mesh's cell order (the data layout, which
+     * keeps neighbouring cells on one worker as in the paper's fig. 8), each sorted front to
+     * back by nearest depth (visibility cycles do no harm: pixel lists are depth sorted). */
     uint32_t nk = 0;
-    for (uint32_t c = 0; c < nt; c++) {
-        const uint32_t *t = &mesh->tets[4 * c];
-        int bad = 0;
-        float nearest = INFINITY;
-        for (int k = 0; k < 4; k++) {
-            if (t[k] >= np) {
-                snprintf(err, 256, "tet_render: tet %u references point %u of %u", c, t[k], np);
-                rc = VFX_ERR_INVALID_ARGUMENT;
-                goto done;
-            }
-            double z = -vp[3 * t[k] + 2];
-            if (isnan(z) || isnan(mesh->scalar[t[k]]))
-                bad = 1;
-            if (z < nearest)
-                nearest = (float)z;
-        }
-        if (bad) {
-            cnt.cells_nan++;
-            continue;
-        }
-        keys[nk].nearest = nearest;
-        keys[nk].id = c;
-        nk++;
-    }
-    qsort(keys, nk, sizeof *keys, cmp_key);
-
-    const double ix0 = P[8], iy0 = P[9];
-    const int ert = opts->ert;
-    const int C = opts->update_c > 0 ? opts->update_c : 1;
-    uint32_t next_update = ert ? (nk / C > 0 ? nk / C : 1) : UINT32_MAX;
-    uint32_t since = 0;
-    double t0 = now_ms();
-    for (uint32_t k = 0; k < nk; k++) {
-        if (ert && since >= next_update) {
-            double tu = now_ms();
-            for (int ty = 0; ty < D; ty++)
-                for (int tx = 0; tx < D; tx++) {
-                    int x0 = tx * W / D, x1 = (tx + 1) * W / D;
-                    int y0 = ty * H / D, y1 = (ty + 1) * H / D;
-                    int term = 1;
-                    float deep = 0;
-                    for (int y = y0; y < y1 && term; y++)
-                        for (int x = x0; x < x1; x++) {
-                            float z = pixel_termination(&pool, heads[(size_t)y * W + x],
-                                                        opts->ert_threshold);
-                            if (z < 0) { term = 0; break; }
-                            if (z > deep) deep = z;
-                        }
-                    tiles[ty * D + tx].terminated = term && x1 > x0 && y1 > y0;
-                    tiles[ty * D + tx].deepest = deep;
-                }
-            cnt.table_updates++;
-            cnt.t_update_ms += now_ms() - tu;
-            uint32_t rem = nk - k;
-            next_update = rem / C > 0 ? rem / C : 1;
-            since = 0;
-        }
-        since++;
-        uint32_t c = keys[k].id;
-        const uint32_t *t = &mesh->tets[4 * c];
-        double v[4][3], s[4];
-        int behind = 0;
-        for (int j = 0; j < 4; j++) {
-            memcpy(v[j], &vp[3 * t[j]], sizeof v[j]);
-            s[j] = mesh->scalar[t[j]];
-            if (-v[j][2] <= near_d)
-                behind++;
-        }
-        if (behind == 4) {
-            cnt.cells_behind++;
-            continue;
-        }
-        /* screen bounding box; a cell crossing the near plane may cover anything */
-        int bx0 = 0, by0 = 0, bx1 = W - 1, by1 = H - 1;
-        if (behind) {
-            cnt.cells_near_crossing++;
-        } else {
-            double mnx = INFINITY, mxx = -INFINITY, mny = INFINITY, mxy = -INFINITY;
-            for (int j = 0; j < 4; j++) {
-                double w = -v[j][2];
-                double nx = (P[0] * v[j][0] + P[8] * v[j][2]) / w;
-                double ny = (P[5] * v[j][1] + P[9] * v[j][2]) / w;
-                double px = (nx + 1) * 0.5 * W - 0.5, py = (ny + 1) * 0.5 * H - 0.5;
-                if (px < mnx) mnx = px;
-                if (px > mxx) mxx = px;
-                if (py < mny) mny = py;
-                if (py > mxy) mxy = py;
-            }
-            if (mxx < 0 || mxy < 0 || mnx > W - 1 || mny > H - 1)
-                continue; /* off screen */
-            bx0 = mnx < 0 ? 0 : (int)ceil(mnx);
-            by0 = mny < 0 ? 0 : (int)ceil(mny);
-            bx1 = mxx > W - 1 ? W - 1 : (int)floor(mxx);
-            by1 = mxy > H - 1 ? H - 1 : (int)floor(mxy);
-            if (bx1 < bx0 || by1 < by0)
-                continue; /* falls between pixel centres */
-            if (ert) {
-                /* CST: every tile the bbox touches is terminated in front of the cell */
-                int tx0 = bx0 * D / W, tx1 = bx1 * D / W, ty0 = by0 * D / H, ty1 = by1 * D / H;
-                int skip = 1;
-                for (int ty = ty0; ty <= ty1 && skip; ty++)
-                    for (int tx = tx0; tx <= tx1; tx++) {
-                        const tile *tl = &tiles[ty * D + tx];
-                        if (!tl->terminated || !(tl->deepest < keys[k].nearest)) {
-                            skip = 0;
-                            break;
-                        }
-                    }
-                if (skip) {
-                    cnt.cells_skipped_ert++;
-                    continue;
-                }
-            }
-        }
-        /* barycentric coordinates as affine functions of the ray parameter */
-        double e[3][3];
-        for (int j = 0; j < 3; j++)
-            for (int r = 0; r < 3; r++)
-                e[r][j] = v[j][r] - v[3][r];
-        double det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
-                     e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-                     e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
-        double scale = 0;
-        for (int r = 0; r < 3; r++)
-            for (int j = 0; j < 3; j++)
-                scale = fmax(scale, fabs(e[r][j]));
-        if (!(fabs(det) > 1e-12 * scale * scale * scale)) {
-            cnt.cells_degenerate++;
-            continue;
-        }
-        double inv[3][3];
-        inv[0][0] = (e[1][1] * e[2][2] - e[1][2] * e[2][1]) / det;
-        inv[0][1] = (e[0][2] * e[2][1] - e[0][1] * e[2][2]) / det;
-        inv[0][2] = (e[0][1] * e[1][2] - e[0][2] * e[1][1]) / det;
-        inv[1][0] = (e[1][2] * e[2][0] - e[1][0] * e[2][2]) / det;
-        inv[1][1] = (e[0][0] * e[2][2] - e[0][2] * e[2][0]) / det;
-        inv[1][2] = (e[0][2] * e[1][0] - e[0][0] * e[1][2]) / det;
-        inv[2][0] = (e[1][0] * e[2][1] - e[1][1] * e[2][0]) / det;
-        inv[2][1] = (e[0][1] * e[2][0] - e[0][0] * e[2][1]) / det;
-        inv[2][2] = (e[0][0] * e[1][1] - e[0][1] * e[1][0]) / det;
-        double a0[4]; /* lambda at the eye (t = 0) */
-        for (int j = 0; j < 3; j++)
-            a0[j] = -(inv[j][0] * v[3][0] + inv[j][1] * v[3][1] + inv[j][2] * v[3][2]);
-        a0[3] = 1 - a0[0] - a0[1] - a0[2];
-        cnt.cells_scanned++;
-        for (int y = by0; y <= by1; y++) {
-            double dy = (((y + 0.5) / H) * 2 - 1 + iy0) / P[5];
-            for (int x = bx0; x <= bx1; x++) {
-                double dx = (((x + 0.5) / W) * 2 - 1 + ix0) / P[0];
-                double inl = 1.0 / sqrt(dx * dx + dy * dy + 1.0);
-                double d[3] = {dx * inl, dy * inl, -inl};
-                double b[4];
-                for (int j = 0; j < 3; j++)
-                    b[j] = inv[j][0] * d[0] + inv[j][1] * d[1] + inv[j][2] * d[2];
-                b[3] = -b[0] - b[1] - b[2];
-                double tin = near_d / inl, tout = INFINITY; /* near plane as ray distance */
-                int empty = 0;
-                for (int j = 0; j < 4 && !empty; j++) {
-                    if (b[j] > 0) {
-                        double tt = -a0[j] / b[j];
-                        if (tt > tin) tin = tt;
-                    } else if (b[j] < 0) {
-                        double tt = -a0[j] / b[j];
-                        if (tt < tout) tout = tt;
-                    } else if (a0[j] < 0) {
-                        empty = 1;
-                    }
-                }
-                size_t pix = (size_t)y * W + x;
-                if (opts->max_dist && opts->max_dist[pix] < tout)
-                    tout = opts->max_dist[pix];
-                if (empty || !(tout > tin))
-                    continue;
-                double sf = 0, sb = 0;
-                for (int j = 0; j < 4; j++) {
-                    sf += (a0[j] + b[j] * tin) * s[j];
-                    sb += (a0[j] + b[j] * tout) * s[j];
-                }
-                /* colour and extinction at the segment midpoint scalar; the opacity is
-                 * corrected for the segment's thickness: alpha = 1 - exp(-tau * length) */
-                double tau, rgb[3];
-                tf_eval(tf, 0.5 * (sf + sb), &tau, rgb);
-                double alpha = 1.0 - exp(-tau * (tout - tin));
-                seg sg = {(float)tin, (float)tout, (float)(rgb[0] * alpha),
-                          (float)(rgb[1] * alpha), (float)(rgb[2] * alpha), (float)alpha, -1};
-                cnt.segments_made++;
-                if (insert_seg(&pool, &heads[pix], sg, opts->partial_composite,
-                               opts->ert_threshold, &cnt.segments_merged) != 0) {
-                    snprintf(err, 256, "tet_render: out of memory at %zu segments", pool.n);
-                    rc = VFX_ERR_OUT_OF_MEMORY;
+    for (int wi = 0; wi < nw; wi++) {
+        uint32_t c0 = (uint32_t)((uint64_t)nt * wi / nw), c1 = (uint32_t)((uint64_t)nt * (wi + 1) / nw);
+        uint32_t k0 = nk;
+        for (uint32_t c = c0; c < c1; c++) {
+            const uint32_t *t = &mesh->tets[4 * c];
+            int bad = 0;
+            float nearest = INFINITY;
+            for (int k = 0; k < 4; k++) {
+                if (t[k] >= np) {
+                    snprintf(err, 256, "tet_render: tet %u references point %u of %u", c, t[k], np);
+                    rc = VFX_ERR_INVALID_ARGUMENT;
                     goto done;
                 }
+                double z = -vp[3 * t[k] + 2];
+                if (isnan(z) || isnan(mesh->scalar[t[k]]))
+                    bad = 1;
+                if (z < nearest)
+                    nearest = (float)z;
             }
+            if (bad) {
+                cnt.cells_nan++;
+                continue;
+            }
+            keys[nk].nearest = nearest;
+            keys[nk].id = c;
+            nk++;
         }
+        qsort(keys + k0, nk - k0, sizeof *keys, cmp_key);
+        ws[wi].next = k0;
+        ws[wi].end = nk;
     }
-    cnt.t_sc_ms = now_ms() - t0 - cnt.t_update_ms;
+    scan_ctx X = {mesh, tf, opts, vp, P, near_d, W, H, D};
+    sh.X = &X;
+    sh.keys = keys;
+    sh.w = ws;
+    sh.nw = nw;
+    sh.table = table;
+    for (int i = 0; i < nw; i++)
+        ws[i].sh = &sh;
+    if (nw == 1) {
+        worker_main(&ws[0]);
+    } else {
+        for (; nthreads < nw; nthreads++)
+            if (pthread_create(&th[nthreads], NULL, worker_main, &ws[nthreads]) != 0)
+                break;
+        if (nthreads < nw) /* run the ones that did not start here; DLB may already cover them */
+            for (int i = nthreads; i < nw; i++)
+                worker_main(&ws[i]);
+        for (int i = 0; i < nthreads; i++)
+            pthread_join(th[i], NULL);
+    }
+    for (int i = 0; i < nw; i++)
+        if (ws[i].failed) {
+            snprintf(err, 256, "tet_render: worker %d out of memory at %zu segments", i,
+                     ws[i].pool.n);
+            rc = VFX_ERR_OUT_OF_MEMORY;
+            goto done;
+        }
     double tc = now_ms();
-    for (size_t i = 0; i < (size_t)W * H; i++) {
-        seg acc = {0, 0, 0, 0, 0, 0, -1};
-        for (int32_t c = heads[i]; c >= 0; c = pool.s[c].next)
-            over(&acc, &pool.s[c]);
-        rgba[4 * i + 0] = acc.r;
-        rgba[4 * i + 1] = acc.g;
-        rgba[4 * i + 2] = acc.b;
-        rgba[4 * i + 3] = acc.a;
+    comp_job jobs[64];
+    int nj = 0;
+    for (int i = 0; i < nw; i++) {
+        jobs[i].sh = &sh;
+        jobs[i].rgba = rgba;
+        jobs[i].y0 = H * i / nw;
+        jobs[i].y1 = H * (i + 1) / nw;
     }
+    for (; nj < nw - 1; nj++)
+        if (pthread_create(&th[nj], NULL, composite_main, &jobs[nj + 1]) != 0)
+            break;
+    for (int i = nj + 1; i < nw; i++)
+        composite_main(&jobs[i]);
+    composite_main(&jobs[0]);
+    for (int i = 0; i < nj; i++)
+        pthread_join(th[i], NULL);
     cnt.t_composite_ms = now_ms() - tc;
 done:
+    if (ws) {
+        for (int i = 0; i < nw; i++) {
+            vfx_tet_counters *c = &ws[i].cnt;
+            cnt.cells_scanned += c->cells_scanned;
+            cnt.cells_skipped_ert += c->cells_skipped_ert;
+            cnt.cells_behind += c->cells_behind;
+            cnt.cells_near_crossing += c->cells_near_crossing;
+            cnt.cells_degenerate += c->cells_degenerate;
+            cnt.segments_made += c->segments_made;
+            cnt.segments_merged += c->segments_merged;
+            cnt.table_updates += c->table_updates;
+            if (c->t_sc_ms > cnt.t_sc_ms) cnt.t_sc_ms = c->t_sc_ms;
+            if (c->t_update_ms > cnt.t_update_ms) cnt.t_update_ms = c->t_update_ms;
+            if (per_worker) per_worker[i] = *c;
+            free(ws[i].heads);
+            free(ws[i].tiles);
+            free(ws[i].pool.s);
+            pthread_mutex_destroy(&ws[i].lock);
+        }
+    }
     if (counters)
         *counters = cnt;
+    pthread_mutex_destroy(&sh.lock);
     free(vp);
-    free(heads);
     free(keys);
-    free(tiles);
-    free(pool.s);
+    free(ws);
+    free(table);
+    free(bounds);
     return rc;
 }

@@ -29,6 +29,9 @@ typedef struct vfx_tet_options {
     int update_c;          /* C: table updated every (remaining cells)/C cells */
     int partial_composite; /* 1: merge adjacent segments on insert */
     const float *max_dist; /* optional width*height host depth as ray distance; NULL = none */
+    int workers;           /* threads, each owning a partition of cells (<= 0 means 1, max 64) */
+    int share;             /* 1: weak sharing of the ERT tables at each table update */
+    int dlb;               /* 1: dynamic load balancing (idle worker takes 1/3 of the most loaded) */
 } vfx_tet_options;
 
 typedef struct vfx_tet_counters {
@@ -44,7 +47,8 @@ typedef struct vfx_tet_counters {
     double t_sc_ms, t_update_ms, t_composite_ms;
 } vfx_tet_counters;
 
-/* Fills opts with the paper's defaults (ERT on, threshold 0.9, D = 20, C = 100, partial on). */
+/* Fills opts with the paper's defaults (ERT on, threshold 0.9, D = 20, C = 100, partial on,
+ * one worker, sharing and load balancing on). */
 void vfx_tet_options_default(vfx_tet_options *opts);
 
 /* Renders mesh (with its scalar) into rgba (width*height*4 floats, premultiplied, row 0 = bottom).
@@ -52,5 +56,12 @@ void vfx_tet_options_default(vfx_tet_options *opts);
 int vfx_tet_render(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam, const vfx_tet_tf *tf,
                    const vfx_tet_options *opts, float *rgba, vfx_tet_counters *counters,
                    char err[256]);
+
+/* As vfx_tet_render with opts->workers threads; per_worker (NULL or opts->workers entries)
+ * receives each worker's counters. counters totals the cells and keeps the maximum times. */
+int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
+                           const vfx_tet_tf *tf, const vfx_tet_options *opts, float *rgba,
+                           vfx_tet_counters *counters, vfx_tet_counters *per_worker,
+                           char err[256]);
 
 #endif

@@ -234,6 +234,37 @@ static void test_ert_threshold(void **state)
                   (unsigned long long)c2.cells_skipped_ert, NT, (unsigned long long)c2.cells_scanned, (unsigned long long)c2.table_updates, a[4 * (20 * 40 + 20) + 3], mx);
     assert_true(c2.cells_skipped_ert > 0);
     assert_true(mx <= 0.1 + 1e-5); /* skipped light is attenuated by at least 1 - 0.9 */
+
+    /* Workers: without ERT, 1 vs 4 workers (with and without DLB) differ only by the float
+     * association of partial compositing (different segments merge on each worker): 1e-5 is
+     * ~100 float32 ulps of values <= 1. With ERT 0.9, SHARE/DLB on/off only change which
+     * hidden cells are skipped, so each stays within 0.1 of the no-ERT image. */
+    float *c = calloc(40 * 40 * 4, sizeof *c);
+    vfx_tet_counters pw[4];
+    for (int mode = 0; mode < 4; mode++) {
+        o.ert = 0; o.ert_threshold = 1.0f; o.workers = 4; o.share = mode & 1; o.dlb = (mode >> 1) & 1;
+        assert_int_equal(vfx_tet_render_workers(&m, &cam, &tf, &o, c, &c1, pw, err), 0);
+        double dmax = 0;
+        for (int i = 0; i < 40 * 40 * 4; i++)
+            dmax = fmax(dmax, fabs(a[i] - c[i]));
+        assert_true(dmax < 1e-5);
+        uint64_t sum = 0;
+        for (int i = 0; i < 4; i++)
+            sum += pw[i].cells_scanned;
+        assert_int_equal(sum, c0.cells_scanned);
+        o.ert = 1; o.ert_threshold = 0.9f;
+        assert_int_equal(vfx_tet_render_workers(&m, &cam, &tf, &o, c, &c1, pw, err), 0);
+        dmax = 0;
+        for (int i = 0; i < 40 * 40 * 4; i++)
+            dmax = fmax(dmax, fabs(a[i] - c[i]));
+        print_message("4 workers share=%d dlb=%d: ERT 0.9 skipped %llu, max diff %.4g, scanned per worker %llu %llu %llu %llu\n",
+                      o.share, o.dlb, (unsigned long long)c1.cells_skipped_ert, dmax,
+                      (unsigned long long)pw[0].cells_scanned, (unsigned long long)pw[1].cells_scanned,
+                      (unsigned long long)pw[2].cells_scanned, (unsigned long long)pw[3].cells_scanned);
+        assert_true(dmax <= 0.1 + 1e-5);
+    }
+    o.workers = 1;
+    free(c);
     free(a); free(b); free(pts); free(sc); free(tets);
 }
 
