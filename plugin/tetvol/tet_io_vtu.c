@@ -165,8 +165,9 @@ static void XMLCALL on_text(void *ud, const XML_Char *txt, int len)
 /* Decodes base64 from [src, src+n), skipping whitespace; '=' padding ends a 4-char group and
  * decoding resumes, so separately encoded header and data blocks concatenate. Returns bytes
  * written or (size_t)-1 on an invalid character. */
-static size_t b64_decode(const char *src, size_t n, unsigned char *dst)
+static size_t b64_decode(const char *src, size_t n, unsigned char *dst, int *bad)
 {
+    *bad = 0;
     size_t o = 0;
     unsigned v = 0;
     int k = 0, pad = 0;
@@ -180,16 +181,14 @@ static size_t b64_decode(const char *src, size_t n, unsigned char *dst)
         else if (c == '/') x = 63;
         else if (c == '=') { x = 0; pad++; }
         else if (c == ' ' || c == '\n' || c == '\r' || c == '\t') continue;
-        else return (size_t)-1;
-        if (pad && c != '=')
-            return (size_t)-1;
+        else { *bad = 1; return o; }
+        if (pad && c != '=') { *bad = 1; return o; }
         v = (v << 6) | (unsigned)x;
         if (++k == 4) {
             unsigned char b[3] = {(unsigned char)(v >> 16), (unsigned char)(v >> 8),
                                   (unsigned char)v};
             int keep = 3 - pad;
-            if (keep < 1)
-                return (size_t)-1;
+            if (keep < 1) { *bad = 1; return o; }
             for (int j = 0; j < keep; j++)
                 dst[o++] = b[j];
             v = 0;
@@ -197,7 +196,9 @@ static size_t b64_decode(const char *src, size_t n, unsigned char *dst)
             pad = 0;
         }
     }
-    return k ? (size_t)-1 : o;
+    if (k)
+        *bad = 1;
+    return o;
 }
 
 static uint64_t rd_header(const unsigned char *p, int h64)
@@ -316,14 +317,18 @@ static vfx_result read_array(vtu_state *s, const vtu_array *d, size_t count, dou
         }
         dec = malloc(n / 4 * 3 + 4);
         if (!dec) { free(v); return VFX_ERR_OUT_OF_MEMORY; }
-        size_t dn = b64_decode(src, n, dec);
-        if (dn == (size_t)-1) {
-            /* appended base64 runs on into the next array: decode only up to a bad char. */
+        int bad;
+        size_t dn = b64_decode(src, n, dec, &bad);
+        /* Appended base64 runs on into the next arrays: a bad character there only matters
+         * when this array's bytes are not complete before it. */
+        if (bad && d->format == F_BINARY) {
             snprintf(s->err, s->errlen, "%s: invalid base64", what);
             r = VFX_ERR_FORMAT;
             goto out;
         }
         r = unpack(s, dec, dn, want, &raw, what);
+        if (r == VFX_ERR_FORMAT && bad)
+            snprintf(s->err, s->errlen, "%s: invalid base64", what);
     } else {
         if (app_start == 0 || app_start + d->offset > s->size) goto trunc;
         r = unpack(s, (const unsigned char *)s->data + app_start + d->offset,
