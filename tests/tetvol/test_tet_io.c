@@ -11,7 +11,7 @@
 #include <string.h>
 #include <zlib.h>
 
-#include "tet_io.h"
+#include "tetvol/tet_io.h"
 
 /* One tet, positively oriented, plus a second one written inverted. */
 #define HEAD "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" " \
