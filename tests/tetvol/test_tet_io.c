@@ -359,9 +359,42 @@ static int pipe_present(void)
     return f != NULL;
 }
 
+/* "gen": scripts/make-tet-mesh.sh with 2,000 points, then load it (77 without tetgen/python). */
+static int run_generated(void)
+{
+    const char *root = getenv("VFX_SOURCE_ROOT");
+    char dir[] = "/tmp/vfx_gen_XXXXXX", cmd[1024], base[128], err[256];
+    if (!root || system("command -v tetgen >/dev/null && test -x /usr/bin/python3") != 0)
+        return 77;
+    if (!mkdtemp(dir))
+        return 1;
+    snprintf(base, sizeof base, "%s/torus", dir);
+    snprintf(cmd, sizeof cmd, "sh '%s/scripts/make-tet-mesh.sh' '%s' 2000 7 >/dev/null", root,
+             base);
+    int rc = system(cmd);
+    vfx_tet_mesh m;
+    vfx_result r = rc == 0 ? vfx_tet_load_tetgen(base, "attr0", &m, err, sizeof err) : VFX_ERR_IO;
+    int ok = r == VFX_OK && m.point_count == 2000 && m.tet_count > 5 * 2000 &&
+             m.scalar_min >= 0.0f && m.scalar_max <= 2.0f;
+    if (r == VFX_OK) {
+        printf("generated: %u points, %u tets, %u inverted, %u degenerate, attr0 %g..%g\n",
+               m.point_count, m.tet_count, m.inverted_fixed, m.degenerate_count, m.scalar_min,
+               m.scalar_max);
+        vfx_tet_mesh_free(&m);
+    } else {
+        printf("generated mesh failed: rc %d, %s\n", rc, rc == 0 ? err : "script");
+    }
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    if (system(cmd) != 0)
+        return 1;
+    return ok ? 0 : 1;
+}
+
 /* "pipe" as argv[1] runs only the real-data test: exit 77 (skip) when the file is absent. */
 int main(int argc, char **argv)
 {
+    if (argc > 1 && !strcmp(argv[1], "gen"))
+        return run_generated();
     if (argc > 1 && !strcmp(argv[1], "pipe")) {
         if (!pipe_present())
             return 77;
