@@ -38,17 +38,18 @@ static vfx_result failf(pctx *c, vfx_result r, const char *path, const char *fmt
     return r;
 }
 
+/* JSON paths longer than JPATH are cut: the message stays readable, the check unaffected. */
 static void join(char *out, const char *parent, const char *key)
 {
-    if (parent && *parent)
-        snprintf(out, JPATH, "%s.%s", parent, key);
-    else
-        snprintf(out, JPATH, "%s", key);
+    int n = parent && *parent ? snprintf(out, JPATH, "%s.%s", parent, key) : snprintf(out, JPATH, "%s", key);
+    if (n < 0)
+        out[0] = 0;
 }
 
 static void join_index(char *out, const char *parent, int i)
 {
-    snprintf(out, JPATH, "%s[%d]", parent, i);
+    if (snprintf(out, JPATH, "%s[%d]", parent, i) < 0)
+        out[0] = 0;
 }
 
 static const char *type_name(const cJSON *v)
@@ -103,12 +104,12 @@ typedef struct range {
 static vfx_result check_range(pctx *c, const char *path, double v, range rg)
 {
     if (!isfinite(v))
-        return failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be finite, got %g", v);
+        return failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be finite, got %.9g", v);
     if (rg.lo_open ? !(v > rg.lo) : !(v >= rg.lo))
-        return failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be %s %g, got %g", rg.lo_open ? ">" : ">=",
+        return failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be %s %.9g, got %.9g", rg.lo_open ? ">" : ">=",
                      rg.lo, v);
     if (v > rg.hi)
-        return failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be <= %g, got %g", rg.hi, v);
+        return failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be <= %.9g, got %.9g", rg.hi, v);
     return VFX_OK;
 }
 

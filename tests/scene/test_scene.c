@@ -1,0 +1,604 @@
+/* test_scene.c — scene files: every field read back, the sample scenes, bad input (error code
+ * and the JSON path in the message), syntax-error locations, keyframe interpolation against
+ * hand-computed values, generators against independent checks. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "scene/particle_file.h"
+#include "scene/scene.h"
+#include "test_util.h"
+
+extern const char vfx_default_scene_json[];
+extern const unsigned long vfx_default_scene_json_len;
+
+static vfx_result load(const char *json, vfx_test_log *log, vfx_scene **s, char *err, size_t errlen)
+{
+    vfx_logger lg = {vfx_test_log_fn, log};
+    return vfx_scene_load_mem(json, strlen(json), "/base", &lg, s, err, errlen);
+}
+
+/* float parameters are stored as float: compare with a float-epsilon-relative tolerance */
+#define assert_close(a, b) assert_true(fabs((double)(a) - (double)(b)) <= 1e-6 * (1 + fabs((double)(b))))
+
+static void test_every_field(void **state)
+{
+    (void)state;
+    const char *json =
+        "{\"version\":1,\"name\":\"full\",\"description\":\"d\","
+        "\"camera\":{\"eye\":[1,2,3],\"target\":[0,1,0],\"up\":[0,0,1],\"fov_y_deg\":45,\"width\":320,"
+        "\"height\":200,\"near\":0.1,\"far\":50},"
+        "\"meshes\":[{\"path\":\"m/arena.obj\",\"translate\":[1,2,3],\"rotate_deg\":[0,90,0],\"scale\":2,"
+        "\"color\":[0.1,0.2,0.3]},"
+        "{\"box\":{\"min\":[0,0,0],\"max\":[1,2,3]},\"matrix\":[1,0,0,0,0,1,0,0,0,0,1,0,5,6,7,1]},"
+        "{\"path\":\"/abs/x.ply\"}],"
+        "\"beam_settings\":{\"saturation\":\"clamp\",\"c\":2.5,\"far_distance\":30,\"method\":\"march\","
+        "\"march_samples\":64},"
+        "\"beams\":[{\"head\":[1,2,3],\"dir\":[0,0,-1],\"length\":4,\"radius\":0.7,\"a\":0.1,\"b\":0.2,"
+        "\"eps\":0.03,\"color\":[1,0.5,0.25,1],\"loop_s\":2}],"
+        "\"water\":{\"source\":\"file\",\"path\":\"p.bin\",\"h\":0.3,\"threshold\":0.5,"
+        "\"quality\":{\"max_samples\":32,\"step\":0.01,\"refine_iters\":5,\"pyramid_level\":2,"
+        "\"method\":\"grid\",\"disable\":[\"skip\",\"pack4\"]},\"color\":[0.2,0.4,0.6],"
+        "\"absorption\":1.5,\"ior\":1.2},"
+        "\"volume\":{\"path\":\"v/pipe.vtu\",\"scalar\":\"Velocity\",\"transfer\":[{\"scalar\":-1,"
+        "\"rgba\":[0,0,0,0]},{\"scalar\":3,\"rgba\":[1,1,1,2]}],\"ert_threshold\":0.8,\"tiles\":8,"
+        "\"update_c\":4,\"workers\":2,\"disable\":[\"share\"],\"translate\":[0,0,-2]}}";
+    vfx_test_log log = {0};
+    vfx_scene *s = NULL;
+    char err[256];
+    assert_int_equal(load(json, &log, &s, err, sizeof err), VFX_OK);
+    assert_int_equal(log.warnings, 0);
+    assert_string_equal(s->name, "full");
+    assert_close(s->camera.eye[2], 3);
+    assert_close(s->camera.up[2], 1);
+    assert_close(s->camera.fov_y_deg, 45);
+    assert_int_equal(s->camera.width, 320);
+    assert_int_equal(s->camera.height, 200);
+    assert_close(s->camera.near_plane, 0.1);
+    assert_close(s->camera.far_plane, 50);
+    assert_int_equal(s->mesh_count, 3);
+    assert_string_equal(s->meshes[0].path, "/base/m/arena.obj");
+    assert_string_equal(s->meshes[2].path, "/abs/x.ply");
+    /* rotate 90 deg about y then scale 2: x axis -> -z (column 0 = (0,0,-2)), translate last */
+    assert_close(s->meshes[0].model[0], 0);
+    assert_close(s->meshes[0].model[2], -2);
+    assert_close(s->meshes[0].model[8], 2);
+    assert_close(s->meshes[0].model[5], 2);
+    assert_close(s->meshes[0].model[12], 1);
+    assert_close(s->meshes[0].model[14], 3);
+    assert_close(s->meshes[0].color[2], 0.3);
+    assert_true(s->meshes[1].is_box);
+    assert_close(s->meshes[1].box_max[2], 3);
+    assert_close(s->meshes[1].model[13], 6);
+    assert_int_equal(s->beams_view.saturation, VFX_SATURATE_CLAMP);
+    assert_close(s->beams_view.saturate_c, 2.5);
+    assert_close(s->beams_view.far_distance, 30);
+    assert_int_equal(s->beams_view.method, 1);
+    assert_int_equal(s->beams_view.march_samples, 64);
+    assert_int_equal(s->beam_count, 1);
+    const vfx_beam *b = &s->beams[0].base;
+    assert_close(b->head[1], 2);
+    assert_close(b->dir[2], -1);
+    assert_close(b->length, 4);
+    assert_close(b->radius, 0.7);
+    assert_close(b->a, 0.1);
+    assert_close(b->b, 0.2);
+    assert_close(b->eps, 0.03);
+    assert_close(b->color[2], 0.25);
+    assert_close(s->beams[0].loop_s, 2);
+    assert_true(s->has_water);
+    assert_int_equal(s->water.source, VFX_SCENE_WATER_FILE);
+    assert_string_equal(s->water.path, "/base/p.bin");
+    const vfx_water_params *wp = &s->water.params;
+    assert_int_equal(wp->size, sizeof *wp);
+    assert_int_equal(wp->version, VFX_WATER_PARAMS_VERSION);
+    assert_close(wp->h, 0.3);
+    assert_close(wp->threshold, 0.5);
+    assert_int_equal(wp->max_samples, 32);
+    assert_close(wp->step, 0.01);
+    assert_int_equal(wp->refine_iters, 5);
+    assert_int_equal(wp->pyramid_level, 2);
+    assert_int_equal(wp->method, VFX_WATER_METHOD_GRID);
+    assert_int_equal(wp->disable, VFX_WATER_NO_SKIP | VFX_WATER_NO_PACK4);
+    assert_close(wp->color[1], 0.4);
+    assert_close(wp->absorption, 1.5);
+    assert_close(wp->ior, 1.2);
+    assert_true(s->has_volume);
+    assert_false(s->volume.generated);
+    assert_string_equal(s->volume.path, "/base/v/pipe.vtu");
+    assert_string_equal(s->volume.scalar, "Velocity");
+    assert_int_equal(s->volume.transfer_count, 2);
+    assert_close(s->volume.transfer[1].rgba[3], 2);
+    assert_close(s->volume.ert_threshold, 0.8);
+    assert_int_equal(s->volume.tiles, 8);
+    assert_int_equal(s->volume.update_c, 4);
+    assert_int_equal(s->volume.workers, 2);
+    assert_int_equal(s->volume.disable, VFX_VOLUME_NO_SHARE);
+    assert_close(s->volume.model[14], -2);
+    vfx_scene_free(s);
+}
+
+static void test_defaults(void **state)
+{
+    (void)state;
+    vfx_test_log log = {0};
+    vfx_scene *s = NULL;
+    char err[256];
+    assert_int_equal(load("{}", &log, &s, err, sizeof err), VFX_OK);
+    assert_int_equal(s->camera.width, 640);
+    assert_int_equal(s->camera.height, 360);
+    assert_close(s->camera.fov_y_deg, 60);
+    assert_int_equal(s->mesh_count, 0);
+    assert_int_equal(s->beam_count, 0);
+    assert_false(s->has_water);
+    assert_false(s->has_volume);
+    assert_int_equal(s->beams_view.saturation, VFX_SATURATE_SMOOTH);
+    vfx_scene_free(s);
+    /* beam defaults: only head and dir given */
+    assert_int_equal(load("{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0]}]}", &log, &s, err, sizeof err), VFX_OK);
+    assert_close(s->beams[0].base.radius, 0.5);
+    assert_close(s->beams[0].base.length, 1);
+    assert_close(s->beams[0].base.color[3], 1);
+    vfx_scene_free(s);
+}
+
+typedef struct bad_case {
+    const char *json;
+    vfx_result code;
+    const char *needle; /* must appear in the message: the JSON path and the reason */
+} bad_case;
+
+static const bad_case bad_cases[] = {
+    {"[]", VFX_ERR_FORMAT, "(root): expected an object"},
+    {"{\"version\":2}", VFX_ERR_UNSUPPORTED, "version: scene format version 2"},
+    {"{\"camera\":{\"fov_y_deg\":\"wide\"}}", VFX_ERR_FORMAT, "camera.fov_y_deg: expected a number, got a string"},
+    {"{\"camera\":{\"fov_y_deg\":180}}", VFX_ERR_INVALID_ARGUMENT, "camera.fov_y_deg: must be <= 179"},
+    {"{\"camera\":{\"width\":0}}", VFX_ERR_INVALID_ARGUMENT, "camera.width: must be >= 1, got 0"},
+    {"{\"camera\":{\"width\":64.5}}", VFX_ERR_INVALID_ARGUMENT, "camera.width: must be an integer"},
+    {"{\"camera\":{\"height\":1e12}}", VFX_ERR_INVALID_ARGUMENT, "camera.height: must be <= 16384"},
+    {"{\"camera\":{\"near\":1,\"far\":0.5}}", VFX_ERR_INVALID_ARGUMENT, "camera.far: must be > near"},
+    {"{\"camera\":{\"eye\":[0,0,0],\"target\":[0,0,0]}}", VFX_ERR_INVALID_ARGUMENT, "camera.target: equals camera.eye"},
+    {"{\"camera\":{\"eye\":[0,5,0],\"target\":[0,0,0],\"up\":[0,1,0]}}", VFX_ERR_INVALID_ARGUMENT, "camera.up: zero or parallel"},
+    {"{\"camera\":{\"eye\":[1,2]}}", VFX_ERR_FORMAT, "camera.eye: expected 3 numbers, got 2"},
+    {"{\"camera\":{\"eye\":[1,2,1e999]}}", VFX_ERR_INVALID_ARGUMENT, "camera.eye[2]: must be finite, got inf"},
+    {"{\"camera\":{\"eye\":[1,-1e300,0]}}", VFX_ERR_INVALID_ARGUMENT, "camera.eye[1]: must be >= -1000000, got -1e+300"},
+    {"{\"camera\":[]}", VFX_ERR_FORMAT, "camera: expected an object, got an array"},
+    {"{\"meshes\":{}}", VFX_ERR_FORMAT, "meshes: expected an array"},
+    {"{\"meshes\":[{}]}", VFX_ERR_FORMAT, "meshes[0]: needs exactly one of"},
+    {"{\"meshes\":[{\"path\":\"a.obj\",\"box\":{}}]}", VFX_ERR_FORMAT, "meshes[0]: needs exactly one of"},
+    {"{\"meshes\":[{\"path\":\"\"}]}", VFX_ERR_INVALID_ARGUMENT, "meshes[0].path: empty path"},
+    {"{\"meshes\":[{\"path\":7}]}", VFX_ERR_FORMAT, "meshes[0].path: expected a string, got a number"},
+    {"{\"meshes\":[{\"path\":\"a\"},{\"box\":{\"min\":[0,0,0],\"max\":[1,0,1]}}]}", VFX_ERR_INVALID_ARGUMENT,
+     "meshes[1].box.max: must exceed min on every axis (axis 1"},
+    {"{\"meshes\":[{\"path\":\"a\",\"scale\":0}]}", VFX_ERR_INVALID_ARGUMENT, "meshes[0].scale: must be > 0, got 0"},
+    {"{\"meshes\":[{\"path\":\"a\",\"scale\":[1,-1,1]}]}", VFX_ERR_INVALID_ARGUMENT, "meshes[0].scale[1]: must be > 0"},
+    {"{\"meshes\":[{\"path\":\"a\",\"matrix\":[1,0,0,0],\"scale\":1}]}", VFX_ERR_INVALID_ARGUMENT,
+     "meshes[0].matrix: give either matrix"},
+    {"{\"meshes\":[{\"path\":\"a\",\"matrix\":[1,0,0,0]}]}", VFX_ERR_FORMAT, "meshes[0].matrix: expected 16 numbers, got 4"},
+    {"{\"meshes\":[{\"path\":\"a\",\"color\":[1,2,0]}]}", VFX_ERR_INVALID_ARGUMENT, "meshes[0].color[1]: must be <= 1, got 2"},
+    {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0]},{\"head\":[0,0,0],\"dir\":[1,0,0]},"
+     "{\"head\":[0,0,0],\"dir\":[1,0,0],\"radius\":-1}]}",
+     VFX_ERR_INVALID_ARGUMENT, "beams[2].radius: must be > 0, got -1"},
+    {"{\"beams\":[{\"dir\":[1,0,0]}]}", VFX_ERR_FORMAT, "beams[0].head: required array of 3 numbers missing"},
+    {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[0,0,0]}]}", VFX_ERR_INVALID_ARGUMENT, "beams[0].dir: direction must not be the zero vector"},
+    {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"a\":-0.5}]}", VFX_ERR_INVALID_ARGUMENT, "beams[0].a: must be >= 0, got -0.5"},
+    {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"length\":1e40}]}", VFX_ERR_INVALID_ARGUMENT, "beams[0].length: must be <= 1000000"},
+    {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"eps\":null}]}", VFX_ERR_FORMAT, "beams[0].eps: expected a number, got null"},
+    {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"keyframes\":{\"length\":[]}}]}", VFX_ERR_INVALID_ARGUMENT,
+     "beams[0].keyframes.length: 0 keyframes; must be 1 to"},
+    {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"keyframes\":{\"length\":[{\"t\":1,\"value\":1},"
+     "{\"t\":1,\"value\":2}]}}]}",
+     VFX_ERR_INVALID_ARGUMENT, "beams[0].keyframes.length[1].t: keyframe times must increase strictly"},
+    {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"keyframes\":{\"radius\":[{\"t\":0,\"value\":0}]}}]}",
+     VFX_ERR_INVALID_ARGUMENT, "beams[0].keyframes.radius[0].value: must be > 0, got 0"},
+    {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"keyframes\":{\"head\":[{\"t\":0,\"value\":1}]}}]}",
+     VFX_ERR_FORMAT, "beams[0].keyframes.head[0].value: expected an array of 3 numbers"},
+    {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"keyframes\":{\"dir\":[{\"t\":0,\"value\":[0,0,0]}]}}]}",
+     VFX_ERR_INVALID_ARGUMENT, "beams[0].keyframes.dir[0].value: direction must not be the zero vector"},
+    {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"keyframes\":{\"a\":[{\"value\":1}]}}]}",
+     VFX_ERR_FORMAT, "beams[0].keyframes.a[0].t: required number missing"},
+    {"{\"beam_settings\":{\"saturation\":\"soft\"}}", VFX_ERR_INVALID_ARGUMENT,
+     "beam_settings.saturation: unknown value \"soft\"; expected one of \"clamp\", \"smooth\""},
+    {"{\"beam_settings\":{\"c\":0}}", VFX_ERR_INVALID_ARGUMENT, "beam_settings.c: must be > 0"},
+    {"{\"water\":{}}", VFX_ERR_FORMAT, "water.source: required string missing"},
+    {"{\"water\":{\"source\":\"rain\"}}", VFX_ERR_INVALID_ARGUMENT, "water.source: unknown value \"rain\""},
+    {"{\"water\":{\"source\":\"file\"}}", VFX_ERR_FORMAT, "water.path: required string missing"},
+    {"{\"water\":{\"source\":\"generator\"}}", VFX_ERR_FORMAT, "water.generator: required for source"},
+    {"{\"water\":{\"source\":\"generator\",\"generator\":{\"kind\":\"layers\",\"count\":-5}}}", VFX_ERR_INVALID_ARGUMENT,
+     "water.generator.count: must be >= 0, got -5"},
+    {"{\"water\":{\"source\":\"generator\",\"generator\":{\"kind\":\"layers\",\"count\":1e9}}}", VFX_ERR_INVALID_ARGUMENT,
+     "water.generator.count: must be <= 4194304"},
+    {"{\"water\":{\"source\":\"generator\",\"generator\":{\"kind\":\"sphere\",\"count\":10}}}", VFX_ERR_FORMAT,
+     "water.generator.radius: required number missing"},
+    {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
+     "\"fluid\":{\"min\":[0,0,0],\"max\":[2,1,1]},\"particle_count\":10}}}",
+     VFX_ERR_INVALID_ARGUMENT, "water.simulation.fluid: must lie inside the tank (axis 0)"},
+    {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
+     "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]}}}}",
+     VFX_ERR_FORMAT, "water.simulation.particle_count: required integer missing"},
+    {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
+     "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"paddle\":{\"axis\":\"w\"}}}}",
+     VFX_ERR_INVALID_ARGUMENT, "water.simulation.paddle.axis: unknown value \"w\""},
+    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"h\":0}}", VFX_ERR_INVALID_ARGUMENT, "water.h: must be > 0, got 0"},
+    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"disable\":[\"pyramid\",\"magic\"]}}}",
+     VFX_ERR_INVALID_ARGUMENT, "water.quality.disable[1]: unknown flag \"magic\""},
+    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"max_samples\":0}}}", VFX_ERR_INVALID_ARGUMENT,
+     "water.quality.max_samples: must be >= 1"},
+    {"{\"volume\":{}}", VFX_ERR_FORMAT, "volume: needs exactly one of"},
+    {"{\"volume\":{\"path\":\"mesh.stl\"}}", VFX_ERR_INVALID_ARGUMENT, "volume.path: \"/base/mesh.stl\" is neither"},
+    {"{\"volume\":{\"generator\":{\"cells\":1000}}}", VFX_ERR_INVALID_ARGUMENT, "volume.generator.cells: must be <= 64"},
+    {"{\"volume\":{\"path\":\"a.vtu\",\"transfer\":[{\"scalar\":1,\"rgba\":[0,0,0,0]},{\"scalar\":0,\"rgba\":[1,1,1,1]}]}}",
+     VFX_ERR_INVALID_ARGUMENT, "volume.transfer[1].scalar: control points must increase strictly"},
+    {"{\"volume\":{\"path\":\"a.vtu\",\"transfer\":[{\"scalar\":0,\"rgba\":[0,0,-1,0]}]}}", VFX_ERR_INVALID_ARGUMENT,
+     "volume.transfer[0].rgba[2]: must be >= 0, got -1"},
+    {"{\"volume\":{\"path\":\"a.vtu\",\"ert_threshold\":1.5}}", VFX_ERR_INVALID_ARGUMENT, "volume.ert_threshold: must be <= 1"},
+    {"{\"volume\":{\"path\":\"a.vtu\",\"tiles\":0}}", VFX_ERR_INVALID_ARGUMENT, "volume.tiles: must be >= 1, got 0"},
+    {"{\"volume\":{\"path\":\"a.vtu\",\"scalar\":\"0123456789012345678901234567890123456789012345678901234567890123456789\"}}",
+     VFX_ERR_INVALID_ARGUMENT, "volume.scalar: string of 70 bytes is longer than 63"},
+};
+
+static void test_bad_inputs(void **state)
+{
+    (void)state;
+    for (size_t i = 0; i < sizeof bad_cases / sizeof bad_cases[0]; ++i) {
+        vfx_test_log log = {0};
+        vfx_scene *s = (vfx_scene *)&log; /* must be reset to NULL */
+        char err[512] = "";
+        vfx_result r = load(bad_cases[i].json, &log, &s, err, sizeof err);
+        if (r != bad_cases[i].code || !strstr(err, bad_cases[i].needle))
+            fail_msg("case %zu: %s\n got %d \"%s\"\n want %d containing \"%s\"", i, bad_cases[i].json, r, err,
+                     bad_cases[i].code, bad_cases[i].needle);
+        assert_null(s);
+    }
+}
+
+static void test_too_many_beams(void **state)
+{
+    (void)state;
+    size_t cap = VFX_SCENE_MAX_BEAMS + 1, len = 32 + cap * 40;
+    char *json = malloc(len), *p = json;
+    p += sprintf(p, "{\"beams\":[");
+    for (size_t i = 0; i < cap; ++i)
+        p += sprintf(p, "%s{\"head\":[0,0,0],\"dir\":[1,0,0]}", i ? "," : "");
+    sprintf(p, "]}");
+    vfx_test_log log = {0};
+    vfx_scene *s = NULL;
+    char err[256];
+    assert_int_equal(load(json, &log, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "beams: 257 beams, above the cap of 256"));
+    /* exactly the cap loads */
+    p = strrchr(json, '{');
+    sprintf(p - 1, "]}");
+    assert_int_equal(load(json, &log, &s, err, sizeof err), VFX_OK);
+    assert_int_equal(s->beam_count, VFX_SCENE_MAX_BEAMS);
+    vfx_scene_free(s);
+    free(json);
+}
+
+static void test_syntax_errors(void **state)
+{
+    (void)state;
+    vfx_test_log log = {0};
+    vfx_scene *s = NULL;
+    char err[256];
+    /* the stray comma is on line 3, column 18 (1-based): cJSON stops at or just before it */
+    const char *json = "{\n  \"camera\": {\n    \"eye\": [1, 2,, 3]\n  }\n}\n";
+    assert_int_equal(load(json, &log, &s, err, sizeof err), VFX_ERR_FORMAT);
+    assert_null(s);
+    assert_non_null(strstr(err, "JSON syntax error at line 3, column"));
+    /* truncated file */
+    assert_int_equal(load("{\"camera\": {\"eye\": [1", &log, &s, err, sizeof err), VFX_ERR_FORMAT);
+    assert_non_null(strstr(err, "line 1"));
+    /* empty input */
+    assert_int_equal(load("", &log, &s, err, sizeof err), VFX_ERR_FORMAT);
+    assert_non_null(strstr(err, "syntax error"));
+    /* two objects: text after the scene */
+    assert_int_equal(load("{}\n{}", &log, &s, err, sizeof err), VFX_ERR_FORMAT);
+    assert_non_null(strstr(err, "line 2, column 1 (byte 3): text after the scene object"));
+    /* an embedded NUL inside the given length */
+    vfx_logger lg = {vfx_test_log_fn, &log};
+    assert_int_equal(vfx_scene_load_mem("{}\0{}", 5, NULL, &lg, &s, err, sizeof err), VFX_ERR_FORMAT);
+    /* NULL arguments */
+    assert_int_equal(vfx_scene_load_mem(NULL, 3, NULL, &lg, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(vfx_scene_load_mem("{}", 2, NULL, &lg, NULL, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    /* deep nesting beyond cJSON's limit (1000) is a syntax error, not a stack overflow */
+    size_t depth = 5000;
+    char *deep = malloc(2 * depth + 16);
+    strcpy(deep, "{\"a\":");
+    memset(deep + 5, '[', depth);
+    memset(deep + 5 + depth, ']', depth);
+    strcpy(deep + 5 + 2 * depth, "}");
+    assert_int_equal(load(deep, &log, &s, err, sizeof err), VFX_ERR_FORMAT);
+    free(deep);
+}
+
+static void test_unknown_keys_warn(void **state)
+{
+    (void)state;
+    vfx_test_log log = {0};
+    vfx_scene *s = NULL;
+    char err[256];
+    assert_int_equal(load("{\"camera\":{\"fov\":40},\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"raduis\":1}]}",
+                          &log, &s, err, sizeof err),
+                     VFX_OK);
+    assert_int_equal(log.warnings, 2);
+    assert_string_equal(log.last, "beams[0].raduis: unknown key ignored");
+    vfx_scene_free(s);
+    log = (vfx_test_log){0};
+    assert_int_equal(load("{\"name\":\"a\",\"name\":\"b\"}", &log, &s, err, sizeof err), VFX_OK);
+    assert_int_equal(log.warnings, 1);
+    assert_string_equal(log.last, "name: duplicate key, the first one is used");
+    assert_string_equal(s->name, "a");
+    vfx_scene_free(s);
+}
+
+static void test_keyframes(void **state)
+{
+    (void)state;
+    const char *json =
+        "{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"keyframes\":{"
+        "\"length\":[{\"t\":1,\"value\":2},{\"t\":3,\"value\":6},{\"t\":4,\"value\":4}],"
+        "\"head\":[{\"t\":0,\"value\":[0,0,0]},{\"t\":2,\"value\":[2,-4,8]}],"
+        "\"dir\":[{\"t\":0,\"value\":[1,0,0]},{\"t\":2,\"value\":[-1,0,0]}],"
+        "\"color\":[{\"t\":0,\"value\":[0,0,0,1]},{\"t\":10,\"value\":[1,0.5,0,1]}]}},"
+        "{\"head\":[5,5,5],\"dir\":[0,1,0],\"loop_s\":2,\"keyframes\":{\"radius\":[{\"t\":0,\"value\":1},"
+        "{\"t\":2,\"value\":3}]}}]}";
+    vfx_test_log log = {0};
+    vfx_scene *s = NULL;
+    char err[256];
+    assert_int_equal(load(json, &log, &s, err, sizeof err), VFX_OK);
+    vfx_beam b[4];
+    /* hand-computed: length keys (1,2) (3,6) (4,4) */
+    struct { double t, length; } L[] = {{-5, 2}, {1, 2}, {2, 4}, {2.5, 5}, {3, 6}, {3.25, 5.5}, {4, 4}, {100, 4}};
+    for (size_t i = 0; i < sizeof L / sizeof L[0]; ++i) {
+        assert_int_equal(vfx_scene_beams_at(s, L[i].t, b, 4), 2);
+        assert_close(b[0].length, L[i].length);
+    }
+    vfx_scene_beams_at(s, 0.5, b, 4);
+    assert_close(b[0].head[0], 0.5);
+    assert_close(b[0].head[1], -1);
+    assert_close(b[0].head[2], 2);
+    assert_close(b[0].color[0], 0.05);
+    assert_close(b[0].color[1], 0.025);
+    assert_close(b[0].color[3], 1);
+    assert_close(b[0].dir[0], 0.5);
+    assert_close(b[0].radius, 0.5); /* not animated: the default */
+    /* opposite direction keys pass through zero at t=1: the earlier key's direction is held */
+    vfx_scene_beams_at(s, 1.0, b, 4);
+    assert_close(b[0].dir[0], 1);
+    /* beam 1 loops every 2 s: t=5 -> 1 -> radius 2; t=-0.5 -> 1.5 -> 2.5; static head */
+    vfx_scene_beams_at(s, 5.0, b, 4);
+    assert_close(b[1].radius, 2);
+    assert_close(b[1].head[0], 5);
+    vfx_scene_beams_at(s, -0.5, b, 4);
+    assert_close(b[1].radius, 2.5);
+    /* non-finite time is treated as 0; n smaller than the count writes n */
+    assert_int_equal(vfx_scene_beams_at(s, NAN, b, 1), 1);
+    assert_close(b[0].length, 2);
+    assert_int_equal(vfx_scene_beams_at(s, 0, NULL, 4), 0);
+    vfx_scene_free(s);
+    /* an animated head with no static head takes the first key as the base */
+    assert_int_equal(load("{\"beams\":[{\"dir\":[1,0,0],\"keyframes\":{\"head\":[{\"t\":0,\"value\":[7,8,9]}]}}]}",
+                          &log, &s, err, sizeof err),
+                     VFX_OK);
+    assert_close(s->beams[0].base.head[1], 8);
+    vfx_scene_free(s);
+}
+
+static void test_sample_scenes(void **state)
+{
+    (void)state;
+    const char *root = getenv("VFX_SOURCE_ROOT");
+    if (!root)
+        root = ".";
+    static const char *names[] = {"default", "beams-only", "water-only", "empty"};
+    for (size_t i = 0; i < 4; ++i) {
+        char path[1024], err[512];
+        snprintf(path, sizeof path, "%s/sample_game/scenes/%s.json", root, names[i]);
+        vfx_test_log log = {0};
+        vfx_logger lg = {vfx_test_log_fn, &log};
+        vfx_scene *s = NULL;
+        vfx_result r = vfx_scene_load_file(path, &lg, &s, err, sizeof err);
+        if (r)
+            fail_msg("%s: %s", path, err);
+        assert_int_equal(log.warnings, 0);
+        assert_string_equal(s->name, names[i]);
+        if (s->has_water) {
+            float *xyz = NULL;
+            uint32_t n = 0;
+            assert_int_equal(vfx_scene_water_particles(&s->water, &xyz, &n, err, sizeof err), VFX_OK);
+            assert_int_equal(n, s->water.count);
+            assert_true(n <= 4096); /* llvmpipe budget of the sample scenes */
+            free(xyz);
+        }
+        if (i == 0) {
+            assert_true(s->beam_count >= 2 && s->beam_count <= 3);
+            assert_true(s->beams[0].tracks[VFX_BEAM_PARAM_LENGTH].count >= 2);
+            assert_true(s->has_water && s->water.source == VFX_SCENE_WATER_SIMULATION && s->water.paddle);
+            assert_true(s->has_volume);
+            assert_true(s->mesh_count >= 1);
+        }
+        vfx_scene_free(s);
+    }
+    /* the embedded copy is the same text and loads the same way */
+    char path[1024];
+    snprintf(path, sizeof path, "%s/sample_game/scenes/default.json", root);
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    static char text[1 << 16];
+    size_t n = fread(text, 1, sizeof text, f);
+    fclose(f);
+    assert_int_equal(n, vfx_default_scene_json_len);
+    assert_memory_equal(text, vfx_default_scene_json, n);
+    vfx_scene *s = NULL;
+    char err[256];
+    vfx_test_log log = {0};
+    vfx_logger lg = {vfx_test_log_fn, &log};
+    assert_int_equal(vfx_scene_load_mem(vfx_default_scene_json, vfx_default_scene_json_len, NULL, &lg, &s, err, sizeof err),
+                     VFX_OK);
+    vfx_scene_free(s);
+}
+
+static void test_relative_paths_and_io(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/vfx_scene_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char scene_path[256], part_path[256], err[512];
+    snprintf(scene_path, sizeof scene_path, "%s/s.json", dir);
+    snprintf(part_path, sizeof part_path, "%s/p.bin", dir);
+    FILE *f = fopen(scene_path, "w");
+    fputs("{\"water\":{\"source\":\"file\",\"path\":\"p.bin\"}}", f);
+    fclose(f);
+    const float xyz[6] = {1, 2, 3, 4, 5, 6};
+    assert_int_equal(vfx_particle_file_save(part_path, xyz, 2, err, sizeof err), VFX_OK);
+    vfx_scene *s = NULL;
+    assert_int_equal(vfx_scene_load_file(scene_path, NULL, &s, err, sizeof err), VFX_OK);
+    assert_string_equal(s->water.path, part_path);
+    float *got = NULL;
+    uint32_t n = 0;
+    assert_int_equal(vfx_scene_water_particles(&s->water, &got, &n, err, sizeof err), VFX_OK);
+    assert_int_equal(n, 2);
+    assert_memory_equal(got, xyz, sizeof xyz);
+    free(got);
+    vfx_scene_free(s);
+    /* a syntax error in a file names the file and the line */
+    f = fopen(scene_path, "w");
+    fputs("{\n\"camera\": }", f);
+    fclose(f);
+    assert_int_equal(vfx_scene_load_file(scene_path, NULL, &s, err, sizeof err), VFX_ERR_FORMAT);
+    assert_non_null(strstr(err, scene_path));
+    assert_non_null(strstr(err, "line 2"));
+    unlink(scene_path);
+    unlink(part_path);
+    rmdir(dir);
+    assert_int_equal(vfx_scene_load_file(scene_path, NULL, &s, err, sizeof err), VFX_ERR_IO);
+    assert_non_null(strstr(err, "cannot open"));
+    assert_int_equal(vfx_scene_load_file("/tmp", NULL, &s, err, sizeof err) != VFX_OK, 1);
+}
+
+static void test_generators(void **state)
+{
+    (void)state;
+    vfx_scene_water w = {.source = VFX_SCENE_WATER_GENERATOR, .generator = VFX_SCENE_GEN_LAYERS, .count = 600,
+                         .origin = {1, 2, 3}, .spacing = 0.5f, .layer_side = 24};
+    float *p = NULL;
+    uint32_t n = 0;
+    char err[256];
+    assert_int_equal(vfx_scene_water_particles(&w, &p, &n, err, sizeof err), VFX_OK);
+    assert_int_equal(n, 600);
+    /* particle 577 = layer 1 (576 per layer), index 1 in that layer: x = 1 + 0.5, y = 2 + 0.5, z = 3 */
+    assert_close(p[3 * 577], 1.5);
+    assert_close(p[3 * 577 + 1], 2.5);
+    assert_close(p[3 * 577 + 2], 3);
+    assert_close(p[3 * 575 + 2], 3 + 23 * 0.5);
+    free(p);
+    /* box: exact count, every particle inside, no two identical */
+    w = (vfx_scene_water){.source = VFX_SCENE_WATER_GENERATOR, .generator = VFX_SCENE_GEN_BOX, .count = 1000,
+                          .box_min = {-1, 0, 0}, .box_max = {1, 0.5f, 3}};
+    assert_int_equal(vfx_scene_water_particles(&w, &p, &n, err, sizeof err), VFX_OK);
+    assert_int_equal(n, 1000);
+    for (uint32_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k)
+            assert_true(p[3 * i + k] >= w.box_min[k] - 1e-5f && p[3 * i + k] <= w.box_max[k] + 1e-5f);
+    for (uint32_t i = 1; i < n; ++i)
+        assert_memory_not_equal(&p[3 * i], &p[3 * (i - 1)], 12);
+    free(p);
+    /* sphere */
+    w = (vfx_scene_water){.source = VFX_SCENE_WATER_GENERATOR, .generator = VFX_SCENE_GEN_SPHERE, .count = 2000,
+                          .center = {0, 1, 0}, .radius = 0.5f};
+    assert_int_equal(vfx_scene_water_particles(&w, &p, &n, err, sizeof err), VFX_OK);
+    assert_int_equal(n, 2000);
+    for (uint32_t i = 0; i < n; ++i) {
+        double d = hypot(hypot(p[3 * i], p[3 * i + 1] - 1.0), p[3 * i + 2]);
+        assert_true(d <= 0.5 + 1e-5);
+    }
+    free(p);
+    /* zero particles: defined, empty */
+    w.count = 0;
+    assert_int_equal(vfx_scene_water_particles(&w, &p, &n, err, sizeof err), VFX_OK);
+    assert_int_equal(n, 0);
+    assert_null(p);
+    /* simulation: the initial block */
+    w = (vfx_scene_water){.source = VFX_SCENE_WATER_SIMULATION, .count = 500, .box_min = {0, 0, 0}, .box_max = {1, 1, 1}};
+    assert_int_equal(vfx_scene_water_particles(&w, &p, &n, err, sizeof err), VFX_OK);
+    assert_int_equal(n, 500);
+    free(p);
+}
+
+static void test_volume_generate_and_transfer(void **state)
+{
+    (void)state;
+    vfx_scene_volume v = {.generated = true, .gen_cells = 3, .gen_min = {0, 0, 0}, .gen_max = {2, 1, 3}};
+    float *pts = NULL, *sc = NULL;
+    uint32_t *tets = NULL, np = 0, nt = 0;
+    char err[256];
+    assert_int_equal(vfx_scene_volume_generate(&v, &pts, &np, &tets, &nt, &sc, err, sizeof err), VFX_OK);
+    assert_int_equal(np, 64);
+    assert_int_equal(nt, 6 * 27);
+    /* independent check in double: every tet positive, their volumes sum to the box's (6) */
+    double total = 0;
+    for (uint32_t t = 0; t < nt; ++t) {
+        const float *a = &pts[3 * tets[4 * t]], *b = &pts[3 * tets[4 * t + 1]], *c = &pts[3 * tets[4 * t + 2]],
+                    *d = &pts[3 * tets[4 * t + 3]];
+        double u[3], w[3], e[3];
+        for (int k = 0; k < 3; ++k)
+            u[k] = b[k] - a[k], w[k] = c[k] - a[k], e[k] = d[k] - a[k];
+        double vol = (u[0] * (w[1] * e[2] - w[2] * e[1]) - u[1] * (w[0] * e[2] - w[2] * e[0]) +
+                      u[2] * (w[0] * e[1] - w[1] * e[0])) / 6.0;
+        assert_true(vol > 0);
+        total += vol;
+        for (int k = 0; k < 4; ++k)
+            assert_true(tets[4 * t + k] < np);
+    }
+    assert_true(fabs(total - 6.0) < 1e-9);
+    /* scalar: 1 at nothing but 0 at the corners (distance = half-diagonal) */
+    assert_close(sc[0], 0);
+    free(pts), free(tets), free(sc);
+    v.gen_cells = 0;
+    assert_int_equal(vfx_scene_volume_generate(&v, &pts, &np, &tets, &nt, &sc, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+
+    /* transfer: points (0: 0,0,0,0) (1: 1,0,0,1) (3: 1,1,1,3) sampled at 7 entries over [0, 3] */
+    vfx_scene_volume tv = {.transfer_count = 3,
+                           .transfer = {{0, {0, 0, 0, 0}}, {1, {1, 0, 0, 1}}, {3, {1, 1, 1, 3}}}};
+    float rgba[28], lo, hi;
+    vfx_scene_transfer_sample(&tv, 7, rgba, &lo, &hi);
+    assert_close(lo, 0);
+    assert_close(hi, 3);
+    assert_close(rgba[4 * 1 + 0], 0.5); /* s = 0.5 */
+    assert_close(rgba[4 * 1 + 3], 0.5);
+    assert_close(rgba[4 * 2 + 0], 1);   /* s = 1 */
+    assert_close(rgba[4 * 3 + 1], 0.25); /* s = 1.5 */
+    assert_close(rgba[4 * 3 + 3], 1.5);
+    assert_close(rgba[4 * 6 + 2], 1);   /* s = 3 */
+    assert_close(rgba[4 * 6 + 3], 3);
+    tv.transfer_normalized = true;
+    vfx_scene_transfer_sample(&tv, 7, rgba, &lo, &hi);
+    assert_close(lo, 0);
+    assert_close(hi, 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_every_field),
+        cmocka_unit_test(test_defaults),
+        cmocka_unit_test(test_bad_inputs),
+        cmocka_unit_test(test_too_many_beams),
+        cmocka_unit_test(test_syntax_errors),
+        cmocka_unit_test(test_unknown_keys_warn),
+        cmocka_unit_test(test_keyframes),
+        cmocka_unit_test(test_sample_scenes),
+        cmocka_unit_test(test_relative_paths_and_io),
+        cmocka_unit_test(test_generators),
+        cmocka_unit_test(test_volume_generate_and_transfer),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
