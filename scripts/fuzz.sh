@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets in a separate clang build dir and runs each for a bounded time.
+# usage: scripts/fuzz.sh [seconds per target, default 60]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+secs=${1:-60}
+[ -f build-fuzz/build.ninja ] || CC=clang meson setup build-fuzz -Dfuzz=true -Db_lundef=false \
+  -Dmetaballs=false -Dbeams=false -Dtetvol=false >/dev/null
+ninja -C build-fuzz tests/fuzz/fuzz_scene tests/fuzz/fuzz_particle_file
+for t in scene particle_file; do
+  work=build-fuzz/corpus-$t; mkdir -p "$work"
+  log=build-fuzz/fuzz-$t.log
+  set +e
+  build-fuzz/tests/fuzz/fuzz_$t -max_total_time="$secs" -max_len=8192 -artifact_prefix=build-fuzz/ "$work" "tests/fuzz/corpus/$t" >"$log" 2>&1
+  rc=$?
+  set -e
+  runs=$(grep -o 'Done [0-9]* runs' "$log" | tail -1 || true)
+  echo "fuzz_$t: ${runs:-no summary} rc=$rc crashes=$(ls build-fuzz/crash-* 2>/dev/null | wc -l)"
+done
