@@ -87,6 +87,8 @@ static void sb_printf(strbuf *b, const char *fmt, ...)
         sb_put(b, tmp, (size_t)n < sizeof tmp ? (size_t)n : sizeof tmp - 1);
 }
 
+long vfx_shader_line_base(int index) { return (long)(index + 1) * VFX_SHADER_LINE_STRIDE; }
+
 /* Expands one level of #include "x" with #line directives so the driver's line numbers point
  * into the right file: source-string number = the file's index in the embedded table. */
 static bool expand(strbuf *out, const char *path, const char *defines, int depth, char *err, size_t errlen)
@@ -103,7 +105,7 @@ static bool expand(strbuf *out, const char *path, const char *defines, int depth
         if (defines)
             sb_printf(out, "%s\n", defines);
     }
-    sb_printf(out, "#line 1 %d\n", idx);
+    sb_printf(out, "#line %ld\n", vfx_shader_line_base(idx) + 1);
     int line = 1;
     for (const char *p = src; *p;) {
         const char *e = strchr(p, '\n');
@@ -126,7 +128,7 @@ static bool expand(strbuf *out, const char *path, const char *defines, int depth
                 free(override);
                 return false;
             }
-            sb_printf(out, "\n#line %d %d\n", line + 1, idx);
+            sb_printf(out, "\n#line %ld\n", vfx_shader_line_base(idx) + line + 1);
         } else {
             sb_put(out, p, n);
             sb_put(out, "\n", 1);
@@ -159,6 +161,10 @@ void vfx_shader_rewrite_log(const char *log, char *out, size_t cap, const char *
             } else {
                 line = -1;
             }
+        }
+        if (line >= VFX_SHADER_LINE_STRIDE) { /* the file is encoded in the line number */
+            file = line / VFX_SHADER_LINE_STRIDE - 1;
+            line %= VFX_SHADER_LINE_STRIDE;
         }
         const char *name = (line >= 0 && file >= 0 && file < (long)vfx_embedded_shader_count)
                                ? vfx_embedded_shaders[file].path : fallback;

@@ -4,14 +4,20 @@
 
 #include <stddef.h>
 
+/* Drivers disagree on reporting #line's source-string number (Mesa always prints 0), so the file
+ * is encoded in the line number itself: line (index + 1) * STRIDE + n is line n of file index. */
+#define VFX_SHADER_LINE_STRIDE 100000L
+/* First encoded line number of embedded shader `index` (line n is base + n). */
+long vfx_shader_line_base(int index);
 /* Index of an embedded shader by path relative to shaders/ (-1 when absent). */
 int vfx_shader_index(const char *path);
 /* Full source ready for glShaderSource: "#version 450 core", `defines`, then the file with one
- * level of #include "x" expanded and #line <n> <file-index> markers. malloc'd; NULL on error
+ * level of #include "x" expanded and #line markers encoding file and line. malloc'd; NULL on error
  * (message in err). */
 char *vfx_shader_expand(const char *path, const char *defines, char *err, size_t errlen);
-/* Rewrites a driver info log ("0:12(3): error" Mesa, "0(12) : error" NVIDIA) into
- * "file:12: error" lines using the source-string numbers set by vfx_shader_expand. */
+/* Rewrites a driver info log ("0:L(3): error" Mesa, "0(L) : error" NVIDIA) into "file:n: error"
+ * lines, decoding the line numbers of vfx_shader_expand (or a driver's source number when L is
+ * small). */
 void vfx_shader_rewrite_log(const char *log, char *out, size_t cap, const char *fallback);
 
 #endif

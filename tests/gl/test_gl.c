@@ -144,14 +144,21 @@ static void test_shader_error_names_file_line(void **state)
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
     char src[256];
     extern int vfx_shader_index(const char *path);
+    extern long vfx_shader_line_base(int index);
     int idx = vfx_shader_index("common/depth.glsl");
     assert_true(idx >= 0);
     /* line 3 of the named file has the error */
-    snprintf(src, sizeof src, "#version 450 core\n#line 1 %d\nvoid f() {}\n\nvoid main() { undefined_thing = 1; }\n", idx);
+    snprintf(src, sizeof src, "#version 450 core\n#line %ld\nvoid f() {}\n\nvoid main() { undefined_thing = 1; }\n",
+             vfx_shader_line_base(idx) + 1);
     const char *srcs[1] = {src}, *names[1] = {"common/depth.glsl"};
     GLenum stage = GL_FRAGMENT_SHADER;
     assert_int_equal(vfx_gpu_link_sources(ctx, 1, &stage, srcs, names), 0);
     assert_non_null(strstr(api->last_error(ctx), "common/depth.glsl:3:"));
+    /* an error inside an included file names that file: the integrate shader compiled with a
+     * define that breaks the included beam_field.glsl is reported at beam_field.glsl */
+    assert_int_equal(vfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
+                                     "#define fma undefined_fma"), 0);
+    assert_non_null(strstr(api->last_error(ctx), "beams/beam_field.glsl:"));
     /* a shader that is not embedded is named */
     assert_int_equal(vfx_gpu_program(ctx, "common/fullscreen.vert", "nope/none.frag", NULL), 0);
     assert_non_null(strstr(api->last_error(ctx), "nope/none.frag"));

@@ -84,6 +84,10 @@ static void test_shader_log_rewrite(void **state)
     snprintf(log, sizeof log, "%d(9) : error C0000: bad\n", idx);
     vfx_shader_rewrite_log(log, out, sizeof out, "x");
     assert_non_null(strstr(out, "common/fullscreen.vert:9:"));
+    /* Mesa prints source string 0 whatever #line said: the file comes from the line number */
+    snprintf(log, sizeof log, "0:%ld(3): error: x\n", vfx_shader_line_base(idx) + 42);
+    vfx_shader_rewrite_log(log, out, sizeof out, "x");
+    assert_non_null(strstr(out, "common/fullscreen.vert:42: error: x"));
     char err[128];
     assert_null(vfx_shader_expand("nope/missing.frag", NULL, err, sizeof err));
     assert_non_null(strstr(err, "nope/missing.frag"));
