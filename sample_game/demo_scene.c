@@ -1,119 +1,185 @@
-/* demo_scene.c — default scene: an arena (floor, walls, an Assimp model when installed), a
- * water block that sloshes, beams fired at targets that grow, thicken and turn. */
+/* demo_scene.c — turns a scene (runtime/scene) into app content and animates it. */
 #include "demo_scene.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define ARENA_MODEL "/usr/share/assimp/models/OBJ/spider.obj"
+extern const char vfx_default_scene_json[];
+extern const unsigned long vfx_default_scene_json_len;
+
+static vfx_result load_meshes(vfx_app *app, const vfx_scene *sc)
+{
+    for (uint32_t i = 0; i < sc->mesh_count; ++i) {
+        const vfx_scene_mesh *m = &sc->meshes[i];
+        vfx_entity e;
+        vfx_result r;
+        if (m->is_box) {
+            if ((r = vfx_app_add_box(app, m->box_min, m->box_max, m->color, &e)))
+                return r;
+            memcpy(vfx_world_get(app->world, e, app->transform_comp, 0), m->model, sizeof m->model);
+            continue;
+        }
+        FILE *f = fopen(m->path, "rb");
+        if (!f) { /* a missing decoration is not worth refusing the scene for */
+            vfx_logf(&app->log, VFX_LOG_WARN, "scene meshes[%u]: %s not found, skipped", i, m->path);
+            continue;
+        }
+        fclose(f);
+        if ((r = vfx_app_add_mesh_file(app, m->path, m->model, m->color, NULL)))
+            return r;
+    }
+    return VFX_OK;
+}
+
+static vfx_result load_water(vfx_app *app, vfx_demo *demo, const vfx_scene *sc)
+{
+    const vfx_scene_water *w = &sc->water;
+    float *xyz = NULL;
+    uint32_t n = 0;
+    char err[256];
+    vfx_result r = vfx_scene_water_particles(w, &xyz, &n, err, sizeof err);
+    if (r) {
+        vfx_logf(&app->log, VFX_LOG_ERROR, "scene water: %s", err);
+        return r;
+    }
+    float *px = malloc((n ? n : 1) * sizeof(float)), *py = malloc((n ? n : 1) * sizeof(float)),
+          *pz = malloc((n ? n : 1) * sizeof(float));
+    if (!px || !py || !pz) {
+        free(px), free(py), free(pz), free(xyz);
+        return VFX_ERR_OUT_OF_MEMORY;
+    }
+    for (uint32_t i = 0; i < n; ++i)
+        px[i] = xyz[3 * i], py[i] = xyz[3 * i + 1], pz[i] = xyz[3 * i + 2];
+    free(xyz);
+    if (w->source == VFX_SCENE_WATER_SIMULATION && n > 0) {
+        /* the particle spacing follows from the count filling the initial block */
+        double vol = 1.0;
+        for (int k = 0; k < 3; ++k)
+            vol *= fmax(w->box_max[k] - w->box_min[k], 1e-6);
+        float spacing = (float)cbrt(vol / n);
+        vfx_sph_desc sd = {.spacing = spacing, .max_substeps = 64,
+                           /* ~0.6 m of water moves at ~3.4 m/s: c0 = 25 m/s keeps the compression
+                            * near (3.4/25)^2 = 2% with half the substeps of the default */
+                           .sound_speed = 25.0f};
+        memcpy(sd.domain_min, w->tank_min, sizeof sd.domain_min);
+        memcpy(sd.domain_max, w->tank_max, sizeof sd.domain_max);
+        memcpy(sd.gravity, w->gravity, sizeof sd.gravity);
+        if (w->gravity[0] == 0 && w->gravity[1] == 0 && w->gravity[2] == 0)
+            sd.flags |= VFX_SPH_NO_GRAVITY;
+        if ((r = vfx_sim_system_create(app->world, &sd, &demo->sim, err, sizeof err))) {
+            vfx_logf(&app->log, VFX_LOG_ERROR, "scene water simulation: %s", err);
+            goto done;
+        }
+        if (w->paddle) {
+            uint32_t ax = w->paddle_axis < 3 ? w->paddle_axis : 0;
+            vfx_sph_collider paddle = {.kind = VFX_SPH_BOX, .motion_amplitude = w->paddle_amplitude,
+                                       .motion_frequency = w->paddle_period_s > 0 ? 1.0f / w->paddle_period_s : 0};
+            for (int k = 0; k < 3; ++k) {
+                paddle.center[k] = 0.5f * (w->tank_min[k] + w->tank_max[k]);
+                paddle.half[k] = 0.5f * (w->tank_max[k] - w->tank_min[k]);
+            }
+            /* a thin plate at the low end of the axis, pushing the fluid along it */
+            paddle.half[ax] = 0.5f * spacing;
+            paddle.center[ax] = w->tank_min[ax] + w->paddle_amplitude + spacing;
+            paddle.motion_axis[ax] = 1.0f;
+            if ((r = vfx_sph_add_collider(vfx_sim_system_solver(demo->sim), &paddle, NULL)))
+                goto done;
+        }
+    }
+    if ((r = vfx_particles_spawn(app->world, &app->particles, n, px, py, pz, false)))
+        goto done;
+    demo->particle_count = n;
+    app->water = w->params;
+    app->water_enabled = n > 0;
+done:
+    free(px), free(py), free(pz);
+    return r;
+}
+
+/* The volume's mesh stays with the demo; the host api hands the plugin pointers into it. */
+static vfx_result load_volume(vfx_app *app, vfx_demo *demo, const vfx_scene *sc)
+{
+    const vfx_scene_volume *v = &sc->volume;
+    if (!v->generated) {
+        vfx_logf(&app->log, VFX_LOG_INFO, "scene volume %s: file volumes are not wired into the game yet", v->path);
+        return VFX_OK;
+    }
+    char err[256];
+    vfx_result r = vfx_scene_volume_generate(v, &demo->vol_points, &demo->vol_point_count, &demo->vol_tets,
+                                             &demo->vol_tet_count, &demo->vol_scalar, err, sizeof err);
+    if (r) {
+        vfx_logf(&app->log, VFX_LOG_ERROR, "scene volume: %s", err);
+        return r;
+    }
+    vfx_volume_view *vv = &app->volumes[0];
+    memset(vv, 0, sizeof *vv);
+    vv->size = sizeof *vv;
+    vv->version = VFX_VOLUME_VIEW_VERSION;
+    vv->point_count = demo->vol_point_count;
+    vv->tet_count = demo->vol_tet_count;
+    vv->points = demo->vol_points;
+    vv->tets = demo->vol_tets;
+    vv->scalar = demo->vol_scalar;
+    if (v->transfer_count) {
+        vfx_scene_transfer_sample(v, 64, demo->vol_transfer, &vv->scalar_min, &vv->scalar_max);
+        vv->transfer_rgba = demo->vol_transfer;
+        vv->transfer_count = 64;
+    }
+    vv->ert_threshold = v->ert_threshold;
+    vv->tiles = v->tiles;
+    vv->update_c = v->update_c;
+    vv->workers = v->workers;
+    vv->disable = v->disable;
+    memcpy(vv->model, v->model, sizeof vv->model);
+    vv->revision = 1;
+    app->volume_count = 1;
+    return VFX_OK;
+}
 
 vfx_result vfx_demo_load(vfx_app *app, vfx_demo *demo, const char *scene_path, uint32_t effects_off)
 {
     memset(demo, 0, sizeof *demo);
-    demo->effects_off = effects_off;
-    if (scene_path) {
-        vfx_logf(&app->log, VFX_LOG_ERROR, "scene files are not supported by this build yet: %s",
-                 scene_path);
-        return VFX_ERR_UNSUPPORTED;
-    }
-    static const float floor_c[3] = {0.55f, 0.5f, 0.45f}, wall_c[3] = {0.35f, 0.4f, 0.5f};
-    vfx_result r = vfx_app_add_box(app, (float[3]){-4, -0.2f, -4}, (float[3]){4, 0, 4}, floor_c, NULL);
-    if (!r) r = vfx_app_add_box(app, (float[3]){-4, 0, -4}, (float[3]){4, 2, -3.8f}, wall_c, NULL);
-    if (!r) r = vfx_app_add_box(app, (float[3]){-1.7f, 0, -1.2f}, (float[3]){-1.6f, 0.7f, 1.2f}, wall_c, NULL);
-    if (!r) r = vfx_app_add_box(app, (float[3]){1.6f, 0, -1.2f}, (float[3]){1.7f, 0.7f, 1.2f}, wall_c, NULL);
-    if (r)
+    demo->effects_off = effects_off | ~app->api->effects_built; /* what the plugin lacks is off too */
+    char err[512];
+    vfx_result r = scene_path
+                       ? vfx_scene_load_file(scene_path, &app->log, &demo->scene, err, sizeof err)
+                       : vfx_scene_load_mem(vfx_default_scene_json, vfx_default_scene_json_len, NULL,
+                                            &app->log, &demo->scene, err, sizeof err);
+    if (r) {
+        vfx_logf(&app->log, VFX_LOG_ERROR, "scene %s: %s", scene_path ? scene_path : "(built-in default)", err);
         return r;
-    FILE *f = fopen(ARENA_MODEL, "rb");
-    if (f) {
-        fclose(f);
-        float model[16] = {0.02f, 0, 0, 0, 0, 0.02f, 0, 0, 0, 0, 0.02f, 0, 2.6f, 0.4f, -2.2f, 1};
-        static const float c[3] = {0.7f, 0.35f, 0.3f};
-        if (vfx_app_add_mesh_file(app, ARENA_MODEL, model, c, NULL))
-            vfx_logf(&app->log, VFX_LOG_WARN, "arena model skipped");
     }
-    /* Water: an SPH pool between the two low walls, sloshed by a paddle; the simulation
-     * system writes the particle columns the plugin reads. */
-    if (!(effects_off & VFX_EFFECT_BIT(VFX_EFFECT_WATER))) {
-        const float spacing = 0.1f;
-        vfx_sph_desc sd = {.spacing = spacing, .domain_min = {-1.55f, 0.0f, -1.15f},
-                           .domain_max = {1.55f, 1.4f, 1.15f}, .max_substeps = 64,
-                           /* 0.6 m of water moves at ~3.4 m/s: c0 = 25 m/s keeps compression near
-                            * (3.4/25)^2 = 2% with half the substeps of the default */
-                           .sound_speed = 25.0f};
-        char err[256];
-        if ((r = vfx_sim_system_create(app->world, &sd, &demo->sim, err, sizeof err))) {
-            vfx_logf(&app->log, VFX_LOG_ERROR, "water simulation: %s", err);
-            return r;
-        }
-        vfx_sph_collider paddle = {.kind = VFX_SPH_BOX, .center = {-1.45f, 0.5f, 0}, .half = {0.05f, 0.5f, 1.1f},
-                                   .motion_axis = {1, 0, 0}, .motion_amplitude = 0.25f,
-                                   .motion_frequency = 0.45f};
-        if ((r = vfx_sph_add_collider(vfx_sim_system_solver(demo->sim), &paddle, NULL)))
-            return r;
-        const int nx = 14, ny = 6, nz = 22;
-        uint32_t n = (uint32_t)(nx * ny * nz), k = 0;
-        float *px = malloc(n * sizeof(float)), *py = malloc(n * sizeof(float)), *pz = malloc(n * sizeof(float));
-        if (!px || !py || !pz) {
-            free(px), free(py), free(pz);
-            return VFX_ERR_OUT_OF_MEMORY;
-        }
-        for (int a = 0; a < nx; ++a)
-            for (int b = 0; b < ny; ++b)
-                for (int c = 0; c < nz; ++c, ++k) {
-                    px[k] = -1.2f + (a + 0.5f) * spacing;
-                    py[k] = (b + 0.5f) * spacing;
-                    pz[k] = -1.1f + (c + 0.5f) * spacing;
-                }
-        r = vfx_particles_spawn(app->world, &app->particles, n, px, py, pz, false);
-        free(px), free(py), free(pz);
-        if (r)
-            return r;
-        demo->particle_count = n;
-        app->water_enabled = true;
-        app->water = (vfx_water_params){.size = sizeof app->water, .version = VFX_WATER_PARAMS_VERSION,
-                                        .h = 2.2f * spacing};
+    const vfx_scene *sc = demo->scene;
+    const vfx_scene_camera *c = &sc->camera;
+    vfx_ref_camera cam = {{c->eye[0], c->eye[1], c->eye[2]}, {c->target[0], c->target[1], c->target[2]},
+                          {c->up[0], c->up[1], c->up[2]}, c->fov_y_deg * M_PI / 180.0,
+                          app->desc.width ? app->desc.width : c->width, app->desc.height ? app->desc.height : c->height,
+                          c->near_plane, c->far_plane};
+    if ((r = vfx_app_set_camera(app, &cam)) || (r = load_meshes(app, sc)))
+        return r;
+    if (sc->has_water && !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_WATER)) && (r = load_water(app, demo, sc)))
+        return r;
+    if (sc->beam_count && !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_BEAMS))) {
+        demo->beam_base_count = sc->beam_count < VFX_APP_MAX_BEAMS ? sc->beam_count : VFX_APP_MAX_BEAMS;
+        app->beams_view = sc->beams_view;
+        app->beam_count = vfx_scene_beams_at(sc, 0.0, app->beams, demo->beam_base_count);
     }
-    if (!(effects_off & VFX_EFFECT_BIT(VFX_EFFECT_BEAMS))) {
-        static const vfx_beam base[3] = {
-            {.head = {-3.0f, 1.2f, 0.5f}, .dir = {1, 0, 0}, .length = 2.0f, .radius = 0.6f, .a = 0.05f, .b = 0.03f, .eps = 0.02f, .color = {0.4f, 0.8f, 1.0f, 1}},
-            {.head = {2.5f, 1.6f, -1.5f}, .dir = {-1, 0, 0.3f}, .length = 1.5f, .radius = 0.5f, .a = 0.04f, .b = 0.02f, .eps = 0.02f, .color = {1.0f, 0.5f, 0.2f, 1}},
-            {.head = {0.0f, 2.2f, 1.5f}, .dir = {0, -0.3f, -1}, .length = 1.0f, .radius = 0.4f, .a = 0.05f, .b = 0.03f, .eps = 0.02f, .color = {0.7f, 1.0f, 0.4f, 1}},
-        };
-        memcpy(demo->beam_base, base, sizeof base);
-        demo->beam_base_count = 3;
-        memcpy(app->beams, base, sizeof base);
-        app->beam_count = 3;
-        app->beams_view = (vfx_beams_view){.size = sizeof app->beams_view, .version = VFX_BEAMS_VIEW_VERSION,
-                                           .saturation = VFX_SATURATE_SMOOTH, .saturate_c = 1.0f};
-    }
+    if (sc->has_volume && !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_VOLUME)) && (r = load_volume(app, demo, sc)))
+        return r;
+    if (sc->has_volume && (demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_VOLUME)))
+        vfx_logf(&app->log, VFX_LOG_INFO, "scene volume left out (effect switched off or not built)");
     snprintf(demo->description, sizeof demo->description,
-             "default scene: %u meshes, %u particles, %u beams, %u volumes", app->mesh_count,
-             demo->particle_count, app->beam_count, app->volume_count);
+             "scene '%.60s': %u meshes, %u particles%s, %u beams, %u volumes", sc->name, app->mesh_count,
+             demo->particle_count, demo->sim ? " (SPH)" : "", app->beam_count, app->volume_count);
     return VFX_OK;
 }
 
 void vfx_demo_animate(vfx_app *app, vfx_demo *demo, float dt)
 {
     (void)dt;
-    double t = app->time;
-    for (uint32_t i = 0; i < demo->beam_base_count && i < app->beam_count; ++i) {
-        const vfx_beam *b = &demo->beam_base[i];
-        vfx_beam *o = &app->beams[i];
-        /* fired at a target: the head travels, the trail grows and thickens, the beam turns */
-        double phase = fmod(t * 0.5 + i * 0.33, 1.0);
-        double turn = 0.4 * sin(t * 0.7 + i);
-        double c = cos(turn), s = sin(turn);
-        o->dir[0] = (float)(b->dir[0] * c - b->dir[2] * s);
-        o->dir[1] = b->dir[1];
-        o->dir[2] = (float)(b->dir[0] * s + b->dir[2] * c);
-        for (int k = 0; k < 3; ++k)
-            o->head[k] = b->head[k] + o->dir[k] * (float)(phase * 3.0);
-        o->length = b->length * (float)(0.2 + phase);
-        o->a = b->a * (float)(0.6 + 0.8 * phase);
-        o->b = b->b * (float)(0.6 + 0.8 * phase);
-        o->radius = b->radius * (float)(0.7 + 0.6 * phase);
-    }
+    if (demo->scene && app->beam_count) /* keyframed: grow, thicken, move, turn */
+        app->beam_count = vfx_scene_beams_at(demo->scene, app->time, app->beams, demo->beam_base_count);
 }
 
 void vfx_demo_toggle(vfx_app *app, vfx_demo *demo, vfx_effect_kind kind)
@@ -125,7 +191,7 @@ void vfx_demo_toggle(vfx_app *app, vfx_demo *demo, vfx_effect_kind kind)
     else if (kind == VFX_EFFECT_BEAMS)
         app->beam_count = off ? 0 : demo->beam_base_count;
     else if (kind == VFX_EFFECT_VOLUME)
-        app->volume_count = 0; /* volumes come back with the scene file support */
+        app->volume_count = off || !demo->vol_tets ? 0 : 1;
 }
 
 void vfx_demo_print_profile(vfx_app *app, FILE *out)
@@ -149,12 +215,16 @@ void vfx_demo_print_profile(vfx_app *app, FILE *out)
 
 void vfx_demo_free(vfx_app *app, vfx_demo *demo)
 {
-    (void)app;
     if (demo->sim) {
         const vfx_sph_report *rep = vfx_sim_system_report(demo->sim);
         if (rep->cap_hit)
             vfx_logf(&app->log, VFX_LOG_WARN, "water simulation: substep cap hit in the last frame");
     }
-    vfx_sim_system_destroy(demo->sim); /* the world is destroyed after: it must not run again */
+    app->volume_count = 0; /* the views point into the arrays freed here */
+    vfx_sim_system_destroy(demo->sim); /* the world must not run again after this */
+    vfx_scene_free(demo->scene);
+    free(demo->vol_points);
+    free(demo->vol_tets);
+    free(demo->vol_scalar);
     memset(demo, 0, sizeof *demo);
 }

@@ -5,22 +5,27 @@
 
 #include <stdio.h>
 #include "app.h"
+#include "scene/scene.h"
 #include "sim/sim_system.h"
 
 typedef struct vfx_demo {
-    char description[160];
+    char description[256];
     uint32_t effects_off;      /* VFX_EFFECT_BIT mask switched off by options or keys */
     uint32_t particle_count;
-    vfx_beam beam_base[8];
-    uint32_t beam_base_count;
+    vfx_scene *scene;          /* the loaded scene (beams are re-evaluated from it each frame) */
+    uint32_t beam_base_count;  /* beams in the scene (restored when toggled back on) */
     bool key_latch[8];
     bool mouse_down;
     double mouse_x, mouse_y;
     vfx_sim_system *sim;       /* SPH writing the particle columns (NULL without water) */
+    float *vol_points, *vol_scalar, vol_transfer[64 * 4];
+    uint32_t *vol_tets, vol_point_count, vol_tet_count;
 } vfx_demo;
 
-/* Loads `scene_path` (NULL -> the built-in default) into the app; effects in `effects_off`
- * are left out entirely (nothing allocated for them). */
+/* Loads the scene file `scene_path` (NULL -> the built-in default, sample_game/scenes/
+ * default.json embedded at build time) into the app: meshes as entities, water particles (an
+ * SPH system when the scene sets up a simulation), beams with their keyframes, the volume.
+ * Effects in `effects_off`, or not built into the plugin, are left out entirely. */
 vfx_result vfx_demo_load(vfx_app *app, vfx_demo *demo, const char *scene_path, uint32_t effects_off);
 /* Advances the animation by dt (0 = paused). */
 void vfx_demo_animate(vfx_app *app, vfx_demo *demo, float dt);

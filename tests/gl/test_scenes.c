@@ -1,0 +1,69 @@
+/* Every sample scene (sample_game/scenes/NAME.json) and the built-in default load into the real
+ * host and render frames; effects a scene lacks allocate nothing. Small size for llvmpipe. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "demo_scene.h"
+#include "plugin_internal.h"
+#include "test_util.h"
+
+static void run_scene(const char *file, bool expect_water, bool expect_beams)
+{
+    char path[1024];
+    const char *root = getenv("VFX_SOURCE_ROOT");
+    if (file)
+        snprintf(path, sizeof path, "%s/sample_game/scenes/%s", root ? root : ".", file);
+    vfx_test_log log = {0};
+    vfx_app_desc d = {.mode = VFX_GL_HEADLESS, .width = 64, .height = 36, .logger = {vfx_test_log_fn, &log}};
+    vfx_app *app;
+    if (vfx_app_create(&d, &app) != VFX_OK)
+        exit(VFX_TEST_SKIP);
+    vfx_demo demo;
+    assert_int_equal(vfx_demo_load(app, &demo, file ? path : NULL, 0), VFX_OK);
+    for (int f = 0; f < 2; ++f) {
+        vfx_demo_animate(app, &demo, 1.f / 60.f);
+        assert_int_equal(vfx_app_frame(app, 1.f / 60.f), VFX_OK);
+    }
+    assert_true((app->ctx->effect_state[VFX_EFFECT_WATER] != NULL) == expect_water);
+    assert_true((app->ctx->effect_state[VFX_EFFECT_BEAMS] != NULL) == expect_beams);
+    assert_int_equal(log.errors, 0);
+    vfx_demo_free(app, &demo);
+    vfx_app_destroy(app);
+}
+
+static void test_default(void **s) { (void)s; run_scene(NULL, true, true); }
+static void test_default_file(void **s) { (void)s; run_scene("default.json", true, true); }
+static void test_beams_only(void **s) { (void)s; run_scene("beams-only.json", false, true); }
+static void test_water_only(void **s) { (void)s; run_scene("water-only.json", true, false); }
+static void test_empty(void **s) { (void)s; run_scene("empty.json", false, false); }
+
+static void test_bad_scene_refused(void **state)
+{
+    (void)state;
+    vfx_test_log log = {0};
+    vfx_app_desc d = {.mode = VFX_GL_HEADLESS, .width = 32, .height = 32, .logger = {vfx_test_log_fn, &log}};
+    vfx_app *app;
+    if (vfx_app_create(&d, &app) != VFX_OK)
+        exit(VFX_TEST_SKIP);
+    vfx_demo demo;
+    assert_int_not_equal(vfx_demo_load(app, &demo, "/no/such/scene.json", 0), VFX_OK);
+    assert_non_null(strstr(log.last, "/no/such/scene.json"));
+    vfx_demo_free(app, &demo);
+    vfx_app_destroy(app);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_default), cmocka_unit_test(test_default_file),
+        cmocka_unit_test(test_beams_only), cmocka_unit_test(test_water_only),
+        cmocka_unit_test(test_empty), cmocka_unit_test(test_bad_scene_refused),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
