@@ -285,7 +285,6 @@ static void test_zero_particles(void **state)
 int main(void)
 {
     vfx_gl_context *gl = vfx_test_gl_or_skip();
-    (void)gl;
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_blobs_vs_reference),
         cmocka_unit_test(test_one_particle_and_camera_inside),
@@ -295,5 +294,7 @@ int main(void)
         cmocka_unit_test(test_paper_ablation_bits),
         cmocka_unit_test(test_h_huge_and_tiny),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    int rc = cmocka_run_group_tests(tests, NULL, NULL);
+    vfx_gl_context_destroy(gl); /* LeakSanitizer in CI's sanitizer run checks this */
+    return rc;
 }
