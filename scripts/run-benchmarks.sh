@@ -17,7 +17,7 @@ if [ "${1:-}" != "--skip-effects" ]; then
 fi
 bench="$build/sample_game/volfx-bench"
 ecs=$("$bench" ecs --json 2>/dev/null | tail -1)
-frame=$("$bench" frame --frames 120 --json 2>/dev/null | tail -1)
+frame=$("$bench" frame --frames 20 --json 2>/dev/null | tail -1)
 cpu=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')
 renderer=$(echo "$ecs" | /usr/bin/python3 -c 'import json,sys; print(json.load(sys.stdin)["gl_renderer"])')
 {
@@ -31,7 +31,7 @@ renderer=$(echo "$ecs" | /usr/bin/python3 -c 'import json,sys; print(json.load(s
   echo "## Foundation (issue 2)"
   echo
   echo "\`volfx-bench ecs\` (1,000,000 particle entities, 15 repetitions, median) and \`volfx-bench frame\`"
-  echo "(default scene, 640x360, 120 frames, first 5 dropped):"
+  echo "(default scene, 640x360, 20 frames, first 5 dropped):"
   echo
   echo '```json'
   echo "$ecs"
