@@ -86,6 +86,38 @@ int vfx_bench_beams_gpu(int argc, char **argv)
                     ref[(size_t)j * w + i] = s;
                     hmax = fmax(hmax, s);
                 }
+            /* Per-frame cost under animation: each animated configuration (a, b, M, D, L changed
+             * since the last frame) is drawn, then drawn again unchanged; frame wall times (the
+             * headless host waits for the GPU) are compared. Equal medians mean a change costs
+             * nothing beyond the drawing the new configuration needs. */
+            {
+                double *moved = malloc(frames * sizeof(double)), *still = malloc(frames * sizeof(double));
+                app->beams_view.method = 0;
+                for (uint32_t f = 0; f < frames; ++f) {
+                    make_beams(app, sets[si]);
+                    for (uint32_t b = 0; b < sets[si]; ++b) {
+                        float ph = 0.4f * (float)f + (float)b;
+                        vfx_beam *bm = &app->beams[b];
+                        bm->a *= 0.5f + 0.5f * sinf(ph), bm->b *= 0.5f + 0.5f * cosf(ph);
+                        bm->head[0] += 0.5f * sinf(ph), bm->length *= 0.6f + 0.4f * sinf(ph);
+                        bm->dir[1] += 0.3f * cosf(ph), bm->radius *= 0.8f + 0.2f * sinf(ph);
+                    }
+                    for (int rep = 0; rep < 2; ++rep) {
+                        double t0 = vfx_now_ms();
+                        if (vfx_app_frame(app, 0.f))
+                            return 1;
+                        (rep ? still : moved)[f] = vfx_now_ms() - t0;
+                    }
+                }
+                double mm = vfx_median(moved, frames), ms_still = vfx_median(still, frames);
+                printf("{\"effect\":\"beams\",\"path\":\"gpu\",\"beams\":%u,\"width\":%u,\"height\":%u,"
+                       "\"animation\":{\"frames\":%u,\"changed_frame_ms_p50\":%.4f,\"unchanged_frame_ms_p50\":%.4f,"
+                       "\"ratio\":%.3f},\"gl_renderer\":\"%s\"}\n", sets[si], w, h, frames, mm, ms_still,
+                       mm / ms_still, vfx_gl_context_renderer(app->gl));
+                free(moved);
+                free(still);
+                make_beams(app, sets[si]);
+            }
             static const uint32_t samples[4] = {0, 8, 32, 120};
             for (int mi = 0; mi < 4; ++mi) {
                 app->beams_view.method = samples[mi] ? 1 : 0;

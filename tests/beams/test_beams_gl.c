@@ -174,6 +174,46 @@ static void test_hidden_by_depth(void **state)
     assert_int_equal(bad, 0);
 }
 
+/* An Assimp model (Debian's assimp-testmodels box.obj, a cube of side 1) scaled and placed so the
+ * beam passes through it: each ray ends at the model's front face. */
+static double g_box_min[3], g_box_max[3];
+static double t_box(uint32_t i, uint32_t j)
+{
+    double d[3], t0 = 0, t1 = 50;
+    vfx_ref_pixel_ray(&g_app->camera, i, j, d);
+    for (int k = 0; k < 3; ++k) { /* slab test, float64 */
+        double a = (g_box_min[k] - g_app->camera.eye[k]) / d[k], b = (g_box_max[k] - g_app->camera.eye[k]) / d[k];
+        if (a > b) { double t = a; a = b; b = t; }
+        t0 = fmax(t0, a), t1 = fmin(t1, b);
+    }
+    return t0 < t1 ? t0 : 50.0;
+}
+
+static void test_hidden_by_assimp_mesh(void **state)
+{
+    (void)state;
+    const char *model = "/usr/share/assimp/models/OBJ/box.obj";
+    FILE *f = fopen(model, "rb");
+    if (!f)
+        skip(); /* assimp-testmodels not installed */
+    fclose(f);
+    const float s = 0.6f, c[3] = {0.0f, 0.2f, 0.0f};
+    float m[16] = {s, 0, 0, 0, 0, s, 0, 0, 0, 0, s, 0, c[0], c[1], c[2], 1};
+    vfx_entity e;
+    assert_int_equal(vfx_app_add_mesh_file(g_app, model, m, (float[3]){0.7f, 0.3f, 0.3f}, &e), VFX_OK);
+    for (int k = 0; k < 3; ++k)
+        g_box_min[k] = c[k] - 0.5 * s, g_box_max[k] = c[k] + 0.5 * s;
+    float *raw = render_raw();
+    double max_rel;
+    int bad = compare_image(raw, t_box, &max_rel);
+    free(raw);
+    vfx_app_mesh *mm = vfx_world_get(g_app->world, e, g_app->mesh_comp, 0);
+    vfx_mesh_gpu_destroy(&mm->gpu);
+    assert_int_equal(vfx_world_despawn(g_app->world, e), VFX_OK);
+    printf("beam through box.obj: max relative error %.3g\n", max_rel);
+    assert_int_equal(bad, 0);
+}
+
 static void test_mz_sweep(void **state)
 {
     (void)state;
@@ -266,6 +306,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_matches_reference),
         cmocka_unit_test(test_hidden_by_depth),
+        cmocka_unit_test(test_hidden_by_assimp_mesh),
         cmocka_unit_test(test_mz_sweep),
         cmocka_unit_test(test_marching_baseline),
         cmocka_unit_test(test_bad_input_and_absence),
