@@ -132,7 +132,7 @@ static vfx_result get_float(pctx *c, const cJSON *obj, const char *path, const c
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!v)
         return required ? failf(c, VFX_ERR_FORMAT, p, "required number missing") : VFX_OK;
-    double d;
+    double d = 0; /* set by number_value on success; -O3 cannot see that */
     vfx_result r = number_value(c, v, p, rg, &d);
     if (!r)
         *out = (float)d;
@@ -147,7 +147,7 @@ static vfx_result get_uint(pctx *c, const cJSON *obj, const char *path, const ch
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!v)
         return required ? failf(c, VFX_ERR_FORMAT, p, "required integer missing") : VFX_OK;
-    double d;
+    double d = 0; /* set by number_value on success; -O3 cannot see that */
     vfx_result r = number_value(c, v, p, (range){lo, hi, false}, &d);
     if (r)
         return r;
@@ -168,7 +168,7 @@ static vfx_result vec_value(pctx *c, const cJSON *v, const char *p, int n, range
     for (const cJSON *e = v->child; e; e = e->next, ++i) {
         char pi[JPATH];
         join_index(pi, p, i);
-        double d;
+        double d = 0;
         vfx_result r = number_value(c, e, pi, rg, &d);
         if (r)
             return r;
