@@ -44,7 +44,7 @@ renderer=$(echo "$ecs" | /usr/bin/python3 -c 'import json,sys; print(json.load(s
   for part in docs/benchmarks-*.md; do
     [ -f "$part" ] || continue
     echo
-    sed 's/^# /## /' "$part"
+    sed 's/^\(#\+\) /#\1 /' "$part"  # every heading one level down
   done
 } > docs/benchmarks.md
 echo "wrote docs/benchmarks.md"
