@@ -13,7 +13,7 @@
 #include "plugin_internal.h"
 #include "test_util.h"
 
-static void run_scene(const char *file, bool expect_water, bool expect_beams)
+static void run_scene(const char *file, bool expect_water, bool expect_beams, bool expect_volume)
 {
     char path[1024];
     const char *root = getenv("VFX_SOURCE_ROOT");
@@ -32,16 +32,17 @@ static void run_scene(const char *file, bool expect_water, bool expect_beams)
     }
     assert_true((app->ctx->effect_state[VFX_EFFECT_WATER] != NULL) == expect_water);
     assert_true((app->ctx->effect_state[VFX_EFFECT_BEAMS] != NULL) == expect_beams);
+    assert_true((app->ctx->effect_state[VFX_EFFECT_VOLUME] != NULL) == expect_volume);
     assert_int_equal(log.errors, 0);
     vfx_demo_free(app, &demo);
     vfx_app_destroy(app);
 }
 
-static void test_default(void **s) { (void)s; run_scene(NULL, true, true); }
-static void test_default_file(void **s) { (void)s; run_scene("default.json", true, true); }
-static void test_beams_only(void **s) { (void)s; run_scene("beams-only.json", false, true); }
-static void test_water_only(void **s) { (void)s; run_scene("water-only.json", true, false); }
-static void test_empty(void **s) { (void)s; run_scene("empty.json", false, false); }
+static void test_default(void **s) { (void)s; run_scene(NULL, true, true, true); }
+static void test_default_file(void **s) { (void)s; run_scene("default.json", true, true, true); }
+static void test_beams_only(void **s) { (void)s; run_scene("beams-only.json", false, true, false); }
+static void test_water_only(void **s) { (void)s; run_scene("water-only.json", true, false, false); }
+static void test_empty(void **s) { (void)s; run_scene("empty.json", false, false, false); }
 
 static void test_bad_scene_refused(void **state)
 {
