@@ -15,23 +15,43 @@ int vfx_bench_beams(int argc, char **argv) __attribute__((weak));
 int vfx_bench_tetvol(int argc, char **argv) __attribute__((weak));
 int vfx_bench_ecs(int argc, char **argv);
 
-/* `frame`: the sample game's default scene, headless, N frames. */
+/* `frame`: a scene (the built-in default unless --scene), headless, N frames; optionally the
+ * raw quantity of one effect of the last frame as a PFM (--dump-raw water|beams|volume FILE). */
 static int bench_frame(int argc, char **argv)
 {
-    uint32_t frames = 60, w = 640, h = 360;
+    uint32_t frames = 60, w = 0, h = 0;
+    const char *scene = NULL, *raw_effect = NULL, *raw_path = NULL;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--frames") && i + 1 < argc) frames = (uint32_t)strtoul(argv[++i], NULL, 10);
         else if (!strcmp(argv[i], "--size") && i + 1 < argc) {
             if (sscanf(argv[++i], "%ux%u", &w, &h) != 2) { fprintf(stderr, "--size wants WxH\n"); return 2; }
+        } else if (!strcmp(argv[i], "--scene") && i + 1 < argc) {
+            scene = argv[++i];
+        } else if (!strcmp(argv[i], "--dump-raw") && i + 2 < argc) {
+            raw_effect = argv[++i];
+            raw_path = argv[++i];
         } else if (!strcmp(argv[i], "--json")) {
-        } else { fprintf(stderr, "volfx-bench frame: unknown option '%s'\n", argv[i]); return 2; }
+        } else {
+            fprintf(stderr, "volfx-bench frame: unknown option '%s' (--frames N --size WxH --scene FILE "
+                            "--dump-raw water|beams|volume FILE.pfm --json)\n", argv[i]);
+            return 2;
+        }
+    }
+    vfx_effect_kind raw_kind = VFX_EFFECT_COUNT;
+    if (raw_effect) {
+        raw_kind = !strcmp(raw_effect, "water") ? VFX_EFFECT_WATER : !strcmp(raw_effect, "beams") ? VFX_EFFECT_BEAMS
+                   : !strcmp(raw_effect, "volume") ? VFX_EFFECT_VOLUME : VFX_EFFECT_COUNT;
+        if (raw_kind == VFX_EFFECT_COUNT) {
+            fprintf(stderr, "volfx-bench frame: --dump-raw wants water, beams or volume, got '%s'\n", raw_effect);
+            return 2;
+        }
     }
     vfx_app_desc d = {.mode = VFX_GL_HEADLESS, .width = w, .height = h};
     vfx_app *app;
     if (vfx_app_create(&d, &app))
         return 1;
     vfx_demo demo;
-    if (vfx_demo_load(app, &demo, NULL, 0)) {
+    if (vfx_demo_load(app, &demo, scene, 0)) {
         vfx_app_destroy(app);
         return 1;
     }
@@ -41,9 +61,12 @@ static int bench_frame(int argc, char **argv)
         rc = vfx_app_frame(app, 1.f / 60.f) ? 1 : 0;
     }
     vfx_frame_summary s = vfx_profiler_summary(app->profiler, frames > 10 ? 5 : 0);
-    printf("{\"effect\":\"frame\",\"width\":%u,\"height\":%u,\"frames\":%u,\"gl_renderer\":\"%s\","
+    if (rc == 0 && raw_path && vfx_app_dump_raw(app, raw_kind, raw_path) != VFX_OK)
+        rc = 1;
+    printf("{\"effect\":\"frame\",\"scene\":\"%s\",\"width\":%u,\"height\":%u,\"frames\":%u,\"gl_renderer\":\"%s\","
            "\"frame_ms\":{\"p50\":%.4f,\"p95\":%.4f,\"p99\":%.4f},\"mean_fps\":%.3f,\"stats\":{",
-           w, h, s.frames, vfx_gl_context_renderer(app->gl), s.p50_ms, s.p95_ms, s.p99_ms, s.mean_fps);
+           scene ? scene : "(default)", app->camera.width, app->camera.height, s.frames,
+           vfx_gl_context_renderer(app->gl), s.p50_ms, s.p95_ms, s.p99_ms, s.mean_fps);
     vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
     app->api->get_stats(app->ctx, &st);
     for (uint32_t i = 0; i < st.count; ++i)
