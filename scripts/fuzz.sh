@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets in a separate clang build dir and runs each for a bounded time.
-# usage: scripts/fuzz.sh [seconds per target, default 60]
+# usage: [FUZZ_TARGETS="vtu tetgen"] scripts/fuzz.sh [seconds per target, default 60]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 secs=${1:-60}
 [ -f build-fuzz/build.ninja ] || CC=clang meson setup build-fuzz -Dfuzz=true -Db_lundef=false \
   -Dmetaballs=false -Dbeams=false -Dtetvol=false >/dev/null
-ninja -C build-fuzz tests/fuzz/fuzz_scene tests/fuzz/fuzz_particle_file
-for t in scene particle_file; do
+targets="${FUZZ_TARGETS:-scene particle_file vtu tetgen assimp}"
+ninja -C build-fuzz $(for t in $targets; do printf 'tests/fuzz/fuzz_%s ' "$t"; done)
+for t in $targets; do
   work=build-fuzz/corpus-$t; mkdir -p "$work"
   log=build-fuzz/fuzz-$t.log
   set +e
