@@ -11,10 +11,12 @@ ninja -C build-fuzz $(for t in $targets; do printf 'tests/fuzz/fuzz_%s ' "$t"; d
 for t in $targets; do
   work=build-fuzz/corpus-$t; mkdir -p "$work"
   log=build-fuzz/fuzz-$t.log
+  # a fresh artifact folder per target and run: crash-*, oom-*, leak-*, timeout-* all count
+  art=build-fuzz/artifacts-$t; rm -rf "$art"; mkdir -p "$art"
   set +e
-  build-fuzz/tests/fuzz/fuzz_$t -max_total_time="$secs" -max_len=8192 -artifact_prefix=build-fuzz/ "$work" "tests/fuzz/corpus/$t" >"$log" 2>&1
+  build-fuzz/tests/fuzz/fuzz_$t -max_total_time="$secs" -max_len=8192 -artifact_prefix="$art/" "$work" "tests/fuzz/corpus/$t" >"$log" 2>&1
   rc=$?
   set -e
   runs=$(grep -o 'Done [0-9]* runs' "$log" | tail -1 || true)
-  echo "fuzz_$t: ${runs:-no summary} rc=$rc crashes=$(ls build-fuzz/crash-* 2>/dev/null | wc -l)"
+  echo "fuzz_$t: ${runs:-no summary} rc=$rc findings=$(find "$art" -type f | wc -l) (in $art)"
 done
