@@ -1,6 +1,7 @@
 /* particle_file.c — see particle_file.h. Bytes are assembled explicitly so the format stays
  * little-endian on any host. */
 #include "scene/particle_file.h"
+#include "core/file.h"
 
 #include <errno.h>
 #include <math.h>
@@ -93,40 +94,14 @@ vfx_result vfx_particle_file_load(const char *path, float **xyz, uint32_t *count
     }
     *xyz = NULL;
     *count = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        if (err && errlen)
-            snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
-        return VFX_ERR_IO;
-    }
-    long end = -1;
-    if (fseek(f, 0, SEEK_END) == 0)
-        end = ftell(f);
-    if (end < 0 || fseek(f, 0, SEEK_SET) != 0) {
-        set_err(err, errlen, "%s: cannot determine the size (not a regular file?)", path);
-        fclose(f);
-        return VFX_ERR_IO;
-    }
-    size_t size = (size_t)end;
-    /* refuse a huge file before allocating anything for it */
-    if (size / 12 > VFX_PARTICLE_FILE_MAX_COUNT) {
-        set_err(err, errlen, "%s: %llu bytes, above the cap of 16777216 particles", path,
-                (unsigned long long)size);
-        fclose(f);
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
-    unsigned char *buf = malloc(size ? size : 1);
-    if (!buf) {
-        fclose(f);
-        set_err(err, errlen, "%s: out of memory for %llu bytes", path, (unsigned long long)size);
-        return VFX_ERR_OUT_OF_MEMORY;
-    }
-    size_t got = fread(buf, 1, size, f);
-    fclose(f);
-    if (got != size) {
-        free(buf);
-        set_err(err, errlen, "%s: short read (%llu bytes expected)", path, (unsigned long long)size);
-        return VFX_ERR_IO;
+    char *buf;
+    size_t size;
+    char tmp[512];
+    vfx_result rr = vfx_read_file(path, (size_t)VFX_PARTICLE_FILE_MAX_COUNT * 12, "16777216 particles", &buf,
+                                  &size, tmp, sizeof tmp);
+    if (rr) {
+        set_err(err, errlen, "%s", tmp);
+        return rr;
     }
     vfx_result r = parse_named(path, buf, size, xyz, count, err, errlen);
     free(buf);

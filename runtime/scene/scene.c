@@ -2,6 +2,7 @@
  * the message can carry its JSON path; ranges are checked on the double before any cast, so a
  * huge value is refused rather than turned into Inf or a wrapped integer. */
 #include "scene/scene.h"
+#include "core/file.h"
 
 #include <cjson/cJSON.h>
 #include <errno.h>
@@ -1012,39 +1013,13 @@ vfx_result vfx_scene_load_file(const char *path, const vfx_logger *logger, vfx_s
         return VFX_ERR_INVALID_ARGUMENT;
     }
     *out = NULL;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
+    char *buf, tmp[512];
+    size_t size;
+    vfx_result rr = vfx_read_file(path, VFX_SCENE_MAX_BYTES, "16 MiB for a scene", &buf, &size, tmp, sizeof tmp);
+    if (rr) {
         if (err && errlen)
-            snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
-        return VFX_ERR_IO;
-    }
-    long size = -1;
-    if (fseek(f, 0, SEEK_END) == 0)
-        size = ftell(f);
-    if (size < 0 || fseek(f, 0, SEEK_SET) != 0) {
-        fclose(f);
-        if (err && errlen)
-            snprintf(err, errlen, "%s: cannot determine the size (not a regular file?)", path);
-        return VFX_ERR_IO;
-    }
-    if ((unsigned long)size > VFX_SCENE_MAX_BYTES) {
-        fclose(f);
-        if (err && errlen)
-            snprintf(err, errlen, "%s: %ld bytes, above the scene cap of %u", path, size, VFX_SCENE_MAX_BYTES);
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
-    char *buf = malloc((size_t)size + 1);
-    if (!buf) {
-        fclose(f);
-        return VFX_ERR_OUT_OF_MEMORY;
-    }
-    size_t got = fread(buf, 1, (size_t)size, f);
-    fclose(f);
-    if (got != (size_t)size) {
-        free(buf);
-        if (err && errlen)
-            snprintf(err, errlen, "%s: short read", path);
-        return VFX_ERR_IO;
+            snprintf(err, errlen, "%s", tmp);
+        return rr;
     }
     char dir[VFX_SCENE_PATH_MAX];
     const char *slash = strrchr(path, '/');
@@ -1055,7 +1030,7 @@ vfx_result vfx_scene_load_file(const char *path, const vfx_logger *logger, vfx_s
     else
         snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
     char msg[512] = "";
-    vfx_result r = vfx_scene_load_mem(buf, (size_t)size, dir, logger, out, msg, sizeof msg);
+    vfx_result r = vfx_scene_load_mem(buf, size, dir, logger, out, msg, sizeof msg);
     free(buf);
     if (r && err && errlen)
         snprintf(err, errlen, "%s: %s", path, msg);
