@@ -402,19 +402,33 @@ static vfx_result parse_camera(pctx *c, const cJSON *v, vfx_scene_camera *cam)
     return VFX_OK;
 }
 
+/* The prologue every array of objects shares: `v` must be an array of at most `cap` items;
+ * *out gets calloc'd room for them (NULL when empty). */
+static vfx_result alloc_array(pctx *c, const cJSON *v, const char *name, int cap, size_t elem,
+                              void **out, int *count)
+{
+    *out = NULL;
+    *count = 0;
+    if (!cJSON_IsArray(v))
+        return failf(c, VFX_ERR_FORMAT, name, "expected an array, got %s", type_name(v));
+    int n = cJSON_GetArraySize(v);
+    if (n > cap)
+        return failf(c, VFX_ERR_INVALID_ARGUMENT, name, "%d %s, above the cap of %d", n, name, cap);
+    if (n == 0)
+        return VFX_OK;
+    if (!(*out = calloc((size_t)n, elem)))
+        return failf(c, VFX_ERR_OUT_OF_MEMORY, name, "out of memory");
+    *count = n;
+    return VFX_OK;
+}
+
 static vfx_result parse_meshes(pctx *c, const cJSON *v, vfx_scene *s)
 {
     static const char *const keys[] = {"path", "box", "translate", "rotate_deg", "scale", "matrix", "color", NULL};
-    if (!cJSON_IsArray(v))
-        return failf(c, VFX_ERR_FORMAT, "meshes", "expected an array, got %s", type_name(v));
-    int n = cJSON_GetArraySize(v);
-    if (n > VFX_SCENE_MAX_MESHES)
-        return failf(c, VFX_ERR_INVALID_ARGUMENT, "meshes", "%d meshes, above the cap of %d", n, VFX_SCENE_MAX_MESHES);
-    if (n == 0)
-        return VFX_OK;
-    s->meshes = calloc((size_t)n, sizeof *s->meshes);
-    if (!s->meshes)
-        return failf(c, VFX_ERR_OUT_OF_MEMORY, "meshes", "out of memory");
+    int n;
+    vfx_result ra = alloc_array(c, v, "meshes", VFX_SCENE_MAX_MESHES, sizeof *s->meshes, (void **)&s->meshes, &n);
+    if (ra || n == 0)
+        return ra;
     int i = 0;
     for (const cJSON *m = v->child; m; m = m->next, ++i) {
         char P[JPATH];
@@ -545,16 +559,10 @@ static vfx_result parse_beams(pctx *c, const cJSON *v, vfx_scene *s)
 {
     static const char *const keys[] = {"head", "dir", "length", "radius", "a", "b", "eps", "color",
                                        "keyframes", "loop_s", NULL};
-    if (!cJSON_IsArray(v))
-        return failf(c, VFX_ERR_FORMAT, "beams", "expected an array, got %s", type_name(v));
-    int n = cJSON_GetArraySize(v);
-    if (n > VFX_SCENE_MAX_BEAMS)
-        return failf(c, VFX_ERR_INVALID_ARGUMENT, "beams", "%d beams, above the cap of %d", n, VFX_SCENE_MAX_BEAMS);
-    if (n == 0)
-        return VFX_OK;
-    s->beams = calloc((size_t)n, sizeof *s->beams);
-    if (!s->beams)
-        return failf(c, VFX_ERR_OUT_OF_MEMORY, "beams", "out of memory");
+    int n;
+    vfx_result ra = alloc_array(c, v, "beams", VFX_SCENE_MAX_BEAMS, sizeof *s->beams, (void **)&s->beams, &n);
+    if (ra || n == 0)
+        return ra;
     int i = 0;
     for (const cJSON *e = v->child; e; e = e->next, ++i) {
         char P[JPATH];
