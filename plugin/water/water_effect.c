@@ -324,6 +324,31 @@ static vfx_result potential_pass(vfx_context *ctx, water_state *s, const vfx_fra
     return VFX_OK;
 }
 
+/* A depth-tested billboard pass into the distance buffer: each pixel keeps its nearest cube
+ * front face. With after = 0 that is the initial sample (eq. 1); with the t'_next texture bound
+ * as `after`, the nearest candidate region at or beyond it (eqs. 3-4). */
+static void nearest_face_pass(vfx_context *ctx, const water_state *s, GLuint prog,
+                              const vfx_frame_view *frame, const vfx_frame_targets *targets,
+                              float t_end, const float vp[16], GLuint after)
+{
+    static const float far4[4] = {1e30f, 1e30f, 1e30f, 1e30f};
+    glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_dist);
+    glViewport(0, 0, (GLsizei)s->width, (GLsizei)s->height);
+    glClearNamedFramebufferfv(s->fbo_dist, GL_COLOR, 0, far4);
+    glClearNamedFramebufferfi(s->fbo_dist, GL_DEPTH_STENCIL, 0, 1.0f, 0);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+    glUseProgram(prog);
+    set_common(prog, s, frame, targets, t_end);
+    glUniformMatrix4fv(glGetUniformLocation(prog, "u_view_proj"), 1, GL_FALSE, vp);
+    if (after)
+        glBindTextureUnit(0, after);
+    draw_billboards(ctx, s);
+    glDisable(GL_DEPTH_TEST);
+}
+
 static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
                               vfx_frame_targets *targets)
 {
@@ -355,7 +380,7 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, s->cols[k]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->counters);
     glClearNamedBufferData(s->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
-    float zero[4] = {0, 0, 0, 0}, far4[4] = {1e30f, 1e30f, 1e30f, 1e30f};
+    float zero[4] = {0, 0, 0, 0};
     glClearTexImage(s->st, 0, GL_RGBA, GL_FLOAT, zero);
     glClearTexImage(s->br, 0, GL_RGBA, GL_FLOAT, zero);
     char defs[96];
@@ -369,19 +394,7 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
         GLuint prog = vfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_INIT\n#define NS 1\n");
         if (!prog)
             return VFX_ERR_GL;
-        glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_dist);
-        glViewport(0, 0, (GLsizei)s->width, (GLsizei)s->height);
-        glClearNamedFramebufferfv(s->fbo_dist, GL_COLOR, 0, far4);
-        glClearNamedFramebufferfi(s->fbo_dist, GL_DEPTH_STENCIL, 0, 1.0f, 0);
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_LESS);
-        glDepthMask(GL_TRUE);
-        glDisable(GL_BLEND);
-        glUseProgram(prog);
-        set_common(prog, s, frame, targets, t_end);
-        glUniformMatrix4fv(glGetUniformLocation(prog, "u_view_proj"), 1, GL_FALSE, vp);
-        draw_billboards(ctx, s);
-        glDisable(GL_DEPTH_TEST);
+        nearest_face_pass(ctx, s, prog, frame, targets, t_end, vp, 0);
     }
     vfx_gpu_pass_end(ctx);
 
@@ -442,19 +455,7 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
             s->next1 = t;
             glNamedFramebufferTexture(s->fbo_dist, GL_COLOR_ATTACHMENT0, s->cur, 0);
         } else {
-            glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_dist);
-            glViewport(0, 0, (GLsizei)s->width, (GLsizei)s->height);
-            glClearNamedFramebufferfv(s->fbo_dist, GL_COLOR, 0, far4);
-            glClearNamedFramebufferfi(s->fbo_dist, GL_DEPTH_STENCIL, 0, 1.0f, 0);
-            glEnable(GL_DEPTH_TEST);
-            glDepthFunc(GL_LESS);
-            glDepthMask(GL_TRUE);
-            glUseProgram(skip);
-            set_common(skip, s, frame, targets, t_end);
-            glUniformMatrix4fv(glGetUniformLocation(skip, "u_view_proj"), 1, GL_FALSE, vp);
-            glBindTextureUnit(0, s->next1);
-            draw_billboards(ctx, s);
-            glDisable(GL_DEPTH_TEST);
+            nearest_face_pass(ctx, s, skip, frame, targets, t_end, vp, s->next1);
         }
         vfx_gpu_pass_end(ctx);
     }
