@@ -24,6 +24,8 @@ typedef struct beams_state {
     vfx_beams_view view;
     vfx_beam_d *beams;        /* validated, normalised */
     beam_gpu *gpu;
+    uint32_t (*rects)[4];     /* per beam: its tile rectangle this frame */
+    bool *visible;            /* per beam: on screen this frame */
     uint32_t count, capacity;
     uint32_t *ranges, *list;  /* 2 per tile; tile lists */
     uint32_t list_capacity;
@@ -46,6 +48,8 @@ static void beams_destroy(vfx_context *ctx, void *state)
     glDeleteFramebuffers(1, &s->acc_fbo);
     vfx_free(ctx, s->beams);
     vfx_free(ctx, s->gpu);
+    vfx_free(ctx, s->rects);
+    vfx_free(ctx, s->visible);
     vfx_free(ctx, s->ranges);
     vfx_free(ctx, s->list);
     vfx_free(ctx, s); /* programs belong to the shared cache */
@@ -109,9 +113,13 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
     if (v.count > s->capacity) {
         vfx_free(ctx, s->beams);
         vfx_free(ctx, s->gpu);
+        vfx_free(ctx, s->rects);
+        vfx_free(ctx, s->visible);
         s->beams = vfx_alloc(ctx, v.count * sizeof *s->beams);
         s->gpu = vfx_alloc(ctx, v.count * sizeof *s->gpu);
-        s->capacity = (s->beams && s->gpu) ? v.count : 0;
+        s->rects = vfx_alloc(ctx, v.count * sizeof *s->rects);
+        s->visible = vfx_alloc(ctx, v.count * sizeof *s->visible);
+        s->capacity = (s->beams && s->gpu && s->rects && s->visible) ? v.count : 0;
         if (!s->capacity)
             return VFX_ERR_OUT_OF_MEMORY;
     }
@@ -192,13 +200,8 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
         eye[k] = -((double)frame->view[k * 4 + 0] * frame->view[12] + (double)frame->view[k * 4 + 1] * frame->view[13]
                    + (double)frame->view[k * 4 + 2] * frame->view[14]);
     uint32_t ntiles = s->tiles_x * s->tiles_y;
-    uint32_t (*rects)[4] = vfx_alloc(ctx, (size_t)(s->count ? s->count : 1) * sizeof *rects);
-    bool *visible = vfx_alloc(ctx, s->count ? s->count : 1);
-    if (!rects || !visible) {
-        vfx_free(ctx, rects);
-        vfx_free(ctx, visible);
-        return VFX_ERR_OUT_OF_MEMORY;
-    }
+    uint32_t (*rects)[4] = s->rects; /* sized with the beams in update: no per-frame allocation */
+    bool *visible = s->visible;
     memset(s->ranges, 0, (size_t)ntiles * 2 * sizeof(uint32_t));
     uint64_t pairs = 0;
     for (uint32_t i = 0; i < s->count; ++i) {
@@ -222,8 +225,6 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
         pairs += (uint64_t)(rects[i][2] - rects[i][0] + 1) * (rects[i][3] - rects[i][1] + 1);
     }
     if (pairs > UINT32_MAX / 2) {
-        vfx_free(ctx, rects);
-        vfx_free(ctx, visible);
         return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: %llu beam-tile pairs", (unsigned long long)pairs);
     }
     uint32_t offset = 0, empty = 0;
@@ -238,11 +239,8 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
         s->list = vfx_alloc(ctx, pairs * sizeof(uint32_t));
         s->list_capacity = s->list ? (uint32_t)pairs : 0;
     }
-    if (pairs && !s->list) {
-        vfx_free(ctx, rects);
-        vfx_free(ctx, visible);
+    if (pairs && !s->list)
         return VFX_ERR_OUT_OF_MEMORY;
-    }
     for (uint32_t i = 0; i < s->count; ++i) {
         if (!visible[i])
             continue;
@@ -252,8 +250,6 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
                 s->list[s->ranges[2 * t] + s->ranges[2 * t + 1]++] = i;
             }
     }
-    vfx_free(ctx, rects);
-    vfx_free(ctx, visible);
     vfx_stat_set(ctx, "beams.count", s->count);
     vfx_stat_set(ctx, "beams.tiles", ntiles);
     vfx_stat_set(ctx, "beams.tiles_empty", empty);
