@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <cmocka.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -67,14 +68,58 @@ static double ref_pixel(uint32_t i, uint32_t j, double t1)
     return vfx_beams_ref_integral(&b, 1, g_app->camera.eye, dir, 0.0, t1, 1e-10, NULL);
 }
 
-/* Tolerance: the GPU ray comes from unprojecting the pixel centre in float32 (direction good to
- * ~1e-6), the closed form is good to ~1e-6 relative (tests/beams/test_beam_field.c), so 1e-4
- * relative is generous where H is above 5% of the image maximum; nearer the hard support edge a
- * 1e-6 direction change moves H by more (the integrand jumps there), so those pixels get an
- * absolute bound of 1e-3 of the maximum. Where the ray ends on a surface, the end distance comes
- * from a float32 depth unprojected in float32 (relative error ~2e-5 measured at these depths),
- * which moves H by rho(end) * dt: that term is added. Returns the number of failing pixels. */
-static int compare_image(const float *gpu, double (*t1_of)(uint32_t, uint32_t), double *max_rel)
+/* The float32 inputs the GPU works from: the pixel direction, unprojected in float32 from the
+ * pixel centre (a 4-term matrix-vector product, a divide and a normalise: a few ulps per
+ * component), and the head relative to the eye, rounded to float once from an eye that the effect
+ * recovers from the float view matrix (a few ulps of max(|eye|, |M - eye|)). cond_abs is the
+ * largest change of the exact H (float64 closed form, itself within 1e-9 of the quadrature) when
+ * one of these moves by 2 ulps: no float32 pipeline fed these inputs can be more accurate than
+ * that. At a hard support edge it is large: a grazing ray whose chord through the support is 2h
+ * has relative condition ~(R/h)^2 in the distance d of the ray from the centre or axis, and d
+ * moves by ~eps |M - eye| (docs/beams.md, "What float32 can reach"). */
+static double cond_abs(const vfx_beam_d *b, const double dir[3], double t1, double h)
+{
+    const double *eye = g_app->camera.eye;
+    double rel[3], scale = 0;
+    for (int k = 0; k < 3; ++k) {
+        rel[k] = b->head[k] - eye[k];
+        scale = fmax(scale, fmax(fabs(eye[k]), fabs(rel[k])));
+    }
+    double worst = 0, zero[3] = {0, 0, 0};
+    for (int k = 0; k < 6; ++k)
+        for (int sgn = -1; sgn <= 1; sgn += 2) {
+            double d[3] = {dir[0], dir[1], dir[2]};
+            vfx_beam_d bp = *b;
+            for (int c = 0; c < 3; ++c)
+                bp.head[c] = rel[c];
+            if (k < 3)
+                d[k] += sgn * 2.0 * FLT_EPSILON;
+            else
+                bp.head[k - 3] += sgn * 2.0 * FLT_EPSILON * scale;
+            double n = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            for (int c = 0; c < 3; ++c)
+                d[c] /= n;
+            worst = fmax(worst, fabs(vfx_beam_integral_d(&bp, zero, d, 0.0, t1) - h));
+        }
+    return worst;
+}
+
+typedef struct image_errors {
+    double max_rel;       /* over pixels with H > 1e-6 of the image maximum */
+    double max_rel_wc;    /* the same, where cond_abs + cut < 1e-6 H (well conditioned) */
+    double max_ratio;     /* max of error / tolerance */
+    int cond_needed;      /* pixels above 1e-5 relative (all within their conditioning) */
+    int pixels;           /* pixels with H > 1e-6 of the maximum */
+} image_errors;
+
+/* Every pixel against the float64 quadrature: |gpu - ref| <= 1e-5 ref + cond_abs + cut where
+ * ref > 1e-6 of the image maximum (the issue's criterion; 1e-5 is the target, cond_abs what the
+ * float32 inputs allow), <= 1e-6 max + cond_abs + cut below that (the support edge, and pixels
+ * outside it, which must stay 0). cut: where the ray ends on a surface, the end distance comes
+ * from the float32 depth buffer, unprojected in float32 (relative error ~2e-5 measured at these
+ * depths: t^2 (1/n - 1/f) times a depth ulp, and the unprojection's rounding), which moves H by
+ * rho(end) dt. Returns the number of failing pixels. */
+static int compare_image(const float *gpu, double (*t1_of)(uint32_t, uint32_t), image_errors *ie)
 {
     vfx_beam_d b;
     char err[128];
@@ -87,7 +132,7 @@ static int compare_image(const float *gpu, double (*t1_of)(uint32_t, uint32_t), 
             hmax = fmax(hmax, ref[j * W + i]);
         }
     assert_true(hmax > 0.1);
-    *max_rel = 0;
+    memset(ie, 0, sizeof *ie);
     for (uint32_t k = 0; k < W * H; ++k) {
         double e = fabs(gpu[k] - ref[k]);
         uint32_t i = k % W, j = k / W;
@@ -96,19 +141,34 @@ static int compare_image(const float *gpu, double (*t1_of)(uint32_t, uint32_t), 
         for (int c = 0; c < 3; ++c)
             end[c] = g_app->camera.eye[c] + t1 * dir[c];
         double cut = t1 < 50.0 ? vfx_beam_density_d(&b, end) * 2e-5 * t1 : 0.0;
-        if (ref[k] > 0.05 * hmax) {
-            *max_rel = fmax(*max_rel, e / ref[k]);
-            if (e > 1e-4 * ref[k] + cut) {
-                printf("pixel %u: gpu %.7g ref %.7g rel %.3g\n", k, gpu[k], ref[k], e / ref[k]);
-                bad++;
-            }
-        } else if (e > 1e-3 * hmax + cut) {
-            printf("pixel %u: gpu %.7g ref %.7g abs %.3g (max %.4g)\n", k, gpu[k], ref[k], e, hmax);
+        double cond = cond_abs(&b, dir, t1, vfx_beam_integral_d(&b, g_app->camera.eye, dir, 0.0, t1));
+        int bright = ref[k] > 1e-6 * hmax;
+        double tol = (bright ? 1e-5 * ref[k] : 1e-6 * hmax) + cond + cut;
+        ie->max_ratio = fmax(ie->max_ratio, e / tol);
+        if (bright) {
+            double rel = e / ref[k];
+            ie->pixels++;
+            ie->max_rel = fmax(ie->max_rel, rel);
+            if (cond + cut < 1e-6 * ref[k])
+                ie->max_rel_wc = fmax(ie->max_rel_wc, rel);
+            if (rel > 1e-5)
+                ie->cond_needed++;
+        }
+        if (e > tol) {
+            printf("pixel %u: gpu %.7g ref %.7g err %.3g tol %.3g (cond %.3g cut %.3g, max %.4g)\n", k,
+                   gpu[k], ref[k], e, tol, cond, cut, hmax);
             bad++;
         }
     }
     free(ref);
     return bad;
+}
+
+static void print_errors(const char *what, const image_errors *ie)
+{
+    printf("%s: %d pixels above 1e-6 of max: max relative error %.3g (%.3g where well conditioned), "
+           "%d above 1e-5 (within their conditioning), max error/tolerance %.3g\n",
+           what, ie->pixels, ie->max_rel, ie->max_rel_wc, ie->cond_needed, ie->max_ratio);
 }
 
 static double t_far(uint32_t i, uint32_t j) { (void)i, (void)j; return 50.0; }
@@ -117,9 +177,10 @@ static void test_matches_reference(void **state)
 {
     (void)state;
     float *raw = render_raw();
-    double max_rel;
-    assert_int_equal(compare_image(raw, t_far, &max_rel), 0);
-    printf("open sky: max relative error %.3g\n", max_rel);
+    image_errors ie;
+    assert_int_equal(compare_image(raw, t_far, &ie), 0);
+    print_errors("open sky", &ie);
+    assert_true(ie.max_rel_wc <= 1e-5); /* the target, where the inputs allow it */
     /* tiles the beam cannot touch were culled: the counter says so and their pixels are 0 */
     vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
     assert_int_equal(g_app->api->get_stats(g_app->ctx, &st), VFX_OK);
@@ -164,13 +225,15 @@ static void test_hidden_by_depth(void **state)
     assert_int_equal(vfx_app_add_box(g_app, (float[3]){-20, -20, (float)g_wall_z - 1}, (float[3]){20, 20, (float)g_wall_z},
                                      (float[3]){0.5f, 0.5f, 0.5f}, &wall), VFX_OK);
     float *raw = render_raw();
-    double max_rel;
-    int bad = compare_image(raw, t_wall, &max_rel);
+    image_errors ie;
+    int bad = compare_image(raw, t_wall, &ie);
     free(raw);
     vfx_app_mesh *m = vfx_world_get(g_app->world, wall, g_app->mesh_comp, 0);
     vfx_mesh_gpu_destroy(&m->gpu);
     assert_int_equal(vfx_world_despawn(g_app->world, wall), VFX_OK);
-    printf("wall at z=%.2f: max relative error %.3g\n", g_wall_z, max_rel);
+    char what[64];
+    snprintf(what, sizeof what, "wall at z=%.2f", g_wall_z);
+    print_errors(what, &ie);
     assert_int_equal(bad, 0);
 }
 
@@ -204,13 +267,14 @@ static void test_hidden_by_assimp_mesh(void **state)
     for (int k = 0; k < 3; ++k)
         g_box_min[k] = c[k] - 0.5 * s, g_box_max[k] = c[k] + 0.5 * s;
     float *raw = render_raw();
-    double max_rel;
-    int bad = compare_image(raw, t_box, &max_rel);
+    image_errors ie;
+    int bad = compare_image(raw, t_box, &ie);
     free(raw);
     vfx_app_mesh *mm = vfx_world_get(g_app->world, e, g_app->mesh_comp, 0);
     vfx_mesh_gpu_destroy(&mm->gpu);
     assert_int_equal(vfx_world_despawn(g_app->world, e), VFX_OK);
-    printf("beam through box.obj: max relative error %.3g\n", max_rel);
+    print_errors("beam through box.obj", &ie);
+    assert_true(ie.max_rel_wc <= 1e-5);
     assert_int_equal(bad, 0);
 }
 
