@@ -99,13 +99,15 @@ static void sphere_breaks(const double *o, const double *v, const double *c, dou
 {
     double w[3] = {o[0] - c[0], o[1] - c[1], o[2] - c[2]};
     double b = w[0] * v[0] + w[1] * v[1] + w[2] * v[2];
-    double cc = w[0] * w[0] + w[1] * w[1] + w[2] * w[2] - R * R;
     out[(*n)++] = -b;
     double dd = 0;
     for (int k = 0; k < 3; ++k)
         dd += (w[k] - b * v[k]) * (w[k] - b * v[k]);
     peak_breaks(-b, sqrt(dd + eps * eps), t0, t1, out, n);
-    double disc = b * b - cc;
+    /* R^2 - dd, not b^2 - (|w|^2 - R^2): for a sphere far from the origin that difference of two
+     * ~|w|^2 numbers loses the half-chord, the breakpoint misses the support edge, and the
+     * quadrature then straddles the jump (6.7e-8 off on a ray grazing a beam 1e3 away) */
+    double disc = R * R - dd;
     if (disc > 0) {
         out[(*n)++] = -b - sqrt(disc);
         out[(*n)++] = -b + sqrt(disc);
@@ -146,17 +148,16 @@ double vfx_beams_ref_integral(const vfx_beam_d *beams, uint32_t n, const double 
         double A = vp[0] * vp[0] + vp[1] * vp[1] + vp[2] * vp[2];
         if (A > 0) {
             double B = wp[0] * vp[0] + wp[1] * vp[1] + wp[2] * vp[2];
-            double C = wp[0] * wp[0] + wp[1] * wp[1] + wp[2] * wp[2] - b->radius * b->radius;
             br[m++] = -B / A;
             double dd = 0;
             for (int k = 0; k < 3; ++k)
                 dd += (wp[k] - B / A * vp[k]) * (wp[k] - B / A * vp[k]);
             /* peak width along the ray: sqrt(d^2 + eps^2) / |v_perp| */
             peak_breaks(-B / A, sqrt((dd + eps * eps) / A), t0, t1, br, &m);
-            double disc = B * B - A * C;
+            double disc = b->radius * b->radius - dd; /* as in sphere_breaks: no B^2 - A C */
             if (disc > 0) {
-                br[m++] = (-B - sqrt(disc)) / A;
-                br[m++] = (-B + sqrt(disc)) / A;
+                br[m++] = -B / A - sqrt(disc / A);
+                br[m++] = -B / A + sqrt(disc / A);
             }
         }
     }

@@ -3,12 +3,15 @@
  * singular and near-singular rays plus seeded random beams and rays.
  *
  * Tolerances.
- *  - float32 closed form: relative error <= 1e-5 + cond, where cond is the spread of the exact
+ *  - float32 closed form: relative error <= 1e-6 + cond, where cond is the spread of the exact
  *    answer (float64 closed form) when the float32 inputs (ray origin, direction, head M, end
  *    t1) move by 2 float32 ulps. A float32 algorithm cannot do better than the float32 rounding
  *    of its own inputs: a ray 1e6 units away from a beam of radius 1 moves by 0.1 when its
  *    direction moves by one ulp. Where the inputs are well conditioned (cond << 1e-5) this is
- *    the issue's 1e-5 target. The test also counts how many cases needed the cond term.
+ *    the issue's 1e-5 target with 10x margin (3.6e-7 is the largest seen there). Where cond
+ *    dominates, the error measured is at most 0.5 cond (2026-12-01): the float32 algorithm is as
+ *    accurate as about one ulp of its inputs, so 1 cond keeps a 2x margin. The test also counts
+ *    how many cases needed the cond term.
  *  - float64 closed form: 1e-8 + cond * (DBL_EPSILON / FLT_EPSILON). The quadrature is asked
  *    for 1e-12 relative but near a 1/r peak at the 1e-6 R softening floor the density itself is
  *    only good to ~eps*|t|/width (see beams_ref.c); 8.5e-10 was the largest difference seen.
@@ -84,7 +87,7 @@ static double conditioning(const tcase *c, double h)
 
 typedef struct tally {
     int cases, failures, cond_limited;
-    double max_rel_f, max_rel_d, max_rel_f_wellcond;
+    double max_rel_f, max_rel_d, max_rel_f_wellcond, max_ratio_f;
 } tally;
 
 static void check(tally *t, const tcase *c)
@@ -127,9 +130,11 @@ static void check(tally *t, const tcase *c)
         return;
     }
     double ef = fabs(hf - ref) / ref, ed = fabs(hd - ref) / ref;
-    double tol_f = 1e-5 + cond, tol_d = 1e-8 + cond * (DBL_EPSILON / FLT_EPSILON);
+    double tol_f = 1e-6 + cond, tol_d = 1e-8 + cond * (DBL_EPSILON / FLT_EPSILON);
     if (ef > 1e-5)
         t->cond_limited++;
+    if (ef / tol_f > t->max_ratio_f)
+        t->max_ratio_f = ef / tol_f;
     if (ef > t->max_rel_f)
         t->max_rel_f = ef;
     if (ed > t->max_rel_d)
@@ -214,6 +219,16 @@ int main(void)
         mk("tiny: R = 1e-4 through axis", mk_beam(1e-3f, 0, 0, 0, 1, 0, 3e-4f, 1e-4f, 1, 1, 0), 0, 1.5e-4f, 0, 1, 0, 0, 1),
         mk("large close asinh arguments", mk_beam(0, 0, 0, 1, 0, 0, 1e5f, 1e3f, 1, 1, 0), 1e4f, 1, 0, 1, 1e-5f, 0, 5e4f),
         mk("ray starts beyond, looks back along the axis", std, 50, 0, 1e-3f, -1, 0, 0, 1e3f),
+        /* grazing the hard support edge: H ~ 2 b h / R with relative condition ~ (R/h)^2 */
+        mk("grazing the head sphere, h = 0.09 R", std, -0.3f, -5, 0.95f, 0, 1, 0, 100),
+        mk("grazing the head sphere, h = 0.01 R", std, -0.3f, -5, 0.953887f, 0, 1, 0, 100),
+        mk("grazing the cylinder, h = 0.014 R", std, 5, -5, 0.9999f, 0, 1, 0, 100),
+        mk("grazing the cylinder, h = 1.4e-3 R", std, 5, -5, 0.999999f, 0, 1, 0, 100),
+        mk("grazing the cylinder, cut by depth mid-chord", std, 5, -5, 0.9999f, 0, 1, 0, 5),
+        mk("grazing the cylinder, cut just inside", std, 5, -5, 0.99f, 0, 1, 0, 4.9f),
+        mk("grazing the cap beyond", std, 10.3f, -5, 0.95f, 0, 1, 0, 100),
+        mk("grazing a beam 1e3 away", mk_beam(1e3f, 0, 0, 0, 0, 1, 5, 1, 1, 1, 0), 0, 0, 2, 1, 0.9995e-3f, 0, 3e3f),
+        mk("grazing obliquely, cut by depth", std, 2, -5, -3, 0.3f, 1, 0.6f, 5.5f),
     };
     for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; ++i)
         check(&t, &fixed[i]);
@@ -262,7 +277,7 @@ int main(void)
     printf("beam field: %d cases (%d torture, %d random), %d failures\n", t.cases, fixed_cases,
            t.cases - fixed_cases, t.failures);
     printf("max relative error: float32 %.3g (%.3g where cond < 1e-6; %d cases above 1e-5, all "
-           "within their input conditioning), float64 %.3g\n",
-           t.max_rel_f, t.max_rel_f_wellcond, t.cond_limited, t.max_rel_d);
+           "within their input conditioning; max error / (1e-6 + cond) %.3g), float64 %.3g\n",
+           t.max_rel_f, t.max_rel_f_wellcond, t.cond_limited, t.max_ratio_f, t.max_rel_d);
     return t.failures ? 1 : 0;
 }
