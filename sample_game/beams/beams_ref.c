@@ -176,3 +176,33 @@ double vfx_beams_ref_integral(const vfx_beam_d *beams, uint32_t n, const double 
         *evals = q.evals;
     return total;
 }
+
+double vfx_beams_ref_cond_abs(const vfx_beam_d *beams, uint32_t n, const double eye[3],
+                              const double dir[3], double t0, double t1, double ulps)
+{
+    double total = 0, zero[3] = {0, 0, 0};
+    for (uint32_t i = 0; i < n; ++i) {
+        vfx_beam_d b = beams[i];
+        double scale = 0;
+        for (int k = 0; k < 3; ++k) {
+            b.head[k] -= eye[k];
+            scale = fmax(scale, fmax(fabs(eye[k]), fabs(b.head[k])));
+        }
+        double h = vfx_beam_integral_d(&b, zero, dir, t0, t1), worst = 0;
+        for (int k = 0; k < 6; ++k)
+            for (int sgn = -1; sgn <= 1; sgn += 2) {
+                double d[3] = {dir[0], dir[1], dir[2]};
+                vfx_beam_d bp = b;
+                if (k < 3)
+                    d[k] += sgn * ulps * FLT_EPSILON;
+                else
+                    bp.head[k - 3] += sgn * ulps * FLT_EPSILON * scale;
+                double nd = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                for (int c = 0; c < 3; ++c)
+                    d[c] /= nd;
+                worst = fmax(worst, fabs(vfx_beam_integral_d(&bp, zero, d, t0, t1) - h));
+            }
+        total += worst;
+    }
+    return total;
+}

@@ -13,4 +13,12 @@ double vfx_beams_ref_integral(const vfx_beam_d *beams, uint32_t n, const double 
                               const double dir[3], double t0, double t1, double rel_tol,
                               uint64_t *evals);
 
+/* The conditioning of H for a float32 pipeline: the largest change of the exact H (float64
+ * closed form, summed over beams, each beam bounded separately) when one float32 input moves by
+ * `ulps` float32 ulps: a component of dir (by ulps * FLT_EPSILON), or a component of a beam's
+ * head relative to the eye (by ulps * FLT_EPSILON * max(|eye|, |head - eye|)). Absolute, same
+ * units as H. No float32 algorithm fed such inputs can be more accurate than this. */
+double vfx_beams_ref_cond_abs(const vfx_beam_d *beams, uint32_t n, const double eye[3],
+                              const double dir[3], double t0, double t1, double ulps);
+
 #endif
