@@ -14,7 +14,7 @@
  *    how many cases needed the cond term.
  *  - float64 closed form: 1e-8 + cond * (DBL_EPSILON / FLT_EPSILON). The quadrature is asked
  *    for 1e-12 relative but near a 1/r peak at the 1e-6 R softening floor the density itself is
- *    only good to ~eps*|t|/width (see beams_ref.c); 8.5e-10 was the largest difference seen.
+ *    only good to ~eps*|t|/width (see beams_ref.c); 2.7e-10 is the largest difference seen.
  * Cases whose reference H is 0 must give 0 (outside the support nothing is added) unless the
  * ray grazes the support (cond-limited), where |H| <= 1e-6 * (a + b) is accepted. */
 #include <float.h>
