@@ -45,8 +45,9 @@ elif kind == "gpu":
         print("| beams | image | frames | frame ms (p50) | last beams.integrate GPU ms | beam-tile pairs | culled |")
         print("|---|---|---|---|---|---|---|")
         for r in big:
+            gms = "-" if r["last_gpu_ms"] is None else f"{r['last_gpu_ms']:.0f}"
             print(f"| {r['beams']} | {r['width']}x{r['height']} | {r['frames']} | {r['frame_ms_p50']:.0f} | "
-                  f"{r['last_gpu_ms']:.0f} | {r['pairs']:.0f} | {r['pairs_culled']:.0f} |")
+                  f"{gms} | {r['pairs']:.0f} | {r['pairs_culled']:.0f} |")
     anim = [r for r in rows if "animation" in r]
     if anim:
         print()
