@@ -234,6 +234,25 @@ static void dispatch(const water_state *s)
     glMemoryBarrier(GL_ALL_BARRIER_BITS);
 }
 
+/* The march loop runs up to 16 iterations of 4 passes; timing every one would fill the
+ * 32-slot timestamp ring before refine and shade. Only the first iteration is timed (its
+ * passes keep their names); the others get a debug group only. */
+static void loop_pass_begin(vfx_context *ctx, const char *name, uint32_t it)
+{
+    if (it == 0)
+        vfx_gpu_pass_begin(ctx, name);
+    else
+        glPushDebugGroup(GL_DEBUG_SOURCE_APPLICATION, 0, -1, name);
+}
+
+static void loop_pass_end(vfx_context *ctx, uint32_t it)
+{
+    if (it == 0)
+        vfx_gpu_pass_end(ctx);
+    else
+        glPopDebugGroup();
+}
+
 /* Draws every particle's billboard with `prog` (one instanced strip). */
 static void draw_billboards(vfx_context *ctx, const water_state *s)
 {
@@ -410,10 +429,11 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
     int level = (int)p->pyramid_level;
     if (level >= s->pyr_levels)
         level = s->pyr_levels - 1;
+    vfx_gpu_pass_begin(ctx, "water.march");
     for (uint32_t it = 0; it < iters; ++it) {
         /* (5) min/max pyramid of the current samples, 2x2 reductions down to `level` */
         if (cull) {
-            vfx_gpu_pass_begin(ctx, "water.pyramid");
+            loop_pass_begin(ctx, "water.pyramid", it);
             glUseProgram(pyr0);
             set_common(pyr0, s, frame, targets, t_end);
             glBindImageTexture(2, s->cur, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
@@ -427,16 +447,16 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
                 glDispatchCompute(((w ? w : 1) + 7) / 8, ((h ? h : 1) + 7) / 8, 1);
                 glMemoryBarrier(GL_ALL_BARRIER_BITS);
             }
-            vfx_gpu_pass_end(ctx);
+            loop_pass_end(ctx, it);
         }
         /* (3)+(4) potentials at NS consecutive samples */
-        vfx_gpu_pass_begin(ctx, "water.potential");
+        loop_pass_begin(ctx, "water.potential", it);
         vfx_result r = potential_pass(ctx, s, frame, targets, s->cur, ns, cull, t_end);
-        vfx_gpu_pass_end(ctx);
+        loop_pass_end(ctx, it);
         if (r)
             return r;
         /* inside/outside, stop flag, t'_next = t + NS w (eq. 2) into buffer 1 */
-        vfx_gpu_pass_begin(ctx, "water.update");
+        loop_pass_begin(ctx, "water.update", it);
         glUseProgram(upd);
         set_common(upd, s, frame, targets, t_end);
         glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
@@ -445,10 +465,10 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
         glBindImageTexture(3, s->next1, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
         glBindTextureUnit(0, s->pot);
         dispatch(s);
-        vfx_gpu_pass_end(ctx);
+        loop_pass_end(ctx, it);
         /* (2) jump over gaps: buffer 2 = nearest candidate region at or after t'_next
          * (eqs. 3-4, depth test); without it the next sample is t'_next itself */
-        vfx_gpu_pass_begin(ctx, "water.skip");
+        loop_pass_begin(ctx, "water.skip", it);
         if (dis & VFX_WATER_NO_SKIP) {
             GLuint t = s->cur;
             s->cur = s->next1;
@@ -457,8 +477,10 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
         } else {
             nearest_face_pass(ctx, s, skip, frame, targets, t_end, vp, s->next1);
         }
-        vfx_gpu_pass_end(ctx);
+        loop_pass_end(ctx, it);
     }
+
+    vfx_gpu_pass_end(ctx);
 
     /* (6) eq. 5 then eq. 6 regula falsi, each iteration's potential again by blending */
     vfx_gpu_pass_begin(ctx, "water.refine");
