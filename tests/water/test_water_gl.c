@@ -290,10 +290,10 @@ static void session_open(session *ss, scene *s, const vfx_ref_camera *cam, const
                          uint32_t buffer_cap, bool sync)
 {
     memset(ss, 0, sizeof *ss);
-    static vfx_host_api host_api;
-    host_api = (vfx_host_api){.size = sizeof host_api, .version = VFX_HOST_API_VERSION, .user = s,
-                              .log = vfx_test_log_fn, .particle_chunk_count = chunk_count,
-                              .particle_chunk = chunk_view, .water_params = water_params};
+    /* the plugin keeps a copy of the table */
+    vfx_host_api host_api = {.size = sizeof host_api, .version = VFX_HOST_API_VERSION, .user = s,
+                             .log = vfx_test_log_fn, .particle_chunk_count = chunk_count,
+                             .particle_chunk = chunk_view, .water_params = water_params};
     ss->api.size = sizeof ss->api;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
     assert_int_equal(ss->api.create(&host_api, &ss->ctx), VFX_OK);
