@@ -8,9 +8,9 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "water/water_effect.h"
 #include "gpu/gpu.h"
 #include "plugin_internal.h"
-#include "water/water_effect.h"
 
 /* Counter readback ring: frames the GPU may run behind before a result is dropped. */
 #define WATER_COUNTER_RING 3
@@ -138,11 +138,11 @@ static void water_destroy(vfx_context *ctx, void *state)
     water_state *s = state;
     groups_free(ctx, s);
     paper_free(s);
+    glDeleteVertexArrays(1, &s->vao);
     for (int k = 0; k < WATER_COUNTER_RING; ++k)
         if (s->fence[k])
             glDeleteSync(s->fence[k]);
     glDeleteBuffers(WATER_COUNTER_RING, s->ring);
-    glDeleteVertexArrays(1, &s->vao);
     if (s->counters)
         glDeleteBuffers(1, &s->counters);
     if (ctx->water_dist_tex) {
@@ -348,25 +348,6 @@ static void dispatch(const water_state *s)
     glMemoryBarrier(GL_ALL_BARRIER_BITS);
 }
 
-/* The march loop runs up to 16 iterations of 4 passes; timing every one would fill the
- * 32-slot timestamp ring before refine and shade. Only the first iteration is timed (its
- * passes keep their names); the others get a debug group only. */
-static void loop_pass_begin(vfx_context *ctx, const char *name, uint32_t it)
-{
-    if (it == 0)
-        vfx_gpu_pass_begin(ctx, name);
-    else
-        glPushDebugGroup(GL_DEBUG_SOURCE_APPLICATION, 0, -1, name);
-}
-
-static void loop_pass_end(vfx_context *ctx, uint32_t it)
-{
-    if (it == 0)
-        vfx_gpu_pass_end(ctx);
-    else
-        glPopDebugGroup();
-}
-
 /* Min/max pyramid of the distances in `src` (level 0 from `pyr0`, 2x2 reductions by `pyrd`
  * down to `level`): the tiles the billboard passes cull against. */
 static void build_pyramid(const water_state *s, GLuint pyr0, GLuint pyrd, const vfx_frame_view *frame,
@@ -512,143 +493,6 @@ static void nearest_face_pass(vfx_context *ctx, const water_state *s, GLuint pro
     glDisable(GL_DEPTH_TEST);
 }
 
-static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                              vfx_frame_targets *targets)
-{
-    const vfx_water_params *p = &s->params;
-    const uint32_t dis = p->disable;
-    const int ns = (dis & VFX_WATER_NO_PACK4) ? 1 : 4;
-    const int cull = !(dis & VFX_WATER_NO_PYRAMID);
-    /* farthest point of the particles' box grown by h: beyond it no sample can be inside */
-    float t_end = 0;
-    for (int c = 0; c < 8; ++c) {
-        float d2 = 0;
-        for (int k = 0; k < 3; ++k) {
-            float v = ((c >> k) & 1 ? s->hi[k] + p->h : s->lo[k] - p->h) - frame->eye[k];
-            d2 += v * v;
-        }
-        if (d2 > t_end) t_end = d2;
-    }
-    t_end = sqrtf(t_end);
-    float vp[16];
-    for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) {
-            float a = 0;
-            for (int k = 0; k < 4; ++k)
-                a += frame->proj[k * 4 + r] * frame->view[c * 4 + k];
-            vp[c * 4 + r] = a;
-        }
-    memcpy(s->view_proj, vp, sizeof vp);
-    for (int k = 0; k < 3; ++k)
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, s->cols[k]);
-    float zero[4] = {0, 0, 0, 0};
-    glClearTexImage(s->st, 0, GL_RGBA, GL_FLOAT, zero);
-    glClearTexImage(s->br, 0, GL_RGBA, GL_FLOAT, zero);
-    char defs[96];
-
-    /* (1) initial sample: nearest cube front face per pixel by the depth test (eq. 1) */
-    vfx_gpu_pass_begin(ctx, "water.init");
-    if (dis & VFX_WATER_NO_BILLBOARD_INIT) {
-        float nearv[4] = {frame->near_plane, 0, 0, 0};
-        glClearTexImage(s->cur, 0, GL_RED, GL_FLOAT, nearv);
-    } else {
-        GLuint prog = vfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_INIT\n#define NS 1\n");
-        if (!prog)
-            return VFX_ERR_GL;
-        nearest_face_pass(ctx, s, prog, frame, targets, t_end, vp, 0);
-    }
-    vfx_gpu_pass_end(ctx);
-
-    uint32_t iters = (p->max_samples + (uint32_t)ns - 1) / (uint32_t)ns;
-    snprintf(defs, sizeof defs, "#define MODE_UPDATE\n#define NS %d\n", ns);
-    GLuint upd = vfx_gpu_compute(ctx, "water/march.comp", defs);
-    snprintf(defs, sizeof defs, "#define MODE_PYR0\n#define NS %d\n", ns);
-    GLuint pyr0 = vfx_gpu_compute(ctx, "water/march.comp", defs);
-    GLuint pyrd = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_PYRDOWN\n#define NS 1\n");
-    GLuint skip = vfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_SKIP\n#define NS 1\n");
-    if (!upd || !pyr0 || !pyrd || !skip)
-        return VFX_ERR_GL;
-    int level = (int)p->pyramid_level;
-    if (level >= s->pyr_levels)
-        level = s->pyr_levels - 1;
-    vfx_gpu_pass_begin(ctx, "water.march");
-    for (uint32_t it = 0; it < iters; ++it) {
-        /* (5) min/max pyramid of the current samples, 2x2 reductions down to `level` */
-        if (cull) {
-            loop_pass_begin(ctx, "water.pyramid", it);
-            build_pyramid(s, pyr0, pyrd, frame, targets, t_end, s->cur, level);
-            loop_pass_end(ctx, it);
-        }
-        /* (3)+(4) potentials at NS consecutive samples */
-        loop_pass_begin(ctx, "water.potential", it);
-        vfx_result r = potential_pass(ctx, s, frame, targets, s->cur, ns, cull, t_end);
-        loop_pass_end(ctx, it);
-        if (r)
-            return r;
-        /* inside/outside, stop flag, t'_next = t + NS w (eq. 2) into buffer 1 */
-        loop_pass_begin(ctx, "water.update", it);
-        glUseProgram(upd);
-        set_common(upd, s, frame, targets, t_end);
-        glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-        glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-        glBindImageTexture(2, s->cur, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
-        glBindImageTexture(3, s->next1, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-        glBindTextureUnit(0, s->pot);
-        dispatch(s);
-        loop_pass_end(ctx, it);
-        /* (2) jump over gaps: buffer 2 = nearest candidate region at or after t'_next
-         * (eqs. 3-4, depth test); without it the next sample is t'_next itself */
-        loop_pass_begin(ctx, "water.skip", it);
-        if (dis & VFX_WATER_NO_SKIP) {
-            GLuint t = s->cur;
-            s->cur = s->next1;
-            s->next1 = t;
-            glNamedFramebufferTexture(s->fbo_dist, GL_COLOR_ATTACHMENT0, s->cur, 0);
-        } else {
-            nearest_face_pass(ctx, s, skip, frame, targets, t_end, vp, s->next1);
-        }
-        loop_pass_end(ctx, it);
-    }
-
-    vfx_gpu_pass_end(ctx);
-
-    /* (6) eq. 5 then eq. 6 regula falsi, each iteration's potential again by blending */
-    vfx_gpu_pass_begin(ctx, "water.refine");
-    GLuint interp = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_INTERP\n#define NS 1\n");
-    GLuint refine = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_REFINE\n#define NS 1\n");
-    GLuint fin = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_FINAL\n#define NS 1\n");
-    if (!interp || !refine || !fin)
-        return VFX_ERR_GL;
-    glUseProgram(interp);
-    set_common(interp, s, frame, targets, t_end);
-    glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-    glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-    glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
-    dispatch(s);
-    uint32_t riters = (dis & VFX_WATER_NO_REFINE) ? 0 : p->refine_iters;
-    for (uint32_t it = 0; it < riters; ++it) {
-        vfx_result r = potential_pass(ctx, s, frame, targets, s->reft, 1, 0, t_end);
-        if (r)
-            return r;
-        glUseProgram(refine);
-        set_common(refine, s, frame, targets, t_end);
-        glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-        glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-        glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
-        glBindTextureUnit(0, s->pot);
-        dispatch(s);
-    }
-    glUseProgram(fin);
-    set_common(fin, s, frame, targets, t_end);
-    glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-    glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-    glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
-    glBindImageTexture(3, ctx->water_dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-    dispatch(s);
-    vfx_gpu_pass_end(ctx);
-    return VFX_OK;
-}
-
 /* Shading inputs at the found surface, for every method: the gradient pass (additive
  * blending of grad P and P at the surface point, tile-culled against the pyramid of the final
  * distances like the potential passes) and the back-distance pass (max blending of the ray's
@@ -768,14 +612,149 @@ static void counters_frame_end(vfx_context *ctx, water_state *s, uint32_t method
         publish_counters(ctx, s);
 }
 
+static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
+                              vfx_frame_targets *targets)
+{
+    const vfx_water_params *p = &s->params;
+    const uint32_t dis = p->disable;
+    const int ns = (dis & VFX_WATER_NO_PACK4) ? 1 : 4;
+    const int cull = !(dis & VFX_WATER_NO_PYRAMID);
+    /* farthest point of the particles' box grown by h: beyond it no sample can be inside */
+    float t_end = 0;
+    for (int c = 0; c < 8; ++c) {
+        float d2 = 0;
+        for (int k = 0; k < 3; ++k) {
+            float v = ((c >> k) & 1 ? s->hi[k] + p->h : s->lo[k] - p->h) - frame->eye[k];
+            d2 += v * v;
+        }
+        if (d2 > t_end) t_end = d2;
+    }
+    t_end = sqrtf(t_end);
+    float vp[16];
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) {
+            float a = 0;
+            for (int k = 0; k < 4; ++k)
+                a += frame->proj[k * 4 + r] * frame->view[c * 4 + k];
+            vp[c * 4 + r] = a;
+        }
+    memcpy(s->view_proj, vp, sizeof vp);
+    for (int k = 0; k < 3; ++k)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, s->cols[k]);
+    float zero[4] = {0, 0, 0, 0};
+    glClearTexImage(s->st, 0, GL_RGBA, GL_FLOAT, zero);
+    glClearTexImage(s->br, 0, GL_RGBA, GL_FLOAT, zero);
+    char defs[96];
+
+    /* (1) initial sample: nearest cube front face per pixel by the depth test (eq. 1) */
+    vfx_gpu_pass_begin(ctx, "water.init");
+    if (dis & VFX_WATER_NO_BILLBOARD_INIT) {
+        float nearv[4] = {frame->near_plane, 0, 0, 0};
+        glClearTexImage(s->cur, 0, GL_RED, GL_FLOAT, nearv);
+    } else {
+        GLuint prog = vfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_INIT\n#define NS 1\n");
+        if (!prog)
+            return VFX_ERR_GL;
+        nearest_face_pass(ctx, s, prog, frame, targets, t_end, vp, 0);
+    }
+    vfx_gpu_pass_end(ctx);
+
+    uint32_t iters = (p->max_samples + (uint32_t)ns - 1) / (uint32_t)ns;
+    snprintf(defs, sizeof defs, "#define MODE_UPDATE\n#define NS %d\n", ns);
+    GLuint upd = vfx_gpu_compute(ctx, "water/march.comp", defs);
+    snprintf(defs, sizeof defs, "#define MODE_PYR0\n#define NS %d\n", ns);
+    GLuint pyr0 = vfx_gpu_compute(ctx, "water/march.comp", defs);
+    GLuint pyrd = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_PYRDOWN\n#define NS 1\n");
+    GLuint skip = vfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_SKIP\n#define NS 1\n");
+    if (!upd || !pyr0 || !pyrd || !skip)
+        return VFX_ERR_GL;
+    int level = (int)p->pyramid_level;
+    if (level >= s->pyr_levels)
+        level = s->pyr_levels - 1;
+    vfx_gpu_pass_begin(ctx, "water.march");
+    for (uint32_t it = 0; it < iters; ++it) {
+        /* (5) min/max pyramid of the current samples, 2x2 reductions down to `level` */
+        if (cull) {
+            vfx_gpu_pass_begin(ctx, "water.pyramid");
+            build_pyramid(s, pyr0, pyrd, frame, targets, t_end, s->cur, level);
+            vfx_gpu_pass_end(ctx);
+        }
+        /* (3)+(4) potentials at NS consecutive samples */
+        vfx_gpu_pass_begin(ctx, "water.potential");
+        vfx_result r = potential_pass(ctx, s, frame, targets, s->cur, ns, cull, t_end);
+        vfx_gpu_pass_end(ctx);
+        if (r)
+            return r;
+        /* inside/outside, stop flag, t'_next = t + NS w (eq. 2) into buffer 1 */
+        vfx_gpu_pass_begin(ctx, "water.update");
+        glUseProgram(upd);
+        set_common(upd, s, frame, targets, t_end);
+        glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+        glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+        glBindImageTexture(2, s->cur, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
+        glBindImageTexture(3, s->next1, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindTextureUnit(0, s->pot);
+        dispatch(s);
+        vfx_gpu_pass_end(ctx);
+        /* (2) jump over gaps: buffer 2 = nearest candidate region at or after t'_next
+         * (eqs. 3-4, depth test); without it the next sample is t'_next itself */
+        vfx_gpu_pass_begin(ctx, "water.skip");
+        if (dis & VFX_WATER_NO_SKIP) {
+            GLuint t = s->cur;
+            s->cur = s->next1;
+            s->next1 = t;
+            glNamedFramebufferTexture(s->fbo_dist, GL_COLOR_ATTACHMENT0, s->cur, 0);
+        } else {
+            nearest_face_pass(ctx, s, skip, frame, targets, t_end, vp, s->next1);
+        }
+        vfx_gpu_pass_end(ctx);
+    }
+
+    vfx_gpu_pass_end(ctx);
+
+    /* (6) eq. 5 then eq. 6 regula falsi, each iteration's potential again by blending */
+    vfx_gpu_pass_begin(ctx, "water.refine");
+    GLuint interp = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_INTERP\n#define NS 1\n");
+    GLuint refine = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_REFINE\n#define NS 1\n");
+    GLuint fin = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_FINAL\n#define NS 1\n");
+    if (!interp || !refine || !fin)
+        return VFX_ERR_GL;
+    glUseProgram(interp);
+    set_common(interp, s, frame, targets, t_end);
+    glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+    dispatch(s);
+    uint32_t riters = (dis & VFX_WATER_NO_REFINE) ? 0 : p->refine_iters;
+    for (uint32_t it = 0; it < riters; ++it) {
+        vfx_result r = potential_pass(ctx, s, frame, targets, s->reft, 1, 0, t_end);
+        if (r)
+            return r;
+        glUseProgram(refine);
+        set_common(refine, s, frame, targets, t_end);
+        glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+        glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+        glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+        glBindTextureUnit(0, s->pot);
+        dispatch(s);
+    }
+    glUseProgram(fin);
+    set_common(fin, s, frame, targets, t_end);
+    glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+    glBindImageTexture(3, ctx->water_dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    dispatch(s);
+    vfx_gpu_pass_end(ctx);
+    return VFX_OK;
+}
+
 static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
                                vfx_frame_targets *targets)
 {
     water_state *s = state;
     const vfx_water_params *p = &s->params;
     targets->water_dist = ctx->water_dist_tex;
-    vfx_stat_set(ctx, "water.particles", s->count);
-    vfx_stat_set(ctx, "water.nan_skipped", s->nan_count);
     vfx_stat_set(ctx, "water.position_buffers", s->group_count);
     if (s->group_count > 1 && (p->method != VFX_WATER_METHOD_PAPER || (p->disable & VFX_WATER_NO_BLEND)))
         return vfx_fail(ctx, VFX_ERR_UNSUPPORTED,
@@ -786,6 +765,8 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     vfx_mat4_mul(frame->proj, frame->view, s->view_proj);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->counters);
     glClearNamedBufferData(s->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
+    vfx_stat_set(ctx, "water.particles", s->count);
+    vfx_stat_set(ctx, "water.nan_skipped", s->nan_count);
     vfx_result r = p->method == VFX_WATER_METHOD_PAPER ? paper_march(ctx, s, frame, targets)
                                                        : brute_march(ctx, s, frame, targets);
     if (r != VFX_OK)
