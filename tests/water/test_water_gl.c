@@ -272,7 +272,6 @@ static void test_paper_ablation_bits(void **state)
     }
 }
 
-
 /* Zero particles: the effect is absent, no state, no pass, no stat. */
 static void test_zero_particles(void **state)
 {
