@@ -49,6 +49,14 @@ extern const vfx_effect_ops vfx_beams_ops;
 extern const vfx_effect_ops vfx_volume_ops;
 #endif
 
+/* Knobs that only tests and benchmarks set (through this header: hosts of the shared library
+ * cannot reach them). Zero is the production behaviour. */
+typedef struct vfx_debug_knobs {
+    bool sync_counters;        /* GPU counters of this frame, waited for (a stall); otherwise
+                                  effects report those of the last frame the GPU finished */
+    uint32_t water_buffer_cap; /* particles per water position buffer; 0 -> the GL limit */
+} vfx_debug_knobs;
+
 struct vfx_context {
     vfx_host_api host;          /* copy of the host's table */
     vfx_gpu *gpu;               /* program cache, timers, fullscreen VAO */
@@ -59,6 +67,7 @@ struct vfx_context {
     vfx_stats last_stats;       /* counters of the last finished frame */
     char last_error[512];
     unsigned water_dist_tex;    /* shared target owned by the context */
+    vfx_debug_knobs debug;
 };
 
 /* Logs through the host logger, printf-style. */

@@ -8,12 +8,35 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "water/water_effect.h"
 #include "gpu/gpu.h"
 #include "plugin_internal.h"
 
+/* Counter readback ring: frames the GPU may run behind before a result is dropped. */
+#define WATER_COUNTER_RING 3
+#define WATER_COUNTERS 8
+/* Particles the effect takes at most: positions are 12 bytes each (12 GiB at the limit) and a
+ * particle index must fit the int of gl_InstanceID and of the draw's instance count. */
+#define WATER_MAX_PARTICLES (1u << 30)
+/* The gradient target accumulates signed terms up to 2/h that partly cancel at the surface:
+ * RGBA16F rounds each add to ~5e-4 relative. Measured on the blob test with the brute-force
+ * surface (exact to 1e-5 h): mean normal error 0.025 deg in RGBA16F, 0.002 deg in RGBA32F.
+ * The pass runs once per frame, not per march iteration, so the wider format costs little. */
+#define WATER_GRAD_FORMAT GL_RGBA32F
+
+/* One position buffer triple: particles [first, first + count) of the concatenated chunks. */
+typedef struct water_group {
+    GLuint cols[3];
+    uint32_t first, count;
+} water_group;
+
 typedef struct water_state {
-    GLuint cols[3];        /* x, y, z columns of every chunk, concatenated */
-    uint32_t capacity;     /* floats each column buffer holds */
+    GLuint cols[3];        /* group 0's columns: the compute paths (brute, NO_BLEND) read only it */
+    water_group *groups;   /* position buffers of at most buffer_cap particles each */
+    uint32_t group_count;
+    uint32_t gl_cap;       /* particles one SSBO binding holds (GL_MAX_SHADER_STORAGE_BLOCK_SIZE) */
+    uint32_t buffer_cap;   /* particles per buffer in use: gl_cap or the lower debug knob */
+    uint32_t capacity;     /* particles the groups hold */
     uint32_t count;        /* particles uploaded (NaN ones included: the shaders skip them) */
     uint32_t nan_count;
     uint32_t width, height;
@@ -22,19 +45,43 @@ typedef struct water_state {
     float lo[3], hi[3];    /* box of the finite particles */
     /* paper pipeline targets */
     GLuint cur, next1, pot, st, br, reft, depth, pyr, fbo_dist, fbo_pot, counters;
+    GLuint grad, back, fbo_grad, fbo_back; /* surface gradient and back distance (shading) */
     int pyr_levels;
+    /* counters: copied into ring[slot] and fenced each frame, read once the fence signals */
+    GLuint ring[WATER_COUNTER_RING];
+    GLsync fence[WATER_COUNTER_RING];
+    uint64_t ring_frame[WATER_COUNTER_RING];
+    uint32_t ring_method[WATER_COUNTER_RING];
+    uint64_t frame_no;
+    uint32_t last[WATER_COUNTERS];
+    uint64_t last_frame;   /* frame whose counters `last` holds */
+    uint32_t last_method;
+    int have_last;
+    uint32_t dropped;      /* counter results overwritten before the GPU finished them */
     float view_proj[16];
     GLuint vao; /* empty: billboards are built from gl_VertexID / gl_InstanceID */
 } water_state;
 
 static void paper_free(water_state *s)
 {
-    GLuint tex[] = {s->cur, s->next1, s->pot, s->st, s->br, s->reft, s->depth, s->pyr};
-    glDeleteTextures(8, tex);
-    GLuint fb[] = {s->fbo_dist, s->fbo_pot};
-    glDeleteFramebuffers(2, fb);
+    GLuint tex[] = {s->cur, s->next1, s->pot, s->st, s->br, s->reft, s->depth, s->pyr, s->grad, s->back};
+    glDeleteTextures(10, tex);
+    GLuint fb[] = {s->fbo_dist, s->fbo_pot, s->fbo_grad, s->fbo_back};
+    glDeleteFramebuffers(4, fb);
     s->cur = s->next1 = s->pot = s->st = s->br = s->reft = s->depth = s->pyr = 0;
-    s->fbo_dist = s->fbo_pot = 0;
+    s->grad = s->back = 0;
+    s->fbo_dist = s->fbo_pot = s->fbo_grad = s->fbo_back = 0;
+}
+
+static void groups_free(vfx_context *ctx, water_state *s)
+{
+    for (uint32_t g = 0; g < s->group_count; ++g)
+        glDeleteBuffers(3, s->groups[g].cols);
+    vfx_free(ctx, s->groups);
+    s->groups = NULL;
+    s->group_count = 0;
+    s->capacity = 0;
+    s->cols[0] = s->cols[1] = s->cols[2] = 0;
 }
 
 static GLuint make_tex(GLenum fmt, uint32_t w, uint32_t h, int levels, const char *label)
@@ -74,6 +121,14 @@ static vfx_result water_create(vfx_context *ctx, void **out)
     if (!s)
         return VFX_ERR_OUT_OF_MEMORY;
     glCreateVertexArrays(1, &s->vao);
+    /* one SSBO binding must hold a whole column */
+    GLint64 block = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
+    uint64_t cap = block > 0 ? (uint64_t)block / sizeof(float) : (1u << 24);
+    s->gl_cap = cap > WATER_MAX_PARTICLES ? WATER_MAX_PARTICLES : (uint32_t)cap;
+    glCreateBuffers(WATER_COUNTER_RING, s->ring);
+    for (int k = 0; k < WATER_COUNTER_RING; ++k)
+        glNamedBufferStorage(s->ring[k], WATER_COUNTERS * sizeof(uint32_t), NULL, GL_MAP_READ_BIT);
     *out = s;
     return VFX_OK;
 }
@@ -81,10 +136,13 @@ static vfx_result water_create(vfx_context *ctx, void **out)
 static void water_destroy(vfx_context *ctx, void *state)
 {
     water_state *s = state;
-    if (s->cols[0])
-        glDeleteBuffers(3, s->cols);
+    groups_free(ctx, s);
     paper_free(s);
     glDeleteVertexArrays(1, &s->vao);
+    for (int k = 0; k < WATER_COUNTER_RING; ++k)
+        if (s->fence[k])
+            glDeleteSync(s->fence[k]);
+    glDeleteBuffers(WATER_COUNTER_RING, s->ring);
     if (s->counters)
         glDeleteBuffers(1, &s->counters);
     if (ctx->water_dist_tex) {
@@ -119,21 +177,70 @@ static vfx_result water_resize(vfx_context *ctx, void *state, uint32_t width, ui
         ++levels;
     s->pyr_levels = levels;
     s->pyr = make_tex(GL_RG32F, width, height, levels, "water.minmax_pyramid");
+    s->grad = make_tex(WATER_GRAD_FORMAT, width, height, 1, "water.surface_gradient");
+    s->back = make_tex(GL_R32F, width, height, 1, "water.back_distance");
+    glCreateFramebuffers(1, &s->fbo_grad);
+    glNamedFramebufferTexture(s->fbo_grad, GL_COLOR_ATTACHMENT0, s->grad, 0);
+    glCreateFramebuffers(1, &s->fbo_back);
+    glNamedFramebufferTexture(s->fbo_back, GL_COLOR_ATTACHMENT0, s->back, 0);
     glCreateFramebuffers(1, &s->fbo_dist);
     glNamedFramebufferTexture(s->fbo_dist, GL_COLOR_ATTACHMENT0, s->cur, 0);
     glNamedFramebufferTexture(s->fbo_dist, GL_DEPTH_ATTACHMENT, s->depth, 0);
     glCreateFramebuffers(1, &s->fbo_pot);
     glNamedFramebufferTexture(s->fbo_pot, GL_COLOR_ATTACHMENT0, s->pot, 0);
     if (glCheckNamedFramebufferStatus(s->fbo_dist, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE ||
-        glCheckNamedFramebufferStatus(s->fbo_pot, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        glCheckNamedFramebufferStatus(s->fbo_pot, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE ||
+        glCheckNamedFramebufferStatus(s->fbo_grad, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE ||
+        glCheckNamedFramebufferStatus(s->fbo_back, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
         return vfx_fail(ctx, VFX_ERR_GL, "water resize %ux%u: incomplete framebuffer", width, height);
     if (!s->counters) {
         glCreateBuffers(1, &s->counters);
-        glNamedBufferStorage(s->counters, 8 * sizeof(uint32_t), NULL, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
+        glNamedBufferStorage(s->counters, WATER_COUNTERS * sizeof(uint32_t), NULL, GL_DYNAMIC_STORAGE_BIT);
     }
     const char *e = vfx_gpu_error_string();
     if (e)
         return vfx_fail(ctx, VFX_ERR_GL, "water resize %ux%u: %s", width, height, e);
+    return VFX_OK;
+}
+
+/* Position buffers for `total` particles, at most buffer_cap each (recreated when the count
+ * grows past what they hold, or the cap changed). */
+static vfx_result ensure_groups(vfx_context *ctx, water_state *s, uint32_t total)
+{
+    uint32_t cap = s->gl_cap;
+    if (ctx->debug.water_buffer_cap && ctx->debug.water_buffer_cap < cap)
+        cap = ctx->debug.water_buffer_cap;
+    uint32_t need = total ? (uint32_t)(((uint64_t)total + cap - 1) / cap) : 1;
+    if (s->groups && total <= s->capacity && need == s->group_count && cap == s->buffer_cap) {
+        /* as many particles or fewer: same buffers (each sized for its group at capacity) */
+        for (uint32_t g = 0; g < need; ++g) {
+            uint32_t first = g * cap;
+            s->groups[g].count = total > first ? (total - first < cap ? total - first : cap) : 0;
+        }
+        return VFX_OK;
+    }
+    groups_free(ctx, s);
+    s->buffer_cap = cap;
+    s->groups = vfx_alloc(ctx, need * sizeof *s->groups);
+    if (!s->groups)
+        return VFX_ERR_OUT_OF_MEMORY;
+    s->group_count = need;
+    for (uint32_t g = 0; g < need; ++g) {
+        water_group *w = &s->groups[g];
+        w->first = g * cap;
+        w->count = total - w->first < cap ? total - w->first : cap;
+        glCreateBuffers(3, w->cols);
+        for (int k = 0; k < 3; ++k)
+            glNamedBufferStorage(w->cols[k], (GLsizeiptr)(w->count ? w->count : 1) * 4, NULL, GL_DYNAMIC_STORAGE_BIT);
+    }
+    memcpy(s->cols, s->groups[0].cols, sizeof s->cols);
+    s->capacity = total;
+    const char *e = vfx_gpu_error_string();
+    if (e) {
+        groups_free(ctx, s);
+        return vfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water: position buffers for %u particles (%u buffers of at most %u): %s",
+                        total, need, cap, e);
+    }
     return VFX_OK;
 }
 
@@ -165,24 +272,31 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
             return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u has %u particles but a NULL position column", c, v.count);
         total += v.count;
     }
-    if (total > (1u << 26))
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: %llu particles exceed the 2^26 limit", (unsigned long long)total);
-    if (total > s->capacity || !s->cols[0]) {
-        if (s->cols[0])
-            glDeleteBuffers(3, s->cols);
-        s->capacity = total ? (uint32_t)total : 1;
-        glCreateBuffers(3, s->cols);
-        for (int k = 0; k < 3; ++k)
-            glNamedBufferStorage(s->cols[k], (GLsizeiptr)s->capacity * 4, NULL, GL_DYNAMIC_STORAGE_BIT);
-    }
+    if (total > WATER_MAX_PARTICLES)
+        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                        "water: %u particle chunks hold %llu particles, more than the limit of %u (2^30)",
+                        chunks, (unsigned long long)total, WATER_MAX_PARTICLES);
+    vfx_result gr = ensure_groups(ctx, s, (uint32_t)total);
+    if (gr)
+        return gr;
     uint32_t off = 0, nan_count = 0;
     int seen = 0;
     for (uint32_t c = 0; c < chunks; ++c) {
         vfx_particle_view v = {.size = sizeof v, .version = VFX_PARTICLE_VIEW_VERSION};
-        ctx->host.particle_chunk(ctx->host.user, c, &v);
-        for (int k = 0; k < 3; ++k)
-            if (v.count)
-                glNamedBufferSubData(s->cols[k], (GLintptr)off * 4, (GLsizeiptr)v.count * 4, v.pos[k]);
+        vfx_result r = ctx->host.particle_chunk(ctx->host.user, c, &v);
+        if (r || off + (uint64_t)v.count > total)
+            return vfx_fail(ctx, r ? r : VFX_ERR_INVALID_ARGUMENT,
+                            "water: particle chunk %u changed between the count and the upload", c);
+        /* a chunk may straddle buffers: it goes in pieces, each inside one group */
+        for (uint32_t done = 0; done < v.count;) {
+            uint32_t at = off + done, g = at / s->buffer_cap, within = at - s->groups[g].first;
+            uint32_t n = s->groups[g].count - within;
+            if (n > v.count - done)
+                n = v.count - done;
+            for (int k = 0; k < 3; ++k)
+                glNamedBufferSubData(s->groups[g].cols[k], (GLintptr)within * 4, (GLsizeiptr)n * 4, v.pos[k] + done);
+            done += n;
+        }
         /* NaN/Inf positions are uploaded as they are and skipped by the shaders (a NaN
          * distance fails every `<` test); counted here so the host can see them. */
         for (uint32_t i = 0; i < v.count; ++i) {
@@ -234,12 +348,42 @@ static void dispatch(const water_state *s)
     glMemoryBarrier(GL_ALL_BARRIER_BITS);
 }
 
+/* Min/max pyramid of the distances in `src` (level 0 from `pyr0`, 2x2 reductions by `pyrd`
+ * down to `level`): the tiles the billboard passes cull against. */
+static void build_pyramid(const water_state *s, GLuint pyr0, GLuint pyrd, const vfx_frame_view *frame,
+                          const vfx_frame_targets *targets, float t_end, GLuint src, int level)
+{
+    glUseProgram(pyr0);
+    set_common(pyr0, s, frame, targets, t_end);
+    glBindImageTexture(2, src, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
+    glBindImageTexture(5, s->pyr, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
+    dispatch(s);
+    glUseProgram(pyrd);
+    for (int l = 1; l <= level; ++l) {
+        glBindImageTexture(5, s->pyr, l, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
+        glBindImageTexture(6, s->pyr, l - 1, GL_FALSE, 0, GL_READ_ONLY, GL_RG32F);
+        uint32_t w = s->width >> l, h = s->height >> l;
+        glDispatchCompute(((w ? w : 1) + 7) / 8, ((h ? h : 1) + 7) / 8, 1);
+        glMemoryBarrier(GL_ALL_BARRIER_BITS);
+    }
+}
+
 /* Draws every particle's billboard with `prog` (one instanced strip). */
 static void draw_billboards(vfx_context *ctx, const water_state *s)
 {
     (void)ctx;
     glBindVertexArray(s->vao);
-    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)s->count);
+    /* one draw per buffer, in order: the blending order (hence the rounding) is the same as
+     * one draw over all particles */
+    for (uint32_t g = 0; g < s->group_count; ++g) {
+        if (!s->groups[g].count)
+            continue;
+        for (int k = 0; k < 3; ++k)
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, s->groups[g].cols[k]);
+        glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)s->groups[g].count);
+    }
+    for (int k = 0; k < 3; ++k)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, s->cols[k]);
     glMemoryBarrier(GL_ALL_BARRIER_BITS);
 }
 
@@ -349,6 +493,125 @@ static void nearest_face_pass(vfx_context *ctx, const water_state *s, GLuint pro
     glDisable(GL_DEPTH_TEST);
 }
 
+/* Shading inputs at the found surface, for every method: the gradient pass (additive
+ * blending of grad P and P at the surface point, tile-culled against the pyramid of the final
+ * distances like the potential passes) and the back-distance pass (max blending of the ray's
+ * exit from each particle's ball of radius h(1 - T)). */
+static vfx_result surface_passes(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
+                                 const vfx_frame_targets *targets)
+{
+    const vfx_water_params *p = &s->params;
+    const int cull = !(p->disable & VFX_WATER_NO_PYRAMID);
+    int level = (int)p->pyramid_level;
+    if (level >= s->pyr_levels)
+        level = s->pyr_levels - 1;
+    GLuint pyr0 = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_PYR0\n#define NS 1\n");
+    GLuint pyrd = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_PYRDOWN\n#define NS 1\n");
+    GLuint grad = vfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_GRAD\n#define NS 1\n");
+    GLuint back = vfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_BACK\n#define NS 1\n");
+    if (!pyr0 || !pyrd || !grad || !back)
+        return VFX_ERR_GL;
+    static const float zero[4] = {0, 0, 0, 0};
+
+    vfx_gpu_pass_begin(ctx, "water.normal");
+    if (cull)
+        build_pyramid(s, pyr0, pyrd, frame, targets, 0, ctx->water_dist_tex, level);
+    glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_grad);
+    glViewport(0, 0, (GLsizei)s->width, (GLsizei)s->height);
+    glClearNamedFramebufferfv(s->fbo_grad, GL_COLOR, 0, zero);
+    glDisable(GL_DEPTH_TEST);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glBlendEquation(GL_FUNC_ADD);
+    glUseProgram(grad);
+    set_common(grad, s, frame, targets, 0);
+    glUniformMatrix4fv(glGetUniformLocation(grad, "u_view_proj"), 1, GL_FALSE, s->view_proj);
+    glUniform1i(glGetUniformLocation(grad, "u_pyr_level"), level);
+    glUniform1i(glGetUniformLocation(grad, "u_cull"), cull);
+    glBindTextureUnit(0, ctx->water_dist_tex);
+    glBindTextureUnit(1, s->pyr);
+    draw_billboards(ctx, s);
+    vfx_gpu_pass_end(ctx);
+
+    vfx_gpu_pass_begin(ctx, "water.back");
+    glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_back);
+    glClearNamedFramebufferfv(s->fbo_back, GL_COLOR, 0, zero);
+    glBlendEquation(GL_MAX);
+    glUseProgram(back);
+    set_common(back, s, frame, targets, 0);
+    glUniformMatrix4fv(glGetUniformLocation(back, "u_view_proj"), 1, GL_FALSE, s->view_proj);
+    /* every point within h(1 - T) of a particle is inside (one term alone reaches T^2), so
+     * these balls lie in the water: exact for a lone particle, short of a merged body's back */
+    float rho = p->h * (1.0f - p->threshold);
+    glUniform1f(glGetUniformLocation(back, "u_rho"), rho > 0 ? rho : 0.0f);
+    glBindTextureUnit(0, ctx->water_dist_tex);
+    draw_billboards(ctx, s);
+    glBlendEquation(GL_FUNC_ADD);
+    glDisable(GL_BLEND);
+    vfx_gpu_pass_end(ctx);
+    return VFX_OK;
+}
+
+static void publish_counters(vfx_context *ctx, water_state *s)
+{
+    const uint32_t *c = s->last;
+    if (s->last_method == VFX_WATER_METHOD_PAPER) {
+        vfx_stat_set(ctx, "water.fragments_culled", c[0]);
+        vfx_stat_set(ctx, "water.potential_fragments", c[1]);
+        vfx_stat_set(ctx, "water.samples", c[2]);
+        vfx_stat_set(ctx, "water.pixels_found", c[3]);
+        vfx_stat_set(ctx, "water.pixels_sample_cap", c[4]);
+        vfx_stat_set(ctx, "water.pixels_left", c[5]);
+    }
+    vfx_stat_set(ctx, "water.normal_fragments_culled", c[6]);
+    vfx_stat_set(ctx, "water.normal_fragments", c[7]);
+    vfx_stat_set(ctx, "water.counters_age", (double)(s->frame_no - 1 - s->last_frame));
+}
+
+/* Counters without a stall: this frame's are copied into a ring slot and fenced; every slot
+ * whose fence has signalled is read (the copy is done, so the read does not wait) and the
+ * newest is reported, `water.counters_age` frames old. A slot still in flight when its turn
+ * comes again (the GPU 3 frames behind) is waited for. debug.sync_counters waits for this
+ * frame's at once (tests, benchmarks). */
+static void counters_frame_end(vfx_context *ctx, water_state *s, uint32_t method)
+{
+    const GLuint64 forever = 60ull * 1000000000ull;
+    uint32_t slot = (uint32_t)(s->frame_no % WATER_COUNTER_RING);
+    if (s->fence[slot])
+        glClientWaitSync(s->fence[slot], GL_SYNC_FLUSH_COMMANDS_BIT, forever);
+    for (int pass = 0; pass < 2; ++pass) {
+        for (uint32_t k = 0; k < WATER_COUNTER_RING; ++k) {
+            if (!s->fence[k])
+                continue;
+            GLenum st = glClientWaitSync(s->fence[k], 0, 0);
+            if (st != GL_ALREADY_SIGNALED && st != GL_CONDITION_SATISFIED)
+                continue;
+            if (!s->have_last || s->ring_frame[k] > s->last_frame) {
+                glGetNamedBufferSubData(s->ring[k], 0, sizeof s->last, s->last);
+                s->last_frame = s->ring_frame[k];
+                s->last_method = s->ring_method[k];
+                s->have_last = 1;
+            }
+            glDeleteSync(s->fence[k]);
+            s->fence[k] = 0;
+        }
+        if (pass == 1)
+            break;
+        /* this frame's copy after the older slots are read, so the poll sees them first */
+        glCopyNamedBufferSubData(s->counters, s->ring[slot], 0, 0, sizeof s->last);
+        s->fence[slot] = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+        s->ring_frame[slot] = s->frame_no;
+        s->ring_method[slot] = method;
+        if (ctx->debug.sync_counters)
+            glClientWaitSync(s->fence[slot], GL_SYNC_FLUSH_COMMANDS_BIT, forever);
+        else
+            break;
+    }
+    ++s->frame_no;
+    if (s->have_last)
+        publish_counters(ctx, s);
+}
+
 static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
                               vfx_frame_targets *targets)
 {
@@ -378,8 +641,6 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
     memcpy(s->view_proj, vp, sizeof vp);
     for (int k = 0; k < 3; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, s->cols[k]);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->counters);
-    glClearNamedBufferData(s->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     float zero[4] = {0, 0, 0, 0};
     glClearTexImage(s->st, 0, GL_RGBA, GL_FLOAT, zero);
     glClearTexImage(s->br, 0, GL_RGBA, GL_FLOAT, zero);
@@ -410,23 +671,12 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
     int level = (int)p->pyramid_level;
     if (level >= s->pyr_levels)
         level = s->pyr_levels - 1;
+    vfx_gpu_pass_begin(ctx, "water.march");
     for (uint32_t it = 0; it < iters; ++it) {
         /* (5) min/max pyramid of the current samples, 2x2 reductions down to `level` */
         if (cull) {
             vfx_gpu_pass_begin(ctx, "water.pyramid");
-            glUseProgram(pyr0);
-            set_common(pyr0, s, frame, targets, t_end);
-            glBindImageTexture(2, s->cur, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
-            glBindImageTexture(5, s->pyr, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
-            dispatch(s);
-            glUseProgram(pyrd);
-            for (int l = 1; l <= level; ++l) {
-                glBindImageTexture(5, s->pyr, l, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
-                glBindImageTexture(6, s->pyr, l - 1, GL_FALSE, 0, GL_READ_ONLY, GL_RG32F);
-                uint32_t w = s->width >> l, h = s->height >> l;
-                glDispatchCompute(((w ? w : 1) + 7) / 8, ((h ? h : 1) + 7) / 8, 1);
-                glMemoryBarrier(GL_ALL_BARRIER_BITS);
-            }
+            build_pyramid(s, pyr0, pyrd, frame, targets, t_end, s->cur, level);
             vfx_gpu_pass_end(ctx);
         }
         /* (3)+(4) potentials at NS consecutive samples */
@@ -459,6 +709,8 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
         }
         vfx_gpu_pass_end(ctx);
     }
+
+    vfx_gpu_pass_end(ctx);
 
     /* (6) eq. 5 then eq. 6 regula falsi, each iteration's potential again by blending */
     vfx_gpu_pass_begin(ctx, "water.refine");
@@ -494,16 +746,6 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
     glBindImageTexture(3, ctx->water_dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     dispatch(s);
     vfx_gpu_pass_end(ctx);
-
-    /* counters: read back after the frame's work (a stall; acceptable for measurement) */
-    uint32_t c[6];
-    glGetNamedBufferSubData(s->counters, 0, sizeof c, c);
-    vfx_stat_set(ctx, "water.fragments_culled", c[0]);
-    vfx_stat_set(ctx, "water.potential_fragments", c[1]);
-    vfx_stat_set(ctx, "water.samples", c[2]);
-    vfx_stat_set(ctx, "water.pixels_found", c[3]);
-    vfx_stat_set(ctx, "water.pixels_sample_cap", c[4]);
-    vfx_stat_set(ctx, "water.pixels_left", c[5]);
     return VFX_OK;
 }
 
@@ -513,11 +755,23 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     water_state *s = state;
     const vfx_water_params *p = &s->params;
     targets->water_dist = ctx->water_dist_tex;
+    vfx_stat_set(ctx, "water.position_buffers", s->group_count);
+    if (s->group_count > 1 && (p->method != VFX_WATER_METHOD_PAPER || (p->disable & VFX_WATER_NO_BLEND)))
+        return vfx_fail(ctx, VFX_ERR_UNSUPPORTED,
+                        "water: %u particles span %u position buffers of at most %u; method %u%s reads one "
+                        "buffer (only the paper method's billboard passes draw several)",
+                        s->count, s->group_count, s->buffer_cap, p->method,
+                        (p->disable & VFX_WATER_NO_BLEND) ? " with NO_BLEND" : "");
+    vfx_mat4_mul(frame->proj, frame->view, s->view_proj);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->counters);
+    glClearNamedBufferData(s->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     vfx_stat_set(ctx, "water.particles", s->count);
     vfx_stat_set(ctx, "water.nan_skipped", s->nan_count);
     vfx_result r = p->method == VFX_WATER_METHOD_PAPER ? paper_march(ctx, s, frame, targets)
                                                        : brute_march(ctx, s, frame, targets);
     if (r != VFX_OK)
+        return r;
+    if (!(p->disable & VFX_WATER_NO_SHADING) && (r = surface_passes(ctx, s, frame, targets)) != VFX_OK)
         return r;
 
     GLuint shade = vfx_gpu_program(ctx, "common/fullscreen.vert", "water/shade.frag", NULL);
@@ -531,20 +785,42 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     glUseProgram(shade);
     glBindTextureUnit(0, ctx->water_dist_tex);
     glBindTextureUnit(1, frame->color_texture);
+    glBindTextureUnit(2, s->grad);
+    glBindTextureUnit(3, s->back);
+    glBindTextureUnit(4, frame->depth_texture);
     glUniformMatrix4fv(glGetUniformLocation(shade, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
     glUniform3fv(glGetUniformLocation(shade, "u_eye"), 1, frame->eye);
-    glUniform1ui(glGetUniformLocation(shade, "u_count"), s->count);
-    glUniform1f(glGetUniformLocation(shade, "u_h"), p->h);
     glUniform1f(glGetUniformLocation(shade, "u_absorption"), p->absorption);
     glUniform1f(glGetUniformLocation(shade, "u_ior"), p->ior);
     glUniform3fv(glGetUniformLocation(shade, "u_tint"), 1, p->color);
     glUniform1i(glGetUniformLocation(shade, "u_flat"), (p->disable & VFX_WATER_NO_SHADING) != 0);
     glUniform1i(glGetUniformLocation(shade, "u_has_color"), frame->color_texture != 0);
+    glUniform1i(glGetUniformLocation(shade, "u_has_depth"), frame->depth_texture != 0);
     vfx_gpu_fullscreen(ctx);
     vfx_gpu_pass_end(ctx);
+    counters_frame_end(ctx, s, p->method);
     const char *e = vfx_gpu_error_string();
     if (e)
         return vfx_fail(ctx, VFX_ERR_GL, "water render: %s", e);
+    return VFX_OK;
+}
+
+vfx_result vfx_water_debug_gradient(vfx_context *ctx, float *out, size_t count)
+{
+    water_state *s = ctx->effect_state[VFX_EFFECT_WATER];
+    if (!s || !s->grad)
+        return vfx_fail(ctx, VFX_ERR_NOT_FOUND, "water debug gradient: no water effect or no render yet");
+    size_t n = (size_t)s->width * s->height * 4;
+    if (!out || count < n)
+        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water debug gradient: %zu floats, need %zu", count, n);
+    float *tmp = vfx_alloc(ctx, n * sizeof *tmp);
+    if (!tmp)
+        return VFX_ERR_OUT_OF_MEMORY;
+    glGetTextureImage(s->grad, 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * sizeof *tmp), tmp);
+    size_t row = (size_t)s->width * 4;
+    for (uint32_t j = 0; j < s->height; ++j)
+        memcpy(out + j * row, tmp + (size_t)(s->height - 1 - j) * row, row * sizeof *out);
+    vfx_free(ctx, tmp);
     return VFX_OK;
 }
 

@@ -4,7 +4,9 @@
 // taken. br = (t_neg, I_neg, t_pos, I_pos), the bracket of eqs. 5-6.
 #include "common/depth.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std430, binding = 4) buffer Counters { uint c_culled, c_frags, c_samples, c_found, c_cap, c_left; };
+layout(std430, binding = 4) buffer Counters {
+    uint c_culled, c_frags, c_samples, c_found, c_cap, c_left, c_gculled, c_gfrags;
+};
 uniform mat4 u_inv_view_proj;
 uniform vec3 u_eye;
 uniform float u_T, u_step, u_t_end;
@@ -103,7 +105,8 @@ void main()
     imageStore(u_next, pix, vec4(s.x == 0.0 ? t + float(NS) * u_step : 1.0e30));
 #elif defined(MODE_PYR0)
     float t = imageLoad(u_cur, pix).r;
-    vec2 mm = t >= 1.0e29 ? vec2(1.0e30, -1.0e30) : vec2(t, t + float(NS - 1) * u_step);
+    // 1e30: stopped ray; < 0: a miss of the final distance image (gradient pass)
+    vec2 mm = t >= 1.0e29 || t < 0.0 ? vec2(1.0e30, -1.0e30) : vec2(t, t + float(NS - 1) * u_step);
     imageStore(u_dst, pix, vec4(mm, 0.0, 0.0));
 #elif defined(MODE_INTERP)
     vec4 s = imageLoad(u_st, pix);

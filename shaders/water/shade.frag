@@ -1,30 +1,20 @@
-// Water shading from the distance image: normal = -grad I (central differences of the field),
+// Water shading from the distance image and the two billboard passes run at the surface:
+// normal = -grad sum P normalised (PASS_GRAD, blended: no loop over the particles here),
 // Schlick Fresnel between a sky reflection and the refracted host colour, absorbed with
-// Beer-Lambert over a thickness guess. Misses are discarded so the host image shows through.
+// Beer-Lambert over the thickness to the back of the water (PASS_BACK), clipped at the host
+// depth. Misses are discarded so the host image shows through unchanged.
 #include "common/depth.glsl"
-layout(std430, binding = 0) readonly buffer PX { float px[]; };
-layout(std430, binding = 1) readonly buffer PY { float py[]; };
-layout(std430, binding = 2) readonly buffer PZ { float pz[]; };
 layout(binding = 0) uniform sampler2D u_dist;
 layout(binding = 1) uniform sampler2D u_scene_color;
+layout(binding = 2) uniform sampler2D u_grad;   // xyz = grad sum P, w = sum P
+layout(binding = 3) uniform sampler2D u_back;   // farthest ball exit along the ray
+layout(binding = 4) uniform sampler2D u_scene_depth;
 uniform mat4 u_inv_view_proj;
 uniform vec3 u_eye;
-uniform uint u_count;
-uniform float u_h, u_absorption, u_ior;
+uniform float u_absorption, u_ior;
 uniform vec3 u_tint;
-uniform bool u_flat, u_has_color;
+uniform bool u_flat, u_has_color, u_has_depth;
 out vec4 o_color;
-
-float sum_p(vec3 x)
-{
-    float s = 0.0, h2 = u_h * u_h;
-    for (uint j = 0u; j < u_count; ++j) {
-        vec3 d = x - vec3(px[j], py[j], pz[j]);
-        float r2 = dot(d, d);
-        if (r2 < h2) { float q = 1.0 - sqrt(r2) / u_h; s += q * q; }
-    }
-    return sqrt(s);
-}
 
 void main()
 {
@@ -35,12 +25,9 @@ void main()
     vec2 size = vec2(textureSize(u_dist, 0));
     vec2 ndc = (vec2(pix) + 0.5) / size * 2.0 - 1.0;
     vec3 dir = vfx_ray_dir(u_inv_view_proj, u_eye, ndc);
-    vec3 x = u_eye + t * dir;
-    float e = u_h * 0.02;
-    vec3 g = vec3(sum_p(x + vec3(e, 0, 0)) - sum_p(x - vec3(e, 0, 0)),
-                  sum_p(x + vec3(0, e, 0)) - sum_p(x - vec3(0, e, 0)),
-                  sum_p(x + vec3(0, 0, e)) - sum_p(x - vec3(0, 0, e)));
-    vec3 n = length(g) > 0.0 ? -normalize(g) : -dir;
+    vec3 g = texelFetch(u_grad, pix, 0).xyz;
+    // a zero gradient (the eye inside a symmetric blob) has no direction: face the viewer
+    vec3 n = dot(g, g) > 0.0 ? -normalize(g) : -dir;
     float c = clamp(dot(-dir, n), 0.0, 1.0);
     float r0 = pow((u_ior - 1.0) / (u_ior + 1.0), 2.0);
     float fresnel = r0 + (1.0 - r0) * pow(1.0 - c, 5.0);
@@ -51,7 +38,10 @@ void main()
         vec2 uv = (vec2(pix) + 0.5) / size + rd.xy * 0.03;
         behind = texture(u_scene_color, uv).rgb;
     }
-    // thickness guess: one influence diameter, the surface's local depth is not known here
-    vec3 absorbed = behind * exp(-u_absorption * 2.0 * u_h * (vec3(1.0) - u_tint));
+    float back = texelFetch(u_back, pix, 0).r;
+    if (u_has_depth)
+        back = min(back, vfx_depth_distance(u_inv_view_proj, u_eye, ndc, texelFetch(u_scene_depth, pix, 0).r));
+    float thickness = max(back - t, 0.0);
+    vec3 absorbed = behind * exp(-u_absorption * thickness * (vec3(1.0) - u_tint));
     o_color = vec4(mix(absorbed, sky, fresnel), 1.0);
 }
