@@ -357,7 +357,6 @@ static void start_round(rank_scan *R)
  * start is set and none is in flight. */
 static void poll_rank(rank_scan *R, int start)
 {
-    double t = now_ms();
     if (R->round_active) {
         int flag = 0;
         MPI_Test(&R->round, &flag, MPI_STATUS_IGNORE);
@@ -392,7 +391,6 @@ static void poll_rank(rank_scan *R, int start)
     }
     if (start && !R->round_active && !R->all_done)
         start_round(R);
-    R->st->t_comm_ms += now_ms() - t;
 }
 
 /* Out of keys: ask the rank with the most remaining keys (as of the last reduction) for some.
@@ -474,7 +472,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
     const uint32_t C = opts->update_c > 0 ? (uint32_t)opts->update_c : 1;
     /* progress between table updates: cheap MPI_Test / MPI_Iprobe so that reductions and
      * requests move while a rank scans a long stretch */
-    const uint32_t POLL = 64;
+    const uint32_t POLL = 256;
     int failed = 0;
     double t1 = now_ms();
     vfx_tet_counters *cnt = vfx_tet_local_counters(R.L);
@@ -491,6 +489,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
                     if (R.share)
                         vfx_tet_local_table_merge(R.L, R.known);
                     poll_rank(&R, 1);
+                    st.polls++;
                     tin += now_ms() - tp;
                 }
                 interval = (R.end - R.next) / C > 0 ? (R.end - R.next) / C : 1;
@@ -498,6 +497,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
             } else if (coop && since % POLL == POLL - 1) {
                 double tp = now_ms();
                 poll_rank(&R, 0);
+                st.polls++;
                 tin += now_ms() - tp;
             }
             if (R.next >= R.end)
@@ -512,6 +512,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
             }
         }
         cnt->t_sc_ms += now_ms() - ts - tin - (cnt->t_update_ms - tu0);
+        st.t_comm_ms += tin;
         if (!coop || failed || !R.dlb)
             break;
         /* Out of keys: ask for more until a request is answered with some, or nobody has
@@ -528,7 +529,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
                 idle_pause();
             }
             MPI_Wait(&R.ask_rq, MPI_STATUS_IGNORE); /* received: it was answered */
-            st.t_comm_ms += now_ms() - tw;
+            st.t_idle_ms += now_ms() - tw;
             uint32_t n = R.give[1] - R.give[0];
             if (n > 0) {
                 R.next = R.give[0];
@@ -555,7 +556,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
             if (!R.all_done)
                 idle_pause();
         }
-        st.t_comm_ms += now_ms() - tw;
+        st.t_idle_ms += now_ms() - tw;
     }
     st.t_phase1_ms = now_ms() - t1;
     rc = agree(comm, failed ? VFX_ERR_OUT_OF_MEMORY : VFX_OK, err, "the scan");

@@ -32,7 +32,9 @@ typedef struct vfx_tet_mpi_stats {
     uint64_t bytes_sent;      /* binary swap (and fold) payload sent by this rank */
     uint64_t pixels_final;    /* pixels this rank composited */
     double t_phase1_ms;       /* scan loop wall time, communication included */
-    double t_comm_ms;         /* of which polling, sharing and idle waiting */
+    double t_comm_ms;         /* of which polling and sharing while the rank had keys */
+    double t_idle_ms;         /* of which waiting out of keys (asking for work, last rounds) */
+    uint64_t polls;           /* progress calls while scanning */
     double t_swap_ms, t_gather_ms, t_total_ms;
 } vfx_tet_mpi_stats;
 
