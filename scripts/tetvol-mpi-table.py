@@ -11,8 +11,8 @@ for s in (r for r in rows if r["test"] == "setup"):
           f"{s['one_process_ms']:.0f} ms")
 print()
 print("| P | mode | median ms | vs base (same P) | scanned | skipped by ERT | imbalance T_sc max/mean "
-      "| imbalance scanned | keys moved by DLB | swap bytes (sum) | max diff vs 1 process |")
-print("|---|---|---|---|---|---|---|---|---|---|---|")
+      "| imbalance CPU max/mean | imbalance scanned | keys moved by DLB | swap bytes (sum) | max diff vs 1 process |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|")
 base = {}
 for r in (r for r in rows if r["test"] == "mode"):
     if r["mode"] == "base":
@@ -20,17 +20,19 @@ for r in (r for r in rows if r["test"] == "mode"):
     b = base.get(r["ranks"])
     ratio = f"{b / r['median_ms']:.2f}x" if b else "-"
     print(f"| {r['ranks']} | {r['mode']} | {r['median_ms']:.0f} | {ratio} | {r['cells_scanned']} | "
-          f"{r['cells_skipped_ert']} | {r['imbalance_t_sc']:.2f} | {r['imbalance_scanned']:.2f} | "
+          f"{r['cells_skipped_ert']} | {r['imbalance_t_sc']:.2f} | {r['imbalance_cpu']:.2f} | "
+          f"{r['imbalance_scanned']:.2f} | "
           f"{r['keys_moved']} | {r['swap_bytes']} | {r['max_vs_one_process']:.2g} |")
 print()
 print("Per rank (last render of each configuration): scanned cells / segments made / segments "
-      "after the scan / T_sc ms / idle ms / swap bytes sent")
+      "after the scan / phase-1 CPU ms / T_sc wall ms / poll ms / idle ms / swap bytes sent")
 print()
 print("| P | mode | per rank |")
 print("|---|---|---|")
 for r in (r for r in rows if r["test"] == "mode"):
     per = "; ".join(
         f"{r['scanned'][i]}/{r['segments_made'][i]}/{r['segments_local'][i]}/"
-        f"{r['t_sc_ms'][i]:.0f}/{r['t_idle_ms'][i]:.0f}/{r['swap_bytes_rank'][i]}"
+        f"{r['t_phase1_cpu_ms'][i]:.0f}/{r['t_sc_ms'][i]:.0f}/{r['t_comm_ms'][i]:.0f}/"
+        f"{r['t_idle_ms'][i]:.0f}/{r['swap_bytes_rank'][i]}"
         for i in range(r["ranks"]))
     print(f"| {r['ranks']} | {r['mode']} | {per} |")

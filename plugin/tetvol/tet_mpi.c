@@ -25,12 +25,32 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
+static double cpu_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
 /* An idle rank sleeps between polls instead of spinning in MPI_Wait: with more ranks than
  * cores (the test and bench machines) a spinning rank would take CPU from working ones. */
 static void idle_pause(void)
 {
     struct timespec ts = {0, 100000};
     nanosleep(&ts, NULL);
+}
+
+/* Waits for requests by testing and sleeping: blocking MPI waits spin (or, with
+ * mpi_yield_when_idle, give the core away at every test), which with more ranks than cores
+ * takes CPU from the ranks still working. */
+static void wait_polite(int n, MPI_Request *rq)
+{
+    int flag = 0;
+    MPI_Testall(n, rq, &flag, MPI_STATUSES_IGNORE);
+    while (!flag) {
+        idle_pause();
+        MPI_Testall(n, rq, &flag, MPI_STATUSES_IGNORE);
+    }
 }
 
 void vfx_tet_seglists_free(vfx_tet_seglists *l)
@@ -119,7 +139,9 @@ static int slice_lists(const vfx_tet_seglists *l, size_t q0, size_t q1, vfx_tet_
 static int agree(MPI_Comm comm, int rc, char err[256], const char *what)
 {
     int worst = rc;
-    MPI_Allreduce(&rc, &worst, 1, MPI_INT, MPI_MAX, comm);
+    MPI_Request rq;
+    MPI_Iallreduce(&rc, &worst, 1, MPI_INT, MPI_MAX, comm, &rq);
+    wait_polite(1, &rq);
     if (worst != VFX_OK && rc == VFX_OK)
         snprintf(err, 256, "tet_mpi: another rank failed during %s (code %d)", what, worst);
     return worst;
@@ -146,7 +168,9 @@ static int exchange(MPI_Comm comm, MPI_Datatype segt, const vfx_tet_seglists *cu
         MPI_Isend(&ns, 1, MPI_UINT64_T, dst, TAG_SWAP_N, comm, &rq[nrq++]);
     }
     if (src >= 0) {
-        MPI_Recv(&nr, 1, MPI_UINT64_T, src, TAG_SWAP_N, comm, MPI_STATUS_IGNORE);
+        MPI_Request r1;
+        MPI_Irecv(&nr, 1, MPI_UINT64_T, src, TAG_SWAP_N, comm, &r1);
+        wait_polite(1, &r1);
         in->p0 = k0;
         in->p1 = k1;
         in->off = malloc((k1 - k0 + 1) * sizeof *in->off);
@@ -166,7 +190,10 @@ static int exchange(MPI_Comm comm, MPI_Datatype segt, const vfx_tet_seglists *cu
     }
     if (rc == VFX_OK && src >= 0) {
         size_t np = k1 - k0;
-        MPI_Recv(in->off, (int)np, MPI_UINT32_T, src, TAG_SWAP_N, comm, MPI_STATUS_IGNORE);
+        MPI_Request r2[2];
+        MPI_Irecv(in->off, (int)np, MPI_UINT32_T, src, TAG_SWAP_N, comm, &r2[0]);
+        MPI_Irecv(in->segs, (int)nr, segt, src, TAG_SWAP_S, comm, &r2[1]);
+        wait_polite(2, r2);
         uint32_t acc = 0; /* counts -> offsets */
         for (size_t p = 0; p < np; p++) {
             uint32_t c = in->off[p];
@@ -174,9 +201,8 @@ static int exchange(MPI_Comm comm, MPI_Datatype segt, const vfx_tet_seglists *cu
             acc += c;
         }
         in->off[np] = acc;
-        MPI_Recv(in->segs, (int)nr, segt, src, TAG_SWAP_S, comm, MPI_STATUS_IGNORE);
     }
-    MPI_Waitall(nrq, rq, MPI_STATUSES_IGNORE);
+    wait_polite(nrq, rq);
     if (rc != VFX_OK)
         vfx_tet_seglists_free(in);
     return rc;
@@ -287,14 +313,17 @@ int vfx_tet_mpi_composite(MPI_Comm comm, int W, int H, vfx_tet_seglists *lists, 
             part[4 * p + 3] = acc.a;
         }
         long long range[2] = {(long long)(rank < G ? p0 : 0), (long long)mine};
-        MPI_Gather(range, 2, MPI_LONG_LONG, ranges, 2, MPI_LONG_LONG, 0, comm);
+        MPI_Request rq;
+        MPI_Igather(range, 2, MPI_LONG_LONG, ranges, 2, MPI_LONG_LONG, 0, comm, &rq);
+        wait_polite(1, &rq);
         if (rank == 0)
             for (int r = 0; r < P; r++) {
                 cnts[r] = (int)(ranges[2 * r + 1] * 4);
                 cnts[P + r] = (int)(ranges[2 * r] * 4);
             }
-        MPI_Gatherv(part, (int)(mine * 4), MPI_FLOAT, rgba, cnts, rank == 0 ? cnts + P : NULL,
-                    MPI_FLOAT, 0, comm);
+        MPI_Igatherv(part, (int)(mine * 4), MPI_FLOAT, rgba, cnts, rank == 0 ? cnts + P : NULL,
+                     MPI_FLOAT, 0, comm, &rq);
+        wait_polite(1, &rq);
         if (st) {
             st->pixels_final = mine;
             st->segments_final = rank < G ? cur.off[mine] : 0;
@@ -474,7 +503,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
      * requests move while a rank scans a long stretch */
     const uint32_t POLL = 256;
     int failed = 0;
-    double t1 = now_ms();
+    double t1 = now_ms(), c1 = cpu_ms();
     vfx_tet_counters *cnt = vfx_tet_local_counters(R.L);
     for (;;) {
         uint32_t rem = R.end - R.next;
@@ -528,7 +557,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
                 poll_rank(&R, 1);
                 idle_pause();
             }
-            MPI_Wait(&R.ask_rq, MPI_STATUS_IGNORE); /* received: it was answered */
+            wait_polite(1, &R.ask_rq); /* it was answered, so it was received */
             st.t_idle_ms += now_ms() - tw;
             uint32_t n = R.give[1] - R.give[0];
             if (n > 0) {
@@ -559,6 +588,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
         st.t_idle_ms += now_ms() - tw;
     }
     st.t_phase1_ms = now_ms() - t1;
+    st.t_phase1_cpu_ms = cpu_ms() - c1;
     rc = agree(comm, failed ? VFX_ERR_OUT_OF_MEMORY : VFX_OK, err, "the scan");
     if (rc != VFX_OK)
         goto done;
@@ -594,9 +624,12 @@ done:
     st.t_total_ms = now_ms() - t_start;
     if (mine)
         *mine = st;
-    if (rc == VFX_OK)
-        MPI_Gather(&st, (int)sizeof st, MPI_BYTE, all ? all : gather_tmp, (int)sizeof st,
-                   MPI_BYTE, 0, comm);
+    if (rc == VFX_OK) {
+        MPI_Request rq;
+        MPI_Igather(&st, (int)sizeof st, MPI_BYTE, all ? all : gather_tmp, (int)sizeof st,
+                    MPI_BYTE, 0, comm, &rq);
+        wait_polite(1, &rq);
+    }
     free(gather_tmp);
     vfx_tet_local_destroy(R.L);
     free(R.sendbuf);

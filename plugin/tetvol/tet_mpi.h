@@ -32,6 +32,8 @@ typedef struct vfx_tet_mpi_stats {
     uint64_t bytes_sent;      /* binary swap (and fold) payload sent by this rank */
     uint64_t pixels_final;    /* pixels this rank composited */
     double t_phase1_ms;       /* scan loop wall time, communication included */
+    double t_phase1_cpu_ms;   /* CPU time of this rank's thread in the scan loop (with more
+                               * ranks than cores the wall times include other ranks' turns) */
     double t_comm_ms;         /* of which polling and sharing while the rank had keys */
     double t_idle_ms;         /* of which waiting out of keys (asking for work, last rounds) */
     uint64_t polls;           /* progress calls while scanning */

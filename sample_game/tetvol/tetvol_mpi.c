@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 #include <mpi.h>
 
@@ -98,6 +99,19 @@ static void camera(vfx_tet_camera *c, const vfx_tet_mesh *m, int w, int h, float
     c->proj[10] = (farp + nearp) / (nearp - farp);
     c->proj[11] = -1;
     c->proj[14] = 2 * farp * nearp / (nearp - farp);
+}
+
+/* A barrier that sleeps while waiting: MPI_Barrier spins, and with more ranks than cores the
+ * spinning ranks would slow the one-process reference render on rank 0. */
+static void barrier_polite(void)
+{
+    MPI_Request rq;
+    int flag = 0;
+    MPI_Ibarrier(MPI_COMM_WORLD, &rq);
+    for (MPI_Test(&rq, &flag, MPI_STATUS_IGNORE); !flag; MPI_Test(&rq, &flag, MPI_STATUS_IGNORE)) {
+        struct timespec ts = {0, 200000};
+        nanosleep(&ts, NULL);
+    }
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -287,7 +301,7 @@ int main(int argc, char **argv)
         o.share = md->share;
         o.dlb = md->dlb;
         for (int r = 0; r < repeat; r++) {
-            MPI_Barrier(MPI_COMM_WORLD);
+            barrier_polite();
             double t0 = MPI_Wtime();
             rc = vfx_tet_mpi_render(MPI_COMM_WORLD, &m, &cam, &tf, &o, img, NULL, all, err);
             double t = (MPI_Wtime() - t0) * 1e3, tmax = t;
@@ -319,16 +333,19 @@ int main(int argc, char **argv)
         printf("{\"effect\":\"tetvol_mpi\",\"test\":\"mode\",\"mode\":\"%s\",\"ranks\":%d,"
                "\"view\":\"%s\",\"median_ms\":%.1f,\"min_ms\":%.1f,\"max_ms\":%.1f,\"repeat\":%d,"
                "\"cells_scanned\":%llu,\"cells_skipped_ert\":%llu,\"keys_moved\":%llu,"
-               "\"swap_bytes\":%llu,\"imbalance_t_sc\":%.2f,\"imbalance_scanned\":%.2f,"
+               "\"swap_bytes\":%llu,\"imbalance_t_sc\":%.2f,\"imbalance_cpu\":%.2f,"
+               "\"imbalance_scanned\":%.2f,"
                "\"max_vs_one_process\":%.3g,\"rmse_vs_one_process\":%.3g",
                md->name, P, view, times[repeat / 2], times[0], times[repeat - 1], repeat,
                (unsigned long long)scanned, (unsigned long long)skipped,
                (unsigned long long)moved, (unsigned long long)bytes,
                imbalance(all, P, offsetof(vfx_tet_mpi_stats, cnt.t_sc_ms), 1),
+               imbalance(all, P, offsetof(vfx_tet_mpi_stats, t_phase1_cpu_ms), 1),
                imbalance(all, P, offsetof(vfx_tet_mpi_stats, cnt.cells_scanned), 0), mx,
                sqrt(se / n4));
         print_array_d("t_sc_ms", all, P, offsetof(vfx_tet_mpi_stats, cnt.t_sc_ms));
         print_array_d("t_phase1_ms", all, P, offsetof(vfx_tet_mpi_stats, t_phase1_ms));
+        print_array_d("t_phase1_cpu_ms", all, P, offsetof(vfx_tet_mpi_stats, t_phase1_cpu_ms));
         print_array_d("t_comm_ms", all, P, offsetof(vfx_tet_mpi_stats, t_comm_ms));
         print_array_d("t_idle_ms", all, P, offsetof(vfx_tet_mpi_stats, t_idle_ms));
         print_array_u("polls", all, P, offsetof(vfx_tet_mpi_stats, polls));
