@@ -24,6 +24,15 @@ for r in (r for r in rows if r["test"] == "mode"):
           f"{r['imbalance_scanned']:.2f} | "
           f"{r['keys_moved']} | {r['swap_bytes']} | {r['max_vs_one_process']:.2g} |")
 print()
+print("Phases of the last render (max over ranks, ms): set-up (replicated) / phase 1 / export / "
+      "binary swap (includes waiting for the partner) / gather")
+print()
+print("| P | mode | set-up | phase 1 | export | swap | gather |")
+print("|---|---|---|---|---|---|---|")
+for r in (r for r in rows if r["test"] == "mode"):
+    print(f"| {r['ranks']} | {r['mode']} | {max(r['t_setup_ms']):.0f} | {max(r['t_phase1_ms']):.0f} | "
+          f"{max(r['t_export_ms']):.0f} | {max(r['t_swap_ms']):.0f} | {max(r['t_gather_ms']):.0f} |")
+print()
 print("Per rank (last render of each configuration): scanned cells / segments made / segments "
       "after the scan / phase-1 CPU ms / T_sc wall ms / poll ms / idle ms / swap bytes sent")
 print()

@@ -463,7 +463,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
     R.st = &st;
     /* rank 0 gathers the statistics even when the caller wants none */
     vfx_tet_mpi_stats *gather_tmp = rank == 0 && !all ? malloc((size_t)P * sizeof *gather_tmp) : NULL;
-    int rc = vfx_tet_local_create(mesh, cam, tf, opts, P, &R.L, err);
+    int rc = vfx_tet_local_create(mesh, cam, tf, opts, P, rank, &R.L, err);
     if (rc == VFX_OK && rank == 0 && !all && !gather_tmp) {
         snprintf(err, 256, "tet_mpi: out of memory for %d ranks' statistics", P);
         rc = VFX_ERR_OUT_OF_MEMORY;
@@ -487,11 +487,8 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
     st.cells_assigned = R.end - R.next;
     for (int i = 0; i < R.DD; i++)
         R.known[i] = INFINITY;
-    for (int i = 0; i < P; i++) {
-        uint32_t a, b;
-        vfx_tet_local_part(R.L, i, &a, &b);
-        R.remaining[i] = (float)(b - a);
-    }
+    for (int i = 0; i < P; i++) /* until the first reduction: cells, NaN ones included */
+        R.remaining[i] = (float)vfx_tet_local_part_cells(R.L, i);
     R.share = opts->share && opts->ert;
     R.dlb = opts->dlb;
     /* reductions are needed for sharing, and for the remaining counts and the termination
@@ -504,6 +501,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
     const uint32_t POLL = 256;
     int failed = 0;
     double t1 = now_ms(), c1 = cpu_ms();
+    st.t_setup_ms = t1 - t_start;
     vfx_tet_counters *cnt = vfx_tet_local_counters(R.L);
     for (;;) {
         uint32_t rem = R.end - R.next;
@@ -561,6 +559,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
             st.t_idle_ms += now_ms() - tw;
             uint32_t n = R.give[1] - R.give[0];
             if (n > 0) {
+                vfx_tet_local_need(R.L, R.give[0], R.give[1]); /* sorts the victim's keys */
                 R.next = R.give[0];
                 R.end = R.give[1];
                 st.cells_taken += n;
@@ -593,6 +592,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
     if (rc != VFX_OK)
         goto done;
     /* Phase 2: this rank's full-screen lists, exported and composited by binary swap. */
+    double te = now_ms();
     vfx_tet_seglists lists;
     memset(&lists, 0, sizeof lists);
     size_t npix = (size_t)cam->width * cam->height;
@@ -614,6 +614,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
     vfx_tet_local_destroy(R.L); /* the lists are all phase 2 needs */
     R.L = NULL;
     rc = agree(comm, r2, err, "export");
+    st.t_export_ms = now_ms() - te;
     if (rc == VFX_OK)
         rc = vfx_tet_mpi_composite(comm, cam->width, cam->height, &lists, opts->partial_composite,
                                    rgba, &st, err);

@@ -37,6 +37,8 @@ typedef struct vfx_tet_mpi_stats {
     double t_comm_ms;         /* of which polling and sharing while the rank had keys */
     double t_idle_ms;         /* of which waiting out of keys (asking for work, last rounds) */
     uint64_t polls;           /* progress calls while scanning */
+    double t_setup_ms;        /* transform, keys of every partition, sort (replicated per rank) */
+    double t_export_ms;       /* copying the lists out of the scan state */
     double t_swap_ms, t_gather_ms, t_total_ms;
 } vfx_tet_mpi_stats;
 

@@ -682,25 +682,60 @@ done:
 }
 
 /* ---- Single-worker scan engine for the MPI backend (tet_render_internal.h) ----
- * The set-up mirrors vfx_tet_render_workers (same checks, same partition and key order) so
- * that P processes partition the cells exactly as P threads would. */
+ * The set-up mirrors vfx_tet_render_workers (same checks, same partitions, same key order) so
+ * that P processes partition the cells exactly as P threads would. Partition p's keys live at
+ * [bounds[p], bounds[p] + valid[p]) whichever process builds them, so a key index means the
+ * same cell on every process; only the own partition is built at creation, the others when
+ * keys of theirs arrive by load balancing. */
 struct vfx_tet_local {
     scan_ctx X;
     shared sh;
     worker w;
     double *vp;
     cellkey *keys;
-    uint32_t *bounds; /* parts + 1 key offsets */
+    uint32_t *bounds; /* parts + 1 cell offsets: partition p is cells [bounds[p], bounds[p+1]) */
+    uint32_t *valid;  /* keys of partition p (its cells without NaN) once built */
+    uint8_t *built;
     int parts;
 };
 
+/* Builds partition p's keys sorted front to back; NaN cells are counted when count is set. */
+static void local_build(vfx_tet_local *L, int p, int count)
+{
+    const vfx_tet_mesh *mesh = L->X.mesh;
+    uint32_t c0 = L->bounds[p], c1 = L->bounds[p + 1], n = 0;
+    for (uint32_t c = c0; c < c1; c++) {
+        const uint32_t *t = &mesh->tets[4 * c];
+        int bad = 0;
+        float nearest = INFINITY;
+        for (int k = 0; k < 4; k++) {
+            double z = -L->vp[3 * t[k] + 2];
+            if (isnan(z) || isnan(mesh->scalar[t[k]]))
+                bad = 1;
+            if (z < nearest)
+                nearest = (float)z;
+        }
+        if (bad) {
+            if (count)
+                L->w.cnt.cells_nan++;
+            continue;
+        }
+        L->keys[c0 + n].nearest = nearest;
+        L->keys[c0 + n].id = c;
+        n++;
+    }
+    qsort(L->keys + c0, n, sizeof *L->keys, cmp_key);
+    L->valid[p] = n;
+    L->built[p] = 1;
+}
+
 int vfx_tet_local_create(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
                          const vfx_tet_tf *tf, const vfx_tet_options *opts, int parts,
-                         vfx_tet_local **out, char err[256])
+                         int own, vfx_tet_local **out, char err[256])
 {
     *out = NULL;
-    if (!mesh || !cam || !tf || !opts || parts <= 0) {
-        snprintf(err, 256, "tet_render: NULL argument or %d partitions", parts);
+    if (!mesh || !cam || !tf || !opts || parts <= 0 || own < 0 || own >= parts) {
+        snprintf(err, 256, "tet_render: NULL argument or partition %d of %d", own, parts);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     const int W = cam->width, H = cam->height;
@@ -731,11 +766,14 @@ int vfx_tet_local_create(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
     L->vp = malloc((size_t)np * 3 * sizeof *L->vp + 1);
     L->keys = malloc((size_t)(nt ? nt : 1) * sizeof *L->keys);
     L->bounds = calloc((size_t)parts + 1, sizeof *L->bounds);
+    L->valid = calloc((size_t)parts, sizeof *L->valid);
+    L->built = calloc((size_t)parts, sizeof *L->built);
     L->w.heads = malloc((size_t)W * H * sizeof *L->w.heads);
     L->w.tiles = calloc((size_t)D * D, sizeof *L->w.tiles);
     pthread_mutex_init(&L->w.lock, NULL);
     pthread_mutex_init(&L->sh.lock, NULL);
-    if (!L->vp || !L->keys || !L->bounds || !L->w.heads || !L->w.tiles) {
+    if (!L->vp || !L->keys || !L->bounds || !L->valid || !L->built || !L->w.heads ||
+        !L->w.tiles) {
         snprintf(err, 256, "tet_render: out of memory (%u points, %u tets, %dx%d)", np, nt, W, H);
         vfx_tet_local_destroy(L);
         return VFX_ERR_OUT_OF_MEMORY;
@@ -748,39 +786,17 @@ int vfx_tet_local_create(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
             L->vp[3 * i + r] = (double)V[r] * x[0] + (double)V[4 + r] * x[1] +
                                (double)V[8 + r] * x[2] + V[12 + r];
     }
-    uint32_t nk = 0;
-    for (int pi = 0; pi < parts; pi++) {
-        uint32_t c0 = (uint32_t)((uint64_t)nt * pi / parts);
-        uint32_t c1 = (uint32_t)((uint64_t)nt * (pi + 1) / parts);
-        uint32_t k0 = nk;
-        for (uint32_t c = c0; c < c1; c++) {
-            const uint32_t *t = &mesh->tets[4 * c];
-            int bad = 0;
-            float nearest = INFINITY;
-            for (int k = 0; k < 4; k++) {
-                if (t[k] >= np) {
-                    snprintf(err, 256, "tet_render: tet %u references point %u of %u", c, t[k], np);
-                    vfx_tet_local_destroy(L);
-                    return VFX_ERR_INVALID_ARGUMENT;
-                }
-                double z = -L->vp[3 * t[k] + 2];
-                if (isnan(z) || isnan(mesh->scalar[t[k]]))
-                    bad = 1;
-                if (z < nearest)
-                    nearest = (float)z;
+    /* every index is checked on every process (cheap), so all report the same bad tet */
+    for (uint32_t c = 0; c < nt; c++)
+        for (int k = 0; k < 4; k++)
+            if (mesh->tets[4 * c + k] >= np) {
+                snprintf(err, 256, "tet_render: tet %u references point %u of %u", c,
+                         mesh->tets[4 * c + k], np);
+                vfx_tet_local_destroy(L);
+                return VFX_ERR_INVALID_ARGUMENT;
             }
-            if (bad) {
-                L->w.cnt.cells_nan++;
-                continue;
-            }
-            L->keys[nk].nearest = nearest;
-            L->keys[nk].id = c;
-            nk++;
-        }
-        qsort(L->keys + k0, nk - k0, sizeof *L->keys, cmp_key);
-        L->bounds[pi] = k0;
-    }
-    L->bounds[parts] = nk;
+    for (int pi = 0; pi <= parts; pi++)
+        L->bounds[pi] = (uint32_t)((uint64_t)nt * pi / parts);
     scan_ctx X = {mesh, tf, opts, L->vp, P, near_d, W, H, D};
     L->X = X;
     L->sh.X = &L->X;
@@ -788,6 +804,7 @@ int vfx_tet_local_create(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
     L->sh.w = &L->w;
     L->sh.nw = 1; /* update_table then never touches the shared table */
     L->w.sh = &L->sh;
+    local_build(L, own, 1);
     *out = L;
     return VFX_OK;
 }
@@ -799,6 +816,8 @@ void vfx_tet_local_destroy(vfx_tet_local *L)
     free(L->vp);
     free(L->keys);
     free(L->bounds);
+    free(L->valid);
+    free(L->built);
     free(L->w.heads);
     free(L->w.tiles);
     free(L->w.pool.s);
@@ -807,10 +826,24 @@ void vfx_tet_local_destroy(vfx_tet_local *L)
     free(L);
 }
 
-void vfx_tet_local_part(const vfx_tet_local *L, int part, uint32_t *k0, uint32_t *k1)
+void vfx_tet_local_part(vfx_tet_local *L, int part, uint32_t *k0, uint32_t *k1)
 {
+    if (!L->built[part])
+        local_build(L, part, 0);
     *k0 = L->bounds[part];
-    *k1 = L->bounds[part + 1];
+    *k1 = L->bounds[part] + L->valid[part];
+}
+
+uint32_t vfx_tet_local_part_cells(const vfx_tet_local *L, int part)
+{
+    return L->bounds[part + 1] - L->bounds[part];
+}
+
+void vfx_tet_local_need(vfx_tet_local *L, uint32_t k0, uint32_t k1)
+{
+    for (int p = 0; p < L->parts; p++)
+        if (!L->built[p] && k0 < L->bounds[p + 1] && L->bounds[p] < k1)
+            local_build(L, p, 0);
 }
 
 int vfx_tet_local_scan(vfx_tet_local *L, uint32_t k)

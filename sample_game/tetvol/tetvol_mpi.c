@@ -344,12 +344,15 @@ int main(int argc, char **argv)
                imbalance(all, P, offsetof(vfx_tet_mpi_stats, cnt.cells_scanned), 0), mx,
                sqrt(se / n4));
         print_array_d("t_sc_ms", all, P, offsetof(vfx_tet_mpi_stats, cnt.t_sc_ms));
+        print_array_d("t_setup_ms", all, P, offsetof(vfx_tet_mpi_stats, t_setup_ms));
         print_array_d("t_phase1_ms", all, P, offsetof(vfx_tet_mpi_stats, t_phase1_ms));
+        print_array_d("t_export_ms", all, P, offsetof(vfx_tet_mpi_stats, t_export_ms));
         print_array_d("t_phase1_cpu_ms", all, P, offsetof(vfx_tet_mpi_stats, t_phase1_cpu_ms));
         print_array_d("t_comm_ms", all, P, offsetof(vfx_tet_mpi_stats, t_comm_ms));
         print_array_d("t_idle_ms", all, P, offsetof(vfx_tet_mpi_stats, t_idle_ms));
         print_array_u("polls", all, P, offsetof(vfx_tet_mpi_stats, polls));
         print_array_d("t_swap_ms", all, P, offsetof(vfx_tet_mpi_stats, t_swap_ms));
+        print_array_d("t_gather_ms", all, P, offsetof(vfx_tet_mpi_stats, t_gather_ms));
         print_array_u("scanned", all, P, offsetof(vfx_tet_mpi_stats, cnt.cells_scanned));
         print_array_u("keys_done", all, P, offsetof(vfx_tet_mpi_stats, keys_done));
         print_array_u("taken", all, P, offsetof(vfx_tet_mpi_stats, cells_taken));

@@ -15,6 +15,7 @@
 #include "tetvol/tet_mpi.h"
 #include "tetvol/tet_render.h"
 
+
 static int g_rank;
 
 #define CHECK(cond, ...)                                                                   \
