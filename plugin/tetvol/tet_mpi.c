@@ -351,10 +351,14 @@ typedef struct rank_scan {
     const vfx_tet_options *opts;
     uint32_t next, end;   /* remaining keys [next, end) of this rank */
     int share, dlb;
-    /* the current reduction: D*D table entries (MIN: the terminated entry with the smallest
-     * deepest, +inf when none), one "done" flag (MIN: 1 only when every rank is done) and one
-     * remaining-key count per rank (each rank writes its own slot, +inf elsewhere) */
-    float *sendbuf, *recvbuf, *known, *remaining;
+    /* weak sharing: the shared table lives in a window on rank 0 (the paper's manager node,
+     * without a manager process), D*D floats: deepest where terminated, +inf elsewhere */
+    MPI_Win win;
+    float *win_mem, *enc, *known;
+    /* the current reduction (load balancing and termination): one "done" flag (MIN: 1 only
+     * when every rank is done) and one remaining-key count per rank (each rank writes its own
+     * slot, +inf elsewhere) */
+    float *sendbuf, *recvbuf, *remaining;
     MPI_Request round;
     int round_active, all_done, done;
     /* load balancing: the outstanding request, if any */
@@ -367,23 +371,39 @@ typedef struct rank_scan {
 
 static void start_round(rank_scan *R)
 {
-    if (R->share && R->opts->ert)
-        vfx_tet_local_table_get(R->L, R->sendbuf);
-    else
-        for (int i = 0; i < R->DD; i++)
-            R->sendbuf[i] = INFINITY;
-    R->sendbuf[R->DD] = R->done ? 1.0f : 0.0f;
+    R->sendbuf[0] = R->done ? 1.0f : 0.0f;
     for (int i = 0; i < R->P; i++)
-        R->sendbuf[R->DD + 1 + i] = i == R->rank ? (float)(R->end - R->next) : INFINITY;
-    MPI_Iallreduce(R->sendbuf, R->recvbuf, R->DD + 1 + R->P, MPI_FLOAT, MPI_MIN, R->comm,
-                   &R->round);
+        R->sendbuf[1 + i] = i == R->rank ? (float)(R->end - R->next) : INFINITY;
+    MPI_Iallreduce(R->sendbuf, R->recvbuf, 1 + R->P, MPI_FLOAT, MPI_MIN, R->comm, &R->round);
     R->round_active = 1;
 }
 
-/* Progress: completes the reduction in flight (merging its table: another rank's termination
- * is valid here since our segments only add opacity in front of it), answers load-balancing
- * requests with 1/3 of our remaining keys from the deep end, and starts a new reduction when
- * start is set and none is in flight. */
+/* Weak sharing (paper 3.2): one atomic exchange with the shared table, element-wise
+ * minimum in, previous value out (MPI_Get_accumulate under a shared lock: concurrent
+ * accumulates with one op are atomic per element). It involves no other rank's progress, so
+ * a rank shares at its own pace as with the paper's manager node. The result is merged into
+ * the monotone known table (terminations only move forward) and into the local table:
+ * another rank's termination is valid here since our segments only add opacity in front. */
+static void share_table(rank_scan *R)
+{
+    vfx_tet_local_table_get(R->L, R->enc);
+    MPI_Win_lock(MPI_LOCK_SHARED, 0, 0, R->win);
+    MPI_Get_accumulate(R->enc, R->DD, MPI_FLOAT, R->sendbuf + 1 + R->P, R->DD, MPI_FLOAT, 0, 0,
+                       R->DD, MPI_FLOAT, MPI_MIN, R->win);
+    MPI_Win_unlock(0, R->win);
+    const float *got = R->sendbuf + 1 + R->P;
+    for (int i = 0; i < R->DD; i++) {
+        float v = got[i] < R->enc[i] ? got[i] : R->enc[i];
+        if (v < R->known[i])
+            R->known[i] = v;
+    }
+    vfx_tet_local_table_merge(R->L, R->known);
+    R->st->share_rounds++;
+}
+
+/* Progress: completes the reduction in flight, answers load-balancing requests with 1/3 of
+ * our remaining keys from the deep end, and starts a new reduction when start is set and none
+ * is in flight. */
 static void poll_rank(rank_scan *R, int start)
 {
     if (R->round_active) {
@@ -391,16 +411,10 @@ static void poll_rank(rank_scan *R, int start)
         MPI_Test(&R->round, &flag, MPI_STATUS_IGNORE);
         if (flag) {
             R->round_active = 0;
-            R->st->share_rounds++;
-            if (R->share && R->opts->ert) {
-                for (int i = 0; i < R->DD; i++)
-                    if (R->recvbuf[i] < R->known[i])
-                        R->known[i] = R->recvbuf[i];
-                vfx_tet_local_table_merge(R->L, R->known);
-            }
-            R->all_done = R->recvbuf[R->DD] >= 1.0f;
+            R->st->reductions++;
+            R->all_done = R->recvbuf[0] >= 1.0f;
             for (int i = 0; i < R->P; i++)
-                R->remaining[i] = R->recvbuf[R->DD + 1 + i];
+                R->remaining[i] = R->recvbuf[1 + i];
         }
     }
     for (;;) {
@@ -470,12 +484,13 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
     }
     if (rc == VFX_OK) {
         R.DD = vfx_tet_local_tiles_d(R.L) * vfx_tet_local_tiles_d(R.L);
-        size_t n = (size_t)R.DD + 1 + (size_t)P;
+        size_t n = (size_t)R.DD + 1 + (size_t)P; /* the reduction, then a table's scratch */
         R.sendbuf = malloc(n * sizeof(float));
         R.recvbuf = malloc(n * sizeof(float));
         R.known = malloc((size_t)R.DD * sizeof(float));
+        R.enc = malloc((size_t)R.DD * sizeof(float));
         R.remaining = malloc((size_t)P * sizeof(float));
-        if (!R.sendbuf || !R.recvbuf || !R.known || !R.remaining) {
+        if (!R.sendbuf || !R.recvbuf || !R.known || !R.enc || !R.remaining) {
             snprintf(err, 256, "tet_mpi: out of memory for the ERT exchange (D*D = %d)", R.DD);
             rc = VFX_ERR_OUT_OF_MEMORY;
         }
@@ -483,13 +498,25 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
     rc = agree(comm, rc, err, "set-up");
     if (rc != VFX_OK)
         goto done;
+    R.share = opts->share && opts->ert && P > 1;
+    if (R.share) {
+        /* same decision on every rank (same opts), so the collective matches */
+        MPI_Aint bytes = rank == 0 ? (MPI_Aint)R.DD * (MPI_Aint)sizeof(float) : 0;
+        MPI_Win_allocate(bytes, sizeof(float), MPI_INFO_NULL, comm, &R.win_mem, &R.win);
+        if (rank == 0) {
+            MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, R.win);
+            for (int i = 0; i < R.DD; i++)
+                R.win_mem[i] = INFINITY;
+            MPI_Win_unlock(0, R.win);
+        }
+        agree(comm, VFX_OK, err, "window set-up"); /* nobody reads it before it is filled */
+    }
     vfx_tet_local_part(R.L, rank, &R.next, &R.end);
     st.cells_assigned = R.end - R.next;
     for (int i = 0; i < R.DD; i++)
         R.known[i] = INFINITY;
     for (int i = 0; i < P; i++) /* until the first reduction: cells, NaN ones included */
         R.remaining[i] = (float)vfx_tet_local_part_cells(R.L, i);
-    R.share = opts->share && opts->ert;
     R.dlb = opts->dlb;
     /* reductions are needed for sharing, and for the remaining counts and the termination
      * agreement of load balancing; without either the ranks scan independently */
@@ -514,7 +541,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
                 if (coop) {
                     double tp = now_ms();
                     if (R.share)
-                        vfx_tet_local_table_merge(R.L, R.known);
+                        share_table(&R);
                     poll_rank(&R, 1);
                     st.polls++;
                     tin += now_ms() - tp;
@@ -588,6 +615,10 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
     }
     st.t_phase1_ms = now_ms() - t1;
     st.t_phase1_cpu_ms = cpu_ms() - c1;
+    if (R.share) {
+        MPI_Win_free(&R.win); /* collective: every rank gets here (the same decision) */
+        R.share = 0;
+    }
     rc = agree(comm, failed ? VFX_ERR_OUT_OF_MEMORY : VFX_OK, err, "the scan");
     if (rc != VFX_OK)
         goto done;
@@ -636,6 +667,7 @@ done:
     free(R.sendbuf);
     free(R.recvbuf);
     free(R.known);
+    free(R.enc);
     free(R.remaining);
     return rc;
 }

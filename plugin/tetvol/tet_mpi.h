@@ -26,7 +26,8 @@ typedef struct vfx_tet_mpi_stats {
     uint64_t cells_taken;     /* keys received by load balancing */
     uint64_t cells_given;     /* keys handed to other ranks */
     uint64_t steal_requests;  /* requests this rank sent */
-    uint64_t share_rounds;    /* completed non-blocking reductions */
+    uint64_t share_rounds;    /* exchanges with the shared ERT table */
+    uint64_t reductions;      /* completed load-balancing / termination reductions */
     uint64_t segments_local;  /* segments in this rank's lists after the scan */
     uint64_t segments_final;  /* segments in the rank's screen part after binary swap */
     uint64_t bytes_sent;      /* binary swap (and fold) payload sent by this rank */

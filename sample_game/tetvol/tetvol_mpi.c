@@ -360,7 +360,8 @@ int main(int argc, char **argv)
         print_array_u("segments_local", all, P, offsetof(vfx_tet_mpi_stats, segments_local));
         print_array_u("segments_final", all, P, offsetof(vfx_tet_mpi_stats, segments_final));
         print_array_u("swap_bytes_rank", all, P, offsetof(vfx_tet_mpi_stats, bytes_sent));
-        print_array_u("reductions", all, P, offsetof(vfx_tet_mpi_stats, share_rounds));
+        print_array_u("shares", all, P, offsetof(vfx_tet_mpi_stats, share_rounds));
+        print_array_u("reductions", all, P, offsetof(vfx_tet_mpi_stats, reductions));
         printf("}\n");
         fflush(stdout);
     }

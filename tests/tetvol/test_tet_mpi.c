@@ -284,7 +284,7 @@ static int test_render(int P)
                     rounds += all[r].share_rounds;
                 }
                 printf("P=%d shuffle=%d share=%d dlb=%d ERT 0.9: max diff %.3g, skipped %llu, "
-                       "reductions %llu\n", P, shuffle, o.share, o.dlb, d,
+                       "table exchanges %llu\n", P, shuffle, o.share, o.dlb, d,
                        (unsigned long long)skipped, (unsigned long long)rounds);
                 CHECK(d <= 0.1 + 1e-5, "ERT 0.9 differs from no-ERT by %g", d);
                 CHECK(skipped > 0, "ERT skipped nothing");
