@@ -343,6 +343,39 @@ int vfx_tet_mpi_composite(MPI_Comm comm, int W, int H, vfx_tet_seglists *lists, 
     return rc;
 }
 
+struct vfx_tet_mpi {
+    MPI_Comm comm;
+    MPI_Win win;   /* the shared ERT table on rank 0, kept between renders */
+    float *win_mem;
+    int win_dd;    /* its entries; 0 = no window yet */
+};
+
+int vfx_tet_mpi_create(MPI_Comm comm, vfx_tet_mpi **out, char err[256])
+{
+    vfx_tet_mpi *m = calloc(1, sizeof *m);
+    int rc = m ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
+    if (!m)
+        snprintf(err, 256, "tet_mpi: out of memory for the context");
+    rc = agree(comm, rc, err, "context creation");
+    if (rc != VFX_OK) {
+        free(m);
+        *out = NULL;
+        return rc;
+    }
+    m->comm = comm;
+    *out = m;
+    return VFX_OK;
+}
+
+void vfx_tet_mpi_destroy(vfx_tet_mpi *m)
+{
+    if (!m)
+        return;
+    if (m->win_dd)
+        MPI_Win_free(&m->win);
+    free(m);
+}
+
 /* Phase-1 state of one rank. */
 typedef struct rank_scan {
     MPI_Comm comm;
@@ -354,7 +387,7 @@ typedef struct rank_scan {
     /* weak sharing: the shared table lives in a window on rank 0 (the paper's manager node,
      * without a manager process), D*D floats: deepest where terminated, +inf elsewhere */
     MPI_Win win;
-    float *win_mem, *enc, *known;
+    float *enc, *known;
     /* the current reduction (load balancing and termination): one "done" flag (MIN: 1 only
      * when every rank is done) and one remaining-key count per rank (each rank writes its own
      * slot, +inf elsewhere) */
@@ -457,11 +490,12 @@ static int ask_for_work(rank_scan *R)
     return 1;
 }
 
-int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
+int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
                        const vfx_tet_tf *tf, const vfx_tet_options *opts, float *rgba,
                        vfx_tet_mpi_stats *mine, vfx_tet_mpi_stats *all, char err[256])
 {
     double t_start = now_ms();
+    MPI_Comm comm = ctx->comm;
     int rank, P;
     MPI_Comm_rank(comm, &rank);
     MPI_Comm_size(comm, &P);
@@ -500,16 +534,27 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
         goto done;
     R.share = opts->share && opts->ert && P > 1;
     if (R.share) {
-        /* same decision on every rank (same opts), so the collective matches */
-        MPI_Aint bytes = rank == 0 ? (MPI_Aint)R.DD * (MPI_Aint)sizeof(float) : 0;
-        MPI_Win_allocate(bytes, sizeof(float), MPI_INFO_NULL, comm, &R.win_mem, &R.win);
+        /* Same decision and D on every rank (same opts), so the collectives match. The window
+         * is kept in the context: creating one is a collective that spins inside Open MPI,
+         * which with more ranks than cores cost seconds per frame. */
+        if (ctx->win_dd != R.DD) {
+            if (ctx->win_dd)
+                MPI_Win_free(&ctx->win);
+            MPI_Aint bytes = rank == 0 ? (MPI_Aint)R.DD * (MPI_Aint)sizeof(float) : 0;
+            MPI_Win_allocate(bytes, sizeof(float), MPI_INFO_NULL, comm, &ctx->win_mem,
+                             &ctx->win);
+            ctx->win_dd = R.DD;
+        }
+        R.win = ctx->win;
         if (rank == 0) {
             MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, R.win);
             for (int i = 0; i < R.DD; i++)
-                R.win_mem[i] = INFINITY;
+                ctx->win_mem[i] = INFINITY;
             MPI_Win_unlock(0, R.win);
         }
-        agree(comm, VFX_OK, err, "window set-up"); /* nobody reads it before it is filled */
+        /* nobody reads it before it is reset; the agreement after the scan keeps the next
+         * frame's reset after every access of this one */
+        agree(comm, VFX_OK, err, "window set-up");
     }
     vfx_tet_local_part(R.L, rank, &R.next, &R.end);
     st.cells_assigned = R.end - R.next;
@@ -615,10 +660,7 @@ int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_ca
     }
     st.t_phase1_ms = now_ms() - t1;
     st.t_phase1_cpu_ms = cpu_ms() - c1;
-    if (R.share) {
-        MPI_Win_free(&R.win); /* collective: every rank gets here (the same decision) */
-        R.share = 0;
-    }
+
     rc = agree(comm, failed ? VFX_ERR_OUT_OF_MEMORY : VFX_OK, err, "the scan");
     if (rc != VFX_OK)
         goto done;

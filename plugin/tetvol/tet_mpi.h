@@ -43,12 +43,21 @@ typedef struct vfx_tet_mpi_stats {
     double t_swap_ms, t_gather_ms, t_total_ms;
 } vfx_tet_mpi_stats;
 
-/* Renders mesh on all ranks of comm (every rank passes the same mesh, camera, tf and opts;
+/* A communicator and what is kept between renders on it (the shared ERT table's window). */
+typedef struct vfx_tet_mpi vfx_tet_mpi;
+
+/* Creates a context on comm (which must outlive it). Collective; VFX_OK or an error code on
+ * every rank with a message in err. */
+int vfx_tet_mpi_create(MPI_Comm comm, vfx_tet_mpi **out, char err[256]);
+/* Frees a context; NULL allowed. Collective when not NULL. */
+void vfx_tet_mpi_destroy(vfx_tet_mpi *ctx);
+
+/* Renders mesh on all ranks of ctx's comm (every rank passes the same mesh, camera, tf and opts;
  * opts->workers is ignored: one scan per rank). rgba (width*height*4, premultiplied) is filled
  * on rank 0 and may be NULL elsewhere; mine (may be NULL) gets this rank's statistics, all
  * (rank 0, NULL or comm-size entries) every rank's. Collective; returns VFX_OK or the same
  * error code on every rank, with a message in err. */
-int vfx_tet_mpi_render(MPI_Comm comm, const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
+int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
                        const vfx_tet_tf *tf, const vfx_tet_options *opts, float *rgba,
                        vfx_tet_mpi_stats *mine, vfx_tet_mpi_stats *all, char err[256]);
 

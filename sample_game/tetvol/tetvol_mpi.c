@@ -253,6 +253,11 @@ int main(int argc, char **argv)
         fprintf(stderr, "volfx-tetvol-mpi: out of memory for %dx%d images\n", size, size);
         MPI_Abort(MPI_COMM_WORLD, 1);
     }
+    vfx_tet_mpi *ctx;
+    if (vfx_tet_mpi_create(MPI_COMM_WORLD, &ctx, err) != 0) {
+        fprintf(stderr, "volfx-tetvol-mpi: %s\n", err);
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
     vfx_tet_options o;
     vfx_tet_options_default(&o);
     o.tiles_d = tiles_d;
@@ -303,12 +308,13 @@ int main(int argc, char **argv)
         for (int r = 0; r < repeat; r++) {
             barrier_polite();
             double t0 = MPI_Wtime();
-            rc = vfx_tet_mpi_render(MPI_COMM_WORLD, &m, &cam, &tf, &o, img, NULL, all, err);
+            rc = vfx_tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err);
             double t = (MPI_Wtime() - t0) * 1e3, tmax = t;
             MPI_Reduce(&t, &tmax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
             if (rc != 0) {
                 if (rank == 0)
                     fprintf(stderr, "volfx-tetvol-mpi: %s\n", err);
+                vfx_tet_mpi_destroy(ctx);
                 MPI_Finalize();
                 return 1;
             }
@@ -381,6 +387,7 @@ int main(int argc, char **argv)
             fclose(f);
         }
     }
+    vfx_tet_mpi_destroy(ctx);
     free(img);
     free(ref);
     free(all);

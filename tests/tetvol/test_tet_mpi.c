@@ -222,6 +222,8 @@ static int test_render(int P)
     tf.color_lo[0] = 0.1f; tf.color_lo[1] = 0.3f; tf.color_lo[2] = 1.0f;
     tf.color_hi[0] = 1.0f; tf.color_hi[1] = 0.6f; tf.color_hi[2] = 0.1f;
     char err[256];
+    vfx_tet_mpi *ctx;
+    CHECK(vfx_tet_mpi_create(MPI_COMM_WORLD, &ctx, err) == VFX_OK, "%s", err);
     vfx_tet_mpi_stats *all = calloc((size_t)P, sizeof *all);
     float *ref = calloc(n4, sizeof *ref), *img = calloc(n4, sizeof *img);
     CHECK(all && ref && img, "memory");
@@ -245,7 +247,7 @@ static int test_render(int P)
              * rank and in each swap stage): 1e-5 is ~100 ulps of values <= 1 */
             o.ert = 0;
             o.ert_threshold = 1.0f;
-            CHECK(vfx_tet_mpi_render(MPI_COMM_WORLD, &m, &cam, &tf, &o, img, NULL, all, err) ==
+            CHECK(vfx_tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err) ==
                       VFX_OK, "%s", err);
             if (g_rank == 0) {
                 double d = max_diff(ref, img, n4);
@@ -274,7 +276,7 @@ static int test_render(int P)
              * attenuated by >= 0.9: each variant stays within 1 - 0.9 = 0.1 of no-ERT */
             o.ert = 1;
             o.ert_threshold = 0.9f;
-            CHECK(vfx_tet_mpi_render(MPI_COMM_WORLD, &m, &cam, &tf, &o, img, NULL, all, err) ==
+            CHECK(vfx_tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err) ==
                       VFX_OK, "%s", err);
             if (g_rank == 0) {
                 double d = max_diff(ref, img, n4);
@@ -293,7 +295,7 @@ static int test_render(int P)
         /* bad input: every rank reports the same error naming the tet, no rank hangs */
         uint32_t keep = m.tets[4 * 5 + 2];
         m.tets[4 * 5 + 2] = m.point_count + 3;
-        int rc = vfx_tet_mpi_render(MPI_COMM_WORLD, &m, &cam, &tf, &o, img, NULL, all, err);
+        int rc = vfx_tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err);
         CHECK(rc == VFX_ERR_INVALID_ARGUMENT && strstr(err, "tet 5"), "rc %d: %s", rc, err);
         m.tets[4 * 5 + 2] = keep;
         free(m.points);
@@ -336,7 +338,7 @@ static int test_render(int P)
         CHECK(vfx_tet_render(&g, &cam, &tf, &o, ref, NULL, err) == VFX_OK, "%s", err);
         int moved = 0;
         for (int attempt = 0; attempt < 8 && !moved; attempt++) {
-            CHECK(vfx_tet_mpi_render(MPI_COMM_WORLD, &m, &cam, &tf, &o, img, NULL, all, err) ==
+            CHECK(vfx_tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err) ==
                       VFX_OK, "%s", err);
             if (g_rank == 0) {
                 double d = max_diff(ref, img, n4);
@@ -361,6 +363,7 @@ static int test_render(int P)
         free(m.points); free(m.scalar); free(m.tets);
         free(g.points); free(g.scalar); free(g.tets);
     }
+    vfx_tet_mpi_destroy(ctx);
     free(all);
     free(ref);
     free(img);
