@@ -267,6 +267,7 @@ int main(int argc, char **argv)
     if (rank == 0) {
         vfx_tet_counters c;
         o.ert = 0;
+        o.ert_threshold = 1.0f; /* the partial-compositing stop of the no-ERT runs below */
         double t0 = MPI_Wtime();
         if (vfx_tet_render(&m, &cam, &tf, &o, ref, &c, err) != 0) {
             fprintf(stderr, "volfx-tetvol-mpi: %s\n", err);
