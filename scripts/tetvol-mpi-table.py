@@ -45,3 +45,19 @@ for r in (r for r in rows if r["test"] == "mode"):
         f"{r['t_idle_ms'][i]:.0f}/{r['swap_bytes_rank'][i]}"
         for i in range(r["ranks"]))
     print(f"| {r['ranks']} | {r['mode']} | {per} |")
+print()
+print("Phase-1 CPU time of the busiest rank (ms; what the slowest node would take with one core "
+      "per rank; sum over ranks in brackets), last render:")
+print()
+modes = ["base", "dlb", "ert", "ert_share", "ert_dlb", "ert_share_dlb"]
+print("| P | " + " | ".join(modes) + " |")
+print("|---|" + "---|" * len(modes))
+by = {}
+for r in (r for r in rows if r["test"] == "mode"):
+    by[(r["ranks"], r["mode"])] = r
+for p in sorted({k[0] for k in by}):
+    cells = []
+    for m in modes:
+        r = by.get((p, m))
+        cells.append(f"{max(r['t_phase1_cpu_ms']):.0f} ({sum(r['t_phase1_cpu_ms']):.0f})" if r else "-")
+    print(f"| {p} | " + " | ".join(cells) + " |")
