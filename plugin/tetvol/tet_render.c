@@ -4,6 +4,7 @@
 #define _POSIX_C_SOURCE 199309L
 #endif
 #include "tet_render.h"
+#include "tet_render_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -678,4 +679,223 @@ done:
     free(table);
     free(bounds);
     return rc;
+}
+
+/* ---- Single-worker scan engine for the MPI backend (tet_render_internal.h) ----
+ * The set-up mirrors vfx_tet_render_workers (same checks, same partitions, same key order) so
+ * that P processes partition the cells exactly as P threads would. Partition p's keys live at
+ * [bounds[p], bounds[p] + valid[p]) whichever process builds them, so a key index means the
+ * same cell on every process; only the own partition is built at creation, the others when
+ * keys of theirs arrive by load balancing. */
+struct vfx_tet_local {
+    scan_ctx X;
+    shared sh;
+    worker w;
+    double *vp;
+    cellkey *keys;
+    uint32_t *bounds; /* parts + 1 cell offsets: partition p is cells [bounds[p], bounds[p+1]) */
+    uint32_t *valid;  /* keys of partition p (its cells without NaN) once built */
+    uint8_t *built;
+    int parts;
+};
+
+/* Builds partition p's keys sorted front to back; NaN cells are counted when count is set. */
+static void local_build(vfx_tet_local *L, int p, int count)
+{
+    const vfx_tet_mesh *mesh = L->X.mesh;
+    uint32_t c0 = L->bounds[p], c1 = L->bounds[p + 1], n = 0;
+    for (uint32_t c = c0; c < c1; c++) {
+        const uint32_t *t = &mesh->tets[4 * c];
+        int bad = 0;
+        float nearest = INFINITY;
+        for (int k = 0; k < 4; k++) {
+            double z = -L->vp[3 * t[k] + 2];
+            if (isnan(z) || isnan(mesh->scalar[t[k]]))
+                bad = 1;
+            if (z < nearest)
+                nearest = (float)z;
+        }
+        if (bad) {
+            if (count)
+                L->w.cnt.cells_nan++;
+            continue;
+        }
+        L->keys[c0 + n].nearest = nearest;
+        L->keys[c0 + n].id = c;
+        n++;
+    }
+    qsort(L->keys + c0, n, sizeof *L->keys, cmp_key);
+    L->valid[p] = n;
+    L->built[p] = 1;
+}
+
+int vfx_tet_local_create(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
+                         const vfx_tet_tf *tf, const vfx_tet_options *opts, int parts,
+                         int own, vfx_tet_local **out, char err[256])
+{
+    *out = NULL;
+    if (!mesh || !cam || !tf || !opts || parts <= 0 || own < 0 || own >= parts) {
+        snprintf(err, 256, "tet_render: NULL argument or partition %d of %d", own, parts);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    const int W = cam->width, H = cam->height;
+    if (W <= 0 || H <= 0 || W > 16384 || H > 16384) {
+        snprintf(err, 256, "tet_render: image size %dx%d out of range", W, H);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    if (!mesh->scalar) {
+        snprintf(err, 256, "tet_render: mesh has no scalar field");
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    const float *P = cam->proj, *V = cam->view;
+    if (P[11] > -0.5f || !(fabsf(P[0]) > 0) || !(fabsf(P[5]) > 0)) {
+        snprintf(err, 256, "tet_render: projection is not a perspective matrix (P[11]=%g)",
+                 (double)P[11]);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    double near_d = (double)P[14] / ((double)P[10] - 1.0);
+    if (!(near_d > 0)) near_d = 1e-4;
+    const uint32_t np = mesh->point_count, nt = mesh->tet_count;
+    const int D = opts->tiles_d > 0 ? opts->tiles_d : 1;
+    vfx_tet_local *L = calloc(1, sizeof *L);
+    if (!L) {
+        snprintf(err, 256, "tet_render: out of memory");
+        return VFX_ERR_OUT_OF_MEMORY;
+    }
+    L->parts = parts;
+    L->vp = malloc((size_t)np * 3 * sizeof *L->vp + 1);
+    L->keys = malloc((size_t)(nt ? nt : 1) * sizeof *L->keys);
+    L->bounds = calloc((size_t)parts + 1, sizeof *L->bounds);
+    L->valid = calloc((size_t)parts, sizeof *L->valid);
+    L->built = calloc((size_t)parts, sizeof *L->built);
+    L->w.heads = malloc((size_t)W * H * sizeof *L->w.heads);
+    L->w.tiles = calloc((size_t)D * D, sizeof *L->w.tiles);
+    pthread_mutex_init(&L->w.lock, NULL);
+    pthread_mutex_init(&L->sh.lock, NULL);
+    if (!L->vp || !L->keys || !L->bounds || !L->valid || !L->built || !L->w.heads ||
+        !L->w.tiles) {
+        snprintf(err, 256, "tet_render: out of memory (%u points, %u tets, %dx%d)", np, nt, W, H);
+        vfx_tet_local_destroy(L);
+        return VFX_ERR_OUT_OF_MEMORY;
+    }
+    for (size_t p = 0; p < (size_t)W * H; p++)
+        L->w.heads[p] = -1;
+    for (uint32_t i = 0; i < np; i++) {
+        const float *x = &mesh->points[3 * i];
+        for (int r = 0; r < 3; r++)
+            L->vp[3 * i + r] = (double)V[r] * x[0] + (double)V[4 + r] * x[1] +
+                               (double)V[8 + r] * x[2] + V[12 + r];
+    }
+    /* every index is checked on every process (cheap), so all report the same bad tet */
+    for (uint32_t c = 0; c < nt; c++)
+        for (int k = 0; k < 4; k++)
+            if (mesh->tets[4 * c + k] >= np) {
+                snprintf(err, 256, "tet_render: tet %u references point %u of %u", c,
+                         mesh->tets[4 * c + k], np);
+                vfx_tet_local_destroy(L);
+                return VFX_ERR_INVALID_ARGUMENT;
+            }
+    for (int pi = 0; pi <= parts; pi++)
+        L->bounds[pi] = (uint32_t)((uint64_t)nt * pi / parts);
+    scan_ctx X = {mesh, tf, opts, L->vp, P, near_d, W, H, D};
+    L->X = X;
+    L->sh.X = &L->X;
+    L->sh.keys = L->keys;
+    L->sh.w = &L->w;
+    L->sh.nw = 1; /* update_table then never touches the shared table */
+    L->w.sh = &L->sh;
+    local_build(L, own, 1);
+    *out = L;
+    return VFX_OK;
+}
+
+void vfx_tet_local_destroy(vfx_tet_local *L)
+{
+    if (!L)
+        return;
+    free(L->vp);
+    free(L->keys);
+    free(L->bounds);
+    free(L->valid);
+    free(L->built);
+    free(L->w.heads);
+    free(L->w.tiles);
+    free(L->w.pool.s);
+    pthread_mutex_destroy(&L->w.lock);
+    pthread_mutex_destroy(&L->sh.lock);
+    free(L);
+}
+
+void vfx_tet_local_part(vfx_tet_local *L, int part, uint32_t *k0, uint32_t *k1)
+{
+    if (!L->built[part])
+        local_build(L, part, 0);
+    *k0 = L->bounds[part];
+    *k1 = L->bounds[part] + L->valid[part];
+}
+
+uint32_t vfx_tet_local_part_cells(const vfx_tet_local *L, int part)
+{
+    return L->bounds[part + 1] - L->bounds[part];
+}
+
+void vfx_tet_local_need(vfx_tet_local *L, uint32_t k0, uint32_t k1)
+{
+    for (int p = 0; p < L->parts; p++)
+        if (!L->built[p] && k0 < L->bounds[p + 1] && L->bounds[p] < k1)
+            local_build(L, p, 0);
+}
+
+int vfx_tet_local_scan(vfx_tet_local *L, uint32_t k)
+{
+    return scan_cell(&L->X, &L->w, &L->keys[k]);
+}
+
+void vfx_tet_local_update_table(vfx_tet_local *L)
+{
+    update_table(&L->sh, &L->w);
+}
+
+void vfx_tet_local_table_get(const vfx_tet_local *L, float *enc)
+{
+    for (int i = 0; i < L->X.D * L->X.D; i++)
+        enc[i] = L->w.tiles[i].terminated ? L->w.tiles[i].deepest : INFINITY;
+}
+
+void vfx_tet_local_table_merge(vfx_tet_local *L, const float *enc)
+{
+    for (int i = 0; i < L->X.D * L->X.D; i++) {
+        tile *t = &L->w.tiles[i];
+        if (enc[i] < INFINITY && (!t->terminated || enc[i] < t->deepest)) {
+            t->terminated = 1;
+            t->deepest = enc[i];
+        }
+    }
+}
+
+int vfx_tet_local_tiles_d(const vfx_tet_local *L)
+{
+    return L->X.D;
+}
+
+size_t vfx_tet_local_export(const vfx_tet_local *L, size_t p0, size_t p1, uint32_t *offsets,
+                            vfx_tet_rseg *segs)
+{
+    size_t n = 0;
+    for (size_t p = p0; p < p1; p++) {
+        offsets[p - p0] = (uint32_t)n;
+        for (int32_t c = L->w.heads[p]; c >= 0; c = L->w.pool.s[c].next, n++)
+            if (segs) {
+                const seg *s = &L->w.pool.s[c];
+                vfx_tet_rseg o = {s->zf, s->zb, s->r, s->g, s->b, s->a};
+                segs[n] = o;
+            }
+    }
+    offsets[p1 - p0] = (uint32_t)n;
+    return n;
+}
+
+vfx_tet_counters *vfx_tet_local_counters(vfx_tet_local *L)
+{
+    return &L->w.cnt;
 }

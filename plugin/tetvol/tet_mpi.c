@@ -1,0 +1,715 @@
+/* tet_mpi.c — the seed-002 renderer across MPI processes: phase 1 (cell-parallel scan with
+ * local ERT tables, weak sharing, dynamic load balancing), phase 2 (binary-swap composition of
+ * depth-tagged ray-segment lists). See docs/tetvol-mpi.md for the protocol and its choices. */
+#if !defined(_POSIX_C_SOURCE) && !defined(_GNU_SOURCE)
+#define _POSIX_C_SOURCE 199309L
+#endif
+#include "tet_mpi.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+enum { TAG_REQ = 7101, TAG_GIVE = 7102, TAG_SWAP_N = 7103, TAG_SWAP_S = 7104 };
+
+/* as in tet_render.c: segments this close (relative to depth) count as touching */
+#define TOUCH_EPS 1e-5f
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+static double cpu_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+/* An idle rank sleeps between polls instead of spinning in MPI_Wait: with more ranks than
+ * cores (the test and bench machines) a spinning rank would take CPU from working ones. */
+static void idle_pause(void)
+{
+    struct timespec ts = {0, 100000};
+    nanosleep(&ts, NULL);
+}
+
+/* Waits for requests by testing and sleeping: blocking MPI waits spin (or, with
+ * mpi_yield_when_idle, give the core away at every test), which with more ranks than cores
+ * takes CPU from the ranks still working. */
+static void wait_polite(int n, MPI_Request *rq)
+{
+    int flag = 0;
+    MPI_Testall(n, rq, &flag, MPI_STATUSES_IGNORE);
+    while (!flag) {
+        idle_pause();
+        MPI_Testall(n, rq, &flag, MPI_STATUSES_IGNORE);
+    }
+}
+
+void vfx_tet_seglists_free(vfx_tet_seglists *l)
+{
+    if (!l)
+        return;
+    free(l->off);
+    free(l->segs);
+    memset(l, 0, sizeof *l);
+}
+
+static void over(vfx_tet_rseg *f, const vfx_tet_rseg *b)
+{
+    float t = 1.0f - f->a;
+    f->r += t * b->r;
+    f->g += t * b->g;
+    f->b += t * b->b;
+    f->a += t * b->a;
+}
+
+int vfx_tet_seglists_merge(const vfx_tet_seglists *a, const vfx_tet_seglists *b, int partial,
+                           vfx_tet_seglists *out)
+{
+    size_t np = a->p1 - a->p0;
+    size_t na = a->off[np], nb = b->off[np];
+    memset(out, 0, sizeof *out);
+    if (na + nb > INT_MAX) /* offsets are uint32 and MPI counts int */
+        return -1;
+    out->p0 = a->p0;
+    out->p1 = a->p1;
+    out->off = malloc((np + 1) * sizeof *out->off);
+    out->segs = malloc((na + nb + 1) * sizeof *out->segs);
+    if (!out->off || !out->segs) {
+        vfx_tet_seglists_free(out);
+        return -1;
+    }
+    size_t n = 0;
+    for (size_t p = 0; p < np; p++) {
+        out->off[p] = (uint32_t)n;
+        size_t i = a->off[p], ie = a->off[p + 1], j = b->off[p], je = b->off[p + 1];
+        size_t first = n;
+        while (i < ie || j < je) {
+            const vfx_tet_rseg *s;
+            if (j >= je || (i < ie && a->segs[i].zf <= b->segs[j].zf))
+                s = &a->segs[i++];
+            else
+                s = &b->segs[j++];
+            /* partial compositing across ranks: a segment that touches the previous one
+             * (adjacent cells of two partitions) joins it, which shrinks the next stage's
+             * message without changing the image beyond float association */
+            if (partial && n > first) {
+                vfx_tet_rseg *last = &out->segs[n - 1];
+                if (fabsf(last->zb - s->zf) <= TOUCH_EPS * (1.0f + fabsf(s->zf))) {
+                    over(last, s);
+                    last->zb = s->zb;
+                    continue;
+                }
+            }
+            out->segs[n++] = *s;
+        }
+    }
+    out->off[np] = (uint32_t)n;
+    return 0;
+}
+
+/* The lists of pixels [q0, q1) (inside l's range) as their own lists (copied). */
+static int slice_lists(const vfx_tet_seglists *l, size_t q0, size_t q1, vfx_tet_seglists *out)
+{
+    size_t a = q0 - l->p0, np = q1 - q0, base = l->off[a], ns = l->off[a + np] - base;
+    memset(out, 0, sizeof *out);
+    out->p0 = q0;
+    out->p1 = q1;
+    out->off = malloc((np + 1) * sizeof *out->off);
+    out->segs = malloc((ns + 1) * sizeof *out->segs);
+    if (!out->off || !out->segs) {
+        vfx_tet_seglists_free(out);
+        return -1;
+    }
+    for (size_t p = 0; p <= np; p++)
+        out->off[p] = l->off[a + p] - (uint32_t)base;
+    memcpy(out->segs, l->segs + base, ns * sizeof *out->segs);
+    return 0;
+}
+
+/* All ranks agree on failure: the worst code wins, and its message is the local one if any. */
+static int agree(MPI_Comm comm, int rc, char err[256], const char *what)
+{
+    int worst = rc;
+    MPI_Request rq;
+    MPI_Iallreduce(&rc, &worst, 1, MPI_INT, MPI_MAX, comm, &rq);
+    wait_polite(1, &rq);
+    if (worst != VFX_OK && rc == VFX_OK)
+        snprintf(err, 256, "tet_mpi: another rank failed during %s (code %d)", what, worst);
+    return worst;
+}
+
+/* One exchange step, called by every rank of comm: sends the lists of [s0, s1) of cur to dst
+ * (dst < 0: none) and receives those of [k0, k1) from src (src < 0: none) into in. The segment
+ * counts travel first and every rank agrees that the receive buffers exist before any payload
+ * moves, so a failed allocation returns an error everywhere instead of leaving a send hanging. */
+static int exchange(MPI_Comm comm, MPI_Datatype segt, const vfx_tet_seglists *cur, int dst,
+                    size_t s0, size_t s1, int src, size_t k0, size_t k1, uint32_t *counts,
+                    vfx_tet_seglists *in, uint64_t *bytes, char err[256])
+{
+    int rc = VFX_OK;
+    uint64_t ns = 0, nr = 0;
+    MPI_Request rq[3];
+    int nrq = 0;
+    memset(in, 0, sizeof *in);
+    if (dst >= 0) {
+        size_t a = s0 - cur->p0, b = s1 - cur->p0;
+        for (size_t p = a; p < b; p++)
+            counts[p - a] = cur->off[p + 1] - cur->off[p];
+        ns = cur->off[b] - cur->off[a];
+        MPI_Isend(&ns, 1, MPI_UINT64_T, dst, TAG_SWAP_N, comm, &rq[nrq++]);
+    }
+    if (src >= 0) {
+        MPI_Request r1;
+        MPI_Irecv(&nr, 1, MPI_UINT64_T, src, TAG_SWAP_N, comm, &r1);
+        wait_polite(1, &r1);
+        in->p0 = k0;
+        in->p1 = k1;
+        in->off = malloc((k1 - k0 + 1) * sizeof *in->off);
+        in->segs = nr <= INT_MAX ? malloc((size_t)(nr + 1) * sizeof *in->segs) : NULL;
+        if (!in->off || !in->segs) {
+            snprintf(err, 256, "tet_mpi: out of memory receiving %llu segments from rank %d",
+                     (unsigned long long)nr, src);
+            rc = VFX_ERR_OUT_OF_MEMORY;
+        }
+    }
+    rc = agree(comm, rc, err, "list exchange");
+    if (rc == VFX_OK && dst >= 0) {
+        size_t a = s0 - cur->p0;
+        MPI_Isend(counts, (int)(s1 - s0), MPI_UINT32_T, dst, TAG_SWAP_N, comm, &rq[nrq++]);
+        MPI_Isend(cur->segs + cur->off[a], (int)ns, segt, dst, TAG_SWAP_S, comm, &rq[nrq++]);
+        *bytes += sizeof ns + (uint64_t)(s1 - s0) * sizeof(uint32_t) + ns * sizeof(vfx_tet_rseg);
+    }
+    if (rc == VFX_OK && src >= 0) {
+        size_t np = k1 - k0;
+        MPI_Request r2[2];
+        MPI_Irecv(in->off, (int)np, MPI_UINT32_T, src, TAG_SWAP_N, comm, &r2[0]);
+        MPI_Irecv(in->segs, (int)nr, segt, src, TAG_SWAP_S, comm, &r2[1]);
+        wait_polite(2, r2);
+        uint32_t acc = 0; /* counts -> offsets */
+        for (size_t p = 0; p < np; p++) {
+            uint32_t c = in->off[p];
+            in->off[p] = acc;
+            acc += c;
+        }
+        in->off[np] = acc;
+    }
+    wait_polite(nrq, rq);
+    if (rc != VFX_OK)
+        vfx_tet_seglists_free(in);
+    return rc;
+}
+
+int vfx_tet_mpi_composite(MPI_Comm comm, int W, int H, vfx_tet_seglists *lists, int partial,
+                          float *rgba, vfx_tet_mpi_stats *st, char err[256])
+{
+    int rank, P, rc = VFX_OK;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &P);
+    double t0 = now_ms();
+    MPI_Datatype segt;
+    MPI_Type_contiguous(6, MPI_FLOAT, &segt);
+    MPI_Type_commit(&segt);
+    const size_t npix = (size_t)W * H;
+    uint64_t bytes = 0;
+    uint32_t *counts = malloc((npix + 1) * sizeof *counts);
+    if (!counts) {
+        snprintf(err, 256, "tet_mpi: out of memory for %zu pixel counts", npix);
+        rc = VFX_ERR_OUT_OF_MEMORY;
+    } else if (lists->p0 != 0 || lists->p1 != npix || !lists->off) {
+        snprintf(err, 256, "tet_mpi: composite needs full-screen lists (got pixels %zu..%zu of %zu)",
+                 lists->p0, lists->p1, npix);
+        rc = VFX_ERR_INVALID_ARGUMENT;
+    }
+    rc = agree(comm, rc, err, "composite set-up");
+    int G = 1;
+    while (G * 2 <= P)
+        G *= 2;
+    vfx_tet_seglists cur = *lists, in, keep, merged;
+    memset(lists, 0, sizeof *lists);
+    memset(&merged, 0, sizeof merged);
+    /* Fold: ranks G..P-1 hand their whole screen to rank - G, so the swap runs on 2^k ranks. */
+    if (rc == VFX_OK && P > G) {
+        int dst = rank >= G ? rank - G : -1, src = rank + G < P ? rank + G : -1;
+        rc = exchange(comm, segt, &cur, dst, 0, npix, src, 0, npix, counts, &in, &bytes, err);
+        int r2 = VFX_OK;
+        if (rc == VFX_OK && src >= 0) {
+            if (vfx_tet_seglists_merge(&cur, &in, partial, &merged) != 0) {
+                snprintf(err, 256, "tet_mpi: out of memory folding rank %d's lists", src);
+                r2 = VFX_ERR_OUT_OF_MEMORY;
+            } else {
+                vfx_tet_seglists_free(&cur);
+                cur = merged;
+            }
+        }
+        if (rc == VFX_OK && dst >= 0)
+            vfx_tet_seglists_free(&cur);
+        vfx_tet_seglists_free(&in);
+        if (rc == VFX_OK)
+            rc = agree(comm, r2, err, "fold");
+    }
+    /* Binary swap: at stage s the pair (rank, rank ^ 2^s) splits its common range in halves;
+     * the lower rank keeps the first. Lists are merged by depth, so the result is exact
+     * however the two ranks' cells interleave along the rays. Ranks >= G only take part in
+     * the agreements. */
+    size_t p0 = 0, p1 = npix;
+    for (int bit = 1; rc == VFX_OK && bit < G; bit <<= 1) {
+        int partner = rank < G ? rank ^ bit : -1;
+        size_t mid = p0 + (p1 - p0) / 2;
+        size_t k0 = (rank & bit) ? mid : p0, k1 = (rank & bit) ? p1 : mid;
+        size_t s0 = (rank & bit) ? p0 : mid, s1 = (rank & bit) ? mid : p1;
+        rc = exchange(comm, segt, &cur, partner, s0, s1, partner, k0, k1, counts, &in, &bytes,
+                      err);
+        if (rc != VFX_OK)
+            break;
+        int r2 = VFX_OK;
+        if (partner >= 0) {
+            if (slice_lists(&cur, k0, k1, &keep) != 0 ||
+                vfx_tet_seglists_merge(&keep, &in, partial, &merged) != 0) {
+                snprintf(err, 256, "tet_mpi: out of memory in binary swap stage %d", bit);
+                r2 = VFX_ERR_OUT_OF_MEMORY;
+            }
+            vfx_tet_seglists_free(&keep);
+            vfx_tet_seglists_free(&in);
+            vfx_tet_seglists_free(&cur);
+            cur = merged;
+            memset(&merged, 0, sizeof merged);
+            p0 = k0;
+            p1 = k1;
+        }
+        rc = agree(comm, r2, err, "binary swap");
+    }
+    double t1 = now_ms();
+    /* Final composition of this rank's part, then gather to rank 0. */
+    size_t mine = rank < G ? p1 - p0 : 0;
+    float *part = malloc((mine + 1) * 4 * sizeof *part);
+    long long *ranges = rank == 0 ? malloc((size_t)P * 2 * sizeof *ranges) : NULL;
+    int *cnts = rank == 0 ? malloc((size_t)P * 2 * sizeof *cnts) : NULL;
+    if (rc == VFX_OK && (!part || (rank == 0 && (!ranges || !cnts)))) {
+        snprintf(err, 256, "tet_mpi: out of memory for %zu final pixels", mine);
+        rc = VFX_ERR_OUT_OF_MEMORY;
+    }
+    if (rc == VFX_OK && rank == 0 && !rgba) {
+        snprintf(err, 256, "tet_mpi: rank 0 needs an output image");
+        rc = VFX_ERR_INVALID_ARGUMENT;
+    }
+    rc = agree(comm, rc, err, "final composition");
+    if (rc == VFX_OK) {
+        for (size_t p = 0; p < mine; p++) {
+            vfx_tet_rseg acc = {0, 0, 0, 0, 0, 0};
+            for (uint32_t i = cur.off[p]; i < cur.off[p + 1]; i++)
+                over(&acc, &cur.segs[i]);
+            part[4 * p + 0] = acc.r;
+            part[4 * p + 1] = acc.g;
+            part[4 * p + 2] = acc.b;
+            part[4 * p + 3] = acc.a;
+        }
+        long long range[2] = {(long long)(rank < G ? p0 : 0), (long long)mine};
+        MPI_Request rq;
+        MPI_Igather(range, 2, MPI_LONG_LONG, ranges, 2, MPI_LONG_LONG, 0, comm, &rq);
+        wait_polite(1, &rq);
+        if (rank == 0)
+            for (int r = 0; r < P; r++) {
+                cnts[r] = (int)(ranges[2 * r + 1] * 4);
+                cnts[P + r] = (int)(ranges[2 * r] * 4);
+            }
+        MPI_Igatherv(part, (int)(mine * 4), MPI_FLOAT, rgba, cnts, rank == 0 ? cnts + P : NULL,
+                     MPI_FLOAT, 0, comm, &rq);
+        wait_polite(1, &rq);
+        if (st) {
+            st->pixels_final = mine;
+            st->segments_final = rank < G ? cur.off[mine] : 0;
+        }
+    }
+    free(ranges);
+    free(cnts);
+    if (st) {
+        st->bytes_sent += bytes;
+        st->t_swap_ms += t1 - t0;
+        st->t_gather_ms += now_ms() - t1;
+    }
+    free(part);
+    free(counts);
+    vfx_tet_seglists_free(&cur);
+    MPI_Type_free(&segt);
+    return rc;
+}
+
+struct vfx_tet_mpi {
+    MPI_Comm comm;
+    MPI_Win win;   /* the shared ERT table on rank 0, kept between renders */
+    float *win_mem;
+    int win_dd;    /* its entries; 0 = no window yet */
+};
+
+int vfx_tet_mpi_create(MPI_Comm comm, vfx_tet_mpi **out, char err[256])
+{
+    vfx_tet_mpi *m = calloc(1, sizeof *m);
+    int rc = m ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
+    if (!m)
+        snprintf(err, 256, "tet_mpi: out of memory for the context");
+    rc = agree(comm, rc, err, "context creation");
+    if (rc != VFX_OK) {
+        free(m);
+        *out = NULL;
+        return rc;
+    }
+    m->comm = comm;
+    *out = m;
+    return VFX_OK;
+}
+
+void vfx_tet_mpi_destroy(vfx_tet_mpi *m)
+{
+    if (!m)
+        return;
+    if (m->win_dd)
+        MPI_Win_free(&m->win);
+    free(m);
+}
+
+/* Phase-1 state of one rank. */
+typedef struct rank_scan {
+    MPI_Comm comm;
+    int rank, P, DD;
+    vfx_tet_local *L;
+    const vfx_tet_options *opts;
+    uint32_t next, end;   /* remaining keys [next, end) of this rank */
+    int share, dlb;
+    /* weak sharing: the shared table lives in a window on rank 0 (the paper's manager node,
+     * without a manager process), D*D floats: deepest where terminated, +inf elsewhere */
+    MPI_Win win;
+    float *enc, *known;
+    /* the current reduction (load balancing and termination): one "done" flag (MIN: 1 only
+     * when every rank is done) and one remaining-key count per rank (each rank writes its own
+     * slot, +inf elsewhere) */
+    float *sendbuf, *recvbuf, *remaining;
+    MPI_Request round;
+    int round_active, all_done, done;
+    /* load balancing: the outstanding request, if any */
+    MPI_Request give_rq, ask_rq;
+    uint32_t give[2];
+    int ask_msg;
+    int asked;            /* rank asked, -1 when none */
+    vfx_tet_mpi_stats *st;
+} rank_scan;
+
+static void start_round(rank_scan *R)
+{
+    R->sendbuf[0] = R->done ? 1.0f : 0.0f;
+    for (int i = 0; i < R->P; i++)
+        R->sendbuf[1 + i] = i == R->rank ? (float)(R->end - R->next) : INFINITY;
+    MPI_Iallreduce(R->sendbuf, R->recvbuf, 1 + R->P, MPI_FLOAT, MPI_MIN, R->comm, &R->round);
+    R->round_active = 1;
+}
+
+/* Weak sharing (paper 3.2): one atomic exchange with the shared table, element-wise
+ * minimum in, previous value out (MPI_Get_accumulate under a shared lock: concurrent
+ * accumulates with one op are atomic per element). It involves no other rank's progress, so
+ * a rank shares at its own pace as with the paper's manager node. The result is merged into
+ * the monotone known table (terminations only move forward) and into the local table:
+ * another rank's termination is valid here since our segments only add opacity in front. */
+static void share_table(rank_scan *R)
+{
+    vfx_tet_local_table_get(R->L, R->enc);
+    MPI_Win_lock(MPI_LOCK_SHARED, 0, 0, R->win);
+    MPI_Get_accumulate(R->enc, R->DD, MPI_FLOAT, R->sendbuf + 1 + R->P, R->DD, MPI_FLOAT, 0, 0,
+                       R->DD, MPI_FLOAT, MPI_MIN, R->win);
+    MPI_Win_unlock(0, R->win);
+    const float *got = R->sendbuf + 1 + R->P;
+    for (int i = 0; i < R->DD; i++) {
+        float v = got[i] < R->enc[i] ? got[i] : R->enc[i];
+        if (v < R->known[i])
+            R->known[i] = v;
+    }
+    vfx_tet_local_table_merge(R->L, R->known);
+    R->st->share_rounds++;
+}
+
+/* Progress: completes the reduction in flight, answers load-balancing requests with 1/3 of
+ * our remaining keys from the deep end, and starts a new reduction when start is set and none
+ * is in flight. */
+static void poll_rank(rank_scan *R, int start)
+{
+    if (R->round_active) {
+        int flag = 0;
+        MPI_Test(&R->round, &flag, MPI_STATUS_IGNORE);
+        if (flag) {
+            R->round_active = 0;
+            R->st->reductions++;
+            R->all_done = R->recvbuf[0] >= 1.0f;
+            for (int i = 0; i < R->P; i++)
+                R->remaining[i] = R->recvbuf[1 + i];
+        }
+    }
+    for (;;) {
+        int flag = 0;
+        MPI_Status s;
+        MPI_Iprobe(MPI_ANY_SOURCE, TAG_REQ, R->comm, &flag, &s);
+        if (!flag)
+            break;
+        int dummy;
+        MPI_Recv(&dummy, 1, MPI_INT, s.MPI_SOURCE, TAG_REQ, R->comm, MPI_STATUS_IGNORE);
+        uint32_t rem = R->end - R->next, n = rem / 3 ? rem / 3 : (rem >= 2 ? 1 : 0);
+        uint32_t reply[2] = {R->end - n, R->end};
+        R->end -= n;
+        R->st->cells_given += n;
+        /* the thief posted its receive before asking, so this send is matched at once */
+        MPI_Send(reply, 2, MPI_UINT32_T, s.MPI_SOURCE, TAG_GIVE, R->comm);
+    }
+    if (start && !R->round_active && !R->all_done)
+        start_round(R);
+}
+
+/* Out of keys: ask the rank with the most remaining keys (as of the last reduction) for some.
+ * Returns 1 when a request went out. */
+static int ask_for_work(rank_scan *R)
+{
+    int best = -1;
+    float most = 1.5f; /* a rank with fewer than 2 keys gives none */
+    for (int i = 0; i < R->P; i++)
+        if (i != R->rank && R->remaining[i] > most && R->remaining[i] < INFINITY) {
+            most = R->remaining[i];
+            best = i;
+        }
+    if (best < 0)
+        return 0;
+    R->ask_msg = 0;
+    MPI_Irecv(R->give, 2, MPI_UINT32_T, best, TAG_GIVE, R->comm, &R->give_rq);
+    MPI_Isend(&R->ask_msg, 1, MPI_INT, best, TAG_REQ, R->comm, &R->ask_rq);
+    R->asked = best;
+    R->st->steal_requests++;
+    return 1;
+}
+
+int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
+                       const vfx_tet_tf *tf, const vfx_tet_options *opts, float *rgba,
+                       vfx_tet_mpi_stats *mine, vfx_tet_mpi_stats *all, char err[256])
+{
+    double t_start = now_ms();
+    MPI_Comm comm = ctx->comm;
+    int rank, P;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Comm_size(comm, &P);
+    vfx_tet_mpi_stats st;
+    memset(&st, 0, sizeof st);
+    rank_scan R;
+    memset(&R, 0, sizeof R);
+    R.comm = comm;
+    R.rank = rank;
+    R.P = P;
+    R.opts = opts;
+    R.asked = -1;
+    R.st = &st;
+    /* rank 0 gathers the statistics even when the caller wants none */
+    vfx_tet_mpi_stats *gather_tmp = rank == 0 && !all ? malloc((size_t)P * sizeof *gather_tmp) : NULL;
+    int rc = vfx_tet_local_create(mesh, cam, tf, opts, P, rank, &R.L, err);
+    if (rc == VFX_OK && rank == 0 && !all && !gather_tmp) {
+        snprintf(err, 256, "tet_mpi: out of memory for %d ranks' statistics", P);
+        rc = VFX_ERR_OUT_OF_MEMORY;
+    }
+    if (rc == VFX_OK) {
+        R.DD = vfx_tet_local_tiles_d(R.L) * vfx_tet_local_tiles_d(R.L);
+        size_t n = (size_t)R.DD + 1 + (size_t)P; /* the reduction, then a table's scratch */
+        R.sendbuf = malloc(n * sizeof(float));
+        R.recvbuf = malloc(n * sizeof(float));
+        R.known = malloc((size_t)R.DD * sizeof(float));
+        R.enc = malloc((size_t)R.DD * sizeof(float));
+        R.remaining = malloc((size_t)P * sizeof(float));
+        if (!R.sendbuf || !R.recvbuf || !R.known || !R.enc || !R.remaining) {
+            snprintf(err, 256, "tet_mpi: out of memory for the ERT exchange (D*D = %d)", R.DD);
+            rc = VFX_ERR_OUT_OF_MEMORY;
+        }
+    }
+    rc = agree(comm, rc, err, "set-up");
+    if (rc != VFX_OK)
+        goto done;
+    R.share = opts->share && opts->ert && P > 1;
+    if (R.share) {
+        /* Same decision and D on every rank (same opts), so the collectives match. The window
+         * is kept in the context: creating one is a collective that spins inside Open MPI,
+         * which with more ranks than cores cost seconds per frame. */
+        if (ctx->win_dd != R.DD) {
+            if (ctx->win_dd)
+                MPI_Win_free(&ctx->win);
+            MPI_Aint bytes = rank == 0 ? (MPI_Aint)R.DD * (MPI_Aint)sizeof(float) : 0;
+            MPI_Win_allocate(bytes, sizeof(float), MPI_INFO_NULL, comm, &ctx->win_mem,
+                             &ctx->win);
+            ctx->win_dd = R.DD;
+        }
+        R.win = ctx->win;
+        if (rank == 0) {
+            MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, R.win);
+            for (int i = 0; i < R.DD; i++)
+                ctx->win_mem[i] = INFINITY;
+            MPI_Win_unlock(0, R.win);
+        }
+        /* nobody reads it before it is reset; the agreement after the scan keeps the next
+         * frame's reset after every access of this one */
+        agree(comm, VFX_OK, err, "window set-up");
+    }
+    vfx_tet_local_part(R.L, rank, &R.next, &R.end);
+    st.cells_assigned = R.end - R.next;
+    for (int i = 0; i < R.DD; i++)
+        R.known[i] = INFINITY;
+    for (int i = 0; i < P; i++) /* until the first reduction: cells, NaN ones included */
+        R.remaining[i] = (float)vfx_tet_local_part_cells(R.L, i);
+    R.dlb = opts->dlb;
+    /* reductions are needed for sharing, and for the remaining counts and the termination
+     * agreement of load balancing; without either the ranks scan independently */
+    const int coop = P > 1 && (R.share || R.dlb);
+    const int ert = opts->ert;
+    const uint32_t C = opts->update_c > 0 ? (uint32_t)opts->update_c : 1;
+    /* progress between table updates: cheap MPI_Test / MPI_Iprobe so that reductions and
+     * requests move while a rank scans a long stretch */
+    const uint32_t POLL = 256;
+    int failed = 0;
+    double t1 = now_ms(), c1 = cpu_ms();
+    st.t_setup_ms = t1 - t_start;
+    vfx_tet_counters *cnt = vfx_tet_local_counters(R.L);
+    for (;;) {
+        uint32_t rem = R.end - R.next;
+        uint32_t interval = rem / C > 0 ? rem / C : 1, since = 0;
+        double ts = now_ms(), tin = 0, tu0 = cnt->t_update_ms;
+        while (R.next < R.end && !failed) {
+            if (since >= interval) {
+                if (ert)
+                    vfx_tet_local_update_table(R.L);
+                if (coop) {
+                    double tp = now_ms();
+                    if (R.share)
+                        share_table(&R);
+                    poll_rank(&R, 1);
+                    st.polls++;
+                    tin += now_ms() - tp;
+                }
+                interval = (R.end - R.next) / C > 0 ? (R.end - R.next) / C : 1;
+                since = 0;
+            } else if (coop && since % POLL == POLL - 1) {
+                double tp = now_ms();
+                poll_rank(&R, 0);
+                st.polls++;
+                tin += now_ms() - tp;
+            }
+            if (R.next >= R.end)
+                break; /* everything left was handed away */
+            since++;
+            st.keys_done++;
+            if (vfx_tet_local_scan(R.L, R.next++) != 0) {
+                failed = 1;
+                R.end = R.next; /* nothing to hand out either */
+                snprintf(err, 256, "tet_mpi: rank %d out of memory at %llu segments", rank,
+                         (unsigned long long)cnt->segments_made);
+            }
+        }
+        cnt->t_sc_ms += now_ms() - ts - tin - (cnt->t_update_ms - tu0);
+        st.t_comm_ms += tin;
+        if (!coop || failed || !R.dlb)
+            break;
+        /* Out of keys: ask for more until a request is answered with some, or nobody has
+         * any to give. The rank keeps answering other requests meanwhile (with nothing). */
+        int got = 0;
+        while (!got && ask_for_work(&R)) {
+            double tw = now_ms();
+            for (;;) {
+                int flag = 0;
+                MPI_Test(&R.give_rq, &flag, MPI_STATUS_IGNORE);
+                if (flag)
+                    break;
+                poll_rank(&R, 1);
+                idle_pause();
+            }
+            wait_polite(1, &R.ask_rq); /* it was answered, so it was received */
+            st.t_idle_ms += now_ms() - tw;
+            uint32_t n = R.give[1] - R.give[0];
+            if (n > 0) {
+                vfx_tet_local_need(R.L, R.give[0], R.give[1]); /* sorts the victim's keys */
+                R.next = R.give[0];
+                R.end = R.give[1];
+                st.cells_taken += n;
+                got = 1;
+            } else {
+                R.remaining[R.asked] = 0; /* stale: do not ask it again before new counts */
+            }
+            R.asked = -1;
+        }
+        if (!got)
+            break;
+    }
+    /* Done: keep taking part in reductions (answering requests with nothing) until one shows
+     * every rank done. Every rank sees the same result of the same reduction, so all leave
+     * after the same one and no message is left in flight (a rank waiting for an answer is
+     * not done, so that reduction cannot say all done). */
+    if (coop) {
+        double tw = now_ms();
+        R.done = 1;
+        while (!R.all_done) {
+            poll_rank(&R, 1);
+            if (!R.all_done)
+                idle_pause();
+        }
+        st.t_idle_ms += now_ms() - tw;
+    }
+    st.t_phase1_ms = now_ms() - t1;
+    st.t_phase1_cpu_ms = cpu_ms() - c1;
+
+    rc = agree(comm, failed ? VFX_ERR_OUT_OF_MEMORY : VFX_OK, err, "the scan");
+    if (rc != VFX_OK)
+        goto done;
+    /* Phase 2: this rank's full-screen lists, exported and composited by binary swap. */
+    double te = now_ms();
+    vfx_tet_seglists lists;
+    memset(&lists, 0, sizeof lists);
+    size_t npix = (size_t)cam->width * cam->height;
+    lists.p0 = 0;
+    lists.p1 = npix;
+    lists.off = malloc((npix + 1) * sizeof *lists.off);
+    size_t nseg = lists.off ? vfx_tet_local_export(R.L, 0, npix, lists.off, NULL) : 0;
+    lists.segs = lists.off && nseg <= INT_MAX ? malloc((nseg + 1) * sizeof *lists.segs) : NULL;
+    int r2 = VFX_OK;
+    if (!lists.segs) {
+        snprintf(err, 256, "tet_mpi: rank %d out of memory exporting %zu segments", rank, nseg);
+        r2 = VFX_ERR_OUT_OF_MEMORY;
+        vfx_tet_seglists_free(&lists);
+    } else {
+        vfx_tet_local_export(R.L, 0, npix, lists.off, lists.segs);
+    }
+    st.segments_local = nseg;
+    st.cnt = *cnt;
+    vfx_tet_local_destroy(R.L); /* the lists are all phase 2 needs */
+    R.L = NULL;
+    rc = agree(comm, r2, err, "export");
+    st.t_export_ms = now_ms() - te;
+    if (rc == VFX_OK)
+        rc = vfx_tet_mpi_composite(comm, cam->width, cam->height, &lists, opts->partial_composite,
+                                   rgba, &st, err);
+    vfx_tet_seglists_free(&lists);
+done:
+    if (R.L)
+        st.cnt = *vfx_tet_local_counters(R.L);
+    st.t_total_ms = now_ms() - t_start;
+    if (mine)
+        *mine = st;
+    if (rc == VFX_OK) {
+        MPI_Request rq;
+        MPI_Igather(&st, (int)sizeof st, MPI_BYTE, all ? all : gather_tmp, (int)sizeof st,
+                    MPI_BYTE, 0, comm, &rq);
+        wait_polite(1, &rq);
+    }
+    free(gather_tmp);
+    vfx_tet_local_destroy(R.L);
+    free(R.sendbuf);
+    free(R.recvbuf);
+    free(R.known);
+    free(R.enc);
+    free(R.remaining);
+    return rc;
+}

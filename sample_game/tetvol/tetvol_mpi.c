@@ -1,0 +1,405 @@
+/* tetvol_mpi.c — volfx-tetvol-mpi: the seed-002 renderer across MPI ranks (tet_mpi.c) on a
+ * .vtu / TetGen mesh or a generated grid, in the paper's configurations (Base, ERT, ERT+SHARE,
+ * ERT+DLB, ERT+SHARE+DLB, DLB). Rank 0 prints one JSON line per configuration: median wall
+ * time over --repeat renders, per-rank scan times and counts of the last render, imbalance
+ * (max/mean), binary-swap bytes, and the image difference against the one-process renderer.
+ * Usage: mpirun -np P volfx-tetvol-mpi [--vtu PATH [--field NAME] | --tetgen BASE [--field
+ *        attrK] | --grid N] [--size S] [--view A|B|Z] [--tau T] [--repeat R] [--modes a,b,..]
+ *        [--threshold X] [--tiles-d D] [--update-c C] [--ppm OUT] (OUT: the last image) */
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+#include <mpi.h>
+
+#include "tetvol/tet_io.h"
+#include "tetvol/tet_mpi.h"
+#include "tetvol/tet_render.h"
+
+static const uint32_t cube5[20] = {0, 1, 3, 4, 1, 2, 3, 6, 1, 4, 5, 6, 3, 4, 6, 7, 1, 3, 4, 6};
+
+static int make_grid(int n, vfx_tet_mesh *m)
+{
+    uint32_t np = (uint32_t)((n + 1) * (n + 1) * (n + 1)), nt = (uint32_t)(n * n * n * 5);
+    memset(m, 0, sizeof *m);
+    m->points = malloc((size_t)np * 3 * sizeof(float));
+    m->scalar = malloc((size_t)np * sizeof(float));
+    m->tets = malloc((size_t)nt * 4 * sizeof(uint32_t));
+    if (!m->points || !m->scalar || !m->tets)
+        return -1;
+    for (int k = 0, i = 0; k <= n; k++)
+        for (int j = 0; j <= n; j++)
+            for (int l = 0; l <= n; l++, i++) {
+                float x = -1 + 2.0f * l / n, y = -1 + 2.0f * j / n, z = -1 + 2.0f * k / n;
+                m->points[3 * i] = x;
+                m->points[3 * i + 1] = y;
+                m->points[3 * i + 2] = z;
+                m->scalar[i] = 0.5f + 0.5f * sinf(3 * x) * cosf(2 * y) * cosf(1.5f * z);
+            }
+    uint32_t t = 0;
+    for (int k = 0; k < n; k++)
+        for (int j = 0; j < n; j++)
+            for (int l = 0; l < n; l++) {
+                uint32_t c[8];
+                for (int q = 0; q < 8; q++)
+                    c[q] = (uint32_t)((k + (q >> 2 & 1)) * (n + 1) * (n + 1) +
+                                      (j + (q >> 1 & 1)) * (n + 1) + l + (q & 1));
+                uint32_t o8[8] = {c[0], c[1], c[3], c[2], c[4], c[5], c[7], c[6]};
+                static const uint32_t mirror[8] = {1, 0, 3, 2, 5, 4, 7, 6};
+                int flip = (l + j + k) & 1;
+                for (int q = 0; q < 20; q++)
+                    m->tets[(size_t)t * 4 + q] = o8[flip ? mirror[cube5[q]] : cube5[q]];
+                t += 5;
+            }
+    m->point_count = np;
+    m->tet_count = nt;
+    m->scalar_min = 0;
+    m->scalar_max = 1;
+    return 0;
+}
+
+/* Frames the mesh's bounding sphere: view = T(0,0,-dist) Rx(pitch) Ry(yaw) T(-centre). */
+static void camera(vfx_tet_camera *c, const vfx_tet_mesh *m, int w, int h, float yaw,
+                   float pitch, float *radius)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < m->point_count; i++)
+        for (int r = 0; r < 3; r++) {
+            lo[r] = fmin(lo[r], m->points[3 * i + r]);
+            hi[r] = fmax(hi[r], m->points[3 * i + r]);
+        }
+    double ctr[3], rad = 0;
+    for (int r = 0; r < 3; r++) {
+        ctr[r] = 0.5 * (lo[r] + hi[r]);
+        rad += 0.25 * (hi[r] - lo[r]) * (hi[r] - lo[r]);
+    }
+    rad = sqrt(rad);
+    *radius = (float)rad;
+    const float fov = 0.8f;
+    float dist = (float)(rad / sin(0.5 * fov) * 1.05);
+    memset(c, 0, sizeof *c);
+    c->width = w;
+    c->height = h;
+    float cy = cosf(yaw), sy = sinf(yaw), cp = cosf(pitch), sp = sinf(pitch);
+    float R[9] = {cy, sp * sy, -cp * sy, 0, cp, sp, sy, -sp * cy, cp * cy};
+    for (int col = 0; col < 3; col++)
+        for (int r = 0; r < 3; r++)
+            c->view[col * 4 + r] = R[col * 3 + r];
+    for (int r = 0; r < 3; r++)
+        c->view[12 + r] = -(float)(R[r] * ctr[0] + R[3 + r] * ctr[1] + R[6 + r] * ctr[2]);
+    c->view[14] -= dist;
+    c->view[15] = 1;
+    float f = 1.0f / tanf(0.5f * fov), nearp = dist * 0.01f, farp = dist * 4;
+    c->proj[0] = f * h / (float)w;
+    c->proj[5] = f;
+    c->proj[10] = (farp + nearp) / (nearp - farp);
+    c->proj[11] = -1;
+    c->proj[14] = 2 * farp * nearp / (nearp - farp);
+}
+
+/* A barrier that sleeps while waiting: MPI_Barrier spins, and with more ranks than cores the
+ * spinning ranks would slow the one-process reference render on rank 0. */
+static void barrier_polite(void)
+{
+    MPI_Request rq;
+    int flag = 0;
+    MPI_Ibarrier(MPI_COMM_WORLD, &rq);
+    for (MPI_Test(&rq, &flag, MPI_STATUS_IGNORE); !flag; MPI_Test(&rq, &flag, MPI_STATUS_IGNORE)) {
+        struct timespec ts = {0, 200000};
+        nanosleep(&ts, NULL);
+    }
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+typedef struct mode {
+    const char *name;
+    int ert, share, dlb;
+} mode;
+
+static const mode modes[] = {
+    {"base", 0, 0, 0},      {"dlb", 0, 0, 1},     {"ert", 1, 0, 0},
+    {"ert_share", 1, 1, 0}, {"ert_dlb", 1, 0, 1}, {"ert_share_dlb", 1, 1, 1},
+};
+
+static void print_array_u(const char *key, const vfx_tet_mpi_stats *all, int P, size_t off)
+{
+    printf(",\"%s\":[", key);
+    for (int r = 0; r < P; r++)
+        printf("%s%llu", r ? "," : "",
+               (unsigned long long)*(const uint64_t *)((const char *)&all[r] + off));
+    printf("]");
+}
+
+static void print_array_d(const char *key, const vfx_tet_mpi_stats *all, int P, size_t off)
+{
+    printf(",\"%s\":[", key);
+    for (int r = 0; r < P; r++)
+        printf("%s%.1f", r ? "," : "", *(const double *)((const char *)&all[r] + off));
+    printf("]");
+}
+
+static double imbalance(const vfx_tet_mpi_stats *all, int P, size_t off, int is_double)
+{
+    double mx = 0, sum = 0;
+    for (int r = 0; r < P; r++) {
+        const char *p = (const char *)&all[r] + off;
+        double v = is_double ? *(const double *)p : (double)*(const uint64_t *)p;
+        mx = fmax(mx, v);
+        sum += v;
+    }
+    return sum > 0 ? mx / (sum / P) : 1.0;
+}
+
+int main(int argc, char **argv)
+{
+    MPI_Init(&argc, &argv);
+    int rank, P;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &P);
+    const char *ppm = NULL, *vtu = NULL, *tetgen = NULL, *field = NULL, *view = "A", *mode_list = NULL;
+    int grid = 30, size = 300, repeat = 3, tiles_d = 20, update_c = 100;
+    float tau = 4.0f, threshold = 0.9f;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!v) {
+            if (rank == 0)
+                fprintf(stderr, "volfx-tetvol-mpi: option %s needs a value\n", a);
+            MPI_Finalize();
+            return 2;
+        }
+        i++;
+        if (!strcmp(a, "--vtu")) vtu = v;
+        else if (!strcmp(a, "--tetgen")) tetgen = v;
+        else if (!strcmp(a, "--field")) field = v;
+        else if (!strcmp(a, "--ppm")) ppm = v;
+        else if (!strcmp(a, "--grid")) grid = atoi(v);
+        else if (!strcmp(a, "--size")) size = atoi(v);
+        else if (!strcmp(a, "--view")) view = v;
+        else if (!strcmp(a, "--tau")) tau = (float)atof(v);
+        else if (!strcmp(a, "--repeat")) repeat = atoi(v);
+        else if (!strcmp(a, "--modes")) mode_list = v;
+        else if (!strcmp(a, "--threshold")) threshold = (float)atof(v);
+        else if (!strcmp(a, "--tiles-d")) tiles_d = atoi(v);
+        else if (!strcmp(a, "--update-c")) update_c = atoi(v);
+        else {
+            if (rank == 0)
+                fprintf(stderr, "volfx-tetvol-mpi: unknown option %s\n", a);
+            MPI_Finalize();
+            return 2;
+        }
+    }
+    if (grid < 1 || grid > 200 || size < 1 || size > 4096 || repeat < 1 || repeat > 100 ||
+        !(threshold > 0 && threshold <= 1) || tiles_d < 1 || tiles_d > 1000 || update_c < 1 ||
+        (strcmp(view, "A") && strcmp(view, "B") && strcmp(view, "Z"))) {
+        if (rank == 0)
+            fprintf(stderr, "volfx-tetvol-mpi: --grid 1..200, --size 1..4096, --repeat 1..100, "
+                            "--threshold (0,1], --tiles-d 1..1000, --update-c >= 1, --view A|B|Z\n");
+        MPI_Finalize();
+        return 2;
+    }
+    /* every rank loads the mesh itself (the paper's nodes hold their data where the
+     * simulation left it; here each rank holds it all so that work can move as key ranges) */
+    vfx_tet_mesh m;
+    char err[256] = "";
+    int rc = 0;
+    const char *src = "grid";
+    if (vtu) {
+        src = vtu;
+        rc = vfx_tet_load_vtu(vtu, field ? field : "Velocity", &m, err, sizeof err);
+    } else if (tetgen) {
+        src = tetgen;
+        rc = vfx_tet_load_tetgen(tetgen, field ? field : "attr0", &m, err, sizeof err);
+    } else if (make_grid(grid, &m) != 0) {
+        rc = VFX_ERR_OUT_OF_MEMORY;
+        snprintf(err, sizeof err, "out of memory for a %d^3 grid", grid);
+    }
+    int worst = rc;
+    MPI_Allreduce(&rc, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    if (worst != 0) {
+        if (rc != 0)
+            fprintf(stderr, "volfx-tetvol-mpi: rank %d: %s\n", rank, err);
+        MPI_Finalize();
+        return 1;
+    }
+    vfx_tet_camera cam;
+    float radius;
+    /* A: from the side (across z), Z: down the z axis (the pipe's axis: long rays, many
+     * cells per pixel), B: along the bounding box diagonal */
+    if (!strcmp(view, "A"))
+        camera(&cam, &m, size, size, 1.5708f, 0.0f, &radius);
+    else if (!strcmp(view, "Z"))
+        camera(&cam, &m, size, size, 0.0f, 0.0f, &radius);
+    else
+        camera(&cam, &m, size, size, 0.785f, 0.6155f, &radius);
+    /* extinction per world unit scaled by the mesh's size: tau is the optical depth across
+     * one bounding radius at the top of the scalar range */
+    vfx_tet_tf tf = {m.scalar_min, m.scalar_max, 0.1f * tau / radius, tau / radius,
+                     {0.1f, 0.3f, 1.0f}, {1.0f, 0.6f, 0.1f}};
+    const size_t n4 = (size_t)size * size * 4;
+    float *img = rank == 0 ? malloc(n4 * sizeof *img) : NULL;
+    float *ref = rank == 0 ? malloc(n4 * sizeof *ref) : NULL;
+    vfx_tet_mpi_stats *all = rank == 0 ? calloc((size_t)P, sizeof *all) : NULL;
+    double *times = malloc((size_t)repeat * sizeof *times);
+    if ((rank == 0 && (!img || !ref || !all)) || !times) {
+        fprintf(stderr, "volfx-tetvol-mpi: out of memory for %dx%d images\n", size, size);
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+    vfx_tet_mpi *ctx;
+    if (vfx_tet_mpi_create(MPI_COMM_WORLD, &ctx, err) != 0) {
+        fprintf(stderr, "volfx-tetvol-mpi: %s\n", err);
+        MPI_Abort(MPI_COMM_WORLD, 1);
+    }
+    vfx_tet_options o;
+    vfx_tet_options_default(&o);
+    o.tiles_d = tiles_d;
+    o.update_c = update_c;
+    /* the one-process image every configuration is compared with */
+    double t_one = 0;
+    if (rank == 0) {
+        vfx_tet_counters c;
+        o.ert = 0;
+        o.ert_threshold = 1.0f; /* the partial-compositing stop of the no-ERT runs below */
+        double t0 = MPI_Wtime();
+        if (vfx_tet_render(&m, &cam, &tf, &o, ref, &c, err) != 0) {
+            fprintf(stderr, "volfx-tetvol-mpi: %s\n", err);
+            MPI_Abort(MPI_COMM_WORLD, 1);
+        }
+        t_one = (MPI_Wtime() - t0) * 1e3;
+        char host[64] = "";
+        gethostname(host, sizeof host - 1);
+        printf("{\"effect\":\"tetvol_mpi\",\"test\":\"setup\",\"mesh\":\"%s\",\"field\":\"%s\","
+               "\"tets\":%u,\"points\":%u,\"size\":%d,\"view\":\"%s\",\"ranks\":%d,\"cores\":%ld,"
+               "\"host\":\"%s\",\"threshold\":%.2f,\"D\":%d,\"C\":%d,\"one_process_ms\":%.1f,"
+               "\"one_process_scanned\":%llu}\n",
+               src, m.scalar_name[0] ? m.scalar_name : "grid", m.tet_count, m.point_count, size,
+               view, P, sysconf(_SC_NPROCESSORS_ONLN), host, threshold, tiles_d, update_c, t_one,
+               (unsigned long long)c.cells_scanned);
+        fflush(stdout);
+    }
+    for (size_t mi = 0; mi < sizeof modes / sizeof modes[0]; mi++) {
+        const mode *md = &modes[mi];
+        if (mode_list) {
+            /* exact match of one comma-separated entry */
+            const char *p = mode_list;
+            size_t n = strlen(md->name);
+            int found = 0;
+            while (*p) {
+                const char *e = strchr(p, ',');
+                size_t len = e ? (size_t)(e - p) : strlen(p);
+                if (len == n && !strncmp(p, md->name, n))
+                    found = 1;
+                p += len + (e ? 1 : 0);
+            }
+            if (!found)
+                continue;
+        }
+        o.ert = md->ert;
+        o.ert_threshold = md->ert ? threshold : 1.0f;
+        o.share = md->share;
+        o.dlb = md->dlb;
+        for (int r = 0; r < repeat; r++) {
+            barrier_polite();
+            double t0 = MPI_Wtime();
+            rc = vfx_tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err);
+            double t = (MPI_Wtime() - t0) * 1e3, tmax = t;
+            MPI_Reduce(&t, &tmax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
+            if (rc != 0) {
+                if (rank == 0)
+                    fprintf(stderr, "volfx-tetvol-mpi: %s\n", err);
+                vfx_tet_mpi_destroy(ctx);
+                MPI_Finalize();
+                return 1;
+            }
+            times[r] = tmax;
+        }
+        if (rank != 0)
+            continue;
+        qsort(times, (size_t)repeat, sizeof *times, cmp_double);
+        double se = 0, mx = 0;
+        for (size_t i = 0; i < n4; i++) {
+            double e = fabs((double)img[i] - ref[i]);
+            se += e * e;
+            mx = fmax(mx, e);
+        }
+        uint64_t scanned = 0, skipped = 0, moved = 0, bytes = 0;
+        for (int r = 0; r < P; r++) {
+            scanned += all[r].cnt.cells_scanned;
+            skipped += all[r].cnt.cells_skipped_ert;
+            moved += all[r].cells_taken;
+            bytes += all[r].bytes_sent;
+        }
+        printf("{\"effect\":\"tetvol_mpi\",\"test\":\"mode\",\"mode\":\"%s\",\"ranks\":%d,"
+               "\"view\":\"%s\",\"median_ms\":%.1f,\"min_ms\":%.1f,\"max_ms\":%.1f,\"repeat\":%d,"
+               "\"cells_scanned\":%llu,\"cells_skipped_ert\":%llu,\"keys_moved\":%llu,"
+               "\"swap_bytes\":%llu,\"imbalance_t_sc\":%.2f,\"imbalance_cpu\":%.2f,"
+               "\"imbalance_scanned\":%.2f,"
+               "\"max_vs_one_process\":%.3g,\"rmse_vs_one_process\":%.3g",
+               md->name, P, view, times[repeat / 2], times[0], times[repeat - 1], repeat,
+               (unsigned long long)scanned, (unsigned long long)skipped,
+               (unsigned long long)moved, (unsigned long long)bytes,
+               imbalance(all, P, offsetof(vfx_tet_mpi_stats, cnt.t_sc_ms), 1),
+               imbalance(all, P, offsetof(vfx_tet_mpi_stats, t_phase1_cpu_ms), 1),
+               imbalance(all, P, offsetof(vfx_tet_mpi_stats, cnt.cells_scanned), 0), mx,
+               sqrt(se / n4));
+        print_array_d("t_sc_ms", all, P, offsetof(vfx_tet_mpi_stats, cnt.t_sc_ms));
+        print_array_d("t_setup_ms", all, P, offsetof(vfx_tet_mpi_stats, t_setup_ms));
+        print_array_d("t_phase1_ms", all, P, offsetof(vfx_tet_mpi_stats, t_phase1_ms));
+        print_array_d("t_export_ms", all, P, offsetof(vfx_tet_mpi_stats, t_export_ms));
+        print_array_d("t_phase1_cpu_ms", all, P, offsetof(vfx_tet_mpi_stats, t_phase1_cpu_ms));
+        print_array_d("t_comm_ms", all, P, offsetof(vfx_tet_mpi_stats, t_comm_ms));
+        print_array_d("t_idle_ms", all, P, offsetof(vfx_tet_mpi_stats, t_idle_ms));
+        print_array_u("polls", all, P, offsetof(vfx_tet_mpi_stats, polls));
+        print_array_d("t_swap_ms", all, P, offsetof(vfx_tet_mpi_stats, t_swap_ms));
+        print_array_d("t_gather_ms", all, P, offsetof(vfx_tet_mpi_stats, t_gather_ms));
+        print_array_u("scanned", all, P, offsetof(vfx_tet_mpi_stats, cnt.cells_scanned));
+        print_array_u("keys_done", all, P, offsetof(vfx_tet_mpi_stats, keys_done));
+        print_array_u("taken", all, P, offsetof(vfx_tet_mpi_stats, cells_taken));
+        print_array_u("segments_made", all, P, offsetof(vfx_tet_mpi_stats, cnt.segments_made));
+        print_array_u("segments_local", all, P, offsetof(vfx_tet_mpi_stats, segments_local));
+        print_array_u("segments_final", all, P, offsetof(vfx_tet_mpi_stats, segments_final));
+        print_array_u("swap_bytes_rank", all, P, offsetof(vfx_tet_mpi_stats, bytes_sent));
+        print_array_u("shares", all, P, offsetof(vfx_tet_mpi_stats, share_rounds));
+        print_array_u("reductions", all, P, offsetof(vfx_tet_mpi_stats, reductions));
+        printf("}\n");
+        fflush(stdout);
+    }
+    if (rank == 0 && ppm) {
+        /* premultiplied colour over black, rows flipped (row 0 is the bottom) */
+        FILE *f = fopen(ppm, "wb");
+        if (!f) {
+            fprintf(stderr, "volfx-tetvol-mpi: cannot write %s\n", ppm);
+        } else {
+            fprintf(f, "P6\n%d %d\n255\n", size, size);
+            for (int y = size - 1; y >= 0; y--)
+                for (int x = 0; x < size; x++)
+                    for (int k = 0; k < 3; k++) {
+                        float c = img[4 * ((size_t)y * size + x) + k];
+                        fputc((int)(255.0f * (c < 0 ? 0 : c > 1 ? 1 : c) + 0.5f), f);
+                    }
+            fclose(f);
+        }
+    }
+    vfx_tet_mpi_destroy(ctx);
+    free(img);
+    free(ref);
+    free(all);
+    free(times);
+    if (vtu || tetgen)
+        vfx_tet_mesh_free(&m);
+    else {
+        free(m.points);
+        free(m.scalar);
+        free(m.tets);
+    }
+    MPI_Finalize();
+    return 0;
+}

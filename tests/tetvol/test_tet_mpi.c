@@ -1,0 +1,389 @@
+/* Tests of the MPI backend of the tet renderer (run under mpirun by run-mpi.sh).
+ *   test_tet_mpi swap   — binary-swap composition alone against a direct float64 front-to-back
+ *                         composite of every rank's segments (any rank count, folds included);
+ *   test_tet_mpi render — the whole MPI renderer on a generated grid against the one-process
+ *                         renderer, ERT off and on, each SHARE/DLB combination, plus bad input.
+ * Plain C (no cmocka): a failed check prints and calls MPI_Abort, so no rank is left waiting in
+ * a collective the failing one skipped. */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <mpi.h>
+
+#include "tetvol/tet_mpi.h"
+#include "tetvol/tet_render.h"
+
+
+static int g_rank;
+
+#define CHECK(cond, ...)                                                                   \
+    do {                                                                                   \
+        if (!(cond)) {                                                                     \
+            fprintf(stderr, "rank %d: %s:%d: check failed: %s: ", g_rank, __FILE__,        \
+                    __LINE__, #cond);                                                      \
+            fprintf(stderr, __VA_ARGS__);                                                  \
+            fprintf(stderr, "\n");                                                         \
+            MPI_Abort(MPI_COMM_WORLD, 1);                                                  \
+        }                                                                                  \
+    } while (0)
+
+static uint32_t hash3(uint32_t a, uint32_t b, uint32_t c)
+{
+    uint32_t h = a * 0x9E3779B1u ^ (b + 0x7F4A7C15u) * 0x85EBCA77u ^ (c + 0x165667B1u) * 0xC2B2AE3Du;
+    h ^= h >> 15;
+    h *= 0x2C1B3C6Du;
+    h ^= h >> 12;
+    return h;
+}
+
+/* Global segment i of pixel p: [i, i + 1) when it touches its successor, else [i, i + 0.6);
+ * opacity and colour from the hash; owned by rank hash % P, so every rank's segments
+ * interleave with every other's along each ray. */
+static void swap_seg(uint32_t p, uint32_t i, int P, int *owner, vfx_tet_rseg *s)
+{
+    uint32_t h = hash3(p, i, 1);
+    *owner = (int)(hash3(p, i, 2) % (uint32_t)P);
+    float a = 0.05f + 0.3f * (float)(h & 1023) / 1023.0f;
+    s->zf = (float)i;
+    s->zb = (float)i + ((h >> 10) & 1 ? 1.0f : 0.6f);
+    s->a = a;
+    s->r = a * (float)((h >> 11) & 255) / 255.0f;
+    s->g = a * (float)((h >> 19) & 255) / 255.0f;
+    s->b = a * 0.5f;
+}
+
+static int test_swap(int P)
+{
+    enum { W = 13, H = 7, M = 24 }; /* odd sizes: the halves are unequal at every stage */
+    const size_t npix = (size_t)W * H;
+    char err[256];
+    for (int partial = 0; partial <= 1; partial++) {
+        vfx_tet_seglists l = {0, npix, calloc(npix + 1, sizeof(uint32_t)),
+                              calloc(npix * M + 1, sizeof(vfx_tet_rseg))};
+        CHECK(l.off && l.segs, "memory");
+        size_t n = 0;
+        for (size_t p = 0; p < npix; p++) {
+            l.off[p] = (uint32_t)n;
+            for (uint32_t i = 0; i < M; i++) {
+                int owner;
+                vfx_tet_rseg s;
+                swap_seg((uint32_t)p, i, P, &owner, &s);
+                if (owner == g_rank)
+                    l.segs[n++] = s;
+            }
+        }
+        l.off[npix] = (uint32_t)n;
+        float *img = g_rank == 0 ? calloc(npix * 4, sizeof *img) : NULL;
+        vfx_tet_mpi_stats st;
+        memset(&st, 0, sizeof st);
+        int rc = vfx_tet_mpi_composite(MPI_COMM_WORLD, W, H, &l, partial, img, &st, err);
+        CHECK(rc == VFX_OK, "composite failed: %s", err);
+        if (g_rank == 0) {
+            /* Reference: all segments in depth order, float64 front to back. Naive: each
+             * rank's own segments composited to a flat image, the images composited in rank
+             * order, which is what flat-image binary swap would do here. */
+            double emax = 0, naive_max = 0;
+            for (size_t p = 0; p < npix; p++) {
+                double ref[4] = {0, 0, 0, 0}, flat[8][4], nv[4] = {0, 0, 0, 0};
+                memset(flat, 0, sizeof flat);
+                for (uint32_t i = 0; i < M; i++) {
+                    int owner;
+                    vfx_tet_rseg s;
+                    swap_seg((uint32_t)p, i, P, &owner, &s);
+                    double c[4] = {s.r, s.g, s.b, s.a};
+                    double t = 1 - ref[3], tf = 1 - flat[owner][3];
+                    for (int k = 0; k < 4; k++) {
+                        ref[k] += t * c[k];
+                        flat[owner][k] += tf * c[k];
+                    }
+                }
+                for (int r = 0; r < P && r < 8; r++) {
+                    double t = 1 - nv[3];
+                    for (int k = 0; k < 4; k++)
+                        nv[k] += t * flat[r][k];
+                }
+                for (int k = 0; k < 4; k++) {
+                    emax = fmax(emax, fabs(img[4 * p + k] - ref[k]));
+                    naive_max = fmax(naive_max, fabs(nv[k] - ref[k]));
+                }
+            }
+            printf("swap P=%d partial=%d: max |mpi - float64| %.3g, flat rank-order composite "
+                   "would be off by %.3g\n", P, partial, emax, naive_max);
+            /* float32 over of <= 24 segments: each step rounds at ~6e-8 relative, the
+             * accumulated error is below 24 * 1.2e-7 ~ 3e-6; 1e-5 leaves margin while a
+             * segment composited out of order changes values by >= 1e-2 */
+            CHECK(emax < 1e-5, "binary swap differs from the reference by %g", emax);
+            if (P > 1) /* the data does interleave: a fixed-order composite would be wrong */
+                CHECK(naive_max > 0.05, "test data does not interleave (%g)", naive_max);
+            free(img);
+        }
+        /* every rank ends with a part of the screen; the parts cover it exactly */
+        unsigned long long px = st.pixels_final, total = 0;
+        MPI_Reduce(&px, &total, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
+        if (g_rank == 0)
+            CHECK(total == npix, "final parts cover %llu of %zu pixels", total, npix);
+    }
+    return 0;
+}
+
+static const uint32_t cube5[20] = {0, 1, 3, 4, 1, 2, 3, 6, 1, 4, 5, 6, 3, 4, 6, 7, 1, 3, 4, 6};
+
+/* n^3 cubes x 5 tets in [-1,1]^3 with a smooth scalar; when shuffle is set the cell order is
+ * permuted so that every rank's partition is scattered through the volume (its cells
+ * interleave in depth with every other rank's). */
+static void make_grid(int n, int shuffle, vfx_tet_mesh *m)
+{
+    uint32_t np = (uint32_t)((n + 1) * (n + 1) * (n + 1)), nt = (uint32_t)(n * n * n * 5);
+    memset(m, 0, sizeof *m);
+    m->points = malloc((size_t)np * 3 * sizeof(float));
+    m->scalar = malloc((size_t)np * sizeof(float));
+    m->tets = malloc((size_t)nt * 4 * sizeof(uint32_t));
+    CHECK(m->points && m->scalar && m->tets, "memory");
+    for (int k = 0, i = 0; k <= n; k++)
+        for (int j = 0; j <= n; j++)
+            for (int l = 0; l <= n; l++, i++) {
+                float x = -1 + 2.0f * l / n, y = -1 + 2.0f * j / n, z = -1 + 2.0f * k / n;
+                m->points[3 * i] = x;
+                m->points[3 * i + 1] = y;
+                m->points[3 * i + 2] = z;
+                m->scalar[i] = 0.5f + 0.5f * sinf(3 * x) * cosf(2 * y) * cosf(1.5f * z);
+            }
+    uint32_t t = 0;
+    for (int k = 0; k < n; k++)
+        for (int j = 0; j < n; j++)
+            for (int l = 0; l < n; l++) {
+                uint32_t c[8];
+                for (int q = 0; q < 8; q++)
+                    c[q] = (uint32_t)((k + (q >> 2 & 1)) * (n + 1) * (n + 1) +
+                                      (j + (q >> 1 & 1)) * (n + 1) + l + (q & 1));
+                uint32_t o8[8] = {c[0], c[1], c[3], c[2], c[4], c[5], c[7], c[6]};
+                static const uint32_t mirror[8] = {1, 0, 3, 2, 5, 4, 7, 6};
+                int flip = (l + j + k) & 1;
+                for (int q = 0; q < 20; q++)
+                    m->tets[(size_t)t * 4 + q] = o8[flip ? mirror[cube5[q]] : cube5[q]];
+                t += 5;
+            }
+    if (shuffle)
+        for (uint32_t i = nt - 1; i > 0; i--) {
+            uint32_t j = hash3(i, 17, 3) % (i + 1), tmp[4];
+            memcpy(tmp, &m->tets[4 * i], sizeof tmp);
+            memcpy(&m->tets[4 * i], &m->tets[4 * j], sizeof tmp);
+            memcpy(&m->tets[4 * j], tmp, sizeof tmp);
+        }
+    m->point_count = np;
+    m->tet_count = nt;
+    m->scalar_min = 0;
+    m->scalar_max = 1;
+}
+
+/* view rotated about x then y, eye at distance dist, 60 degree fov */
+static void make_cam(vfx_tet_camera *c, int w, int h, float yaw, float pitch, float dist)
+{
+    memset(c, 0, sizeof *c);
+    c->width = w;
+    c->height = h;
+    float cy = cosf(yaw), sy = sinf(yaw), cp = cosf(pitch), sp = sinf(pitch);
+    float R[9] = {cy, sp * sy, -cp * sy, 0, cp, sp, sy, -sp * cy, cp * cy};
+    for (int col = 0; col < 3; col++)
+        for (int r = 0; r < 3; r++)
+            c->view[col * 4 + r] = R[col * 3 + r];
+    c->view[14] = -dist;
+    c->view[15] = 1;
+    float f = 1.0f / tanf(0.5f * 1.0471976f), near = 0.1f, far = 100.0f;
+    c->proj[0] = f * h / (float)w;
+    c->proj[5] = f;
+    c->proj[10] = (far + near) / (near - far);
+    c->proj[11] = -1;
+    c->proj[14] = 2 * far * near / (near - far);
+}
+
+static double max_diff(const float *a, const float *b, size_t n)
+{
+    double m = 0;
+    for (size_t i = 0; i < n; i++)
+        m = fmax(m, fabs(a[i] - b[i]));
+    return m;
+}
+
+static int test_render(int P)
+{
+    enum { W = 48, H = 40 };
+    const size_t n4 = (size_t)W * H * 4;
+    vfx_tet_camera cam;
+    make_cam(&cam, W, H, 0.6f, 0.4f, 4.0f);
+    vfx_tet_tf tf;
+    memset(&tf, 0, sizeof tf);
+    tf.smin = 0;
+    tf.smax = 1;
+    tf.tau_lo = 4.0f;
+    tf.tau_hi = 20.0f;
+    tf.color_lo[0] = 0.1f; tf.color_lo[1] = 0.3f; tf.color_lo[2] = 1.0f;
+    tf.color_hi[0] = 1.0f; tf.color_hi[1] = 0.6f; tf.color_hi[2] = 0.1f;
+    char err[256];
+    vfx_tet_mpi *ctx;
+    CHECK(vfx_tet_mpi_create(MPI_COMM_WORLD, &ctx, err) == VFX_OK, "%s", err);
+    vfx_tet_mpi_stats *all = calloc((size_t)P, sizeof *all);
+    float *ref = calloc(n4, sizeof *ref), *img = calloc(n4, sizeof *img);
+    CHECK(all && ref && img, "memory");
+    for (int shuffle = 0; shuffle <= 1; shuffle++) {
+        vfx_tet_mesh m;
+        make_grid(7, shuffle, &m);
+        vfx_tet_options o;
+        vfx_tet_options_default(&o);
+        o.tiles_d = 8;
+        o.update_c = 50;
+        /* one-process reference (every rank computes it; only rank 0 compares) */
+        vfx_tet_counters c0;
+        o.ert = 0;
+        o.ert_threshold = 1.0f; /* the same partial-compositing stop as an ERT-1.0 run */
+        CHECK(vfx_tet_render(&m, &cam, &tf, &o, ref, &c0, err) == VFX_OK, "%s", err);
+        for (int mode = 0; mode < 4; mode++) {
+            o.share = mode & 1;
+            o.dlb = (mode >> 1) & 1;
+            /* ERT off: the same segments, composited in the same depth order; only the float
+             * association of partial compositing differs (different segments meet on each
+             * rank and in each swap stage): 1e-5 is ~100 ulps of values <= 1 */
+            o.ert = 0;
+            o.ert_threshold = 1.0f;
+            CHECK(vfx_tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err) ==
+                      VFX_OK, "%s", err);
+            if (g_rank == 0) {
+                double d = max_diff(ref, img, n4);
+                uint64_t keys = 0, scanned = 0, taken = 0, given = 0;
+                for (int r = 0; r < P; r++) {
+                    keys += all[r].keys_done;
+                    scanned += all[r].cnt.cells_scanned;
+                    taken += all[r].cells_taken;
+                    given += all[r].cells_given;
+                }
+                printf("P=%d shuffle=%d share=%d dlb=%d ERT off: max diff %.3g, scanned %llu "
+                       "(1 process %llu), moved by DLB %llu\n", P, shuffle, o.share, o.dlb, d,
+                       (unsigned long long)scanned, (unsigned long long)c0.cells_scanned,
+                       (unsigned long long)taken);
+                CHECK(d < 1e-5, "ERT off differs from one process by %g", d);
+                /* every key is processed exactly once, whoever ends up with it */
+                CHECK(keys == m.tet_count, "keys processed %llu of %u", (unsigned long long)keys,
+                      m.tet_count);
+                CHECK(scanned == c0.cells_scanned, "scanned %llu vs %llu",
+                      (unsigned long long)scanned, (unsigned long long)c0.cells_scanned);
+                CHECK(taken == given, "taken %llu given %llu", (unsigned long long)taken,
+                      (unsigned long long)given);
+                CHECK(o.dlb || taken == 0, "work moved without DLB");
+            }
+            /* ERT 0.9: a skipped cell lies behind pixels of opacity >= 0.9, so its light is
+             * attenuated by >= 0.9: each variant stays within 1 - 0.9 = 0.1 of no-ERT */
+            o.ert = 1;
+            o.ert_threshold = 0.9f;
+            CHECK(vfx_tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err) ==
+                      VFX_OK, "%s", err);
+            if (g_rank == 0) {
+                double d = max_diff(ref, img, n4);
+                uint64_t skipped = 0, rounds = 0;
+                for (int r = 0; r < P; r++) {
+                    skipped += all[r].cnt.cells_skipped_ert;
+                    rounds += all[r].share_rounds;
+                }
+                printf("P=%d shuffle=%d share=%d dlb=%d ERT 0.9: max diff %.3g, skipped %llu, "
+                       "table exchanges %llu\n", P, shuffle, o.share, o.dlb, d,
+                       (unsigned long long)skipped, (unsigned long long)rounds);
+                CHECK(d <= 0.1 + 1e-5, "ERT 0.9 differs from no-ERT by %g", d);
+                CHECK(skipped > 0, "ERT skipped nothing");
+            }
+        }
+        /* bad input: every rank reports the same error naming the tet, no rank hangs */
+        uint32_t keep = m.tets[4 * 5 + 2];
+        m.tets[4 * 5 + 2] = m.point_count + 3;
+        int rc = vfx_tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err);
+        CHECK(rc == VFX_ERR_INVALID_ARGUMENT && strstr(err, "tet 5"), "rc %d: %s", rc, err);
+        m.tets[4 * 5 + 2] = keep;
+        free(m.points);
+        free(m.scalar);
+        free(m.tets);
+    }
+    /* Load balancing moves work: the first half of the cells (ranks 0..P/2-1) is the grid in
+     * view, the second half the same grid far off screen (each such cell costs a bounding-box
+     * test), so the upper ranks run dry at once and must take keys from the lower ones. The
+     * image must still equal the one-process image. Whether a request arrives while the
+     * victim still has keys depends on scheduling (other processes share the 2 cores), so up
+     * to 8 tries must show at least one move. */
+    {
+        vfx_tet_mesh g, m;
+        make_grid(7, 0, &g);
+        m = g;
+        m.point_count = 2 * g.point_count;
+        m.tet_count = 2 * g.tet_count;
+        m.points = malloc((size_t)m.point_count * 3 * sizeof(float));
+        m.scalar = malloc((size_t)m.point_count * sizeof(float));
+        m.tets = malloc((size_t)m.tet_count * 4 * sizeof(uint32_t));
+        CHECK(m.points && m.scalar && m.tets, "memory");
+        for (uint32_t i = 0; i < g.point_count; i++)
+            for (int r = 0; r < 3; r++) {
+                m.points[3 * i + r] = g.points[3 * i + r];
+                m.points[3 * (g.point_count + i) + r] = g.points[3 * i + r] + (r == 0 ? 100.0f : 0);
+            }
+        memcpy(m.scalar, g.scalar, g.point_count * sizeof(float));
+        memcpy(m.scalar + g.point_count, g.scalar, g.point_count * sizeof(float));
+        for (size_t i = 0; i < (size_t)g.tet_count * 4; i++) {
+            m.tets[i] = g.tets[i];
+            m.tets[(size_t)g.tet_count * 4 + i] = g.tets[i] + g.point_count;
+        }
+        vfx_tet_options o;
+        vfx_tet_options_default(&o);
+        o.tiles_d = 8;
+        o.update_c = 50;
+        o.ert = 0;
+        o.ert_threshold = 1.0f;
+        CHECK(vfx_tet_render(&g, &cam, &tf, &o, ref, NULL, err) == VFX_OK, "%s", err);
+        int moved = 0;
+        for (int attempt = 0; attempt < 8 && !moved; attempt++) {
+            CHECK(vfx_tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err) ==
+                      VFX_OK, "%s", err);
+            if (g_rank == 0) {
+                double d = max_diff(ref, img, n4);
+                uint64_t taken = 0, given = 0, keys = 0;
+                for (int r = 0; r < P; r++) {
+                    taken += all[r].cells_taken;
+                    given += all[r].cells_given;
+                    keys += all[r].keys_done;
+                }
+                printf("P=%d imbalanced, DLB: try %d moved %llu keys, max diff %.3g\n", P,
+                       attempt, (unsigned long long)taken, d);
+                CHECK(d < 1e-5, "DLB image differs from one process by %g", d); /* as above */
+                CHECK(taken == given && keys == m.tet_count, "taken %llu given %llu keys %llu",
+                      (unsigned long long)taken, (unsigned long long)given,
+                      (unsigned long long)keys);
+                moved = taken > 0;
+            }
+            MPI_Bcast(&moved, 1, MPI_INT, 0, MPI_COMM_WORLD);
+        }
+        if (g_rank == 0)
+            CHECK(moved, "dynamic load balancing never moved work in 8 tries");
+        free(m.points); free(m.scalar); free(m.tets);
+        free(g.points); free(g.scalar); free(g.tets);
+    }
+    vfx_tet_mpi_destroy(ctx);
+    free(all);
+    free(ref);
+    free(img);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    MPI_Init(&argc, &argv);
+    int P;
+    MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &P);
+    const char *mode = argc > 1 ? argv[1] : "render";
+    if (strcmp(mode, "swap") == 0)
+        test_swap(P);
+    else
+        test_render(P);
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (g_rank == 0)
+        printf("ok (%d ranks, %s)\n", P, mode);
+    MPI_Finalize();
+    return 0;
+}
