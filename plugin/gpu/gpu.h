@@ -21,7 +21,7 @@ GLuint vfx_gpu_compute(vfx_context *ctx, const char *comp, const char *defines);
 
 /* Opens a named pass: a debug group (RenderDoc shows it) and a timestamp pair. Names are
  * "effect.pass", e.g. "water.accumulate"; the GPU ms of the pass reach the stats as
- * "<name>.gpu_ms" a few frames later, without stalling. */
+ * "<name>.gpu_ms" a few frames later, without stalling (passes of one name in a frame summed). */
 void vfx_gpu_pass_begin(vfx_context *ctx, const char *name);
 /* Closes the innermost open pass. */
 void vfx_gpu_pass_end(vfx_context *ctx);
