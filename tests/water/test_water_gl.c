@@ -380,6 +380,32 @@ static void test_grid_all_nan(void **state)
     free_scene(&s);
 }
 
+/* An unknown method value: the frame fails with a message naming it (nothing silently drawn). */
+static void test_unknown_method(void **state)
+{
+    (void)state;
+    scene s = make_scene(3);
+    s.params.method = 7;
+    for (uint32_t k = 0; k < 3; ++k) s.x[k] = s.y[k] = s.z[k] = 0.1f * (float)k;
+    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &s,
+                         .log = vfx_test_log_fn, .particle_chunk_count = chunk_count,
+                         .particle_chunk = chunk_view, .water_params = water_params};
+    vfx_plugin_api api = {.size = sizeof api};
+    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
+    vfx_context *ctx;
+    assert_int_equal(api.create(&host, &ctx), VFX_OK);
+    vfx_ref_camera cam = {{0, 0, 3.0}, {0, 0, 0}, {0, 1, 0}, 0.6, 16, 16, 0.1, 100};
+    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = 0,
+                         .width = 16, .height = 16, .fov_y = 0.6f, .near_plane = 0.1f, .far_plane = 100.0f};
+    fv.eye[2] = 3.0f;
+    vfx_ref_camera_matrices(&cam, fv.view, fv.proj);
+    assert_int_equal(api.update(ctx, 0.0, 0.0f), VFX_OK);
+    assert_int_equal(api.render(ctx, &fv), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(api.last_error(ctx), "unknown method 7"));
+    api.destroy(ctx);
+    free_scene(&s);
+}
+
 /* Zero particles: the effect is absent, no state, no pass, no stat. */
 static void test_zero_particles(void **state)
 {
@@ -406,6 +432,7 @@ int main(void)
         cmocka_unit_test(test_grid_blobs_vs_reference),
         cmocka_unit_test(test_grid_h_extremes),
         cmocka_unit_test(test_grid_all_nan),
+        cmocka_unit_test(test_unknown_method),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     vfx_gl_context_destroy(gl); /* LeakSanitizer in CI's sanitizer run checks this */
