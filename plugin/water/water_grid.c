@@ -128,14 +128,16 @@ vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, g->start);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, g->blocks);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, g->sorted);
-    GLuint groups_p = (in->count + 63u) / 64u, blocks = need / 1024u;
+    /* per-particle passes as 2D dispatches: GL promises only 65535 groups per dimension */
+    GLuint groups = (in->count + 63u) / 64u, blocks = need / 1024u;
+    GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
 
     vfx_gpu_pass_begin(ctx, "water.grid_build");
     glClearNamedBufferSubData(g->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     glUseProgram(count);
     grid_uniforms(count, in, g0, cs, dims, nscan);
-    if (groups_p)
-        glDispatchCompute(groups_p, 1, 1);
+    if (groups)
+        glDispatchCompute(gx, gy, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     glUseProgram(scan);
     grid_uniforms(scan, in, g0, cs, dims, nscan);
@@ -153,8 +155,8 @@ vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_
     glClearNamedBufferSubData(g->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     glUseProgram(scatter);
     grid_uniforms(scatter, in, g0, cs, dims, nscan);
-    if (groups_p)
-        glDispatchCompute(groups_p, 1, 1);
+    if (groups)
+        glDispatchCompute(gx, gy, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     vfx_gpu_pass_end(ctx);
 

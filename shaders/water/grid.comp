@@ -53,6 +53,11 @@ uniform uint u_max_samples, u_refine_iters;
 uniform bool u_has_depth, u_seek_init, u_seek_gaps;
 uniform vec3 u_blo, u_bhi; // particles' box grown by h: no potential outside it
 
+// llvmpipe ends every loop of an invocation after 65535 iterations in all (one budget shared
+// by all loops, LP_MAX_TGSI_LOOP_ITERATIONS), which would leave holes where rays take many
+// samples in dense cells: the loops over a row's particles take 4 per iteration.
+#define X4(M, j) M(j) M(j + 1u) M(j + 2u) M(j + 3u)
+
 // sum_j P(|x - p_j|) over the cells x's h-ball touches.
 float pot_sum(vec3 x)
 {
@@ -62,14 +67,11 @@ float pot_sum(vec3 x)
         for (int y = lo.y; y <= hi.y; ++y) {
             uint row = linear(ivec3(0, y, z));
             uint a = start[row + uint(lo.x)], b = start[row + uint(hi.x) + 1u];
-            for (uint j = a; j < b; ++j) {
-                vec3 d = x - sorted[j].xyz;
-                float r2 = dot(d, d);
-                if (r2 < h2) {
-                    float q = 1.0 - sqrt(r2) / u_h;
-                    s += q * q;
-                }
-            }
+#define POT(j) { vec3 d = x - sorted[j].xyz; float r2 = dot(d, d); \
+    if (r2 < h2) { float q = 1.0 - sqrt(r2) / u_h; s += q * q; } }
+            uint j = a;
+            for (; j + 4u <= b; j += 4u) { X4(POT, j) }
+            for (; j < b; ++j) POT(j)
         }
     return s;
 }
@@ -85,14 +87,12 @@ float next_entry(vec3 dir, float t0, ivec3 c, inout uint tests)
             uint row = linear(ivec3(0, y, z));
             uint a = start[row + uint(lo.x)], b = start[row + uint(hi.x) + 1u];
             tests += b - a;
-            for (uint j = a; j < b; ++j) {
-                vec3 oc = u_eye - sorted[j].xyz;
-                float bb = dot(oc, dir), disc = bb * bb - (dot(oc, oc) - h2);
-                if (disc > 0.0) {
-                    float sq = sqrt(disc);
-                    if (-bb + sq > t0) best = min(best, max(t0, -bb - sq));
-                }
-            }
+#define ENTRY(j) { vec3 oc = u_eye - sorted[j].xyz; \
+    float bb = dot(oc, dir), disc = bb * bb - (dot(oc, oc) - h2); \
+    if (disc > 0.0) { float sq = sqrt(disc); if (-bb + sq > t0) best = min(best, max(t0, -bb - sq)); } }
+            uint j = a;
+            for (; j + 4u <= b; j += 4u) { X4(ENTRY, j) }
+            for (; j < b; ++j) ENTRY(j)
         }
     return best;
 }
@@ -118,7 +118,8 @@ float cell_exit(vec3 dir, ivec3 c)
 void main()
 {
 #if defined(MODE_COUNT) || defined(MODE_SCATTER)
-    uint i = gl_GlobalInvocationID.x;
+    // 2D dispatch: past 65535 groups of 64 (4.2 M particles) the x count alone may not suffice
+    uint i = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 64u;
     if (i >= u_count) return;
     vec3 p = vec3(px[i], py[i], pz[i]);
     if (any(isnan(p)) || any(isinf(p))) return; // skipped (counted on the CPU)
