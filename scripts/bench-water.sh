@@ -4,6 +4,8 @@
 # stdout and the error-vs-time plot into docs/img/water-error-vs-time.png.
 # Usage: scripts/bench-water.sh [build dir, default build]
 #   PLOT_ONLY=1 scripts/bench-water.sh   re-prints the tables and plot from an existing $OUT
+#   SECTION=repeat scripts/bench-water.sh   re-runs one section (table1, ablation, sweep,
+#                                          repeat) into an existing $OUT, replacing its rows
 # Every run uses flat shading (--disable 64): the shading pass is not what is compared here.
 # llvmpipe budget: configurations expected over ~1 minute a frame are run with 1 frame and no
 # warm-up, or skipped (listed in SKIPPED below and printed).
@@ -17,10 +19,13 @@ run() { # section, then volfx-bench metaballs options
   echo "  $sec: $*" >&2
   "$B/sample_game/volfx-bench" metaballs --reference "$@" 2>/dev/null | sed "s/^{/{\"section\":\"$sec\",/" >> "$OUT"
 }
+want() { [ -z "$SECTION" ] || [ "$SECTION" = "$1" ]; }
 if [ -z "$PLOT_ONLY" ]; then
 ninja -C "$B" >/dev/null
-: > "$OUT"
+if [ -z "$SECTION" ]; then : > "$OUT"; else
+  grep -v "\"section\":\"$SECTION\"" "$OUT" > "$OUT.tmp" || true; mv "$OUT.tmp" "$OUT"; fi
 F="--disable 64"
+if want table1; then
 # --- Table 1 of the paper: 4,096 / 16,384 / 65,536 particles at 128^2 / 256^2 / 512^2
 for n in 4096 16384 65536; do
   run table1 --method grid --particles $n --size 128 --size 256 --size 512 --frames 5 $F
@@ -31,9 +36,13 @@ run table1 --method paper --particles 16384 --particles 65536 --size 128 --frame
 run table1 --method paper --particles 16384 --size 256 --size 512 --frames 1 --warmup 0 $F
 run table1 --method paper --particles 65536 --size 256 --frames 1 --warmup 0 $F
 run table1 --method brute --particles 4096 --size 128 --frames 1 --warmup 0 $F
+fi
+if want ablation; then
 # --- ablation at 4,096 / 128^2: each technique off in turn (bits of VFX_WATER_NO_*)
 for d in 0 1 2 4 8 16 32; do run ablation --method paper --particles 4096 --size 128 --frames 1 --disable $((d | 64)); done
 for d in 0 1 2 3; do run ablation --method grid --particles 4096 --size 128 --frames 3 --disable $((d | 64)); done
+fi
+if want sweep; then
 # --- quality knobs at 4,096 / 128^2: sample cap (Fig. 12: 16 / 32 / 54), step, refinement, pyramid
 for m in paper grid; do
   fr=1; [ $m = grid ] && fr=3
@@ -44,6 +53,15 @@ for m in paper grid; do
 done
 for l in 1 2 4 5; do run sweep --method paper --particles 4096 --size 128 --frames 1 --pyramid $l $F; done
 for c in 16 32; do run sweep --method brute --particles 4096 --size 128 --frames 1 --warmup 0 --samples $c $F; done
+fi
+if want repeat; then
+# --- the equal-error settings again, three interleaved rounds (4,096 / 128^2): run-to-run spread
+for r in 1 2 3; do
+  run repeat --method paper --particles 4096 --size 128 --frames 1 --samples 32 $F
+  run repeat --method grid --particles 4096 --size 128 --frames 3 --samples 54 $F
+  run repeat --method brute --particles 4096 --size 128 --frames 1 --warmup 0 --samples 16 $F
+done
+fi
 fi
 /usr/bin/python3 - "$OUT" "$PNG" "$SKIPPED" <<'PY'
 import json, sys
@@ -122,6 +140,18 @@ if ref:
                   "%.1f" % (d["frame_ms"]["p50"] / best["grid"]["frame_ms"]["p50"]) if "grid" in best else "-"))
         else:
             print("| %s | none of the sweep's settings | - | - |" % m)
+rp = [d for d in rows if d.get("section") == "repeat"]
+if rp:
+    print("\nRepeats of the equal-error settings (4,096 / 128^2), three interleaved rounds:\n")
+    print("| round | paper cap 32 ms | grid cap 54 ms | brute cap 16 ms | paper / grid | brute / grid |")
+    print("|---|---|---|---|---|---|")
+    rounds = [rp[i:i + 3] for i in range(0, len(rp) - 2, 3)]
+    pr, br = [], []
+    for i, (p, g, b) in enumerate(rounds):
+        pr.append(p["frame_ms"]["p50"] / g["frame_ms"]["p50"]); br.append(b["frame_ms"]["p50"] / g["frame_ms"]["p50"])
+        print("| %d | %.0f | %.0f | %.0f | %.1f | %.1f |" % (i + 1, p["frame_ms"]["p50"], g["frame_ms"]["p50"], b["frame_ms"]["p50"], pr[-1], br[-1]))
+    med = lambda v: sorted(v)[len(v) // 2]
+    print("\nMedian ratios over the rounds: paper / grid %.1f, brute / grid %.1f." % (med(pr), med(br)))
 try:
     import matplotlib
     matplotlib.use("Agg")
