@@ -80,7 +80,7 @@ def knobs(d):
     dis = d["disable"] & ~64
     return "cap %d, w h*%g, refine %s, pyr %d%s" % (d["max_samples"], d["step_h"], "0" if dis & 32 else d["refine"], d["pyramid"],
                                                    ", off %d" % dis if dis else "")
-print("### Table 1 (paper layout; the paper's Table 1 fps in brackets)\n")
+print("### Table 1 (paper layout; the paper's Table 1 fps on a GeForce 8800 GTX in parentheses)\n")
 paper_fps = {(4096, 128): 60, (16384, 128): 37, (65536, 128): 12, (4096, 256): 35, (16384, 256): 21,
              (65536, 256): 7, (4096, 512): 11, (16384, 512): 10, (65536, 512): 3}
 print("| method | particles | size | frames | frame ms p50 | fps | ms per pass (GPU timers) | hole rate | false hits | dist mean/h | dist p99/h | samples |")
