@@ -10,6 +10,7 @@ pkgs=(
   libopenmpi-dev openmpi-bin
   assimp-testmodels tetgen
   xvfb xauth
+  python3-matplotlib   # scripts/bench-water.sh plots with /usr/bin/python3
   "$@"
 )
 missing=()

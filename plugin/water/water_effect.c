@@ -2,8 +2,8 @@
  * depth test (eq. 1), potentials by additive blending into RGBA16F at 4 samples per texel,
  * sample update with two distance buffers and depth-tested gap jumping (eqs. 2-4), min/max
  * pyramid culling, eq. 5 interpolation and eq. 6 regula falsi (each pass again by blending).
- * Method BRUTE: per-pixel compute march over every particle. Method GRID is not written yet
- * and falls back to BRUTE with a counter (water.method_fallback) and a one-time warning. */
+ * Method BRUTE: per-pixel compute march over every particle. Method GRID: per-pixel compute
+ * march over a uniform grid built on the GPU (water_grid.c). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -11,6 +11,7 @@
 #include "water/water_effect.h"
 #include "gpu/gpu.h"
 #include "plugin_internal.h"
+#include "water_grid.h"
 
 /* Counter readback ring: frames the GPU may run behind before a result is dropped. */
 #define WATER_COUNTER_RING 3
@@ -41,7 +42,7 @@ typedef struct water_state {
     uint32_t nan_count;
     uint32_t width, height;
     vfx_water_params params;
-    int warned_fallback;
+    vfx_water_grid *grid;  /* GRID baseline state, made the first time GRID is asked for */
     float lo[3], hi[3];    /* box of the finite particles */
     /* paper pipeline targets */
     GLuint cur, next1, pot, st, br, reft, depth, pyr, fbo_dist, fbo_pot, counters;
@@ -138,6 +139,7 @@ static void water_destroy(vfx_context *ctx, void *state)
     water_state *s = state;
     groups_free(ctx, s);
     paper_free(s);
+    vfx_water_grid_destroy(ctx, s->grid);
     glDeleteVertexArrays(1, &s->vao);
     for (int k = 0; k < WATER_COUNTER_RING; ++k)
         if (s->fence[k])
@@ -391,13 +393,6 @@ static vfx_result brute_march(vfx_context *ctx, water_state *s, const vfx_frame_
                               vfx_frame_targets *targets)
 {
     const vfx_water_params *p = &s->params;
-    if (p->method != VFX_WATER_METHOD_BRUTE) {
-        vfx_stat_set(ctx, "water.method_fallback", 1);
-        if (!s->warned_fallback) {
-            vfx_log(ctx, VFX_LOG_WARN, "water: method %u (grid) is not implemented yet; rendering with the brute-force baseline", p->method);
-            s->warned_fallback = 1;
-        }
-    }
     GLuint prog = vfx_gpu_compute(ctx, "water/brute.comp", NULL);
     if (!prog)
         return VFX_ERR_GL;
@@ -749,6 +744,16 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
     return VFX_OK;
 }
 
+static vfx_result grid_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
+                             const vfx_frame_targets *targets)
+{
+    if (!s->grid && !(s->grid = vfx_water_grid_create(ctx)))
+        return VFX_ERR_OUT_OF_MEMORY;
+    vfx_water_grid_input in = {s->cols, s->count, s->count - s->nan_count, s->lo, s->hi, &s->params,
+                               s->width, s->height, ctx->water_dist_tex};
+    return vfx_water_grid_render(ctx, s->grid, &in, frame, targets);
+}
+
 static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
                                vfx_frame_targets *targets)
 {
@@ -767,8 +772,15 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     glClearNamedBufferData(s->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     vfx_stat_set(ctx, "water.particles", s->count);
     vfx_stat_set(ctx, "water.nan_skipped", s->nan_count);
-    vfx_result r = p->method == VFX_WATER_METHOD_PAPER ? paper_march(ctx, s, frame, targets)
-                                                       : brute_march(ctx, s, frame, targets);
+    vfx_result r;
+    if (p->method == VFX_WATER_METHOD_PAPER)
+        r = paper_march(ctx, s, frame, targets);
+    else if (p->method == VFX_WATER_METHOD_BRUTE)
+        r = brute_march(ctx, s, frame, targets);
+    else if (p->method == VFX_WATER_METHOD_GRID)
+        r = grid_march(ctx, s, frame, targets);
+    else
+        r = vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: unknown method %u in vfx_water_params (0 paper, 1 brute, 2 grid)", p->method);
     if (r != VFX_OK)
         return r;
     if (!(p->disable & VFX_WATER_NO_SHADING) && (r = surface_passes(ctx, s, frame, targets)) != VFX_OK)

@@ -1,7 +1,9 @@
 /* bench_water.c — volfx-bench metaballs: frame time of the water effect on the paper's layout
  * (24x24 square layers stacked, spacing 0.3), one JSON object per configuration.
  * Options: --particles N (repeatable) --size S (repeatable) --frames F --reference
- * --method paper|brute|grid --disable BITS (VFX_WATER_NO_*) --samples CAP. */
+ * --method paper|brute|grid --disable BITS (VFX_WATER_NO_*) --samples CAP --step W (in units of h)
+ * --refine ITERS --pyramid LEVEL --warmup 0|1 (default 1: one untimed frame first, which
+ * compiles the shaders). Per-pass GPU ms (counters *.gpu_ms) need at least 4 frames. */
 #include <epoxy/gl.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,7 +19,9 @@
 typedef struct bench_scene {
     float *x, *y, *z;
     uint32_t n;
-    uint32_t method, disable, max_samples;
+    uint32_t method, disable, max_samples, refine, pyramid;
+    float step_h; /* step in units of h; 0 -> default (1/8) */
+    int no_warmup;
 } bench_scene;
 
 static uint32_t bench_chunks(void *user) { return ((bench_scene *)user)->n ? 1 : 0; }
@@ -42,6 +46,9 @@ static vfx_result bench_params(void *user, vfx_water_params *out)
     out->method = s->method;
     out->disable = s->disable;
     out->max_samples = s->max_samples;
+    out->refine_iters = s->refine;
+    out->pyramid_level = s->pyramid;
+    out->step = s->step_h > 0 ? s->step_h * 0.61f : 0.0f;
     return VFX_OK;
 }
 
@@ -54,10 +61,13 @@ static double now_ms(void)
 
 static const char *method_name(uint32_t m) { return m == 0 ? "paper" : m == 1 ? "brute" : "grid"; }
 
-static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, uint32_t method,
-                   uint32_t disable, uint32_t max_samples)
+static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, const bench_scene *opt)
 {
-    bench_scene s = {malloc(n * 4), malloc(n * 4), malloc(n * 4), n, method, disable, max_samples};
+    bench_scene s = *opt;
+    s.x = malloc(n * 4);
+    s.y = malloc(n * 4);
+    s.z = malloc(n * 4);
+    s.n = n;
     vfx_water_ref_layers(n, 0.3, s.x, s.y, s.z);
     double top = (double)((n - 1) / 576) * 0.3;
     vfx_ref_camera cam = {{0, top + 4.0, 8.0}, {0, top * 0.5, 0}, {0, 1, 0}, 0.9, size, size, 0.1, 100};
@@ -81,6 +91,11 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, ui
     vfx_ref_camera_matrices(&cam, fv.view, fv.proj);
     double *ms = malloc(frames * sizeof *ms);
     int rc = 0;
+    if (!s.no_warmup && (api.update(ctx, 0.0, 1.f / 60.f) != VFX_OK || api.render(ctx, &fv) != VFX_OK)) {
+        fprintf(stderr, "metaballs: warm-up frame failed: %s\n", api.last_error(ctx));
+        rc = 1;
+    }
+    glFinish();
     for (uint32_t f = 0; f < frames && rc == 0; ++f) {
         double t0 = now_ms();
         if (api.update(ctx, f / 60.0, 1.f / 60.f) != VFX_OK || api.render(ctx, &fv) != VFX_OK) {
@@ -91,9 +106,11 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, ui
         ms[f] = now_ms() - t0;
     }
     double p50 = vfx_median(ms, frames);
-    printf("{\"effect\":\"metaballs\",\"method\":\"%s\",\"disable\":%u,\"max_samples\":%u,\"particles\":%u,\"width\":%u,\"height\":%u,"
-           "\"frames\":%u,\"frame_ms\":{\"p50\":%.2f},\"gl_renderer\":\"%s\"",
-           method_name(method), disable, max_samples ? max_samples : 64, n, size, size, frames, p50,
+    printf("{\"effect\":\"metaballs\",\"method\":\"%s\",\"disable\":%u,\"max_samples\":%u,\"step_h\":%.4g,"
+           "\"refine\":%u,\"pyramid\":%u,\"particles\":%u,\"width\":%u,\"height\":%u,"
+           "\"frames\":%u,\"warmup\":%d,\"frame_ms\":{\"p50\":%.2f},\"fps\":%.3g,\"gl_renderer\":\"%s\"",
+           method_name(s.method), s.disable, s.max_samples ? s.max_samples : 64, s.step_h > 0 ? s.step_h : 0.125,
+           s.refine ? s.refine : 3, s.pyramid ? s.pyramid : 3, n, size, size, frames, !s.no_warmup, p50, 1000.0 / p50,
            (const char *)glGetString(GL_RENDERER));
     vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
     if (api.get_stats(ctx, &st) == VFX_OK) {
@@ -133,7 +150,9 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, ui
 
 int vfx_bench_metaballs(int argc, char **argv)
 {
-    uint32_t parts[8], sizes[8], np = 0, ns = 0, frames = 3, method = 0, disable = 0, cap = 0;
+    uint32_t parts[8], sizes[8], np = 0, ns = 0, frames = 3, method = 0;
+    bench_scene opt;
+    memset(&opt, 0, sizeof opt);
     int reference = 0;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--particles") && i + 1 < argc && np < 8) parts[np++] = (uint32_t)atoi(argv[++i]);
@@ -145,8 +164,12 @@ int vfx_bench_metaballs(int argc, char **argv)
             method = !strcmp(argv[i], "brute") ? 1 : !strcmp(argv[i], "grid") ? 2 : !strcmp(argv[i], "paper") ? 0 : 99;
             if (method == 99) { fprintf(stderr, "metaballs: --method paper|brute|grid, not %s\n", argv[i]); return 2; }
         }
-        else if (!strcmp(argv[i], "--disable") && i + 1 < argc) disable = (uint32_t)strtoul(argv[++i], NULL, 0);
-        else if (!strcmp(argv[i], "--samples") && i + 1 < argc) cap = (uint32_t)atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--disable") && i + 1 < argc) opt.disable = (uint32_t)strtoul(argv[++i], NULL, 0);
+        else if (!strcmp(argv[i], "--samples") && i + 1 < argc) opt.max_samples = (uint32_t)atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--step") && i + 1 < argc) opt.step_h = (float)atof(argv[++i]);
+        else if (!strcmp(argv[i], "--refine") && i + 1 < argc) opt.refine = (uint32_t)atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--pyramid") && i + 1 < argc) opt.pyramid = (uint32_t)atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--warmup") && i + 1 < argc) opt.no_warmup = atoi(argv[++i]) == 0;
         else if (!strcmp(argv[i], "--json")) continue;
         else { fprintf(stderr, "metaballs: unknown option %s\n", argv[i]); return 2; }
     }
@@ -167,7 +190,8 @@ int vfx_bench_metaballs(int argc, char **argv)
                 rc = 2;
                 break;
             }
-            rc = run_one(parts[a], sizes[b], frames, reference, method, disable, cap);
+            opt.method = method;
+            rc = run_one(parts[a], sizes[b], frames, reference, &opt);
         }
     vfx_gl_context_destroy(gl);
     return rc;

@@ -1,0 +1,207 @@
+/* water_grid.c — GRID baseline: uniform grid of cell h (grown when it would exceed
+ * GRID_MAX_CELLS), built on the GPU every frame from the position columns: count per cell,
+ * exclusive prefix sum (two levels of 1024), scatter of the positions into cell order. The
+ * march (grid.comp MODE_MARCH) then sums each sample's potential over the cells its h-ball
+ * touches and jumps over empty space. Cell size and origin come from the box the CPU already
+ * computes while counting NaNs in water_update, so the only CPU work here is a few uniforms. */
+#include <math.h>
+#include <string.h>
+
+#include "gpu/gpu.h"
+#include "water_grid.h"
+
+/* 1024 scan blocks of 1024 entries: the top-level scan fits one workgroup. */
+#define GRID_MAX_CELLS ((1u << 20) - 1u)
+
+struct vfx_water_grid {
+    GLuint count, start, blocks, sorted, counters;
+    uint32_t cell_cap;     /* entries count/start hold (ncells + 1, rounded up to 1024) */
+    uint32_t sorted_cap;   /* particles `sorted` holds */
+};
+
+vfx_water_grid *vfx_water_grid_create(vfx_context *ctx)
+{
+    vfx_water_grid *g = vfx_alloc(ctx, sizeof *g);
+    if (!g)
+        return NULL;
+    glCreateBuffers(1, &g->counters);
+    glNamedBufferStorage(g->counters, 8 * sizeof(uint32_t), NULL, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
+    glCreateBuffers(1, &g->blocks);
+    glNamedBufferStorage(g->blocks, 1024 * sizeof(uint32_t), NULL, 0);
+    vfx_gpu_label(GL_BUFFER, g->counters, "water.grid_counters");
+    vfx_gpu_label(GL_BUFFER, g->blocks, "water.grid_blocks");
+    return g;
+}
+
+void vfx_water_grid_destroy(vfx_context *ctx, vfx_water_grid *g)
+{
+    if (!g)
+        return;
+    GLuint b[] = {g->count, g->start, g->blocks, g->sorted, g->counters};
+    for (int k = 0; k < 5; ++k)
+        if (b[k])
+            glDeleteBuffers(1, &b[k]);
+    vfx_free(ctx, g);
+}
+
+/* Grid geometry: origin one cell below the box, cell >= h (times 1 + 1e-4 so that rounding in
+ * floor() never puts a particle within h of a sample two cells away), grown by the cube root of
+ * the excess when the box would need more than GRID_MAX_CELLS cells (h tiny against the extent). */
+static void grid_layout(const vfx_water_grid_input *in, float g0[3], float *cs_out, int dims[3])
+{
+    double cs = (double)in->params->h * (1.0 + 1e-4);
+    double lo[3] = {0, 0, 0}, ext[3] = {0, 0, 0};
+    if (in->finite)
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = in->lo[k];
+            ext[k] = (double)in->hi[k] - in->lo[k];
+        }
+    for (int tries = 0; tries < 64; ++tries) {
+        double cells = 1;
+        for (int k = 0; k < 3; ++k)
+            cells *= floor(ext[k] / cs) + 3;
+        if (cells <= GRID_MAX_CELLS)
+            break;
+        cs *= cbrt(cells / GRID_MAX_CELLS) * 1.01;
+    }
+    for (int k = 0; k < 3; ++k) {
+        dims[k] = (int)(floor(ext[k] / cs) + 3);
+        g0[k] = (float)(lo[k] - cs);
+    }
+    *cs_out = (float)cs;
+}
+
+static GLuint storage(GLsizeiptr bytes, const char *label)
+{
+    GLuint b;
+    glCreateBuffers(1, &b);
+    glNamedBufferStorage(b, bytes, NULL, GL_DYNAMIC_STORAGE_BIT);
+    vfx_gpu_label(GL_BUFFER, b, label);
+    return b;
+}
+
+static void grid_uniforms(GLuint prog, const vfx_water_grid_input *in, const float g0[3], float cs,
+                          const int dims[3], uint32_t n)
+{
+    glUniform1ui(glGetUniformLocation(prog, "u_count"), in->count);
+    glUniform1ui(glGetUniformLocation(prog, "u_n"), n);
+    glUniform3fv(glGetUniformLocation(prog, "u_g0"), 1, g0);
+    glUniform1f(glGetUniformLocation(prog, "u_cs"), cs);
+    glUniform3iv(glGetUniformLocation(prog, "u_dims"), 1, dims);
+}
+
+vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_water_grid_input *in,
+                                 const vfx_frame_view *frame, const vfx_frame_targets *targets)
+{
+    const vfx_water_params *p = in->params;
+    float g0[3], cs;
+    int dims[3];
+    grid_layout(in, g0, &cs, dims);
+    uint32_t ncells = (uint32_t)dims[0] * (uint32_t)dims[1] * (uint32_t)dims[2];
+    uint32_t nscan = ncells + 1; /* start[ncells] = number of finite particles */
+    uint32_t need = (nscan + 1023u) & ~1023u;
+    if (need > g->cell_cap) {
+        if (g->count) glDeleteBuffers(1, &g->count);
+        if (g->start) glDeleteBuffers(1, &g->start);
+        g->count = storage((GLsizeiptr)need * 4, "water.grid_count");
+        g->start = storage((GLsizeiptr)need * 4, "water.grid_start");
+        g->cell_cap = need;
+    }
+    uint32_t np = in->count ? in->count : 1;
+    if (np > g->sorted_cap) {
+        if (g->sorted) glDeleteBuffers(1, &g->sorted);
+        g->sorted = storage((GLsizeiptr)np * 16, "water.grid_sorted");
+        g->sorted_cap = np;
+    }
+    GLuint count = vfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_COUNT\n");
+    GLuint scan = vfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n");
+    GLuint top = vfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n#define SCAN_TOP\n");
+    GLuint add = vfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN_ADD\n");
+    GLuint scatter = vfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCATTER\n");
+    GLuint march = vfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_MARCH\n");
+    if (!count || !scan || !top || !add || !scatter || !march)
+        return VFX_ERR_GL;
+    for (int k = 0; k < 3; ++k)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, in->cols[k]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, g->count);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, g->counters);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, g->start);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, g->blocks);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, g->sorted);
+    /* per-particle passes as 2D dispatches: GL promises only 65535 groups per dimension */
+    GLuint groups = (in->count + 63u) / 64u, blocks = need / 1024u;
+    GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
+
+    vfx_gpu_pass_begin(ctx, "water.grid_build");
+    glClearNamedBufferSubData(g->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
+    glUseProgram(count);
+    grid_uniforms(count, in, g0, cs, dims, nscan);
+    if (groups)
+        glDispatchCompute(gx, gy, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glUseProgram(scan);
+    grid_uniforms(scan, in, g0, cs, dims, nscan);
+    glDispatchCompute(blocks, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glUseProgram(top);
+    grid_uniforms(top, in, g0, cs, dims, blocks);
+    glDispatchCompute(1, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glUseProgram(add);
+    grid_uniforms(add, in, g0, cs, dims, nscan);
+    glDispatchCompute((nscan + 255u) / 256u, 1, 1);
+    /* the counts are spent: the same buffer becomes the per-cell fill cursor of the scatter */
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    glClearNamedBufferSubData(g->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
+    glUseProgram(scatter);
+    grid_uniforms(scatter, in, g0, cs, dims, nscan);
+    if (groups)
+        glDispatchCompute(gx, gy, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    vfx_gpu_pass_end(ctx);
+
+    vfx_gpu_pass_begin(ctx, "water.grid_march");
+    glClearNamedBufferData(g->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
+    glUseProgram(march);
+    grid_uniforms(march, in, g0, cs, dims, nscan);
+    float blo[3], bhi[3];
+    for (int k = 0; k < 3; ++k) {
+        blo[k] = in->finite ? in->lo[k] - p->h : 0.0f;
+        bhi[k] = in->finite ? in->hi[k] + p->h : -1.0f; /* empty box: every ray misses */
+    }
+    glUniform3fv(glGetUniformLocation(march, "u_blo"), 1, blo);
+    glUniform3fv(glGetUniformLocation(march, "u_bhi"), 1, bhi);
+    glBindImageTexture(0, in->dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    glBindTextureUnit(1, frame->depth_texture);
+    glUniformMatrix4fv(glGetUniformLocation(march, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
+    glUniform3fv(glGetUniformLocation(march, "u_eye"), 1, frame->eye);
+    glUniform1f(glGetUniformLocation(march, "u_h"), p->h);
+    glUniform1f(glGetUniformLocation(march, "u_T"), p->threshold);
+    glUniform1f(glGetUniformLocation(march, "u_step"), p->step);
+    glUniform1ui(glGetUniformLocation(march, "u_max_samples"), p->max_samples);
+    glUniform1ui(glGetUniformLocation(march, "u_refine_iters"), (p->disable & VFX_WATER_NO_REFINE) ? 0u : p->refine_iters);
+    glUniform1i(glGetUniformLocation(march, "u_has_depth"), frame->depth_texture != 0);
+    /* the paper's technique bits mean the same here: 1 = start at the box entry instead of the
+     * first sphere entry, 2 = fixed steps after the start (no jump over empty space) */
+    glUniform1i(glGetUniformLocation(march, "u_seek_init"), !(p->disable & VFX_WATER_NO_BILLBOARD_INIT));
+    glUniform1i(glGetUniformLocation(march, "u_seek_gaps"), !(p->disable & VFX_WATER_NO_SKIP));
+    glDispatchCompute((in->width + 7) / 8, (in->height + 7) / 8, 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    vfx_gpu_pass_end(ctx);
+
+    uint32_t c[6];
+    glGetNamedBufferSubData(g->counters, 0, sizeof c, c);
+    vfx_stat_set(ctx, "water.samples", c[0]);
+    vfx_stat_set(ctx, "water.pixels_found", c[1]);
+    vfx_stat_set(ctx, "water.pixels_sample_cap", c[2]);
+    vfx_stat_set(ctx, "water.pixels_left", c[3]);
+    vfx_stat_set(ctx, "water.grid_cells_visited", c[4]);
+    vfx_stat_set(ctx, "water.grid_sphere_tests", c[5]);
+    vfx_stat_set(ctx, "water.grid_cells", ncells);
+    vfx_stat_set(ctx, "water.grid_cell_size", cs);
+    const char *e = vfx_gpu_error_string();
+    if (e)
+        return vfx_fail(ctx, VFX_ERR_GL, "water grid (%dx%dx%d cells of %g): %s", dims[0], dims[1], dims[2], (double)cs, e);
+    return VFX_OK;
+}

@@ -1,0 +1,32 @@
+/* water_grid.h — the GRID baseline of the water effect: a uniform particle grid (cell >= h)
+ * built on the GPU each frame (count, prefix sum, scatter), then a per-pixel compute march over
+ * it with empty-space skipping; the same sampling rule and refinement as the BRUTE baseline. */
+#ifndef VFX_WATER_GRID_H
+#define VFX_WATER_GRID_H
+
+#include <epoxy/gl.h>
+#include "plugin_internal.h"
+
+typedef struct vfx_water_grid vfx_water_grid;
+
+/* What one GRID frame needs from the water effect's state (borrowed, not owned). */
+typedef struct vfx_water_grid_input {
+    const GLuint *cols;              /* x, y, z position columns (SSBOs of `count` floats) */
+    uint32_t count;                  /* particles in the columns, non-finite ones included */
+    uint32_t finite;                 /* of which finite (0: nothing to draw) */
+    const float *lo, *hi;            /* box of the finite particles */
+    const vfx_water_params *params;  /* defaults already applied */
+    uint32_t width, height;
+    GLuint dist_tex;                 /* R32F target: distance along the ray or -1 */
+} vfx_water_grid_input;
+
+/* Makes the (empty) grid state; NULL on allocation failure (error recorded). */
+vfx_water_grid *vfx_water_grid_create(vfx_context *ctx);
+/* Frees the grid's buffers and the state; NULL allowed. */
+void vfx_water_grid_destroy(vfx_context *ctx, vfx_water_grid *g);
+/* Builds the grid from in->cols and writes in->dist_tex; sets the water.grid_* counters and
+ * water.samples / pixels_found / pixels_sample_cap / pixels_left (read back: a stall). */
+vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_water_grid_input *in,
+                                 const vfx_frame_view *frame, const vfx_frame_targets *targets);
+
+#endif
