@@ -365,6 +365,24 @@ int vfx_bench_tetvol(int argc, char **argv)
                     break;
                 }
             }
+            /* the fast setting: every core, ERT 0.99 with sharing and load balancing */
+            o.ert = 1; o.ert_threshold = 0.99f; o.workers = 2; o.share = o.dlb = 1;
+            if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
+            printf(HEAD "\"test\":\"image_fast\",\"workers\":2,\"threshold\":0.99,\"wall_ms\":%.2f,"
+                   "\"N_skipped\":%llu,\"rmse_vs_no_ert\":%.3g,\"max_vs_no_ert\":%.3g}\n",
+                   HARGS, res->wall_ms, (unsigned long long)res->c.cells_skipped_ert, res->rmse, res->max);
+            if (out_prefix) {
+                char p1[1100], p2[1100];
+                snprintf(p1, sizeof p1, "%s_%s_fast.rgb.pfm", out_prefix, vw->name);
+                snprintf(p2, sizeof p2, "%s_%s_fast.alpha.pfm", out_prefix, vw->name);
+                if (write_pfm(p1, img, w, h, -1) || write_pfm(p2, img, w, h, 3)) {
+                    fprintf(stderr, "bench tetvol: cannot write %s\n", p1);
+                    rc = 1;
+                    break;
+                }
+            }
+            vfx_tet_options_default(&o);
+            o.ert = 0; o.workers = 1;
         }
         if (has(only, "table1")) {
             for (int e = 0; e < 2; e++) {
