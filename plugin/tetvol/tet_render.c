@@ -343,6 +343,36 @@ static int scan_cell(const scan_ctx *X, worker *w, const cellkey *key)
     for (int j = 0; j < 3; j++)
         a0[j] = -(inv[j][0] * v[3][0] + inv[j][1] * v[3][1] + inv[j][2] * v[3][2]);
     a0[3] = 1 - a0[0] - a0[1] - a0[2];
+    /* A face whose plane contains the eye projects to a line; a pixel ray on that line runs
+     * inside the face, where lambda_j is 0 all along and rounding decides whether the ray is in
+     * the tet, so a shared face could be drawn twice or dropped. Tie rule (a symbolic
+     * perturbation of the ray): the ray counts as inside exactly when the face's inward normal
+     * (grad lambda_j) is lexicographically positive; the two tets sharing the face have opposite
+     * normals, so exactly one of them takes the ray. Faces on the eye are rare: flagged here. */
+    double g[4][3];
+    for (int r = 0; r < 3; r++) {
+        g[0][r] = inv[0][r];
+        g[1][r] = inv[1][r];
+        g[2][r] = inv[2][r];
+        g[3][r] = -inv[0][r] - inv[1][r] - inv[2][r];
+    }
+    unsigned on_face = 0, owns = 0;
+    double gnorm[4];
+    for (int j = 0; j < 4; j++) {
+        double ga = fabs(g[j][0]) + fabs(g[j][1]) + fabs(g[j][2]);
+        gnorm[j] = ga;
+        double ea = 1e-10 * (1.0 + fabs(g[j][0] * v[3][0]) + fabs(g[j][1] * v[3][1]) +
+                             fabs(g[j][2] * v[3][2]));
+        if (fabs(a0[j]) > ea)
+            continue;
+        on_face |= 1u << j;
+        int sign = 0;
+        for (int r = 0; r < 3 && !sign; r++)
+            if (fabs(g[j][r]) > 1e-9 * ga)
+                sign = g[j][r] > 0 ? 1 : -1;
+        if (sign > 0)
+            owns |= 1u << j;
+    }
     w->cnt.cells_scanned++;
     /* Per pixel the ray is p(t) = t * (dx, dy, -1), t = view depth, so each barycentric
      * coordinate is a0 + t * b with b affine in dx along a row: b is stepped, not recomputed.
@@ -405,6 +435,12 @@ static int scan_cell(const scan_ctx *X, worker *w, const cellkey *key)
             double tin = near_d, tout = INFINITY; /* the near plane as view depth */
             int empty = 0;
             for (int j = 0; j < 4; j++) {
+                if ((on_face >> j & 1u) &&
+                    fabs(b[j]) <= 1e-10 * gnorm[j] * (fabs(dx) + fabs(dy) + 1.0)) {
+                    if (!(owns >> j & 1u))
+                        empty = 1;
+                    continue; /* inside this face's half-space by the tie rule */
+                }
                 if (b[j] > 0) {
                     double tt = -a0[j] / b[j];
                     if (tt > tin) tin = tt;
