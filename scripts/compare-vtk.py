@@ -162,13 +162,14 @@ def render(ug, tf, cam, name, integrator, reps, modified):
     c.SetViewUp(*cam['up'])
     c.SetViewAngle(cam['fovy_deg'])
     c.SetClippingRange(cam['near'], cam['far'])
-    times = []
+    times, cpus = [], []
     for i in range(reps + 1):
         if modified:
             vol.Modified()  # invalidate what the mapper caches between frames
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         win.Render()
         times.append(time.perf_counter() - t0)
+        cpus.append(time.process_time() - c0)  # every thread of the process (llvmpipe's too)
     grab = vtk.vtkWindowToImageFilter()
     grab.SetInput(win)
     grab.SetInputBufferTypeToRGB()
@@ -178,7 +179,8 @@ def render(ug, tf, cam, name, integrator, reps, modified):
     arr = numpy_support.vtk_to_numpy(img.GetPointData().GetScalars()).reshape(h, w, 3)
     gl = win.ReportCapabilities().split('OpenGL renderer string:')[-1].split('\n')[0].strip()
     win.Finalize()
-    return arr.astype(np.float64) / 255.0, statistics.median(times[1:]), times[0], gl
+    return (arr.astype(np.float64) / 255.0, statistics.median(times[1:]), times[0],
+            statistics.median(cpus[1:]), gl)
 
 
 def ray_march(ug, tf, cam, mask, steps):
@@ -288,11 +290,12 @@ def main():
         fast = next(l for l in lines if l['test'] == 'image_fast' and l['view'] == view)
         ours = {'ours_1w_noERT': (read_pfm('%s_%s.rgb.pfm' % (prefix, view)), cam['wall_ms']),
                 'ours_2w_ERT0.99': (read_pfm('%s_%s_fast.rgb.pfm' % (prefix, view)), fast['wall_ms'])}
+        ours_cpu = {'ours_1w_noERT': cam['cpu_ms'], 'ours_2w_ERT0.99': fast['cpu_ms']}
         alpha = read_pfm('%s_%s.alpha.pfm' % (prefix, view))[:, :, 0]
         cov = alpha > 0
         for k, (img, ms) in ours.items():
             print(json.dumps({'test': 'ours', 'mesh': meshline['mesh'], 'view': view, 'config': k,
-                              'ms': ms}), flush=True)
+                              'ms': ms, 'cpu_ms': ours_cpu[k]}), flush=True)
             if a.png_dir:
                 os.makedirs(a.png_dir, exist_ok=True)
                 write_png(os.path.join(a.png_dir, '%s_%s_%s.png' % (meshline['mesh'], view, k)), img)
@@ -313,15 +316,16 @@ def main():
             if a.png_dir:
                 write_png(os.path.join(a.png_dir, '%s_%s_truth.png' % (meshline['mesh'], view)), truth)
         for name in a.mappers.split(','):
-            img, med, first, gl = render(ug, tf, cam, name, a.integrator, a.reps, a.modified)
+            img, med, first, cpu, gl = render(ug, tf, cam, name, a.integrator, a.reps, a.modified)
             if a.png_dir:
                 write_png(os.path.join(a.png_dir, '%s_%s_%s.png' % (meshline['mesh'], view, name)), img)
             row = {'test': 'vtk', 'mesh': meshline['mesh'], 'view': view, 'mapper': name,
                    'gl_renderer': gl, 'median_ms': round(med * 1e3, 1),
-                   'first_ms': round(first * 1e3, 1)}
+                   'first_ms': round(first * 1e3, 1), 'median_cpu_ms': round(cpu * 1e3, 1)}
             for k, (ours_img, ms) in ours.items():
                 d = img - ours_img
                 row[k] = {'ours_ms': ms, 'speedup': round(med * 1e3 / ms, 2),
+                          'ours_cpu_ms': ours_cpu[k], 'cpu_ratio': round(cpu * 1e3 / ours_cpu[k], 2),
                           'rmse_rgb': float(np.sqrt(np.mean(d * d))),
                           'rmse_rgb_covered': float(np.sqrt(np.mean(d[cov] ** 2))) if cov.any() else 0.0,
                           'max_rgb': float(np.abs(d).max())}

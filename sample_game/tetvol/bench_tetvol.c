@@ -65,6 +65,14 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
+/* CPU time of the whole process (every worker thread): the figure that survives other load */
+static double cpu_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
 typedef struct view {
     const char *name;
     double eye[3], center[3], up[3];
@@ -168,7 +176,7 @@ static int write_pfm(const char *path, const float *rgba, int w, int h, int ch)
 }
 
 typedef struct run_result {
-    double wall_ms, t_sc_ms, t_update_ms, rmse, max;
+    double wall_ms, cpu_ms, t_sc_ms, t_update_ms, rmse, max;
     vfx_tet_counters c;
     vfx_tet_counters pw[64];
 } run_result;
@@ -196,25 +204,32 @@ static int run_cfg(const vfx_tet_mesh *m, const vfx_tet_camera *cam, const vfx_t
     size_t n = (size_t)cam->width * cam->height * 4;
     for (int r = 0; r <= reps; r++) {
         run_result *rr = &runs[r > 0 ? r - 1 : 0];
-        double t0 = now_ms();
+        double t0 = now_ms(), c0 = cpu_ms();
         if (vfx_tet_render_workers(m, cam, tf, o, img, &rr->c, rr->pw, err) != 0) {
             fprintf(stderr, "bench tetvol: %s\n", err);
             return -1;
         }
         rr->wall_ms = now_ms() - t0;
+        rr->cpu_ms = cpu_ms() - c0;
         rr->t_sc_ms = rr->c.t_sc_ms;
         rr->t_update_ms = rr->c.t_update_ms;
         rr->rmse = rr->max = 0;
         if (ref) diff(ref, img, n, &rr->rmse, &rr->max);
     }
-    double sc[64], up[64];
-    for (int r = 0; r < reps; r++) { sc[r] = runs[r].t_sc_ms; up[r] = runs[r].t_update_ms; }
+    double sc[64], up[64], cp[64];
+    for (int r = 0; r < reps; r++) {
+        sc[r] = runs[r].t_sc_ms;
+        up[r] = runs[r].t_update_ms;
+        cp[r] = runs[r].cpu_ms;
+    }
     qsort(sc, (size_t)reps, sizeof *sc, cmp_d);
     qsort(up, (size_t)reps, sizeof *up, cmp_d);
+    qsort(cp, (size_t)reps, sizeof *cp, cmp_d);
     qsort(runs, (size_t)reps, sizeof *runs, cmp_run);
     *out = runs[reps / 2];
     out->t_sc_ms = sc[reps / 2];
     out->t_update_ms = up[reps / 2];
+    out->cpu_ms = cp[reps / 2];
     return 0;
 }
 
@@ -231,7 +246,7 @@ static void usage(void)
 {
     fputs("volfx-bench tetvol [--mesh FILE.vtu|TETGEN_BASE] [--scalar NAME] [--grid N] [--size PX]\n"
           "  [--view across,axis] [--only table1,ert,D,C,table2,image] [--workers N] [--reps R]\n"
-          "  [--tau T] [--out PREFIX] [--json]\n"
+          "  [--tau T] [--out PREFIX] [--c-nopartial-max C] [--json]\n"
           "--tau: optical depth through the mesh's thinnest box extent at the top of the transfer\n"
           "function (default 4). --out writes PREFIX_<view>.rgb.pfm (premultiplied) and .alpha.pfm\n"
           "of the no-ERT image. Output is JSON lines (--json is accepted for symmetry).\n", stderr);
@@ -239,7 +254,7 @@ static void usage(void)
 
 int vfx_bench_tetvol(int argc, char **argv)
 {
-    int n = 24, w = 300, h = 300, maxw = 8, reps = 5;
+    int n = 24, w = 300, h = 300, maxw = 8, reps = 5, cnp_max = 100;
     float tau = 4.0f;
     const char *mesh_path = NULL, *scalar = NULL, *views_opt = "across,axis", *only = "all";
     const char *out_prefix = NULL;
@@ -259,6 +274,7 @@ int vfx_bench_tetvol(int argc, char **argv)
         else if (!strcmp(a, "--view")) views_opt = v;
         else if (!strcmp(a, "--only")) only = v;
         else if (!strcmp(a, "--out")) out_prefix = v;
+        else if (!strcmp(a, "--c-nopartial-max")) cnp_max = atoi(v);
         else { fprintf(stderr, "bench tetvol: unknown option '%s'\n", a); usage(); return 2; }
     }
     if (n < 1 || n > 200 || w < 1 || w > 4096 || maxw < 1 || maxw > 64 || reps < 1 || reps > 63 || !(tau > 0)) {
@@ -348,11 +364,11 @@ int vfx_bench_tetvol(int argc, char **argv)
         if (has(only, "image")) {
             printf(HEAD "\"test\":\"image\",\"width\":%d,\"height\":%d,\"eye\":[%.9g,%.9g,%.9g],"
                    "\"center\":[%.9g,%.9g,%.9g],\"up\":[%.9g,%.9g,%.9g],\"fovy_deg\":%.9g,\"near\":%.9g,\"far\":%.9g,"
-                   "\"wall_ms\":%.2f,\"t_sc_ms\":%.2f,\"t_composite_ms\":%.2f,\"covered\":%.0f,\"mean_alpha_covered\":%.4f,"
+                   "\"wall_ms\":%.2f,\"cpu_ms\":%.2f,\"t_sc_ms\":%.2f,\"t_composite_ms\":%.2f,\"covered\":%.0f,\"mean_alpha_covered\":%.4f,"
                    "\"pixels_alpha_ge_0.9\":%.0f,\"cells_scanned\":%llu,\"segments\":%llu}\n",
                    HARGS, w, h, vw->eye[0], vw->eye[1], vw->eye[2], vw->center[0], vw->center[1],
                    vw->center[2], vw->up[0], vw->up[1], vw->up[2], vw->fovy * 57.29577951308232, vw->nearp,
-                   vw->farp, base.wall_ms, base.t_sc_ms, base.c.t_composite_ms, cov,
+                   vw->farp, base.wall_ms, base.cpu_ms, base.t_sc_ms, base.c.t_composite_ms, cov,
                    cov > 0 ? asum / cov : 0.0, opaque, (unsigned long long)base.c.cells_scanned,
                    (unsigned long long)base.c.segments_made);
             if (out_prefix) {
@@ -368,9 +384,9 @@ int vfx_bench_tetvol(int argc, char **argv)
             /* the fast setting: every core, ERT 0.99 with sharing and load balancing */
             o.ert = 1; o.ert_threshold = 0.99f; o.workers = 2; o.share = o.dlb = 1;
             if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
-            printf(HEAD "\"test\":\"image_fast\",\"workers\":2,\"threshold\":0.99,\"wall_ms\":%.2f,"
+            printf(HEAD "\"test\":\"image_fast\",\"workers\":2,\"threshold\":0.99,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,"
                    "\"N_skipped\":%llu,\"rmse_vs_no_ert\":%.3g,\"max_vs_no_ert\":%.3g}\n",
-                   HARGS, res->wall_ms, (unsigned long long)res->c.cells_skipped_ert, res->rmse, res->max);
+                   HARGS, res->wall_ms, res->cpu_ms, (unsigned long long)res->c.cells_skipped_ert, res->rmse, res->max);
             if (out_prefix) {
                 char p1[1100], p2[1100];
                 snprintf(p1, sizeof p1, "%s_%s_fast.rgb.pfm", out_prefix, vw->name);
@@ -389,10 +405,10 @@ int vfx_bench_tetvol(int argc, char **argv)
                 o.ert = e; o.ert_threshold = 0.9f;
                 if (e && (rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
                 const run_result *r = e ? res : &base;
-                printf(HEAD "\"test\":\"table1\",\"ert\":%d,\"threshold\":0.9,\"D\":%d,\"C\":%d,\"wall_ms\":%.2f,"
+                printf(HEAD "\"test\":\"table1\",\"ert\":%d,\"threshold\":0.9,\"D\":%d,\"C\":%d,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,"
                        "\"t_sc_ms\":%.2f,\"t_update_ms\":%.2f,\"t_composite_ms\":%.2f,\"N_skipped\":%llu,"
                        "\"cells_scanned\":%llu,\"segments\":%llu,\"merged\":%llu,\"updates\":%llu,\"rmse\":%.3g,\"max\":%.3g}\n",
-                       HARGS, e, o.tiles_d, o.update_c, r->wall_ms, r->t_sc_ms, r->t_update_ms,
+                       HARGS, e, o.tiles_d, o.update_c, r->wall_ms, r->cpu_ms, r->t_sc_ms, r->t_update_ms,
                        r->c.t_composite_ms, (unsigned long long)r->c.cells_skipped_ert,
                        (unsigned long long)r->c.cells_scanned, (unsigned long long)r->c.segments_made,
                        (unsigned long long)r->c.segments_merged, (unsigned long long)r->c.table_updates,
@@ -405,10 +421,10 @@ int vfx_bench_tetvol(int argc, char **argv)
             for (int i = 0; i < 4 && rc == 0; i++) {
                 o.ert = 1; o.ert_threshold = thr[i];
                 if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
-                printf(HEAD "\"test\":\"ert_threshold\",\"threshold\":%.2f,\"D\":%d,\"C\":%d,\"wall_ms\":%.2f,"
-                       "\"t_sc_ms\":%.2f,\"t_update_ms\":%.2f,\"no_ert_wall_ms\":%.2f,\"N_skipped\":%llu,\"rmse\":%.3g,\"max\":%.3g}\n",
-                       HARGS, thr[i], o.tiles_d, o.update_c, res->wall_ms, res->t_sc_ms,
-                       res->t_update_ms, base.wall_ms, (unsigned long long)res->c.cells_skipped_ert,
+                printf(HEAD "\"test\":\"ert_threshold\",\"threshold\":%.2f,\"D\":%d,\"C\":%d,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,"
+                       "\"t_sc_ms\":%.2f,\"t_update_ms\":%.2f,\"no_ert_wall_ms\":%.2f,\"no_ert_cpu_ms\":%.2f,\"N_skipped\":%llu,\"rmse\":%.3g,\"max\":%.3g}\n",
+                       HARGS, thr[i], o.tiles_d, o.update_c, res->wall_ms, res->cpu_ms, res->t_sc_ms,
+                       res->t_update_ms, base.wall_ms, base.cpu_ms, (unsigned long long)res->c.cells_skipped_ert,
                        res->rmse, res->max);
             }
         }
@@ -418,9 +434,9 @@ int vfx_bench_tetvol(int argc, char **argv)
             for (int i = 0; i < 6 && rc == 0; i++) {
                 o.tiles_d = Ds[i];
                 if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
-                printf(HEAD "\"test\":\"D_sweep\",\"D\":%d,\"C\":%d,\"wall_ms\":%.2f,\"t_sc_ms\":%.2f,"
+                printf(HEAD "\"test\":\"D_sweep\",\"D\":%d,\"C\":%d,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,\"t_sc_ms\":%.2f,"
                        "\"t_update_ms\":%.2f,\"updates\":%llu,\"N_skipped\":%llu,\"rmse\":%.3g}\n",
-                       HARGS, o.tiles_d, o.update_c, res->wall_ms, res->t_sc_ms, res->t_update_ms,
+                       HARGS, o.tiles_d, o.update_c, res->wall_ms, res->cpu_ms, res->t_sc_ms, res->t_update_ms,
                        (unsigned long long)res->c.table_updates,
                        (unsigned long long)res->c.cells_skipped_ert, res->rmse);
             }
@@ -428,16 +444,17 @@ int vfx_bench_tetvol(int argc, char **argv)
         }
         if (has(only, "C")) {
             const int Cs[5] = {1, 10, 100, 1000, 10000};
-            /* without partial compositing each update walks whole lists: C is capped at 100 and
-             * the runs at 3 there, or the sweep would take minutes per point */
+            /* without partial compositing each update walks whole lists: C is capped at
+             * --c-nopartial-max and one run is timed (after the warm-up), or the sweep would take
+             * minutes per point */
             for (int pc = 1; pc >= 0 && rc == 0; pc--)
-                for (int i = 0; i < (pc ? 5 : 3) && rc == 0; i++) {
+                for (int i = 0; i < 5 && (pc || Cs[i] <= cnp_max) && rc == 0; i++) {
                     o.update_c = Cs[i]; o.partial_composite = pc;
-                    int rp = pc ? reps : (reps < 3 ? reps : 3);
+                    int rp = pc ? reps : 1;
                     if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, rp, runs, res)) != 0) break;
-                    printf(HEAD "\"test\":\"C_sweep\",\"partial\":%d,\"D\":%d,\"C\":%d,\"reps\":%d,\"wall_ms\":%.2f,"
+                    printf(HEAD "\"test\":\"C_sweep\",\"partial\":%d,\"D\":%d,\"C\":%d,\"reps\":%d,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,"
                            "\"t_sc_ms\":%.2f,\"t_update_ms\":%.2f,\"updates\":%llu,\"N_skipped\":%llu,\"segments_in_lists\":%llu}\n",
-                           HARGS, pc, o.tiles_d, o.update_c, rp, res->wall_ms, res->t_sc_ms,
+                           HARGS, pc, o.tiles_d, o.update_c, rp, res->wall_ms, res->cpu_ms, res->t_sc_ms,
                            res->t_update_ms, (unsigned long long)res->c.table_updates,
                            (unsigned long long)res->c.cells_skipped_ert,
                            (unsigned long long)(res->c.segments_made - res->c.segments_merged));
@@ -453,22 +470,25 @@ int vfx_bench_tetvol(int argc, char **argv)
                     int nw = wcounts[wc];
                     o.workers = nw; o.ert = cfg[i][0]; o.share = cfg[i][1]; o.dlb = cfg[i][2];
                     if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
-                    double sum = 0, tmax = 0, csum = 0, cmax = 0;
-                    printf(HEAD "\"test\":\"table2\",\"config\":\"%s\",\"workers\":%d,\"wall_ms\":%.2f,\"rmse\":%.3g,\"max\":%.3g,\"per_worker\":[",
-                           HARGS, names[i], nw, res->wall_ms, res->rmse, res->max);
+                    double sum = 0, tmax = 0, csum = 0, cmax = 0, csum_cpu = 0, cmax_cpu = 0;
+                    printf(HEAD "\"test\":\"table2\",\"config\":\"%s\",\"workers\":%d,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,\"rmse\":%.3g,\"max\":%.3g,\"per_worker\":[",
+                           HARGS, names[i], nw, res->wall_ms, res->cpu_ms, res->rmse, res->max);
                     for (int k = 0; k < nw; k++) {
                         const vfx_tet_counters *p = &res->pw[k];
                         double t = p->t_sc_ms + p->t_update_ms;
+                        csum_cpu += p->cpu_ms;
+                        if (p->cpu_ms > cmax_cpu) cmax_cpu = p->cpu_ms;
                         double work = (double)p->cells_scanned;
                         sum += t; if (t > tmax) tmax = t;
                         csum += work; if (work > cmax) cmax = work;
-                        printf("%s{\"ms\":%.1f,\"cells\":%llu,\"skipped\":%llu,\"segments\":%llu}", k ? "," : "", t,
+                        printf("%s{\"ms\":%.1f,\"cpu_ms\":%.1f,\"cells\":%llu,\"skipped\":%llu,\"segments\":%llu,\"merged\":%llu}", k ? "," : "", t, p->cpu_ms,
                                (unsigned long long)p->cells_scanned, (unsigned long long)p->cells_skipped_ert,
-                               (unsigned long long)p->segments_made);
+                               (unsigned long long)p->segments_made, (unsigned long long)p->segments_merged);
                     }
-                    printf("],\"t_worker_max_ms\":%.2f,\"imbalance_time\":%.3f,\"imbalance_cells\":%.3f,"
+                    printf("],\"t_worker_max_ms\":%.2f,\"cpu_worker_max_ms\":%.2f,\"imbalance_cpu\":%.3f,\"imbalance_time\":%.3f,\"imbalance_cells\":%.3f,"
                            "\"N_skipped\":%llu,\"cells_scanned\":%llu,\"segments\":%llu,\"t_composite_ms\":%.2f}\n",
-                           tmax, sum > 0 ? tmax / (sum / nw) : 0.0, csum > 0 ? cmax / (csum / nw) : 0.0,
+                           tmax, cmax_cpu, csum_cpu > 0 ? cmax_cpu / (csum_cpu / nw) : 0.0,
+                           sum > 0 ? tmax / (sum / nw) : 0.0, csum > 0 ? cmax / (csum / nw) : 0.0,
                            (unsigned long long)res->c.cells_skipped_ert,
                            (unsigned long long)res->c.cells_scanned,
                            (unsigned long long)res->c.segments_made, res->c.t_composite_ms);
