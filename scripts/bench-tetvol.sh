@@ -38,6 +38,9 @@ fi
 # C = 10 only: at 400k tets each point takes minutes), each followed by its VTK comparison
 (
     run pipe "$BENCH" tetvol --mesh "$PIPE" --reps "$REPS" --json
+    # an opaque transfer function (4x the extinction): where ERT has something to terminate
+    run pipe_opaque "$BENCH" tetvol --mesh "$PIPE" --tau 16 --view axis --only table1,ert,D \
+        --reps "$REPS" --json
     [ -z "$HAVE_VTK" ] || run vtk_pipe xvfb-run -a -s '-screen 0 640x480x24' /usr/bin/python3 \
         scripts/compare-vtk.py --bench "$BENCH" --mesh "$PIPE" --reps "$REPS" --truth-steps 400 \
         --tmp "$OUT/vtk_pipe"
