@@ -81,8 +81,9 @@ for mesh_file, title in (('pipe.jsonl', 'Pipe mesh (real data, |Velocity|)'),
       (m['mesh'], m['points'], m['tets'], m['scalar'], m['tf']['smin'], m['tf']['smax'],
        m['tf']['tau_lo'], m['tf']['tau_hi']))
     P()
-    P('| view | covered px | mean alpha (covered) | px alpha >= 0.9 | cells scanned | segments | segments / covered px |')
-    P('|---|---|---|---|---|---|---|')
+    if any(r['test'] == 'image' for r in rows):
+        P('| view | covered px | mean alpha (covered) | px alpha >= 0.9 | cells scanned | segments | segments / covered px |')
+        P('|---|---|---|---|---|---|---|')
     for r in rows:
         if r['test'] == 'image':
             P('| %s | %d | %.3f | %d | %d | %d | %.1f |' % (
