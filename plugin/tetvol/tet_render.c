@@ -36,6 +36,15 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
+/* CPU time of the calling thread: on a loaded machine wall time mostly measures the scheduler */
+static double thread_cpu_ms(void)
+{
+    struct timespec ts;
+    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0)
+        return 0;
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
 void vfx_tet_options_default(vfx_tet_options *o)
 {
     memset(o, 0, sizeof *o);
@@ -78,10 +87,17 @@ static void over(seg *f, const seg *b)
 
 /* Inserts v into the pixel list at *head in order of zf; merges with the neighbours it touches
  * (the paper's partial compositing: a merged segment is again a segment). */
-static int insert_seg(seg_pool *p, int32_t *head, seg v, int partial, float stop,
-                      uint64_t *merged)
+static int insert_seg(seg_pool *p, int32_t *head, int32_t *hint, seg v, int partial,
+                      float stop, uint64_t *merged)
 {
     int32_t prev = -1, cur = *head;
+    /* cells arrive roughly front to back, so the pixel's last inserted segment is usually just
+     * in front of the new one: start the walk there. It is always linked: the only unlink (the
+     * chain merge below) happens in an insertion, which then points the hint at the survivor. */
+    if (*hint >= 0 && p->s[*hint].zf < v.zf) {
+        prev = *hint;
+        cur = p->s[prev].next;
+    }
     while (cur >= 0 && p->s[cur].zf < v.zf) {
         prev = cur;
         cur = p->s[cur].next;
@@ -101,6 +117,7 @@ static int insert_seg(seg_pool *p, int32_t *head, seg v, int partial, float stop
                 ps->zb = p->s[cur].zb;
                 ps->next = p->s[cur].next;
             }
+            *hint = prev;
             return 0;
         }
         if (cur >= 0 && v.a < stop && fabsf(v.zb - p->s[cur].zf) <= eps) {
@@ -111,6 +128,7 @@ static int insert_seg(seg_pool *p, int32_t *head, seg v, int partial, float stop
             m.next = cs->next;
             *cs = m;
             (*merged)++;
+            *hint = cur;
             return 0;
         }
     }
@@ -122,6 +140,7 @@ static int insert_seg(seg_pool *p, int32_t *head, seg v, int partial, float stop
         p->s[prev].next = idx;
     else
         *head = idx;
+    *hint = idx;
     return 0;
 }
 
@@ -155,27 +174,72 @@ typedef struct cellkey {
     uint32_t id;
 } cellkey;
 
-static int cmp_key(const void *a, const void *b)
+/* float -> unsigned with the same order (sign bit flipped for positives, all bits for negatives) */
+static inline uint32_t fkey(float f)
 {
-    const cellkey *x = a, *y = b;
-    if (x->nearest < y->nearest) return -1;
-    if (x->nearest > y->nearest) return 1;
-    return (x->id > y->id) - (x->id < y->id);
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    return (u & 0x80000000u) ? ~u : u | 0x80000000u;
+}
+
+/* Stable LSD radix sort of keys by nearest (4 passes of 8 bits through tmp); keys arrive in
+ * ascending id, so ties stay in id order. qsort cost ~8% of a frame on the pipe mesh. */
+static void sort_keys(cellkey *keys, cellkey *tmp, uint32_t n)
+{
+    cellkey *src = keys, *dst = tmp;
+    for (int pass = 0; pass < 4; pass++) {
+        uint32_t cnt[257] = {0};
+        const int sh = 8 * pass;
+        for (uint32_t i = 0; i < n; i++)
+            cnt[((fkey(src[i].nearest) >> sh) & 255u) + 1]++;
+        for (int b = 0; b < 256; b++)
+            cnt[b + 1] += cnt[b];
+        for (uint32_t i = 0; i < n; i++)
+            dst[cnt[(fkey(src[i].nearest) >> sh) & 255u]++] = src[i];
+        cellkey *t = src;
+        src = dst;
+        dst = t;
+    }
+    /* an even number of passes leaves the result in keys */
+}
+
+/* A vertex in view space with its scalar and, when in front of the eye, its pixel coordinates:
+ * packed so a cell's four vertices cost four cache lines at most (cells are visited in depth
+ * order, so vertex accesses are scattered). */
+typedef struct pvert {
+    double x, y, z, s, px, py;
+} pvert;
+
+/* floor/ceil without the libm call (no SSE4.1 rounding by default); |v| < 2^31 here */
+static inline int ifloor(double v)
+{
+    int i = (int)v;
+    return i - (v < i);
+}
+
+static inline int iceil(double v)
+{
+    int i = (int)v;
+    return i + (v > i);
 }
 
 typedef struct scan_ctx {
     const vfx_tet_mesh *mesh;
     const vfx_tet_tf *tf;
     const vfx_tet_options *opts;
-    const double *vp;
+    const pvert *vp;
     const float *P;
     double near_d;
     int W, H, D;
 } scan_ctx;
 
+/* Each worker on its own cache lines: its counters are written per segment, and a neighbour
+ * sharing the line would read its pool and list pointers through a line bouncing between cores
+ * (false sharing). */
 typedef struct worker {
-    seg_pool pool;
+    _Alignas(64) seg_pool pool;
     int32_t *heads;
+    int32_t *hints;         /* per pixel: the segment last inserted (a walk start), or -1 */
     tile *tiles;            /* local ERT table */
     vfx_tet_counters cnt;
     uint32_t next, end;     /* remaining cells: keys[next..end), guarded by lock */
@@ -200,17 +264,22 @@ static int scan_cell(const scan_ctx *X, worker *w, const cellkey *key)
     const vfx_tet_mesh *mesh = X->mesh;
     const vfx_tet_tf *tf = X->tf;
     const vfx_tet_options *opts = X->opts;
-    const double *vp = X->vp;
+    const pvert *vp = X->vp;
     const float *P = X->P;
     const double near_d = X->near_d, ix0 = P[8], iy0 = P[9];
     const int W = X->W, H = X->H, D = X->D, ert = opts->ert;
     uint32_t c = key->id;
     const uint32_t *t = &mesh->tets[4 * c];
-    double v[4][3], s[4];
+    double v[4][3], s[4], spx[4] = {0}, spy[4] = {0};
     int behind = 0;
     for (int j = 0; j < 4; j++) {
-        memcpy(v[j], &vp[3 * t[j]], sizeof v[j]);
-        s[j] = mesh->scalar[t[j]];
+        const pvert *q = &vp[t[j]];
+        v[j][0] = q->x;
+        v[j][1] = q->y;
+        v[j][2] = q->z;
+        s[j] = q->s;
+        spx[j] = q->px;
+        spy[j] = q->py;
         if (-v[j][2] <= near_d)
             behind++;
     }
@@ -225,10 +294,7 @@ static int scan_cell(const scan_ctx *X, worker *w, const cellkey *key)
     } else {
         double mnx = INFINITY, mxx = -INFINITY, mny = INFINITY, mxy = -INFINITY;
         for (int j = 0; j < 4; j++) {
-            double w = -v[j][2];
-            double nx = (P[0] * v[j][0] + P[8] * v[j][2]) / w;
-            double ny = (P[5] * v[j][1] + P[9] * v[j][2]) / w;
-            double px = (nx + 1) * 0.5 * W - 0.5, py = (ny + 1) * 0.5 * H - 0.5;
+            double px = spx[j], py = spy[j];
             if (px < mnx) mnx = px;
             if (px > mxx) mxx = px;
             if (py < mny) mny = py;
@@ -236,10 +302,10 @@ static int scan_cell(const scan_ctx *X, worker *w, const cellkey *key)
         }
         if (mxx < 0 || mxy < 0 || mnx > W - 1 || mny > H - 1)
             return 0; /* off screen */
-        bx0 = mnx < 0 ? 0 : (int)ceil(mnx);
-        by0 = mny < 0 ? 0 : (int)ceil(mny);
-        bx1 = mxx > W - 1 ? W - 1 : (int)floor(mxx);
-        by1 = mxy > H - 1 ? H - 1 : (int)floor(mxy);
+        bx0 = mnx < 0 ? 0 : iceil(mnx);
+        by0 = mny < 0 ? 0 : iceil(mny);
+        bx1 = mxx > W - 1 ? W - 1 : ifloor(mxx);
+        by1 = mxy > H - 1 ? H - 1 : ifloor(mxy);
         if (bx1 < bx0 || by1 < by0)
             return 0; /* falls between pixel centres */
         if (ert) {
@@ -290,20 +356,104 @@ static int scan_cell(const scan_ctx *X, worker *w, const cellkey *key)
     for (int j = 0; j < 3; j++)
         a0[j] = -(inv[j][0] * v[3][0] + inv[j][1] * v[3][1] + inv[j][2] * v[3][2]);
     a0[3] = 1 - a0[0] - a0[1] - a0[2];
+    /* A face whose plane contains the eye projects to a line; a pixel ray on that line runs
+     * inside the face, where lambda_j is 0 all along and rounding decides whether the ray is in
+     * the tet, so a shared face could be drawn twice or dropped. Tie rule (a symbolic
+     * perturbation of the ray): the ray counts as inside exactly when the face's inward normal
+     * (grad lambda_j) is lexicographically positive; the two tets sharing the face have opposite
+     * normals, so exactly one of them takes the ray. Faces on the eye are rare: flagged here. */
+    double g[4][3];
+    for (int r = 0; r < 3; r++) {
+        g[0][r] = inv[0][r];
+        g[1][r] = inv[1][r];
+        g[2][r] = inv[2][r];
+        g[3][r] = -inv[0][r] - inv[1][r] - inv[2][r];
+    }
+    unsigned on_face = 0, owns = 0;
+    double gnorm[4];
+    for (int j = 0; j < 4; j++) {
+        double ga = fabs(g[j][0]) + fabs(g[j][1]) + fabs(g[j][2]);
+        gnorm[j] = ga;
+        double ea = 1e-10 * (1.0 + fabs(g[j][0] * v[3][0]) + fabs(g[j][1] * v[3][1]) +
+                             fabs(g[j][2] * v[3][2]));
+        if (fabs(a0[j]) > ea)
+            continue;
+        on_face |= 1u << j;
+        int sign = 0;
+        for (int r = 0; r < 3 && !sign; r++)
+            if (fabs(g[j][r]) > 1e-9 * ga)
+                sign = g[j][r] > 0 ? 1 : -1;
+        if (sign > 0)
+            owns |= 1u << j;
+    }
     w->cnt.cells_scanned++;
+    /* Per pixel the ray is p(t) = t * (dx, dy, -1), t = view depth, so each barycentric
+     * coordinate is a0 + t * b with b affine in dx along a row: b is stepped, not recomputed.
+     * The scalar along the ray is S0 + t * Sb with Sb stepped the same way. */
+    double S0 = 0;
+    for (int j = 0; j < 4; j++)
+        S0 += a0[j] * s[j];
+    const double ddx = 2.0 / (W * (double)P[0]);
     for (int y = by0; y <= by1; y++) {
-        double dy = (((y + 0.5) / H) * 2 - 1 + iy0) / P[5];
-        for (int x = bx0; x <= bx1; x++) {
-            double dx = (((x + 0.5) / W) * 2 - 1 + ix0) / P[0];
-            double inl = 1.0 / sqrt(dx * dx + dy * dy + 1.0);
-            double d[3] = {dx * inl, dy * inl, -inl};
-            double b[4];
-            for (int j = 0; j < 3; j++)
-                b[j] = inv[j][0] * d[0] + inv[j][1] * d[1] + inv[j][2] * d[2];
-            b[3] = -b[0] - b[1] - b[2];
-            double tin = near_d / inl, tout = INFINITY; /* near plane as ray distance */
+        int x0 = bx0, x1 = bx1;
+        if (!behind) {
+            /* the footprint is the convex hull of the projected vertices: its span on this
+             * row is [min, max] of the row's crossings of the 6 projected edges, widened by a
+             * little so a pixel centre on an edge is still tested exactly below */
+            double lo = INFINITY, hi = -INFINITY;
+            for (int j = 0; j < 4; j++)
+                for (int k = j + 1; k < 4; k++) {
+                    double yj = spy[j] - y, yk = spy[k] - y;
+                    if ((yj > 0 && yk > 0) || (yj < 0 && yk < 0))
+                        continue;
+                    double xa, xb;
+                    if (yj == yk) {
+                        xa = spx[j];
+                        xb = spx[k];
+                    } else {
+                        xa = xb = spx[j] + (spx[k] - spx[j]) * (yj / (yj - yk));
+                    }
+                    if (xa < lo) lo = xa;
+                    if (xb < lo) lo = xb;
+                    if (xa > hi) hi = xa;
+                    if (xb > hi) hi = xb;
+                }
+            if (!(hi >= lo))
+                continue;
+            double pad = 1e-6 * (1.0 + fabs(lo) + fabs(hi));
+            lo -= pad;
+            hi += pad;
+            if (lo > x0) x0 = iceil(lo);
+            if (hi < x1) x1 = ifloor(hi);
+            if (x1 < x0)
+                continue;
+        }
+        const double dy = (((y + 0.5) / H) * 2 - 1 + iy0) / P[5];
+        double dx = (((x0 + 0.5) / W) * 2 - 1 + ix0) / P[0];
+        double b[4], bstep[4], Sb = 0, Sbstep = 0;
+        for (int j = 0; j < 3; j++) {
+            b[j] = inv[j][0] * dx + inv[j][1] * dy - inv[j][2];
+            bstep[j] = inv[j][0] * ddx;
+        }
+        b[3] = -b[0] - b[1] - b[2];
+        bstep[3] = -bstep[0] - bstep[1] - bstep[2];
+        for (int j = 0; j < 4; j++) {
+            Sb += b[j] * s[j];
+            Sbstep += bstep[j] * s[j];
+        }
+        for (int x = x0; x <= x1; x++, dx += ddx, Sb += Sbstep) {
+            if (x > x0)
+                for (int j = 0; j < 4; j++)
+                    b[j] += bstep[j];
+            double tin = near_d, tout = INFINITY; /* the near plane as view depth */
             int empty = 0;
-            for (int j = 0; j < 4 && !empty; j++) {
+            for (int j = 0; j < 4; j++) {
+                if ((on_face >> j & 1u) &&
+                    fabs(b[j]) <= 1e-10 * gnorm[j] * (fabs(dx) + fabs(dy) + 1.0)) {
+                    if (!(owns >> j & 1u))
+                        empty = 1;
+                    continue; /* inside this face's half-space by the tie rule */
+                }
                 if (b[j] > 0) {
                     double tt = -a0[j] / b[j];
                     if (tt > tin) tin = tt;
@@ -314,25 +464,26 @@ static int scan_cell(const scan_ctx *X, worker *w, const cellkey *key)
                     empty = 1;
                 }
             }
-            size_t pix = (size_t)y * W + x;
-            if (opts->max_dist && opts->max_dist[pix] < tout)
-                tout = opts->max_dist[pix];
             if (empty || !(tout > tin))
                 continue;
-            double sf = 0, sb = 0;
-            for (int j = 0; j < 4; j++) {
-                sf += (a0[j] + b[j] * tin) * s[j];
-                sb += (a0[j] + b[j] * tout) * s[j];
+            /* ray distance = view depth * |(dx, dy, -1)| */
+            const double L = sqrt(dx * dx + dy * dy + 1.0);
+            size_t pix = (size_t)y * W + x;
+            if (opts->max_dist && opts->max_dist[pix] < tout * L) {
+                tout = opts->max_dist[pix] / L;
+                if (!(tout > tin))
+                    continue;
             }
             /* colour and extinction at the segment midpoint scalar; the opacity is
              * corrected for the segment's thickness: alpha = 1 - exp(-tau * length) */
             double tau, rgb[3];
-            tf_eval(tf, 0.5 * (sf + sb), &tau, rgb);
-            double alpha = 1.0 - exp(-tau * (tout - tin));
-            seg sg = {(float)tin, (float)tout, (float)(rgb[0] * alpha),
+            tf_eval(tf, S0 + Sb * 0.5 * (tin + tout), &tau, rgb);
+            /* float32 exp: alpha is stored as a float anyway */
+            double alpha = 1.0 - (double)expf((float)(-tau * (tout - tin) * L));
+            seg sg = {(float)(tin * L), (float)(tout * L), (float)(rgb[0] * alpha),
                       (float)(rgb[1] * alpha), (float)(rgb[2] * alpha), (float)alpha, -1};
             w->cnt.segments_made++;
-            if (insert_seg(&w->pool, &w->heads[pix], sg, opts->partial_composite,
+            if (insert_seg(&w->pool, &w->heads[pix], &w->hints[pix], sg, opts->partial_composite,
                            opts->ert_threshold, &w->cnt.segments_merged) != 0) {
                 return -1;
             }
@@ -420,7 +571,7 @@ static void *worker_main(void *arg)
     const scan_ctx *X = sh->X;
     const int ert = X->opts->ert;
     const uint32_t C = X->opts->update_c > 0 ? (uint32_t)X->opts->update_c : 1;
-    double t0 = now_ms();
+    double t0 = now_ms(), c0 = thread_cpu_ms();
     pthread_mutex_lock(&w->lock);
     uint32_t rem0 = w->end - w->next;
     pthread_mutex_unlock(&w->lock);
@@ -448,6 +599,7 @@ static void *worker_main(void *arg)
         }
     }
     w->cnt.t_sc_ms = now_ms() - t0 - w->cnt.t_update_ms;
+    w->cnt.cpu_ms = thread_cpu_ms() - c0;
     return NULL;
 }
 
@@ -536,9 +688,12 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
 
     const uint32_t np = mesh->point_count, nt = mesh->tet_count;
     const int D = opts->tiles_d > 0 ? opts->tiles_d : 1;
-    double *vp = malloc((size_t)np * 3 * sizeof *vp + 1);
+    pvert *vp = malloc((size_t)np * sizeof *vp + 1);
     cellkey *keys = malloc((size_t)(nt ? nt : 1) * sizeof *keys);
-    worker *ws = calloc((size_t)nw, sizeof *ws);
+    cellkey *ktmp = malloc((size_t)(nt ? nt : 1) * sizeof *ktmp);
+    worker *ws = aligned_alloc(64, (size_t)nw * sizeof *ws);
+    if (ws)
+        memset(ws, 0, (size_t)nw * sizeof *ws);
     tile *table = calloc((size_t)D * D, sizeof *table);
     uint32_t *bounds = calloc((size_t)nw + 1, sizeof *bounds);
     int rc = VFX_OK, nthreads = 0;
@@ -546,7 +701,7 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
     shared sh;
     memset(&sh, 0, sizeof sh);
     pthread_mutex_init(&sh.lock, NULL);
-    if (!vp || !keys || !ws || !table || !bounds) {
+    if (!vp || !keys || !ktmp || !ws || !table || !bounds) {
         snprintf(err, 256, "tet_render: out of memory (%u points, %u tets)", np, nt);
         rc = VFX_ERR_OUT_OF_MEMORY;
         goto done;
@@ -554,20 +709,33 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
     for (int i = 0; i < nw; i++) {
         pthread_mutex_init(&ws[i].lock, NULL);
         ws[i].heads = malloc((size_t)W * H * sizeof *ws[i].heads);
+        ws[i].hints = malloc((size_t)W * H * sizeof *ws[i].hints);
         ws[i].tiles = calloc((size_t)D * D, sizeof *ws[i].tiles);
-        if (!ws[i].heads || !ws[i].tiles) {
+        if (!ws[i].heads || !ws[i].hints || !ws[i].tiles) {
             snprintf(err, 256, "tet_render: out of memory for worker %d (%dx%d)", i, W, H);
             rc = VFX_ERR_OUT_OF_MEMORY;
             goto done;
         }
         for (size_t p = 0; p < (size_t)W * H; p++)
-            ws[i].heads[p] = -1;
+            ws[i].heads[p] = ws[i].hints[p] = -1;
     }
     for (uint32_t i = 0; i < np; i++) {
         const float *x = &mesh->points[3 * i];
+        double e[3];
         for (int r = 0; r < 3; r++)
-            vp[3 * i + r] = (double)V[r] * x[0] + (double)V[4 + r] * x[1] +
-                            (double)V[8 + r] * x[2] + V[12 + r];
+            e[r] = (double)V[r] * x[0] + (double)V[4 + r] * x[1] + (double)V[8 + r] * x[2] + V[12 + r];
+        vp[i].x = e[0];
+        vp[i].y = e[1];
+        vp[i].z = e[2];
+        vp[i].s = mesh->scalar[i];
+        vp[i].px = vp[i].py = 0;
+        double wz = -vp[i].z;
+        if (wz > 0) { /* pixel coordinates: pixel k's centre is at k */
+            double nx = (P[0] * vp[i].x + P[8] * vp[i].z) / wz;
+            double ny = (P[5] * vp[i].y + P[9] * vp[i].z) / wz;
+            vp[i].px = (nx + 1) * 0.5 * W - 0.5;
+            vp[i].py = (ny + 1) * 0.5 * H - 0.5;
+        }
     }
     /* Initial assignment: contiguous ranges of the mesh's cell order (the data layout, which
      * keeps neighbouring cells on one worker as in the paper's fig. 8), each sorted front to
@@ -586,7 +754,7 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
                     rc = VFX_ERR_INVALID_ARGUMENT;
                     goto done;
                 }
-                double z = -vp[3 * t[k] + 2];
+                double z = -vp[t[k]].z;
                 if (isnan(z) || isnan(mesh->scalar[t[k]]))
                     bad = 1;
                 if (z < nearest)
@@ -600,7 +768,7 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
             keys[nk].id = c;
             nk++;
         }
-        qsort(keys + k0, nk - k0, sizeof *keys, cmp_key);
+        sort_keys(keys + k0, ktmp, nk - k0);
         ws[wi].next = k0;
         ws[wi].end = nk;
     }
@@ -661,10 +829,12 @@ done:
             cnt.segments_made += c->segments_made;
             cnt.segments_merged += c->segments_merged;
             cnt.table_updates += c->table_updates;
+            cnt.cpu_ms += c->cpu_ms;
             if (c->t_sc_ms > cnt.t_sc_ms) cnt.t_sc_ms = c->t_sc_ms;
             if (c->t_update_ms > cnt.t_update_ms) cnt.t_update_ms = c->t_update_ms;
             if (per_worker) per_worker[i] = *c;
             free(ws[i].heads);
+            free(ws[i].hints);
             free(ws[i].tiles);
             free(ws[i].pool.s);
             pthread_mutex_destroy(&ws[i].lock);
@@ -675,6 +845,7 @@ done:
     pthread_mutex_destroy(&sh.lock);
     free(vp);
     free(keys);
+    free(ktmp);
     free(ws);
     free(table);
     free(bounds);

@@ -45,6 +45,7 @@ typedef struct vfx_tet_counters {
     uint64_t segments_merged;    /* of those, merged by partial compositing on insert */
     uint64_t table_updates;
     double t_sc_ms, t_update_ms, t_composite_ms;
+    double cpu_ms;               /* CPU time of the worker thread (scan + updates); totals: sum */
 } vfx_tet_counters;
 
 /* Fills opts with the paper's defaults (ERT on, threshold 0.9, D = 20, C = 100, partial on,

@@ -1,13 +1,22 @@
-/* bench_tetvol.c — volfx-bench tetvol: the seed-002 cell-projection renderer on a generated
- * tetrahedral grid (N^3 cubes x 5 tets, scalar = smooth field): ERT threshold sweep against the
- * no-ERT image (RMSE, max, time), D and C sweeps, and worker configurations (Base, ERT,
- * ERT+SHARE, ERT+DLB, ERT+DLB+SHARE) with per-worker times and counts. One JSON line each. */
+/* bench_tetvol.c — volfx-bench tetvol: the seed-002 cell-projection renderer on a loaded mesh
+ * (--mesh FILE.vtu or a TetGen base, --scalar NAME) or a generated grid (--grid N), from a low-
+ * and a high-overlap view: Table 1 (one worker, ERT off/on), the ERT threshold sweep against the
+ * no-ERT image (RMSE, max, time), D and C sweeps (figs. 11-12), Table 2 (Base, ERT, ERT+SHARE,
+ * ERT+DLB, ERT+DLB+SHARE at 2 and at --workers threads) with per-worker times and counts, and an
+ * "image" line (camera, transfer function, wall time) with the image written by --out PREFIX for
+ * the VTK comparison. Every time is the median of --reps runs after one dropped warm-up run.
+ * One JSON line per configuration. */
+#if !defined(_POSIX_C_SOURCE)
+#define _POSIX_C_SOURCE 199309L
+#endif
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
+#include "tetvol/tet_io.h"
 #include "tetvol/tet_render.h"
 
 static const uint32_t cube5[20] = {0, 1, 3, 4, 1, 2, 3, 6, 1, 4, 5, 6, 3, 4, 6, 7, 1, 3, 4, 6};
@@ -45,25 +54,101 @@ static int make_grid(int n, vfx_tet_mesh *m)
     m->point_count = np;
     m->tet_count = nt;
     m->scalar_min = 0; m->scalar_max = 1;
+    snprintf(m->scalar_name, sizeof m->scalar_name, "grid");
     return 0;
 }
 
-/* view A looks face-on along z; view B along the cube diagonal (longer rays, more cells per
- * pixel: the higher-overlap view). */
-static void camera(vfx_tet_camera *c, int w, int h, float yaw, float pitch, float dist)
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+/* CPU time of the whole process (every worker thread): the figure that survives other load */
+static double cpu_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+typedef struct view {
+    const char *name;
+    double eye[3], center[3], up[3];
+    double fovy, nearp, farp;
+} view;
+
+static void norm3(double *v)
+{
+    double l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int i = 0; i < 3; i++) v[i] /= l;
+}
+
+/* Camera looking along dir (from the eye towards the mesh) at the bounding box centre, placed so
+ * the box's extent across the view fits the field of view at the box's near face. */
+static void make_view(view *v, const char *name, const float bmin[3], const float bmax[3],
+                      double dir[3])
+{
+    norm3(dir);
+    double up[3] = {0, 0, 0};
+    int k = 0; /* world axis least aligned with dir */
+    for (int i = 1; i < 3; i++)
+        if (fabs(dir[i]) < fabs(dir[k])) k = i;
+    up[k] = 1;
+    double c[3], half[3];
+    for (int i = 0; i < 3; i++) {
+        c[i] = 0.5 * ((double)bmin[i] + bmax[i]);
+        half[i] = 0.5 * ((double)bmax[i] - bmin[i]);
+    }
+    /* extent of the box along the view and across it (max over the 8 corners) */
+    double s[3] = {dir[1] * up[2] - dir[2] * up[1], dir[2] * up[0] - dir[0] * up[2], dir[0] * up[1] - dir[1] * up[0]};
+    norm3(s);
+    double u[3] = {s[1] * dir[2] - s[2] * dir[1], s[2] * dir[0] - s[0] * dir[2], s[0] * dir[1] - s[1] * dir[0]};
+    double depth = 0, across = 0;
+    for (int q = 0; q < 8; q++) {
+        double p[3] = {q & 1 ? half[0] : -half[0], q & 2 ? half[1] : -half[1], q & 4 ? half[2] : -half[2]};
+        double dd = fabs(p[0] * dir[0] + p[1] * dir[1] + p[2] * dir[2]);
+        double ds = fabs(p[0] * s[0] + p[1] * s[1] + p[2] * s[2]);
+        double du = fabs(p[0] * u[0] + p[1] * u[1] + p[2] * u[2]);
+        if (dd > depth) depth = dd;
+        if (ds > across) across = ds;
+        if (du > across) across = du;
+    }
+    v->name = name;
+    v->fovy = 0.8;
+    double dist = depth + 1.05 * across / tan(0.5 * v->fovy);
+    for (int i = 0; i < 3; i++) {
+        v->center[i] = c[i];
+        v->eye[i] = c[i] - dir[i] * dist;
+        v->up[i] = u[i];
+    }
+    v->nearp = 0.05 * (dist - depth);
+    v->farp = 2.0 * (dist + depth);
+}
+
+static void view_camera(const view *v, int w, int h, vfx_tet_camera *c)
 {
     memset(c, 0, sizeof *c);
     c->width = w; c->height = h;
-    float cy = cosf(yaw), sy = sinf(yaw), cp = cosf(pitch), sp = sinf(pitch);
-    float R[9] = {cy, sp * sy, -cp * sy, 0, cp, sp, sy, -sp * cy, cp * cy};
-    for (int col = 0; col < 3; col++)
-        for (int r = 0; r < 3; r++)
-            c->view[col * 4 + r] = R[col * 3 + r];
-    c->view[14] = -dist; c->view[15] = 1;
-    float f = 1.0f / tanf(0.5f * 0.8f), nearp = 0.05f, farp = 100;
-    c->proj[0] = f * h / (float)w; c->proj[5] = f;
-    c->proj[10] = (farp + nearp) / (nearp - farp); c->proj[11] = -1;
-    c->proj[14] = 2 * farp * nearp / (nearp - farp);
+    double f[3] = {v->center[0] - v->eye[0], v->center[1] - v->eye[1], v->center[2] - v->eye[2]};
+    norm3(f);
+    double s[3] = {f[1] * v->up[2] - f[2] * v->up[1], f[2] * v->up[0] - f[0] * v->up[2], f[0] * v->up[1] - f[1] * v->up[0]};
+    norm3(s);
+    double u[3] = {s[1] * f[2] - s[2] * f[1], s[2] * f[0] - s[0] * f[2], s[0] * f[1] - s[1] * f[0]};
+    for (int i = 0; i < 3; i++) {
+        c->view[4 * i + 0] = (float)s[i];
+        c->view[4 * i + 1] = (float)u[i];
+        c->view[4 * i + 2] = (float)-f[i];
+    }
+    c->view[12] = (float)-(s[0] * v->eye[0] + s[1] * v->eye[1] + s[2] * v->eye[2]);
+    c->view[13] = (float)-(u[0] * v->eye[0] + u[1] * v->eye[1] + u[2] * v->eye[2]);
+    c->view[14] = (float)(f[0] * v->eye[0] + f[1] * v->eye[1] + f[2] * v->eye[2]);
+    c->view[15] = 1;
+    double ff = 1.0 / tan(0.5 * v->fovy);
+    c->proj[0] = (float)(ff * h / w); c->proj[5] = (float)ff;
+    c->proj[10] = (float)((v->farp + v->nearp) / (v->nearp - v->farp)); c->proj[11] = -1;
+    c->proj[14] = (float)(2 * v->farp * v->nearp / (v->nearp - v->farp));
 }
 
 static void diff(const float *a, const float *b, size_t n, double *rmse, double *mx)
@@ -77,90 +162,343 @@ static void diff(const float *a, const float *b, size_t n, double *rmse, double 
     *rmse = sqrt(se / n); *mx = m;
 }
 
+/* PFM (little endian, bottom row first, which is the renderer's row order): channel ch of the
+ * RGBA image, or the three premultiplied colour channels when ch < 0. */
+static int write_pfm(const char *path, const float *rgba, int w, int h, int ch)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) return -1;
+    int ok = fprintf(f, "%s\n%d %d\n-1.0\n", ch < 0 ? "PF" : "Pf", w, h) > 0;
+    for (size_t i = 0; i < (size_t)w * h && ok; i++)
+        ok = ch < 0 ? fwrite(&rgba[4 * i], sizeof(float), 3, f) == 3
+                    : fwrite(&rgba[4 * i + ch], sizeof(float), 1, f) == 1;
+    return (fclose(f) == 0 && ok) ? 0 : -1;
+}
+
+typedef struct run_result {
+    double wall_ms, cpu_ms, t_sc_ms, t_update_ms, rmse, max;
+    vfx_tet_counters c;
+    vfx_tet_counters pw[64];
+} run_result;
+
+static int cmp_run(const void *a, const void *b)
+{
+    const run_result *x = a, *y = b;
+    return (x->wall_ms > y->wall_ms) - (x->wall_ms < y->wall_ms);
+}
+
+static int cmp_d(const void *a, const void *b)
+{
+    const double *x = a, *y = b;
+    return (*x > *y) - (*x < *y);
+}
+
+/* Runs one configuration reps + 1 times, drops the first (warm-up), and returns in *out the run
+ * of median wall time, with t_sc and t_update replaced by their own medians. ref (or NULL) gives
+ * rmse/max of each run against it. */
+static int run_cfg(const vfx_tet_mesh *m, const vfx_tet_camera *cam, const vfx_tet_tf *tf,
+                   const vfx_tet_options *o, float *img, const float *ref, int reps,
+                   run_result *runs, run_result *out)
+{
+    char err[256];
+    size_t n = (size_t)cam->width * cam->height * 4;
+    for (int r = 0; r <= reps; r++) {
+        run_result *rr = &runs[r > 0 ? r - 1 : 0];
+        double t0 = now_ms(), c0 = cpu_ms();
+        if (vfx_tet_render_workers(m, cam, tf, o, img, &rr->c, rr->pw, err) != 0) {
+            fprintf(stderr, "bench tetvol: %s\n", err);
+            return -1;
+        }
+        rr->wall_ms = now_ms() - t0;
+        rr->cpu_ms = cpu_ms() - c0;
+        rr->t_sc_ms = rr->c.t_sc_ms;
+        rr->t_update_ms = rr->c.t_update_ms;
+        rr->rmse = rr->max = 0;
+        if (ref) diff(ref, img, n, &rr->rmse, &rr->max);
+    }
+    double sc[64], up[64], cp[64];
+    for (int r = 0; r < reps; r++) {
+        sc[r] = runs[r].t_sc_ms;
+        up[r] = runs[r].t_update_ms;
+        cp[r] = runs[r].cpu_ms;
+    }
+    qsort(sc, (size_t)reps, sizeof *sc, cmp_d);
+    qsort(up, (size_t)reps, sizeof *up, cmp_d);
+    qsort(cp, (size_t)reps, sizeof *cp, cmp_d);
+    qsort(runs, (size_t)reps, sizeof *runs, cmp_run);
+    *out = runs[reps / 2];
+    out->t_sc_ms = sc[reps / 2];
+    out->t_update_ms = up[reps / 2];
+    out->cpu_ms = cp[reps / 2];
+    return 0;
+}
+
+static int has(const char *list, const char *item)
+{
+    size_t l = strlen(item);
+    for (const char *p = list; (p = strstr(p, item)) != NULL; p += l)
+        if ((p == list || p[-1] == ',') && (p[l] == 0 || p[l] == ','))
+            return 1;
+    return !strcmp(list, "all");
+}
+
+static void usage(void)
+{
+    fputs("volfx-bench tetvol [--mesh FILE.vtu|TETGEN_BASE] [--scalar NAME] [--grid N] [--size PX]\n"
+          "  [--view across,axis] [--only table1,ert,D,C,table2,image] [--workers N] [--reps R]\n"
+          "  [--tau T] [--out PREFIX] [--c-nopartial-max C] [--json]\n"
+          "--tau: optical depth through the mesh's thinnest box extent at the top of the transfer\n"
+          "function (default 4). --out writes PREFIX_<view>.rgb.pfm (premultiplied) and .alpha.pfm\n"
+          "of the no-ERT image. Output is JSON lines (--json is accepted for symmetry).\n", stderr);
+}
+
 int vfx_bench_tetvol(int argc, char **argv)
 {
-    int n = 40, w = 300, h = 300, maxw = 8;
+    int n = 24, w = 300, h = 300, maxw = 8, reps = 5, cnp_max = 100;
     float tau = 4.0f;
-    for (int i = 1; i + 1 < argc; i++) {
-        if (!strcmp(argv[i], "--grid")) n = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--size")) w = h = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--tau")) tau = (float)atof(argv[++i]);
-        else if (!strcmp(argv[i], "--workers")) maxw = atoi(argv[++i]);
+    const char *mesh_path = NULL, *scalar = NULL, *views_opt = "across,axis", *only = "all";
+    const char *out_prefix = NULL;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--json")) continue;
+        if (!strcmp(a, "--help")) { usage(); return 0; }
+        if (!v) { fprintf(stderr, "bench tetvol: %s needs a value\n", a); usage(); return 2; }
+        i++;
+        if (!strcmp(a, "--grid")) n = atoi(v);
+        else if (!strcmp(a, "--size")) w = h = atoi(v);
+        else if (!strcmp(a, "--tau")) tau = (float)atof(v);
+        else if (!strcmp(a, "--workers")) maxw = atoi(v);
+        else if (!strcmp(a, "--reps")) reps = atoi(v);
+        else if (!strcmp(a, "--mesh")) mesh_path = v;
+        else if (!strcmp(a, "--scalar")) scalar = v;
+        else if (!strcmp(a, "--view")) views_opt = v;
+        else if (!strcmp(a, "--only")) only = v;
+        else if (!strcmp(a, "--out")) out_prefix = v;
+        else if (!strcmp(a, "--c-nopartial-max")) cnp_max = atoi(v);
+        else { fprintf(stderr, "bench tetvol: unknown option '%s'\n", a); usage(); return 2; }
     }
-    if (n < 1 || n > 200 || w < 1 || w > 4096 || maxw < 1 || maxw > 64) {
-        fprintf(stderr, "bench tetvol: --grid 1..200, --size 1..4096, --workers 1..64\n");
+    if (n < 1 || n > 200 || w < 1 || w > 4096 || maxw < 1 || maxw > 64 || reps < 1 || reps > 63 || !(tau > 0)) {
+        fprintf(stderr, "bench tetvol: --grid 1..200, --size 1..4096, --workers 1..64, --reps 1..63, --tau > 0\n");
         return 2;
     }
     vfx_tet_mesh m;
-    if (make_grid(n, &m) != 0) { fprintf(stderr, "bench tetvol: out of memory\n"); return 1; }
-    vfx_tet_tf tf = {0, 1, 0.1f * tau, tau, {0.1f, 0.3f, 1.0f}, {1.0f, 0.6f, 0.1f}};
+    char err[256];
+    const char *mesh_name = "grid";
+    if (mesh_path) {
+        size_t l = strlen(mesh_path);
+        int r;
+        if (l > 4 && !strcmp(mesh_path + l - 4, ".vtu")) {
+            r = vfx_tet_load_vtu(mesh_path, scalar ? scalar : "Velocity", &m, err, sizeof err);
+        } else {
+            char base[1024];
+            snprintf(base, sizeof base, "%s", mesh_path);
+            l = strlen(base);
+            if (l > 5 && (!strcmp(base + l - 5, ".node") || !strcmp(base + l - 4, ".ele")))
+                base[!strcmp(base + l - 4, ".ele") ? l - 4 : l - 5] = 0;
+            r = vfx_tet_load_tetgen(base, scalar ? scalar : "attr0", &m, err, sizeof err);
+        }
+        if (r != 0) { fprintf(stderr, "bench tetvol: %s\n", err); return 1; }
+        const char *sl = strrchr(mesh_path, '/');
+        mesh_name = sl ? sl + 1 : mesh_path;
+    } else if (make_grid(n, &m) != 0) {
+        fprintf(stderr, "bench tetvol: out of memory\n");
+        return 1;
+    }
+    float bmin[3] = {INFINITY, INFINITY, INFINITY}, bmax[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < m.point_count; i++)
+        for (int r = 0; r < 3; r++) {
+            float x = m.points[3 * i + r];
+            if (x < bmin[r]) bmin[r] = x;
+            if (x > bmax[r]) bmax[r] = x;
+        }
+    int lo = 0, hi = 0;
+    for (int r = 1; r < 3; r++) {
+        if (bmax[r] - bmin[r] < bmax[lo] - bmin[lo]) lo = r;
+        if (bmax[r] - bmin[r] > bmax[hi] - bmin[hi]) hi = r;
+    }
+    if (lo == hi) hi = (lo + 2) % 3;
+    /* low overlap: along the thinnest box axis ("across" a pipe); high overlap: along the
+     * longest ("down the axis"); both tilted slightly so no face is exactly edge-on. A cube grid
+     * (all extents equal) looks along z and along its diagonal. */
+    view views[2];
+    double d0[3] = {0, 0, 0}, d1[3] = {0, 0, 0};
+    d0[lo] = 1; d0[(lo + 1) % 3] = 0.15; d0[(lo + 2) % 3] = 0.1;
+    d1[hi] = 1; d1[(hi + 1) % 3] = 0.1; d1[(hi + 2) % 3] = 0.15;
+    if (!mesh_path) { d1[0] = d1[1] = d1[2] = 1; }
+    make_view(&views[0], "across", bmin, bmax, d0);
+    make_view(&views[1], "axis", bmin, bmax, d1);
+
+    float thin = bmax[lo] - bmin[lo];
+    float tau_hi = tau / thin;
+    vfx_tet_tf tf = {m.scalar_min, m.scalar_max, 0.2f * tau_hi, tau_hi, {0.1f, 0.3f, 1.0f}, {1.0f, 0.6f, 0.1f}};
     size_t npx = (size_t)w * h * 4;
     float *ref = malloc(npx * sizeof *ref), *img = malloc(npx * sizeof *img);
-    vfx_tet_counters *pw = calloc((size_t)maxw, sizeof *pw);
-    char err[256];
-    if (!ref || !img || !pw) return 1;
-    const char *views[2] = {"A_side", "B_diagonal"};
-    for (int v = 0; v < 2; v++) {
+    run_result *runs = malloc(64 * sizeof *runs), *res = malloc(sizeof *res);
+    if (!ref || !img || !runs || !res) return 1;
+    printf("{\"effect\":\"tetvol\",\"test\":\"mesh\",\"mesh\":\"%s\",\"scalar\":\"%s\",\"points\":%u,\"tets\":%u,"
+           "\"bbox\":[%g,%g,%g,%g,%g,%g],\"width\":%d,\"height\":%d,\"reps\":%d,"
+           "\"tf\":{\"smin\":%.9g,\"smax\":%.9g,\"tau_lo\":%.9g,\"tau_hi\":%.9g,\"color_lo\":[%g,%g,%g],\"color_hi\":[%g,%g,%g]}}\n",
+           mesh_name, m.scalar_name, m.point_count, m.tet_count, bmin[0], bmin[1], bmin[2], bmax[0],
+           bmax[1], bmax[2], w, h, reps, tf.smin, tf.smax, tf.tau_lo, tf.tau_hi, tf.color_lo[0],
+           tf.color_lo[1], tf.color_lo[2], tf.color_hi[0], tf.color_hi[1], tf.color_hi[2]);
+#define HEAD "{\"effect\":\"tetvol\",\"mesh\":\"%s\",\"tets\":%u,\"view\":\"%s\","
+#define HARGS mesh_name, m.tet_count, vw->name
+    int rc = 0;
+    for (int vi = 0; vi < 2 && rc == 0; vi++) {
+        const view *vw = &views[vi];
+        if (!has(views_opt, vw->name) && strcmp(views_opt, "all") != 0)
+            continue;
         vfx_tet_camera cam;
-        if (v == 0) camera(&cam, w, h, 0.0f, 0.0f, 4.5f);
-        else camera(&cam, w, h, 0.785f, 0.6155f, 4.5f);
+        view_camera(vw, w, h, &cam);
         vfx_tet_options o; vfx_tet_options_default(&o);
-        vfx_tet_counters c;
-        o.ert = 0;
-        if (vfx_tet_render_workers(&m, &cam, &tf, &o, ref, &c, pw, err)) { fprintf(stderr, "%s\n", err); return 1; }
-        double base_ms = c.t_sc_ms + c.t_update_ms;
-        printf("{\"effect\":\"tetvol\",\"test\":\"table1\",\"view\":\"%s\",\"tets\":%u,\"width\":%d,\"height\":%d,\"ert\":0,\"t_sc_ms\":%.1f,\"t_composite_ms\":%.1f,\"cells_scanned\":%llu,\"segments\":%llu}\n",
-               views[v], m.tet_count, w, h, c.t_sc_ms, c.t_composite_ms,
-               (unsigned long long)c.cells_scanned, (unsigned long long)c.segments_made);
-        const float thr[4] = {0.9f, 0.95f, 0.99f, 1.0f};
-        for (int i = 0; i < 4; i++) {
-            o.ert = 1; o.ert_threshold = thr[i];
-            vfx_tet_render_workers(&m, &cam, &tf, &o, img, &c, pw, err);
-            double r, mx; diff(ref, img, npx, &r, &mx);
-            printf("{\"effect\":\"tetvol\",\"test\":\"ert_threshold\",\"view\":\"%s\",\"threshold\":%.2f,\"D\":%d,\"C\":%d,\"t_sc_ms\":%.1f,\"t_update_ms\":%.1f,\"speedup_vs_no_ert\":%.2f,\"N_skipped\":%llu,\"rmse\":%.3g,\"max\":%.3g}\n",
-                   views[v], thr[i], o.tiles_d, o.update_c, c.t_sc_ms, c.t_update_ms,
-                   base_ms / (c.t_sc_ms + c.t_update_ms), (unsigned long long)c.cells_skipped_ert, r, mx);
+        o.ert = 0; o.workers = 1;
+        /* the no-ERT one-worker image is the reference of every error figure */
+        if ((rc = run_cfg(&m, &cam, &tf, &o, ref, NULL, reps, runs, res)) != 0) break;
+        run_result base = *res;
+        double asum = 0, cov = 0, opaque = 0;
+        for (size_t p = 0; p < (size_t)w * h; p++) {
+            float a = ref[4 * p + 3];
+            if (a > 0) { cov++; asum += a; }
+            if (a >= 0.9f) opaque++;
         }
-        o.ert_threshold = 0.9f;
-        const int Ds[5] = {5, 10, 20, 40, 80};
-        for (int i = 0; i < 5; i++) {
-            o.tiles_d = Ds[i];
-            vfx_tet_render_workers(&m, &cam, &tf, &o, img, &c, pw, err);
-            printf("{\"effect\":\"tetvol\",\"test\":\"D_sweep\",\"view\":\"%s\",\"D\":%d,\"C\":%d,\"t_sc_ms\":%.1f,\"t_update_ms\":%.1f,\"updates\":%llu,\"N_skipped\":%llu}\n",
-                   views[v], o.tiles_d, o.update_c, c.t_sc_ms, c.t_update_ms,
-                   (unsigned long long)c.table_updates, (unsigned long long)c.cells_skipped_ert);
-        }
-        o.tiles_d = 20;
-        const int Cs[5] = {1, 10, 100, 1000, 10000};
-        for (int pc = 0; pc < 2; pc++)
-            for (int i = 0; i < 5; i++) {
-                o.update_c = Cs[i]; o.partial_composite = pc;
-                vfx_tet_render_workers(&m, &cam, &tf, &o, img, &c, pw, err);
-                printf("{\"effect\":\"tetvol\",\"test\":\"C_sweep\",\"view\":\"%s\",\"partial\":%d,\"D\":20,\"C\":%d,\"t_sc_ms\":%.1f,\"t_update_ms\":%.1f,\"N_skipped\":%llu}\n",
-                       views[v], pc, o.update_c, c.t_sc_ms, c.t_update_ms, (unsigned long long)c.cells_skipped_ert);
+        if (has(only, "image")) {
+            printf(HEAD "\"test\":\"image\",\"width\":%d,\"height\":%d,\"eye\":[%.9g,%.9g,%.9g],"
+                   "\"center\":[%.9g,%.9g,%.9g],\"up\":[%.9g,%.9g,%.9g],\"fovy_deg\":%.9g,\"near\":%.9g,\"far\":%.9g,"
+                   "\"wall_ms\":%.2f,\"cpu_ms\":%.2f,\"t_sc_ms\":%.2f,\"t_composite_ms\":%.2f,\"covered\":%.0f,\"mean_alpha_covered\":%.4f,"
+                   "\"pixels_alpha_ge_0.9\":%.0f,\"cells_scanned\":%llu,\"segments\":%llu}\n",
+                   HARGS, w, h, vw->eye[0], vw->eye[1], vw->eye[2], vw->center[0], vw->center[1],
+                   vw->center[2], vw->up[0], vw->up[1], vw->up[2], vw->fovy * 57.29577951308232, vw->nearp,
+                   vw->farp, base.wall_ms, base.cpu_ms, base.t_sc_ms, base.c.t_composite_ms, cov,
+                   cov > 0 ? asum / cov : 0.0, opaque, (unsigned long long)base.c.cells_scanned,
+                   (unsigned long long)base.c.segments_made);
+            if (out_prefix) {
+                char p1[1100], p2[1100];
+                snprintf(p1, sizeof p1, "%s_%s.rgb.pfm", out_prefix, vw->name);
+                snprintf(p2, sizeof p2, "%s_%s.alpha.pfm", out_prefix, vw->name);
+                if (write_pfm(p1, ref, w, h, -1) || write_pfm(p2, ref, w, h, 3)) {
+                    fprintf(stderr, "bench tetvol: cannot write %s\n", p1);
+                    rc = 1;
+                    break;
+                }
             }
-        o.update_c = 100; o.partial_composite = 1;
-        const char *names[5] = {"Base", "ERT", "ERT+SHARE", "ERT+DLB", "ERT+DLB+SHARE"};
-        const int cfg[5][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {1, 0, 1}, {1, 1, 1}};
-        for (int i = 0; i < 5; i++) {
-            o.workers = maxw; o.ert = cfg[i][0]; o.share = cfg[i][1]; o.dlb = cfg[i][2];
-            vfx_tet_render_workers(&m, &cam, &tf, &o, img, &c, pw, err);
-            double r, mx; diff(ref, img, npx, &r, &mx);
-            double sum = 0, tmax = 0;
-            printf("{\"effect\":\"tetvol\",\"test\":\"table2\",\"view\":\"%s\",\"config\":\"%s\",\"workers\":%d,\"rmse\":%.3g,\"per_worker\":[",
-                   views[v], names[i], maxw, r);
-            for (int k = 0; k < maxw; k++) {
-                double t = pw[k].t_sc_ms + pw[k].t_update_ms;
-                sum += t; if (t > tmax) tmax = t;
-                printf("%s{\"ms\":%.1f,\"cells\":%llu,\"segments\":%llu}", k ? "," : "", t,
-                       (unsigned long long)pw[k].cells_scanned, (unsigned long long)pw[k].segments_made);
+            /* the fast setting: every core, ERT 0.99 with sharing and load balancing */
+            o.ert = 1; o.ert_threshold = 0.99f; o.workers = 2; o.share = o.dlb = 1;
+            if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
+            printf(HEAD "\"test\":\"image_fast\",\"workers\":2,\"threshold\":0.99,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,"
+                   "\"N_skipped\":%llu,\"rmse_vs_no_ert\":%.3g,\"max_vs_no_ert\":%.3g}\n",
+                   HARGS, res->wall_ms, res->cpu_ms, (unsigned long long)res->c.cells_skipped_ert, res->rmse, res->max);
+            if (out_prefix) {
+                char p1[1100], p2[1100];
+                snprintf(p1, sizeof p1, "%s_%s_fast.rgb.pfm", out_prefix, vw->name);
+                snprintf(p2, sizeof p2, "%s_%s_fast.alpha.pfm", out_prefix, vw->name);
+                if (write_pfm(p1, img, w, h, -1) || write_pfm(p2, img, w, h, 3)) {
+                    fprintf(stderr, "bench tetvol: cannot write %s\n", p1);
+                    rc = 1;
+                    break;
+                }
             }
-            printf("],\"t_sc_max_ms\":%.1f,\"imbalance_max_over_mean\":%.2f,\"N_skipped\":%llu,\"t_composite_ms\":%.1f}\n",
-                   tmax, tmax / (sum / maxw), (unsigned long long)c.cells_skipped_ert, c.t_composite_ms);
+            vfx_tet_options_default(&o);
+            o.ert = 0; o.workers = 1;
         }
-        o.workers = 1;
+        if (has(only, "table1")) {
+            for (int e = 0; e < 2; e++) {
+                o.ert = e; o.ert_threshold = 0.9f;
+                if (e && (rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
+                const run_result *r = e ? res : &base;
+                printf(HEAD "\"test\":\"table1\",\"ert\":%d,\"threshold\":0.9,\"D\":%d,\"C\":%d,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,"
+                       "\"t_sc_ms\":%.2f,\"t_update_ms\":%.2f,\"t_composite_ms\":%.2f,\"N_skipped\":%llu,"
+                       "\"cells_scanned\":%llu,\"segments\":%llu,\"merged\":%llu,\"updates\":%llu,\"rmse\":%.3g,\"max\":%.3g}\n",
+                       HARGS, e, o.tiles_d, o.update_c, r->wall_ms, r->cpu_ms, r->t_sc_ms, r->t_update_ms,
+                       r->c.t_composite_ms, (unsigned long long)r->c.cells_skipped_ert,
+                       (unsigned long long)r->c.cells_scanned, (unsigned long long)r->c.segments_made,
+                       (unsigned long long)r->c.segments_merged, (unsigned long long)r->c.table_updates,
+                       r->rmse, r->max);
+            }
+            if (rc) break;
+        }
+        if (has(only, "ert")) {
+            const float thr[4] = {0.9f, 0.95f, 0.99f, 1.0f};
+            for (int i = 0; i < 4 && rc == 0; i++) {
+                o.ert = 1; o.ert_threshold = thr[i];
+                if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
+                printf(HEAD "\"test\":\"ert_threshold\",\"threshold\":%.2f,\"D\":%d,\"C\":%d,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,"
+                       "\"t_sc_ms\":%.2f,\"t_update_ms\":%.2f,\"no_ert_wall_ms\":%.2f,\"no_ert_cpu_ms\":%.2f,\"N_skipped\":%llu,\"rmse\":%.3g,\"max\":%.3g}\n",
+                       HARGS, thr[i], o.tiles_d, o.update_c, res->wall_ms, res->cpu_ms, res->t_sc_ms,
+                       res->t_update_ms, base.wall_ms, base.cpu_ms, (unsigned long long)res->c.cells_skipped_ert,
+                       res->rmse, res->max);
+            }
+        }
+        o.ert = 1; o.ert_threshold = 0.9f;
+        if (has(only, "D")) {
+            const int Ds[6] = {5, 10, 20, 40, 80, 150};
+            for (int i = 0; i < 6 && rc == 0; i++) {
+                o.tiles_d = Ds[i];
+                if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
+                printf(HEAD "\"test\":\"D_sweep\",\"D\":%d,\"C\":%d,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,\"t_sc_ms\":%.2f,"
+                       "\"t_update_ms\":%.2f,\"updates\":%llu,\"N_skipped\":%llu,\"rmse\":%.3g}\n",
+                       HARGS, o.tiles_d, o.update_c, res->wall_ms, res->cpu_ms, res->t_sc_ms, res->t_update_ms,
+                       (unsigned long long)res->c.table_updates,
+                       (unsigned long long)res->c.cells_skipped_ert, res->rmse);
+            }
+            o.tiles_d = 20;
+        }
+        if (has(only, "C")) {
+            const int Cs[5] = {1, 10, 100, 1000, 10000};
+            /* without partial compositing each update walks whole lists: C is capped at
+             * --c-nopartial-max and one run is timed (after the warm-up), or the sweep would take
+             * minutes per point */
+            for (int pc = 1; pc >= 0 && rc == 0; pc--)
+                for (int i = 0; i < 5 && (pc || Cs[i] <= cnp_max) && rc == 0; i++) {
+                    o.update_c = Cs[i]; o.partial_composite = pc;
+                    int rp = pc ? reps : 1;
+                    if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, rp, runs, res)) != 0) break;
+                    printf(HEAD "\"test\":\"C_sweep\",\"partial\":%d,\"D\":%d,\"C\":%d,\"reps\":%d,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,"
+                           "\"t_sc_ms\":%.2f,\"t_update_ms\":%.2f,\"updates\":%llu,\"N_skipped\":%llu,\"segments_in_lists\":%llu}\n",
+                           HARGS, pc, o.tiles_d, o.update_c, rp, res->wall_ms, res->cpu_ms, res->t_sc_ms,
+                           res->t_update_ms, (unsigned long long)res->c.table_updates,
+                           (unsigned long long)res->c.cells_skipped_ert,
+                           (unsigned long long)(res->c.segments_made - res->c.segments_merged));
+                }
+            o.update_c = 100; o.partial_composite = 1;
+        }
+        if (has(only, "table2")) {
+            const char *names[5] = {"Base", "ERT", "ERT+SHARE", "ERT+DLB", "ERT+DLB+SHARE"};
+            const int cfg[5][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {1, 0, 1}, {1, 1, 1}};
+            int wcounts[2] = {2, maxw};
+            for (int wc = 0; wc < (maxw != 2 ? 2 : 1) && rc == 0; wc++)
+                for (int i = 0; i < 5 && rc == 0; i++) {
+                    int nw = wcounts[wc];
+                    o.workers = nw; o.ert = cfg[i][0]; o.share = cfg[i][1]; o.dlb = cfg[i][2];
+                    if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
+                    double sum = 0, tmax = 0, csum = 0, cmax = 0, csum_cpu = 0, cmax_cpu = 0;
+                    printf(HEAD "\"test\":\"table2\",\"config\":\"%s\",\"workers\":%d,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,\"rmse\":%.3g,\"max\":%.3g,\"per_worker\":[",
+                           HARGS, names[i], nw, res->wall_ms, res->cpu_ms, res->rmse, res->max);
+                    for (int k = 0; k < nw; k++) {
+                        const vfx_tet_counters *p = &res->pw[k];
+                        double t = p->t_sc_ms + p->t_update_ms;
+                        csum_cpu += p->cpu_ms;
+                        if (p->cpu_ms > cmax_cpu) cmax_cpu = p->cpu_ms;
+                        double work = (double)p->cells_scanned;
+                        sum += t; if (t > tmax) tmax = t;
+                        csum += work; if (work > cmax) cmax = work;
+                        printf("%s{\"ms\":%.1f,\"cpu_ms\":%.1f,\"cells\":%llu,\"skipped\":%llu,\"segments\":%llu,\"merged\":%llu}", k ? "," : "", t, p->cpu_ms,
+                               (unsigned long long)p->cells_scanned, (unsigned long long)p->cells_skipped_ert,
+                               (unsigned long long)p->segments_made, (unsigned long long)p->segments_merged);
+                    }
+                    printf("],\"t_worker_max_ms\":%.2f,\"cpu_worker_max_ms\":%.2f,\"imbalance_cpu\":%.3f,\"imbalance_time\":%.3f,\"imbalance_cells\":%.3f,"
+                           "\"N_skipped\":%llu,\"cells_scanned\":%llu,\"segments\":%llu,\"t_composite_ms\":%.2f}\n",
+                           tmax, cmax_cpu, csum_cpu > 0 ? cmax_cpu / (csum_cpu / nw) : 0.0,
+                           sum > 0 ? tmax / (sum / nw) : 0.0, csum > 0 ? cmax / (csum / nw) : 0.0,
+                           (unsigned long long)res->c.cells_skipped_ert,
+                           (unsigned long long)res->c.cells_scanned,
+                           (unsigned long long)res->c.segments_made, res->c.t_composite_ms);
+                }
+            o.workers = 1;
+        }
+        fflush(stdout);
     }
-    free(ref); free(img); free(pw);
-    free(m.points); free(m.scalar); free(m.tets);
-    return 0;
+    free(ref); free(img); free(runs); free(res);
+    if (mesh_path) vfx_tet_mesh_free(&m);
+    else { free(m.points); free(m.scalar); free(m.tets); }
+    return rc ? 1 : 0;
 }

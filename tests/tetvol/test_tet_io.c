@@ -348,6 +348,72 @@ static void test_tetgen(void **st)
     remove(base);
 }
 
+static char *replace_once(const char *s, const char *from, const char *to)
+{
+    static char buf[8192];
+    const char *at = strstr(s, from);
+    assert_non_null(at);
+    snprintf(buf, sizeof buf, "%.*s%s%s", (int)(at - s), s, to, at + strlen(from));
+    return buf;
+}
+
+/* Inputs the other tests leave out: non-4 offsets, a missing Cells array, 2-component points,
+ * no Piece, AppendedData without its marker, a coincident-vertex tet (kept and counted as
+ * degenerate, not refused), and TetGen with the .ele file missing or a node line too short. */
+static void test_more_malformed(void **st)
+{
+    (void)st;
+    vfx_tet_mesh m;
+    char err[256];
+    const char *good = make_ascii("5", "5", "2 2 2", "4", "10");
+    char copy[4096];
+    snprintf(copy, sizeof copy, "%s", good);
+    assert_int_equal(load_str(replace_once(copy, ">4 8<", ">4 9<"), NULL, &m, err), VFX_ERR_FORMAT);
+    assert_non_null(strstr(err, "cell 1: offset 9, expected 8"));
+    assert_int_equal(load_str(replace_once(copy, "Name=\"offsets\"", "Name=\"offs\""), NULL, &m, err),
+                     VFX_ERR_FORMAT);
+    assert_non_null(strstr(err, "missing Cells offsets"));
+    assert_int_equal(load_str(replace_once(copy, "Float32\" NumberOfComponents=\"3\"",
+                                           "Float32\" NumberOfComponents=\"2\""), NULL, &m, err),
+                     VFX_ERR_FORMAT);
+    assert_non_null(strstr(err, "Points must be 3-component"));
+    char nopiece[4096];
+    snprintf(nopiece, sizeof nopiece, "%s", replace_once(copy, "<Piece ", "<Peace "));
+    assert_int_equal(load_str(replace_once(nopiece, "</Piece>", "</Peace>"), NULL, &m, err),
+                     VFX_ERR_FORMAT);
+    assert_non_null(strstr(err, "no UnstructuredGrid Piece"));
+    char app[8192];
+    size_t n = build_binary(app, sizeof app, ENC_RAW, 0, 0);
+    char *mark = strstr(app, "<AppendedData encoding=\"raw\">\n_");
+    assert_non_null(mark);
+    mark[strlen("<AppendedData encoding=\"raw\">\n")] = 'X';
+    assert_int_equal(vfx_tet_load_vtu_mem(app, n, "P", &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_non_null(strstr(err, "without its '_' marker"));
+    /* point 4 placed on point 0: the second tet (0,2,1,4) has two identical vertices */
+    assert_int_equal(load_str(make_ascii("5", "5", "0 0 0", "4", "10"), "P", &m, err), VFX_OK);
+    assert_int_equal(m.tet_count, 2);
+    assert_int_equal(m.degenerate_count, 1);
+    vfx_tet_mesh_free(&m);
+
+    char base[] = "/tmp/vfx_tg2_XXXXXX";
+    int fd = mkstemp(base);
+    assert_true(fd >= 0);
+    char p[64];
+    snprintf(p, sizeof p, "%s.node", base);
+    write_file(p, "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n");
+    assert_int_equal(vfx_tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_IO);
+    assert_non_null(strstr(err, ".ele: cannot open"));
+    write_file(p, "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1\n3 0 0 1\n");
+    snprintf(p, sizeof p, "%s.ele", base);
+    write_file(p, "1 4 0\n0 0 1 2 3\n");
+    assert_int_equal(vfx_tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_non_null(strstr(err, ":4: point 2 has 3 numbers, expected 4"));
+    remove(p);
+    snprintf(p, sizeof p, "%s.node", base);
+    remove(p);
+    remove(base);
+}
+
 static int pipe_present(void)
 {
     const char *dir = getenv("VFX_SHARED_DATA");
@@ -407,6 +473,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_nan_coordinate),    cmocka_unit_test(test_nan_scalar),
         cmocka_unit_test(test_wrong_counts),      cmocka_unit_test(test_empty_and_not_xml),
         cmocka_unit_test(test_binary_encodings),  cmocka_unit_test(test_tetgen),
+        cmocka_unit_test(test_more_malformed),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
