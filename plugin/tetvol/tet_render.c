@@ -223,6 +223,32 @@ static inline int iceil(double v)
     return i + (v > i);
 }
 
+/* Transforms every point to view space with its scalar and, in front of the eye, its pixel
+ * coordinates (pixel k's centre at k). Shared by the threaded path and the MPI engine so both
+ * see bit-identical vertices. */
+static void view_vertices(const vfx_tet_mesh *mesh, const float *V, const float *P, int W, int H,
+                          pvert *vp)
+{
+    for (uint32_t i = 0; i < mesh->point_count; i++) {
+        const float *x = &mesh->points[3 * i];
+        double e[3];
+        for (int r = 0; r < 3; r++)
+            e[r] = (double)V[r] * x[0] + (double)V[4 + r] * x[1] + (double)V[8 + r] * x[2] + V[12 + r];
+        vp[i].x = e[0];
+        vp[i].y = e[1];
+        vp[i].z = e[2];
+        vp[i].s = mesh->scalar[i];
+        vp[i].px = vp[i].py = 0;
+        double wz = -vp[i].z;
+        if (wz > 0) {
+            double nx = (P[0] * vp[i].x + P[8] * vp[i].z) / wz;
+            double ny = (P[5] * vp[i].y + P[9] * vp[i].z) / wz;
+            vp[i].px = (nx + 1) * 0.5 * W - 0.5;
+            vp[i].py = (ny + 1) * 0.5 * H - 0.5;
+        }
+    }
+}
+
 typedef struct scan_ctx {
     const vfx_tet_mesh *mesh;
     const vfx_tet_tf *tf;
@@ -719,24 +745,7 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
         for (size_t p = 0; p < (size_t)W * H; p++)
             ws[i].heads[p] = ws[i].hints[p] = -1;
     }
-    for (uint32_t i = 0; i < np; i++) {
-        const float *x = &mesh->points[3 * i];
-        double e[3];
-        for (int r = 0; r < 3; r++)
-            e[r] = (double)V[r] * x[0] + (double)V[4 + r] * x[1] + (double)V[8 + r] * x[2] + V[12 + r];
-        vp[i].x = e[0];
-        vp[i].y = e[1];
-        vp[i].z = e[2];
-        vp[i].s = mesh->scalar[i];
-        vp[i].px = vp[i].py = 0;
-        double wz = -vp[i].z;
-        if (wz > 0) { /* pixel coordinates: pixel k's centre is at k */
-            double nx = (P[0] * vp[i].x + P[8] * vp[i].z) / wz;
-            double ny = (P[5] * vp[i].y + P[9] * vp[i].z) / wz;
-            vp[i].px = (nx + 1) * 0.5 * W - 0.5;
-            vp[i].py = (ny + 1) * 0.5 * H - 0.5;
-        }
-    }
+    view_vertices(mesh, V, P, W, H, vp);
     /* Initial assignment: contiguous ranges of the mesh's cell order (the data layout, which
      * keeps neighbouring cells on one worker as in the paper's fig. 8), each sorted front to
      * back by nearest depth (visibility cycles do no harm: pixel lists are depth sorted). */
@@ -862,8 +871,9 @@ struct vfx_tet_local {
     scan_ctx X;
     shared sh;
     worker w;
-    double *vp;
+    pvert *vp;
     cellkey *keys;
+    cellkey *ktmp;    /* radix-sort scratch, as long as the largest partition */
     uint32_t *bounds; /* parts + 1 cell offsets: partition p is cells [bounds[p], bounds[p+1]) */
     uint32_t *valid;  /* keys of partition p (its cells without NaN) once built */
     uint8_t *built;
@@ -880,7 +890,7 @@ static void local_build(vfx_tet_local *L, int p, int count)
         int bad = 0;
         float nearest = INFINITY;
         for (int k = 0; k < 4; k++) {
-            double z = -L->vp[3 * t[k] + 2];
+            double z = -L->vp[t[k]].z;
             if (isnan(z) || isnan(mesh->scalar[t[k]]))
                 bad = 1;
             if (z < nearest)
@@ -895,7 +905,7 @@ static void local_build(vfx_tet_local *L, int p, int count)
         L->keys[c0 + n].id = c;
         n++;
     }
-    qsort(L->keys + c0, n, sizeof *L->keys, cmp_key);
+    sort_keys(L->keys + c0, L->ktmp, n);
     L->valid[p] = n;
     L->built[p] = 1;
 }
@@ -934,29 +944,25 @@ int vfx_tet_local_create(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
         return VFX_ERR_OUT_OF_MEMORY;
     }
     L->parts = parts;
-    L->vp = malloc((size_t)np * 3 * sizeof *L->vp + 1);
+    L->vp = malloc((size_t)np * sizeof *L->vp + 1);
     L->keys = malloc((size_t)(nt ? nt : 1) * sizeof *L->keys);
+    L->ktmp = malloc((size_t)(nt ? nt : 1) * sizeof *L->ktmp);
     L->bounds = calloc((size_t)parts + 1, sizeof *L->bounds);
     L->valid = calloc((size_t)parts, sizeof *L->valid);
     L->built = calloc((size_t)parts, sizeof *L->built);
     L->w.heads = malloc((size_t)W * H * sizeof *L->w.heads);
+    L->w.hints = malloc((size_t)W * H * sizeof *L->w.hints);
     L->w.tiles = calloc((size_t)D * D, sizeof *L->w.tiles);
     pthread_mutex_init(&L->w.lock, NULL);
     pthread_mutex_init(&L->sh.lock, NULL);
-    if (!L->vp || !L->keys || !L->bounds || !L->valid || !L->built || !L->w.heads ||
-        !L->w.tiles) {
+    if (!L->vp || !L->keys || !L->ktmp || !L->bounds || !L->valid || !L->built ||
+        !L->w.heads || !L->w.hints || !L->w.tiles) {
         snprintf(err, 256, "tet_render: out of memory (%u points, %u tets, %dx%d)", np, nt, W, H);
         vfx_tet_local_destroy(L);
         return VFX_ERR_OUT_OF_MEMORY;
     }
     for (size_t p = 0; p < (size_t)W * H; p++)
-        L->w.heads[p] = -1;
-    for (uint32_t i = 0; i < np; i++) {
-        const float *x = &mesh->points[3 * i];
-        for (int r = 0; r < 3; r++)
-            L->vp[3 * i + r] = (double)V[r] * x[0] + (double)V[4 + r] * x[1] +
-                               (double)V[8 + r] * x[2] + V[12 + r];
-    }
+        L->w.heads[p] = L->w.hints[p] = -1;
     /* every index is checked on every process (cheap), so all report the same bad tet */
     for (uint32_t c = 0; c < nt; c++)
         for (int k = 0; k < 4; k++)
@@ -966,6 +972,7 @@ int vfx_tet_local_create(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
                 vfx_tet_local_destroy(L);
                 return VFX_ERR_INVALID_ARGUMENT;
             }
+    view_vertices(mesh, V, P, W, H, L->vp);
     for (int pi = 0; pi <= parts; pi++)
         L->bounds[pi] = (uint32_t)((uint64_t)nt * pi / parts);
     scan_ctx X = {mesh, tf, opts, L->vp, P, near_d, W, H, D};
@@ -986,10 +993,12 @@ void vfx_tet_local_destroy(vfx_tet_local *L)
         return;
     free(L->vp);
     free(L->keys);
+    free(L->ktmp);
     free(L->bounds);
     free(L->valid);
     free(L->built);
     free(L->w.heads);
+    free(L->w.hints);
     free(L->w.tiles);
     free(L->w.pool.s);
     pthread_mutex_destroy(&L->w.lock);
