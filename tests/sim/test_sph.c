@@ -186,11 +186,13 @@ static void test_two_coincident(void **state)
     vfx_sph_destroy(s);
     /* Inside a block: a duplicate of a bulk particle is compressed (rho ~ 1.2 rho0), and the
      * spiky gradient (non-zero at r = 0, along a pseudo-random antisymmetric axis) separates
-     * the pair; momentum stays zero. */
+     * the pair; momentum stays zero. The block is kept more than H from every wall, where
+     * the wall terms (which take momentum) do not reach. */
+    d.domain_max[2] = 0.1f;
     s = make(d);
-    float lo[3] = {0.02f, 0.05f, 0.0f}, hi[3] = {0.08f, 0.11f, 0.06f};
+    float lo[3] = {0.02f, 0.05f, 0.02f}, hi[3] = {0.08f, 0.11f, 0.08f};
     assert_int_equal(vfx_sph_add_block(s, lo, hi, NULL), VFX_OK);
-    float px = 0.055f, py = 0.085f, pz = 0.035f; /* exactly a lattice site */
+    float px = 0.055f, py = 0.085f, pz = 0.055f; /* exactly a lattice site */
     assert_int_equal(vfx_sph_add_particles(s, 1, &px, &py, &pz, NULL, NULL, NULL), VFX_OK);
     uint32_t dup = vfx_sph_get_columns(s).count - 1;
     for (int f = 0; f < 3; ++f) {
@@ -214,10 +216,9 @@ static void test_two_coincident(void **state)
     }
     print_message("duplicate particle: nearest neighbour at %.4f m after 1/80 s\n", best);
     assert_true(best > 0.1f * 0.01f);
-    /* the block is >= 2.5 cm (> H) from the x and y walls: x and y momentum are conserved
-     * (pairwise antisymmetric forces), up to float rounding of ~300 terms */
-    (void)mz; /* the block touches the z walls, which take z momentum */
-    assert_true(fabs(mx) < 1e-3 && fabs(my) < 1e-3);
+    /* the block is >= 2.5 cm (> H) from every wall: momentum is conserved (pairwise
+     * antisymmetric forces), up to float rounding of ~200 terms */
+    assert_true(fabs(mx) < 1e-3 && fabs(my) < 1e-3 && fabs(mz) < 1e-3);
     vfx_sph_destroy(s);
 }
 
@@ -269,6 +270,7 @@ static void run_block(vfx_sph *s, int frames, float frame_dt, bool expect_cap, f
     vfx_sph_report r;
     assert_int_equal(vfx_sph_step(s, 0.f, &r), VFX_OK);
     double e0 = energy(&r);
+    print_message("block at rest: initial max density error %.5f\n", r.max_density_error);
     for (int f = 0; f < frames; ++f) {
         assert_int_equal(vfx_sph_step(s, frame_dt, &r), VFX_OK);
         check_state(s);
@@ -281,6 +283,7 @@ static void run_block(vfx_sph *s, int frames, float frame_dt, bool expect_cap, f
         if (!(energy(&r) <= e0 * 1.02))
             print_message("energy %.6g > 1.02 * %.6g (ke %.3g), substeps %u\n", energy(&r), e0, r.kinetic_energy, r.substeps);
         assert_true(energy(&r) <= e0 * 1.02);
+        if (!(r.max_density_error < max_err)) print_message("frame %d: max density error %.5f (bound %.5f)\n", f, r.max_density_error, max_err);
         assert_true(r.max_density_error < max_err);
     }
 }
@@ -296,9 +299,12 @@ static void test_stiffness_1000x(void **state)
     d.max_substeps = 100;
     vfx_sph *s = make(d);
     /* c0 grows by sqrt(1000): the acoustic dt is ~32x smaller, a 60 Hz frame needs more than
-     * the cap: every frame must report cap_hit; compression stays under 0.1% */
+     * the cap: every frame must report cap_hit. Compression: the fresh lattice starts at up
+     * to 0.66% (the wall density's kernel tail reaches lattice layers that miss nothing:
+     * +0.22% per wall on the second layer, more at edges); a stiff fluid must relax that,
+     * not add to it: bound 0.2% (measured 0.125% in the first frame, 0 from the third) */
     assert_true(vfx_sph_params(s)->sound_speed > 30.f * 10.f);
-    run_block(s, 5, 1.f / 60.f, true, 0.001f);
+    run_block(s, 5, 1.f / 60.f, true, 0.002f);
     vfx_sph_destroy(s);
 }
 
@@ -501,6 +507,15 @@ static void test_mesh_collider(void **state)
     vfx_sph_destroy(s);
 }
 
+/* Least-squares slope of y on x over n points. */
+static double fit_slope(const double *x, const double *y, int n)
+{
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (int k = 0; k < n; ++k)
+        sx += x[k], sy += y[k], sxx += x[k] * x[k], sxy += x[k] * y[k];
+    return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
 static void test_hydrostatic(void **state)
 {
     (void)state;
@@ -508,7 +523,10 @@ static void test_hydrostatic(void **state)
      * carries acoustic noise (gamma 7 turns 1% of density into 7% of B = 56 kPa, against a
      * hydrostatic 1.5 kPa), so the pressure is averaged over particles in 2 cm depth bins and
      * over 30 frames (0.5 s, ~3 periods of the slowest column mode) after 0.5 s of settling.
-     * Reference: p = rho0 g depth, depth below the mean free surface (float64). */
+     * Reference: p = rho0 g depth, depth below the mean free surface (float64). The column is
+     * 6 particles wide, so 20 of its 36 particle columns touch a side wall: the wall layer
+     * (within 1 cm of a side wall) and the rest are also fitted on their own, so a wall
+     * treatment that only holds on average (one group high, the other low) fails. */
     vfx_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.06f, 0.2f, 0.06f},
                       .threads = 2, .viscosity = 0.1f};
     vfx_sph *s = make(d);
@@ -516,8 +534,8 @@ static void test_hydrostatic(void **state)
     assert_int_equal(vfx_sph_add_block(s, lo, hi, NULL), VFX_OK);
     vfx_sph_report r;
     enum { BINS = 8 };
-    double psum[BINS] = {0}, dsum[BINS] = {0};
-    int cnt[BINS] = {0};
+    double psum[3][BINS] = {{0}}, dsum[3][BINS] = {{0}}; /* all, wall layer, inner */
+    int cnt[3][BINS] = {{0}};
     float max_err = 0.f, mean_err = 0.f;
     for (int f = 0; f < 60; ++f) {
         assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
@@ -537,37 +555,47 @@ static void test_hydrostatic(void **state)
             int b = (int)((top - c.y[i]) / 0.02);
             if (b < 0 || b >= BINS)
                 continue;
-            psum[b] += vfx_sph_pressure(s, i);
-            dsum[b] += top - c.y[i];
-            cnt[b]++;
+            float side = fminf(fminf(c.x[i], 0.06f - c.x[i]), fminf(c.z[i], 0.06f - c.z[i]));
+            int grp[2] = {0, side < 0.01f ? 1 : 2};
+            for (int k = 0; k < 2; ++k) {
+                psum[grp[k]][b] += vfx_sph_pressure(s, i);
+                dsum[grp[k]][b] += top - c.y[i];
+                cnt[grp[k]][b]++;
+            }
         }
     }
-    /* density error bounds over the measured frames: max 3%, mean 0.5% */
+    /* Density error over the measured frames. The hydrostatic compression at the floor is
+     * rho0 g h / (gamma B) = 0.37% (float64: 1000*9.81*0.15 / (7*56 kPa)), 0.19% on average
+     * over the depth; bounds 1.5% max (4x, for the acoustic noise), 0.5% mean. */
     print_message("hydrostatic density error: max %.4f, mean %.4f\n", max_err, mean_err);
-    assert_true(max_err < 0.03f);
+    assert_true(max_err < 0.015f);
     assert_true(mean_err < 0.005f);
-    /* bins below the first (free surface) and above the floor layer. Pressure rises linearly
-     * with depth; the fitted slope is held to rho0 g within 35% and each bin to 50%. These
-     * bounds are loose on purpose and the measured bias (+20-35%, docs/simulation.md) is a
-     * known shortcoming: the clamped p >= 0 EOS truncates the negative half of the acoustic
-     * noise, and the energy-consistent single-sided wall force lets wall layers compress. */
-    int checked = 0;
-    double sx = 0, sy = 0, sxx = 0, sxy = 0;
-    for (int b = 1; b < 6; ++b) { /* bin 6 holds the floor layer */
-        if (cnt[b] < 30 * 20)
-            continue;
-        double dm = dsum[b] / cnt[b], pm = psum[b] / cnt[b], ref = 1000.0 * 9.81 * dm;
-        print_message("hydrostatic bin depth %.3f m: p %.1f Pa, rho0 g d %.1f Pa (%+.1f%%)\n",
-                      dm, pm, ref, 100.0 * (pm - ref) / ref);
-        assert_true(fabs(pm - ref) < 0.5 * ref);
-        sx += dm, sy += pm, sxx += dm * dm, sxy += dm * pm;
-        checked++;
+    /* Bins below the first (free surface) and above the floor layer (bin 6). The fitted slope
+     * of all particles is held to rho0 g within 5% and each bin to 8%; the wall layer and the
+     * inner particles on their own within 10% (fewer particles, ~2x the noise; the earlier
+     * single-sided wall force read +58% in the wall layer, +26% overall). Measured:
+     * docs/simulation.md. */
+    static const char *gname[3] = {"all", "wall layer", "inner"};
+    for (int gi = 0; gi < 3; ++gi) {
+        double xs[BINS], ys[BINS];
+        int checked = 0;
+        for (int b = 1; b < 6; ++b) {
+            if (cnt[gi][b] < 30 * 8)
+                continue;
+            double dm = dsum[gi][b] / cnt[gi][b], pm = psum[gi][b] / cnt[gi][b], ref = 1000.0 * 9.81 * dm;
+            print_message("hydrostatic %s, depth %.3f m: p %.1f Pa, rho0 g d %.1f Pa (%+.1f%%)\n",
+                          gname[gi], dm, pm, ref, 100.0 * (pm - ref) / ref);
+            if (gi == 0)
+                assert_true(fabs(pm - ref) < 0.08 * ref);
+            xs[checked] = dm, ys[checked] = pm;
+            checked++;
+        }
+        assert_true(checked >= 4);
+        double slope = fit_slope(xs, ys, checked);
+        print_message("hydrostatic %s: dp/ddepth %.0f Pa/m, rho0 g %.0f (%+.1f%%)\n", gname[gi], slope,
+                      9810.0, 100.0 * (slope - 9810.0) / 9810.0);
+        assert_true(fabs(slope - 9810.0) < (gi == 0 ? 0.05 : 0.10) * 9810.0);
     }
-    assert_true(checked >= 4);
-    double slope = (checked * sxy - sx * sy) / (checked * sxx - sx * sx);
-    print_message("hydrostatic dp/ddepth %.0f Pa/m, rho0 g %.0f (%+.1f%%)\n", slope, 9810.0,
-                  100.0 * (slope - 9810.0) / 9810.0);
-    assert_true(fabs(slope - 9810.0) < 0.35 * 9810.0);
     vfx_sph_destroy(s);
 }
 
