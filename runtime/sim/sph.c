@@ -1132,6 +1132,39 @@ static inline int walls_box(const sph_wall_hit *w, int nw)
     return k;
 }
 
+float vfx_sph_volume_fraction(const vfx_sph *s, const float p[3])
+{
+    if (!s || !p || !isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
+        return NAN;
+    /* the grid of the last density pass matches the columns (vfx_sph_step ends with one) */
+    sph_ranges r;
+    neighbor_ranges(s, p[0], p[1], p[2], &r);
+    double sum = 0.0;
+    for (int q = 0; q < r.count; ++q)
+        for (uint32_t j = r.lo[q]; j < r.hi[q] && j < s->n; ++j) {
+            float dx = p[0] - s->x[j], dy = p[1] - s->y[j], dz = p[2] - s->z[j];
+            float r2 = dx * dx + dy * dy + dz * dz;
+            if (r2 < s->H2) {
+                float t = s->H2 - r2;
+                sum += (double)t * t * t;
+            }
+        }
+    sph_wall_hit walls[SPH_MAX_WALLS];
+    int nw = gather_walls(s, p[0], p[1], p[2], walls, SPH_MAX_WALLS), nb = walls_box(walls, nw);
+    float inside = 1.f, extra = 0.f;
+    for (int w = 0; w < nw; ++w) {
+        float f = s->wall_scale * (float)vfx_sph_wall_density_fraction(walls[w].d, s->H);
+        if (w < nb)
+            inside *= 1.f - f;
+        else
+            extra += f;
+    }
+    float gam = inside - extra;
+    if (!(gam > 0.05f))
+        return 0.f; /* inside a solid */
+    return (float)(sum * s->mass * s->k_poly6 / s->p.rest_density / gam);
+}
+
 /* ---- passes -------------------------------------------------------------------------------- */
 
 static void density_chunk(vfx_sph *s, uint32_t chunk)
@@ -1140,7 +1173,9 @@ static void density_chunk(vfx_sph *s, uint32_t chunk)
     const float H2 = s->H2, kp = s->k_poly6, m = s->mass, rho0 = s->p.rest_density;
     const double H = s->H;
     const float gam = s->p.gamma, B = s->B, c2_0 = s->c0 * s->c0;
-    sph_chunk_out *o = &s->out[chunk];
+    /* reductions in a local copy, stored once per chunk: neighbouring chunks' slots share a
+     * cache line and run on different threads (false sharing on every particle otherwise) */
+    sph_chunk_out acc = s->out[chunk], *o = &acc;
     const float *X = s->x, *Y = s->y, *Z = s->z;
     sph_wall_hit walls[SPH_MAX_WALLS];
     uint32_t used = 0;
@@ -1158,6 +1193,7 @@ static void density_chunk(vfx_sph *s, uint32_t chunk)
             uint32_t *nl = realloc(s->cnb[chunk], (size_t)cap * sizeof *nl);
             if (!nl) {
                 atomic_store(&s->nb_oom, true);
+                s->out[chunk] = acc;
                 return;
             }
             s->cnb[chunk] = nl;
@@ -1224,6 +1260,7 @@ static void density_chunk(vfx_sph *s, uint32_t chunk)
         if (!isfinite(rho) && o->bad == UINT32_MAX)
             o->bad = i, o->bad_kind = 1, o->bad_value = rho;
     }
+    s->out[chunk] = acc;
 }
 
 /* Deterministic, antisymmetric unit direction for exactly coincident particles. */
@@ -1249,7 +1286,9 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
     const float *g = s->p.gravity;
     const float *X = s->x, *Y = s->y, *Z = s->z, *VX = s->vx, *VY = s->vy, *VZ = s->vz;
     const float *R = s->rho, *P = s->pr;
-    sph_chunk_out *o = &s->out[chunk];
+    /* reductions in a local copy, stored once per chunk: neighbouring chunks' slots share a
+     * cache line and run on different threads (false sharing on every particle otherwise) */
+    sph_chunk_out acc = s->out[chunk], *o = &acc;
     sph_wall_hit walls[SPH_MAX_WALLS];
     for (uint32_t i = b; i < e; ++i) {
         float px = X[i], py = Y[i], pz = Z[i], vxi = VX[i], vyi = VY[i], vzi = VZ[i];
@@ -1344,6 +1383,7 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
         if (!isfinite(a2) && o->bad == UINT32_MAX)
             o->bad = i, o->bad_kind = 1, o->bad_value = a2;
     }
+    s->out[chunk] = acc;
 }
 
 static void integrate_chunk(vfx_sph *s, uint32_t chunk)
@@ -1354,7 +1394,9 @@ static void integrate_chunk(vfx_sph *s, uint32_t chunk)
     const float *lo = s->p.domain_min, *hi = s->p.domain_max;
     const float m = s->mass;
     const float *g = s->p.gravity;
-    sph_chunk_out *o = &s->out[chunk];
+    /* reductions in a local copy, stored once per chunk: neighbouring chunks' slots share a
+     * cache line and run on different threads (false sharing on every particle otherwise) */
+    sph_chunk_out acc = s->out[chunk], *o = &acc;
     for (uint32_t i = b; i < e; ++i) {
         float v[3] = {s->vx[i] + dt * s->ax[i], s->vy[i] + dt * s->ay[i], s->vz[i] + dt * s->az[i]};
         float p[3] = {s->x[i] + dt * v[0], s->y[i] + dt * v[1], s->z[i] + dt * v[2]};
@@ -1399,6 +1441,7 @@ static void integrate_chunk(vfx_sph *s, uint32_t chunk)
         o->ke += 0.5 * (double)m * v2;
         o->pe -= (double)m * (g[0] * (p[0] - lo[0]) + g[1] * (p[1] - lo[1]) + g[2] * (p[2] - lo[2]));
     }
+    s->out[chunk] = acc;
 }
 
 /* ---- emitters ------------------------------------------------------------------------------ */

@@ -156,6 +156,10 @@ vfx_result vfx_sph_step(vfx_sph *sim, float frame_dt, vfx_sph_report *report);
 vfx_sph_columns vfx_sph_get_columns(vfx_sph *sim);
 /* Pressure [Pa] of row i from the last density pass (0 when i is out of range). */
 float vfx_sph_pressure(const vfx_sph *sim, uint32_t i);
+/* Fluid volume fraction at p: sum_j (m/rho0) W_poly6(p - x_j) over the fluid share of the
+ * kernel (walls excluded), ~1 inside the fluid, 1/2 on its surface, 0 in air or in a solid;
+ * NaN for non-finite p. Uses the grid of the last vfx_sph_step. */
+float vfx_sph_volume_fraction(const vfx_sph *sim, const float p[3]);
 /* Simulated time since creation [s]. */
 double vfx_sph_time(const vfx_sph *sim);
 /* Bytes allocated by the solver (columns, grid, chunk reductions). */
