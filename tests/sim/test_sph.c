@@ -223,9 +223,29 @@ static void test_two_coincident(void **state)
     float px = 0.055f, py = 0.085f, pz = 0.055f; /* exactly a lattice site */
     assert_int_equal(vfx_sph_add_particles(s, 1, &px, &py, &pz, NULL, NULL, NULL), VFX_OK);
     uint32_t dup = vfx_sph_get_columns(s).count - 1;
+    assert_int_equal(vfx_sph_step(s, 0.f, &r), VFX_OK);
+    double e0 = energy(&r);
+    float err0 = r.max_density_error;
+    print_message("duplicate particle: initial compression %.3f, energy %.4g J\n", err0, e0);
+    assert_true(err0 > 0.1f); /* the pair sits at ~2x the lattice density of one particle */
+    double e_prev = 0.0;
     for (int f = 0; f < 3; ++f) {
         assert_int_equal(vfx_sph_step(s, 1.f / 240.f, &r), VFX_OK);
         check_state(s);
+        /* No gravity. The separation is not energy-conserving: the spiky gradient that pushes
+         * the pair apart is not the derivative of the poly6 density (whose gradient vanishes
+         * at r = 0), so the push does more work than the EOS energy it releases: measured
+         * 2.04x E0 after the first frame (the same before the Ferrand walls). Bound: 2.5x,
+         * then (separated) the energy may only decay, 1% for time integration. */
+        double e = energy(&r);
+        print_message("duplicate particle: frame %d energy %.4g J (%.2fx), compression %.3f\n", f, e,
+                      e / e0, r.max_density_error);
+        if (f == 0)
+            assert_true(e <= 2.5 * e0);
+        else
+            assert_true(e <= 1.01 * e_prev);
+        e_prev = e;
+        assert_true(r.max_density_error <= err0); /* compression only relaxes */
     }
     vfx_sph_columns c = vfx_sph_get_columns(s);
     float best = 1e9f;
@@ -332,6 +352,7 @@ static void test_stiffness_1000x(void **state)
      * +0.22% per wall on the second layer, more at edges); a stiff fluid must relax that,
      * not add to it: bound 0.2% (measured 0.125% in the first frame, 0 from the third) */
     assert_true(vfx_sph_params(s)->sound_speed > 30.f * 10.f);
+    assert_true(vfx_sph_params(s)->gamma == 7.f); /* the Tait exponent of water, the default */
     run_block(s, 5, 1.f / 60.f, true, 0.002f);
     vfx_sph_destroy(s);
 }
