@@ -4,8 +4,10 @@
  * Kernels (support radius H = support_ratio * spacing): Mueller et al. 2003 poly6 for density,
  * spiky gradient for pressure and viscosity forces (its gradient does not vanish at r = 0, so
  * coincident particles are pushed apart). Walls (domain box, planes, sphere and box colliders,
- * moving paddles) are semi-analytic: the density and pressure force of the missing fluid beyond
- * a wall are integrated in closed form over the half-space, plus a hard non-penetration clamp.
+ * moving paddles) are semi-analytic: the density of the missing fluid beyond a wall is
+ * integrated in closed form over the half-space; it acts as a mirror image (pressure and
+ * artificial viscosity) and the particle's force sum is divided by the kernel fraction inside
+ * the fluid (Ferrand et al. 2013); plus a hard non-penetration clamp.
  * Time step: min of CFL, acoustic, force and viscosity conditions, substeps per frame with a
  * cap; a substep whose result blows up (NaN/Inf, speed or density change beyond bounds) is
  * redone with half the dt, and fails with a message naming the particle if that keeps failing.
