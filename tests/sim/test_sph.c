@@ -331,7 +331,9 @@ static void run_block(vfx_sph *s, int frames, float frame_dt, bool expect_cap, f
         if (!(energy(&r) <= e0 * 1.02))
             print_message("energy %.6g > 1.02 * %.6g (ke %.3g), substeps %u\n", energy(&r), e0, r.kinetic_energy, r.substeps);
         assert_true(energy(&r) <= e0 * 1.02);
-        if (!(r.max_density_error < max_err)) print_message("frame %d: max density error %.5f (bound %.5f)\n", f, r.max_density_error, max_err);
+        if (!(r.max_density_error < max_err))
+            print_message("frame %d: max density error %.5f (bound %.5f)\n", f, r.max_density_error,
+                          max_err);
         assert_true(r.max_density_error < max_err);
     }
 }
