@@ -4,8 +4,10 @@
  * Kernels (support radius H = support_ratio * spacing): Mueller et al. 2003 poly6 for density,
  * spiky gradient for pressure and viscosity forces (its gradient does not vanish at r = 0, so
  * coincident particles are pushed apart). Walls (domain box, planes, sphere and box colliders,
- * moving paddles) are semi-analytic: the density and pressure force of the missing fluid beyond
- * a wall are integrated in closed form over the half-space, plus a hard non-penetration clamp.
+ * moving paddles) are semi-analytic: the density of the missing fluid beyond a wall is
+ * integrated in closed form over the half-space; it acts as a mirror image (pressure and
+ * artificial viscosity) and the particle's force sum is divided by the kernel fraction inside
+ * the fluid (Ferrand et al. 2013); plus a hard non-penetration clamp.
  * Time step: min of CFL, acoustic, force and viscosity conditions, substeps per frame with a
  * cap; a substep whose result blows up (NaN/Inf, speed or density change beyond bounds) is
  * redone with half the dt, and fails with a message naming the particle if that keeps failing.
@@ -156,6 +158,10 @@ vfx_result vfx_sph_step(vfx_sph *sim, float frame_dt, vfx_sph_report *report);
 vfx_sph_columns vfx_sph_get_columns(vfx_sph *sim);
 /* Pressure [Pa] of row i from the last density pass (0 when i is out of range). */
 float vfx_sph_pressure(const vfx_sph *sim, uint32_t i);
+/* Fluid volume fraction at p: sum_j (m/rho0) W_poly6(p - x_j) over the fluid share of the
+ * kernel (walls excluded), ~1 inside the fluid, 1/2 on its surface, 0 in air or in a solid;
+ * NaN for non-finite p. Uses the grid of the last vfx_sph_step. */
+float vfx_sph_volume_fraction(const vfx_sph *sim, const float p[3]);
 /* Simulated time since creation [s]. */
 double vfx_sph_time(const vfx_sph *sim);
 /* Bytes allocated by the solver (columns, grid, chunk reductions). */

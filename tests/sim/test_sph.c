@@ -86,6 +86,34 @@ static void test_wall_integrals(void **state)
     }
 }
 
+static void test_volume_fraction(void **state)
+{
+    (void)state;
+    vfx_sph_desc d = small_box();
+    d.flags = VFX_SPH_NO_GRAVITY;
+    vfx_sph *s = make(d);
+    float lo[3] = {0, 0, 0}, hi[3] = {0.05f, 0.1f, 0.06f};
+    assert_int_equal(vfx_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    vfx_sph_report r;
+    assert_int_equal(vfx_sph_step(s, 0.f, &r), VFX_OK); /* builds the grid, moves nothing */
+    /* on the lattice the mass is calibrated so that sum (m/rho0) W = 1; a particle next to a
+     * wall misses exactly the calibrated wall share, which the fraction divides out */
+    float in[3] = {0.025f, 0.055f, 0.035f}, wall[3] = {0.025f, 0.005f, 0.035f};
+    assert_true(fabsf(vfx_sph_volume_fraction(s, in) - 1.f) < 1e-4f);
+    assert_true(fabsf(vfx_sph_volume_fraction(s, wall) - 1.f) < 1e-3f);
+    /* the block's free face (x = 0.05, half a spacing beyond the last centres): a smoothed
+     * step crosses 1/2 there (lattice sum of half the kernel: within 0.1 of it) */
+    float face[3] = {0.05f, 0.055f, 0.035f}, air[3] = {0.08f, 0.055f, 0.035f};
+    float f = vfx_sph_volume_fraction(s, face);
+    print_message("volume fraction at the free face: %.3f\n", f);
+    assert_true(f > 0.4f && f < 0.6f);
+    assert_true(vfx_sph_volume_fraction(s, air) == 0.f);
+    float bad[3] = {NAN, 0.f, 0.f};
+    assert_true(isnan(vfx_sph_volume_fraction(s, bad)));
+    assert_true(isnan(vfx_sph_volume_fraction(NULL, in)));
+    vfx_sph_destroy(s);
+}
+
 static void test_bad_desc_and_input(void **state)
 {
     (void)state;
@@ -186,16 +214,38 @@ static void test_two_coincident(void **state)
     vfx_sph_destroy(s);
     /* Inside a block: a duplicate of a bulk particle is compressed (rho ~ 1.2 rho0), and the
      * spiky gradient (non-zero at r = 0, along a pseudo-random antisymmetric axis) separates
-     * the pair; momentum stays zero. */
+     * the pair; momentum stays zero. The block is kept more than H from every wall, where
+     * the wall terms (which take momentum) do not reach. */
+    d.domain_max[2] = 0.1f;
     s = make(d);
-    float lo[3] = {0.02f, 0.05f, 0.0f}, hi[3] = {0.08f, 0.11f, 0.06f};
+    float lo[3] = {0.02f, 0.05f, 0.02f}, hi[3] = {0.08f, 0.11f, 0.08f};
     assert_int_equal(vfx_sph_add_block(s, lo, hi, NULL), VFX_OK);
-    float px = 0.055f, py = 0.085f, pz = 0.035f; /* exactly a lattice site */
+    float px = 0.055f, py = 0.085f, pz = 0.055f; /* exactly a lattice site */
     assert_int_equal(vfx_sph_add_particles(s, 1, &px, &py, &pz, NULL, NULL, NULL), VFX_OK);
     uint32_t dup = vfx_sph_get_columns(s).count - 1;
+    assert_int_equal(vfx_sph_step(s, 0.f, &r), VFX_OK);
+    double e0 = energy(&r);
+    float err0 = r.max_density_error;
+    print_message("duplicate particle: initial compression %.3f, energy %.4g J\n", err0, e0);
+    assert_true(err0 > 0.1f); /* the pair sits at ~2x the lattice density of one particle */
+    double e_prev = 0.0;
     for (int f = 0; f < 3; ++f) {
         assert_int_equal(vfx_sph_step(s, 1.f / 240.f, &r), VFX_OK);
         check_state(s);
+        /* No gravity. The separation is not energy-conserving: the spiky gradient that pushes
+         * the pair apart is not the derivative of the poly6 density (whose gradient vanishes
+         * at r = 0), so the push does more work than the EOS energy it releases: measured
+         * 2.04x E0 after the first frame (the same before the Ferrand walls). Bound: 2.5x,
+         * then (separated) the energy may only decay, 1% for time integration. */
+        double e = energy(&r);
+        print_message("duplicate particle: frame %d energy %.4g J (%.2fx), compression %.3f\n", f, e,
+                      e / e0, r.max_density_error);
+        if (f == 0)
+            assert_true(e <= 2.5 * e0);
+        else
+            assert_true(e <= 1.01 * e_prev);
+        e_prev = e;
+        assert_true(r.max_density_error <= err0); /* compression only relaxes */
     }
     vfx_sph_columns c = vfx_sph_get_columns(s);
     float best = 1e9f;
@@ -214,10 +264,9 @@ static void test_two_coincident(void **state)
     }
     print_message("duplicate particle: nearest neighbour at %.4f m after 1/80 s\n", best);
     assert_true(best > 0.1f * 0.01f);
-    /* the block is >= 2.5 cm (> H) from the x and y walls: x and y momentum are conserved
-     * (pairwise antisymmetric forces), up to float rounding of ~300 terms */
-    (void)mz; /* the block touches the z walls, which take z momentum */
-    assert_true(fabs(mx) < 1e-3 && fabs(my) < 1e-3);
+    /* the block is >= 2.5 cm (> H) from every wall: momentum is conserved (pairwise
+     * antisymmetric forces), up to float rounding of ~200 terms */
+    assert_true(fabs(mx) < 1e-3 && fabs(my) < 1e-3 && fabs(mz) < 1e-3);
     vfx_sph_destroy(s);
 }
 
@@ -269,6 +318,7 @@ static void run_block(vfx_sph *s, int frames, float frame_dt, bool expect_cap, f
     vfx_sph_report r;
     assert_int_equal(vfx_sph_step(s, 0.f, &r), VFX_OK);
     double e0 = energy(&r);
+    print_message("block at rest: initial max density error %.5f\n", r.max_density_error);
     for (int f = 0; f < frames; ++f) {
         assert_int_equal(vfx_sph_step(s, frame_dt, &r), VFX_OK);
         check_state(s);
@@ -281,6 +331,9 @@ static void run_block(vfx_sph *s, int frames, float frame_dt, bool expect_cap, f
         if (!(energy(&r) <= e0 * 1.02))
             print_message("energy %.6g > 1.02 * %.6g (ke %.3g), substeps %u\n", energy(&r), e0, r.kinetic_energy, r.substeps);
         assert_true(energy(&r) <= e0 * 1.02);
+        if (!(r.max_density_error < max_err))
+            print_message("frame %d: max density error %.5f (bound %.5f)\n", f, r.max_density_error,
+                          max_err);
         assert_true(r.max_density_error < max_err);
     }
 }
@@ -296,9 +349,13 @@ static void test_stiffness_1000x(void **state)
     d.max_substeps = 100;
     vfx_sph *s = make(d);
     /* c0 grows by sqrt(1000): the acoustic dt is ~32x smaller, a 60 Hz frame needs more than
-     * the cap: every frame must report cap_hit; compression stays under 0.1% */
+     * the cap: every frame must report cap_hit. Compression: the fresh lattice starts at up
+     * to 0.66% (the wall density's kernel tail reaches lattice layers that miss nothing:
+     * +0.22% per wall on the second layer, more at edges); a stiff fluid must relax that,
+     * not add to it: bound 0.2% (measured 0.125% in the first frame, 0 from the third) */
     assert_true(vfx_sph_params(s)->sound_speed > 30.f * 10.f);
-    run_block(s, 5, 1.f / 60.f, true, 0.001f);
+    assert_true(vfx_sph_params(s)->gamma == 7.f); /* the Tait exponent of water, the default */
+    run_block(s, 5, 1.f / 60.f, true, 0.002f);
     vfx_sph_destroy(s);
 }
 
@@ -501,6 +558,15 @@ static void test_mesh_collider(void **state)
     vfx_sph_destroy(s);
 }
 
+/* Least-squares slope of y on x over n points. */
+static double fit_slope(const double *x, const double *y, int n)
+{
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (int k = 0; k < n; ++k)
+        sx += x[k], sy += y[k], sxx += x[k] * x[k], sxy += x[k] * y[k];
+    return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
 static void test_hydrostatic(void **state)
 {
     (void)state;
@@ -508,7 +574,10 @@ static void test_hydrostatic(void **state)
      * carries acoustic noise (gamma 7 turns 1% of density into 7% of B = 56 kPa, against a
      * hydrostatic 1.5 kPa), so the pressure is averaged over particles in 2 cm depth bins and
      * over 30 frames (0.5 s, ~3 periods of the slowest column mode) after 0.5 s of settling.
-     * Reference: p = rho0 g depth, depth below the mean free surface (float64). */
+     * Reference: p = rho0 g depth, depth below the mean free surface (float64). The column is
+     * 6 particles wide, so 20 of its 36 particle columns touch a side wall: the wall layer
+     * (within 1 cm of a side wall) and the rest are also fitted on their own, so a wall
+     * treatment that only holds on average (one group high, the other low) fails. */
     vfx_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.06f, 0.2f, 0.06f},
                       .threads = 2, .viscosity = 0.1f};
     vfx_sph *s = make(d);
@@ -516,8 +585,8 @@ static void test_hydrostatic(void **state)
     assert_int_equal(vfx_sph_add_block(s, lo, hi, NULL), VFX_OK);
     vfx_sph_report r;
     enum { BINS = 8 };
-    double psum[BINS] = {0}, dsum[BINS] = {0};
-    int cnt[BINS] = {0};
+    double psum[3][BINS] = {{0}}, dsum[3][BINS] = {{0}}; /* all, wall layer, inner */
+    int cnt[3][BINS] = {{0}};
     float max_err = 0.f, mean_err = 0.f;
     for (int f = 0; f < 60; ++f) {
         assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
@@ -537,37 +606,47 @@ static void test_hydrostatic(void **state)
             int b = (int)((top - c.y[i]) / 0.02);
             if (b < 0 || b >= BINS)
                 continue;
-            psum[b] += vfx_sph_pressure(s, i);
-            dsum[b] += top - c.y[i];
-            cnt[b]++;
+            float side = fminf(fminf(c.x[i], 0.06f - c.x[i]), fminf(c.z[i], 0.06f - c.z[i]));
+            int grp[2] = {0, side < 0.01f ? 1 : 2};
+            for (int k = 0; k < 2; ++k) {
+                psum[grp[k]][b] += vfx_sph_pressure(s, i);
+                dsum[grp[k]][b] += top - c.y[i];
+                cnt[grp[k]][b]++;
+            }
         }
     }
-    /* density error bounds over the measured frames: max 3%, mean 0.5% */
+    /* Density error over the measured frames. The hydrostatic compression at the floor is
+     * rho0 g h / (gamma B) = 0.37% (float64: 1000*9.81*0.15 / (7*56 kPa)), 0.19% on average
+     * over the depth; bounds 1.5% max (4x, for the acoustic noise), 0.5% mean. */
     print_message("hydrostatic density error: max %.4f, mean %.4f\n", max_err, mean_err);
-    assert_true(max_err < 0.03f);
+    assert_true(max_err < 0.015f);
     assert_true(mean_err < 0.005f);
-    /* bins below the first (free surface) and above the floor layer. Pressure rises linearly
-     * with depth; the fitted slope is held to rho0 g within 35% and each bin to 50%. These
-     * bounds are loose on purpose and the measured bias (+20-35%, docs/simulation.md) is a
-     * known shortcoming: the clamped p >= 0 EOS truncates the negative half of the acoustic
-     * noise, and the energy-consistent single-sided wall force lets wall layers compress. */
-    int checked = 0;
-    double sx = 0, sy = 0, sxx = 0, sxy = 0;
-    for (int b = 1; b < 6; ++b) { /* bin 6 holds the floor layer */
-        if (cnt[b] < 30 * 20)
-            continue;
-        double dm = dsum[b] / cnt[b], pm = psum[b] / cnt[b], ref = 1000.0 * 9.81 * dm;
-        print_message("hydrostatic bin depth %.3f m: p %.1f Pa, rho0 g d %.1f Pa (%+.1f%%)\n",
-                      dm, pm, ref, 100.0 * (pm - ref) / ref);
-        assert_true(fabs(pm - ref) < 0.5 * ref);
-        sx += dm, sy += pm, sxx += dm * dm, sxy += dm * pm;
-        checked++;
+    /* Bins below the first (free surface) and above the floor layer (bin 6). The fitted slope
+     * of all particles is held to rho0 g within 5% and each bin to 8%; the wall layer and the
+     * inner particles on their own within 10% (fewer particles, ~2x the noise; the earlier
+     * single-sided wall force read +58% in the wall layer, +26% overall). Measured:
+     * docs/simulation.md. */
+    static const char *gname[3] = {"all", "wall layer", "inner"};
+    for (int gi = 0; gi < 3; ++gi) {
+        double xs[BINS], ys[BINS];
+        int checked = 0;
+        for (int b = 1; b < 6; ++b) {
+            if (cnt[gi][b] < 30 * 8)
+                continue;
+            double dm = dsum[gi][b] / cnt[gi][b], pm = psum[gi][b] / cnt[gi][b], ref = 1000.0 * 9.81 * dm;
+            print_message("hydrostatic %s, depth %.3f m: p %.1f Pa, rho0 g d %.1f Pa (%+.1f%%)\n",
+                          gname[gi], dm, pm, ref, 100.0 * (pm - ref) / ref);
+            if (gi == 0)
+                assert_true(fabs(pm - ref) < 0.08 * ref);
+            xs[checked] = dm, ys[checked] = pm;
+            checked++;
+        }
+        assert_true(checked >= 4);
+        double slope = fit_slope(xs, ys, checked);
+        print_message("hydrostatic %s: dp/ddepth %.0f Pa/m, rho0 g %.0f (%+.1f%%)\n", gname[gi], slope,
+                      9810.0, 100.0 * (slope - 9810.0) / 9810.0);
+        assert_true(fabs(slope - 9810.0) < (gi == 0 ? 0.05 : 0.10) * 9810.0);
     }
-    assert_true(checked >= 4);
-    double slope = (checked * sxy - sx * sy) / (checked * sxx - sx * sx);
-    print_message("hydrostatic dp/ddepth %.0f Pa/m, rho0 g %.0f (%+.1f%%)\n", slope, 9810.0,
-                  100.0 * (slope - 9810.0) / 9810.0);
-    assert_true(fabs(slope - 9810.0) < 0.35 * 9810.0);
     vfx_sph_destroy(s);
 }
 
@@ -576,8 +655,11 @@ static void test_dam_break_small(void **state)
     (void)state;
     /* Martin & Moyce (1952), n^2 = 2 (height 2a), a = 2.25 in: (T, Z) read from their
      * Fig. 3 (digitised values as published in the PySPH example db_exp_data.py).
-     * Coarse run (a/dx = 10, 4 layers deep): the surge front within 15% of the data for
-     * T <= 2 (the finer bench run `volfx-bench sim --dam-break` is held to 10%). */
+     * Coarse run (a/dx = 10, 4 layers deep): the surge front within the 10% target for
+     * T <= 2 (measured +2.7, +4.0, +1.9%; all 9 points and a/dx = 20 are in the bench,
+     * `volfx-bench sim --dam-break`, docs/simulation.md). Front: where the fluid volume
+     * fraction on the floor falls to 1/2 (the edge of the continuum the particles stand for;
+     * a lone particle thrown ahead is spray), as in the bench. */
     static const double T_mm[] = {0.832, 1.219, 1.997};
     static const double Z_mm[] = {1.217, 1.474, 2.292};
     const double a = 0.05715, g = 9.81;
@@ -600,13 +682,21 @@ static void test_dam_break_small(void **state)
         assert_true(energy(&r) <= e0 * 1.01);
         assert_true(r.max_density_error < 0.1f);
         vfx_sph_columns c = vfx_sph_get_columns(s);
-        float front = 0.f;
+        float xmax = 0.f;
         for (uint32_t i = 0; i < c.count; ++i)
-            front = c.x[i] > front ? c.x[i] : front;
-        double Z = (front + 0.5 * dx) / a;
+            xmax = c.x[i] > xmax ? c.x[i] : xmax;
+        float q[3] = {xmax + 2.f * dx, 0.5f * dx, 2.f * dx}, front = 0.f;
+        for (; q[0] > 0.f; q[0] -= dx / 20.f)
+            if (vfx_sph_volume_fraction(s, q) >= 0.5f) {
+                front = q[0];
+                break;
+            }
+        /* the front lies within a spacing of the last particle centre either way */
+        assert_true(front > xmax - dx && front < xmax + dx);
+        double Z = front / a;
         print_message("dam break T=%.3f Z=%.3f (Martin & Moyce %.3f, %+.1f%%)\n", T_mm[k], Z,
                       Z_mm[k], 100.0 * (Z - Z_mm[k]) / Z_mm[k]);
-        assert_true(fabs(Z - Z_mm[k]) < 0.15 * Z_mm[k]);
+        assert_true(fabs(Z - Z_mm[k]) < 0.10 * Z_mm[k]);
     }
     vfx_sph_destroy(s);
 }
@@ -638,6 +728,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_wall_integrals),
+        cmocka_unit_test(test_volume_fraction),
         cmocka_unit_test(test_bad_desc_and_input),
         cmocka_unit_test(test_zero_particles),
         cmocka_unit_test(test_single_particle),
