@@ -15,7 +15,8 @@
 
 /* Counter readback ring: frames the GPU may run behind before a result is dropped. */
 #define WATER_COUNTER_RING 3
-#define WATER_COUNTERS 8
+/* march.comp's 8 (PAPER and the gradient pass) and GRID's cells visited and sphere tests */
+#define WATER_COUNTERS 10
 /* Particles the effect takes at most: positions are 12 bytes each (12 GiB at the limit) and a
  * particle index must fit the int of gl_InstanceID and of the draw's instance count. */
 #define WATER_MAX_PARTICLES (1u << 30)
@@ -44,6 +45,13 @@ typedef struct water_state {
     vfx_water_params params;
     vfx_water_grid *grid;  /* GRID baseline state, made the first time GRID is asked for */
     float lo[3], hi[3];    /* box of the finite particles */
+    /* upload skipping: the host's per-chunk revisions of the last upload (0 = untracked: the
+     * host gives none, so every frame uploads); data_rev counts uploads, which GRID keys on */
+    uint64_t *chunk_rev;
+    uint32_t chunk_rev_count;
+    uint64_t data_rev;
+    int upload_skipped;    /* this frame's update found every revision unchanged */
+    uint32_t last_method_drawn; /* method of the last frame: debug_pixel_class reads PAPER's state */
     /* paper pipeline targets */
     GLuint cur, next1, pot, st, br, reft, depth, pyr, fbo_dist, fbo_pot, counters;
     GLuint grad, back, fbo_grad, fbo_back; /* surface gradient and back distance (shading) */
@@ -140,6 +148,7 @@ static void water_destroy(vfx_context *ctx, void *state)
     groups_free(ctx, s);
     paper_free(s);
     vfx_water_grid_destroy(ctx, s->grid);
+    vfx_free(ctx, s->chunk_rev);
     glDeleteVertexArrays(1, &s->vao);
     for (int k = 0; k < WATER_COUNTER_RING; ++k)
         if (s->fence[k])
@@ -265,6 +274,8 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
     water_defaults(&s->params);
     uint32_t chunks = ctx->host.particle_chunk_count(ctx->host.user);
     uint64_t total = 0;
+    /* every chunk with the nonzero revision of the last upload (0: the host tracks none) */
+    int revs_same = s->chunk_rev != NULL && s->chunk_rev_count == chunks;
     for (uint32_t c = 0; c < chunks; ++c) {
         vfx_particle_view v = {.size = sizeof v, .version = VFX_PARTICLE_VIEW_VERSION};
         vfx_result r = ctx->host.particle_chunk(ctx->host.user, c, &v);
@@ -273,14 +284,36 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
         if (v.count && (!v.pos[0] || !v.pos[1] || !v.pos[2]))
             return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u has %u particles but a NULL position column", c, v.count);
         total += v.count;
+        revs_same = revs_same && v.revision != 0 && v.revision == s->chunk_rev[c];
     }
     if (total > WATER_MAX_PARTICLES)
         return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
                         "water: %u particle chunks hold %llu particles, more than the limit of %u (2^30)",
                         chunks, (unsigned long long)total, WATER_MAX_PARTICLES);
+    GLuint before = s->groups ? s->groups[0].cols[0] : 0;
+    uint32_t before_groups = s->group_count;
     vfx_result gr = ensure_groups(ctx, s, (uint32_t)total);
     if (gr)
         return gr;
+    /* The same revisions, the same total and the same buffers: the columns already hold these
+     * positions (the box and the NaN count are still right), so nothing is read or uploaded. */
+    int same = revs_same && total == s->count && s->groups[0].cols[0] == before &&
+               s->group_count == before_groups;
+    s->upload_skipped = same;
+    if (same)
+        return VFX_OK;
+    if (chunks != s->chunk_rev_count) {
+        vfx_free(ctx, s->chunk_rev);
+        s->chunk_rev_count = 0;
+        s->chunk_rev = chunks ? vfx_alloc(ctx, chunks * sizeof *s->chunk_rev) : NULL;
+        if (chunks && !s->chunk_rev)
+            return VFX_ERR_OUT_OF_MEMORY;
+        s->chunk_rev_count = chunks;
+    }
+    /* cleared first: an upload that fails half way leaves 0s, so the next frame uploads again */
+    if (chunks)
+        memset(s->chunk_rev, 0, chunks * sizeof *s->chunk_rev);
+    ++s->data_rev;
     uint32_t off = 0, nan_count = 0;
     int seen = 0;
     for (uint32_t c = 0; c < chunks; ++c) {
@@ -314,6 +347,7 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
             seen = 1;
         }
         off += v.count;
+        s->chunk_rev[c] = v.revision;
     }
     s->count = off;
     s->nan_count = nan_count;
@@ -557,6 +591,13 @@ static void publish_counters(vfx_context *ctx, water_state *s)
         vfx_stat_set(ctx, "water.pixels_found", c[3]);
         vfx_stat_set(ctx, "water.pixels_sample_cap", c[4]);
         vfx_stat_set(ctx, "water.pixels_left", c[5]);
+    } else if (s->last_method == VFX_WATER_METHOD_GRID) {
+        vfx_stat_set(ctx, "water.samples", c[2]);
+        vfx_stat_set(ctx, "water.pixels_found", c[3]);
+        vfx_stat_set(ctx, "water.pixels_sample_cap", c[4]);
+        vfx_stat_set(ctx, "water.pixels_left", c[5]);
+        vfx_stat_set(ctx, "water.grid_cells_visited", c[8]);
+        vfx_stat_set(ctx, "water.grid_sphere_tests", c[9]);
     }
     vfx_stat_set(ctx, "water.normal_fragments_culled", c[6]);
     vfx_stat_set(ctx, "water.normal_fragments", c[7]);
@@ -739,6 +780,7 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
     glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
     glBindImageTexture(3, ctx->water_dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    glBindImageTexture(4, s->cur, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
     dispatch(s);
     vfx_gpu_pass_end(ctx);
     return VFX_OK;
@@ -750,7 +792,7 @@ static vfx_result grid_march(vfx_context *ctx, water_state *s, const vfx_frame_v
     if (!s->grid && !(s->grid = vfx_water_grid_create(ctx)))
         return VFX_ERR_OUT_OF_MEMORY;
     vfx_water_grid_input in = {s->cols, s->count, s->count - s->nan_count, s->lo, s->hi, &s->params,
-                               s->width, s->height, ctx->water_dist_tex};
+                               s->width, s->height, ctx->water_dist_tex, s->counters, s->data_rev};
     return vfx_water_grid_render(ctx, s->grid, &in, frame, targets);
 }
 
@@ -772,6 +814,8 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     glClearNamedBufferData(s->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     vfx_stat_set(ctx, "water.particles", s->count);
     vfx_stat_set(ctx, "water.nan_skipped", s->nan_count);
+    vfx_stat_set(ctx, "water.upload_skipped", s->upload_skipped);
+    s->last_method_drawn = UINT32_MAX; /* until this frame completes: nothing for debug_pixel_class */
     vfx_result r;
     if (p->method == VFX_WATER_METHOD_PAPER)
         r = paper_march(ctx, s, frame, targets);
@@ -811,6 +855,7 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     vfx_gpu_fullscreen(ctx);
     vfx_gpu_pass_end(ctx);
     counters_frame_end(ctx, s, p->method);
+    s->last_method_drawn = p->method;
     const char *e = vfx_gpu_error_string();
     if (e)
         return vfx_fail(ctx, VFX_ERR_GL, "water render: %s", e);
@@ -832,6 +877,25 @@ vfx_result vfx_water_debug_gradient(vfx_context *ctx, float *out, size_t count)
     size_t row = (size_t)s->width * 4;
     for (uint32_t j = 0; j < s->height; ++j)
         memcpy(out + j * row, tmp + (size_t)(s->height - 1 - j) * row, row * sizeof *out);
+    vfx_free(ctx, tmp);
+    return VFX_OK;
+}
+
+vfx_result vfx_water_debug_pixel_class(vfx_context *ctx, uint8_t *out, size_t count)
+{
+    water_state *s = ctx->effect_state[VFX_EFFECT_WATER];
+    if (!s || !s->st || s->frame_no == 0 || s->last_method_drawn != VFX_WATER_METHOD_PAPER)
+        return vfx_fail(ctx, VFX_ERR_NOT_FOUND, "water debug pixel class: no paper-method frame rendered yet");
+    size_t n = (size_t)s->width * s->height;
+    if (!out || count < n)
+        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water debug pixel class: %zu bytes, need %zu", count, n);
+    float *tmp = vfx_alloc(ctx, n * 4 * sizeof *tmp);
+    if (!tmp)
+        return VFX_ERR_OUT_OF_MEMORY;
+    glGetTextureImage(s->st, 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * 4 * sizeof *tmp), tmp);
+    for (uint32_t j = 0; j < s->height; ++j)
+        for (uint32_t i = 0; i < s->width; ++i)
+            out[(size_t)j * s->width + i] = (uint8_t)tmp[4 * ((size_t)(s->height - 1 - j) * s->width + i)];
     vfx_free(ctx, tmp);
     return VFX_OK;
 }

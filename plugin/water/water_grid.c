@@ -1,5 +1,6 @@
 /* water_grid.c — GRID baseline: uniform grid of cell h (grown when it would exceed
- * GRID_MAX_CELLS), built on the GPU every frame from the position columns: count per cell,
+ * GRID_MAX_CELLS), built on the GPU from the position columns whenever they were uploaded
+ * again or h changed (a static scene keeps its grid): count per cell,
  * exclusive prefix sum (two levels of 1024), scatter of the positions into cell order. The
  * march (grid.comp MODE_MARCH) then sums each sample's potential over the cells its h-ball
  * touches and jumps over empty space. Cell size and origin come from the box the CPU already
@@ -14,9 +15,14 @@
 #define GRID_MAX_CELLS ((1u << 20) - 1u)
 
 struct vfx_water_grid {
-    GLuint count, start, blocks, sorted, counters;
+    GLuint count, start, blocks, sorted;
     uint32_t cell_cap;     /* entries count/start hold (ncells + 1, rounded up to 1024) */
     uint32_t sorted_cap;   /* particles `sorted` holds */
+    /* what the grid in the buffers was built from: the same, and it is still right */
+    int built;
+    uint64_t built_rev;
+    uint32_t built_count;
+    float built_h;
 };
 
 vfx_water_grid *vfx_water_grid_create(vfx_context *ctx)
@@ -24,11 +30,8 @@ vfx_water_grid *vfx_water_grid_create(vfx_context *ctx)
     vfx_water_grid *g = vfx_alloc(ctx, sizeof *g);
     if (!g)
         return NULL;
-    glCreateBuffers(1, &g->counters);
-    glNamedBufferStorage(g->counters, 8 * sizeof(uint32_t), NULL, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
     glCreateBuffers(1, &g->blocks);
     glNamedBufferStorage(g->blocks, 1024 * sizeof(uint32_t), NULL, 0);
-    vfx_gpu_label(GL_BUFFER, g->counters, "water.grid_counters");
     vfx_gpu_label(GL_BUFFER, g->blocks, "water.grid_blocks");
     return g;
 }
@@ -37,8 +40,8 @@ void vfx_water_grid_destroy(vfx_context *ctx, vfx_water_grid *g)
 {
     if (!g)
         return;
-    GLuint b[] = {g->count, g->start, g->blocks, g->sorted, g->counters};
-    for (int k = 0; k < 5; ++k)
+    GLuint b[] = {g->count, g->start, g->blocks, g->sorted};
+    for (int k = 0; k < 4; ++k)
         if (b[k])
             glDeleteBuffers(1, &b[k]);
     vfx_free(ctx, g);
@@ -106,13 +109,20 @@ vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_
         g->count = storage((GLsizeiptr)need * 4, "water.grid_count");
         g->start = storage((GLsizeiptr)need * 4, "water.grid_start");
         g->cell_cap = need;
+        g->built = 0;
     }
     uint32_t np = in->count ? in->count : 1;
     if (np > g->sorted_cap) {
         if (g->sorted) glDeleteBuffers(1, &g->sorted);
         g->sorted = storage((GLsizeiptr)np * 16, "water.grid_sorted");
         g->sorted_cap = np;
+        g->built = 0;
     }
+    /* The box, hence the layout, comes from the same upload as the positions: a grid built
+     * from this upload with this h is the one this frame would build (bit for bit but for the
+     * order within a cell, which the atomics may change: skipping keeps the image identical). */
+    int rebuild = !g->built || g->built_rev != in->data_rev || g->built_count != in->count ||
+                  memcmp(&g->built_h, &p->h, sizeof p->h) != 0;
     GLuint count = vfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_COUNT\n");
     GLuint scan = vfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n");
     GLuint top = vfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n#define SCAN_TOP\n");
@@ -124,7 +134,7 @@ vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_
     for (int k = 0; k < 3; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, in->cols[k]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, g->count);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, g->counters);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, in->counters);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, g->start);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, g->blocks);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, g->sorted);
@@ -132,36 +142,42 @@ vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_
     GLuint groups = (in->count + 63u) / 64u, blocks = need / 1024u;
     GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
 
-    vfx_gpu_pass_begin(ctx, "water.grid_build");
-    glClearNamedBufferSubData(g->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
-    glUseProgram(count);
-    grid_uniforms(count, in, g0, cs, dims, nscan);
-    if (groups)
-        glDispatchCompute(gx, gy, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glUseProgram(scan);
-    grid_uniforms(scan, in, g0, cs, dims, nscan);
-    glDispatchCompute(blocks, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glUseProgram(top);
-    grid_uniforms(top, in, g0, cs, dims, blocks);
-    glDispatchCompute(1, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glUseProgram(add);
-    grid_uniforms(add, in, g0, cs, dims, nscan);
-    glDispatchCompute((nscan + 255u) / 256u, 1, 1);
-    /* the counts are spent: the same buffer becomes the per-cell fill cursor of the scatter */
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    glClearNamedBufferSubData(g->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
-    glUseProgram(scatter);
-    grid_uniforms(scatter, in, g0, cs, dims, nscan);
-    if (groups)
-        glDispatchCompute(gx, gy, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    vfx_gpu_pass_end(ctx);
+    if (rebuild) {
+        vfx_gpu_pass_begin(ctx, "water.grid_build");
+        glClearNamedBufferSubData(g->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
+        glUseProgram(count);
+        grid_uniforms(count, in, g0, cs, dims, nscan);
+        if (groups)
+            glDispatchCompute(gx, gy, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        glUseProgram(scan);
+        grid_uniforms(scan, in, g0, cs, dims, nscan);
+        glDispatchCompute(blocks, 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        glUseProgram(top);
+        grid_uniforms(top, in, g0, cs, dims, blocks);
+        glDispatchCompute(1, 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        glUseProgram(add);
+        grid_uniforms(add, in, g0, cs, dims, nscan);
+        glDispatchCompute((nscan + 255u) / 256u, 1, 1);
+        /* the counts are spent: the same buffer becomes the per-cell fill cursor of the scatter */
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+        glClearNamedBufferSubData(g->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
+        glUseProgram(scatter);
+        grid_uniforms(scatter, in, g0, cs, dims, nscan);
+        if (groups)
+            glDispatchCompute(gx, gy, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        vfx_gpu_pass_end(ctx);
+        g->built = 1;
+        g->built_rev = in->data_rev;
+        g->built_count = in->count;
+        g->built_h = p->h;
+    }
 
+    /* the counters were cleared by the effect at the start of the frame */
     vfx_gpu_pass_begin(ctx, "water.grid_march");
-    glClearNamedBufferData(g->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     glUseProgram(march);
     grid_uniforms(march, in, g0, cs, dims, nscan);
     float blo[3], bhi[3];
@@ -190,14 +206,7 @@ vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_
                     GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     vfx_gpu_pass_end(ctx);
 
-    uint32_t c[6];
-    glGetNamedBufferSubData(g->counters, 0, sizeof c, c);
-    vfx_stat_set(ctx, "water.samples", c[0]);
-    vfx_stat_set(ctx, "water.pixels_found", c[1]);
-    vfx_stat_set(ctx, "water.pixels_sample_cap", c[2]);
-    vfx_stat_set(ctx, "water.pixels_left", c[3]);
-    vfx_stat_set(ctx, "water.grid_cells_visited", c[4]);
-    vfx_stat_set(ctx, "water.grid_sphere_tests", c[5]);
+    vfx_stat_set(ctx, "water.grid_rebuilt", rebuild);
     vfx_stat_set(ctx, "water.grid_cells", ncells);
     vfx_stat_set(ctx, "water.grid_cell_size", cs);
     const char *e = vfx_gpu_error_string();

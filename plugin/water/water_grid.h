@@ -18,14 +18,18 @@ typedef struct vfx_water_grid_input {
     const vfx_water_params *params;  /* defaults already applied */
     uint32_t width, height;
     GLuint dist_tex;                 /* R32F target: distance along the ray or -1 */
+    GLuint counters;                 /* the effect's counter buffer (fenced readback ring) */
+    uint64_t data_rev;               /* changes whenever the columns were uploaded again */
 } vfx_water_grid_input;
 
 /* Makes the (empty) grid state; NULL on allocation failure (error recorded). */
 vfx_water_grid *vfx_water_grid_create(vfx_context *ctx);
 /* Frees the grid's buffers and the state; NULL allowed. */
 void vfx_water_grid_destroy(vfx_context *ctx, vfx_water_grid *g);
-/* Builds the grid from in->cols and writes in->dist_tex; sets the water.grid_* counters and
- * water.samples / pixels_found / pixels_sample_cap / pixels_left (read back: a stall). */
+/* Builds the grid from in->cols unless data_rev, count and h are those of the last build, then
+ * writes in->dist_tex; adds water.samples / pixels_found / pixels_sample_cap / pixels_left /
+ * grid cells visited / sphere tests into in->counters (no readback here); sets water.grid_cells,
+ * water.grid_cell_size and water.grid_rebuilt (0/1). */
 vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_water_grid_input *in,
                                  const vfx_frame_view *frame, const vfx_frame_targets *targets);
 

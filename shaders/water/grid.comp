@@ -22,7 +22,11 @@ layout(std430, binding = 0) readonly buffer PX { float px[]; };
 layout(std430, binding = 1) readonly buffer PY { float py[]; };
 layout(std430, binding = 2) readonly buffer PZ { float pz[]; };
 layout(std430, binding = 3) buffer Count { uint count[]; };   // counts, then the scatter fill
-layout(std430, binding = 4) buffer Counters { uint c_samples, c_found, c_cap, c_left, c_cells, c_tests; };
+// the water effect's counter buffer (march.comp's layout; the first two and the gradient
+// pass's two are not GRID's), copied into its fenced readback ring at the end of the frame
+layout(std430, binding = 4) buffer Counters {
+    uint c_culled_, c_frags_, c_samples, c_found, c_cap, c_left, c_gculled_, c_gfrags_, c_cells, c_tests;
+};
 layout(std430, binding = 5) buffer Start { uint start[]; };   // ncells + 1 entries (+ padding)
 layout(std430, binding = 6) buffer Blocks { uint blocks[]; };
 layout(std430, binding = 7) buffer Sorted { vec4 sorted[]; };

@@ -40,6 +40,9 @@ layout(rgba32f, binding = 1) uniform image2D u_br;
 layout(r32f, binding = 2) uniform image2D u_t;
 layout(r32f, binding = 3) uniform writeonly image2D u_out;
 layout(binding = 0) uniform sampler2D u_pot;
+#if defined(MODE_FINAL)
+layout(r32f, binding = 4) uniform readonly image2D u_cur;   // the sample the loop would take next
+#endif
 #elif defined(MODE_POTSUM)
 layout(std430, binding = 0) readonly buffer PX { float px[]; };
 layout(std430, binding = 1) readonly buffer PY { float py[]; };
@@ -124,9 +127,21 @@ void main()
     vec4 s = imageLoad(u_st, pix);
     float tt = imageLoad(u_t, pix).r;
     float r = -1.0;
-    if (s.x == 1.0 && tt <= scene_t(pix)) { r = tt; atomicAdd(c_found, 1u); }
-    if (s.x == 3.0) atomicAdd(c_cap, 1u);
-    if (s.x == 0.0 || s.x == 2.0) atomicAdd(c_left, 1u);
+    float ts = scene_t(pix);
+    // The loop runs a fixed ceil(cap / NS) iterations, so a ray that spent its budget with its
+    // next sample still inside the box and in front of the host depth ends with flag 0: that is
+    // the cap (a hole of the method), not a ray that left. Regula falsi may land a hair behind
+    // the host depth: hidden, so counted as left. The final class goes back into st.x
+    // (1 found, 2 left, 3 cap) for vfx_water_debug_pixel_class.
+    if (s.x == 0.0) {
+        float tn = imageLoad(u_cur, pix).r;
+        s.x = (tn >= 1.0e29 || tn > min(u_t_end, ts)) ? 2.0 : 3.0;
+    }
+    if (s.x == 1.0 && !(tt <= ts)) s.x = 2.0;
+    if (s.x == 1.0) { r = tt; atomicAdd(c_found, 1u); }
+    else if (s.x == 3.0) atomicAdd(c_cap, 1u);
+    else atomicAdd(c_left, 1u);
+    imageStore(u_st, pix, s);
     imageStore(u_out, pix, vec4(r));
 #elif defined(MODE_POTSUM)
     float t = imageLoad(u_cur, pix).r;
