@@ -22,8 +22,9 @@ if [ ! -f "$root/etc/debian_version" ]; then
   command -v debootstrap >/dev/null || { apt-get update -qq; apt-get install -y -qq debootstrap; }
   mkdir -p "$root"
   echo "check-fresh-debian: debootstrap minbase bookworm into $root"
+  t0=$(date +%s)
   debootstrap --variant=minbase bookworm "$root" http://deb.debian.org/debian
-  fresh=yes
+  fresh="yes (debootstrap $(( $(date +%s) - t0 )) s)"
 else
   echo "check-fresh-debian: reusing the system already in $root (not fresh: packages may be installed)"
   fresh=no
