@@ -9,6 +9,8 @@
 #   ROOTDIR default /var/tmp/deb12. Give a new folder for a truly fresh machine: a reused one
 #   already has the packages from the previous check installed.
 #   SHARED  default ../shared next to the repository.
+#   VFX_CHECK_TEST_FIRST=1 runs scripts/test.sh before scripts/run-game.sh, so that test.sh is the
+#   one that installs and builds (each README command must set up on its own).
 # Logs: ROOTDIR/root/run-game.log, ROOTDIR/root/test.log.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
@@ -64,13 +66,18 @@ run() { # run NAME: runs scripts/NAME.sh in the chroot with an empty environment
   secs=$((t1 - t0))
 }
 
-run run-game
-game_rc=$rc game_s=$secs
-fps=$(grep -m1 -o '[0-9.]* fps' "$root/root/run-game.log" || true)
-png=no; [ -s "$root/root/volfx/volfx-game.png" ] && png=yes
-run test
-test_rc=$rc test_s=$secs
-count=$(tail -n 1 "$root/root/test.log")
+game() {
+  run run-game
+  game_rc=$rc game_s=$secs
+  fps=$(grep -m1 -o '[0-9.]* fps' "$root/root/run-game.log" || true)
+  png=no; [ -s "$root/root/volfx/volfx-game.png" ] && png=yes
+}
+tests() {
+  run test
+  test_rc=$rc test_s=$secs
+  count=$(tail -n 1 "$root/root/test.log")
+}
+if [ "${VFX_CHECK_TEST_FIRST:-0}" = 1 ]; then tests; game; else game; tests; fi
 
 echo "check-fresh-debian: fresh root: $fresh"
 echo "  scripts/run-game.sh: exit $game_rc, ${game_s} s, fps '${fps}', volfx-game.png written: $png"
