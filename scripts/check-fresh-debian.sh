@@ -83,6 +83,10 @@ echo "check-fresh-debian: fresh root: $fresh"
 echo "  scripts/run-game.sh: exit $game_rc, ${game_s} s, fps '${fps}', volfx-game.png written: $png"
 echo "  scripts/test.sh:     exit $test_rc, ${test_s} s, '$count'"
 ok=1
-[ "$game_rc" -eq 0 ] && [ -n "$fps" ] && [ "$png" = yes ] || { ok=0; echo "  run-game FAILED: see $root/root/run-game.log"; }
-[ "$test_rc" -eq 0 ] && [[ "$count" =~ ^[0-9]+\ passed,\ 0\ failed ]] || { ok=0; echo "  test.sh FAILED: see $root/root/test.log"; }
-[ $ok -eq 1 ] && echo "check-fresh-debian: PASS" || { echo "check-fresh-debian: FAIL"; exit 1; }
+if ! { [ "$game_rc" -eq 0 ] && [ -n "$fps" ] && [ "$png" = yes ]; }; then
+  ok=0; echo "  run-game FAILED: see $root/root/run-game.log"
+fi
+if ! { [ "$test_rc" -eq 0 ] && [[ "$count" =~ ^[0-9]+\ passed,\ 0\ failed ]]; }; then
+  ok=0; echo "  test.sh FAILED: see $root/root/test.log"
+fi
+if [ $ok -eq 1 ]; then echo "check-fresh-debian: PASS"; else echo "check-fresh-debian: FAIL"; exit 1; fi
