@@ -3,9 +3,12 @@
 # fetched again, and apt-get update runs only when something is missing.
 # Usage: scripts/install-deps.sh [extra-package ...]
 set -euo pipefail
+# python3: the shader/scene embedders, tests/gl/check_bench_dump.sh, scripts/testlog-count.py and
+# scripts/make-tet-mesh.sh call it directly (meson pulls it in too). Checked on a debootstrap
+# minbase bookworm by scripts/check-fresh-debian.sh (docs/robustness.md, "Fresh machine").
 pkgs=(
-  build-essential meson ninja-build pkg-config
-  libglfw3-dev libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri mesa-utils
+  build-essential meson ninja-build pkg-config python3
+  libglfw3-dev libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
   libcglm-dev libassimp-dev libcjson-dev zlib1g-dev libexpat1-dev libcmocka-dev
   libopenmpi-dev openmpi-bin
   assimp-testmodels tetgen
