@@ -289,7 +289,10 @@ static int test_render(int P)
                        "table exchanges %llu\n", P, shuffle, o.share, o.dlb, d,
                        (unsigned long long)skipped, (unsigned long long)rounds);
                 CHECK(d <= 0.1 + 1e-5, "ERT 0.9 differs from no-ERT by %g", d);
-                CHECK(skipped > 0, "ERT skipped nothing");
+                /* Without DLB each rank's partition is fixed, so its local table alone skips
+                 * the same cells every run (sharing only adds); with DLB the cells a rank ends
+                 * up with depend on timing and a run may skip none (seen under ASan). */
+                CHECK(o.dlb || skipped > 0, "ERT skipped nothing");
             }
         }
         /* bad input: every rank reports the same error naming the tet, no rank hangs */
