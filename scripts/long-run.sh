@@ -3,6 +3,8 @@
 # resident memory and live GL object counts sampled every 1,000 frames; fails when RSS grows by
 # more than 1 MB or any GL object count grows after warm-up (the first sample after frame 1,000).
 # Not a CI test (it takes a long time on llvmpipe). Usage: scripts/long-run.sh [frames] [game args]
+# The issue-8 run: scripts/long-run.sh 100000 --scene sample_game/scenes/long-run.json --size 64x36
+# (every effect of the default scene, cut down so llvmpipe does ~30 fps: about an hour).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 frames=${1:-100000}

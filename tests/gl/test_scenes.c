@@ -43,6 +43,7 @@ static void test_default_file(void **s) { (void)s; run_scene("default.json", tru
 static void test_beams_only(void **s) { (void)s; run_scene("beams-only.json", false, true, false); }
 static void test_water_only(void **s) { (void)s; run_scene("water-only.json", true, false, false); }
 static void test_empty(void **s) { (void)s; run_scene("empty.json", false, false, false); }
+static void test_long_run(void **s) { (void)s; run_scene("long-run.json", true, true, true); }
 
 static void test_bad_scene_refused(void **state)
 {
@@ -64,7 +65,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_default), cmocka_unit_test(test_default_file),
         cmocka_unit_test(test_beams_only), cmocka_unit_test(test_water_only),
-        cmocka_unit_test(test_empty), cmocka_unit_test(test_bad_scene_refused),
+        cmocka_unit_test(test_empty),
+        cmocka_unit_test(test_long_run), cmocka_unit_test(test_bad_scene_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -398,8 +398,8 @@ static void test_sample_scenes(void **state)
     const char *root = getenv("VFX_SOURCE_ROOT");
     if (!root)
         root = ".";
-    static const char *names[] = {"default", "beams-only", "water-only", "empty"};
-    for (size_t i = 0; i < 4; ++i) {
+    static const char *names[] = {"default", "beams-only", "water-only", "empty", "long-run"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
         char path[1024], err[512];
         snprintf(path, sizeof path, "%s/sample_game/scenes/%s.json", root, names[i]);
         vfx_test_log log = {0};
