@@ -8,7 +8,7 @@
 # oversubscribed, see docs/tetvol-mpi.md; MPIRUN_ARGS= gives Open MPI's default).
 set -eu
 cd "$(dirname "$0")/.."
-BUILD=${BUILD:-build}
+BUILD=${BUILD:-${VFX_BUILD_DIR:-build}}
 out=${1:-$BUILD/bench-tetvol-mpi.jsonl}
 ninja -C "$BUILD" sample_game/tetvol/volfx-tetvol-mpi
 pipe=${VFX_SHARED_DATA:-../shared/data}/tets/pipe_RCR_init_flow.vtu

@@ -41,6 +41,9 @@ renderer=$(echo "$ecs" | /usr/bin/python3 -c 'import json,sys; print(json.load(s
   echo "- ECS iteration: a system integrating positions from velocities over the particle columns."
   echo "- Column upload: three \`glNamedBufferSubData\` calls (x, y, z columns) straight from ECS storage,"
   echo "  timed to \`glFinish\`; on llvmpipe this is a memory copy, not a bus transfer."
+  echo
+  echo "The MPI backend's figures (ranks, ERT sharing, load balancing, binary-swap bytes) are in"
+  echo "docs/tetvol-mpi.md; \`scripts/bench-tetvol-mpi.sh\` (run above with the others) prints its tables."
   for part in docs/benchmarks-*.md; do
     [ -f "$part" ] || continue
     echo
