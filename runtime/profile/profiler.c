@@ -12,6 +12,10 @@ typedef struct series {
     bool gpu;
 } series;
 
+/* Frames kept exactly at the start of a run, so a summary can drop up to this many warm-up
+ * frames after the ring has rolled past them. */
+#define VFX_PROF_HEAD 256
+
 struct vfx_profiler {
     uint32_t max_frames;
     uint32_t frame;         /* frames ended */
@@ -23,8 +27,12 @@ struct vfx_profiler {
     double cursor;          /* CPU time of the current frame's spans laid end to end */
     series series[VFX_PROFILER_MAX_SERIES];
     uint32_t series_count;
-    double *all_frame_ms;   /* every frame, for the summary */
-    uint32_t all_count, all_cap;
+    /* Whole-run frame times in bounded memory (a game runs for hours): a log histogram of every
+     * frame, the first VFX_PROF_HEAD frames exactly (so warm-up frames can be dropped from it),
+     * the sum and the max after the head. */
+    uint32_t *hist;
+    double head[VFX_PROF_HEAD];
+    double sum_ms, tail_max;
 };
 
 double vfx_now_ms(void)
@@ -32,6 +40,25 @@ double vfx_now_ms(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+/* Bucket b holds times in [lo r^b, lo r^(b+1)), r = 1.001: a percentile read from it is within
+ * 0.05% of the exact one (the bucket's geometric centre), far below frame-time noise. */
+#define VFX_PROF_LO_MS 1e-3
+#define VFX_PROF_LOG_R 9.995003330835332e-4 /* ln 1.001 */
+#define VFX_PROF_BUCKETS 20736               /* 1e-3 ms .. ~1e6 ms */
+
+static uint32_t bucket_of(double ms)
+{
+    if (!(ms > VFX_PROF_LO_MS))
+        return 0;
+    double b = log(ms / VFX_PROF_LO_MS) / VFX_PROF_LOG_R;
+    return b >= VFX_PROF_BUCKETS - 1 ? VFX_PROF_BUCKETS - 1 : (uint32_t)b;
+}
+
+static double bucket_centre(uint32_t b)
+{
+    return VFX_PROF_LO_MS * exp(((double)b + 0.5) * VFX_PROF_LOG_R);
 }
 
 vfx_profiler *vfx_profiler_create(uint32_t max_frames)
@@ -45,13 +72,23 @@ vfx_profiler *vfx_profiler_create(uint32_t max_frames)
     p->frame_ms = calloc(max_frames, sizeof(double));
     p->frame_t0 = calloc(max_frames, sizeof(double));
     p->values = malloc((size_t)max_frames * VFX_PROFILER_MAX_SERIES * sizeof(double));
-    p->starts = calloc((size_t)max_frames * VFX_PROFILER_MAX_SERIES, sizeof(double));
-    if (!p->frame_ms || !p->frame_t0 || !p->values || !p->starts) {
+    p->starts = malloc((size_t)max_frames * VFX_PROFILER_MAX_SERIES * sizeof(double));
+    p->hist = calloc(VFX_PROF_BUCKETS, sizeof *p->hist);
+    if (!p->frame_ms || !p->frame_t0 || !p->values || !p->starts || !p->hist) {
         vfx_profiler_destroy(p);
         return NULL;
     }
-    for (size_t i = 0; i < (size_t)max_frames * VFX_PROFILER_MAX_SERIES; ++i)
+    /* Every ring page is written now, not as the ring first fills: resident memory is then flat
+     * from the first frame (calloc's lazy zero pages made RSS creep for max_frames frames). */
+    for (size_t i = 0; i < (size_t)max_frames * VFX_PROFILER_MAX_SERIES; ++i) {
         p->values[i] = NAN;
+        p->starts[i] = NAN;
+    }
+    for (uint32_t i = 0; i < max_frames; ++i)
+        p->frame_ms[i] = p->frame_t0[i] = NAN;
+    for (uint32_t b = 0; b < VFX_PROF_BUCKETS; b += 1024)
+        p->hist[b] = 1; /* touch each page of the histogram, then clear it */
+    memset(p->hist, 0, VFX_PROF_BUCKETS * sizeof *p->hist);
     return p;
 }
 
@@ -63,7 +100,7 @@ void vfx_profiler_destroy(vfx_profiler *p)
     free(p->frame_t0);
     free(p->values);
     free(p->starts);
-    free(p->all_frame_ms);
+    free(p->hist);
     free(p);
 }
 
@@ -88,20 +125,25 @@ double vfx_profiler_frame_end(vfx_profiler *p)
     if (!p)
         return 0;
     double ms = vfx_now_ms() - p->frame_start;
+    vfx_profiler_frame_add(p, ms);
+    return ms;
+}
+
+void vfx_profiler_frame_add(vfx_profiler *p, double ms)
+{
+    if (!p)
+        return;
+    if (!(ms >= 0) || isinf(ms))
+        ms = 0; /* a clock step backwards or a broken clock: counted, not poisoning the sums */
     p->frame_ms[p->frame % p->max_frames] = ms;
     p->frame_t0[p->frame % p->max_frames] = p->frame_start;
-    if (p->all_count == p->all_cap) {
-        uint32_t cap = p->all_cap ? p->all_cap * 2 : 256;
-        double *n = realloc(p->all_frame_ms, cap * sizeof(double));
-        if (n) {
-            p->all_frame_ms = n;
-            p->all_cap = cap;
-        }
-    }
-    if (p->all_count < p->all_cap)
-        p->all_frame_ms[p->all_count++] = ms;
+    p->hist[bucket_of(ms)]++;
+    p->sum_ms += ms;
+    if (p->frame < VFX_PROF_HEAD)
+        p->head[p->frame] = ms;
+    else if (ms > p->tail_max)
+        p->tail_max = ms;
     p->frame++;
-    return ms;
 }
 
 static int series_index(vfx_profiler *p, const char *name, bool gpu)
@@ -171,29 +213,85 @@ static double pct(const double *s, uint32_t n, double q)
     return s[i < n ? i : n - 1];
 }
 
-vfx_frame_summary vfx_profiler_summary(const vfx_profiler *p, uint32_t skip)
+static void summary_of_sorted(vfx_frame_summary *s, double *sorted, uint32_t n)
 {
-    vfx_frame_summary s;
-    memset(&s, 0, sizeof s);
-    if (!p || p->all_count <= skip)
-        return s;
-    uint32_t n = p->all_count - skip;
-    double *sorted = malloc(n * sizeof(double));
-    if (!sorted)
-        return s;
-    memcpy(sorted, p->all_frame_ms + skip, n * sizeof(double));
     qsort(sorted, n, sizeof(double), cmp_double);
     double sum = 0;
     for (uint32_t i = 0; i < n; ++i)
         sum += sorted[i];
+    s->frames = n;
+    s->mean_ms = sum / n;
+    s->mean_fps = sum > 0 ? 1000.0 * n / sum : 0;
+    s->p50_ms = pct(sorted, n, 0.50);
+    s->p95_ms = pct(sorted, n, 0.95);
+    s->p99_ms = pct(sorted, n, 0.99);
+    s->max_ms = sorted[n - 1];
+}
+
+/* Nearest-rank percentiles q[0..2] from the histogram less the head frames [0, skip). */
+static int hist_pcts(const vfx_profiler *p, uint32_t skip, uint32_t n, const double q[3],
+                     double out[3])
+{
+    uint32_t *h = malloc(VFX_PROF_BUCKETS * sizeof *h);
+    if (!h)
+        return -1;
+    memcpy(h, p->hist, VFX_PROF_BUCKETS * sizeof *h);
+    for (uint32_t i = 0; i < skip; ++i)
+        h[bucket_of(p->head[i])]--;
+    uint64_t seen = 0;
+    int k = 0;
+    for (uint32_t b = 0; b < VFX_PROF_BUCKETS && k < 3; ++b) {
+        seen += h[b];
+        while (k < 3) {
+            double rank = ceil(q[k] * n);
+            uint64_t want = rank < 1 ? 1 : (uint64_t)rank;
+            if (seen < want)
+                break;
+            out[k++] = bucket_centre(b);
+        }
+    }
+    free(h);
+    return k == 3 ? 0 : -1;
+}
+
+vfx_frame_summary vfx_profiler_summary(const vfx_profiler *p, uint32_t skip)
+{
+    vfx_frame_summary s;
+    memset(&s, 0, sizeof s);
+    if (!p || p->frame <= skip)
+        return s;
+    uint32_t n = p->frame - skip;
+    if (n <= p->max_frames) { /* every frame asked for is still in the ring: exact */
+        double *sorted = malloc(n * sizeof(double));
+        if (!sorted)
+            return s;
+        for (uint32_t i = 0; i < n; ++i)
+            sorted[i] = p->frame_ms[(skip + i) % p->max_frames];
+        summary_of_sorted(&s, sorted, n);
+        free(sorted);
+        return s;
+    }
+    /* Older frames live only in the histogram: a skip beyond the head is taken as the head. */
+    if (skip > VFX_PROF_HEAD)
+        skip = VFX_PROF_HEAD;
+    n = p->frame - skip;
+    double sum = p->sum_ms, mx = p->tail_max;
+    for (uint32_t i = 0; i < skip; ++i)
+        sum -= p->head[i];
+    for (uint32_t i = skip; i < VFX_PROF_HEAD; ++i)
+        if (p->head[i] > mx)
+            mx = p->head[i];
+    static const double q[3] = {0.50, 0.95, 0.99};
+    double v[3];
+    if (hist_pcts(p, skip, n, q, v) != 0)
+        return s;
     s.frames = n;
     s.mean_ms = sum / n;
     s.mean_fps = sum > 0 ? 1000.0 * n / sum : 0;
-    s.p50_ms = pct(sorted, n, 0.50);
-    s.p95_ms = pct(sorted, n, 0.95);
-    s.p99_ms = pct(sorted, n, 0.99);
-    s.max_ms = sorted[n - 1];
-    free(sorted);
+    s.p50_ms = fmin(v[0], mx);
+    s.p95_ms = fmin(v[1], mx);
+    s.p99_ms = fmin(v[2], mx);
+    s.max_ms = mx;
     return s;
 }
 
