@@ -676,6 +676,37 @@ int vfx_tet_render(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam, const vf
     return vfx_tet_render_workers(mesh, cam, tf, opts, rgba, counters, NULL, err);
 }
 
+/* The checks both entry points make once their pointers are known non-NULL, in one order so
+ * that both report the same first fault: image size, worker count (nw, at most 64), a scalar
+ * field, a perspective projection. Sets *near_d to the near-plane distance the projection
+ * implies (z_ndc = -1 at z = -near; 1e-4 when it implies none). */
+static int check_view(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam, int nw,
+                      double *near_d, char err[256])
+{
+    const int W = cam->width, H = cam->height;
+    if (W <= 0 || H <= 0 || W > 16384 || H > 16384) {
+        snprintf(err, 256, "tet_render: image size %dx%d out of range", W, H);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    if (nw > 64) {
+        snprintf(err, 256, "tet_render: %d workers requested, at most 64", nw);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    if (!mesh->scalar) {
+        snprintf(err, 256, "tet_render: mesh has no scalar field");
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    const float *P = cam->proj;
+    if (P[11] > -0.5f || !(fabsf(P[0]) > 0) || !(fabsf(P[5]) > 0)) {
+        snprintf(err, 256, "tet_render: projection is not a perspective matrix (P[11]=%g)",
+                 (double)P[11]);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    *near_d = (double)P[14] / ((double)P[10] - 1.0);
+    if (!(*near_d > 0)) *near_d = 1e-4;
+    return VFX_OK;
+}
+
 int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
                            const vfx_tet_tf *tf, const vfx_tet_options *opts, float *rgba,
                            vfx_tet_counters *counters, vfx_tet_counters *per_worker,
@@ -689,28 +720,12 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
         return VFX_ERR_INVALID_ARGUMENT;
     }
     const int W = cam->width, H = cam->height;
-    if (W <= 0 || H <= 0 || W > 16384 || H > 16384) {
-        snprintf(err, 256, "tet_render: image size %dx%d out of range", W, H);
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
     const int nw = opts->workers <= 0 ? 1 : opts->workers;
-    if (nw > 64) {
-        snprintf(err, 256, "tet_render: %d workers requested, at most 64", nw);
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
-    if (!mesh->scalar) {
-        snprintf(err, 256, "tet_render: mesh has no scalar field");
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
+    double near_d;
+    int rc = check_view(mesh, cam, nw, &near_d, err);
+    if (rc != VFX_OK)
+        return rc;
     const float *P = cam->proj, *V = cam->view;
-    if (P[11] > -0.5f || !(fabsf(P[0]) > 0) || !(fabsf(P[5]) > 0)) {
-        snprintf(err, 256, "tet_render: projection is not a perspective matrix (P[11]=%g)",
-                 (double)P[11]);
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
-    /* near plane distance from the projection: z_ndc = -1 at z = -near */
-    double near_d = (double)P[14] / ((double)P[10] - 1.0);
-    if (!(near_d > 0)) near_d = 1e-4;
 
     const uint32_t np = mesh->point_count, nt = mesh->tet_count;
     const int D = opts->tiles_d > 0 ? opts->tiles_d : 1;
@@ -722,7 +737,7 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
         memset(ws, 0, (size_t)nw * sizeof *ws);
     tile *table = calloc((size_t)D * D, sizeof *table);
     uint32_t *bounds = calloc((size_t)nw + 1, sizeof *bounds);
-    int rc = VFX_OK, nthreads = 0;
+    int nthreads = 0;
     pthread_t th[64];
     shared sh;
     memset(&sh, 0, sizeof sh);
@@ -920,22 +935,11 @@ int vfx_tet_local_create(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
         return VFX_ERR_INVALID_ARGUMENT;
     }
     const int W = cam->width, H = cam->height;
-    if (W <= 0 || H <= 0 || W > 16384 || H > 16384) {
-        snprintf(err, 256, "tet_render: image size %dx%d out of range", W, H);
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
-    if (!mesh->scalar) {
-        snprintf(err, 256, "tet_render: mesh has no scalar field");
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
+    double near_d;
+    int rc = check_view(mesh, cam, 1, &near_d, err);
+    if (rc != VFX_OK)
+        return rc;
     const float *P = cam->proj, *V = cam->view;
-    if (P[11] > -0.5f || !(fabsf(P[0]) > 0) || !(fabsf(P[5]) > 0)) {
-        snprintf(err, 256, "tet_render: projection is not a perspective matrix (P[11]=%g)",
-                 (double)P[11]);
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
-    double near_d = (double)P[14] / ((double)P[10] - 1.0);
-    if (!(near_d > 0)) near_d = 1e-4;
     const uint32_t np = mesh->point_count, nt = mesh->tet_count;
     const int D = opts->tiles_d > 0 ? opts->tiles_d : 1;
     vfx_tet_local *L = calloc(1, sizeof *L);
