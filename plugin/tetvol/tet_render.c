@@ -5,6 +5,7 @@
 #endif
 #include "tet_render.h"
 #include "tet_render_internal.h"
+#include "tet_clock.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -28,22 +29,6 @@ typedef struct tile {
     int terminated;
     float deepest;
 } tile;
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-/* CPU time of the calling thread: on a loaded machine wall time mostly measures the scheduler */
-static double thread_cpu_ms(void)
-{
-    struct timespec ts;
-    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0)
-        return 0;
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
 
 void vfx_tet_options_default(vfx_tet_options *o)
 {
@@ -525,7 +510,7 @@ static void update_table(shared *sh, worker *w)
 {
     const scan_ctx *X = sh->X;
     const int W = X->W, H = X->H, D = X->D;
-    double tu = now_ms();
+    double tu = vfx_tet_now_ms();
     for (int ty = 0; ty < D; ty++)
         for (int tx = 0; tx < D; tx++) {
             int x0 = tx * W / D, x1 = (tx + 1) * W / D;
@@ -554,7 +539,7 @@ static void update_table(shared *sh, worker *w)
         pthread_mutex_unlock(&sh->lock);
     }
     w->cnt.table_updates++;
-    w->cnt.t_update_ms += now_ms() - tu;
+    w->cnt.t_update_ms += vfx_tet_now_ms() - tu;
 }
 
 /* Dynamic load balancing (paper 4.3.2): take 1/3 of the remaining cells of the most loaded
@@ -597,7 +582,7 @@ static void *worker_main(void *arg)
     const scan_ctx *X = sh->X;
     const int ert = X->opts->ert;
     const uint32_t C = X->opts->update_c > 0 ? (uint32_t)X->opts->update_c : 1;
-    double t0 = now_ms(), c0 = thread_cpu_ms();
+    double t0 = vfx_tet_now_ms(), c0 = vfx_tet_thread_cpu_ms();
     pthread_mutex_lock(&w->lock);
     uint32_t rem0 = w->end - w->next;
     pthread_mutex_unlock(&w->lock);
@@ -624,8 +609,8 @@ static void *worker_main(void *arg)
             break;
         }
     }
-    w->cnt.t_sc_ms = now_ms() - t0 - w->cnt.t_update_ms;
-    w->cnt.cpu_ms = thread_cpu_ms() - c0;
+    w->cnt.t_sc_ms = vfx_tet_now_ms() - t0 - w->cnt.t_update_ms;
+    w->cnt.cpu_ms = vfx_tet_thread_cpu_ms() - c0;
     return NULL;
 }
 
@@ -823,7 +808,7 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
             rc = VFX_ERR_OUT_OF_MEMORY;
             goto done;
         }
-    double tc = now_ms();
+    double tc = vfx_tet_now_ms();
     comp_job jobs[64];
     int nj = 0;
     for (int i = 0; i < nw; i++) {
@@ -840,7 +825,7 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
     composite_main(&jobs[0]);
     for (int i = 0; i < nj; i++)
         pthread_join(th[i], NULL);
-    cnt.t_composite_ms = now_ms() - tc;
+    cnt.t_composite_ms = vfx_tet_now_ms() - tc;
 done:
     if (ws) {
         for (int i = 0; i < nw; i++) {

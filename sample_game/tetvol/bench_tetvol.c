@@ -16,6 +16,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "tetvol/tet_clock.h"
 #include "tetvol/tet_io.h"
 #include "tetvol/tet_render.h"
 
@@ -56,21 +57,6 @@ static int make_grid(int n, vfx_tet_mesh *m)
     m->scalar_min = 0; m->scalar_max = 1;
     snprintf(m->scalar_name, sizeof m->scalar_name, "grid");
     return 0;
-}
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-/* CPU time of the whole process (every worker thread): the figure that survives other load */
-static double cpu_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
 typedef struct view {
@@ -204,13 +190,15 @@ static int run_cfg(const vfx_tet_mesh *m, const vfx_tet_camera *cam, const vfx_t
     size_t n = (size_t)cam->width * cam->height * 4;
     for (int r = 0; r <= reps; r++) {
         run_result *rr = &runs[r > 0 ? r - 1 : 0];
-        double t0 = now_ms(), c0 = cpu_ms();
+        /* CPU time of the whole process (every worker thread): the figure that survives other
+         * load */
+        double t0 = vfx_tet_now_ms(), c0 = vfx_tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID);
         if (vfx_tet_render_workers(m, cam, tf, o, img, &rr->c, rr->pw, err) != 0) {
             fprintf(stderr, "bench tetvol: %s\n", err);
             return -1;
         }
-        rr->wall_ms = now_ms() - t0;
-        rr->cpu_ms = cpu_ms() - c0;
+        rr->wall_ms = vfx_tet_now_ms() - t0;
+        rr->cpu_ms = vfx_tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID) - c0;
         rr->t_sc_ms = rr->c.t_sc_ms;
         rr->t_update_ms = rr->c.t_update_ms;
         rr->rmse = rr->max = 0;
