@@ -19,45 +19,7 @@
 #include "tetvol/tet_clock.h"
 #include "tetvol/tet_io.h"
 #include "tetvol/tet_render.h"
-
-static const uint32_t cube5[20] = {0, 1, 3, 4, 1, 2, 3, 6, 1, 4, 5, 6, 3, 4, 6, 7, 1, 3, 4, 6};
-
-static int make_grid(int n, vfx_tet_mesh *m)
-{
-    uint32_t np = (uint32_t)((n + 1) * (n + 1) * (n + 1)), nt = (uint32_t)(n * n * n * 5);
-    memset(m, 0, sizeof *m);
-    m->points = malloc((size_t)np * 3 * sizeof(float));
-    m->scalar = malloc((size_t)np * sizeof(float));
-    m->tets = malloc((size_t)nt * 4 * sizeof(uint32_t));
-    if (!m->points || !m->scalar || !m->tets)
-        return -1;
-    for (int k = 0, i = 0; k <= n; k++)
-        for (int j = 0; j <= n; j++)
-            for (int l = 0; l <= n; l++, i++) {
-                float x = -1 + 2.0f * l / n, y = -1 + 2.0f * j / n, z = -1 + 2.0f * k / n;
-                m->points[3 * i] = x; m->points[3 * i + 1] = y; m->points[3 * i + 2] = z;
-                m->scalar[i] = 0.5f + 0.5f * sinf(3 * x) * cosf(2 * y) * cosf(1.5f * z);
-            }
-    uint32_t t = 0;
-    for (int k = 0; k < n; k++)
-        for (int j = 0; j < n; j++)
-            for (int l = 0; l < n; l++) {
-                uint32_t c[8];
-                for (int q = 0; q < 8; q++)
-                    c[q] = (uint32_t)((k + (q >> 2 & 1)) * (n + 1) * (n + 1) + (j + (q >> 1 & 1)) * (n + 1) + l + (q & 1));
-                uint32_t o8[8] = {c[0], c[1], c[3], c[2], c[4], c[5], c[7], c[6]};
-                static const uint32_t mirror[8] = {1, 0, 3, 2, 5, 4, 7, 6};
-                int flip = (l + j + k) & 1;
-                for (int q = 0; q < 20; q++)
-                    m->tets[(size_t)t * 4 + q] = o8[flip ? mirror[cube5[q]] : cube5[q]];
-                t += 5;
-            }
-    m->point_count = np;
-    m->tet_count = nt;
-    m->scalar_min = 0; m->scalar_max = 1;
-    snprintf(m->scalar_name, sizeof m->scalar_name, "grid");
-    return 0;
-}
+#include "tetvol/tet_testmesh.h"
 
 typedef struct view {
     const char *name;
@@ -288,7 +250,7 @@ int vfx_bench_tetvol(int argc, char **argv)
         if (r != 0) { fprintf(stderr, "bench tetvol: %s\n", err); return 1; }
         const char *sl = strrchr(mesh_path, '/');
         mesh_name = sl ? sl + 1 : mesh_path;
-    } else if (make_grid(n, &m) != 0) {
+    } else if (vfx_tet_testmesh_grid(n, &m) != 0) {
         fprintf(stderr, "bench tetvol: out of memory\n");
         return 1;
     }
