@@ -144,6 +144,27 @@ static vfx_ref_camera blob_camera(uint32_t size)
     return (vfx_ref_camera){{0.5, 1.0, 5.0}, {0, 0, 0}, {0, 1, 0}, 0.8, size, size, 0.1, 100};
 }
 
+/* The h-extreme tests' scene: 64 particles on a 4x4x4 lattice of spacing 0.3 around the
+ * origin, drawn by method with kernel radius h. */
+static scene lattice_scene(uint32_t method, float h)
+{
+    scene s = make_scene(64);
+    s.params.method = method;
+    s.params.h = h;
+    for (uint32_t i = 0; i < 64; ++i) {
+        s.x[i] = 0.3f * (float)(i % 4) - 0.45f;
+        s.y[i] = 0.3f * (float)((i / 4) % 4) - 0.45f;
+        s.z[i] = 0.3f * (float)(i / 16) - 0.45f;
+    }
+    return s;
+}
+
+/* The lattice seen from (0.2, 0.3, dist) at 48x48. */
+static vfx_ref_camera lattice_camera(double dist)
+{
+    return (vfx_ref_camera){{0.2, 0.3, dist}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
+}
+
 /* Blobs at 64x64 in 4 chunks: the brute-force march (step h/8, cap 64, 3 regula falsi
  * iterations, float32) against the float64 reference (step h/32 + bisection). */
 static void test_blobs_vs_reference(void **state)
@@ -219,16 +240,8 @@ static void test_h_huge_and_tiny(void **state)
     (void)state;
     const float hs[2] = {3.0f, 0.08f};
     for (int k = 0; k < 2; ++k) {
-        scene s = make_scene(64);
-        s.params.method = VFX_WATER_METHOD_PAPER;
-        s.params.h = hs[k];
-        for (uint32_t i = 0; i < 64; ++i) {
-            s.x[i] = 0.3f * (float)(i % 4) - 0.45f;
-            s.y[i] = 0.3f * (float)((i / 4) % 4) - 0.45f;
-            s.z[i] = 0.3f * (float)(i / 16) - 0.45f;
-        }
-        double dist = k == 0 ? 9.0 : 1.6;
-        vfx_ref_camera cam = {{0.2, 0.3, dist}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
+        scene s = lattice_scene(VFX_WATER_METHOD_PAPER, hs[k]);
+        vfx_ref_camera cam = lattice_camera(k == 0 ? 9.0 : 1.6);
         vfx_water_ref_error e = render_and_compare(&s, &cam, NULL);
         print_message("h %.2f: ref hits %u holes %.4f false %.4f dist p99 %.2e (x h)\n", hs[k],
                       e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_p99_rel_h);
@@ -330,16 +343,8 @@ static void test_grid_h_extremes(void **state)
     (void)state;
     const float hs[2] = {3.0f, 0.08f};
     for (int k = 0; k < 2; ++k) {
-        scene s = make_scene(64);
-        s.params.method = VFX_WATER_METHOD_GRID;
-        s.params.h = hs[k];
-        for (uint32_t i = 0; i < 64; ++i) {
-            s.x[i] = 0.3f * (float)(i % 4) - 0.45f;
-            s.y[i] = 0.3f * (float)((i / 4) % 4) - 0.45f;
-            s.z[i] = 0.3f * (float)(i / 16) - 0.45f;
-        }
-        double dist = k == 0 ? 9.0 : 1.6;
-        vfx_ref_camera cam = {{0.2, 0.3, dist}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
+        scene s = lattice_scene(VFX_WATER_METHOD_GRID, hs[k]);
+        vfx_ref_camera cam = lattice_camera(k == 0 ? 9.0 : 1.6);
         vfx_stats st;
         vfx_water_ref_error e = render_and_compare(&s, &cam, &st);
         print_message("grid h %.2f: ref hits %u holes %.4f false %.4f dist p99 %.2e (x h), %.0f cells\n", hs[k],
