@@ -574,18 +574,19 @@ static vfx_result surface_passes(vfx_context *ctx, water_state *s, const vfx_fra
 static void publish_counters(vfx_context *ctx, water_state *s)
 {
     const uint32_t *c = s->last;
-    if (s->last_method == VFX_WATER_METHOD_PAPER) {
+    const int paper = s->last_method == VFX_WATER_METHOD_PAPER;
+    const int grid = s->last_method == VFX_WATER_METHOD_GRID;
+    if (paper) {
         vfx_stat_set(ctx, "water.fragments_culled", c[0]);
         vfx_stat_set(ctx, "water.potential_fragments", c[1]);
+    }
+    if (paper || grid) { /* both marches count samples and pixel classes in the same slots */
         vfx_stat_set(ctx, "water.samples", c[2]);
         vfx_stat_set(ctx, "water.pixels_found", c[3]);
         vfx_stat_set(ctx, "water.pixels_sample_cap", c[4]);
         vfx_stat_set(ctx, "water.pixels_left", c[5]);
-    } else if (s->last_method == VFX_WATER_METHOD_GRID) {
-        vfx_stat_set(ctx, "water.samples", c[2]);
-        vfx_stat_set(ctx, "water.pixels_found", c[3]);
-        vfx_stat_set(ctx, "water.pixels_sample_cap", c[4]);
-        vfx_stat_set(ctx, "water.pixels_left", c[5]);
+    }
+    if (grid) {
         vfx_stat_set(ctx, "water.grid_cells_visited", c[8]);
         vfx_stat_set(ctx, "water.grid_sphere_tests", c[9]);
     }
