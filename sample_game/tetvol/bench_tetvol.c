@@ -123,6 +123,21 @@ static int write_pfm(const char *path, const float *rgba, int w, int h, int ch)
     return (fclose(f) == 0 && ok) ? 0 : -1;
 }
 
+/* Writes PREFIX_VIEW<suffix>.rgb.pfm (premultiplied colour) and .alpha.pfm of an image. Returns
+ * 0, or -1 with a message naming the file. */
+static int write_pfm_pair(const char *prefix, const char *view, const char *suffix,
+                          const float *rgba, int w, int h)
+{
+    char p1[1100], p2[1100];
+    snprintf(p1, sizeof p1, "%s_%s%s.rgb.pfm", prefix, view, suffix);
+    snprintf(p2, sizeof p2, "%s_%s%s.alpha.pfm", prefix, view, suffix);
+    if (write_pfm(p1, rgba, w, h, -1) || write_pfm(p2, rgba, w, h, 3)) {
+        fprintf(stderr, "bench tetvol: cannot write %s\n", p1);
+        return -1;
+    }
+    return 0;
+}
+
 typedef struct run_result {
     double wall_ms, cpu_ms, t_sc_ms, t_update_ms, rmse, max;
     vfx_tet_counters c;
@@ -321,15 +336,9 @@ int vfx_bench_tetvol(int argc, char **argv)
                    vw->farp, base.wall_ms, base.cpu_ms, base.t_sc_ms, base.c.t_composite_ms, cov,
                    cov > 0 ? asum / cov : 0.0, opaque, (unsigned long long)base.c.cells_scanned,
                    (unsigned long long)base.c.segments_made);
-            if (out_prefix) {
-                char p1[1100], p2[1100];
-                snprintf(p1, sizeof p1, "%s_%s.rgb.pfm", out_prefix, vw->name);
-                snprintf(p2, sizeof p2, "%s_%s.alpha.pfm", out_prefix, vw->name);
-                if (write_pfm(p1, ref, w, h, -1) || write_pfm(p2, ref, w, h, 3)) {
-                    fprintf(stderr, "bench tetvol: cannot write %s\n", p1);
-                    rc = 1;
-                    break;
-                }
+            if (out_prefix && write_pfm_pair(out_prefix, vw->name, "", ref, w, h) != 0) {
+                rc = 1;
+                break;
             }
             /* the fast setting: every core, ERT 0.99 with sharing and load balancing */
             o.ert = 1; o.ert_threshold = 0.99f; o.workers = 2; o.share = o.dlb = 1;
@@ -337,15 +346,9 @@ int vfx_bench_tetvol(int argc, char **argv)
             printf(HEAD "\"test\":\"image_fast\",\"workers\":2,\"threshold\":0.99,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,"
                    "\"N_skipped\":%llu,\"rmse_vs_no_ert\":%.3g,\"max_vs_no_ert\":%.3g}\n",
                    HARGS, res->wall_ms, res->cpu_ms, (unsigned long long)res->c.cells_skipped_ert, res->rmse, res->max);
-            if (out_prefix) {
-                char p1[1100], p2[1100];
-                snprintf(p1, sizeof p1, "%s_%s_fast.rgb.pfm", out_prefix, vw->name);
-                snprintf(p2, sizeof p2, "%s_%s_fast.alpha.pfm", out_prefix, vw->name);
-                if (write_pfm(p1, img, w, h, -1) || write_pfm(p2, img, w, h, 3)) {
-                    fprintf(stderr, "bench tetvol: cannot write %s\n", p1);
-                    rc = 1;
-                    break;
-                }
+            if (out_prefix && write_pfm_pair(out_prefix, vw->name, "_fast", img, w, h) != 0) {
+                rc = 1;
+                break;
             }
             vfx_tet_options_default(&o);
             o.ert = 0; o.workers = 1;
