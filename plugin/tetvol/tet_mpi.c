@@ -5,6 +5,7 @@
 #define _POSIX_C_SOURCE 199309L
 #endif
 #include "tet_mpi.h"
+#include "tet_clock.h"
 
 #include <limits.h>
 #include <math.h>
@@ -17,20 +18,6 @@ enum { TAG_REQ = 7101, TAG_GIVE = 7102, TAG_SWAP_N = 7103, TAG_SWAP_S = 7104 };
 
 /* as in tet_render.c: segments this close (relative to depth) count as touching */
 #define TOUCH_EPS 1e-5f
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-static double cpu_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
 
 /* An idle rank sleeps between polls instead of spinning in MPI_Wait: with more ranks than
  * cores (the test and bench machines) a spinning rank would take CPU from working ones. */
@@ -214,7 +201,7 @@ int vfx_tet_mpi_composite(MPI_Comm comm, int W, int H, vfx_tet_seglists *lists, 
     int rank, P, rc = VFX_OK;
     MPI_Comm_rank(comm, &rank);
     MPI_Comm_size(comm, &P);
-    double t0 = now_ms();
+    double t0 = vfx_tet_now_ms();
     MPI_Datatype segt;
     MPI_Type_contiguous(6, MPI_FLOAT, &segt);
     MPI_Type_commit(&segt);
@@ -287,7 +274,7 @@ int vfx_tet_mpi_composite(MPI_Comm comm, int W, int H, vfx_tet_seglists *lists, 
         }
         rc = agree(comm, r2, err, "binary swap");
     }
-    double t1 = now_ms();
+    double t1 = vfx_tet_now_ms();
     /* Final composition of this rank's part, then gather to rank 0. */
     size_t mine = rank < G ? p1 - p0 : 0;
     float *part = malloc((mine + 1) * 4 * sizeof *part);
@@ -334,7 +321,7 @@ int vfx_tet_mpi_composite(MPI_Comm comm, int W, int H, vfx_tet_seglists *lists, 
     if (st) {
         st->bytes_sent += bytes;
         st->t_swap_ms += t1 - t0;
-        st->t_gather_ms += now_ms() - t1;
+        st->t_gather_ms += vfx_tet_now_ms() - t1;
     }
     free(part);
     free(counts);
@@ -494,7 +481,7 @@ int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet
                        const vfx_tet_tf *tf, const vfx_tet_options *opts, float *rgba,
                        vfx_tet_mpi_stats *mine, vfx_tet_mpi_stats *all, char err[256])
 {
-    double t_start = now_ms();
+    double t_start = vfx_tet_now_ms();
     MPI_Comm comm = ctx->comm;
     int rank, P;
     MPI_Comm_rank(comm, &rank);
@@ -572,32 +559,32 @@ int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet
      * requests move while a rank scans a long stretch */
     const uint32_t POLL = 256;
     int failed = 0;
-    double t1 = now_ms(), c1 = cpu_ms();
+    double t1 = vfx_tet_now_ms(), c1 = vfx_tet_thread_cpu_ms();
     st.t_setup_ms = t1 - t_start;
     vfx_tet_counters *cnt = vfx_tet_local_counters(R.L);
     for (;;) {
         uint32_t rem = R.end - R.next;
         uint32_t interval = rem / C > 0 ? rem / C : 1, since = 0;
-        double ts = now_ms(), tin = 0, tu0 = cnt->t_update_ms;
+        double ts = vfx_tet_now_ms(), tin = 0, tu0 = cnt->t_update_ms;
         while (R.next < R.end && !failed) {
             if (since >= interval) {
                 if (ert)
                     vfx_tet_local_update_table(R.L);
                 if (coop) {
-                    double tp = now_ms();
+                    double tp = vfx_tet_now_ms();
                     if (R.share)
                         share_table(&R);
                     poll_rank(&R, 1);
                     st.polls++;
-                    tin += now_ms() - tp;
+                    tin += vfx_tet_now_ms() - tp;
                 }
                 interval = (R.end - R.next) / C > 0 ? (R.end - R.next) / C : 1;
                 since = 0;
             } else if (coop && since % POLL == POLL - 1) {
-                double tp = now_ms();
+                double tp = vfx_tet_now_ms();
                 poll_rank(&R, 0);
                 st.polls++;
-                tin += now_ms() - tp;
+                tin += vfx_tet_now_ms() - tp;
             }
             if (R.next >= R.end)
                 break; /* everything left was handed away */
@@ -610,7 +597,7 @@ int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet
                          (unsigned long long)cnt->segments_made);
             }
         }
-        cnt->t_sc_ms += now_ms() - ts - tin - (cnt->t_update_ms - tu0);
+        cnt->t_sc_ms += vfx_tet_now_ms() - ts - tin - (cnt->t_update_ms - tu0);
         st.t_comm_ms += tin;
         if (!coop || failed || !R.dlb)
             break;
@@ -618,7 +605,7 @@ int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet
          * any to give. The rank keeps answering other requests meanwhile (with nothing). */
         int got = 0;
         while (!got && ask_for_work(&R)) {
-            double tw = now_ms();
+            double tw = vfx_tet_now_ms();
             for (;;) {
                 int flag = 0;
                 MPI_Test(&R.give_rq, &flag, MPI_STATUS_IGNORE);
@@ -628,7 +615,7 @@ int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet
                 idle_pause();
             }
             wait_polite(1, &R.ask_rq); /* it was answered, so it was received */
-            st.t_idle_ms += now_ms() - tw;
+            st.t_idle_ms += vfx_tet_now_ms() - tw;
             uint32_t n = R.give[1] - R.give[0];
             if (n > 0) {
                 vfx_tet_local_need(R.L, R.give[0], R.give[1]); /* sorts the victim's keys */
@@ -649,23 +636,23 @@ int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet
      * after the same one and no message is left in flight (a rank waiting for an answer is
      * not done, so that reduction cannot say all done). */
     if (coop) {
-        double tw = now_ms();
+        double tw = vfx_tet_now_ms();
         R.done = 1;
         while (!R.all_done) {
             poll_rank(&R, 1);
             if (!R.all_done)
                 idle_pause();
         }
-        st.t_idle_ms += now_ms() - tw;
+        st.t_idle_ms += vfx_tet_now_ms() - tw;
     }
-    st.t_phase1_ms = now_ms() - t1;
-    st.t_phase1_cpu_ms = cpu_ms() - c1;
+    st.t_phase1_ms = vfx_tet_now_ms() - t1;
+    st.t_phase1_cpu_ms = vfx_tet_thread_cpu_ms() - c1;
 
     rc = agree(comm, failed ? VFX_ERR_OUT_OF_MEMORY : VFX_OK, err, "the scan");
     if (rc != VFX_OK)
         goto done;
     /* Phase 2: this rank's full-screen lists, exported and composited by binary swap. */
-    double te = now_ms();
+    double te = vfx_tet_now_ms();
     vfx_tet_seglists lists;
     memset(&lists, 0, sizeof lists);
     size_t npix = (size_t)cam->width * cam->height;
@@ -687,7 +674,7 @@ int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet
     vfx_tet_local_destroy(R.L); /* the lists are all phase 2 needs */
     R.L = NULL;
     rc = agree(comm, r2, err, "export");
-    st.t_export_ms = now_ms() - te;
+    st.t_export_ms = vfx_tet_now_ms() - te;
     if (rc == VFX_OK)
         rc = vfx_tet_mpi_composite(comm, cam->width, cam->height, &lists, opts->partial_composite,
                                    rgba, &st, err);
@@ -695,7 +682,7 @@ int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet
 done:
     if (R.L)
         st.cnt = *vfx_tet_local_counters(R.L);
-    st.t_total_ms = now_ms() - t_start;
+    st.t_total_ms = vfx_tet_now_ms() - t_start;
     if (mine)
         *mine = st;
     if (rc == VFX_OK) {

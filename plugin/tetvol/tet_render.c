@@ -5,6 +5,7 @@
 #endif
 #include "tet_render.h"
 #include "tet_render_internal.h"
+#include "tet_clock.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -28,22 +29,6 @@ typedef struct tile {
     int terminated;
     float deepest;
 } tile;
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-/* CPU time of the calling thread: on a loaded machine wall time mostly measures the scheduler */
-static double thread_cpu_ms(void)
-{
-    struct timespec ts;
-    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0)
-        return 0;
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
 
 void vfx_tet_options_default(vfx_tet_options *o)
 {
@@ -525,7 +510,7 @@ static void update_table(shared *sh, worker *w)
 {
     const scan_ctx *X = sh->X;
     const int W = X->W, H = X->H, D = X->D;
-    double tu = now_ms();
+    double tu = vfx_tet_now_ms();
     for (int ty = 0; ty < D; ty++)
         for (int tx = 0; tx < D; tx++) {
             int x0 = tx * W / D, x1 = (tx + 1) * W / D;
@@ -554,7 +539,7 @@ static void update_table(shared *sh, worker *w)
         pthread_mutex_unlock(&sh->lock);
     }
     w->cnt.table_updates++;
-    w->cnt.t_update_ms += now_ms() - tu;
+    w->cnt.t_update_ms += vfx_tet_now_ms() - tu;
 }
 
 /* Dynamic load balancing (paper 4.3.2): take 1/3 of the remaining cells of the most loaded
@@ -597,7 +582,7 @@ static void *worker_main(void *arg)
     const scan_ctx *X = sh->X;
     const int ert = X->opts->ert;
     const uint32_t C = X->opts->update_c > 0 ? (uint32_t)X->opts->update_c : 1;
-    double t0 = now_ms(), c0 = thread_cpu_ms();
+    double t0 = vfx_tet_now_ms(), c0 = vfx_tet_thread_cpu_ms();
     pthread_mutex_lock(&w->lock);
     uint32_t rem0 = w->end - w->next;
     pthread_mutex_unlock(&w->lock);
@@ -624,8 +609,8 @@ static void *worker_main(void *arg)
             break;
         }
     }
-    w->cnt.t_sc_ms = now_ms() - t0 - w->cnt.t_update_ms;
-    w->cnt.cpu_ms = thread_cpu_ms() - c0;
+    w->cnt.t_sc_ms = vfx_tet_now_ms() - t0 - w->cnt.t_update_ms;
+    w->cnt.cpu_ms = vfx_tet_thread_cpu_ms() - c0;
     return NULL;
 }
 
@@ -676,6 +661,37 @@ int vfx_tet_render(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam, const vf
     return vfx_tet_render_workers(mesh, cam, tf, opts, rgba, counters, NULL, err);
 }
 
+/* The checks both entry points make once their pointers are known non-NULL, in one order so
+ * that both report the same first fault: image size, worker count (nw, at most 64), a scalar
+ * field, a perspective projection. Sets *near_d to the near-plane distance the projection
+ * implies (z_ndc = -1 at z = -near; 1e-4 when it implies none). */
+static int check_view(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam, int nw,
+                      double *near_d, char err[256])
+{
+    const int W = cam->width, H = cam->height;
+    if (W <= 0 || H <= 0 || W > 16384 || H > 16384) {
+        snprintf(err, 256, "tet_render: image size %dx%d out of range", W, H);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    if (nw > 64) {
+        snprintf(err, 256, "tet_render: %d workers requested, at most 64", nw);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    if (!mesh->scalar) {
+        snprintf(err, 256, "tet_render: mesh has no scalar field");
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    const float *P = cam->proj;
+    if (P[11] > -0.5f || !(fabsf(P[0]) > 0) || !(fabsf(P[5]) > 0)) {
+        snprintf(err, 256, "tet_render: projection is not a perspective matrix (P[11]=%g)",
+                 (double)P[11]);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    *near_d = (double)P[14] / ((double)P[10] - 1.0);
+    if (!(*near_d > 0)) *near_d = 1e-4;
+    return VFX_OK;
+}
+
 int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
                            const vfx_tet_tf *tf, const vfx_tet_options *opts, float *rgba,
                            vfx_tet_counters *counters, vfx_tet_counters *per_worker,
@@ -689,28 +705,12 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
         return VFX_ERR_INVALID_ARGUMENT;
     }
     const int W = cam->width, H = cam->height;
-    if (W <= 0 || H <= 0 || W > 16384 || H > 16384) {
-        snprintf(err, 256, "tet_render: image size %dx%d out of range", W, H);
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
     const int nw = opts->workers <= 0 ? 1 : opts->workers;
-    if (nw > 64) {
-        snprintf(err, 256, "tet_render: %d workers requested, at most 64", nw);
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
-    if (!mesh->scalar) {
-        snprintf(err, 256, "tet_render: mesh has no scalar field");
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
+    double near_d;
+    int rc = check_view(mesh, cam, nw, &near_d, err);
+    if (rc != VFX_OK)
+        return rc;
     const float *P = cam->proj, *V = cam->view;
-    if (P[11] > -0.5f || !(fabsf(P[0]) > 0) || !(fabsf(P[5]) > 0)) {
-        snprintf(err, 256, "tet_render: projection is not a perspective matrix (P[11]=%g)",
-                 (double)P[11]);
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
-    /* near plane distance from the projection: z_ndc = -1 at z = -near */
-    double near_d = (double)P[14] / ((double)P[10] - 1.0);
-    if (!(near_d > 0)) near_d = 1e-4;
 
     const uint32_t np = mesh->point_count, nt = mesh->tet_count;
     const int D = opts->tiles_d > 0 ? opts->tiles_d : 1;
@@ -722,7 +722,7 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
         memset(ws, 0, (size_t)nw * sizeof *ws);
     tile *table = calloc((size_t)D * D, sizeof *table);
     uint32_t *bounds = calloc((size_t)nw + 1, sizeof *bounds);
-    int rc = VFX_OK, nthreads = 0;
+    int nthreads = 0;
     pthread_t th[64];
     shared sh;
     memset(&sh, 0, sizeof sh);
@@ -808,7 +808,7 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
             rc = VFX_ERR_OUT_OF_MEMORY;
             goto done;
         }
-    double tc = now_ms();
+    double tc = vfx_tet_now_ms();
     comp_job jobs[64];
     int nj = 0;
     for (int i = 0; i < nw; i++) {
@@ -825,7 +825,7 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
     composite_main(&jobs[0]);
     for (int i = 0; i < nj; i++)
         pthread_join(th[i], NULL);
-    cnt.t_composite_ms = now_ms() - tc;
+    cnt.t_composite_ms = vfx_tet_now_ms() - tc;
 done:
     if (ws) {
         for (int i = 0; i < nw; i++) {
@@ -920,22 +920,11 @@ int vfx_tet_local_create(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
         return VFX_ERR_INVALID_ARGUMENT;
     }
     const int W = cam->width, H = cam->height;
-    if (W <= 0 || H <= 0 || W > 16384 || H > 16384) {
-        snprintf(err, 256, "tet_render: image size %dx%d out of range", W, H);
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
-    if (!mesh->scalar) {
-        snprintf(err, 256, "tet_render: mesh has no scalar field");
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
+    double near_d;
+    int rc = check_view(mesh, cam, 1, &near_d, err);
+    if (rc != VFX_OK)
+        return rc;
     const float *P = cam->proj, *V = cam->view;
-    if (P[11] > -0.5f || !(fabsf(P[0]) > 0) || !(fabsf(P[5]) > 0)) {
-        snprintf(err, 256, "tet_render: projection is not a perspective matrix (P[11]=%g)",
-                 (double)P[11]);
-        return VFX_ERR_INVALID_ARGUMENT;
-    }
-    double near_d = (double)P[14] / ((double)P[10] - 1.0);
-    if (!(near_d > 0)) near_d = 1e-4;
     const uint32_t np = mesh->point_count, nt = mesh->tet_count;
     const int D = opts->tiles_d > 0 ? opts->tiles_d : 1;
     vfx_tet_local *L = calloc(1, sizeof *L);

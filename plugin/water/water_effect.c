@@ -426,7 +426,6 @@ static void draw_billboards(vfx_context *ctx, const water_state *s)
 static vfx_result brute_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
                               vfx_frame_targets *targets)
 {
-    const vfx_water_params *p = &s->params;
     GLuint prog = vfx_gpu_compute(ctx, "water/brute.comp", NULL);
     if (!prog)
         return VFX_ERR_GL;
@@ -434,17 +433,8 @@ static vfx_result brute_march(vfx_context *ctx, water_state *s, const vfx_frame_
     glUseProgram(prog);
     for (int k = 0; k < 3; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, s->cols[k]);
-    glBindImageTexture(0, ctx->water_dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-    glBindTextureUnit(1, frame->depth_texture);
-    glUniformMatrix4fv(glGetUniformLocation(prog, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
-    glUniform3fv(glGetUniformLocation(prog, "u_eye"), 1, frame->eye);
+    vfx_water_march_bind(prog, ctx->water_dist_tex, &s->params, frame, targets);
     glUniform1ui(glGetUniformLocation(prog, "u_count"), s->count);
-    glUniform1f(glGetUniformLocation(prog, "u_h"), p->h);
-    glUniform1f(glGetUniformLocation(prog, "u_T"), p->threshold);
-    glUniform1f(glGetUniformLocation(prog, "u_step"), p->step);
-    glUniform1ui(glGetUniformLocation(prog, "u_max_samples"), p->max_samples);
-    glUniform1ui(glGetUniformLocation(prog, "u_refine_iters"), (p->disable & VFX_WATER_NO_REFINE) ? 0u : p->refine_iters);
-    glUniform1i(glGetUniformLocation(prog, "u_has_depth"), frame->depth_texture != 0);
     glDispatchCompute((s->width + 7) / 8, (s->height + 7) / 8, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     vfx_gpu_pass_end(ctx);
@@ -584,18 +574,19 @@ static vfx_result surface_passes(vfx_context *ctx, water_state *s, const vfx_fra
 static void publish_counters(vfx_context *ctx, water_state *s)
 {
     const uint32_t *c = s->last;
-    if (s->last_method == VFX_WATER_METHOD_PAPER) {
+    const int paper = s->last_method == VFX_WATER_METHOD_PAPER;
+    const int grid = s->last_method == VFX_WATER_METHOD_GRID;
+    if (paper) {
         vfx_stat_set(ctx, "water.fragments_culled", c[0]);
         vfx_stat_set(ctx, "water.potential_fragments", c[1]);
+    }
+    if (paper || grid) { /* both marches count samples and pixel classes in the same slots */
         vfx_stat_set(ctx, "water.samples", c[2]);
         vfx_stat_set(ctx, "water.pixels_found", c[3]);
         vfx_stat_set(ctx, "water.pixels_sample_cap", c[4]);
         vfx_stat_set(ctx, "water.pixels_left", c[5]);
-    } else if (s->last_method == VFX_WATER_METHOD_GRID) {
-        vfx_stat_set(ctx, "water.samples", c[2]);
-        vfx_stat_set(ctx, "water.pixels_found", c[3]);
-        vfx_stat_set(ctx, "water.pixels_sample_cap", c[4]);
-        vfx_stat_set(ctx, "water.pixels_left", c[5]);
+    }
+    if (grid) {
         vfx_stat_set(ctx, "water.grid_cells_visited", c[8]);
         vfx_stat_set(ctx, "water.grid_sphere_tests", c[9]);
     }

@@ -93,6 +93,21 @@ static void grid_uniforms(GLuint prog, const vfx_water_grid_input *in, const flo
     glUniform3iv(glGetUniformLocation(prog, "u_dims"), 1, dims);
 }
 
+void vfx_water_march_bind(GLuint prog, GLuint dist_tex, const vfx_water_params *p,
+                          const vfx_frame_view *frame, const vfx_frame_targets *targets)
+{
+    glBindImageTexture(0, dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    glBindTextureUnit(1, frame->depth_texture);
+    glUniformMatrix4fv(glGetUniformLocation(prog, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
+    glUniform3fv(glGetUniformLocation(prog, "u_eye"), 1, frame->eye);
+    glUniform1f(glGetUniformLocation(prog, "u_h"), p->h);
+    glUniform1f(glGetUniformLocation(prog, "u_T"), p->threshold);
+    glUniform1f(glGetUniformLocation(prog, "u_step"), p->step);
+    glUniform1ui(glGetUniformLocation(prog, "u_max_samples"), p->max_samples);
+    glUniform1ui(glGetUniformLocation(prog, "u_refine_iters"), (p->disable & VFX_WATER_NO_REFINE) ? 0u : p->refine_iters);
+    glUniform1i(glGetUniformLocation(prog, "u_has_depth"), frame->depth_texture != 0);
+}
+
 vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_water_grid_input *in,
                                  const vfx_frame_view *frame, const vfx_frame_targets *targets)
 {
@@ -187,16 +202,7 @@ vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_
     }
     glUniform3fv(glGetUniformLocation(march, "u_blo"), 1, blo);
     glUniform3fv(glGetUniformLocation(march, "u_bhi"), 1, bhi);
-    glBindImageTexture(0, in->dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-    glBindTextureUnit(1, frame->depth_texture);
-    glUniformMatrix4fv(glGetUniformLocation(march, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
-    glUniform3fv(glGetUniformLocation(march, "u_eye"), 1, frame->eye);
-    glUniform1f(glGetUniformLocation(march, "u_h"), p->h);
-    glUniform1f(glGetUniformLocation(march, "u_T"), p->threshold);
-    glUniform1f(glGetUniformLocation(march, "u_step"), p->step);
-    glUniform1ui(glGetUniformLocation(march, "u_max_samples"), p->max_samples);
-    glUniform1ui(glGetUniformLocation(march, "u_refine_iters"), (p->disable & VFX_WATER_NO_REFINE) ? 0u : p->refine_iters);
-    glUniform1i(glGetUniformLocation(march, "u_has_depth"), frame->depth_texture != 0);
+    vfx_water_march_bind(march, in->dist_tex, p, frame, targets);
     /* the paper's technique bits mean the same here: 1 = start at the box entry instead of the
      * first sphere entry, 2 = fixed steps after the start (no jump over empty space) */
     glUniform1i(glGetUniformLocation(march, "u_seek_init"), !(p->disable & VFX_WATER_NO_BILLBOARD_INIT));

@@ -33,4 +33,11 @@ void vfx_water_grid_destroy(vfx_context *ctx, vfx_water_grid *g);
 vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_water_grid_input *in,
                                  const vfx_frame_view *frame, const vfx_frame_targets *targets);
 
+/* The march inputs BRUTE (brute.comp) and GRID (grid.comp MODE_MARCH) share, on the current
+ * program prog: dist_tex as image 0, the scene depth on unit 1, the ray (inverse view-projection,
+ * eye), the sampling rule (h, T, step, sample cap), refinement (off with VFX_WATER_NO_REFINE)
+ * and whether there is scene depth. */
+void vfx_water_march_bind(GLuint prog, GLuint dist_tex, const vfx_water_params *p,
+                          const vfx_frame_view *frame, const vfx_frame_targets *targets);
+
 #endif

@@ -16,62 +16,10 @@
 #include <string.h>
 #include <time.h>
 
+#include "tetvol/tet_clock.h"
 #include "tetvol/tet_io.h"
 #include "tetvol/tet_render.h"
-
-static const uint32_t cube5[20] = {0, 1, 3, 4, 1, 2, 3, 6, 1, 4, 5, 6, 3, 4, 6, 7, 1, 3, 4, 6};
-
-static int make_grid(int n, vfx_tet_mesh *m)
-{
-    uint32_t np = (uint32_t)((n + 1) * (n + 1) * (n + 1)), nt = (uint32_t)(n * n * n * 5);
-    memset(m, 0, sizeof *m);
-    m->points = malloc((size_t)np * 3 * sizeof(float));
-    m->scalar = malloc((size_t)np * sizeof(float));
-    m->tets = malloc((size_t)nt * 4 * sizeof(uint32_t));
-    if (!m->points || !m->scalar || !m->tets)
-        return -1;
-    for (int k = 0, i = 0; k <= n; k++)
-        for (int j = 0; j <= n; j++)
-            for (int l = 0; l <= n; l++, i++) {
-                float x = -1 + 2.0f * l / n, y = -1 + 2.0f * j / n, z = -1 + 2.0f * k / n;
-                m->points[3 * i] = x; m->points[3 * i + 1] = y; m->points[3 * i + 2] = z;
-                m->scalar[i] = 0.5f + 0.5f * sinf(3 * x) * cosf(2 * y) * cosf(1.5f * z);
-            }
-    uint32_t t = 0;
-    for (int k = 0; k < n; k++)
-        for (int j = 0; j < n; j++)
-            for (int l = 0; l < n; l++) {
-                uint32_t c[8];
-                for (int q = 0; q < 8; q++)
-                    c[q] = (uint32_t)((k + (q >> 2 & 1)) * (n + 1) * (n + 1) + (j + (q >> 1 & 1)) * (n + 1) + l + (q & 1));
-                uint32_t o8[8] = {c[0], c[1], c[3], c[2], c[4], c[5], c[7], c[6]};
-                static const uint32_t mirror[8] = {1, 0, 3, 2, 5, 4, 7, 6};
-                int flip = (l + j + k) & 1;
-                for (int q = 0; q < 20; q++)
-                    m->tets[(size_t)t * 4 + q] = o8[flip ? mirror[cube5[q]] : cube5[q]];
-                t += 5;
-            }
-    m->point_count = np;
-    m->tet_count = nt;
-    m->scalar_min = 0; m->scalar_max = 1;
-    snprintf(m->scalar_name, sizeof m->scalar_name, "grid");
-    return 0;
-}
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
-
-/* CPU time of the whole process (every worker thread): the figure that survives other load */
-static double cpu_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
+#include "tetvol/tet_testmesh.h"
 
 typedef struct view {
     const char *name;
@@ -175,6 +123,21 @@ static int write_pfm(const char *path, const float *rgba, int w, int h, int ch)
     return (fclose(f) == 0 && ok) ? 0 : -1;
 }
 
+/* Writes PREFIX_VIEW<suffix>.rgb.pfm (premultiplied colour) and .alpha.pfm of an image. Returns
+ * 0, or -1 with a message naming the file. */
+static int write_pfm_pair(const char *prefix, const char *view, const char *suffix,
+                          const float *rgba, int w, int h)
+{
+    char p1[1100], p2[1100];
+    snprintf(p1, sizeof p1, "%s_%s%s.rgb.pfm", prefix, view, suffix);
+    snprintf(p2, sizeof p2, "%s_%s%s.alpha.pfm", prefix, view, suffix);
+    if (write_pfm(p1, rgba, w, h, -1) || write_pfm(p2, rgba, w, h, 3)) {
+        fprintf(stderr, "bench tetvol: cannot write %s\n", p1);
+        return -1;
+    }
+    return 0;
+}
+
 typedef struct run_result {
     double wall_ms, cpu_ms, t_sc_ms, t_update_ms, rmse, max;
     vfx_tet_counters c;
@@ -204,13 +167,15 @@ static int run_cfg(const vfx_tet_mesh *m, const vfx_tet_camera *cam, const vfx_t
     size_t n = (size_t)cam->width * cam->height * 4;
     for (int r = 0; r <= reps; r++) {
         run_result *rr = &runs[r > 0 ? r - 1 : 0];
-        double t0 = now_ms(), c0 = cpu_ms();
+        /* CPU time of the whole process (every worker thread): the figure that survives other
+         * load */
+        double t0 = vfx_tet_now_ms(), c0 = vfx_tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID);
         if (vfx_tet_render_workers(m, cam, tf, o, img, &rr->c, rr->pw, err) != 0) {
             fprintf(stderr, "bench tetvol: %s\n", err);
             return -1;
         }
-        rr->wall_ms = now_ms() - t0;
-        rr->cpu_ms = cpu_ms() - c0;
+        rr->wall_ms = vfx_tet_now_ms() - t0;
+        rr->cpu_ms = vfx_tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID) - c0;
         rr->t_sc_ms = rr->c.t_sc_ms;
         rr->t_update_ms = rr->c.t_update_ms;
         rr->rmse = rr->max = 0;
@@ -300,7 +265,7 @@ int vfx_bench_tetvol(int argc, char **argv)
         if (r != 0) { fprintf(stderr, "bench tetvol: %s\n", err); return 1; }
         const char *sl = strrchr(mesh_path, '/');
         mesh_name = sl ? sl + 1 : mesh_path;
-    } else if (make_grid(n, &m) != 0) {
+    } else if (vfx_tet_testmesh_grid(n, &m) != 0) {
         fprintf(stderr, "bench tetvol: out of memory\n");
         return 1;
     }
@@ -371,15 +336,9 @@ int vfx_bench_tetvol(int argc, char **argv)
                    vw->farp, base.wall_ms, base.cpu_ms, base.t_sc_ms, base.c.t_composite_ms, cov,
                    cov > 0 ? asum / cov : 0.0, opaque, (unsigned long long)base.c.cells_scanned,
                    (unsigned long long)base.c.segments_made);
-            if (out_prefix) {
-                char p1[1100], p2[1100];
-                snprintf(p1, sizeof p1, "%s_%s.rgb.pfm", out_prefix, vw->name);
-                snprintf(p2, sizeof p2, "%s_%s.alpha.pfm", out_prefix, vw->name);
-                if (write_pfm(p1, ref, w, h, -1) || write_pfm(p2, ref, w, h, 3)) {
-                    fprintf(stderr, "bench tetvol: cannot write %s\n", p1);
-                    rc = 1;
-                    break;
-                }
+            if (out_prefix && write_pfm_pair(out_prefix, vw->name, "", ref, w, h) != 0) {
+                rc = 1;
+                break;
             }
             /* the fast setting: every core, ERT 0.99 with sharing and load balancing */
             o.ert = 1; o.ert_threshold = 0.99f; o.workers = 2; o.share = o.dlb = 1;
@@ -387,15 +346,9 @@ int vfx_bench_tetvol(int argc, char **argv)
             printf(HEAD "\"test\":\"image_fast\",\"workers\":2,\"threshold\":0.99,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,"
                    "\"N_skipped\":%llu,\"rmse_vs_no_ert\":%.3g,\"max_vs_no_ert\":%.3g}\n",
                    HARGS, res->wall_ms, res->cpu_ms, (unsigned long long)res->c.cells_skipped_ert, res->rmse, res->max);
-            if (out_prefix) {
-                char p1[1100], p2[1100];
-                snprintf(p1, sizeof p1, "%s_%s_fast.rgb.pfm", out_prefix, vw->name);
-                snprintf(p2, sizeof p2, "%s_%s_fast.alpha.pfm", out_prefix, vw->name);
-                if (write_pfm(p1, img, w, h, -1) || write_pfm(p2, img, w, h, 3)) {
-                    fprintf(stderr, "bench tetvol: cannot write %s\n", p1);
-                    rc = 1;
-                    break;
-                }
+            if (out_prefix && write_pfm_pair(out_prefix, vw->name, "_fast", img, w, h) != 0) {
+                rc = 1;
+                break;
             }
             vfx_tet_options_default(&o);
             o.ert = 0; o.workers = 1;

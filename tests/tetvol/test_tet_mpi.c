@@ -14,6 +14,7 @@
 
 #include "tetvol/tet_mpi.h"
 #include "tetvol/tet_render.h"
+#include "tetvol/tet_testmesh.h"
 
 
 static int g_rank;
@@ -128,43 +129,13 @@ static int test_swap(int P)
     return 0;
 }
 
-static const uint32_t cube5[20] = {0, 1, 3, 4, 1, 2, 3, 6, 1, 4, 5, 6, 3, 4, 6, 7, 1, 3, 4, 6};
-
-/* n^3 cubes x 5 tets in [-1,1]^3 with a smooth scalar; when shuffle is set the cell order is
- * permuted so that every rank's partition is scattered through the volume (its cells
- * interleave in depth with every other rank's). */
+/* n^3 cubes x 5 tets in [-1,1]^3 with a smooth scalar (tet_testmesh.c); when shuffle is set
+ * the cell order is permuted so that every rank's partition is scattered through the volume
+ * (its cells interleave in depth with every other rank's). */
 static void make_grid(int n, int shuffle, vfx_tet_mesh *m)
 {
-    uint32_t np = (uint32_t)((n + 1) * (n + 1) * (n + 1)), nt = (uint32_t)(n * n * n * 5);
-    memset(m, 0, sizeof *m);
-    m->points = malloc((size_t)np * 3 * sizeof(float));
-    m->scalar = malloc((size_t)np * sizeof(float));
-    m->tets = malloc((size_t)nt * 4 * sizeof(uint32_t));
-    CHECK(m->points && m->scalar && m->tets, "memory");
-    for (int k = 0, i = 0; k <= n; k++)
-        for (int j = 0; j <= n; j++)
-            for (int l = 0; l <= n; l++, i++) {
-                float x = -1 + 2.0f * l / n, y = -1 + 2.0f * j / n, z = -1 + 2.0f * k / n;
-                m->points[3 * i] = x;
-                m->points[3 * i + 1] = y;
-                m->points[3 * i + 2] = z;
-                m->scalar[i] = 0.5f + 0.5f * sinf(3 * x) * cosf(2 * y) * cosf(1.5f * z);
-            }
-    uint32_t t = 0;
-    for (int k = 0; k < n; k++)
-        for (int j = 0; j < n; j++)
-            for (int l = 0; l < n; l++) {
-                uint32_t c[8];
-                for (int q = 0; q < 8; q++)
-                    c[q] = (uint32_t)((k + (q >> 2 & 1)) * (n + 1) * (n + 1) +
-                                      (j + (q >> 1 & 1)) * (n + 1) + l + (q & 1));
-                uint32_t o8[8] = {c[0], c[1], c[3], c[2], c[4], c[5], c[7], c[6]};
-                static const uint32_t mirror[8] = {1, 0, 3, 2, 5, 4, 7, 6};
-                int flip = (l + j + k) & 1;
-                for (int q = 0; q < 20; q++)
-                    m->tets[(size_t)t * 4 + q] = o8[flip ? mirror[cube5[q]] : cube5[q]];
-                t += 5;
-            }
+    CHECK(vfx_tet_testmesh_grid(n, m) == 0, "memory");
+    uint32_t nt = m->tet_count;
     if (shuffle)
         for (uint32_t i = nt - 1; i > 0; i--) {
             uint32_t j = hash3(i, 17, 3) % (i + 1), tmp[4];
@@ -172,31 +143,13 @@ static void make_grid(int n, int shuffle, vfx_tet_mesh *m)
             memcpy(&m->tets[4 * i], &m->tets[4 * j], sizeof tmp);
             memcpy(&m->tets[4 * j], tmp, sizeof tmp);
         }
-    m->point_count = np;
-    m->tet_count = nt;
-    m->scalar_min = 0;
-    m->scalar_max = 1;
 }
 
 /* view rotated about x then y, eye at distance dist, 60 degree fov */
 static void make_cam(vfx_tet_camera *c, int w, int h, float yaw, float pitch, float dist)
 {
-    memset(c, 0, sizeof *c);
-    c->width = w;
-    c->height = h;
-    float cy = cosf(yaw), sy = sinf(yaw), cp = cosf(pitch), sp = sinf(pitch);
-    float R[9] = {cy, sp * sy, -cp * sy, 0, cp, sp, sy, -sp * cy, cp * cy};
-    for (int col = 0; col < 3; col++)
-        for (int r = 0; r < 3; r++)
-            c->view[col * 4 + r] = R[col * 3 + r];
+    vfx_tet_testmesh_orbit(c, w, h, yaw, pitch, 1.0f / tanf(0.5f * 1.0471976f), 0.1f, 100.0f);
     c->view[14] = -dist;
-    c->view[15] = 1;
-    float f = 1.0f / tanf(0.5f * 1.0471976f), near = 0.1f, far = 100.0f;
-    c->proj[0] = f * h / (float)w;
-    c->proj[5] = f;
-    c->proj[10] = (far + near) / (near - far);
-    c->proj[11] = -1;
-    c->proj[14] = 2 * far * near / (near - far);
 }
 
 static double max_diff(const float *a, const float *b, size_t n)

@@ -228,41 +228,11 @@ static void test_ert_threshold(void **state)
 {
     (void)state;
     /* a 6x6x6 grid of cubes, 5 tets each */
-    enum { N = 6, NP = (N + 1) * (N + 1) * (N + 1), NT = N * N * N * 5 };
-    float *pts = malloc(NP * 3 * sizeof *pts), *sc = malloc(NP * sizeof *sc);
-    uint32_t *tets = malloc(NT * 4 * sizeof *tets);
-    for (int k = 0, i = 0; k <= N; k++)
-        for (int j = 0; j <= N; j++)
-            for (int l = 0; l <= N; l++, i++) {
-                pts[3 * i] = -1 + 2.0f * l / N;
-                pts[3 * i + 1] = -1 + 2.0f * j / N;
-                pts[3 * i + 2] = -1 + 2.0f * k / N;
-                sc[i] = 0.5f + 0.5f * sinf(3 * pts[3 * i]) * cosf(2 * pts[3 * i + 1]);
-            }
-    uint32_t t = 0;
-    for (int k = 0; k < N; k++)
-        for (int j = 0; j < N; j++)
-            for (int l = 0; l < N; l++) {
-                uint32_t c[8];
-                for (int q = 0; q < 8; q++) {
-                    int dl = q & 1 ? 1 : 0, dj = q & 2 ? 1 : 0, dk = q & 4 ? 1 : 0;
-                    c[q] = (uint32_t)((k + dk) * (N + 1) * (N + 1) + (j + dj) * (N + 1) + l + dl);
-                }
-                /* corner order 0..7 as in cube_pts: (0,0,0)(1,0,0)(1,1,0)(0,1,0)... */
-                uint32_t o8[8] = {c[0], c[1], c[3], c[2], c[4], c[5], c[7], c[6]};
-                int flip = (l + j + k) & 1; /* alternate so faces match between cubes */
-                for (int q = 0; q < 20; q++) {
-                    uint32_t idx = cube_tets[q];
-                    if (flip) {
-                        static const uint32_t mirror[8] = {1, 0, 3, 2, 5, 4, 7, 6};
-                        idx = mirror[idx];
-                    }
-                    tets[(size_t)((t + q / 4) * 4 + q % 4)] = o8[idx];
-                }
-                t += 5;
-            }
-    vfx_tet_mesh m = {0};
-    m.point_count = NP; m.tet_count = NT; m.points = pts; m.tets = tets; m.scalar = sc;
+    enum { N = 6, NT = N * N * N * 5 };
+    vfx_tet_mesh m;
+    float *pts, *sc;
+    uint32_t *tets;
+    make_grid(N, &m, &pts, &sc, &tets);
     vfx_tet_camera cam; make_cam(&cam, 40, 40, 4.0f, 0.1f);
     vfx_tet_tf tf; make_tf(&tf, 20.0f);
     vfx_tet_options o; vfx_tet_options_default(&o); o.tiles_d = 8; o.update_c = 50;

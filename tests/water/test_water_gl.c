@@ -128,14 +128,50 @@ static scene make_scene(uint32_t n)
 
 static void free_scene(scene *s) { free(s->x); free(s->y); free(s->z); }
 
+/* The blob scene of most tests: 300 particles in 4 blobs (vfx_water_ref_blobs, seed 7) drawn
+ * by method. */
+static scene blob_scene(uint32_t method)
+{
+    scene s = make_scene(300);
+    s.params.method = method;
+    vfx_water_ref_blobs(s.n, 4, 1.0, 0.35, 7, s.x, s.y, s.z);
+    return s;
+}
+
+/* The view of the blob scene, size x size pixels. */
+static vfx_ref_camera blob_camera(uint32_t size)
+{
+    return (vfx_ref_camera){{0.5, 1.0, 5.0}, {0, 0, 0}, {0, 1, 0}, 0.8, size, size, 0.1, 100};
+}
+
+/* The h-extreme tests' scene: 64 particles on a 4x4x4 lattice of spacing 0.3 around the
+ * origin, drawn by method with kernel radius h. */
+static scene lattice_scene(uint32_t method, float h)
+{
+    scene s = make_scene(64);
+    s.params.method = method;
+    s.params.h = h;
+    for (uint32_t i = 0; i < 64; ++i) {
+        s.x[i] = 0.3f * (float)(i % 4) - 0.45f;
+        s.y[i] = 0.3f * (float)((i / 4) % 4) - 0.45f;
+        s.z[i] = 0.3f * (float)(i / 16) - 0.45f;
+    }
+    return s;
+}
+
+/* The lattice seen from (0.2, 0.3, dist) at 48x48. */
+static vfx_ref_camera lattice_camera(double dist)
+{
+    return (vfx_ref_camera){{0.2, 0.3, dist}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
+}
+
 /* Blobs at 64x64 in 4 chunks: the brute-force march (step h/8, cap 64, 3 regula falsi
  * iterations, float32) against the float64 reference (step h/32 + bisection). */
 static void test_blobs_vs_reference(void **state)
 {
     (void)state;
-    scene s = make_scene(300);
-    vfx_water_ref_blobs(s.n, 4, 1.0, 0.35, 7, s.x, s.y, s.z);
-    vfx_ref_camera cam = {{0.5, 1.0, 5.0}, {0, 0, 0}, {0, 1, 0}, 0.8, 64, 64, 0.1, 100};
+    scene s = blob_scene(VFX_WATER_METHOD_BRUTE);
+    vfx_ref_camera cam = blob_camera(64);
     vfx_stats st;
     vfx_water_ref_error e = render_and_compare(&s, &cam, &st);
     print_message("blobs: ref hits %u holes %.4f false %.4f dist mean %.2e p99 %.2e (x h)\n",
@@ -204,16 +240,8 @@ static void test_h_huge_and_tiny(void **state)
     (void)state;
     const float hs[2] = {3.0f, 0.08f};
     for (int k = 0; k < 2; ++k) {
-        scene s = make_scene(64);
-        s.params.method = VFX_WATER_METHOD_PAPER;
-        s.params.h = hs[k];
-        for (uint32_t i = 0; i < 64; ++i) {
-            s.x[i] = 0.3f * (float)(i % 4) - 0.45f;
-            s.y[i] = 0.3f * (float)((i / 4) % 4) - 0.45f;
-            s.z[i] = 0.3f * (float)(i / 16) - 0.45f;
-        }
-        double dist = k == 0 ? 9.0 : 1.6;
-        vfx_ref_camera cam = {{0.2, 0.3, dist}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
+        scene s = lattice_scene(VFX_WATER_METHOD_PAPER, hs[k]);
+        vfx_ref_camera cam = lattice_camera(k == 0 ? 9.0 : 1.6);
         vfx_water_ref_error e = render_and_compare(&s, &cam, NULL);
         print_message("h %.2f: ref hits %u holes %.4f false %.4f dist p99 %.2e (x h)\n", hs[k],
                       e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_p99_rel_h);
@@ -230,10 +258,8 @@ static void test_h_huge_and_tiny(void **state)
 static void test_paper_blobs_vs_reference(void **state)
 {
     (void)state;
-    scene s = make_scene(300);
-    s.params.method = VFX_WATER_METHOD_PAPER;
-    vfx_water_ref_blobs(s.n, 4, 1.0, 0.35, 7, s.x, s.y, s.z);
-    vfx_ref_camera cam = {{0.5, 1.0, 5.0}, {0, 0, 0}, {0, 1, 0}, 0.8, 64, 64, 0.1, 100};
+    scene s = blob_scene(VFX_WATER_METHOD_PAPER);
+    vfx_ref_camera cam = blob_camera(64);
     vfx_stats st;
     vfx_water_ref_error e = render_and_compare(&s, &cam, &st);
     print_message("paper blobs: ref hits %u holes %.4f false %.4f dist mean %.2e p99 %.2e (x h) samples %.0f culled %.0f\n",
@@ -284,11 +310,9 @@ static void test_grid_blobs_vs_reference(void **state)
     (void)state;
     double samples[2];
     for (int k = 0; k < 2; ++k) {
-        scene s = make_scene(300);
-        s.params.method = VFX_WATER_METHOD_GRID;
+        scene s = blob_scene(VFX_WATER_METHOD_GRID);
         s.params.disable = k ? VFX_WATER_NO_SKIP : 0;
-        vfx_water_ref_blobs(s.n, 4, 1.0, 0.35, 7, s.x, s.y, s.z);
-        vfx_ref_camera cam = {{0.5, 1.0, 5.0}, {0, 0, 0}, {0, 1, 0}, 0.8, 64, 64, 0.1, 100};
+        vfx_ref_camera cam = blob_camera(64);
         vfx_stats st;
         vfx_water_ref_error e = render_and_compare(&s, &cam, &st);
         samples[k] = stat_of(&st, "water.samples");
@@ -319,16 +343,8 @@ static void test_grid_h_extremes(void **state)
     (void)state;
     const float hs[2] = {3.0f, 0.08f};
     for (int k = 0; k < 2; ++k) {
-        scene s = make_scene(64);
-        s.params.method = VFX_WATER_METHOD_GRID;
-        s.params.h = hs[k];
-        for (uint32_t i = 0; i < 64; ++i) {
-            s.x[i] = 0.3f * (float)(i % 4) - 0.45f;
-            s.y[i] = 0.3f * (float)((i / 4) % 4) - 0.45f;
-            s.z[i] = 0.3f * (float)(i / 16) - 0.45f;
-        }
-        double dist = k == 0 ? 9.0 : 1.6;
-        vfx_ref_camera cam = {{0.2, 0.3, dist}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
+        scene s = lattice_scene(VFX_WATER_METHOD_GRID, hs[k]);
+        vfx_ref_camera cam = lattice_camera(k == 0 ? 9.0 : 1.6);
         vfx_stats st;
         vfx_water_ref_error e = render_and_compare(&s, &cam, &st);
         print_message("grid h %.2f: ref hits %u holes %.4f false %.4f dist p99 %.2e (x h), %.0f cells\n", hs[k],
@@ -542,10 +558,8 @@ static void test_normals_vs_reference(void **state)
 {
     (void)state;
     for (uint32_t m = 0; m < 2; ++m) {
-        scene s = make_scene(300);
-        s.params.method = m;
-        vfx_water_ref_blobs(s.n, 4, 1.0, 0.35, 7, s.x, s.y, s.z);
-        vfx_ref_camera cam = {{0.5, 1.0, 5.0}, {0, 0, 0}, {0, 1, 0}, 0.8, 64, 64, 0.1, 100};
+        scene s = blob_scene(m);
+        vfx_ref_camera cam = blob_camera(64);
         const size_t n = 64 * 64;
         static const float black[4] = {0, 0, 0, 1};
         session ss;
@@ -619,7 +633,7 @@ static void test_shading_pixels(void **state)
     for (int part = 0; part < 2; ++part) {
         scene s = make_scene(part == 0 ? 300 : 1);
         s.params.method = VFX_WATER_METHOD_PAPER;
-        vfx_ref_camera cam = {{0.5, 1.0, 5.0}, {0, 0, 0}, {0, 1, 0}, 0.8, 64, 64, 0.1, 100};
+        vfx_ref_camera cam = blob_camera(64);
         if (part == 0) {
             vfx_water_ref_blobs(s.n, 4, 1.0, 0.35, 7, s.x, s.y, s.z);
             s.params.color[0] = s.params.color[1] = s.params.color[2] = 1.0f;
@@ -807,10 +821,8 @@ static void test_async_counters(void **state)
          "water.grid_sphere_tests"}};
     const uint32_t methods[2] = {VFX_WATER_METHOD_PAPER, VFX_WATER_METHOD_GRID};
     for (int m = 0; m < 2; ++m) {
-        scene s = make_scene(300);
-        s.params.method = methods[m];
-        vfx_water_ref_blobs(s.n, 4, 1.0, 0.35, 7, s.x, s.y, s.z);
-        vfx_ref_camera cam = {{0.5, 1.0, 5.0}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
+        scene s = blob_scene(methods[m]);
+        vfx_ref_camera cam = blob_camera(48);
         static const float host[4] = {0, 0, 0, 1};
         double exact[5], got[5];
         session ss;
@@ -848,11 +860,9 @@ static void test_paper_sample_cap_counted(void **state)
     (void)state;
     const uint32_t caps[2] = {16, 64};
     for (int c = 0; c < 2; ++c) {
-        scene s = make_scene(300);
-        s.params.method = VFX_WATER_METHOD_PAPER;
+        scene s = blob_scene(VFX_WATER_METHOD_PAPER);
         s.params.max_samples = caps[c];
-        vfx_water_ref_blobs(s.n, 4, 1.0, 0.35, 7, s.x, s.y, s.z);
-        vfx_ref_camera cam = {{0.5, 1.0, 5.0}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
+        vfx_ref_camera cam = blob_camera(48);
         const size_t n = 48 * 48;
         static const float host[4] = {0, 0, 0, 1};
         session ss;
@@ -903,11 +913,9 @@ static void test_paper_sample_cap_counted(void **state)
 static void test_grid_rebuild_only_on_change(void **state)
 {
     (void)state;
-    scene s = make_scene(300);
-    s.params.method = VFX_WATER_METHOD_GRID;
-    vfx_water_ref_blobs(s.n, 4, 1.0, 0.35, 7, s.x, s.y, s.z);
+    scene s = blob_scene(VFX_WATER_METHOD_GRID);
     s.rev = 1;
-    vfx_ref_camera cam = {{0.5, 1.0, 5.0}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
+    vfx_ref_camera cam = blob_camera(48);
     const size_t n = 48 * 48;
     static const float host[4] = {0.2f, 0.3f, 0.4f, 1};
     session ss;
