@@ -275,6 +275,8 @@ static void test_too_many_beams(void **state)
     assert_non_null(strstr(err, "beams: 257 beams, above the cap of 256"));
     /* exactly the cap loads */
     p = strrchr(json, '{');
+    if (!p || p == json)
+        fail_msg("no last beam object in the generated scene");
     sprintf(p - 1, "]}");
     assert_int_equal(load(json, &log, &s, err, sizeof err), VFX_OK);
     assert_int_equal(s->beam_count, VFX_SCENE_MAX_BEAMS);
@@ -309,14 +311,13 @@ static void test_syntax_errors(void **state)
     assert_int_equal(vfx_scene_load_mem(NULL, 3, NULL, &lg, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
     assert_int_equal(vfx_scene_load_mem("{}", 2, NULL, &lg, NULL, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
     /* deep nesting beyond cJSON's limit (1000) is a syntax error, not a stack overflow */
-    size_t depth = 5000;
-    char *deep = malloc(2 * depth + 16);
+    enum { depth = 5000 };
+    static char deep[2 * depth + 16];
     strcpy(deep, "{\"a\":");
     memset(deep + 5, '[', depth);
     memset(deep + 5 + depth, ']', depth);
     strcpy(deep + 5 + 2 * depth, "}");
     assert_int_equal(load(deep, &log, &s, err, sizeof err), VFX_ERR_FORMAT);
-    free(deep);
 }
 
 static void test_unknown_keys_warn(void **state)
