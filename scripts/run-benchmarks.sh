@@ -17,7 +17,9 @@ if [ "${1:-}" != "--skip-effects" ]; then
 fi
 bench="$build/sample_game/volfx-bench"
 ecs=$("$bench" ecs --json 2>/dev/null | tail -1)
+load0=$(cut -d' ' -f1-3 /proc/loadavg)
 frame=$("$bench" frame --frames 20 --json 2>/dev/null | tail -1)
+load1=$(cut -d' ' -f1-3 /proc/loadavg)
 cpu=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')
 renderer=$(echo "$ecs" | /usr/bin/python3 -c 'import json,sys; print(json.load(sys.stdin)["gl_renderer"])')
 {
@@ -31,7 +33,8 @@ renderer=$(echo "$ecs" | /usr/bin/python3 -c 'import json,sys; print(json.load(s
   echo "## Foundation (issue 2)"
   echo
   echo "\`volfx-bench ecs\` (1,000,000 particle entities, 15 repetitions, median) and \`volfx-bench frame\`"
-  echo "(default scene, 640x360, 20 frames, first 5 dropped):"
+  echo "(default scene, 640x360, 20 frames, first 5 dropped); load average $load0 before, $load1 after"
+  echo "(above 0 means other processes shared the $(nproc) cores):"
   echo
   echo '```json'
   echo "$ecs"
