@@ -34,7 +34,7 @@ renderer=$(echo "$ecs" | /usr/bin/python3 -c 'import json,sys; print(json.load(s
   echo
   echo "\`volfx-bench ecs\` (1,000,000 particle entities, 15 repetitions, median) and \`volfx-bench frame\`"
   echo "(default scene, 640x360, 20 frames, first 5 dropped); load average $load0 before, $load1 after"
-  echo "(above 0 means other processes shared the $(nproc) cores):"
+  echo "(a load above about 1, the benchmark itself, means other processes shared the $(nproc) cores):"
   echo
   echo '```json'
   echo "$ecs"
