@@ -328,6 +328,17 @@ double vfx_median(double *v, uint32_t n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+vfx_frame_pcts vfx_frame_percentiles(double *v, uint32_t n)
+{
+    vfx_frame_pcts r = {NAN, NAN, NAN};
+    if (n == 0)
+        return r;
+    r.p50 = vfx_median(v, n); /* sorts */
+    r.p95 = pct(v, n, 0.95);
+    r.p99 = pct(v, n, 0.99);
+    return r;
+}
+
 vfx_result vfx_profiler_write_csv(const vfx_profiler *p, const char *path)
 {
     FILE *f = fopen(path, "w");

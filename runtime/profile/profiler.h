@@ -49,6 +49,12 @@ vfx_result vfx_profiler_write_csv(const vfx_profiler *p, const char *path);
 vfx_result vfx_profiler_write_trace(const vfx_profiler *p, const char *path);
 /* Median of v[0..n) (sorts v in place); NAN when n is 0. */
 double vfx_median(double *v, uint32_t n);
+/* Frame-time percentiles for benchmark JSON ("frame_ms":{"p50","p95","p99"}). */
+typedef struct vfx_frame_pcts {
+    double p50, p95, p99;
+} vfx_frame_pcts;
+/* Median (as vfx_median) and nearest-rank p95/p99 of v[0..n) (sorts v in place); NAN when n is 0. */
+vfx_frame_pcts vfx_frame_percentiles(double *v, uint32_t n);
 /* Monotonic clock in ms. */
 double vfx_now_ms(void);
 

@@ -182,11 +182,12 @@ int vfx_bench_beams(int argc, char **argv)
                 }
                 printf("{\"effect\":\"beams\",\"device\":\"cpu-float32-1-thread\",\"method\":\"%s\","
                        "\"samples\":%d,\"beams\":%u,\"width\":%u,\"height\":%u,\"reps\":%d,"
-                       "\"frame_ms\":{\"p50\":%.3f,\"min\":%.3f,\"max\":%.3f},"
+                       "\"frame_ms\":{\"p50\":%.3f,\"p95\":%.3f,\"p99\":%.3f,\"min\":%.3f,\"max\":%.3f},"
                        "\"error_vs_f64_closed_form\":{\"max_rel\":%.3g,\"mean_rel\":%.3g,\"pixels\":%zu,"
                        "\"above_1e-5\":%zu,\"max_rel_where_cond_below_1e-5\":%.3g,\"max_err_over_1e-5_plus_cond\":%.3g}}\n",
                        n == 0 ? "closed_form" : "ray_march", n, s.count, s.width, s.height, reps,
-                       times[reps / 2], times[0], times[reps - 1], emax,
+                       times[reps / 2], times[(size_t)ceil(0.95 * reps) - 1], times[(size_t)ceil(0.99 * reps) - 1],
+                       times[0], times[reps - 1], emax,
                        counted ? esum / counted : 0.0, counted, above, emax_wc, ratio);
                 fflush(stdout);
             }

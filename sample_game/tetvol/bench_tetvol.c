@@ -140,6 +140,7 @@ static int write_pfm_pair(const char *prefix, const char *view, const char *suff
 
 typedef struct run_result {
     double wall_ms, cpu_ms, t_sc_ms, t_update_ms, rmse, max;
+    double wall_p95, wall_p99; /* nearest-rank over the timed runs ("frame_ms" in the JSON) */
     vfx_tet_counters c;
     vfx_tet_counters pw[64];
 } run_result;
@@ -192,6 +193,8 @@ static int run_cfg(const vfx_tet_mesh *m, const vfx_tet_camera *cam, const vfx_t
     qsort(cp, (size_t)reps, sizeof *cp, cmp_d);
     qsort(runs, (size_t)reps, sizeof *runs, cmp_run);
     *out = runs[reps / 2];
+    out->wall_p95 = runs[(int)ceil(0.95 * reps) - 1].wall_ms;
+    out->wall_p99 = runs[(int)ceil(0.99 * reps) - 1].wall_ms;
     out->t_sc_ms = sc[reps / 2];
     out->t_update_ms = up[reps / 2];
     out->cpu_ms = cp[reps / 2];
@@ -329,11 +332,11 @@ int vfx_bench_tetvol(int argc, char **argv)
         if (has(only, "image")) {
             printf(HEAD "\"test\":\"image\",\"width\":%d,\"height\":%d,\"eye\":[%.9g,%.9g,%.9g],"
                    "\"center\":[%.9g,%.9g,%.9g],\"up\":[%.9g,%.9g,%.9g],\"fovy_deg\":%.9g,\"near\":%.9g,\"far\":%.9g,"
-                   "\"wall_ms\":%.2f,\"cpu_ms\":%.2f,\"t_sc_ms\":%.2f,\"t_composite_ms\":%.2f,\"covered\":%.0f,\"mean_alpha_covered\":%.4f,"
+                   "\"wall_ms\":%.2f,\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"cpu_ms\":%.2f,\"t_sc_ms\":%.2f,\"t_composite_ms\":%.2f,\"covered\":%.0f,\"mean_alpha_covered\":%.4f,"
                    "\"pixels_alpha_ge_0.9\":%.0f,\"cells_scanned\":%llu,\"segments\":%llu}\n",
                    HARGS, w, h, vw->eye[0], vw->eye[1], vw->eye[2], vw->center[0], vw->center[1],
                    vw->center[2], vw->up[0], vw->up[1], vw->up[2], vw->fovy * 57.29577951308232, vw->nearp,
-                   vw->farp, base.wall_ms, base.cpu_ms, base.t_sc_ms, base.c.t_composite_ms, cov,
+                   vw->farp, base.wall_ms, base.wall_ms, base.wall_p95, base.wall_p99, base.cpu_ms, base.t_sc_ms, base.c.t_composite_ms, cov,
                    cov > 0 ? asum / cov : 0.0, opaque, (unsigned long long)base.c.cells_scanned,
                    (unsigned long long)base.c.segments_made);
             if (out_prefix && write_pfm_pair(out_prefix, vw->name, "", ref, w, h) != 0) {
@@ -343,9 +346,9 @@ int vfx_bench_tetvol(int argc, char **argv)
             /* the fast setting: every core, ERT 0.99 with sharing and load balancing */
             o.ert = 1; o.ert_threshold = 0.99f; o.workers = 2; o.share = o.dlb = 1;
             if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
-            printf(HEAD "\"test\":\"image_fast\",\"workers\":2,\"threshold\":0.99,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,"
+            printf(HEAD "\"test\":\"image_fast\",\"workers\":2,\"threshold\":0.99,\"wall_ms\":%.2f,\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"cpu_ms\":%.2f,"
                    "\"N_skipped\":%llu,\"rmse_vs_no_ert\":%.3g,\"max_vs_no_ert\":%.3g}\n",
-                   HARGS, res->wall_ms, res->cpu_ms, (unsigned long long)res->c.cells_skipped_ert, res->rmse, res->max);
+                   HARGS, res->wall_ms, res->wall_ms, res->wall_p95, res->wall_p99, res->cpu_ms, (unsigned long long)res->c.cells_skipped_ert, res->rmse, res->max);
             if (out_prefix && write_pfm_pair(out_prefix, vw->name, "_fast", img, w, h) != 0) {
                 rc = 1;
                 break;
@@ -358,10 +361,10 @@ int vfx_bench_tetvol(int argc, char **argv)
                 o.ert = e; o.ert_threshold = 0.9f;
                 if (e && (rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
                 const run_result *r = e ? res : &base;
-                printf(HEAD "\"test\":\"table1\",\"ert\":%d,\"threshold\":0.9,\"D\":%d,\"C\":%d,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,"
+                printf(HEAD "\"test\":\"table1\",\"ert\":%d,\"threshold\":0.9,\"D\":%d,\"C\":%d,\"wall_ms\":%.2f,\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"cpu_ms\":%.2f,"
                        "\"t_sc_ms\":%.2f,\"t_update_ms\":%.2f,\"t_composite_ms\":%.2f,\"N_skipped\":%llu,"
                        "\"cells_scanned\":%llu,\"segments\":%llu,\"merged\":%llu,\"updates\":%llu,\"rmse\":%.3g,\"max\":%.3g}\n",
-                       HARGS, e, o.tiles_d, o.update_c, r->wall_ms, r->cpu_ms, r->t_sc_ms, r->t_update_ms,
+                       HARGS, e, o.tiles_d, o.update_c, r->wall_ms, r->wall_ms, r->wall_p95, r->wall_p99, r->cpu_ms, r->t_sc_ms, r->t_update_ms,
                        r->c.t_composite_ms, (unsigned long long)r->c.cells_skipped_ert,
                        (unsigned long long)r->c.cells_scanned, (unsigned long long)r->c.segments_made,
                        (unsigned long long)r->c.segments_merged, (unsigned long long)r->c.table_updates,
@@ -374,9 +377,9 @@ int vfx_bench_tetvol(int argc, char **argv)
             for (int i = 0; i < 4 && rc == 0; i++) {
                 o.ert = 1; o.ert_threshold = thr[i];
                 if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
-                printf(HEAD "\"test\":\"ert_threshold\",\"threshold\":%.2f,\"D\":%d,\"C\":%d,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,"
+                printf(HEAD "\"test\":\"ert_threshold\",\"threshold\":%.2f,\"D\":%d,\"C\":%d,\"wall_ms\":%.2f,\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"cpu_ms\":%.2f,"
                        "\"t_sc_ms\":%.2f,\"t_update_ms\":%.2f,\"no_ert_wall_ms\":%.2f,\"no_ert_cpu_ms\":%.2f,\"N_skipped\":%llu,\"rmse\":%.3g,\"max\":%.3g}\n",
-                       HARGS, thr[i], o.tiles_d, o.update_c, res->wall_ms, res->cpu_ms, res->t_sc_ms,
+                       HARGS, thr[i], o.tiles_d, o.update_c, res->wall_ms, res->wall_ms, res->wall_p95, res->wall_p99, res->cpu_ms, res->t_sc_ms,
                        res->t_update_ms, base.wall_ms, base.cpu_ms, (unsigned long long)res->c.cells_skipped_ert,
                        res->rmse, res->max);
             }
@@ -387,9 +390,9 @@ int vfx_bench_tetvol(int argc, char **argv)
             for (int i = 0; i < 6 && rc == 0; i++) {
                 o.tiles_d = Ds[i];
                 if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
-                printf(HEAD "\"test\":\"D_sweep\",\"D\":%d,\"C\":%d,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,\"t_sc_ms\":%.2f,"
+                printf(HEAD "\"test\":\"D_sweep\",\"D\":%d,\"C\":%d,\"wall_ms\":%.2f,\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"cpu_ms\":%.2f,\"t_sc_ms\":%.2f,"
                        "\"t_update_ms\":%.2f,\"updates\":%llu,\"N_skipped\":%llu,\"rmse\":%.3g}\n",
-                       HARGS, o.tiles_d, o.update_c, res->wall_ms, res->cpu_ms, res->t_sc_ms, res->t_update_ms,
+                       HARGS, o.tiles_d, o.update_c, res->wall_ms, res->wall_ms, res->wall_p95, res->wall_p99, res->cpu_ms, res->t_sc_ms, res->t_update_ms,
                        (unsigned long long)res->c.table_updates,
                        (unsigned long long)res->c.cells_skipped_ert, res->rmse);
             }
@@ -405,9 +408,9 @@ int vfx_bench_tetvol(int argc, char **argv)
                     o.update_c = Cs[i]; o.partial_composite = pc;
                     int rp = pc ? reps : 1;
                     if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, rp, runs, res)) != 0) break;
-                    printf(HEAD "\"test\":\"C_sweep\",\"partial\":%d,\"D\":%d,\"C\":%d,\"reps\":%d,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,"
+                    printf(HEAD "\"test\":\"C_sweep\",\"partial\":%d,\"D\":%d,\"C\":%d,\"reps\":%d,\"wall_ms\":%.2f,\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"cpu_ms\":%.2f,"
                            "\"t_sc_ms\":%.2f,\"t_update_ms\":%.2f,\"updates\":%llu,\"N_skipped\":%llu,\"segments_in_lists\":%llu}\n",
-                           HARGS, pc, o.tiles_d, o.update_c, rp, res->wall_ms, res->cpu_ms, res->t_sc_ms,
+                           HARGS, pc, o.tiles_d, o.update_c, rp, res->wall_ms, res->wall_ms, res->wall_p95, res->wall_p99, res->cpu_ms, res->t_sc_ms,
                            res->t_update_ms, (unsigned long long)res->c.table_updates,
                            (unsigned long long)res->c.cells_skipped_ert,
                            (unsigned long long)(res->c.segments_made - res->c.segments_merged));
@@ -424,8 +427,8 @@ int vfx_bench_tetvol(int argc, char **argv)
                     o.workers = nw; o.ert = cfg[i][0]; o.share = cfg[i][1]; o.dlb = cfg[i][2];
                     if ((rc = run_cfg(&m, &cam, &tf, &o, img, ref, reps, runs, res)) != 0) break;
                     double sum = 0, tmax = 0, csum = 0, cmax = 0, csum_cpu = 0, cmax_cpu = 0;
-                    printf(HEAD "\"test\":\"table2\",\"config\":\"%s\",\"workers\":%d,\"wall_ms\":%.2f,\"cpu_ms\":%.2f,\"rmse\":%.3g,\"max\":%.3g,\"per_worker\":[",
-                           HARGS, names[i], nw, res->wall_ms, res->cpu_ms, res->rmse, res->max);
+                    printf(HEAD "\"test\":\"table2\",\"config\":\"%s\",\"workers\":%d,\"wall_ms\":%.2f,\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"cpu_ms\":%.2f,\"rmse\":%.3g,\"max\":%.3g,\"per_worker\":[",
+                           HARGS, names[i], nw, res->wall_ms, res->wall_ms, res->wall_p95, res->wall_p99, res->cpu_ms, res->rmse, res->max);
                     for (int k = 0; k < nw; k++) {
                         const vfx_tet_counters *p = &res->pw[k];
                         double t = p->t_sc_ms + p->t_update_ms;

@@ -105,12 +105,13 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
         glFinish();
         ms[f] = now_ms() - t0;
     }
-    double p50 = vfx_median(ms, frames);
+    vfx_frame_pcts fp = vfx_frame_percentiles(ms, frames);
+    double p50 = fp.p50;
     printf("{\"effect\":\"metaballs\",\"method\":\"%s\",\"disable\":%u,\"max_samples\":%u,\"step_h\":%.4g,"
            "\"refine\":%u,\"pyramid\":%u,\"particles\":%u,\"width\":%u,\"height\":%u,"
-           "\"frames\":%u,\"warmup\":%d,\"frame_ms\":{\"p50\":%.2f},\"fps\":%.3g,\"gl_renderer\":\"%s\"",
+           "\"frames\":%u,\"warmup\":%d,\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"fps\":%.3g,\"gl_renderer\":\"%s\"",
            method_name(s.method), s.disable, s.max_samples ? s.max_samples : 64, s.step_h > 0 ? s.step_h : 0.125,
-           s.refine ? s.refine : 3, s.pyramid ? s.pyramid : 3, n, size, size, frames, !s.no_warmup, p50, 1000.0 / p50,
+           s.refine ? s.refine : 3, s.pyramid ? s.pyramid : 3, n, size, size, frames, !s.no_warmup, p50, fp.p95, fp.p99, 1000.0 / p50,
            (const char *)glGetString(GL_RENDERER));
     vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
     if (api.get_stats(ctx, &st) == VFX_OK) {
