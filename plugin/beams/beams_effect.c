@@ -319,15 +319,7 @@ static vfx_result beams_read_raw(vfx_context *ctx, void *state, float *out, size
     size_t n = (size_t)s->width * s->height;
     if (count < n)
         return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams read_raw: %zu floats < %zu", count, n);
-    float *rgba = vfx_alloc(ctx, n * 4 * sizeof(float));
-    if (!rgba)
-        return VFX_ERR_OUT_OF_MEMORY;
-    glGetTextureImage(s->acc_tex, 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * 4 * sizeof(float)), rgba);
-    for (uint32_t y = 0; y < s->height; ++y) /* GL rows are bottom-up; raw dumps are top row first */
-        for (uint32_t x = 0; x < s->width; ++x)
-            out[(size_t)y * s->width + x] = rgba[4 * ((size_t)(s->height - 1 - y) * s->width + x)];
-    vfx_free(ctx, rgba);
-    return VFX_OK;
+    return vfx_gpu_read_top_first(ctx, s->acc_tex, GL_RGBA, 4, 0, s->width, s->height, out);
 }
 
 const vfx_effect_ops vfx_beams_ops = {

@@ -259,3 +259,24 @@ void vfx_gpu_fullscreen(vfx_context *ctx)
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
 }
+
+vfx_result vfx_gpu_read_top_first(vfx_context *ctx, GLuint tex, GLenum format, uint32_t comps,
+                                  int channel, uint32_t w, uint32_t h, float *out)
+{
+    size_t n = (size_t)w * h * comps;
+    float *tmp = vfx_alloc(ctx, n * sizeof *tmp);
+    if (!tmp)
+        return VFX_ERR_OUT_OF_MEMORY;
+    glGetTextureImage(tex, 0, format, GL_FLOAT, (GLsizei)(n * sizeof *tmp), tmp);
+    size_t row = (size_t)w * comps;
+    for (uint32_t j = 0; j < h; ++j) {
+        const float *src = tmp + (size_t)(h - 1 - j) * row;
+        if (channel < 0)
+            memcpy(out + j * row, src, row * sizeof *out);
+        else
+            for (uint32_t i = 0; i < w; ++i)
+                out[(size_t)j * w + i] = src[(size_t)i * comps + (uint32_t)channel];
+    }
+    vfx_free(ctx, tmp);
+    return VFX_OK;
+}

@@ -30,6 +30,11 @@ void vfx_gpu_frame_end(vfx_context *ctx);
 
 /* Draws one fullscreen triangle (bind a program using common/fullscreen.vert first). */
 void vfx_gpu_fullscreen(vfx_context *ctx);
+/* Reads a w x h float texture of comps components (format GL_RED/GL_RGBA...) into out with the
+ * top row first (GL's rows are bottom first): every component (w*h*comps floats) when channel < 0,
+ * else that one component (w*h floats). VFX_ERR_OUT_OF_MEMORY when the staging copy fails. */
+vfx_result vfx_gpu_read_top_first(vfx_context *ctx, GLuint tex, GLenum format, uint32_t comps,
+                                  int channel, uint32_t w, uint32_t h, float *out);
 /* Labels a GL object for debuggers (no-op without KHR_debug). */
 void vfx_gpu_label(GLenum kind, GLuint object, const char *label);
 /* Returns a GL error as a string, or NULL when glGetError() is GL_NO_ERROR. */

@@ -861,15 +861,7 @@ vfx_result vfx_water_debug_gradient(vfx_context *ctx, float *out, size_t count)
     size_t n = (size_t)s->width * s->height * 4;
     if (!out || count < n)
         return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water debug gradient: %zu floats, need %zu", count, n);
-    float *tmp = vfx_alloc(ctx, n * sizeof *tmp);
-    if (!tmp)
-        return VFX_ERR_OUT_OF_MEMORY;
-    glGetTextureImage(s->grad, 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * sizeof *tmp), tmp);
-    size_t row = (size_t)s->width * 4;
-    for (uint32_t j = 0; j < s->height; ++j)
-        memcpy(out + j * row, tmp + (size_t)(s->height - 1 - j) * row, row * sizeof *out);
-    vfx_free(ctx, tmp);
-    return VFX_OK;
+    return vfx_gpu_read_top_first(ctx, s->grad, GL_RGBA, 4, -1, s->width, s->height, out);
 }
 
 vfx_result vfx_water_debug_pixel_class(vfx_context *ctx, uint8_t *out, size_t count)
@@ -880,15 +872,14 @@ vfx_result vfx_water_debug_pixel_class(vfx_context *ctx, uint8_t *out, size_t co
     size_t n = (size_t)s->width * s->height;
     if (!out || count < n)
         return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water debug pixel class: %zu bytes, need %zu", count, n);
-    float *tmp = vfx_alloc(ctx, n * 4 * sizeof *tmp);
-    if (!tmp)
+    float *cls = vfx_alloc(ctx, n * sizeof *cls);
+    if (!cls)
         return VFX_ERR_OUT_OF_MEMORY;
-    glGetTextureImage(s->st, 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * 4 * sizeof *tmp), tmp);
-    for (uint32_t j = 0; j < s->height; ++j)
-        for (uint32_t i = 0; i < s->width; ++i)
-            out[(size_t)j * s->width + i] = (uint8_t)tmp[4 * ((size_t)(s->height - 1 - j) * s->width + i)];
-    vfx_free(ctx, tmp);
-    return VFX_OK;
+    vfx_result r = vfx_gpu_read_top_first(ctx, s->st, GL_RGBA, 4, 0, s->width, s->height, cls);
+    for (size_t p = 0; r == VFX_OK && p < n; ++p)
+        out[p] = (uint8_t)cls[p];
+    vfx_free(ctx, cls);
+    return r;
 }
 
 static vfx_result water_read_raw(vfx_context *ctx, void *state, float *out, size_t count)
@@ -897,15 +888,7 @@ static vfx_result water_read_raw(vfx_context *ctx, void *state, float *out, size
     size_t n = (size_t)s->width * s->height;
     if (count < n || !ctx->water_dist_tex)
         return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water read_raw: %zu floats, need %zu", count, n);
-    float *tmp = vfx_alloc(ctx, n * sizeof *tmp);
-    if (!tmp)
-        return VFX_ERR_OUT_OF_MEMORY;
-    glGetTextureImage(ctx->water_dist_tex, 0, GL_RED, GL_FLOAT, (GLsizei)(n * sizeof *tmp), tmp);
-    /* GL rows are bottom first; the API's are top first. */
-    for (uint32_t j = 0; j < s->height; ++j)
-        memcpy(out + (size_t)j * s->width, tmp + (size_t)(s->height - 1 - j) * s->width, s->width * sizeof *out);
-    vfx_free(ctx, tmp);
-    return VFX_OK;
+    return vfx_gpu_read_top_first(ctx, ctx->water_dist_tex, GL_RED, 1, -1, s->width, s->height, out);
 }
 
 const vfx_effect_ops vfx_water_ops = {
