@@ -52,6 +52,8 @@ struct vfx_sph {
     float mass, H, H2, h, inv_cell;
     float k_poly6, k_spiky;          /* W = k_poly6 (H^2-r^2)^3, |grad W| = k_spiky (H-r)^2 */
     float wall_scale;                /* lattice calibration of the wall density fraction */
+    float fric_scale;                /* lattice calibration of the wall-law shear (see create) */
+    bool friction;                   /* some face or collider is no-slip */
     float B, c0;
     double time;
     uint32_t n, cap, next_id, clamped_on_add;
@@ -127,6 +129,33 @@ double vfx_sph_wall_density_gradient(double d, double H)
     /* -d/dd of vfx_sph_wall_density_fraction = (pi k/4) (H^2-d^2)^4 = (315/256)(1-u^2)^4/H */
     double u = d / H, q = 1.0 - u * u;
     return 315.0 / 256.0 * q * q * q * q / H;
+}
+
+double vfx_sph_wall_friction_velocity(double ut, double y, double nu)
+{
+    if (!(ut > 0.0) || !(y > 0.0) || !(nu > 0.0) || !isfinite(ut) || !isfinite(y) || !isfinite(nu))
+        return 0.0;
+    /* smooth wall, kappa = 0.41, B = 5.2; the two laws meet at y+ = 11.06 */
+    const double kappa = 0.41, Bl = 5.2, yc = 11.06;
+    double us = sqrt(nu * ut / y); /* linear sublayer: u+ = y+ */
+    if (y * us / nu <= yc)
+        return us;
+    /* log law, F(u*) = u* (ln(y u* / nu)/kappa + B) - u_t: increasing and convex, and the
+     * sublayer value lies left of its root (there u+_log < y+), so Newton overshoots once to
+     * the right and then descends monotonically */
+    for (int it = 0; it < 40; ++it) {
+        double lg = log(y * us / nu) / kappa + Bl;
+        double F = us * lg - ut, dF = lg + 1.0 / kappa;
+        double next = us - F / dF;
+        if (!(next > 0.0))
+            next = 0.5 * us;
+        if (fabs(next - us) <= 1e-12 * us) {
+            us = next;
+            break;
+        }
+        us = next;
+    }
+    return us;
 }
 
 /* ---- thread pool --------------------------------------------------------------------------- */
@@ -229,15 +258,21 @@ static vfx_result fill_params(vfx_sph_desc *p, char *err, size_t err_len)
         p->threads = nc > 0 ? (uint32_t)nc : 1u;
     }
     p->density_change_limit = def(p->density_change_limit, 0.05f);
+    p->kinematic_viscosity = def(p->kinematic_viscosity, 1.0e-6f);
+    if (p->no_slip_faces & ~0x3fu) {
+        snprintf(err, err_len, "vfx_sph_create: desc.no_slip_faces 0x%x has bits beyond the six "
+                 "VFX_SPH_FACE_* faces", p->no_slip_faces);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
 
     const float *fields[] = {&p->spacing, &p->support_ratio, &p->rest_density, &p->sound_speed,
                              &p->stiffness, &p->gamma, &p->viscosity, &p->cfl, &p->velocity_limit,
-                             &p->density_change_limit, &p->gravity[0], &p->gravity[1], &p->gravity[2],
-                             &p->domain_min[0], &p->domain_min[1], &p->domain_min[2],
+                             &p->density_change_limit, &p->kinematic_viscosity,
+                             &p->gravity[0], &p->gravity[1], &p->gravity[2], &p->domain_min[0], &p->domain_min[1], &p->domain_min[2],
                              &p->domain_max[0], &p->domain_max[1], &p->domain_max[2]};
     static const char *names[] = {"spacing", "support_ratio", "rest_density", "sound_speed",
                                   "stiffness", "gamma", "viscosity", "cfl", "velocity_limit",
-                                  "density_change_limit", "gravity[0]", "gravity[1]", "gravity[2]",
+                                  "density_change_limit", "kinematic_viscosity", "gravity[0]", "gravity[1]", "gravity[2]",
                                   "domain_min[0]", "domain_min[1]", "domain_min[2]",
                                   "domain_max[0]", "domain_max[1]", "domain_max[2]"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
@@ -248,7 +283,8 @@ static vfx_result fill_params(vfx_sph_desc *p, char *err, size_t err_len)
     }
     if (p->spacing < 0.f || p->support_ratio < 1.f || p->rest_density < 0.f || p->gamma < 1.f ||
         p->viscosity < 0.f || p->cfl <= 0.f || p->cfl > 1.f || p->sound_speed < 0.f ||
-        p->stiffness < 0.f || p->velocity_limit < 0.f || p->density_change_limit < 0.f) {
+        p->stiffness < 0.f || p->velocity_limit < 0.f || p->density_change_limit < 0.f ||
+        p->kinematic_viscosity < 0.f) {
         snprintf(err, err_len, "vfx_sph_create: a parameter is out of range (spacing>0, "
                  "support_ratio>=1, rest_density>0, gamma>=1, 0<cfl<=1, others >= 0)");
         return VFX_ERR_INVALID_ARGUMENT;
@@ -330,6 +366,16 @@ vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, si
                     beyond += (double)s->k_poly6 * q * q * q;
             }
     s->wall_scale = (float)(beyond / sum / vfx_sph_wall_density_fraction(0.5 * p.spacing, s->H));
+    /* Wall-law friction: a wall shear stress tau = rho0 u*^2 is a force per wall area; it is
+     * spread over the particles within H of the wall with the weight of the wall-density
+     * gradient g(d), a = u*^2 g(d) fric_scale. On the lattice (layers at d = dx/2 + k dx, mass
+     * m per dx^2 of wall each) the summed force is tau exactly when
+     * fric_scale = rho0 dx^3 / (m sum_k dx g(d_k)). */
+    double gl = 0.0;
+    for (int k = 0; (k + 0.5) * p.spacing < s->H; ++k)
+        gl += p.spacing * vfx_sph_wall_density_gradient((k + 0.5) * p.spacing, s->H);
+    s->fric_scale = (float)(p.rest_density * pow(p.spacing, 3) / (s->mass * gl));
+    s->friction = p.no_slip_faces != 0;
     float height = 0.f, g = sqrtf(p.gravity[0] * p.gravity[0] + p.gravity[1] * p.gravity[1] +
                                   p.gravity[2] * p.gravity[2]);
     for (int a = 0; a < 3; ++a)
@@ -672,6 +718,7 @@ vfx_result vfx_sph_add_collider(vfx_sph *s, const vfx_sph_collider *c, uint32_t 
         k.motion_amplitude = 0.f;
     sph_collider_state *st = &s->col[s->ncol];
     st->c = k;
+    s->friction |= k.no_slip != 0;
     memcpy(st->pos, k.center, sizeof st->pos);
     memset(st->vel, 0, sizeof st->vel);
     if (index)
@@ -876,6 +923,7 @@ vfx_result vfx_sph_add_mesh_collider(vfx_sph *s, const float *positions, uint32_
                 st.sdf[i + (size_t)st.sdf_n[0] * (j + (size_t)st.sdf_n[1] * k)] = (float)(inside ? -dmin : dmin);
             }
     memcpy(st.pos, st.c.center, sizeof st.pos);
+    s->friction |= st.c.no_slip != 0;
     s->col[s->ncol] = st;
     if (index)
         *index = s->ncol;
@@ -1089,7 +1137,7 @@ static inline void neighbor_ranges(const vfx_sph *s, float px, float py, float p
 /* Walls of the domain box and every collider: density fraction and force integral. */
 typedef struct sph_wall_hit {
     float n[3], d, vel[3];
-    bool is_box;
+    bool is_box, no_slip;
 } sph_wall_hit;
 
 static int gather_walls(const vfx_sph *s, float px, float py, float pz, sph_wall_hit *w, int max)
@@ -1100,12 +1148,12 @@ static int gather_walls(const vfx_sph *s, float px, float py, float pz, sph_wall
     for (int a = 0; a < 3; ++a) {
         float d0 = pp[a] - lo[a], d1 = hi[a] - pp[a];
         if (d0 < s->H && k < max) {
-            w[k] = (sph_wall_hit){{0}, d0, {0}, true};
+            w[k] = (sph_wall_hit){{0}, d0, {0}, true, (s->p.no_slip_faces >> (2 * a)) & 1u};
             w[k].n[a] = 1.f;
             k++;
         }
         if (d1 < s->H && k < max) {
-            w[k] = (sph_wall_hit){{0}, d1, {0}, true};
+            w[k] = (sph_wall_hit){{0}, d1, {0}, true, (s->p.no_slip_faces >> (2 * a + 1)) & 1u};
             w[k].n[a] = -1.f;
             k++;
         }
@@ -1114,7 +1162,8 @@ static int gather_walls(const vfx_sph *s, float px, float py, float pz, sph_wall
         float n[3];
         float d = collider_distance(&s->col[c], px, py, pz, n);
         if (d < s->H) {
-            w[k] = (sph_wall_hit){{n[0], n[1], n[2]}, d, {s->col[c].vel[0], s->col[c].vel[1], s->col[c].vel[2]}, false};
+            w[k] = (sph_wall_hit){{n[0], n[1], n[2]}, d, {s->col[c].vel[0], s->col[c].vel[1], s->col[c].vel[2]},
+                                  false, s->col[c].c.no_slip != 0};
             k++;
         }
     }
@@ -1372,6 +1421,26 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
          * (only inside a collider, which the clamp then pushes it out of) the factor is held */
         float gam = inside - extra, inv_gam = gam > 0.2f ? 1.f / gam : 5.f;
         ax *= inv_gam, ay *= inv_gam, az *= inv_gam;
+        /* No-slip walls: the shear stress of the smooth-wall law at the particle's own
+         * tangential speed and distance, spread over the wall's kernel layer (see create).
+         * Free-slip walls (the default) take no tangential force. The law, not a resolved
+         * boundary layer: at the spacings of a game the viscous layer is far thinner than dx. */
+        if (s->friction)
+            for (int w = 0; w < nw; ++w) {
+                if (!walls[w].no_slip)
+                    continue;
+                const float *wv = walls[w].vel, *wn = walls[w].n;
+                float rx = vxi - wv[0], ry = vyi - wv[1], rz = vzi - wv[2];
+                float vn = rx * wn[0] + ry * wn[1] + rz * wn[2];
+                float tx = rx - vn * wn[0], ty = ry - vn * wn[1], tz = rz - vn * wn[2];
+                float ut = sqrtf(tx * tx + ty * ty + tz * tz);
+                if (!(ut > 0.f))
+                    continue;
+                float y = walls[w].d > 0.25f * s->p.spacing ? walls[w].d : 0.25f * s->p.spacing;
+                float us = (float)vfx_sph_wall_friction_velocity(ut, y, s->p.kinematic_viscosity);
+                float am = us * us * s->fric_scale * (float)vfx_sph_wall_density_gradient(walls[w].d, H) / ut;
+                ax -= am * tx, ay -= am * ty, az -= am * tz;
+            }
         ax += g[0], ay += g[1], az += g[2];
         s->ax[i] = ax, s->ay[i] = ay, s->az[i] = az;
         s->drho[i] = dr; /* continuity: d rho_i/dt = sum_j m v_ij . grad_i W_ij */
@@ -1605,6 +1674,8 @@ vfx_result vfx_sph_step(vfx_sph *s, float frame_dt, vfx_sph_report *report)
             }
             double vmax = sqrt(v2), amax = sqrt(a2), cmax = sqrt(c2);
             double nu = s->p.viscosity * h * s->c0 / 10.0; /* artificial viscosity as nu, 3D */
+            if (s->friction && s->p.kinematic_viscosity > nu)
+                nu = s->p.kinematic_viscosity; /* keeps the explicit wall shear from overshooting */
             if (vmax > 0 && lam * h / vmax < dt)
                 dt = lam * h / vmax, lim = VFX_SPH_DT_CFL;
             if (cmax > 0 && lam * h / cmax < dt)

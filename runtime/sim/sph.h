@@ -29,6 +29,13 @@ enum {
     VFX_SPH_NO_VISCOSITY = 1u << 1, /* artificial viscosity alpha = 0 */
 };
 
+/* Faces of the domain box, for vfx_sph_desc.no_slip_faces. */
+enum {
+    VFX_SPH_FACE_X_MIN = 1u << 0, VFX_SPH_FACE_X_MAX = 1u << 1,
+    VFX_SPH_FACE_Y_MIN = 1u << 2, VFX_SPH_FACE_Y_MAX = 1u << 3, /* y min: the floor */
+    VFX_SPH_FACE_Z_MIN = 1u << 4, VFX_SPH_FACE_Z_MAX = 1u << 5,
+};
+
 /* Zero in any field means its default (listed). */
 typedef struct vfx_sph_desc {
     float spacing;              /* particle spacing dx [m]; 0.02 */
@@ -49,6 +56,11 @@ typedef struct vfx_sph_desc {
     uint32_t max_particles;     /* capacity bound (adds and emitters); 1<<27 */
     uint32_t threads;           /* worker threads; all online cores */
     uint32_t flags;             /* VFX_SPH_* */
+    /* Wall friction (smooth-wall law of the wall, see docs/simulation.md): box faces that are
+     * no-slip (VFX_SPH_FACE_* bits; 0 = every face free-slip) and the fluid's molecular
+     * kinematic viscosity that sets their shear stress [m^2/s]; 1.0e-6 (water at 20 C). */
+    uint32_t no_slip_faces;
+    float kinematic_viscosity;
 } vfx_sph_desc;
 
 typedef enum vfx_sph_dt_limit {
@@ -98,6 +110,7 @@ typedef struct vfx_sph_collider {
     float motion_axis[3];
     float motion_amplitude;   /* [m] */
     float motion_frequency;   /* [Hz] */
+    uint32_t no_slip;         /* nonzero: wall-law friction on its surface (default free-slip) */
 } vfx_sph_collider;
 
 typedef struct vfx_sph_emitter {
@@ -137,7 +150,8 @@ vfx_result vfx_sph_add_block(vfx_sph *sim, const float lo[3], const float hi[3],
 uint32_t vfx_sph_clamped_on_add(const vfx_sph *sim);
 /* Adds a static or moving collider; its index in *index when not NULL. */
 vfx_result vfx_sph_add_collider(vfx_sph *sim, const vfx_sph_collider *c, uint32_t *index);
-/* Adds a solid triangle mesh (closed, any winding; e.g. from vfx_mesh_import) as a collider:
+/* Adds a solid triangle mesh (closed, any winding; e.g. from vfx_mesh_import) as a collider
+ * (motion->no_slip makes it no-slip):
  * its signed distance is sampled once on a grid of ~H/2 (at most 64 nodes per axis, brute
  * force over <= 20,000 triangles, inside by generalised winding number) and interpolated.
  * motion (NULL = static) moves it rigidly: centre(t) - centre(0) is added to the mesh. */
@@ -173,5 +187,10 @@ uint32_t vfx_sph_thread_count(const vfx_sph *sim);
  * plane at distance d (0.5 at d = 0, 0 at d >= H), and minus its derivative in d [1/m]. */
 double vfx_sph_wall_density_fraction(double d, double H);
 double vfx_sph_wall_density_gradient(double d, double H);
+/* Friction velocity u* [m/s] of a smooth no-slip wall (wall shear stress tau = rho u*^2) for a
+ * tangential speed u_t at distance y with kinematic viscosity nu: the linear sublayer
+ * u_t/u* = y u* / nu below y+ = 11.06, the log law u_t/u* = ln(y u* / nu)/0.41 + 5.2 above.
+ * 0 when any argument is <= 0 or not finite. */
+double vfx_sph_wall_friction_velocity(double u_t, double y, double nu);
 
 #endif

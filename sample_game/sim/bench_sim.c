@@ -152,13 +152,14 @@ static double surge_front(vfx_sph *s, float dx)
     return 0.0;
 }
 
-static int dam_break(int res, uint32_t threads, double t_max, double settle_s, const char *cpu)
+static int dam_break(int res, uint32_t threads, double t_max, double settle_s, uint32_t no_slip,
+                     const char *cpu)
 {
     const double a = 0.05715, g = 9.81;
     float dx = (float)(a / res);
     vfx_sph_desc d = {.spacing = dx, .domain_min = {0, 0, 0},
                       .domain_max = {(float)(10 * a), (float)(2.5 * a), 4 * dx},
-                      .threads = threads, .max_substeps = 1000000};
+                      .threads = threads, .max_substeps = 1000000, .no_slip_faces = no_slip};
     vfx_sph *s;
     char err[256];
     if (vfx_sph_create(&d, &s, err, sizeof err)) {
@@ -217,13 +218,13 @@ static int dam_break(int res, uint32_t threads, double t_max, double settle_s, c
         double Z = front / a, e = (Z - mm_Z[k]) / mm_Z[k];
         worst = fabs(e) > worst ? fabs(e) : worst;
         used++;
-        printf("{\"effect\":\"sim\",\"case\":\"dam_break\",\"a_over_dx\":%d,\"settle_s\":%.2f,\"particles\":%u,\"T\":%.3f,"
+        printf("{\"effect\":\"sim\",\"case\":\"dam_break\",\"a_over_dx\":%d,\"settle_s\":%.2f,\"no_slip\":%u,\"particles\":%u,\"T\":%.3f,"
                "\"Z\":%.4f,\"Z_martin_moyce\":%.3f,\"error_pct\":%.2f,\"max_density_error\":%.4f}\n",
-               res, settle_s, n, mm_T[k], Z, mm_Z[k], 100.0 * e, r.max_density_error);
+               res, settle_s, no_slip, n, mm_T[k], Z, mm_Z[k], 100.0 * e, r.max_density_error);
     }
-    printf("{\"effect\":\"sim\",\"case\":\"dam_break_summary\",\"a_over_dx\":%d,\"settle_s\":%.2f,\"particles\":%u,"
+    printf("{\"effect\":\"sim\",\"case\":\"dam_break_summary\",\"a_over_dx\":%d,\"settle_s\":%.2f,\"no_slip\":%u,\"particles\":%u,"
            "\"points\":%d,\"max_abs_error_pct\":%.2f,\"substeps\":%llu,\"wall_s\":%.2f,\"cpu\":\"%s\"}\n",
-           res, settle_s, n, used, 100.0 * worst, (unsigned long long)substeps, now_s() - t0, cpu);
+           res, settle_s, no_slip, n, used, 100.0 * worst, (unsigned long long)substeps, now_s() - t0, cpu);
     vfx_sph_destroy(s);
     return rc;
 }
@@ -250,6 +251,7 @@ int vfx_bench_sim(int argc, char **argv)
     int nsizes = 3, nthreads = 2, substeps = 20, reps = 5, res = 20;
     bool dam = false;
     double t_max = 6.0, settle_s = 0.0;
+    uint32_t no_slip = 0;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--sizes") && i + 1 < argc) {
             if ((nsizes = parse_list(argv[++i], sizes, 8)) <= 0) {
@@ -273,10 +275,14 @@ int vfx_bench_sim(int argc, char **argv)
             t_max = atof(argv[++i]);
         } else if (!strcmp(argv[i], "--settle") && i + 1 < argc) {
             settle_s = atof(argv[++i]);
+        } else if (!strcmp(argv[i], "--no-slip")) {
+            /* the experiment's solid walls: the floor and the back wall behind the column */
+            no_slip = VFX_SPH_FACE_Y_MIN | VFX_SPH_FACE_X_MIN;
         } else if (!strcmp(argv[i], "--help")) {
             puts("volfx-bench sim [--sizes 4096,16384,65536] [--threads 1,2] [--substeps 20] [--reps 5]\n"
                  "volfx-bench sim --dam-break [--res 20 (a/dx)] [--t-max 6 (last T)] [--threads 2]\n"
-                 "                            [--settle 0 (s at rest behind a gate first; 0 = release a fresh lattice)]");
+                 "                            [--settle 0 (s at rest behind a gate first; 0 = release a fresh lattice)]\n"
+                 "                            [--no-slip (wall-law friction on the floor and back wall)]");
             return 0;
         } else if (strcmp(argv[i], "--json") != 0) {
             fprintf(stderr, "volfx-bench sim: unknown option '%s'\n", argv[i]);
@@ -291,7 +297,7 @@ int vfx_bench_sim(int argc, char **argv)
     char cpu[256];
     cpu_model(cpu, sizeof cpu);
     if (dam)
-        return dam_break(res, threads[nthreads - 1], t_max, settle_s, cpu);
+        return dam_break(res, threads[nthreads - 1], t_max, settle_s, no_slip, cpu);
     for (int k = 0; k < nsizes; ++k)
         if (bench_size(sizes[k], threads, nthreads, substeps, reps, cpu))
             return 1;
