@@ -67,6 +67,8 @@ static vfx_result load_water(vfx_app *app, vfx_demo *demo, const vfx_scene *sc)
         memcpy(sd.gravity, w->gravity, sizeof sd.gravity);
         if (w->gravity[0] == 0 && w->gravity[1] == 0 && w->gravity[2] == 0)
             sd.flags |= VFX_SPH_NO_GRAVITY;
+        if (w->no_slip)
+            sd.no_slip_faces = 0x3fu; /* every tank face */
         if ((r = vfx_sim_system_create(app->world, &sd, &demo->sim, err, sizeof err))) {
             vfx_logf(&app->log, VFX_LOG_ERROR, "scene water simulation: %s", err);
             goto done;

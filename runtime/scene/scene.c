@@ -715,7 +715,7 @@ static vfx_result parse_water(pctx *c, const cJSON *v, vfx_scene_water *w)
         if (r)
             return r;
     } else {
-        static const char *const skeys[] = {"tank", "fluid", "particle_count", "gravity", "dt", "paddle", NULL};
+        static const char *const skeys[] = {"tank", "fluid", "particle_count", "gravity", "dt", "paddle", "no_slip", NULL};
         const char *PS = "water.simulation";
         const cJSON *s = cJSON_GetObjectItemCaseSensitive(v, "simulation");
         if (!s)
@@ -731,6 +731,7 @@ static vfx_result parse_water(pctx *c, const cJSON *v, vfx_scene_water *w)
         if (!r) r = get_uint(c, s, PS, "particle_count", true, 0, VFX_SCENE_MAX_PARTICLES, &w->count);
         if (!r) r = get_vec(c, s, PS, "gravity", 3, false, (range){-1000, 1000, false}, w->gravity);
         if (!r) r = get_float(c, s, PS, "dt", false, (range){0, 0.1, true}, &w->dt);
+        if (!r) r = get_bool(c, s, PS, "no_slip", &w->no_slip);
         if (r)
             return r;
         const cJSON *pd = cJSON_GetObjectItemCaseSensitive(s, "paddle");

@@ -97,6 +97,7 @@ typedef struct vfx_scene_water {
     uint32_t paddle_axis;            /* 0 x, 1 y, 2 z: the axis the paddle moves along */
     float paddle_amplitude;          /* metres */
     float paddle_period_s;
+    bool no_slip;                    /* tank walls (all six faces) with wall-law friction */
     /* rendering (seed 000), a full vfx_water_params with size/version filled */
     vfx_water_params params;
 } vfx_scene_water;
