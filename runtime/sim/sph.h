@@ -7,7 +7,8 @@
  * moving paddles) are semi-analytic: the density of the missing fluid beyond a wall is
  * integrated in closed form over the half-space; it acts as a mirror image (pressure and
  * artificial viscosity) and the particle's force sum is divided by the kernel fraction inside
- * the fluid (Ferrand et al. 2013); plus a hard non-penetration clamp.
+ * the fluid (Ferrand et al. 2013); plus a hard non-penetration clamp. Walls are free-slip unless
+ * marked no-slip, which adds the shear stress of a smooth wall's law of the wall.
  * Time step: min of CFL, acoustic, force and viscosity conditions, substeps per frame with a
  * cap; a substep whose result blows up (NaN/Inf, speed or density change beyond bounds) is
  * redone with half the dt, and fails with a message naming the particle if that keeps failing.
