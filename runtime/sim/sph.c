@@ -1448,6 +1448,7 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
     const float H = s->H, H2 = s->H2, ks = s->k_spiky, m = s->mass, h = s->h;
     const float alpha = s->p.viscosity, c0 = s->c0, rho0 = s->p.rest_density;
     const float eps2 = 1e-12f * H2;
+    const float hh = 0.01f * h * h, visc = 2.f * alpha * c0, mks = m * ks;
     const float *g = s->p.gravity;
     const float *X = s->x, *Y = s->y, *Z = s->z, *VX = s->vx, *VY = s->vy, *VZ = s->vz;
     const float *R = s->rho, *P = s->pr;
@@ -1462,33 +1463,51 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
         const uint32_t *L = s->cnb[chunk] + s->nb_start[i];
         const uint32_t nn = s->nb_count[i];
         {
+            /* Per pair, with d = x_i - x_j, r = |d|: grad_i W = -ks (H - r)^2 d / r, so the
+             * constant -ks and the mass leave the loop (applied to the sums after it) and the
+             * unit vector is never formed; v.u r = v.d in the viscosity term. Fewer live values
+             * per pair: the loop had spilled to the stack on every iteration. */
+            float sx = 0.f, sy = 0.f, sz = 0.f, sd = 0.f;
+            uint32_t coincident = 0;
             for (uint32_t k = 0; k < nn; ++k) {
                 uint32_t j = L[k];
                 float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
                 float r2 = dx * dx + dy * dy + dz * dz;
-                float rl, ux, uy, uz;
-                if (r2 > eps2) {
-                    rl = sqrtf(r2);
-                    float inv = 1.f / rl;
-                    ux = dx * inv, uy = dy * inv, uz = dz * inv;
-                } else {
-                    float u[3];
-                    coincident_dir(s->id[i], s->id[j], u);
-                    rl = 0.f, ux = u[0], uy = u[1], uz = u[2];
-                }
-                float hr = H - rl;
-                float gw = -ks * hr * hr; /* dW/dr of the spiky kernel, grad_i W = gw * u */
                 float dvx = vxi - VX[j], dvy = vyi - VY[j], dvz = vzi - VZ[j];
-                float vdotu = dvx * ux + dvy * uy + dvz * uz;
-                /* Monaghan (1992) artificial viscosity, mu = h v.r/(r^2 + 0.01 h^2), approaching
-                 * pairs only; branch-free (the sign is a coin flip for the predictor) */
-                float vneg = vdotu < 0.f ? vdotu : 0.f;
-                float mu = h * vneg * rl / ((r2 + 0.01f * h * h) * (rhoi + R[j]));
-                float coef = pri + P[j] - 2.f * alpha * c0 * mu;
-                float f = -m * coef * gw;
-                ax += f * ux, ay += f * uy, az += f * uz;
-                dr += m * vdotu * gw;
+                if (r2 > eps2) {
+                    float rl = sqrtf(r2);
+                    float hr = H - rl;
+                    float w = hr * hr / rl; /* |grad W| / (ks r) */
+                    float vdotd = dvx * dx + dvy * dy + dvz * dz;
+                    /* Monaghan (1992) artificial viscosity, mu = h v.r/(r^2 + 0.01 h^2),
+                     * approaching pairs only; branch-free (the sign is a coin flip) */
+                    float vneg = vdotd < 0.f ? vdotd : 0.f;
+                    float mu = h * vneg / ((r2 + hh) * (rhoi + R[j]));
+                    float coef = (pri + P[j] - visc * mu) * w;
+                    sx += coef * dx, sy += coef * dy, sz += coef * dz;
+                    sd += vdotd * w;
+                } else {
+                    coincident++;
+                }
             }
+            /* exactly coincident pairs (r = 0): the deterministic direction u, (H - r)^2 = H^2.
+             * In a loop of their own: a call inside the main loop made the compiler keep its
+             * array pointers on the stack */
+            for (uint32_t k = 0; coincident && k < nn; ++k) {
+                uint32_t j = L[k];
+                float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
+                if (!(dx * dx + dy * dy + dz * dz <= eps2))
+                    continue;
+                float u[3];
+                coincident_dir(s->id[i], s->id[j], u);
+                float coef = (pri + P[j]) * H * H;
+                sx += coef * u[0], sy += coef * u[1], sz += coef * u[2];
+                sd += ((vxi - VX[j]) * u[0] + (vyi - VY[j]) * u[1] + (vzi - VZ[j]) * u[2]) * H * H;
+                coincident--;
+            }
+            /* a_i = -sum m coef grad W = m ks sum coef w d; d rho_i/dt = sum m v.grad W */
+            ax = mks * sx, ay = mks * sy, az = mks * sz;
+            dr = -mks * sd;
         }
         /* Walls, after the unified semi-analytical walls of Ferrand et al. (2013): the fluid
          * beyond a wall is missing from the sums above, so
