@@ -10,6 +10,21 @@
 #include <string.h>
 #include <unistd.h>
 
+#if defined(__SSE2__) && (defined(__GNUC__) || defined(__clang__))
+#include <emmintrin.h>
+/* SSE2 (every x86-64): the density walk and the force pair loop take four pairs at a time;
+ * elsewhere the scalar loops below do the same sums */
+#define SPH_SSE 1
+static inline float sph_hsum(__m128 v)
+{
+    float l[4];
+    _mm_storeu_ps(l, v);
+    return (l[0] + l[1]) + (l[2] + l[3]);
+}
+#else
+#define SPH_SSE 0
+#endif
+
 #define SPH_CHUNK 1024u          /* particles per work item: fixed, so sums do not depend on threads */
 #define SPH_MAX_COLLIDERS 64u
 #define SPH_MAX_EMITTERS 16u
@@ -1384,8 +1399,30 @@ static void density_walk(vfx_sph *s, uint32_t chunk)
         }
         uint32_t *L = s->cnb[chunk] + used;
         float sum = self;
-        uint32_t nn = 0;
-        for (uint32_t k = 0; k < ns; ++k) {
+        uint32_t nn = 0, k = 0;
+#if SPH_SSE
+        {
+            const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), vpz = _mm_set1_ps(pz);
+            const __m128 vH2 = _mm_set1_ps(H2), zero = _mm_setzero_ps();
+            __m128 acc = zero;
+            for (; k + 4 <= ns; k += 4) {
+                uint32_t j0 = SL[k], j1 = SL[k + 1], j2 = SL[k + 2], j3 = SL[k + 3];
+                __m128 dx = vpx - _mm_setr_ps(X[j0], X[j1], X[j2], X[j3]);
+                __m128 dy = vpy - _mm_setr_ps(Y[j0], Y[j1], Y[j2], Y[j3]);
+                __m128 dz = vpz - _mm_setr_ps(Z[j0], Z[j1], Z[j2], Z[j3]);
+                __m128 r2 = dx * dx + dy * dy + dz * dz;
+                __m128 t = _mm_max_ps(vH2 - r2, zero);
+                acc += t * t * t;
+                int in = _mm_movemask_ps(_mm_cmplt_ps(r2, vH2));
+                L[nn] = j0, nn += (uint32_t)in & 1u;
+                L[nn] = j1, nn += ((uint32_t)in >> 1) & 1u;
+                L[nn] = j2, nn += ((uint32_t)in >> 2) & 1u;
+                L[nn] = j3, nn += ((uint32_t)in >> 3) & 1u;
+            }
+            sum += sph_hsum(acc);
+        }
+#endif
+        for (; k < ns; ++k) {
             uint32_t j = SL[k];
             float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
             float r2 = dx * dx + dy * dy + dz * dz;
@@ -1468,8 +1505,40 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
              * unit vector is never formed; v.u r = v.d in the viscosity term. Fewer live values
              * per pair: the loop had spilled to the stack on every iteration. */
             float sx = 0.f, sy = 0.f, sz = 0.f, sd = 0.f;
-            uint32_t coincident = 0;
-            for (uint32_t k = 0; k < nn; ++k) {
+            uint32_t coincident = 0, k = 0;
+#if SPH_SSE
+            /* four pairs at a time: the same operations lane by lane (IEEE, so each pair's
+             * terms are the scalar ones), summed per lane and then across */
+            {
+                const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), vpz = _mm_set1_ps(pz);
+                const __m128 vvx = _mm_set1_ps(vxi), vvy = _mm_set1_ps(vyi), vvz = _mm_set1_ps(vzi);
+                const __m128 veps = _mm_set1_ps(eps2), vH = _mm_set1_ps(H), vh = _mm_set1_ps(h);
+                const __m128 vhh = _mm_set1_ps(hh), vrho = _mm_set1_ps(rhoi), vpri = _mm_set1_ps(pri);
+                const __m128 vvisc = _mm_set1_ps(visc), zero = _mm_setzero_ps();
+                __m128 ax4 = zero, ay4 = zero, az4 = zero, ad4 = zero;
+                for (; k + 4 <= nn; k += 4) {
+                    uint32_t j0 = L[k], j1 = L[k + 1], j2 = L[k + 2], j3 = L[k + 3];
+#define SPH_G4(A) _mm_setr_ps(A[j0], A[j1], A[j2], A[j3])
+                    __m128 dx = vpx - SPH_G4(X), dy = vpy - SPH_G4(Y), dz = vpz - SPH_G4(Z);
+                    __m128 dvx = vvx - SPH_G4(VX), dvy = vvy - SPH_G4(VY), dvz = vvz - SPH_G4(VZ);
+                    __m128 rj = SPH_G4(R), pj = SPH_G4(P);
+#undef SPH_G4
+                    __m128 r2 = dx * dx + dy * dy + dz * dz;
+                    __m128 valid = _mm_cmpgt_ps(r2, veps);
+                    coincident += (uint32_t)__builtin_popcount(~_mm_movemask_ps(valid) & 15);
+                    __m128 rl = _mm_sqrt_ps(r2), hr = vH - rl;
+                    __m128 w = _mm_and_ps(valid, hr * hr / rl); /* r = 0 lanes: 0, not inf */
+                    __m128 vdotd = dvx * dx + dvy * dy + dvz * dz;
+                    __m128 vneg = _mm_min_ps(vdotd, zero);
+                    __m128 mu = vh * vneg / ((r2 + vhh) * (vrho + rj));
+                    __m128 coef = (vpri + pj - vvisc * mu) * w;
+                    ax4 += coef * dx, ay4 += coef * dy, az4 += coef * dz;
+                    ad4 += vdotd * w;
+                }
+                sx = sph_hsum(ax4), sy = sph_hsum(ay4), sz = sph_hsum(az4), sd = sph_hsum(ad4);
+            }
+#endif
+            for (; k < nn; ++k) {
                 uint32_t j = L[k];
                 float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
                 float r2 = dx * dx + dy * dy + dz * dz;
