@@ -60,7 +60,8 @@ __attribute__((noinline)) vfx_result bench_timed_step(vfx_sph *s, vfx_sph_report
 typedef struct bench_opts {
     int substeps, reps;
     double warmup_s;  /* simulated seconds of the collapse before timing */
-    float skin;       /* desc.neighbor_skin (0 = the solver's default) */
+    float skin[4];    /* desc.neighbor_skin per Verlet solver set (0 = the solver's default) */
+    int nskin;
     bool rebuild, verlet;
 } bench_opts;
 
@@ -72,7 +73,7 @@ typedef struct bench_opts {
  * load other processes put on a shared machine falls on every configuration alike). Ratios
  * (threads, methods) are medians of the per-repetition ratios. */
 #define BENCH_MAX_T 8
-#define BENCH_MAX_S (2 * BENCH_MAX_T)
+#define BENCH_MAX_S (5 * BENCH_MAX_T)
 static int bench_size(uint32_t n_target, const uint32_t *threads, int nthreads, const bench_opts *o,
                       const char *cpu)
 {
@@ -85,7 +86,7 @@ static int bench_size(uint32_t n_target, const uint32_t *threads, int nthreads, 
     const float dx = 0.02f;
     float bx = (float)kx * dx, by = (float)ky * dx, bz = (float)kx * dx;
     vfx_sph_desc base = {.spacing = dx, .domain_min = {0, 0, 0}, .domain_max = {3.f * bx, 1.2f * by, bz},
-                         .neighbor_skin = o->skin};
+                         .neighbor_skin = o->skin[0]};
     char err[256];
     /* warm-up: the collapse, on all the threads asked for */
     vfx_sph *w = NULL;
@@ -111,21 +112,24 @@ static int bench_size(uint32_t n_target, const uint32_t *threads, int nthreads, 
     vfx_sph *s[BENCH_MAX_S] = {0};
     bool rebuild_of[BENCH_MAX_S];
     uint32_t thr_of[BENCH_MAX_S];
+    int set_of[BENCH_MAX_S], tidx_of[BENCH_MAX_S]; /* solver set (method, skin), thread index */
     double *ps[BENCH_MAX_S] = {0}, *is[BENCH_MAX_S] = {0}, *ms[BENCH_MAX_S] = {0};
     double *rt[BENCH_MAX_S] = {0}, *rm[BENCH_MAX_S] = {0};
     uint64_t sub_sum[BENCH_MAX_S] = {0}, reb_sum[BENCH_MAX_S] = {0}, skin_sum[BENCH_MAX_S] = {0};
     vfx_sph_report r[BENCH_MAX_S];
     int rc = 0;
-    for (int m = 0; m < 2 && !rc; ++m) {
-        if ((m == 0 && !o->rebuild) || (m == 1 && !o->verlet))
+    for (int m = 0; m < 1 + o->nskin && !rc; ++m) {
+        if ((m == 0 && !o->rebuild) || (m > 0 && !o->verlet))
             continue;
         for (int t = 0; t < nthreads && !rc; ++t) {
             vfx_sph_desc d = base;
             d.threads = threads[t];
             d.max_substeps = (uint32_t)substeps;
             d.flags = m == 0 ? VFX_SPH_REBUILD_EVERY_SUBSTEP : 0;
+            d.neighbor_skin = o->skin[m > 0 ? m - 1 : 0];
             int k = nsol++;
             rebuild_of[k] = m == 0;
+            set_of[k] = m, tidx_of[k] = t;
             if (vfx_sph_create(&d, &s[k], err, sizeof err)) {
                 fprintf(stderr, "volfx-bench sim: %s\n", err);
                 rc = 1;
@@ -169,9 +173,14 @@ static int bench_size(uint32_t n_target, const uint32_t *threads, int nthreads, 
             skin_sum[k] += r[k].skin_pairs;
         }
         for (int k = 0; k < nsol && !rc; ++k) {
-            int first = rebuild_of[k] ? 0 : (o->rebuild ? nthreads : 0); /* 1st thread count, same method */
+            int first = k, same = k; /* 1st thread count of the same set; rebuild, same threads */
+            for (int q = 0; q < nsol; ++q) {
+                if (set_of[q] == set_of[k] && tidx_of[q] == 0)
+                    first = q;
+                if (set_of[q] == 0 && tidx_of[q] == tidx_of[k])
+                    same = q;
+            }
             rt[k][i] = ps[k][i] / ps[first][i];
-            int same = o->rebuild && !rebuild_of[k] ? k - nthreads : k; /* rebuild, same threads */
             rm[k][i] = ps[k][i] / ps[same][i];
         }
     }
@@ -336,7 +345,7 @@ int vfx_bench_sim(int argc, char **argv)
     uint32_t sizes[8] = {4096, 16384, 65536}, threads[8] = {1, 2};
     int nsizes = 3, nthreads = 2, substeps = 20, reps = 5, res = 20;
     bool dam = false;
-    bench_opts bo = {.warmup_s = 0.2, .rebuild = true, .verlet = true};
+    bench_opts bo = {.warmup_s = 0.2, .nskin = 1, .rebuild = true, .verlet = true};
     double t_max = 6.0, settle_s = 0.0;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--sizes") && i + 1 < argc) {
@@ -356,7 +365,17 @@ int vfx_bench_sim(int argc, char **argv)
         } else if (!strcmp(argv[i], "--warmup-s") && i + 1 < argc) {
             bo.warmup_s = atof(argv[++i]);
         } else if (!strcmp(argv[i], "--skin") && i + 1 < argc) {
-            bo.skin = (float)atof(argv[++i]);
+            /* a comma list: one set of Verlet solvers per skin, all stepped in the same run */
+            char *v = argv[++i], *end;
+            bo.nskin = 0;
+            while (*v && bo.nskin < 4) {
+                bo.skin[bo.nskin++] = strtof(v, &end);
+                if (end == v || (*end && *end != ',')) {
+                    fprintf(stderr, "volfx-bench sim: --skin wants a comma list of fractions of H\n");
+                    return 2;
+                }
+                v = *end ? end + 1 : end;
+            }
         } else if (!strcmp(argv[i], "--methods") && i + 1 < argc) {
             const char *v = argv[++i];
             bo.rebuild = strstr(v, "rebuild") != NULL;
@@ -376,7 +395,8 @@ int vfx_bench_sim(int argc, char **argv)
         } else if (!strcmp(argv[i], "--help")) {
             puts("volfx-bench sim [--sizes 4096,16384,65536] [--threads 1,2] [--substeps 20] [--reps 5]\n"
                  "                [--warmup-s 0.2 (simulated s of the collapse before timing)]\n"
-                 "                [--methods rebuild,verlet] [--skin 0 (neighbor_skin / H; 0 = default)]\n"
+                 "                [--methods rebuild,verlet] [--skin 0 (neighbor_skin / H, up to 4 in a comma\n"
+                 "                list, one set of Verlet solvers each; 0 = default)]\n"
                  "volfx-bench sim --dam-break [--res 20 (a/dx)] [--t-max 6 (last T)] [--threads 2]\n"
                  "                            [--settle 0 (s at rest behind a gate first; 0 = release a fresh lattice)]");
             return 0;
@@ -387,7 +407,8 @@ int vfx_bench_sim(int argc, char **argv)
     }
     if (substeps < 1 || substeps > 100000 || reps < 1 || reps > 1000 || res < 4 || res > 200 ||
         !(settle_s >= 0.0 && settle_s <= 10.0) || !(bo.warmup_s >= 0.0 && bo.warmup_s <= 10.0) ||
-        !(bo.skin >= 0.f && bo.skin <= 1.f)) {
+        !(bo.skin[0] >= 0.f && bo.skin[0] <= 1.f && bo.skin[1] >= 0.f && bo.skin[1] <= 1.f &&
+          bo.skin[2] >= 0.f && bo.skin[2] <= 1.f && bo.skin[3] >= 0.f && bo.skin[3] <= 1.f)) {
         fprintf(stderr, "volfx-bench sim: need 1..100000 substeps, 1..1000 reps, 4..200 res, 0..10 s settle, "
                 "0..10 s warm-up, skin 0..1\n");
         return 2;
