@@ -55,7 +55,7 @@ typedef struct vfx_sph_desc {
     float density_change_limit; /* blow-up bound on |d rho|/rho per substep; 0.05 */
     uint32_t max_particles;     /* capacity bound (adds and emitters); 1<<27 */
     uint32_t threads;           /* worker threads; all online cores */
-    float neighbor_skin;        /* Verlet skin as a fraction of H, 0 < skin <= 1; 0.2 */
+    float neighbor_skin;        /* Verlet skin as a fraction of H, 0 < skin <= 1; 0.3 */
     uint32_t flags;             /* VFX_SPH_* */
 } vfx_sph_desc;
 
