@@ -1291,7 +1291,13 @@ density_tail(vfx_sph *s, uint32_t i, float sum, uint32_t nn, float px, float py,
     /* EOS on the clamped ratio: p >= 0 (no tensile attraction at the free surface) and
      * ratio <= 2 (p <= 127 B) so a collapsed input cannot produce an unbounded force. */
     float ratio = clampf(rho / rho0, 1.f, 2.f);
-    float rg1 = powf(ratio, gam - 1.f);
+    float rg1;
+    if (gam == 7.f) {
+        float q2 = ratio * ratio; /* the default exponent: ratio^6 without a powf call */
+        rg1 = q2 * q2 * q2;
+    } else {
+        rg1 = powf(ratio, gam - 1.f);
+    }
     float p = B * (rg1 * ratio - 1.f);
     s->pr[i] = p / (rho * rho);
     float c2 = c2_0 * rg1;
@@ -1529,10 +1535,15 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
                      * is a libgcc call without -mpopcnt (4% of all instructions) */
                     coincident += (0x4332322132212110ull >> (4 * (~_mm_movemask_ps(valid) & 15))) & 15u;
                     __m128 rl = _mm_sqrt_ps(r2), hr = vH - rl;
-                    __m128 w = _mm_and_ps(valid, hr * hr / rl); /* r = 0 lanes: 0, not inf */
+                    /* one division for w = (H - r)^2 / r and the viscosity's denominator (the
+                     * divider is as busy as everything else in this loop); r = 0 lanes get
+                     * inv = 0, so w = mu = 0 there, not inf or NaN */
+                    __m128 den = (r2 + vhh) * (vrho + rj);
+                    __m128 inv = _mm_and_ps(valid, _mm_set1_ps(1.f) / (rl * den));
+                    __m128 w = hr * hr * den * inv;
                     __m128 vdotd = dvx * dx + dvy * dy + dvz * dz;
                     __m128 vneg = _mm_min_ps(vdotd, zero);
-                    __m128 mu = vh * vneg / ((r2 + vhh) * (vrho + rj));
+                    __m128 mu = vh * vneg * rl * inv;
                     __m128 coef = (vpri + pj - vvisc * mu) * w;
                     ax4 += coef * dx, ay4 += coef * dy, az4 += coef * dz;
                     ad4 += vdotd * w;
