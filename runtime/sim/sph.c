@@ -1383,8 +1383,8 @@ static inline __attribute__((always_inline)) void density_scan(vfx_sph *s, uint3
 }
 
 /* Density by a walk of the Verlet lists (r < H test), writing the exact list for the force
- * pass. Branch-free: ~60% of a list is within H at a skin of 0.2 H, a coin flip for the
- * predictor (the cell scan's 27% hit rate is why its branch measured cheaper there). */
+ * pass. Branch-free: ~40% of a list is within H at the default skin of 0.3 H, a coin flip for
+ * the predictor (the cell scan's 27% hit rate is why its branch measured cheaper there). */
 static void density_walk(vfx_sph *s, uint32_t chunk)
 {
     uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
