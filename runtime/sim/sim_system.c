@@ -1,6 +1,7 @@
 /* sim_system.c — see sim_system.h. */
 #include "sim/sim_system.h"
 
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -85,11 +86,23 @@ static vfx_result sim_run(vfx_world *w, const vfx_system_ctx *ctx)
             memcpy(d[f], c[f], (size_t)it.rows * sizeof(float));
         k += it.rows;
     }
-    vfx_sph_clear(s->sph);
-    r = vfx_sph_add_particles(s->sph, k, s->x, s->y, s->z, s->vx, s->vy, s->vz);
-    if (r) {
-        snprintf(s->err, sizeof s->err, "vfx.sim.sph: %s", vfx_sph_last_error(s->sph));
-        return r;
+    /* Nothing changed since the last write-back (same count, every imported value the solver's
+     * own, by id): keep the solver's state, and with it its Verlet lists and grid order (a
+     * clear and add would force a rebuild every frame). Any edit, spawn or despawn re-imports. */
+    vfx_sph_columns c0 = vfx_sph_get_columns(s->sph);
+    bool same = k > 0 && c0.count == k;
+    for (uint32_t i = 0; same && i < c0.count; ++i) {
+        uint32_t id = c0.id[i];
+        same = id < k && s->x[id] == c0.x[i] && s->y[id] == c0.y[i] && s->z[id] == c0.z[i] &&
+               s->vx[id] == c0.vx[i] && s->vy[id] == c0.vy[i] && s->vz[id] == c0.vz[i];
+    }
+    if (!same) {
+        vfx_sph_clear(s->sph);
+        r = vfx_sph_add_particles(s->sph, k, s->x, s->y, s->z, s->vx, s->vy, s->vz);
+        if (r) {
+            snprintf(s->err, sizeof s->err, "vfx.sim.sph: %s", vfx_sph_last_error(s->sph));
+            return r;
+        }
     }
     r = vfx_sph_step(s->sph, ctx->dt, &s->report);
     if (r)

@@ -10,6 +10,21 @@
 #include <string.h>
 #include <unistd.h>
 
+#if defined(__SSE2__) && (defined(__GNUC__) || defined(__clang__))
+#include <emmintrin.h>
+/* SSE2 (every x86-64): the density walk and the force pair loop take four pairs at a time;
+ * elsewhere the scalar loops below do the same sums */
+#define SPH_SSE 1
+static inline float sph_hsum(__m128 v)
+{
+    float l[4];
+    _mm_storeu_ps(l, v);
+    return (l[0] + l[1]) + (l[2] + l[3]);
+}
+#else
+#define SPH_SSE 0
+#endif
+
 #define SPH_CHUNK 1024u          /* particles per work item: fixed, so sums do not depend on threads */
 #define SPH_MAX_COLLIDERS 64u
 #define SPH_MAX_EMITTERS 16u
@@ -22,7 +37,8 @@ typedef struct sph_chunk_out {
     float v2_max, a2_max, c2_max;
     float rho_err_max;
     double rho_err_sum, ke, pe, ie;
-    uint64_t pairs;
+    uint64_t pairs, skin_pairs;
+    float disp2_max;   /* max squared displacement since the last rebuild (integration pass) */
     uint32_t bad;      /* first failing row in the chunk, UINT32_MAX when none */
     int bad_kind;      /* 1 non-finite, 2 speed, 3 density change */
     float bad_value;
@@ -80,6 +96,17 @@ struct vfx_sph {
     uint32_t **cnb, *cnb_cap, *nb_start, *nb_count;
     uint32_t cnb_chunks;
     atomic_bool nb_oom;
+    /* Verlet lists: every pair within H + skin at the last rebuild, per chunk like cnb (rows
+     * are only re-sorted at a rebuild, so a row's chunk is stable between rebuilds), and the
+     * positions at that rebuild. Valid while 2 max|x - x0| < skin. */
+    bool verlet;                 /* false with VFX_SPH_REBUILD_EVERY_SUBSTEP */
+    bool lists_valid;
+    int dens_mode;               /* density pass: 0 cell scan, 1 cell scan recording the Verlet
+                                  * lists, 2 walk the Verlet lists */
+    float skin, S2;              /* skin [m], (H + skin)^2 */
+    float disp2_max;             /* of the last integration, over all particles */
+    float *x0, *y0, *z0;
+    uint32_t **snb, *snb_cap, *snb_used, *sk_start, *sk_count;
     /* thread pool */
     pthread_t *threads;
     uint32_t nthreads; /* workers besides the caller */
@@ -203,6 +230,7 @@ static void parallel(vfx_sph *s, sph_chunk_fn fn, bool fresh)
         } else {
             s->out[c].bad = UINT32_MAX;
             s->out[c].ke = s->out[c].pe = 0.0;
+            s->out[c].disp2_max = 0.f;
         }
     }
     s->job = fn;
@@ -264,17 +292,21 @@ static vfx_result fill_params(vfx_sph_desc *p, char *err, size_t err_len)
                  "VFX_SPH_FACE_* faces", p->no_slip_faces);
         return VFX_ERR_INVALID_ARGUMENT;
     }
+    p->neighbor_skin = def(p->neighbor_skin, 0.3f); /* measured: docs/simulation.md */
 
     const float *fields[] = {&p->spacing, &p->support_ratio, &p->rest_density, &p->sound_speed,
                              &p->stiffness, &p->gamma, &p->viscosity, &p->cfl, &p->velocity_limit,
                              &p->density_change_limit, &p->kinematic_viscosity,
-                             &p->gravity[0], &p->gravity[1], &p->gravity[2], &p->domain_min[0], &p->domain_min[1], &p->domain_min[2],
-                             &p->domain_max[0], &p->domain_max[1], &p->domain_max[2]};
+                             &p->gravity[0], &p->gravity[1], &p->gravity[2],
+                             &p->domain_min[0], &p->domain_min[1], &p->domain_min[2],
+                             &p->domain_max[0], &p->domain_max[1], &p->domain_max[2],
+                             &p->neighbor_skin};
     static const char *names[] = {"spacing", "support_ratio", "rest_density", "sound_speed",
                                   "stiffness", "gamma", "viscosity", "cfl", "velocity_limit",
                                   "density_change_limit", "kinematic_viscosity", "gravity[0]", "gravity[1]", "gravity[2]",
                                   "domain_min[0]", "domain_min[1]", "domain_min[2]",
-                                  "domain_max[0]", "domain_max[1]", "domain_max[2]"};
+                                  "domain_max[0]", "domain_max[1]", "domain_max[2]",
+                                  "neighbor_skin"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
         if (!isfinite(*fields[i])) {
             snprintf(err, err_len, "vfx_sph_create: desc.%s is not finite", names[i]);
@@ -287,6 +319,12 @@ static vfx_result fill_params(vfx_sph_desc *p, char *err, size_t err_len)
         p->kinematic_viscosity < 0.f) {
         snprintf(err, err_len, "vfx_sph_create: a parameter is out of range (spacing>0, "
                  "support_ratio>=1, rest_density>0, gamma>=1, 0<cfl<=1, others >= 0)");
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    if (!(p->neighbor_skin > 0.f && p->neighbor_skin <= 1.f)) {
+        /* <= 1: vfx_sph_volume_fraction's 7x7x7 stencil of H/2 cells reaches H + skin/2 */
+        snprintf(err, err_len, "vfx_sph_create: desc.neighbor_skin %g must be in (0, 1] (a "
+                 "fraction of H)", (double)p->neighbor_skin);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     for (int a = 0; a < 3; ++a) {
@@ -392,6 +430,9 @@ vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, si
     s->B = p.stiffness;
     s->c0 = p.sound_speed;
     s->p = p;
+    s->verlet = !(p.flags & VFX_SPH_REBUILD_EVERY_SUBSTEP);
+    s->skin = p.neighbor_skin * s->H;
+    s->S2 = (s->H + s->skin) * (s->H + s->skin);
     /* cells of H/2 and a 5x5x5 stencil: 42% fewer candidate pairs than H cells and 3x3x3 */
     s->inv_cell = 2.f / s->H;
     double dims[3];
@@ -439,17 +480,25 @@ vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, si
 static void free_columns(vfx_sph *s)
 {
     float **f[] = {&s->x, &s->y, &s->z, &s->vx, &s->vy, &s->vz, &s->rho, &s->pr, &s->ax, &s->ay,
-                   &s->az, &s->drho, &s->xn, &s->yn, &s->zn, &s->vxn, &s->vyn, &s->vzn, &s->tmp};
+                   &s->az, &s->drho, &s->xn, &s->yn, &s->zn, &s->vxn, &s->vyn, &s->vzn, &s->tmp,
+                   &s->x0, &s->y0, &s->z0};
     for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) {
         free(*f[i]);
         *f[i] = NULL;
     }
     free(s->id), free(s->idtmp), free(s->key), free(s->perm), free(s->nb_start), free(s->nb_count);
+    free(s->sk_start), free(s->sk_count);
     s->id = s->idtmp = s->key = s->perm = s->nb_start = s->nb_count = NULL;
-    for (uint32_t c = 0; c < s->cnb_chunks; ++c)
+    s->sk_start = s->sk_count = NULL;
+    for (uint32_t c = 0; c < s->cnb_chunks; ++c) {
         free(s->cnb[c]);
-    free(s->cnb), free(s->cnb_cap);
+        if (s->snb)
+            free(s->snb[c]);
+    }
+    free(s->cnb), free(s->cnb_cap), free(s->snb), free(s->snb_cap), free(s->snb_used);
     s->cnb = NULL, s->cnb_cap = NULL, s->cnb_chunks = 0;
+    s->snb = NULL, s->snb_cap = NULL, s->snb_used = NULL;
+    s->lists_valid = false;
 }
 
 void vfx_sph_destroy(vfx_sph *s)
@@ -488,8 +537,9 @@ size_t vfx_sph_memory_bytes(const vfx_sph *s)
         return 0;
     size_t lists = 0;
     for (uint32_t c = 0; c < s->cnb_chunks; ++c)
-        lists += (size_t)s->cnb_cap[c] * sizeof(uint32_t);
-    return sizeof *s + lists + (size_t)s->cap * (19 * sizeof(float) + 6 * sizeof(uint32_t)) +
+        lists += ((size_t)s->cnb_cap[c] + s->snb_cap[c]) * sizeof(uint32_t) + 3 * sizeof(uint32_t) +
+                 2 * sizeof(uint32_t *);
+    return sizeof *s + lists + (size_t)s->cap * (22 * sizeof(float) + 8 * sizeof(uint32_t)) +
            ((size_t)s->ncells + 1) * sizeof(uint32_t) + (size_t)s->out_cap * sizeof(sph_chunk_out);
 }
 
@@ -522,14 +572,16 @@ static vfx_result reserve(vfx_sph *s, uint64_t want)
     if (cap > s->p.max_particles)
         cap = s->p.max_particles;
     float **f[] = {&s->x, &s->y, &s->z, &s->vx, &s->vy, &s->vz, &s->rho, &s->pr, &s->ax, &s->ay,
-                   &s->az, &s->drho, &s->xn, &s->yn, &s->zn, &s->vxn, &s->vyn, &s->vzn, &s->tmp};
+                   &s->az, &s->drho, &s->xn, &s->yn, &s->zn, &s->vxn, &s->vyn, &s->vzn, &s->tmp,
+                   &s->x0, &s->y0, &s->z0};
     for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) {
         float *np = realloc(*f[i], (size_t)cap * sizeof(float));
         if (!np)
             goto oom;
         *f[i] = np;
     }
-    uint32_t **u[] = {&s->id, &s->idtmp, &s->key, &s->perm, &s->nb_start, &s->nb_count};
+    uint32_t **u[] = {&s->id, &s->idtmp, &s->key, &s->perm, &s->nb_start, &s->nb_count,
+                      &s->sk_start, &s->sk_count};
     for (size_t i = 0; i < sizeof u / sizeof u[0]; ++i) {
         uint32_t *np = realloc(*u[i], (size_t)cap * sizeof(uint32_t));
         if (!np)
@@ -551,8 +603,20 @@ static vfx_result reserve(vfx_sph *s, uint64_t want)
         if (!nc)
             goto oom;
         s->cnb_cap = nc;
+        uint32_t **sl = realloc(s->snb, (size_t)chunks * sizeof *sl);
+        if (!sl)
+            goto oom;
+        s->snb = sl;
+        uint32_t *sc = realloc(s->snb_cap, (size_t)chunks * sizeof *sc);
+        if (!sc)
+            goto oom;
+        s->snb_cap = sc;
+        uint32_t *su = realloc(s->snb_used, (size_t)chunks * sizeof *su);
+        if (!su)
+            goto oom;
+        s->snb_used = su;
         for (uint32_t c = s->cnb_chunks; c < chunks; ++c)
-            s->cnb[c] = NULL, s->cnb_cap[c] = 0;
+            s->cnb[c] = NULL, s->cnb_cap[c] = 0, s->snb[c] = NULL, s->snb_cap[c] = 0, s->snb_used[c] = 0;
         s->cnb_chunks = chunks;
     }
     s->cap = (uint32_t)cap;
@@ -611,6 +675,7 @@ vfx_result vfx_sph_add_particles(vfx_sph *s, uint32_t n, const float *x, const f
         s->id[k] = s->next_id++;
     }
     s->n += n;
+    s->lists_valid = false; /* new rows are in no list */
     return VFX_OK;
 }
 
@@ -620,6 +685,7 @@ void vfx_sph_clear(vfx_sph *s)
         return;
     s->n = 0;
     s->next_id = 0;
+    s->lists_valid = false;
 }
 
 vfx_result vfx_sph_add_block(vfx_sph *s, const float lo[3], const float hi[3], uint32_t *added)
@@ -666,6 +732,7 @@ vfx_result vfx_sph_add_block(vfx_sph *s, const float lo[3], const float hi[3], u
             s->clamped_on_add++;
         s->x[q] = px, s->y[q] = py, s->z[q] = pz;
     }
+    s->lists_valid = false;
     if (added)
         *added = (uint32_t)total;
     return VFX_OK;
@@ -1185,18 +1252,31 @@ float vfx_sph_volume_fraction(const vfx_sph *s, const float p[3])
 {
     if (!s || !p || !isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
         return NAN;
-    /* the grid of the last density pass matches the columns (vfx_sph_step ends with one) */
-    sph_ranges r;
-    neighbor_ranges(s, p[0], p[1], p[2], &r);
+    /* The grid is that of the last rebuild; with Verlet lists the particles have moved less
+     * than skin/2 <= H/2 since, so every particle now within H of p was within 1.5 H = 3 cells
+     * of H/2 then: a 7x7x7 stencil over the rows as sorted, distances from the current
+     * positions. The 5x5x5 stencil when the grid is rebuilt every substep (it is current). */
+    const int R = s->verlet ? 3 : 2;
+    const float *glo = s->p.domain_min;
+    int cx = cell_coord(p[0], glo[0], s->inv_cell, s->nx);
+    int cy = cell_coord(p[1], glo[1], s->inv_cell, s->ny);
+    int cz = cell_coord(p[2], glo[2], s->inv_cell, s->nz);
+    int x0 = cx >= R ? cx - R : 0, x1 = cx + R < s->nx ? cx + R : s->nx - 1;
     double sum = 0.0;
-    for (int q = 0; q < r.count; ++q)
-        for (uint32_t j = r.lo[q]; j < r.hi[q] && j < s->n; ++j) {
+    for (int zc = cz - R; zc <= cz + R; ++zc)
+        for (int yc = cy - R; yc <= cy + R; ++yc) {
+            if (zc < 0 || zc >= s->nz || yc < 0 || yc >= s->ny)
+                continue;
+            uint32_t row = (uint32_t)((zc * s->ny + yc) * s->nx);
+            uint32_t a = s->cell_start[row + (uint32_t)x0], b = s->cell_start[row + (uint32_t)x1 + 1];
+        for (uint32_t j = a; j < b && j < s->n; ++j) {
             float dx = p[0] - s->x[j], dy = p[1] - s->y[j], dz = p[2] - s->z[j];
             float r2 = dx * dx + dy * dy + dz * dz;
             if (r2 < s->H2) {
                 float t = s->H2 - r2;
                 sum += (double)t * t * t;
             }
+        }
         }
     sph_wall_hit walls[SPH_MAX_WALLS];
     int nw = gather_walls(s, p[0], p[1], p[2], walls, SPH_MAX_WALLS), nb = walls_box(walls, nw);
@@ -1216,18 +1296,94 @@ float vfx_sph_volume_fraction(const vfx_sph *s, const float p[3])
 
 /* ---- passes -------------------------------------------------------------------------------- */
 
-static void density_chunk(vfx_sph *s, uint32_t chunk)
+/* Grows a per-chunk list buffer to hold `want` entries; false (and nb_oom set) when it cannot. */
+static bool grow_list(vfx_sph *s, uint32_t **buf, uint32_t *cap, uint32_t want)
 {
-    uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
-    const float H2 = s->H2, kp = s->k_poly6, m = s->mass, rho0 = s->p.rest_density;
+    if (want <= *cap)
+        return true;
+    /* 1/8 slack rather than doubling: at 1 M particles the lists are most of the memory, and
+     * after the first rebuild their sizes change little */
+    uint64_t c64 = (uint64_t)want + want / 8 + 1024;
+    uint32_t c = c64 > UINT32_MAX ? UINT32_MAX : (uint32_t)c64;
+    uint32_t *nl = realloc(*buf, (size_t)c * sizeof *nl);
+    if (!nl) {
+        atomic_store(&s->nb_oom, true);
+        return false;
+    }
+    *buf = nl;
+    *cap = c;
+    return true;
+}
+
+/* Everything of the density pass after the neighbour sum: walls, EOS, reductions. */
+static inline __attribute__((always_inline)) void
+density_tail(vfx_sph *s, uint32_t i, float sum, uint32_t nn, float px, float py, float pz,
+             sph_chunk_out *o, sph_wall_hit *walls)
+{
+    const float kp = s->k_poly6, m = s->mass, rho0 = s->p.rest_density;
     const double H = s->H;
     const float gam = s->p.gamma, B = s->B, c2_0 = s->c0 * s->c0;
+    float rho = m * kp * sum;
+    int nw = gather_walls(s, px, py, pz, walls, SPH_MAX_WALLS);
+    /* The box walls are perpendicular: the region beyond them is a union of half-spaces,
+     * counted as 1 - prod(1 - f) (exact for a separable kernel, close for poly6) so the
+     * edges and corners are not compressed by double counting. Colliders just add. */
+    float inside = 1.f, extra = 0.f;
+    for (int w = 0; w < nw; ++w) {
+        float f = s->wall_scale * (float)vfx_sph_wall_density_fraction(walls[w].d, H);
+        if (w < walls_box(walls, nw))
+            inside *= 1.f - f;
+        else
+            extra += f;
+    }
+    rho += rho0 * (1.f - inside + extra);
+    s->rho[i] = rho;
+    /* EOS on the clamped ratio: p >= 0 (no tensile attraction at the free surface) and
+     * ratio <= 2 (p <= 127 B) so a collapsed input cannot produce an unbounded force. */
+    float ratio = clampf(rho / rho0, 1.f, 2.f);
+    float rg1;
+    if (gam == 7.f) {
+        float q2 = ratio * ratio; /* the default exponent: ratio^6 without a powf call */
+        rg1 = q2 * q2 * q2;
+    } else {
+        rg1 = powf(ratio, gam - 1.f);
+    }
+    float p = B * (rg1 * ratio - 1.f);
+    s->pr[i] = p / (rho * rho);
+    float c2 = c2_0 * rg1;
+    if (c2 > o->c2_max)
+        o->c2_max = c2;
+    /* internal (EOS) energy m e(rho), e = int p/rho^2 drho from rho0, with the clamps:
+     * what a compressed fluid can turn into motion (tests bound total energy with it) */
+    double rr = rho / rho0, rc = rr > 2.0 ? 2.0 : rr;
+    if (s->want_energy && rr > 1.0) {
+        double e = B / rho0 * ((pow(rc, gam - 1.0) - 1.0) / (gam - 1.0) + 1.0 / rc - 1.0);
+        if (rr > 2.0)
+            e += B * (pow(2.0, gam) - 1.0) / rho0 * (0.5 - 1.0 / rr);
+        o->ie += (double)m * e;
+    }
+    float err = (rho - rho0) / rho0;
+    if (err > o->rho_err_max)
+        o->rho_err_max = err;
+    if (err > 0.f)
+        o->rho_err_sum += err;
+    o->pairs += nn;
+    if (!isfinite(rho) && o->bad == UINT32_MAX)
+        o->bad = i, o->bad_kind = 1, o->bad_value = rho;
+}
+
+/* Density by a scan of the 5x5x5 cells, recording the exact list (r < H) for the force pass
+ * and, when `record`, the Verlet list (r < H + skin) and the positions it was built at. */
+static inline __attribute__((always_inline)) void density_scan(vfx_sph *s, uint32_t chunk, const bool record)
+{
+    uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
+    const float H2 = s->H2, S2 = s->S2;
     /* reductions in a local copy, stored once per chunk: neighbouring chunks' slots share a
      * cache line and run on different threads (false sharing on every particle otherwise) */
     sph_chunk_out acc = s->out[chunk], *o = &acc;
     const float *X = s->x, *Y = s->y, *Z = s->z;
     sph_wall_hit walls[SPH_MAX_WALLS];
-    uint32_t used = 0;
+    uint32_t used = 0, sused = 0;
     for (uint32_t i = b; i < e; ++i) {
         float px = X[i], py = Y[i], pz = Z[i];
         sph_ranges r;
@@ -1235,26 +1391,22 @@ static void density_chunk(vfx_sph *s, uint32_t chunk)
         uint32_t cand = 0;
         for (int q = 0; q < r.count; ++q)
             cand += r.hi[q] - r.lo[q];
-        if (used + cand > s->cnb_cap[chunk]) {
-            uint32_t cap = s->cnb_cap[chunk] ? s->cnb_cap[chunk] : 4096;
-            while (cap < used + cand)
-                cap *= 2;
-            uint32_t *nl = realloc(s->cnb[chunk], (size_t)cap * sizeof *nl);
-            if (!nl) {
-                atomic_store(&s->nb_oom, true);
-                s->out[chunk] = acc;
-                return;
-            }
-            s->cnb[chunk] = nl;
-            s->cnb_cap[chunk] = cap;
+        if (!grow_list(s, &s->cnb[chunk], &s->cnb_cap[chunk], used + cand) ||
+            (record && !grow_list(s, &s->snb[chunk], &s->snb_cap[chunk], sused + cand))) {
+            s->out[chunk] = acc;
+            return;
         }
-        uint32_t *L = s->cnb[chunk] + used;
+        uint32_t *L = s->cnb[chunk] + used, *SL = record ? s->snb[chunk] + sused : NULL;
         float sum = 0.f;
-        uint32_t nn = 0;
+        uint32_t nn = 0, ns = 0;
         for (int q = 0; q < r.count; ++q) {
             for (uint32_t j = r.lo[q]; j < r.hi[q]; ++j) {
                 float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
                 float r2 = dx * dx + dy * dy + dz * dz;
+                if (record && r2 < S2) {
+                    SL[ns] = j;
+                    ns += j != i;
+                }
                 if (r2 < H2) {
                     float t = H2 - r2;
                     sum += t * t * t;
@@ -1266,50 +1418,107 @@ static void density_chunk(vfx_sph *s, uint32_t chunk)
         s->nb_start[i] = used;
         s->nb_count[i] = nn;
         used += nn;
-        uint32_t pairs = nn + 1;
-        float rho = m * kp * sum;
-        int nw = gather_walls(s, px, py, pz, walls, SPH_MAX_WALLS);
-        /* The box walls are perpendicular: the region beyond them is a union of half-spaces,
-         * counted as 1 - prod(1 - f) (exact for a separable kernel, close for poly6) so the
-         * edges and corners are not compressed by double counting. Colliders just add. */
-        float inside = 1.f, extra = 0.f;
-        for (int w = 0; w < nw; ++w) {
-            float f = s->wall_scale * (float)vfx_sph_wall_density_fraction(walls[w].d, H);
-            if (w < walls_box(walls, nw))
-                inside *= 1.f - f;
-            else
-                extra += f;
+        if (record) {
+            s->sk_start[i] = sused;
+            s->sk_count[i] = ns;
+            sused += ns;
+            o->skin_pairs += ns;
+            s->x0[i] = px, s->y0[i] = py, s->z0[i] = pz;
         }
-        rho += rho0 * (1.f - inside + extra);
-        s->rho[i] = rho;
-        /* EOS on the clamped ratio: p >= 0 (no tensile attraction at the free surface) and
-         * ratio <= 2 (p <= 127 B) so a collapsed input cannot produce an unbounded force. */
-        float ratio = clampf(rho / rho0, 1.f, 2.f);
-        float rg1 = powf(ratio, gam - 1.f);
-        float p = B * (rg1 * ratio - 1.f);
-        s->pr[i] = p / (rho * rho);
-        float c2 = c2_0 * rg1;
-        if (c2 > o->c2_max)
-            o->c2_max = c2;
-        /* internal (EOS) energy m e(rho), e = int p/rho^2 drho from rho0, with the clamps:
-         * what a compressed fluid can turn into motion (tests bound total energy with it) */
-        double rr = rho / rho0, rc = rr > 2.0 ? 2.0 : rr;
-        if (s->want_energy && rr > 1.0) {
-            double e = B / rho0 * ((pow(rc, gam - 1.0) - 1.0) / (gam - 1.0) + 1.0 / rc - 1.0);
-            if (rr > 2.0)
-                e += B * (pow(2.0, gam) - 1.0) / rho0 * (0.5 - 1.0 / rr);
-            o->ie += (double)m * e;
+        density_tail(s, i, sum, nn, px, py, pz, o, walls);
+    }
+    if (record)
+        s->snb_used[chunk] = sused;
+    s->out[chunk] = acc;
+}
+
+/* Density by a walk of the Verlet lists (r < H test), writing the exact list for the force
+ * pass. Branch-free: ~40% of a list is within H at the default skin of 0.3 H, a coin flip for
+ * the predictor (the cell scan's 27% hit rate is why its branch measured cheaper there). */
+static void density_walk(vfx_sph *s, uint32_t chunk)
+{
+    uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
+    const float H2 = s->H2, self = H2 * H2 * H2;
+    sph_chunk_out acc = s->out[chunk], *o = &acc;
+    const float *X = s->x, *Y = s->y, *Z = s->z;
+    sph_wall_hit walls[SPH_MAX_WALLS];
+    const uint32_t *SLc = s->snb[chunk];
+    uint32_t used = 0;
+    for (uint32_t i = b; i < e; ++i) {
+        float px = X[i], py = Y[i], pz = Z[i];
+        const uint32_t *SL = SLc + s->sk_start[i];
+        const uint32_t ns = s->sk_count[i];
+        /* the exact list of i is a subset of its Verlet list */
+        if (used + ns > s->cnb_cap[chunk] && !grow_list(s, &s->cnb[chunk], &s->cnb_cap[chunk], used + ns)) {
+            s->out[chunk] = acc;
+            return;
         }
-        float err = (rho - rho0) / rho0;
-        if (err > o->rho_err_max)
-            o->rho_err_max = err;
-        if (err > 0.f)
-            o->rho_err_sum += err;
-        o->pairs += pairs - 1; /* minus self */
-        if (!isfinite(rho) && o->bad == UINT32_MAX)
-            o->bad = i, o->bad_kind = 1, o->bad_value = rho;
+        uint32_t *L = s->cnb[chunk] + used;
+        float sum = self;
+        uint32_t nn = 0, k = 0;
+#if SPH_SSE
+        {
+            const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), vpz = _mm_set1_ps(pz);
+            const __m128 vH2 = _mm_set1_ps(H2), zero = _mm_setzero_ps();
+            __m128 acc = zero;
+            for (; k + 4 <= ns; k += 4) {
+                uint32_t j0 = SL[k], j1 = SL[k + 1], j2 = SL[k + 2], j3 = SL[k + 3];
+                __m128 dx = vpx - _mm_setr_ps(X[j0], X[j1], X[j2], X[j3]);
+                __m128 dy = vpy - _mm_setr_ps(Y[j0], Y[j1], Y[j2], Y[j3]);
+                __m128 dz = vpz - _mm_setr_ps(Z[j0], Z[j1], Z[j2], Z[j3]);
+                __m128 r2 = dx * dx + dy * dy + dz * dz;
+                __m128 t = _mm_max_ps(vH2 - r2, zero);
+                acc += t * t * t;
+                int in = _mm_movemask_ps(_mm_cmplt_ps(r2, vH2));
+                L[nn] = j0, nn += (uint32_t)in & 1u;
+                L[nn] = j1, nn += ((uint32_t)in >> 1) & 1u;
+                L[nn] = j2, nn += ((uint32_t)in >> 2) & 1u;
+                L[nn] = j3, nn += ((uint32_t)in >> 3) & 1u;
+            }
+            sum += sph_hsum(acc);
+        }
+#endif
+        for (; k < ns; ++k) {
+            uint32_t j = SL[k];
+            float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
+            float r2 = dx * dx + dy * dy + dz * dz;
+            float t = H2 - r2;
+            t = t > 0.f ? t : 0.f;
+            sum += t * t * t;
+            L[nn] = j;
+            nn += r2 < H2;
+        }
+        s->nb_start[i] = used;
+        s->nb_count[i] = nn;
+        used += nn;
+        o->skin_pairs += ns;
+        density_tail(s, i, sum, nn, px, py, pz, o, walls);
     }
     s->out[chunk] = acc;
+}
+
+static void density_chunk(vfx_sph *s, uint32_t chunk)
+{
+    if (s->dens_mode == 2)
+        density_walk(s, chunk);
+    else if (s->dens_mode == 1)
+        density_scan(s, chunk, true);
+    else
+        density_scan(s, chunk, false);
+}
+
+/* Squared displacement of every particle since the last rebuild (columns edited by hand). */
+static void disp_chunk(vfx_sph *s, uint32_t chunk)
+{
+    uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
+    float d2 = 0.f;
+    for (uint32_t i = b; i < e; ++i) {
+        float dx = s->x[i] - s->x0[i], dy = s->y[i] - s->y0[i], dz = s->z[i] - s->z0[i];
+        float q = dx * dx + dy * dy + dz * dz;
+        if (!(q <= d2))
+            d2 = isnan(q) ? INFINITY : q; /* a NaN edit forces a rebuild too */
+    }
+    s->out[chunk].disp2_max = d2;
 }
 
 /* Deterministic, antisymmetric unit direction for exactly coincident particles. */
@@ -1332,6 +1541,7 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
     const float H = s->H, H2 = s->H2, ks = s->k_spiky, m = s->mass, h = s->h;
     const float alpha = s->p.viscosity, c0 = s->c0, rho0 = s->p.rest_density;
     const float eps2 = 1e-12f * H2;
+    const float hh = 0.01f * h * h, visc = 2.f * alpha * c0, mks = m * ks;
     const float *g = s->p.gravity;
     const float *X = s->x, *Y = s->y, *Z = s->z, *VX = s->vx, *VY = s->vy, *VZ = s->vz;
     const float *R = s->rho, *P = s->pr;
@@ -1346,33 +1556,90 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
         const uint32_t *L = s->cnb[chunk] + s->nb_start[i];
         const uint32_t nn = s->nb_count[i];
         {
-            for (uint32_t k = 0; k < nn; ++k) {
+            /* Per pair, with d = x_i - x_j, r = |d|: grad_i W = -ks (H - r)^2 d / r, so the
+             * constant -ks and the mass leave the loop (applied to the sums after it) and the
+             * unit vector is never formed; v.u r = v.d in the viscosity term. Fewer live values
+             * per pair: the loop had spilled to the stack on every iteration. */
+            float sx = 0.f, sy = 0.f, sz = 0.f, sd = 0.f;
+            uint32_t coincident = 0, k = 0;
+#if SPH_SSE
+            /* four pairs at a time: the same operations lane by lane (IEEE, so each pair's
+             * terms are the scalar ones), summed per lane and then across */
+            {
+                const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), vpz = _mm_set1_ps(pz);
+                const __m128 vvx = _mm_set1_ps(vxi), vvy = _mm_set1_ps(vyi), vvz = _mm_set1_ps(vzi);
+                const __m128 veps = _mm_set1_ps(eps2), vH = _mm_set1_ps(H), vh = _mm_set1_ps(h);
+                const __m128 vhh = _mm_set1_ps(hh), vrho = _mm_set1_ps(rhoi), vpri = _mm_set1_ps(pri);
+                const __m128 vvisc = _mm_set1_ps(visc), zero = _mm_setzero_ps();
+                __m128 ax4 = zero, ay4 = zero, az4 = zero, ad4 = zero;
+                for (; k + 4 <= nn; k += 4) {
+                    uint32_t j0 = L[k], j1 = L[k + 1], j2 = L[k + 2], j3 = L[k + 3];
+#define SPH_G4(A) _mm_setr_ps(A[j0], A[j1], A[j2], A[j3])
+                    __m128 dx = vpx - SPH_G4(X), dy = vpy - SPH_G4(Y), dz = vpz - SPH_G4(Z);
+                    __m128 dvx = vvx - SPH_G4(VX), dvy = vvy - SPH_G4(VY), dvz = vvz - SPH_G4(VZ);
+                    __m128 rj = SPH_G4(R), pj = SPH_G4(P);
+#undef SPH_G4
+                    __m128 r2 = dx * dx + dy * dy + dz * dz;
+                    __m128 valid = _mm_cmpgt_ps(r2, veps);
+                    /* lanes with r^2 <= eps2, counted by a nibble table: __builtin_popcount
+                     * is a libgcc call without -mpopcnt (4% of all instructions) */
+                    coincident += (0x4332322132212110ull >> (4 * (~_mm_movemask_ps(valid) & 15))) & 15u;
+                    __m128 rl = _mm_sqrt_ps(r2), hr = vH - rl;
+                    /* one division for w = (H - r)^2 / r and the viscosity's denominator (the
+                     * divider is as busy as everything else in this loop); r = 0 lanes get
+                     * inv = 0, so w = mu = 0 there, not inf or NaN */
+                    __m128 den = (r2 + vhh) * (vrho + rj);
+                    __m128 inv = _mm_and_ps(valid, _mm_set1_ps(1.f) / (rl * den));
+                    __m128 w = hr * hr * den * inv;
+                    __m128 vdotd = dvx * dx + dvy * dy + dvz * dz;
+                    __m128 vneg = _mm_min_ps(vdotd, zero);
+                    __m128 mu = vh * vneg * rl * inv;
+                    __m128 coef = (vpri + pj - vvisc * mu) * w;
+                    ax4 += coef * dx, ay4 += coef * dy, az4 += coef * dz;
+                    ad4 += vdotd * w;
+                }
+                sx = sph_hsum(ax4), sy = sph_hsum(ay4), sz = sph_hsum(az4), sd = sph_hsum(ad4);
+            }
+#endif
+            for (; k < nn; ++k) {
                 uint32_t j = L[k];
                 float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
                 float r2 = dx * dx + dy * dy + dz * dz;
-                float rl, ux, uy, uz;
-                if (r2 > eps2) {
-                    rl = sqrtf(r2);
-                    float inv = 1.f / rl;
-                    ux = dx * inv, uy = dy * inv, uz = dz * inv;
-                } else {
-                    float u[3];
-                    coincident_dir(s->id[i], s->id[j], u);
-                    rl = 0.f, ux = u[0], uy = u[1], uz = u[2];
-                }
-                float hr = H - rl;
-                float gw = -ks * hr * hr; /* dW/dr of the spiky kernel, grad_i W = gw * u */
                 float dvx = vxi - VX[j], dvy = vyi - VY[j], dvz = vzi - VZ[j];
-                float vdotu = dvx * ux + dvy * uy + dvz * uz;
-                /* Monaghan (1992) artificial viscosity, mu = h v.r/(r^2 + 0.01 h^2), approaching
-                 * pairs only; branch-free (the sign is a coin flip for the predictor) */
-                float vneg = vdotu < 0.f ? vdotu : 0.f;
-                float mu = h * vneg * rl / ((r2 + 0.01f * h * h) * (rhoi + R[j]));
-                float coef = pri + P[j] - 2.f * alpha * c0 * mu;
-                float f = -m * coef * gw;
-                ax += f * ux, ay += f * uy, az += f * uz;
-                dr += m * vdotu * gw;
+                if (r2 > eps2) {
+                    float rl = sqrtf(r2);
+                    float hr = H - rl;
+                    float w = hr * hr / rl; /* |grad W| / (ks r) */
+                    float vdotd = dvx * dx + dvy * dy + dvz * dz;
+                    /* Monaghan (1992) artificial viscosity, mu = h v.r/(r^2 + 0.01 h^2),
+                     * approaching pairs only; branch-free (the sign is a coin flip) */
+                    float vneg = vdotd < 0.f ? vdotd : 0.f;
+                    float mu = h * vneg / ((r2 + hh) * (rhoi + R[j]));
+                    float coef = (pri + P[j] - visc * mu) * w;
+                    sx += coef * dx, sy += coef * dy, sz += coef * dz;
+                    sd += vdotd * w;
+                } else {
+                    coincident++;
+                }
             }
+            /* exactly coincident pairs (r = 0): the deterministic direction u, (H - r)^2 = H^2.
+             * In a loop of their own: a call inside the main loop made the compiler keep its
+             * array pointers on the stack */
+            for (uint32_t k = 0; coincident && k < nn; ++k) {
+                uint32_t j = L[k];
+                float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
+                if (!(dx * dx + dy * dy + dz * dz <= eps2))
+                    continue;
+                float u[3];
+                coincident_dir(s->id[i], s->id[j], u);
+                float coef = (pri + P[j]) * H * H;
+                sx += coef * u[0], sy += coef * u[1], sz += coef * u[2];
+                sd += ((vxi - VX[j]) * u[0] + (vyi - VY[j]) * u[1] + (vzi - VZ[j]) * u[2]) * H * H;
+                coincident--;
+            }
+            /* a_i = -sum m coef grad W = m ks sum coef w d; d rho_i/dt = sum m v.grad W */
+            ax = mks * sx, ay = mks * sy, az = mks * sz;
+            dr = -mks * sd;
         }
         /* Walls, after the unified semi-analytical walls of Ferrand et al. (2013): the fluid
          * beyond a wall is missing from the sums above, so
@@ -1466,6 +1733,8 @@ static void integrate_chunk(vfx_sph *s, uint32_t chunk)
     /* reductions in a local copy, stored once per chunk: neighbouring chunks' slots share a
      * cache line and run on different threads (false sharing on every particle otherwise) */
     sph_chunk_out acc = s->out[chunk], *o = &acc;
+    const bool track = s->verlet;
+    float disp2 = 0.f;
     for (uint32_t i = b; i < e; ++i) {
         float v[3] = {s->vx[i] + dt * s->ax[i], s->vy[i] + dt * s->ay[i], s->vz[i] + dt * s->az[i]};
         float p[3] = {s->x[i] + dt * v[0], s->y[i] + dt * v[1], s->z[i] + dt * v[2]};
@@ -1507,9 +1776,17 @@ static void integrate_chunk(vfx_sph *s, uint32_t chunk)
         }
         s->xn[i] = p[0], s->yn[i] = p[1], s->zn[i] = p[2];
         s->vxn[i] = v[0], s->vyn[i] = v[1], s->vzn[i] = v[2];
+        if (track) {
+            /* exact per-particle displacement since the rebuild: the rebuild decision is a max
+             * over particles, the same whatever the thread count */
+            float ex = p[0] - s->x0[i], ey = p[1] - s->y0[i], ez = p[2] - s->z0[i];
+            float d2 = ex * ex + ey * ey + ez * ez;
+            disp2 = d2 > disp2 ? d2 : disp2;
+        }
         o->ke += 0.5 * (double)m * v2;
         o->pe -= (double)m * (g[0] * (p[0] - lo[0]) + g[1] * (p[1] - lo[1]) + g[2] * (p[2] - lo[2]));
     }
+    acc.disp2_max = disp2;
     s->out[chunk] = acc;
 }
 
@@ -1581,6 +1858,36 @@ static uint32_t first_bad(const vfx_sph *s, uint32_t nchunks, const sph_chunk_ou
     return UINT32_MAX;
 }
 
+/* The density pass of a substep (or the closing one): with Verlet lists, a walk of them while
+ * every particle has moved less than skin/2 since the rebuild (then no pair can have come
+ * within H unlisted: each side moved < skin/2), otherwise a rebuild: sort by cell, scan the
+ * cells, record the lists. Returns true when it rebuilt. */
+static bool density_pass(vfx_sph *s)
+{
+    bool rebuild = !s->verlet || !s->lists_valid || !(4.f * s->disp2_max < s->skin * s->skin);
+    if (rebuild) {
+        build_grid(s);
+        s->dens_mode = s->verlet ? 1 : 0;
+    } else {
+        s->dens_mode = 2;
+    }
+    parallel(s, density_chunk, true);
+    if (s->verlet && rebuild) {
+        s->lists_valid = !atomic_load(&s->nb_oom);
+        s->disp2_max = 0.f;
+    }
+    return rebuild;
+}
+
+static void reduce_disp(vfx_sph *s)
+{
+    uint32_t nchunks = (s->n + SPH_CHUNK - 1) / SPH_CHUNK;
+    float d2 = 0.f;
+    for (uint32_t c = 0; c < nchunks; ++c)
+        d2 = s->out[c].disp2_max > d2 ? s->out[c].disp2_max : d2;
+    s->disp2_max = d2;
+}
+
 static void finish_report(vfx_sph *s, vfx_sph_report *rep)
 {
     uint32_t nchunks = (s->n + SPH_CHUNK - 1) / SPH_CHUNK;
@@ -1589,10 +1896,12 @@ static void finish_report(vfx_sph *s, vfx_sph_report *rep)
     const float m = s->mass;
     const float *g = s->p.gravity, *lo = s->p.domain_min;
     if (s->n) {
-        build_grid(s);
         s->want_energy = true;
-        parallel(s, density_chunk, true);
+        if (density_pass(s))
+            rep->neighbor_rebuilds++;
         s->want_energy = false;
+        if (atomic_exchange(&s->nb_oom, false))
+            s->lists_valid = false; /* the sums below are partial; the next substep says why */
         for (uint32_t c = 0; c < nchunks; ++c) {
             if (s->out[c].rho_err_max > emax)
                 emax = s->out[c].rho_err_max;
@@ -1631,6 +1940,11 @@ vfx_result vfx_sph_step(vfx_sph *s, float frame_dt, vfx_sph_report *report)
     double t = 0.0;
     rep.dt_min = INFINITY;
     vfx_result res = VFX_OK;
+    if (s->verlet && s->lists_valid && s->n) {
+        /* the columns are writable between steps: measure how far they were moved */
+        parallel(s, disp_chunk, false);
+        reduce_disp(s);
+    }
     while (t < (double)frame_dt * (1.0 - 1e-9)) {
         if (rep.substeps >= s->p.max_substeps) {
             rep.cap_hit = true;
@@ -1647,9 +1961,10 @@ vfx_result vfx_sph_step(vfx_sph *s, float frame_dt, vfx_sph_report *report)
         vfx_sph_dt_limit lim = VFX_SPH_DT_FRAME;
         uint32_t nchunks = (s->n + SPH_CHUNK - 1) / SPH_CHUNK;
         if (s->n) {
-            build_grid(s);
-            parallel(s, density_chunk, true);
+            if (density_pass(s))
+                rep.neighbor_rebuilds++;
             if (atomic_exchange(&s->nb_oom, false)) {
+                s->lists_valid = false;
                 set_err(s, "vfx_sph_step: out of memory for the neighbour lists of %u particles", s->n);
                 res = VFX_ERR_OUT_OF_MEMORY;
                 break;
@@ -1671,6 +1986,7 @@ vfx_result vfx_sph_step(vfx_sph *s, float frame_dt, vfx_sph_report *report)
                 a2 = o->a2_max > a2 ? o->a2_max : a2;
                 c2 = o->c2_max > c2 ? o->c2_max : c2;
                 rep.neighbor_pairs += o->pairs;
+                rep.skin_pairs += o->skin_pairs;
             }
             double vmax = sqrt(v2), amax = sqrt(a2), cmax = sqrt(c2);
             double nu = s->p.viscosity * h * s->c0 / 10.0; /* artificial viscosity as nu, 3D */
@@ -1713,6 +2029,8 @@ vfx_result vfx_sph_step(vfx_sph *s, float frame_dt, vfx_sph_report *report)
             if (res)
                 break;
             swap_state(s);
+            if (s->verlet)
+                reduce_disp(s);
         }
         t += dt;
         s->time += dt;

@@ -14,8 +14,12 @@
  * redone with half the dt, and fails with a message naming the particle if that keeps failing.
  * The columns never hold NaN: a failed substep leaves the previous state in place.
  *
+ * Neighbours: Verlet lists with a skin (every pair within H + skin, found by a sort by grid cell
+ * and a cell scan), rebuilt when a particle has moved half the skin since the last rebuild, when
+ * particles are added or cleared, or when the columns were edited by hand beyond that (checked
+ * at the start of every vfx_sph_step).
  * Column pointers returned by vfx_sph_columns stay valid until the next add or step (particles
- * are reordered by grid cell every substep for locality; `id` says which input particle a row
+ * are reordered by grid cell at every rebuild for locality; `id` says which input particle a row
  * is). No global state; one vfx_sph is not thread-safe, it uses its own worker threads. */
 #ifndef VFX_SIM_SPH_H
 #define VFX_SIM_SPH_H
@@ -28,6 +32,9 @@
 enum {
     VFX_SPH_NO_GRAVITY = 1u << 0,   /* gravity = 0 (a zero gravity field otherwise means default) */
     VFX_SPH_NO_VISCOSITY = 1u << 1, /* artificial viscosity alpha = 0 */
+    /* the grid sort and 5x5x5 cell scan on every substep instead of Verlet lists (the
+     * baseline the benchmark compares against) */
+    VFX_SPH_REBUILD_EVERY_SUBSTEP = 1u << 2,
 };
 
 /* Faces of the domain box, for vfx_sph_desc.no_slip_faces. */
@@ -56,6 +63,7 @@ typedef struct vfx_sph_desc {
     float density_change_limit; /* blow-up bound on |d rho|/rho per substep; 0.05 */
     uint32_t max_particles;     /* capacity bound (adds and emitters); 1<<27 */
     uint32_t threads;           /* worker threads; all online cores */
+    float neighbor_skin;        /* Verlet skin as a fraction of H, 0 < skin <= 1; 0.3 */
     uint32_t flags;             /* VFX_SPH_* */
     /* Wall friction (smooth-wall law of the wall, see docs/simulation.md): box faces that are
      * no-slip (VFX_SPH_FACE_* bits; 0 = every face free-slip) and the fluid's molecular
@@ -86,6 +94,9 @@ typedef struct vfx_sph_report {
     double potential_energy;    /* [J], -sum m g.(x - domain_min), end state */
     double internal_energy;     /* [J], sum m e(rho) of the clamped Tait EOS, end state */
     uint64_t neighbor_pairs;    /* ordered pairs (i != j) within H, summed over substeps (one pass) */
+    uint32_t neighbor_rebuilds; /* grid sorts + cell scans, the closing density pass included
+                                 * (substeps + 1 with VFX_SPH_REBUILD_EVERY_SUBSTEP) */
+    uint64_t skin_pairs;        /* entries of the Verlet lists walked, summed over substeps */
     uint32_t emitted;           /* particles emitted during this step */
 } vfx_sph_report;
 
@@ -175,11 +186,12 @@ vfx_sph_columns vfx_sph_get_columns(vfx_sph *sim);
 float vfx_sph_pressure(const vfx_sph *sim, uint32_t i);
 /* Fluid volume fraction at p: sum_j (m/rho0) W_poly6(p - x_j) over the fluid share of the
  * kernel (walls excluded), ~1 inside the fluid, 1/2 on its surface, 0 in air or in a solid;
- * NaN for non-finite p. Uses the grid of the last vfx_sph_step. */
+ * NaN for non-finite p. Uses the grid of the last rebuild and the current positions. */
 float vfx_sph_volume_fraction(const vfx_sph *sim, const float p[3]);
 /* Simulated time since creation [s]. */
 double vfx_sph_time(const vfx_sph *sim);
-/* Bytes allocated by the solver (columns, grid, chunk reductions). */
+/* Bytes allocated by the solver (columns, grid, Verlet and exact neighbour lists, chunk
+ * reductions). */
 size_t vfx_sph_memory_bytes(const vfx_sph *sim);
 /* Number of worker threads in use (including the calling thread). */
 uint32_t vfx_sph_thread_count(const vfx_sph *sim);

@@ -7,6 +7,15 @@
 #include <string.h>
 #include <time.h>
 
+#if defined(__has_include)
+#if __has_include(<valgrind/callgrind.h>)
+#include <valgrind/callgrind.h>
+#endif
+#endif
+#ifndef CALLGRIND_START_INSTRUMENTATION
+#define CALLGRIND_START_INSTRUMENTATION
+#endif
+
 #include "profile/profiler.h"
 #include "sim/sph.h"
 
@@ -40,15 +49,35 @@ static void cpu_model(char *out, size_t len)
     fclose(f);
 }
 
-/* Block of n particles (dx = 2 cm) in the corner of a tank twice as long: a dam break, so
- * the measured substeps are of a moving fluid with free surface and walls. One solver per
- * thread count, stepped in turn within each repetition (1, 2, 1, 2, ...), so that the load
- * other processes put on a shared machine falls on every thread count alike; the ratio of
- * thread counts is the median of the per-repetition ratios. */
+/* The timed call, out of line so that `valgrind --tool=callgrind --toggle-collect=bench_timed_step`
+ * counts the timed substeps only (not the warm-up or the setup). */
+__attribute__((noinline)) vfx_result bench_timed_step(vfx_sph *s, vfx_sph_report *r);
+__attribute__((noinline)) vfx_result bench_timed_step(vfx_sph *s, vfx_sph_report *r)
+{
+    return vfx_sph_step(s, 1.f, r);
+}
+
+typedef struct bench_opts {
+    int substeps, reps;
+    double warmup_s;  /* simulated seconds of the collapse before timing */
+    float skin[4];    /* desc.neighbor_skin per Verlet solver set (0 = the solver's default) */
+    int nskin;
+    bool rebuild, verlet;
+} bench_opts;
+
+/* Block of n particles (dx = 2 cm) in the corner of a tank three times as long: a dam break.
+ * It first collapses for `warmup_s` simulated seconds in one solver (untimed), so that the
+ * timed substeps are of a moving fluid (a block at rest would almost never rebuild its Verlet
+ * lists and flatter them); that state is copied into one solver per method (rebuild every
+ * substep, Verlet lists) and thread count, all stepped in turn within each repetition (so the
+ * load other processes put on a shared machine falls on every configuration alike). Ratios
+ * (threads, methods) are medians of the per-repetition ratios. */
 #define BENCH_MAX_T 8
-static int bench_size(uint32_t n_target, const uint32_t *threads, int nthreads, int substeps, int reps,
+#define BENCH_MAX_S (5 * BENCH_MAX_T)
+static int bench_size(uint32_t n_target, const uint32_t *threads, int nthreads, const bench_opts *o,
                       const char *cpu)
 {
+    const int substeps = o->substeps, reps = o->reps;
     /* block of exactly n_target particles: kx = kz, the largest divisor pair with kx <= cbrt */
     uint32_t kx = (uint32_t)floor(cbrt((double)n_target) + 1e-9);
     while (kx > 1 && n_target % (kx * kx) != 0)
@@ -56,71 +85,138 @@ static int bench_size(uint32_t n_target, const uint32_t *threads, int nthreads, 
     uint32_t ky = n_target / (kx * kx);
     const float dx = 0.02f;
     float bx = (float)kx * dx, by = (float)ky * dx, bz = (float)kx * dx;
-    vfx_sph *s[BENCH_MAX_T] = {0};
-    double *ps[BENCH_MAX_T] = {0}, *is[BENCH_MAX_T] = {0}, *ms[BENCH_MAX_T] = {0}, *ratio = NULL;
-    vfx_sph_report r[BENCH_MAX_T];
-    uint32_t n = 0;
-    int rc = 0;
-    for (int t = 0; t < nthreads && !rc; ++t) {
-        vfx_sph_desc d = {.spacing = dx, .domain_min = {0, 0, 0}, .domain_max = {3.f * bx, 1.2f * by, bz},
-                          .threads = threads[t], .max_substeps = (uint32_t)substeps};
-        char err[256];
-        if (vfx_sph_create(&d, &s[t], err, sizeof err)) {
-            fprintf(stderr, "volfx-bench sim: %s\n", err);
-            rc = 1;
-            break;
-        }
-        float lo[3] = {0, 0, 0}, hi[3] = {bx, by, bz};
-        if (vfx_sph_add_block(s[t], lo, hi, &n)) {
-            fprintf(stderr, "volfx-bench sim: %s\n", vfx_sph_last_error(s[t]));
-            rc = 1;
-            break;
-        }
-        vfx_sph_step(s[t], 1.f, &r[t]); /* warm-up: the column starts to fall, pages touched */
-        ps[t] = calloc((size_t)reps, sizeof *ps[t]);
-        is[t] = calloc((size_t)reps, sizeof *is[t]);
-        ms[t] = calloc((size_t)reps, sizeof *ms[t]);
-        if (!ps[t] || !is[t] || !ms[t])
-            rc = 1;
+    vfx_sph_desc base = {.spacing = dx, .domain_min = {0, 0, 0}, .domain_max = {3.f * bx, 1.2f * by, bz},
+                         .neighbor_skin = o->skin[0]};
+    char err[256];
+    /* warm-up: the collapse, on all the threads asked for */
+    vfx_sph *w = NULL;
+    vfx_sph_desc dw = base;
+    dw.threads = threads[nthreads - 1];
+    dw.max_substeps = 100000000;
+    if (vfx_sph_create(&dw, &w, err, sizeof err)) {
+        fprintf(stderr, "volfx-bench sim: %s\n", err);
+        return 1;
     }
-    ratio = calloc((size_t)reps * BENCH_MAX_T, sizeof *ratio);
-    if (!ratio)
-        rc = 1;
-    for (int i = 0; i < reps && !rc; ++i) {
+    float lo[3] = {0, 0, 0}, hi[3] = {bx, by, bz};
+    uint32_t n = 0;
+    vfx_sph_report wr = {0};
+    double tw = now_s();
+    if (vfx_sph_add_block(w, lo, hi, &n) || (o->warmup_s > 0.0 && vfx_sph_step(w, (float)o->warmup_s, &wr))) {
+        fprintf(stderr, "volfx-bench sim: warm-up: %s\n", vfx_sph_last_error(w));
+        vfx_sph_destroy(w);
+        return 1;
+    }
+    tw = now_s() - tw;
+    vfx_sph_columns wc = vfx_sph_get_columns(w);
+    int nsol = 0;
+    vfx_sph *s[BENCH_MAX_S] = {0};
+    bool rebuild_of[BENCH_MAX_S];
+    uint32_t thr_of[BENCH_MAX_S];
+    int set_of[BENCH_MAX_S], tidx_of[BENCH_MAX_S]; /* solver set (method, skin), thread index */
+    double *ps[BENCH_MAX_S] = {0}, *is[BENCH_MAX_S] = {0}, *ms[BENCH_MAX_S] = {0};
+    double *rt[BENCH_MAX_S] = {0}, *rm[BENCH_MAX_S] = {0};
+    uint64_t sub_sum[BENCH_MAX_S] = {0}, reb_sum[BENCH_MAX_S] = {0}, skin_sum[BENCH_MAX_S] = {0};
+    vfx_sph_report r[BENCH_MAX_S];
+    int rc = 0;
+    for (int m = 0; m < 1 + o->nskin && !rc; ++m) {
+        if ((m == 0 && !o->rebuild) || (m > 0 && !o->verlet))
+            continue;
         for (int t = 0; t < nthreads && !rc; ++t) {
-            double t0 = now_s();
-            /* frame_dt 1 s and a substep cap: exactly `substeps` substeps + one closing density pass */
-            vfx_result e = vfx_sph_step(s[t], 1.f, &r[t]);
-            double dt = now_s() - t0;
-            if (e) {
-                fprintf(stderr, "volfx-bench sim: %s\n", vfx_sph_last_error(s[t]));
+            vfx_sph_desc d = base;
+            d.threads = threads[t];
+            d.max_substeps = (uint32_t)substeps;
+            d.flags = m == 0 ? VFX_SPH_REBUILD_EVERY_SUBSTEP : 0;
+            d.neighbor_skin = o->skin[m > 0 ? m - 1 : 0];
+            int k = nsol++;
+            rebuild_of[k] = m == 0;
+            set_of[k] = m, tidx_of[k] = t;
+            if (vfx_sph_create(&d, &s[k], err, sizeof err)) {
+                fprintf(stderr, "volfx-bench sim: %s\n", err);
                 rc = 1;
                 break;
             }
-            ps[t][i] = (double)n * r[t].substeps / dt;
-            is[t][i] = 2.0 * (double)r[t].neighbor_pairs / dt; /* density + force pass */
-            ms[t][i] = 1e3 * dt / r[t].substeps;
+            thr_of[k] = vfx_sph_thread_count(s[k]);
+            if (vfx_sph_add_particles(s[k], wc.count, wc.x, wc.y, wc.z, wc.vx, wc.vy, wc.vz)) {
+                fprintf(stderr, "volfx-bench sim: %s\n", vfx_sph_last_error(s[k]));
+                rc = 1;
+                break;
+            }
+            vfx_sph_step(s[k], 1.f, &r[k]); /* untimed: pages touched, lists built */
+            ps[k] = calloc((size_t)reps, sizeof *ps[k]);
+            is[k] = calloc((size_t)reps, sizeof *is[k]);
+            ms[k] = calloc((size_t)reps, sizeof *ms[k]);
+            rt[k] = calloc((size_t)reps, sizeof *rt[k]);
+            rm[k] = calloc((size_t)reps, sizeof *rm[k]);
+            if (!ps[k] || !is[k] || !ms[k] || !rt[k] || !rm[k])
+                rc = 1;
         }
-        for (int t = 0; t < nthreads && !rc; ++t)
-            ratio[(size_t)t * reps + i] = ps[t][i] / ps[0][i];
     }
-    for (int t = 0; t < nthreads && !rc; ++t) {
-        double p = vfx_median(ps[t], (uint32_t)reps), in = vfx_median(is[t], (uint32_t)reps);
-        double m = vfx_median(ms[t], (uint32_t)reps), q = vfx_median(ratio + (size_t)t * reps, (uint32_t)reps);
-        uint32_t tc = vfx_sph_thread_count(s[t]);
+    /* a no-op natively; under `valgrind --tool=callgrind --instr-atstart=no` the warm-up runs
+     * uninstrumented (fast) and counting starts here */
+    CALLGRIND_START_INSTRUMENTATION;
+    for (int i = 0; i < reps && !rc; ++i) {
+        for (int k = 0; k < nsol && !rc; ++k) {
+            double t0 = now_s();
+            /* frame_dt 1 s and a substep cap: exactly `substeps` substeps + one closing density pass */
+            vfx_result e = bench_timed_step(s[k], &r[k]);
+            double dt = now_s() - t0;
+            if (e) {
+                fprintf(stderr, "volfx-bench sim: %s\n", vfx_sph_last_error(s[k]));
+                rc = 1;
+                break;
+            }
+            ps[k][i] = (double)n * r[k].substeps / dt;
+            is[k][i] = 2.0 * (double)r[k].neighbor_pairs / dt; /* density + force pass */
+            ms[k][i] = 1e3 * dt / r[k].substeps;
+            sub_sum[k] += r[k].substeps;
+            reb_sum[k] += r[k].neighbor_rebuilds;
+            skin_sum[k] += r[k].skin_pairs;
+        }
+        for (int k = 0; k < nsol && !rc; ++k) {
+            int first = k, same = k; /* 1st thread count of the same set; rebuild, same threads */
+            for (int q = 0; q < nsol; ++q) {
+                if (set_of[q] == set_of[k] && tidx_of[q] == 0)
+                    first = q;
+                if (set_of[q] == 0 && tidx_of[q] == tidx_of[k])
+                    same = q;
+            }
+            rt[k][i] = ps[k][i] / ps[first][i];
+            rm[k][i] = ps[k][i] / ps[same][i];
+        }
+    }
+    double load[3] = {0, 0, 0};
+    FILE *la = fopen("/proc/loadavg", "r");
+    if (la) {
+        if (fscanf(la, "%lf %lf %lf", &load[0], &load[1], &load[2]) != 3)
+            load[0] = load[1] = load[2] = -1.0;
+        fclose(la);
+    }
+    for (int k = 0; k < nsol && !rc; ++k) {
+        double p = vfx_median(ps[k], (uint32_t)reps), in = vfx_median(is[k], (uint32_t)reps);
+        double m = vfx_median(ms[k], (uint32_t)reps), q = vfx_median(rt[k], (uint32_t)reps);
+        double qm = vfx_median(rm[k], (uint32_t)reps);
+        uint32_t tc = thr_of[k];
         printf("{\"effect\":\"sim\",\"particles\":%u,\"threads\":%u,\"substeps_per_rep\":%d,\"reps\":%d,"
                "\"particle_steps_per_s\":%.0f,\"particle_steps_per_s_per_thread\":%.0f,"
                "\"neighbour_interactions_per_s\":%.0f,\"ms_per_substep\":%.3f,"
-               "\"neighbours_per_particle\":%.1f,\"memory_mb\":%.1f,\"ratio_to_first\":%.3f,\"cpu\":\"%s\"}\n",
+               "\"neighbours_per_particle\":%.1f,\"memory_mb\":%.1f,\"ratio_to_first\":%.3f,\"cpu\":\"%s\","
+               "\"method\":\"%s\",\"skin_over_H\":%.3f,\"ratio_to_rebuild\":%.3f,"
+               "\"rebuilds_per_substep\":%.4f,\"mean_skin_list\":%.1f,\"warmup_s\":%.3f,"
+               "\"warmup_substeps\":%u,\"warmup_wall_s\":%.1f,\"max_speed_after_warmup\":%.3f,"
+               "\"loadavg\":[%.2f,%.2f,%.2f]}\n",
                n, tc, substeps, reps, p, p / tc, in, m,
-               r[t].substeps ? (double)r[t].neighbor_pairs / r[t].substeps / n : 0.0,
-               vfx_sph_memory_bytes(s[t]) / 1048576.0, q, cpu);
+               r[k].substeps ? (double)r[k].neighbor_pairs / r[k].substeps / n : 0.0,
+               vfx_sph_memory_bytes(s[k]) / 1048576.0, q, cpu, rebuild_of[k] ? "rebuild" : "verlet",
+               vfx_sph_params(s[k])->neighbor_skin, qm,
+               sub_sum[k] ? (double)reb_sum[k] / (double)sub_sum[k] : 0.0,
+               sub_sum[k] ? (double)skin_sum[k] / (double)sub_sum[k] / n : 0.0, o->warmup_s,
+               wr.substeps, tw, wr.max_speed, load[0], load[1], load[2]);
     }
-    for (int t = 0; t < nthreads; ++t) {
-        free(ps[t]), free(is[t]), free(ms[t]);
-        vfx_sph_destroy(s[t]);
+    for (int k = 0; k < nsol; ++k) {
+        free(ps[k]), free(is[k]), free(ms[k]), free(rt[k]), free(rm[k]);
+        vfx_sph_destroy(s[k]);
     }
-    free(ratio);
+    vfx_sph_destroy(w);
     return rc;
 }
 
@@ -250,6 +346,7 @@ int vfx_bench_sim(int argc, char **argv)
     uint32_t sizes[8] = {4096, 16384, 65536}, threads[8] = {1, 2};
     int nsizes = 3, nthreads = 2, substeps = 20, reps = 5, res = 20;
     bool dam = false;
+    bench_opts bo = {.warmup_s = 0.2, .nskin = 1, .rebuild = true, .verlet = true};
     double t_max = 6.0, settle_s = 0.0;
     uint32_t no_slip = 0;
     for (int i = 1; i < argc; ++i) {
@@ -267,6 +364,28 @@ int vfx_bench_sim(int argc, char **argv)
             substeps = atoi(argv[++i]);
         } else if (!strcmp(argv[i], "--reps") && i + 1 < argc) {
             reps = atoi(argv[++i]);
+        } else if (!strcmp(argv[i], "--warmup-s") && i + 1 < argc) {
+            bo.warmup_s = atof(argv[++i]);
+        } else if (!strcmp(argv[i], "--skin") && i + 1 < argc) {
+            /* a comma list: one set of Verlet solvers per skin, all stepped in the same run */
+            char *v = argv[++i], *end;
+            bo.nskin = 0;
+            while (*v && bo.nskin < 4) {
+                bo.skin[bo.nskin++] = strtof(v, &end);
+                if (end == v || (*end && *end != ',')) {
+                    fprintf(stderr, "volfx-bench sim: --skin wants a comma list of fractions of H\n");
+                    return 2;
+                }
+                v = *end ? end + 1 : end;
+            }
+        } else if (!strcmp(argv[i], "--methods") && i + 1 < argc) {
+            const char *v = argv[++i];
+            bo.rebuild = strstr(v, "rebuild") != NULL;
+            bo.verlet = strstr(v, "verlet") != NULL;
+            if (!bo.rebuild && !bo.verlet) {
+                fprintf(stderr, "volfx-bench sim: --methods wants rebuild, verlet or rebuild,verlet\n");
+                return 2;
+            }
         } else if (!strcmp(argv[i], "--dam-break")) {
             dam = true;
         } else if (!strcmp(argv[i], "--res") && i + 1 < argc) {
@@ -280,6 +399,9 @@ int vfx_bench_sim(int argc, char **argv)
             no_slip = VFX_SPH_FACE_Y_MIN | VFX_SPH_FACE_X_MIN;
         } else if (!strcmp(argv[i], "--help")) {
             puts("volfx-bench sim [--sizes 4096,16384,65536] [--threads 1,2] [--substeps 20] [--reps 5]\n"
+                 "                [--warmup-s 0.2 (simulated s of the collapse before timing)]\n"
+                 "                [--methods rebuild,verlet] [--skin 0 (neighbor_skin / H, up to 4 in a comma\n"
+                 "                list, one set of Verlet solvers each; 0 = default)]\n"
                  "volfx-bench sim --dam-break [--res 20 (a/dx)] [--t-max 6 (last T)] [--threads 2]\n"
                  "                            [--settle 0 (s at rest behind a gate first; 0 = release a fresh lattice)]\n"
                  "                            [--no-slip (wall-law friction on the floor and back wall)]");
@@ -290,16 +412,21 @@ int vfx_bench_sim(int argc, char **argv)
         }
     }
     if (substeps < 1 || substeps > 100000 || reps < 1 || reps > 1000 || res < 4 || res > 200 ||
-        !(settle_s >= 0.0 && settle_s <= 10.0)) {
-        fprintf(stderr, "volfx-bench sim: need 1..100000 substeps, 1..1000 reps, 4..200 res, 0..10 s settle\n");
+        !(settle_s >= 0.0 && settle_s <= 10.0) || !(bo.warmup_s >= 0.0 && bo.warmup_s <= 10.0) ||
+        !(bo.skin[0] >= 0.f && bo.skin[0] <= 1.f && bo.skin[1] >= 0.f && bo.skin[1] <= 1.f &&
+          bo.skin[2] >= 0.f && bo.skin[2] <= 1.f && bo.skin[3] >= 0.f && bo.skin[3] <= 1.f)) {
+        fprintf(stderr, "volfx-bench sim: need 1..100000 substeps, 1..1000 reps, 4..200 res, 0..10 s settle, "
+                "0..10 s warm-up, skin 0..1\n");
         return 2;
     }
     char cpu[256];
     cpu_model(cpu, sizeof cpu);
     if (dam)
         return dam_break(res, threads[nthreads - 1], t_max, settle_s, no_slip, cpu);
+    bo.substeps = substeps;
+    bo.reps = reps;
     for (int k = 0; k < nsizes; ++k)
-        if (bench_size(sizes[k], threads, nthreads, substeps, reps, cpu))
+        if (bench_size(sizes[k], threads, nthreads, &bo, cpu))
             return 1;
     return 0;
 }

@@ -63,6 +63,35 @@ static void test_system_writes_columns(void **state)
     assert_int_equal(seen, N + 20);
     /* the block (centre 0.1 m) fell onto the floor in 1/3 s */
     assert_true(ymean / seen < 0.07);
+    /* An unchanged world keeps the solver's state between frames: its Verlet lists survive
+     * (a re-import would rebuild them at the first substep of every frame). */
+    /* Short frames (1e-4 s, one substep or two): a re-import would rebuild at the first
+     * substep of each; kept lists rebuild only when a particle has moved half the skin. */
+    uint32_t rebuilds = 0;
+    for (int f = 0; f < 20; ++f) {
+        assert_int_equal(vfx_world_run_phase(w, VFX_PHASE_SIMULATE, 0.35 + f * 1e-4, 1e-4f), VFX_OK);
+        rebuilds += vfx_sim_system_report(sys)->neighbor_rebuilds;
+    }
+    print_message("20 frames of 1e-4 s with the world unchanged: %u rebuilds\n", rebuilds);
+    assert_true(rebuilds < 10);
+    /* ... and an edit by the game is seen: a particle moved 4 cm sideways lands there */
+    it = vfx_query_begin(w, terms, 3);
+    assert_true(vfx_query_next(&it));
+    float *qx = vfx_query_column(&it, pc.position, 0);
+    float *qy = vfx_query_column(&it, pc.position, 1);
+    float *qv[3] = {vfx_query_column(&it, pc.velocity, 0), vfx_query_column(&it, pc.velocity, 1),
+                    vfx_query_column(&it, pc.velocity, 2)};
+    float x_new = qx[0] < 0.05f ? qx[0] + 0.04f : qx[0] - 0.04f;
+    qx[0] = x_new, qy[0] = 0.15f;
+    qv[0][0] = qv[1][0] = qv[2][0] = 0.f; /* at rest, in the air above the fluid */
+    assert_int_equal(vfx_world_run_phase(w, VFX_PHASE_SIMULATE, 26 / 60.0, 1.f / 60.f), VFX_OK);
+    it = vfx_query_begin(w, terms, 3);
+    assert_true(vfx_query_next(&it));
+    qx = vfx_query_column(&it, pc.position, 0);
+    qy = vfx_query_column(&it, pc.position, 1);
+    /* in 1/60 s from rest it falls g t^2 / 2 = 1.4 mm and does not move sideways */
+    print_message("edited particle: x %.4f (set %.4f), y %.4f (set 0.15)\n", qx[0], x_new, qy[0]);
+    assert_true(fabsf(qx[0] - x_new) < 0.002f && qy[0] > 0.147f && qy[0] < 0.1495f);
     vfx_world_destroy(w);
     vfx_sim_system_destroy(sys);
 }
