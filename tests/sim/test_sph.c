@@ -796,7 +796,7 @@ static void test_dam_break_small(void **state)
      * Coarse run (a/dx = 10, 4 layers deep, the bench's tank 10a long) with the experiment's
      * solid walls no-slip (floor and back wall, smooth-wall law, water's viscosity; the z walls
      * of the slab stand for a 2D flow and stay free-slip): every point of the measured range
-     * within the 10% target (measured 2026-12-01: +2.6 ... +4.3% and -3.9%; free-slip walls
+     * within the 10% target (measured 2026-12-01: +2.6 ... +4.2% and -4.0%; free-slip walls
      * gave up to +5.7%). a/dx = 20 and 40 are in the bench, `volfx-bench sim --dam-break
      * --no-slip`, docs/simulation.md. Front: where the fluid volume fraction on the floor falls
      * to 1/2 (the edge of the continuum the particles stand for; a lone particle thrown ahead
