@@ -558,10 +558,22 @@ static void test_blowup_reported(void **state)
     vfx_sph_destroy(s);
 }
 
+/* s[0] on 1 thread and s[1] on 2 after the same steps: the columns must be bitwise equal. */
+static void assert_bitwise_equal_and_destroy(vfx_sph *s[2])
+{
+    vfx_sph_columns c[2] = {vfx_sph_get_columns(s[0]), vfx_sph_get_columns(s[1])};
+    assert_int_equal(vfx_sph_thread_count(s[1]), 2);
+    assert_int_equal(c[0].count, c[1].count);
+    assert_memory_equal(c[0].x, c[1].x, c[0].count * sizeof(float));
+    assert_memory_equal(c[0].vy, c[1].vy, c[0].count * sizeof(float));
+    assert_memory_equal(c[0].id, c[1].id, c[0].count * sizeof(uint32_t));
+    vfx_sph_destroy(s[0]);
+    vfx_sph_destroy(s[1]);
+}
+
 static void test_thread_count_determinism(void **state)
 {
     (void)state;
-    vfx_sph_columns c[2];
     vfx_sph *s[2];
     for (int t = 0; t < 2; ++t) {
         vfx_sph_desc d = small_box();
@@ -574,16 +586,9 @@ static void test_thread_count_determinism(void **state)
         vfx_sph_report r;
         for (int f = 0; f < 5; ++f)
             assert_int_equal(vfx_sph_step(s[t], 1.f / 60.f, &r), VFX_OK);
-        c[t] = vfx_sph_get_columns(s[t]);
     }
-    assert_int_equal(vfx_sph_thread_count(s[1]), 2);
-    assert_int_equal(c[0].count, c[1].count);
     /* each particle sums its neighbours in the same order whatever thread runs it */
-    assert_memory_equal(c[0].x, c[1].x, c[0].count * sizeof(float));
-    assert_memory_equal(c[0].vy, c[1].vy, c[0].count * sizeof(float));
-    assert_memory_equal(c[0].id, c[1].id, c[0].count * sizeof(uint32_t));
-    vfx_sph_destroy(s[0]);
-    vfx_sph_destroy(s[1]);
+    assert_bitwise_equal_and_destroy(s);
 }
 
 static void test_colliders_emitter_paddle(void **state)
@@ -1044,7 +1049,6 @@ static void test_verlet_rebuild_trigger(void **state)
 static void test_verlet_threads_bitwise(void **state)
 {
     (void)state;
-    vfx_sph_columns c[2];
     vfx_sph *s[2];
     for (int t = 0; t < 2; ++t) {
         vfx_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.4f, 0.3f, 0.1f},
@@ -1061,15 +1065,8 @@ static void test_verlet_threads_bitwise(void **state)
             rebuilds += r.neighbor_rebuilds;
         }
         assert_true(rebuilds >= 2);
-        c[t] = vfx_sph_get_columns(s[t]);
     }
-    assert_int_equal(vfx_sph_thread_count(s[1]), 2);
-    assert_int_equal(c[0].count, c[1].count);
-    assert_memory_equal(c[0].x, c[1].x, c[0].count * sizeof(float));
-    assert_memory_equal(c[0].vy, c[1].vy, c[0].count * sizeof(float));
-    assert_memory_equal(c[0].id, c[1].id, c[0].count * sizeof(uint32_t));
-    vfx_sph_destroy(s[0]);
-    vfx_sph_destroy(s[1]);
+    assert_bitwise_equal_and_destroy(s);
 }
 
 static void test_million_particles(void **state)
