@@ -50,7 +50,7 @@ print("pairs (i != j, r < H) evaluated, counted once in the density pass and onc
 print("Rebuilds per substep count the closing pass too (1.05 for `rebuild`). Goal: 2,000,000")
 print("particle-steps/s per core at 65,536 particles.")
 load = open("/proc/loadavg").read().split()[:3]
-print(f"Load average when the script finished: {' '.join(load)} (other sessions were running).\n")
+print(f"Load average when the script finished: {' '.join(load)} (the bench itself runs up to 2 threads; more than that means other processes shared the cores).\n")
 print("| particles | method | threads | particle-steps/s | per thread | verlet / rebuild | neighbour interactions/s | ms/substep | neighbours/particle | rebuilds/substep | Verlet list/particle | max speed m/s | MiB |")
 print("|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
 for r in rows:
