@@ -1172,22 +1172,24 @@ static void build_grid(vfx_sph *s)
 }
 
 typedef struct sph_ranges {
-    uint32_t lo[25], hi[25];
+    uint32_t lo[49], hi[49]; /* up to 7x7 rows of cells */
     int count;
 } sph_ranges;
 
-static inline void neighbor_ranges(const vfx_sph *s, float px, float py, float pz, sph_ranges *r)
+/* The particle index ranges of the (2R+1)^3 cells of H/2 around p (R <= 3): one range per row
+ * of x-adjacent cells, rows with no particle left out. */
+static inline void neighbor_ranges(const vfx_sph *s, float px, float py, float pz, int R, sph_ranges *r)
 {
     const float *lo = s->p.domain_min;
     int cx = cell_coord(px, lo[0], s->inv_cell, s->nx);
     int cy = cell_coord(py, lo[1], s->inv_cell, s->ny);
     int cz = cell_coord(pz, lo[2], s->inv_cell, s->nz);
-    int x0 = cx > 1 ? cx - 2 : 0, x1 = cx + 2 < s->nx ? cx + 2 : s->nx - 1;
+    int x0 = cx >= R ? cx - R : 0, x1 = cx + R < s->nx ? cx + R : s->nx - 1;
     r->count = 0;
-    for (int z = cz - 2; z <= cz + 2; ++z) {
+    for (int z = cz - R; z <= cz + R; ++z) {
         if (z < 0 || z >= s->nz)
             continue;
-        for (int y = cy - 2; y <= cy + 2; ++y) {
+        for (int y = cy - R; y <= cy + R; ++y) {
             if (y < 0 || y >= s->ny)
                 continue;
             uint32_t row = (uint32_t)((z * s->ny + y) * s->nx);
@@ -1256,27 +1258,17 @@ float vfx_sph_volume_fraction(const vfx_sph *s, const float p[3])
      * than skin/2 <= H/2 since, so every particle now within H of p was within 1.5 H = 3 cells
      * of H/2 then: a 7x7x7 stencil over the rows as sorted, distances from the current
      * positions. The 5x5x5 stencil when the grid is rebuilt every substep (it is current). */
-    const int R = s->verlet ? 3 : 2;
-    const float *glo = s->p.domain_min;
-    int cx = cell_coord(p[0], glo[0], s->inv_cell, s->nx);
-    int cy = cell_coord(p[1], glo[1], s->inv_cell, s->ny);
-    int cz = cell_coord(p[2], glo[2], s->inv_cell, s->nz);
-    int x0 = cx >= R ? cx - R : 0, x1 = cx + R < s->nx ? cx + R : s->nx - 1;
+    sph_ranges r;
+    neighbor_ranges(s, p[0], p[1], p[2], s->verlet ? 3 : 2, &r);
     double sum = 0.0;
-    for (int zc = cz - R; zc <= cz + R; ++zc)
-        for (int yc = cy - R; yc <= cy + R; ++yc) {
-            if (zc < 0 || zc >= s->nz || yc < 0 || yc >= s->ny)
-                continue;
-            uint32_t row = (uint32_t)((zc * s->ny + yc) * s->nx);
-            uint32_t a = s->cell_start[row + (uint32_t)x0], b = s->cell_start[row + (uint32_t)x1 + 1];
-        for (uint32_t j = a; j < b && j < s->n; ++j) {
+    for (int q = 0; q < r.count; ++q)
+        for (uint32_t j = r.lo[q]; j < r.hi[q] && j < s->n; ++j) {
             float dx = p[0] - s->x[j], dy = p[1] - s->y[j], dz = p[2] - s->z[j];
             float r2 = dx * dx + dy * dy + dz * dz;
             if (r2 < s->H2) {
                 float t = s->H2 - r2;
                 sum += (double)t * t * t;
             }
-        }
         }
     sph_wall_hit walls[SPH_MAX_WALLS];
     int nw = gather_walls(s, p[0], p[1], p[2], walls, SPH_MAX_WALLS), nb = walls_box(walls, nw);
@@ -1387,7 +1379,7 @@ static inline __attribute__((always_inline)) void density_scan(vfx_sph *s, uint3
     for (uint32_t i = b; i < e; ++i) {
         float px = X[i], py = Y[i], pz = Z[i];
         sph_ranges r;
-        neighbor_ranges(s, px, py, pz, &r);
+        neighbor_ranges(s, px, py, pz, 2, &r);
         uint32_t cand = 0;
         for (int q = 0; q < r.count; ++q)
             cand += r.hi[q] - r.lo[q];
@@ -1659,7 +1651,7 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
          * viscosity pumped energy into a resting tank; (2) alone compressed the wall layer. */
         int nw = gather_walls(s, px, py, pz, walls, SPH_MAX_WALLS);
         int nb = walls_box(walls, nw);
-        float fr[SPH_MAX_WALLS];
+        float fr[SPH_MAX_WALLS], gr[SPH_MAX_WALLS]; /* density fraction, its gradient */
         float inside = 1.f, extra = 0.f;
         for (int w = 0; w < nw; ++w) {
             fr[w] = s->wall_scale * (float)vfx_sph_wall_density_fraction(walls[w].d, H);
@@ -1680,8 +1672,8 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
             float vneg = vn < 0.f ? vn : 0.f;
             float mu = h * (2.f * vneg) * (2.f * dd) / ((4.f * dd * dd + 0.01f * h * h) * rhoi);
             float coef = 2.f * pri - alpha * c0 * mu;
-            float f = coef * rho0 * s->wall_scale * others *
-                      (float)vfx_sph_wall_density_gradient(walls[w].d, H);
+            gr[w] = (float)vfx_sph_wall_density_gradient(walls[w].d, H);
+            float f = coef * rho0 * s->wall_scale * others * gr[w];
             ax += f * wn[0], ay += f * wn[1], az += f * wn[2];
         }
         /* a particle in a box corner at the clamp margin keeps 0.28 of its kernel; below 0.2
@@ -1705,7 +1697,7 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
                     continue;
                 float y = walls[w].d > 0.25f * s->p.spacing ? walls[w].d : 0.25f * s->p.spacing;
                 float us = (float)vfx_sph_wall_friction_velocity(ut, y, s->p.kinematic_viscosity);
-                float am = us * us * s->fric_scale * (float)vfx_sph_wall_density_gradient(walls[w].d, H) / ut;
+                float am = us * us * s->fric_scale * gr[w] / ut;
                 ax -= am * tx, ay -= am * ty, az -= am * tz;
             }
         ax += g[0], ay += g[1], az += g[2];
