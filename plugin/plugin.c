@@ -21,7 +21,7 @@
 
 /* ------------------------------------------------------------ logging, errors, memory */
 
-void vfx_log(vfx_context *ctx, vfx_log_level level, const char *fmt, ...)
+void volfx_log(vfx_context *ctx, vfx_log_level level, const char *fmt, ...)
 {
     char buf[1024];
     va_list ap;
@@ -32,7 +32,7 @@ void vfx_log(vfx_context *ctx, vfx_log_level level, const char *fmt, ...)
         ctx->host.log(ctx->host.user, level, buf);
 }
 
-vfx_result vfx_fail(vfx_context *ctx, vfx_result code, const char *fmt, ...)
+vfx_result volfx_fail(vfx_context *ctx, vfx_result code, const char *fmt, ...)
 {
     char buf[sizeof ctx->last_error];
     va_list ap;
@@ -54,17 +54,17 @@ typedef struct alloc_header {
     size_t size;
 } alloc_header;
 
-void *vfx_alloc(vfx_context *ctx, size_t size)
+void *volfx_alloc(vfx_context *ctx, size_t size)
 {
     const size_t align = 64;
     if (size > SIZE_MAX - align - sizeof(alloc_header)) {
-        vfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "allocation of %zu bytes is too large", size);
+        volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "allocation of %zu bytes is too large", size);
         return NULL;
     }
     size_t total = size + align + sizeof(alloc_header);
     void *base = ctx->host.alloc ? ctx->host.alloc(ctx->host.user, total, 16) : malloc(total);
     if (!base) {
-        vfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "out of memory allocating %zu bytes", size);
+        volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "out of memory allocating %zu bytes", size);
         return NULL;
     }
     uintptr_t p = ((uintptr_t)base + sizeof(alloc_header) + align - 1) & ~(uintptr_t)(align - 1);
@@ -75,7 +75,7 @@ void *vfx_alloc(vfx_context *ctx, size_t size)
     return (void *)p;
 }
 
-void vfx_free(vfx_context *ctx, void *ptr)
+void volfx_free(vfx_context *ctx, void *ptr)
 {
     if (!ptr)
         return;
@@ -100,14 +100,14 @@ static vfx_stat *stat_slot(vfx_context *ctx, const char *name)
     return e;
 }
 
-void vfx_stat_set(vfx_context *ctx, const char *name, double value)
+void volfx_stat_set(vfx_context *ctx, const char *name, double value)
 {
     vfx_stat *e = stat_slot(ctx, name);
     if (e)
         e->value = value;
 }
 
-void vfx_stat_add(vfx_context *ctx, const char *name, double value)
+void volfx_stat_add(vfx_context *ctx, const char *name, double value)
 {
     vfx_stat *e = stat_slot(ctx, name);
     if (e)
@@ -119,13 +119,13 @@ void vfx_stat_add(vfx_context *ctx, const char *name, double value)
 static void register_effects(vfx_context *ctx)
 {
 #if VFX_WITH_WATER && VFX_HAS_WATER_OPS
-    ctx->effect_ops[VFX_EFFECT_WATER] = &vfx_water_ops;
+    ctx->effect_ops[VFX_EFFECT_WATER] = &volfx_water_ops;
 #endif
 #if VFX_WITH_BEAMS && VFX_HAS_BEAMS_OPS
-    ctx->effect_ops[VFX_EFFECT_BEAMS] = &vfx_beams_ops;
+    ctx->effect_ops[VFX_EFFECT_BEAMS] = &volfx_beams_ops;
 #endif
 #if VFX_WITH_TETVOL && VFX_HAS_VOLUME_OPS
-    ctx->effect_ops[VFX_EFFECT_VOLUME] = &vfx_volume_ops;
+    ctx->effect_ops[VFX_EFFECT_VOLUME] = &volfx_volume_ops;
 #endif
     (void)ctx;
 }
@@ -139,7 +139,7 @@ static void plugin_destroy(vfx_context *ctx)
             ctx->effect_ops[k]->destroy(ctx, ctx->effect_state[k]);
             ctx->effect_state[k] = NULL;
         }
-    vfx_gpu_destroy(ctx, ctx->gpu);
+    volfx_gpu_destroy(ctx, ctx->gpu);
     vfx_host_api host = ctx->host;
     if (host.free)
         host.free(host.user, ctx);
@@ -165,7 +165,7 @@ static vfx_result plugin_create(const vfx_host_api *host, vfx_context **out)
     ctx->stats.size = ctx->last_stats.size = sizeof(vfx_stats);
     ctx->stats.version = ctx->last_stats.version = VFX_STATS_VERSION;
     register_effects(ctx);
-    vfx_result r = vfx_gpu_create(ctx, &ctx->gpu);
+    vfx_result r = volfx_gpu_create(ctx, &ctx->gpu);
     if (r != VFX_OK) {
         /* keep the message: the caller has no context to ask */
         plugin_destroy(ctx);
@@ -180,7 +180,7 @@ static vfx_result plugin_resize(vfx_context *ctx, uint32_t width, uint32_t heigh
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
     if (width == 0 || height == 0 || width > 16384 || height > 16384)
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
                         "resize: %ux%u outside 1..16384 in each direction", width, height);
     ctx->width = width;
     ctx->height = height;
@@ -198,10 +198,10 @@ static vfx_result plugin_update(vfx_context *ctx, double time, float dt)
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
     if (!isfinite(time) || !isfinite(dt))
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "update: time %g or dt %g is not finite",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "update: time %g or dt %g is not finite",
                         time, (double)dt);
     for (int k = 0; k < VFX_EFFECT_COUNT; ++k) {
-        const vfx_effect_ops *ops = ctx->effect_ops[k];
+        const volfx_effect_ops *ops = ctx->effect_ops[k];
         if (!ops)
             continue;
         bool present = ops->present(ctx);
@@ -209,14 +209,14 @@ static vfx_result plugin_update(vfx_context *ctx, double time, float dt)
             vfx_result r = ops->create(ctx, &ctx->effect_state[k]);
             if (r)
                 return r;
-            vfx_log(ctx, VFX_LOG_DEBUG, "effect %s created", ops->name);
+            volfx_log(ctx, VFX_LOG_DEBUG, "effect %s created", ops->name);
             if (ctx->width && ops->resize
                 && (r = ops->resize(ctx, ctx->effect_state[k], ctx->width, ctx->height)))
                 return r;
         } else if (!present && ctx->effect_state[k]) {
             ops->destroy(ctx, ctx->effect_state[k]);
             ctx->effect_state[k] = NULL;
-            vfx_log(ctx, VFX_LOG_DEBUG, "effect %s destroyed (absent from the world)", ops->name);
+            volfx_log(ctx, VFX_LOG_DEBUG, "effect %s destroyed (absent from the world)", ops->name);
         }
         if (ctx->effect_state[k]) {
             vfx_result r = ops->update(ctx, ctx->effect_state[k], time, dt);
@@ -228,7 +228,7 @@ static vfx_result plugin_update(vfx_context *ctx, double time, float dt)
 }
 
 /* Cofactors in double, so near-singular projections keep their digits. */
-bool vfx_mat4_invert(const float m[16], float out[16])
+bool volfx_mat4_invert(const float m[16], float out[16])
 {
     double a[16], inv[16];
     for (int i = 0; i < 16; ++i)
@@ -257,7 +257,7 @@ bool vfx_mat4_invert(const float m[16], float out[16])
     return true;
 }
 
-void vfx_mat4_mul(const float a[16], const float b[16], float out[16])
+void volfx_mat4_mul(const float a[16], const float b[16], float out[16])
 {
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r) {
@@ -273,27 +273,27 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
     if (!frame || frame->size < sizeof(vfx_frame_view) || frame->version != VFX_FRAME_VIEW_VERSION)
-        return vfx_fail(ctx, VFX_ERR_ABI, "render: frame view missing or of version %u (need %u)",
+        return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view missing or of version %u (need %u)",
                         frame ? frame->version : 0, VFX_FRAME_VIEW_VERSION);
     if (frame->width == 0 || frame->height == 0)
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame is %ux%u", frame->width,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame is %ux%u", frame->width,
                         frame->height);
     for (int i = 0; i < 16; ++i)
         if (!isfinite(frame->view[i]) || !isfinite(frame->proj[i]))
-            return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: camera matrix element %d is not finite", i);
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: camera matrix element %d is not finite", i);
     if (frame->width != ctx->width || frame->height != ctx->height) {
         vfx_result r = plugin_resize(ctx, frame->width, frame->height);
         if (r)
             return r;
     }
-    vfx_frame_targets targets;
+    volfx_frame_targets targets;
     memset(&targets, 0, sizeof targets);
     targets.scene_depth = frame->depth_texture;
     targets.scene_color = frame->color_texture;
     float vp[16];
-    vfx_mat4_mul(frame->proj, frame->view, vp);
-    if (!vfx_mat4_invert(vp, targets.inv_view_proj))
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: view*projection is singular");
+    volfx_mat4_mul(frame->proj, frame->view, vp);
+    if (!volfx_mat4_invert(vp, targets.inv_view_proj))
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: view*projection is singular");
 
     ctx->stats.count = 0;
     uint32_t mask = frame->effects ? frame->effects : 0xffffffffu;
@@ -306,7 +306,7 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
             continue;
         result = ctx->effect_ops[k]->render(ctx, ctx->effect_state[k], frame, &targets);
     }
-    vfx_gpu_frame_end(ctx);
+    volfx_gpu_frame_end(ctx);
     ctx->last_stats = ctx->stats;
     return result;
 }
@@ -316,7 +316,7 @@ static vfx_result plugin_get_stats(vfx_context *ctx, vfx_stats *out)
     if (!ctx || !out)
         return VFX_ERR_INVALID_ARGUMENT;
     if (out->size < sizeof(vfx_stats))
-        return vfx_fail(ctx, VFX_ERR_ABI, "get_stats: stats struct size %u < %zu", out->size,
+        return volfx_fail(ctx, VFX_ERR_ABI, "get_stats: stats struct size %u < %zu", out->size,
                         sizeof(vfx_stats));
     *out = ctx->last_stats;
     return VFX_OK;
@@ -329,14 +329,14 @@ static vfx_result plugin_read_raw(vfx_context *ctx, vfx_effect_kind effect, floa
     if (!ctx || !out)
         return VFX_ERR_INVALID_ARGUMENT;
     if ((unsigned)effect >= VFX_EFFECT_COUNT)
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "read_raw: effect %d out of range", (int)effect);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "read_raw: effect %d out of range", (int)effect);
     if (!ctx->effect_ops[effect])
-        return vfx_fail(ctx, VFX_ERR_UNSUPPORTED, "read_raw: effect %d is not built in", (int)effect);
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, "read_raw: effect %d is not built in", (int)effect);
     if (!ctx->effect_state[effect])
-        return vfx_fail(ctx, VFX_ERR_NOT_FOUND, "read_raw: effect %s is absent from the world",
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "read_raw: effect %s is absent from the world",
                         ctx->effect_ops[effect]->name);
     if (count < (size_t)ctx->width * ctx->height)
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "read_raw: buffer of %zu floats, need %ux%u",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "read_raw: buffer of %zu floats, need %ux%u",
                         count, ctx->width, ctx->height);
     return ctx->effect_ops[effect]->read_raw(ctx, ctx->effect_state[effect], out, count);
 }

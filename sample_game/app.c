@@ -14,40 +14,40 @@
 
 static void host_log(void *user, vfx_log_level level, const char *message)
 {
-    vfx_app *app = user;
-    vfx_logf(&app->log, level, "%s", message);
+    game_app *app = user;
+    rt_logf(&app->log, level, "%s", message);
 }
 
 static void *host_proc(void *user, const char *name)
 {
-    vfx_app *app = user;
-    return vfx_gl_context_get_proc(app->gl, name);
+    game_app *app = user;
+    return rt_gl_context_get_proc(app->gl, name);
 }
 
-static vfx_component particle_terms(const vfx_app *app) { return app->particles.position; }
+static rt_component particle_terms(const game_app *app) { return app->particles.position; }
 
 static uint32_t host_particle_chunk_count(void *user)
 {
-    vfx_app *app = user;
+    game_app *app = user;
     if (!app->water_enabled)
         return 0;
-    vfx_component t = particle_terms(app);
+    rt_component t = particle_terms(app);
     uint32_t n = 0;
-    vfx_query_iter it = vfx_query_begin(app->world, &t, 1);
-    while (vfx_query_next(&it))
+    rt_query_iter it = rt_query_begin(app->world, &t, 1);
+    while (rt_query_next(&it))
         ++n;
     return n;
 }
 
 static vfx_result host_particle_chunk(void *user, uint32_t index, vfx_particle_view *out)
 {
-    vfx_app *app = user;
+    game_app *app = user;
     if (!out || out->size < sizeof *out)
         return VFX_ERR_ABI;
-    vfx_component t = particle_terms(app);
-    vfx_query_iter it = vfx_query_begin(app->world, &t, 1);
+    rt_component t = particle_terms(app);
+    rt_query_iter it = rt_query_begin(app->world, &t, 1);
     uint32_t i = 0;
-    while (vfx_query_next(&it)) {
+    while (rt_query_next(&it)) {
         if (i++ != index)
             continue;
         memset(out, 0, sizeof *out);
@@ -55,12 +55,12 @@ static vfx_result host_particle_chunk(void *user, uint32_t index, vfx_particle_v
         out->version = VFX_PARTICLE_VIEW_VERSION;
         out->count = it.rows;
         for (uint32_t k = 0; k < 3; ++k) {
-            out->pos[k] = vfx_query_column(&it, app->particles.position, k);
-            out->vel[k] = vfx_query_column(&it, app->particles.velocity, k);
+            out->pos[k] = rt_query_column(&it, app->particles.position, k);
+            out->vel[k] = rt_query_column(&it, app->particles.velocity, k);
         }
-        out->density = vfx_query_column(&it, app->particles.density, 0);
-        out->radius = vfx_query_column(&it, app->particles.radius, 0);
-        out->revision = vfx_world_table_revision(app->world, it.table);
+        out->density = rt_query_column(&it, app->particles.density, 0);
+        out->radius = rt_query_column(&it, app->particles.radius, 0);
+        out->revision = rt_world_table_revision(app->world, it.table);
         return VFX_OK;
     }
     return VFX_ERR_NOT_FOUND;
@@ -68,7 +68,7 @@ static vfx_result host_particle_chunk(void *user, uint32_t index, vfx_particle_v
 
 static vfx_result host_water_params(void *user, vfx_water_params *out)
 {
-    vfx_app *app = user;
+    game_app *app = user;
     if (!out || out->size < sizeof *out)
         return VFX_ERR_ABI;
     *out = app->water;
@@ -79,7 +79,7 @@ static vfx_result host_water_params(void *user, vfx_water_params *out)
 
 static vfx_result host_beams(void *user, vfx_beams_view *out)
 {
-    vfx_app *app = user;
+    game_app *app = user;
     if (!out || out->size < sizeof *out)
         return VFX_ERR_ABI;
     if (app->beam_count == 0)
@@ -92,11 +92,11 @@ static vfx_result host_beams(void *user, vfx_beams_view *out)
     return VFX_OK;
 }
 
-static uint32_t host_volume_count(void *user) { return ((vfx_app *)user)->volume_count; }
+static uint32_t host_volume_count(void *user) { return ((game_app *)user)->volume_count; }
 
 static vfx_result host_volume(void *user, uint32_t index, vfx_volume_view *out)
 {
-    vfx_app *app = user;
+    game_app *app = user;
     if (!out || out->size < sizeof *out)
         return VFX_ERR_ABI;
     if (index >= app->volume_count)
@@ -109,21 +109,21 @@ static vfx_result host_volume(void *user, uint32_t index, vfx_volume_view *out)
 
 /* -------------------------------------------------------------------- lifecycle */
 
-vfx_result vfx_app_set_camera(vfx_app *app, const vfx_ref_camera *cam)
+vfx_result game_app_set_camera(game_app *app, const ref_camera *cam)
 {
     if (!cam || cam->width == 0 || cam->height == 0 || !(cam->fov_y > 0 && cam->fov_y < M_PI)
         || !(cam->near_plane > 0) || !(cam->far_plane > cam->near_plane)) {
-        vfx_logf(&app->log, VFX_LOG_ERROR, "camera: need size > 0, 0 < fov_y < pi, 0 < near < far");
+        rt_logf(&app->log, VFX_LOG_ERROR, "camera: need size > 0, 0 < fov_y < pi, 0 < near < far");
         return VFX_ERR_INVALID_ARGUMENT;
     }
     app->camera = *cam;
-    return vfx_renderer_resize(app->renderer, cam->width, cam->height);
+    return rt_renderer_resize(app->renderer, cam->width, cam->height);
 }
 
-vfx_result vfx_app_create(const vfx_app_desc *desc, vfx_app **out)
+vfx_result game_app_create(const game_app_desc *desc, game_app **out)
 {
     *out = NULL;
-    vfx_app *app = calloc(1, sizeof *app);
+    game_app *app = calloc(1, sizeof *app);
     if (!app)
         return VFX_ERR_OUT_OF_MEMORY;
     if (desc)
@@ -133,28 +133,28 @@ vfx_result vfx_app_create(const vfx_app_desc *desc, vfx_app **out)
 #ifndef VFX_GL_DEBUG_DEFAULT
 #define VFX_GL_DEBUG_DEFAULT 0
 #endif
-    vfx_gl_context_desc gd = {.mode = app->desc.mode, .width = w, .height = h, .title = "volfx",
+    rt_gl_context_desc gd = {.mode = app->desc.mode, .width = w, .height = h, .title = "volfx",
                               .debug = app->desc.debug_gl || VFX_GL_DEBUG_DEFAULT, .logger = app->log};
-    vfx_result r = vfx_gl_context_create(&gd, &app->gl);
+    vfx_result r = rt_gl_context_create(&gd, &app->gl);
     if (r)
         goto fail;
-    app->profiler = vfx_profiler_create(app->desc.profile_frames ? app->desc.profile_frames : 4096);
-    vfx_world_desc wd = {.logger = app->log, .on_system_done = vfx_profiler_on_system,
+    app->profiler = rt_profiler_create(app->desc.profile_frames ? app->desc.profile_frames : 4096);
+    rt_world_desc wd = {.logger = app->log, .on_system_done = rt_profiler_on_system,
                          .on_system_user = app->profiler};
-    app->world = vfx_world_create(&wd);
+    app->world = rt_world_create(&wd);
     if (!app->profiler || !app->world) {
         r = VFX_ERR_OUT_OF_MEMORY;
         goto fail;
     }
-    if ((r = vfx_particles_register(app->world, &app->particles)))
+    if ((r = rt_particles_register(app->world, &app->particles)))
         goto fail;
-    if ((r = vfx_world_register(app->world, &(vfx_component_desc){"vfx.mesh", sizeof(vfx_app_mesh), 8, 1}, &app->mesh_comp))
-        || (r = vfx_world_register(app->world, &(vfx_component_desc){"vfx.transform", 64, 16, 1}, &app->transform_comp)))
+    if ((r = rt_world_register(app->world, &(rt_component_desc){"vfx.mesh", sizeof(game_app_mesh), 8, 1}, &app->mesh_comp))
+        || (r = rt_world_register(app->world, &(rt_component_desc){"vfx.transform", 64, 16, 1}, &app->transform_comp)))
         goto fail;
-    if ((r = vfx_renderer_create(&app->log, &app->renderer)))
+    if ((r = rt_renderer_create(&app->log, &app->renderer)))
         goto fail;
-    app->camera = (vfx_ref_camera){{0, 2, 6}, {0, 0.5, 0}, {0, 1, 0}, 60.0 * M_PI / 180.0, w, h, 0.05, 200.0};
-    if ((r = vfx_renderer_resize(app->renderer, w, h)))
+    app->camera = (ref_camera){{0, 2, 6}, {0, 0.5, 0}, {0, 1, 0}, 60.0 * M_PI / 180.0, w, h, 0.05, 200.0};
+    if ((r = rt_renderer_resize(app->renderer, w, h)))
         goto fail;
     app->clear_color[0] = 0.05f, app->clear_color[1] = 0.06f, app->clear_color[2] = 0.09f;
     app->host = (vfx_host_api){
@@ -164,168 +164,168 @@ vfx_result vfx_app_create(const vfx_app_desc *desc, vfx_app **out)
         .water_params = host_water_params, .beams = host_beams,
         .volume_count = host_volume_count, .volume = host_volume};
     if (app->desc.plugin_path)
-        r = vfx_plugin_host_load(app->desc.plugin_path, &app->host, &app->log, &app->plugin);
+        r = rt_plugin_host_load(app->desc.plugin_path, &app->host, &app->log, &app->plugin);
     else
-        r = vfx_plugin_host_load_static(vfx_plugin_entry, &app->host, &app->log, &app->plugin);
+        r = rt_plugin_host_load_static(vfx_plugin_entry, &app->host, &app->log, &app->plugin);
     if (r)
         goto fail;
-    app->api = vfx_plugin_host_api(app->plugin);
+    app->api = rt_plugin_host_api(app->plugin);
     if ((r = app->api->create(&app->host, &app->ctx)))
         goto fail;
     *out = app;
     return VFX_OK;
 fail:
-    vfx_logf(&app->log, VFX_LOG_ERROR, "app: start-up failed: %s", vfx_result_name(r));
-    vfx_app_destroy(app);
+    rt_logf(&app->log, VFX_LOG_ERROR, "app: start-up failed: %s", vfx_result_name(r));
+    game_app_destroy(app);
     return r;
 }
 
-void vfx_app_destroy(vfx_app *app)
+void game_app_destroy(game_app *app)
 {
     if (!app)
         return;
     if (app->ctx)
         app->api->destroy(app->ctx);
-    vfx_plugin_host_unload(app->plugin);
+    rt_plugin_host_unload(app->plugin);
     if (app->world) {
-        vfx_query_iter it = vfx_query_begin(app->world, &app->mesh_comp, 1);
-        while (vfx_query_next(&it)) {
-            vfx_app_mesh *m = vfx_query_column(&it, app->mesh_comp, 0);
+        rt_query_iter it = rt_query_begin(app->world, &app->mesh_comp, 1);
+        while (rt_query_next(&it)) {
+            game_app_mesh *m = rt_query_column(&it, app->mesh_comp, 0);
             for (uint32_t i = 0; i < it.rows; ++i)
-                vfx_mesh_gpu_destroy(&m[i].gpu);
+                rt_mesh_gpu_destroy(&m[i].gpu);
         }
     }
-    vfx_renderer_destroy(app->renderer);
-    vfx_world_destroy(app->world);
-    vfx_profiler_destroy(app->profiler);
-    vfx_gl_context_destroy(app->gl);
+    rt_renderer_destroy(app->renderer);
+    rt_world_destroy(app->world);
+    rt_profiler_destroy(app->profiler);
+    rt_gl_context_destroy(app->gl);
     free(app);
 }
 
-static vfx_result add_mesh(vfx_app *app, vfx_mesh_data *data, const float model[16],
-                           const float rgb[3], vfx_entity *out)
+static vfx_result add_mesh(game_app *app, rt_mesh_data *data, const float model[16],
+                           const float rgb[3], rt_entity *out)
 {
-    vfx_app_mesh m;
+    game_app_mesh m;
     memset(&m, 0, sizeof m);
-    vfx_result r = vfx_mesh_upload(data, &m.gpu);
+    vfx_result r = rt_mesh_upload(data, &m.gpu);
     memcpy(m.bounds_min, data->bounds_min, sizeof m.bounds_min);
     memcpy(m.bounds_max, data->bounds_max, sizeof m.bounds_max);
-    vfx_mesh_data_free(data);
+    rt_mesh_data_free(data);
     if (r)
         return r;
     memcpy(m.color, rgb, sizeof m.color);
-    vfx_component comps[2] = {app->mesh_comp, app->transform_comp};
-    vfx_entity e;
-    if ((r = vfx_world_spawn(app->world, 1, comps, 2, &e))) {
-        vfx_mesh_gpu_destroy(&m.gpu);
+    rt_component comps[2] = {app->mesh_comp, app->transform_comp};
+    rt_entity e;
+    if ((r = rt_world_spawn(app->world, 1, comps, 2, &e))) {
+        rt_mesh_gpu_destroy(&m.gpu);
         return r;
     }
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    memcpy(vfx_world_get(app->world, e, app->mesh_comp, 0), &m, sizeof m);
-    memcpy(vfx_world_get(app->world, e, app->transform_comp, 0), model ? model : identity, 64);
+    memcpy(rt_world_get(app->world, e, app->mesh_comp, 0), &m, sizeof m);
+    memcpy(rt_world_get(app->world, e, app->transform_comp, 0), model ? model : identity, 64);
     app->mesh_count++;
     if (out)
         *out = e;
     return VFX_OK;
 }
 
-vfx_result vfx_app_add_mesh_file(vfx_app *app, const char *path, const float model[16],
-                                 const float rgb[3], vfx_entity *out)
+vfx_result game_app_add_mesh_file(game_app *app, const char *path, const float model[16],
+                                 const float rgb[3], rt_entity *out)
 {
-    vfx_mesh_data data;
+    rt_mesh_data data;
     char err[512];
-    vfx_result r = vfx_mesh_import(path, &data, err, sizeof err);
+    vfx_result r = rt_mesh_import(path, &data, err, sizeof err);
     if (r) {
-        vfx_logf(&app->log, VFX_LOG_ERROR, "%s", err);
+        rt_logf(&app->log, VFX_LOG_ERROR, "%s", err);
         return r;
     }
     return add_mesh(app, &data, model, rgb, out);
 }
 
-vfx_result vfx_app_add_box(vfx_app *app, const float mn[3], const float mx[3], const float rgb[3],
-                           vfx_entity *out)
+vfx_result game_app_add_box(game_app *app, const float mn[3], const float mx[3], const float rgb[3],
+                           rt_entity *out)
 {
-    vfx_mesh_data data;
-    vfx_result r = vfx_mesh_make_box(mn, mx, &data);
+    rt_mesh_data data;
+    vfx_result r = rt_mesh_make_box(mn, mx, &data);
     return r ? r : add_mesh(app, &data, NULL, rgb, out);
 }
 
-vfx_result vfx_app_frame(vfx_app *app, float dt)
+vfx_result game_app_frame(game_app *app, float dt)
 {
-    vfx_profiler_frame_begin(app->profiler);
+    rt_profiler_frame_begin(app->profiler);
     app->time += dt;
-    vfx_result r = vfx_world_run_phase(app->world, VFX_PHASE_SIMULATE, app->time, dt);
+    vfx_result r = rt_world_run_phase(app->world, RT_PHASE_SIMULATE, app->time, dt);
     if (!r)
-        r = vfx_world_run_phase(app->world, VFX_PHASE_PRE_RENDER, app->time, dt);
+        r = rt_world_run_phase(app->world, RT_PHASE_PRE_RENDER, app->time, dt);
     if (r)
         return r;
-    double t0 = vfx_now_ms();
+    double t0 = rt_now_ms();
     if ((r = app->api->update(app->ctx, app->time, dt))) {
-        vfx_logf(&app->log, VFX_LOG_ERROR, "plugin update: %s", app->api->last_error(app->ctx));
+        rt_logf(&app->log, VFX_LOG_ERROR, "plugin update: %s", app->api->last_error(app->ctx));
         return r;
     }
-    vfx_profiler_cpu(app->profiler, "plugin.update", vfx_now_ms() - t0);
+    rt_profiler_cpu(app->profiler, "plugin.update", rt_now_ms() - t0);
     float view[16], proj[16];
-    vfx_ref_camera_matrices(&app->camera, view, proj);
-    t0 = vfx_now_ms();
-    vfx_renderer_begin_scene(app->renderer, view, proj, app->clear_color);
-    vfx_component draw_terms[2] = {app->mesh_comp, app->transform_comp};
-    vfx_query_iter it = vfx_query_begin(app->world, draw_terms, 2);
-    while (vfx_query_next(&it)) {
-        const vfx_app_mesh *m = vfx_query_column(&it, app->mesh_comp, 0);
-        const float *xf = vfx_query_column(&it, app->transform_comp, 0);
+    ref_camera_matrices(&app->camera, view, proj);
+    t0 = rt_now_ms();
+    rt_renderer_begin_scene(app->renderer, view, proj, app->clear_color);
+    rt_component draw_terms[2] = {app->mesh_comp, app->transform_comp};
+    rt_query_iter it = rt_query_begin(app->world, draw_terms, 2);
+    while (rt_query_next(&it)) {
+        const game_app_mesh *m = rt_query_column(&it, app->mesh_comp, 0);
+        const float *xf = rt_query_column(&it, app->transform_comp, 0);
         for (uint32_t i = 0; i < it.rows; ++i)
-            vfx_renderer_draw_mesh(app->renderer, &m[i].gpu, xf + 16 * (size_t)i, m[i].color);
+            rt_renderer_draw_mesh(app->renderer, &m[i].gpu, xf + 16 * (size_t)i, m[i].color);
     }
     vfx_frame_view frame;
-    vfx_renderer_end_scene(app->renderer, &frame);
+    rt_renderer_end_scene(app->renderer, &frame);
     for (int k = 0; k < 3; ++k)
         frame.eye[k] = (float)app->camera.eye[k];
     frame.near_plane = (float)app->camera.near_plane;
     frame.far_plane = (float)app->camera.far_plane;
     frame.fov_y = (float)app->camera.fov_y;
-    vfx_profiler_cpu(app->profiler, "host.scene", vfx_now_ms() - t0);
-    t0 = vfx_now_ms();
-    if ((r = vfx_world_run_phase(app->world, VFX_PHASE_RENDER, app->time, dt)))
+    rt_profiler_cpu(app->profiler, "host.scene", rt_now_ms() - t0);
+    t0 = rt_now_ms();
+    if ((r = rt_world_run_phase(app->world, RT_PHASE_RENDER, app->time, dt)))
         return r;
     if ((r = app->api->render(app->ctx, &frame))) {
-        vfx_logf(&app->log, VFX_LOG_ERROR, "plugin render: %s", app->api->last_error(app->ctx));
+        rt_logf(&app->log, VFX_LOG_ERROR, "plugin render: %s", app->api->last_error(app->ctx));
         return r;
     }
-    vfx_profiler_cpu(app->profiler, "plugin.render", vfx_now_ms() - t0);
-    if ((r = vfx_world_run_phase(app->world, VFX_PHASE_POST_RENDER, app->time, dt)))
+    rt_profiler_cpu(app->profiler, "plugin.render", rt_now_ms() - t0);
+    if ((r = rt_world_run_phase(app->world, RT_PHASE_POST_RENDER, app->time, dt)))
         return r;
-    if (vfx_gl_context_has_window(app->gl)) {
+    if (rt_gl_context_has_window(app->gl)) {
         uint32_t ww, wh;
-        vfx_gl_context_size(app->gl, &ww, &wh);
-        vfx_renderer_present(app->renderer, ww, wh);
-        vfx_gl_context_swap(app->gl);
+        rt_gl_context_size(app->gl, &ww, &wh);
+        rt_renderer_present(app->renderer, ww, wh);
+        rt_gl_context_swap(app->gl);
     } else {
         glFinish(); /* headless: make the frame time include the GPU work */
     }
     vfx_stats stats = {.size = sizeof stats, .version = VFX_STATS_VERSION};
     if (app->api->get_stats(app->ctx, &stats) == VFX_OK)
-        vfx_profiler_gpu_stats(app->profiler, &stats);
-    vfx_profiler_frame_end(app->profiler);
+        rt_profiler_gpu_stats(app->profiler, &stats);
+    rt_profiler_frame_end(app->profiler);
     app->frame++;
     return VFX_OK;
 }
 
-vfx_result vfx_app_screenshot(vfx_app *app, const char *path)
+vfx_result game_app_screenshot(game_app *app, const char *path)
 {
     uint32_t w = app->camera.width, h = app->camera.height;
     uint8_t *rgba = malloc((size_t)w * h * 4);
     if (!rgba)
         return VFX_ERR_OUT_OF_MEMORY;
-    vfx_result r = vfx_renderer_read_rgba(app->renderer, rgba);
+    vfx_result r = rt_renderer_read_rgba(app->renderer, rgba);
     char err[256];
-    if (!r && (r = vfx_write_png(path, w, h, rgba, err, sizeof err)))
-        vfx_logf(&app->log, VFX_LOG_ERROR, "%s", err);
+    if (!r && (r = rt_write_png(path, w, h, rgba, err, sizeof err)))
+        rt_logf(&app->log, VFX_LOG_ERROR, "%s", err);
     free(rgba);
     return r;
 }
 
-vfx_result vfx_app_dump_raw(vfx_app *app, vfx_effect_kind effect, const char *path)
+vfx_result game_app_dump_raw(game_app *app, vfx_effect_kind effect, const char *path)
 {
     uint32_t w = app->camera.width, h = app->camera.height;
     float *data = malloc((size_t)w * h * sizeof(float));
@@ -334,9 +334,9 @@ vfx_result vfx_app_dump_raw(vfx_app *app, vfx_effect_kind effect, const char *pa
     vfx_result r = app->api->read_raw(app->ctx, effect, data, (size_t)w * h);
     char err[256];
     if (r)
-        vfx_logf(&app->log, VFX_LOG_ERROR, "dump raw: %s", app->api->last_error(app->ctx));
-    else if ((r = vfx_write_pfm(path, w, h, data, err, sizeof err)))
-        vfx_logf(&app->log, VFX_LOG_ERROR, "%s", err);
+        rt_logf(&app->log, VFX_LOG_ERROR, "dump raw: %s", app->api->last_error(app->ctx));
+    else if ((r = rt_write_pfm(path, w, h, data, err, sizeof err)))
+        rt_logf(&app->log, VFX_LOG_ERROR, "%s", err);
     free(data);
     return r;
 }

@@ -9,11 +9,11 @@
 #include "demo_scene.h"
 
 /* Weak: an effect left out of the build (or not written yet) leaves its entry NULL. */
-int vfx_bench_sim(int argc, char **argv) __attribute__((weak));
-int vfx_bench_metaballs(int argc, char **argv) __attribute__((weak));
-int vfx_bench_beams(int argc, char **argv) __attribute__((weak));
-int vfx_bench_tetvol(int argc, char **argv) __attribute__((weak));
-int vfx_bench_ecs(int argc, char **argv);
+int bench_sim(int argc, char **argv) __attribute__((weak));
+int bench_metaballs(int argc, char **argv) __attribute__((weak));
+int bench_beams(int argc, char **argv) __attribute__((weak));
+int bench_tetvol(int argc, char **argv) __attribute__((weak));
+int bench_ecs(int argc, char **argv);
 
 /* `frame`: a scene (the built-in default unless --scene), headless, N frames; optionally the
  * raw quantity of one effect of the last frame as a PFM (--dump-raw water|beams|volume FILE). */
@@ -46,34 +46,34 @@ static int bench_frame(int argc, char **argv)
             return 2;
         }
     }
-    vfx_app_desc d = {.mode = VFX_GL_HEADLESS, .width = w, .height = h};
-    vfx_app *app;
-    if (vfx_app_create(&d, &app))
+    game_app_desc d = {.mode = RT_GL_HEADLESS, .width = w, .height = h};
+    game_app *app;
+    if (game_app_create(&d, &app))
         return 1;
-    vfx_demo demo;
-    if (vfx_demo_load(app, &demo, scene, 0)) {
-        vfx_app_destroy(app);
+    game_demo demo;
+    if (game_demo_load(app, &demo, scene, 0)) {
+        game_app_destroy(app);
         return 1;
     }
     int rc = 0;
     for (uint32_t f = 0; f < frames && rc == 0; ++f) {
-        vfx_demo_animate(app, &demo, 1.f / 60.f);
-        rc = vfx_app_frame(app, 1.f / 60.f) ? 1 : 0;
+        game_demo_animate(app, &demo, 1.f / 60.f);
+        rc = game_app_frame(app, 1.f / 60.f) ? 1 : 0;
     }
-    vfx_frame_summary s = vfx_profiler_summary(app->profiler, frames > 10 ? 5 : 0);
-    if (rc == 0 && raw_path && vfx_app_dump_raw(app, raw_kind, raw_path) != VFX_OK)
+    rt_frame_summary s = rt_profiler_summary(app->profiler, frames > 10 ? 5 : 0);
+    if (rc == 0 && raw_path && game_app_dump_raw(app, raw_kind, raw_path) != VFX_OK)
         rc = 1;
     printf("{\"effect\":\"frame\",\"scene\":\"%s\",\"width\":%u,\"height\":%u,\"frames\":%u,\"gl_renderer\":\"%s\","
            "\"frame_ms\":{\"p50\":%.4f,\"p95\":%.4f,\"p99\":%.4f},\"mean_fps\":%.3f,\"stats\":{",
            scene ? scene : "(default)", app->camera.width, app->camera.height, s.frames,
-           vfx_gl_context_renderer(app->gl), s.p50_ms, s.p95_ms, s.p99_ms, s.mean_fps);
+           rt_gl_context_renderer(app->gl), s.p50_ms, s.p95_ms, s.p99_ms, s.mean_fps);
     vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
     app->api->get_stats(app->ctx, &st);
     for (uint32_t i = 0; i < st.count; ++i)
         printf("%s\"%s\":%.6g", i ? "," : "", st.entries[i].name, st.entries[i].value);
     printf("}}\n");
-    vfx_demo_free(app, &demo);
-    vfx_app_destroy(app);
+    game_demo_free(app, &demo);
+    game_app_destroy(app);
     return rc;
 }
 
@@ -86,8 +86,8 @@ int main(int argc, char **argv)
     }
     const char *sub = argv[1];
     struct { const char *name; int (*fn)(int, char **); } subs[] = {
-        {"sim", vfx_bench_sim}, {"metaballs", vfx_bench_metaballs}, {"beams", vfx_bench_beams},
-        {"tetvol", vfx_bench_tetvol}, {"ecs", vfx_bench_ecs}, {"frame", bench_frame}};
+        {"sim", bench_sim}, {"metaballs", bench_metaballs}, {"beams", bench_beams},
+        {"tetvol", bench_tetvol}, {"ecs", bench_ecs}, {"frame", bench_frame}};
     for (size_t i = 0; i < sizeof subs / sizeof subs[0]; ++i) {
         if (strcmp(sub, subs[i].name) != 0)
             continue;

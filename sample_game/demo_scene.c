@@ -5,42 +5,42 @@
 #include <stdlib.h>
 #include <string.h>
 
-extern const char vfx_default_scene_json[];
-extern const unsigned long vfx_default_scene_json_len;
+extern const char game_default_scene_json[];
+extern const unsigned long game_default_scene_json_len;
 
-static vfx_result load_meshes(vfx_app *app, const vfx_scene *sc)
+static vfx_result load_meshes(game_app *app, const rt_scene *sc)
 {
     for (uint32_t i = 0; i < sc->mesh_count; ++i) {
-        const vfx_scene_mesh *m = &sc->meshes[i];
-        vfx_entity e;
+        const rt_scene_mesh *m = &sc->meshes[i];
+        rt_entity e;
         vfx_result r;
         if (m->is_box) {
-            if ((r = vfx_app_add_box(app, m->box_min, m->box_max, m->color, &e)))
+            if ((r = game_app_add_box(app, m->box_min, m->box_max, m->color, &e)))
                 return r;
-            memcpy(vfx_world_get(app->world, e, app->transform_comp, 0), m->model, sizeof m->model);
+            memcpy(rt_world_get(app->world, e, app->transform_comp, 0), m->model, sizeof m->model);
             continue;
         }
         FILE *f = fopen(m->path, "rb");
         if (!f) { /* a missing decoration is not worth refusing the scene for */
-            vfx_logf(&app->log, VFX_LOG_WARN, "scene meshes[%u]: %s not found, skipped", i, m->path);
+            rt_logf(&app->log, VFX_LOG_WARN, "scene meshes[%u]: %s not found, skipped", i, m->path);
             continue;
         }
         fclose(f);
-        if ((r = vfx_app_add_mesh_file(app, m->path, m->model, m->color, NULL)))
+        if ((r = game_app_add_mesh_file(app, m->path, m->model, m->color, NULL)))
             return r;
     }
     return VFX_OK;
 }
 
-static vfx_result load_water(vfx_app *app, vfx_demo *demo, const vfx_scene *sc)
+static vfx_result load_water(game_app *app, game_demo *demo, const rt_scene *sc)
 {
-    const vfx_scene_water *w = &sc->water;
+    const rt_scene_water *w = &sc->water;
     float *xyz = NULL;
     uint32_t n = 0;
     char err[256];
-    vfx_result r = vfx_scene_water_particles(w, &xyz, &n, err, sizeof err);
+    vfx_result r = rt_scene_water_particles(w, &xyz, &n, err, sizeof err);
     if (r) {
-        vfx_logf(&app->log, VFX_LOG_ERROR, "scene water: %s", err);
+        rt_logf(&app->log, VFX_LOG_ERROR, "scene water: %s", err);
         return r;
     }
     float *px = malloc((n ? n : 1) * sizeof(float)), *py = malloc((n ? n : 1) * sizeof(float)),
@@ -52,13 +52,13 @@ static vfx_result load_water(vfx_app *app, vfx_demo *demo, const vfx_scene *sc)
     for (uint32_t i = 0; i < n; ++i)
         px[i] = xyz[3 * i], py[i] = xyz[3 * i + 1], pz[i] = xyz[3 * i + 2];
     free(xyz);
-    if (w->source == VFX_SCENE_WATER_SIMULATION && n > 0) {
+    if (w->source == RT_SCENE_WATER_SIMULATION && n > 0) {
         /* the particle spacing follows from the count filling the initial block */
         double vol = 1.0;
         for (int k = 0; k < 3; ++k)
             vol *= fmax(w->box_max[k] - w->box_min[k], 1e-6);
         float spacing = (float)cbrt(vol / n);
-        vfx_sph_desc sd = {.spacing = spacing, .max_substeps = 64,
+        rt_sph_desc sd = {.spacing = spacing, .max_substeps = 64,
                            /* ~0.6 m of water moves at ~3.4 m/s: c0 = 25 m/s keeps the compression
                             * near (3.4/25)^2 = 2% with half the substeps of the default */
                            .sound_speed = 25.0f};
@@ -66,16 +66,16 @@ static vfx_result load_water(vfx_app *app, vfx_demo *demo, const vfx_scene *sc)
         memcpy(sd.domain_max, w->tank_max, sizeof sd.domain_max);
         memcpy(sd.gravity, w->gravity, sizeof sd.gravity);
         if (w->gravity[0] == 0 && w->gravity[1] == 0 && w->gravity[2] == 0)
-            sd.flags |= VFX_SPH_NO_GRAVITY;
+            sd.flags |= RT_SPH_NO_GRAVITY;
         if (w->no_slip)
             sd.no_slip_faces = 0x3fu; /* every tank face */
-        if ((r = vfx_sim_system_create(app->world, &sd, &demo->sim, err, sizeof err))) {
-            vfx_logf(&app->log, VFX_LOG_ERROR, "scene water simulation: %s", err);
+        if ((r = rt_sim_system_create(app->world, &sd, &demo->sim, err, sizeof err))) {
+            rt_logf(&app->log, VFX_LOG_ERROR, "scene water simulation: %s", err);
             goto done;
         }
         if (w->paddle) {
             uint32_t ax = w->paddle_axis < 3 ? w->paddle_axis : 0;
-            vfx_sph_collider paddle = {.kind = VFX_SPH_BOX, .motion_amplitude = w->paddle_amplitude,
+            rt_sph_collider paddle = {.kind = RT_SPH_BOX, .motion_amplitude = w->paddle_amplitude,
                                        .motion_frequency = w->paddle_period_s > 0 ? 1.0f / w->paddle_period_s : 0};
             for (int k = 0; k < 3; ++k) {
                 paddle.center[k] = 0.5f * (w->tank_min[k] + w->tank_max[k]);
@@ -85,11 +85,11 @@ static vfx_result load_water(vfx_app *app, vfx_demo *demo, const vfx_scene *sc)
             paddle.half[ax] = 0.5f * spacing;
             paddle.center[ax] = w->tank_min[ax] + w->paddle_amplitude + spacing;
             paddle.motion_axis[ax] = 1.0f;
-            if ((r = vfx_sph_add_collider(vfx_sim_system_solver(demo->sim), &paddle, NULL)))
+            if ((r = rt_sph_add_collider(rt_sim_system_solver(demo->sim), &paddle, NULL)))
                 goto done;
         }
     }
-    if ((r = vfx_particles_spawn(app->world, &app->particles, n, px, py, pz, false)))
+    if ((r = rt_particles_spawn(app->world, &app->particles, n, px, py, pz, false)))
         goto done;
     demo->particle_count = n;
     app->water = w->params;
@@ -100,18 +100,18 @@ done:
 }
 
 /* The volume's mesh stays with the demo; the host api hands the plugin pointers into it. */
-static vfx_result load_volume(vfx_app *app, vfx_demo *demo, const vfx_scene *sc)
+static vfx_result load_volume(game_app *app, game_demo *demo, const rt_scene *sc)
 {
-    const vfx_scene_volume *v = &sc->volume;
+    const rt_scene_volume *v = &sc->volume;
     if (!v->generated) {
-        vfx_logf(&app->log, VFX_LOG_INFO, "scene volume %s: file volumes are not wired into the game yet", v->path);
+        rt_logf(&app->log, VFX_LOG_INFO, "scene volume %s: file volumes are not wired into the game yet", v->path);
         return VFX_OK;
     }
     char err[256];
-    vfx_result r = vfx_scene_volume_generate(v, &demo->vol_points, &demo->vol_point_count, &demo->vol_tets,
+    vfx_result r = rt_scene_volume_generate(v, &demo->vol_points, &demo->vol_point_count, &demo->vol_tets,
                                              &demo->vol_tet_count, &demo->vol_scalar, err, sizeof err);
     if (r) {
-        vfx_logf(&app->log, VFX_LOG_ERROR, "scene volume: %s", err);
+        rt_logf(&app->log, VFX_LOG_ERROR, "scene volume: %s", err);
         return r;
     }
     vfx_volume_view *vv = &app->volumes[0];
@@ -124,7 +124,7 @@ static vfx_result load_volume(vfx_app *app, vfx_demo *demo, const vfx_scene *sc)
     vv->tets = demo->vol_tets;
     vv->scalar = demo->vol_scalar;
     if (v->transfer_count) {
-        vfx_scene_transfer_sample(v, 64, demo->vol_transfer, &vv->scalar_min, &vv->scalar_max);
+        rt_scene_transfer_sample(v, 64, demo->vol_transfer, &vv->scalar_min, &vv->scalar_max);
         vv->transfer_rgba = demo->vol_transfer;
         vv->transfer_count = 64;
     }
@@ -139,52 +139,52 @@ static vfx_result load_volume(vfx_app *app, vfx_demo *demo, const vfx_scene *sc)
     return VFX_OK;
 }
 
-vfx_result vfx_demo_load(vfx_app *app, vfx_demo *demo, const char *scene_path, uint32_t effects_off)
+vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path, uint32_t effects_off)
 {
     memset(demo, 0, sizeof *demo);
     demo->effects_off = effects_off | ~app->api->effects_built; /* what the plugin lacks is off too */
     char err[512];
     vfx_result r = scene_path
-                       ? vfx_scene_load_file(scene_path, &app->log, &demo->scene, err, sizeof err)
-                       : vfx_scene_load_mem(vfx_default_scene_json, vfx_default_scene_json_len, NULL,
+                       ? rt_scene_load_file(scene_path, &app->log, &demo->scene, err, sizeof err)
+                       : rt_scene_load_mem(game_default_scene_json, game_default_scene_json_len, NULL,
                                             &app->log, &demo->scene, err, sizeof err);
     if (r) {
-        vfx_logf(&app->log, VFX_LOG_ERROR, "scene %s: %s", scene_path ? scene_path : "(built-in default)", err);
+        rt_logf(&app->log, VFX_LOG_ERROR, "scene %s: %s", scene_path ? scene_path : "(built-in default)", err);
         return r;
     }
-    const vfx_scene *sc = demo->scene;
-    const vfx_scene_camera *c = &sc->camera;
-    vfx_ref_camera cam = {{c->eye[0], c->eye[1], c->eye[2]}, {c->target[0], c->target[1], c->target[2]},
+    const rt_scene *sc = demo->scene;
+    const rt_scene_camera *c = &sc->camera;
+    ref_camera cam = {{c->eye[0], c->eye[1], c->eye[2]}, {c->target[0], c->target[1], c->target[2]},
                           {c->up[0], c->up[1], c->up[2]}, c->fov_y_deg * M_PI / 180.0,
                           app->desc.width ? app->desc.width : c->width, app->desc.height ? app->desc.height : c->height,
                           c->near_plane, c->far_plane};
-    if ((r = vfx_app_set_camera(app, &cam)) || (r = load_meshes(app, sc)))
+    if ((r = game_app_set_camera(app, &cam)) || (r = load_meshes(app, sc)))
         return r;
     if (sc->has_water && !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_WATER)) && (r = load_water(app, demo, sc)))
         return r;
     if (sc->beam_count && !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_BEAMS))) {
-        demo->beam_base_count = sc->beam_count < VFX_APP_MAX_BEAMS ? sc->beam_count : VFX_APP_MAX_BEAMS;
+        demo->beam_base_count = sc->beam_count < GAME_APP_MAX_BEAMS ? sc->beam_count : GAME_APP_MAX_BEAMS;
         app->beams_view = sc->beams_view;
-        app->beam_count = vfx_scene_beams_at(sc, 0.0, app->beams, demo->beam_base_count);
+        app->beam_count = rt_scene_beams_at(sc, 0.0, app->beams, demo->beam_base_count);
     }
     if (sc->has_volume && !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_VOLUME)) && (r = load_volume(app, demo, sc)))
         return r;
     if (sc->has_volume && (demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_VOLUME)))
-        vfx_logf(&app->log, VFX_LOG_INFO, "scene volume left out (effect switched off or not built)");
+        rt_logf(&app->log, VFX_LOG_INFO, "scene volume left out (effect switched off or not built)");
     snprintf(demo->description, sizeof demo->description,
              "scene '%.60s': %u meshes, %u particles%s, %u beams, %u volumes", sc->name, app->mesh_count,
              demo->particle_count, demo->sim ? " (SPH)" : "", app->beam_count, app->volume_count);
     return VFX_OK;
 }
 
-void vfx_demo_animate(vfx_app *app, vfx_demo *demo, float dt)
+void game_demo_animate(game_app *app, game_demo *demo, float dt)
 {
     (void)dt;
     if (demo->scene && app->beam_count) /* keyframed: grow, thicken, move, turn */
-        app->beam_count = vfx_scene_beams_at(demo->scene, app->time, app->beams, demo->beam_base_count);
+        app->beam_count = rt_scene_beams_at(demo->scene, app->time, app->beams, demo->beam_base_count);
 }
 
-void vfx_demo_toggle(vfx_app *app, vfx_demo *demo, vfx_effect_kind kind)
+void game_demo_toggle(game_app *app, game_demo *demo, vfx_effect_kind kind)
 {
     demo->effects_off ^= VFX_EFFECT_BIT(kind);
     bool off = demo->effects_off & VFX_EFFECT_BIT(kind);
@@ -196,12 +196,12 @@ void vfx_demo_toggle(vfx_app *app, vfx_demo *demo, vfx_effect_kind kind)
         app->volume_count = off || !demo->vol_tets ? 0 : 1;
 }
 
-void vfx_demo_print_profile(vfx_app *app, FILE *out)
+void game_demo_print_profile(game_app *app, FILE *out)
 {
     static const char *series[] = {"vfx.sim.sph", "plugin.update", "host.scene", "plugin.render"};
     fprintf(out, "cpu ms (median):");
     for (size_t i = 0; i < sizeof series / sizeof series[0]; ++i) {
-        double m = vfx_profiler_series_median(app->profiler, series[i]);
+        double m = rt_profiler_series_median(app->profiler, series[i]);
         if (!isnan(m))
             fprintf(out, " %s %.3f", series[i], m);
     }
@@ -215,16 +215,16 @@ void vfx_demo_print_profile(vfx_app *app, FILE *out)
     }
 }
 
-void vfx_demo_free(vfx_app *app, vfx_demo *demo)
+void game_demo_free(game_app *app, game_demo *demo)
 {
     if (demo->sim) {
-        const vfx_sph_report *rep = vfx_sim_system_report(demo->sim);
+        const rt_sph_report *rep = rt_sim_system_report(demo->sim);
         if (rep->cap_hit)
-            vfx_logf(&app->log, VFX_LOG_WARN, "water simulation: substep cap hit in the last frame");
+            rt_logf(&app->log, VFX_LOG_WARN, "water simulation: substep cap hit in the last frame");
     }
     app->volume_count = 0; /* the views point into the arrays freed here */
-    vfx_sim_system_destroy(demo->sim); /* the world must not run again after this */
-    vfx_scene_free(demo->scene);
+    rt_sim_system_destroy(demo->sim); /* the world must not run again after this */
+    rt_scene_free(demo->scene);
     free(demo->vol_points);
     free(demo->vol_tets);
     free(demo->vol_scalar);

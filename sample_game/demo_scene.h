@@ -1,39 +1,39 @@
 /* demo_scene.h — the sample game's scene: the built-in default scene or a scene file, and
  * the animation that moves and deforms every effect each frame. */
-#ifndef VFX_DEMO_SCENE_H
-#define VFX_DEMO_SCENE_H
+#ifndef GAME_DEMO_SCENE_H
+#define GAME_DEMO_SCENE_H
 
 #include <stdio.h>
 #include "app.h"
 #include "scene/scene.h"
 #include "sim/sim_system.h"
 
-typedef struct vfx_demo {
+typedef struct game_demo {
     char description[256];
     uint32_t effects_off;      /* VFX_EFFECT_BIT mask switched off by options or keys */
     uint32_t particle_count;
-    vfx_scene *scene;          /* the loaded scene (beams are re-evaluated from it each frame) */
+    rt_scene *scene;          /* the loaded scene (beams are re-evaluated from it each frame) */
     uint32_t beam_base_count;  /* beams in the scene (restored when toggled back on) */
     bool key_latch[8];
     bool mouse_down;
     double mouse_x, mouse_y;
-    vfx_sim_system *sim;       /* SPH writing the particle columns (NULL without water) */
+    rt_sim_system *sim;       /* SPH writing the particle columns (NULL without water) */
     float *vol_points, *vol_scalar, vol_transfer[64 * 4];
     uint32_t *vol_tets, vol_point_count, vol_tet_count;
-} vfx_demo;
+} game_demo;
 
 /* Loads the scene file `scene_path` (NULL -> the built-in default, sample_game/scenes/
  * default.json embedded at build time) into the app: meshes as entities, water particles (an
  * SPH system when the scene sets up a simulation), beams with their keyframes, the volume.
  * Effects in `effects_off`, or not built into the plugin, are left out entirely. */
-vfx_result vfx_demo_load(vfx_app *app, vfx_demo *demo, const char *scene_path, uint32_t effects_off);
+vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path, uint32_t effects_off);
 /* Advances the animation by dt (0 = paused). */
-void vfx_demo_animate(vfx_app *app, vfx_demo *demo, float dt);
+void game_demo_animate(game_app *app, game_demo *demo, float dt);
 /* Switches an effect on or off at run time (off = absent from the world). */
-void vfx_demo_toggle(vfx_app *app, vfx_demo *demo, vfx_effect_kind kind);
+void game_demo_toggle(game_app *app, game_demo *demo, vfx_effect_kind kind);
 /* Prints median CPU ms per system and GPU ms per pass. */
-void vfx_demo_print_profile(vfx_app *app, FILE *out);
+void game_demo_print_profile(game_app *app, FILE *out);
 /* Frees what load made. */
-void vfx_demo_free(vfx_app *app, vfx_demo *demo);
+void game_demo_free(game_app *app, game_demo *demo);
 
 #endif

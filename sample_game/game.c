@@ -16,7 +16,7 @@ typedef struct game_options {
     double seconds;
     uint32_t width, height;
     const char *png, *csv, *trace, *plugin, *scene;
-    vfx_gl_mode mode;
+    rt_gl_mode mode;
     bool debug;
     uint32_t effects_off;
     uint32_t mem_every;        /* print RSS and GL object counts every N frames (0 = never) */
@@ -41,8 +41,8 @@ static bool parse(int argc, char **argv, game_options *o)
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
 #define NEED_ARG() do { if (!v) { fprintf(stderr, "volfx-game: %s needs a value\n", a); return false; } ++i; } while (0)
-        if (!strcmp(a, "--headless")) o->mode = VFX_GL_HEADLESS;
-        else if (!strcmp(a, "--window")) o->mode = VFX_GL_WINDOW;
+        if (!strcmp(a, "--headless")) o->mode = RT_GL_HEADLESS;
+        else if (!strcmp(a, "--window")) o->mode = RT_GL_WINDOW;
         else if (!strcmp(a, "--frames")) { NEED_ARG(); o->frames = (uint32_t)strtoul(v, NULL, 10); }
         else if (!strcmp(a, "--seconds")) { NEED_ARG(); o->seconds = strtod(v, NULL); }
         else if (!strcmp(a, "--size")) {
@@ -76,9 +76,9 @@ static bool parse(int argc, char **argv, game_options *o)
 }
 
 /* Orbit camera and toggles for the window mode. */
-static void handle_input(vfx_app *app, vfx_demo *demo, bool *paused, bool *step, double dt)
+static void handle_input(game_app *app, game_demo *demo, bool *paused, bool *step, double dt)
 {
-    GLFWwindow *w = vfx_gl_context_window(app->gl);
+    GLFWwindow *w = rt_gl_context_window(app->gl);
     if (!w)
         return;
     if (glfwGetKey(w, GLFW_KEY_ESCAPE) == GLFW_PRESS)
@@ -88,7 +88,7 @@ static void handle_input(vfx_app *app, vfx_demo *demo, bool *paused, bool *step,
     for (int k = 0; k < 3; ++k) {
         bool down = glfwGetKey(w, keys[k]) == GLFW_PRESS;
         if (down && !demo->key_latch[k])
-            vfx_demo_toggle(app, demo, kinds[k]);
+            game_demo_toggle(app, demo, kinds[k]);
         demo->key_latch[k] = down;
     }
     bool tab = glfwGetKey(w, GLFW_KEY_TAB) == GLFW_PRESS;
@@ -107,7 +107,7 @@ static void handle_input(vfx_app *app, vfx_demo *demo, bool *paused, bool *step,
     if (n && !demo->key_latch[4]) *step = true;
     demo->key_latch[3] = p, demo->key_latch[4] = n;
     double f[3], r[3], u[3];
-    vfx_ref_camera_basis(&app->camera, f, r, u);
+    ref_camera_basis(&app->camera, f, r, u);
     double speed = 3.0 * dt, move[3] = {0, 0, 0};
     if (glfwGetKey(w, GLFW_KEY_W) == GLFW_PRESS) for (int k = 0; k < 3; ++k) move[k] += f[k] * speed;
     if (glfwGetKey(w, GLFW_KEY_S) == GLFW_PRESS) for (int k = 0; k < 3; ++k) move[k] -= f[k] * speed;
@@ -140,63 +140,63 @@ int main(int argc, char **argv)
     game_options o;
     if (!parse(argc, argv, &o))
         return 2;
-    vfx_app_desc d = {.mode = o.mode, .width = o.width, .height = o.height, .debug_gl = o.debug,
+    game_app_desc d = {.mode = o.mode, .width = o.width, .height = o.height, .debug_gl = o.debug,
                       .plugin_path = o.plugin};
-    vfx_app *app;
-    if (vfx_app_create(&d, &app)) {
+    game_app *app;
+    if (game_app_create(&d, &app)) {
         fprintf(stderr, "volfx-game: could not start (see the messages above)\n");
         return 1;
     }
-    vfx_demo demo;
-    if (vfx_demo_load(app, &demo, o.scene, o.effects_off)) {
-        vfx_app_destroy(app);
+    game_demo demo;
+    if (game_demo_load(app, &demo, o.scene, o.effects_off)) {
+        game_app_destroy(app);
         return 1;
     }
-    bool headless = !vfx_gl_context_has_window(app->gl);
+    bool headless = !rt_gl_context_has_window(app->gl);
     /* headless default: 30 frames (the default scene runs at ~0.5 fps on llvmpipe) */
     uint32_t frames = o.frames ? o.frames : (headless && o.seconds <= 0 ? 30 : UINT32_MAX);
-    printf("volfx-game: %s, %ux%u, %s, %s\n", vfx_gl_context_renderer(app->gl), app->camera.width,
+    printf("volfx-game: %s, %ux%u, %s, %s\n", rt_gl_context_renderer(app->gl), app->camera.width,
            app->camera.height, headless ? "headless" : "window", demo.description);
     const float dt = 1.0f / 60.0f; /* fixed simulation step: runs are repeatable */
     bool paused = false, step = false;
-    double start = vfx_now_ms();
+    double start = rt_now_ms();
     int rc = 0;
     for (uint32_t f = 0; f < frames; ++f) {
-        if (o.seconds > 0 && (vfx_now_ms() - start) > o.seconds * 1000.0)
+        if (o.seconds > 0 && (rt_now_ms() - start) > o.seconds * 1000.0)
             break;
-        if (vfx_gl_context_should_close(app->gl))
+        if (rt_gl_context_should_close(app->gl))
             break;
         handle_input(app, &demo, &paused, &step, dt);
         float frame_dt = (paused && !step) ? 0.f : dt;
         step = false;
-        vfx_demo_animate(app, &demo, frame_dt);
-        if (vfx_app_frame(app, frame_dt)) {
+        game_demo_animate(app, &demo, frame_dt);
+        if (game_app_frame(app, frame_dt)) {
             fprintf(stderr, "volfx-game: frame %u failed\n", f);
             rc = 1;
             break;
         }
         if (o.mem_every && (f % o.mem_every) == 0) {
-            vfx_gl_object_counts c = vfx_gl_count_objects(4096);
+            rt_gl_object_counts c = rt_gl_count_objects(4096);
             printf("mem frame %u rss_kb %llu gl_objects %u (buffers %u textures %u programs %u queries %u)\n", f,
-                   (unsigned long long)(vfx_resident_bytes() / 1024), c.total, c.buffers, c.textures,
+                   (unsigned long long)(rt_resident_bytes() / 1024), c.total, c.buffers, c.textures,
                    c.programs, c.queries);
             fflush(stdout);
         }
         if (!headless && (f % 30) == 0) {
-            vfx_frame_summary s = vfx_profiler_summary(app->profiler, app->frame > 60 ? (uint32_t)app->frame - 60 : 0);
+            rt_frame_summary s = rt_profiler_summary(app->profiler, app->frame > 60 ? (uint32_t)app->frame - 60 : 0);
             char title[128];
             snprintf(title, sizeof title, "volfx  %.1f fps  %.2f ms (p95 %.2f)", s.mean_fps, s.p50_ms, s.p95_ms);
-            glfwSetWindowTitle(vfx_gl_context_window(app->gl), title);
+            glfwSetWindowTitle(rt_gl_context_window(app->gl), title);
         }
     }
     uint32_t warm = app->frame > 10 ? 5 : 0;
-    vfx_frame_summary s = vfx_profiler_summary(app->profiler, warm);
+    rt_frame_summary s = rt_profiler_summary(app->profiler, warm);
     printf("frames %u (after %u warm-up), mean %.2f fps, frame ms p50 %.3f p95 %.3f p99 %.3f max %.3f\n",
            s.frames, warm, s.mean_fps, s.p50_ms, s.p95_ms, s.p99_ms, s.max_ms);
-    vfx_demo_print_profile(app, stdout);
+    game_demo_print_profile(app, stdout);
     const char *png = o.png ? o.png : (headless ? "volfx-game.png" : NULL);
     if (png && rc == 0) {
-        if (vfx_app_screenshot(app, png) == VFX_OK)
+        if (game_app_screenshot(app, png) == VFX_OK)
             printf("screenshot: %s\n", png);
         else
             rc = 1;
@@ -205,22 +205,22 @@ int main(int argc, char **argv)
         vfx_effect_kind k = !strcmp(o.raw_effect, "water") ? VFX_EFFECT_WATER
                             : !strcmp(o.raw_effect, "beams") ? VFX_EFFECT_BEAMS
                             : !strcmp(o.raw_effect, "volume") ? VFX_EFFECT_VOLUME : VFX_EFFECT_COUNT;
-        if (k == VFX_EFFECT_COUNT || vfx_app_dump_raw(app, k, o.raw_path) != VFX_OK) {
+        if (k == VFX_EFFECT_COUNT || game_app_dump_raw(app, k, o.raw_path) != VFX_OK) {
             fprintf(stderr, "volfx-game: cannot dump '%s' to %s\n", o.raw_effect, o.raw_path);
             rc = 1;
         } else {
             printf("raw %s: %s\n", o.raw_effect, o.raw_path);
         }
     }
-    if (o.csv && vfx_profiler_write_csv(app->profiler, o.csv)) {
+    if (o.csv && rt_profiler_write_csv(app->profiler, o.csv)) {
         fprintf(stderr, "volfx-game: cannot write %s\n", o.csv);
         rc = 1;
     }
-    if (o.trace && vfx_profiler_write_trace(app->profiler, o.trace)) {
+    if (o.trace && rt_profiler_write_trace(app->profiler, o.trace)) {
         fprintf(stderr, "volfx-game: cannot write %s\n", o.trace);
         rc = 1;
     }
-    vfx_demo_free(app, &demo);
-    vfx_app_destroy(app);
+    game_demo_free(app, &demo);
+    game_app_destroy(app);
     return rc;
 }

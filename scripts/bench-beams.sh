@@ -45,7 +45,7 @@ Error columns, over pixels with H above 1e-6 of the image maximum (the issue's c
 the float64 closed form (within 2.7e-10 of the float64 quadrature in tests/beams): max and mean
 relative error; how many pixels are above 1e-5; the max where the float32 inputs allow 1e-5
 (cond < 1e-5 H); and the max of error / (1e-5 H + cond), where cond is the largest change of the
-exact H when the float32 ray or a camera-relative head moves by 2 ulps (\`vfx_beams_ref_cond_abs\`;
+exact H when the float32 ray or a camera-relative head moves by 2 ulps (\`ref_beams_cond_abs\`;
 docs/beams.md, "What float32 can reach"). A value below 1 there means the pixel is as accurate as
 its float32 inputs allow.
 

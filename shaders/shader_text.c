@@ -9,14 +9,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "vfx_shaders.h"
+#include "volfx_shaders.h"
 
 /* ------------------------------------------------------------------- shader text */
 
-int vfx_shader_index(const char *path)
+int volfx_shader_index(const char *path)
 {
-    for (unsigned i = 0; i < vfx_embedded_shader_count; ++i)
-        if (strcmp(vfx_embedded_shaders[i].path, path) == 0)
+    for (unsigned i = 0; i < volfx_embedded_shader_count; ++i)
+        if (strcmp(volfx_embedded_shaders[i].path, path) == 0)
             return (int)i;
     return -1;
 }
@@ -87,15 +87,15 @@ static void sb_printf(strbuf *b, const char *fmt, ...)
         sb_put(b, tmp, (size_t)n < sizeof tmp ? (size_t)n : sizeof tmp - 1);
 }
 
-long vfx_shader_line_base(int index) { return (long)(index + 1) * VFX_SHADER_LINE_STRIDE; }
+long volfx_shader_line_base(int index) { return (long)(index + 1) * VOLFX_SHADER_LINE_STRIDE; }
 
 /* Expands one level of #include "x" with #line directives so the driver's line numbers point
  * into the right file: source-string number = the file's index in the embedded table. */
 static bool expand(strbuf *out, const char *path, const char *defines, int depth, char *err, size_t errlen)
 {
-    int idx = vfx_shader_index(path);
+    int idx = volfx_shader_index(path);
     char *override = load_override(path);
-    const char *src = override ? override : (idx >= 0 ? vfx_embedded_shaders[idx].source : NULL);
+    const char *src = override ? override : (idx >= 0 ? volfx_embedded_shaders[idx].source : NULL);
     if (!src) {
         snprintf(err, errlen, "shader '%s' is not embedded (listed in shaders/*/meson.build?)", path);
         return false;
@@ -105,7 +105,7 @@ static bool expand(strbuf *out, const char *path, const char *defines, int depth
         if (defines)
             sb_printf(out, "%s\n", defines);
     }
-    sb_printf(out, "#line %ld\n", vfx_shader_line_base(idx) + 1);
+    sb_printf(out, "#line %ld\n", volfx_shader_line_base(idx) + 1);
     int line = 1;
     for (const char *p = src; *p;) {
         const char *e = strchr(p, '\n');
@@ -128,7 +128,7 @@ static bool expand(strbuf *out, const char *path, const char *defines, int depth
                 free(override);
                 return false;
             }
-            sb_printf(out, "\n#line %ld\n", vfx_shader_line_base(idx) + line + 1);
+            sb_printf(out, "\n#line %ld\n", volfx_shader_line_base(idx) + line + 1);
         } else {
             sb_put(out, p, n);
             sb_put(out, "\n", 1);
@@ -141,7 +141,7 @@ static bool expand(strbuf *out, const char *path, const char *defines, int depth
 }
 
 /* Rewrites "N:L(C): msg" (Mesa) and "N(L) : msg" (NVIDIA) into "file:L: msg". */
-void vfx_shader_rewrite_log(const char *log, char *out, size_t cap, const char *fallback)
+void volfx_shader_rewrite_log(const char *log, char *out, size_t cap, const char *fallback)
 {
     size_t o = 0;
     for (const char *p = log; *p && o + 1 < cap;) {
@@ -162,12 +162,12 @@ void vfx_shader_rewrite_log(const char *log, char *out, size_t cap, const char *
                 line = -1;
             }
         }
-        if (line >= VFX_SHADER_LINE_STRIDE) { /* the file is encoded in the line number */
-            file = line / VFX_SHADER_LINE_STRIDE - 1;
-            line %= VFX_SHADER_LINE_STRIDE;
+        if (line >= VOLFX_SHADER_LINE_STRIDE) { /* the file is encoded in the line number */
+            file = line / VOLFX_SHADER_LINE_STRIDE - 1;
+            line %= VOLFX_SHADER_LINE_STRIDE;
         }
-        const char *name = (line >= 0 && file >= 0 && file < (long)vfx_embedded_shader_count)
-                               ? vfx_embedded_shaders[file].path : fallback;
+        const char *name = (line >= 0 && file >= 0 && file < (long)volfx_embedded_shader_count)
+                               ? volfx_embedded_shaders[file].path : fallback;
         int w;
         if (line >= 0)
             w = snprintf(out + o, cap - o, "%s:%ld: %.*s\n", name, line, (int)(n - (size_t)(rest - p)), rest);
@@ -181,7 +181,7 @@ void vfx_shader_rewrite_log(const char *log, char *out, size_t cap, const char *
     out[o < cap ? o : cap - 1] = 0;
 }
 
-char *vfx_shader_expand(const char *path, const char *defines, char *err, size_t errlen)
+char *volfx_shader_expand(const char *path, const char *defines, char *err, size_t errlen)
 {
     strbuf b = {0};
     if (!expand(&b, path, defines, 0, err, errlen) || b.oom) {

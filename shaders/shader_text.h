@@ -1,23 +1,23 @@
 /* shader_text.h — embedded GLSL: lookup, #include expansion, error-log rewriting. */
-#ifndef VFX_SHADER_TEXT_H
-#define VFX_SHADER_TEXT_H
+#ifndef VOLFX_SHADER_TEXT_H
+#define VOLFX_SHADER_TEXT_H
 
 #include <stddef.h>
 
 /* Drivers disagree on reporting #line's source-string number (Mesa always prints 0), so the file
  * is encoded in the line number itself: line (index + 1) * STRIDE + n is line n of file index. */
-#define VFX_SHADER_LINE_STRIDE 100000L
+#define VOLFX_SHADER_LINE_STRIDE 100000L
 /* First encoded line number of embedded shader `index` (line n is base + n). */
-long vfx_shader_line_base(int index);
+long volfx_shader_line_base(int index);
 /* Index of an embedded shader by path relative to shaders/ (-1 when absent). */
-int vfx_shader_index(const char *path);
+int volfx_shader_index(const char *path);
 /* Full source ready for glShaderSource: "#version 450 core", `defines`, then the file with one
  * level of #include "x" expanded and #line markers encoding file and line. malloc'd; NULL on error
  * (message in err). */
-char *vfx_shader_expand(const char *path, const char *defines, char *err, size_t errlen);
+char *volfx_shader_expand(const char *path, const char *defines, char *err, size_t errlen);
 /* Rewrites a driver info log ("0:L(3): error" Mesa, "0(L) : error" NVIDIA) into "file:n: error"
- * lines, decoding the line numbers of vfx_shader_expand (or a driver's source number when L is
+ * lines, decoding the line numbers of volfx_shader_expand (or a driver's source number when L is
  * small). */
-void vfx_shader_rewrite_log(const char *log, char *out, size_t cap, const char *fallback);
+void volfx_shader_rewrite_log(const char *log, char *out, size_t cap, const char *fallback);
 
 #endif

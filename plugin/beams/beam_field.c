@@ -43,7 +43,7 @@ static double log1p_over_d(double z) { return z > 0 ? log1p(z) / z : 1.0; }
 #undef R_FMA
 #undef R_LOG1P_OVER
 
-vfx_result vfx_beam_validate(const vfx_beam *in, vfx_beam_d *out, char *err, size_t errlen)
+vfx_result volfx_beam_validate(const vfx_beam *in, volfx_beam_d *out, char *err, size_t errlen)
 {
     const float *f = &in->head[0];
     static const char *names[] = {"head.x", "head.y", "head.z", "length", "dir.x", "dir.y",
@@ -76,7 +76,7 @@ vfx_result vfx_beam_validate(const vfx_beam *in, vfx_beam_d *out, char *err, siz
     return VFX_OK;
 }
 
-float vfx_beam_integral_f(const vfx_beam_d *bm, const float O[3], const float V[3], float t0, float t1)
+float volfx_beam_integral_f(const volfx_beam_d *bm, const float O[3], const float V[3], float t0, float t1)
 {
     float M[3] = {(float)bm->head[0], (float)bm->head[1], (float)bm->head[2]};
     float D[3] = {(float)bm->dir[0], (float)bm->dir[1], (float)bm->dir[2]};
@@ -84,14 +84,14 @@ float vfx_beam_integral_f(const vfx_beam_d *bm, const float O[3], const float V[
                            (float)bm->eps, O, V, t0, t1);
 }
 
-double vfx_beam_integral_d(const vfx_beam_d *bm, const double O[3], const double V[3], double t0, double t1)
+double volfx_beam_integral_d(const volfx_beam_d *bm, const double O[3], const double V[3], double t0, double t1)
 {
     return beam_integral_d(bm->head, bm->dir, bm->length, bm->radius, bm->a, bm->b, bm->eps, O, V, t0, t1);
 }
 
-double vfx_beam_density_d(const vfx_beam_d *bm, const double p[3])
+double volfx_beam_density_d(const volfx_beam_d *bm, const double p[3])
 {
-    double e = bm->eps > VFX_BEAM_EPS_FLOOR * bm->radius ? bm->eps : VFX_BEAM_EPS_FLOOR * bm->radius;
+    double e = bm->eps > VOLFX_BEAM_EPS_FLOOR * bm->radius ? bm->eps : VOLFX_BEAM_EPS_FLOOR * bm->radius;
     double d[3], d2 = 0, u = 0;
     for (int k = 0; k < 3; ++k) {
         d[k] = p[k] - bm->head[k];

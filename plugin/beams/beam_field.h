@@ -8,40 +8,40 @@
  *          u = (P-M).D
  * H = integral of sum(rho) along a ray. The closed form splits each beam into four pieces
  * (head sphere, cap behind M, cylinder slab, cap beyond M+L D), each clipped to its support;
- * each piece is an integral of 1/sqrt((s x + beta)^2 + Q^2), done by vfx_beam_segment_integral.
- * The softening is floored at VFX_BEAM_EPS_FLOOR * R so that eps = 0 with a ray exactly
+ * each piece is an integral of 1/sqrt((s x + beta)^2 + Q^2), done by volfx_beam_segment_integral.
+ * The softening is floored at VOLFX_BEAM_EPS_FLOOR * R so that eps = 0 with a ray exactly
  * through M or the axis gives a large finite H, not Inf/NaN (the reference uses the same floor).
  * docs/beams.md has the derivation; shaders/beams/beam_field.glsl is the same code in GLSL. */
-#ifndef VFX_BEAM_FIELD_H
-#define VFX_BEAM_FIELD_H
+#ifndef VOLFX_BEAM_FIELD_H
+#define VOLFX_BEAM_FIELD_H
 
 #include <volfx/volfx.h>
 
-#define VFX_BEAM_EPS_FLOOR 1e-6
+#define VOLFX_BEAM_EPS_FLOOR 1e-6
 
 /* Beam in float64, normalised (unit D), as the integrals use it. */
-typedef struct vfx_beam_d {
+typedef struct volfx_beam_d {
     double head[3], dir[3];
     double length, radius, a, b, eps;
-} vfx_beam_d;
+} volfx_beam_d;
 
 /* Checks a beam (finite, L >= 0, R > 0, a, b, eps >= 0, D not zero) and normalises D into out;
  * VFX_ERR_INVALID_ARGUMENT with a message naming the field otherwise. */
-vfx_result vfx_beam_validate(const vfx_beam *in, vfx_beam_d *out, char *err, size_t errlen);
+vfx_result volfx_beam_validate(const vfx_beam *in, volfx_beam_d *out, char *err, size_t errlen);
 
 /* Integral over x in [x0, x1] of 1/sqrt((s x + beta)^2 + Q^2), s >= 0, Q > 0, without
  * cancellation: float and double versions of the same code. */
-float vfx_beam_segment_integral_f(float x0, float x1, float s, float beta, float Q);
-double vfx_beam_segment_integral_d(double x0, double x1, double s, double beta, double Q);
+float volfx_beam_segment_integral_f(float x0, float x1, float s, float beta, float Q);
+double volfx_beam_segment_integral_d(double x0, double x1, double s, double beta, double Q);
 
 /* H of one beam along the ray origin + t*dir (|dir| = 1), t in [t0, t1]. _f is float32
  * throughout (it mirrors the GLSL), _d float64. */
-float vfx_beam_integral_f(const vfx_beam_d *beam, const float origin[3], const float dir[3],
+float volfx_beam_integral_f(const volfx_beam_d *beam, const float origin[3], const float dir[3],
                           float t0, float t1);
-double vfx_beam_integral_d(const vfx_beam_d *beam, const double origin[3], const double dir[3],
+double volfx_beam_integral_d(const volfx_beam_d *beam, const double origin[3], const double dir[3],
                            double t0, double t1);
 
 /* The density at a point (float64), for references and tests. */
-double vfx_beam_density_d(const vfx_beam_d *beam, const double p[3]);
+double volfx_beam_density_d(const volfx_beam_d *beam, const double p[3]);
 
 #endif

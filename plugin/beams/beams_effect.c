@@ -22,7 +22,7 @@ typedef struct beams_state {
     GLuint acc_tex, acc_fbo;
     uint32_t width, height, tiles_x, tiles_y;
     vfx_beams_view view;
-    vfx_beam_d *beams;        /* validated, normalised */
+    volfx_beam_d *beams;        /* validated, normalised */
     beam_gpu *gpu;
     uint32_t (*rects)[4];     /* per beam: its tile rectangle this frame */
     bool *visible;            /* per beam: on screen this frame */
@@ -46,22 +46,22 @@ static void beams_destroy(vfx_context *ctx, void *state)
     glDeleteBuffers(3, bufs);
     glDeleteTextures(1, &s->acc_tex);
     glDeleteFramebuffers(1, &s->acc_fbo);
-    vfx_free(ctx, s->beams);
-    vfx_free(ctx, s->gpu);
-    vfx_free(ctx, s->rects);
-    vfx_free(ctx, s->visible);
-    vfx_free(ctx, s->ranges);
-    vfx_free(ctx, s->list);
-    vfx_free(ctx, s); /* programs belong to the shared cache */
+    volfx_free(ctx, s->beams);
+    volfx_free(ctx, s->gpu);
+    volfx_free(ctx, s->rects);
+    volfx_free(ctx, s->visible);
+    volfx_free(ctx, s->ranges);
+    volfx_free(ctx, s->list);
+    volfx_free(ctx, s); /* programs belong to the shared cache */
 }
 
 static vfx_result beams_create(vfx_context *ctx, void **out)
 {
-    beams_state *s = vfx_alloc(ctx, sizeof *s);
+    beams_state *s = volfx_alloc(ctx, sizeof *s);
     if (!s)
         return VFX_ERR_OUT_OF_MEMORY;
-    s->prog_closed = vfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag", NULL);
-    s->prog_composite = vfx_gpu_program(ctx, "common/fullscreen.vert", "beams/composite.frag", NULL);
+    s->prog_closed = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag", NULL);
+    s->prog_composite = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/composite.frag", NULL);
     if (!s->prog_closed || !s->prog_composite) {
         beams_destroy(ctx, s);
         return VFX_ERR_GL;
@@ -69,9 +69,9 @@ static vfx_result beams_create(vfx_context *ctx, void **out)
     GLuint bufs[3];
     glCreateBuffers(3, bufs);
     s->beam_buf = bufs[0], s->range_buf = bufs[1], s->list_buf = bufs[2];
-    vfx_gpu_label(GL_BUFFER, s->beam_buf, "beams.beams");
-    vfx_gpu_label(GL_BUFFER, s->range_buf, "beams.tile_ranges");
-    vfx_gpu_label(GL_BUFFER, s->list_buf, "beams.tile_lists");
+    volfx_gpu_label(GL_BUFFER, s->beam_buf, "beams.beams");
+    volfx_gpu_label(GL_BUFFER, s->range_buf, "beams.tile_ranges");
+    volfx_gpu_label(GL_BUFFER, s->list_buf, "beams.tile_lists");
     *out = s;
     return VFX_OK;
 }
@@ -83,16 +83,16 @@ static vfx_result beams_resize(vfx_context *ctx, void *state, uint32_t w, uint32
     glDeleteFramebuffers(1, &s->acc_fbo);
     glCreateTextures(GL_TEXTURE_2D, 1, &s->acc_tex);
     glTextureStorage2D(s->acc_tex, 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
-    vfx_gpu_label(GL_TEXTURE, s->acc_tex, "beams.H");
+    volfx_gpu_label(GL_TEXTURE, s->acc_tex, "beams.H");
     glCreateFramebuffers(1, &s->acc_fbo);
     glNamedFramebufferTexture(s->acc_fbo, GL_COLOR_ATTACHMENT0, s->acc_tex, 0);
     if (glCheckNamedFramebufferStatus(s->acc_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-        return vfx_fail(ctx, VFX_ERR_GL, "beams: H target %ux%u incomplete", w, h);
+        return volfx_fail(ctx, VFX_ERR_GL, "beams: H target %ux%u incomplete", w, h);
     s->width = w, s->height = h;
     s->tiles_x = (w + TILE_PX - 1) / TILE_PX;
     s->tiles_y = (h + TILE_PX - 1) / TILE_PX;
-    vfx_free(ctx, s->ranges);
-    s->ranges = vfx_alloc(ctx, (size_t)s->tiles_x * s->tiles_y * 2 * sizeof(uint32_t));
+    volfx_free(ctx, s->ranges);
+    s->ranges = volfx_alloc(ctx, (size_t)s->tiles_x * s->tiles_y * 2 * sizeof(uint32_t));
     return s->ranges ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
 }
 
@@ -103,30 +103,30 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
     vfx_beams_view v = {.size = sizeof v, .version = VFX_BEAMS_VIEW_VERSION};
     vfx_result r = ctx->host.beams(ctx->host.user, &v);
     if (r || v.version != VFX_BEAMS_VIEW_VERSION)
-        return vfx_fail(ctx, VFX_ERR_ABI, "beams: host view of version %u (need %u)", v.version,
+        return volfx_fail(ctx, VFX_ERR_ABI, "beams: host view of version %u (need %u)", v.version,
                         VFX_BEAMS_VIEW_VERSION);
     if (v.count > MAX_BEAMS || !v.beams)
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: %u beams (at most %u, non-NULL array)",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: %u beams (at most %u, non-NULL array)",
                         v.count, MAX_BEAMS);
     if (!(v.saturate_c >= 0) || !isfinite(v.saturate_c) || !(v.far_distance >= 0) || !isfinite(v.far_distance))
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: saturate_c and far_distance must be finite and >= 0");
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: saturate_c and far_distance must be finite and >= 0");
     if (v.count > s->capacity) {
-        vfx_free(ctx, s->beams);
-        vfx_free(ctx, s->gpu);
-        vfx_free(ctx, s->rects);
-        vfx_free(ctx, s->visible);
-        s->beams = vfx_alloc(ctx, v.count * sizeof *s->beams);
-        s->gpu = vfx_alloc(ctx, v.count * sizeof *s->gpu);
-        s->rects = vfx_alloc(ctx, v.count * sizeof *s->rects);
-        s->visible = vfx_alloc(ctx, v.count * sizeof *s->visible);
+        volfx_free(ctx, s->beams);
+        volfx_free(ctx, s->gpu);
+        volfx_free(ctx, s->rects);
+        volfx_free(ctx, s->visible);
+        s->beams = volfx_alloc(ctx, v.count * sizeof *s->beams);
+        s->gpu = volfx_alloc(ctx, v.count * sizeof *s->gpu);
+        s->rects = volfx_alloc(ctx, v.count * sizeof *s->rects);
+        s->visible = volfx_alloc(ctx, v.count * sizeof *s->visible);
         s->capacity = (s->beams && s->gpu && s->rects && s->visible) ? v.count : 0;
         if (!s->capacity)
             return VFX_ERR_OUT_OF_MEMORY;
     }
     char err[200];
     for (uint32_t i = 0; i < v.count; ++i)
-        if (vfx_beam_validate(&v.beams[i], &s->beams[i], err, sizeof err))
-            return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: %s", i, err);
+        if (volfx_beam_validate(&v.beams[i], &s->beams[i], err, sizeof err))
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: %s", i, err);
     s->count = v.count;
     s->view = v;
     for (uint32_t i = 0; i < v.count; ++i) {
@@ -178,12 +178,12 @@ static vfx_result upload(vfx_context *ctx, GLuint buf, size_t *cap, const void *
     }
     if (data)
         glNamedBufferSubData(buf, 0, (GLsizeiptr)bytes, data);
-    const char *e = vfx_gpu_error_string();
-    return e ? vfx_fail(ctx, VFX_ERR_GL, "beams: buffer upload of %zu bytes: %s", bytes, e) : VFX_OK;
+    const char *e = volfx_gpu_error_string();
+    return e ? volfx_fail(ctx, VFX_ERR_GL, "beams: buffer upload of %zu bytes: %s", bytes, e) : VFX_OK;
 }
 
 static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
-                               vfx_frame_targets *targets)
+                               volfx_frame_targets *targets)
 {
     beams_state *s = state;
     /* Camera-relative frame: the eye is the origin and heads are M - eye in double, so a beam
@@ -191,9 +191,9 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
     float view_rot[16], vp_rot[16], inv[16];
     memcpy(view_rot, frame->view, sizeof view_rot);
     view_rot[12] = view_rot[13] = view_rot[14] = 0.f;
-    vfx_mat4_mul(frame->proj, view_rot, vp_rot);
-    if (!vfx_mat4_invert(vp_rot, inv))
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: camera rotation*projection is singular");
+    volfx_mat4_mul(frame->proj, view_rot, vp_rot);
+    if (!volfx_mat4_invert(vp_rot, inv))
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: camera rotation*projection is singular");
     /* eye = -R^T t from the view matrix (robust even when frame->eye is not filled) */
     double eye[3];
     for (int k = 0; k < 3; ++k)
@@ -205,7 +205,7 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
     memset(s->ranges, 0, (size_t)ntiles * 2 * sizeof(uint32_t));
     uint64_t pairs = 0;
     for (uint32_t i = 0; i < s->count; ++i) {
-        const vfx_beam_d *b = &s->beams[i];
+        const volfx_beam_d *b = &s->beams[i];
         beam_gpu *g = &s->gpu[i];
         double rel[3], centre[3];
         for (int k = 0; k < 3; ++k) {
@@ -225,7 +225,7 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
         pairs += (uint64_t)(rects[i][2] - rects[i][0] + 1) * (rects[i][3] - rects[i][1] + 1);
     }
     if (pairs > UINT32_MAX / 2) {
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: %llu beam-tile pairs", (unsigned long long)pairs);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: %llu beam-tile pairs", (unsigned long long)pairs);
     }
     uint32_t offset = 0, empty = 0;
     for (uint32_t t = 0; t < ntiles; ++t) {
@@ -235,8 +235,8 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
         s->ranges[2 * t + 1] = 0; /* refilled below as a cursor */
     }
     if (pairs > s->list_capacity) {
-        vfx_free(ctx, s->list);
-        s->list = vfx_alloc(ctx, pairs * sizeof(uint32_t));
+        volfx_free(ctx, s->list);
+        s->list = volfx_alloc(ctx, pairs * sizeof(uint32_t));
         s->list_capacity = s->list ? (uint32_t)pairs : 0;
     }
     if (pairs && !s->list)
@@ -250,11 +250,11 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
                 s->list[s->ranges[2 * t] + s->ranges[2 * t + 1]++] = i;
             }
     }
-    vfx_stat_set(ctx, "beams.count", s->count);
-    vfx_stat_set(ctx, "beams.tiles", ntiles);
-    vfx_stat_set(ctx, "beams.tiles_empty", empty);
-    vfx_stat_set(ctx, "beams.pairs", (double)pairs);
-    vfx_stat_set(ctx, "beams.pairs_culled", (double)s->count * ntiles - (double)pairs);
+    volfx_stat_set(ctx, "beams.count", s->count);
+    volfx_stat_set(ctx, "beams.tiles", ntiles);
+    volfx_stat_set(ctx, "beams.tiles_empty", empty);
+    volfx_stat_set(ctx, "beams.pairs", (double)pairs);
+    volfx_stat_set(ctx, "beams.pairs_culled", (double)s->count * ntiles - (double)pairs);
     vfx_result r;
     if ((r = upload(ctx, s->beam_buf, &s->beam_cap, s->gpu, s->count * sizeof(beam_gpu)))
         || (r = upload(ctx, s->range_buf, &s->range_cap, s->ranges, (size_t)ntiles * 2 * sizeof(uint32_t)))
@@ -265,15 +265,15 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
     GLuint prog = s->prog_closed;
     if (march) {
         if (!s->prog_march)
-            s->prog_march = vfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
-                                            "#define VFX_BEAMS_MARCH 1");
+            s->prog_march = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
+                                            "#define VOLFX_BEAMS_MARCH 1");
         if (!(prog = s->prog_march))
             return VFX_ERR_GL;
     }
     float far = s->view.far_distance > 0 ? s->view.far_distance : frame->far_plane;
     if (!(far > 0))
         far = 1e30f;
-    vfx_gpu_pass_begin(ctx, march ? "beams.march" : "beams.integrate");
+    volfx_gpu_pass_begin(ctx, march ? "beams.march" : "beams.integrate");
     glBindFramebuffer(GL_FRAMEBUFFER, s->acc_fbo);
     glViewport(0, 0, (GLsizei)s->width, (GLsizei)s->height);
     glDisable(GL_DEPTH_TEST);
@@ -292,10 +292,10 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s->beam_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s->range_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s->list_buf);
-    vfx_gpu_fullscreen(ctx);
-    vfx_gpu_pass_end(ctx);
+    volfx_gpu_fullscreen(ctx);
+    volfx_gpu_pass_end(ctx);
 
-    vfx_gpu_pass_begin(ctx, "beams.composite");
+    volfx_gpu_pass_begin(ctx, "beams.composite");
     glBindFramebuffer(GL_FRAMEBUFFER, frame->framebuffer);
     glViewport(0, 0, (GLsizei)frame->width, (GLsizei)frame->height);
     glEnable(GL_BLEND);
@@ -305,12 +305,12 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
     glUniform1f(glGetUniformLocation(s->prog_composite, "u_c"), s->view.saturate_c > 0 ? s->view.saturate_c : 1.f);
     glUniform1i(glGetUniformLocation(s->prog_composite, "u_smooth"), s->view.saturation == VFX_SATURATE_SMOOTH);
     glBindTextureUnit(0, s->acc_tex);
-    vfx_gpu_fullscreen(ctx);
+    volfx_gpu_fullscreen(ctx);
     glDisable(GL_BLEND);
     glUseProgram(0);
-    vfx_gpu_pass_end(ctx);
-    const char *e = vfx_gpu_error_string();
-    return e ? vfx_fail(ctx, VFX_ERR_GL, "beams render: %s", e) : VFX_OK;
+    volfx_gpu_pass_end(ctx);
+    const char *e = volfx_gpu_error_string();
+    return e ? volfx_fail(ctx, VFX_ERR_GL, "beams render: %s", e) : VFX_OK;
 }
 
 static vfx_result beams_read_raw(vfx_context *ctx, void *state, float *out, size_t count)
@@ -318,11 +318,11 @@ static vfx_result beams_read_raw(vfx_context *ctx, void *state, float *out, size
     beams_state *s = state;
     size_t n = (size_t)s->width * s->height;
     if (count < n)
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams read_raw: %zu floats < %zu", count, n);
-    return vfx_gpu_read_top_first(ctx, s->acc_tex, GL_RGBA, 4, 0, s->width, s->height, out);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams read_raw: %zu floats < %zu", count, n);
+    return volfx_gpu_read_top_first(ctx, s->acc_tex, GL_RGBA, 4, 0, s->width, s->height, out);
 }
 
-const vfx_effect_ops vfx_beams_ops = {
+const volfx_effect_ops volfx_beams_ops = {
     .name = "beams",
     .kind = VFX_EFFECT_BEAMS,
     .present = beams_present,

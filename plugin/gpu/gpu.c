@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "vfx_shaders.h"
+#include "volfx_shaders.h"
 #include "shader_text.h"
 
 #define GPU_MAX_PROGRAMS 256
@@ -24,7 +24,7 @@ typedef struct timer_frame {
     uint32_t count;
 } timer_frame;
 
-struct vfx_gpu {
+struct volfx_gpu {
     program_entry programs[GPU_MAX_PROGRAMS];
     uint32_t program_count;
     GLuint empty_vao;
@@ -35,7 +35,7 @@ struct vfx_gpu {
     bool has_debug;
 };
 
-const char *vfx_gpu_error_string(void)
+const char *volfx_gpu_error_string(void)
 {
     switch (glGetError()) {
     case GL_NO_ERROR: return NULL;
@@ -48,34 +48,34 @@ const char *vfx_gpu_error_string(void)
     }
 }
 
-vfx_result vfx_gpu_create(vfx_context *ctx, vfx_gpu **out)
+vfx_result volfx_gpu_create(vfx_context *ctx, volfx_gpu **out)
 {
     *out = NULL;
     const GLubyte *version = glGetString(GL_VERSION);
     if (!version)
-        return vfx_fail(ctx, VFX_ERR_GL, "volfx needs a current GL context on the calling thread");
+        return volfx_fail(ctx, VFX_ERR_GL, "volfx needs a current GL context on the calling thread");
     int ver = epoxy_gl_version();
     if (ver < 45 || !epoxy_is_desktop_gl())
-        return vfx_fail(ctx, VFX_ERR_GL_UNSUPPORTED,
+        return volfx_fail(ctx, VFX_ERR_GL_UNSUPPORTED,
                         "volfx needs desktop GL 4.5, the current context is %s", (const char *)version);
-    vfx_gpu *g = vfx_alloc(ctx, sizeof *g);
+    volfx_gpu *g = volfx_alloc(ctx, sizeof *g);
     if (!g)
         return VFX_ERR_OUT_OF_MEMORY;
     glCreateVertexArrays(1, &g->empty_vao);
-    vfx_gpu_label(GL_VERTEX_ARRAY, g->empty_vao, "volfx.fullscreen_vao");
+    volfx_gpu_label(GL_VERTEX_ARRAY, g->empty_vao, "volfx.fullscreen_vao");
     for (int f = 0; f < GPU_RING; ++f)
         glCreateQueries(GL_TIMESTAMP, GPU_MAX_PASSES * 2, g->ring[f].queries);
     g->has_debug = true; /* KHR_debug is core in 4.3 */
-    const char *err = vfx_gpu_error_string();
+    const char *err = volfx_gpu_error_string();
     if (err) {
-        vfx_gpu_destroy(ctx, g);
-        return vfx_fail(ctx, VFX_ERR_GL, "volfx gpu setup: %s", err);
+        volfx_gpu_destroy(ctx, g);
+        return volfx_fail(ctx, VFX_ERR_GL, "volfx gpu setup: %s", err);
     }
     *out = g;
     return VFX_OK;
 }
 
-void vfx_gpu_destroy(vfx_context *ctx, vfx_gpu *g)
+void volfx_gpu_destroy(vfx_context *ctx, volfx_gpu *g)
 {
     if (!g)
         return;
@@ -86,16 +86,16 @@ void vfx_gpu_destroy(vfx_context *ctx, vfx_gpu *g)
     for (int f = 0; f < GPU_RING; ++f)
         glDeleteQueries(GPU_MAX_PASSES * 2, g->ring[f].queries);
     glDeleteVertexArrays(1, &g->empty_vao);
-    vfx_free(ctx, g);
+    volfx_free(ctx, g);
 }
 
-void vfx_gpu_label(GLenum kind, GLuint object, const char *label)
+void volfx_gpu_label(GLenum kind, GLuint object, const char *label)
 {
     if (object)
         glObjectLabel(kind, object, -1, label);
 }
 
-GLuint vfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *stages,
+GLuint volfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *stages,
                             const char *const *sources, const char *const *names)
 {
     GLuint prog = glCreateProgram();
@@ -110,8 +110,8 @@ GLuint vfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *sta
         glGetShaderiv(shaders[i], GL_COMPILE_STATUS, &status);
         if (!status) {
             glGetShaderInfoLog(shaders[i], sizeof log, NULL, log);
-            vfx_shader_rewrite_log(log, pretty, sizeof pretty, names[i]);
-            vfx_fail(ctx, VFX_ERR_GL, "shader compile failed: %s", pretty);
+            volfx_shader_rewrite_log(log, pretty, sizeof pretty, names[i]);
+            volfx_fail(ctx, VFX_ERR_GL, "shader compile failed: %s", pretty);
             ok = false;
         } else {
             glAttachShader(prog, shaders[i]);
@@ -123,7 +123,7 @@ GLuint vfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *sta
         glGetProgramiv(prog, GL_LINK_STATUS, &status);
         if (!status) {
             glGetProgramInfoLog(prog, sizeof log, NULL, log);
-            vfx_fail(ctx, VFX_ERR_GL, "program link failed (%s%s%s): %s", names[0],
+            volfx_fail(ctx, VFX_ERR_GL, "program link failed (%s%s%s): %s", names[0],
                      stage_count > 1 ? " + " : "", stage_count > 1 ? names[1] : "", log);
             ok = false;
         }
@@ -141,11 +141,11 @@ GLuint vfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *sta
 static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const char *const *paths,
                           const char *defines)
 {
-    vfx_gpu *g = ctx->gpu;
+    volfx_gpu *g = ctx->gpu;
     size_t klen = strlen(paths[0]) + (n > 1 ? strlen(paths[1]) : 0) + (defines ? strlen(defines) : 0) + 3;
     char *key = malloc(klen);
     if (!key) {
-        vfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "program cache: out of memory");
+        volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "program cache: out of memory");
         return 0;
     }
     snprintf(key, klen, "%s|%s|%s", paths[0], n > 1 ? paths[1] : "", defines ? defines : "");
@@ -156,7 +156,7 @@ static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const c
         }
     if (g->program_count >= GPU_MAX_PROGRAMS) {
         free(key);
-        vfx_fail(ctx, VFX_ERR_GL, "program cache full (%d programs)", GPU_MAX_PROGRAMS);
+        volfx_fail(ctx, VFX_ERR_GL, "program cache full (%d programs)", GPU_MAX_PROGRAMS);
         return 0;
     }
     char *bufs[2] = {NULL, NULL};
@@ -164,12 +164,12 @@ static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const c
     GLuint prog = 0;
     bool ok = true;
     for (int i = 0; i < n && ok; ++i)
-        if (!(bufs[i] = vfx_shader_expand(paths[i], defines, err, sizeof err))) {
-            vfx_fail(ctx, VFX_ERR_GL, "%s", err);
+        if (!(bufs[i] = volfx_shader_expand(paths[i], defines, err, sizeof err))) {
+            volfx_fail(ctx, VFX_ERR_GL, "%s", err);
             ok = false;
         }
     if (ok)
-        prog = vfx_gpu_link_sources(ctx, n, stages, (const char *const *)bufs, paths);
+        prog = volfx_gpu_link_sources(ctx, n, stages, (const char *const *)bufs, paths);
     for (int i = 0; i < n; ++i)
         free(bufs[i]);
     if (!prog) {
@@ -181,18 +181,18 @@ static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const c
     e->program = prog;
     char label[96];
     snprintf(label, sizeof label, "volfx.%s", n > 1 ? paths[1] : paths[0]);
-    vfx_gpu_label(GL_PROGRAM, prog, label);
+    volfx_gpu_label(GL_PROGRAM, prog, label);
     return prog;
 }
 
-GLuint vfx_gpu_program(vfx_context *ctx, const char *vert, const char *frag, const char *defines)
+GLuint volfx_gpu_program(vfx_context *ctx, const char *vert, const char *frag, const char *defines)
 {
     const GLenum stages[2] = {GL_VERTEX_SHADER, GL_FRAGMENT_SHADER};
     const char *paths[2] = {vert, frag};
     return get_program(ctx, 2, stages, paths, defines);
 }
 
-GLuint vfx_gpu_compute(vfx_context *ctx, const char *comp, const char *defines)
+GLuint volfx_gpu_compute(vfx_context *ctx, const char *comp, const char *defines)
 {
     const GLenum stages[1] = {GL_COMPUTE_SHADER};
     const char *paths[1] = {comp};
@@ -201,9 +201,9 @@ GLuint vfx_gpu_compute(vfx_context *ctx, const char *comp, const char *defines)
 
 /* ------------------------------------------------------------------------ timers */
 
-void vfx_gpu_pass_begin(vfx_context *ctx, const char *name)
+void volfx_gpu_pass_begin(vfx_context *ctx, const char *name)
 {
-    vfx_gpu *g = ctx->gpu;
+    volfx_gpu *g = ctx->gpu;
     glPushDebugGroup(GL_DEBUG_SOURCE_APPLICATION, 0, -1, name);
     timer_frame *f = &g->ring[g->frame];
     if (f->count >= GPU_MAX_PASSES || g->open_count >= GPU_PASS_DEPTH) {
@@ -217,9 +217,9 @@ void vfx_gpu_pass_begin(vfx_context *ctx, const char *name)
     g->open[g->open_count++] = slot;
 }
 
-void vfx_gpu_pass_end(vfx_context *ctx)
+void volfx_gpu_pass_end(vfx_context *ctx)
 {
-    vfx_gpu *g = ctx->gpu;
+    volfx_gpu *g = ctx->gpu;
     if (g->open_count == 0)
         return;
     uint32_t slot = g->open[--g->open_count];
@@ -228,11 +228,11 @@ void vfx_gpu_pass_end(vfx_context *ctx)
     glPopDebugGroup();
 }
 
-void vfx_gpu_frame_end(vfx_context *ctx)
+void volfx_gpu_frame_end(vfx_context *ctx)
 {
-    vfx_gpu *g = ctx->gpu;
+    volfx_gpu *g = ctx->gpu;
     while (g->open_count)
-        vfx_gpu_pass_end(ctx);
+        volfx_gpu_pass_end(ctx);
     /* The oldest slot was recorded GPU_RING-1 frames ago: read it only if it is ready. */
     uint32_t oldest = (g->frame + 1) % GPU_RING;
     timer_frame *f = &g->ring[oldest];
@@ -247,24 +247,24 @@ void vfx_gpu_frame_end(vfx_context *ctx)
         char name[48];
         snprintf(name, sizeof name, "%s.gpu_ms", f->names[i]);
         /* a pass run several times in one frame (the paper's march loop) reports its total */
-        vfx_stat_add(ctx, name, t1 > t0 ? (double)(t1 - t0) * 1e-6 : 0.0);
+        volfx_stat_add(ctx, name, t1 > t0 ? (double)(t1 - t0) * 1e-6 : 0.0);
     }
     f->count = 0;
     g->frame = oldest;
 }
 
-void vfx_gpu_fullscreen(vfx_context *ctx)
+void volfx_gpu_fullscreen(vfx_context *ctx)
 {
     glBindVertexArray(ctx->gpu->empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
 }
 
-vfx_result vfx_gpu_read_top_first(vfx_context *ctx, GLuint tex, GLenum format, uint32_t comps,
+vfx_result volfx_gpu_read_top_first(vfx_context *ctx, GLuint tex, GLenum format, uint32_t comps,
                                   int channel, uint32_t w, uint32_t h, float *out)
 {
     size_t n = (size_t)w * h * comps;
-    float *tmp = vfx_alloc(ctx, n * sizeof *tmp);
+    float *tmp = volfx_alloc(ctx, n * sizeof *tmp);
     if (!tmp)
         return VFX_ERR_OUT_OF_MEMORY;
     glGetTextureImage(tex, 0, format, GL_FLOAT, (GLsizei)(n * sizeof *tmp), tmp);
@@ -277,6 +277,6 @@ vfx_result vfx_gpu_read_top_first(vfx_context *ctx, GLuint tex, GLenum format, u
             for (uint32_t i = 0; i < w; ++i)
                 out[(size_t)j * w + i] = src[(size_t)i * comps + (uint32_t)channel];
     }
-    vfx_free(ctx, tmp);
+    volfx_free(ctx, tmp);
     return VFX_OK;
 }

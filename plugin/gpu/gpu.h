@@ -1,47 +1,47 @@
 /* gpu.h — plugin-side GL helpers: embedded-shader program cache with file:line errors,
  * non-stalling timestamp ring per pass, debug groups and labels, a fullscreen triangle. */
-#ifndef VFX_GPU_H
-#define VFX_GPU_H
+#ifndef VOLFX_GPU_H
+#define VOLFX_GPU_H
 
 #include <epoxy/gl.h>
 #include "plugin_internal.h"
 
 /* Makes the helper state; needs a current GL 4.5 context (checked, VFX_ERR_GL_UNSUPPORTED). */
-vfx_result vfx_gpu_create(vfx_context *ctx, vfx_gpu **out);
+vfx_result volfx_gpu_create(vfx_context *ctx, volfx_gpu **out);
 /* Deletes every program, query and VAO it made. */
-void vfx_gpu_destroy(vfx_context *ctx, vfx_gpu *gpu);
+void volfx_gpu_destroy(vfx_context *ctx, volfx_gpu *gpu);
 
 /* Returns a linked program from embedded shaders (paths relative to shaders/, e.g.
  * "common/fullscreen.vert"); `defines` is inserted after #version (may be NULL). Programs are
  * cached by (paths, defines). 0 on failure, with an error naming file:line. A source may
  * `#include "common/x.glsl"` (one level, expanded with #line so errors keep file:line). */
-GLuint vfx_gpu_program(vfx_context *ctx, const char *vert, const char *frag, const char *defines);
+GLuint volfx_gpu_program(vfx_context *ctx, const char *vert, const char *frag, const char *defines);
 /* Same for a compute shader. */
-GLuint vfx_gpu_compute(vfx_context *ctx, const char *comp, const char *defines);
+GLuint volfx_gpu_compute(vfx_context *ctx, const char *comp, const char *defines);
 
 /* Opens a named pass: a debug group (RenderDoc shows it) and a timestamp pair. Names are
  * "effect.pass", e.g. "water.accumulate"; the GPU ms of the pass reach the stats as
  * "<name>.gpu_ms" a few frames later, without stalling (passes of one name in a frame summed). */
-void vfx_gpu_pass_begin(vfx_context *ctx, const char *name);
+void volfx_gpu_pass_begin(vfx_context *ctx, const char *name);
 /* Closes the innermost open pass. */
-void vfx_gpu_pass_end(vfx_context *ctx);
+void volfx_gpu_pass_end(vfx_context *ctx);
 /* Called once per frame by the plugin: collects finished timer results. */
-void vfx_gpu_frame_end(vfx_context *ctx);
+void volfx_gpu_frame_end(vfx_context *ctx);
 
 /* Draws one fullscreen triangle (bind a program using common/fullscreen.vert first). */
-void vfx_gpu_fullscreen(vfx_context *ctx);
+void volfx_gpu_fullscreen(vfx_context *ctx);
 /* Reads a w x h float texture of comps components (format GL_RED/GL_RGBA...) into out with the
  * top row first (GL's rows are bottom first): every component (w*h*comps floats) when channel < 0,
  * else that one component (w*h floats). VFX_ERR_OUT_OF_MEMORY when the staging copy fails. */
-vfx_result vfx_gpu_read_top_first(vfx_context *ctx, GLuint tex, GLenum format, uint32_t comps,
+vfx_result volfx_gpu_read_top_first(vfx_context *ctx, GLuint tex, GLenum format, uint32_t comps,
                                   int channel, uint32_t w, uint32_t h, float *out);
 /* Labels a GL object for debuggers (no-op without KHR_debug). */
-void vfx_gpu_label(GLenum kind, GLuint object, const char *label);
+void volfx_gpu_label(GLenum kind, GLuint object, const char *label);
 /* Returns a GL error as a string, or NULL when glGetError() is GL_NO_ERROR. */
-const char *vfx_gpu_error_string(void);
+const char *volfx_gpu_error_string(void);
 
-/* Compiles and links from source strings (used by vfx_gpu_program; tests call it directly).
+/* Compiles and links from source strings (used by volfx_gpu_program; tests call it directly).
  * `names` give the file name of each stage for error messages. */
-GLuint vfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *stages,
+GLuint volfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *stages,
                             const char *const *sources, const char *const *names);
 #endif

@@ -88,8 +88,8 @@ static int parse_numbers(char *s, double *v, int maxn)
 
 #define TG_MAXCOL 64
 
-vfx_result vfx_tet_load_tetgen(const char *path_base, const char *scalar_name,
-                               vfx_tet_mesh *out, char *err, size_t errlen)
+vfx_result tet_load_tetgen(const char *path_base, const char *scalar_name,
+                               tet_mesh *out, char *err, size_t errlen)
 {
     if (!path_base || !out) {
         snprintf(err, errlen, "NULL argument");
@@ -264,10 +264,10 @@ vfx_result vfx_tet_load_tetgen(const char *path_base, const char *scalar_name,
             out->tets[4 * (size_t)t + k] = (uint32_t)idx;
         }
     }
-    res = vfx_tet_validate(out, err, errlen);
+    res = tet_validate(out, err, errlen);
 done:
     if (res != VFX_OK)
-        vfx_tet_mesh_free(out);
+        tet_mesh_free(out);
     free(nodebuf);
     free(elebuf);
     free(path);

@@ -371,8 +371,8 @@ static const vtu_array *find(const vtu_state *s, int section, const char *name)
     return NULL;
 }
 
-vfx_result vfx_tet_load_vtu_mem(const void *data, size_t size, const char *scalar_name,
-                                vfx_tet_mesh *out, char *err, size_t errlen)
+vfx_result tet_load_vtu_mem(const void *data, size_t size, const char *scalar_name,
+                                tet_mesh *out, char *err, size_t errlen)
 {
     if (!data || !out || !err) {
         if (err) snprintf(err, errlen, "NULL argument");
@@ -507,16 +507,16 @@ vfx_result vfx_tet_load_vtu_mem(const void *data, size_t size, const char *scala
             out->scalar[i] = (float)(as->ncomp == 1 ? m : sqrt(m));
         }
     }
-    r = vfx_tet_validate(out, err, errlen);
+    r = tet_validate(out, err, errlen);
 done:
-    if (r != VFX_OK) vfx_tet_mesh_free(out);
+    if (r != VFX_OK) tet_mesh_free(out);
     if (s->parser) XML_ParserFree(s->parser);
     free(s);
     free(pts); free(conn); free(offs); free(types); free(sc);
     return r;
 }
 
-vfx_result vfx_tet_load_vtu(const char *path, const char *scalar_name, vfx_tet_mesh *out,
+vfx_result tet_load_vtu(const char *path, const char *scalar_name, tet_mesh *out,
                             char *err, size_t errlen)
 {
     if (!path || !out) {
@@ -541,7 +541,7 @@ vfx_result vfx_tet_load_vtu(const char *path, const char *scalar_name, vfx_tet_m
     }
     fclose(f);
     char inner[256];
-    vfx_result r = vfx_tet_load_vtu_mem(buf, (size_t)n, scalar_name, out, inner, sizeof inner);
+    vfx_result r = tet_load_vtu_mem(buf, (size_t)n, scalar_name, out, inner, sizeof inner);
     if (r != VFX_OK)
         snprintf(err, errlen, "%s: %s", path, inner);
     free(buf);

@@ -1,10 +1,10 @@
-/* tet_mesh.c — ownership of vfx_tet_mesh arrays. */
+/* tet_mesh.c — ownership of tet_mesh arrays. */
 #include "tet_mesh.h"
 
 #include <stdlib.h>
 #include <string.h>
 
-void vfx_tet_mesh_free(vfx_tet_mesh *mesh)
+void tet_mesh_free(tet_mesh *mesh)
 {
     if (!mesh)
         return;

@@ -1,13 +1,13 @@
 /* tet_mesh.h — an unstructured tetrahedral grid in memory, as the loaders produce it and the
- * cell-projection renderer consumes it. Owned by whoever loaded it; vfx_tet_mesh_free frees. */
-#ifndef VFX_TET_MESH_H
-#define VFX_TET_MESH_H
+ * cell-projection renderer consumes it. Owned by whoever loaded it; tet_mesh_free frees. */
+#ifndef TET_MESH_H
+#define TET_MESH_H
 
 #include <stddef.h>
 #include <stdint.h>
 #include <volfx/volfx.h>
 
-typedef struct vfx_tet_mesh {
+typedef struct tet_mesh {
     uint32_t point_count;
     uint32_t tet_count;
     float *points;     /* 3 * point_count: x, y, z */
@@ -17,9 +17,9 @@ typedef struct vfx_tet_mesh {
     float scalar_min, scalar_max;
     uint32_t inverted_fixed;   /* tets whose orientation the loader flipped */
     uint32_t degenerate_count; /* zero-volume tets found (kept, reported) */
-} vfx_tet_mesh;
+} tet_mesh;
 
 /* Frees the arrays of a mesh and zeroes it; NULL allowed. */
-void vfx_tet_mesh_free(vfx_tet_mesh *mesh);
+void tet_mesh_free(tet_mesh *mesh);
 
 #endif

@@ -40,7 +40,7 @@ static void wait_polite(int n, MPI_Request *rq)
     }
 }
 
-void vfx_tet_seglists_free(vfx_tet_seglists *l)
+void tet_seglists_free(tet_seglists *l)
 {
     if (!l)
         return;
@@ -49,7 +49,7 @@ void vfx_tet_seglists_free(vfx_tet_seglists *l)
     memset(l, 0, sizeof *l);
 }
 
-static void over(vfx_tet_rseg *f, const vfx_tet_rseg *b)
+static void over(tet_rseg *f, const tet_rseg *b)
 {
     float t = 1.0f - f->a;
     f->r += t * b->r;
@@ -58,8 +58,8 @@ static void over(vfx_tet_rseg *f, const vfx_tet_rseg *b)
     f->a += t * b->a;
 }
 
-int vfx_tet_seglists_merge(const vfx_tet_seglists *a, const vfx_tet_seglists *b, int partial,
-                           vfx_tet_seglists *out)
+int tet_seglists_merge(const tet_seglists *a, const tet_seglists *b, int partial,
+                           tet_seglists *out)
 {
     size_t np = a->p1 - a->p0;
     size_t na = a->off[np], nb = b->off[np];
@@ -71,7 +71,7 @@ int vfx_tet_seglists_merge(const vfx_tet_seglists *a, const vfx_tet_seglists *b,
     out->off = malloc((np + 1) * sizeof *out->off);
     out->segs = malloc((na + nb + 1) * sizeof *out->segs);
     if (!out->off || !out->segs) {
-        vfx_tet_seglists_free(out);
+        tet_seglists_free(out);
         return -1;
     }
     size_t n = 0;
@@ -80,7 +80,7 @@ int vfx_tet_seglists_merge(const vfx_tet_seglists *a, const vfx_tet_seglists *b,
         size_t i = a->off[p], ie = a->off[p + 1], j = b->off[p], je = b->off[p + 1];
         size_t first = n;
         while (i < ie || j < je) {
-            const vfx_tet_rseg *s;
+            const tet_rseg *s;
             if (j >= je || (i < ie && a->segs[i].zf <= b->segs[j].zf))
                 s = &a->segs[i++];
             else
@@ -89,7 +89,7 @@ int vfx_tet_seglists_merge(const vfx_tet_seglists *a, const vfx_tet_seglists *b,
              * (adjacent cells of two partitions) joins it, which shrinks the next stage's
              * message without changing the image beyond float association */
             if (partial && n > first) {
-                vfx_tet_rseg *last = &out->segs[n - 1];
+                tet_rseg *last = &out->segs[n - 1];
                 if (fabsf(last->zb - s->zf) <= TOUCH_EPS * (1.0f + fabsf(s->zf))) {
                     over(last, s);
                     last->zb = s->zb;
@@ -104,7 +104,7 @@ int vfx_tet_seglists_merge(const vfx_tet_seglists *a, const vfx_tet_seglists *b,
 }
 
 /* The lists of pixels [q0, q1) (inside l's range) as their own lists (copied). */
-static int slice_lists(const vfx_tet_seglists *l, size_t q0, size_t q1, vfx_tet_seglists *out)
+static int slice_lists(const tet_seglists *l, size_t q0, size_t q1, tet_seglists *out)
 {
     size_t a = q0 - l->p0, np = q1 - q0, base = l->off[a], ns = l->off[a + np] - base;
     memset(out, 0, sizeof *out);
@@ -113,7 +113,7 @@ static int slice_lists(const vfx_tet_seglists *l, size_t q0, size_t q1, vfx_tet_
     out->off = malloc((np + 1) * sizeof *out->off);
     out->segs = malloc((ns + 1) * sizeof *out->segs);
     if (!out->off || !out->segs) {
-        vfx_tet_seglists_free(out);
+        tet_seglists_free(out);
         return -1;
     }
     for (size_t p = 0; p <= np; p++)
@@ -138,9 +138,9 @@ static int agree(MPI_Comm comm, int rc, char err[256], const char *what)
  * (dst < 0: none) and receives those of [k0, k1) from src (src < 0: none) into in. The segment
  * counts travel first and every rank agrees that the receive buffers exist before any payload
  * moves, so a failed allocation returns an error everywhere instead of leaving a send hanging. */
-static int exchange(MPI_Comm comm, MPI_Datatype segt, const vfx_tet_seglists *cur, int dst,
+static int exchange(MPI_Comm comm, MPI_Datatype segt, const tet_seglists *cur, int dst,
                     size_t s0, size_t s1, int src, size_t k0, size_t k1, uint32_t *counts,
-                    vfx_tet_seglists *in, uint64_t *bytes, char err[256])
+                    tet_seglists *in, uint64_t *bytes, char err[256])
 {
     int rc = VFX_OK;
     uint64_t ns = 0, nr = 0;
@@ -173,7 +173,7 @@ static int exchange(MPI_Comm comm, MPI_Datatype segt, const vfx_tet_seglists *cu
         size_t a = s0 - cur->p0;
         MPI_Isend(counts, (int)(s1 - s0), MPI_UINT32_T, dst, TAG_SWAP_N, comm, &rq[nrq++]);
         MPI_Isend(cur->segs + cur->off[a], (int)ns, segt, dst, TAG_SWAP_S, comm, &rq[nrq++]);
-        *bytes += sizeof ns + (uint64_t)(s1 - s0) * sizeof(uint32_t) + ns * sizeof(vfx_tet_rseg);
+        *bytes += sizeof ns + (uint64_t)(s1 - s0) * sizeof(uint32_t) + ns * sizeof(tet_rseg);
     }
     if (rc == VFX_OK && src >= 0) {
         size_t np = k1 - k0;
@@ -191,17 +191,17 @@ static int exchange(MPI_Comm comm, MPI_Datatype segt, const vfx_tet_seglists *cu
     }
     wait_polite(nrq, rq);
     if (rc != VFX_OK)
-        vfx_tet_seglists_free(in);
+        tet_seglists_free(in);
     return rc;
 }
 
-int vfx_tet_mpi_composite(MPI_Comm comm, int W, int H, vfx_tet_seglists *lists, int partial,
-                          float *rgba, vfx_tet_mpi_stats *st, char err[256])
+int tet_mpi_composite(MPI_Comm comm, int W, int H, tet_seglists *lists, int partial,
+                          float *rgba, tet_mpi_stats *st, char err[256])
 {
     int rank, P, rc = VFX_OK;
     MPI_Comm_rank(comm, &rank);
     MPI_Comm_size(comm, &P);
-    double t0 = vfx_tet_now_ms();
+    double t0 = tet_now_ms();
     MPI_Datatype segt;
     MPI_Type_contiguous(6, MPI_FLOAT, &segt);
     MPI_Type_commit(&segt);
@@ -220,7 +220,7 @@ int vfx_tet_mpi_composite(MPI_Comm comm, int W, int H, vfx_tet_seglists *lists, 
     int G = 1;
     while (G * 2 <= P)
         G *= 2;
-    vfx_tet_seglists cur = *lists, in, keep, merged;
+    tet_seglists cur = *lists, in, keep, merged;
     memset(lists, 0, sizeof *lists);
     memset(&merged, 0, sizeof merged);
     /* Fold: ranks G..P-1 hand their whole screen to rank - G, so the swap runs on 2^k ranks. */
@@ -229,17 +229,17 @@ int vfx_tet_mpi_composite(MPI_Comm comm, int W, int H, vfx_tet_seglists *lists, 
         rc = exchange(comm, segt, &cur, dst, 0, npix, src, 0, npix, counts, &in, &bytes, err);
         int r2 = VFX_OK;
         if (rc == VFX_OK && src >= 0) {
-            if (vfx_tet_seglists_merge(&cur, &in, partial, &merged) != 0) {
+            if (tet_seglists_merge(&cur, &in, partial, &merged) != 0) {
                 snprintf(err, 256, "tet_mpi: out of memory folding rank %d's lists", src);
                 r2 = VFX_ERR_OUT_OF_MEMORY;
             } else {
-                vfx_tet_seglists_free(&cur);
+                tet_seglists_free(&cur);
                 cur = merged;
             }
         }
         if (rc == VFX_OK && dst >= 0)
-            vfx_tet_seglists_free(&cur);
-        vfx_tet_seglists_free(&in);
+            tet_seglists_free(&cur);
+        tet_seglists_free(&in);
         if (rc == VFX_OK)
             rc = agree(comm, r2, err, "fold");
     }
@@ -260,13 +260,13 @@ int vfx_tet_mpi_composite(MPI_Comm comm, int W, int H, vfx_tet_seglists *lists, 
         int r2 = VFX_OK;
         if (partner >= 0) {
             if (slice_lists(&cur, k0, k1, &keep) != 0 ||
-                vfx_tet_seglists_merge(&keep, &in, partial, &merged) != 0) {
+                tet_seglists_merge(&keep, &in, partial, &merged) != 0) {
                 snprintf(err, 256, "tet_mpi: out of memory in binary swap stage %d", bit);
                 r2 = VFX_ERR_OUT_OF_MEMORY;
             }
-            vfx_tet_seglists_free(&keep);
-            vfx_tet_seglists_free(&in);
-            vfx_tet_seglists_free(&cur);
+            tet_seglists_free(&keep);
+            tet_seglists_free(&in);
+            tet_seglists_free(&cur);
             cur = merged;
             memset(&merged, 0, sizeof merged);
             p0 = k0;
@@ -274,7 +274,7 @@ int vfx_tet_mpi_composite(MPI_Comm comm, int W, int H, vfx_tet_seglists *lists, 
         }
         rc = agree(comm, r2, err, "binary swap");
     }
-    double t1 = vfx_tet_now_ms();
+    double t1 = tet_now_ms();
     /* Final composition of this rank's part, then gather to rank 0. */
     size_t mine = rank < G ? p1 - p0 : 0;
     float *part = malloc((mine + 1) * 4 * sizeof *part);
@@ -291,7 +291,7 @@ int vfx_tet_mpi_composite(MPI_Comm comm, int W, int H, vfx_tet_seglists *lists, 
     rc = agree(comm, rc, err, "final composition");
     if (rc == VFX_OK) {
         for (size_t p = 0; p < mine; p++) {
-            vfx_tet_rseg acc = {0, 0, 0, 0, 0, 0};
+            tet_rseg acc = {0, 0, 0, 0, 0, 0};
             for (uint32_t i = cur.off[p]; i < cur.off[p + 1]; i++)
                 over(&acc, &cur.segs[i]);
             part[4 * p + 0] = acc.r;
@@ -321,25 +321,25 @@ int vfx_tet_mpi_composite(MPI_Comm comm, int W, int H, vfx_tet_seglists *lists, 
     if (st) {
         st->bytes_sent += bytes;
         st->t_swap_ms += t1 - t0;
-        st->t_gather_ms += vfx_tet_now_ms() - t1;
+        st->t_gather_ms += tet_now_ms() - t1;
     }
     free(part);
     free(counts);
-    vfx_tet_seglists_free(&cur);
+    tet_seglists_free(&cur);
     MPI_Type_free(&segt);
     return rc;
 }
 
-struct vfx_tet_mpi {
+struct tet_mpi {
     MPI_Comm comm;
     MPI_Win win;   /* the shared ERT table on rank 0, kept between renders */
     float *win_mem;
     int win_dd;    /* its entries; 0 = no window yet */
 };
 
-int vfx_tet_mpi_create(MPI_Comm comm, vfx_tet_mpi **out, char err[256])
+int tet_mpi_create(MPI_Comm comm, tet_mpi **out, char err[256])
 {
-    vfx_tet_mpi *m = calloc(1, sizeof *m);
+    tet_mpi *m = calloc(1, sizeof *m);
     int rc = m ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
     if (!m)
         snprintf(err, 256, "tet_mpi: out of memory for the context");
@@ -354,7 +354,7 @@ int vfx_tet_mpi_create(MPI_Comm comm, vfx_tet_mpi **out, char err[256])
     return VFX_OK;
 }
 
-void vfx_tet_mpi_destroy(vfx_tet_mpi *m)
+void tet_mpi_destroy(tet_mpi *m)
 {
     if (!m)
         return;
@@ -367,8 +367,8 @@ void vfx_tet_mpi_destroy(vfx_tet_mpi *m)
 typedef struct rank_scan {
     MPI_Comm comm;
     int rank, P, DD;
-    vfx_tet_local *L;
-    const vfx_tet_options *opts;
+    tet_local *L;
+    const tet_options *opts;
     uint32_t next, end;   /* remaining keys [next, end) of this rank */
     int share, dlb;
     /* weak sharing: the shared table lives in a window on rank 0 (the paper's manager node,
@@ -386,7 +386,7 @@ typedef struct rank_scan {
     uint32_t give[2];
     int ask_msg;
     int asked;            /* rank asked, -1 when none */
-    vfx_tet_mpi_stats *st;
+    tet_mpi_stats *st;
 } rank_scan;
 
 static void start_round(rank_scan *R)
@@ -406,7 +406,7 @@ static void start_round(rank_scan *R)
  * another rank's termination is valid here since our segments only add opacity in front. */
 static void share_table(rank_scan *R)
 {
-    vfx_tet_local_table_get(R->L, R->enc);
+    tet_local_table_get(R->L, R->enc);
     MPI_Win_lock(MPI_LOCK_SHARED, 0, 0, R->win);
     MPI_Get_accumulate(R->enc, R->DD, MPI_FLOAT, R->sendbuf + 1 + R->P, R->DD, MPI_FLOAT, 0, 0,
                        R->DD, MPI_FLOAT, MPI_MIN, R->win);
@@ -417,7 +417,7 @@ static void share_table(rank_scan *R)
         if (v < R->known[i])
             R->known[i] = v;
     }
-    vfx_tet_local_table_merge(R->L, R->known);
+    tet_local_table_merge(R->L, R->known);
     R->st->share_rounds++;
 }
 
@@ -477,16 +477,16 @@ static int ask_for_work(rank_scan *R)
     return 1;
 }
 
-int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
-                       const vfx_tet_tf *tf, const vfx_tet_options *opts, float *rgba,
-                       vfx_tet_mpi_stats *mine, vfx_tet_mpi_stats *all, char err[256])
+int tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
+                       const tet_tf *tf, const tet_options *opts, float *rgba,
+                       tet_mpi_stats *mine, tet_mpi_stats *all, char err[256])
 {
-    double t_start = vfx_tet_now_ms();
+    double t_start = tet_now_ms();
     MPI_Comm comm = ctx->comm;
     int rank, P;
     MPI_Comm_rank(comm, &rank);
     MPI_Comm_size(comm, &P);
-    vfx_tet_mpi_stats st;
+    tet_mpi_stats st;
     memset(&st, 0, sizeof st);
     rank_scan R;
     memset(&R, 0, sizeof R);
@@ -497,14 +497,14 @@ int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet
     R.asked = -1;
     R.st = &st;
     /* rank 0 gathers the statistics even when the caller wants none */
-    vfx_tet_mpi_stats *gather_tmp = rank == 0 && !all ? malloc((size_t)P * sizeof *gather_tmp) : NULL;
-    int rc = vfx_tet_local_create(mesh, cam, tf, opts, P, rank, &R.L, err);
+    tet_mpi_stats *gather_tmp = rank == 0 && !all ? malloc((size_t)P * sizeof *gather_tmp) : NULL;
+    int rc = tet_local_create(mesh, cam, tf, opts, P, rank, &R.L, err);
     if (rc == VFX_OK && rank == 0 && !all && !gather_tmp) {
         snprintf(err, 256, "tet_mpi: out of memory for %d ranks' statistics", P);
         rc = VFX_ERR_OUT_OF_MEMORY;
     }
     if (rc == VFX_OK) {
-        R.DD = vfx_tet_local_tiles_d(R.L) * vfx_tet_local_tiles_d(R.L);
+        R.DD = tet_local_tiles_d(R.L) * tet_local_tiles_d(R.L);
         size_t n = (size_t)R.DD + 1 + (size_t)P; /* the reduction, then a table's scratch */
         R.sendbuf = malloc(n * sizeof(float));
         R.recvbuf = malloc(n * sizeof(float));
@@ -543,12 +543,12 @@ int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet
          * frame's reset after every access of this one */
         agree(comm, VFX_OK, err, "window set-up");
     }
-    vfx_tet_local_part(R.L, rank, &R.next, &R.end);
+    tet_local_part(R.L, rank, &R.next, &R.end);
     st.cells_assigned = R.end - R.next;
     for (int i = 0; i < R.DD; i++)
         R.known[i] = INFINITY;
     for (int i = 0; i < P; i++) /* until the first reduction: cells, NaN ones included */
-        R.remaining[i] = (float)vfx_tet_local_part_cells(R.L, i);
+        R.remaining[i] = (float)tet_local_part_cells(R.L, i);
     R.dlb = opts->dlb;
     /* reductions are needed for sharing, and for the remaining counts and the termination
      * agreement of load balancing; without either the ranks scan independently */
@@ -559,45 +559,45 @@ int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet
      * requests move while a rank scans a long stretch */
     const uint32_t POLL = 256;
     int failed = 0;
-    double t1 = vfx_tet_now_ms(), c1 = vfx_tet_thread_cpu_ms();
+    double t1 = tet_now_ms(), c1 = tet_thread_cpu_ms();
     st.t_setup_ms = t1 - t_start;
-    vfx_tet_counters *cnt = vfx_tet_local_counters(R.L);
+    tet_counters *cnt = tet_local_counters(R.L);
     for (;;) {
         uint32_t rem = R.end - R.next;
         uint32_t interval = rem / C > 0 ? rem / C : 1, since = 0;
-        double ts = vfx_tet_now_ms(), tin = 0, tu0 = cnt->t_update_ms;
+        double ts = tet_now_ms(), tin = 0, tu0 = cnt->t_update_ms;
         while (R.next < R.end && !failed) {
             if (since >= interval) {
                 if (ert)
-                    vfx_tet_local_update_table(R.L);
+                    tet_local_update_table(R.L);
                 if (coop) {
-                    double tp = vfx_tet_now_ms();
+                    double tp = tet_now_ms();
                     if (R.share)
                         share_table(&R);
                     poll_rank(&R, 1);
                     st.polls++;
-                    tin += vfx_tet_now_ms() - tp;
+                    tin += tet_now_ms() - tp;
                 }
                 interval = (R.end - R.next) / C > 0 ? (R.end - R.next) / C : 1;
                 since = 0;
             } else if (coop && since % POLL == POLL - 1) {
-                double tp = vfx_tet_now_ms();
+                double tp = tet_now_ms();
                 poll_rank(&R, 0);
                 st.polls++;
-                tin += vfx_tet_now_ms() - tp;
+                tin += tet_now_ms() - tp;
             }
             if (R.next >= R.end)
                 break; /* everything left was handed away */
             since++;
             st.keys_done++;
-            if (vfx_tet_local_scan(R.L, R.next++) != 0) {
+            if (tet_local_scan(R.L, R.next++) != 0) {
                 failed = 1;
                 R.end = R.next; /* nothing to hand out either */
                 snprintf(err, 256, "tet_mpi: rank %d out of memory at %llu segments", rank,
                          (unsigned long long)cnt->segments_made);
             }
         }
-        cnt->t_sc_ms += vfx_tet_now_ms() - ts - tin - (cnt->t_update_ms - tu0);
+        cnt->t_sc_ms += tet_now_ms() - ts - tin - (cnt->t_update_ms - tu0);
         st.t_comm_ms += tin;
         if (!coop || failed || !R.dlb)
             break;
@@ -605,7 +605,7 @@ int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet
          * any to give. The rank keeps answering other requests meanwhile (with nothing). */
         int got = 0;
         while (!got && ask_for_work(&R)) {
-            double tw = vfx_tet_now_ms();
+            double tw = tet_now_ms();
             for (;;) {
                 int flag = 0;
                 MPI_Test(&R.give_rq, &flag, MPI_STATUS_IGNORE);
@@ -615,10 +615,10 @@ int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet
                 idle_pause();
             }
             wait_polite(1, &R.ask_rq); /* it was answered, so it was received */
-            st.t_idle_ms += vfx_tet_now_ms() - tw;
+            st.t_idle_ms += tet_now_ms() - tw;
             uint32_t n = R.give[1] - R.give[0];
             if (n > 0) {
-                vfx_tet_local_need(R.L, R.give[0], R.give[1]); /* sorts the victim's keys */
+                tet_local_need(R.L, R.give[0], R.give[1]); /* sorts the victim's keys */
                 R.next = R.give[0];
                 R.end = R.give[1];
                 st.cells_taken += n;
@@ -636,53 +636,53 @@ int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet
      * after the same one and no message is left in flight (a rank waiting for an answer is
      * not done, so that reduction cannot say all done). */
     if (coop) {
-        double tw = vfx_tet_now_ms();
+        double tw = tet_now_ms();
         R.done = 1;
         while (!R.all_done) {
             poll_rank(&R, 1);
             if (!R.all_done)
                 idle_pause();
         }
-        st.t_idle_ms += vfx_tet_now_ms() - tw;
+        st.t_idle_ms += tet_now_ms() - tw;
     }
-    st.t_phase1_ms = vfx_tet_now_ms() - t1;
-    st.t_phase1_cpu_ms = vfx_tet_thread_cpu_ms() - c1;
+    st.t_phase1_ms = tet_now_ms() - t1;
+    st.t_phase1_cpu_ms = tet_thread_cpu_ms() - c1;
 
     rc = agree(comm, failed ? VFX_ERR_OUT_OF_MEMORY : VFX_OK, err, "the scan");
     if (rc != VFX_OK)
         goto done;
     /* Phase 2: this rank's full-screen lists, exported and composited by binary swap. */
-    double te = vfx_tet_now_ms();
-    vfx_tet_seglists lists;
+    double te = tet_now_ms();
+    tet_seglists lists;
     memset(&lists, 0, sizeof lists);
     size_t npix = (size_t)cam->width * cam->height;
     lists.p0 = 0;
     lists.p1 = npix;
     lists.off = malloc((npix + 1) * sizeof *lists.off);
-    size_t nseg = lists.off ? vfx_tet_local_export(R.L, 0, npix, lists.off, NULL) : 0;
+    size_t nseg = lists.off ? tet_local_export(R.L, 0, npix, lists.off, NULL) : 0;
     lists.segs = lists.off && nseg <= INT_MAX ? malloc((nseg + 1) * sizeof *lists.segs) : NULL;
     int r2 = VFX_OK;
     if (!lists.segs) {
         snprintf(err, 256, "tet_mpi: rank %d out of memory exporting %zu segments", rank, nseg);
         r2 = VFX_ERR_OUT_OF_MEMORY;
-        vfx_tet_seglists_free(&lists);
+        tet_seglists_free(&lists);
     } else {
-        vfx_tet_local_export(R.L, 0, npix, lists.off, lists.segs);
+        tet_local_export(R.L, 0, npix, lists.off, lists.segs);
     }
     st.segments_local = nseg;
     st.cnt = *cnt;
-    vfx_tet_local_destroy(R.L); /* the lists are all phase 2 needs */
+    tet_local_destroy(R.L); /* the lists are all phase 2 needs */
     R.L = NULL;
     rc = agree(comm, r2, err, "export");
-    st.t_export_ms = vfx_tet_now_ms() - te;
+    st.t_export_ms = tet_now_ms() - te;
     if (rc == VFX_OK)
-        rc = vfx_tet_mpi_composite(comm, cam->width, cam->height, &lists, opts->partial_composite,
+        rc = tet_mpi_composite(comm, cam->width, cam->height, &lists, opts->partial_composite,
                                    rgba, &st, err);
-    vfx_tet_seglists_free(&lists);
+    tet_seglists_free(&lists);
 done:
     if (R.L)
-        st.cnt = *vfx_tet_local_counters(R.L);
-    st.t_total_ms = vfx_tet_now_ms() - t_start;
+        st.cnt = *tet_local_counters(R.L);
+    st.t_total_ms = tet_now_ms() - t_start;
     if (mine)
         *mine = st;
     if (rc == VFX_OK) {
@@ -692,7 +692,7 @@ done:
         wait_polite(1, &rq);
     }
     free(gather_tmp);
-    vfx_tet_local_destroy(R.L);
+    tet_local_destroy(R.L);
     free(R.sendbuf);
     free(R.recvbuf);
     free(R.known);

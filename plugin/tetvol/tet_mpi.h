@@ -2,8 +2,8 @@
  * holds the whole mesh, owns a partition of cells and a local ERT table, shares ERT tables
  * weakly through non-blocking reductions, balances load by moving key ranges, and composites
  * the per-pixel depth-tagged ray-segment lists by binary swap. Built only with -Dmpi. */
-#ifndef VFX_TET_MPI_H
-#define VFX_TET_MPI_H
+#ifndef TET_MPI_H
+#define TET_MPI_H
 
 #include <mpi.h>
 #include <stddef.h>
@@ -13,14 +13,14 @@
 
 /* Per-pixel ray-segment lists of the pixel range [p0, p1), depth ordered per pixel, in CSR
  * form: pixel p's segments are segs[off[p - p0] .. off[p - p0 + 1]). Heap arrays. */
-typedef struct vfx_tet_seglists {
+typedef struct tet_seglists {
     size_t p0, p1;
     uint32_t *off;
-    vfx_tet_rseg *segs;
-} vfx_tet_seglists;
+    tet_rseg *segs;
+} tet_seglists;
 
-typedef struct vfx_tet_mpi_stats {
-    vfx_tet_counters cnt;     /* this rank's scan counters (t_sc_ms: scan time alone) */
+typedef struct tet_mpi_stats {
+    tet_counters cnt;     /* this rank's scan counters (t_sc_ms: scan time alone) */
     uint64_t cells_assigned;  /* keys of the initial partition */
     uint64_t keys_done;       /* keys this rank took through the scan loop (any outcome) */
     uint64_t cells_taken;     /* keys received by load balancing */
@@ -41,25 +41,25 @@ typedef struct vfx_tet_mpi_stats {
     double t_setup_ms;        /* transform, keys of every partition, sort (replicated per rank) */
     double t_export_ms;       /* copying the lists out of the scan state */
     double t_swap_ms, t_gather_ms, t_total_ms;
-} vfx_tet_mpi_stats;
+} tet_mpi_stats;
 
 /* A communicator and what is kept between renders on it (the shared ERT table's window). */
-typedef struct vfx_tet_mpi vfx_tet_mpi;
+typedef struct tet_mpi tet_mpi;
 
 /* Creates a context on comm (which must outlive it). Collective; VFX_OK or an error code on
  * every rank with a message in err. */
-int vfx_tet_mpi_create(MPI_Comm comm, vfx_tet_mpi **out, char err[256]);
+int tet_mpi_create(MPI_Comm comm, tet_mpi **out, char err[256]);
 /* Frees a context; NULL allowed. Collective when not NULL. */
-void vfx_tet_mpi_destroy(vfx_tet_mpi *ctx);
+void tet_mpi_destroy(tet_mpi *ctx);
 
 /* Renders mesh on all ranks of ctx's comm (every rank passes the same mesh, camera, tf and opts;
  * opts->workers is ignored: one scan per rank). rgba (width*height*4, premultiplied) is filled
  * on rank 0 and may be NULL elsewhere; mine (may be NULL) gets this rank's statistics, all
  * (rank 0, NULL or comm-size entries) every rank's. Collective; returns VFX_OK or the same
  * error code on every rank, with a message in err. */
-int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
-                       const vfx_tet_tf *tf, const vfx_tet_options *opts, float *rgba,
-                       vfx_tet_mpi_stats *mine, vfx_tet_mpi_stats *all, char err[256]);
+int tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
+                       const tet_tf *tf, const tet_options *opts, float *rgba,
+                       tet_mpi_stats *mine, tet_mpi_stats *all, char err[256]);
 
 /* Binary-swap composition of every rank's full-screen lists (range [0, width*height)): ranks
  * beyond the largest power of two first fold theirs into a partner, then log2 stages swap
@@ -67,15 +67,15 @@ int vfx_tet_mpi_render(vfx_tet_mpi *ctx, const vfx_tet_mesh *mesh, const vfx_tet
  * segments partially composited when partial is set); each rank composites its 1/P front to
  * back and rank 0 gathers rgba. lists is consumed (its arrays freed). st may be NULL.
  * Collective; returns VFX_OK or an error code on every rank with a message in err. */
-int vfx_tet_mpi_composite(MPI_Comm comm, int width, int height, vfx_tet_seglists *lists,
-                          int partial, float *rgba, vfx_tet_mpi_stats *st, char err[256]);
+int tet_mpi_composite(MPI_Comm comm, int width, int height, tet_seglists *lists,
+                          int partial, float *rgba, tet_mpi_stats *st, char err[256]);
 
 /* Merges two depth-ordered lists over the same pixel range into out (allocated here);
  * touching segments are partially composited when partial is set. Returns 0 or -1 (memory). */
-int vfx_tet_seglists_merge(const vfx_tet_seglists *a, const vfx_tet_seglists *b, int partial,
-                           vfx_tet_seglists *out);
+int tet_seglists_merge(const tet_seglists *a, const tet_seglists *b, int partial,
+                           tet_seglists *out);
 
 /* Frees the arrays of lists and zeroes it; NULL allowed. */
-void vfx_tet_seglists_free(vfx_tet_seglists *lists);
+void tet_seglists_free(tet_seglists *lists);
 
 #endif

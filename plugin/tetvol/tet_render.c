@@ -30,7 +30,7 @@ typedef struct tile {
     float deepest;
 } tile;
 
-void vfx_tet_options_default(vfx_tet_options *o)
+void tet_options_default(tet_options *o)
 {
     memset(o, 0, sizeof *o);
     o->ert = 1;
@@ -129,7 +129,7 @@ static int insert_seg(seg_pool *p, int32_t *head, int32_t *hint, seg v, int part
     return 0;
 }
 
-static void tf_eval(const vfx_tet_tf *tf, double s, double *tau, double rgb[3])
+static void tf_eval(const tet_tf *tf, double s, double *tau, double rgb[3])
 {
     double range = (double)tf->smax - tf->smin;
     double u = range > 0 ? (s - tf->smin) / range : 0.0;
@@ -211,7 +211,7 @@ static inline int iceil(double v)
 /* Transforms every point to view space with its scalar and, in front of the eye, its pixel
  * coordinates (pixel k's centre at k). Shared by the threaded path and the MPI engine so both
  * see bit-identical vertices. */
-static void view_vertices(const vfx_tet_mesh *mesh, const float *V, const float *P, int W, int H,
+static void view_vertices(const tet_mesh *mesh, const float *V, const float *P, int W, int H,
                           pvert *vp)
 {
     for (uint32_t i = 0; i < mesh->point_count; i++) {
@@ -235,9 +235,9 @@ static void view_vertices(const vfx_tet_mesh *mesh, const float *V, const float 
 }
 
 typedef struct scan_ctx {
-    const vfx_tet_mesh *mesh;
-    const vfx_tet_tf *tf;
-    const vfx_tet_options *opts;
+    const tet_mesh *mesh;
+    const tet_tf *tf;
+    const tet_options *opts;
     const pvert *vp;
     const float *P;
     double near_d;
@@ -252,7 +252,7 @@ typedef struct worker {
     int32_t *heads;
     int32_t *hints;         /* per pixel: the segment last inserted (a walk start), or -1 */
     tile *tiles;            /* local ERT table */
-    vfx_tet_counters cnt;
+    tet_counters cnt;
     uint32_t next, end;     /* remaining cells: keys[next..end), guarded by lock */
     pthread_mutex_t lock;
     int failed;
@@ -272,9 +272,9 @@ typedef struct shared {
  * Returns 0, or -1 when out of memory. */
 static int scan_cell(const scan_ctx *X, worker *w, const cellkey *key)
 {
-    const vfx_tet_mesh *mesh = X->mesh;
-    const vfx_tet_tf *tf = X->tf;
-    const vfx_tet_options *opts = X->opts;
+    const tet_mesh *mesh = X->mesh;
+    const tet_tf *tf = X->tf;
+    const tet_options *opts = X->opts;
     const pvert *vp = X->vp;
     const float *P = X->P;
     const double near_d = X->near_d, ix0 = P[8], iy0 = P[9];
@@ -510,7 +510,7 @@ static void update_table(shared *sh, worker *w)
 {
     const scan_ctx *X = sh->X;
     const int W = X->W, H = X->H, D = X->D;
-    double tu = vfx_tet_now_ms();
+    double tu = tet_now_ms();
     for (int ty = 0; ty < D; ty++)
         for (int tx = 0; tx < D; tx++) {
             int x0 = tx * W / D, x1 = (tx + 1) * W / D;
@@ -539,7 +539,7 @@ static void update_table(shared *sh, worker *w)
         pthread_mutex_unlock(&sh->lock);
     }
     w->cnt.table_updates++;
-    w->cnt.t_update_ms += vfx_tet_now_ms() - tu;
+    w->cnt.t_update_ms += tet_now_ms() - tu;
 }
 
 /* Dynamic load balancing (paper 4.3.2): take 1/3 of the remaining cells of the most loaded
@@ -582,7 +582,7 @@ static void *worker_main(void *arg)
     const scan_ctx *X = sh->X;
     const int ert = X->opts->ert;
     const uint32_t C = X->opts->update_c > 0 ? (uint32_t)X->opts->update_c : 1;
-    double t0 = vfx_tet_now_ms(), c0 = vfx_tet_thread_cpu_ms();
+    double t0 = tet_now_ms(), c0 = tet_thread_cpu_ms();
     pthread_mutex_lock(&w->lock);
     uint32_t rem0 = w->end - w->next;
     pthread_mutex_unlock(&w->lock);
@@ -609,8 +609,8 @@ static void *worker_main(void *arg)
             break;
         }
     }
-    w->cnt.t_sc_ms = vfx_tet_now_ms() - t0 - w->cnt.t_update_ms;
-    w->cnt.cpu_ms = vfx_tet_thread_cpu_ms() - c0;
+    w->cnt.t_sc_ms = tet_now_ms() - t0 - w->cnt.t_update_ms;
+    w->cnt.cpu_ms = tet_thread_cpu_ms() - c0;
     return NULL;
 }
 
@@ -654,18 +654,18 @@ static void *composite_main(void *arg)
     return NULL;
 }
 
-int vfx_tet_render(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam, const vfx_tet_tf *tf,
-                   const vfx_tet_options *opts, float *rgba, vfx_tet_counters *counters,
+int tet_render(const tet_mesh *mesh, const tet_camera *cam, const tet_tf *tf,
+                   const tet_options *opts, float *rgba, tet_counters *counters,
                    char err[256])
 {
-    return vfx_tet_render_workers(mesh, cam, tf, opts, rgba, counters, NULL, err);
+    return tet_render_workers(mesh, cam, tf, opts, rgba, counters, NULL, err);
 }
 
 /* The checks both entry points make once their pointers are known non-NULL, in one order so
  * that both report the same first fault: image size, worker count (nw, at most 64), a scalar
  * field, a perspective projection. Sets *near_d to the near-plane distance the projection
  * implies (z_ndc = -1 at z = -near; 1e-4 when it implies none). */
-static int check_view(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam, int nw,
+static int check_view(const tet_mesh *mesh, const tet_camera *cam, int nw,
                       double *near_d, char err[256])
 {
     const int W = cam->width, H = cam->height;
@@ -692,12 +692,12 @@ static int check_view(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam, int n
     return VFX_OK;
 }
 
-int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
-                           const vfx_tet_tf *tf, const vfx_tet_options *opts, float *rgba,
-                           vfx_tet_counters *counters, vfx_tet_counters *per_worker,
+int tet_render_workers(const tet_mesh *mesh, const tet_camera *cam,
+                           const tet_tf *tf, const tet_options *opts, float *rgba,
+                           tet_counters *counters, tet_counters *per_worker,
                            char err[256])
 {
-    vfx_tet_counters cnt;
+    tet_counters cnt;
     memset(&cnt, 0, sizeof cnt);
     if (counters) *counters = cnt;
     if (!mesh || !cam || !tf || !opts || !rgba) {
@@ -808,7 +808,7 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
             rc = VFX_ERR_OUT_OF_MEMORY;
             goto done;
         }
-    double tc = vfx_tet_now_ms();
+    double tc = tet_now_ms();
     comp_job jobs[64];
     int nj = 0;
     for (int i = 0; i < nw; i++) {
@@ -825,11 +825,11 @@ int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
     composite_main(&jobs[0]);
     for (int i = 0; i < nj; i++)
         pthread_join(th[i], NULL);
-    cnt.t_composite_ms = vfx_tet_now_ms() - tc;
+    cnt.t_composite_ms = tet_now_ms() - tc;
 done:
     if (ws) {
         for (int i = 0; i < nw; i++) {
-            vfx_tet_counters *c = &ws[i].cnt;
+            tet_counters *c = &ws[i].cnt;
             cnt.cells_scanned += c->cells_scanned;
             cnt.cells_skipped_ert += c->cells_skipped_ert;
             cnt.cells_behind += c->cells_behind;
@@ -862,12 +862,12 @@ done:
 }
 
 /* ---- Single-worker scan engine for the MPI backend (tet_render_internal.h) ----
- * The set-up mirrors vfx_tet_render_workers (same checks, same partitions, same key order) so
+ * The set-up mirrors tet_render_workers (same checks, same partitions, same key order) so
  * that P processes partition the cells exactly as P threads would. Partition p's keys live at
  * [bounds[p], bounds[p] + valid[p]) whichever process builds them, so a key index means the
  * same cell on every process; only the own partition is built at creation, the others when
  * keys of theirs arrive by load balancing. */
-struct vfx_tet_local {
+struct tet_local {
     scan_ctx X;
     shared sh;
     worker w;
@@ -881,9 +881,9 @@ struct vfx_tet_local {
 };
 
 /* Builds partition p's keys sorted front to back; NaN cells are counted when count is set. */
-static void local_build(vfx_tet_local *L, int p, int count)
+static void local_build(tet_local *L, int p, int count)
 {
-    const vfx_tet_mesh *mesh = L->X.mesh;
+    const tet_mesh *mesh = L->X.mesh;
     uint32_t c0 = L->bounds[p], c1 = L->bounds[p + 1], n = 0;
     for (uint32_t c = c0; c < c1; c++) {
         const uint32_t *t = &mesh->tets[4 * c];
@@ -910,9 +910,9 @@ static void local_build(vfx_tet_local *L, int p, int count)
     L->built[p] = 1;
 }
 
-int vfx_tet_local_create(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
-                         const vfx_tet_tf *tf, const vfx_tet_options *opts, int parts,
-                         int own, vfx_tet_local **out, char err[256])
+int tet_local_create(const tet_mesh *mesh, const tet_camera *cam,
+                         const tet_tf *tf, const tet_options *opts, int parts,
+                         int own, tet_local **out, char err[256])
 {
     *out = NULL;
     if (!mesh || !cam || !tf || !opts || parts <= 0 || own < 0 || own >= parts) {
@@ -927,7 +927,7 @@ int vfx_tet_local_create(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
     const float *P = cam->proj, *V = cam->view;
     const uint32_t np = mesh->point_count, nt = mesh->tet_count;
     const int D = opts->tiles_d > 0 ? opts->tiles_d : 1;
-    vfx_tet_local *L = calloc(1, sizeof *L);
+    tet_local *L = calloc(1, sizeof *L);
     if (!L) {
         snprintf(err, 256, "tet_render: out of memory");
         return VFX_ERR_OUT_OF_MEMORY;
@@ -947,7 +947,7 @@ int vfx_tet_local_create(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
     if (!L->vp || !L->keys || !L->ktmp || !L->bounds || !L->valid || !L->built ||
         !L->w.heads || !L->w.hints || !L->w.tiles) {
         snprintf(err, 256, "tet_render: out of memory (%u points, %u tets, %dx%d)", np, nt, W, H);
-        vfx_tet_local_destroy(L);
+        tet_local_destroy(L);
         return VFX_ERR_OUT_OF_MEMORY;
     }
     for (size_t p = 0; p < (size_t)W * H; p++)
@@ -958,7 +958,7 @@ int vfx_tet_local_create(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
             if (mesh->tets[4 * c + k] >= np) {
                 snprintf(err, 256, "tet_render: tet %u references point %u of %u", c,
                          mesh->tets[4 * c + k], np);
-                vfx_tet_local_destroy(L);
+                tet_local_destroy(L);
                 return VFX_ERR_INVALID_ARGUMENT;
             }
     view_vertices(mesh, V, P, W, H, L->vp);
@@ -976,7 +976,7 @@ int vfx_tet_local_create(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
     return VFX_OK;
 }
 
-void vfx_tet_local_destroy(vfx_tet_local *L)
+void tet_local_destroy(tet_local *L)
 {
     if (!L)
         return;
@@ -995,7 +995,7 @@ void vfx_tet_local_destroy(vfx_tet_local *L)
     free(L);
 }
 
-void vfx_tet_local_part(vfx_tet_local *L, int part, uint32_t *k0, uint32_t *k1)
+void tet_local_part(tet_local *L, int part, uint32_t *k0, uint32_t *k1)
 {
     if (!L->built[part])
         local_build(L, part, 0);
@@ -1003,35 +1003,35 @@ void vfx_tet_local_part(vfx_tet_local *L, int part, uint32_t *k0, uint32_t *k1)
     *k1 = L->bounds[part] + L->valid[part];
 }
 
-uint32_t vfx_tet_local_part_cells(const vfx_tet_local *L, int part)
+uint32_t tet_local_part_cells(const tet_local *L, int part)
 {
     return L->bounds[part + 1] - L->bounds[part];
 }
 
-void vfx_tet_local_need(vfx_tet_local *L, uint32_t k0, uint32_t k1)
+void tet_local_need(tet_local *L, uint32_t k0, uint32_t k1)
 {
     for (int p = 0; p < L->parts; p++)
         if (!L->built[p] && k0 < L->bounds[p + 1] && L->bounds[p] < k1)
             local_build(L, p, 0);
 }
 
-int vfx_tet_local_scan(vfx_tet_local *L, uint32_t k)
+int tet_local_scan(tet_local *L, uint32_t k)
 {
     return scan_cell(&L->X, &L->w, &L->keys[k]);
 }
 
-void vfx_tet_local_update_table(vfx_tet_local *L)
+void tet_local_update_table(tet_local *L)
 {
     update_table(&L->sh, &L->w);
 }
 
-void vfx_tet_local_table_get(const vfx_tet_local *L, float *enc)
+void tet_local_table_get(const tet_local *L, float *enc)
 {
     for (int i = 0; i < L->X.D * L->X.D; i++)
         enc[i] = L->w.tiles[i].terminated ? L->w.tiles[i].deepest : INFINITY;
 }
 
-void vfx_tet_local_table_merge(vfx_tet_local *L, const float *enc)
+void tet_local_table_merge(tet_local *L, const float *enc)
 {
     for (int i = 0; i < L->X.D * L->X.D; i++) {
         tile *t = &L->w.tiles[i];
@@ -1042,13 +1042,13 @@ void vfx_tet_local_table_merge(vfx_tet_local *L, const float *enc)
     }
 }
 
-int vfx_tet_local_tiles_d(const vfx_tet_local *L)
+int tet_local_tiles_d(const tet_local *L)
 {
     return L->X.D;
 }
 
-size_t vfx_tet_local_export(const vfx_tet_local *L, size_t p0, size_t p1, uint32_t *offsets,
-                            vfx_tet_rseg *segs)
+size_t tet_local_export(const tet_local *L, size_t p0, size_t p1, uint32_t *offsets,
+                            tet_rseg *segs)
 {
     size_t n = 0;
     for (size_t p = p0; p < p1; p++) {
@@ -1056,7 +1056,7 @@ size_t vfx_tet_local_export(const vfx_tet_local *L, size_t p0, size_t p1, uint32
         for (int32_t c = L->w.heads[p]; c >= 0; c = L->w.pool.s[c].next, n++)
             if (segs) {
                 const seg *s = &L->w.pool.s[c];
-                vfx_tet_rseg o = {s->zf, s->zb, s->r, s->g, s->b, s->a};
+                tet_rseg o = {s->zf, s->zb, s->r, s->g, s->b, s->a};
                 segs[n] = o;
             }
     }
@@ -1064,7 +1064,7 @@ size_t vfx_tet_local_export(const vfx_tet_local *L, size_t p0, size_t p1, uint32
     return n;
 }
 
-vfx_tet_counters *vfx_tet_local_counters(vfx_tet_local *L)
+tet_counters *tet_local_counters(tet_local *L)
 {
     return &L->w.cnt;
 }

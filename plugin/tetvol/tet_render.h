@@ -1,28 +1,28 @@
 /* tet_render.h — CPU cell-projection renderer for tetrahedral meshes (seed 002): each tet is
  * scan-converted into per-pixel ray segments kept in depth-ordered per-pixel lists with partial
  * compositing on insert, with Conservative Subscreen Termination (DxD ERT table). */
-#ifndef VFX_TET_RENDER_H
-#define VFX_TET_RENDER_H
+#ifndef TET_RENDER_H
+#define TET_RENDER_H
 
 #include <stdint.h>
 #include "tet_mesh.h"
 
 /* Perspective camera: column-major view and projection matrices (OpenGL/cglm convention). */
-typedef struct vfx_tet_camera {
+typedef struct tet_camera {
     float view[16];
     float proj[16];
     int width, height;
-} vfx_tet_camera;
+} tet_camera;
 
 /* Linear transfer function over the normalised scalar u = (s - smin) / (smax - smin) clamped to
  * [0,1]: extinction tau = tau_lo + (tau_hi - tau_lo) u per world unit, colour lerped. */
-typedef struct vfx_tet_tf {
+typedef struct tet_tf {
     float smin, smax;
     float tau_lo, tau_hi;
     float color_lo[3], color_hi[3];
-} vfx_tet_tf;
+} tet_tf;
 
-typedef struct vfx_tet_options {
+typedef struct tet_options {
     int ert;               /* 1: Conservative Subscreen Termination on */
     float ert_threshold;   /* accumulated opacity at which a pixel counts as terminated */
     int tiles_d;           /* D: the ERT table is D x D tiles */
@@ -32,9 +32,9 @@ typedef struct vfx_tet_options {
     int workers;           /* threads, each owning a partition of cells (<= 0 means 1, max 64) */
     int share;             /* 1: weak sharing of the ERT tables at each table update */
     int dlb;               /* 1: dynamic load balancing (idle worker takes 1/3 of the most loaded) */
-} vfx_tet_options;
+} tet_options;
 
-typedef struct vfx_tet_counters {
+typedef struct tet_counters {
     uint64_t cells_scanned;      /* cells scan-converted */
     uint64_t cells_skipped_ert;  /* N: cells skipped by subscreen termination */
     uint64_t cells_behind;       /* cells wholly behind the near plane (skipped) */
@@ -46,23 +46,23 @@ typedef struct vfx_tet_counters {
     uint64_t table_updates;
     double t_sc_ms, t_update_ms, t_composite_ms;
     double cpu_ms;               /* CPU time of the worker thread (scan + updates); totals: sum */
-} vfx_tet_counters;
+} tet_counters;
 
 /* Fills opts with the paper's defaults (ERT on, threshold 0.9, D = 20, C = 100, partial on,
  * one worker, sharing and load balancing on). */
-void vfx_tet_options_default(vfx_tet_options *opts);
+void tet_options_default(tet_options *opts);
 
 /* Renders mesh (with its scalar) into rgba (width*height*4 floats, premultiplied, row 0 = bottom).
  * Returns VFX_OK or an error code with a message in err; counters may be NULL. */
-int vfx_tet_render(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam, const vfx_tet_tf *tf,
-                   const vfx_tet_options *opts, float *rgba, vfx_tet_counters *counters,
+int tet_render(const tet_mesh *mesh, const tet_camera *cam, const tet_tf *tf,
+                   const tet_options *opts, float *rgba, tet_counters *counters,
                    char err[256]);
 
-/* As vfx_tet_render with opts->workers threads; per_worker (NULL or opts->workers entries)
+/* As tet_render with opts->workers threads; per_worker (NULL or opts->workers entries)
  * receives each worker's counters. counters totals the cells and keeps the maximum times. */
-int vfx_tet_render_workers(const vfx_tet_mesh *mesh, const vfx_tet_camera *cam,
-                           const vfx_tet_tf *tf, const vfx_tet_options *opts, float *rgba,
-                           vfx_tet_counters *counters, vfx_tet_counters *per_worker,
+int tet_render_workers(const tet_mesh *mesh, const tet_camera *cam,
+                           const tet_tf *tf, const tet_options *opts, float *rgba,
+                           tet_counters *counters, tet_counters *per_worker,
                            char err[256]);
 
 #endif

@@ -19,7 +19,7 @@ static double signed_volume6(const float *p, const uint32_t *t)
            u[2] * (v[0] * w[1] - v[1] * w[0]);
 }
 
-vfx_result vfx_tet_validate(vfx_tet_mesh *m, char *err, size_t errlen)
+vfx_result tet_validate(tet_mesh *m, char *err, size_t errlen)
 {
     if (!m || m->point_count == 0 || m->tet_count == 0 || !m->points || !m->tets) {
         snprintf(err, errlen, "mesh has no points or no tetrahedra");

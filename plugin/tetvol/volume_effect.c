@@ -17,7 +17,7 @@ typedef struct volume_state {
     float *max_dist;    /* width*height ray distances to the nearest host surface */
     float *depth;       /* read-back host depth */
     vfx_volume_view view;
-    vfx_tet_mesh mesh;  /* points into the host's arrays (no copy) */
+    tet_mesh mesh;  /* points into the host's arrays (no copy) */
     uint64_t revision;
     float data_min, data_max;
     bool warned_many;
@@ -34,18 +34,18 @@ static void volume_destroy(vfx_context *ctx, void *state)
     if (!s)
         return;
     glDeleteTextures(1, &s->tex);
-    vfx_free(ctx, s->rgba);
-    vfx_free(ctx, s->max_dist);
-    vfx_free(ctx, s->depth);
-    vfx_free(ctx, s);
+    volfx_free(ctx, s->rgba);
+    volfx_free(ctx, s->max_dist);
+    volfx_free(ctx, s->depth);
+    volfx_free(ctx, s);
 }
 
 static vfx_result volume_create(vfx_context *ctx, void **out)
 {
-    volume_state *s = vfx_alloc(ctx, sizeof *s);
+    volume_state *s = volfx_alloc(ctx, sizeof *s);
     if (!s)
         return VFX_ERR_OUT_OF_MEMORY;
-    s->prog = vfx_gpu_program(ctx, "common/fullscreen.vert", "tetvol/composite.frag", NULL);
+    s->prog = volfx_gpu_program(ctx, "common/fullscreen.vert", "tetvol/composite.frag", NULL);
     if (!s->prog) {
         volume_destroy(ctx, s);
         return VFX_ERR_GL;
@@ -60,14 +60,14 @@ static vfx_result volume_resize(vfx_context *ctx, void *state, uint32_t w, uint3
     glDeleteTextures(1, &s->tex);
     glCreateTextures(GL_TEXTURE_2D, 1, &s->tex);
     glTextureStorage2D(s->tex, 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
-    vfx_gpu_label(GL_TEXTURE, s->tex, "volume.image");
-    vfx_free(ctx, s->rgba);
-    vfx_free(ctx, s->max_dist);
-    vfx_free(ctx, s->depth);
+    volfx_gpu_label(GL_TEXTURE, s->tex, "volume.image");
+    volfx_free(ctx, s->rgba);
+    volfx_free(ctx, s->max_dist);
+    volfx_free(ctx, s->depth);
     size_t n = (size_t)w * h;
-    s->rgba = vfx_alloc(ctx, n * 4 * sizeof(float));
-    s->max_dist = vfx_alloc(ctx, n * sizeof(float));
-    s->depth = vfx_alloc(ctx, n * sizeof(float));
+    s->rgba = volfx_alloc(ctx, n * 4 * sizeof(float));
+    s->max_dist = volfx_alloc(ctx, n * sizeof(float));
+    s->depth = volfx_alloc(ctx, n * sizeof(float));
     s->width = w, s->height = h;
     return s->rgba && s->max_dist && s->depth ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
 }
@@ -78,27 +78,27 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
     volume_state *s = state;
     uint32_t n = ctx->host.volume_count(ctx->host.user);
     if (n > 1 && !s->warned_many) {
-        vfx_log(ctx, VFX_LOG_WARN, "volume: the host has %u volumes; only the first is drawn", n);
+        volfx_log(ctx, VFX_LOG_WARN, "volume: the host has %u volumes; only the first is drawn", n);
         s->warned_many = true;
     }
     vfx_volume_view v = {.size = sizeof v, .version = VFX_VOLUME_VIEW_VERSION};
     if (ctx->host.volume(ctx->host.user, 0, &v) != VFX_OK || v.version != VFX_VOLUME_VIEW_VERSION)
-        return vfx_fail(ctx, VFX_ERR_ABI, "volume: host view of version %u (need %u)", v.version,
+        return volfx_fail(ctx, VFX_ERR_ABI, "volume: host view of version %u (need %u)", v.version,
                         VFX_VOLUME_VIEW_VERSION);
     if (!v.points || !v.tets || !v.scalar || v.point_count == 0 || v.tet_count == 0)
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
                         "volume[0]: needs points, tets and scalar arrays and counts > 0 (%u points, %u tets)",
                         v.point_count, v.tet_count);
     if (v.transfer_rgba && v.transfer_count < 2)
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: transfer function needs >= 2 entries");
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: transfer function needs >= 2 entries");
     if (!(v.ert_threshold >= 0 && v.ert_threshold <= 1))
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: ert_threshold %g outside [0, 1]",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: ert_threshold %g outside [0, 1]",
                         (double)v.ert_threshold);
     /* tet indices are checked once per revision: the renderer trusts them */
     if (v.revision != s->revision || v.tets != s->view.tets || v.scalar != s->view.scalar) {
         for (uint64_t i = 0; i < (uint64_t)v.tet_count * 4; ++i)
             if (v.tets[i] >= v.point_count)
-                return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: tet %llu uses point %u of %u",
+                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: tet %llu uses point %u of %u",
                                 (unsigned long long)(i / 4), v.tets[i], v.point_count);
         s->data_min = INFINITY, s->data_max = -INFINITY;
         for (uint32_t i = 0; i < v.point_count; ++i)
@@ -119,7 +119,7 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
 }
 
 static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
-                                vfx_frame_targets *targets)
+                                volfx_frame_targets *targets)
 {
     volume_state *s = state;
     const vfx_volume_view *v = &s->view;
@@ -153,17 +153,17 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
             if (s->depth[p] >= 0 && s->depth[p] < s->max_dist[p])
                 s->max_dist[p] = s->depth[p];
     }
-    vfx_tet_camera cam;
+    tet_camera cam;
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     bool has_model = false;
     for (int i = 0; i < 16; ++i)
         has_model |= v->model[i] != 0;
-    vfx_mat4_mul(frame->view, has_model ? v->model : identity, cam.view);
+    volfx_mat4_mul(frame->view, has_model ? v->model : identity, cam.view);
     memcpy(cam.proj, frame->proj, sizeof cam.proj);
     cam.width = (int)s->width, cam.height = (int)s->height;
     /* The renderer's transfer function is linear between two ends: the view's table gives its
      * first and last entries (alpha = extinction per unit length). */
-    vfx_tet_tf tf = {.smin = v->scalar_min, .smax = v->scalar_max, .tau_lo = 0.2f, .tau_hi = 3.0f,
+    tet_tf tf = {.smin = v->scalar_min, .smax = v->scalar_max, .tau_lo = 0.2f, .tau_hi = 3.0f,
                      .color_lo = {0.1f, 0.3f, 0.9f}, .color_hi = {1.0f, 0.85f, 0.3f}};
     if (!(v->scalar_max > v->scalar_min))
         tf.smin = s->data_min, tf.smax = s->data_max > s->data_min ? s->data_max : s->data_min + 1;
@@ -173,8 +173,8 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
         memcpy(tf.color_hi, hi, sizeof tf.color_hi);
         tf.tau_lo = lo[3], tf.tau_hi = hi[3];
     }
-    vfx_tet_options o;
-    vfx_tet_options_default(&o);
+    tet_options o;
+    tet_options_default(&o);
     o.ert = !(v->disable & VFX_VOLUME_NO_ERT);
     o.share = !(v->disable & VFX_VOLUME_NO_SHARE);
     o.dlb = !(v->disable & VFX_VOLUME_NO_DLB);
@@ -184,17 +184,17 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     o.workers = v->workers ? (int)v->workers : (int)(cores > 0 ? (cores < 64 ? cores : 64) : 1);
     o.max_dist = s->max_dist;
-    vfx_tet_counters c;
+    tet_counters c;
     char err[256];
-    int r = vfx_tet_render_workers(&s->mesh, &cam, &tf, &o, s->rgba, &c, NULL, err);
+    int r = tet_render_workers(&s->mesh, &cam, &tf, &o, s->rgba, &c, NULL, err);
     if (r != VFX_OK)
-        return vfx_fail(ctx, (vfx_result)r, "volume[0]: %s", err);
-    vfx_stat_set(ctx, "volume.cells_scanned", (double)c.cells_scanned);
-    vfx_stat_set(ctx, "volume.cells_skipped_ert", (double)c.cells_skipped_ert);
-    vfx_stat_set(ctx, "volume.segments", (double)c.segments_made);
-    vfx_stat_set(ctx, "volume.t_sc_ms", c.t_sc_ms);
-    vfx_stat_set(ctx, "volume.t_update_ms", c.t_update_ms);
-    vfx_gpu_pass_begin(ctx, "volume.composite");
+        return volfx_fail(ctx, (vfx_result)r, "volume[0]: %s", err);
+    volfx_stat_set(ctx, "volume.cells_scanned", (double)c.cells_scanned);
+    volfx_stat_set(ctx, "volume.cells_skipped_ert", (double)c.cells_skipped_ert);
+    volfx_stat_set(ctx, "volume.segments", (double)c.segments_made);
+    volfx_stat_set(ctx, "volume.t_sc_ms", c.t_sc_ms);
+    volfx_stat_set(ctx, "volume.t_update_ms", c.t_update_ms);
+    volfx_gpu_pass_begin(ctx, "volume.composite");
     glTextureSubImage2D(s->tex, 0, 0, 0, (GLsizei)s->width, (GLsizei)s->height, GL_RGBA, GL_FLOAT, s->rgba);
     glBindFramebuffer(GL_FRAMEBUFFER, frame->framebuffer);
     glViewport(0, 0, (GLsizei)frame->width, (GLsizei)frame->height);
@@ -204,26 +204,26 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
     glUseProgram(s->prog);
     glUniform1i(glGetUniformLocation(s->prog, "u_image"), 0);
     glBindTextureUnit(0, s->tex);
-    vfx_gpu_fullscreen(ctx);
+    volfx_gpu_fullscreen(ctx);
     glDisable(GL_BLEND);
     glUseProgram(0);
-    vfx_gpu_pass_end(ctx);
-    const char *e = vfx_gpu_error_string();
-    return e ? vfx_fail(ctx, VFX_ERR_GL, "volume render: %s", e) : VFX_OK;
+    volfx_gpu_pass_end(ctx);
+    const char *e = volfx_gpu_error_string();
+    return e ? volfx_fail(ctx, VFX_ERR_GL, "volume render: %s", e) : VFX_OK;
 }
 
 static vfx_result volume_read_raw(vfx_context *ctx, void *state, float *out, size_t count)
 {
     volume_state *s = state;
     if (count < (size_t)s->width * s->height)
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume read_raw: buffer too small");
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume read_raw: buffer too small");
     for (uint32_t y = 0; y < s->height; ++y) /* accumulated opacity, top row first */
         for (uint32_t x = 0; x < s->width; ++x)
             out[(size_t)y * s->width + x] = s->rgba[4 * ((size_t)(s->height - 1 - y) * s->width + x) + 3];
     return VFX_OK;
 }
 
-const vfx_effect_ops vfx_volume_ops = {
+const volfx_effect_ops volfx_volume_ops = {
     .name = "volume",
     .kind = VFX_EFFECT_VOLUME,
     .present = volume_present,

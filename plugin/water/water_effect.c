@@ -43,7 +43,7 @@ typedef struct water_state {
     uint32_t nan_count;
     uint32_t width, height;
     vfx_water_params params;
-    vfx_water_grid *grid;  /* GRID baseline state, made the first time GRID is asked for */
+    volfx_water_grid *grid;  /* GRID baseline state, made the first time GRID is asked for */
     float lo[3], hi[3];    /* box of the finite particles */
     /* upload skipping: the host's per-chunk revisions of the last upload (0 = untracked: the
      * host gives none, so every frame uploads); data_rev counts uploads, which GRID keys on */
@@ -86,7 +86,7 @@ static void groups_free(vfx_context *ctx, water_state *s)
 {
     for (uint32_t g = 0; g < s->group_count; ++g)
         glDeleteBuffers(3, s->groups[g].cols);
-    vfx_free(ctx, s->groups);
+    volfx_free(ctx, s->groups);
     s->groups = NULL;
     s->group_count = 0;
     s->capacity = 0;
@@ -100,7 +100,7 @@ static GLuint make_tex(GLenum fmt, uint32_t w, uint32_t h, int levels, const cha
     glTextureStorage2D(t, levels, fmt, (GLsizei)w, (GLsizei)h);
     glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    vfx_gpu_label(GL_TEXTURE, t, label);
+    volfx_gpu_label(GL_TEXTURE, t, label);
     return t;
 }
 
@@ -126,7 +126,7 @@ static bool water_present(vfx_context *ctx)
 
 static vfx_result water_create(vfx_context *ctx, void **out)
 {
-    water_state *s = vfx_alloc(ctx, sizeof *s);
+    water_state *s = volfx_alloc(ctx, sizeof *s);
     if (!s)
         return VFX_ERR_OUT_OF_MEMORY;
     glCreateVertexArrays(1, &s->vao);
@@ -147,8 +147,8 @@ static void water_destroy(vfx_context *ctx, void *state)
     water_state *s = state;
     groups_free(ctx, s);
     paper_free(s);
-    vfx_water_grid_destroy(ctx, s->grid);
-    vfx_free(ctx, s->chunk_rev);
+    volfx_water_grid_destroy(ctx, s->grid);
+    volfx_free(ctx, s->chunk_rev);
     glDeleteVertexArrays(1, &s->vao);
     for (int k = 0; k < WATER_COUNTER_RING; ++k)
         if (s->fence[k])
@@ -160,7 +160,7 @@ static void water_destroy(vfx_context *ctx, void *state)
         glDeleteTextures(1, &ctx->water_dist_tex);
         ctx->water_dist_tex = 0;
     }
-    vfx_free(ctx, s);
+    volfx_free(ctx, s);
 }
 
 static vfx_result water_resize(vfx_context *ctx, void *state, uint32_t width, uint32_t height)
@@ -172,7 +172,7 @@ static vfx_result water_resize(vfx_context *ctx, void *state, uint32_t width, ui
     glTextureStorage2D(ctx->water_dist_tex, 1, GL_R32F, (GLsizei)width, (GLsizei)height);
     glTextureParameteri(ctx->water_dist_tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTextureParameteri(ctx->water_dist_tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    vfx_gpu_label(GL_TEXTURE, ctx->water_dist_tex, "water.dist");
+    volfx_gpu_label(GL_TEXTURE, ctx->water_dist_tex, "water.dist");
     s->width = width;
     s->height = height;
     paper_free(s);
@@ -203,14 +203,14 @@ static vfx_result water_resize(vfx_context *ctx, void *state, uint32_t width, ui
         glCheckNamedFramebufferStatus(s->fbo_pot, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE ||
         glCheckNamedFramebufferStatus(s->fbo_grad, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE ||
         glCheckNamedFramebufferStatus(s->fbo_back, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-        return vfx_fail(ctx, VFX_ERR_GL, "water resize %ux%u: incomplete framebuffer", width, height);
+        return volfx_fail(ctx, VFX_ERR_GL, "water resize %ux%u: incomplete framebuffer", width, height);
     if (!s->counters) {
         glCreateBuffers(1, &s->counters);
         glNamedBufferStorage(s->counters, WATER_COUNTERS * sizeof(uint32_t), NULL, GL_DYNAMIC_STORAGE_BIT);
     }
-    const char *e = vfx_gpu_error_string();
+    const char *e = volfx_gpu_error_string();
     if (e)
-        return vfx_fail(ctx, VFX_ERR_GL, "water resize %ux%u: %s", width, height, e);
+        return volfx_fail(ctx, VFX_ERR_GL, "water resize %ux%u: %s", width, height, e);
     return VFX_OK;
 }
 
@@ -232,7 +232,7 @@ static vfx_result ensure_groups(vfx_context *ctx, water_state *s, uint32_t total
     }
     groups_free(ctx, s);
     s->buffer_cap = cap;
-    s->groups = vfx_alloc(ctx, need * sizeof *s->groups);
+    s->groups = volfx_alloc(ctx, need * sizeof *s->groups);
     if (!s->groups)
         return VFX_ERR_OUT_OF_MEMORY;
     s->group_count = need;
@@ -246,10 +246,10 @@ static vfx_result ensure_groups(vfx_context *ctx, water_state *s, uint32_t total
     }
     memcpy(s->cols, s->groups[0].cols, sizeof s->cols);
     s->capacity = total;
-    const char *e = vfx_gpu_error_string();
+    const char *e = volfx_gpu_error_string();
     if (e) {
         groups_free(ctx, s);
-        return vfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water: position buffers for %u particles (%u buffers of at most %u): %s",
+        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water: position buffers for %u particles (%u buffers of at most %u): %s",
                         total, need, cap, e);
     }
     return VFX_OK;
@@ -266,7 +266,7 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
     if (ctx->host.water_params) {
         vfx_result r = ctx->host.water_params(ctx->host.user, &s->params);
         if (r != VFX_OK && r != VFX_ERR_NOT_FOUND)
-            return vfx_fail(ctx, r, "water: host water_params failed (%d)", (int)r);
+            return volfx_fail(ctx, r, "water: host water_params failed (%d)", (int)r);
         if (r == VFX_ERR_NOT_FOUND) {
             memset(&s->params, 0, sizeof s->params);
         }
@@ -280,14 +280,14 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
         vfx_particle_view v = {.size = sizeof v, .version = VFX_PARTICLE_VIEW_VERSION};
         vfx_result r = ctx->host.particle_chunk(ctx->host.user, c, &v);
         if (r)
-            return vfx_fail(ctx, r, "water: particle chunk %u of %u failed (%d)", c, chunks, (int)r);
+            return volfx_fail(ctx, r, "water: particle chunk %u of %u failed (%d)", c, chunks, (int)r);
         if (v.count && (!v.pos[0] || !v.pos[1] || !v.pos[2]))
-            return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u has %u particles but a NULL position column", c, v.count);
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u has %u particles but a NULL position column", c, v.count);
         total += v.count;
         revs_same = revs_same && v.revision != 0 && v.revision == s->chunk_rev[c];
     }
     if (total > WATER_MAX_PARTICLES)
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
                         "water: %u particle chunks hold %llu particles, more than the limit of %u (2^30)",
                         chunks, (unsigned long long)total, WATER_MAX_PARTICLES);
     GLuint before = s->groups ? s->groups[0].cols[0] : 0;
@@ -303,9 +303,9 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
     if (same)
         return VFX_OK;
     if (chunks != s->chunk_rev_count) {
-        vfx_free(ctx, s->chunk_rev);
+        volfx_free(ctx, s->chunk_rev);
         s->chunk_rev_count = 0;
-        s->chunk_rev = chunks ? vfx_alloc(ctx, chunks * sizeof *s->chunk_rev) : NULL;
+        s->chunk_rev = chunks ? volfx_alloc(ctx, chunks * sizeof *s->chunk_rev) : NULL;
         if (chunks && !s->chunk_rev)
             return VFX_ERR_OUT_OF_MEMORY;
         s->chunk_rev_count = chunks;
@@ -320,7 +320,7 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
         vfx_particle_view v = {.size = sizeof v, .version = VFX_PARTICLE_VIEW_VERSION};
         vfx_result r = ctx->host.particle_chunk(ctx->host.user, c, &v);
         if (r || off + (uint64_t)v.count > total)
-            return vfx_fail(ctx, r ? r : VFX_ERR_INVALID_ARGUMENT,
+            return volfx_fail(ctx, r ? r : VFX_ERR_INVALID_ARGUMENT,
                             "water: particle chunk %u changed between the count and the upload", c);
         /* a chunk may straddle buffers: it goes in pieces, each inside one group */
         for (uint32_t done = 0; done < v.count;) {
@@ -351,15 +351,15 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
     }
     s->count = off;
     s->nan_count = nan_count;
-    const char *e = vfx_gpu_error_string();
+    const char *e = volfx_gpu_error_string();
     if (e)
-        return vfx_fail(ctx, VFX_ERR_GL, "water upload of %u particles: %s", off, e);
+        return volfx_fail(ctx, VFX_ERR_GL, "water upload of %u particles: %s", off, e);
     return VFX_OK;
 }
 
 
 static void set_common(GLuint prog, const water_state *s, const vfx_frame_view *frame,
-                       const vfx_frame_targets *targets, float t_end)
+                       const volfx_frame_targets *targets, float t_end)
 {
     const vfx_water_params *p = &s->params;
     glUniformMatrix4fv(glGetUniformLocation(prog, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
@@ -387,7 +387,7 @@ static void dispatch(const water_state *s)
 /* Min/max pyramid of the distances in `src` (level 0 from `pyr0`, 2x2 reductions by `pyrd`
  * down to `level`): the tiles the billboard passes cull against. */
 static void build_pyramid(const water_state *s, GLuint pyr0, GLuint pyrd, const vfx_frame_view *frame,
-                          const vfx_frame_targets *targets, float t_end, GLuint src, int level)
+                          const volfx_frame_targets *targets, float t_end, GLuint src, int level)
 {
     glUseProgram(pyr0);
     set_common(pyr0, s, frame, targets, t_end);
@@ -424,33 +424,33 @@ static void draw_billboards(vfx_context *ctx, const water_state *s)
 }
 
 static vfx_result brute_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                              vfx_frame_targets *targets)
+                              volfx_frame_targets *targets)
 {
-    GLuint prog = vfx_gpu_compute(ctx, "water/brute.comp", NULL);
+    GLuint prog = volfx_gpu_compute(ctx, "water/brute.comp", NULL);
     if (!prog)
         return VFX_ERR_GL;
-    vfx_gpu_pass_begin(ctx, "water.brute");
+    volfx_gpu_pass_begin(ctx, "water.brute");
     glUseProgram(prog);
     for (int k = 0; k < 3; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, s->cols[k]);
-    vfx_water_march_bind(prog, ctx->water_dist_tex, &s->params, frame, targets);
+    volfx_water_march_bind(prog, ctx->water_dist_tex, &s->params, frame, targets);
     glUniform1ui(glGetUniformLocation(prog, "u_count"), s->count);
     glDispatchCompute((s->width + 7) / 8, (s->height + 7) / 8, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
-    vfx_gpu_pass_end(ctx);
+    volfx_gpu_pass_end(ctx);
     return VFX_OK;
 }
 
 /* Potentials at the current samples (tex `at`, NS samples from it) into s->pot: additive
  * blending of billboards (technique 3) or the compute-shader sum (VFX_WATER_NO_BLEND). */
 static vfx_result potential_pass(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                                 const vfx_frame_targets *targets, GLuint at, int ns, int cull,
+                                 const volfx_frame_targets *targets, GLuint at, int ns, int cull,
                                  float t_end)
 {
     char defs[96];
     if (s->params.disable & VFX_WATER_NO_BLEND) {
         snprintf(defs, sizeof defs, "#define MODE_POTSUM\n#define NS %d\n", ns);
-        GLuint prog = vfx_gpu_compute(ctx, "water/march.comp", defs);
+        GLuint prog = volfx_gpu_compute(ctx, "water/march.comp", defs);
         if (!prog)
             return VFX_ERR_GL;
         glUseProgram(prog);
@@ -461,7 +461,7 @@ static vfx_result potential_pass(vfx_context *ctx, water_state *s, const vfx_fra
         return VFX_OK;
     }
     snprintf(defs, sizeof defs, "#define PASS_POT\n#define NS %d\n", ns);
-    GLuint prog = vfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", defs);
+    GLuint prog = volfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", defs);
     if (!prog)
         return VFX_ERR_GL;
     glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_pot);
@@ -491,7 +491,7 @@ static vfx_result potential_pass(vfx_context *ctx, water_state *s, const vfx_fra
  * front face. With after = 0 that is the initial sample (eq. 1); with the t'_next texture bound
  * as `after`, the nearest candidate region at or beyond it (eqs. 3-4). */
 static void nearest_face_pass(vfx_context *ctx, const water_state *s, GLuint prog,
-                              const vfx_frame_view *frame, const vfx_frame_targets *targets,
+                              const vfx_frame_view *frame, const volfx_frame_targets *targets,
                               float t_end, const float vp[16], GLuint after)
 {
     static const float far4[4] = {1e30f, 1e30f, 1e30f, 1e30f};
@@ -517,22 +517,22 @@ static void nearest_face_pass(vfx_context *ctx, const water_state *s, GLuint pro
  * distances like the potential passes) and the back-distance pass (max blending of the ray's
  * exit from each particle's ball of radius h(1 - T)). */
 static vfx_result surface_passes(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                                 const vfx_frame_targets *targets)
+                                 const volfx_frame_targets *targets)
 {
     const vfx_water_params *p = &s->params;
     const int cull = !(p->disable & VFX_WATER_NO_PYRAMID);
     int level = (int)p->pyramid_level;
     if (level >= s->pyr_levels)
         level = s->pyr_levels - 1;
-    GLuint pyr0 = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_PYR0\n#define NS 1\n");
-    GLuint pyrd = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_PYRDOWN\n#define NS 1\n");
-    GLuint grad = vfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_GRAD\n#define NS 1\n");
-    GLuint back = vfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_BACK\n#define NS 1\n");
+    GLuint pyr0 = volfx_gpu_compute(ctx, "water/march.comp", "#define MODE_PYR0\n#define NS 1\n");
+    GLuint pyrd = volfx_gpu_compute(ctx, "water/march.comp", "#define MODE_PYRDOWN\n#define NS 1\n");
+    GLuint grad = volfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_GRAD\n#define NS 1\n");
+    GLuint back = volfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_BACK\n#define NS 1\n");
     if (!pyr0 || !pyrd || !grad || !back)
         return VFX_ERR_GL;
     static const float zero[4] = {0, 0, 0, 0};
 
-    vfx_gpu_pass_begin(ctx, "water.normal");
+    volfx_gpu_pass_begin(ctx, "water.normal");
     if (cull)
         build_pyramid(s, pyr0, pyrd, frame, targets, 0, ctx->water_dist_tex, level);
     glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_grad);
@@ -550,9 +550,9 @@ static vfx_result surface_passes(vfx_context *ctx, water_state *s, const vfx_fra
     glBindTextureUnit(0, ctx->water_dist_tex);
     glBindTextureUnit(1, s->pyr);
     draw_billboards(ctx, s);
-    vfx_gpu_pass_end(ctx);
+    volfx_gpu_pass_end(ctx);
 
-    vfx_gpu_pass_begin(ctx, "water.back");
+    volfx_gpu_pass_begin(ctx, "water.back");
     glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_back);
     glClearNamedFramebufferfv(s->fbo_back, GL_COLOR, 0, zero);
     glBlendEquation(GL_MAX);
@@ -567,7 +567,7 @@ static vfx_result surface_passes(vfx_context *ctx, water_state *s, const vfx_fra
     draw_billboards(ctx, s);
     glBlendEquation(GL_FUNC_ADD);
     glDisable(GL_BLEND);
-    vfx_gpu_pass_end(ctx);
+    volfx_gpu_pass_end(ctx);
     return VFX_OK;
 }
 
@@ -577,22 +577,22 @@ static void publish_counters(vfx_context *ctx, water_state *s)
     const int paper = s->last_method == VFX_WATER_METHOD_PAPER;
     const int grid = s->last_method == VFX_WATER_METHOD_GRID;
     if (paper) {
-        vfx_stat_set(ctx, "water.fragments_culled", c[0]);
-        vfx_stat_set(ctx, "water.potential_fragments", c[1]);
+        volfx_stat_set(ctx, "water.fragments_culled", c[0]);
+        volfx_stat_set(ctx, "water.potential_fragments", c[1]);
     }
     if (paper || grid) { /* both marches count samples and pixel classes in the same slots */
-        vfx_stat_set(ctx, "water.samples", c[2]);
-        vfx_stat_set(ctx, "water.pixels_found", c[3]);
-        vfx_stat_set(ctx, "water.pixels_sample_cap", c[4]);
-        vfx_stat_set(ctx, "water.pixels_left", c[5]);
+        volfx_stat_set(ctx, "water.samples", c[2]);
+        volfx_stat_set(ctx, "water.pixels_found", c[3]);
+        volfx_stat_set(ctx, "water.pixels_sample_cap", c[4]);
+        volfx_stat_set(ctx, "water.pixels_left", c[5]);
     }
     if (grid) {
-        vfx_stat_set(ctx, "water.grid_cells_visited", c[8]);
-        vfx_stat_set(ctx, "water.grid_sphere_tests", c[9]);
+        volfx_stat_set(ctx, "water.grid_cells_visited", c[8]);
+        volfx_stat_set(ctx, "water.grid_sphere_tests", c[9]);
     }
-    vfx_stat_set(ctx, "water.normal_fragments_culled", c[6]);
-    vfx_stat_set(ctx, "water.normal_fragments", c[7]);
-    vfx_stat_set(ctx, "water.counters_age", (double)(s->frame_no - 1 - s->last_frame));
+    volfx_stat_set(ctx, "water.normal_fragments_culled", c[6]);
+    volfx_stat_set(ctx, "water.normal_fragments", c[7]);
+    volfx_stat_set(ctx, "water.counters_age", (double)(s->frame_no - 1 - s->last_frame));
 }
 
 /* Counters without a stall: this frame's are copied into a ring slot and fenced; every slot
@@ -640,7 +640,7 @@ static void counters_frame_end(vfx_context *ctx, water_state *s, uint32_t method
 }
 
 static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                              vfx_frame_targets *targets)
+                              volfx_frame_targets *targets)
 {
     const vfx_water_params *p = &s->params;
     const uint32_t dis = p->disable;
@@ -674,46 +674,46 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
     char defs[96];
 
     /* (1) initial sample: nearest cube front face per pixel by the depth test (eq. 1) */
-    vfx_gpu_pass_begin(ctx, "water.init");
+    volfx_gpu_pass_begin(ctx, "water.init");
     if (dis & VFX_WATER_NO_BILLBOARD_INIT) {
         float nearv[4] = {frame->near_plane, 0, 0, 0};
         glClearTexImage(s->cur, 0, GL_RED, GL_FLOAT, nearv);
     } else {
-        GLuint prog = vfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_INIT\n#define NS 1\n");
+        GLuint prog = volfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_INIT\n#define NS 1\n");
         if (!prog)
             return VFX_ERR_GL;
         nearest_face_pass(ctx, s, prog, frame, targets, t_end, vp, 0);
     }
-    vfx_gpu_pass_end(ctx);
+    volfx_gpu_pass_end(ctx);
 
     uint32_t iters = (p->max_samples + (uint32_t)ns - 1) / (uint32_t)ns;
     snprintf(defs, sizeof defs, "#define MODE_UPDATE\n#define NS %d\n", ns);
-    GLuint upd = vfx_gpu_compute(ctx, "water/march.comp", defs);
+    GLuint upd = volfx_gpu_compute(ctx, "water/march.comp", defs);
     snprintf(defs, sizeof defs, "#define MODE_PYR0\n#define NS %d\n", ns);
-    GLuint pyr0 = vfx_gpu_compute(ctx, "water/march.comp", defs);
-    GLuint pyrd = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_PYRDOWN\n#define NS 1\n");
-    GLuint skip = vfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_SKIP\n#define NS 1\n");
+    GLuint pyr0 = volfx_gpu_compute(ctx, "water/march.comp", defs);
+    GLuint pyrd = volfx_gpu_compute(ctx, "water/march.comp", "#define MODE_PYRDOWN\n#define NS 1\n");
+    GLuint skip = volfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_SKIP\n#define NS 1\n");
     if (!upd || !pyr0 || !pyrd || !skip)
         return VFX_ERR_GL;
     int level = (int)p->pyramid_level;
     if (level >= s->pyr_levels)
         level = s->pyr_levels - 1;
-    vfx_gpu_pass_begin(ctx, "water.march");
+    volfx_gpu_pass_begin(ctx, "water.march");
     for (uint32_t it = 0; it < iters; ++it) {
         /* (5) min/max pyramid of the current samples, 2x2 reductions down to `level` */
         if (cull) {
-            vfx_gpu_pass_begin(ctx, "water.pyramid");
+            volfx_gpu_pass_begin(ctx, "water.pyramid");
             build_pyramid(s, pyr0, pyrd, frame, targets, t_end, s->cur, level);
-            vfx_gpu_pass_end(ctx);
+            volfx_gpu_pass_end(ctx);
         }
         /* (3)+(4) potentials at NS consecutive samples */
-        vfx_gpu_pass_begin(ctx, "water.potential");
+        volfx_gpu_pass_begin(ctx, "water.potential");
         vfx_result r = potential_pass(ctx, s, frame, targets, s->cur, ns, cull, t_end);
-        vfx_gpu_pass_end(ctx);
+        volfx_gpu_pass_end(ctx);
         if (r)
             return r;
         /* inside/outside, stop flag, t'_next = t + NS w (eq. 2) into buffer 1 */
-        vfx_gpu_pass_begin(ctx, "water.update");
+        volfx_gpu_pass_begin(ctx, "water.update");
         glUseProgram(upd);
         set_common(upd, s, frame, targets, t_end);
         glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
@@ -722,10 +722,10 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
         glBindImageTexture(3, s->next1, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
         glBindTextureUnit(0, s->pot);
         dispatch(s);
-        vfx_gpu_pass_end(ctx);
+        volfx_gpu_pass_end(ctx);
         /* (2) jump over gaps: buffer 2 = nearest candidate region at or after t'_next
          * (eqs. 3-4, depth test); without it the next sample is t'_next itself */
-        vfx_gpu_pass_begin(ctx, "water.skip");
+        volfx_gpu_pass_begin(ctx, "water.skip");
         if (dis & VFX_WATER_NO_SKIP) {
             GLuint t = s->cur;
             s->cur = s->next1;
@@ -734,16 +734,16 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
         } else {
             nearest_face_pass(ctx, s, skip, frame, targets, t_end, vp, s->next1);
         }
-        vfx_gpu_pass_end(ctx);
+        volfx_gpu_pass_end(ctx);
     }
 
-    vfx_gpu_pass_end(ctx);
+    volfx_gpu_pass_end(ctx);
 
     /* (6) eq. 5 then eq. 6 regula falsi, each iteration's potential again by blending */
-    vfx_gpu_pass_begin(ctx, "water.refine");
-    GLuint interp = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_INTERP\n#define NS 1\n");
-    GLuint refine = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_REFINE\n#define NS 1\n");
-    GLuint fin = vfx_gpu_compute(ctx, "water/march.comp", "#define MODE_FINAL\n#define NS 1\n");
+    volfx_gpu_pass_begin(ctx, "water.refine");
+    GLuint interp = volfx_gpu_compute(ctx, "water/march.comp", "#define MODE_INTERP\n#define NS 1\n");
+    GLuint refine = volfx_gpu_compute(ctx, "water/march.comp", "#define MODE_REFINE\n#define NS 1\n");
+    GLuint fin = volfx_gpu_compute(ctx, "water/march.comp", "#define MODE_FINAL\n#define NS 1\n");
     if (!interp || !refine || !fin)
         return VFX_ERR_GL;
     glUseProgram(interp);
@@ -773,39 +773,39 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
     glBindImageTexture(3, ctx->water_dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     glBindImageTexture(4, s->cur, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
     dispatch(s);
-    vfx_gpu_pass_end(ctx);
+    volfx_gpu_pass_end(ctx);
     return VFX_OK;
 }
 
 static vfx_result grid_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                             const vfx_frame_targets *targets)
+                             const volfx_frame_targets *targets)
 {
-    if (!s->grid && !(s->grid = vfx_water_grid_create(ctx)))
+    if (!s->grid && !(s->grid = volfx_water_grid_create(ctx)))
         return VFX_ERR_OUT_OF_MEMORY;
-    vfx_water_grid_input in = {s->cols, s->count, s->count - s->nan_count, s->lo, s->hi, &s->params,
+    volfx_water_grid_input in = {s->cols, s->count, s->count - s->nan_count, s->lo, s->hi, &s->params,
                                s->width, s->height, ctx->water_dist_tex, s->counters, s->data_rev};
-    return vfx_water_grid_render(ctx, s->grid, &in, frame, targets);
+    return volfx_water_grid_render(ctx, s->grid, &in, frame, targets);
 }
 
 static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
-                               vfx_frame_targets *targets)
+                               volfx_frame_targets *targets)
 {
     water_state *s = state;
     const vfx_water_params *p = &s->params;
     targets->water_dist = ctx->water_dist_tex;
-    vfx_stat_set(ctx, "water.position_buffers", s->group_count);
+    volfx_stat_set(ctx, "water.position_buffers", s->group_count);
     if (s->group_count > 1 && (p->method != VFX_WATER_METHOD_PAPER || (p->disable & VFX_WATER_NO_BLEND)))
-        return vfx_fail(ctx, VFX_ERR_UNSUPPORTED,
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED,
                         "water: %u particles span %u position buffers of at most %u; method %u%s reads one "
                         "buffer (only the paper method's billboard passes draw several)",
                         s->count, s->group_count, s->buffer_cap, p->method,
                         (p->disable & VFX_WATER_NO_BLEND) ? " with NO_BLEND" : "");
-    vfx_mat4_mul(frame->proj, frame->view, s->view_proj);
+    volfx_mat4_mul(frame->proj, frame->view, s->view_proj);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->counters);
     glClearNamedBufferData(s->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
-    vfx_stat_set(ctx, "water.particles", s->count);
-    vfx_stat_set(ctx, "water.nan_skipped", s->nan_count);
-    vfx_stat_set(ctx, "water.upload_skipped", s->upload_skipped);
+    volfx_stat_set(ctx, "water.particles", s->count);
+    volfx_stat_set(ctx, "water.nan_skipped", s->nan_count);
+    volfx_stat_set(ctx, "water.upload_skipped", s->upload_skipped);
     s->last_method_drawn = UINT32_MAX; /* until this frame completes: nothing for debug_pixel_class */
     vfx_result r;
     if (p->method == VFX_WATER_METHOD_PAPER)
@@ -815,16 +815,16 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     else if (p->method == VFX_WATER_METHOD_GRID)
         r = grid_march(ctx, s, frame, targets);
     else
-        r = vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: unknown method %u in vfx_water_params (0 paper, 1 brute, 2 grid)", p->method);
+        r = volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: unknown method %u in vfx_water_params (0 paper, 1 brute, 2 grid)", p->method);
     if (r != VFX_OK)
         return r;
     if (!(p->disable & VFX_WATER_NO_SHADING) && (r = surface_passes(ctx, s, frame, targets)) != VFX_OK)
         return r;
 
-    GLuint shade = vfx_gpu_program(ctx, "common/fullscreen.vert", "water/shade.frag", NULL);
+    GLuint shade = volfx_gpu_program(ctx, "common/fullscreen.vert", "water/shade.frag", NULL);
     if (!shade)
         return VFX_ERR_GL;
-    vfx_gpu_pass_begin(ctx, "water.shade");
+    volfx_gpu_pass_begin(ctx, "water.shade");
     glBindFramebuffer(GL_FRAMEBUFFER, frame->framebuffer);
     glViewport(0, 0, (GLsizei)frame->width, (GLsizei)frame->height);
     glDisable(GL_DEPTH_TEST);
@@ -843,42 +843,42 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     glUniform1i(glGetUniformLocation(shade, "u_flat"), (p->disable & VFX_WATER_NO_SHADING) != 0);
     glUniform1i(glGetUniformLocation(shade, "u_has_color"), frame->color_texture != 0);
     glUniform1i(glGetUniformLocation(shade, "u_has_depth"), frame->depth_texture != 0);
-    vfx_gpu_fullscreen(ctx);
-    vfx_gpu_pass_end(ctx);
+    volfx_gpu_fullscreen(ctx);
+    volfx_gpu_pass_end(ctx);
     counters_frame_end(ctx, s, p->method);
     s->last_method_drawn = p->method;
-    const char *e = vfx_gpu_error_string();
+    const char *e = volfx_gpu_error_string();
     if (e)
-        return vfx_fail(ctx, VFX_ERR_GL, "water render: %s", e);
+        return volfx_fail(ctx, VFX_ERR_GL, "water render: %s", e);
     return VFX_OK;
 }
 
-vfx_result vfx_water_debug_gradient(vfx_context *ctx, float *out, size_t count)
+vfx_result volfx_water_debug_gradient(vfx_context *ctx, float *out, size_t count)
 {
     water_state *s = ctx->effect_state[VFX_EFFECT_WATER];
     if (!s || !s->grad)
-        return vfx_fail(ctx, VFX_ERR_NOT_FOUND, "water debug gradient: no water effect or no render yet");
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "water debug gradient: no water effect or no render yet");
     size_t n = (size_t)s->width * s->height * 4;
     if (!out || count < n)
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water debug gradient: %zu floats, need %zu", count, n);
-    return vfx_gpu_read_top_first(ctx, s->grad, GL_RGBA, 4, -1, s->width, s->height, out);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water debug gradient: %zu floats, need %zu", count, n);
+    return volfx_gpu_read_top_first(ctx, s->grad, GL_RGBA, 4, -1, s->width, s->height, out);
 }
 
-vfx_result vfx_water_debug_pixel_class(vfx_context *ctx, uint8_t *out, size_t count)
+vfx_result volfx_water_debug_pixel_class(vfx_context *ctx, uint8_t *out, size_t count)
 {
     water_state *s = ctx->effect_state[VFX_EFFECT_WATER];
     if (!s || !s->st || s->frame_no == 0 || s->last_method_drawn != VFX_WATER_METHOD_PAPER)
-        return vfx_fail(ctx, VFX_ERR_NOT_FOUND, "water debug pixel class: no paper-method frame rendered yet");
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "water debug pixel class: no paper-method frame rendered yet");
     size_t n = (size_t)s->width * s->height;
     if (!out || count < n)
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water debug pixel class: %zu bytes, need %zu", count, n);
-    float *cls = vfx_alloc(ctx, n * sizeof *cls);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water debug pixel class: %zu bytes, need %zu", count, n);
+    float *cls = volfx_alloc(ctx, n * sizeof *cls);
     if (!cls)
         return VFX_ERR_OUT_OF_MEMORY;
-    vfx_result r = vfx_gpu_read_top_first(ctx, s->st, GL_RGBA, 4, 0, s->width, s->height, cls);
+    vfx_result r = volfx_gpu_read_top_first(ctx, s->st, GL_RGBA, 4, 0, s->width, s->height, cls);
     for (size_t p = 0; r == VFX_OK && p < n; ++p)
         out[p] = (uint8_t)cls[p];
-    vfx_free(ctx, cls);
+    volfx_free(ctx, cls);
     return r;
 }
 
@@ -887,11 +887,11 @@ static vfx_result water_read_raw(vfx_context *ctx, void *state, float *out, size
     water_state *s = state;
     size_t n = (size_t)s->width * s->height;
     if (count < n || !ctx->water_dist_tex)
-        return vfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water read_raw: %zu floats, need %zu", count, n);
-    return vfx_gpu_read_top_first(ctx, ctx->water_dist_tex, GL_RED, 1, -1, s->width, s->height, out);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water read_raw: %zu floats, need %zu", count, n);
+    return volfx_gpu_read_top_first(ctx, ctx->water_dist_tex, GL_RED, 1, -1, s->width, s->height, out);
 }
 
-const vfx_effect_ops vfx_water_ops = {
+const volfx_effect_ops volfx_water_ops = {
     .name = "water",
     .kind = VFX_EFFECT_WATER,
     .present = water_present,

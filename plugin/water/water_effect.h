@@ -1,17 +1,17 @@
 /* water_effect.h — what tests read of the water effect beyond the public read_raw. */
-#ifndef VFX_WATER_EFFECT_H
-#define VFX_WATER_EFFECT_H
+#ifndef VOLFX_WATER_EFFECT_H
+#define VOLFX_WATER_EFFECT_H
 
 #include "plugin_internal.h"
 
 /* Copies the surface gradient target of the last water render: 4 floats per pixel, top row
  * first, (grad sum P, sum P) at the found surface point, zeros where no water. The shading
  * normal is -xyz normalised. VFX_ERR_NOT_FOUND when the effect is absent. */
-vfx_result vfx_water_debug_gradient(vfx_context *ctx, float *out, size_t count);
+vfx_result volfx_water_debug_gradient(vfx_context *ctx, float *out, size_t count);
 /* Copies the paper method's final per-pixel class of the last render, top row first: 1 surface
  * found, 2 left the particles' box or hit the host depth, 3 sample cap reached (the counters
  * water.pixels_found / _left / _sample_cap count these). VFX_ERR_NOT_FOUND unless the last
  * frame used the paper method. */
-vfx_result vfx_water_debug_pixel_class(vfx_context *ctx, uint8_t *out, size_t count);
+vfx_result volfx_water_debug_pixel_class(vfx_context *ctx, uint8_t *out, size_t count);
 
 #endif

@@ -14,7 +14,7 @@
 /* 1024 scan blocks of 1024 entries: the top-level scan fits one workgroup. */
 #define GRID_MAX_CELLS ((1u << 20) - 1u)
 
-struct vfx_water_grid {
+struct volfx_water_grid {
     GLuint count, start, blocks, sorted;
     uint32_t cell_cap;     /* entries count/start hold (ncells + 1, rounded up to 1024) */
     uint32_t sorted_cap;   /* particles `sorted` holds */
@@ -25,18 +25,18 @@ struct vfx_water_grid {
     float built_h;
 };
 
-vfx_water_grid *vfx_water_grid_create(vfx_context *ctx)
+volfx_water_grid *volfx_water_grid_create(vfx_context *ctx)
 {
-    vfx_water_grid *g = vfx_alloc(ctx, sizeof *g);
+    volfx_water_grid *g = volfx_alloc(ctx, sizeof *g);
     if (!g)
         return NULL;
     glCreateBuffers(1, &g->blocks);
     glNamedBufferStorage(g->blocks, 1024 * sizeof(uint32_t), NULL, 0);
-    vfx_gpu_label(GL_BUFFER, g->blocks, "water.grid_blocks");
+    volfx_gpu_label(GL_BUFFER, g->blocks, "water.grid_blocks");
     return g;
 }
 
-void vfx_water_grid_destroy(vfx_context *ctx, vfx_water_grid *g)
+void volfx_water_grid_destroy(vfx_context *ctx, volfx_water_grid *g)
 {
     if (!g)
         return;
@@ -44,13 +44,13 @@ void vfx_water_grid_destroy(vfx_context *ctx, vfx_water_grid *g)
     for (int k = 0; k < 4; ++k)
         if (b[k])
             glDeleteBuffers(1, &b[k]);
-    vfx_free(ctx, g);
+    volfx_free(ctx, g);
 }
 
 /* Grid geometry: origin one cell below the box, cell >= h (times 1 + 1e-4 so that rounding in
  * floor() never puts a particle within h of a sample two cells away), grown by the cube root of
  * the excess when the box would need more than GRID_MAX_CELLS cells (h tiny against the extent). */
-static void grid_layout(const vfx_water_grid_input *in, float g0[3], float *cs_out, int dims[3])
+static void grid_layout(const volfx_water_grid_input *in, float g0[3], float *cs_out, int dims[3])
 {
     double cs = (double)in->params->h * (1.0 + 1e-4);
     double lo[3] = {0, 0, 0}, ext[3] = {0, 0, 0};
@@ -79,11 +79,11 @@ static GLuint storage(GLsizeiptr bytes, const char *label)
     GLuint b;
     glCreateBuffers(1, &b);
     glNamedBufferStorage(b, bytes, NULL, GL_DYNAMIC_STORAGE_BIT);
-    vfx_gpu_label(GL_BUFFER, b, label);
+    volfx_gpu_label(GL_BUFFER, b, label);
     return b;
 }
 
-static void grid_uniforms(GLuint prog, const vfx_water_grid_input *in, const float g0[3], float cs,
+static void grid_uniforms(GLuint prog, const volfx_water_grid_input *in, const float g0[3], float cs,
                           const int dims[3], uint32_t n)
 {
     glUniform1ui(glGetUniformLocation(prog, "u_count"), in->count);
@@ -93,8 +93,8 @@ static void grid_uniforms(GLuint prog, const vfx_water_grid_input *in, const flo
     glUniform3iv(glGetUniformLocation(prog, "u_dims"), 1, dims);
 }
 
-void vfx_water_march_bind(GLuint prog, GLuint dist_tex, const vfx_water_params *p,
-                          const vfx_frame_view *frame, const vfx_frame_targets *targets)
+void volfx_water_march_bind(GLuint prog, GLuint dist_tex, const vfx_water_params *p,
+                          const vfx_frame_view *frame, const volfx_frame_targets *targets)
 {
     glBindImageTexture(0, dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     glBindTextureUnit(1, frame->depth_texture);
@@ -108,8 +108,8 @@ void vfx_water_march_bind(GLuint prog, GLuint dist_tex, const vfx_water_params *
     glUniform1i(glGetUniformLocation(prog, "u_has_depth"), frame->depth_texture != 0);
 }
 
-vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_water_grid_input *in,
-                                 const vfx_frame_view *frame, const vfx_frame_targets *targets)
+vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const volfx_water_grid_input *in,
+                                 const vfx_frame_view *frame, const volfx_frame_targets *targets)
 {
     const vfx_water_params *p = in->params;
     float g0[3], cs;
@@ -138,12 +138,12 @@ vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_
      * order within a cell, which the atomics may change: skipping keeps the image identical). */
     int rebuild = !g->built || g->built_rev != in->data_rev || g->built_count != in->count ||
                   memcmp(&g->built_h, &p->h, sizeof p->h) != 0;
-    GLuint count = vfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_COUNT\n");
-    GLuint scan = vfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n");
-    GLuint top = vfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n#define SCAN_TOP\n");
-    GLuint add = vfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN_ADD\n");
-    GLuint scatter = vfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCATTER\n");
-    GLuint march = vfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_MARCH\n");
+    GLuint count = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_COUNT\n");
+    GLuint scan = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n");
+    GLuint top = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n#define SCAN_TOP\n");
+    GLuint add = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN_ADD\n");
+    GLuint scatter = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCATTER\n");
+    GLuint march = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_MARCH\n");
     if (!count || !scan || !top || !add || !scatter || !march)
         return VFX_ERR_GL;
     for (int k = 0; k < 3; ++k)
@@ -158,7 +158,7 @@ vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_
     GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
 
     if (rebuild) {
-        vfx_gpu_pass_begin(ctx, "water.grid_build");
+        volfx_gpu_pass_begin(ctx, "water.grid_build");
         glClearNamedBufferSubData(g->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
         glUseProgram(count);
         grid_uniforms(count, in, g0, cs, dims, nscan);
@@ -184,7 +184,7 @@ vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_
         if (groups)
             glDispatchCompute(gx, gy, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        vfx_gpu_pass_end(ctx);
+        volfx_gpu_pass_end(ctx);
         g->built = 1;
         g->built_rev = in->data_rev;
         g->built_count = in->count;
@@ -192,7 +192,7 @@ vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_
     }
 
     /* the counters were cleared by the effect at the start of the frame */
-    vfx_gpu_pass_begin(ctx, "water.grid_march");
+    volfx_gpu_pass_begin(ctx, "water.grid_march");
     glUseProgram(march);
     grid_uniforms(march, in, g0, cs, dims, nscan);
     float blo[3], bhi[3];
@@ -202,7 +202,7 @@ vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_
     }
     glUniform3fv(glGetUniformLocation(march, "u_blo"), 1, blo);
     glUniform3fv(glGetUniformLocation(march, "u_bhi"), 1, bhi);
-    vfx_water_march_bind(march, in->dist_tex, p, frame, targets);
+    volfx_water_march_bind(march, in->dist_tex, p, frame, targets);
     /* the paper's technique bits mean the same here: 1 = start at the box entry instead of the
      * first sphere entry, 2 = fixed steps after the start (no jump over empty space) */
     glUniform1i(glGetUniformLocation(march, "u_seek_init"), !(p->disable & VFX_WATER_NO_BILLBOARD_INIT));
@@ -210,13 +210,13 @@ vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_
     glDispatchCompute((in->width + 7) / 8, (in->height + 7) / 8, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    vfx_gpu_pass_end(ctx);
+    volfx_gpu_pass_end(ctx);
 
-    vfx_stat_set(ctx, "water.grid_rebuilt", rebuild);
-    vfx_stat_set(ctx, "water.grid_cells", ncells);
-    vfx_stat_set(ctx, "water.grid_cell_size", cs);
-    const char *e = vfx_gpu_error_string();
+    volfx_stat_set(ctx, "water.grid_rebuilt", rebuild);
+    volfx_stat_set(ctx, "water.grid_cells", ncells);
+    volfx_stat_set(ctx, "water.grid_cell_size", cs);
+    const char *e = volfx_gpu_error_string();
     if (e)
-        return vfx_fail(ctx, VFX_ERR_GL, "water grid (%dx%dx%d cells of %g): %s", dims[0], dims[1], dims[2], (double)cs, e);
+        return volfx_fail(ctx, VFX_ERR_GL, "water grid (%dx%dx%d cells of %g): %s", dims[0], dims[1], dims[2], (double)cs, e);
     return VFX_OK;
 }

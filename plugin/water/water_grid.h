@@ -1,16 +1,16 @@
 /* water_grid.h — the GRID baseline of the water effect: a uniform particle grid (cell >= h)
  * built on the GPU each frame (count, prefix sum, scatter), then a per-pixel compute march over
  * it with empty-space skipping; the same sampling rule and refinement as the BRUTE baseline. */
-#ifndef VFX_WATER_GRID_H
-#define VFX_WATER_GRID_H
+#ifndef VOLFX_WATER_GRID_H
+#define VOLFX_WATER_GRID_H
 
 #include <epoxy/gl.h>
 #include "plugin_internal.h"
 
-typedef struct vfx_water_grid vfx_water_grid;
+typedef struct volfx_water_grid volfx_water_grid;
 
 /* What one GRID frame needs from the water effect's state (borrowed, not owned). */
-typedef struct vfx_water_grid_input {
+typedef struct volfx_water_grid_input {
     const GLuint *cols;              /* x, y, z position columns (SSBOs of `count` floats) */
     uint32_t count;                  /* particles in the columns, non-finite ones included */
     uint32_t finite;                 /* of which finite (0: nothing to draw) */
@@ -20,24 +20,24 @@ typedef struct vfx_water_grid_input {
     GLuint dist_tex;                 /* R32F target: distance along the ray or -1 */
     GLuint counters;                 /* the effect's counter buffer (fenced readback ring) */
     uint64_t data_rev;               /* changes whenever the columns were uploaded again */
-} vfx_water_grid_input;
+} volfx_water_grid_input;
 
 /* Makes the (empty) grid state; NULL on allocation failure (error recorded). */
-vfx_water_grid *vfx_water_grid_create(vfx_context *ctx);
+volfx_water_grid *volfx_water_grid_create(vfx_context *ctx);
 /* Frees the grid's buffers and the state; NULL allowed. */
-void vfx_water_grid_destroy(vfx_context *ctx, vfx_water_grid *g);
+void volfx_water_grid_destroy(vfx_context *ctx, volfx_water_grid *g);
 /* Builds the grid from in->cols unless data_rev, count and h are those of the last build, then
  * writes in->dist_tex; adds water.samples / pixels_found / pixels_sample_cap / pixels_left /
  * grid cells visited / sphere tests into in->counters (no readback here); sets water.grid_cells,
  * water.grid_cell_size and water.grid_rebuilt (0/1). */
-vfx_result vfx_water_grid_render(vfx_context *ctx, vfx_water_grid *g, const vfx_water_grid_input *in,
-                                 const vfx_frame_view *frame, const vfx_frame_targets *targets);
+vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const volfx_water_grid_input *in,
+                                 const vfx_frame_view *frame, const volfx_frame_targets *targets);
 
 /* The march inputs BRUTE (brute.comp) and GRID (grid.comp MODE_MARCH) share, on the current
  * program prog: dist_tex as image 0, the scene depth on unit 1, the ray (inverse view-projection,
  * eye), the sampling rule (h, T, step, sample cap), refinement (off with VFX_WATER_NO_REFINE)
  * and whether there is scene depth. */
-void vfx_water_march_bind(GLuint prog, GLuint dist_tex, const vfx_water_params *p,
-                          const vfx_frame_view *frame, const vfx_frame_targets *targets);
+void volfx_water_march_bind(GLuint prog, GLuint dist_tex, const vfx_water_params *p,
+                          const vfx_frame_view *frame, const volfx_frame_targets *targets);
 
 #endif

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-vfx_result vfx_read_file(const char *path, size_t max_bytes, const char *cap_text, char **out,
+vfx_result rt_read_file(const char *path, size_t max_bytes, const char *cap_text, char **out,
                          size_t *size, char *err, size_t errlen)
 {
     *out = NULL;

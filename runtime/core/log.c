@@ -4,14 +4,14 @@
 #include <stdarg.h>
 #include <stdio.h>
 
-void vfx_log_stderr(void *user, vfx_log_level level, const char *message)
+void rt_log_stderr(void *user, vfx_log_level level, const char *message)
 {
     static const char *names[] = {"debug", "info", "warn", "error"};
     (void)user;
     fprintf(stderr, "[volfx %s] %s\n", names[level <= VFX_LOG_ERROR ? level : VFX_LOG_ERROR], message);
 }
 
-void vfx_logf(const vfx_logger *logger, vfx_log_level level, const char *fmt, ...)
+void rt_logf(const rt_logger *logger, vfx_log_level level, const char *fmt, ...)
 {
     char buf[1024];
     va_list ap;
@@ -21,5 +21,5 @@ void vfx_logf(const vfx_logger *logger, vfx_log_level level, const char *fmt, ..
     if (logger && logger->fn)
         logger->fn(logger->user, level, buf);
     else
-        vfx_log_stderr(NULL, level, buf);
+        rt_log_stderr(NULL, level, buf);
 }

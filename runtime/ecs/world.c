@@ -14,19 +14,19 @@
 #define COLUMN_ALIGN 64u
 
 typedef struct component_info {
-    vfx_component_desc desc;
+    rt_component_desc desc;
     char name[64];
     uint32_t field_size; /* size / fields */
 } component_info;
 
 typedef struct table {
     uint32_t comp_count;
-    vfx_component comps[VFX_MAX_TABLE_COMPONENTS]; /* sorted ascending */
-    uint32_t column_base[VFX_MAX_TABLE_COMPONENTS]; /* first column index of comps[i] */
+    rt_component comps[RT_MAX_TABLE_COMPONENTS]; /* sorted ascending */
+    uint32_t column_base[RT_MAX_TABLE_COMPONENTS]; /* first column index of comps[i] */
     uint32_t column_count;
     void **columns;           /* column_count arrays */
     uint32_t *column_size;    /* element size of each column */
-    vfx_entity *entities;
+    rt_entity *entities;
     uint32_t rows, capacity;
     uint64_t revision;
 } table;
@@ -39,15 +39,15 @@ typedef struct entity_record {
 } entity_record;
 
 typedef struct system_entry {
-    vfx_system_desc desc;
+    rt_system_desc desc;
     char name[64];
-    vfx_component reads[VFX_MAX_QUERY_TERMS], writes[VFX_MAX_QUERY_TERMS];
+    rt_component reads[RT_MAX_QUERY_TERMS], writes[RT_MAX_QUERY_TERMS];
     uint32_t order; /* registration order */
 } system_entry;
 
-struct vfx_world {
-    vfx_world_desc desc;
-    component_info comps[VFX_MAX_COMPONENTS];
+struct rt_world {
+    rt_world_desc desc;
+    component_info comps[RT_MAX_COMPONENTS];
     uint32_t comp_count;
     table *tables;
     uint32_t table_count, table_capacity;
@@ -61,16 +61,16 @@ struct vfx_world {
     char error[256];
 };
 
-static vfx_result world_fail(vfx_world *w, vfx_result r, const char *fmt, ...)
+static vfx_result world_fail(rt_world *w, vfx_result r, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
-static vfx_result world_fail(vfx_world *w, vfx_result r, const char *fmt, ...)
+static vfx_result world_fail(rt_world *w, vfx_result r, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(w->error, sizeof w->error, fmt, ap);
     va_end(ap);
-    vfx_logf(&w->desc.logger, VFX_LOG_ERROR, "ecs: %s", w->error);
+    rt_logf(&w->desc.logger, VFX_LOG_ERROR, "ecs: %s", w->error);
     return r;
 }
 
@@ -103,9 +103,9 @@ static bool grow(void **arr, uint32_t *cap, uint32_t need, size_t elem)
     return true;
 }
 
-vfx_world *vfx_world_create(const vfx_world_desc *desc)
+rt_world *rt_world_create(const rt_world_desc *desc)
 {
-    vfx_world *w = calloc(1, sizeof *w);
+    rt_world *w = calloc(1, sizeof *w);
     if (!w)
         return NULL;
     if (desc)
@@ -122,7 +122,7 @@ static void table_free(table *t)
     free(t->entities);
 }
 
-void vfx_world_destroy(vfx_world *w)
+void rt_world_destroy(rt_world *w)
 {
     if (!w)
         return;
@@ -135,9 +135,9 @@ void vfx_world_destroy(vfx_world *w)
     free(w);
 }
 
-const char *vfx_world_last_error(const vfx_world *w) { return w ? w->error : "no world"; }
+const char *rt_world_last_error(const rt_world *w) { return w ? w->error : "no world"; }
 
-vfx_result vfx_world_register(vfx_world *w, const vfx_component_desc *desc, vfx_component *out)
+vfx_result rt_world_register(rt_world *w, const rt_component_desc *desc, rt_component *out)
 {
     if (!w || !desc || !desc->name || !desc->name[0])
         return w ? world_fail(w, VFX_ERR_INVALID_ARGUMENT, "register: component needs a name")
@@ -145,12 +145,12 @@ vfx_result vfx_world_register(vfx_world *w, const vfx_component_desc *desc, vfx_
     if (strlen(desc->name) >= sizeof w->comps[0].name)
         return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "register: name '%.40s...' longer than %zu",
                           desc->name, sizeof w->comps[0].name - 1);
-    if (vfx_world_lookup(w, desc->name) != VFX_COMPONENT_NONE)
+    if (rt_world_lookup(w, desc->name) != RT_COMPONENT_NONE)
         return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "register: component '%s' already registered",
                           desc->name);
-    if (w->comp_count >= VFX_MAX_COMPONENTS)
+    if (w->comp_count >= RT_MAX_COMPONENTS)
         return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "register: more than %d components",
-                          VFX_MAX_COMPONENTS);
+                          RT_MAX_COMPONENTS);
     uint32_t fields = desc->fields ? desc->fields : 1;
     if (desc->size % fields != 0)
         return world_fail(w, VFX_ERR_INVALID_ARGUMENT,
@@ -172,24 +172,24 @@ vfx_result vfx_world_register(vfx_world *w, const vfx_component_desc *desc, vfx_
     return VFX_OK;
 }
 
-vfx_component vfx_world_lookup(const vfx_world *w, const char *name)
+rt_component rt_world_lookup(const rt_world *w, const char *name)
 {
     if (!w || !name)
-        return VFX_COMPONENT_NONE;
+        return RT_COMPONENT_NONE;
     for (uint32_t i = 0; i < w->comp_count; ++i)
         if (strcmp(w->comps[i].name, name) == 0)
             return i;
-    return VFX_COMPONENT_NONE;
+    return RT_COMPONENT_NONE;
 }
 
-const vfx_component_desc *vfx_world_component_desc(const vfx_world *w, vfx_component c)
+const rt_component_desc *rt_world_component_desc(const rt_world *w, rt_component c)
 {
     return (w && c < w->comp_count) ? &w->comps[c].desc : NULL;
 }
 
 /* ------------------------------------------------------------------------ tables */
 
-static int table_comp_slot(const table *t, vfx_component c)
+static int table_comp_slot(const table *t, rt_component c)
 {
     for (uint32_t i = 0; i < t->comp_count; ++i)
         if (t->comps[i] == c)
@@ -204,10 +204,10 @@ static int cmp_u32(const void *a, const void *b)
 }
 
 /* Sorted, de-duplicated copy of a component set; returns its length or -1 on a bad id. */
-static int normalize_set(const vfx_world *w, const vfx_component *in, uint32_t n,
-                         vfx_component out[VFX_MAX_TABLE_COMPONENTS])
+static int normalize_set(const rt_world *w, const rt_component *in, uint32_t n,
+                         rt_component out[RT_MAX_TABLE_COMPONENTS])
 {
-    if (n > VFX_MAX_TABLE_COMPONENTS)
+    if (n > RT_MAX_TABLE_COMPONENTS)
         return -1;
     for (uint32_t i = 0; i < n; ++i) {
         if (in[i] >= w->comp_count)
@@ -222,7 +222,7 @@ static int normalize_set(const vfx_world *w, const vfx_component *in, uint32_t n
     return (int)m;
 }
 
-static vfx_result table_find_or_make(vfx_world *w, const vfx_component *set, uint32_t n,
+static vfx_result table_find_or_make(rt_world *w, const rt_component *set, uint32_t n,
                                      uint32_t *out)
 {
     for (uint32_t i = 0; i < w->table_count; ++i) {
@@ -264,7 +264,7 @@ static vfx_result table_find_or_make(vfx_world *w, const vfx_component *set, uin
 }
 
 /* Makes room for `need` rows; columns are reallocated (and so move) only here. */
-static vfx_result table_reserve(vfx_world *w, table *t, uint32_t need)
+static vfx_result table_reserve(rt_world *w, table *t, uint32_t need)
 {
     if (need <= t->capacity)
         return VFX_OK;
@@ -283,7 +283,7 @@ static vfx_result table_reserve(vfx_world *w, table *t, uint32_t need)
         free(t->columns[c]);
         t->columns[c] = p;
     }
-    vfx_entity *e = realloc(t->entities, (size_t)cap * sizeof *e);
+    rt_entity *e = realloc(t->entities, (size_t)cap * sizeof *e);
     if (!e)
         return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "out of memory for %llu rows",
                           (unsigned long long)cap);
@@ -293,7 +293,7 @@ static vfx_result table_reserve(vfx_world *w, table *t, uint32_t need)
 }
 
 /* Removes row r by moving the last row into it; fixes the moved entity's record. */
-static void table_swap_remove(vfx_world *w, table *t, uint32_t r)
+static void table_swap_remove(rt_world *w, table *t, uint32_t r)
 {
     uint32_t last = t->rows - 1;
     if (r != last) {
@@ -302,7 +302,7 @@ static void table_swap_remove(vfx_world *w, table *t, uint32_t r)
             memcpy((char *)t->columns[c] + (size_t)r * s, (char *)t->columns[c] + (size_t)last * s, s);
         }
         t->entities[r] = t->entities[last];
-        w->records[vfx_entity_index(t->entities[r])].row = r;
+        w->records[rt_entity_index(t->entities[r])].row = r;
     }
     for (uint32_t c = 0; c < t->column_count; ++c) {
         uint32_t s = t->column_size[c];
@@ -314,7 +314,7 @@ static void table_swap_remove(vfx_world *w, table *t, uint32_t r)
 
 /* ---------------------------------------------------------------------- entities */
 
-static vfx_result new_entity(vfx_world *w, uint32_t table_index, uint32_t row, vfx_entity *out)
+static vfx_result new_entity(rt_world *w, uint32_t table_index, uint32_t row, rt_entity *out)
 {
     uint32_t idx;
     if (w->free_count) {
@@ -336,12 +336,12 @@ static vfx_result new_entity(vfx_world *w, uint32_t table_index, uint32_t row, v
     rec->table = table_index;
     rec->row = row;
     w->alive_count++;
-    *out = ((vfx_entity)rec->generation << 32) | idx;
+    *out = ((rt_entity)rec->generation << 32) | idx;
     return VFX_OK;
 }
 
-vfx_result vfx_world_spawn(vfx_world *w, uint32_t count, const vfx_component *comps,
-                           uint32_t comp_count, vfx_entity *out_ids)
+vfx_result rt_world_spawn(rt_world *w, uint32_t count, const rt_component *comps,
+                           uint32_t comp_count, rt_entity *out_ids)
 {
     if (!w)
         return VFX_ERR_INVALID_ARGUMENT;
@@ -349,12 +349,12 @@ vfx_result vfx_world_spawn(vfx_world *w, uint32_t count, const vfx_component *co
         return VFX_OK;
     if (comp_count && !comps)
         return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "spawn: NULL component list");
-    vfx_component set[VFX_MAX_TABLE_COMPONENTS];
+    rt_component set[RT_MAX_TABLE_COMPONENTS];
     int n = normalize_set(w, comps, comp_count, set);
     if (n < 0)
         return world_fail(w, VFX_ERR_INVALID_ARGUMENT,
                           "spawn: unknown component id or more than %d components",
-                          VFX_MAX_TABLE_COMPONENTS);
+                          RT_MAX_TABLE_COMPONENTS);
     if ((uint64_t)w->alive_count + count > UINT32_MAX - 1)
         return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "spawn: %u entities exceed the id space", count);
     uint32_t ti;
@@ -370,7 +370,7 @@ vfx_result vfx_world_spawn(vfx_world *w, uint32_t count, const vfx_component *co
               sizeof(entity_record)))
         return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "spawn: out of memory for %u records", count);
     for (uint32_t i = 0; i < count; ++i) {
-        vfx_entity e = VFX_ENTITY_NULL;
+        rt_entity e = RT_ENTITY_NULL;
         if ((r = new_entity(w, ti, t->rows, &e)))
             return r;
         t->entities[t->rows++] = e;
@@ -381,45 +381,45 @@ vfx_result vfx_world_spawn(vfx_world *w, uint32_t count, const vfx_component *co
     return VFX_OK;
 }
 
-static entity_record *live_record(const vfx_world *w, vfx_entity e)
+static entity_record *live_record(const rt_world *w, rt_entity e)
 {
-    uint32_t idx = vfx_entity_index(e);
-    if (e == VFX_ENTITY_NULL || idx >= w->record_count)
+    uint32_t idx = rt_entity_index(e);
+    if (e == RT_ENTITY_NULL || idx >= w->record_count)
         return NULL;
     entity_record *rec = &w->records[idx];
-    if (!rec->alive || rec->generation != vfx_entity_generation(e))
+    if (!rec->alive || rec->generation != rt_entity_generation(e))
         return NULL;
     return rec;
 }
 
-bool vfx_world_alive(const vfx_world *w, vfx_entity e) { return w && live_record(w, e) != NULL; }
+bool rt_world_alive(const rt_world *w, rt_entity e) { return w && live_record(w, e) != NULL; }
 
-uint32_t vfx_world_entity_count(const vfx_world *w) { return w ? w->alive_count : 0; }
+uint32_t rt_world_entity_count(const rt_world *w) { return w ? w->alive_count : 0; }
 
-vfx_result vfx_world_despawn(vfx_world *w, vfx_entity e)
+vfx_result rt_world_despawn(rt_world *w, rt_entity e)
 {
     if (!w)
         return VFX_ERR_INVALID_ARGUMENT;
     entity_record *rec = live_record(w, e);
     if (!rec)
         return world_fail(w, VFX_ERR_NOT_FOUND, "despawn: entity %u (generation %u) is not alive",
-                          vfx_entity_index(e), vfx_entity_generation(e));
+                          rt_entity_index(e), rt_entity_generation(e));
     table_swap_remove(w, &w->tables[rec->table], rec->row);
     rec->alive = false;
     if (!grow((void **)&w->free_indices, &w->free_capacity, w->free_count + 1, sizeof(uint32_t)))
         return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "despawn: out of memory for the free list");
-    w->free_indices[w->free_count++] = vfx_entity_index(e);
+    w->free_indices[w->free_count++] = rt_entity_index(e);
     w->alive_count--;
     return VFX_OK;
 }
 
-bool vfx_world_has(const vfx_world *w, vfx_entity e, vfx_component c)
+bool rt_world_has(const rt_world *w, rt_entity e, rt_component c)
 {
     entity_record *rec = w ? live_record(w, e) : NULL;
     return rec && table_comp_slot(&w->tables[rec->table], c) >= 0;
 }
 
-void *vfx_world_get(vfx_world *w, vfx_entity e, vfx_component c, uint32_t field)
+void *rt_world_get(rt_world *w, rt_entity e, rt_component c, uint32_t field)
 {
     entity_record *rec = w ? live_record(w, e) : NULL;
     if (!rec)
@@ -433,8 +433,8 @@ void *vfx_world_get(vfx_world *w, vfx_entity e, vfx_component c, uint32_t field)
 }
 
 /* Moves entity e to the table with component set `set`, copying shared columns. */
-static vfx_result move_entity(vfx_world *w, entity_record *rec, vfx_entity e,
-                              const vfx_component *set, uint32_t n)
+static vfx_result move_entity(rt_world *w, entity_record *rec, rt_entity e,
+                              const rt_component *set, uint32_t n)
 {
     uint32_t dst_i;
     vfx_result r = table_find_or_make(w, set, n, &dst_i);
@@ -464,41 +464,41 @@ static vfx_result move_entity(vfx_world *w, entity_record *rec, vfx_entity e,
     return VFX_OK;
 }
 
-vfx_result vfx_world_add(vfx_world *w, vfx_entity e, vfx_component c)
+vfx_result rt_world_add(rt_world *w, rt_entity e, rt_component c)
 {
     if (!w)
         return VFX_ERR_INVALID_ARGUMENT;
     entity_record *rec = live_record(w, e);
     if (!rec)
-        return world_fail(w, VFX_ERR_NOT_FOUND, "add: entity %u is not alive", vfx_entity_index(e));
+        return world_fail(w, VFX_ERR_NOT_FOUND, "add: entity %u is not alive", rt_entity_index(e));
     if (c >= w->comp_count)
         return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "add: unknown component id %u", c);
     const table *t = &w->tables[rec->table];
     if (table_comp_slot(t, c) >= 0)
         return VFX_OK;
-    if (t->comp_count >= VFX_MAX_TABLE_COMPONENTS)
+    if (t->comp_count >= RT_MAX_TABLE_COMPONENTS)
         return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "add: entity already has %d components",
-                          VFX_MAX_TABLE_COMPONENTS);
-    vfx_component set[VFX_MAX_TABLE_COMPONENTS];
+                          RT_MAX_TABLE_COMPONENTS);
+    rt_component set[RT_MAX_TABLE_COMPONENTS];
     memcpy(set, t->comps, t->comp_count * sizeof *set);
     set[t->comp_count] = c;
-    vfx_component sorted[VFX_MAX_TABLE_COMPONENTS];
+    rt_component sorted[RT_MAX_TABLE_COMPONENTS];
     int n = normalize_set(w, set, t->comp_count + 1, sorted);
     return move_entity(w, rec, e, sorted, (uint32_t)n);
 }
 
-vfx_result vfx_world_remove(vfx_world *w, vfx_entity e, vfx_component c)
+vfx_result rt_world_remove(rt_world *w, rt_entity e, rt_component c)
 {
     if (!w)
         return VFX_ERR_INVALID_ARGUMENT;
     entity_record *rec = live_record(w, e);
     if (!rec)
         return world_fail(w, VFX_ERR_NOT_FOUND, "remove: entity %u is not alive",
-                          vfx_entity_index(e));
+                          rt_entity_index(e));
     const table *t = &w->tables[rec->table];
     if (table_comp_slot(t, c) < 0)
         return VFX_OK;
-    vfx_component set[VFX_MAX_TABLE_COMPONENTS];
+    rt_component set[RT_MAX_TABLE_COMPONENTS];
     uint32_t n = 0;
     for (uint32_t i = 0; i < t->comp_count; ++i)
         if (t->comps[i] != c)
@@ -508,16 +508,16 @@ vfx_result vfx_world_remove(vfx_world *w, vfx_entity e, vfx_component c)
 
 /* ----------------------------------------------------------------------- queries */
 
-vfx_query_iter vfx_query_begin(vfx_world *w, const vfx_component *terms, uint32_t term_count)
+rt_query_iter rt_query_begin(rt_world *w, const rt_component *terms, uint32_t term_count)
 {
-    vfx_query_iter it;
+    rt_query_iter it;
     memset(&it, 0, sizeof it);
     it.world = w;
-    if (term_count > VFX_MAX_QUERY_TERMS) {
+    if (term_count > RT_MAX_QUERY_TERMS) {
         if (w)
-            vfx_logf(&w->desc.logger, VFX_LOG_WARN, "ecs: query of %u terms cut to %d", term_count,
-                     VFX_MAX_QUERY_TERMS);
-        term_count = VFX_MAX_QUERY_TERMS;
+            rt_logf(&w->desc.logger, VFX_LOG_WARN, "ecs: query of %u terms cut to %d", term_count,
+                     RT_MAX_QUERY_TERMS);
+        term_count = RT_MAX_QUERY_TERMS;
     }
     if (terms)
         memcpy(it.terms, terms, term_count * sizeof *terms);
@@ -526,7 +526,7 @@ vfx_query_iter vfx_query_begin(vfx_world *w, const vfx_component *terms, uint32_
     return it;
 }
 
-static bool table_matches(const table *t, const vfx_component *terms, uint32_t n)
+static bool table_matches(const table *t, const rt_component *terms, uint32_t n)
 {
     for (uint32_t i = 0; i < n; ++i)
         if (table_comp_slot(t, terms[i]) < 0)
@@ -534,9 +534,9 @@ static bool table_matches(const table *t, const vfx_component *terms, uint32_t n
     return true;
 }
 
-bool vfx_query_next(vfx_query_iter *it)
+bool rt_query_next(rt_query_iter *it)
 {
-    vfx_world *w = it->world;
+    rt_world *w = it->world;
     if (!w)
         return false;
     while (it->next_table < w->table_count) {
@@ -554,9 +554,9 @@ bool vfx_query_next(vfx_query_iter *it)
     return false;
 }
 
-void *vfx_query_column(const vfx_query_iter *it, vfx_component c, uint32_t field)
+void *rt_query_column(const rt_query_iter *it, rt_component c, uint32_t field)
 {
-    vfx_world *w = it->world;
+    rt_world *w = it->world;
     if (!w || it->table >= w->table_count || c >= w->comp_count)
         return NULL;
     table *t = &w->tables[it->table];
@@ -566,21 +566,21 @@ void *vfx_query_column(const vfx_query_iter *it, vfx_component c, uint32_t field
     return t->columns[t->column_base[slot] + field];
 }
 
-uint32_t vfx_query_count(vfx_world *w, const vfx_component *terms, uint32_t term_count)
+uint32_t rt_query_count(rt_world *w, const rt_component *terms, uint32_t term_count)
 {
     uint32_t total = 0;
-    vfx_query_iter it = vfx_query_begin(w, terms, term_count);
-    while (vfx_query_next(&it))
+    rt_query_iter it = rt_query_begin(w, terms, term_count);
+    while (rt_query_next(&it))
         total += it.rows;
     return total;
 }
 
-uint64_t vfx_world_table_revision(const vfx_world *w, uint32_t table_index)
+uint64_t rt_world_table_revision(const rt_world *w, uint32_t table_index)
 {
     return (w && table_index < w->table_count) ? w->tables[table_index].revision : 0;
 }
 
-vfx_result vfx_world_table_permute(vfx_world *w, uint32_t ti, const uint32_t *perm)
+vfx_result rt_world_table_permute(rt_world *w, uint32_t ti, const uint32_t *perm)
 {
     if (!w || ti >= w->table_count || !perm)
         return w ? world_fail(w, VFX_ERR_INVALID_ARGUMENT, "permute: bad table %u or NULL perm", ti)
@@ -601,7 +601,7 @@ vfx_result vfx_world_table_permute(vfx_world *w, uint32_t ti, const uint32_t *pe
         seen[perm[i]] = 1;
     }
     free(seen);
-    size_t max_size = sizeof(vfx_entity);
+    size_t max_size = sizeof(rt_entity);
     for (uint32_t c = 0; c < t->column_count; ++c)
         if (t->column_size[c] > max_size)
             max_size = t->column_size[c];
@@ -615,12 +615,12 @@ vfx_result vfx_world_table_permute(vfx_world *w, uint32_t ti, const uint32_t *pe
             memcpy(tmp + (size_t)i * s, src + (size_t)perm[i] * s, s);
         memcpy(t->columns[c], tmp, (size_t)t->rows * s);
     }
-    vfx_entity *ent = (vfx_entity *)tmp;
+    rt_entity *ent = (rt_entity *)tmp;
     for (uint32_t i = 0; i < t->rows; ++i)
         ent[i] = t->entities[perm[i]];
     memcpy(t->entities, ent, (size_t)t->rows * sizeof *ent);
     for (uint32_t i = 0; i < t->rows; ++i)
-        w->records[vfx_entity_index(t->entities[i])].row = i;
+        w->records[rt_entity_index(t->entities[i])].row = i;
     free(tmp);
     t->revision++;
     return VFX_OK;
@@ -628,18 +628,18 @@ vfx_result vfx_world_table_permute(vfx_world *w, uint32_t ti, const uint32_t *pe
 
 /* ----------------------------------------------------------------------- systems */
 
-vfx_result vfx_world_add_system(vfx_world *w, const vfx_system_desc *d)
+vfx_result rt_world_add_system(rt_world *w, const rt_system_desc *d)
 {
     if (!w || !d || !d->fn)
         return w ? world_fail(w, VFX_ERR_INVALID_ARGUMENT, "add_system: NULL function")
                  : VFX_ERR_INVALID_ARGUMENT;
     const char *name = d->name ? d->name : "(unnamed)";
-    if ((unsigned)d->phase >= VFX_PHASE_COUNT)
+    if ((unsigned)d->phase >= RT_PHASE_COUNT)
         return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "add_system '%s': phase %d out of range",
                           name, (int)d->phase);
-    if (d->read_count > VFX_MAX_QUERY_TERMS || d->write_count > VFX_MAX_QUERY_TERMS)
+    if (d->read_count > RT_MAX_QUERY_TERMS || d->write_count > RT_MAX_QUERY_TERMS)
         return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "add_system '%s': more than %d reads/writes",
-                          name, VFX_MAX_QUERY_TERMS);
+                          name, RT_MAX_QUERY_TERMS);
     for (uint32_t i = 0; i < d->read_count; ++i)
         if (d->reads[i] >= w->comp_count)
             return world_fail(w, VFX_ERR_INVALID_ARGUMENT,
@@ -689,15 +689,15 @@ static double now_ms(void)
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 
-vfx_result vfx_world_run_phase(vfx_world *w, vfx_phase phase, double time, float dt)
+vfx_result rt_world_run_phase(rt_world *w, rt_phase phase, double time, float dt)
 {
-    if (!w || (unsigned)phase >= VFX_PHASE_COUNT)
+    if (!w || (unsigned)phase >= RT_PHASE_COUNT)
         return VFX_ERR_INVALID_ARGUMENT;
     for (uint32_t i = 0; i < w->system_count; ++i) {
         system_entry *s = &w->systems[i];
         if (s->desc.phase != phase)
             continue;
-        vfx_system_ctx ctx = {time, dt, s->desc.user, s->name};
+        rt_system_ctx ctx = {time, dt, s->desc.user, s->name};
         double t0 = now_ms();
         vfx_result r = s->desc.fn(w, &ctx);
         double ms = now_ms() - t0;
@@ -719,37 +719,37 @@ vfx_result vfx_world_run_phase(vfx_world *w, vfx_phase phase, double time, float
     return VFX_OK;
 }
 
-vfx_result vfx_world_progress(vfx_world *w, double time, float dt)
+vfx_result rt_world_progress(rt_world *w, double time, float dt)
 {
-    for (int p = 0; p < VFX_PHASE_COUNT; ++p) {
-        vfx_result r = vfx_world_run_phase(w, (vfx_phase)p, time, dt);
+    for (int p = 0; p < RT_PHASE_COUNT; ++p) {
+        vfx_result r = rt_world_run_phase(w, (rt_phase)p, time, dt);
         if (r)
             return r;
     }
     return VFX_OK;
 }
 
-uint32_t vfx_world_system_count(const vfx_world *w) { return w ? w->system_count : 0; }
+uint32_t rt_world_system_count(const rt_world *w) { return w ? w->system_count : 0; }
 
-const char *vfx_world_system_name(const vfx_world *w, uint32_t i)
+const char *rt_world_system_name(const rt_world *w, uint32_t i)
 {
     return (w && i < w->system_count) ? w->systems[i].name : NULL;
 }
 
 /* ---------------------------------------------------------------------- particles */
 
-vfx_result vfx_particles_register(vfx_world *w, vfx_particle_components *out)
+vfx_result rt_particles_register(rt_world *w, rt_particle_components *out)
 {
     static const struct { const char *name; uint32_t fields; } defs[4] = {
-        {VFX_PARTICLE_POSITION, 3}, {VFX_PARTICLE_VELOCITY, 3},
-        {VFX_PARTICLE_DENSITY, 1}, {VFX_PARTICLE_RADIUS, 1}};
-    vfx_component ids[4];
+        {RT_PARTICLE_POSITION, 3}, {RT_PARTICLE_VELOCITY, 3},
+        {RT_PARTICLE_DENSITY, 1}, {RT_PARTICLE_RADIUS, 1}};
+    rt_component ids[4];
     for (int i = 0; i < 4; ++i) {
-        ids[i] = vfx_world_lookup(w, defs[i].name);
-        if (ids[i] != VFX_COMPONENT_NONE)
+        ids[i] = rt_world_lookup(w, defs[i].name);
+        if (ids[i] != RT_COMPONENT_NONE)
             continue;
-        vfx_component_desc d = {defs[i].name, 4 * defs[i].fields, 4, defs[i].fields};
-        vfx_result r = vfx_world_register(w, &d, &ids[i]);
+        rt_component_desc d = {defs[i].name, 4 * defs[i].fields, 4, defs[i].fields};
+        vfx_result r = rt_world_register(w, &d, &ids[i]);
         if (r)
             return r;
     }
@@ -760,7 +760,7 @@ vfx_result vfx_particles_register(vfx_world *w, vfx_particle_components *out)
     return VFX_OK;
 }
 
-vfx_result vfx_particles_spawn(vfx_world *w, const vfx_particle_components *pc, uint32_t n,
+vfx_result rt_particles_spawn(rt_world *w, const rt_particle_components *pc, uint32_t n,
                                const float *x, const float *y, const float *z, bool with_radius)
 {
     if (!w || !pc)
@@ -773,27 +773,27 @@ vfx_result vfx_particles_spawn(vfx_world *w, const vfx_particle_components *pc, 
                                   "particles: position %c of particle %u is not finite",
                                   "xyz"[k], i);
     }
-    vfx_component comps[4] = {pc->position, pc->velocity, pc->density, pc->radius};
+    rt_component comps[4] = {pc->position, pc->velocity, pc->density, pc->radius};
     /* Spawn in bulk, then fill the new rows (the last n of the particle table). */
-    vfx_result r = vfx_world_spawn(w, n, comps, with_radius ? 4 : 3, NULL);
+    vfx_result r = rt_world_spawn(w, n, comps, with_radius ? 4 : 3, NULL);
     if (r || n == 0)
         return r;
-    vfx_query_iter it = vfx_query_begin(w, comps, with_radius ? 4 : 3);
-    while (vfx_query_next(&it)) {
+    rt_query_iter it = rt_query_begin(w, comps, with_radius ? 4 : 3);
+    while (rt_query_next(&it)) {
         table *t = &w->tables[it.table];
         if (t->comp_count != (with_radius ? 4u : 3u))
             continue;
         uint32_t base = t->rows - n;
-        float *px = vfx_query_column(&it, pc->position, 0);
-        float *py = vfx_query_column(&it, pc->position, 1);
-        float *pz = vfx_query_column(&it, pc->position, 2);
+        float *px = rt_query_column(&it, pc->position, 0);
+        float *py = rt_query_column(&it, pc->position, 1);
+        float *pz = rt_query_column(&it, pc->position, 2);
         for (uint32_t i = 0; i < n; ++i) {
             px[base + i] = x ? x[i] : 0.f;
             py[base + i] = y ? y[i] : 0.f;
             pz[base + i] = z ? z[i] : 0.f;
         }
         if (with_radius) {
-            float *rad = vfx_query_column(&it, pc->radius, 0);
+            float *rad = rt_query_column(&it, pc->radius, 0);
             for (uint32_t i = 0; i < n; ++i)
                 rad[base + i] = 1.f;
         }

@@ -13,8 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-struct vfx_gl_context {
-    vfx_gl_context_desc desc;
+struct rt_gl_context {
+    rt_gl_context_desc desc;
     GLFWwindow *window;
     EGLDisplay egl_display;
     EGLContext egl_context;
@@ -27,12 +27,12 @@ static void APIENTRY debug_cb(GLenum source, GLenum type, GLuint id, GLenum seve
                               GLsizei length, const GLchar *message, const void *user)
 {
     (void)source; (void)length;
-    const vfx_gl_context *c = user;
+    const rt_gl_context *c = user;
     if (severity == GL_DEBUG_SEVERITY_NOTIFICATION)
         return;
     vfx_log_level lvl = severity == GL_DEBUG_SEVERITY_HIGH || type == GL_DEBUG_TYPE_ERROR
                             ? VFX_LOG_ERROR : VFX_LOG_WARN;
-    vfx_logf(&c->desc.logger, lvl, "GL debug (id %u): %s", id, message);
+    rt_logf(&c->desc.logger, lvl, "GL debug (id %u): %s", id, message);
 }
 
 static bool egl_has(const char *exts, const char *name)
@@ -72,12 +72,12 @@ typedef struct egl_try {
     EGLDisplay d;
 } egl_try;
 
-static vfx_result make_headless(vfx_gl_context *c)
+static vfx_result make_headless(rt_gl_context *c)
 {
     const char *force = getenv("VFX_EGL_PLATFORM");
     const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     if (!client) {
-        vfx_logf(&c->desc.logger, VFX_LOG_ERROR,
+        rt_logf(&c->desc.logger, VFX_LOG_ERROR,
                  "headless GL: EGL client extensions unavailable (no EGL 1.5 / libglvnd?)");
         return VFX_ERR_GL_UNSUPPORTED;
     }
@@ -103,7 +103,7 @@ static vfx_result make_headless(vfx_gl_context *c)
         const char *dext = eglQueryString(d, EGL_EXTENSIONS);
         if (!egl_has(dext, "EGL_KHR_no_config_context") || !egl_has(dext, "EGL_KHR_surfaceless_context")
             || !eglBindAPI(EGL_OPENGL_API)) {
-            vfx_logf(&c->desc.logger, VFX_LOG_WARN,
+            rt_logf(&c->desc.logger, VFX_LOG_WARN,
                      "headless GL: EGL %s display lacks no-config/surfaceless contexts", tries[i].name);
             eglTerminate(d);
             continue;
@@ -118,7 +118,7 @@ static vfx_result make_headless(vfx_gl_context *c)
         }
         EGLContext ctx = eglCreateContext(d, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, dbg);
         if (ctx == EGL_NO_CONTEXT) {
-            vfx_logf(&c->desc.logger, VFX_LOG_WARN,
+            rt_logf(&c->desc.logger, VFX_LOG_WARN,
                      "headless GL: EGL %s display gives no GL 4.5 core context (EGL error 0x%x)",
                      tries[i].name, eglGetError());
             eglTerminate(d);
@@ -134,16 +134,16 @@ static vfx_result make_headless(vfx_gl_context *c)
         snprintf(c->platform, sizeof c->platform, "egl-%s", tries[i].name);
         return VFX_OK;
     }
-    vfx_logf(&c->desc.logger, VFX_LOG_ERROR,
+    rt_logf(&c->desc.logger, VFX_LOG_ERROR,
              "headless GL: no EGL platform gave a GL 4.5 core context (tried %d%s%s)", nt,
              force ? ", VFX_EGL_PLATFORM=" : "", force ? force : "");
     return VFX_ERR_GL_UNSUPPORTED;
 }
 
-static vfx_result make_window(vfx_gl_context *c)
+static vfx_result make_window(rt_gl_context *c)
 {
     if (!glfwInit()) {
-        vfx_logf(&c->desc.logger, VFX_LOG_ERROR, "window GL: glfwInit failed (no display?)");
+        rt_logf(&c->desc.logger, VFX_LOG_ERROR, "window GL: glfwInit failed (no display?)");
         return VFX_ERR_GL_UNSUPPORTED;
     }
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
@@ -156,7 +156,7 @@ static vfx_result make_window(vfx_gl_context *c)
     if (!c->window) {
         const char *msg = NULL;
         glfwGetError(&msg);
-        vfx_logf(&c->desc.logger, VFX_LOG_ERROR, "window GL: no GL 4.5 core window: %s",
+        rt_logf(&c->desc.logger, VFX_LOG_ERROR, "window GL: no GL 4.5 core window: %s",
                  msg ? msg : "unknown GLFW error");
         glfwTerminate();
         return VFX_ERR_GL_UNSUPPORTED;
@@ -168,11 +168,11 @@ static vfx_result make_window(vfx_gl_context *c)
 }
 
 /* Checks what every effect relies on; names what is missing. */
-static vfx_result check_caps(vfx_gl_context *c)
+static vfx_result check_caps(rt_gl_context *c)
 {
     int ver = epoxy_gl_version();
     if (ver < 45) {
-        vfx_logf(&c->desc.logger, VFX_LOG_ERROR,
+        rt_logf(&c->desc.logger, VFX_LOG_ERROR,
                  "GL 4.5 core is required, the driver gives %d.%d (%s)", ver / 10, ver % 10,
                  (const char *)glGetString(GL_VERSION));
         return VFX_ERR_GL_UNSUPPORTED;
@@ -181,7 +181,7 @@ static vfx_result check_caps(vfx_gl_context *c)
     glGetIntegerv(GL_MAX_SHADER_STORAGE_BUFFER_BINDINGS, &ssbo);
     glGetIntegerv(GL_MAX_FRAGMENT_SHADER_STORAGE_BLOCKS, &frag_ssbo);
     if (ssbo < 8 || frag_ssbo < 4) {
-        vfx_logf(&c->desc.logger, VFX_LOG_ERROR,
+        rt_logf(&c->desc.logger, VFX_LOG_ERROR,
                  "GL: need >= 8 shader storage bindings and >= 4 in fragment shaders, have %d/%d",
                  ssbo, frag_ssbo);
         return VFX_ERR_GL_UNSUPPORTED;
@@ -189,28 +189,28 @@ static vfx_result check_caps(vfx_gl_context *c)
     return VFX_OK;
 }
 
-vfx_result vfx_gl_context_create(const vfx_gl_context_desc *desc, vfx_gl_context **out)
+vfx_result rt_gl_context_create(const rt_gl_context_desc *desc, rt_gl_context **out)
 {
     if (!out)
         return VFX_ERR_INVALID_ARGUMENT;
     *out = NULL;
-    vfx_gl_context *c = calloc(1, sizeof *c);
+    rt_gl_context *c = calloc(1, sizeof *c);
     if (!c)
         return VFX_ERR_OUT_OF_MEMORY;
     if (desc)
         c->desc = *desc;
     c->width = c->desc.width ? c->desc.width : 1280;
     c->height = c->desc.height ? c->desc.height : 720;
-    vfx_gl_mode mode = c->desc.mode;
-    if (mode == VFX_GL_AUTO) {
+    rt_gl_mode mode = c->desc.mode;
+    if (mode == RT_GL_AUTO) {
         const char *x = getenv("DISPLAY"), *wl = getenv("WAYLAND_DISPLAY");
-        mode = ((x && *x) || (wl && *wl)) ? VFX_GL_WINDOW : VFX_GL_HEADLESS;
+        mode = ((x && *x) || (wl && *wl)) ? RT_GL_WINDOW : RT_GL_HEADLESS;
     }
-    vfx_result r = mode == VFX_GL_WINDOW ? make_window(c) : make_headless(c);
+    vfx_result r = mode == RT_GL_WINDOW ? make_window(c) : make_headless(c);
     if (r == VFX_OK)
         r = check_caps(c);
     if (r != VFX_OK) {
-        vfx_gl_context_destroy(c);
+        rt_gl_context_destroy(c);
         return r;
     }
     snprintf(c->renderer, sizeof c->renderer, "%s", (const char *)glGetString(GL_RENDERER));
@@ -219,13 +219,13 @@ vfx_result vfx_gl_context_create(const vfx_gl_context_desc *desc, vfx_gl_context
         glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);
         glDebugMessageCallback(debug_cb, c);
     }
-    vfx_logf(&c->desc.logger, VFX_LOG_INFO, "GL context: %s, %s, via %s", c->renderer,
+    rt_logf(&c->desc.logger, VFX_LOG_INFO, "GL context: %s, %s, via %s", c->renderer,
              (const char *)glGetString(GL_VERSION), c->platform);
     *out = c;
     return VFX_OK;
 }
 
-void vfx_gl_context_destroy(vfx_gl_context *c)
+void rt_gl_context_destroy(rt_gl_context *c)
 {
     if (!c)
         return;
@@ -245,11 +245,11 @@ void vfx_gl_context_destroy(vfx_gl_context *c)
     free(c);
 }
 
-bool vfx_gl_context_has_window(const vfx_gl_context *c) { return c && c->window; }
-void *vfx_gl_context_window(vfx_gl_context *c) { return c ? c->window : NULL; }
-const char *vfx_gl_context_renderer(const vfx_gl_context *c) { return c ? c->renderer : ""; }
+bool rt_gl_context_has_window(const rt_gl_context *c) { return c && c->window; }
+void *rt_gl_context_window(rt_gl_context *c) { return c ? c->window : NULL; }
+const char *rt_gl_context_renderer(const rt_gl_context *c) { return c ? c->renderer : ""; }
 
-void vfx_gl_context_swap(vfx_gl_context *c)
+void rt_gl_context_swap(rt_gl_context *c)
 {
     if (c && c->window) {
         glfwSwapBuffers(c->window);
@@ -257,20 +257,20 @@ void vfx_gl_context_swap(vfx_gl_context *c)
     }
 }
 
-bool vfx_gl_context_should_close(vfx_gl_context *c)
+bool rt_gl_context_should_close(rt_gl_context *c)
 {
     return c && c->window && glfwWindowShouldClose(c->window);
 }
 
-void *vfx_gl_context_get_proc(void *user, const char *name)
+void *rt_gl_context_get_proc(void *user, const char *name)
 {
-    vfx_gl_context *c = user;
+    rt_gl_context *c = user;
     if (c && c->window)
         return (void *)glfwGetProcAddress(name);
     return (void *)eglGetProcAddress(name);
 }
 
-void vfx_gl_context_size(vfx_gl_context *c, uint32_t *w, uint32_t *h)
+void rt_gl_context_size(rt_gl_context *c, uint32_t *w, uint32_t *h)
 {
     if (c && c->window) {
         int fw, fh;

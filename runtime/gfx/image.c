@@ -26,7 +26,7 @@ static bool chunk(FILE *f, const char *type, const uint8_t *data, uint32_t len)
            && fwrite(c, 1, 4, f) == 4;
 }
 
-vfx_result vfx_write_png(const char *path, uint32_t w, uint32_t h, const uint8_t *rgba, char *err,
+vfx_result rt_write_png(const char *path, uint32_t w, uint32_t h, const uint8_t *rgba, char *err,
                          size_t errlen)
 {
     if (!path || !rgba || w == 0 || h == 0 || w > 65535 || h > 65535) {
@@ -76,7 +76,7 @@ vfx_result vfx_write_png(const char *path, uint32_t w, uint32_t h, const uint8_t
     return VFX_OK;
 }
 
-vfx_result vfx_write_pfm(const char *path, uint32_t w, uint32_t h, const float *data, char *err,
+vfx_result rt_write_pfm(const char *path, uint32_t w, uint32_t h, const float *data, char *err,
                          size_t errlen)
 {
     if (!path || !data || w == 0 || h == 0) {
@@ -99,7 +99,7 @@ vfx_result vfx_write_pfm(const char *path, uint32_t w, uint32_t h, const float *
     return VFX_OK;
 }
 
-vfx_result vfx_read_pfm(const char *path, uint32_t *w, uint32_t *h, float **data, char *err,
+vfx_result rt_read_pfm(const char *path, uint32_t *w, uint32_t *h, float **data, char *err,
                         size_t errlen)
 {
     *data = NULL;

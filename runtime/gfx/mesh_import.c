@@ -15,7 +15,7 @@
                       | aiProcess_SortByPType | aiProcess_FindInvalidData)
 #define MAX_VERTICES (64u * 1024u * 1024u)
 
-void vfx_mesh_data_free(vfx_mesh_data *m)
+void rt_mesh_data_free(rt_mesh_data *m)
 {
     if (!m)
         return;
@@ -41,7 +41,7 @@ static void count_node(const struct aiScene *s, const struct aiNode *n, uint64_t
 }
 
 static void add_node(const struct aiScene *s, const struct aiNode *n, struct aiMatrix4x4 parent,
-                     vfx_mesh_data *out)
+                     rt_mesh_data *out)
 {
     struct aiMatrix4x4 t = parent;
     aiMultiplyMatrix4(&t, &n->mTransformation);
@@ -84,7 +84,7 @@ static void add_node(const struct aiScene *s, const struct aiNode *n, struct aiM
         add_node(s, n->mChildren[c], t, out);
 }
 
-static vfx_result from_scene(const struct aiScene *s, const char *what, vfx_mesh_data *out,
+static vfx_result from_scene(const struct aiScene *s, const char *what, rt_mesh_data *out,
                              char *err, size_t errlen)
 {
     memset(out, 0, sizeof *out);
@@ -114,7 +114,7 @@ static vfx_result from_scene(const struct aiScene *s, const char *what, vfx_mesh
     out->normals = malloc(nv * 3 * sizeof(float));
     out->indices = malloc(ni * sizeof(uint32_t));
     if (!out->positions || !out->normals || !out->indices) {
-        vfx_mesh_data_free(out);
+        rt_mesh_data_free(out);
         aiReleaseImport(s);
         snprintf(err, errlen, "%s: out of memory", what);
         return VFX_ERR_OUT_OF_MEMORY;
@@ -128,13 +128,13 @@ static vfx_result from_scene(const struct aiScene *s, const char *what, vfx_mesh
     for (uint32_t i = 0; i < out->vertex_count * 3; ++i)
         if (!isfinite(out->positions[i])) {
             snprintf(err, errlen, "%s: vertex %u has a non-finite coordinate", what, i / 3);
-            vfx_mesh_data_free(out);
+            rt_mesh_data_free(out);
             return VFX_ERR_FORMAT;
         }
     return VFX_OK;
 }
 
-vfx_result vfx_mesh_import(const char *path, vfx_mesh_data *out, char *err, size_t errlen)
+vfx_result rt_mesh_import(const char *path, rt_mesh_data *out, char *err, size_t errlen)
 {
     if (!path || !out)
         return VFX_ERR_INVALID_ARGUMENT;
@@ -148,8 +148,8 @@ vfx_result vfx_mesh_import(const char *path, vfx_mesh_data *out, char *err, size
     return from_scene(aiImportFile(path, IMPORT_FLAGS), path, out, err, errlen);
 }
 
-vfx_result vfx_mesh_import_memory(const void *data, size_t size, const char *hint,
-                                  vfx_mesh_data *out, char *err, size_t errlen)
+vfx_result rt_mesh_import_memory(const void *data, size_t size, const char *hint,
+                                  rt_mesh_data *out, char *err, size_t errlen)
 {
     if (!data || !out || size == 0 || size > UINT32_MAX)
         return VFX_ERR_INVALID_ARGUMENT;
@@ -157,14 +157,14 @@ vfx_result vfx_mesh_import_memory(const void *data, size_t size, const char *hin
                       out, err, errlen);
 }
 
-vfx_result vfx_mesh_make_box(const float mn[3], const float mx[3], vfx_mesh_data *out)
+vfx_result rt_mesh_make_box(const float mn[3], const float mx[3], rt_mesh_data *out)
 {
     memset(out, 0, sizeof *out);
     out->positions = malloc(24 * 3 * sizeof(float));
     out->normals = malloc(24 * 3 * sizeof(float));
     out->indices = malloc(36 * sizeof(uint32_t));
     if (!out->positions || !out->normals || !out->indices) {
-        vfx_mesh_data_free(out);
+        rt_mesh_data_free(out);
         return VFX_ERR_OUT_OF_MEMORY;
     }
     for (int face = 0; face < 6; ++face) {
@@ -193,7 +193,7 @@ vfx_result vfx_mesh_make_box(const float mn[3], const float mx[3], vfx_mesh_data
     return VFX_OK;
 }
 
-vfx_result vfx_mesh_upload(const vfx_mesh_data *m, vfx_mesh_gpu *out)
+vfx_result rt_mesh_upload(const rt_mesh_data *m, rt_mesh_gpu *out)
 {
     memset(out, 0, sizeof *out);
     if (!m || !m->vertex_count || !m->index_count)
@@ -219,7 +219,7 @@ vfx_result vfx_mesh_upload(const vfx_mesh_data *m, vfx_mesh_gpu *out)
     return glGetError() == GL_NO_ERROR ? VFX_OK : VFX_ERR_GL;
 }
 
-void vfx_mesh_gpu_destroy(vfx_mesh_gpu *g)
+void rt_mesh_gpu_destroy(rt_mesh_gpu *g)
 {
     if (!g)
         return;

@@ -1,39 +1,39 @@
 /* mesh_import.h — static meshes from files (Assimp C API) or made in code, and their upload. */
-#ifndef VFX_MESH_IMPORT_H
-#define VFX_MESH_IMPORT_H
+#ifndef RT_MESH_IMPORT_H
+#define RT_MESH_IMPORT_H
 
 #include <stddef.h>
 #include <stdint.h>
 #include <volfx/volfx.h>
 
 /* CPU mesh: every mesh of a file flattened into one with node transforms applied. */
-typedef struct vfx_mesh_data {
+typedef struct rt_mesh_data {
     float *positions;    /* 3 per vertex */
     float *normals;      /* 3 per vertex */
     uint32_t *indices;   /* 3 per triangle */
     uint32_t vertex_count, index_count;
     float bounds_min[3], bounds_max[3];
-} vfx_mesh_data;
+} rt_mesh_data;
 
 /* GPU mesh ready to draw. */
-typedef struct vfx_mesh_gpu {
+typedef struct rt_mesh_gpu {
     unsigned vao, vbo, ibo;
     uint32_t index_count;
-} vfx_mesh_gpu;
+} rt_mesh_gpu;
 
 /* Imports a file with Assimp (triangulated, normals generated when absent). Errors name the
  * file and carry Assimp's message; a file with no triangles is VFX_ERR_FORMAT. */
-vfx_result vfx_mesh_import(const char *path, vfx_mesh_data *out, char *err, size_t errlen);
+vfx_result rt_mesh_import(const char *path, rt_mesh_data *out, char *err, size_t errlen);
 /* Same from memory (`hint` is the format extension, e.g. "obj"); for fuzzing and tests. */
-vfx_result vfx_mesh_import_memory(const void *data, size_t size, const char *hint,
-                                  vfx_mesh_data *out, char *err, size_t errlen);
+vfx_result rt_mesh_import_memory(const void *data, size_t size, const char *hint,
+                                  rt_mesh_data *out, char *err, size_t errlen);
 /* An axis-aligned box from min to max (outward normals). */
-vfx_result vfx_mesh_make_box(const float min[3], const float max[3], vfx_mesh_data *out);
+vfx_result rt_mesh_make_box(const float min[3], const float max[3], rt_mesh_data *out);
 /* Frees the arrays; NULL allowed. */
-void vfx_mesh_data_free(vfx_mesh_data *m);
+void rt_mesh_data_free(rt_mesh_data *m);
 /* Uploads to GL (needs a current context). */
-vfx_result vfx_mesh_upload(const vfx_mesh_data *m, vfx_mesh_gpu *out);
+vfx_result rt_mesh_upload(const rt_mesh_data *m, rt_mesh_gpu *out);
 /* Deletes the GL objects. */
-void vfx_mesh_gpu_destroy(vfx_mesh_gpu *g);
+void rt_mesh_gpu_destroy(rt_mesh_gpu *g);
 
 #endif

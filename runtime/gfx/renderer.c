@@ -8,8 +8,8 @@
 
 #include "shader_text.h"
 
-struct vfx_renderer {
-    vfx_logger log;
+struct rt_renderer {
+    rt_logger log;
     GLuint mesh_prog;
     GLint u_model, u_view_proj, u_color, u_light;
     GLuint scene_fbo, scene_color, scene_depth;
@@ -18,12 +18,12 @@ struct vfx_renderer {
     float view[16], proj[16];
 };
 
-static GLuint compile(const vfx_logger *log, GLenum stage, const char *path)
+static GLuint compile(const rt_logger *log, GLenum stage, const char *path)
 {
     char err[256], raw[4096], pretty[8192];
-    char *src = vfx_shader_expand(path, NULL, err, sizeof err);
+    char *src = volfx_shader_expand(path, NULL, err, sizeof err);
     if (!src) {
-        vfx_logf(log, VFX_LOG_ERROR, "host shader: %s", err);
+        rt_logf(log, VFX_LOG_ERROR, "host shader: %s", err);
         return 0;
     }
     GLuint s = glCreateShader(stage);
@@ -34,17 +34,17 @@ static GLuint compile(const vfx_logger *log, GLenum stage, const char *path)
     glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
     if (!ok) {
         glGetShaderInfoLog(s, sizeof raw, NULL, raw);
-        vfx_shader_rewrite_log(raw, pretty, sizeof pretty, path);
-        vfx_logf(log, VFX_LOG_ERROR, "host shader compile failed: %s", pretty);
+        volfx_shader_rewrite_log(raw, pretty, sizeof pretty, path);
+        rt_logf(log, VFX_LOG_ERROR, "host shader compile failed: %s", pretty);
         glDeleteShader(s);
         return 0;
     }
     return s;
 }
 
-vfx_result vfx_renderer_create(const vfx_logger *logger, vfx_renderer **out)
+vfx_result rt_renderer_create(const rt_logger *logger, rt_renderer **out)
 {
-    vfx_renderer *r = calloc(1, sizeof *r);
+    rt_renderer *r = calloc(1, sizeof *r);
     if (!r)
         return VFX_ERR_OUT_OF_MEMORY;
     if (logger)
@@ -68,7 +68,7 @@ vfx_result vfx_renderer_create(const vfx_logger *logger, vfx_renderer **out)
     if (!ok) {
         char log[2048];
         glGetProgramInfoLog(r->mesh_prog, sizeof log, NULL, log);
-        vfx_logf(&r->log, VFX_LOG_ERROR, "host mesh program link failed: %s", log);
+        rt_logf(&r->log, VFX_LOG_ERROR, "host mesh program link failed: %s", log);
         glDeleteProgram(r->mesh_prog);
         free(r);
         return VFX_ERR_GL;
@@ -82,7 +82,7 @@ vfx_result vfx_renderer_create(const vfx_logger *logger, vfx_renderer **out)
     return VFX_OK;
 }
 
-static void free_targets(vfx_renderer *r)
+static void free_targets(rt_renderer *r)
 {
     GLuint tex[4] = {r->scene_color, r->scene_depth, r->out_color, r->out_depth};
     glDeleteTextures(4, tex);
@@ -92,7 +92,7 @@ static void free_targets(vfx_renderer *r)
     r->scene_fbo = r->out_fbo = 0;
 }
 
-void vfx_renderer_destroy(vfx_renderer *r)
+void rt_renderer_destroy(rt_renderer *r)
 {
     if (!r)
         return;
@@ -124,7 +124,7 @@ static GLuint make_fbo(GLuint color, GLuint depth, const char *label)
     return f;
 }
 
-vfx_result vfx_renderer_resize(vfx_renderer *r, uint32_t w, uint32_t h)
+vfx_result rt_renderer_resize(rt_renderer *r, uint32_t w, uint32_t h)
 {
     if (!r || w == 0 || h == 0 || w > 16384 || h > 16384)
         return VFX_ERR_INVALID_ARGUMENT;
@@ -141,13 +141,13 @@ vfx_result vfx_renderer_resize(vfx_renderer *r, uint32_t w, uint32_t h)
     r->height = h;
     if (glCheckNamedFramebufferStatus(r->scene_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE
         || glCheckNamedFramebufferStatus(r->out_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-        vfx_logf(&r->log, VFX_LOG_ERROR, "host targets %ux%u incomplete", w, h);
+        rt_logf(&r->log, VFX_LOG_ERROR, "host targets %ux%u incomplete", w, h);
         return VFX_ERR_GL;
     }
     return VFX_OK;
 }
 
-void vfx_renderer_begin_scene(vfx_renderer *r, const float view[16], const float proj[16],
+void rt_renderer_begin_scene(rt_renderer *r, const float view[16], const float proj[16],
                               const float clear_rgb[3])
 {
     memcpy(r->view, view, sizeof r->view);
@@ -161,7 +161,7 @@ void vfx_renderer_begin_scene(vfx_renderer *r, const float view[16], const float
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 }
 
-void vfx_renderer_draw_mesh(vfx_renderer *r, const vfx_mesh_gpu *mesh, const float model[16],
+void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float model[16],
                             const float rgb[3])
 {
     float vp[16];
@@ -185,7 +185,7 @@ void vfx_renderer_draw_mesh(vfx_renderer *r, const vfx_mesh_gpu *mesh, const flo
     glBindVertexArray(0);
 }
 
-void vfx_renderer_end_scene(vfx_renderer *r, vfx_frame_view *frame)
+void rt_renderer_end_scene(rt_renderer *r, vfx_frame_view *frame)
 {
     glPopDebugGroup();
     glBlitNamedFramebuffer(r->scene_fbo, r->out_fbo, 0, 0, (GLint)r->width, (GLint)r->height, 0, 0,
@@ -206,7 +206,7 @@ void vfx_renderer_end_scene(vfx_renderer *r, vfx_frame_view *frame)
     memcpy(frame->proj, r->proj, sizeof frame->proj);
 }
 
-vfx_result vfx_renderer_read_rgba(vfx_renderer *r, uint8_t *rgba)
+vfx_result rt_renderer_read_rgba(rt_renderer *r, uint8_t *rgba)
 {
     if (!r || !rgba)
         return VFX_ERR_INVALID_ARGUMENT;
@@ -221,7 +221,7 @@ vfx_result vfx_renderer_read_rgba(vfx_renderer *r, uint8_t *rgba)
     return glGetError() == GL_NO_ERROR ? VFX_OK : VFX_ERR_GL;
 }
 
-void vfx_renderer_present(vfx_renderer *r, uint32_t ww, uint32_t wh)
+void rt_renderer_present(rt_renderer *r, uint32_t ww, uint32_t wh)
 {
     glBlitNamedFramebuffer(r->out_fbo, 0, 0, 0, (GLint)r->width, (GLint)r->height, 0, 0, (GLint)ww,
                            (GLint)wh, GL_COLOR_BUFFER_BIT, GL_LINEAR);

@@ -1,33 +1,33 @@
 /* renderer.h — the host's own drawing: opaque meshes into a scene target (colour + depth
  * textures the plugin reads), copied into the output target the plugin draws into, then shown
  * or read back. */
-#ifndef VFX_RENDERER_H
-#define VFX_RENDERER_H
+#ifndef RT_RENDERER_H
+#define RT_RENDERER_H
 
 #include <stdint.h>
 #include <volfx/volfx.h>
 #include "core/log.h"
 #include "gfx/mesh_import.h"
 
-typedef struct vfx_renderer vfx_renderer;
+typedef struct rt_renderer rt_renderer;
 
 /* Compiles the host shaders; needs a current GL 4.5 context. */
-vfx_result vfx_renderer_create(const vfx_logger *logger, vfx_renderer **out);
+vfx_result rt_renderer_create(const rt_logger *logger, rt_renderer **out);
 /* Frees every GL object. NULL allowed. */
-void vfx_renderer_destroy(vfx_renderer *r);
+void rt_renderer_destroy(rt_renderer *r);
 /* (Re)allocates the targets at width x height (1..16384). */
-vfx_result vfx_renderer_resize(vfx_renderer *r, uint32_t width, uint32_t height);
+vfx_result rt_renderer_resize(rt_renderer *r, uint32_t width, uint32_t height);
 /* Clears the scene target and sets the camera (column-major view and projection). */
-void vfx_renderer_begin_scene(vfx_renderer *r, const float view[16], const float proj[16],
+void rt_renderer_begin_scene(rt_renderer *r, const float view[16], const float proj[16],
                               const float clear_rgb[3]);
 /* Draws a mesh with a model matrix and a colour into the scene target. */
-void vfx_renderer_draw_mesh(vfx_renderer *r, const vfx_mesh_gpu *mesh, const float model[16],
+void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float model[16],
                             const float rgb[3]);
 /* Copies scene colour and depth into the output target and fills `frame` for the plugin. */
-void vfx_renderer_end_scene(vfx_renderer *r, vfx_frame_view *frame);
+void rt_renderer_end_scene(rt_renderer *r, vfx_frame_view *frame);
 /* Reads the output colour, RGBA8, top row first (width*height*4 bytes). */
-vfx_result vfx_renderer_read_rgba(vfx_renderer *r, uint8_t *rgba);
+vfx_result rt_renderer_read_rgba(rt_renderer *r, uint8_t *rgba);
 /* Blits the output to the default framebuffer of the current window. */
-void vfx_renderer_present(vfx_renderer *r, uint32_t window_w, uint32_t window_h);
+void rt_renderer_present(rt_renderer *r, uint32_t window_w, uint32_t window_h);
 
 #endif

@@ -5,58 +5,58 @@
 #include <stdlib.h>
 #include <string.h>
 
-struct vfx_plugin_host {
+struct rt_plugin_host {
     void *handle; /* NULL for a static plugin */
     vfx_plugin_api api;
 };
 
 /* Calls the entry and checks what came back, so a broken plugin never reaches the game. */
 static vfx_result handshake(vfx_plugin_entry_fn entry, uint32_t abi, const vfx_host_api *host,
-                            const vfx_logger *log, vfx_plugin_host *h, const char *where)
+                            const rt_logger *log, rt_plugin_host *h, const char *where)
 {
     memset(&h->api, 0, sizeof h->api);
     h->api.size = sizeof h->api;
     h->api.version = VFX_PLUGIN_API_VERSION;
     vfx_result r = entry(abi, host, &h->api);
     if (r != VFX_OK) {
-        vfx_logf(log, VFX_LOG_ERROR, "plugin %s refused the host (host ABI %u): %s", where, abi,
+        rt_logf(log, VFX_LOG_ERROR, "plugin %s refused the host (host ABI %u): %s", where, abi,
                  vfx_result_name(r));
         return r;
     }
     if (h->api.version != VFX_PLUGIN_API_VERSION || h->api.size != sizeof h->api) {
-        vfx_logf(log, VFX_LOG_ERROR,
+        rt_logf(log, VFX_LOG_ERROR,
                  "plugin %s: plugin API version %u (size %u), this host needs version %u (size %zu)",
                  where, h->api.version, h->api.size, VFX_PLUGIN_API_VERSION, sizeof h->api);
         return VFX_ERR_ABI;
     }
     if (!h->api.create || !h->api.destroy || !h->api.resize || !h->api.update || !h->api.render
         || !h->api.get_stats || !h->api.last_error || !h->api.read_raw) {
-        vfx_logf(log, VFX_LOG_ERROR, "plugin %s: function table has NULL entries", where);
+        rt_logf(log, VFX_LOG_ERROR, "plugin %s: function table has NULL entries", where);
         return VFX_ERR_ABI;
     }
     return VFX_OK;
 }
 
-vfx_result vfx_plugin_host_load_as(const char *path, uint32_t abi, const vfx_host_api *host,
-                                   const vfx_logger *log, vfx_plugin_host **out)
+vfx_result rt_plugin_host_load_as(const char *path, uint32_t abi, const vfx_host_api *host,
+                                   const rt_logger *log, rt_plugin_host **out)
 {
     if (!path || !out)
         return VFX_ERR_INVALID_ARGUMENT;
     *out = NULL;
     void *handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
     if (!handle) {
-        vfx_logf(log, VFX_LOG_ERROR, "plugin '%s' cannot be loaded: %s", path, dlerror());
+        rt_logf(log, VFX_LOG_ERROR, "plugin '%s' cannot be loaded: %s", path, dlerror());
         return VFX_ERR_IO;
     }
     vfx_plugin_entry_fn entry;
     void *sym = dlsym(handle, VFX_ENTRY_SYMBOL);
     memcpy(&entry, &sym, sizeof entry); /* object-to-function pointer, as POSIX allows */
     if (!entry) {
-        vfx_logf(log, VFX_LOG_ERROR, "plugin '%s' has no '%s' symbol", path, VFX_ENTRY_SYMBOL);
+        rt_logf(log, VFX_LOG_ERROR, "plugin '%s' has no '%s' symbol", path, VFX_ENTRY_SYMBOL);
         dlclose(handle);
         return VFX_ERR_NOT_FOUND;
     }
-    vfx_plugin_host *h = calloc(1, sizeof *h);
+    rt_plugin_host *h = calloc(1, sizeof *h);
     if (!h) {
         dlclose(handle);
         return VFX_ERR_OUT_OF_MEMORY;
@@ -64,26 +64,26 @@ vfx_result vfx_plugin_host_load_as(const char *path, uint32_t abi, const vfx_hos
     h->handle = handle;
     vfx_result r = handshake(entry, abi, host, log, h, path);
     if (r != VFX_OK) {
-        vfx_plugin_host_unload(h);
+        rt_plugin_host_unload(h);
         return r;
     }
     *out = h;
     return VFX_OK;
 }
 
-vfx_result vfx_plugin_host_load(const char *path, const vfx_host_api *host, const vfx_logger *log,
-                                vfx_plugin_host **out)
+vfx_result rt_plugin_host_load(const char *path, const vfx_host_api *host, const rt_logger *log,
+                                rt_plugin_host **out)
 {
-    return vfx_plugin_host_load_as(path, VFX_ABI_VERSION, host, log, out);
+    return rt_plugin_host_load_as(path, VFX_ABI_VERSION, host, log, out);
 }
 
-vfx_result vfx_plugin_host_load_static(vfx_plugin_entry_fn entry, const vfx_host_api *host,
-                                       const vfx_logger *log, vfx_plugin_host **out)
+vfx_result rt_plugin_host_load_static(vfx_plugin_entry_fn entry, const vfx_host_api *host,
+                                       const rt_logger *log, rt_plugin_host **out)
 {
     if (!entry || !out)
         return VFX_ERR_INVALID_ARGUMENT;
     *out = NULL;
-    vfx_plugin_host *h = calloc(1, sizeof *h);
+    rt_plugin_host *h = calloc(1, sizeof *h);
     if (!h)
         return VFX_ERR_OUT_OF_MEMORY;
     vfx_result r = handshake(entry, VFX_ABI_VERSION, host, log, h, "(static)");
@@ -95,9 +95,9 @@ vfx_result vfx_plugin_host_load_static(vfx_plugin_entry_fn entry, const vfx_host
     return VFX_OK;
 }
 
-const vfx_plugin_api *vfx_plugin_host_api(const vfx_plugin_host *h) { return h ? &h->api : NULL; }
+const vfx_plugin_api *rt_plugin_host_api(const rt_plugin_host *h) { return h ? &h->api : NULL; }
 
-void vfx_plugin_host_unload(vfx_plugin_host *h)
+void rt_plugin_host_unload(rt_plugin_host *h)
 {
     if (!h)
         return;

@@ -1,27 +1,27 @@
 /* plugin_host.h — loads the volfx plugin (dlopen, or the statically linked entry), checks
  * its ABI, and owns the resulting function table. */
-#ifndef VFX_PLUGIN_HOST_H
-#define VFX_PLUGIN_HOST_H
+#ifndef RT_PLUGIN_HOST_H
+#define RT_PLUGIN_HOST_H
 
 #include <volfx/volfx.h>
 #include "core/log.h"
 
-typedef struct vfx_plugin_host vfx_plugin_host;
+typedef struct rt_plugin_host rt_plugin_host;
 
 /* Loads the shared plugin at `path` and calls its entry with VFX_ABI_VERSION. Fails with
  * VFX_ERR_IO (cannot open: dlerror text), VFX_ERR_NOT_FOUND (no vfx_plugin_entry symbol),
  * VFX_ERR_ABI (versions differ: the message names both). */
-vfx_result vfx_plugin_host_load(const char *path, const vfx_host_api *host, const vfx_logger *log,
-                                vfx_plugin_host **out);
+vfx_result rt_plugin_host_load(const char *path, const vfx_host_api *host, const rt_logger *log,
+                                rt_plugin_host **out);
 /* Same, with an entry function linked into the executable (static plugin). */
-vfx_result vfx_plugin_host_load_static(vfx_plugin_entry_fn entry, const vfx_host_api *host,
-                                       const vfx_logger *log, vfx_plugin_host **out);
+vfx_result rt_plugin_host_load_static(vfx_plugin_entry_fn entry, const vfx_host_api *host,
+                                       const rt_logger *log, rt_plugin_host **out);
 /* Like load, but passes `abi_version` instead of ours (tests of the refusal path). */
-vfx_result vfx_plugin_host_load_as(const char *path, uint32_t abi_version, const vfx_host_api *host,
-                                   const vfx_logger *log, vfx_plugin_host **out);
+vfx_result rt_plugin_host_load_as(const char *path, uint32_t abi_version, const vfx_host_api *host,
+                                   const rt_logger *log, rt_plugin_host **out);
 /* The plugin's function table (valid until unload). */
-const vfx_plugin_api *vfx_plugin_host_api(const vfx_plugin_host *h);
+const vfx_plugin_api *rt_plugin_host_api(const rt_plugin_host *h);
 /* Unloads (dlclose) the plugin. Destroy every context first. NULL allowed. */
-void vfx_plugin_host_unload(vfx_plugin_host *h);
+void rt_plugin_host_unload(rt_plugin_host *h);
 
 #endif

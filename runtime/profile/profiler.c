@@ -14,28 +14,28 @@ typedef struct series {
 
 /* Frames kept exactly at the start of a run, so a summary can drop up to this many warm-up
  * frames after the ring has rolled past them. */
-#define VFX_PROF_HEAD 256
+#define RT_PROF_HEAD 256
 
-struct vfx_profiler {
+struct rt_profiler {
     uint32_t max_frames;
     uint32_t frame;         /* frames ended */
     double frame_start;     /* ms */
     double *frame_ms;       /* ring of max_frames */
     double *frame_t0;       /* start time of each frame (trace) */
-    double *values;         /* ring: max_frames x VFX_PROFILER_MAX_SERIES, NAN when absent */
+    double *values;         /* ring: max_frames x RT_PROFILER_MAX_SERIES, NAN when absent */
     double *starts;         /* span start offsets within the frame (trace) */
     double cursor;          /* CPU time of the current frame's spans laid end to end */
-    series series[VFX_PROFILER_MAX_SERIES];
+    series series[RT_PROFILER_MAX_SERIES];
     uint32_t series_count;
     /* Whole-run frame times in bounded memory (a game runs for hours): a log histogram of every
-     * frame, the first VFX_PROF_HEAD frames exactly (so warm-up frames can be dropped from it),
+     * frame, the first RT_PROF_HEAD frames exactly (so warm-up frames can be dropped from it),
      * the sum and the max after the head. */
     uint32_t *hist;
-    double head[VFX_PROF_HEAD];
+    double head[RT_PROF_HEAD];
     double sum_ms, tail_max;
 };
 
-double vfx_now_ms(void)
+double rt_now_ms(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -44,55 +44,55 @@ double vfx_now_ms(void)
 
 /* Bucket b holds times in [lo r^b, lo r^(b+1)), r = 1.001: a percentile read from it is within
  * 0.05% of the exact one (the bucket's geometric centre), far below frame-time noise. */
-#define VFX_PROF_LO_MS 1e-3
-#define VFX_PROF_LOG_R 9.995003330835332e-4 /* ln 1.001 */
-#define VFX_PROF_BUCKETS 20736               /* 1e-3 ms .. ~1e6 ms */
+#define RT_PROF_LO_MS 1e-3
+#define RT_PROF_LOG_R 9.995003330835332e-4 /* ln 1.001 */
+#define RT_PROF_BUCKETS 20736               /* 1e-3 ms .. ~1e6 ms */
 
 static uint32_t bucket_of(double ms)
 {
-    if (!(ms > VFX_PROF_LO_MS))
+    if (!(ms > RT_PROF_LO_MS))
         return 0;
-    double b = log(ms / VFX_PROF_LO_MS) / VFX_PROF_LOG_R;
-    return b >= VFX_PROF_BUCKETS - 1 ? VFX_PROF_BUCKETS - 1 : (uint32_t)b;
+    double b = log(ms / RT_PROF_LO_MS) / RT_PROF_LOG_R;
+    return b >= RT_PROF_BUCKETS - 1 ? RT_PROF_BUCKETS - 1 : (uint32_t)b;
 }
 
 static double bucket_centre(uint32_t b)
 {
-    return VFX_PROF_LO_MS * exp(((double)b + 0.5) * VFX_PROF_LOG_R);
+    return RT_PROF_LO_MS * exp(((double)b + 0.5) * RT_PROF_LOG_R);
 }
 
-vfx_profiler *vfx_profiler_create(uint32_t max_frames)
+rt_profiler *rt_profiler_create(uint32_t max_frames)
 {
     if (max_frames == 0)
         max_frames = 1;
-    vfx_profiler *p = calloc(1, sizeof *p);
+    rt_profiler *p = calloc(1, sizeof *p);
     if (!p)
         return NULL;
     p->max_frames = max_frames;
     p->frame_ms = calloc(max_frames, sizeof(double));
     p->frame_t0 = calloc(max_frames, sizeof(double));
-    p->values = malloc((size_t)max_frames * VFX_PROFILER_MAX_SERIES * sizeof(double));
-    p->starts = malloc((size_t)max_frames * VFX_PROFILER_MAX_SERIES * sizeof(double));
-    p->hist = calloc(VFX_PROF_BUCKETS, sizeof *p->hist);
+    p->values = malloc((size_t)max_frames * RT_PROFILER_MAX_SERIES * sizeof(double));
+    p->starts = malloc((size_t)max_frames * RT_PROFILER_MAX_SERIES * sizeof(double));
+    p->hist = calloc(RT_PROF_BUCKETS, sizeof *p->hist);
     if (!p->frame_ms || !p->frame_t0 || !p->values || !p->starts || !p->hist) {
-        vfx_profiler_destroy(p);
+        rt_profiler_destroy(p);
         return NULL;
     }
     /* Every ring page is written now, not as the ring first fills: resident memory is then flat
      * from the first frame (calloc's lazy zero pages made RSS creep for max_frames frames). */
-    for (size_t i = 0; i < (size_t)max_frames * VFX_PROFILER_MAX_SERIES; ++i) {
+    for (size_t i = 0; i < (size_t)max_frames * RT_PROFILER_MAX_SERIES; ++i) {
         p->values[i] = NAN;
         p->starts[i] = NAN;
     }
     for (uint32_t i = 0; i < max_frames; ++i)
         p->frame_ms[i] = p->frame_t0[i] = NAN;
-    for (uint32_t b = 0; b < VFX_PROF_BUCKETS; b += 1024)
+    for (uint32_t b = 0; b < RT_PROF_BUCKETS; b += 1024)
         p->hist[b] = 1; /* touch each page of the histogram, then clear it */
-    memset(p->hist, 0, VFX_PROF_BUCKETS * sizeof *p->hist);
+    memset(p->hist, 0, RT_PROF_BUCKETS * sizeof *p->hist);
     return p;
 }
 
-void vfx_profiler_destroy(vfx_profiler *p)
+void rt_profiler_destroy(rt_profiler *p)
 {
     if (!p)
         return;
@@ -104,32 +104,32 @@ void vfx_profiler_destroy(vfx_profiler *p)
     free(p);
 }
 
-static double *row(const vfx_profiler *p, uint32_t frame)
+static double *row(const rt_profiler *p, uint32_t frame)
 {
-    return &p->values[(size_t)(frame % p->max_frames) * VFX_PROFILER_MAX_SERIES];
+    return &p->values[(size_t)(frame % p->max_frames) * RT_PROFILER_MAX_SERIES];
 }
 
-void vfx_profiler_frame_begin(vfx_profiler *p)
+void rt_profiler_frame_begin(rt_profiler *p)
 {
     if (!p)
         return;
-    p->frame_start = vfx_now_ms();
+    p->frame_start = rt_now_ms();
     p->cursor = 0;
     double *r = row(p, p->frame);
-    for (int i = 0; i < VFX_PROFILER_MAX_SERIES; ++i)
+    for (int i = 0; i < RT_PROFILER_MAX_SERIES; ++i)
         r[i] = NAN;
 }
 
-double vfx_profiler_frame_end(vfx_profiler *p)
+double rt_profiler_frame_end(rt_profiler *p)
 {
     if (!p)
         return 0;
-    double ms = vfx_now_ms() - p->frame_start;
-    vfx_profiler_frame_add(p, ms);
+    double ms = rt_now_ms() - p->frame_start;
+    rt_profiler_frame_add(p, ms);
     return ms;
 }
 
-void vfx_profiler_frame_add(vfx_profiler *p, double ms)
+void rt_profiler_frame_add(rt_profiler *p, double ms)
 {
     if (!p)
         return;
@@ -139,19 +139,19 @@ void vfx_profiler_frame_add(vfx_profiler *p, double ms)
     p->frame_t0[p->frame % p->max_frames] = p->frame_start;
     p->hist[bucket_of(ms)]++;
     p->sum_ms += ms;
-    if (p->frame < VFX_PROF_HEAD)
+    if (p->frame < RT_PROF_HEAD)
         p->head[p->frame] = ms;
     else if (ms > p->tail_max)
         p->tail_max = ms;
     p->frame++;
 }
 
-static int series_index(vfx_profiler *p, const char *name, bool gpu)
+static int series_index(rt_profiler *p, const char *name, bool gpu)
 {
     for (uint32_t i = 0; i < p->series_count; ++i)
         if (strcmp(p->series[i].name, name) == 0)
             return (int)i;
-    if (p->series_count >= VFX_PROFILER_MAX_SERIES)
+    if (p->series_count >= RT_PROFILER_MAX_SERIES)
         return -1;
     series *s = &p->series[p->series_count];
     snprintf(s->name, sizeof s->name, "%s", name);
@@ -159,12 +159,12 @@ static int series_index(vfx_profiler *p, const char *name, bool gpu)
     return (int)p->series_count++;
 }
 
-static void record(vfx_profiler *p, const char *name, double ms, bool gpu)
+static void record(rt_profiler *p, const char *name, double ms, bool gpu)
 {
     int i = series_index(p, name, gpu);
     if (i < 0)
         return;
-    size_t at = (size_t)(p->frame % p->max_frames) * VFX_PROFILER_MAX_SERIES + (size_t)i;
+    size_t at = (size_t)(p->frame % p->max_frames) * RT_PROFILER_MAX_SERIES + (size_t)i;
     p->values[at] = ms;
     if (!gpu) {
         p->starts[at] = p->cursor;
@@ -172,20 +172,20 @@ static void record(vfx_profiler *p, const char *name, double ms, bool gpu)
     }
 }
 
-void vfx_profiler_on_system(void *user, const char *name, vfx_phase phase, double cpu_ms)
+void rt_profiler_on_system(void *user, const char *name, rt_phase phase, double cpu_ms)
 {
     (void)phase;
     if (user)
         record(user, name, cpu_ms, false);
 }
 
-void vfx_profiler_cpu(vfx_profiler *p, const char *name, double cpu_ms)
+void rt_profiler_cpu(rt_profiler *p, const char *name, double cpu_ms)
 {
     if (p)
         record(p, name, cpu_ms, false);
 }
 
-void vfx_profiler_gpu_stats(vfx_profiler *p, const vfx_stats *stats)
+void rt_profiler_gpu_stats(rt_profiler *p, const vfx_stats *stats)
 {
     if (!p || !stats)
         return;
@@ -213,7 +213,7 @@ static double pct(const double *s, uint32_t n, double q)
     return s[i < n ? i : n - 1];
 }
 
-static void summary_of_sorted(vfx_frame_summary *s, double *sorted, uint32_t n)
+static void summary_of_sorted(rt_frame_summary *s, double *sorted, uint32_t n)
 {
     qsort(sorted, n, sizeof(double), cmp_double);
     double sum = 0;
@@ -229,18 +229,18 @@ static void summary_of_sorted(vfx_frame_summary *s, double *sorted, uint32_t n)
 }
 
 /* Nearest-rank percentiles q[0..2] from the histogram less the head frames [0, skip). */
-static int hist_pcts(const vfx_profiler *p, uint32_t skip, uint32_t n, const double q[3],
+static int hist_pcts(const rt_profiler *p, uint32_t skip, uint32_t n, const double q[3],
                      double out[3])
 {
-    uint32_t *h = malloc(VFX_PROF_BUCKETS * sizeof *h);
+    uint32_t *h = malloc(RT_PROF_BUCKETS * sizeof *h);
     if (!h)
         return -1;
-    memcpy(h, p->hist, VFX_PROF_BUCKETS * sizeof *h);
+    memcpy(h, p->hist, RT_PROF_BUCKETS * sizeof *h);
     for (uint32_t i = 0; i < skip; ++i)
         h[bucket_of(p->head[i])]--;
     uint64_t seen = 0;
     int k = 0;
-    for (uint32_t b = 0; b < VFX_PROF_BUCKETS && k < 3; ++b) {
+    for (uint32_t b = 0; b < RT_PROF_BUCKETS && k < 3; ++b) {
         seen += h[b];
         while (k < 3) {
             double rank = ceil(q[k] * n);
@@ -254,9 +254,9 @@ static int hist_pcts(const vfx_profiler *p, uint32_t skip, uint32_t n, const dou
     return k == 3 ? 0 : -1;
 }
 
-vfx_frame_summary vfx_profiler_summary(const vfx_profiler *p, uint32_t skip)
+rt_frame_summary rt_profiler_summary(const rt_profiler *p, uint32_t skip)
 {
-    vfx_frame_summary s;
+    rt_frame_summary s;
     memset(&s, 0, sizeof s);
     if (!p || p->frame <= skip)
         return s;
@@ -272,13 +272,13 @@ vfx_frame_summary vfx_profiler_summary(const vfx_profiler *p, uint32_t skip)
         return s;
     }
     /* Older frames live only in the histogram: a skip beyond the head is taken as the head. */
-    if (skip > VFX_PROF_HEAD)
-        skip = VFX_PROF_HEAD;
+    if (skip > RT_PROF_HEAD)
+        skip = RT_PROF_HEAD;
     n = p->frame - skip;
     double sum = p->sum_ms, mx = p->tail_max;
     for (uint32_t i = 0; i < skip; ++i)
         sum -= p->head[i];
-    for (uint32_t i = skip; i < VFX_PROF_HEAD; ++i)
+    for (uint32_t i = skip; i < RT_PROF_HEAD; ++i)
         if (p->head[i] > mx)
             mx = p->head[i];
     static const double q[3] = {0.50, 0.95, 0.99};
@@ -295,7 +295,7 @@ vfx_frame_summary vfx_profiler_summary(const vfx_profiler *p, uint32_t skip)
     return s;
 }
 
-double vfx_profiler_series_median(const vfx_profiler *p, const char *name)
+double rt_profiler_series_median(const rt_profiler *p, const char *name)
 {
     if (!p)
         return NAN;
@@ -315,12 +315,12 @@ double vfx_profiler_series_median(const vfx_profiler *p, const char *name)
         if (!isnan(x))
             v[n++] = x;
     }
-    double m = vfx_median(v, n);
+    double m = rt_median(v, n);
     free(v);
     return m;
 }
 
-double vfx_median(double *v, uint32_t n)
+double rt_median(double *v, uint32_t n)
 {
     if (n == 0)
         return NAN;
@@ -328,18 +328,18 @@ double vfx_median(double *v, uint32_t n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-vfx_frame_pcts vfx_frame_percentiles(double *v, uint32_t n)
+rt_frame_pcts rt_frame_percentiles(double *v, uint32_t n)
 {
-    vfx_frame_pcts r = {NAN, NAN, NAN};
+    rt_frame_pcts r = {NAN, NAN, NAN};
     if (n == 0)
         return r;
-    r.p50 = vfx_median(v, n); /* sorts */
+    r.p50 = rt_median(v, n); /* sorts */
     r.p95 = pct(v, n, 0.95);
     r.p99 = pct(v, n, 0.99);
     return r;
 }
 
-vfx_result vfx_profiler_write_csv(const vfx_profiler *p, const char *path)
+vfx_result rt_profiler_write_csv(const rt_profiler *p, const char *path)
 {
     FILE *f = fopen(path, "w");
     if (!f)
@@ -359,7 +359,7 @@ vfx_result vfx_profiler_write_csv(const vfx_profiler *p, const char *path)
     return fclose(f) == 0 ? VFX_OK : VFX_ERR_IO;
 }
 
-vfx_result vfx_profiler_write_trace(const vfx_profiler *p, const char *path)
+vfx_result rt_profiler_write_trace(const rt_profiler *p, const char *path)
 {
     FILE *f = fopen(path, "w");
     if (!f)
@@ -374,7 +374,7 @@ vfx_result vfx_profiler_write_trace(const vfx_profiler *p, const char *path)
         fprintf(f, ",\n{\"name\":\"frame %u\",\"ph\":\"X\",\"pid\":1,\"tid\":1,\"ts\":%.3f,\"dur\":%.3f}",
                 fr, t0, p->frame_ms[fr % p->max_frames] * 1000.0);
         const double *r = row(p, fr);
-        const double *st = &p->starts[(size_t)(fr % p->max_frames) * VFX_PROFILER_MAX_SERIES];
+        const double *st = &p->starts[(size_t)(fr % p->max_frames) * RT_PROFILER_MAX_SERIES];
         double gpu_cursor = 0;
         for (uint32_t i = 0; i < p->series_count; ++i) {
             if (isnan(r[i]))

@@ -5,7 +5,7 @@
 #include <stdio.h>
 #include <unistd.h>
 
-uint64_t vfx_resident_bytes(void)
+uint64_t rt_resident_bytes(void)
 {
     FILE *f = fopen("/proc/self/statm", "r");
     if (!f)
@@ -17,9 +17,9 @@ uint64_t vfx_resident_bytes(void)
     return n == 2 && page > 0 ? (uint64_t)resident * (uint64_t)page : 0;
 }
 
-vfx_gl_object_counts vfx_gl_count_objects(uint32_t max_name)
+rt_gl_object_counts rt_gl_count_objects(uint32_t max_name)
 {
-    vfx_gl_object_counts c = {0};
+    rt_gl_object_counts c = {0};
     for (GLuint i = 1; i <= max_name; ++i) {
         c.buffers += glIsBuffer(i) == GL_TRUE;
         c.textures += glIsTexture(i) == GL_TRUE;

@@ -1,18 +1,18 @@
 /* resources.h — process and GL resource counts for long-run leak checks. */
-#ifndef VFX_RESOURCES_H
-#define VFX_RESOURCES_H
+#ifndef RT_RESOURCES_H
+#define RT_RESOURCES_H
 
 #include <stdint.h>
 
-typedef struct vfx_gl_object_counts {
+typedef struct rt_gl_object_counts {
     uint32_t buffers, textures, framebuffers, vertex_arrays, programs, shaders, queries;
     uint32_t total;
-} vfx_gl_object_counts;
+} rt_gl_object_counts;
 
 /* Resident set size of this process in bytes (from /proc/self/statm; 0 when unavailable). */
-uint64_t vfx_resident_bytes(void);
+uint64_t rt_resident_bytes(void);
 /* Counts live GL object names 1..max_name of each kind in the current context (glIs*): the
  * names a leak would pile up. Cost grows with max_name: for sampling, not per frame. */
-vfx_gl_object_counts vfx_gl_count_objects(uint32_t max_name);
+rt_gl_object_counts rt_gl_count_objects(uint32_t max_name);
 
 #endif

@@ -48,7 +48,7 @@ static vfx_result parse_named(const char *name, const void *data, size_t size, f
         return VFX_ERR_FORMAT;
     }
     size_t n = size / 12;
-    if (n > VFX_PARTICLE_FILE_MAX_COUNT) {
+    if (n > RT_PARTICLE_FILE_MAX_COUNT) {
         set_err(err, errlen, "%s: %llu particles, above the cap of 16777216", name, (unsigned long long)n);
         return VFX_ERR_INVALID_ARGUMENT;
     }
@@ -75,7 +75,7 @@ static vfx_result parse_named(const char *name, const void *data, size_t size, f
     return VFX_OK;
 }
 
-vfx_result vfx_particle_file_parse(const void *data, size_t size, float **xyz, uint32_t *count,
+vfx_result rt_particle_file_parse(const void *data, size_t size, float **xyz, uint32_t *count,
                                    char *err, size_t errlen)
 {
     if (!xyz || !count || (!data && size)) {
@@ -85,7 +85,7 @@ vfx_result vfx_particle_file_parse(const void *data, size_t size, float **xyz, u
     return parse_named("particle data", data, size, xyz, count, err, errlen);
 }
 
-vfx_result vfx_particle_file_load(const char *path, float **xyz, uint32_t *count, char *err,
+vfx_result rt_particle_file_load(const char *path, float **xyz, uint32_t *count, char *err,
                                   size_t errlen)
 {
     if (!path || !xyz || !count) {
@@ -97,7 +97,7 @@ vfx_result vfx_particle_file_load(const char *path, float **xyz, uint32_t *count
     char *buf;
     size_t size;
     char tmp[512];
-    vfx_result rr = vfx_read_file(path, (size_t)VFX_PARTICLE_FILE_MAX_COUNT * 12, "16777216 particles", &buf,
+    vfx_result rr = rt_read_file(path, (size_t)RT_PARTICLE_FILE_MAX_COUNT * 12, "16777216 particles", &buf,
                                   &size, tmp, sizeof tmp);
     if (rr) {
         set_err(err, errlen, "%s", tmp);
@@ -108,7 +108,7 @@ vfx_result vfx_particle_file_load(const char *path, float **xyz, uint32_t *count
     return r;
 }
 
-vfx_result vfx_particle_file_save(const char *path, const float *xyz, uint32_t count, char *err,
+vfx_result rt_particle_file_save(const char *path, const float *xyz, uint32_t count, char *err,
                                   size_t errlen)
 {
     if (!path || (!xyz && count)) {

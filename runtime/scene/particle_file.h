@@ -1,25 +1,25 @@
 /* particle_file.h — the particle file: little-endian float32 x,y,z triples, nothing else
  * (12 bytes per particle, no header). Zero particles (an empty file) is a valid file. */
-#ifndef VFX_PARTICLE_FILE_H
-#define VFX_PARTICLE_FILE_H
+#ifndef RT_PARTICLE_FILE_H
+#define RT_PARTICLE_FILE_H
 
 #include <stddef.h>
 #include <stdint.h>
 #include <volfx/volfx.h>
 
 /* Files holding more particles than this are refused before anything is read (201 MB). */
-#define VFX_PARTICLE_FILE_MAX_COUNT (1u << 24)
+#define RT_PARTICLE_FILE_MAX_COUNT (1u << 24)
 
 /* Decodes `size` bytes into a malloc'd xyz array (NULL when count is 0). Errors: size not a
  * multiple of 12 (VFX_ERR_FORMAT, names the size), NaN/Inf (VFX_ERR_FORMAT, names the particle
  * index and coordinate), above the cap (VFX_ERR_INVALID_ARGUMENT). */
-vfx_result vfx_particle_file_parse(const void *data, size_t size, float **xyz, uint32_t *count,
+vfx_result rt_particle_file_parse(const void *data, size_t size, float **xyz, uint32_t *count,
                                    char *err, size_t errlen);
 /* Reads a particle file (errors also name the path; VFX_ERR_IO when it cannot be read). */
-vfx_result vfx_particle_file_load(const char *path, float **xyz, uint32_t *count, char *err,
+vfx_result rt_particle_file_load(const char *path, float **xyz, uint32_t *count, char *err,
                                   size_t errlen);
 /* Writes `count` xyz triples; refuses NaN/Inf (VFX_ERR_INVALID_ARGUMENT) before writing. */
-vfx_result vfx_particle_file_save(const char *path, const float *xyz, uint32_t count, char *err,
+vfx_result rt_particle_file_save(const char *path, const float *xyz, uint32_t count, char *err,
                                   size_t errlen);
 
 #endif

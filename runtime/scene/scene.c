@@ -18,7 +18,7 @@
 #define COORD_MAX 1e6 /* metres: beyond this float precision is gone anyway */
 
 typedef struct pctx {
-    const vfx_logger *log;
+    const rt_logger *log;
     char *err;
     size_t errlen;
     const char *base_dir;
@@ -79,12 +79,12 @@ static void check_keys(pctx *c, const cJSON *obj, const char *path, const char *
         char p[JPATH];
         join(p, path, k);
         if (!known)
-            vfx_logf(c->log, VFX_LOG_WARN, "%s: unknown key ignored", p);
+            rt_logf(c->log, VFX_LOG_WARN, "%s: unknown key ignored", p);
         /* duplicates: quadratic, but only for the first 64 keys of an object */
         if (index < 64)
             for (const cJSON *prev = obj->child; prev != it; prev = prev->next)
                 if (prev->string && strcmp(prev->string, k) == 0) {
-                    vfx_logf(c->log, VFX_LOG_WARN, "%s: duplicate key, the first one is used", p);
+                    rt_logf(c->log, VFX_LOG_WARN, "%s: duplicate key, the first one is used", p);
                     break;
                 }
     }
@@ -278,18 +278,18 @@ static vfx_result resolve_path(pctx *c, const char *p, const char *rel, char *ou
         return failf(c, VFX_ERR_INVALID_ARGUMENT, p, "empty path");
     int n;
     if (rel[0] == '/' || !c->base_dir || !*c->base_dir)
-        n = snprintf(out, VFX_SCENE_PATH_MAX, "%s", rel);
+        n = snprintf(out, RT_SCENE_PATH_MAX, "%s", rel);
     else
-        n = snprintf(out, VFX_SCENE_PATH_MAX, "%s/%s", c->base_dir, rel);
-    if (n < 0 || n >= VFX_SCENE_PATH_MAX)
-        return failf(c, VFX_ERR_INVALID_ARGUMENT, p, "resolved path longer than %d bytes", VFX_SCENE_PATH_MAX - 1);
+        n = snprintf(out, RT_SCENE_PATH_MAX, "%s/%s", c->base_dir, rel);
+    if (n < 0 || n >= RT_SCENE_PATH_MAX)
+        return failf(c, VFX_ERR_INVALID_ARGUMENT, p, "resolved path longer than %d bytes", RT_SCENE_PATH_MAX - 1);
     return VFX_OK;
 }
 
 static vfx_result get_path(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
                            char *out)
 {
-    char raw[VFX_SCENE_PATH_MAX] = "", p[JPATH];
+    char raw[RT_SCENE_PATH_MAX] = "", p[JPATH];
     vfx_result r = get_string(c, obj, path, key, required, raw, sizeof raw);
     if (r || !cJSON_GetObjectItemCaseSensitive(obj, key))
         return r;
@@ -365,7 +365,7 @@ static vfx_result parse_transform(pctx *c, const cJSON *obj, const char *path, f
 
 /* ------------------------------------------------------------------ sections */
 
-static vfx_result parse_camera(pctx *c, const cJSON *v, vfx_scene_camera *cam)
+static vfx_result parse_camera(pctx *c, const cJSON *v, rt_scene_camera *cam)
 {
     static const char *const keys[] = {"eye", "target", "up", "fov_y_deg", "width", "height", "near", "far", NULL};
     const char *P = "camera";
@@ -422,18 +422,18 @@ static vfx_result alloc_array(pctx *c, const cJSON *v, const char *name, int cap
     return VFX_OK;
 }
 
-static vfx_result parse_meshes(pctx *c, const cJSON *v, vfx_scene *s)
+static vfx_result parse_meshes(pctx *c, const cJSON *v, rt_scene *s)
 {
     static const char *const keys[] = {"path", "box", "translate", "rotate_deg", "scale", "matrix", "color", NULL};
     int n;
-    vfx_result ra = alloc_array(c, v, "meshes", VFX_SCENE_MAX_MESHES, sizeof *s->meshes, (void **)&s->meshes, &n);
+    vfx_result ra = alloc_array(c, v, "meshes", RT_SCENE_MAX_MESHES, sizeof *s->meshes, (void **)&s->meshes, &n);
     if (ra || n == 0)
         return ra;
     int i = 0;
     for (const cJSON *m = v->child; m; m = m->next, ++i) {
         char P[JPATH];
         join_index(P, "meshes", i);
-        vfx_scene_mesh *o = &s->meshes[i];
+        rt_scene_mesh *o = &s->meshes[i];
         vfx_result r = expect_object(c, m, P);
         if (r)
             return r;
@@ -471,17 +471,17 @@ static vfx_result parse_meshes(pctx *c, const cJSON *v, vfx_scene *s)
     return VFX_OK;
 }
 
-static const char *const beam_param_names[VFX_BEAM_PARAM_COUNT + 1] = {
+static const char *const beam_param_names[RT_BEAM_PARAM_COUNT + 1] = {
     "head", "dir", "length", "radius", "a", "b", "eps", "color", NULL};
-static const int beam_param_dim[VFX_BEAM_PARAM_COUNT] = {3, 3, 1, 1, 1, 1, 1, 4};
+static const int beam_param_dim[RT_BEAM_PARAM_COUNT] = {3, 3, 1, 1, 1, 1, 1, 4};
 
 static range beam_param_range(int k)
 {
     switch (k) {
-    case VFX_BEAM_PARAM_HEAD:
-    case VFX_BEAM_PARAM_DIR: return COORD;
-    case VFX_BEAM_PARAM_RADIUS: return POSITIVE;
-    case VFX_BEAM_PARAM_COLOR: return (range){0, 1000, false};
+    case RT_BEAM_PARAM_HEAD:
+    case RT_BEAM_PARAM_DIR: return COORD;
+    case RT_BEAM_PARAM_RADIUS: return POSITIVE;
+    case RT_BEAM_PARAM_COLOR: return (range){0, 1000, false};
     default: return NONNEG;
     }
 }
@@ -489,13 +489,13 @@ static range beam_param_range(int k)
 static float *beam_param_ptr(vfx_beam *b, int k)
 {
     switch (k) {
-    case VFX_BEAM_PARAM_HEAD: return b->head;
-    case VFX_BEAM_PARAM_DIR: return b->dir;
-    case VFX_BEAM_PARAM_LENGTH: return &b->length;
-    case VFX_BEAM_PARAM_RADIUS: return &b->radius;
-    case VFX_BEAM_PARAM_A: return &b->a;
-    case VFX_BEAM_PARAM_B: return &b->b;
-    case VFX_BEAM_PARAM_EPS: return &b->eps;
+    case RT_BEAM_PARAM_HEAD: return b->head;
+    case RT_BEAM_PARAM_DIR: return b->dir;
+    case RT_BEAM_PARAM_LENGTH: return &b->length;
+    case RT_BEAM_PARAM_RADIUS: return &b->radius;
+    case RT_BEAM_PARAM_A: return &b->a;
+    case RT_BEAM_PARAM_B: return &b->b;
+    case RT_BEAM_PARAM_EPS: return &b->eps;
     default: return b->color;
     }
 }
@@ -505,14 +505,14 @@ static bool is_zero3(const float *v)
     return (double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2] < 1e-24;
 }
 
-static vfx_result parse_track(pctx *c, const cJSON *v, const char *P, int k, vfx_scene_track *tr)
+static vfx_result parse_track(pctx *c, const cJSON *v, const char *P, int k, rt_scene_track *tr)
 {
     static const char *const keys[] = {"t", "value", NULL};
     if (!cJSON_IsArray(v))
         return failf(c, VFX_ERR_FORMAT, P, "expected an array of {\"t\", \"value\"} keyframes, got %s", type_name(v));
     int n = cJSON_GetArraySize(v);
-    if (n < 1 || n > VFX_SCENE_MAX_KEYS)
-        return failf(c, VFX_ERR_INVALID_ARGUMENT, P, "%d keyframes; must be 1 to %d", n, VFX_SCENE_MAX_KEYS);
+    if (n < 1 || n > RT_SCENE_MAX_KEYS)
+        return failf(c, VFX_ERR_INVALID_ARGUMENT, P, "%d keyframes; must be 1 to %d", n, RT_SCENE_MAX_KEYS);
     int dim = beam_param_dim[k];
     tr->dim = (uint32_t)dim;
     tr->times = malloc((size_t)n * sizeof(float));
@@ -548,26 +548,26 @@ static vfx_result parse_track(pctx *c, const cJSON *v, const char *P, int k, vfx
         } else if ((r = vec_value(c, val, PV, dim, beam_param_range(k), dst))) {
             return r;
         }
-        if (k == VFX_BEAM_PARAM_DIR && is_zero3(dst))
+        if (k == RT_BEAM_PARAM_DIR && is_zero3(dst))
             return failf(c, VFX_ERR_INVALID_ARGUMENT, PV, "direction must not be the zero vector");
         tr->count = (uint32_t)i + 1;
     }
     return VFX_OK;
 }
 
-static vfx_result parse_beams(pctx *c, const cJSON *v, vfx_scene *s)
+static vfx_result parse_beams(pctx *c, const cJSON *v, rt_scene *s)
 {
     static const char *const keys[] = {"head", "dir", "length", "radius", "a", "b", "eps", "color",
                                        "keyframes", "loop_s", NULL};
     int n;
-    vfx_result ra = alloc_array(c, v, "beams", VFX_SCENE_MAX_BEAMS, sizeof *s->beams, (void **)&s->beams, &n);
+    vfx_result ra = alloc_array(c, v, "beams", RT_SCENE_MAX_BEAMS, sizeof *s->beams, (void **)&s->beams, &n);
     if (ra || n == 0)
         return ra;
     int i = 0;
     for (const cJSON *e = v->child; e; e = e->next, ++i) {
         char P[JPATH];
         join_index(P, "beams", i);
-        vfx_scene_beam *o = &s->beams[i];
+        rt_scene_beam *o = &s->beams[i];
         s->beam_count = (uint32_t)i + 1; /* so that free() sees tracks of a half-parsed beam */
         vfx_beam *b = &o->base;
         *b = (vfx_beam){.length = 1.0f, .radius = 0.5f, .a = 0.05f, .b = 0.03f, .eps = 0.02f, .color = {1, 1, 1, 1}};
@@ -583,11 +583,11 @@ static vfx_result parse_beams(pctx *c, const cJSON *v, vfx_scene *s)
                 return r;
             check_keys(c, kf, PK, beam_param_names);
         }
-        for (int k = 0; k < VFX_BEAM_PARAM_COUNT; ++k) {
+        for (int k = 0; k < RT_BEAM_PARAM_COUNT; ++k) {
             const char *name = beam_param_names[k];
             const cJSON *track = kf ? cJSON_GetObjectItemCaseSensitive(kf, name) : NULL;
             /* head and dir are required unless animated (then the first key is the base) */
-            bool required = (k == VFX_BEAM_PARAM_HEAD || k == VFX_BEAM_PARAM_DIR) && !track;
+            bool required = (k == RT_BEAM_PARAM_HEAD || k == RT_BEAM_PARAM_DIR) && !track;
             float *dst = beam_param_ptr(b, k);
             if (beam_param_dim[k] == 1)
                 r = get_float(c, e, P, name, required, beam_param_range(k), dst);
@@ -657,7 +657,7 @@ static vfx_result parse_box(pctx *c, const cJSON *obj, const char *path, const c
     return r;
 }
 
-static vfx_result parse_water(pctx *c, const cJSON *v, vfx_scene_water *w)
+static vfx_result parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
 {
     static const char *const keys[] = {"source", "path", "generator", "simulation", "h", "threshold",
                                        "quality", "color", "absorption", "ior", NULL};
@@ -670,17 +670,17 @@ static vfx_result parse_water(pctx *c, const cJSON *v, vfx_scene_water *w)
     uint32_t src = 0;
     if ((r = get_enum(c, v, P, "source", true, sources, &src)))
         return r;
-    w->source = (vfx_scene_water_source)src;
+    w->source = (rt_scene_water_source)src;
     w->layer_side = 24;
     w->spacing = 0.1f;
     w->dt = 0.004f;
     w->gravity[1] = -9.81f;
     w->paddle_amplitude = 0.2f;
     w->paddle_period_s = 2.0f;
-    if (w->source == VFX_SCENE_WATER_FILE) {
+    if (w->source == RT_SCENE_WATER_FILE) {
         if ((r = get_path(c, v, P, "path", true, w->path)))
             return r;
-    } else if (w->source == VFX_SCENE_WATER_GENERATOR) {
+    } else if (w->source == RT_SCENE_WATER_GENERATOR) {
         static const char *const gkeys[] = {"kind", "count", "origin", "spacing", "layer_side", "min", "max",
                                             "center", "radius", NULL};
         static const char *const kinds[] = {"layers", "box", "sphere", NULL};
@@ -693,15 +693,15 @@ static vfx_result parse_water(pctx *c, const cJSON *v, vfx_scene_water *w)
         check_keys(c, g, PG, gkeys);
         uint32_t kind = 0;
         r = get_enum(c, g, PG, "kind", true, kinds, &kind);
-        if (!r) r = get_uint(c, g, PG, "count", true, 0, VFX_SCENE_MAX_PARTICLES, &w->count);
+        if (!r) r = get_uint(c, g, PG, "count", true, 0, RT_SCENE_MAX_PARTICLES, &w->count);
         if (r)
             return r;
-        w->generator = (vfx_scene_generator)kind;
-        if (kind == VFX_SCENE_GEN_LAYERS) {
+        w->generator = (rt_scene_generator)kind;
+        if (kind == RT_SCENE_GEN_LAYERS) {
             r = get_vec(c, g, PG, "origin", 3, false, COORD, w->origin);
             if (!r) r = get_float(c, g, PG, "spacing", false, POSITIVE, &w->spacing);
             if (!r) r = get_uint(c, g, PG, "layer_side", false, 1, 4096, &w->layer_side);
-        } else if (kind == VFX_SCENE_GEN_BOX) {
+        } else if (kind == RT_SCENE_GEN_BOX) {
             r = get_vec(c, g, PG, "min", 3, true, COORD, w->box_min);
             if (!r) r = get_vec(c, g, PG, "max", 3, true, COORD, w->box_max);
             for (int k = 0; k < 3 && !r; ++k)
@@ -728,7 +728,7 @@ static vfx_result parse_water(pctx *c, const cJSON *v, vfx_scene_water *w)
         for (int k = 0; k < 3 && !r; ++k)
             if (w->box_min[k] < w->tank_min[k] || w->box_max[k] > w->tank_max[k])
                 r = failf(c, VFX_ERR_INVALID_ARGUMENT, "water.simulation.fluid", "must lie inside the tank (axis %d)", k);
-        if (!r) r = get_uint(c, s, PS, "particle_count", true, 0, VFX_SCENE_MAX_PARTICLES, &w->count);
+        if (!r) r = get_uint(c, s, PS, "particle_count", true, 0, RT_SCENE_MAX_PARTICLES, &w->count);
         if (!r) r = get_vec(c, s, PS, "gravity", 3, false, (range){-1000, 1000, false}, w->gravity);
         if (!r) r = get_float(c, s, PS, "dt", false, (range){0, 0.1, true}, &w->dt);
         if (!r) r = get_bool(c, s, PS, "no_slip", &w->no_slip);
@@ -789,7 +789,7 @@ static bool ends_with(const char *s, const char *suffix)
     return a >= b && strcmp(s + a - b, suffix) == 0;
 }
 
-static vfx_result parse_volume(pctx *c, const cJSON *v, vfx_scene_volume *vol)
+static vfx_result parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol)
 {
     static const char *const keys[] = {"path", "generator", "scalar", "transfer", "transfer_normalized",
                                        "ert_threshold", "tiles", "update_c", "workers", "disable",
@@ -818,7 +818,7 @@ static vfx_result parse_volume(pctx *c, const cJSON *v, vfx_scene_volume *vol)
         vol->gen_cells = 8;
         vol->gen_min[0] = vol->gen_min[1] = vol->gen_min[2] = -1;
         vol->gen_max[0] = vol->gen_max[1] = vol->gen_max[2] = 1;
-        r = get_uint(c, gen, PG, "cells", false, 1, VFX_SCENE_MAX_VOLUME_CELLS, &vol->gen_cells);
+        r = get_uint(c, gen, PG, "cells", false, 1, RT_SCENE_MAX_VOLUME_CELLS, &vol->gen_cells);
         if (!r) r = get_vec(c, gen, PG, "min", 3, false, COORD, vol->gen_min);
         if (!r) r = get_vec(c, gen, PG, "max", 3, false, COORD, vol->gen_max);
         for (int k = 0; k < 3 && !r; ++k)
@@ -849,14 +849,14 @@ static vfx_result parse_volume(pctx *c, const cJSON *v, vfx_scene_volume *vol)
     if (!cJSON_IsArray(tf))
         return failf(c, VFX_ERR_FORMAT, PT, "expected an array of {\"scalar\", \"rgba\"}, got %s", type_name(tf));
     int n = cJSON_GetArraySize(tf);
-    if (n < 1 || n > VFX_SCENE_MAX_TRANSFER)
-        return failf(c, VFX_ERR_INVALID_ARGUMENT, PT, "%d control points; must be 1 to %d", n, VFX_SCENE_MAX_TRANSFER);
+    if (n < 1 || n > RT_SCENE_MAX_TRANSFER)
+        return failf(c, VFX_ERR_INVALID_ARGUMENT, PT, "%d control points; must be 1 to %d", n, RT_SCENE_MAX_TRANSFER);
     int i = 0;
     for (const cJSON *e = tf->child; e; e = e->next, ++i) {
         static const char *const tkeys[] = {"scalar", "rgba", NULL};
         char PI[JPATH];
         join_index(PI, PT, i);
-        vfx_scene_transfer_point *tp = &vol->transfer[i];
+        rt_scene_transfer_point *tp = &vol->transfer[i];
         if ((r = expect_object(c, e, PI)))
             return r;
         check_keys(c, e, PI, tkeys);
@@ -875,7 +875,7 @@ static vfx_result parse_volume(pctx *c, const cJSON *v, vfx_scene_volume *vol)
     return VFX_OK;
 }
 
-static vfx_result parse_root(pctx *c, const cJSON *root, vfx_scene *s)
+static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
 {
     static const char *const keys[] = {"version", "name", "description", "camera", "meshes", "beams",
                                        "beam_settings", "water", "volume", NULL};
@@ -888,16 +888,16 @@ static vfx_result parse_root(pctx *c, const cJSON *root, vfx_scene *s)
         uint32_t version = 0;
         if ((r = get_uint(c, root, "", "version", false, 0, 1e9, &version)))
             return r;
-        if (version != VFX_SCENE_FORMAT_VERSION)
+        if (version != RT_SCENE_FORMAT_VERSION)
             return failf(c, VFX_ERR_UNSUPPORTED, "version", "scene format version %u is not supported (this build reads %d)",
-                         version, VFX_SCENE_FORMAT_VERSION);
+                         version, RT_SCENE_FORMAT_VERSION);
     }
     char desc[512];
     r = get_string(c, root, "", "name", false, s->name, sizeof s->name);
     if (!r) r = get_string(c, root, "", "description", false, desc, sizeof desc);
     if (r)
         return r;
-    s->camera = (vfx_scene_camera){.eye = {0, 2, 6}, .target = {0, 0.5f, 0}, .up = {0, 1, 0}, .fov_y_deg = 60,
+    s->camera = (rt_scene_camera){.eye = {0, 2, 6}, .target = {0, 0.5f, 0}, .up = {0, 1, 0}, .fov_y_deg = 60,
                                    .width = 640, .height = 360, .near_plane = 0.05f, .far_plane = 200};
     s->beams_view = (vfx_beams_view){.size = sizeof s->beams_view, .version = VFX_BEAMS_VIEW_VERSION,
                                      .saturation = VFX_SATURATE_SMOOTH, .saturate_c = 1};
@@ -925,12 +925,12 @@ static vfx_result parse_root(pctx *c, const cJSON *root, vfx_scene *s)
 
 /* ------------------------------------------------------------------ load / free */
 
-void vfx_scene_free(vfx_scene *scene)
+void rt_scene_free(rt_scene *scene)
 {
     if (!scene)
         return;
     for (uint32_t i = 0; i < scene->beam_count; ++i)
-        for (int k = 0; k < VFX_BEAM_PARAM_COUNT; ++k) {
+        for (int k = 0; k < RT_BEAM_PARAM_COUNT; ++k) {
             free(scene->beams[i].tracks[k].times);
             free(scene->beams[i].tracks[k].values);
         }
@@ -939,8 +939,8 @@ void vfx_scene_free(vfx_scene *scene)
     free(scene);
 }
 
-vfx_result vfx_scene_load_mem(const char *json, size_t len, const char *base_dir, const vfx_logger *logger,
-                              vfx_scene **out, char *err, size_t errlen)
+vfx_result rt_scene_load_mem(const char *json, size_t len, const char *base_dir, const rt_logger *logger,
+                              rt_scene **out, char *err, size_t errlen)
 {
     pctx c = {.log = logger, .err = err, .errlen = errlen, .base_dir = base_dir};
     if (err && errlen)
@@ -948,10 +948,10 @@ vfx_result vfx_scene_load_mem(const char *json, size_t len, const char *base_dir
     if (!out || (!json && len))
         return failf(&c, VFX_ERR_INVALID_ARGUMENT, "scene", "NULL argument");
     *out = NULL;
-    if (len > VFX_SCENE_MAX_BYTES)
-        return failf(&c, VFX_ERR_INVALID_ARGUMENT, "scene", "%zu bytes, above the cap of %u", len, VFX_SCENE_MAX_BYTES);
-    if (base_dir && strlen(base_dir) >= VFX_SCENE_PATH_MAX)
-        return failf(&c, VFX_ERR_INVALID_ARGUMENT, "scene", "base directory longer than %d bytes", VFX_SCENE_PATH_MAX - 1);
+    if (len > RT_SCENE_MAX_BYTES)
+        return failf(&c, VFX_ERR_INVALID_ARGUMENT, "scene", "%zu bytes, above the cap of %u", len, RT_SCENE_MAX_BYTES);
+    if (base_dir && strlen(base_dir) >= RT_SCENE_PATH_MAX)
+        return failf(&c, VFX_ERR_INVALID_ARGUMENT, "scene", "base directory longer than %d bytes", RT_SCENE_PATH_MAX - 1);
     /* a private NUL-terminated copy: cJSON then never depends on the caller's termination */
     char *text = malloc(len + 1);
     if (!text)
@@ -993,7 +993,7 @@ vfx_result vfx_scene_load_mem(const char *json, size_t len, const char *base_dir
         return failf(&c, VFX_ERR_FORMAT, "scene", "JSON syntax error at line %u, column %u (byte %zu): text after the scene object",
                      line, col, off);
     }
-    vfx_scene *s = calloc(1, sizeof *s);
+    rt_scene *s = calloc(1, sizeof *s);
     vfx_result r = VFX_OK;
     if (!s) {
         r = failf(&c, VFX_ERR_OUT_OF_MEMORY, "scene", "out of memory");
@@ -1005,14 +1005,14 @@ vfx_result vfx_scene_load_mem(const char *json, size_t len, const char *base_dir
     cJSON_Delete(root);
     free(text);
     if (r) {
-        vfx_scene_free(s);
+        rt_scene_free(s);
         return r;
     }
     *out = s;
     return VFX_OK;
 }
 
-vfx_result vfx_scene_load_file(const char *path, const vfx_logger *logger, vfx_scene **out, char *err, size_t errlen)
+vfx_result rt_scene_load_file(const char *path, const rt_logger *logger, rt_scene **out, char *err, size_t errlen)
 {
     if (err && errlen)
         err[0] = 0;
@@ -1024,13 +1024,13 @@ vfx_result vfx_scene_load_file(const char *path, const vfx_logger *logger, vfx_s
     *out = NULL;
     char *buf, tmp[512];
     size_t size;
-    vfx_result rr = vfx_read_file(path, VFX_SCENE_MAX_BYTES, "16 MiB for a scene", &buf, &size, tmp, sizeof tmp);
+    vfx_result rr = rt_read_file(path, RT_SCENE_MAX_BYTES, "16 MiB for a scene", &buf, &size, tmp, sizeof tmp);
     if (rr) {
         if (err && errlen)
             snprintf(err, errlen, "%s", tmp);
         return rr;
     }
-    char dir[VFX_SCENE_PATH_MAX];
+    char dir[RT_SCENE_PATH_MAX];
     const char *slash = strrchr(path, '/');
     if (!slash)
         snprintf(dir, sizeof dir, ".");
@@ -1039,7 +1039,7 @@ vfx_result vfx_scene_load_file(const char *path, const vfx_logger *logger, vfx_s
     else
         snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
     char msg[512] = "";
-    vfx_result r = vfx_scene_load_mem(buf, size, dir, logger, out, msg, sizeof msg);
+    vfx_result r = rt_scene_load_mem(buf, size, dir, logger, out, msg, sizeof msg);
     free(buf);
     if (r && err && errlen)
         snprintf(err, errlen, "%s: %s", path, msg);
@@ -1049,7 +1049,7 @@ vfx_result vfx_scene_load_file(const char *path, const vfx_logger *logger, vfx_s
 /* ------------------------------------------------------------------ animation */
 
 /* Index of the last key with time <= t (0 when t is before the first). */
-static uint32_t key_before(const vfx_scene_track *tr, double t)
+static uint32_t key_before(const rt_scene_track *tr, double t)
 {
     uint32_t lo = 0, hi = tr->count - 1;
     if (t <= tr->times[0])
@@ -1066,7 +1066,7 @@ static uint32_t key_before(const vfx_scene_track *tr, double t)
     return lo;
 }
 
-void vfx_scene_track_eval(const vfx_scene_track *tr, double t, float *out)
+void rt_scene_track_eval(const rt_scene_track *tr, double t, float *out)
 {
     if (!tr || tr->count == 0)
         return;
@@ -1082,7 +1082,7 @@ void vfx_scene_track_eval(const vfx_scene_track *tr, double t, float *out)
         out[k] = (float)(v0[k] + f * ((double)v1[k] - v0[k]));
 }
 
-uint32_t vfx_scene_beams_at(const vfx_scene *scene, double time, vfx_beam *out, uint32_t n)
+uint32_t rt_scene_beams_at(const rt_scene *scene, double time, vfx_beam *out, uint32_t n)
 {
     if (!scene || !out)
         return 0;
@@ -1090,7 +1090,7 @@ uint32_t vfx_scene_beams_at(const vfx_scene *scene, double time, vfx_beam *out, 
     if (!isfinite(time))
         time = 0;
     for (uint32_t i = 0; i < count; ++i) {
-        const vfx_scene_beam *b = &scene->beams[i];
+        const rt_scene_beam *b = &scene->beams[i];
         double t = time;
         if (b->loop_s > 0) {
             t = fmod(t, b->loop_s);
@@ -1098,14 +1098,14 @@ uint32_t vfx_scene_beams_at(const vfx_scene *scene, double time, vfx_beam *out, 
                 t += b->loop_s;
         }
         out[i] = b->base;
-        for (int k = 0; k < VFX_BEAM_PARAM_COUNT; ++k) {
-            const vfx_scene_track *tr = &b->tracks[k];
+        for (int k = 0; k < RT_BEAM_PARAM_COUNT; ++k) {
+            const rt_scene_track *tr = &b->tracks[k];
             if (!tr->count)
                 continue;
             float *dst = beam_param_ptr(&out[i], k);
-            vfx_scene_track_eval(tr, t, dst);
+            rt_scene_track_eval(tr, t, dst);
             /* opposite direction keys pass through zero: hold the earlier key's direction */
-            if (k == VFX_BEAM_PARAM_DIR && is_zero3(dst))
+            if (k == RT_BEAM_PARAM_DIR && is_zero3(dst))
                 memcpy(dst, &tr->values[(size_t)key_before(tr, t) * 3], 3 * sizeof(float));
         }
     }
@@ -1174,7 +1174,7 @@ static vfx_result lattice_sphere(const float c[3], float r, uint32_t count, floa
     return i == count ? VFX_OK : VFX_ERR_NUMERIC;
 }
 
-vfx_result vfx_scene_water_particles(const vfx_scene_water *w, float **xyz, uint32_t *count, char *err,
+vfx_result rt_scene_water_particles(const rt_scene_water *w, float **xyz, uint32_t *count, char *err,
                                      size_t errlen)
 {
     if (!w || !xyz || !count) {
@@ -1184,14 +1184,14 @@ vfx_result vfx_scene_water_particles(const vfx_scene_water *w, float **xyz, uint
     }
     *xyz = NULL;
     *count = 0;
-    if (w->source == VFX_SCENE_WATER_FILE)
-        return vfx_particle_file_load(w->path, xyz, count, err, errlen);
+    if (w->source == RT_SCENE_WATER_FILE)
+        return rt_particle_file_load(w->path, xyz, count, err, errlen);
     uint32_t n = w->count;
     if (n == 0)
         return VFX_OK;
-    if (n > VFX_SCENE_MAX_PARTICLES) {
+    if (n > RT_SCENE_MAX_PARTICLES) {
         if (err && errlen)
-            snprintf(err, errlen, "water: %u particles, above the cap of %u", n, VFX_SCENE_MAX_PARTICLES);
+            snprintf(err, errlen, "water: %u particles, above the cap of %u", n, RT_SCENE_MAX_PARTICLES);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     float *p = malloc((size_t)n * 3 * sizeof(float));
@@ -1201,7 +1201,7 @@ vfx_result vfx_scene_water_particles(const vfx_scene_water *w, float **xyz, uint
         return VFX_ERR_OUT_OF_MEMORY;
     }
     vfx_result r = VFX_OK;
-    if (w->source == VFX_SCENE_WATER_GENERATOR && w->generator == VFX_SCENE_GEN_LAYERS) {
+    if (w->source == RT_SCENE_WATER_GENERATOR && w->generator == RT_SCENE_GEN_LAYERS) {
         uint32_t side = w->layer_side ? w->layer_side : 24, per = side * side;
         for (uint32_t i = 0; i < n; ++i) {
             uint32_t layer = i / per, q = i % per;
@@ -1209,7 +1209,7 @@ vfx_result vfx_scene_water_particles(const vfx_scene_water *w, float **xyz, uint
             p[3 * (size_t)i + 1] = w->origin[1] + (float)layer * w->spacing;
             p[3 * (size_t)i + 2] = w->origin[2] + (float)(q / side) * w->spacing;
         }
-    } else if (w->source == VFX_SCENE_WATER_GENERATOR && w->generator == VFX_SCENE_GEN_SPHERE) {
+    } else if (w->source == RT_SCENE_WATER_GENERATOR && w->generator == RT_SCENE_GEN_SPHERE) {
         r = lattice_sphere(w->center, w->radius, n, p);
     } else {
         r = lattice_box(w->box_min, w->box_max, n, p);
@@ -1228,12 +1228,12 @@ vfx_result vfx_scene_water_particles(const vfx_scene_water *w, float **xyz, uint
     return VFX_OK;
 }
 
-void vfx_scene_transfer_sample(const vfx_scene_volume *v, uint32_t n, float *rgba, float *smin, float *smax)
+void rt_scene_transfer_sample(const rt_scene_volume *v, uint32_t n, float *rgba, float *smin, float *smax)
 {
     if (!v || !rgba || n < 2)
         return;
     uint32_t m = v->transfer_count;
-    const vfx_scene_transfer_point *tp = v->transfer;
+    const rt_scene_transfer_point *tp = v->transfer;
     if (smin) *smin = 0;
     if (smax) *smax = 0;
     if (m == 0) { /* grey ramp, opacity rising with the scalar */
@@ -1266,11 +1266,11 @@ void vfx_scene_transfer_sample(const vfx_scene_volume *v, uint32_t n, float *rgb
     }
 }
 
-vfx_result vfx_scene_volume_generate(const vfx_scene_volume *v, float **points, uint32_t *point_count,
+vfx_result rt_scene_volume_generate(const rt_scene_volume *v, float **points, uint32_t *point_count,
                                      uint32_t **tets, uint32_t *tet_count, float **scalar, char *err, size_t errlen)
 {
     if (!v || !points || !point_count || !tets || !tet_count || !scalar || !v->generated || v->gen_cells == 0 ||
-        v->gen_cells > VFX_SCENE_MAX_VOLUME_CELLS) {
+        v->gen_cells > RT_SCENE_MAX_VOLUME_CELLS) {
         if (err && errlen)
             snprintf(err, errlen, "volume.generator: NULL argument, not a generated volume or cells out of range");
         return VFX_ERR_INVALID_ARGUMENT;

@@ -1,11 +1,11 @@
 /* scene.h — scene files (JSON, docs/scene-format.md) parsed into a plain C struct. No GL here:
- * the game and the bench turn a vfx_scene into meshes, particles, beams and volumes.
+ * the game and the bench turn a rt_scene into meshes, particles, beams and volumes.
  *
  * Every bad input is refused with a vfx_result and a message that names the JSON path of the
  * offending value ("beams[2].radius: must be > 0, got -1"), or the line and column of a syntax
  * error. Unknown keys are not errors: they are reported as warnings through the logger. */
-#ifndef VFX_SCENE_H
-#define VFX_SCENE_H
+#ifndef RT_SCENE_H
+#define RT_SCENE_H
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -14,74 +14,74 @@
 
 #include "core/log.h"
 
-#define VFX_SCENE_FORMAT_VERSION 1
-#define VFX_SCENE_MAX_BYTES (16u << 20)        /* scene files above 16 MiB are refused */
-#define VFX_SCENE_MAX_MESHES 64
-#define VFX_SCENE_MAX_BEAMS 256
-#define VFX_SCENE_MAX_KEYS 4096                /* keyframes per animated parameter */
-#define VFX_SCENE_MAX_TRANSFER 256             /* transfer-function control points */
-#define VFX_SCENE_MAX_PARTICLES (1u << 22)     /* generated or simulated particles (4,194,304) */
-#define VFX_SCENE_MAX_VOLUME_CELLS 64          /* generated volume: cells per axis (1.5M tets) */
-#define VFX_SCENE_PATH_MAX 1024
+#define RT_SCENE_FORMAT_VERSION 1
+#define RT_SCENE_MAX_BYTES (16u << 20)        /* scene files above 16 MiB are refused */
+#define RT_SCENE_MAX_MESHES 64
+#define RT_SCENE_MAX_BEAMS 256
+#define RT_SCENE_MAX_KEYS 4096                /* keyframes per animated parameter */
+#define RT_SCENE_MAX_TRANSFER 256             /* transfer-function control points */
+#define RT_SCENE_MAX_PARTICLES (1u << 22)     /* generated or simulated particles (4,194,304) */
+#define RT_SCENE_MAX_VOLUME_CELLS 64          /* generated volume: cells per axis (1.5M tets) */
+#define RT_SCENE_PATH_MAX 1024
 
-typedef struct vfx_scene_camera {
+typedef struct rt_scene_camera {
     float eye[3], target[3], up[3];
     float fov_y_deg;
     uint32_t width, height;
     float near_plane, far_plane;
-} vfx_scene_camera;
+} rt_scene_camera;
 
-typedef struct vfx_scene_mesh {
+typedef struct rt_scene_mesh {
     bool is_box;                        /* a generated box instead of a file */
-    char path[VFX_SCENE_PATH_MAX];      /* Assimp-readable file, resolved against the scene */
+    char path[RT_SCENE_PATH_MAX];      /* Assimp-readable file, resolved against the scene */
     float box_min[3], box_max[3];
     float model[16];                    /* column-major, from translate/rotate/scale or matrix */
     float color[3];
-} vfx_scene_mesh;
+} rt_scene_mesh;
 
-/* Animated parameters of a beam, in the order of vfx_scene_beam.tracks[]. */
-typedef enum vfx_scene_beam_param {
-    VFX_BEAM_PARAM_HEAD = 0,   /* 3 values */
-    VFX_BEAM_PARAM_DIR,        /* 3 */
-    VFX_BEAM_PARAM_LENGTH,     /* 1 */
-    VFX_BEAM_PARAM_RADIUS,     /* 1 */
-    VFX_BEAM_PARAM_A,          /* 1 */
-    VFX_BEAM_PARAM_B,          /* 1 */
-    VFX_BEAM_PARAM_EPS,        /* 1 */
-    VFX_BEAM_PARAM_COLOR,      /* 4 */
-    VFX_BEAM_PARAM_COUNT
-} vfx_scene_beam_param;
+/* Animated parameters of a beam, in the order of rt_scene_beam.tracks[]. */
+typedef enum rt_scene_beam_param {
+    RT_BEAM_PARAM_HEAD = 0,   /* 3 values */
+    RT_BEAM_PARAM_DIR,        /* 3 */
+    RT_BEAM_PARAM_LENGTH,     /* 1 */
+    RT_BEAM_PARAM_RADIUS,     /* 1 */
+    RT_BEAM_PARAM_A,          /* 1 */
+    RT_BEAM_PARAM_B,          /* 1 */
+    RT_BEAM_PARAM_EPS,        /* 1 */
+    RT_BEAM_PARAM_COLOR,      /* 4 */
+    RT_BEAM_PARAM_COUNT
+} rt_scene_beam_param;
 
 /* Keyframes of one parameter: times strictly increasing; values has dim * count floats. */
-typedef struct vfx_scene_track {
+typedef struct rt_scene_track {
     uint32_t count, dim;
     float *times;
     float *values;
-} vfx_scene_track;
+} rt_scene_track;
 
-typedef struct vfx_scene_beam {
+typedef struct rt_scene_beam {
     vfx_beam base;                                  /* values when not animated */
-    vfx_scene_track tracks[VFX_BEAM_PARAM_COUNT];   /* count 0 = not animated */
+    rt_scene_track tracks[RT_BEAM_PARAM_COUNT];   /* count 0 = not animated */
     float loop_s;                                   /* >0: time wraps modulo loop_s */
-} vfx_scene_beam;
+} rt_scene_beam;
 
-typedef enum vfx_scene_water_source {
-    VFX_SCENE_WATER_FILE = 0,        /* particle file (particle_file.h) */
-    VFX_SCENE_WATER_GENERATOR = 1,   /* static particles laid out by a generator */
-    VFX_SCENE_WATER_SIMULATION = 2,  /* an SPH set-up: tank, initial fluid block, paddle */
-} vfx_scene_water_source;
+typedef enum rt_scene_water_source {
+    RT_SCENE_WATER_FILE = 0,        /* particle file (particle_file.h) */
+    RT_SCENE_WATER_GENERATOR = 1,   /* static particles laid out by a generator */
+    RT_SCENE_WATER_SIMULATION = 2,  /* an SPH set-up: tank, initial fluid block, paddle */
+} rt_scene_water_source;
 
-typedef enum vfx_scene_generator {
-    VFX_SCENE_GEN_LAYERS = 0,   /* seed 000 Table 1: 24x24 squares per layer, stacked in y */
-    VFX_SCENE_GEN_BOX = 1,      /* a lattice filling [min, max] */
-    VFX_SCENE_GEN_SPHERE = 2,   /* a lattice inside a sphere, filled from the bottom */
-} vfx_scene_generator;
+typedef enum rt_scene_generator {
+    RT_SCENE_GEN_LAYERS = 0,   /* seed 000 Table 1: 24x24 squares per layer, stacked in y */
+    RT_SCENE_GEN_BOX = 1,      /* a lattice filling [min, max] */
+    RT_SCENE_GEN_SPHERE = 2,   /* a lattice inside a sphere, filled from the bottom */
+} rt_scene_generator;
 
-typedef struct vfx_scene_water {
-    vfx_scene_water_source source;
-    char path[VFX_SCENE_PATH_MAX];   /* FILE */
+typedef struct rt_scene_water {
+    rt_scene_water_source source;
+    char path[RT_SCENE_PATH_MAX];   /* FILE */
     /* GENERATOR */
-    vfx_scene_generator generator;
+    rt_scene_generator generator;
     uint32_t count;                  /* also the SIMULATION particle count */
     float origin[3];                 /* layers: corner of the first layer */
     float spacing;                   /* layers: distance between neighbours */
@@ -100,72 +100,72 @@ typedef struct vfx_scene_water {
     bool no_slip;                    /* tank walls (all six faces) with wall-law friction */
     /* rendering (seed 000), a full vfx_water_params with size/version filled */
     vfx_water_params params;
-} vfx_scene_water;
+} rt_scene_water;
 
-typedef struct vfx_scene_transfer_point {
+typedef struct rt_scene_transfer_point {
     float scalar;
     float rgba[4];   /* alpha is opacity per unit length */
-} vfx_scene_transfer_point;
+} rt_scene_transfer_point;
 
-typedef struct vfx_scene_volume {
+typedef struct rt_scene_volume {
     bool generated;                  /* a generated grid instead of a file */
-    char path[VFX_SCENE_PATH_MAX];   /* .vtu, or .node (its .ele beside it) */
+    char path[RT_SCENE_PATH_MAX];   /* .vtu, or .node (its .ele beside it) */
     char scalar[64];                 /* point-data array name; "" = the loader's default */
     uint32_t gen_cells;              /* generated: cells per axis (6 tets each) */
     float gen_min[3], gen_max[3];
     bool transfer_normalized;        /* control-point scalars are in [0,1] of the data range */
     uint32_t transfer_count;         /* 0 = the plugin's default ramp */
-    vfx_scene_transfer_point transfer[VFX_SCENE_MAX_TRANSFER];
+    rt_scene_transfer_point transfer[RT_SCENE_MAX_TRANSFER];
     float ert_threshold;             /* 0 -> plugin default */
     uint32_t tiles, update_c, workers, disable;
     float model[16];
-} vfx_scene_volume;
+} rt_scene_volume;
 
-typedef struct vfx_scene {
+typedef struct rt_scene {
     char name[128];
-    char base_dir[VFX_SCENE_PATH_MAX];
-    vfx_scene_camera camera;
+    char base_dir[RT_SCENE_PATH_MAX];
+    rt_scene_camera camera;
     uint32_t mesh_count;
-    vfx_scene_mesh *meshes;
+    rt_scene_mesh *meshes;
     uint32_t beam_count;
-    vfx_scene_beam *beams;
+    rt_scene_beam *beams;
     vfx_beams_view beams_view;       /* saturation, saturate_c, far_distance, method, samples */
     bool has_water;
-    vfx_scene_water water;
+    rt_scene_water water;
     bool has_volume;
-    vfx_scene_volume volume;
-} vfx_scene;
+    rt_scene_volume volume;
+} rt_scene;
 
 /* Parses `len` bytes of JSON (no NUL needed). Relative paths resolve against `base_dir`
  * (NULL or "" -> the current directory). On error *out is NULL and err names the JSON path. */
-vfx_result vfx_scene_load_mem(const char *json, size_t len, const char *base_dir,
-                              const vfx_logger *logger, vfx_scene **out, char *err, size_t errlen);
+vfx_result rt_scene_load_mem(const char *json, size_t len, const char *base_dir,
+                              const rt_logger *logger, rt_scene **out, char *err, size_t errlen);
 /* Reads and parses a scene file; relative paths resolve against the file's folder. */
-vfx_result vfx_scene_load_file(const char *path, const vfx_logger *logger, vfx_scene **out,
+vfx_result rt_scene_load_file(const char *path, const rt_logger *logger, rt_scene **out,
                                char *err, size_t errlen);
 /* Frees a scene; NULL allowed. */
-void vfx_scene_free(vfx_scene *scene);
+void rt_scene_free(rt_scene *scene);
 
 /* Writes the beams at `time` (keyframes interpolated linearly, clamped at the ends, wrapped by
  * loop_s) into out[0..n); returns how many were written (min(n, beam_count)). */
-uint32_t vfx_scene_beams_at(const vfx_scene *scene, double time, vfx_beam *out, uint32_t n);
+uint32_t rt_scene_beams_at(const rt_scene *scene, double time, vfx_beam *out, uint32_t n);
 /* Linear interpolation of one track at time t into out[0..dim); clamped at the ends. */
-void vfx_scene_track_eval(const vfx_scene_track *track, double t, float *out);
+void rt_scene_track_eval(const rt_scene_track *track, double t, float *out);
 
 /* The water's initial particles (x,y,z interleaved, malloc'd; caller frees): read from the
  * file, laid out by the generator, or the simulation's initial fluid block. */
-vfx_result vfx_scene_water_particles(const vfx_scene_water *water, float **xyz, uint32_t *count,
+vfx_result rt_scene_water_particles(const rt_scene_water *water, float **xyz, uint32_t *count,
                                      char *err, size_t errlen);
 
 /* Resamples the transfer function to n uniform RGBA entries over [first, last] control-point
  * scalar; smin and smax receive that domain (both 0 when normalized: the plugin uses the data
  * range). rgba must hold 4*n floats; n >= 2. */
-void vfx_scene_transfer_sample(const vfx_scene_volume *v, uint32_t n, float *rgba, float *smin,
+void rt_scene_transfer_sample(const rt_scene_volume *v, uint32_t n, float *rgba, float *smin,
                                float *smax);
 
 /* A generated tetrahedral grid: gen_cells^3 cubes of 6 positively oriented tets each, with the
  * scalar 1 - |p - centre| / half-diagonal per point. Arrays are malloc'd; caller frees. */
-vfx_result vfx_scene_volume_generate(const vfx_scene_volume *v, float **points, uint32_t *point_count,
+vfx_result rt_scene_volume_generate(const rt_scene_volume *v, float **points, uint32_t *point_count,
                                      uint32_t **tets, uint32_t *tet_count, float **scalar,
                                      char *err, size_t errlen);
 

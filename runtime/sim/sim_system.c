@@ -6,10 +6,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-struct vfx_sim_system {
-    vfx_sph *sph;
-    vfx_particle_components pc;
-    vfx_sph_report report;
+struct rt_sim_system {
+    rt_sph *sph;
+    rt_particle_components pc;
+    rt_sph_report report;
     /* import buffers (world order) */
     float *x, *y, *z, *vx, *vy, *vz;
     uint32_t cap;
@@ -19,7 +19,7 @@ struct vfx_sim_system {
     char err[512];
 };
 
-static vfx_result grow(vfx_sim_system *s, uint32_t n)
+static vfx_result grow(rt_sim_system *s, uint32_t n)
 {
     if (n <= s->cap)
         return VFX_OK;
@@ -39,7 +39,7 @@ static vfx_result grow(vfx_sim_system *s, uint32_t n)
     return VFX_OK;
 }
 
-static vfx_result grow_tables(vfx_sim_system *s, uint32_t n)
+static vfx_result grow_tables(rt_sim_system *s, uint32_t n)
 {
     if (n <= s->table_cap)
         return VFX_OK;
@@ -57,19 +57,19 @@ static vfx_result grow_tables(vfx_sim_system *s, uint32_t n)
     return VFX_OK;
 }
 
-static vfx_result sim_run(vfx_world *w, const vfx_system_ctx *ctx)
+static vfx_result sim_run(rt_world *w, const rt_system_ctx *ctx)
 {
-    vfx_sim_system *s = ctx->user;
+    rt_sim_system *s = ctx->user;
     s->err[0] = 0;
-    vfx_component terms[3] = {s->pc.position, s->pc.velocity, s->pc.density};
-    uint32_t n = vfx_query_count(w, terms, 3);
+    rt_component terms[3] = {s->pc.position, s->pc.velocity, s->pc.density};
+    uint32_t n = rt_query_count(w, terms, 3);
     vfx_result r = grow(s, n);
     if (r)
         return r;
     /* import, remembering where each table starts in the global order */
     uint32_t k = 0, nt = 0;
-    vfx_query_iter it = vfx_query_begin(w, terms, 3);
-    while (vfx_query_next(&it)) {
+    rt_query_iter it = rt_query_begin(w, terms, 3);
+    while (rt_query_next(&it)) {
         if (grow_tables(s, nt + 1)) {
             snprintf(s->err, sizeof s->err, "vfx.sim.sph: out of memory");
             return VFX_ERR_OUT_OF_MEMORY;
@@ -78,9 +78,9 @@ static vfx_result sim_run(vfx_world *w, const vfx_system_ctx *ctx)
         s->table_rows[nt] = it.rows;
         s->table_index[nt] = it.table;
         nt++;
-        const float *c[6] = {vfx_query_column(&it, s->pc.position, 0), vfx_query_column(&it, s->pc.position, 1),
-                             vfx_query_column(&it, s->pc.position, 2), vfx_query_column(&it, s->pc.velocity, 0),
-                             vfx_query_column(&it, s->pc.velocity, 1), vfx_query_column(&it, s->pc.velocity, 2)};
+        const float *c[6] = {rt_query_column(&it, s->pc.position, 0), rt_query_column(&it, s->pc.position, 1),
+                             rt_query_column(&it, s->pc.position, 2), rt_query_column(&it, s->pc.velocity, 0),
+                             rt_query_column(&it, s->pc.velocity, 1), rt_query_column(&it, s->pc.velocity, 2)};
         float *d[6] = {s->x + k, s->y + k, s->z + k, s->vx + k, s->vy + k, s->vz + k};
         for (int f = 0; f < 6; ++f)
             memcpy(d[f], c[f], (size_t)it.rows * sizeof(float));
@@ -89,7 +89,7 @@ static vfx_result sim_run(vfx_world *w, const vfx_system_ctx *ctx)
     /* Nothing changed since the last write-back (same count, every imported value the solver's
      * own, by id): keep the solver's state, and with it its Verlet lists and grid order (a
      * clear and add would force a rebuild every frame). Any edit, spawn or despawn re-imports. */
-    vfx_sph_columns c0 = vfx_sph_get_columns(s->sph);
+    rt_sph_columns c0 = rt_sph_get_columns(s->sph);
     bool same = k > 0 && c0.count == k;
     for (uint32_t i = 0; same && i < c0.count; ++i) {
         uint32_t id = c0.id[i];
@@ -97,27 +97,27 @@ static vfx_result sim_run(vfx_world *w, const vfx_system_ctx *ctx)
                s->vx[id] == c0.vx[i] && s->vy[id] == c0.vy[i] && s->vz[id] == c0.vz[i];
     }
     if (!same) {
-        vfx_sph_clear(s->sph);
-        r = vfx_sph_add_particles(s->sph, k, s->x, s->y, s->z, s->vx, s->vy, s->vz);
+        rt_sph_clear(s->sph);
+        r = rt_sph_add_particles(s->sph, k, s->x, s->y, s->z, s->vx, s->vy, s->vz);
         if (r) {
-            snprintf(s->err, sizeof s->err, "vfx.sim.sph: %s", vfx_sph_last_error(s->sph));
+            snprintf(s->err, sizeof s->err, "vfx.sim.sph: %s", rt_sph_last_error(s->sph));
             return r;
         }
     }
-    r = vfx_sph_step(s->sph, ctx->dt, &s->report);
+    r = rt_sph_step(s->sph, ctx->dt, &s->report);
     if (r)
-        snprintf(s->err, sizeof s->err, "vfx.sim.sph: %s", vfx_sph_last_error(s->sph));
+        snprintf(s->err, sizeof s->err, "vfx.sim.sph: %s", rt_sph_last_error(s->sph));
     /* write back (even after a numeric failure: the solver then holds the last good state,
      * which is finite). Solver rows are sorted by grid cell; id is the import index. */
-    vfx_sph_columns c = vfx_sph_get_columns(s->sph);
+    rt_sph_columns c = rt_sph_get_columns(s->sph);
     uint32_t t = 0;
-    it = vfx_query_begin(w, terms, 3);
-    while (vfx_query_next(&it) && t < nt) {
+    it = rt_query_begin(w, terms, 3);
+    while (rt_query_next(&it) && t < nt) {
         /* same tables in the same order as the import (nothing structural happened between) */
-        float *o[7] = {vfx_query_column(&it, s->pc.position, 0), vfx_query_column(&it, s->pc.position, 1),
-                       vfx_query_column(&it, s->pc.position, 2), vfx_query_column(&it, s->pc.velocity, 0),
-                       vfx_query_column(&it, s->pc.velocity, 1), vfx_query_column(&it, s->pc.velocity, 2),
-                       vfx_query_column(&it, s->pc.density, 0)};
+        float *o[7] = {rt_query_column(&it, s->pc.position, 0), rt_query_column(&it, s->pc.position, 1),
+                       rt_query_column(&it, s->pc.position, 2), rt_query_column(&it, s->pc.velocity, 0),
+                       rt_query_column(&it, s->pc.velocity, 1), rt_query_column(&it, s->pc.velocity, 2),
+                       rt_query_column(&it, s->pc.density, 0)};
         uint32_t base = s->table_base[t], rows = s->table_rows[t];
         const float *src[7] = {c.x, c.y, c.z, c.vx, c.vy, c.vz, c.density};
         for (uint32_t i = 0; i < c.count; ++i) {
@@ -132,18 +132,18 @@ static vfx_result sim_run(vfx_world *w, const vfx_system_ctx *ctx)
     /* particles the emitters made: new entities */
     uint32_t extra = c.count > k ? c.count - k : 0;
     if (extra && r == VFX_OK) {
-        vfx_entity *ids = malloc((size_t)extra * sizeof *ids);
+        rt_entity *ids = malloc((size_t)extra * sizeof *ids);
         if (!ids)
             return VFX_ERR_OUT_OF_MEMORY;
-        r = vfx_world_spawn(w, extra, terms, 3, ids);
+        r = rt_world_spawn(w, extra, terms, 3, ids);
         if (!r) {
             for (uint32_t i = 0; i < c.count; ++i) {
                 if (c.id[i] < k)
                     continue;
-                vfx_entity e = ids[c.id[i] - k];
+                rt_entity e = ids[c.id[i] - k];
                 float vals[7] = {c.x[i], c.y[i], c.z[i], c.vx[i], c.vy[i], c.vz[i], c.density[i]};
                 for (int f = 0; f < 7; ++f) {
-                    float *p = vfx_world_get(w, e, f < 3 ? s->pc.position : f < 6 ? s->pc.velocity : s->pc.density,
+                    float *p = rt_world_get(w, e, f < 3 ? s->pc.position : f < 6 ? s->pc.velocity : s->pc.density,
                                              (uint32_t)(f < 6 ? f % 3 : 0));
                     if (p)
                         *p = vals[f];
@@ -151,14 +151,14 @@ static vfx_result sim_run(vfx_world *w, const vfx_system_ctx *ctx)
             }
         } else {
             snprintf(s->err, sizeof s->err, "vfx.sim.sph: spawning %u emitted particles: %s", extra,
-                     vfx_world_last_error(w));
+                     rt_world_last_error(w));
         }
         free(ids);
     }
     return r;
 }
 
-vfx_result vfx_sim_system_create(vfx_world *world, const vfx_sph_desc *desc, vfx_sim_system **out,
+vfx_result rt_sim_system_create(rt_world *world, const rt_sph_desc *desc, rt_sim_system **out,
                                  char *err, size_t err_len)
 {
     char dummy[8];
@@ -166,49 +166,49 @@ vfx_result vfx_sim_system_create(vfx_world *world, const vfx_sph_desc *desc, vfx
         err = dummy, err_len = sizeof dummy;
     err[0] = 0;
     if (!world || !out) {
-        snprintf(err, err_len, "vfx_sim_system_create: world and out are required");
+        snprintf(err, err_len, "rt_sim_system_create: world and out are required");
         return VFX_ERR_INVALID_ARGUMENT;
     }
     *out = NULL;
-    vfx_sim_system *s = calloc(1, sizeof *s);
+    rt_sim_system *s = calloc(1, sizeof *s);
     if (!s) {
-        snprintf(err, err_len, "vfx_sim_system_create: out of memory");
+        snprintf(err, err_len, "rt_sim_system_create: out of memory");
         return VFX_ERR_OUT_OF_MEMORY;
     }
-    vfx_result r = vfx_particles_register(world, &s->pc);
+    vfx_result r = rt_particles_register(world, &s->pc);
     if (r) {
-        snprintf(err, err_len, "vfx_sim_system_create: %s", vfx_world_last_error(world));
+        snprintf(err, err_len, "rt_sim_system_create: %s", rt_world_last_error(world));
         free(s);
         return r;
     }
-    r = vfx_sph_create(desc, &s->sph, err, err_len);
+    r = rt_sph_create(desc, &s->sph, err, err_len);
     if (r) {
         free(s);
         return r;
     }
-    vfx_component rw[3] = {s->pc.position, s->pc.velocity, s->pc.density};
-    vfx_system_desc sd = {.name = "vfx.sim.sph", .phase = VFX_PHASE_SIMULATE, .reads = rw, .read_count = 3,
+    rt_component rw[3] = {s->pc.position, s->pc.velocity, s->pc.density};
+    rt_system_desc sd = {.name = "vfx.sim.sph", .phase = RT_PHASE_SIMULATE, .reads = rw, .read_count = 3,
                           .writes = rw, .write_count = 3, .fn = sim_run, .user = s};
-    r = vfx_world_add_system(world, &sd);
+    r = rt_world_add_system(world, &sd);
     if (r) {
-        snprintf(err, err_len, "vfx_sim_system_create: %s", vfx_world_last_error(world));
-        vfx_sim_system_destroy(s);
+        snprintf(err, err_len, "rt_sim_system_create: %s", rt_world_last_error(world));
+        rt_sim_system_destroy(s);
         return r;
     }
     *out = s;
     return VFX_OK;
 }
 
-void vfx_sim_system_destroy(vfx_sim_system *s)
+void rt_sim_system_destroy(rt_sim_system *s)
 {
     if (!s)
         return;
-    vfx_sph_destroy(s->sph);
+    rt_sph_destroy(s->sph);
     free(s->x), free(s->y), free(s->z), free(s->vx), free(s->vy), free(s->vz);
     free(s->table_base), free(s->table_rows), free(s->table_index);
     free(s);
 }
 
-vfx_sph *vfx_sim_system_solver(vfx_sim_system *s) { return s ? s->sph : NULL; }
-const vfx_sph_report *vfx_sim_system_report(const vfx_sim_system *s) { return s ? &s->report : NULL; }
-const char *vfx_sim_system_last_error(const vfx_sim_system *s) { return s ? s->err : "vfx_sim_system is NULL"; }
+rt_sph *rt_sim_system_solver(rt_sim_system *s) { return s ? s->sph : NULL; }
+const rt_sph_report *rt_sim_system_report(const rt_sim_system *s) { return s ? &s->report : NULL; }
+const char *rt_sim_system_last_error(const rt_sim_system *s) { return s ? s->err : "rt_sim_system is NULL"; }

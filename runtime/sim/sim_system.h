@@ -6,27 +6,27 @@
  * writes position, velocity and density back to the same rows. So the game may spawn,
  * despawn or move particles between frames. Particles made by the solver's emitters are
  * spawned as new particle entities after the step. */
-#ifndef VFX_SIM_SYSTEM_H
-#define VFX_SIM_SYSTEM_H
+#ifndef RT_SIM_SYSTEM_H
+#define RT_SIM_SYSTEM_H
 
 #include "ecs/particles.h"
 #include "ecs/world.h"
 #include "sim/sph.h"
 
-typedef struct vfx_sim_system vfx_sim_system;
+typedef struct rt_sim_system rt_sim_system;
 
 /* Registers (or looks up) the particle components, creates the solver (NULL desc = defaults)
  * and adds the system to the world. Destroy the system only after the world is destroyed or
  * will not run again (the world keeps a pointer to it). */
-vfx_result vfx_sim_system_create(vfx_world *world, const vfx_sph_desc *desc, vfx_sim_system **out,
+vfx_result rt_sim_system_create(rt_world *world, const rt_sph_desc *desc, rt_sim_system **out,
                                  char *err, size_t err_len);
 /* Frees the solver and the system's buffers. NULL allowed. */
-void vfx_sim_system_destroy(vfx_sim_system *sys);
+void rt_sim_system_destroy(rt_sim_system *sys);
 /* The solver (add colliders and emitters through it; particles come from the world). */
-vfx_sph *vfx_sim_system_solver(vfx_sim_system *sys);
+rt_sph *rt_sim_system_solver(rt_sim_system *sys);
 /* Report of the last step (zeroed before the first). */
-const vfx_sph_report *vfx_sim_system_report(const vfx_sim_system *sys);
+const rt_sph_report *rt_sim_system_report(const rt_sim_system *sys);
 /* Last error message of the system or its solver ("" when none). */
-const char *vfx_sim_system_last_error(const vfx_sim_system *sys);
+const char *rt_sim_system_last_error(const rt_sim_system *sys);
 
 #endif

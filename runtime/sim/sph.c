@@ -45,7 +45,7 @@ typedef struct sph_chunk_out {
 } sph_chunk_out;
 
 typedef struct sph_collider_state {
-    vfx_sph_collider c;
+    rt_sph_collider c;
     float pos[3], vel[3]; /* at the current substep */
     /* triangle mesh: signed distance sampled on a grid (positive outside), trilinear */
     float *sdf;
@@ -54,17 +54,17 @@ typedef struct sph_collider_state {
 } sph_collider_state;
 
 typedef struct sph_emitter_state {
-    vfx_sph_emitter e;
+    rt_sph_emitter e;
     float u[3], w[3];     /* basis of the nozzle plane */
     double travelled;     /* distance moved by the last layer */
     uint32_t emitted;
     bool started;
 } sph_emitter_state;
 
-typedef void (*sph_chunk_fn)(vfx_sph *s, uint32_t chunk);
+typedef void (*sph_chunk_fn)(rt_sph *s, uint32_t chunk);
 
-struct vfx_sph {
-    vfx_sph_desc p;
+struct rt_sph {
+    rt_sph_desc p;
     float mass, H, H2, h, inv_cell;
     float k_poly6, k_spiky;          /* W = k_poly6 (H^2-r^2)^3, |grad W| = k_spiky (H-r)^2 */
     float wall_scale;                /* lattice calibration of the wall density fraction */
@@ -99,7 +99,7 @@ struct vfx_sph {
     /* Verlet lists: every pair within H + skin at the last rebuild, per chunk like cnb (rows
      * are only re-sorted at a rebuild, so a row's chunk is stable between rebuilds), and the
      * positions at that rebuild. Valid while 2 max|x - x0| < skin. */
-    bool verlet;                 /* false with VFX_SPH_REBUILD_EVERY_SUBSTEP */
+    bool verlet;                 /* false with RT_SPH_REBUILD_EVERY_SUBSTEP */
     bool lists_valid;
     int dens_mode;               /* density pass: 0 cell scan, 1 cell scan recording the Verlet
                                   * lists, 2 walk the Verlet lists */
@@ -121,8 +121,8 @@ struct vfx_sph {
     char err[512];
 };
 
-static void set_err(vfx_sph *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void set_err(vfx_sph *s, const char *fmt, ...)
+static void set_err(rt_sph *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void set_err(rt_sph *s, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -132,7 +132,7 @@ static void set_err(vfx_sph *s, const char *fmt, ...)
 
 /* ---- closed-form wall integrals ------------------------------------------------------------ */
 
-double vfx_sph_wall_density_fraction(double d, double H)
+double rt_sph_wall_density_fraction(double d, double H)
 {
     if (d >= H)
         return 0.0;
@@ -147,18 +147,18 @@ double vfx_sph_wall_density_fraction(double d, double H)
     return v;
 }
 
-double vfx_sph_wall_density_gradient(double d, double H)
+double rt_sph_wall_density_gradient(double d, double H)
 {
     if (d >= H)
         return 0.0;
     if (d < 0.0)
         d = 0.0;
-    /* -d/dd of vfx_sph_wall_density_fraction = (pi k/4) (H^2-d^2)^4 = (315/256)(1-u^2)^4/H */
+    /* -d/dd of rt_sph_wall_density_fraction = (pi k/4) (H^2-d^2)^4 = (315/256)(1-u^2)^4/H */
     double u = d / H, q = 1.0 - u * u;
     return 315.0 / 256.0 * q * q * q * q / H;
 }
 
-double vfx_sph_wall_friction_velocity(double ut, double y, double nu)
+double rt_sph_wall_friction_velocity(double ut, double y, double nu)
 {
     if (!(ut > 0.0) || !(y > 0.0) || !(nu > 0.0) || !isfinite(ut) || !isfinite(y) || !isfinite(nu))
         return 0.0;
@@ -187,7 +187,7 @@ double vfx_sph_wall_friction_velocity(double ut, double y, double nu)
 
 /* ---- thread pool --------------------------------------------------------------------------- */
 
-static void run_chunks(vfx_sph *s)
+static void run_chunks(rt_sph *s)
 {
     for (;;) {
         uint32_t c = atomic_fetch_add(&s->next_chunk, 1u);
@@ -199,7 +199,7 @@ static void run_chunks(vfx_sph *s)
 
 static void *worker_main(void *arg)
 {
-    vfx_sph *s = arg;
+    rt_sph *s = arg;
     uint64_t seen = 0;
     for (;;) {
         pthread_mutex_lock(&s->mu);
@@ -221,7 +221,7 @@ static void *worker_main(void *arg)
 
 /* Runs fn over every chunk on all threads. The density pass starts the chunk reductions
  * afresh; later passes of the same substep add to them and only reset the failure slot. */
-static void parallel(vfx_sph *s, sph_chunk_fn fn, bool fresh)
+static void parallel(rt_sph *s, sph_chunk_fn fn, bool fresh)
 {
     uint32_t nchunks = (s->n + SPH_CHUNK - 1) / SPH_CHUNK;
     for (uint32_t c = 0; c < nchunks; ++c) {
@@ -256,18 +256,18 @@ static void parallel(vfx_sph *s, sph_chunk_fn fn, bool fresh)
 
 static float def(float v, float d) { return v != 0.f ? v : d; }
 
-static vfx_result fill_params(vfx_sph_desc *p, char *err, size_t err_len)
+static vfx_result fill_params(rt_sph_desc *p, char *err, size_t err_len)
 {
     p->spacing = def(p->spacing, 0.02f);
     p->support_ratio = def(p->support_ratio, 2.0f);
     p->rest_density = def(p->rest_density, 1000.f);
     p->gamma = def(p->gamma, 7.f);
     p->cfl = def(p->cfl, 0.4f);
-    if (p->flags & VFX_SPH_NO_VISCOSITY)
+    if (p->flags & RT_SPH_NO_VISCOSITY)
         p->viscosity = 0.f;
     else
         p->viscosity = def(p->viscosity, 0.05f);
-    if (p->flags & VFX_SPH_NO_GRAVITY) {
+    if (p->flags & RT_SPH_NO_GRAVITY) {
         p->gravity[0] = p->gravity[1] = p->gravity[2] = 0.f;
     } else if (p->gravity[0] == 0.f && p->gravity[1] == 0.f && p->gravity[2] == 0.f) {
         p->gravity[1] = -9.81f;
@@ -288,8 +288,8 @@ static vfx_result fill_params(vfx_sph_desc *p, char *err, size_t err_len)
     p->density_change_limit = def(p->density_change_limit, 0.05f);
     p->kinematic_viscosity = def(p->kinematic_viscosity, 1.0e-6f);
     if (p->no_slip_faces & ~0x3fu) {
-        snprintf(err, err_len, "vfx_sph_create: desc.no_slip_faces 0x%x has bits beyond the six "
-                 "VFX_SPH_FACE_* faces", p->no_slip_faces);
+        snprintf(err, err_len, "rt_sph_create: desc.no_slip_faces 0x%x has bits beyond the six "
+                 "RT_SPH_FACE_* faces", p->no_slip_faces);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     p->neighbor_skin = def(p->neighbor_skin, 0.3f); /* measured: docs/simulation.md */
@@ -309,7 +309,7 @@ static vfx_result fill_params(vfx_sph_desc *p, char *err, size_t err_len)
                                   "neighbor_skin"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
         if (!isfinite(*fields[i])) {
-            snprintf(err, err_len, "vfx_sph_create: desc.%s is not finite", names[i]);
+            snprintf(err, err_len, "rt_sph_create: desc.%s is not finite", names[i]);
             return VFX_ERR_INVALID_ARGUMENT;
         }
     }
@@ -317,19 +317,19 @@ static vfx_result fill_params(vfx_sph_desc *p, char *err, size_t err_len)
         p->viscosity < 0.f || p->cfl <= 0.f || p->cfl > 1.f || p->sound_speed < 0.f ||
         p->stiffness < 0.f || p->velocity_limit < 0.f || p->density_change_limit < 0.f ||
         p->kinematic_viscosity < 0.f) {
-        snprintf(err, err_len, "vfx_sph_create: a parameter is out of range (spacing>0, "
+        snprintf(err, err_len, "rt_sph_create: a parameter is out of range (spacing>0, "
                  "support_ratio>=1, rest_density>0, gamma>=1, 0<cfl<=1, others >= 0)");
         return VFX_ERR_INVALID_ARGUMENT;
     }
     if (!(p->neighbor_skin > 0.f && p->neighbor_skin <= 1.f)) {
-        /* <= 1: vfx_sph_volume_fraction's 7x7x7 stencil of H/2 cells reaches H + skin/2 */
-        snprintf(err, err_len, "vfx_sph_create: desc.neighbor_skin %g must be in (0, 1] (a "
+        /* <= 1: rt_sph_volume_fraction's 7x7x7 stencil of H/2 cells reaches H + skin/2 */
+        snprintf(err, err_len, "rt_sph_create: desc.neighbor_skin %g must be in (0, 1] (a "
                  "fraction of H)", (double)p->neighbor_skin);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     for (int a = 0; a < 3; ++a) {
         if (!(p->domain_max[a] - p->domain_min[a] >= 2.f * p->spacing)) {
-            snprintf(err, err_len, "vfx_sph_create: domain axis %d is thinner than 2 spacings "
+            snprintf(err, err_len, "rt_sph_create: domain axis %d is thinner than 2 spacings "
                      "(%g..%g)", a, p->domain_min[a], p->domain_max[a]);
             return VFX_ERR_INVALID_ARGUMENT;
         }
@@ -339,24 +339,24 @@ static vfx_result fill_params(vfx_sph_desc *p, char *err, size_t err_len)
     return VFX_OK;
 }
 
-vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, size_t err_len)
+vfx_result rt_sph_create(const rt_sph_desc *desc, rt_sph **out, char *err, size_t err_len)
 {
     char dummy[8];
     if (!err || err_len == 0)
         err = dummy, err_len = sizeof dummy;
     err[0] = 0;
     if (!out) {
-        snprintf(err, err_len, "vfx_sph_create: out is NULL");
+        snprintf(err, err_len, "rt_sph_create: out is NULL");
         return VFX_ERR_INVALID_ARGUMENT;
     }
     *out = NULL;
-    vfx_sph_desc p = desc ? *desc : (vfx_sph_desc){0};
+    rt_sph_desc p = desc ? *desc : (rt_sph_desc){0};
     vfx_result r = fill_params(&p, err, err_len);
     if (r)
         return r;
-    vfx_sph *s = calloc(1, sizeof *s);
+    rt_sph *s = calloc(1, sizeof *s);
     if (!s) {
-        snprintf(err, err_len, "vfx_sph_create: out of memory");
+        snprintf(err, err_len, "rt_sph_create: out of memory");
         return VFX_ERR_OUT_OF_MEMORY;
     }
     s->H = p.spacing * p.support_ratio;
@@ -403,7 +403,7 @@ vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, si
                 if (q > 0)
                     beyond += (double)s->k_poly6 * q * q * q;
             }
-    s->wall_scale = (float)(beyond / sum / vfx_sph_wall_density_fraction(0.5 * p.spacing, s->H));
+    s->wall_scale = (float)(beyond / sum / rt_sph_wall_density_fraction(0.5 * p.spacing, s->H));
     /* Wall-law friction: a wall shear stress tau = rho0 u*^2 is a force per wall area; it is
      * spread over the particles within H of the wall with the weight of the wall-density
      * gradient g(d), a = u*^2 g(d) fric_scale. On the lattice (layers at d = dx/2 + k dx, mass
@@ -411,7 +411,7 @@ vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, si
      * fric_scale = rho0 dx^3 / (m sum_k dx g(d_k)). */
     double gl = 0.0;
     for (int k = 0; (k + 0.5) * p.spacing < s->H; ++k)
-        gl += p.spacing * vfx_sph_wall_density_gradient((k + 0.5) * p.spacing, s->H);
+        gl += p.spacing * rt_sph_wall_density_gradient((k + 0.5) * p.spacing, s->H);
     s->fric_scale = (float)(p.rest_density * pow(p.spacing, 3) / (s->mass * gl));
     s->friction = p.no_slip_faces != 0;
     float height = 0.f, g = sqrtf(p.gravity[0] * p.gravity[0] + p.gravity[1] * p.gravity[1] +
@@ -430,7 +430,7 @@ vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, si
     s->B = p.stiffness;
     s->c0 = p.sound_speed;
     s->p = p;
-    s->verlet = !(p.flags & VFX_SPH_REBUILD_EVERY_SUBSTEP);
+    s->verlet = !(p.flags & RT_SPH_REBUILD_EVERY_SUBSTEP);
     s->skin = p.neighbor_skin * s->H;
     s->S2 = (s->H + s->skin) * (s->H + s->skin);
     /* cells of H/2 and a 5x5x5 stencil: 42% fewer candidate pairs than H cells and 3x3x3 */
@@ -439,7 +439,7 @@ vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, si
     for (int a = 0; a < 3; ++a)
         dims[a] = ceil((p.domain_max[a] - p.domain_min[a]) * s->inv_cell);
     if (dims[0] * dims[1] * dims[2] > SPH_MAX_CELLS) {
-        snprintf(err, err_len, "vfx_sph_create: domain/support gives %.0f grid cells (max %u): "
+        snprintf(err, err_len, "rt_sph_create: domain/support gives %.0f grid cells (max %u): "
                  "shrink the domain or grow the spacing", dims[0] * dims[1] * dims[2], SPH_MAX_CELLS);
         free(s);
         return VFX_ERR_INVALID_ARGUMENT;
@@ -448,7 +448,7 @@ vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, si
     s->ncells = (uint32_t)(s->nx * s->ny * s->nz);
     s->cell_start = calloc((size_t)s->ncells + 1, sizeof *s->cell_start);
     if (!s->cell_start) {
-        snprintf(err, err_len, "vfx_sph_create: out of memory for %u grid cells", s->ncells);
+        snprintf(err, err_len, "rt_sph_create: out of memory for %u grid cells", s->ncells);
         free(s);
         return VFX_ERR_OUT_OF_MEMORY;
     }
@@ -461,8 +461,8 @@ vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, si
     if (workers) {
         s->threads = calloc(workers, sizeof *s->threads);
         if (!s->threads) {
-            vfx_sph_destroy(s);
-            snprintf(err, err_len, "vfx_sph_create: out of memory");
+            rt_sph_destroy(s);
+            snprintf(err, err_len, "rt_sph_create: out of memory");
             return VFX_ERR_OUT_OF_MEMORY;
         }
         for (uint32_t i = 0; i < workers; ++i) {
@@ -477,7 +477,7 @@ vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, si
     return VFX_OK;
 }
 
-static void free_columns(vfx_sph *s)
+static void free_columns(rt_sph *s)
 {
     float **f[] = {&s->x, &s->y, &s->z, &s->vx, &s->vy, &s->vz, &s->rho, &s->pr, &s->ax, &s->ay,
                    &s->az, &s->drho, &s->xn, &s->yn, &s->zn, &s->vxn, &s->vyn, &s->vzn, &s->tmp,
@@ -501,7 +501,7 @@ static void free_columns(vfx_sph *s)
     s->lists_valid = false;
 }
 
-void vfx_sph_destroy(vfx_sph *s)
+void rt_sph_destroy(rt_sph *s)
 {
     if (!s)
         return;
@@ -523,15 +523,15 @@ void vfx_sph_destroy(vfx_sph *s)
     free(s);
 }
 
-const char *vfx_sph_last_error(const vfx_sph *s) { return s ? s->err : "vfx_sph is NULL"; }
-const vfx_sph_desc *vfx_sph_params(const vfx_sph *s) { return s ? &s->p : NULL; }
-float vfx_sph_particle_mass(const vfx_sph *s) { return s ? s->mass : 0.f; }
-float vfx_sph_support(const vfx_sph *s) { return s ? s->H : 0.f; }
-uint32_t vfx_sph_clamped_on_add(const vfx_sph *s) { return s ? s->clamped_on_add : 0; }
-double vfx_sph_time(const vfx_sph *s) { return s ? s->time : 0.0; }
-uint32_t vfx_sph_thread_count(const vfx_sph *s) { return s ? s->nthreads + 1 : 0; }
+const char *rt_sph_last_error(const rt_sph *s) { return s ? s->err : "rt_sph is NULL"; }
+const rt_sph_desc *rt_sph_params(const rt_sph *s) { return s ? &s->p : NULL; }
+float rt_sph_particle_mass(const rt_sph *s) { return s ? s->mass : 0.f; }
+float rt_sph_support(const rt_sph *s) { return s ? s->H : 0.f; }
+uint32_t rt_sph_clamped_on_add(const rt_sph *s) { return s ? s->clamped_on_add : 0; }
+double rt_sph_time(const rt_sph *s) { return s ? s->time : 0.0; }
+uint32_t rt_sph_thread_count(const rt_sph *s) { return s ? s->nthreads + 1 : 0; }
 
-size_t vfx_sph_memory_bytes(const vfx_sph *s)
+size_t rt_sph_memory_bytes(const rt_sph *s)
 {
     if (!s)
         return 0;
@@ -543,24 +543,24 @@ size_t vfx_sph_memory_bytes(const vfx_sph *s)
            ((size_t)s->ncells + 1) * sizeof(uint32_t) + (size_t)s->out_cap * sizeof(sph_chunk_out);
 }
 
-float vfx_sph_pressure(const vfx_sph *s, uint32_t i)
+float rt_sph_pressure(const rt_sph *s, uint32_t i)
 {
     if (!s || i >= s->n)
         return 0.f;
     return s->pr[i] * s->rho[i] * s->rho[i];
 }
 
-vfx_sph_columns vfx_sph_get_columns(vfx_sph *s)
+rt_sph_columns rt_sph_get_columns(rt_sph *s)
 {
     if (!s)
-        return (vfx_sph_columns){0};
-    return (vfx_sph_columns){s->n, s->x, s->y, s->z, s->vx, s->vy, s->vz, s->rho, s->id};
+        return (rt_sph_columns){0};
+    return (rt_sph_columns){s->n, s->x, s->y, s->z, s->vx, s->vy, s->vz, s->rho, s->id};
 }
 
-static vfx_result reserve(vfx_sph *s, uint64_t want)
+static vfx_result reserve(rt_sph *s, uint64_t want)
 {
     if (want > s->p.max_particles) {
-        set_err(s, "vfx_sph: %llu particles requested, capacity bound is %u (desc.max_particles)",
+        set_err(s, "rt_sph: %llu particles requested, capacity bound is %u (desc.max_particles)",
                 (unsigned long long)want, s->p.max_particles);
         return VFX_ERR_INVALID_ARGUMENT;
     }
@@ -622,13 +622,13 @@ static vfx_result reserve(vfx_sph *s, uint64_t want)
     s->cap = (uint32_t)cap;
     return VFX_OK;
 oom:
-    set_err(s, "vfx_sph: out of memory growing to %llu particles", (unsigned long long)cap);
+    set_err(s, "rt_sph: out of memory growing to %llu particles", (unsigned long long)cap);
     return VFX_ERR_OUT_OF_MEMORY;
 }
 
 static float clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
-vfx_result vfx_sph_add_particles(vfx_sph *s, uint32_t n, const float *x, const float *y,
+vfx_result rt_sph_add_particles(rt_sph *s, uint32_t n, const float *x, const float *y,
                                  const float *z, const float *vx, const float *vy, const float *vz)
 {
     if (!s)
@@ -637,11 +637,11 @@ vfx_result vfx_sph_add_particles(vfx_sph *s, uint32_t n, const float *x, const f
     if (n == 0)
         return VFX_OK;
     if (!x || !y || !z) {
-        set_err(s, "vfx_sph_add_particles: position array is NULL for %u particles", n);
+        set_err(s, "rt_sph_add_particles: position array is NULL for %u particles", n);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     if ((uint64_t)s->n + n > s->p.max_particles) {
-        set_err(s, "vfx_sph_add_particles: %u + %u particles exceed the capacity bound %u "
+        set_err(s, "rt_sph_add_particles: %u + %u particles exceed the capacity bound %u "
                 "(desc.max_particles)", s->n, n, s->p.max_particles);
         return VFX_ERR_INVALID_ARGUMENT;
     }
@@ -650,7 +650,7 @@ vfx_result vfx_sph_add_particles(vfx_sph *s, uint32_t n, const float *x, const f
     for (uint32_t i = 0; i < n; ++i)
         for (int a = 0; a < 6; ++a)
             if (arr[a] && !isfinite(arr[a][i])) {
-                set_err(s, "vfx_sph_add_particles: particle %u (of %u in this batch) has a "
+                set_err(s, "rt_sph_add_particles: particle %u (of %u in this batch) has a "
                         "non-finite %s (%g); batch refused", i, n, nm[a], (double)arr[a][i]);
                 return VFX_ERR_INVALID_ARGUMENT;
             }
@@ -679,7 +679,7 @@ vfx_result vfx_sph_add_particles(vfx_sph *s, uint32_t n, const float *x, const f
     return VFX_OK;
 }
 
-void vfx_sph_clear(vfx_sph *s)
+void rt_sph_clear(rt_sph *s)
 {
     if (!s)
         return;
@@ -688,7 +688,7 @@ void vfx_sph_clear(vfx_sph *s)
     s->lists_valid = false;
 }
 
-vfx_result vfx_sph_add_block(vfx_sph *s, const float lo[3], const float hi[3], uint32_t *added)
+vfx_result rt_sph_add_block(rt_sph *s, const float lo[3], const float hi[3], uint32_t *added)
 {
     if (added)
         *added = 0;
@@ -698,7 +698,7 @@ vfx_result vfx_sph_add_block(vfx_sph *s, const float lo[3], const float hi[3], u
     uint64_t c[3];
     for (int a = 0; a < 3; ++a) {
         if (!isfinite(lo[a]) || !isfinite(hi[a]) || hi[a] < lo[a]) {
-            set_err(s, "vfx_sph_add_block: bad bounds on axis %d (%g..%g)", a, (double)lo[a], (double)hi[a]);
+            set_err(s, "rt_sph_add_block: bad bounds on axis %d (%g..%g)", a, (double)lo[a], (double)hi[a]);
             return VFX_ERR_INVALID_ARGUMENT;
         }
         c[a] = (uint64_t)floor((hi[a] - lo[a]) / dx + 1e-4);
@@ -740,40 +740,40 @@ vfx_result vfx_sph_add_block(vfx_sph *s, const float lo[3], const float hi[3], u
 
 static bool finite3(const float *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
 
-vfx_result vfx_sph_add_collider(vfx_sph *s, const vfx_sph_collider *c, uint32_t *index)
+vfx_result rt_sph_add_collider(rt_sph *s, const rt_sph_collider *c, uint32_t *index)
 {
     if (!s || !c)
         return VFX_ERR_INVALID_ARGUMENT;
     if (s->ncol >= SPH_MAX_COLLIDERS) {
-        set_err(s, "vfx_sph_add_collider: at most %u colliders", SPH_MAX_COLLIDERS);
+        set_err(s, "rt_sph_add_collider: at most %u colliders", SPH_MAX_COLLIDERS);
         return VFX_ERR_INVALID_ARGUMENT;
     }
-    vfx_sph_collider k = *c;
+    rt_sph_collider k = *c;
     if (!finite3(k.center) || !finite3(k.normal) || !finite3(k.half) || !finite3(k.motion_axis) ||
         !isfinite(k.radius) || !isfinite(k.motion_amplitude) || !isfinite(k.motion_frequency)) {
-        set_err(s, "vfx_sph_add_collider: collider %u has a non-finite field", s->ncol);
+        set_err(s, "rt_sph_add_collider: collider %u has a non-finite field", s->ncol);
         return VFX_ERR_INVALID_ARGUMENT;
     }
-    if (k.kind == VFX_SPH_PLANE) {
+    if (k.kind == RT_SPH_PLANE) {
         float l = sqrtf(k.normal[0] * k.normal[0] + k.normal[1] * k.normal[1] + k.normal[2] * k.normal[2]);
         if (!(l > 1e-6f)) {
-            set_err(s, "vfx_sph_add_collider: plane %u has a zero normal", s->ncol);
+            set_err(s, "rt_sph_add_collider: plane %u has a zero normal", s->ncol);
             return VFX_ERR_INVALID_ARGUMENT;
         }
         for (int a = 0; a < 3; ++a)
             k.normal[a] /= l;
-    } else if (k.kind == VFX_SPH_SPHERE) {
+    } else if (k.kind == RT_SPH_SPHERE) {
         if (!(k.radius > 0.f)) {
-            set_err(s, "vfx_sph_add_collider: sphere %u needs radius > 0 (got %g)", s->ncol, (double)k.radius);
+            set_err(s, "rt_sph_add_collider: sphere %u needs radius > 0 (got %g)", s->ncol, (double)k.radius);
             return VFX_ERR_INVALID_ARGUMENT;
         }
-    } else if (k.kind == VFX_SPH_BOX) {
+    } else if (k.kind == RT_SPH_BOX) {
         if (!(k.half[0] > 0.f && k.half[1] > 0.f && k.half[2] > 0.f)) {
-            set_err(s, "vfx_sph_add_collider: box %u needs half extents > 0", s->ncol);
+            set_err(s, "rt_sph_add_collider: box %u needs half extents > 0", s->ncol);
             return VFX_ERR_INVALID_ARGUMENT;
         }
     } else {
-        set_err(s, "vfx_sph_add_collider: unknown kind %d", (int)k.kind);
+        set_err(s, "rt_sph_add_collider: unknown kind %d", (int)k.kind);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     float al = sqrtf(k.motion_axis[0] * k.motion_axis[0] + k.motion_axis[1] * k.motion_axis[1] +
@@ -794,20 +794,20 @@ vfx_result vfx_sph_add_collider(vfx_sph *s, const vfx_sph_collider *c, uint32_t 
     return VFX_OK;
 }
 
-vfx_result vfx_sph_add_emitter(vfx_sph *s, const vfx_sph_emitter *e)
+vfx_result rt_sph_add_emitter(rt_sph *s, const rt_sph_emitter *e)
 {
     if (!s || !e)
         return VFX_ERR_INVALID_ARGUMENT;
     if (s->nem >= SPH_MAX_EMITTERS) {
-        set_err(s, "vfx_sph_add_emitter: at most %u emitters", SPH_MAX_EMITTERS);
+        set_err(s, "rt_sph_add_emitter: at most %u emitters", SPH_MAX_EMITTERS);
         return VFX_ERR_INVALID_ARGUMENT;
     }
-    vfx_sph_emitter k = *e;
+    rt_sph_emitter k = *e;
     float l = sqrtf(k.direction[0] * k.direction[0] + k.direction[1] * k.direction[1] +
                     k.direction[2] * k.direction[2]);
     if (!finite3(k.center) || !(l > 1e-6f) || !isfinite(l) || !(k.speed > 0.f) || !isfinite(k.speed) ||
         !(k.radius >= 0.5f * s->p.spacing) || !isfinite(k.radius)) {
-        set_err(s, "vfx_sph_add_emitter: emitter %u needs finite centre, non-zero direction, "
+        set_err(s, "rt_sph_add_emitter: emitter %u needs finite centre, non-zero direction, "
                 "speed > 0 and radius >= spacing/2", s->nem);
         return VFX_ERR_INVALID_ARGUMENT;
     }
@@ -897,24 +897,24 @@ static double tri_solid_angle(const double p[3], const double a0[3], const doubl
     return 2.0 * atan2(det, den);
 }
 
-vfx_result vfx_sph_add_mesh_collider(vfx_sph *s, const float *positions, uint32_t vertex_count,
+vfx_result rt_sph_add_mesh_collider(rt_sph *s, const float *positions, uint32_t vertex_count,
                                      const uint32_t *indices, uint32_t index_count,
-                                     const vfx_sph_collider *motion, uint32_t *index)
+                                     const rt_sph_collider *motion, uint32_t *index)
 {
     if (!s)
         return VFX_ERR_INVALID_ARGUMENT;
     s->err[0] = 0;
     if (s->ncol >= SPH_MAX_COLLIDERS) {
-        set_err(s, "vfx_sph_add_mesh_collider: at most %u colliders", SPH_MAX_COLLIDERS);
+        set_err(s, "rt_sph_add_mesh_collider: at most %u colliders", SPH_MAX_COLLIDERS);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     if (!positions || !indices || vertex_count == 0 || index_count < 3 || index_count % 3 != 0) {
-        set_err(s, "vfx_sph_add_mesh_collider: need vertices and a multiple of 3 indices (got %u "
+        set_err(s, "rt_sph_add_mesh_collider: need vertices and a multiple of 3 indices (got %u "
                 "vertices, %u indices)", vertex_count, index_count);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     if (index_count / 3 > SPH_MAX_MESH_TRIANGLES) {
-        set_err(s, "vfx_sph_add_mesh_collider: %u triangles, at most %u (the distance field is "
+        set_err(s, "rt_sph_add_mesh_collider: %u triangles, at most %u (the distance field is "
                 "built by brute force)", index_count / 3, SPH_MAX_MESH_TRIANGLES);
         return VFX_ERR_INVALID_ARGUMENT;
     }
@@ -923,7 +923,7 @@ vfx_result vfx_sph_add_mesh_collider(vfx_sph *s, const float *positions, uint32_
         for (int a = 0; a < 3; ++a) {
             float x = positions[3 * v + a];
             if (!isfinite(x)) {
-                set_err(s, "vfx_sph_add_mesh_collider: vertex %u is not finite", v);
+                set_err(s, "rt_sph_add_mesh_collider: vertex %u is not finite", v);
                 return VFX_ERR_INVALID_ARGUMENT;
             }
             lo[a] = x < lo[a] ? x : lo[a];
@@ -931,7 +931,7 @@ vfx_result vfx_sph_add_mesh_collider(vfx_sph *s, const float *positions, uint32_
         }
     for (uint32_t i = 0; i < index_count; ++i)
         if (indices[i] >= vertex_count) {
-            set_err(s, "vfx_sph_add_mesh_collider: triangle %u uses vertex %u of %u", i / 3,
+            set_err(s, "rt_sph_add_mesh_collider: triangle %u uses vertex %u of %u", i / 3,
                     indices[i], vertex_count);
             return VFX_ERR_INVALID_ARGUMENT;
         }
@@ -940,11 +940,11 @@ vfx_result vfx_sph_add_mesh_collider(vfx_sph *s, const float *positions, uint32_
         st.c = *motion;
         if (!finite3(st.c.center) || !finite3(st.c.motion_axis) || !isfinite(st.c.motion_amplitude) ||
             !isfinite(st.c.motion_frequency)) {
-            set_err(s, "vfx_sph_add_mesh_collider: motion has a non-finite field");
+            set_err(s, "rt_sph_add_mesh_collider: motion has a non-finite field");
             return VFX_ERR_INVALID_ARGUMENT;
         }
     }
-    st.c.kind = VFX_SPH_BOX; /* unused for meshes: the sdf decides */
+    st.c.kind = RT_SPH_BOX; /* unused for meshes: the sdf decides */
     float al = sqrtf(st.c.motion_axis[0] * st.c.motion_axis[0] + st.c.motion_axis[1] * st.c.motion_axis[1] +
                      st.c.motion_axis[2] * st.c.motion_axis[2]);
     if (al > 0.f)
@@ -966,7 +966,7 @@ vfx_result vfx_sph_add_mesh_collider(vfx_sph *s, const float *positions, uint32_
     }
     st.sdf = malloc(total * sizeof(float));
     if (!st.sdf) {
-        set_err(s, "vfx_sph_add_mesh_collider: out of memory for a %zu-node distance field", total);
+        set_err(s, "rt_sph_add_mesh_collider: out of memory for a %zu-node distance field", total);
         return VFX_ERR_OUT_OF_MEMORY;
     }
     uint32_t ntri = index_count / 3;
@@ -1050,15 +1050,15 @@ static float mesh_distance(const sph_collider_state *st, float px, float py, flo
 
 static float collider_distance(const sph_collider_state *st, float px, float py, float pz, float n[3])
 {
-    const vfx_sph_collider *c = &st->c;
+    const rt_sph_collider *c = &st->c;
     if (st->sdf)
         return mesh_distance(st, px, py, pz, n);
     float dx = px - st->pos[0], dy = py - st->pos[1], dz = pz - st->pos[2];
-    if (c->kind == VFX_SPH_PLANE) {
+    if (c->kind == RT_SPH_PLANE) {
         n[0] = c->normal[0], n[1] = c->normal[1], n[2] = c->normal[2];
         return dx * n[0] + dy * n[1] + dz * n[2];
     }
-    if (c->kind == VFX_SPH_SPHERE) {
+    if (c->kind == RT_SPH_SPHERE) {
         float l = sqrtf(dx * dx + dy * dy + dz * dz);
         if (l < 1e-12f) {
             n[0] = 0.f, n[1] = 1.f, n[2] = 0.f;
@@ -1087,7 +1087,7 @@ static float collider_distance(const sph_collider_state *st, float px, float py,
     return qmax;
 }
 
-float vfx_sph_collider_distance(const vfx_sph *s, uint32_t index, const float p[3])
+float rt_sph_collider_distance(const rt_sph *s, uint32_t index, const float p[3])
 {
     if (!s || index >= s->ncol || !p)
         return NAN;
@@ -1095,11 +1095,11 @@ float vfx_sph_collider_distance(const vfx_sph *s, uint32_t index, const float p[
     return collider_distance(&s->col[index], p[0], p[1], p[2], n);
 }
 
-static void update_colliders(vfx_sph *s, double t)
+static void update_colliders(rt_sph *s, double t)
 {
     for (uint32_t i = 0; i < s->ncol; ++i) {
         sph_collider_state *st = &s->col[i];
-        const vfx_sph_collider *c = &st->c;
+        const rt_sph_collider *c = &st->c;
         double w = 2.0 * SPH_PI * c->motion_frequency;
         double off = c->motion_amplitude * sin(w * t), vel = c->motion_amplitude * w * cos(w * t);
         for (int a = 0; a < 3; ++a) {
@@ -1117,7 +1117,7 @@ static inline int cell_coord(float v, float lo, float inv, int n)
     return c < 0 ? 0 : (c >= n ? n - 1 : c);
 }
 
-static void key_chunk(vfx_sph *s, uint32_t chunk)
+static void key_chunk(rt_sph *s, uint32_t chunk)
 {
     uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
     const float *lo = s->p.domain_min;
@@ -1130,7 +1130,7 @@ static void key_chunk(vfx_sph *s, uint32_t chunk)
 }
 
 /* Gathers the state columns into the (free) integration buffers in sorted order. */
-static void permute_chunk(vfx_sph *s, uint32_t chunk)
+static void permute_chunk(rt_sph *s, uint32_t chunk)
 {
     uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
     const uint32_t *perm = s->perm;
@@ -1142,14 +1142,14 @@ static void permute_chunk(vfx_sph *s, uint32_t chunk)
     }
 }
 
-static void swap_state(vfx_sph *s);
-static void parallel(vfx_sph *s, sph_chunk_fn fn, bool fresh);
+static void swap_state(rt_sph *s);
+static void parallel(rt_sph *s, sph_chunk_fn fn, bool fresh);
 
 /* Counting sort of the particles by cell, then every per-particle column permuted so that a
  * cell's particles are contiguous (and a row of x-adjacent cells is one range). Stable, so
  * the order — and every sum over neighbours — does not depend on the thread count. Keys and
  * the permutation run on all threads; the histogram and the scatter are serial (O(n + cells)). */
-static void build_grid(vfx_sph *s)
+static void build_grid(rt_sph *s)
 {
     uint32_t n = s->n;
     parallel(s, key_chunk, false);
@@ -1178,7 +1178,7 @@ typedef struct sph_ranges {
 
 /* The particle index ranges of the (2R+1)^3 cells of H/2 around p (R <= 3): one range per row
  * of x-adjacent cells, rows with no particle left out. */
-static inline void neighbor_ranges(const vfx_sph *s, float px, float py, float pz, int R, sph_ranges *r)
+static inline void neighbor_ranges(const rt_sph *s, float px, float py, float pz, int R, sph_ranges *r)
 {
     const float *lo = s->p.domain_min;
     int cx = cell_coord(px, lo[0], s->inv_cell, s->nx);
@@ -1209,7 +1209,7 @@ typedef struct sph_wall_hit {
     bool is_box, no_slip;
 } sph_wall_hit;
 
-static int gather_walls(const vfx_sph *s, float px, float py, float pz, sph_wall_hit *w, int max)
+static int gather_walls(const rt_sph *s, float px, float py, float pz, sph_wall_hit *w, int max)
 {
     int k = 0;
     const float *lo = s->p.domain_min, *hi = s->p.domain_max;
@@ -1250,7 +1250,7 @@ static inline int walls_box(const sph_wall_hit *w, int nw)
     return k;
 }
 
-float vfx_sph_volume_fraction(const vfx_sph *s, const float p[3])
+float rt_sph_volume_fraction(const rt_sph *s, const float p[3])
 {
     if (!s || !p || !isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2]))
         return NAN;
@@ -1274,7 +1274,7 @@ float vfx_sph_volume_fraction(const vfx_sph *s, const float p[3])
     int nw = gather_walls(s, p[0], p[1], p[2], walls, SPH_MAX_WALLS), nb = walls_box(walls, nw);
     float inside = 1.f, extra = 0.f;
     for (int w = 0; w < nw; ++w) {
-        float f = s->wall_scale * (float)vfx_sph_wall_density_fraction(walls[w].d, s->H);
+        float f = s->wall_scale * (float)rt_sph_wall_density_fraction(walls[w].d, s->H);
         if (w < nb)
             inside *= 1.f - f;
         else
@@ -1289,7 +1289,7 @@ float vfx_sph_volume_fraction(const vfx_sph *s, const float p[3])
 /* ---- passes -------------------------------------------------------------------------------- */
 
 /* Grows a per-chunk list buffer to hold `want` entries; false (and nb_oom set) when it cannot. */
-static bool grow_list(vfx_sph *s, uint32_t **buf, uint32_t *cap, uint32_t want)
+static bool grow_list(rt_sph *s, uint32_t **buf, uint32_t *cap, uint32_t want)
 {
     if (want <= *cap)
         return true;
@@ -1309,7 +1309,7 @@ static bool grow_list(vfx_sph *s, uint32_t **buf, uint32_t *cap, uint32_t want)
 
 /* Everything of the density pass after the neighbour sum: walls, EOS, reductions. */
 static inline __attribute__((always_inline)) void
-density_tail(vfx_sph *s, uint32_t i, float sum, uint32_t nn, float px, float py, float pz,
+density_tail(rt_sph *s, uint32_t i, float sum, uint32_t nn, float px, float py, float pz,
              sph_chunk_out *o, sph_wall_hit *walls)
 {
     const float kp = s->k_poly6, m = s->mass, rho0 = s->p.rest_density;
@@ -1322,7 +1322,7 @@ density_tail(vfx_sph *s, uint32_t i, float sum, uint32_t nn, float px, float py,
      * edges and corners are not compressed by double counting. Colliders just add. */
     float inside = 1.f, extra = 0.f;
     for (int w = 0; w < nw; ++w) {
-        float f = s->wall_scale * (float)vfx_sph_wall_density_fraction(walls[w].d, H);
+        float f = s->wall_scale * (float)rt_sph_wall_density_fraction(walls[w].d, H);
         if (w < walls_box(walls, nw))
             inside *= 1.f - f;
         else
@@ -1366,7 +1366,7 @@ density_tail(vfx_sph *s, uint32_t i, float sum, uint32_t nn, float px, float py,
 
 /* Density by a scan of the 5x5x5 cells, recording the exact list (r < H) for the force pass
  * and, when `record`, the Verlet list (r < H + skin) and the positions it was built at. */
-static inline __attribute__((always_inline)) void density_scan(vfx_sph *s, uint32_t chunk, const bool record)
+static inline __attribute__((always_inline)) void density_scan(rt_sph *s, uint32_t chunk, const bool record)
 {
     uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
     const float H2 = s->H2, S2 = s->S2;
@@ -1427,7 +1427,7 @@ static inline __attribute__((always_inline)) void density_scan(vfx_sph *s, uint3
 /* Density by a walk of the Verlet lists (r < H test), writing the exact list for the force
  * pass. Branch-free: ~40% of a list is within H at the default skin of 0.3 H, a coin flip for
  * the predictor (the cell scan's 27% hit rate is why its branch measured cheaper there). */
-static void density_walk(vfx_sph *s, uint32_t chunk)
+static void density_walk(rt_sph *s, uint32_t chunk)
 {
     uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
     const float H2 = s->H2, self = H2 * H2 * H2;
@@ -1489,7 +1489,7 @@ static void density_walk(vfx_sph *s, uint32_t chunk)
     s->out[chunk] = acc;
 }
 
-static void density_chunk(vfx_sph *s, uint32_t chunk)
+static void density_chunk(rt_sph *s, uint32_t chunk)
 {
     if (s->dens_mode == 2)
         density_walk(s, chunk);
@@ -1500,7 +1500,7 @@ static void density_chunk(vfx_sph *s, uint32_t chunk)
 }
 
 /* Squared displacement of every particle since the last rebuild (columns edited by hand). */
-static void disp_chunk(vfx_sph *s, uint32_t chunk)
+static void disp_chunk(rt_sph *s, uint32_t chunk)
 {
     uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
     float d2 = 0.f;
@@ -1527,7 +1527,7 @@ static void coincident_dir(uint32_t a, uint32_t b, float out[3])
     out[0] = sg * sz * cosf(th), out[1] = sg * sz * sinf(th), out[2] = sg * cz;
 }
 
-static void force_chunk(vfx_sph *s, uint32_t chunk)
+static void force_chunk(rt_sph *s, uint32_t chunk)
 {
     uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
     const float H = s->H, H2 = s->H2, ks = s->k_spiky, m = s->mass, h = s->h;
@@ -1654,7 +1654,7 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
         float fr[SPH_MAX_WALLS], gr[SPH_MAX_WALLS]; /* density fraction, its gradient */
         float inside = 1.f, extra = 0.f;
         for (int w = 0; w < nw; ++w) {
-            fr[w] = s->wall_scale * (float)vfx_sph_wall_density_fraction(walls[w].d, H);
+            fr[w] = s->wall_scale * (float)rt_sph_wall_density_fraction(walls[w].d, H);
             if (w < nb)
                 inside *= 1.f - fr[w];
             else
@@ -1672,7 +1672,7 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
             float vneg = vn < 0.f ? vn : 0.f;
             float mu = h * (2.f * vneg) * (2.f * dd) / ((4.f * dd * dd + 0.01f * h * h) * rhoi);
             float coef = 2.f * pri - alpha * c0 * mu;
-            gr[w] = (float)vfx_sph_wall_density_gradient(walls[w].d, H);
+            gr[w] = (float)rt_sph_wall_density_gradient(walls[w].d, H);
             float f = coef * rho0 * s->wall_scale * others * gr[w];
             ax += f * wn[0], ay += f * wn[1], az += f * wn[2];
         }
@@ -1696,7 +1696,7 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
                 if (!(ut > 0.f))
                     continue;
                 float y = walls[w].d > 0.25f * s->p.spacing ? walls[w].d : 0.25f * s->p.spacing;
-                float us = (float)vfx_sph_wall_friction_velocity(ut, y, s->p.kinematic_viscosity);
+                float us = (float)rt_sph_wall_friction_velocity(ut, y, s->p.kinematic_viscosity);
                 float am = us * us * s->fric_scale * gr[w] / ut;
                 ax -= am * tx, ay -= am * ty, az -= am * tz;
             }
@@ -1714,7 +1714,7 @@ static void force_chunk(vfx_sph *s, uint32_t chunk)
     s->out[chunk] = acc;
 }
 
-static void integrate_chunk(vfx_sph *s, uint32_t chunk)
+static void integrate_chunk(rt_sph *s, uint32_t chunk)
 {
     uint32_t b = chunk * SPH_CHUNK, e = b + SPH_CHUNK < s->n ? b + SPH_CHUNK : s->n;
     const float dt = s->dt_try, margin = 0.25f * s->p.spacing;
@@ -1784,12 +1784,12 @@ static void integrate_chunk(vfx_sph *s, uint32_t chunk)
 
 /* ---- emitters ------------------------------------------------------------------------------ */
 
-static vfx_result emit(vfx_sph *s, double dt, uint32_t *emitted)
+static vfx_result emit(rt_sph *s, double dt, uint32_t *emitted)
 {
     float dx = s->p.spacing;
     for (uint32_t k = 0; k < s->nem; ++k) {
         sph_emitter_state *st = &s->em[k];
-        const vfx_sph_emitter *e = &st->e;
+        const rt_sph_emitter *e = &st->e;
         if (!st->started) {
             st->started = true;
             st->travelled = dx; /* first layer at once */
@@ -1814,7 +1814,7 @@ static vfx_result emit(vfx_sph *s, double dt, uint32_t *emitted)
                                off * e->direction[c];
                         v[c] = e->speed * e->direction[c];
                     }
-                    vfx_result r = vfx_sph_add_particles(s, 1, &p[0], &p[1], &p[2], &v[0], &v[1], &v[2]);
+                    vfx_result r = rt_sph_add_particles(s, 1, &p[0], &p[1], &p[2], &v[0], &v[1], &v[2]);
                     if (r)
                         return r;
                     st->emitted++;
@@ -1827,7 +1827,7 @@ static vfx_result emit(vfx_sph *s, double dt, uint32_t *emitted)
 
 /* ---- step ---------------------------------------------------------------------------------- */
 
-static void swap_state(vfx_sph *s)
+static void swap_state(rt_sph *s)
 {
     float *t;
 #define SW(a, b) (t = s->a, s->a = s->b, s->b = t)
@@ -1840,7 +1840,7 @@ static void swap_state(vfx_sph *s)
 #undef SW
 }
 
-static uint32_t first_bad(const vfx_sph *s, uint32_t nchunks, const sph_chunk_out **which)
+static uint32_t first_bad(const rt_sph *s, uint32_t nchunks, const sph_chunk_out **which)
 {
     for (uint32_t c = 0; c < nchunks; ++c)
         if (s->out[c].bad != UINT32_MAX) {
@@ -1854,7 +1854,7 @@ static uint32_t first_bad(const vfx_sph *s, uint32_t nchunks, const sph_chunk_ou
  * every particle has moved less than skin/2 since the rebuild (then no pair can have come
  * within H unlisted: each side moved < skin/2), otherwise a rebuild: sort by cell, scan the
  * cells, record the lists. Returns true when it rebuilt. */
-static bool density_pass(vfx_sph *s)
+static bool density_pass(rt_sph *s)
 {
     bool rebuild = !s->verlet || !s->lists_valid || !(4.f * s->disp2_max < s->skin * s->skin);
     if (rebuild) {
@@ -1871,7 +1871,7 @@ static bool density_pass(vfx_sph *s)
     return rebuild;
 }
 
-static void reduce_disp(vfx_sph *s)
+static void reduce_disp(rt_sph *s)
 {
     uint32_t nchunks = (s->n + SPH_CHUNK - 1) / SPH_CHUNK;
     float d2 = 0.f;
@@ -1880,7 +1880,7 @@ static void reduce_disp(vfx_sph *s)
     s->disp2_max = d2;
 }
 
-static void finish_report(vfx_sph *s, vfx_sph_report *rep)
+static void finish_report(rt_sph *s, rt_sph_report *rep)
 {
     uint32_t nchunks = (s->n + SPH_CHUNK - 1) / SPH_CHUNK;
     float emax = 0.f, v2 = 0.f;
@@ -1916,16 +1916,16 @@ static void finish_report(vfx_sph *s, vfx_sph_report *rep)
     rep->internal_energy = ie;
 }
 
-vfx_result vfx_sph_step(vfx_sph *s, float frame_dt, vfx_sph_report *report)
+vfx_result rt_sph_step(rt_sph *s, float frame_dt, rt_sph_report *report)
 {
-    vfx_sph_report rep = {0};
+    rt_sph_report rep = {0};
     if (report)
         *report = rep;
     if (!s)
         return VFX_ERR_INVALID_ARGUMENT;
     s->err[0] = 0;
     if (!isfinite(frame_dt) || frame_dt < 0.f) {
-        set_err(s, "vfx_sph_step: frame_dt %g must be finite and >= 0", (double)frame_dt);
+        set_err(s, "rt_sph_step: frame_dt %g must be finite and >= 0", (double)frame_dt);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     const double h = s->h, lam = s->p.cfl;
@@ -1950,14 +1950,14 @@ vfx_result vfx_sph_step(vfx_sph *s, float frame_dt, vfx_sph_report *report)
         update_colliders(s, s->time);
         double remaining = (double)frame_dt - t;
         double dt = remaining;
-        vfx_sph_dt_limit lim = VFX_SPH_DT_FRAME;
+        rt_sph_dt_limit lim = RT_SPH_DT_FRAME;
         uint32_t nchunks = (s->n + SPH_CHUNK - 1) / SPH_CHUNK;
         if (s->n) {
             if (density_pass(s))
                 rep.neighbor_rebuilds++;
             if (atomic_exchange(&s->nb_oom, false)) {
                 s->lists_valid = false;
-                set_err(s, "vfx_sph_step: out of memory for the neighbour lists of %u particles", s->n);
+                set_err(s, "rt_sph_step: out of memory for the neighbour lists of %u particles", s->n);
                 res = VFX_ERR_OUT_OF_MEMORY;
                 break;
             }
@@ -1966,7 +1966,7 @@ vfx_result vfx_sph_step(vfx_sph *s, float frame_dt, vfx_sph_report *report)
             const sph_chunk_out *bo = NULL;
             uint32_t bad = first_bad(s, nchunks, &bo);
             if (bad != UINT32_MAX) {
-                set_err(s, "vfx_sph_step: particle %u (row %u) has a non-finite density or "
+                set_err(s, "rt_sph_step: particle %u (row %u) has a non-finite density or "
                         "force (%g) at t=%.6g s; state left at the last good substep",
                         s->id[bad], bad, (double)bo->bad_value, s->time);
                 res = VFX_ERR_NUMERIC;
@@ -1985,15 +1985,15 @@ vfx_result vfx_sph_step(vfx_sph *s, float frame_dt, vfx_sph_report *report)
             if (s->friction && s->p.kinematic_viscosity > nu)
                 nu = s->p.kinematic_viscosity; /* keeps the explicit wall shear from overshooting */
             if (vmax > 0 && lam * h / vmax < dt)
-                dt = lam * h / vmax, lim = VFX_SPH_DT_CFL;
+                dt = lam * h / vmax, lim = RT_SPH_DT_CFL;
             if (cmax > 0 && lam * h / cmax < dt)
-                dt = lam * h / cmax, lim = VFX_SPH_DT_ACOUSTIC;
+                dt = lam * h / cmax, lim = RT_SPH_DT_ACOUSTIC;
             if (amax > 0 && 0.25 * sqrt(h / amax) < dt)
-                dt = 0.25 * sqrt(h / amax), lim = VFX_SPH_DT_FORCE;
+                dt = 0.25 * sqrt(h / amax), lim = RT_SPH_DT_FORCE;
             if (nu > 0 && 0.125 * h * h / nu < dt)
-                dt = 0.125 * h * h / nu, lim = VFX_SPH_DT_VISCOUS;
+                dt = 0.125 * h * h / nu, lim = RT_SPH_DT_VISCOUS;
             /* avoid a sliver substep at the end of the frame */
-            if (lim != VFX_SPH_DT_FRAME && remaining < 1.5 * dt && remaining > dt)
+            if (lim != RT_SPH_DT_FRAME && remaining < 1.5 * dt && remaining > dt)
                 dt = 0.5 * remaining;
             uint32_t tries = 0;
             for (;;) {
@@ -2004,7 +2004,7 @@ vfx_result vfx_sph_step(vfx_sph *s, float frame_dt, vfx_sph_report *report)
                     break;
                 if (bo->bad_kind == 1 || tries >= s->p.max_redo) {
                     static const char *what[] = {"", "non-finite state", "speed", "density change"};
-                    set_err(s, "vfx_sph_step: particle %u (row %u) blew up: %s %g (limit %g) "
+                    set_err(s, "rt_sph_step: particle %u (row %u) blew up: %s %g (limit %g) "
                             "after %u dt halvings (dt %.3g s) at t=%.6g s; state left at the "
                             "last good substep", s->id[bad], bad, what[bo->bad_kind],
                             (double)bo->bad_value,

@@ -17,12 +17,12 @@
  * Neighbours: Verlet lists with a skin (every pair within H + skin, found by a sort by grid cell
  * and a cell scan), rebuilt when a particle has moved half the skin since the last rebuild, when
  * particles are added or cleared, or when the columns were edited by hand beyond that (checked
- * at the start of every vfx_sph_step).
- * Column pointers returned by vfx_sph_columns stay valid until the next add or step (particles
+ * at the start of every rt_sph_step).
+ * Column pointers returned by rt_sph_columns stay valid until the next add or step (particles
  * are reordered by grid cell at every rebuild for locality; `id` says which input particle a row
- * is). No global state; one vfx_sph is not thread-safe, it uses its own worker threads. */
-#ifndef VFX_SIM_SPH_H
-#define VFX_SIM_SPH_H
+ * is). No global state; one rt_sph is not thread-safe, it uses its own worker threads. */
+#ifndef RT_SIM_SPH_H
+#define RT_SIM_SPH_H
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -30,22 +30,22 @@
 #include <volfx/volfx.h>
 
 enum {
-    VFX_SPH_NO_GRAVITY = 1u << 0,   /* gravity = 0 (a zero gravity field otherwise means default) */
-    VFX_SPH_NO_VISCOSITY = 1u << 1, /* artificial viscosity alpha = 0 */
+    RT_SPH_NO_GRAVITY = 1u << 0,   /* gravity = 0 (a zero gravity field otherwise means default) */
+    RT_SPH_NO_VISCOSITY = 1u << 1, /* artificial viscosity alpha = 0 */
     /* the grid sort and 5x5x5 cell scan on every substep instead of Verlet lists (the
      * baseline the benchmark compares against) */
-    VFX_SPH_REBUILD_EVERY_SUBSTEP = 1u << 2,
+    RT_SPH_REBUILD_EVERY_SUBSTEP = 1u << 2,
 };
 
-/* Faces of the domain box, for vfx_sph_desc.no_slip_faces. */
+/* Faces of the domain box, for rt_sph_desc.no_slip_faces. */
 enum {
-    VFX_SPH_FACE_X_MIN = 1u << 0, VFX_SPH_FACE_X_MAX = 1u << 1,
-    VFX_SPH_FACE_Y_MIN = 1u << 2, VFX_SPH_FACE_Y_MAX = 1u << 3, /* y min: the floor */
-    VFX_SPH_FACE_Z_MIN = 1u << 4, VFX_SPH_FACE_Z_MAX = 1u << 5,
+    RT_SPH_FACE_X_MIN = 1u << 0, RT_SPH_FACE_X_MAX = 1u << 1,
+    RT_SPH_FACE_Y_MIN = 1u << 2, RT_SPH_FACE_Y_MAX = 1u << 3, /* y min: the floor */
+    RT_SPH_FACE_Z_MIN = 1u << 4, RT_SPH_FACE_Z_MAX = 1u << 5,
 };
 
 /* Zero in any field means its default (listed). */
-typedef struct vfx_sph_desc {
+typedef struct rt_sph_desc {
     float spacing;              /* particle spacing dx [m]; 0.02 */
     float support_ratio;        /* kernel support H / dx; 2.0 */
     float rest_density;         /* rho0 [kg/m^3]; 1000 */
@@ -57,36 +57,36 @@ typedef struct vfx_sph_desc {
     float domain_min[3];        /* solid box walls; [0,1]^3 when min == max */
     float domain_max[3];
     float cfl;                  /* lambda of the CFL and acoustic conditions; 0.4 */
-    uint32_t max_substeps;      /* per vfx_sph_step; 256 */
+    uint32_t max_substeps;      /* per rt_sph_step; 256 */
     uint32_t max_redo;          /* dt halvings per substep before giving up; 10 */
     float velocity_limit;       /* blow-up bound on |v| [m/s]; 20*c0 */
     float density_change_limit; /* blow-up bound on |d rho|/rho per substep; 0.05 */
     uint32_t max_particles;     /* capacity bound (adds and emitters); 1<<27 */
     uint32_t threads;           /* worker threads; all online cores */
     float neighbor_skin;        /* Verlet skin as a fraction of H, 0 < skin <= 1; 0.3 */
-    uint32_t flags;             /* VFX_SPH_* */
+    uint32_t flags;             /* RT_SPH_* */
     /* Wall friction (smooth-wall law of the wall, see docs/simulation.md): box faces that are
-     * no-slip (VFX_SPH_FACE_* bits; 0 = every face free-slip) and the fluid's molecular
+     * no-slip (RT_SPH_FACE_* bits; 0 = every face free-slip) and the fluid's molecular
      * kinematic viscosity that sets their shear stress [m^2/s]; 1.0e-6 (water at 20 C). */
     uint32_t no_slip_faces;
     float kinematic_viscosity;
-} vfx_sph_desc;
+} rt_sph_desc;
 
-typedef enum vfx_sph_dt_limit {
-    VFX_SPH_DT_FRAME = 0,    /* the rest of the frame was shorter than every condition */
-    VFX_SPH_DT_CFL = 1,      /* lambda*h/v_max */
-    VFX_SPH_DT_ACOUSTIC = 2, /* lambda*h/c_max */
-    VFX_SPH_DT_FORCE = 3,    /* 0.25*sqrt(h/a_max) */
-    VFX_SPH_DT_VISCOUS = 4,  /* 0.125*h^2/nu */
-} vfx_sph_dt_limit;
+typedef enum rt_sph_dt_limit {
+    RT_SPH_DT_FRAME = 0,    /* the rest of the frame was shorter than every condition */
+    RT_SPH_DT_CFL = 1,      /* lambda*h/v_max */
+    RT_SPH_DT_ACOUSTIC = 2, /* lambda*h/c_max */
+    RT_SPH_DT_FORCE = 3,    /* 0.25*sqrt(h/a_max) */
+    RT_SPH_DT_VISCOUS = 4,  /* 0.125*h^2/nu */
+} rt_sph_dt_limit;
 
-typedef struct vfx_sph_report {
+typedef struct rt_sph_report {
     uint32_t substeps;
     uint32_t redo_count;        /* substeps redone with a halved dt */
     bool cap_hit;               /* max_substeps reached before the frame time was covered */
     double simulated_time;      /* <= frame_dt; less when cap_hit */
     double dt_min, dt_max, dt_last;
-    vfx_sph_dt_limit dt_limit;  /* what bounded the last dt */
+    rt_sph_dt_limit dt_limit;  /* what bounded the last dt */
     float max_density_error;    /* max (rho - rho0)/rho0 over particles (compression), end state */
     float mean_density_error;   /* mean of max(0, rho - rho0)/rho0, end state */
     float max_speed;            /* end state [m/s] */
@@ -95,25 +95,25 @@ typedef struct vfx_sph_report {
     double internal_energy;     /* [J], sum m e(rho) of the clamped Tait EOS, end state */
     uint64_t neighbor_pairs;    /* ordered pairs (i != j) within H, summed over substeps (one pass) */
     uint32_t neighbor_rebuilds; /* grid sorts + cell scans, the closing density pass included
-                                 * (substeps + 1 with VFX_SPH_REBUILD_EVERY_SUBSTEP) */
+                                 * (substeps + 1 with RT_SPH_REBUILD_EVERY_SUBSTEP) */
     uint64_t skin_pairs;        /* entries of the Verlet lists walked, summed over substeps */
     uint32_t emitted;           /* particles emitted during this step */
-} vfx_sph_report;
+} rt_sph_report;
 
-typedef struct vfx_sph_columns {
+typedef struct rt_sph_columns {
     uint32_t count;
     float *x, *y, *z, *vx, *vy, *vz, *density;
     const uint32_t *id; /* input index (order of addition/emission) of each row */
-} vfx_sph_columns;
+} rt_sph_columns;
 
-typedef enum vfx_sph_collider_kind {
-    VFX_SPH_PLANE = 0,  /* fluid on the side `normal` points to */
-    VFX_SPH_SPHERE = 1, /* solid ball */
-    VFX_SPH_BOX = 2,    /* solid axis-aligned box */
-} vfx_sph_collider_kind;
+typedef enum rt_sph_collider_kind {
+    RT_SPH_PLANE = 0,  /* fluid on the side `normal` points to */
+    RT_SPH_SPHERE = 1, /* solid ball */
+    RT_SPH_BOX = 2,    /* solid axis-aligned box */
+} rt_sph_collider_kind;
 
-typedef struct vfx_sph_collider {
-    vfx_sph_collider_kind kind;
+typedef struct rt_sph_collider {
+    rt_sph_collider_kind kind;
     float center[3];          /* plane: a point on it; sphere/box: centre at t = 0 */
     float normal[3];          /* plane only, normalised on add */
     float radius;             /* sphere */
@@ -123,87 +123,87 @@ typedef struct vfx_sph_collider {
     float motion_amplitude;   /* [m] */
     float motion_frequency;   /* [Hz] */
     uint32_t no_slip;         /* nonzero: wall-law friction on its surface (default free-slip) */
-} vfx_sph_collider;
+} rt_sph_collider;
 
-typedef struct vfx_sph_emitter {
+typedef struct rt_sph_emitter {
     float center[3];
     float direction[3];       /* normalised on add */
     float speed;              /* [m/s], > 0 */
     float radius;             /* nozzle disc radius [m], >= spacing/2 */
     uint32_t max_emit;        /* stop after this many particles; 0 = until capacity */
-} vfx_sph_emitter;
+} rt_sph_emitter;
 
-typedef struct vfx_sph vfx_sph;
+typedef struct rt_sph rt_sph;
 
 /* Creates a solver; NULL desc = defaults. On failure returns an error and, when err is not
  * NULL, a message in err (err_len bytes). */
-vfx_result vfx_sph_create(const vfx_sph_desc *desc, vfx_sph **out, char *err, size_t err_len);
+vfx_result rt_sph_create(const rt_sph_desc *desc, rt_sph **out, char *err, size_t err_len);
 /* Stops the workers and frees everything. NULL allowed. */
-void vfx_sph_destroy(vfx_sph *sim);
+void rt_sph_destroy(rt_sph *sim);
 /* The last error message ("" when none). */
-const char *vfx_sph_last_error(const vfx_sph *sim);
+const char *rt_sph_last_error(const rt_sph *sim);
 /* The resolved parameters (defaults filled in, c0 and B consistent). */
-const vfx_sph_desc *vfx_sph_params(const vfx_sph *sim);
+const rt_sph_desc *rt_sph_params(const rt_sph *sim);
 /* Particle mass [kg] (calibrated so a lattice of `spacing` has the rest density). */
-float vfx_sph_particle_mass(const vfx_sph *sim);
+float rt_sph_particle_mass(const rt_sph *sim);
 /* Kernel support radius H [m]. */
-float vfx_sph_support(const vfx_sph *sim);
+float rt_sph_support(const rt_sph *sim);
 
 /* Adds n particles (x,y,z required, v* NULL = 0). Refuses the whole batch, naming the first
  * particle, when any value is NaN/Inf; positions outside the domain are moved inside (counted
- * in vfx_sph_clamped_on_add). n = 0 is a no-op. */
-vfx_result vfx_sph_add_particles(vfx_sph *sim, uint32_t n, const float *x, const float *y,
+ * in rt_sph_clamped_on_add). n = 0 is a no-op. */
+vfx_result rt_sph_add_particles(rt_sph *sim, uint32_t n, const float *x, const float *y,
                                  const float *z, const float *vx, const float *vy, const float *vz);
 /* Removes every particle (capacity, colliders, emitters and time are kept); ids restart at 0. */
-void vfx_sph_clear(vfx_sph *sim);
+void rt_sph_clear(rt_sph *sim);
 /* Adds a lattice of spacing dx filling [lo, hi] (cell centres), at rest; count in *added. */
-vfx_result vfx_sph_add_block(vfx_sph *sim, const float lo[3], const float hi[3], uint32_t *added);
-/* Number of particles that vfx_sph_add_particles had to move into the domain so far. */
-uint32_t vfx_sph_clamped_on_add(const vfx_sph *sim);
+vfx_result rt_sph_add_block(rt_sph *sim, const float lo[3], const float hi[3], uint32_t *added);
+/* Number of particles that rt_sph_add_particles had to move into the domain so far. */
+uint32_t rt_sph_clamped_on_add(const rt_sph *sim);
 /* Adds a static or moving collider; its index in *index when not NULL. */
-vfx_result vfx_sph_add_collider(vfx_sph *sim, const vfx_sph_collider *c, uint32_t *index);
-/* Adds a solid triangle mesh (closed, any winding; e.g. from vfx_mesh_import) as a collider
+vfx_result rt_sph_add_collider(rt_sph *sim, const rt_sph_collider *c, uint32_t *index);
+/* Adds a solid triangle mesh (closed, any winding; e.g. from rt_mesh_import) as a collider
  * (motion->no_slip makes it no-slip):
  * its signed distance is sampled once on a grid of ~H/2 (at most 64 nodes per axis, brute
  * force over <= 20,000 triangles, inside by generalised winding number) and interpolated.
  * motion (NULL = static) moves it rigidly: centre(t) - centre(0) is added to the mesh. */
-vfx_result vfx_sph_add_mesh_collider(vfx_sph *sim, const float *positions, uint32_t vertex_count,
+vfx_result rt_sph_add_mesh_collider(rt_sph *sim, const float *positions, uint32_t vertex_count,
                                      const uint32_t *indices, uint32_t index_count,
-                                     const vfx_sph_collider *motion, uint32_t *index);
+                                     const rt_sph_collider *motion, uint32_t *index);
 /* Signed distance from p to collider `index` at the current time (positive on the fluid side;
  * +Inf beyond a mesh's grid); NaN for a bad index. */
-float vfx_sph_collider_distance(const vfx_sph *sim, uint32_t index, const float p[3]);
+float rt_sph_collider_distance(const rt_sph *sim, uint32_t index, const float p[3]);
 /* Adds an emitter that injects disc-shaped layers of particles each time they have moved dx. */
-vfx_result vfx_sph_add_emitter(vfx_sph *sim, const vfx_sph_emitter *e);
+vfx_result rt_sph_add_emitter(rt_sph *sim, const rt_sph_emitter *e);
 
 /* Advances by frame_dt seconds in adaptive substeps (see the report). VFX_ERR_NUMERIC when a
  * substep cannot be made stable (message names the particle); the state is then the last good
  * one. frame_dt must be finite and >= 0. */
-vfx_result vfx_sph_step(vfx_sph *sim, float frame_dt, vfx_sph_report *report);
+vfx_result rt_sph_step(rt_sph *sim, float frame_dt, rt_sph_report *report);
 /* The SoA columns (see the validity note above). */
-vfx_sph_columns vfx_sph_get_columns(vfx_sph *sim);
+rt_sph_columns rt_sph_get_columns(rt_sph *sim);
 /* Pressure [Pa] of row i from the last density pass (0 when i is out of range). */
-float vfx_sph_pressure(const vfx_sph *sim, uint32_t i);
+float rt_sph_pressure(const rt_sph *sim, uint32_t i);
 /* Fluid volume fraction at p: sum_j (m/rho0) W_poly6(p - x_j) over the fluid share of the
  * kernel (walls excluded), ~1 inside the fluid, 1/2 on its surface, 0 in air or in a solid;
  * NaN for non-finite p. Uses the grid of the last rebuild and the current positions. */
-float vfx_sph_volume_fraction(const vfx_sph *sim, const float p[3]);
+float rt_sph_volume_fraction(const rt_sph *sim, const float p[3]);
 /* Simulated time since creation [s]. */
-double vfx_sph_time(const vfx_sph *sim);
+double rt_sph_time(const rt_sph *sim);
 /* Bytes allocated by the solver (columns, grid, Verlet and exact neighbour lists, chunk
  * reductions). */
-size_t vfx_sph_memory_bytes(const vfx_sph *sim);
+size_t rt_sph_memory_bytes(const rt_sph *sim);
 /* Number of worker threads in use (including the calling thread). */
-uint32_t vfx_sph_thread_count(const vfx_sph *sim);
+uint32_t rt_sph_thread_count(const rt_sph *sim);
 
 /* Closed-form wall integrals (exposed for tests): fraction of the poly6 kernel mass beyond a
  * plane at distance d (0.5 at d = 0, 0 at d >= H), and minus its derivative in d [1/m]. */
-double vfx_sph_wall_density_fraction(double d, double H);
-double vfx_sph_wall_density_gradient(double d, double H);
+double rt_sph_wall_density_fraction(double d, double H);
+double rt_sph_wall_density_gradient(double d, double H);
 /* Friction velocity u* [m/s] of a smooth no-slip wall (wall shear stress tau = rho u*^2) for a
  * tangential speed u_t at distance y with kinematic viscosity nu: the linear sublayer
  * u_t/u* = y u* / nu below y+ = 11.06, the log law u_t/u* = ln(y u* / nu)/0.41 + 5.2 above.
  * 0 when any argument is <= 0 or not finite. */
-double vfx_sph_wall_friction_velocity(double u_t, double y, double nu);
+double rt_sph_wall_friction_velocity(double u_t, double y, double nu);
 
 #endif

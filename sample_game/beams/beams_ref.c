@@ -7,7 +7,7 @@
 #include <string.h>
 
 typedef struct quad_ctx {
-    const vfx_beam_d *beams;
+    const volfx_beam_d *beams;
     uint32_t n;
     const double *o, *v;
     uint64_t evals;
@@ -18,7 +18,7 @@ static double f(quad_ctx *q, double t)
     double p[3] = {q->o[0] + t * q->v[0], q->o[1] + t * q->v[1], q->o[2] + t * q->v[2]};
     double s = 0;
     for (uint32_t i = 0; i < q->n; ++i)
-        s += vfx_beam_density_d(&q->beams[i], p);
+        s += volfx_beam_density_d(&q->beams[i], p);
     q->evals++;
     return s;
 }
@@ -114,7 +114,7 @@ static void sphere_breaks(const double *o, const double *v, const double *c, dou
     }
 }
 
-double vfx_beams_ref_integral(const vfx_beam_d *beams, uint32_t n, const double o[3], const double v[3],
+double ref_beams_integral(const volfx_beam_d *beams, uint32_t n, const double o[3], const double v[3],
                               double t0, double t1, double rel_tol, uint64_t *evals)
 {
     if (!(t1 > t0))
@@ -126,10 +126,10 @@ double vfx_beams_ref_integral(const vfx_beam_d *beams, uint32_t n, const double 
     br[m++] = t0;
     br[m++] = t1;
     for (uint32_t i = 0; i < n; ++i) {
-        const vfx_beam_d *b = &beams[i];
+        const volfx_beam_d *b = &beams[i];
         double e[3] = {b->head[0] + b->length * b->dir[0], b->head[1] + b->length * b->dir[1],
                        b->head[2] + b->length * b->dir[2]};
-        double eps = b->eps > VFX_BEAM_EPS_FLOOR * b->radius ? b->eps : VFX_BEAM_EPS_FLOOR * b->radius;
+        double eps = b->eps > VOLFX_BEAM_EPS_FLOOR * b->radius ? b->eps : VOLFX_BEAM_EPS_FLOOR * b->radius;
         sphere_breaks(o, v, b->head, b->radius, eps, t0, t1, br, &m);
         sphere_breaks(o, v, e, b->radius, eps, t0, t1, br, &m);
         /* slab planes u = 0 and u = L */
@@ -177,22 +177,22 @@ double vfx_beams_ref_integral(const vfx_beam_d *beams, uint32_t n, const double 
     return total;
 }
 
-double vfx_beams_ref_cond_abs(const vfx_beam_d *beams, uint32_t n, const double eye[3],
+double ref_beams_cond_abs(const volfx_beam_d *beams, uint32_t n, const double eye[3],
                               const double dir[3], double t0, double t1, double ulps)
 {
     double total = 0, zero[3] = {0, 0, 0};
     for (uint32_t i = 0; i < n; ++i) {
-        vfx_beam_d b = beams[i];
+        volfx_beam_d b = beams[i];
         double scale = 0;
         for (int k = 0; k < 3; ++k) {
             b.head[k] -= eye[k];
             scale = fmax(scale, fmax(fabs(eye[k]), fabs(b.head[k])));
         }
-        double h = vfx_beam_integral_d(&b, zero, dir, t0, t1), worst = 0;
+        double h = volfx_beam_integral_d(&b, zero, dir, t0, t1), worst = 0;
         for (int k = 0; k < 6; ++k)
             for (int sgn = -1; sgn <= 1; sgn += 2) {
                 double d[3] = {dir[0], dir[1], dir[2]};
-                vfx_beam_d bp = b;
+                volfx_beam_d bp = b;
                 if (k < 3)
                     d[k] += sgn * ulps * FLT_EPSILON;
                 else
@@ -200,7 +200,7 @@ double vfx_beams_ref_cond_abs(const vfx_beam_d *beams, uint32_t n, const double 
                 double nd = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
                 for (int c = 0; c < 3; ++c)
                     d[c] /= nd;
-                worst = fmax(worst, fabs(vfx_beam_integral_d(&bp, zero, d, t0, t1) - h));
+                worst = fmax(worst, fabs(volfx_beam_integral_d(&bp, zero, d, t0, t1) - h));
             }
         total += worst;
     }

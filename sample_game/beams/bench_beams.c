@@ -7,7 +7,7 @@
  * quadrature per pixel would take minutes per image. Metrics over pixels whose H is above
  * 1e-6 of the image maximum (the issue's criterion): max and mean relative error, how many are
  * above 1e-5, the max where the float32 inputs allow 1e-5 (cond < 1e-5 H), and the
- * max of error / (1e-5 H + cond), cond = vfx_beams_ref_cond_abs at 2 ulps (what float32 inputs
+ * max of error / (1e-5 H + cond), cond = ref_beams_cond_abs at 2 ulps (what float32 inputs
  * allow; docs/beams.md). */
 #include <math.h>
 #include <stdio.h>
@@ -19,7 +19,7 @@
 #include "beams/beams_ref.h"
 
 typedef struct bench_scene {
-    vfx_beam_d beams[10];
+    volfx_beam_d beams[10];
     uint32_t count;
     float eye[3];
     uint32_t width, height;
@@ -58,7 +58,7 @@ static void make_scene(bench_scene *s, uint32_t beams, uint32_t size)
                       2.5f, {(float)-cos(ang + 0.6), (float)-sin(ang + 0.6), 0.2f}, 0.6f, 0.3f, 0.3f,
                       0.0f, 0.0f, {0, 0, 0, 0}};
         char err[256];
-        vfx_beam_validate(&b, &s->beams[i], err, sizeof err);
+        volfx_beam_validate(&b, &s->beams[i], err, sizeof err);
     }
 }
 
@@ -68,7 +68,7 @@ static float march(const bench_scene *s, const float o[3], const float v[3], flo
 {
     float lo = far, hi = 0.0f;
     for (uint32_t i = 0; i < s->count; ++i) {
-        const vfx_beam_d *b = &s->beams[i];
+        const volfx_beam_d *b = &s->beams[i];
         float c[3], rad = (float)(0.5 * b->length + b->radius);
         for (int k = 0; k < 3; ++k)
             c[k] = (float)(b->head[k] + 0.5 * b->length * b->dir[k]) - o[k];
@@ -89,7 +89,7 @@ static float march(const bench_scene *s, const float o[3], const float v[3], flo
         float t = lo + (j + 0.5f) * dt;
         double p[3] = {o[0] + t * v[0], o[1] + t * v[1], o[2] + t * v[2]};
         for (uint32_t i = 0; i < s->count; ++i)
-            sum += (float)vfx_beam_density_d(&s->beams[i], p);
+            sum += (float)volfx_beam_density_d(&s->beams[i], p);
     }
     return sum * dt;
 }
@@ -100,13 +100,13 @@ static int cmp_d(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-int vfx_bench_beams_gpu(int argc, char **argv);
+int bench_beams_gpu(int argc, char **argv);
 
-int vfx_bench_beams(int argc, char **argv)
+int bench_beams(int argc, char **argv)
 {
     for (int i = 1; i < argc; ++i)
         if (!strcmp(argv[i], "--gpu"))
-            return vfx_bench_beams_gpu(argc, argv);
+            return bench_beams_gpu(argc, argv);
     int reps = 5;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--reps") && i + 1 < argc) reps = atoi(argv[++i]);
@@ -142,10 +142,10 @@ int vfx_bench_beams(int argc, char **argv)
                     double v[3], h = 0.0;
                     pixel_ray(&s, x, y, v);
                     for (uint32_t i = 0; i < s.count; ++i)
-                        h += vfx_beam_integral_d(&s.beams[i], od, v, 0.0, far);
+                        h += volfx_beam_integral_d(&s.beams[i], od, v, 0.0, far);
                     ref[(size_t)y * s.width + x] = h;
                     /* what the float32 inputs allow (2-ulp moves of the ray and the heads) */
-                    cond[(size_t)y * s.width + x] = vfx_beams_ref_cond_abs(s.beams, s.count, od, v, 0.0, far, 2.0);
+                    cond[(size_t)y * s.width + x] = ref_beams_cond_abs(s.beams, s.count, od, v, 0.0, far, 2.0);
                     if (h > hmax) hmax = h;
                 }
             for (size_t mi = 0; mi < sizeof samples / sizeof samples[0]; ++mi) {
@@ -159,7 +159,7 @@ int vfx_bench_beams(int argc, char **argv)
                             float v[3] = {(float)vd[0], (float)vd[1], (float)vd[2]}, h = 0.0f;
                             if (n == 0)
                                 for (uint32_t i = 0; i < s.count; ++i)
-                                    h += vfx_beam_integral_f(&s.beams[i], s.eye, v, 0.0f, far);
+                                    h += volfx_beam_integral_f(&s.beams[i], s.eye, v, 0.0f, far);
                             else
                                 h = march(&s, s.eye, v, far, n);
                             img[(size_t)y * s.width + x] = h;

@@ -11,9 +11,9 @@
 #include "beams/beam_field.h"
 #include "beams/beams_ref.h"
 
-int vfx_bench_beams_gpu(int argc, char **argv);
+int bench_beams_gpu(int argc, char **argv);
 
-static double stat_of(vfx_app *app, const char *name)
+static double stat_of(game_app *app, const char *name)
 {
     vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
     app->api->get_stats(app->ctx, &st);
@@ -26,7 +26,7 @@ static double stat_of(vfx_app *app, const char *name)
 /* A beam set as in the thesis: beams fired across the view at different depths and angles. Sets
  * above 10 (the 100 / 1,000-beam runs) are spread over the view on a grid of short, thin beams,
  * as a game's many projectiles would be, so a tile sees a few tens of beams rather than all. */
-static void make_beams(vfx_app *app, uint32_t n)
+static void make_beams(game_app *app, uint32_t n)
 {
     if (n > 10) {
         uint32_t cols = (uint32_t)ceil(sqrt(n * 16.0 / 9.0)), rows = (n + cols - 1) / cols;
@@ -49,7 +49,7 @@ static void make_beams(vfx_app *app, uint32_t n)
     app->beam_count = n;
 }
 
-int vfx_bench_beams_gpu(int argc, char **argv)
+int bench_beams_gpu(int argc, char **argv)
 {
     uint32_t sets[8] = {1, 5, 10}, nsets = 3, sizes[4][2] = {{256, 256}, {512, 512}}, nsizes = 2, frames = 8;
     int timing_only = 0;
@@ -76,18 +76,18 @@ int vfx_bench_beams_gpu(int argc, char **argv)
         }
     }
     for (uint32_t k = 0; k < nsets; ++k)
-        if (sets[k] == 0 || sets[k] > VFX_APP_MAX_BEAMS || frames < (timing_only ? 1u : 5u) || frames > 1000) {
-            fprintf(stderr, "volfx-bench beams --gpu: sets 1..%d, frames 5..1000 (1..1000 with --timing-only)\n", VFX_APP_MAX_BEAMS);
+        if (sets[k] == 0 || sets[k] > GAME_APP_MAX_BEAMS || frames < (timing_only ? 1u : 5u) || frames > 1000) {
+            fprintf(stderr, "volfx-bench beams --gpu: sets 1..%d, frames 5..1000 (1..1000 with --timing-only)\n", GAME_APP_MAX_BEAMS);
             return 2;
         }
     for (uint32_t zi = 0; zi < nsizes; ++zi) {
         uint32_t w = sizes[zi][0], h = sizes[zi][1];
-        vfx_app_desc d = {.mode = VFX_GL_HEADLESS, .width = w, .height = h};
-        vfx_app *app;
-        if (vfx_app_create(&d, &app))
+        game_app_desc d = {.mode = RT_GL_HEADLESS, .width = w, .height = h};
+        game_app *app;
+        if (game_app_create(&d, &app))
             return 1;
-        vfx_ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, M_PI / 3, w, h, 0.05, 50};
-        vfx_app_set_camera(app, &cam);
+        ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, M_PI / 3, w, h, 0.05, 50};
+        game_app_set_camera(app, &cam);
         app->beams_view = (vfx_beams_view){.size = sizeof(vfx_beams_view), .version = VFX_BEAMS_VIEW_VERSION};
         size_t np = (size_t)w * h;
         double *ref = malloc(np * sizeof(double)), *cond = malloc(np * sizeof(double));
@@ -95,25 +95,25 @@ int vfx_bench_beams_gpu(int argc, char **argv)
         double *ms = malloc(frames * sizeof(double)), *fr = malloc(frames * sizeof(double));
         for (uint32_t si = 0; si < nsets; ++si) {
             make_beams(app, sets[si]);
-            vfx_beam_d bd[VFX_APP_MAX_BEAMS];
+            volfx_beam_d bd[GAME_APP_MAX_BEAMS];
             char err[128];
             for (uint32_t i = 0; i < sets[si]; ++i)
-                vfx_beam_validate(&app->beams[i], &bd[i], err, sizeof err);
+                volfx_beam_validate(&app->beams[i], &bd[i], err, sizeof err);
             if (timing_only) {
                 /* large sets: closed form only, frame wall times (the headless host waits for the
                  * GPU), no reference; the pass timer is reported when its ring has delivered */
                 app->beams_view.method = 0;
                 double g = NAN;
                 for (uint32_t f = 0; f < frames; ++f) {
-                    double t0 = vfx_now_ms();
-                    if (vfx_app_frame(app, 0.f))
+                    double t0 = rt_now_ms();
+                    if (game_app_frame(app, 0.f))
                         return 1;
-                    fr[f] = vfx_now_ms() - t0;
+                    fr[f] = rt_now_ms() - t0;
                     double gf = stat_of(app, "beams.integrate.gpu_ms");
                     if (!isnan(gf))
                         g = gf;
                 }
-                vfx_frame_pcts fp = vfx_frame_percentiles(fr, frames);
+                rt_frame_pcts fp = rt_frame_percentiles(fr, frames);
                 char gs[32] = "null"; /* no timer delivered yet (fewer frames than the ring) */
                 if (!isnan(g))
                     snprintf(gs, sizeof gs, "%.4f", g);
@@ -121,7 +121,7 @@ int vfx_bench_beams_gpu(int argc, char **argv)
                        "\"timing_only\":true,\"frames\":%u,\"frame_ms_p50\":%.4f,\"frame_ms\":{\"p50\":%.4f,\"p95\":%.4f,\"p99\":%.4f},"
                        "\"last_gpu_ms\":%s,\"pairs\":%.0f,"
                        "\"pairs_culled\":%.0f,\"gl_renderer\":\"%s\"}\n", sets[si], w, h, frames, fp.p50, fp.p50, fp.p95, fp.p99, gs,
-                       stat_of(app, "beams.pairs"), stat_of(app, "beams.pairs_culled"), vfx_gl_context_renderer(app->gl));
+                       stat_of(app, "beams.pairs"), stat_of(app, "beams.pairs_culled"), rt_gl_context_renderer(app->gl));
                 fflush(stdout);
                 continue;
             }
@@ -129,11 +129,11 @@ int vfx_bench_beams_gpu(int argc, char **argv)
             for (uint32_t j = 0; j < h; ++j)
                 for (uint32_t i = 0; i < w; ++i) {
                     double v[3], s = 0;
-                    vfx_ref_pixel_ray(&cam, i, j, v);
+                    ref_pixel_ray(&cam, i, j, v);
                     for (uint32_t b = 0; b < sets[si]; ++b)
-                        s += vfx_beam_integral_d(&bd[b], cam.eye, v, 0, cam.far_plane);
+                        s += volfx_beam_integral_d(&bd[b], cam.eye, v, 0, cam.far_plane);
                     ref[(size_t)j * w + i] = s;
-                    cond[(size_t)j * w + i] = vfx_beams_ref_cond_abs(bd, sets[si], cam.eye, v, 0, cam.far_plane, 2.0);
+                    cond[(size_t)j * w + i] = ref_beams_cond_abs(bd, sets[si], cam.eye, v, 0, cam.far_plane, 2.0);
                     hmax = fmax(hmax, s);
                 }
             /* Per-frame cost under animation: each animated configuration (a, b, M, D, L changed
@@ -153,17 +153,17 @@ int vfx_bench_beams_gpu(int argc, char **argv)
                         bm->dir[1] += 0.3f * cosf(ph), bm->radius *= 0.8f + 0.2f * sinf(ph);
                     }
                     for (int rep = 0; rep < 2; ++rep) {
-                        double t0 = vfx_now_ms();
-                        if (vfx_app_frame(app, 0.f))
+                        double t0 = rt_now_ms();
+                        if (game_app_frame(app, 0.f))
                             return 1;
-                        (rep ? still : moved)[f] = vfx_now_ms() - t0;
+                        (rep ? still : moved)[f] = rt_now_ms() - t0;
                     }
                 }
-                double mm = vfx_median(moved, frames), ms_still = vfx_median(still, frames);
+                double mm = rt_median(moved, frames), ms_still = rt_median(still, frames);
                 printf("{\"effect\":\"beams\",\"path\":\"gpu\",\"beams\":%u,\"width\":%u,\"height\":%u,"
                        "\"animation\":{\"frames\":%u,\"changed_frame_ms_p50\":%.4f,\"unchanged_frame_ms_p50\":%.4f,"
                        "\"ratio\":%.3f},\"gl_renderer\":\"%s\"}\n", sets[si], w, h, frames, mm, ms_still,
-                       mm / ms_still, vfx_gl_context_renderer(app->gl));
+                       mm / ms_still, rt_gl_context_renderer(app->gl));
                 free(moved);
                 free(still);
                 make_beams(app, sets[si]);
@@ -175,17 +175,17 @@ int vfx_bench_beams_gpu(int argc, char **argv)
                 const char *pass = samples[mi] ? "beams.march.gpu_ms" : "beams.integrate.gpu_ms";
                 uint32_t n = 0;
                 for (uint32_t f = 0; f < frames + 4; ++f) { /* 4 more: the timer ring's latency */
-                    double t0 = vfx_now_ms();
-                    if (vfx_app_frame(app, 0.f))
+                    double t0 = rt_now_ms();
+                    if (game_app_frame(app, 0.f))
                         return 1;
-                    double t = vfx_now_ms() - t0, g = stat_of(app, pass);
+                    double t = rt_now_ms() - t0, g = stat_of(app, pass);
                     if (f >= 4 && !isnan(g)) {
                         ms[n] = g;
                         fr[n++] = t;
                     }
                 }
                 app->api->read_raw(app->ctx, VFX_EFFECT_BEAMS, img, np);
-                vfx_frame_pcts fp = vfx_frame_percentiles(fr, n);
+                rt_frame_pcts fp = rt_frame_percentiles(fr, n);
                 double emax = 0, esum = 0, emax_wc = 0, ratio = 0;
                 uint32_t ne = 0, above = 0;
                 for (size_t p = 0; p < np; ++p)
@@ -205,14 +205,14 @@ int vfx_bench_beams_gpu(int argc, char **argv)
                        "\"frame_ms\":{\"p50\":%.4f,\"p95\":%.4f,\"p99\":%.4f},"
                        "\"max_rel_err\":%.4g,\"mean_rel_err\":%.4g,\"above_1e-5\":%u,\"max_rel_where_cond_below_1e-5\":%.4g,"
                        "\"max_err_over_1e-5_plus_cond\":%.4g,\"pixels\":%u,\"gl_renderer\":\"%s\"}\n",
-                       sets[si], w, h, samples[mi] ? "march" : "closed", samples[mi], n, vfx_median(ms, n),
+                       sets[si], w, h, samples[mi] ? "march" : "closed", samples[mi], n, rt_median(ms, n),
                        fp.p50, fp.p50, fp.p95, fp.p99, emax, ne ? esum / ne : 0.0, above, emax_wc, ratio, ne,
-                       vfx_gl_context_renderer(app->gl));
+                       rt_gl_context_renderer(app->gl));
                 fflush(stdout);
             }
         }
         free(ref), free(cond), free(img), free(ms), free(fr);
-        vfx_app_destroy(app);
+        game_app_destroy(app);
     }
     return 0;
 }

@@ -18,7 +18,7 @@ static void cross3(const double a[3], const double b[3], double o[3])
     o[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-void vfx_ref_camera_basis(const vfx_ref_camera *c, double f[3], double r[3], double u[3])
+void ref_camera_basis(const ref_camera *c, double f[3], double r[3], double u[3])
 {
     for (int k = 0; k < 3; ++k)
         f[k] = c->target[k] - c->eye[k];
@@ -28,10 +28,10 @@ void vfx_ref_camera_basis(const vfx_ref_camera *c, double f[3], double r[3], dou
     cross3(r, f, u);
 }
 
-void vfx_ref_pixel_ray(const vfx_ref_camera *c, uint32_t i, uint32_t j, double d[3])
+void ref_pixel_ray(const ref_camera *c, uint32_t i, uint32_t j, double d[3])
 {
     double f[3], r[3], u[3];
-    vfx_ref_camera_basis(c, f, r, u);
+    ref_camera_basis(c, f, r, u);
     double t = tan(c->fov_y * 0.5);
     double x = (2.0 * (i + 0.5) / c->width - 1.0) * t * (double)c->width / c->height;
     double y = (1.0 - 2.0 * (j + 0.5) / c->height) * t;
@@ -40,10 +40,10 @@ void vfx_ref_pixel_ray(const vfx_ref_camera *c, uint32_t i, uint32_t j, double d
     normalize3(d);
 }
 
-void vfx_ref_camera_matrices(const vfx_ref_camera *c, float view[16], float proj[16])
+void ref_camera_matrices(const ref_camera *c, float view[16], float proj[16])
 {
     double f[3], r[3], u[3];
-    vfx_ref_camera_basis(c, f, r, u);
+    ref_camera_basis(c, f, r, u);
     memset(view, 0, 16 * sizeof(float));
     for (int k = 0; k < 3; ++k) {
         view[k * 4 + 0] = (float)r[k];

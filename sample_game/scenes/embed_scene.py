@@ -2,8 +2,8 @@
 """Embeds the default scene JSON in the binary: usage embed_scene.py IN.json OUT.c
 
 Defines
-  const char vfx_default_scene_json[];          NUL-terminated text of IN.json
-  const unsigned long vfx_default_scene_json_len; its length in bytes (without the NUL)
+  const char game_default_scene_json[];          NUL-terminated text of IN.json
+  const unsigned long game_default_scene_json_len; its length in bytes (without the NUL)
 The JSON is checked here so a broken default scene fails the build, not the game."""
 import json
 import sys
@@ -29,7 +29,7 @@ def c_line(chunk):
 
 with open(dst, 'w', encoding='ascii') as out:
     out.write('/* generated from %s by embed_scene.py; do not edit */\n' % src.replace('\\', '/').split('/')[-1])
-    out.write('const char vfx_default_scene_json[] =\n')
+    out.write('const char game_default_scene_json[] =\n')
     lines = data.split(b'\n')
     for i, line in enumerate(lines):
         if i + 1 < len(lines):
@@ -39,4 +39,4 @@ with open(dst, 'w', encoding='ascii') as out:
     if not data:
         out.write('    ""\n')
     out.write('    ;\n')
-    out.write('const unsigned long vfx_default_scene_json_len = %d;\n' % len(data))
+    out.write('const unsigned long game_default_scene_json_len = %d;\n' % len(data))

@@ -19,7 +19,7 @@
 #include "profile/profiler.h"
 #include "sim/sph.h"
 
-int vfx_bench_sim(int argc, char **argv);
+int bench_sim(int argc, char **argv);
 
 static double now_s(void)
 {
@@ -51,10 +51,10 @@ static void cpu_model(char *out, size_t len)
 
 /* The timed call, out of line so that `valgrind --tool=callgrind --toggle-collect=bench_timed_step`
  * counts the timed substeps only (not the warm-up or the setup). */
-__attribute__((noinline)) vfx_result bench_timed_step(vfx_sph *s, vfx_sph_report *r);
-__attribute__((noinline)) vfx_result bench_timed_step(vfx_sph *s, vfx_sph_report *r)
+__attribute__((noinline)) vfx_result bench_timed_step(rt_sph *s, rt_sph_report *r);
+__attribute__((noinline)) vfx_result bench_timed_step(rt_sph *s, rt_sph_report *r)
 {
-    return vfx_sph_step(s, 1.f, r);
+    return rt_sph_step(s, 1.f, r);
 }
 
 typedef struct bench_opts {
@@ -85,63 +85,63 @@ static int bench_size(uint32_t n_target, const uint32_t *threads, int nthreads, 
     uint32_t ky = n_target / (kx * kx);
     const float dx = 0.02f;
     float bx = (float)kx * dx, by = (float)ky * dx, bz = (float)kx * dx;
-    vfx_sph_desc base = {.spacing = dx, .domain_min = {0, 0, 0}, .domain_max = {3.f * bx, 1.2f * by, bz},
+    rt_sph_desc base = {.spacing = dx, .domain_min = {0, 0, 0}, .domain_max = {3.f * bx, 1.2f * by, bz},
                          .neighbor_skin = o->skin[0]};
     char err[256];
     /* warm-up: the collapse, on all the threads asked for */
-    vfx_sph *w = NULL;
-    vfx_sph_desc dw = base;
+    rt_sph *w = NULL;
+    rt_sph_desc dw = base;
     dw.threads = threads[nthreads - 1];
     dw.max_substeps = 100000000;
-    if (vfx_sph_create(&dw, &w, err, sizeof err)) {
+    if (rt_sph_create(&dw, &w, err, sizeof err)) {
         fprintf(stderr, "volfx-bench sim: %s\n", err);
         return 1;
     }
     float lo[3] = {0, 0, 0}, hi[3] = {bx, by, bz};
     uint32_t n = 0;
-    vfx_sph_report wr = {0};
+    rt_sph_report wr = {0};
     double tw = now_s();
-    if (vfx_sph_add_block(w, lo, hi, &n) || (o->warmup_s > 0.0 && vfx_sph_step(w, (float)o->warmup_s, &wr))) {
-        fprintf(stderr, "volfx-bench sim: warm-up: %s\n", vfx_sph_last_error(w));
-        vfx_sph_destroy(w);
+    if (rt_sph_add_block(w, lo, hi, &n) || (o->warmup_s > 0.0 && rt_sph_step(w, (float)o->warmup_s, &wr))) {
+        fprintf(stderr, "volfx-bench sim: warm-up: %s\n", rt_sph_last_error(w));
+        rt_sph_destroy(w);
         return 1;
     }
     tw = now_s() - tw;
-    vfx_sph_columns wc = vfx_sph_get_columns(w);
+    rt_sph_columns wc = rt_sph_get_columns(w);
     int nsol = 0;
-    vfx_sph *s[BENCH_MAX_S] = {0};
+    rt_sph *s[BENCH_MAX_S] = {0};
     bool rebuild_of[BENCH_MAX_S];
     uint32_t thr_of[BENCH_MAX_S];
     int set_of[BENCH_MAX_S], tidx_of[BENCH_MAX_S]; /* solver set (method, skin), thread index */
     double *ps[BENCH_MAX_S] = {0}, *is[BENCH_MAX_S] = {0}, *ms[BENCH_MAX_S] = {0};
     double *rt[BENCH_MAX_S] = {0}, *rm[BENCH_MAX_S] = {0};
     uint64_t sub_sum[BENCH_MAX_S] = {0}, reb_sum[BENCH_MAX_S] = {0}, skin_sum[BENCH_MAX_S] = {0};
-    vfx_sph_report r[BENCH_MAX_S];
+    rt_sph_report r[BENCH_MAX_S];
     int rc = 0;
     for (int m = 0; m < 1 + o->nskin && !rc; ++m) {
         if ((m == 0 && !o->rebuild) || (m > 0 && !o->verlet))
             continue;
         for (int t = 0; t < nthreads && !rc; ++t) {
-            vfx_sph_desc d = base;
+            rt_sph_desc d = base;
             d.threads = threads[t];
             d.max_substeps = (uint32_t)substeps;
-            d.flags = m == 0 ? VFX_SPH_REBUILD_EVERY_SUBSTEP : 0;
+            d.flags = m == 0 ? RT_SPH_REBUILD_EVERY_SUBSTEP : 0;
             d.neighbor_skin = o->skin[m > 0 ? m - 1 : 0];
             int k = nsol++;
             rebuild_of[k] = m == 0;
             set_of[k] = m, tidx_of[k] = t;
-            if (vfx_sph_create(&d, &s[k], err, sizeof err)) {
+            if (rt_sph_create(&d, &s[k], err, sizeof err)) {
                 fprintf(stderr, "volfx-bench sim: %s\n", err);
                 rc = 1;
                 break;
             }
-            thr_of[k] = vfx_sph_thread_count(s[k]);
-            if (vfx_sph_add_particles(s[k], wc.count, wc.x, wc.y, wc.z, wc.vx, wc.vy, wc.vz)) {
-                fprintf(stderr, "volfx-bench sim: %s\n", vfx_sph_last_error(s[k]));
+            thr_of[k] = rt_sph_thread_count(s[k]);
+            if (rt_sph_add_particles(s[k], wc.count, wc.x, wc.y, wc.z, wc.vx, wc.vy, wc.vz)) {
+                fprintf(stderr, "volfx-bench sim: %s\n", rt_sph_last_error(s[k]));
                 rc = 1;
                 break;
             }
-            vfx_sph_step(s[k], 1.f, &r[k]); /* untimed: pages touched, lists built */
+            rt_sph_step(s[k], 1.f, &r[k]); /* untimed: pages touched, lists built */
             ps[k] = calloc((size_t)reps, sizeof *ps[k]);
             is[k] = calloc((size_t)reps, sizeof *is[k]);
             ms[k] = calloc((size_t)reps, sizeof *ms[k]);
@@ -161,7 +161,7 @@ static int bench_size(uint32_t n_target, const uint32_t *threads, int nthreads, 
             vfx_result e = bench_timed_step(s[k], &r[k]);
             double dt = now_s() - t0;
             if (e) {
-                fprintf(stderr, "volfx-bench sim: %s\n", vfx_sph_last_error(s[k]));
+                fprintf(stderr, "volfx-bench sim: %s\n", rt_sph_last_error(s[k]));
                 rc = 1;
                 break;
             }
@@ -192,9 +192,9 @@ static int bench_size(uint32_t n_target, const uint32_t *threads, int nthreads, 
         fclose(la);
     }
     for (int k = 0; k < nsol && !rc; ++k) {
-        double p = vfx_median(ps[k], (uint32_t)reps), in = vfx_median(is[k], (uint32_t)reps);
-        double m = vfx_median(ms[k], (uint32_t)reps), q = vfx_median(rt[k], (uint32_t)reps);
-        double qm = vfx_median(rm[k], (uint32_t)reps);
+        double p = rt_median(ps[k], (uint32_t)reps), in = rt_median(is[k], (uint32_t)reps);
+        double m = rt_median(ms[k], (uint32_t)reps), q = rt_median(rt[k], (uint32_t)reps);
+        double qm = rt_median(rm[k], (uint32_t)reps);
         uint32_t tc = thr_of[k];
         printf("{\"effect\":\"sim\",\"particles\":%u,\"threads\":%u,\"substeps_per_rep\":%d,\"reps\":%d,"
                "\"particle_steps_per_s\":%.0f,\"particle_steps_per_s_per_thread\":%.0f,"
@@ -206,17 +206,17 @@ static int bench_size(uint32_t n_target, const uint32_t *threads, int nthreads, 
                "\"loadavg\":[%.2f,%.2f,%.2f]}\n",
                n, tc, substeps, reps, p, p / tc, in, m,
                r[k].substeps ? (double)r[k].neighbor_pairs / r[k].substeps / n : 0.0,
-               vfx_sph_memory_bytes(s[k]) / 1048576.0, q, cpu, rebuild_of[k] ? "rebuild" : "verlet",
-               vfx_sph_params(s[k])->neighbor_skin, qm,
+               rt_sph_memory_bytes(s[k]) / 1048576.0, q, cpu, rebuild_of[k] ? "rebuild" : "verlet",
+               rt_sph_params(s[k])->neighbor_skin, qm,
                sub_sum[k] ? (double)reb_sum[k] / (double)sub_sum[k] : 0.0,
                sub_sum[k] ? (double)skin_sum[k] / (double)sub_sum[k] / n : 0.0, o->warmup_s,
                wr.substeps, tw, wr.max_speed, load[0], load[1], load[2]);
     }
     for (int k = 0; k < nsol; ++k) {
         free(ps[k]), free(is[k]), free(ms[k]), free(rt[k]), free(rm[k]);
-        vfx_sph_destroy(s[k]);
+        rt_sph_destroy(s[k]);
     }
-    vfx_sph_destroy(w);
+    rt_sph_destroy(w);
     return rc;
 }
 
@@ -227,22 +227,22 @@ static const double mm_T[] = {0.832, 1.219, 1.997, 2.547, 3.345, 4.034, 4.418, 5
 static const double mm_Z[] = {1.217, 1.474, 2.292, 2.995, 4.134, 4.944, 5.881, 6.980, 7.945};
 
 /* The surge front: the largest x where the fluid volume fraction on the floor
- * (vfx_sph_volume_fraction: sum_j (m/rho0) W_poly6 over the fluid share of the kernel)
+ * (rt_sph_volume_fraction: sum_j (m/rho0) W_poly6 over the fluid share of the kernel)
  * reaches 1/2, sampled every dx/20 at the first layer's height (dx/2) and mid-depth. 1/2 is
  * where a kernel-smoothed step from fluid to air crosses: the edge of the continuum the
  * particles stand for (a flat block's edge lies half a spacing beyond its last particle
  * centres), while a particle thrown ahead alone (fraction < 0.3) is spray, not the surge. */
-static double surge_front(vfx_sph *s, float dx)
+static double surge_front(rt_sph *s, float dx)
 {
-    vfx_sph_columns c = vfx_sph_get_columns(s);
-    const vfx_sph_desc *p = vfx_sph_params(s);
+    rt_sph_columns c = rt_sph_get_columns(s);
+    const rt_sph_desc *p = rt_sph_params(s);
     double xmax = 0.0;
     for (uint32_t i = 0; i < c.count; ++i)
         xmax = c.x[i] > xmax ? c.x[i] : xmax;
     float q[3] = {0.f, p->domain_min[1] + 0.5f * dx, 0.5f * (p->domain_min[2] + p->domain_max[2])};
-    for (double x = xmax + vfx_sph_support(s); x > p->domain_min[0]; x -= dx / 20.0) {
+    for (double x = xmax + rt_sph_support(s); x > p->domain_min[0]; x -= dx / 20.0) {
         q[0] = (float)x;
-        if (vfx_sph_volume_fraction(s, q) >= 0.5f)
+        if (rt_sph_volume_fraction(s, q) >= 0.5f)
             return x;
     }
     return 0.0;
@@ -253,12 +253,12 @@ static int dam_break(int res, uint32_t threads, double t_max, double settle_s, u
 {
     const double a = 0.05715, g = 9.81;
     float dx = (float)(a / res);
-    vfx_sph_desc d = {.spacing = dx, .domain_min = {0, 0, 0},
+    rt_sph_desc d = {.spacing = dx, .domain_min = {0, 0, 0},
                       .domain_max = {(float)(10 * a), (float)(2.5 * a), 4 * dx},
                       .threads = threads, .max_substeps = 1000000, .no_slip_faces = no_slip};
-    vfx_sph *s;
+    rt_sph *s;
     char err[256];
-    if (vfx_sph_create(&d, &s, err, sizeof err)) {
+    if (rt_sph_create(&d, &s, err, sizeof err)) {
         fprintf(stderr, "volfx-bench sim: %s\n", err);
         return 1;
     }
@@ -270,32 +270,32 @@ static int dam_break(int res, uint32_t threads, double t_max, double settle_s, u
          * (a tank a wide, same EOS) so it starts hydrostatic, then release it at rest. A fresh
          * lattice is uncompressed (p = 0 everywhere): released as it is, it first falls and
          * bounces on its own compression, a pressure overshoot the experiment did not have. */
-        vfx_sph_desc dg = d;
+        rt_sph_desc dg = d;
         dg.domain_max[0] = (float)a;
-        dg.sound_speed = vfx_sph_params(s)->sound_speed;
+        dg.sound_speed = rt_sph_params(s)->sound_speed;
         dg.stiffness = 0.f;
-        vfx_sph *gs;
-        if (vfx_sph_create(&dg, &gs, err, sizeof err)) {
+        rt_sph *gs;
+        if (rt_sph_create(&dg, &gs, err, sizeof err)) {
             fprintf(stderr, "volfx-bench sim: %s\n", err);
-            vfx_sph_destroy(s);
+            rt_sph_destroy(s);
             return 1;
         }
-        vfx_sph_add_block(gs, lo, hi, &n);
-        vfx_sph_report r;
-        if (vfx_sph_step(gs, (float)settle_s, &r)) {
-            fprintf(stderr, "volfx-bench sim: settling: %s\n", vfx_sph_last_error(gs));
-            vfx_sph_destroy(gs);
-            vfx_sph_destroy(s);
+        rt_sph_add_block(gs, lo, hi, &n);
+        rt_sph_report r;
+        if (rt_sph_step(gs, (float)settle_s, &r)) {
+            fprintf(stderr, "volfx-bench sim: settling: %s\n", rt_sph_last_error(gs));
+            rt_sph_destroy(gs);
+            rt_sph_destroy(s);
             return 1;
         }
         printf("{\"effect\":\"sim\",\"case\":\"dam_break_settle\",\"a_over_dx\":%d,\"settle_s\":%.3f,"
                "\"kinetic_energy_J\":%.3g,\"max_speed\":%.4f,\"max_density_error\":%.4f}\n",
                res, settle_s, r.kinetic_energy, r.max_speed, r.max_density_error);
-        vfx_sph_columns c = vfx_sph_get_columns(gs);
-        vfx_sph_add_particles(s, c.count, c.x, c.y, c.z, NULL, NULL, NULL); /* released at rest */
-        vfx_sph_destroy(gs);
+        rt_sph_columns c = rt_sph_get_columns(gs);
+        rt_sph_add_particles(s, c.count, c.x, c.y, c.z, NULL, NULL, NULL); /* released at rest */
+        rt_sph_destroy(gs);
     } else {
-        vfx_sph_add_block(s, lo, hi, &n);
+        rt_sph_add_block(s, lo, hi, &n);
     }
     double Ts = sqrt(2 * g / a), worst = 0.0;
     uint64_t substeps = 0;
@@ -303,9 +303,9 @@ static int dam_break(int res, uint32_t threads, double t_max, double settle_s, u
     for (size_t k = 0; k < sizeof mm_T / sizeof mm_T[0]; ++k) {
         if (mm_T[k] > t_max)
             break;
-        vfx_sph_report r;
-        if (vfx_sph_step(s, (float)(mm_T[k] / Ts - vfx_sph_time(s)), &r)) {
-            fprintf(stderr, "volfx-bench sim: %s\n", vfx_sph_last_error(s));
+        rt_sph_report r;
+        if (rt_sph_step(s, (float)(mm_T[k] / Ts - rt_sph_time(s)), &r)) {
+            fprintf(stderr, "volfx-bench sim: %s\n", rt_sph_last_error(s));
             rc = 1;
             break;
         }
@@ -321,7 +321,7 @@ static int dam_break(int res, uint32_t threads, double t_max, double settle_s, u
     printf("{\"effect\":\"sim\",\"case\":\"dam_break_summary\",\"a_over_dx\":%d,\"settle_s\":%.2f,\"no_slip\":%u,\"particles\":%u,"
            "\"points\":%d,\"max_abs_error_pct\":%.2f,\"substeps\":%llu,\"wall_s\":%.2f,\"cpu\":\"%s\"}\n",
            res, settle_s, no_slip, n, used, 100.0 * worst, (unsigned long long)substeps, now_s() - t0, cpu);
-    vfx_sph_destroy(s);
+    rt_sph_destroy(s);
     return rc;
 }
 
@@ -341,7 +341,7 @@ static int parse_list(const char *s, uint32_t *out, int max)
     return n;
 }
 
-int vfx_bench_sim(int argc, char **argv)
+int bench_sim(int argc, char **argv)
 {
     uint32_t sizes[8] = {4096, 16384, 65536}, threads[8] = {1, 2};
     int nsizes = 3, nthreads = 2, substeps = 20, reps = 5, res = 20;
@@ -396,7 +396,7 @@ int vfx_bench_sim(int argc, char **argv)
             settle_s = atof(argv[++i]);
         } else if (!strcmp(argv[i], "--no-slip")) {
             /* the experiment's solid walls: the floor and the back wall behind the column */
-            no_slip = VFX_SPH_FACE_Y_MIN | VFX_SPH_FACE_X_MIN;
+            no_slip = RT_SPH_FACE_Y_MIN | RT_SPH_FACE_X_MIN;
         } else if (!strcmp(argv[i], "--help")) {
             puts("volfx-bench sim [--sizes 4096,16384,65536] [--threads 1,2] [--substeps 20] [--reps 5]\n"
                  "                [--warmup-s 0.2 (simulated s of the collapse before timing)]\n"

@@ -75,7 +75,7 @@ static void make_view(view *v, const char *name, const float bmin[3], const floa
     v->farp = 2.0 * (dist + depth);
 }
 
-static void view_camera(const view *v, int w, int h, vfx_tet_camera *c)
+static void view_camera(const view *v, int w, int h, tet_camera *c)
 {
     memset(c, 0, sizeof *c);
     c->width = w; c->height = h;
@@ -141,8 +141,8 @@ static int write_pfm_pair(const char *prefix, const char *view, const char *suff
 typedef struct run_result {
     double wall_ms, cpu_ms, t_sc_ms, t_update_ms, rmse, max;
     double wall_p95, wall_p99; /* nearest-rank over the timed runs ("frame_ms" in the JSON) */
-    vfx_tet_counters c;
-    vfx_tet_counters pw[64];
+    tet_counters c;
+    tet_counters pw[64];
 } run_result;
 
 static int cmp_run(const void *a, const void *b)
@@ -160,8 +160,8 @@ static int cmp_d(const void *a, const void *b)
 /* Runs one configuration reps + 1 times, drops the first (warm-up), and returns in *out the run
  * of median wall time, with t_sc and t_update replaced by their own medians. ref (or NULL) gives
  * rmse/max of each run against it. */
-static int run_cfg(const vfx_tet_mesh *m, const vfx_tet_camera *cam, const vfx_tet_tf *tf,
-                   const vfx_tet_options *o, float *img, const float *ref, int reps,
+static int run_cfg(const tet_mesh *m, const tet_camera *cam, const tet_tf *tf,
+                   const tet_options *o, float *img, const float *ref, int reps,
                    run_result *runs, run_result *out)
 {
     char err[256];
@@ -170,13 +170,13 @@ static int run_cfg(const vfx_tet_mesh *m, const vfx_tet_camera *cam, const vfx_t
         run_result *rr = &runs[r > 0 ? r - 1 : 0];
         /* CPU time of the whole process (every worker thread): the figure that survives other
          * load */
-        double t0 = vfx_tet_now_ms(), c0 = vfx_tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID);
-        if (vfx_tet_render_workers(m, cam, tf, o, img, &rr->c, rr->pw, err) != 0) {
+        double t0 = tet_now_ms(), c0 = tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID);
+        if (tet_render_workers(m, cam, tf, o, img, &rr->c, rr->pw, err) != 0) {
             fprintf(stderr, "bench tetvol: %s\n", err);
             return -1;
         }
-        rr->wall_ms = vfx_tet_now_ms() - t0;
-        rr->cpu_ms = vfx_tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID) - c0;
+        rr->wall_ms = tet_now_ms() - t0;
+        rr->cpu_ms = tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID) - c0;
         rr->t_sc_ms = rr->c.t_sc_ms;
         rr->t_update_ms = rr->c.t_update_ms;
         rr->rmse = rr->max = 0;
@@ -220,7 +220,7 @@ static void usage(void)
           "of the no-ERT image. Output is JSON lines (--json is accepted for symmetry).\n", stderr);
 }
 
-int vfx_bench_tetvol(int argc, char **argv)
+int bench_tetvol(int argc, char **argv)
 {
     int n = 24, w = 300, h = 300, maxw = 8, reps = 5, cnp_max = 100;
     float tau = 4.0f;
@@ -249,26 +249,26 @@ int vfx_bench_tetvol(int argc, char **argv)
         fprintf(stderr, "bench tetvol: --grid 1..200, --size 1..4096, --workers 1..64, --reps 1..63, --tau > 0\n");
         return 2;
     }
-    vfx_tet_mesh m;
+    tet_mesh m;
     char err[256];
     const char *mesh_name = "grid";
     if (mesh_path) {
         size_t l = strlen(mesh_path);
         int r;
         if (l > 4 && !strcmp(mesh_path + l - 4, ".vtu")) {
-            r = vfx_tet_load_vtu(mesh_path, scalar ? scalar : "Velocity", &m, err, sizeof err);
+            r = tet_load_vtu(mesh_path, scalar ? scalar : "Velocity", &m, err, sizeof err);
         } else {
             char base[1024];
             snprintf(base, sizeof base, "%s", mesh_path);
             l = strlen(base);
             if (l > 5 && (!strcmp(base + l - 5, ".node") || !strcmp(base + l - 4, ".ele")))
                 base[!strcmp(base + l - 4, ".ele") ? l - 4 : l - 5] = 0;
-            r = vfx_tet_load_tetgen(base, scalar ? scalar : "attr0", &m, err, sizeof err);
+            r = tet_load_tetgen(base, scalar ? scalar : "attr0", &m, err, sizeof err);
         }
         if (r != 0) { fprintf(stderr, "bench tetvol: %s\n", err); return 1; }
         const char *sl = strrchr(mesh_path, '/');
         mesh_name = sl ? sl + 1 : mesh_path;
-    } else if (vfx_tet_testmesh_grid(n, &m) != 0) {
+    } else if (ref_testmesh_grid(n, &m) != 0) {
         fprintf(stderr, "bench tetvol: out of memory\n");
         return 1;
     }
@@ -298,7 +298,7 @@ int vfx_bench_tetvol(int argc, char **argv)
 
     float thin = bmax[lo] - bmin[lo];
     float tau_hi = tau / thin;
-    vfx_tet_tf tf = {m.scalar_min, m.scalar_max, 0.2f * tau_hi, tau_hi, {0.1f, 0.3f, 1.0f}, {1.0f, 0.6f, 0.1f}};
+    tet_tf tf = {m.scalar_min, m.scalar_max, 0.2f * tau_hi, tau_hi, {0.1f, 0.3f, 1.0f}, {1.0f, 0.6f, 0.1f}};
     size_t npx = (size_t)w * h * 4;
     float *ref = malloc(npx * sizeof *ref), *img = malloc(npx * sizeof *img);
     run_result *runs = malloc(64 * sizeof *runs), *res = malloc(sizeof *res);
@@ -316,9 +316,9 @@ int vfx_bench_tetvol(int argc, char **argv)
         const view *vw = &views[vi];
         if (!has(views_opt, vw->name) && strcmp(views_opt, "all") != 0)
             continue;
-        vfx_tet_camera cam;
+        tet_camera cam;
         view_camera(vw, w, h, &cam);
-        vfx_tet_options o; vfx_tet_options_default(&o);
+        tet_options o; tet_options_default(&o);
         o.ert = 0; o.workers = 1;
         /* the no-ERT one-worker image is the reference of every error figure */
         if ((rc = run_cfg(&m, &cam, &tf, &o, ref, NULL, reps, runs, res)) != 0) break;
@@ -353,7 +353,7 @@ int vfx_bench_tetvol(int argc, char **argv)
                 rc = 1;
                 break;
             }
-            vfx_tet_options_default(&o);
+            tet_options_default(&o);
             o.ert = 0; o.workers = 1;
         }
         if (has(only, "table1")) {
@@ -430,7 +430,7 @@ int vfx_bench_tetvol(int argc, char **argv)
                     printf(HEAD "\"test\":\"table2\",\"config\":\"%s\",\"workers\":%d,\"wall_ms\":%.2f,\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"cpu_ms\":%.2f,\"rmse\":%.3g,\"max\":%.3g,\"per_worker\":[",
                            HARGS, names[i], nw, res->wall_ms, res->wall_ms, res->wall_p95, res->wall_p99, res->cpu_ms, res->rmse, res->max);
                     for (int k = 0; k < nw; k++) {
-                        const vfx_tet_counters *p = &res->pw[k];
+                        const tet_counters *p = &res->pw[k];
                         double t = p->t_sc_ms + p->t_update_ms;
                         csum_cpu += p->cpu_ms;
                         if (p->cpu_ms > cmax_cpu) cmax_cpu = p->cpu_ms;
@@ -454,7 +454,7 @@ int vfx_bench_tetvol(int argc, char **argv)
         fflush(stdout);
     }
     free(ref); free(img); free(runs); free(res);
-    if (mesh_path) vfx_tet_mesh_free(&m);
+    if (mesh_path) tet_mesh_free(&m);
     else { free(m.points); free(m.scalar); free(m.tets); }
     return rc ? 1 : 0;
 }

@@ -9,7 +9,7 @@
 /* one cube's 5 tets over the corners numbered x + 2y + 4z */
 static const uint32_t cube5[20] = {0, 1, 3, 4, 1, 2, 3, 6, 1, 4, 5, 6, 3, 4, 6, 7, 1, 3, 4, 6};
 
-int vfx_tet_testmesh_grid(int n, vfx_tet_mesh *m)
+int ref_testmesh_grid(int n, tet_mesh *m)
 {
     uint32_t np = (uint32_t)((n + 1) * (n + 1) * (n + 1)), nt = (uint32_t)(n * n * n * 5);
     memset(m, 0, sizeof *m);
@@ -50,7 +50,7 @@ int vfx_tet_testmesh_grid(int n, vfx_tet_mesh *m)
     return 0;
 }
 
-void vfx_tet_testmesh_orbit(vfx_tet_camera *c, int w, int h, float yaw, float pitch, float f,
+void ref_testmesh_orbit(tet_camera *c, int w, int h, float yaw, float pitch, float f,
                             float nearp, float farp)
 {
     memset(c, 0, sizeof *c);

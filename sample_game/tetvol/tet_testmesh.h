@@ -1,21 +1,21 @@
 /* tet_testmesh.h — the generated tetrahedral grid and orbit camera that volfx-bench tetvol,
  * volfx-tetvol-mpi and the MPI tests render, in one place so that all of them render the same
  * mesh. Host-side helpers (not part of the plugin). */
-#ifndef VFX_TET_TESTMESH_H
-#define VFX_TET_TESTMESH_H
+#ifndef REF_TET_TESTMESH_H
+#define REF_TET_TESTMESH_H
 
 #include "tetvol/tet_render.h"
 
 /* Fills m with n^3 cubes x 5 tets over [-1,1]^3 (alternate cubes mirrored so faces match),
  * scalar 0.5 + 0.5 sin(3x) cos(2y) cos(1.5z) at the points, range [0, 1], named "grid"; the
  * arrays are malloc'd (free each). Returns 0, or -1 when out of memory (m partly filled). */
-int vfx_tet_testmesh_grid(int n, vfx_tet_mesh *m);
+int ref_testmesh_grid(int n, tet_mesh *m);
 
 /* Clears c and sets a w x h view rotated Rx(pitch) Ry(yaw), no translation (the caller places
  * the eye), and the perspective projection of focal factor f = 1 / tan(fovy / 2) between the
  * near and far planes. f is the caller's so its rounding stays the caller's (a constant fov
  * folds at compile time). */
-void vfx_tet_testmesh_orbit(vfx_tet_camera *c, int w, int h, float yaw, float pitch, float f,
+void ref_testmesh_orbit(tet_camera *c, int w, int h, float yaw, float pitch, float f,
                             float nearp, float farp);
 
 #endif

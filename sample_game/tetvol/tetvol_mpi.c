@@ -22,7 +22,7 @@
 #include "tetvol/tet_testmesh.h"
 
 /* Frames the mesh's bounding sphere: view = T(0,0,-dist) Rx(pitch) Ry(yaw) T(-centre). */
-static void camera(vfx_tet_camera *c, const vfx_tet_mesh *m, int w, int h, float yaw,
+static void camera(tet_camera *c, const tet_mesh *m, int w, int h, float yaw,
                    float pitch, float *radius)
 {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -40,7 +40,7 @@ static void camera(vfx_tet_camera *c, const vfx_tet_mesh *m, int w, int h, float
     *radius = (float)rad;
     const float fov = 0.8f;
     float dist = (float)(rad / sin(0.5 * fov) * 1.05);
-    vfx_tet_testmesh_orbit(c, w, h, yaw, pitch, 1.0f / tanf(0.5f * fov), dist * 0.01f, dist * 4);
+    ref_testmesh_orbit(c, w, h, yaw, pitch, 1.0f / tanf(0.5f * fov), dist * 0.01f, dist * 4);
     const float *R = c->view; /* the rotation's columns at 0, 4, 8 */
     for (int r = 0; r < 3; r++)
         c->view[12 + r] = -(float)(R[r] * ctr[0] + R[4 + r] * ctr[1] + R[8 + r] * ctr[2]);
@@ -76,7 +76,7 @@ static const mode modes[] = {
     {"ert_share", 1, 1, 0}, {"ert_dlb", 1, 0, 1}, {"ert_share_dlb", 1, 1, 1},
 };
 
-static void print_array_u(const char *key, const vfx_tet_mpi_stats *all, int P, size_t off)
+static void print_array_u(const char *key, const tet_mpi_stats *all, int P, size_t off)
 {
     printf(",\"%s\":[", key);
     for (int r = 0; r < P; r++)
@@ -85,7 +85,7 @@ static void print_array_u(const char *key, const vfx_tet_mpi_stats *all, int P, 
     printf("]");
 }
 
-static void print_array_d(const char *key, const vfx_tet_mpi_stats *all, int P, size_t off)
+static void print_array_d(const char *key, const tet_mpi_stats *all, int P, size_t off)
 {
     printf(",\"%s\":[", key);
     for (int r = 0; r < P; r++)
@@ -93,7 +93,7 @@ static void print_array_d(const char *key, const vfx_tet_mpi_stats *all, int P, 
     printf("]");
 }
 
-static double imbalance(const vfx_tet_mpi_stats *all, int P, size_t off, int is_double)
+static double imbalance(const tet_mpi_stats *all, int P, size_t off, int is_double)
 {
     double mx = 0, sum = 0;
     for (int r = 0; r < P; r++) {
@@ -154,17 +154,17 @@ int main(int argc, char **argv)
     }
     /* every rank loads the mesh itself (the paper's nodes hold their data where the
      * simulation left it; here each rank holds it all so that work can move as key ranges) */
-    vfx_tet_mesh m;
+    tet_mesh m;
     char err[256] = "";
     int rc = 0;
     const char *src = "grid";
     if (vtu) {
         src = vtu;
-        rc = vfx_tet_load_vtu(vtu, field ? field : "Velocity", &m, err, sizeof err);
+        rc = tet_load_vtu(vtu, field ? field : "Velocity", &m, err, sizeof err);
     } else if (tetgen) {
         src = tetgen;
-        rc = vfx_tet_load_tetgen(tetgen, field ? field : "attr0", &m, err, sizeof err);
-    } else if (vfx_tet_testmesh_grid(grid, &m) != 0) {
+        rc = tet_load_tetgen(tetgen, field ? field : "attr0", &m, err, sizeof err);
+    } else if (ref_testmesh_grid(grid, &m) != 0) {
         rc = VFX_ERR_OUT_OF_MEMORY;
         snprintf(err, sizeof err, "out of memory for a %d^3 grid", grid);
     }
@@ -176,7 +176,7 @@ int main(int argc, char **argv)
         MPI_Finalize();
         return 1;
     }
-    vfx_tet_camera cam;
+    tet_camera cam;
     float radius;
     /* A: from the side (across z), Z: down the z axis (the pipe's axis: long rays, many
      * cells per pixel), B: along the bounding box diagonal */
@@ -188,34 +188,34 @@ int main(int argc, char **argv)
         camera(&cam, &m, size, size, 0.785f, 0.6155f, &radius);
     /* extinction per world unit scaled by the mesh's size: tau is the optical depth across
      * one bounding radius at the top of the scalar range */
-    vfx_tet_tf tf = {m.scalar_min, m.scalar_max, 0.1f * tau / radius, tau / radius,
+    tet_tf tf = {m.scalar_min, m.scalar_max, 0.1f * tau / radius, tau / radius,
                      {0.1f, 0.3f, 1.0f}, {1.0f, 0.6f, 0.1f}};
     const size_t n4 = (size_t)size * size * 4;
     float *img = rank == 0 ? malloc(n4 * sizeof *img) : NULL;
     float *ref = rank == 0 ? malloc(n4 * sizeof *ref) : NULL;
-    vfx_tet_mpi_stats *all = rank == 0 ? calloc((size_t)P, sizeof *all) : NULL;
+    tet_mpi_stats *all = rank == 0 ? calloc((size_t)P, sizeof *all) : NULL;
     double *times = malloc((size_t)repeat * sizeof *times);
     if ((rank == 0 && (!img || !ref || !all)) || !times) {
         fprintf(stderr, "volfx-tetvol-mpi: out of memory for %dx%d images\n", size, size);
         MPI_Abort(MPI_COMM_WORLD, 1);
     }
-    vfx_tet_mpi *ctx;
-    if (vfx_tet_mpi_create(MPI_COMM_WORLD, &ctx, err) != 0) {
+    tet_mpi *ctx;
+    if (tet_mpi_create(MPI_COMM_WORLD, &ctx, err) != 0) {
         fprintf(stderr, "volfx-tetvol-mpi: %s\n", err);
         MPI_Abort(MPI_COMM_WORLD, 1);
     }
-    vfx_tet_options o;
-    vfx_tet_options_default(&o);
+    tet_options o;
+    tet_options_default(&o);
     o.tiles_d = tiles_d;
     o.update_c = update_c;
     /* the one-process image every configuration is compared with */
     double t_one = 0;
     if (rank == 0) {
-        vfx_tet_counters c;
+        tet_counters c;
         o.ert = 0;
         o.ert_threshold = 1.0f; /* the partial-compositing stop of the no-ERT runs below */
         double t0 = MPI_Wtime();
-        if (vfx_tet_render(&m, &cam, &tf, &o, ref, &c, err) != 0) {
+        if (tet_render(&m, &cam, &tf, &o, ref, &c, err) != 0) {
             fprintf(stderr, "volfx-tetvol-mpi: %s\n", err);
             MPI_Abort(MPI_COMM_WORLD, 1);
         }
@@ -255,13 +255,13 @@ int main(int argc, char **argv)
         for (int r = 0; r < repeat; r++) {
             barrier_polite();
             double t0 = MPI_Wtime();
-            rc = vfx_tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err);
+            rc = tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err);
             double t = (MPI_Wtime() - t0) * 1e3, tmax = t;
             MPI_Reduce(&t, &tmax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
             if (rc != 0) {
                 if (rank == 0)
                     fprintf(stderr, "volfx-tetvol-mpi: %s\n", err);
-                vfx_tet_mpi_destroy(ctx);
+                tet_mpi_destroy(ctx);
                 MPI_Finalize();
                 return 1;
             }
@@ -292,29 +292,29 @@ int main(int argc, char **argv)
                md->name, P, view, times[repeat / 2], times[0], times[repeat - 1], repeat,
                (unsigned long long)scanned, (unsigned long long)skipped,
                (unsigned long long)moved, (unsigned long long)bytes,
-               imbalance(all, P, offsetof(vfx_tet_mpi_stats, cnt.t_sc_ms), 1),
-               imbalance(all, P, offsetof(vfx_tet_mpi_stats, t_phase1_cpu_ms), 1),
-               imbalance(all, P, offsetof(vfx_tet_mpi_stats, cnt.cells_scanned), 0), mx,
+               imbalance(all, P, offsetof(tet_mpi_stats, cnt.t_sc_ms), 1),
+               imbalance(all, P, offsetof(tet_mpi_stats, t_phase1_cpu_ms), 1),
+               imbalance(all, P, offsetof(tet_mpi_stats, cnt.cells_scanned), 0), mx,
                sqrt(se / n4));
-        print_array_d("t_sc_ms", all, P, offsetof(vfx_tet_mpi_stats, cnt.t_sc_ms));
-        print_array_d("t_setup_ms", all, P, offsetof(vfx_tet_mpi_stats, t_setup_ms));
-        print_array_d("t_phase1_ms", all, P, offsetof(vfx_tet_mpi_stats, t_phase1_ms));
-        print_array_d("t_export_ms", all, P, offsetof(vfx_tet_mpi_stats, t_export_ms));
-        print_array_d("t_phase1_cpu_ms", all, P, offsetof(vfx_tet_mpi_stats, t_phase1_cpu_ms));
-        print_array_d("t_comm_ms", all, P, offsetof(vfx_tet_mpi_stats, t_comm_ms));
-        print_array_d("t_idle_ms", all, P, offsetof(vfx_tet_mpi_stats, t_idle_ms));
-        print_array_u("polls", all, P, offsetof(vfx_tet_mpi_stats, polls));
-        print_array_d("t_swap_ms", all, P, offsetof(vfx_tet_mpi_stats, t_swap_ms));
-        print_array_d("t_gather_ms", all, P, offsetof(vfx_tet_mpi_stats, t_gather_ms));
-        print_array_u("scanned", all, P, offsetof(vfx_tet_mpi_stats, cnt.cells_scanned));
-        print_array_u("keys_done", all, P, offsetof(vfx_tet_mpi_stats, keys_done));
-        print_array_u("taken", all, P, offsetof(vfx_tet_mpi_stats, cells_taken));
-        print_array_u("segments_made", all, P, offsetof(vfx_tet_mpi_stats, cnt.segments_made));
-        print_array_u("segments_local", all, P, offsetof(vfx_tet_mpi_stats, segments_local));
-        print_array_u("segments_final", all, P, offsetof(vfx_tet_mpi_stats, segments_final));
-        print_array_u("swap_bytes_rank", all, P, offsetof(vfx_tet_mpi_stats, bytes_sent));
-        print_array_u("shares", all, P, offsetof(vfx_tet_mpi_stats, share_rounds));
-        print_array_u("reductions", all, P, offsetof(vfx_tet_mpi_stats, reductions));
+        print_array_d("t_sc_ms", all, P, offsetof(tet_mpi_stats, cnt.t_sc_ms));
+        print_array_d("t_setup_ms", all, P, offsetof(tet_mpi_stats, t_setup_ms));
+        print_array_d("t_phase1_ms", all, P, offsetof(tet_mpi_stats, t_phase1_ms));
+        print_array_d("t_export_ms", all, P, offsetof(tet_mpi_stats, t_export_ms));
+        print_array_d("t_phase1_cpu_ms", all, P, offsetof(tet_mpi_stats, t_phase1_cpu_ms));
+        print_array_d("t_comm_ms", all, P, offsetof(tet_mpi_stats, t_comm_ms));
+        print_array_d("t_idle_ms", all, P, offsetof(tet_mpi_stats, t_idle_ms));
+        print_array_u("polls", all, P, offsetof(tet_mpi_stats, polls));
+        print_array_d("t_swap_ms", all, P, offsetof(tet_mpi_stats, t_swap_ms));
+        print_array_d("t_gather_ms", all, P, offsetof(tet_mpi_stats, t_gather_ms));
+        print_array_u("scanned", all, P, offsetof(tet_mpi_stats, cnt.cells_scanned));
+        print_array_u("keys_done", all, P, offsetof(tet_mpi_stats, keys_done));
+        print_array_u("taken", all, P, offsetof(tet_mpi_stats, cells_taken));
+        print_array_u("segments_made", all, P, offsetof(tet_mpi_stats, cnt.segments_made));
+        print_array_u("segments_local", all, P, offsetof(tet_mpi_stats, segments_local));
+        print_array_u("segments_final", all, P, offsetof(tet_mpi_stats, segments_final));
+        print_array_u("swap_bytes_rank", all, P, offsetof(tet_mpi_stats, bytes_sent));
+        print_array_u("shares", all, P, offsetof(tet_mpi_stats, share_rounds));
+        print_array_u("reductions", all, P, offsetof(tet_mpi_stats, reductions));
         printf("}\n");
         fflush(stdout);
     }
@@ -334,13 +334,13 @@ int main(int argc, char **argv)
             fclose(f);
         }
     }
-    vfx_tet_mpi_destroy(ctx);
+    tet_mpi_destroy(ctx);
     free(img);
     free(ref);
     free(all);
     free(times);
     if (vtu || tetgen)
-        vfx_tet_mesh_free(&m);
+        tet_mesh_free(&m);
     else {
         free(m.points);
         free(m.scalar);

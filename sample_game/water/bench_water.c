@@ -68,9 +68,9 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
     s.y = malloc(n * 4);
     s.z = malloc(n * 4);
     s.n = n;
-    vfx_water_ref_layers(n, 0.3, s.x, s.y, s.z);
+    ref_water_layers(n, 0.3, s.x, s.y, s.z);
     double top = (double)((n - 1) / 576) * 0.3;
-    vfx_ref_camera cam = {{0, top + 4.0, 8.0}, {0, top * 0.5, 0}, {0, 1, 0}, 0.9, size, size, 0.1, 100};
+    ref_camera cam = {{0, top + 4.0, 8.0}, {0, top * 0.5, 0}, {0, 1, 0}, 0.9, size, size, 0.1, 100};
     vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &s,
                          .particle_chunk_count = bench_chunks, .particle_chunk = bench_chunk,
                          .water_params = bench_params};
@@ -88,7 +88,7 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
     vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = fbo,
                          .width = size, .height = size, .fov_y = 0.9f, .near_plane = 0.1f, .far_plane = 100.f};
     for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam.eye[k];
-    vfx_ref_camera_matrices(&cam, fv.view, fv.proj);
+    ref_camera_matrices(&cam, fv.view, fv.proj);
     double *ms = malloc(frames * sizeof *ms);
     int rc = 0;
     if (!s.no_warmup && (api.update(ctx, 0.0, 1.f / 60.f) != VFX_OK || api.render(ctx, &fv) != VFX_OK)) {
@@ -105,7 +105,7 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
         glFinish();
         ms[f] = now_ms() - t0;
     }
-    vfx_frame_pcts fp = vfx_frame_percentiles(ms, frames);
+    rt_frame_pcts fp = rt_frame_percentiles(ms, frames);
     double p50 = fp.p50;
     printf("{\"effect\":\"metaballs\",\"method\":\"%s\",\"disable\":%u,\"max_samples\":%u,\"step_h\":%.4g,"
            "\"refine\":%u,\"pyramid\":%u,\"particles\":%u,\"width\":%u,\"height\":%u,"
@@ -124,15 +124,15 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
         float *gpu = malloc((size_t)size * size * 4), *ref = malloc((size_t)size * size * 4);
         api.read_raw(ctx, VFX_EFFECT_WATER, gpu, (size_t)size * size);
         double fwd[3], right[3], up[3];
-        vfx_ref_camera_basis(&cam, fwd, right, up);
-        vfx_water_ref_camera rc2 = {{cam.eye[0], cam.eye[1], cam.eye[2]}, {fwd[0], fwd[1], fwd[2]},
+        ref_camera_basis(&cam, fwd, right, up);
+        ref_water_camera rc2 = {{cam.eye[0], cam.eye[1], cam.eye[2]}, {fwd[0], fwd[1], fwd[2]},
                                     {up[0], up[1], up[2]}, cam.fov_y, size, size};
-        vfx_water_ref_params rp = vfx_water_ref_default_params();
-        vfx_water_ref_error e;
+        ref_water_params rp = ref_water_default_params();
+        ref_water_error e;
         char err[256];
         double r0 = now_ms();
-        if (vfx_water_ref_render(&rc2, s.x, s.y, s.z, n, &rp, ref, NULL, NULL, err) == 0 &&
-            vfx_water_ref_compare(gpu, NULL, ref, NULL, (size_t)size * size, rp.h, &e) == 0)
+        if (ref_water_render(&rc2, s.x, s.y, s.z, n, &rp, ref, NULL, NULL, err) == 0 &&
+            ref_water_compare(gpu, NULL, ref, NULL, (size_t)size * size, rp.h, &e) == 0)
             printf(",\"reference_ms\":%.1f,\"ref_hits\":%u,\"hole_rate\":%.5f,\"false_hit_rate\":%.5f,"
                    "\"dist_mean_rel_h\":%.2e,\"dist_p99_rel_h\":%.2e",
                    now_ms() - r0, e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_mean_rel_h, e.dist_p99_rel_h);
@@ -149,7 +149,7 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
     return rc;
 }
 
-int vfx_bench_metaballs(int argc, char **argv)
+int bench_metaballs(int argc, char **argv)
 {
     uint32_t parts[8], sizes[8], np = 0, ns = 0, frames = 3, method = 0;
     bench_scene opt;
@@ -177,9 +177,9 @@ int vfx_bench_metaballs(int argc, char **argv)
     if (!np) parts[np++] = 4096;
     if (!ns) sizes[ns++] = 128;
     if (frames == 0) frames = 1;
-    vfx_gl_context *gl = NULL;
-    vfx_gl_context_desc d = {.mode = VFX_GL_HEADLESS, .width = 64, .height = 64};
-    if (vfx_gl_context_create(&d, &gl) != VFX_OK) {
+    rt_gl_context *gl = NULL;
+    rt_gl_context_desc d = {.mode = RT_GL_HEADLESS, .width = 64, .height = 64};
+    if (rt_gl_context_create(&d, &gl) != VFX_OK) {
         fprintf(stderr, "metaballs: no headless GL 4.5 context\n");
         return 1;
     }
@@ -194,6 +194,6 @@ int vfx_bench_metaballs(int argc, char **argv)
             opt.method = method;
             rc = run_one(parts[a], sizes[b], frames, reference, &opt);
         }
-    vfx_gl_context_destroy(gl);
+    rt_gl_context_destroy(gl);
     return rc;
 }

@@ -19,20 +19,20 @@ static double kernel_paper_deriv(double r, double h)
     return -2.0 * (1.0 - r / h) / h;
 }
 
-vfx_water_ref_kernel vfx_water_ref_kernel_paper(void)
+ref_water_kernel ref_water_kernel_paper(void)
 {
-    vfx_water_ref_kernel k = {kernel_paper_value, kernel_paper_deriv};
+    ref_water_kernel k = {kernel_paper_value, kernel_paper_deriv};
     return k;
 }
 
-vfx_water_ref_params vfx_water_ref_default_params(void)
+ref_water_params ref_water_default_params(void)
 {
-    vfx_water_ref_params p;
+    ref_water_params p;
     memset(&p, 0, sizeof p);
     p.h = 0.61;
     p.threshold = 0.765625;
     p.step = 0.61 / 32.0;
-    p.kernel = vfx_water_ref_kernel_paper();
+    p.kernel = ref_water_kernel_paper();
     return p;
 }
 
@@ -49,7 +49,7 @@ static void cross3(const double a[3], const double b[3], double o[3])
     o[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-void vfx_water_ref_pixel_dir(const vfx_water_ref_camera *cam, uint32_t i, uint32_t j, double dir[3])
+void ref_water_pixel_dir(const ref_water_camera *cam, uint32_t i, uint32_t j, double dir[3])
 {
     double f[3] = {cam->forward[0], cam->forward[1], cam->forward[2]}, r[3], u[3];
     normalize3(f);
@@ -67,7 +67,7 @@ static int finite3(float a, float b, float c) { return isfinite(a) && isfinite(b
 
 /* Sum of P and of dP * (x - p)/r over the given particle indices (or all when idx == NULL). */
 static void accumulate(const float *x, const float *y, const float *z, const uint32_t *idx,
-                       uint32_t count, const vfx_water_ref_params *p, const double pos[3],
+                       uint32_t count, const ref_water_params *p, const double pos[3],
                        double *sum, double g[3])
 {
     double h2 = p->h * p->h;
@@ -86,7 +86,7 @@ static void accumulate(const float *x, const float *y, const float *z, const uin
     }
 }
 
-static double field_from_sum(double sum, const vfx_water_ref_params *p, double g[3])
+static double field_from_sum(double sum, const ref_water_params *p, double g[3])
 {
     double s = sqrt(sum);
     if (g) {
@@ -97,8 +97,8 @@ static double field_from_sum(double sum, const vfx_water_ref_params *p, double g
     return s - p->threshold;
 }
 
-double vfx_water_ref_field(const float *x, const float *y, const float *z, uint32_t n,
-                           const vfx_water_ref_params *p, const double pos[3], double grad[3])
+double ref_water_field(const float *x, const float *y, const float *z, uint32_t n,
+                           const ref_water_params *p, const double pos[3], double grad[3])
 {
     double sum = 0, g[3] = {0, 0, 0};
     accumulate(x, y, z, NULL, n, p, pos, &sum, grad ? g : NULL);
@@ -179,7 +179,7 @@ static void grid_free(ref_grid *gr)
 }
 
 static double grid_field(const ref_grid *gr, const float *x, const float *y, const float *z,
-                         const vfx_water_ref_params *p, const double pos[3], double grad[3])
+                         const ref_water_params *p, const double pos[3], double grad[3])
 {
     double sum = 0, g[3] = {0, 0, 0};
     if (gr->start) {
@@ -228,11 +228,11 @@ static int ray_box(const double o[3], const double d[3], const double lo[3], con
     return a <= b;
 }
 
-int vfx_water_ref_render(const vfx_water_ref_camera *cam, const float *x, const float *y,
-                         const float *z, uint32_t n, const vfx_water_ref_params *p, float *dist,
-                         float *normal, vfx_water_ref_stats *stats, char err[256])
+int ref_water_render(const ref_water_camera *cam, const float *x, const float *y,
+                         const float *z, uint32_t n, const ref_water_params *p, float *dist,
+                         float *normal, ref_water_stats *stats, char err[256])
 {
-    vfx_water_ref_stats st = {0, 0, 0};
+    ref_water_stats st = {0, 0, 0};
     if (!cam || !p || !dist || cam->width == 0 || cam->height == 0 || !(cam->fov_y > 0) ||
         !(cam->fov_y < 3.1)) {
         snprintf(err, 256, "water_ref_render: bad camera (width %u height %u fov_y %g)",
@@ -262,7 +262,7 @@ int vfx_water_ref_render(const vfx_water_ref_camera *cam, const float *x, const 
     for (uint32_t j = 0; j < cam->height && gr.start; ++j) {
         for (uint32_t i = 0; i < cam->width; ++i) {
             double d[3], t0, t1;
-            vfx_water_ref_pixel_dir(cam, i, j, d);
+            ref_water_pixel_dir(cam, i, j, d);
             if (!ray_box(cam->eye, d, gr.lo, gr.hi, p->h, &t0, &t1)) continue;
             if (p->t_max > 0 && t1 > p->t_max) t1 = p->t_max;
             double tprev = t0, fprev = 0, thit = -1;
@@ -313,8 +313,8 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-int vfx_water_ref_compare(const float *dist, const float *normal, const float *ref_dist,
-                          const float *ref_normal, size_t n, double h, vfx_water_ref_error *out)
+int ref_water_compare(const float *dist, const float *normal, const float *ref_dist,
+                          const float *ref_normal, size_t n, double h, ref_water_error *out)
 {
     memset(out, 0, sizeof *out);
     double *de = malloc((n ? n : 1) * sizeof *de), *ne = malloc((n ? n : 1) * sizeof *ne);
@@ -362,7 +362,7 @@ int vfx_water_ref_compare(const float *dist, const float *normal, const float *r
     return 0;
 }
 
-void vfx_water_ref_layers(uint32_t n, double spacing, float *x, float *y, float *z)
+void ref_water_layers(uint32_t n, double spacing, float *x, float *y, float *z)
 {
     for (uint32_t k = 0; k < n; ++k) {
         uint32_t layer = k / 576, in = k % 576;
@@ -383,7 +383,7 @@ static uint64_t next_u64(uint64_t *s)
 
 static double next_unit(uint64_t *s) { return ((next_u64(s) >> 11) + 0.5) * (1.0 / 9007199254740992.0); }
 
-void vfx_water_ref_blobs(uint32_t n, uint32_t blobs, double extent, double sigma, uint64_t seed,
+void ref_water_blobs(uint32_t n, uint32_t blobs, double extent, double sigma, uint64_t seed,
                          float *x, float *y, float *z)
 {
     uint64_t s = seed;

@@ -2,10 +2,10 @@
 // plugin/beams/beam_field_impl.inc (docs/beams.md has the derivation). Positions are relative
 // to the eye, so the ray origin is 0 and far beams keep their digits.
 
-const float VFX_BEAM_EPS_FLOOR = 1e-6;
+const float VOLFX_BEAM_EPS_FLOOR = 1e-6;
 
 // a*b - c*d with one rounding (Kahan); `precise` stops the compiler from re-fusing it.
-float vfx_dop(float a, float b, float c, float d)
+float volfx_dop(float a, float b, float c, float d)
 {
     precise float w = c * d;
     precise float e = fma(-c, d, w);
@@ -13,13 +13,13 @@ float vfx_dop(float a, float b, float c, float d)
     return f + e;
 }
 
-vec3 vfx_cross_acc(vec3 a, vec3 b)
+vec3 volfx_cross_acc(vec3 a, vec3 b)
 {
-    return vec3(vfx_dop(a.y, b.z, a.z, b.y), vfx_dop(a.z, b.x, a.x, b.z), vfx_dop(a.x, b.y, a.y, b.x));
+    return vec3(volfx_dop(a.y, b.z, a.z, b.y), volfx_dop(a.z, b.x, a.x, b.z), volfx_dop(a.x, b.y, a.y, b.x));
 }
 
 // log1p(z)/z, z >= 0: log() near 1 is only 2^-21 absolute in GLSL, so a series below 0.1.
-float vfx_log1p_over(float z)
+float volfx_log1p_over(float z)
 {
     if (z < 0.1) {
         float s = 0.1;
@@ -30,17 +30,17 @@ float vfx_log1p_over(float z)
     return log(1.0 + z) / z;
 }
 
-float vfx_same_sign(float lo, float hi, float dx, float s, float Q)
+float volfx_same_sign(float lo, float hi, float dx, float s, float Q)
 {
     float S0 = sqrt(lo * lo + Q * Q), S1 = sqrt(hi * hi + Q * Q);
     float k = 1.0 + (hi + lo) / (S1 + S0);
     float den = lo + S0;
     float z = s * dx * k / den;
-    return dx * k / den * vfx_log1p_over(z);
+    return dx * k / den * volfx_log1p_over(z);
 }
 
 // integral over x in [x0, x1] of 1/sqrt((s x + beta)^2 + Q^2)
-float vfx_segment_integral(float x0, float x1, float s, float beta, float Q)
+float volfx_segment_integral(float x0, float x1, float s, float beta, float Q)
 {
     float dx = x1 - x0;
     if (!(dx > 0.0) || !(Q > 0.0))
@@ -48,15 +48,15 @@ float vfx_segment_integral(float x0, float x1, float s, float beta, float Q)
     float y0 = s * x0 + beta, y1 = s * x1 + beta;
     if (y0 < 0.0 && y1 > 0.0) {
         float xa = dx * (-y0) / (y1 - y0);
-        return vfx_same_sign(0.0, -y0, xa, s, Q) + vfx_same_sign(0.0, y1, dx - xa, s, Q);
+        return volfx_same_sign(0.0, -y0, xa, s, Q) + volfx_same_sign(0.0, y1, dx - xa, s, Q);
     }
     if (y1 <= 0.0)
-        return vfx_same_sign(-y1, -y0, dx, s, Q);
-    return vfx_same_sign(y0, y1, dx, s, Q);
+        return volfx_same_sign(-y1, -y0, dx, s, Q);
+    return volfx_same_sign(y0, y1, dx, s, Q);
 }
 
 // restricts [lo, hi] to u0 + c x in [umin, umax) (half-open: a ray in a boundary plane counts once)
-void vfx_clip_linear(float u0, float c, float umin, float umax, inout float lo, inout float hi)
+void volfx_clip_linear(float u0, float c, float umin, float umax, inout float lo, inout float hi)
 {
     if (c == 0.0) {
         if (u0 < umin || u0 >= umax)
@@ -73,7 +73,7 @@ void vfx_clip_linear(float u0, float c, float umin, float umax, inout float lo, 
     hi = min(hi, b);
 }
 
-float vfx_sphere_piece(vec3 g, vec3 V, float R, float eps, float ta, float tb, float u0, float c,
+float volfx_sphere_piece(vec3 g, vec3 V, float R, float eps, float ta, float tb, float u0, float c,
                        float umin, float umax)
 {
     float gv = dot(g, V);
@@ -83,17 +83,17 @@ float vfx_sphere_piece(vec3 g, vec3 V, float R, float eps, float ta, float tb, f
         return 0.0;
     float h = sqrt(R * R - dd);
     float lo = ta, hi = tb;
-    vfx_clip_linear(u0, c, umin, umax, lo, hi);
+    volfx_clip_linear(u0, c, umin, umax, lo, hi);
     float slo = max(lo + gv, -h), shi = min(hi + gv, h);
-    return vfx_segment_integral(slo, shi, 1.0, 0.0, sqrt(dd + eps * eps));
+    return volfx_segment_integral(slo, shi, 1.0, 0.0, sqrt(dd + eps * eps));
 }
 
-float vfx_cylinder_piece(vec3 wp, vec3 V, vec3 D, float L, float R, float eps, float ta, float tb,
+float volfx_cylinder_piece(vec3 wp, vec3 V, vec3 D, float L, float R, float eps, float ta, float tb,
                          float u0, float c)
 {
     float wd = dot(wp, D);
     vec3 a = wp - wd * D;
-    vec3 b = vfx_cross_acc(vfx_cross_acc(D, V), D);
+    vec3 b = volfx_cross_acc(volfx_cross_acc(D, V), D);
     float s = sqrt(dot(b, b));
     float beta = 0.0, rr, lo = ta, hi = tb;
     if (s > 0.0) {
@@ -104,44 +104,44 @@ float vfx_cylinder_piece(vec3 wp, vec3 V, vec3 D, float L, float R, float eps, f
         if (rr >= R * R)
             return 0.0;
         float hc = sqrt(R * R - rr);
-        vfx_clip_linear(beta, s, -hc, hc, lo, hi);
+        volfx_clip_linear(beta, s, -hc, hc, lo, hi);
     } else {
         rr = dot(a, a);
         if (rr > R * R)
             return 0.0;
     }
-    vfx_clip_linear(u0, c, 0.0, L, lo, hi);
-    return vfx_segment_integral(lo, hi, s, beta, sqrt(rr + eps * eps));
+    volfx_clip_linear(u0, c, 0.0, L, lo, hi);
+    return volfx_segment_integral(lo, hi, s, beta, sqrt(rr + eps * eps));
 }
 
 // H of one beam along t*V (origin = eye = 0), t in [t0, t1]; M is relative to the eye.
-float vfx_beam_integral(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, vec3 V,
+float volfx_beam_integral(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, vec3 V,
                         float t0, float t1)
 {
     if (!(t1 > t0))
         return 0.0;
-    float eps = max(eps_in, VFX_BEAM_EPS_FLOOR * R);
+    float eps = max(eps_in, VOLFX_BEAM_EPS_FLOOR * R);
     vec3 w = -M;
-    vec3 wp = vfx_cross_acc(V, vfx_cross_acc(w, V));
+    vec3 wp = volfx_cross_acc(V, volfx_cross_acc(w, V));
     float wv = dot(w, V);
     float ta = t0 + wv, tb = t1 + wv;
     float c = dot(V, D), u0 = dot(wp, D);
     float H = 0.0;
     if (a > 0.0)
-        H += a * vfx_sphere_piece(wp, V, R, eps, ta, tb, 0.0, 0.0, -1.0, 1.0);
+        H += a * volfx_sphere_piece(wp, V, R, eps, ta, tb, 0.0, 0.0, -1.0, 1.0);
     if (b > 0.0) {
         const float inf = 1e30;
-        H += b * vfx_sphere_piece(wp, V, R, eps, ta, tb, u0, c, -inf, 0.0);
-        H += b * vfx_cylinder_piece(wp, V, D, L, R, eps, ta, tb, u0, c);
-        H += b * vfx_sphere_piece(wp - L * D, V, R, eps, ta, tb, u0, c, L, inf);
+        H += b * volfx_sphere_piece(wp, V, R, eps, ta, tb, u0, c, -inf, 0.0);
+        H += b * volfx_cylinder_piece(wp, V, D, L, R, eps, ta, tb, u0, c);
+        H += b * volfx_sphere_piece(wp - L * D, V, R, eps, ta, tb, u0, c, L, inf);
     }
     return H;
 }
 
 // the raw density (for the ray-marching baseline), P relative to the eye
-float vfx_beam_density(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, vec3 P)
+float volfx_beam_density(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, vec3 P)
 {
-    float eps = max(eps_in, VFX_BEAM_EPS_FLOOR * R);
+    float eps = max(eps_in, VOLFX_BEAM_EPS_FLOOR * R);
     vec3 d = P - M;
     float d2 = dot(d, d), u = dot(d, D), rho = 0.0;
     if (d2 <= R * R)

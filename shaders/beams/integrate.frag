@@ -1,6 +1,6 @@
 // Per pixel: H = sum over the beams binned to this pixel's tile of the closed-form integral
 // from the eye to the first surface (host depth, water), or the ray-marching baseline when
-// VFX_BEAMS_MARCH is defined. Writes (H, H-weighted tint) to an RGBA32F target.
+// VOLFX_BEAMS_MARCH is defined. Writes (H, H-weighted tint) to an RGBA32F target.
 #include "beams/beam_field.glsl"
 
 in vec2 v_ndc;
@@ -47,7 +47,7 @@ void main()
     for (uint k = 0u; k < range.y; ++k) {
         Beam bm = beams[list[range.x + k]];
         float h;
-#ifdef VFX_BEAMS_MARCH
+#ifdef VOLFX_BEAMS_MARCH
         // baseline: midpoint samples over the ray's chord through the beam's bounding sphere
         vec3 C = bm.m_l.xyz + 0.5 * bm.m_l.w * bm.d_r.xyz;
         float rad = 0.5 * bm.m_l.w + bm.d_r.w;
@@ -58,11 +58,11 @@ void main()
             float ta = max(tc - sqrt(disc), 0.0), tb = min(tc + sqrt(disc), tmax);
             float dt = (tb - ta) / float(u_samples);
             for (int i = 0; i < u_samples && tb > ta; ++i)
-                h += vfx_beam_density(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x,
+                h += volfx_beam_density(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x,
                                       bm.ab_eps.y, bm.ab_eps.z, (ta + (float(i) + 0.5) * dt) * V) * dt;
         }
 #else
-        h = vfx_beam_integral(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
+        h = volfx_beam_integral(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
                               bm.ab_eps.z, V, 0.0, tmax);
 #endif
         H += h;

@@ -33,7 +33,7 @@ void main()
 {
     ivec2 pix = ivec2(gl_FragCoord.xy);
     vec2 ndc = gl_FragCoord.xy / u_sizef * 2.0 - 1.0;
-    vec3 dir = vfx_ray_dir(u_inv_view_proj, u_eye, ndc);
+    vec3 dir = volfx_ray_dir(u_inv_view_proj, u_eye, ndc);
     float tb = dot(dir, v_p - u_eye);
 #if defined(PASS_INIT)
     float t = max(tb - u_h, 0.0);

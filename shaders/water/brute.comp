@@ -39,10 +39,10 @@ void main()
     ivec2 size = imageSize(u_dist);
     if (any(greaterThanEqual(pix, size))) return;
     vec2 ndc = (vec2(pix) + 0.5) / vec2(size) * 2.0 - 1.0;
-    vec3 dir = vfx_ray_dir(u_inv_view_proj, u_eye, ndc);
+    vec3 dir = volfx_ray_dir(u_inv_view_proj, u_eye, ndc);
     float t_scene = 3.0e38;
     if (u_has_depth)
-        t_scene = vfx_depth_distance(u_inv_view_proj, u_eye, ndc, texelFetch(u_scene_depth, pix, 0).r);
+        t_scene = volfx_depth_distance(u_inv_view_proj, u_eye, ndc, texelFetch(u_scene_depth, pix, 0).r);
     // eq. 1 per pixel, exact sphere instead of the cube face: the nearest entry into any
     // particle's sphere of influence.
     float t0 = 3.0e38;

@@ -176,10 +176,10 @@ void main()
     ivec2 size = imageSize(u_dist);
     if (any(greaterThanEqual(pix, size))) return;
     vec2 ndc = (vec2(pix) + 0.5) / vec2(size) * 2.0 - 1.0;
-    vec3 dir = vfx_ray_dir(u_inv_view_proj, u_eye, ndc);
+    vec3 dir = volfx_ray_dir(u_inv_view_proj, u_eye, ndc);
     float t_scene = 3.0e38;
     if (u_has_depth)
-        t_scene = vfx_depth_distance(u_inv_view_proj, u_eye, ndc, texelFetch(u_scene_depth, pix, 0).r);
+        t_scene = volfx_depth_distance(u_inv_view_proj, u_eye, ndc, texelFetch(u_scene_depth, pix, 0).r);
     // ray against the particles' box grown by h (slabs)
     vec3 inv = safe_inv(dir);
     vec3 ta = (u_blo - u_eye) * inv, tb = (u_bhi - u_eye) * inv;

@@ -19,7 +19,7 @@ float scene_t(ivec2 pix)
 {
     if (!u_has_depth) return 3.0e38;
     vec2 ndc = (vec2(pix) + 0.5) / vec2(u_size) * 2.0 - 1.0;
-    return vfx_depth_distance(u_inv_view_proj, u_eye, ndc, texelFetch(u_scene_depth, pix, 0).r);
+    return volfx_depth_distance(u_inv_view_proj, u_eye, ndc, texelFetch(u_scene_depth, pix, 0).r);
 }
 
 #if defined(MODE_UPDATE)
@@ -132,7 +132,7 @@ void main()
     // next sample still inside the box and in front of the host depth ends with flag 0: that is
     // the cap (a hole of the method), not a ray that left. Regula falsi may land a hair behind
     // the host depth: hidden, so counted as left. The final class goes back into st.x
-    // (1 found, 2 left, 3 cap) for vfx_water_debug_pixel_class.
+    // (1 found, 2 left, 3 cap) for volfx_water_debug_pixel_class.
     if (s.x == 0.0) {
         float tn = imageLoad(u_cur, pix).r;
         s.x = (tn >= 1.0e29 || tn > min(u_t_end, ts)) ? 2.0 : 3.0;
@@ -148,7 +148,7 @@ void main()
     vec4 pot = vec4(0.0);
     if (t < 1.0e29) {
         vec2 ndc = (vec2(pix) + 0.5) / vec2(u_size) * 2.0 - 1.0;
-        vec3 dir = vfx_ray_dir(u_inv_view_proj, u_eye, ndc);
+        vec3 dir = volfx_ray_dir(u_inv_view_proj, u_eye, ndc);
         float h2 = u_h * u_h;
         for (uint j = 0u; j < u_count; ++j) {
             vec3 p = vec3(px[j], py[j], pz[j]);

@@ -24,7 +24,7 @@ void main()
     if (u_flat) { o_color = vec4(u_tint, 1.0); return; }
     vec2 size = vec2(textureSize(u_dist, 0));
     vec2 ndc = (vec2(pix) + 0.5) / size * 2.0 - 1.0;
-    vec3 dir = vfx_ray_dir(u_inv_view_proj, u_eye, ndc);
+    vec3 dir = volfx_ray_dir(u_inv_view_proj, u_eye, ndc);
     vec3 g = texelFetch(u_grad, pix, 0).xyz;
     // a zero gradient (the eye inside a symmetric blob) has no direction: face the viewer
     vec3 n = dot(g, g) > 0.0 ? -normalize(g) : -dir;
@@ -40,7 +40,7 @@ void main()
     }
     float back = texelFetch(u_back, pix, 0).r;
     if (u_has_depth)
-        back = min(back, vfx_depth_distance(u_inv_view_proj, u_eye, ndc, texelFetch(u_scene_depth, pix, 0).r));
+        back = min(back, volfx_depth_distance(u_inv_view_proj, u_eye, ndc, texelFetch(u_scene_depth, pix, 0).r));
     float thickness = max(back - t, 0.0);
     vec3 absorbed = behind * exp(-u_absorption * thickness * (vec3(1.0) - u_tint));
     o_color = vec4(mix(absorbed, sky, fresnel), 1.0);

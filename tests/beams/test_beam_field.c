@@ -47,11 +47,11 @@ static double closed_d(const tcase *c, const float o[3], const float v[3], const
     double vn = sqrt(vd[0] * vd[0] + vd[1] * vd[1] + vd[2] * vd[2]);
     for (int k = 0; k < 3; ++k)
         vd[k] /= vn;
-    vfx_beam_d bd;
+    volfx_beam_d bd;
     char err[256];
-    if (vfx_beam_validate(b, &bd, err, sizeof err) != VFX_OK)
+    if (volfx_beam_validate(b, &bd, err, sizeof err) != VFX_OK)
         return NAN;
-    return vfx_beam_integral_d(&bd, od, vd, c->t0, t1);
+    return volfx_beam_integral_d(&bd, od, vd, c->t0, t1);
 }
 
 /* Relative spread of the exact H over 2-ulp moves of the float32 inputs. */
@@ -99,10 +99,10 @@ static void check(tally *t, const tcase *c)
     for (int k = 0; k < 3; ++k)
         vd[k] /= vn;
     double ref = NAN;
-    vfx_beam_d bd;
+    volfx_beam_d bd;
     char err[256];
     t->cases++;
-    if (vfx_beam_validate(&c->beam, &bd, err, sizeof err) != VFX_OK) {
+    if (volfx_beam_validate(&c->beam, &bd, err, sizeof err) != VFX_OK) {
         printf("FAIL %s: valid beam refused: %s\n", c->name, err);
         t->failures++;
         return;
@@ -110,11 +110,11 @@ static void check(tally *t, const tcase *c)
     uint64_t evals = 0;
     if (getenv("VFX_TEST_VERBOSE"))
         fprintf(stderr, "case %s\n", c->name);
-    ref = vfx_beams_ref_integral(&bd, 1, od, vd, c->t0, c->t1, 1e-12, &evals);
+    ref = ref_beams_integral(&bd, 1, od, vd, c->t0, c->t1, 1e-12, &evals);
     if (getenv("VFX_TEST_VERBOSE"))
         fprintf(stderr, "  %llu evaluations\n", (unsigned long long)evals);
-    double hd = vfx_beam_integral_d(&bd, od, vd, c->t0, c->t1);
-    float hf = vfx_beam_integral_f(&bd, c->o, c->v, (float)c->t0, (float)c->t1);
+    double hd = volfx_beam_integral_d(&bd, od, vd, c->t0, c->t1);
+    float hf = volfx_beam_integral_f(&bd, c->o, c->v, (float)c->t0, (float)c->t1);
     if (!isfinite(hf) || !isfinite(hd)) {
         printf("FAIL %s: non-finite H (f32 %g, f64 %g)\n", c->name, hf, hd);
         t->failures++;
@@ -148,7 +148,7 @@ static void check(tally *t, const tcase *c)
         for (int i = 0; i < N; ++i) {
             double tt = c->t0 + (i + 0.5) * hstep;
             double pp[3] = {od[0] + tt * vd[0], od[1] + tt * vd[1], od[2] + tt * vd[2]};
-            sum += vfx_beam_density_d(&bd, pp);
+            sum += volfx_beam_density_d(&bd, pp);
         }
         printf("  brute %.12g\n", sum * hstep);
     }

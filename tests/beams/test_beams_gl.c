@@ -20,8 +20,8 @@
 #define W 64
 #define H 48
 
-static vfx_app *g_app;
-static vfx_test_log g_log;
+static game_app *g_app;
+static test_log g_log;
 
 static const vfx_beam k_beam = {.head = {-1.5f, 0.1f, 0.0f}, .dir = {1, 0.2f, 0}, .length = 2.5f,
                                 .radius = 0.5f, .a = 0.4f, .b = 0.25f, .eps = 0.05f};
@@ -30,11 +30,11 @@ static int setup(void **state)
 {
     (void)state;
     memset(&g_log, 0, sizeof g_log);
-    vfx_app_desc d = {.mode = VFX_GL_HEADLESS, .width = W, .height = H, .logger = {vfx_test_log_fn, &g_log}};
-    if (vfx_app_create(&d, &g_app) != VFX_OK)
+    game_app_desc d = {.mode = RT_GL_HEADLESS, .width = W, .height = H, .logger = {test_log_fn, &g_log}};
+    if (game_app_create(&d, &g_app) != VFX_OK)
         exit(VFX_TEST_SKIP);
-    vfx_ref_camera cam = {{0.2, 0.3, 4}, {0, 0, 0}, {0, 1, 0}, 0.9, W, H, 0.05, 50};
-    assert_int_equal(vfx_app_set_camera(g_app, &cam), VFX_OK);
+    ref_camera cam = {{0.2, 0.3, 4}, {0, 0, 0}, {0, 1, 0}, 0.9, W, H, 0.05, 50};
+    assert_int_equal(game_app_set_camera(g_app, &cam), VFX_OK);
     g_app->beams[0] = k_beam;
     g_app->beam_count = 1;
     g_app->beams_view = (vfx_beams_view){.size = sizeof(vfx_beams_view), .version = VFX_BEAMS_VIEW_VERSION};
@@ -44,13 +44,13 @@ static int setup(void **state)
 static int teardown(void **state)
 {
     (void)state;
-    vfx_app_destroy(g_app);
+    game_app_destroy(g_app);
     return 0;
 }
 
 static float *render_raw(void)
 {
-    assert_int_equal(vfx_app_frame(g_app, 0.f), VFX_OK);
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     float *raw = malloc(W * H * sizeof(float));
     assert_int_equal(g_app->api->read_raw(g_app->ctx, VFX_EFFECT_BEAMS, raw, W * H), VFX_OK);
     return raw;
@@ -59,12 +59,12 @@ static float *render_raw(void)
 /* float64 reference of pixel (i, j), integrated to t1. */
 static double ref_pixel(uint32_t i, uint32_t j, double t1)
 {
-    vfx_beam_d b;
+    volfx_beam_d b;
     char err[128];
-    assert_int_equal(vfx_beam_validate(&g_app->beams[0], &b, err, sizeof err), VFX_OK);
+    assert_int_equal(volfx_beam_validate(&g_app->beams[0], &b, err, sizeof err), VFX_OK);
     double dir[3];
-    vfx_ref_pixel_ray(&g_app->camera, i, j, dir);
-    return vfx_beams_ref_integral(&b, 1, g_app->camera.eye, dir, 0.0, t1, 1e-10, NULL);
+    ref_pixel_ray(&g_app->camera, i, j, dir);
+    return ref_beams_integral(&b, 1, g_app->camera.eye, dir, 0.0, t1, 1e-10, NULL);
 }
 
 /* The float32 inputs the GPU works from: the pixel direction, unprojected in float32 from the
@@ -76,7 +76,7 @@ static double ref_pixel(uint32_t i, uint32_t j, double t1)
  * that. At a hard support edge it is large: a grazing ray whose chord through the support is 2h
  * has relative condition ~(R/h)^2 in the distance d of the ray from the centre or axis, and d
  * moves by ~eps |M - eye| (docs/beams.md, "What float32 can reach"). cond_abs is
- * vfx_beams_ref_cond_abs at 2 ulps. */
+ * ref_beams_cond_abs at 2 ulps. */
 typedef struct image_errors {
     double max_rel;       /* over pixels with H > 1e-6 of the image maximum */
     double max_rel_wc;    /* the same, where cond_abs + cut < 1e-6 H (well conditioned) */
@@ -94,9 +94,9 @@ typedef struct image_errors {
  * rho(end) dt. Returns the number of failing pixels. */
 static int compare_image(const float *gpu, double (*t1_of)(uint32_t, uint32_t), image_errors *ie)
 {
-    vfx_beam_d b;
+    volfx_beam_d b;
     char err[128];
-    assert_int_equal(vfx_beam_validate(&g_app->beams[0], &b, err, sizeof err), VFX_OK);
+    assert_int_equal(volfx_beam_validate(&g_app->beams[0], &b, err, sizeof err), VFX_OK);
     int bad = 0;
     double *ref = malloc(W * H * sizeof(double)), hmax = 0;
     for (uint32_t j = 0; j < H; ++j)
@@ -110,11 +110,11 @@ static int compare_image(const float *gpu, double (*t1_of)(uint32_t, uint32_t), 
         double e = fabs(gpu[k] - ref[k]);
         uint32_t i = k % W, j = k / W;
         double t1 = t1_of(i, j), dir[3], end[3];
-        vfx_ref_pixel_ray(&g_app->camera, i, j, dir);
+        ref_pixel_ray(&g_app->camera, i, j, dir);
         for (int c = 0; c < 3; ++c)
             end[c] = g_app->camera.eye[c] + t1 * dir[c];
-        double cut = t1 < 50.0 ? vfx_beam_density_d(&b, end) * 2e-5 * t1 : 0.0;
-        double cond = vfx_beams_ref_cond_abs(&b, 1, g_app->camera.eye, dir, 0.0, t1, 2.0);
+        double cut = t1 < 50.0 ? volfx_beam_density_d(&b, end) * 2e-5 * t1 : 0.0;
+        double cond = ref_beams_cond_abs(&b, 1, g_app->camera.eye, dir, 0.0, t1, 2.0);
         int bright = ref[k] > 1e-6 * hmax;
         double tol = (bright ? 1e-5 * ref[k] : 1e-6 * hmax) + cond + cut;
         ie->max_ratio = fmax(ie->max_ratio, e / tol);
@@ -184,7 +184,7 @@ static double g_wall_z;
 static double t_wall(uint32_t i, uint32_t j)
 {
     double d[3];
-    vfx_ref_pixel_ray(&g_app->camera, i, j, d);
+    ref_pixel_ray(&g_app->camera, i, j, d);
     double t = (g_wall_z - g_app->camera.eye[2]) / d[2];
     return t > 0 && t < 50 ? t : 50.0;
 }
@@ -194,16 +194,16 @@ static void test_hidden_by_depth(void **state)
     (void)state;
     /* a wall through the middle of the beam's support, covering the whole view */
     g_wall_z = 0.1;
-    vfx_entity wall;
-    assert_int_equal(vfx_app_add_box(g_app, (float[3]){-20, -20, (float)g_wall_z - 1}, (float[3]){20, 20, (float)g_wall_z},
+    rt_entity wall;
+    assert_int_equal(game_app_add_box(g_app, (float[3]){-20, -20, (float)g_wall_z - 1}, (float[3]){20, 20, (float)g_wall_z},
                                      (float[3]){0.5f, 0.5f, 0.5f}, &wall), VFX_OK);
     float *raw = render_raw();
     image_errors ie;
     int bad = compare_image(raw, t_wall, &ie);
     free(raw);
-    vfx_app_mesh *m = vfx_world_get(g_app->world, wall, g_app->mesh_comp, 0);
-    vfx_mesh_gpu_destroy(&m->gpu);
-    assert_int_equal(vfx_world_despawn(g_app->world, wall), VFX_OK);
+    game_app_mesh *m = rt_world_get(g_app->world, wall, g_app->mesh_comp, 0);
+    rt_mesh_gpu_destroy(&m->gpu);
+    assert_int_equal(rt_world_despawn(g_app->world, wall), VFX_OK);
     char what[64];
     snprintf(what, sizeof what, "wall at z=%.2f", g_wall_z);
     print_errors(what, &ie);
@@ -216,7 +216,7 @@ static double g_box_min[3], g_box_max[3];
 static double t_box(uint32_t i, uint32_t j)
 {
     double d[3], t0 = 0, t1 = 50;
-    vfx_ref_pixel_ray(&g_app->camera, i, j, d);
+    ref_pixel_ray(&g_app->camera, i, j, d);
     for (int k = 0; k < 3; ++k) { /* slab test, float64 */
         double a = (g_box_min[k] - g_app->camera.eye[k]) / d[k], b = (g_box_max[k] - g_app->camera.eye[k]) / d[k];
         if (a > b) { double t = a; a = b; b = t; }
@@ -235,17 +235,17 @@ static void test_hidden_by_assimp_mesh(void **state)
     fclose(f);
     const float s = 0.6f, c[3] = {0.0f, 0.2f, 0.0f};
     float m[16] = {s, 0, 0, 0, 0, s, 0, 0, 0, 0, s, 0, c[0], c[1], c[2], 1};
-    vfx_entity e;
-    assert_int_equal(vfx_app_add_mesh_file(g_app, model, m, (float[3]){0.7f, 0.3f, 0.3f}, &e), VFX_OK);
+    rt_entity e;
+    assert_int_equal(game_app_add_mesh_file(g_app, model, m, (float[3]){0.7f, 0.3f, 0.3f}, &e), VFX_OK);
     for (int k = 0; k < 3; ++k)
         g_box_min[k] = c[k] - 0.5 * s, g_box_max[k] = c[k] + 0.5 * s;
     float *raw = render_raw();
     image_errors ie;
     int bad = compare_image(raw, t_box, &ie);
     free(raw);
-    vfx_app_mesh *mm = vfx_world_get(g_app->world, e, g_app->mesh_comp, 0);
-    vfx_mesh_gpu_destroy(&mm->gpu);
-    assert_int_equal(vfx_world_despawn(g_app->world, e), VFX_OK);
+    game_app_mesh *mm = rt_world_get(g_app->world, e, g_app->mesh_comp, 0);
+    rt_mesh_gpu_destroy(&mm->gpu);
+    assert_int_equal(rt_world_despawn(g_app->world, e), VFX_OK);
     print_errors("beam through box.obj", &ie);
     assert_true(ie.max_rel_wc <= 1e-5);
     assert_int_equal(bad, 0);
@@ -264,26 +264,26 @@ static void test_mz_sweep(void **state)
     double prev = INFINITY;
     const double zs[] = {-2.0, -0.6, -0.3, 0.0, 0.3, 0.6, 2.0};
     for (size_t k = 0; k < sizeof zs / sizeof zs[0]; ++k) {
-        vfx_entity wall;
-        assert_int_equal(vfx_app_add_box(g_app, (float[3]){-20, -20, (float)zs[k] - 1}, (float[3]){20, 20, (float)zs[k]},
+        rt_entity wall;
+        assert_int_equal(game_app_add_box(g_app, (float[3]){-20, -20, (float)zs[k] - 1}, (float[3]){20, 20, (float)zs[k]},
                                          (float[3]){0.5f, 0.5f, 0.5f}, &wall), VFX_OK);
         float *raw = render_raw();
         double h = raw[cy * W + cx];
         free(raw);
-        vfx_app_mesh *m = vfx_world_get(g_app->world, wall, g_app->mesh_comp, 0);
-        vfx_mesh_gpu_destroy(&m->gpu);
-        assert_int_equal(vfx_world_despawn(g_app->world, wall), VFX_OK);
+        game_app_mesh *m = rt_world_get(g_app->world, wall, g_app->mesh_comp, 0);
+        rt_mesh_gpu_destroy(&m->gpu);
+        assert_int_equal(rt_world_despawn(g_app->world, wall), VFX_OK);
         g_wall_z = zs[k];
         double t1 = t_wall(cx, cy), ref = ref_pixel(cx, cy, t1), dir[3], end[3];
-        vfx_beam_d b;
+        volfx_beam_d b;
         char err[128];
-        assert_int_equal(vfx_beam_validate(&g_app->beams[0], &b, err, sizeof err), VFX_OK);
-        vfx_ref_pixel_ray(&g_app->camera, cx, cy, dir);
+        assert_int_equal(volfx_beam_validate(&g_app->beams[0], &b, err, sizeof err), VFX_OK);
+        ref_pixel_ray(&g_app->camera, cx, cy, dir);
         for (int c = 0; c < 3; ++c)
             end[c] = g_app->camera.eye[c] + t1 * dir[c];
         /* the bound of compare_image: 1e-5, the inputs' conditioning, the depth-derived end */
-        double tol = 1e-5 * ref + vfx_beams_ref_cond_abs(&b, 1, g_app->camera.eye, dir, 0.0, t1, 2.0) +
-                     (t1 < 50.0 ? vfx_beam_density_d(&b, end) * 2e-5 * t1 : 0.0);
+        double tol = 1e-5 * ref + ref_beams_cond_abs(&b, 1, g_app->camera.eye, dir, 0.0, t1, 2.0) +
+                     (t1 < 50.0 ? volfx_beam_density_d(&b, end) * 2e-5 * t1 : 0.0);
         printf("m_z %.2f: H %.6g (reference %.6g, error %.3g, bound %.3g)\n", zs[k], h, ref, fabs(h - ref), tol);
         assert_true(fabs(h - ref) <= tol);
         assert_true(h <= prev + 1e-6);
@@ -325,20 +325,20 @@ static void test_bad_input_and_absence(void **state)
 {
     (void)state;
     g_app->beams[0].radius = -1.f;
-    assert_int_not_equal(vfx_app_frame(g_app, 0.f), VFX_OK);
+    assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "beams[0]"));
     g_app->beams[0] = k_beam;
     g_app->beams[0].head[1] = NAN;
-    assert_int_not_equal(vfx_app_frame(g_app, 0.f), VFX_OK);
+    assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "not finite"));
     g_app->beams[0] = k_beam;
-    assert_int_equal(vfx_app_frame(g_app, 0.f), VFX_OK);
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_non_null(g_app->ctx->effect_state[VFX_EFFECT_BEAMS]);
     /* no beams: the effect's state is freed, no pass runs, and once the timer results of the
      * last frames with beams have drained (a ring of 4 frames), no beams stat is reported */
     g_app->beam_count = 0;
     for (int f = 0; f < 5; ++f)
-        assert_int_equal(vfx_app_frame(g_app, 0.f), VFX_OK);
+        assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_null(g_app->ctx->effect_state[VFX_EFFECT_BEAMS]);
     vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
     g_app->api->get_stats(g_app->ctx, &st);

@@ -5,18 +5,18 @@
 #include <stdlib.h>
 #include <string.h>
 
-vfx_gl_context *vfx_test_gl_or_skip(void)
+rt_gl_context *test_gl_or_skip(void)
 {
-    vfx_gl_context *gl = NULL;
-    vfx_gl_context_desc d = {.mode = VFX_GL_HEADLESS, .width = 64, .height = 64};
-    if (vfx_gl_context_create(&d, &gl) != VFX_OK) {
+    rt_gl_context *gl = NULL;
+    rt_gl_context_desc d = {.mode = RT_GL_HEADLESS, .width = 64, .height = 64};
+    if (rt_gl_context_create(&d, &gl) != VFX_OK) {
         fprintf(stderr, "no headless GL 4.5 context: skipping\n");
         exit(VFX_TEST_SKIP);
     }
     return gl;
 }
 
-const char *vfx_test_shared_data_or_skip(const char *rel, char *buf, unsigned buflen)
+const char *test_shared_data_or_skip(const char *rel, char *buf, unsigned buflen)
 {
     const char *dir = getenv("VFX_SHARED_DATA");
     if (!dir)
@@ -31,9 +31,9 @@ const char *vfx_test_shared_data_or_skip(const char *rel, char *buf, unsigned bu
     return buf;
 }
 
-void vfx_test_log_fn(void *user, vfx_log_level level, const char *message)
+void test_log_fn(void *user, vfx_log_level level, const char *message)
 {
-    vfx_test_log *l = user;
+    test_log *l = user;
     snprintf(l->last, sizeof l->last, "%s", message);
     if (level == VFX_LOG_ERROR)
         l->errors++;

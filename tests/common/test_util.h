@@ -1,20 +1,20 @@
 /* test_util.h — shared helpers for tests: a headless GL context or a clean skip (exit 77). */
-#ifndef VFX_TEST_UTIL_H
-#define VFX_TEST_UTIL_H
+#ifndef TEST_UTIL_H
+#define TEST_UTIL_H
 
 #include "gfx/gl_context.h"
 
 #define VFX_TEST_SKIP 77
 
 /* Makes a headless GL 4.5 context, or exits the process with 77 (skip) when none can be made. */
-vfx_gl_context *vfx_test_gl_or_skip(void);
+rt_gl_context *test_gl_or_skip(void);
 /* Path of the shared test data file `rel` (under VFX_SHARED_DATA), or exits 77 when absent. */
-const char *vfx_test_shared_data_or_skip(const char *rel, char *buf, unsigned buflen);
+const char *test_shared_data_or_skip(const char *rel, char *buf, unsigned buflen);
 /* A logger for tests that records the last message, so tests can assert on error text. */
-typedef struct vfx_test_log {
+typedef struct test_log {
     char last[1024];
     int errors, warnings;
-} vfx_test_log;
-void vfx_test_log_fn(void *user, vfx_log_level level, const char *message);
+} test_log;
+void test_log_fn(void *user, vfx_log_level level, const char *message);
 
 #endif

@@ -8,9 +8,9 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    vfx_mesh_data mesh;
+    rt_mesh_data mesh;
     char err[256];
-    if (vfx_mesh_import_memory(data, size, "obj", &mesh, err, sizeof err) == VFX_OK)
-        vfx_mesh_data_free(&mesh);
+    if (rt_mesh_import_memory(data, size, "obj", &mesh, err, sizeof err) == VFX_OK)
+        rt_mesh_data_free(&mesh);
     return 0;
 }

@@ -9,7 +9,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     float *xyz = NULL;
     uint32_t n = 0;
     char err[256];
-    if (vfx_particle_file_parse(data, size, &xyz, &n, err, sizeof err) == VFX_OK)
+    if (rt_particle_file_parse(data, size, &xyz, &n, err, sizeof err) == VFX_OK)
         free(xyz);
     return 0;
 }

@@ -11,14 +11,14 @@ static void quiet(void *user, vfx_log_level level, const char *message)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    vfx_logger lg = {quiet, NULL};
-    vfx_scene *s = NULL;
+    rt_logger lg = {quiet, NULL};
+    rt_scene *s = NULL;
     char err[256];
-    if (vfx_scene_load_mem((const char *)data, size, "/base", &lg, &s, err, sizeof err) == VFX_OK) {
+    if (rt_scene_load_mem((const char *)data, size, "/base", &lg, &s, err, sizeof err) == VFX_OK) {
         vfx_beam b[8];
-        vfx_scene_beams_at(s, 0.37, b, 8);
-        vfx_scene_beams_at(s, 1e6, b, 8);
-        vfx_scene_free(s);
+        rt_scene_beams_at(s, 0.37, b, 8);
+        rt_scene_beams_at(s, 1e6, b, 8);
+        rt_scene_free(s);
     }
     return 0;
 }

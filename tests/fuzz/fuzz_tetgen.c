@@ -45,9 +45,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     /* "attr0" reaches the node-attribute scalar path; NULL the plain geometry path. */
     const char *names[2] = {NULL, "attr0"};
     for (int i = 0; i < 2; i++) {
-        vfx_tet_mesh mesh;
-        if (vfx_tet_load_tetgen(base, names[i], &mesh, err, sizeof err) == VFX_OK)
-            vfx_tet_mesh_free(&mesh);
+        tet_mesh mesh;
+        if (tet_load_tetgen(base, names[i], &mesh, err, sizeof err) == VFX_OK)
+            tet_mesh_free(&mesh);
     }
     return 0;
 }

@@ -11,9 +11,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     /* Both the "no scalar" path and the named vector-magnitude path are reachable from one input. */
     const char *names[2] = {NULL, "Velocity"};
     for (int i = 0; i < 2; i++) {
-        vfx_tet_mesh mesh;
-        if (vfx_tet_load_vtu_mem(data, size, names[i], &mesh, err, sizeof err) == VFX_OK)
-            vfx_tet_mesh_free(&mesh);
+        tet_mesh mesh;
+        if (tet_load_vtu_mem(data, size, names[i], &mesh, err, sizeof err) == VFX_OK)
+            tet_mesh_free(&mesh);
     }
     return 0;
 }

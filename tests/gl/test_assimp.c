@@ -17,9 +17,9 @@
 static void test_box_obj(void **state)
 {
     (void)state;
-    vfx_mesh_data m;
+    rt_mesh_data m;
     char err[512];
-    assert_int_equal(vfx_mesh_import(MODELS "/OBJ/box.obj", &m, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_mesh_import(MODELS "/OBJ/box.obj", &m, err, sizeof err), VFX_OK);
     /* a unit box: 12 triangles, bounds +-0.5 (the file's own coordinates) */
     assert_int_equal(m.index_count, 36);
     for (int a = 0; a < 3; ++a) {
@@ -30,7 +30,7 @@ static void test_box_obj(void **state)
         float *n = &m.normals[3 * i];
         assert_true(fabsf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2] - 1.f) < 1e-4f);
     }
-    vfx_mesh_data_free(&m);
+    rt_mesh_data_free(&m);
 }
 
 static void test_other_formats(void **state)
@@ -43,29 +43,29 @@ static void test_other_formats(void **state)
         if (!f)
             continue;
         fclose(f);
-        vfx_mesh_data m;
+        rt_mesh_data m;
         char err[512];
-        vfx_result r = vfx_mesh_import(files[i], &m, err, sizeof err);
+        vfx_result r = rt_mesh_import(files[i], &m, err, sizeof err);
         if (r != VFX_OK)
             fail_msg("%s: %s", files[i], err);
         assert_true(m.index_count > 0 && m.index_count % 3 == 0);
         for (uint32_t k = 0; k < m.index_count; ++k)
             assert_true(m.indices[k] < m.vertex_count);
-        vfx_mesh_data_free(&m);
+        rt_mesh_data_free(&m);
     }
 }
 
 static void test_corrupt_files(void **state)
 {
     (void)state;
-    vfx_mesh_data m;
+    rt_mesh_data m;
     char err[512];
-    assert_int_not_equal(vfx_mesh_import(MODELS "/invalid/malformed.obj", &m, err, sizeof err), VFX_OK);
+    assert_int_not_equal(rt_mesh_import(MODELS "/invalid/malformed.obj", &m, err, sizeof err), VFX_OK);
     assert_non_null(strstr(err, "malformed.obj"));
     assert_null(m.positions);
-    assert_int_equal(vfx_mesh_import(MODELS "/invalid/empty.obj", &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(rt_mesh_import(MODELS "/invalid/empty.obj", &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "empty.obj"));
-    assert_int_equal(vfx_mesh_import("/no/such/file.obj", &m, err, sizeof err), VFX_ERR_IO);
+    assert_int_equal(rt_mesh_import("/no/such/file.obj", &m, err, sizeof err), VFX_ERR_IO);
     assert_non_null(strstr(err, "/no/such/file.obj"));
     /* truncated binary STL: header says 1000 triangles, body holds none */
     unsigned char stl[84] = {0};
@@ -73,10 +73,10 @@ static void test_corrupt_files(void **state)
     FILE *f = fopen("truncated.stl", "wb");
     fwrite(stl, 1, sizeof stl, f);
     fclose(f);
-    assert_int_not_equal(vfx_mesh_import("truncated.stl", &m, err, sizeof err), VFX_OK);
+    assert_int_not_equal(rt_mesh_import("truncated.stl", &m, err, sizeof err), VFX_OK);
     assert_non_null(strstr(err, "truncated.stl"));
     static const char garbage[] = "v 1 2\nf 1 2 3 4 5\nv nan nan nan\n";
-    vfx_result r = vfx_mesh_import_memory(garbage, sizeof garbage - 1, "obj", &m, err, sizeof err);
+    vfx_result r = rt_mesh_import_memory(garbage, sizeof garbage - 1, "obj", &m, err, sizeof err);
     assert_int_not_equal(r, VFX_OK);
 }
 

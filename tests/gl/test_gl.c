@@ -17,12 +17,12 @@
 #include "plugin_internal.h"
 #include "test_util.h"
 
-static vfx_gl_context *g_gl;
+static rt_gl_context *g_gl;
 
-static vfx_host_api empty_host(vfx_test_log *log)
+static vfx_host_api empty_host(test_log *log)
 {
     return (vfx_host_api){.size = sizeof(vfx_host_api), .version = VFX_HOST_API_VERSION,
-                          .user = log, .log = vfx_test_log_fn};
+                          .user = log, .log = test_log_fn};
 }
 
 static const vfx_plugin_api *plugin_api(void)
@@ -36,28 +36,28 @@ static const vfx_plugin_api *plugin_api(void)
 static void test_render_readback(void **state)
 {
     (void)state;
-    vfx_renderer *r;
-    vfx_logger lg = {0};
-    assert_int_equal(vfx_renderer_create(&lg, &r), VFX_OK);
-    assert_int_equal(vfx_renderer_resize(r, 64, 48), VFX_OK);
-    vfx_ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8, 64, 48, 0.1, 100};
+    rt_renderer *r;
+    rt_logger lg = {0};
+    assert_int_equal(rt_renderer_create(&lg, &r), VFX_OK);
+    assert_int_equal(rt_renderer_resize(r, 64, 48), VFX_OK);
+    ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8, 64, 48, 0.1, 100};
     float view[16], proj[16];
-    vfx_ref_camera_matrices(&cam, view, proj);
-    vfx_mesh_data box;
-    assert_int_equal(vfx_mesh_make_box((float[3]){-1, -1, -1}, (float[3]){1, 1, 1}, &box), VFX_OK);
-    vfx_mesh_gpu gpu;
-    assert_int_equal(vfx_mesh_upload(&box, &gpu), VFX_OK);
-    vfx_mesh_data_free(&box);
+    ref_camera_matrices(&cam, view, proj);
+    rt_mesh_data box;
+    assert_int_equal(rt_mesh_make_box((float[3]){-1, -1, -1}, (float[3]){1, 1, 1}, &box), VFX_OK);
+    rt_mesh_gpu gpu;
+    assert_int_equal(rt_mesh_upload(&box, &gpu), VFX_OK);
+    rt_mesh_data_free(&box);
     static const float clear[3] = {0, 0, 1}, red[3] = {1, 0, 0};
     static const float id[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    vfx_renderer_begin_scene(r, view, proj, clear);
-    vfx_renderer_draw_mesh(r, &gpu, id, red);
+    rt_renderer_begin_scene(r, view, proj, clear);
+    rt_renderer_draw_mesh(r, &gpu, id, red);
     vfx_frame_view fv;
-    vfx_renderer_end_scene(r, &fv);
+    rt_renderer_end_scene(r, &fv);
     assert_int_equal(fv.width, 64);
     assert_int_not_equal(fv.depth_texture, 0);
     uint8_t *px = malloc(64 * 48 * 4);
-    assert_int_equal(vfx_renderer_read_rgba(r, px), VFX_OK);
+    assert_int_equal(rt_renderer_read_rgba(r, px), VFX_OK);
     const uint8_t *centre = px + (24 * 64 + 32) * 4, *corner = px;
     assert_true(centre[0] > 60 && centre[2] < 10);   /* the box, lit red */
     assert_true(corner[2] == 255 && corner[0] == 0); /* the clear colour */
@@ -69,22 +69,22 @@ static void test_render_readback(void **state)
     assert_true(fabs(z_eye - 4.0) < 1e-3); /* depth32F keeps this to ~1e-5 relative */
     free(depth);
     free(px);
-    vfx_mesh_gpu_destroy(&gpu);
-    vfx_renderer_destroy(r);
-    assert_null(vfx_gpu_error_string());
+    rt_mesh_gpu_destroy(&gpu);
+    rt_renderer_destroy(r);
+    assert_null(volfx_gpu_error_string());
 }
 
 static void test_timestamps_and_empty_world(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
+    test_log log = {0};
     vfx_host_api host = empty_host(&log);
     const vfx_plugin_api *api = plugin_api();
     vfx_context *ctx;
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
     vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .width = 32, .height = 32};
-    vfx_ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8, 32, 32, 0.1, 100};
-    vfx_ref_camera_matrices(&cam, fv.view, fv.proj);
+    ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8, 32, 32, 0.1, 100};
+    ref_camera_matrices(&cam, fv.view, fv.proj);
     vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
     /* nothing in the world: no effect state is made, no pass runs, no stat appears */
     for (int i = 0; i < 6; ++i) {
@@ -106,13 +106,13 @@ static void test_timestamps_and_empty_world(void **state)
     bool seen = false;
     for (int frame = 0; frame < 12 && !seen; ++frame) {
         ctx->stats.count = 0;
-        vfx_gpu_pass_begin(ctx, "test.clear");
+        volfx_gpu_pass_begin(ctx, "test.clear");
         glBindFramebuffer(GL_FRAMEBUFFER, fbo);
         glClearColor(0.1f * frame, 0, 0, 1);
         glClear(GL_COLOR_BUFFER_BIT);
-        vfx_gpu_pass_end(ctx);
+        volfx_gpu_pass_end(ctx);
         glFinish();
-        vfx_gpu_frame_end(ctx);
+        volfx_gpu_frame_end(ctx);
         for (uint32_t i = 0; i < ctx->stats.count; ++i)
             if (!strcmp(ctx->stats.entries[i].name, "test.clear.gpu_ms")) {
                 seen = true;
@@ -137,35 +137,35 @@ static void test_timestamps_and_empty_world(void **state)
 static void test_shader_error_names_file_line(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
+    test_log log = {0};
     vfx_host_api host = empty_host(&log);
     const vfx_plugin_api *api = plugin_api();
     vfx_context *ctx;
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
     char src[256];
-    extern int vfx_shader_index(const char *path);
-    extern long vfx_shader_line_base(int index);
-    int idx = vfx_shader_index("common/depth.glsl");
+    extern int volfx_shader_index(const char *path);
+    extern long volfx_shader_line_base(int index);
+    int idx = volfx_shader_index("common/depth.glsl");
     assert_true(idx >= 0);
     /* line 3 of the named file has the error */
     snprintf(src, sizeof src, "#version 450 core\n#line %ld\nvoid f() {}\n\nvoid main() { undefined_thing = 1; }\n",
-             vfx_shader_line_base(idx) + 1);
+             volfx_shader_line_base(idx) + 1);
     const char *srcs[1] = {src}, *names[1] = {"common/depth.glsl"};
     GLenum stage = GL_FRAGMENT_SHADER;
-    assert_int_equal(vfx_gpu_link_sources(ctx, 1, &stage, srcs, names), 0);
+    assert_int_equal(volfx_gpu_link_sources(ctx, 1, &stage, srcs, names), 0);
     assert_non_null(strstr(api->last_error(ctx), "common/depth.glsl:3:"));
     /* an error inside an included file names that file: the integrate shader compiled with a
      * define that breaks the included beam_field.glsl is reported at beam_field.glsl */
-    assert_int_equal(vfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
+    assert_int_equal(volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
                                      "#define fma undefined_fma"), 0);
     assert_non_null(strstr(api->last_error(ctx), "beams/beam_field.glsl:"));
     /* a shader that is not embedded is named */
-    assert_int_equal(vfx_gpu_program(ctx, "common/fullscreen.vert", "nope/none.frag", NULL), 0);
+    assert_int_equal(volfx_gpu_program(ctx, "common/fullscreen.vert", "nope/none.frag", NULL), 0);
     assert_non_null(strstr(api->last_error(ctx), "nope/none.frag"));
     /* the real embedded program links, and is cached */
-    GLuint p0 = vfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", NULL);
+    GLuint p0 = volfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", NULL);
     assert_int_not_equal(p0, 0);
-    assert_int_equal(vfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", NULL), p0);
+    assert_int_equal(volfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", NULL), p0);
     /* define sets that differ only far into the string are different programs */
     char d1[400], d2[400];
     memset(d1, 0, sizeof d1);
@@ -174,8 +174,8 @@ static void test_shader_error_names_file_line(void **state)
     memcpy(d2, d1, sizeof d1);
     strcat(d1, "\n#define VARIANT 1");
     strcat(d2, "\n#define VARIANT 2");
-    GLuint p1 = vfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", d1);
-    GLuint p2 = vfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", d2);
+    GLuint p1 = volfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", d1);
+    GLuint p2 = volfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", d2);
     assert_true(p1 != 0 && p2 != 0 && p1 != p2 && p1 != p0);
     api->destroy(ctx);
 }
@@ -183,7 +183,7 @@ static void test_shader_error_names_file_line(void **state)
 static void test_lifecycle_many(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
+    test_log log = {0};
     vfx_host_api host = empty_host(&log);
     const vfx_plugin_api *api = plugin_api();
     /* create, resize, destroy and re-create; run under valgrind/LSan this proves no leak */
@@ -194,36 +194,36 @@ static void test_lifecycle_many(void **state)
         api->destroy(ctx);
     }
     assert_int_equal(log.errors, 0);
-    assert_null(vfx_gpu_error_string());
+    assert_null(volfx_gpu_error_string());
 }
 
 static void test_app_frame(void **state)
 {
     (void)state;
     /* the full host path: world, scene, plugin, screenshot */
-    vfx_gl_context_destroy(g_gl);
+    rt_gl_context_destroy(g_gl);
     g_gl = NULL;
-    vfx_test_log log = {0};
-    vfx_app_desc d = {.mode = VFX_GL_HEADLESS, .width = 48, .height = 32, .logger = {vfx_test_log_fn, &log}};
-    vfx_app *app;
-    assert_int_equal(vfx_app_create(&d, &app), VFX_OK);
-    assert_int_equal(vfx_app_add_box(app, (float[3]){-1, -1, -1}, (float[3]){1, 1, 1}, (float[3]){0, 1, 0}, NULL), VFX_OK);
+    test_log log = {0};
+    game_app_desc d = {.mode = RT_GL_HEADLESS, .width = 48, .height = 32, .logger = {test_log_fn, &log}};
+    game_app *app;
+    assert_int_equal(game_app_create(&d, &app), VFX_OK);
+    assert_int_equal(game_app_add_box(app, (float[3]){-1, -1, -1}, (float[3]){1, 1, 1}, (float[3]){0, 1, 0}, NULL), VFX_OK);
     for (int i = 0; i < 3; ++i)
-        assert_int_equal(vfx_app_frame(app, 1.f / 60.f), VFX_OK);
-    assert_int_equal(vfx_app_screenshot(app, "app_frame.png"), VFX_OK);
+        assert_int_equal(game_app_frame(app, 1.f / 60.f), VFX_OK);
+    assert_int_equal(game_app_screenshot(app, "app_frame.png"), VFX_OK);
     FILE *f = fopen("app_frame.png", "rb");
     assert_non_null(f);
     fclose(f);
-    vfx_frame_summary s = vfx_profiler_summary(app->profiler, 0);
+    rt_frame_summary s = rt_profiler_summary(app->profiler, 0);
     assert_int_equal(s.frames, 3);
     assert_true(s.p50_ms > 0 && s.p99_ms >= s.p50_ms);
-    assert_int_equal(vfx_app_dump_raw(app, VFX_EFFECT_WATER, "none.pfm") == VFX_OK, 0);
-    vfx_app_destroy(app);
+    assert_int_equal(game_app_dump_raw(app, VFX_EFFECT_WATER, "none.pfm") == VFX_OK, 0);
+    game_app_destroy(app);
 }
 
 int main(void)
 {
-    g_gl = vfx_test_gl_or_skip();
+    g_gl = test_gl_or_skip();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_render_readback),
         cmocka_unit_test(test_timestamps_and_empty_world),
@@ -232,6 +232,6 @@ int main(void)
         cmocka_unit_test(test_app_frame),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
-    vfx_gl_context_destroy(g_gl);
+    rt_gl_context_destroy(g_gl);
     return rc;
 }

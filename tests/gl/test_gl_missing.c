@@ -9,15 +9,15 @@
 
 int main(void)
 {
-    vfx_test_log log = {0};
-    vfx_gl_context *gl = NULL;
-    vfx_gl_context_desc d = {.mode = VFX_GL_HEADLESS, .logger = {vfx_test_log_fn, &log}};
-    vfx_result r = vfx_gl_context_create(&d, &gl);
+    test_log log = {0};
+    rt_gl_context *gl = NULL;
+    rt_gl_context_desc d = {.mode = RT_GL_HEADLESS, .logger = {test_log_fn, &log}};
+    vfx_result r = rt_gl_context_create(&d, &gl);
     const char *renderer = getenv("MESA_GL_VERSION_OVERRIDE");
     if (r == VFX_OK) {
         /* not Mesa (the override is ignored): nothing to check here */
         fprintf(stderr, "driver ignored MESA_GL_VERSION_OVERRIDE=%s: skipping\n", renderer ? renderer : "");
-        vfx_gl_context_destroy(gl);
+        rt_gl_context_destroy(gl);
         return 77;
     }
     if (r != VFX_ERR_GL_UNSUPPORTED || gl != NULL || !strstr(log.last, "4.5")) {

@@ -19,23 +19,23 @@ static void run_scene(const char *file, bool expect_water, bool expect_beams, bo
     const char *root = getenv("VFX_SOURCE_ROOT");
     if (file)
         snprintf(path, sizeof path, "%s/sample_game/scenes/%s", root ? root : ".", file);
-    vfx_test_log log = {0};
-    vfx_app_desc d = {.mode = VFX_GL_HEADLESS, .width = 64, .height = 36, .logger = {vfx_test_log_fn, &log}};
-    vfx_app *app;
-    if (vfx_app_create(&d, &app) != VFX_OK)
+    test_log log = {0};
+    game_app_desc d = {.mode = RT_GL_HEADLESS, .width = 64, .height = 36, .logger = {test_log_fn, &log}};
+    game_app *app;
+    if (game_app_create(&d, &app) != VFX_OK)
         exit(VFX_TEST_SKIP);
-    vfx_demo demo;
-    assert_int_equal(vfx_demo_load(app, &demo, file ? path : NULL, 0), VFX_OK);
+    game_demo demo;
+    assert_int_equal(game_demo_load(app, &demo, file ? path : NULL, 0), VFX_OK);
     for (int f = 0; f < 2; ++f) {
-        vfx_demo_animate(app, &demo, 1.f / 60.f);
-        assert_int_equal(vfx_app_frame(app, 1.f / 60.f), VFX_OK);
+        game_demo_animate(app, &demo, 1.f / 60.f);
+        assert_int_equal(game_app_frame(app, 1.f / 60.f), VFX_OK);
     }
     assert_true((app->ctx->effect_state[VFX_EFFECT_WATER] != NULL) == expect_water);
     assert_true((app->ctx->effect_state[VFX_EFFECT_BEAMS] != NULL) == expect_beams);
     assert_true((app->ctx->effect_state[VFX_EFFECT_VOLUME] != NULL) == expect_volume);
     assert_int_equal(log.errors, 0);
-    vfx_demo_free(app, &demo);
-    vfx_app_destroy(app);
+    game_demo_free(app, &demo);
+    game_app_destroy(app);
 }
 
 static void test_default(void **s) { (void)s; run_scene(NULL, true, true, true); }
@@ -48,16 +48,16 @@ static void test_long_run(void **s) { (void)s; run_scene("long-run.json", true, 
 static void test_bad_scene_refused(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
-    vfx_app_desc d = {.mode = VFX_GL_HEADLESS, .width = 32, .height = 32, .logger = {vfx_test_log_fn, &log}};
-    vfx_app *app;
-    if (vfx_app_create(&d, &app) != VFX_OK)
+    test_log log = {0};
+    game_app_desc d = {.mode = RT_GL_HEADLESS, .width = 32, .height = 32, .logger = {test_log_fn, &log}};
+    game_app *app;
+    if (game_app_create(&d, &app) != VFX_OK)
         exit(VFX_TEST_SKIP);
-    vfx_demo demo;
-    assert_int_not_equal(vfx_demo_load(app, &demo, "/no/such/scene.json", 0), VFX_OK);
+    game_demo demo;
+    assert_int_not_equal(game_demo_load(app, &demo, "/no/such/scene.json", 0), VFX_OK);
     assert_non_null(strstr(log.last, "/no/such/scene.json"));
-    vfx_demo_free(app, &demo);
-    vfx_app_destroy(app);
+    game_demo_free(app, &demo);
+    game_app_destroy(app);
 }
 
 int main(void)

@@ -37,7 +37,7 @@ static void test_round_trip_and_layout(void **state)
     const float xyz[9] = {1.0f, -2.5f, 3.25f, 0, 1e-30f, -1e30f, 7, 8, 9};
     char err[256];
     const char *p = tmp("a.bin");
-    assert_int_equal(vfx_particle_file_save(p, xyz, 3, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_particle_file_save(p, xyz, 3, err, sizeof err), VFX_OK);
     /* byte layout independent of the loader: 1.0f little-endian is 00 00 80 3f */
     unsigned char raw[36];
     FILE *f = fopen(p, "rb");
@@ -49,7 +49,7 @@ static void test_round_trip_and_layout(void **state)
     assert_memory_equal(raw + 4, minus_2_5, 4);
     float *got = NULL;
     uint32_t n = 0;
-    assert_int_equal(vfx_particle_file_load(p, &got, &n, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_particle_file_load(p, &got, &n, err, sizeof err), VFX_OK);
     assert_int_equal(n, 3);
     assert_memory_equal(got, xyz, sizeof xyz);
     free(got);
@@ -61,8 +61,8 @@ static void test_empty_file(void **state)
     char err[256];
     float *got = (float *)err;
     uint32_t n = 99;
-    assert_int_equal(vfx_particle_file_save(tmp("e.bin"), NULL, 0, err, sizeof err), VFX_OK);
-    assert_int_equal(vfx_particle_file_load(tmp("e.bin"), &got, &n, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_particle_file_save(tmp("e.bin"), NULL, 0, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_particle_file_load(tmp("e.bin"), &got, &n, err, sizeof err), VFX_OK);
     assert_int_equal(n, 0);
     assert_null(got);
 }
@@ -75,11 +75,11 @@ static void test_bad_size(void **state)
     char err[256];
     float *got = NULL;
     uint32_t n = 0;
-    assert_int_equal(vfx_particle_file_load(tmp("s.bin"), &got, &n, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(rt_particle_file_load(tmp("s.bin"), &got, &n, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "size 25 bytes is not a multiple of 12"));
     assert_non_null(strstr(err, tmp("s.bin")));
     assert_null(got);
-    assert_int_equal(vfx_particle_file_parse(bytes, 13, &got, &n, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(rt_particle_file_parse(bytes, 13, &got, &n, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "size 13 bytes"));
 }
 
@@ -91,15 +91,15 @@ static void test_non_finite(void **state)
     char err[256];
     float *got = NULL;
     uint32_t n = 0;
-    assert_int_equal(vfx_particle_file_parse(xyz, sizeof xyz, &got, &n, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(rt_particle_file_parse(xyz, sizeof xyz, &got, &n, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "particle 2 has a non-finite y (NaN)"));
     xyz[3 * 2 + 1] = 0;
     xyz[3 * 3 + 2] = -INFINITY;
-    assert_int_equal(vfx_particle_file_parse(xyz, sizeof xyz, &got, &n, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(rt_particle_file_parse(xyz, sizeof xyz, &got, &n, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "particle 3 has a non-finite z (Inf)"));
     assert_null(got);
     /* save refuses them too, before creating the file */
-    assert_int_equal(vfx_particle_file_save(tmp("nan.bin"), xyz, 4, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_particle_file_save(tmp("nan.bin"), xyz, 4, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "particle 3"));
     assert_int_equal(access(tmp("nan.bin"), F_OK), -1);
 }
@@ -111,19 +111,19 @@ static void test_cap_and_io(void **state)
     const char *p = tmp("huge.bin");
     int fd = open(p, O_CREAT | O_WRONLY | O_TRUNC, 0600);
     assert_true(fd >= 0);
-    assert_int_equal(ftruncate(fd, (off_t)12 * (VFX_PARTICLE_FILE_MAX_COUNT + 1ull)), 0);
+    assert_int_equal(ftruncate(fd, (off_t)12 * (RT_PARTICLE_FILE_MAX_COUNT + 1ull)), 0);
     close(fd);
     char err[256];
     float *got = NULL;
     uint32_t n = 0;
-    assert_int_equal(vfx_particle_file_load(p, &got, &n, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_particle_file_load(p, &got, &n, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "above the cap of 16777216 particles"));
     unlink(p);
-    assert_int_equal(vfx_particle_file_load(tmp("missing.bin"), &got, &n, err, sizeof err), VFX_ERR_IO);
+    assert_int_equal(rt_particle_file_load(tmp("missing.bin"), &got, &n, err, sizeof err), VFX_ERR_IO);
     assert_non_null(strstr(err, "missing.bin: cannot open"));
-    assert_int_equal(vfx_particle_file_load(dir, &got, &n, err, sizeof err) != VFX_OK, 1);
-    assert_int_equal(vfx_particle_file_save("/nonexistent-dir/x.bin", got, 0, err, sizeof err), VFX_ERR_IO);
-    assert_int_equal(vfx_particle_file_parse(NULL, 12, &got, &n, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_particle_file_load(dir, &got, &n, err, sizeof err) != VFX_OK, 1);
+    assert_int_equal(rt_particle_file_save("/nonexistent-dir/x.bin", got, 0, err, sizeof err), VFX_ERR_IO);
+    assert_int_equal(rt_particle_file_parse(NULL, 12, &got, &n, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
 }
 
 static int setup(void **state)

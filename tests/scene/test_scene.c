@@ -16,13 +16,13 @@
 #include "scene/scene.h"
 #include "test_util.h"
 
-extern const char vfx_default_scene_json[];
-extern const unsigned long vfx_default_scene_json_len;
+extern const char game_default_scene_json[];
+extern const unsigned long game_default_scene_json_len;
 
-static vfx_result load(const char *json, vfx_test_log *log, vfx_scene **s, char *err, size_t errlen)
+static vfx_result load(const char *json, test_log *log, rt_scene **s, char *err, size_t errlen)
 {
-    vfx_logger lg = {vfx_test_log_fn, log};
-    return vfx_scene_load_mem(json, strlen(json), "/base", &lg, s, err, errlen);
+    rt_logger lg = {test_log_fn, log};
+    return rt_scene_load_mem(json, strlen(json), "/base", &lg, s, err, errlen);
 }
 
 /* float parameters are stored as float: compare with a float-epsilon-relative tolerance */
@@ -50,8 +50,8 @@ static void test_every_field(void **state)
         "\"volume\":{\"path\":\"v/pipe.vtu\",\"scalar\":\"Velocity\",\"transfer\":[{\"scalar\":-1,"
         "\"rgba\":[0,0,0,0]},{\"scalar\":3,\"rgba\":[1,1,1,2]}],\"ert_threshold\":0.8,\"tiles\":8,"
         "\"update_c\":4,\"workers\":2,\"disable\":[\"share\"],\"translate\":[0,0,-2]}}";
-    vfx_test_log log = {0};
-    vfx_scene *s = NULL;
+    test_log log = {0};
+    rt_scene *s = NULL;
     char err[256];
     assert_int_equal(load(json, &log, &s, err, sizeof err), VFX_OK);
     assert_int_equal(log.warnings, 0);
@@ -94,7 +94,7 @@ static void test_every_field(void **state)
     assert_close(b->color[2], 0.25);
     assert_close(s->beams[0].loop_s, 2);
     assert_true(s->has_water);
-    assert_int_equal(s->water.source, VFX_SCENE_WATER_FILE);
+    assert_int_equal(s->water.source, RT_SCENE_WATER_FILE);
     assert_string_equal(s->water.path, "/base/p.bin");
     const vfx_water_params *wp = &s->water.params;
     assert_int_equal(wp->size, sizeof *wp);
@@ -122,14 +122,14 @@ static void test_every_field(void **state)
     assert_int_equal(s->volume.workers, 2);
     assert_int_equal(s->volume.disable, VFX_VOLUME_NO_SHARE);
     assert_close(s->volume.model[14], -2);
-    vfx_scene_free(s);
+    rt_scene_free(s);
 }
 
 static void test_defaults(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
-    vfx_scene *s = NULL;
+    test_log log = {0};
+    rt_scene *s = NULL;
     char err[256];
     assert_int_equal(load("{}", &log, &s, err, sizeof err), VFX_OK);
     assert_int_equal(s->camera.width, 640);
@@ -140,13 +140,13 @@ static void test_defaults(void **state)
     assert_false(s->has_water);
     assert_false(s->has_volume);
     assert_int_equal(s->beams_view.saturation, VFX_SATURATE_SMOOTH);
-    vfx_scene_free(s);
+    rt_scene_free(s);
     /* beam defaults: only head and dir given */
     assert_int_equal(load("{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0]}]}", &log, &s, err, sizeof err), VFX_OK);
     assert_close(s->beams[0].base.radius, 0.5);
     assert_close(s->beams[0].base.length, 1);
     assert_close(s->beams[0].base.color[3], 1);
-    vfx_scene_free(s);
+    rt_scene_free(s);
 }
 
 typedef struct bad_case {
@@ -251,8 +251,8 @@ static void test_bad_inputs(void **state)
 {
     (void)state;
     for (size_t i = 0; i < sizeof bad_cases / sizeof bad_cases[0]; ++i) {
-        vfx_test_log log = {0};
-        vfx_scene *s = (vfx_scene *)&log; /* must be reset to NULL */
+        test_log log = {0};
+        rt_scene *s = (rt_scene *)&log; /* must be reset to NULL */
         char err[512] = "";
         vfx_result r = load(bad_cases[i].json, &log, &s, err, sizeof err);
         if (r != bad_cases[i].code || !strstr(err, bad_cases[i].needle))
@@ -265,14 +265,14 @@ static void test_bad_inputs(void **state)
 static void test_too_many_beams(void **state)
 {
     (void)state;
-    size_t cap = VFX_SCENE_MAX_BEAMS + 1, len = 32 + cap * 40;
+    size_t cap = RT_SCENE_MAX_BEAMS + 1, len = 32 + cap * 40;
     char *json = malloc(len), *p = json;
     p += sprintf(p, "{\"beams\":[");
     for (size_t i = 0; i < cap; ++i)
         p += sprintf(p, "%s{\"head\":[0,0,0],\"dir\":[1,0,0]}", i ? "," : "");
     sprintf(p, "]}");
-    vfx_test_log log = {0};
-    vfx_scene *s = NULL;
+    test_log log = {0};
+    rt_scene *s = NULL;
     char err[256];
     assert_int_equal(load(json, &log, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "beams: 257 beams, above the cap of 256"));
@@ -282,16 +282,16 @@ static void test_too_many_beams(void **state)
         fail_msg("no last beam object in the generated scene");
     sprintf(p - 1, "]}");
     assert_int_equal(load(json, &log, &s, err, sizeof err), VFX_OK);
-    assert_int_equal(s->beam_count, VFX_SCENE_MAX_BEAMS);
-    vfx_scene_free(s);
+    assert_int_equal(s->beam_count, RT_SCENE_MAX_BEAMS);
+    rt_scene_free(s);
     free(json);
 }
 
 static void test_syntax_errors(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
-    vfx_scene *s = NULL;
+    test_log log = {0};
+    rt_scene *s = NULL;
     char err[256];
     /* the stray comma is on line 3, column 18 (1-based): cJSON stops at or just before it */
     const char *json = "{\n  \"camera\": {\n    \"eye\": [1, 2,, 3]\n  }\n}\n";
@@ -308,11 +308,11 @@ static void test_syntax_errors(void **state)
     assert_int_equal(load("{}\n{}", &log, &s, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "line 2, column 1 (byte 3): text after the scene object"));
     /* an embedded NUL inside the given length */
-    vfx_logger lg = {vfx_test_log_fn, &log};
-    assert_int_equal(vfx_scene_load_mem("{}\0{}", 5, NULL, &lg, &s, err, sizeof err), VFX_ERR_FORMAT);
+    rt_logger lg = {test_log_fn, &log};
+    assert_int_equal(rt_scene_load_mem("{}\0{}", 5, NULL, &lg, &s, err, sizeof err), VFX_ERR_FORMAT);
     /* NULL arguments */
-    assert_int_equal(vfx_scene_load_mem(NULL, 3, NULL, &lg, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
-    assert_int_equal(vfx_scene_load_mem("{}", 2, NULL, &lg, NULL, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_scene_load_mem(NULL, 3, NULL, &lg, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_scene_load_mem("{}", 2, NULL, &lg, NULL, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
     /* deep nesting beyond cJSON's limit (1000) is a syntax error, not a stack overflow */
     enum { depth = 5000 };
     static char deep[2 * depth + 16];
@@ -326,21 +326,21 @@ static void test_syntax_errors(void **state)
 static void test_unknown_keys_warn(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
-    vfx_scene *s = NULL;
+    test_log log = {0};
+    rt_scene *s = NULL;
     char err[256];
     assert_int_equal(load("{\"camera\":{\"fov\":40},\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"raduis\":1}]}",
                           &log, &s, err, sizeof err),
                      VFX_OK);
     assert_int_equal(log.warnings, 2);
     assert_string_equal(log.last, "beams[0].raduis: unknown key ignored");
-    vfx_scene_free(s);
-    log = (vfx_test_log){0};
+    rt_scene_free(s);
+    log = (test_log){0};
     assert_int_equal(load("{\"name\":\"a\",\"name\":\"b\"}", &log, &s, err, sizeof err), VFX_OK);
     assert_int_equal(log.warnings, 1);
     assert_string_equal(log.last, "name: duplicate key, the first one is used");
     assert_string_equal(s->name, "a");
-    vfx_scene_free(s);
+    rt_scene_free(s);
 }
 
 static void test_keyframes(void **state)
@@ -354,18 +354,18 @@ static void test_keyframes(void **state)
         "\"color\":[{\"t\":0,\"value\":[0,0,0,1]},{\"t\":10,\"value\":[1,0.5,0,1]}]}},"
         "{\"head\":[5,5,5],\"dir\":[0,1,0],\"loop_s\":2,\"keyframes\":{\"radius\":[{\"t\":0,\"value\":1},"
         "{\"t\":2,\"value\":3}]}}]}";
-    vfx_test_log log = {0};
-    vfx_scene *s = NULL;
+    test_log log = {0};
+    rt_scene *s = NULL;
     char err[256];
     assert_int_equal(load(json, &log, &s, err, sizeof err), VFX_OK);
     vfx_beam b[4];
     /* hand-computed: length keys (1,2) (3,6) (4,4) */
     struct { double t, length; } L[] = {{-5, 2}, {1, 2}, {2, 4}, {2.5, 5}, {3, 6}, {3.25, 5.5}, {4, 4}, {100, 4}};
     for (size_t i = 0; i < sizeof L / sizeof L[0]; ++i) {
-        assert_int_equal(vfx_scene_beams_at(s, L[i].t, b, 4), 2);
+        assert_int_equal(rt_scene_beams_at(s, L[i].t, b, 4), 2);
         assert_close(b[0].length, L[i].length);
     }
-    vfx_scene_beams_at(s, 0.5, b, 4);
+    rt_scene_beams_at(s, 0.5, b, 4);
     assert_close(b[0].head[0], 0.5);
     assert_close(b[0].head[1], -1);
     assert_close(b[0].head[2], 2);
@@ -375,25 +375,25 @@ static void test_keyframes(void **state)
     assert_close(b[0].dir[0], 0.5);
     assert_close(b[0].radius, 0.5); /* not animated: the default */
     /* opposite direction keys pass through zero at t=1: the earlier key's direction is held */
-    vfx_scene_beams_at(s, 1.0, b, 4);
+    rt_scene_beams_at(s, 1.0, b, 4);
     assert_close(b[0].dir[0], 1);
     /* beam 1 loops every 2 s: t=5 -> 1 -> radius 2; t=-0.5 -> 1.5 -> 2.5; static head */
-    vfx_scene_beams_at(s, 5.0, b, 4);
+    rt_scene_beams_at(s, 5.0, b, 4);
     assert_close(b[1].radius, 2);
     assert_close(b[1].head[0], 5);
-    vfx_scene_beams_at(s, -0.5, b, 4);
+    rt_scene_beams_at(s, -0.5, b, 4);
     assert_close(b[1].radius, 2.5);
     /* non-finite time is treated as 0; n smaller than the count writes n */
-    assert_int_equal(vfx_scene_beams_at(s, NAN, b, 1), 1);
+    assert_int_equal(rt_scene_beams_at(s, NAN, b, 1), 1);
     assert_close(b[0].length, 2);
-    assert_int_equal(vfx_scene_beams_at(s, 0, NULL, 4), 0);
-    vfx_scene_free(s);
+    assert_int_equal(rt_scene_beams_at(s, 0, NULL, 4), 0);
+    rt_scene_free(s);
     /* an animated head with no static head takes the first key as the base */
     assert_int_equal(load("{\"beams\":[{\"dir\":[1,0,0],\"keyframes\":{\"head\":[{\"t\":0,\"value\":[7,8,9]}]}}]}",
                           &log, &s, err, sizeof err),
                      VFX_OK);
     assert_close(s->beams[0].base.head[1], 8);
-    vfx_scene_free(s);
+    rt_scene_free(s);
 }
 
 static void test_sample_scenes(void **state)
@@ -406,10 +406,10 @@ static void test_sample_scenes(void **state)
     for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
         char path[1024], err[512];
         snprintf(path, sizeof path, "%s/sample_game/scenes/%s.json", root, names[i]);
-        vfx_test_log log = {0};
-        vfx_logger lg = {vfx_test_log_fn, &log};
-        vfx_scene *s = NULL;
-        vfx_result r = vfx_scene_load_file(path, &lg, &s, err, sizeof err);
+        test_log log = {0};
+        rt_logger lg = {test_log_fn, &log};
+        rt_scene *s = NULL;
+        vfx_result r = rt_scene_load_file(path, &lg, &s, err, sizeof err);
         if (r)
             fail_msg("%s: %s", path, err);
         assert_int_equal(log.warnings, 0);
@@ -417,19 +417,19 @@ static void test_sample_scenes(void **state)
         if (s->has_water) {
             float *xyz = NULL;
             uint32_t n = 0;
-            assert_int_equal(vfx_scene_water_particles(&s->water, &xyz, &n, err, sizeof err), VFX_OK);
+            assert_int_equal(rt_scene_water_particles(&s->water, &xyz, &n, err, sizeof err), VFX_OK);
             assert_int_equal(n, s->water.count);
             assert_true(n <= 4096); /* llvmpipe budget of the sample scenes */
             free(xyz);
         }
         if (i == 0) {
             assert_true(s->beam_count >= 2 && s->beam_count <= 3);
-            assert_true(s->beams[0].tracks[VFX_BEAM_PARAM_LENGTH].count >= 2);
-            assert_true(s->has_water && s->water.source == VFX_SCENE_WATER_SIMULATION && s->water.paddle);
+            assert_true(s->beams[0].tracks[RT_BEAM_PARAM_LENGTH].count >= 2);
+            assert_true(s->has_water && s->water.source == RT_SCENE_WATER_SIMULATION && s->water.paddle);
             assert_true(s->has_volume);
             assert_true(s->mesh_count >= 1);
         }
-        vfx_scene_free(s);
+        rt_scene_free(s);
     }
     /* the embedded copy is the same text and loads the same way */
     char path[1024];
@@ -439,15 +439,15 @@ static void test_sample_scenes(void **state)
     static char text[1 << 16];
     size_t n = fread(text, 1, sizeof text, f);
     fclose(f);
-    assert_int_equal(n, vfx_default_scene_json_len);
-    assert_memory_equal(text, vfx_default_scene_json, n);
-    vfx_scene *s = NULL;
+    assert_int_equal(n, game_default_scene_json_len);
+    assert_memory_equal(text, game_default_scene_json, n);
+    rt_scene *s = NULL;
     char err[256];
-    vfx_test_log log = {0};
-    vfx_logger lg = {vfx_test_log_fn, &log};
-    assert_int_equal(vfx_scene_load_mem(vfx_default_scene_json, vfx_default_scene_json_len, NULL, &lg, &s, err, sizeof err),
+    test_log log = {0};
+    rt_logger lg = {test_log_fn, &log};
+    assert_int_equal(rt_scene_load_mem(game_default_scene_json, game_default_scene_json_len, NULL, &lg, &s, err, sizeof err),
                      VFX_OK);
-    vfx_scene_free(s);
+    rt_scene_free(s);
 }
 
 static void test_relative_paths_and_io(void **state)
@@ -462,41 +462,41 @@ static void test_relative_paths_and_io(void **state)
     fputs("{\"water\":{\"source\":\"file\",\"path\":\"p.bin\"}}", f);
     fclose(f);
     const float xyz[6] = {1, 2, 3, 4, 5, 6};
-    assert_int_equal(vfx_particle_file_save(part_path, xyz, 2, err, sizeof err), VFX_OK);
-    vfx_scene *s = NULL;
-    assert_int_equal(vfx_scene_load_file(scene_path, NULL, &s, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_particle_file_save(part_path, xyz, 2, err, sizeof err), VFX_OK);
+    rt_scene *s = NULL;
+    assert_int_equal(rt_scene_load_file(scene_path, NULL, &s, err, sizeof err), VFX_OK);
     assert_string_equal(s->water.path, part_path);
     float *got = NULL;
     uint32_t n = 0;
-    assert_int_equal(vfx_scene_water_particles(&s->water, &got, &n, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_scene_water_particles(&s->water, &got, &n, err, sizeof err), VFX_OK);
     assert_int_equal(n, 2);
     assert_memory_equal(got, xyz, sizeof xyz);
     free(got);
-    vfx_scene_free(s);
+    rt_scene_free(s);
     /* a syntax error in a file names the file and the line */
     f = fopen(scene_path, "w");
     fputs("{\n\"camera\": }", f);
     fclose(f);
-    assert_int_equal(vfx_scene_load_file(scene_path, NULL, &s, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(rt_scene_load_file(scene_path, NULL, &s, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, scene_path));
     assert_non_null(strstr(err, "line 2"));
     unlink(scene_path);
     unlink(part_path);
     rmdir(dir);
-    assert_int_equal(vfx_scene_load_file(scene_path, NULL, &s, err, sizeof err), VFX_ERR_IO);
+    assert_int_equal(rt_scene_load_file(scene_path, NULL, &s, err, sizeof err), VFX_ERR_IO);
     assert_non_null(strstr(err, "cannot open"));
-    assert_int_equal(vfx_scene_load_file("/tmp", NULL, &s, err, sizeof err) != VFX_OK, 1);
+    assert_int_equal(rt_scene_load_file("/tmp", NULL, &s, err, sizeof err) != VFX_OK, 1);
 }
 
 static void test_generators(void **state)
 {
     (void)state;
-    vfx_scene_water w = {.source = VFX_SCENE_WATER_GENERATOR, .generator = VFX_SCENE_GEN_LAYERS, .count = 600,
+    rt_scene_water w = {.source = RT_SCENE_WATER_GENERATOR, .generator = RT_SCENE_GEN_LAYERS, .count = 600,
                          .origin = {1, 2, 3}, .spacing = 0.5f, .layer_side = 24};
     float *p = NULL;
     uint32_t n = 0;
     char err[256];
-    assert_int_equal(vfx_scene_water_particles(&w, &p, &n, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_scene_water_particles(&w, &p, &n, err, sizeof err), VFX_OK);
     assert_int_equal(n, 600);
     /* particle 577 = layer 1 (576 per layer), index 1 in that layer: x = 1 + 0.5, y = 2 + 0.5, z = 3 */
     assert_close(p[3 * 577], 1.5);
@@ -505,9 +505,9 @@ static void test_generators(void **state)
     assert_close(p[3 * 575 + 2], 3 + 23 * 0.5);
     free(p);
     /* box: exact count, every particle inside, no two identical */
-    w = (vfx_scene_water){.source = VFX_SCENE_WATER_GENERATOR, .generator = VFX_SCENE_GEN_BOX, .count = 1000,
+    w = (rt_scene_water){.source = RT_SCENE_WATER_GENERATOR, .generator = RT_SCENE_GEN_BOX, .count = 1000,
                           .box_min = {-1, 0, 0}, .box_max = {1, 0.5f, 3}};
-    assert_int_equal(vfx_scene_water_particles(&w, &p, &n, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_scene_water_particles(&w, &p, &n, err, sizeof err), VFX_OK);
     assert_int_equal(n, 1000);
     for (uint32_t i = 0; i < n; ++i)
         for (int k = 0; k < 3; ++k)
@@ -516,9 +516,9 @@ static void test_generators(void **state)
         assert_memory_not_equal(&p[3 * i], &p[3 * (i - 1)], 12);
     free(p);
     /* sphere */
-    w = (vfx_scene_water){.source = VFX_SCENE_WATER_GENERATOR, .generator = VFX_SCENE_GEN_SPHERE, .count = 2000,
+    w = (rt_scene_water){.source = RT_SCENE_WATER_GENERATOR, .generator = RT_SCENE_GEN_SPHERE, .count = 2000,
                           .center = {0, 1, 0}, .radius = 0.5f};
-    assert_int_equal(vfx_scene_water_particles(&w, &p, &n, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_scene_water_particles(&w, &p, &n, err, sizeof err), VFX_OK);
     assert_int_equal(n, 2000);
     for (uint32_t i = 0; i < n; ++i) {
         double d = hypot(hypot(p[3 * i], p[3 * i + 1] - 1.0), p[3 * i + 2]);
@@ -527,12 +527,12 @@ static void test_generators(void **state)
     free(p);
     /* zero particles: defined, empty */
     w.count = 0;
-    assert_int_equal(vfx_scene_water_particles(&w, &p, &n, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_scene_water_particles(&w, &p, &n, err, sizeof err), VFX_OK);
     assert_int_equal(n, 0);
     assert_null(p);
     /* simulation: the initial block */
-    w = (vfx_scene_water){.source = VFX_SCENE_WATER_SIMULATION, .count = 500, .box_min = {0, 0, 0}, .box_max = {1, 1, 1}};
-    assert_int_equal(vfx_scene_water_particles(&w, &p, &n, err, sizeof err), VFX_OK);
+    w = (rt_scene_water){.source = RT_SCENE_WATER_SIMULATION, .count = 500, .box_min = {0, 0, 0}, .box_max = {1, 1, 1}};
+    assert_int_equal(rt_scene_water_particles(&w, &p, &n, err, sizeof err), VFX_OK);
     assert_int_equal(n, 500);
     free(p);
 }
@@ -540,11 +540,11 @@ static void test_generators(void **state)
 static void test_volume_generate_and_transfer(void **state)
 {
     (void)state;
-    vfx_scene_volume v = {.generated = true, .gen_cells = 3, .gen_min = {0, 0, 0}, .gen_max = {2, 1, 3}};
+    rt_scene_volume v = {.generated = true, .gen_cells = 3, .gen_min = {0, 0, 0}, .gen_max = {2, 1, 3}};
     float *pts = NULL, *sc = NULL;
     uint32_t *tets = NULL, np = 0, nt = 0;
     char err[256];
-    assert_int_equal(vfx_scene_volume_generate(&v, &pts, &np, &tets, &nt, &sc, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_scene_volume_generate(&v, &pts, &np, &tets, &nt, &sc, err, sizeof err), VFX_OK);
     assert_int_equal(np, 64);
     assert_int_equal(nt, 6 * 27);
     /* independent check in double: every tet positive, their volumes sum to the box's (6) */
@@ -567,13 +567,13 @@ static void test_volume_generate_and_transfer(void **state)
     assert_close(sc[0], 0);
     free(pts), free(tets), free(sc);
     v.gen_cells = 0;
-    assert_int_equal(vfx_scene_volume_generate(&v, &pts, &np, &tets, &nt, &sc, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_scene_volume_generate(&v, &pts, &np, &tets, &nt, &sc, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
 
     /* transfer: points (0: 0,0,0,0) (1: 1,0,0,1) (3: 1,1,1,3) sampled at 7 entries over [0, 3] */
-    vfx_scene_volume tv = {.transfer_count = 3,
+    rt_scene_volume tv = {.transfer_count = 3,
                            .transfer = {{0, {0, 0, 0, 0}}, {1, {1, 0, 0, 1}}, {3, {1, 1, 1, 3}}}};
     float rgba[28], lo, hi;
-    vfx_scene_transfer_sample(&tv, 7, rgba, &lo, &hi);
+    rt_scene_transfer_sample(&tv, 7, rgba, &lo, &hi);
     assert_close(lo, 0);
     assert_close(hi, 3);
     assert_close(rgba[4 * 1 + 0], 0.5); /* s = 0.5 */
@@ -584,7 +584,7 @@ static void test_volume_generate_and_transfer(void **state)
     assert_close(rgba[4 * 6 + 2], 1);   /* s = 3 */
     assert_close(rgba[4 * 6 + 3], 3);
     tv.transfer_normalized = true;
-    vfx_scene_transfer_sample(&tv, 7, rgba, &lo, &hi);
+    rt_scene_transfer_sample(&tv, 7, rgba, &lo, &hi);
     assert_close(lo, 0);
     assert_close(hi, 0);
 }

@@ -14,16 +14,16 @@
 static void test_system_writes_columns(void **state)
 {
     (void)state;
-    vfx_world *w = vfx_world_create(NULL);
+    rt_world *w = rt_world_create(NULL);
     assert_non_null(w);
-    vfx_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.1f, 0.2f, 0.06f}, .threads = 2};
-    vfx_sim_system *sys;
+    rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.1f, 0.2f, 0.06f}, .threads = 2};
+    rt_sim_system *sys;
     char err[256];
-    assert_int_equal(vfx_sim_system_create(w, &d, &sys, err, sizeof err), VFX_OK);
-    assert_int_equal(vfx_world_system_count(w), 1);
-    assert_string_equal(vfx_world_system_name(w, 0), "vfx.sim.sph");
-    vfx_particle_components pc;
-    assert_int_equal(vfx_particles_register(w, &pc), VFX_OK);
+    assert_int_equal(rt_sim_system_create(w, &d, &sys, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_world_system_count(w), 1);
+    assert_string_equal(rt_world_system_name(w, 0), "vfx.sim.sph");
+    rt_particle_components pc;
+    assert_int_equal(rt_particles_register(w, &pc), VFX_OK);
     /* a 5 x 10 x 6 block, 5 cm above the floor */
     enum { N = 300 };
     float x[N], y[N], z[N];
@@ -32,25 +32,25 @@ static void test_system_writes_columns(void **state)
         y[i] = 0.055f + 0.01f * (float)((i / 5) % 10);
         z[i] = 0.005f + 0.01f * (float)(i / 50);
     }
-    assert_int_equal(vfx_particles_spawn(w, &pc, N, x, y, z, false), VFX_OK);
-    vfx_sph_emitter e = {.center = {0.08f, 0.18f, 0.03f}, .direction = {0, -1, 0}, .speed = 1.f,
+    assert_int_equal(rt_particles_spawn(w, &pc, N, x, y, z, false), VFX_OK);
+    rt_sph_emitter e = {.center = {0.08f, 0.18f, 0.03f}, .direction = {0, -1, 0}, .speed = 1.f,
                          .radius = 0.01f, .max_emit = 20};
-    assert_int_equal(vfx_sph_add_emitter(vfx_sim_system_solver(sys), &e), VFX_OK);
+    assert_int_equal(rt_sph_add_emitter(rt_sim_system_solver(sys), &e), VFX_OK);
     for (int f = 0; f < 20; ++f) {
-        assert_int_equal(vfx_world_run_phase(w, VFX_PHASE_SIMULATE, f / 60.0, 1.f / 60.f), VFX_OK);
-        assert_true(vfx_sim_system_report(sys)->substeps > 0);
+        assert_int_equal(rt_world_run_phase(w, RT_PHASE_SIMULATE, f / 60.0, 1.f / 60.f), VFX_OK);
+        assert_true(rt_sim_system_report(sys)->substeps > 0);
     }
     /* the emitter's particles became entities */
-    assert_int_equal(vfx_world_entity_count(w), N + 20);
-    vfx_component terms[3] = {pc.position, pc.velocity, pc.density};
-    vfx_query_iter it = vfx_query_begin(w, terms, 3);
+    assert_int_equal(rt_world_entity_count(w), N + 20);
+    rt_component terms[3] = {pc.position, pc.velocity, pc.density};
+    rt_query_iter it = rt_query_begin(w, terms, 3);
     uint32_t seen = 0;
     double ymean = 0;
-    while (vfx_query_next(&it)) {
-        const float *py = vfx_query_column(&it, pc.position, 1);
-        const float *px = vfx_query_column(&it, pc.position, 0);
-        const float *rho = vfx_query_column(&it, pc.density, 0);
-        const float *vy = vfx_query_column(&it, pc.velocity, 1);
+    while (rt_query_next(&it)) {
+        const float *py = rt_query_column(&it, pc.position, 1);
+        const float *px = rt_query_column(&it, pc.position, 0);
+        const float *rho = rt_query_column(&it, pc.density, 0);
+        const float *vy = rt_query_column(&it, pc.velocity, 1);
         for (uint32_t i = 0; i < it.rows; ++i, ++seen) {
             assert_true(isfinite(px[i]) && isfinite(py[i]) && isfinite(vy[i]));
             assert_true(py[i] > 0.f && py[i] < 0.2f && px[i] > 0.f && px[i] < 0.1f);
@@ -69,52 +69,52 @@ static void test_system_writes_columns(void **state)
      * substep of each; kept lists rebuild only when a particle has moved half the skin. */
     uint32_t rebuilds = 0;
     for (int f = 0; f < 20; ++f) {
-        assert_int_equal(vfx_world_run_phase(w, VFX_PHASE_SIMULATE, 0.35 + f * 1e-4, 1e-4f), VFX_OK);
-        rebuilds += vfx_sim_system_report(sys)->neighbor_rebuilds;
+        assert_int_equal(rt_world_run_phase(w, RT_PHASE_SIMULATE, 0.35 + f * 1e-4, 1e-4f), VFX_OK);
+        rebuilds += rt_sim_system_report(sys)->neighbor_rebuilds;
     }
     print_message("20 frames of 1e-4 s with the world unchanged: %u rebuilds\n", rebuilds);
     assert_true(rebuilds < 10);
     /* ... and an edit by the game is seen: a particle moved 4 cm sideways lands there */
-    it = vfx_query_begin(w, terms, 3);
-    assert_true(vfx_query_next(&it));
-    float *qx = vfx_query_column(&it, pc.position, 0);
-    float *qy = vfx_query_column(&it, pc.position, 1);
-    float *qv[3] = {vfx_query_column(&it, pc.velocity, 0), vfx_query_column(&it, pc.velocity, 1),
-                    vfx_query_column(&it, pc.velocity, 2)};
+    it = rt_query_begin(w, terms, 3);
+    assert_true(rt_query_next(&it));
+    float *qx = rt_query_column(&it, pc.position, 0);
+    float *qy = rt_query_column(&it, pc.position, 1);
+    float *qv[3] = {rt_query_column(&it, pc.velocity, 0), rt_query_column(&it, pc.velocity, 1),
+                    rt_query_column(&it, pc.velocity, 2)};
     float x_new = qx[0] < 0.05f ? qx[0] + 0.04f : qx[0] - 0.04f;
     qx[0] = x_new, qy[0] = 0.15f;
     qv[0][0] = qv[1][0] = qv[2][0] = 0.f; /* at rest, in the air above the fluid */
-    assert_int_equal(vfx_world_run_phase(w, VFX_PHASE_SIMULATE, 26 / 60.0, 1.f / 60.f), VFX_OK);
-    it = vfx_query_begin(w, terms, 3);
-    assert_true(vfx_query_next(&it));
-    qx = vfx_query_column(&it, pc.position, 0);
-    qy = vfx_query_column(&it, pc.position, 1);
+    assert_int_equal(rt_world_run_phase(w, RT_PHASE_SIMULATE, 26 / 60.0, 1.f / 60.f), VFX_OK);
+    it = rt_query_begin(w, terms, 3);
+    assert_true(rt_query_next(&it));
+    qx = rt_query_column(&it, pc.position, 0);
+    qy = rt_query_column(&it, pc.position, 1);
     /* in 1/60 s from rest it falls g t^2 / 2 = 1.4 mm and does not move sideways */
     print_message("edited particle: x %.4f (set %.4f), y %.4f (set 0.15)\n", qx[0], x_new, qy[0]);
     assert_true(fabsf(qx[0] - x_new) < 0.002f && qy[0] > 0.147f && qy[0] < 0.1495f);
-    vfx_world_destroy(w);
-    vfx_sim_system_destroy(sys);
+    rt_world_destroy(w);
+    rt_sim_system_destroy(sys);
 }
 
 static void test_system_reports_bad_column(void **state)
 {
     (void)state;
-    vfx_world *w = vfx_world_create(NULL);
-    vfx_sim_system *sys;
-    assert_int_equal(vfx_sim_system_create(w, NULL, &sys, NULL, 0), VFX_OK);
-    vfx_particle_components pc;
-    assert_int_equal(vfx_particles_register(w, &pc), VFX_OK);
+    rt_world *w = rt_world_create(NULL);
+    rt_sim_system *sys;
+    assert_int_equal(rt_sim_system_create(w, NULL, &sys, NULL, 0), VFX_OK);
+    rt_particle_components pc;
+    assert_int_equal(rt_particles_register(w, &pc), VFX_OK);
     float x[3] = {0.5f, 0.5f, 0.5f}, y[3] = {0.5f, 0.6f, 0.7f}, z[3] = {0.5f, 0.5f, 0.5f};
-    assert_int_equal(vfx_particles_spawn(w, &pc, 3, x, y, z, false), VFX_OK);
+    assert_int_equal(rt_particles_spawn(w, &pc, 3, x, y, z, false), VFX_OK);
     /* the game writes a NaN velocity into row 1: the system refuses, naming the particle */
-    vfx_query_iter it = vfx_query_begin(w, &pc.velocity, 1);
-    assert_true(vfx_query_next(&it));
-    ((float *)vfx_query_column(&it, pc.velocity, 2))[1] = NAN;
-    assert_int_equal(vfx_world_run_phase(w, VFX_PHASE_SIMULATE, 0.0, 1.f / 60.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(vfx_sim_system_last_error(sys), "particle 1"));
-    assert_non_null(strstr(vfx_sim_system_last_error(sys), "vz"));
-    vfx_world_destroy(w);
-    vfx_sim_system_destroy(sys);
+    rt_query_iter it = rt_query_begin(w, &pc.velocity, 1);
+    assert_true(rt_query_next(&it));
+    ((float *)rt_query_column(&it, pc.velocity, 2))[1] = NAN;
+    assert_int_equal(rt_world_run_phase(w, RT_PHASE_SIMULATE, 0.0, 1.f / 60.f), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(rt_sim_system_last_error(sys), "particle 1"));
+    assert_non_null(strstr(rt_sim_system_last_error(sys), "vz"));
+    rt_world_destroy(w);
+    rt_sim_system_destroy(sys);
 }
 
 int main(void)

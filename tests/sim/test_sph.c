@@ -14,11 +14,11 @@
 #include "gfx/mesh_import.h"
 #include "sim/sph.h"
 
-static vfx_sph *make(vfx_sph_desc d)
+static rt_sph *make(rt_sph_desc d)
 {
-    vfx_sph *s = NULL;
+    rt_sph *s = NULL;
     char err[256];
-    vfx_result r = vfx_sph_create(&d, &s, err, sizeof err);
+    vfx_result r = rt_sph_create(&d, &s, err, sizeof err);
     if (r)
         fprintf(stderr, "create: %s\n", err);
     assert_int_equal(r, VFX_OK);
@@ -26,10 +26,10 @@ static vfx_sph *make(vfx_sph_desc d)
 }
 
 /* Finite, inside the domain (walls are solid: nothing may leave). */
-static void check_state(vfx_sph *s)
+static void check_state(rt_sph *s)
 {
-    const vfx_sph_desc *p = vfx_sph_params(s);
-    vfx_sph_columns c = vfx_sph_get_columns(s);
+    const rt_sph_desc *p = rt_sph_params(s);
+    rt_sph_columns c = rt_sph_get_columns(s);
     for (uint32_t i = 0; i < c.count; ++i) {
         float v[7] = {c.x[i], c.y[i], c.z[i], c.vx[i], c.vy[i], c.vz[i], c.density[i]};
         for (int k = 0; k < 7; ++k)
@@ -42,14 +42,14 @@ static void check_state(vfx_sph *s)
 
 /* Total energy: kinetic + gravity above the domain floor + EOS internal energy. Viscosity and
  * the inelastic wall clamp only remove it; explicit time integration error may add a little. */
-static double energy(const vfx_sph_report *r)
+static double energy(const rt_sph_report *r)
 {
     return r->kinetic_energy + r->potential_energy + r->internal_energy;
 }
 
-static vfx_sph_desc small_box(void)
+static rt_sph_desc small_box(void)
 {
-    vfx_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.1f, 0.2f, 0.06f}, .threads = 2};
+    rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.1f, 0.2f, 0.06f}, .threads = 2};
     return d;
 }
 
@@ -59,8 +59,8 @@ static void test_wall_integrals(void **state)
     const double H = 0.02;
     /* closed forms against brute-force float64 quadrature of the poly6 kernel over the
      * half-space beyond the plane (midpoint rule, 200^3 cells: error ~1e-4 of the value) */
-    assert_true(fabs(vfx_sph_wall_density_fraction(0.0, H) - 0.5) < 1e-12);
-    assert_true(vfx_sph_wall_density_fraction(H, H) == 0.0);
+    assert_true(fabs(rt_sph_wall_density_fraction(0.0, H) - 0.5) < 1e-12);
+    assert_true(rt_sph_wall_density_fraction(H, H) == 0.0);
     double k = 315.0 / (64.0 * M_PI * pow(H, 9));
     const double ds[] = {0.0, 0.25 * H, 0.5 * H, 0.8 * H};
     for (int t = 0; t < 4; ++t) {
@@ -75,13 +75,13 @@ static void test_wall_integrals(void **state)
                     if (r2 < H * H)
                         sum += k * pow(H * H - r2, 3) * hx * hx * hz;
                 }
-        double got = vfx_sph_wall_density_fraction(d, H);
+        double got = rt_sph_wall_density_fraction(d, H);
         assert_true(fabs(got - sum) < 2e-3 * 0.5);
         /* the gradient is minus the derivative (central difference, O(e^2)) */
         double e = 1e-6 * H;
         if (d > e) {
-            double fd = -(vfx_sph_wall_density_fraction(d + e, H) - vfx_sph_wall_density_fraction(d - e, H)) / (2 * e);
-            assert_true(fabs(fd - vfx_sph_wall_density_gradient(d, H)) < 1e-5 * fabs(fd) + 1e-6);
+            double fd = -(rt_sph_wall_density_fraction(d + e, H) - rt_sph_wall_density_fraction(d - e, H)) / (2 * e);
+            assert_true(fabs(fd - rt_sph_wall_density_gradient(d, H)) < 1e-5 * fabs(fd) + 1e-6);
         }
     }
 }
@@ -114,7 +114,7 @@ static void test_wall_friction_law(void **state)
     for (int a = 0; a < 2; ++a)
         for (double ut = 1e-4; ut <= 10.0; ut *= 3.7)
             for (double y = 1e-5; y <= 1e-1; y *= 2.9) {
-                double us = vfx_sph_wall_friction_velocity(ut, y, nus[a]);
+                double us = rt_sph_wall_friction_velocity(ut, y, nus[a]);
                 double ref = friction_velocity_bisect(ut, y, nus[a]);
                 assert_true(fabs(us - ref) <= 1e-9 * ref);
                 log_region += y * ref / nus[a] > 11.06;
@@ -123,25 +123,25 @@ static void test_wall_friction_law(void **state)
     assert_true(log_region > 20); /* both branches exercised */
     /* continuity at the junction: ut chosen so that y+ = 11.06 exactly from the sublayer side */
     double nu = 1e-6, y = 1e-3, us_c = 11.06 * nu / y, ut_c = us_c * 11.06;
-    double below = vfx_sph_wall_friction_velocity(ut_c * (1 - 1e-6), y, nu);
-    double above = vfx_sph_wall_friction_velocity(ut_c * (1 + 1e-6), y, nu);
+    double below = rt_sph_wall_friction_velocity(ut_c * (1 - 1e-6), y, nu);
+    double above = rt_sph_wall_friction_velocity(ut_c * (1 + 1e-6), y, nu);
     assert_true(fabs(above - below) < 1e-3 * us_c);
     /* degenerate arguments give no stress rather than NaN */
-    assert_true(vfx_sph_wall_friction_velocity(0.0, y, nu) == 0.0);
-    assert_true(vfx_sph_wall_friction_velocity(1.0, 0.0, nu) == 0.0);
-    assert_true(vfx_sph_wall_friction_velocity(1.0, y, 0.0) == 0.0);
-    assert_true(vfx_sph_wall_friction_velocity(NAN, y, nu) == 0.0);
-    assert_true(vfx_sph_wall_friction_velocity(INFINITY, y, nu) == 0.0);
-    assert_true(vfx_sph_wall_friction_velocity(1.0, y, -1.0) == 0.0);
+    assert_true(rt_sph_wall_friction_velocity(0.0, y, nu) == 0.0);
+    assert_true(rt_sph_wall_friction_velocity(1.0, 0.0, nu) == 0.0);
+    assert_true(rt_sph_wall_friction_velocity(1.0, y, 0.0) == 0.0);
+    assert_true(rt_sph_wall_friction_velocity(NAN, y, nu) == 0.0);
+    assert_true(rt_sph_wall_friction_velocity(INFINITY, y, nu) == 0.0);
+    assert_true(rt_sph_wall_friction_velocity(1.0, y, -1.0) == 0.0);
 }
 
 /* x momentum of all particles */
-static double momentum_x(vfx_sph *s)
+static double momentum_x(rt_sph *s)
 {
-    vfx_sph_columns c = vfx_sph_get_columns(s);
+    rt_sph_columns c = rt_sph_get_columns(s);
     double p = 0.0;
     for (uint32_t i = 0; i < c.count; ++i)
-        p += (double)vfx_sph_particle_mass(s) * c.vx[i];
+        p += (double)rt_sph_particle_mass(s) * c.vx[i];
     return p;
 }
 
@@ -157,24 +157,24 @@ static void test_no_slip_slab(void **state)
      * wall law at each layer's distance, and it lies between u*(H) and u*(dx/2)). */
     const float dx = 0.005f, u = 0.5f;
     for (int noslip = 0; noslip < 2; ++noslip) {
-        vfx_sph_desc d = {.spacing = dx, .domain_min = {0, 0, 0}, .domain_max = {0.2f, 8 * dx, 8 * dx},
-                          .threads = 2, .flags = VFX_SPH_NO_GRAVITY,
-                          .no_slip_faces = noslip ? VFX_SPH_FACE_Y_MIN | VFX_SPH_FACE_Y_MAX : 0};
-        vfx_sph *s = make(d);
+        rt_sph_desc d = {.spacing = dx, .domain_min = {0, 0, 0}, .domain_max = {0.2f, 8 * dx, 8 * dx},
+                          .threads = 2, .flags = RT_SPH_NO_GRAVITY,
+                          .no_slip_faces = noslip ? RT_SPH_FACE_Y_MIN | RT_SPH_FACE_Y_MAX : 0};
+        rt_sph *s = make(d);
         float lo[3] = {0.05f, 0, 0}, hi[3] = {0.05f + 20 * dx, 8 * dx, 8 * dx};
         uint32_t n;
-        assert_int_equal(vfx_sph_add_block(s, lo, hi, &n), VFX_OK);
-        vfx_sph_columns c = vfx_sph_get_columns(s);
+        assert_int_equal(rt_sph_add_block(s, lo, hi, &n), VFX_OK);
+        rt_sph_columns c = rt_sph_get_columns(s);
         float *vx = calloc(n, sizeof *vx), *zero = calloc(n, sizeof *zero);
         for (uint32_t i = 0; i < n; ++i)
             vx[i] = u;
         float *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y), *z = malloc(n * sizeof *z);
         memcpy(x, c.x, n * sizeof *x), memcpy(y, c.y, n * sizeof *y), memcpy(z, c.z, n * sizeof *z);
-        vfx_sph_clear(s);
-        assert_int_equal(vfx_sph_add_particles(s, n, x, y, z, vx, zero, zero), VFX_OK);
+        rt_sph_clear(s);
+        assert_int_equal(rt_sph_add_particles(s, n, x, y, z, vx, zero, zero), VFX_OK);
         double p0 = momentum_x(s), t = 0.002;
-        vfx_sph_report r;
-        assert_int_equal(vfx_sph_step(s, (float)t, &r), VFX_OK);
+        rt_sph_report r;
+        assert_int_equal(rt_sph_step(s, (float)t, &r), VFX_OK);
         check_state(s);
         double p1 = momentum_x(s);
         const double area = 2.0 * (20 * dx) * (8 * dx); /* floor + ceiling under the slab */
@@ -183,10 +183,10 @@ static void test_no_slip_slab(void **state)
             print_message("free-slip slab: x momentum %+.2e relative\n", (p1 - p0) / p0);
             assert_true(fabs(p1 - p0) < 1e-4 * p0);
         } else {
-            const double H = vfx_sph_support(s), nu = 1.0e-6, rho0 = 1000.0;
+            const double H = rt_sph_support(s), nu = 1.0e-6, rho0 = 1000.0;
             double num = 0.0, den = 0.0;
             for (int k = 0; (k + 0.5) * dx < H; ++k) {
-                double dk = (k + 0.5) * dx, w = vfx_sph_wall_density_gradient(dk, H);
+                double dk = (k + 0.5) * dx, w = rt_sph_wall_density_gradient(dk, H);
                 double us = friction_velocity_bisect(u, dk, nu);
                 num += w * rho0 * us * us, den += w;
             }
@@ -202,113 +202,113 @@ static void test_no_slip_slab(void **state)
             assert_true(p1 < p0);
         }
         free(vx), free(zero), free(x), free(y), free(z);
-        vfx_sph_destroy(s);
+        rt_sph_destroy(s);
     }
 }
 
 static void test_volume_fraction(void **state)
 {
     (void)state;
-    vfx_sph_desc d = small_box();
-    d.flags = VFX_SPH_NO_GRAVITY;
-    vfx_sph *s = make(d);
+    rt_sph_desc d = small_box();
+    d.flags = RT_SPH_NO_GRAVITY;
+    rt_sph *s = make(d);
     float lo[3] = {0, 0, 0}, hi[3] = {0.05f, 0.1f, 0.06f};
-    assert_int_equal(vfx_sph_add_block(s, lo, hi, NULL), VFX_OK);
-    vfx_sph_report r;
-    assert_int_equal(vfx_sph_step(s, 0.f, &r), VFX_OK); /* builds the grid, moves nothing */
+    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    rt_sph_report r;
+    assert_int_equal(rt_sph_step(s, 0.f, &r), VFX_OK); /* builds the grid, moves nothing */
     /* on the lattice the mass is calibrated so that sum (m/rho0) W = 1; a particle next to a
      * wall misses exactly the calibrated wall share, which the fraction divides out */
     float in[3] = {0.025f, 0.055f, 0.035f}, wall[3] = {0.025f, 0.005f, 0.035f};
-    assert_true(fabsf(vfx_sph_volume_fraction(s, in) - 1.f) < 1e-4f);
-    assert_true(fabsf(vfx_sph_volume_fraction(s, wall) - 1.f) < 1e-3f);
+    assert_true(fabsf(rt_sph_volume_fraction(s, in) - 1.f) < 1e-4f);
+    assert_true(fabsf(rt_sph_volume_fraction(s, wall) - 1.f) < 1e-3f);
     /* the block's free face (x = 0.05, half a spacing beyond the last centres): a smoothed
      * step crosses 1/2 there (lattice sum of half the kernel: within 0.1 of it) */
     float face[3] = {0.05f, 0.055f, 0.035f}, air[3] = {0.08f, 0.055f, 0.035f};
-    float f = vfx_sph_volume_fraction(s, face);
+    float f = rt_sph_volume_fraction(s, face);
     print_message("volume fraction at the free face: %.3f\n", f);
     assert_true(f > 0.4f && f < 0.6f);
-    assert_true(vfx_sph_volume_fraction(s, air) == 0.f);
+    assert_true(rt_sph_volume_fraction(s, air) == 0.f);
     float bad[3] = {NAN, 0.f, 0.f};
-    assert_true(isnan(vfx_sph_volume_fraction(s, bad)));
-    assert_true(isnan(vfx_sph_volume_fraction(NULL, in)));
-    vfx_sph_destroy(s);
+    assert_true(isnan(rt_sph_volume_fraction(s, bad)));
+    assert_true(isnan(rt_sph_volume_fraction(NULL, in)));
+    rt_sph_destroy(s);
 }
 
 static void test_bad_desc_and_input(void **state)
 {
     (void)state;
-    vfx_sph *s = NULL;
+    rt_sph *s = NULL;
     char err[256];
-    vfx_sph_desc d = {.spacing = NAN};
-    assert_int_equal(vfx_sph_create(&d, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    rt_sph_desc d = {.spacing = NAN};
+    assert_int_equal(rt_sph_create(&d, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "spacing"));
     assert_null(s);
-    d = (vfx_sph_desc){.spacing = 1e-5f, .domain_max = {10, 10, 10}};
-    assert_int_equal(vfx_sph_create(&d, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    d = (rt_sph_desc){.spacing = 1e-5f, .domain_max = {10, 10, 10}};
+    assert_int_equal(rt_sph_create(&d, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "grid cells"));
-    d = (vfx_sph_desc){.no_slip_faces = 0x40};
-    assert_int_equal(vfx_sph_create(&d, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    d = (rt_sph_desc){.no_slip_faces = 0x40};
+    assert_int_equal(rt_sph_create(&d, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "no_slip_faces"));
-    d = (vfx_sph_desc){.kinematic_viscosity = NAN, .no_slip_faces = VFX_SPH_FACE_Y_MIN};
-    assert_int_equal(vfx_sph_create(&d, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    d = (rt_sph_desc){.kinematic_viscosity = NAN, .no_slip_faces = RT_SPH_FACE_Y_MIN};
+    assert_int_equal(rt_sph_create(&d, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "kinematic_viscosity"));
-    d = (vfx_sph_desc){.kinematic_viscosity = -1e-6f};
-    assert_int_equal(vfx_sph_create(&d, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    d = (rt_sph_desc){.kinematic_viscosity = -1e-6f};
+    assert_int_equal(rt_sph_create(&d, &s, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
     assert_null(s);
 
     s = make(small_box());
     float x[5] = {0.05f, 0.05f, 0.05f, 0.05f, 0.05f}, y[5] = {0.05f, 0.06f, 0.07f, NAN, 0.09f};
     float z[5] = {0.03f, 0.03f, 0.03f, 0.03f, 0.03f};
-    assert_int_equal(vfx_sph_add_particles(s, 5, x, y, z, NULL, NULL, NULL), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(vfx_sph_last_error(s), "particle 3"));
-    assert_non_null(strstr(vfx_sph_last_error(s), "non-finite y"));
-    assert_int_equal(vfx_sph_get_columns(s).count, 0); /* whole batch refused */
+    assert_int_equal(rt_sph_add_particles(s, 5, x, y, z, NULL, NULL, NULL), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(rt_sph_last_error(s), "particle 3"));
+    assert_non_null(strstr(rt_sph_last_error(s), "non-finite y"));
+    assert_int_equal(rt_sph_get_columns(s).count, 0); /* whole batch refused */
     y[3] = 0.08f;
     float vz[5] = {0, 0, 0, 0, INFINITY};
-    assert_int_equal(vfx_sph_add_particles(s, 5, x, y, z, NULL, NULL, vz), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(vfx_sph_last_error(s), "particle 4"));
-    assert_non_null(strstr(vfx_sph_last_error(s), "vz"));
-    assert_int_equal(vfx_sph_add_particles(s, 5, NULL, y, z, NULL, NULL, NULL), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_sph_add_particles(s, 5, x, y, z, NULL, NULL, vz), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(rt_sph_last_error(s), "particle 4"));
+    assert_non_null(strstr(rt_sph_last_error(s), "vz"));
+    assert_int_equal(rt_sph_add_particles(s, 5, NULL, y, z, NULL, NULL, NULL), VFX_ERR_INVALID_ARGUMENT);
     /* a huge count is refused before any array is read */
-    assert_int_equal(vfx_sph_add_particles(s, UINT32_MAX, x, y, z, NULL, NULL, NULL), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(vfx_sph_last_error(s), "capacity"));
-    assert_int_equal(vfx_sph_add_particles(s, 5, x, y, z, NULL, NULL, NULL), VFX_OK);
-    vfx_sph_report r;
-    assert_int_equal(vfx_sph_step(s, NAN, &r), VFX_ERR_INVALID_ARGUMENT);
-    assert_int_equal(vfx_sph_step(s, -1.f, &r), VFX_ERR_INVALID_ARGUMENT);
-    vfx_sph_collider c = {.kind = VFX_SPH_SPHERE, .radius = 0.f};
-    assert_int_equal(vfx_sph_add_collider(s, &c, NULL), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(vfx_sph_last_error(s), "radius"));
-    vfx_sph_emitter e = {.direction = {0, 0, 0}, .speed = 1, .radius = 0.02f};
-    assert_int_equal(vfx_sph_add_emitter(s, &e), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_sph_add_particles(s, UINT32_MAX, x, y, z, NULL, NULL, NULL), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(rt_sph_last_error(s), "capacity"));
+    assert_int_equal(rt_sph_add_particles(s, 5, x, y, z, NULL, NULL, NULL), VFX_OK);
+    rt_sph_report r;
+    assert_int_equal(rt_sph_step(s, NAN, &r), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_sph_step(s, -1.f, &r), VFX_ERR_INVALID_ARGUMENT);
+    rt_sph_collider c = {.kind = RT_SPH_SPHERE, .radius = 0.f};
+    assert_int_equal(rt_sph_add_collider(s, &c, NULL), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(rt_sph_last_error(s), "radius"));
+    rt_sph_emitter e = {.direction = {0, 0, 0}, .speed = 1, .radius = 0.02f};
+    assert_int_equal(rt_sph_add_emitter(s, &e), VFX_ERR_INVALID_ARGUMENT);
     check_state(s);
-    vfx_sph_destroy(s);
+    rt_sph_destroy(s);
 }
 
 static void test_zero_particles(void **state)
 {
     (void)state;
-    vfx_sph *s = make(small_box());
-    vfx_sph_report r;
-    assert_int_equal(vfx_sph_add_particles(s, 0, NULL, NULL, NULL, NULL, NULL, NULL), VFX_OK);
-    assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
-    assert_int_equal(vfx_sph_get_columns(s).count, 0);
+    rt_sph *s = make(small_box());
+    rt_sph_report r;
+    assert_int_equal(rt_sph_add_particles(s, 0, NULL, NULL, NULL, NULL, NULL, NULL), VFX_OK);
+    assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+    assert_int_equal(rt_sph_get_columns(s).count, 0);
     assert_true(fabs(r.simulated_time - 1.0 / 60.0) < 1e-9);
     assert_false(r.cap_hit);
     assert_true(r.kinetic_energy == 0.0);
-    vfx_sph_destroy(s);
+    rt_sph_destroy(s);
 }
 
 static void test_single_particle(void **state)
 {
     (void)state;
-    vfx_sph *s = make(small_box());
+    rt_sph *s = make(small_box());
     float x = 0.05f, y = 0.15f, z = 0.03f;
-    assert_int_equal(vfx_sph_add_particles(s, 1, &x, &y, &z, NULL, NULL, NULL), VFX_OK);
-    vfx_sph_report r;
+    assert_int_equal(rt_sph_add_particles(s, 1, &x, &y, &z, NULL, NULL, NULL), VFX_OK);
+    rt_sph_report r;
     double e0 = 0;
     for (int f = 0; f < 30; ++f) {
-        assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
         if (f == 0)
             e0 = energy(&r) + 1e-12;
         check_state(s);
@@ -316,11 +316,11 @@ static void test_single_particle(void **state)
          * substep's explicit Euler drift) */
         assert_true(energy(&r) <= e0 * 1.01);
     }
-    vfx_sph_columns c = vfx_sph_get_columns(s);
+    rt_sph_columns c = rt_sph_get_columns(s);
     assert_true(c.y[0] < 0.02f); /* reached the floor after 0.5 s (free fall takes 0.17 s) */
     /* alone it is far below rest density: max compression error must be <= 0 */
     assert_true(r.max_density_error <= 0.f);
-    vfx_sph_destroy(s);
+    rt_sph_destroy(s);
 }
 
 static void test_two_coincident(void **state)
@@ -328,19 +328,19 @@ static void test_two_coincident(void **state)
     (void)state;
     /* Alone: two coincident particles are far below rest density, so p = 0 (clamped EOS)
      * and nothing moves them; the r = 0 pair must still give finite, symmetric results. */
-    vfx_sph_desc d = small_box();
-    d.flags = VFX_SPH_NO_GRAVITY;
-    vfx_sph *s = make(d);
+    rt_sph_desc d = small_box();
+    d.flags = RT_SPH_NO_GRAVITY;
+    rt_sph *s = make(d);
     float x[2] = {0.05f, 0.05f}, y[2] = {0.1f, 0.1f}, z[2] = {0.03f, 0.03f};
-    assert_int_equal(vfx_sph_add_particles(s, 2, x, y, z, NULL, NULL, NULL), VFX_OK);
-    vfx_sph_report r;
+    assert_int_equal(rt_sph_add_particles(s, 2, x, y, z, NULL, NULL, NULL), VFX_OK);
+    rt_sph_report r;
     for (int f = 0; f < 10; ++f) {
-        assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
         check_state(s);
         assert_true(r.kinetic_energy == 0.0);
         assert_true(r.max_density_error <= 0.f);
     }
-    vfx_sph_destroy(s);
+    rt_sph_destroy(s);
     /* Inside a block: a duplicate of a bulk particle is compressed (rho ~ 1.2 rho0), and the
      * spiky gradient (non-zero at r = 0, along a pseudo-random antisymmetric axis) separates
      * the pair; momentum stays zero. The block is kept more than H from every wall, where
@@ -348,18 +348,18 @@ static void test_two_coincident(void **state)
     d.domain_max[2] = 0.1f;
     s = make(d);
     float lo[3] = {0.02f, 0.05f, 0.02f}, hi[3] = {0.08f, 0.11f, 0.08f};
-    assert_int_equal(vfx_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL), VFX_OK);
     float px = 0.055f, py = 0.085f, pz = 0.055f; /* exactly a lattice site */
-    assert_int_equal(vfx_sph_add_particles(s, 1, &px, &py, &pz, NULL, NULL, NULL), VFX_OK);
-    uint32_t dup = vfx_sph_get_columns(s).count - 1;
-    assert_int_equal(vfx_sph_step(s, 0.f, &r), VFX_OK);
+    assert_int_equal(rt_sph_add_particles(s, 1, &px, &py, &pz, NULL, NULL, NULL), VFX_OK);
+    uint32_t dup = rt_sph_get_columns(s).count - 1;
+    assert_int_equal(rt_sph_step(s, 0.f, &r), VFX_OK);
     double e0 = energy(&r);
     float err0 = r.max_density_error;
     print_message("duplicate particle: initial compression %.3f, energy %.4g J\n", err0, e0);
     assert_true(err0 > 0.1f); /* the pair sits at ~2x the lattice density of one particle */
     double e_prev = 0.0;
     for (int f = 0; f < 3; ++f) {
-        assert_int_equal(vfx_sph_step(s, 1.f / 240.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 240.f, &r), VFX_OK);
         check_state(s);
         /* No gravity. The separation is not energy-conserving: the spiky gradient that pushes
          * the pair apart is not the derivative of the poly6 density (whose gradient vanishes
@@ -376,7 +376,7 @@ static void test_two_coincident(void **state)
         e_prev = e;
         assert_true(r.max_density_error <= err0); /* compression only relaxes */
     }
-    vfx_sph_columns c = vfx_sph_get_columns(s);
+    rt_sph_columns c = rt_sph_get_columns(s);
     float best = 1e9f;
     double mx = 0, my = 0, mz = 0;
     for (uint32_t i = 0; i < c.count; ++i) {
@@ -396,16 +396,16 @@ static void test_two_coincident(void **state)
     /* the block is >= 2.5 cm (> H) from every wall: momentum is conserved (pairwise
      * antisymmetric forces), up to float rounding of ~200 terms */
     assert_true(fabs(mx) < 1e-3 && fabs(my) < 1e-3 && fabs(mz) < 1e-3);
-    vfx_sph_destroy(s);
+    rt_sph_destroy(s);
 }
 
 /* Upper bound on the kinetic energy a clamped-EOS fluid can release: pressure is at most
  * 127 B (rho clamped to 2 rho0, gamma 7), and a particle's volume can grow by at most m/rho0
  * while it is positive, so the work is <= N * 127 B m/rho0; plus falling through the box. */
-static double release_bound(vfx_sph *s, uint32_t n)
+static double release_bound(rt_sph *s, uint32_t n)
 {
-    const vfx_sph_desc *p = vfx_sph_params(s);
-    double m = vfx_sph_particle_mass(s);
+    const rt_sph_desc *p = rt_sph_params(s);
+    double m = rt_sph_particle_mass(s);
     double pmax = p->stiffness * (pow(2.0, p->gamma) - 1.0);
     double h = p->domain_max[1] - p->domain_min[1];
     return n * (pmax * m / p->rest_density + m * 9.81 * h);
@@ -414,42 +414,42 @@ static double release_bound(vfx_sph *s, uint32_t n)
 static void test_all_at_one_point(void **state)
 {
     (void)state;
-    vfx_sph_desc d = small_box();
+    rt_sph_desc d = small_box();
     d.max_substeps = 400;
-    vfx_sph *s = make(d);
+    rt_sph *s = make(d);
     enum { N = 300 };
     float x[N], y[N], z[N];
     for (int i = 0; i < N; ++i)
         x[i] = 0.05f, y[i] = 0.1f, z[i] = 0.03f;
-    assert_int_equal(vfx_sph_add_particles(s, N, x, y, z, NULL, NULL, NULL), VFX_OK);
-    vfx_sph_report r;
-    assert_int_equal(vfx_sph_step(s, 0.f, &r), VFX_OK);
+    assert_int_equal(rt_sph_add_particles(s, N, x, y, z, NULL, NULL, NULL), VFX_OK);
+    rt_sph_report r;
+    assert_int_equal(rt_sph_step(s, 0.f, &r), VFX_OK);
     float err0 = r.max_density_error;
     assert_true(err0 > 10.f); /* 300 particles on one point: a huge compression */
     double bound = release_bound(s, N);
     for (int f = 0; f < 20; ++f) {
-        assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
         check_state(s);
         assert_true(r.kinetic_energy < bound);
     }
     /* the cloud has spread: the worst compression falls below 100% (from >1000%) */
     assert_true(r.max_density_error < 1.0f);
-    vfx_sph_destroy(s);
+    rt_sph_destroy(s);
 }
 
 /* A block resting in the small box; returns the solver after `frames` steps of frame_dt. */
-static void run_block(vfx_sph *s, int frames, float frame_dt, bool expect_cap, float max_err)
+static void run_block(rt_sph *s, int frames, float frame_dt, bool expect_cap, float max_err)
 {
     float lo[3] = {0, 0, 0}, hi[3] = {0.1f, 0.08f, 0.06f};
     uint32_t n;
-    assert_int_equal(vfx_sph_add_block(s, lo, hi, &n), VFX_OK);
+    assert_int_equal(rt_sph_add_block(s, lo, hi, &n), VFX_OK);
     assert_int_equal(n, 10 * 8 * 6);
-    vfx_sph_report r;
-    assert_int_equal(vfx_sph_step(s, 0.f, &r), VFX_OK);
+    rt_sph_report r;
+    assert_int_equal(rt_sph_step(s, 0.f, &r), VFX_OK);
     double e0 = energy(&r);
     print_message("block at rest: initial max density error %.5f\n", r.max_density_error);
     for (int f = 0; f < frames; ++f) {
-        assert_int_equal(vfx_sph_step(s, frame_dt, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, frame_dt, &r), VFX_OK);
         check_state(s);
         if (expect_cap) {
             assert_true(r.cap_hit);
@@ -472,23 +472,23 @@ static void test_stiffness_1000x(void **state)
     (void)state;
     /* free-slip walls, then every face no-slip (the wall law's shear on top of the stiff EOS) */
     for (int noslip = 0; noslip < 2; ++noslip) {
-    vfx_sph_desc d = small_box();
+    rt_sph_desc d = small_box();
     d.no_slip_faces = noslip ? 0x3fu : 0u;
-    vfx_sph *s0 = make(d);
-    float B = vfx_sph_params(s0)->stiffness;
-    vfx_sph_destroy(s0);
+    rt_sph *s0 = make(d);
+    float B = rt_sph_params(s0)->stiffness;
+    rt_sph_destroy(s0);
     d.stiffness = 1000.f * B;
     d.max_substeps = 100;
-    vfx_sph *s = make(d);
+    rt_sph *s = make(d);
     /* c0 grows by sqrt(1000): the acoustic dt is ~32x smaller, a 60 Hz frame needs more than
      * the cap: every frame must report cap_hit. Compression: the fresh lattice starts at up
      * to 0.66% (the wall density's kernel tail reaches lattice layers that miss nothing:
      * +0.22% per wall on the second layer, more at edges); a stiff fluid must relax that,
      * not add to it: bound 0.2% (measured 0.125% in the first frame, 0 from the third) */
-    assert_true(vfx_sph_params(s)->sound_speed > 30.f * 10.f);
-    assert_true(vfx_sph_params(s)->gamma == 7.f); /* the Tait exponent of water, the default */
+    assert_true(rt_sph_params(s)->sound_speed > 30.f * 10.f);
+    assert_true(rt_sph_params(s)->gamma == 7.f); /* the Tait exponent of water, the default */
     run_block(s, 5, 1.f / 60.f, true, 0.002f);
-    vfx_sph_destroy(s);
+    rt_sph_destroy(s);
     }
 }
 
@@ -496,21 +496,21 @@ static void test_dt_100x_too_large(void **state)
 {
     (void)state;
     for (int noslip = 0; noslip < 2; ++noslip) { /* free-slip, then every face no-slip */
-        vfx_sph_desc d = small_box();
+        rt_sph_desc d = small_box();
         d.max_substeps = 200;
         d.no_slip_faces = noslip ? 0x3fu : 0u;
-        vfx_sph *s = make(d);
+        rt_sph *s = make(d);
         /* 100 frames' worth in one call: substeps are bounded by the conditions, not by the
          * request; the cap stops it and says so. Density error bound: 3% (c0 = 10 v gives ~1%) */
         run_block(s, 3, 100.f / 60.f, true, 0.03f);
-        vfx_sph_destroy(s);
+        rt_sph_destroy(s);
     }
 }
 
 static void test_outside_domain(void **state)
 {
     (void)state;
-    vfx_sph *s = make(small_box());
+    rt_sph *s = make(small_box());
     enum { N = 64 };
     float x[N], y[N], z[N], vx[N];
     for (int i = 0; i < N; ++i) {
@@ -519,73 +519,73 @@ static void test_outside_domain(void **state)
         z[i] = 5.f;
         vx[i] = x[i] > 0 ? 3.f : -3.f; /* and moving further out */
     }
-    assert_int_equal(vfx_sph_add_particles(s, N, x, y, z, vx, NULL, NULL), VFX_OK);
-    assert_int_equal(vfx_sph_clamped_on_add(s), N);
+    assert_int_equal(rt_sph_add_particles(s, N, x, y, z, vx, NULL, NULL), VFX_OK);
+    assert_int_equal(rt_sph_clamped_on_add(s), N);
     check_state(s);
-    vfx_sph_report r;
+    rt_sph_report r;
     for (int f = 0; f < 20; ++f) {
-        assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
         check_state(s);
         /* clamped onto two edges 1 mm apart: the pile expands; bounded by the initial
          * 0.5 N m 3^2 plus what the clamped EOS can release */
-        assert_true(r.kinetic_energy <= 0.5 * N * vfx_sph_particle_mass(s) * 9.0 + release_bound(s, N));
+        assert_true(r.kinetic_energy <= 0.5 * N * rt_sph_particle_mass(s) * 9.0 + release_bound(s, N));
     }
     /* piled into two edges: compression stays bounded by the EOS clamp region (100%) */
     assert_true(r.max_density_error < 1.0f);
-    vfx_sph_destroy(s);
+    rt_sph_destroy(s);
 }
 
 static void test_blowup_reported(void **state)
 {
     (void)state;
-    vfx_sph_desc d = small_box();
+    rt_sph_desc d = small_box();
     d.velocity_limit = 1.f;
-    vfx_sph *s = make(d);
+    rt_sph *s = make(d);
     float x[3] = {0.02f, 0.05f, 0.08f}, y[3] = {0.1f, 0.1f, 0.1f}, z[3] = {0.03f, 0.03f, 0.03f};
     float vy[3] = {0.f, 0.f, -5.f}; /* particle 2 is already beyond the limit: no dt helps */
-    assert_int_equal(vfx_sph_add_particles(s, 3, x, y, z, NULL, vy, NULL), VFX_OK);
-    vfx_sph_report r;
-    assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_ERR_NUMERIC);
-    assert_non_null(strstr(vfx_sph_last_error(s), "particle 2"));
-    assert_non_null(strstr(vfx_sph_last_error(s), "speed"));
-    assert_int_equal(r.redo_count, vfx_sph_params(s)->max_redo);
+    assert_int_equal(rt_sph_add_particles(s, 3, x, y, z, NULL, vy, NULL), VFX_OK);
+    rt_sph_report r;
+    assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_ERR_NUMERIC);
+    assert_non_null(strstr(rt_sph_last_error(s), "particle 2"));
+    assert_non_null(strstr(rt_sph_last_error(s), "speed"));
+    assert_int_equal(r.redo_count, rt_sph_params(s)->max_redo);
     /* the last good state stays: unchanged, finite */
     check_state(s);
-    vfx_sph_columns c = vfx_sph_get_columns(s);
+    rt_sph_columns c = rt_sph_get_columns(s);
     for (uint32_t i = 0; i < c.count; ++i)
         if (c.id[i] == 2)
             assert_true(c.vy[i] == -5.f && c.y[i] == 0.1f);
-    vfx_sph_destroy(s);
+    rt_sph_destroy(s);
 }
 
 /* s[0] on 1 thread and s[1] on 2 after the same steps: the columns must be bitwise equal. */
-static void assert_bitwise_equal_and_destroy(vfx_sph *s[2])
+static void assert_bitwise_equal_and_destroy(rt_sph *s[2])
 {
-    vfx_sph_columns c[2] = {vfx_sph_get_columns(s[0]), vfx_sph_get_columns(s[1])};
-    assert_int_equal(vfx_sph_thread_count(s[1]), 2);
+    rt_sph_columns c[2] = {rt_sph_get_columns(s[0]), rt_sph_get_columns(s[1])};
+    assert_int_equal(rt_sph_thread_count(s[1]), 2);
     assert_int_equal(c[0].count, c[1].count);
     assert_memory_equal(c[0].x, c[1].x, c[0].count * sizeof(float));
     assert_memory_equal(c[0].vy, c[1].vy, c[0].count * sizeof(float));
     assert_memory_equal(c[0].id, c[1].id, c[0].count * sizeof(uint32_t));
-    vfx_sph_destroy(s[0]);
-    vfx_sph_destroy(s[1]);
+    rt_sph_destroy(s[0]);
+    rt_sph_destroy(s[1]);
 }
 
 static void test_thread_count_determinism(void **state)
 {
     (void)state;
-    vfx_sph *s[2];
+    rt_sph *s[2];
     for (int t = 0; t < 2; ++t) {
-        vfx_sph_desc d = small_box();
+        rt_sph_desc d = small_box();
         d.threads = (uint32_t)(t + 1);
         s[t] = make(d);
         float lo[3] = {0, 0, 0}, hi[3] = {0.05f, 0.15f, 0.06f};
-        assert_int_equal(vfx_sph_add_block(s[t], lo, hi, NULL), VFX_OK); /* 450 particles: 1 chunk */
+        assert_int_equal(rt_sph_add_block(s[t], lo, hi, NULL), VFX_OK); /* 450 particles: 1 chunk */
         float lo2[3] = {0.06f, 0.1f, 0}, hi2[3] = {0.1f, 0.2f, 0.06f};
-        assert_int_equal(vfx_sph_add_block(s[t], lo2, hi2, NULL), VFX_OK);
-        vfx_sph_report r;
+        assert_int_equal(rt_sph_add_block(s[t], lo2, hi2, NULL), VFX_OK);
+        rt_sph_report r;
         for (int f = 0; f < 5; ++f)
-            assert_int_equal(vfx_sph_step(s[t], 1.f / 60.f, &r), VFX_OK);
+            assert_int_equal(rt_sph_step(s[t], 1.f / 60.f, &r), VFX_OK);
     }
     /* each particle sums its neighbours in the same order whatever thread runs it */
     assert_bitwise_equal_and_destroy(s);
@@ -594,34 +594,34 @@ static void test_thread_count_determinism(void **state)
 static void test_colliders_emitter_paddle(void **state)
 {
     (void)state;
-    vfx_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.3f, 0.2f, 0.06f}, .threads = 2};
-    vfx_sph *s = make(d);
+    rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.3f, 0.2f, 0.06f}, .threads = 2};
+    rt_sph *s = make(d);
     /* the ball and the slope no-slip (wall-law friction on colliders), the rest free-slip */
-    vfx_sph_collider ball = {.kind = VFX_SPH_SPHERE, .center = {0.15f, 0.05f, 0.03f}, .radius = 0.03f, .no_slip = 1};
-    vfx_sph_collider box = {.kind = VFX_SPH_BOX, .center = {0.22f, 0.03f, 0.03f}, .half = {0.02f, 0.03f, 0.1f}};
-    vfx_sph_collider paddle = {.kind = VFX_SPH_BOX, .center = {0.02f, 0.1f, 0.03f}, .half = {0.01f, 0.1f, 0.1f},
+    rt_sph_collider ball = {.kind = RT_SPH_SPHERE, .center = {0.15f, 0.05f, 0.03f}, .radius = 0.03f, .no_slip = 1};
+    rt_sph_collider box = {.kind = RT_SPH_BOX, .center = {0.22f, 0.03f, 0.03f}, .half = {0.02f, 0.03f, 0.1f}};
+    rt_sph_collider paddle = {.kind = RT_SPH_BOX, .center = {0.02f, 0.1f, 0.03f}, .half = {0.01f, 0.1f, 0.1f},
                                .motion_axis = {1, 0, 0}, .motion_amplitude = 0.01f, .motion_frequency = 2.f};
-    vfx_sph_collider slope = {.kind = VFX_SPH_PLANE, .center = {0.28f, 0.0f, 0.f}, .normal = {-1, 1, 0},
+    rt_sph_collider slope = {.kind = RT_SPH_PLANE, .center = {0.28f, 0.0f, 0.f}, .normal = {-1, 1, 0},
                               .no_slip = 1};
-    assert_int_equal(vfx_sph_add_collider(s, &ball, NULL), VFX_OK);
-    assert_int_equal(vfx_sph_add_collider(s, &box, NULL), VFX_OK);
-    assert_int_equal(vfx_sph_add_collider(s, &paddle, NULL), VFX_OK);
-    assert_int_equal(vfx_sph_add_collider(s, &slope, NULL), VFX_OK);
-    vfx_sph_emitter e = {.center = {0.15f, 0.17f, 0.03f}, .direction = {0, -1, 0}, .speed = 1.f,
+    assert_int_equal(rt_sph_add_collider(s, &ball, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_collider(s, &box, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_collider(s, &paddle, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_collider(s, &slope, NULL), VFX_OK);
+    rt_sph_emitter e = {.center = {0.15f, 0.17f, 0.03f}, .direction = {0, -1, 0}, .speed = 1.f,
                          .radius = 0.015f, .max_emit = 400};
-    assert_int_equal(vfx_sph_add_emitter(s, &e), VFX_OK);
+    assert_int_equal(rt_sph_add_emitter(s, &e), VFX_OK);
     float lo[3] = {0.04f, 0, 0}, hi[3] = {0.1f, 0.06f, 0.06f};
-    assert_int_equal(vfx_sph_add_block(s, lo, hi, NULL), VFX_OK);
-    vfx_sph_report r;
+    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    rt_sph_report r;
     uint32_t emitted = 0;
     for (int f = 0; f < 30; ++f) {
-        assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
         emitted += r.emitted;
         check_state(s);
         assert_true(r.max_density_error < 0.1f); /* 10%: impacts of the jet on the ball */
-        double t = vfx_sph_time(s);
+        double t = rt_sph_time(s);
         float px = 0.02f + 0.01f * (float)sin(2 * M_PI * 2.0 * t);
-        vfx_sph_columns c = vfx_sph_get_columns(s);
+        rt_sph_columns c = rt_sph_get_columns(s);
         for (uint32_t i = 0; i < c.count; ++i) {
             /* no particle inside a solid (the clamp keeps a quarter spacing; allow 1e-4 m
              * for the paddle, which moved after the clamp within the last substep) */
@@ -634,7 +634,7 @@ static void test_colliders_emitter_paddle(void **state)
         }
     }
     assert_int_equal(emitted, 400); /* the emitter stops at max_emit */
-    vfx_sph_destroy(s);
+    rt_sph_destroy(s);
 }
 
 static void test_mesh_collider(void **state)
@@ -642,9 +642,9 @@ static void test_mesh_collider(void **state)
     (void)state;
     /* Assimp's test cube (unit cube at the origin), scaled to 4 cm and placed in the tank */
     const char *path = "/usr/share/assimp/models/OBJ/box.obj";
-    vfx_mesh_data m;
+    rt_mesh_data m;
     char err[256];
-    if (vfx_mesh_import(path, &m, err, sizeof err) != VFX_OK) {
+    if (rt_mesh_import(path, &m, err, sizeof err) != VFX_OK) {
         print_message("skipping: %s\n", err);
         skip();
     }
@@ -652,16 +652,16 @@ static void test_mesh_collider(void **state)
     for (uint32_t v = 0; v < m.vertex_count; ++v)
         for (int a = 0; a < 3; ++a)
             m.positions[3 * v + a] = c[a] + 0.04f * m.positions[3 * v + a];
-    vfx_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.3f, 0.2f, 0.06f}, .threads = 2};
-    vfx_sph *s = make(d);
+    rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.3f, 0.2f, 0.06f}, .threads = 2};
+    rt_sph *s = make(d);
     uint32_t bad[3] = {0, 1, 99};
-    assert_int_equal(vfx_sph_add_mesh_collider(s, m.positions, m.vertex_count, bad, 3, NULL, NULL),
+    assert_int_equal(rt_sph_add_mesh_collider(s, m.positions, m.vertex_count, bad, 3, NULL, NULL),
                      VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(vfx_sph_last_error(s), "triangle 0 uses vertex 99"));
+    assert_non_null(strstr(rt_sph_last_error(s), "triangle 0 uses vertex 99"));
     uint32_t idx;
-    assert_int_equal(vfx_sph_add_mesh_collider(s, m.positions, m.vertex_count, m.indices, m.index_count, NULL, &idx),
+    assert_int_equal(rt_sph_add_mesh_collider(s, m.positions, m.vertex_count, m.indices, m.index_count, NULL, &idx),
                      VFX_OK);
-    vfx_mesh_data_free(&m);
+    rt_mesh_data_free(&m);
     /* sampled distance against the exact box distance (float64) on a 9^3 probe lattice around
      * it. Tolerance 5 mm = half the 1 cm node spacing: trilinear interpolation of a distance
      * field is exact on flat faces and errs by at most half a spacing across the slope kinks
@@ -678,27 +678,27 @@ static void test_mesh_collider(void **state)
                     qm = q[a] > qm ? q[a] : qm;
                 }
                 double ref = o2 > 0 ? sqrt(o2) : qm;
-                double got = vfx_sph_collider_distance(s, idx, p);
+                double got = rt_sph_collider_distance(s, idx, p);
                 worst = fmax(worst, fabs(got - ref));
             }
     print_message("mesh collider: max |sdf - exact| %.2e m over 729 probes\n", worst);
     assert_true(worst < 5e-3);
     /* fluid dropped on it: nothing inside the cube (shrunk by the 5 mm tolerance) */
     float lo[3] = {0.11f, 0.1f, 0.0f}, hi[3] = {0.19f, 0.16f, 0.06f};
-    assert_int_equal(vfx_sph_add_block(s, lo, hi, NULL), VFX_OK);
-    vfx_sph_report r;
+    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    rt_sph_report r;
     for (int f = 0; f < 20; ++f) {
-        assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
         check_state(s);
         assert_true(r.max_density_error < 0.1f);
-        vfx_sph_columns col = vfx_sph_get_columns(s);
+        rt_sph_columns col = rt_sph_get_columns(s);
         for (uint32_t i = 0; i < col.count; ++i) {
             bool inside = fabsf(col.x[i] - c[0]) < 0.015f && fabsf(col.y[i] - c[1]) < 0.015f &&
                           fabsf(col.z[i] - c[2]) < 0.015f;
             assert_false(inside);
         }
     }
-    vfx_sph_destroy(s);
+    rt_sph_destroy(s);
 }
 
 /* Least-squares slope of y on x over n points. */
@@ -721,24 +721,24 @@ static void test_hydrostatic(void **state)
      * 6 particles wide, so 20 of its 36 particle columns touch a side wall: the wall layer
      * (within 1 cm of a side wall) and the rest are also fitted on their own, so a wall
      * treatment that only holds on average (one group high, the other low) fails. */
-    vfx_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.06f, 0.2f, 0.06f},
+    rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.06f, 0.2f, 0.06f},
                       .threads = 2, .viscosity = 0.1f};
-    vfx_sph *s = make(d);
+    rt_sph *s = make(d);
     float lo[3] = {0, 0, 0}, hi[3] = {0.06f, 0.15f, 0.06f};
-    assert_int_equal(vfx_sph_add_block(s, lo, hi, NULL), VFX_OK);
-    vfx_sph_report r;
+    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    rt_sph_report r;
     enum { BINS = 8 };
     double psum[3][BINS] = {{0}}, dsum[3][BINS] = {{0}}; /* all, wall layer, inner */
     int cnt[3][BINS] = {{0}};
     float max_err = 0.f, mean_err = 0.f;
     for (int f = 0; f < 60; ++f) {
-        assert_int_equal(vfx_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
         check_state(s);
         if (f < 30)
             continue;
         max_err = r.max_density_error > max_err ? r.max_density_error : max_err;
         mean_err = r.mean_density_error > mean_err ? r.mean_density_error : mean_err;
-        vfx_sph_columns c = vfx_sph_get_columns(s);
+        rt_sph_columns c = rt_sph_get_columns(s);
         double top = 0.0;
         for (uint32_t i = 0; i < c.count; ++i)
             top += c.y[i];
@@ -752,7 +752,7 @@ static void test_hydrostatic(void **state)
             float side = fminf(fminf(c.x[i], 0.06f - c.x[i]), fminf(c.z[i], 0.06f - c.z[i]));
             int grp[2] = {0, side < 0.01f ? 1 : 2};
             for (int k = 0; k < 2; ++k) {
-                psum[grp[k]][b] += vfx_sph_pressure(s, i);
+                psum[grp[k]][b] += rt_sph_pressure(s, i);
                 dsum[grp[k]][b] += top - c.y[i];
                 cnt[grp[k]][b]++;
             }
@@ -790,7 +790,7 @@ static void test_hydrostatic(void **state)
                       9810.0, 100.0 * (slope - 9810.0) / 9810.0);
         assert_true(fabs(slope - 9810.0) < (gi == 0 ? 0.05 : 0.10) * 9810.0);
     }
-    vfx_sph_destroy(s);
+    rt_sph_destroy(s);
 }
 
 static void dam_break_run(int res);
@@ -825,20 +825,20 @@ static void dam_break_run(int res)
     static const double Z_mm[] = {1.217, 1.474, 2.292, 2.995, 4.134, 4.944, 5.881, 6.980, 7.945};
     const double a = 0.05715, g = 9.81;
     float dx = (float)(a / res);
-    vfx_sph_desc d = {.spacing = dx, .domain_min = {0, 0, 0},
+    rt_sph_desc d = {.spacing = dx, .domain_min = {0, 0, 0},
                       .domain_max = {(float)(10 * a), (float)(2.5 * a), 4 * dx}, .threads = 2,
                       .max_substeps = 100000,
-                      .no_slip_faces = VFX_SPH_FACE_Y_MIN | VFX_SPH_FACE_X_MIN};
-    vfx_sph *s = make(d);
+                      .no_slip_faces = RT_SPH_FACE_Y_MIN | RT_SPH_FACE_X_MIN};
+    rt_sph *s = make(d);
     float lo[3] = {0, 0, 0}, hi[3] = {(float)a, (float)(2 * a), 4 * dx};
-    assert_int_equal(vfx_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL), VFX_OK);
     double Ts = sqrt(2 * g / a);
-    vfx_sph_report r;
-    assert_int_equal(vfx_sph_step(s, 0.f, &r), VFX_OK);
+    rt_sph_report r;
+    assert_int_equal(rt_sph_step(s, 0.f, &r), VFX_OK);
     double e0 = energy(&r), e_prev = e0;
     for (int k = 0; k < 9; ++k) {
         double target = T_mm[k] / Ts;
-        assert_int_equal(vfx_sph_step(s, (float)(target - vfx_sph_time(s)), &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, (float)(target - rt_sph_time(s)), &r), VFX_OK);
         assert_false(r.cap_hit);
         check_state(s);
         /* friction and viscosity only take energy out (1% for the explicit integration) */
@@ -846,13 +846,13 @@ static void dam_break_run(int res)
         assert_true(energy(&r) <= e_prev + 0.01 * e0);
         e_prev = energy(&r);
         assert_true(r.max_density_error < 0.1f);
-        vfx_sph_columns c = vfx_sph_get_columns(s);
+        rt_sph_columns c = rt_sph_get_columns(s);
         float xmax = 0.f;
         for (uint32_t i = 0; i < c.count; ++i)
             xmax = c.x[i] > xmax ? c.x[i] : xmax;
         float q[3] = {xmax + 2.f * dx, 0.5f * dx, 2.f * dx}, front = 0.f;
         for (; q[0] > 0.f; q[0] -= dx / 20.f)
-            if (vfx_sph_volume_fraction(s, q) >= 0.5f) {
+            if (rt_sph_volume_fraction(s, q) >= 0.5f) {
                 front = q[0];
                 break;
             }
@@ -863,23 +863,23 @@ static void dam_break_run(int res)
                       Z_mm[k], 100.0 * (Z - Z_mm[k]) / Z_mm[k]);
         assert_true(fabs(Z - Z_mm[k]) < 0.10 * Z_mm[k]);
     }
-    vfx_sph_destroy(s);
+    rt_sph_destroy(s);
 }
 
 /* Ordered pairs (i != j) within H by brute force. Portable form, float64: `lo` those clearly inside
  * (r^2 < H^2 (1 - 1e-5)), `hi` those not clearly outside. The solver's count (float32) must lie
  * in [lo, hi]: every pair within H found, none beyond; the band only absorbs float32 rounding
  * of r^2 (relative 1e-7) at the edge, and is usually empty (lo == hi). */
-static void brute_pairs(vfx_sph *s, uint64_t *lo, uint64_t *hi)
+static void brute_pairs(rt_sph *s, uint64_t *lo, uint64_t *hi)
 {
-    vfx_sph_columns c = vfx_sph_get_columns(s);
-    double H2 = (double)vfx_sph_support(s) * vfx_sph_support(s);
+    rt_sph_columns c = rt_sph_get_columns(s);
+    double H2 = (double)rt_sph_support(s) * rt_sph_support(s);
     *lo = *hi = 0;
 #if defined(__x86_64__) && !defined(__FMA__)
     /* Without FMA contraction the solver's float32 r^2 is reproducible here bit for bit: then
      * the count must be exact. Lattice pairs at exactly r = H (2 dx) make the band above
      * non-empty in almost every substep, so this is the check that bites. */
-    const float Hf = vfx_sph_support(s), H2f = Hf * Hf;
+    const float Hf = rt_sph_support(s), H2f = Hf * Hf;
     for (uint32_t i = 0; i < c.count; ++i)
         for (uint32_t j = 0; j < c.count; ++j) {
             float dx = c.x[i] - c.x[j], dy = c.y[i] - c.y[j], dz = c.z[i] - c.z[j];
@@ -901,19 +901,19 @@ static void brute_pairs(vfx_sph *s, uint64_t *lo, uint64_t *hi)
         }
 }
 
-static vfx_sph_desc splash_desc(uint32_t flags, uint32_t threads)
+static rt_sph_desc splash_desc(uint32_t flags, uint32_t threads)
 {
     /* dx 1 cm, H 2 cm, a tank 0.3 x 0.2 x 0.04 m (4 layers deep); one substep per call of
      * 5e-5 s (below the acoustic limit 0.4 h / c0 = 1e-4 s), so both methods take the same dt */
-    vfx_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.3f, 0.2f, 0.04f},
+    rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.3f, 0.2f, 0.04f},
                       .threads = threads, .max_substeps = 1, .flags = flags};
     return d;
 }
 
 /* A block thrown at 1 m/s against the far wall under gravity: a moving flow with splashes. */
-static vfx_sph *splash(uint32_t flags, uint32_t threads)
+static rt_sph *splash(uint32_t flags, uint32_t threads)
 {
-    vfx_sph *s = make(splash_desc(flags, threads));
+    rt_sph *s = make(splash_desc(flags, threads));
     enum { NX = 10, NY = 15, NZ = 4 };
     static float x[NX * NY * NZ], y[NX * NY * NZ], z[NX * NY * NZ], vx[NX * NY * NZ];
     uint32_t n = 0;
@@ -923,22 +923,22 @@ static vfx_sph *splash(uint32_t flags, uint32_t threads)
                 x[n] = 0.005f + 0.01f * (float)i, y[n] = 0.005f + 0.01f * (float)j;
                 z[n] = 0.005f + 0.01f * (float)k, vx[n] = 1.f;
             }
-    assert_int_equal(vfx_sph_add_particles(s, n, x, y, z, vx, NULL, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_particles(s, n, x, y, z, vx, NULL, NULL), VFX_OK);
     return s;
 }
 
 static void test_verlet_matches_rebuild(void **state)
 {
     (void)state;
-    vfx_sph *v = splash(0, 1), *b = splash(VFX_SPH_REBUILD_EVERY_SUBSTEP, 1);
+    rt_sph *v = splash(0, 1), *b = splash(RT_SPH_REBUILD_EVERY_SUBSTEP, 1);
     const int N = 400; /* 0.02 s: the block crosses ~2 cm, the front reaches the floor flow */
     uint32_t rebuilds = 0, ambiguous = 0;
     for (int k = 0; k < N; ++k) {
         uint64_t lo, hi;
         brute_pairs(v, &lo, &hi);
-        vfx_sph_report rv, rb;
-        assert_int_equal(vfx_sph_step(v, 5e-5f, &rv), VFX_OK);
-        assert_int_equal(vfx_sph_step(b, 5e-5f, &rb), VFX_OK);
+        rt_sph_report rv, rb;
+        assert_int_equal(rt_sph_step(v, 5e-5f, &rv), VFX_OK);
+        assert_int_equal(rt_sph_step(b, 5e-5f, &rb), VFX_OK);
         assert_int_equal(rv.substeps, 1);
         assert_int_equal(rb.neighbor_rebuilds, 2); /* the substep and the closing pass */
         rebuilds += rv.neighbor_rebuilds;
@@ -954,7 +954,7 @@ static void test_verlet_matches_rebuild(void **state)
      * sums differs (float32 rounding, ~1e-7 relative per sum), which the flow amplifies over
      * 400 substeps but must keep far below a spacing. A pair lost by the lists would shift the
      * particles near it by a visible fraction of dx within a few substeps. */
-    vfx_sph_columns cv = vfx_sph_get_columns(v), cb = vfx_sph_get_columns(b);
+    rt_sph_columns cv = rt_sph_get_columns(v), cb = rt_sph_get_columns(b);
     assert_int_equal(cv.count, cb.count);
     float *bx = malloc(cb.count * 3 * sizeof(float));
     assert_non_null(bx);
@@ -978,8 +978,8 @@ static void test_verlet_matches_rebuild(void **state)
     assert_true(rebuilds <= (uint32_t)N / 4); /* and they were reused in between */
     assert_true(dmax < 1e-3 * 0.01);       /* 1e-3 dx */
     free(bx);
-    vfx_sph_destroy(v);
-    vfx_sph_destroy(b);
+    rt_sph_destroy(v);
+    rt_sph_destroy(b);
 }
 
 /* A particle shot at 4 m/s into a block at rest (no gravity): only it moves, so the lists must
@@ -990,20 +990,20 @@ static void test_verlet_rebuild_trigger(void **state)
 {
     (void)state;
     for (int fast = 0; fast < 2; ++fast) {
-        vfx_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.3f, 0.12f, 0.12f},
-                          .threads = 2, .max_substeps = 1, .flags = VFX_SPH_NO_GRAVITY};
-        vfx_sph *s = make(d);
+        rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.3f, 0.12f, 0.12f},
+                          .threads = 2, .max_substeps = 1, .flags = RT_SPH_NO_GRAVITY};
+        rt_sph *s = make(d);
         float lo[3] = {0.1f, 0.02f, 0.02f}, hi[3] = {0.2f, 0.1f, 0.1f};
         uint32_t nb;
-        assert_int_equal(vfx_sph_add_block(s, lo, hi, &nb), VFX_OK);
+        assert_int_equal(rt_sph_add_block(s, lo, hi, &nb), VFX_OK);
         float px = 0.08f, py = 0.06f, pz = 0.06f, pv = fast ? 4.f : 0.05f;
-        assert_int_equal(vfx_sph_add_particles(s, 1, &px, &py, &pz, &pv, NULL, NULL), VFX_OK);
+        assert_int_equal(rt_sph_add_particles(s, 1, &px, &py, &pz, &pv, NULL, NULL), VFX_OK);
         const uint32_t n = nb + 1;
-        const float skin = vfx_sph_params(s)->neighbor_skin * vfx_sph_support(s);
+        const float skin = rt_sph_params(s)->neighbor_skin * rt_sph_support(s);
         float *ref = malloc(3 * n * sizeof(float)), *ref0 = malloc(3 * n * sizeof(float));
         assert_non_null(ref);
         assert_non_null(ref0);
-        vfx_sph_columns c0 = vfx_sph_get_columns(s);
+        rt_sph_columns c0 = rt_sph_get_columns(s);
         for (uint32_t i = 0; i < n; ++i) {
             assert_int_equal(c0.id[i], i);
             ref0[3 * i] = c0.x[i], ref0[3 * i + 1] = c0.y[i], ref0[3 * i + 2] = c0.z[i];
@@ -1012,10 +1012,10 @@ static void test_verlet_rebuild_trigger(void **state)
         for (int k = 0; k < 120; ++k) {
             uint64_t plo, phi;
             brute_pairs(s, &plo, &phi);
-            vfx_sph_report r;
-            assert_int_equal(vfx_sph_step(s, 1e-4f, &r), VFX_OK);
+            rt_sph_report r;
+            assert_int_equal(rt_sph_step(s, 1e-4f, &r), VFX_OK);
             assert_true(r.neighbor_pairs >= plo && r.neighbor_pairs <= phi);
-            vfx_sph_columns c = vfx_sph_get_columns(s);
+            rt_sph_columns c = rt_sph_get_columns(s);
             assert_int_equal(c.count, n);
             if (k > 0) {
                 /* the largest displacement since the last rebuild, as the solver measures it */
@@ -1055,7 +1055,7 @@ static void test_verlet_rebuild_trigger(void **state)
         assert_true(checked >= 100);
         free(ref);
         free(ref0);
-        vfx_sph_destroy(s);
+        rt_sph_destroy(s);
     }
 }
 
@@ -1064,19 +1064,19 @@ static void test_verlet_rebuild_trigger(void **state)
 static void test_verlet_threads_bitwise(void **state)
 {
     (void)state;
-    vfx_sph *s[2];
+    rt_sph *s[2];
     for (int t = 0; t < 2; ++t) {
-        vfx_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.4f, 0.3f, 0.1f},
+        rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.4f, 0.3f, 0.1f},
                           .threads = (uint32_t)(t + 1)};
         s[t] = make(d);
         float lo[3] = {0, 0, 0}, hi[3] = {0.1f, 0.24f, 0.1f};
         uint32_t n;
-        assert_int_equal(vfx_sph_add_block(s[t], lo, hi, &n), VFX_OK);
+        assert_int_equal(rt_sph_add_block(s[t], lo, hi, &n), VFX_OK);
         assert_int_equal(n, 2400);
-        vfx_sph_report r;
+        rt_sph_report r;
         uint32_t rebuilds = 0;
         for (int f = 0; f < 4; ++f) {
-            assert_int_equal(vfx_sph_step(s[t], 1.f / 60.f, &r), VFX_OK);
+            assert_int_equal(rt_sph_step(s[t], 1.f / 60.f, &r), VFX_OK);
             rebuilds += r.neighbor_rebuilds;
         }
         assert_true(rebuilds >= 2);
@@ -1088,25 +1088,25 @@ static void test_million_particles(void **state)
 {
     (void)state;
     /* 100^3 particles: allocate, one short step (1 substep + the closing density pass). */
-    vfx_sph_desc d = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {2.2f, 2.2f, 2.2f}};
-    vfx_sph *s = make(d);
+    rt_sph_desc d = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {2.2f, 2.2f, 2.2f}};
+    rt_sph *s = make(d);
     float lo[3] = {0, 0, 0}, hi[3] = {2.0f, 2.0f, 2.0f};
     uint32_t n;
-    assert_int_equal(vfx_sph_add_block(s, lo, hi, &n), VFX_OK);
+    assert_int_equal(rt_sph_add_block(s, lo, hi, &n), VFX_OK);
     assert_int_equal(n, 1000000);
-    vfx_sph_report r;
-    assert_int_equal(vfx_sph_step(s, 1e-5f, &r), VFX_OK);
+    rt_sph_report r;
+    assert_int_equal(rt_sph_step(s, 1e-5f, &r), VFX_OK);
     assert_int_equal(r.substeps, 1);
     print_message("1,000,000 particles: %.1f MiB in the solver, %llu neighbour pairs\n",
-                  vfx_sph_memory_bytes(s) / 1048576.0, (unsigned long long)r.neighbor_pairs);
+                  rt_sph_memory_bytes(s) / 1048576.0, (unsigned long long)r.neighbor_pairs);
     /* 22 float + 8 uint32 columns (120 B/particle, 114 MiB) + the exact neighbour lists (4 B
      * per pair within H, ~29 pairs/particle on this lattice) + the Verlet lists (4 B per pair
      * within 1.3 H at the default skin: 80 on the lattice), both in per-chunk buffers with 1/8
      * slack: up to ~615 B per particle (measured 544 MiB in all); the bound leaves ~10%. */
-    assert_true(vfx_sph_memory_bytes(s) < 650u * 1024u * 1024u);
+    assert_true(rt_sph_memory_bytes(s) < 650u * 1024u * 1024u);
     check_state(s);
     assert_true(r.max_density_error < 0.01f); /* a fresh lattice is at rho0 (calibrated mass) */
-    vfx_sph_destroy(s);
+    rt_sph_destroy(s);
 }
 
 int main(void)

@@ -37,15 +37,15 @@ static char *make_ascii(const char *npts, const char *p5, const char *x5, const 
     return buf;
 }
 
-static vfx_result load_str(const char *s, const char *field, vfx_tet_mesh *m, char *err)
+static vfx_result load_str(const char *s, const char *field, tet_mesh *m, char *err)
 {
-    return vfx_tet_load_vtu_mem(s, strlen(s), field, m, err, 256);
+    return tet_load_vtu_mem(s, strlen(s), field, m, err, 256);
 }
 
 static void test_ascii_good(void **st)
 {
     (void)st;
-    vfx_tet_mesh m;
+    tet_mesh m;
     char err[256];
     assert_int_equal(load_str(make_ascii("5", "5", "2 2 2", "4", "10"), "V", &m, err), VFX_OK);
     assert_int_equal(m.point_count, 5);
@@ -56,13 +56,13 @@ static void test_ascii_good(void **st)
     assert_float_equal(m.scalar_max, 5.0f, 1e-6f);
     assert_float_equal(m.scalar_min, 0.0f, 0.0f);
     assert_string_equal(m.scalar_name, "|V|");
-    vfx_tet_mesh_free(&m);
+    tet_mesh_free(&m);
 }
 
 static void test_missing_field(void **st)
 {
     (void)st;
-    vfx_tet_mesh m;
+    tet_mesh m;
     char err[256];
     assert_int_equal(load_str(make_ascii("5", "5", "2 2 2", "4", "10"), "Pressure", &m, err),
                      VFX_ERR_NOT_FOUND);
@@ -74,7 +74,7 @@ static void test_missing_field(void **st)
 static void test_non_tet(void **st)
 {
     (void)st;
-    vfx_tet_mesh m;
+    tet_mesh m;
     char err[256];
     assert_int_equal(load_str(make_ascii("5", "5", "2 2 2", "4", "12"), NULL, &m, err),
                      VFX_ERR_UNSUPPORTED);
@@ -84,7 +84,7 @@ static void test_non_tet(void **st)
 static void test_index_out_of_range(void **st)
 {
     (void)st;
-    vfx_tet_mesh m;
+    tet_mesh m;
     char err[256];
     assert_int_equal(load_str(make_ascii("5", "5", "2 2 2", "7", "10"), NULL, &m, err),
                      VFX_ERR_FORMAT);
@@ -94,7 +94,7 @@ static void test_index_out_of_range(void **st)
 static void test_nan_coordinate(void **st)
 {
     (void)st;
-    vfx_tet_mesh m;
+    tet_mesh m;
     char err[256];
     assert_int_equal(load_str(make_ascii("5", "5", "2 nan 2", "4", "10"), NULL, &m, err),
                      VFX_ERR_NUMERIC);
@@ -104,7 +104,7 @@ static void test_nan_coordinate(void **st)
 static void test_nan_scalar(void **st)
 {
     (void)st;
-    vfx_tet_mesh m;
+    tet_mesh m;
     char err[256];
     assert_int_equal(load_str(make_ascii("5", "nan", "2 2 2", "4", "10"), "P", &m, err),
                      VFX_ERR_NUMERIC);
@@ -114,7 +114,7 @@ static void test_nan_scalar(void **st)
 static void test_wrong_counts(void **st)
 {
     (void)st;
-    vfx_tet_mesh m;
+    tet_mesh m;
     char err[256];
     /* 6 points declared, 5 given */
     assert_int_equal(load_str(make_ascii("6", "5", "2 2 2", "4", "10"), NULL, &m, err),
@@ -128,17 +128,17 @@ static void test_wrong_counts(void **st)
 static void test_empty_and_not_xml(void **st)
 {
     (void)st;
-    vfx_tet_mesh m;
+    tet_mesh m;
     char err[256];
-    assert_int_equal(vfx_tet_load_vtu_mem("", 0, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(tet_load_vtu_mem("", 0, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "empty"));
     assert_int_equal(load_str("solid cube\nfacet normal 0 0 1\n", NULL, &m, err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "not valid XML"));
     const char *s = make_ascii("5", "5", "2 2 2", "4", "10");
-    assert_int_equal(vfx_tet_load_vtu_mem(s, strlen(s) / 2, NULL, &m, err, sizeof err),
+    assert_int_equal(tet_load_vtu_mem(s, strlen(s) / 2, NULL, &m, err, sizeof err),
                      VFX_ERR_FORMAT); /* truncated */
     assert_non_null(strstr(err, "not valid XML"));
-    assert_int_equal(vfx_tet_load_vtu("/nonexistent/x.vtu", NULL, &m, err, sizeof err),
+    assert_int_equal(tet_load_vtu("/nonexistent/x.vtu", NULL, &m, err, sizeof err),
                      VFX_ERR_IO);
 }
 
@@ -243,9 +243,9 @@ static void test_binary_encodings(void **st)
     for (int enc = 0; enc < 3; enc++)
         for (int z = 0; z < 2; z++) {
             size_t n = build_binary(buf, sizeof buf, enc, z, 0);
-            vfx_tet_mesh m;
+            tet_mesh m;
             char err[256];
-            vfx_result r = vfx_tet_load_vtu_mem(buf, n, "P", &m, err, sizeof err);
+            vfx_result r = tet_load_vtu_mem(buf, n, "P", &m, err, sizeof err);
             if (r != VFX_OK)
                 fail_msg("enc %d zlib %d: %s", enc, z, err);
             assert_int_equal(m.tet_count, 2);
@@ -253,22 +253,22 @@ static void test_binary_encodings(void **st)
             assert_float_equal(m.points[12], 2.0f, 0.0f);
             assert_float_equal(m.scalar[4], 5.0f, 0.0f);
             assert_int_equal(m.tets[6], 4); /* flipped: q2<->q3 */
-            vfx_tet_mesh_free(&m);
+            tet_mesh_free(&m);
             if (enc != ENC_RAW) {
                 n = build_binary(buf, sizeof buf, enc, z, 1);
-                assert_int_equal(vfx_tet_load_vtu_mem(buf, n, "P", &m, err, sizeof err),
+                assert_int_equal(tet_load_vtu_mem(buf, n, "P", &m, err, sizeof err),
                                  VFX_ERR_FORMAT);
                 assert_non_null(strstr(err, "connectivity"));
             }
             if (z) {
                 n = build_binary(buf, sizeof buf, enc, z, 2);
-                assert_int_equal(vfx_tet_load_vtu_mem(buf, n, "P", &m, err, sizeof err),
+                assert_int_equal(tet_load_vtu_mem(buf, n, "P", &m, err, sizeof err),
                                  VFX_ERR_FORMAT);
                 assert_non_null(strstr(err, "zlib block 0"));
             }
             if (enc == ENC_RAW) { /* truncated appended data */
                 n = build_binary(buf, sizeof buf, enc, z, 0);
-                assert_int_equal(vfx_tet_load_vtu_mem(buf, n - 40, "P", &m, err, sizeof err),
+                assert_int_equal(tet_load_vtu_mem(buf, n - 40, "P", &m, err, sizeof err),
                                  VFX_ERR_FORMAT);
             }
         }
@@ -280,9 +280,9 @@ static void test_pipe(void **st)
     const char *dir = getenv("VFX_SHARED_DATA");
     char path[512];
     snprintf(path, sizeof path, "%s/tets/pipe_RCR_init_flow.vtu", dir ? dir : "../shared/data");
-    vfx_tet_mesh m;
+    tet_mesh m;
     char err[256];
-    vfx_result r = vfx_tet_load_vtu(path, "Velocity", &m, err, sizeof err);
+    vfx_result r = tet_load_vtu(path, "Velocity", &m, err, sizeof err);
     if (r != VFX_OK)
         fail_msg("%s", err);
     assert_int_equal(m.point_count, 30211);
@@ -291,7 +291,7 @@ static void test_pipe(void **st)
     assert_int_equal(m.degenerate_count, 0);
     assert_float_equal(m.scalar_min, 0.0f, 1e-3f);
     assert_float_equal(m.scalar_max, 8.19f, 0.01f); /* README gives 8.19 to 2 decimals */
-    vfx_tet_mesh_free(&m);
+    tet_mesh_free(&m);
 }
 
 static void write_file(const char *path, const char *text)
@@ -309,38 +309,38 @@ static void test_tetgen(void **st)
     int fd = mkstemp(base);
     assert_true(fd >= 0);
     char p[64];
-    vfx_tet_mesh m;
+    tet_mesh m;
     char err[256];
     snprintf(p, sizeof p, "%s.node", base);
     write_file(p, "# comment\n5 3 1 0\n1 0 0 0 1.5\n2 1 0 0 2\n3 0 1 0 3 # c\n4 0 0 1 4\n"
                   "5 2 2 2 5\n");
     snprintf(p, sizeof p, "%s.ele", base);
     write_file(p, "2 4 0\n1 1 2 3 4\n2 1 3 2 5\n");
-    assert_int_equal(vfx_tet_load_tetgen(base, "attr0", &m, err, sizeof err), VFX_OK);
+    assert_int_equal(tet_load_tetgen(base, "attr0", &m, err, sizeof err), VFX_OK);
     assert_int_equal(m.tet_count, 2);
     assert_int_equal(m.tets[6], 4); /* flipped: q2<->q3 */ /* 1-based 5 -> 4 */
     assert_int_equal(m.inverted_fixed, 1);
     assert_float_equal(m.scalar_min, 1.5f, 0.0f);
-    vfx_tet_mesh_free(&m);
-    assert_int_equal(vfx_tet_load_tetgen(base, "attr3", &m, err, sizeof err), VFX_ERR_NOT_FOUND);
+    tet_mesh_free(&m);
+    assert_int_equal(tet_load_tetgen(base, "attr3", &m, err, sizeof err), VFX_ERR_NOT_FOUND);
     assert_non_null(strstr(err, "attr0..attr0"));
     write_file(p, "2 4 0\n1 1 2 3 4\n2 1 3 2 9\n");
-    assert_int_equal(vfx_tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "tetrahedron 1 vertex 3 index 9 out of range"));
     write_file(p, "3 4 0\n1 1 2 3 4\n2 1 3 2 5\n");
-    assert_int_equal(vfx_tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "truncated: 2 of 3"));
     write_file(p, "2 4 0\n1 1 2 3 4\n2 1 3 x 5\n");
-    assert_int_equal(vfx_tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, ":3: tetrahedron 1"));
     write_file(p, "");
-    assert_int_equal(vfx_tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "missing or bad header"));
     snprintf(p, sizeof p, "%s.node", base);
     write_file(p, "5 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 inf\n4 2 2 2\n");
     snprintf(p, sizeof p, "%s.ele", base);
     write_file(p, "1 4 0\n0 0 1 2 3\n");
-    assert_int_equal(vfx_tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_NUMERIC);
+    assert_int_equal(tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_NUMERIC);
     assert_non_null(strstr(err, "point 3"));
     remove(p);
     snprintf(p, sizeof p, "%s.node", base);
@@ -363,7 +363,7 @@ static char *replace_once(const char *s, const char *from, const char *to)
 static void test_more_malformed(void **st)
 {
     (void)st;
-    vfx_tet_mesh m;
+    tet_mesh m;
     char err[256];
     const char *good = make_ascii("5", "5", "2 2 2", "4", "10");
     char copy[4096];
@@ -387,13 +387,13 @@ static void test_more_malformed(void **st)
     char *mark = strstr(app, "<AppendedData encoding=\"raw\">\n_");
     assert_non_null(mark);
     mark[strlen("<AppendedData encoding=\"raw\">\n")] = 'X';
-    assert_int_equal(vfx_tet_load_vtu_mem(app, n, "P", &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(tet_load_vtu_mem(app, n, "P", &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "without its '_' marker"));
     /* point 4 placed on point 0: the second tet (0,2,1,4) has two identical vertices */
     assert_int_equal(load_str(make_ascii("5", "5", "0 0 0", "4", "10"), "P", &m, err), VFX_OK);
     assert_int_equal(m.tet_count, 2);
     assert_int_equal(m.degenerate_count, 1);
-    vfx_tet_mesh_free(&m);
+    tet_mesh_free(&m);
 
     char base[] = "/tmp/vfx_tg2_XXXXXX";
     int fd = mkstemp(base);
@@ -401,12 +401,12 @@ static void test_more_malformed(void **st)
     char p[64];
     snprintf(p, sizeof p, "%s.node", base);
     write_file(p, "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n");
-    assert_int_equal(vfx_tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_IO);
+    assert_int_equal(tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_IO);
     assert_non_null(strstr(err, ".ele: cannot open"));
     write_file(p, "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1\n3 0 0 1\n");
     snprintf(p, sizeof p, "%s.ele", base);
     write_file(p, "1 4 0\n0 0 1 2 3\n");
-    assert_int_equal(vfx_tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, ":4: point 2 has 3 numbers, expected 4"));
     remove(p);
     snprintf(p, sizeof p, "%s.node", base);
@@ -438,15 +438,15 @@ static int run_generated(void)
     snprintf(cmd, sizeof cmd, "sh '%s/scripts/make-tet-mesh.sh' '%s' 2000 7 >/dev/null", root,
              base);
     int rc = system(cmd);
-    vfx_tet_mesh m;
-    vfx_result r = rc == 0 ? vfx_tet_load_tetgen(base, "attr0", &m, err, sizeof err) : VFX_ERR_IO;
+    tet_mesh m;
+    vfx_result r = rc == 0 ? tet_load_tetgen(base, "attr0", &m, err, sizeof err) : VFX_ERR_IO;
     int ok = r == VFX_OK && m.point_count == 2000 && m.tet_count > 5 * 2000 &&
              m.scalar_min >= 0.0f && m.scalar_max <= 2.0f;
     if (r == VFX_OK) {
         printf("generated: %u points, %u tets, %u inverted, %u degenerate, attr0 %g..%g\n",
                m.point_count, m.tet_count, m.inverted_fixed, m.degenerate_count, m.scalar_min,
                m.scalar_max);
-        vfx_tet_mesh_free(&m);
+        tet_mesh_free(&m);
     } else {
         printf("generated mesh failed: rc %d, %s\n", rc, rc == 0 ? err : "script");
     }

@@ -42,7 +42,7 @@ static uint32_t hash3(uint32_t a, uint32_t b, uint32_t c)
 /* Global segment i of pixel p: [i, i + 1) when it touches its successor, else [i, i + 0.6);
  * opacity and colour from the hash; owned by rank hash % P, so every rank's segments
  * interleave with every other's along each ray. */
-static void swap_seg(uint32_t p, uint32_t i, int P, int *owner, vfx_tet_rseg *s)
+static void swap_seg(uint32_t p, uint32_t i, int P, int *owner, tet_rseg *s)
 {
     uint32_t h = hash3(p, i, 1);
     *owner = (int)(hash3(p, i, 2) % (uint32_t)P);
@@ -61,15 +61,15 @@ static int test_swap(int P)
     const size_t npix = (size_t)W * H;
     char err[256];
     for (int partial = 0; partial <= 1; partial++) {
-        vfx_tet_seglists l = {0, npix, calloc(npix + 1, sizeof(uint32_t)),
-                              calloc(npix * M + 1, sizeof(vfx_tet_rseg))};
+        tet_seglists l = {0, npix, calloc(npix + 1, sizeof(uint32_t)),
+                              calloc(npix * M + 1, sizeof(tet_rseg))};
         CHECK(l.off && l.segs, "memory");
         size_t n = 0;
         for (size_t p = 0; p < npix; p++) {
             l.off[p] = (uint32_t)n;
             for (uint32_t i = 0; i < M; i++) {
                 int owner;
-                vfx_tet_rseg s;
+                tet_rseg s;
                 swap_seg((uint32_t)p, i, P, &owner, &s);
                 if (owner == g_rank)
                     l.segs[n++] = s;
@@ -77,9 +77,9 @@ static int test_swap(int P)
         }
         l.off[npix] = (uint32_t)n;
         float *img = g_rank == 0 ? calloc(npix * 4, sizeof *img) : NULL;
-        vfx_tet_mpi_stats st;
+        tet_mpi_stats st;
         memset(&st, 0, sizeof st);
-        int rc = vfx_tet_mpi_composite(MPI_COMM_WORLD, W, H, &l, partial, img, &st, err);
+        int rc = tet_mpi_composite(MPI_COMM_WORLD, W, H, &l, partial, img, &st, err);
         CHECK(rc == VFX_OK, "composite failed: %s", err);
         if (g_rank == 0) {
             /* Reference: all segments in depth order, float64 front to back. Naive: each
@@ -91,7 +91,7 @@ static int test_swap(int P)
                 memset(flat, 0, sizeof flat);
                 for (uint32_t i = 0; i < M; i++) {
                     int owner;
-                    vfx_tet_rseg s;
+                    tet_rseg s;
                     swap_seg((uint32_t)p, i, P, &owner, &s);
                     double c[4] = {s.r, s.g, s.b, s.a};
                     double t = 1 - ref[3], tf = 1 - flat[owner][3];
@@ -132,9 +132,9 @@ static int test_swap(int P)
 /* n^3 cubes x 5 tets in [-1,1]^3 with a smooth scalar (tet_testmesh.c); when shuffle is set
  * the cell order is permuted so that every rank's partition is scattered through the volume
  * (its cells interleave in depth with every other rank's). */
-static void make_grid(int n, int shuffle, vfx_tet_mesh *m)
+static void make_grid(int n, int shuffle, tet_mesh *m)
 {
-    CHECK(vfx_tet_testmesh_grid(n, m) == 0, "memory");
+    CHECK(ref_testmesh_grid(n, m) == 0, "memory");
     uint32_t nt = m->tet_count;
     if (shuffle)
         for (uint32_t i = nt - 1; i > 0; i--) {
@@ -146,9 +146,9 @@ static void make_grid(int n, int shuffle, vfx_tet_mesh *m)
 }
 
 /* view rotated about x then y, eye at distance dist, 60 degree fov */
-static void make_cam(vfx_tet_camera *c, int w, int h, float yaw, float pitch, float dist)
+static void make_cam(tet_camera *c, int w, int h, float yaw, float pitch, float dist)
 {
-    vfx_tet_testmesh_orbit(c, w, h, yaw, pitch, 1.0f / tanf(0.5f * 1.0471976f), 0.1f, 100.0f);
+    ref_testmesh_orbit(c, w, h, yaw, pitch, 1.0f / tanf(0.5f * 1.0471976f), 0.1f, 100.0f);
     c->view[14] = -dist;
 }
 
@@ -164,9 +164,9 @@ static int test_render(int P)
 {
     enum { W = 48, H = 40 };
     const size_t n4 = (size_t)W * H * 4;
-    vfx_tet_camera cam;
+    tet_camera cam;
     make_cam(&cam, W, H, 0.6f, 0.4f, 4.0f);
-    vfx_tet_tf tf;
+    tet_tf tf;
     memset(&tf, 0, sizeof tf);
     tf.smin = 0;
     tf.smax = 1;
@@ -175,23 +175,23 @@ static int test_render(int P)
     tf.color_lo[0] = 0.1f; tf.color_lo[1] = 0.3f; tf.color_lo[2] = 1.0f;
     tf.color_hi[0] = 1.0f; tf.color_hi[1] = 0.6f; tf.color_hi[2] = 0.1f;
     char err[256];
-    vfx_tet_mpi *ctx;
-    CHECK(vfx_tet_mpi_create(MPI_COMM_WORLD, &ctx, err) == VFX_OK, "%s", err);
-    vfx_tet_mpi_stats *all = calloc((size_t)P, sizeof *all);
+    tet_mpi *ctx;
+    CHECK(tet_mpi_create(MPI_COMM_WORLD, &ctx, err) == VFX_OK, "%s", err);
+    tet_mpi_stats *all = calloc((size_t)P, sizeof *all);
     float *ref = calloc(n4, sizeof *ref), *img = calloc(n4, sizeof *img);
     CHECK(all && ref && img, "memory");
     for (int shuffle = 0; shuffle <= 1; shuffle++) {
-        vfx_tet_mesh m;
+        tet_mesh m;
         make_grid(7, shuffle, &m);
-        vfx_tet_options o;
-        vfx_tet_options_default(&o);
+        tet_options o;
+        tet_options_default(&o);
         o.tiles_d = 8;
         o.update_c = 50;
         /* one-process reference (every rank computes it; only rank 0 compares) */
-        vfx_tet_counters c0;
+        tet_counters c0;
         o.ert = 0;
         o.ert_threshold = 1.0f; /* the same partial-compositing stop as an ERT-1.0 run */
-        CHECK(vfx_tet_render(&m, &cam, &tf, &o, ref, &c0, err) == VFX_OK, "%s", err);
+        CHECK(tet_render(&m, &cam, &tf, &o, ref, &c0, err) == VFX_OK, "%s", err);
         for (int mode = 0; mode < 4; mode++) {
             o.share = mode & 1;
             o.dlb = (mode >> 1) & 1;
@@ -200,7 +200,7 @@ static int test_render(int P)
              * rank and in each swap stage): 1e-5 is ~100 ulps of values <= 1 */
             o.ert = 0;
             o.ert_threshold = 1.0f;
-            CHECK(vfx_tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err) ==
+            CHECK(tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err) ==
                       VFX_OK, "%s", err);
             if (g_rank == 0) {
                 double d = max_diff(ref, img, n4);
@@ -229,7 +229,7 @@ static int test_render(int P)
              * attenuated by >= 0.9: each variant stays within 1 - 0.9 = 0.1 of no-ERT */
             o.ert = 1;
             o.ert_threshold = 0.9f;
-            CHECK(vfx_tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err) ==
+            CHECK(tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err) ==
                       VFX_OK, "%s", err);
             if (g_rank == 0) {
                 double d = max_diff(ref, img, n4);
@@ -251,7 +251,7 @@ static int test_render(int P)
         /* bad input: every rank reports the same error naming the tet, no rank hangs */
         uint32_t keep = m.tets[4 * 5 + 2];
         m.tets[4 * 5 + 2] = m.point_count + 3;
-        int rc = vfx_tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err);
+        int rc = tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err);
         CHECK(rc == VFX_ERR_INVALID_ARGUMENT && strstr(err, "tet 5"), "rc %d: %s", rc, err);
         m.tets[4 * 5 + 2] = keep;
         free(m.points);
@@ -265,7 +265,7 @@ static int test_render(int P)
      * victim still has keys depends on scheduling (other processes share the 2 cores), so up
      * to 8 tries must show at least one move. */
     {
-        vfx_tet_mesh g, m;
+        tet_mesh g, m;
         make_grid(7, 0, &g);
         m = g;
         m.point_count = 2 * g.point_count;
@@ -285,16 +285,16 @@ static int test_render(int P)
             m.tets[i] = g.tets[i];
             m.tets[(size_t)g.tet_count * 4 + i] = g.tets[i] + g.point_count;
         }
-        vfx_tet_options o;
-        vfx_tet_options_default(&o);
+        tet_options o;
+        tet_options_default(&o);
         o.tiles_d = 8;
         o.update_c = 50;
         o.ert = 0;
         o.ert_threshold = 1.0f;
-        CHECK(vfx_tet_render(&g, &cam, &tf, &o, ref, NULL, err) == VFX_OK, "%s", err);
+        CHECK(tet_render(&g, &cam, &tf, &o, ref, NULL, err) == VFX_OK, "%s", err);
         int moved = 0;
         for (int attempt = 0; attempt < 8 && !moved; attempt++) {
-            CHECK(vfx_tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err) ==
+            CHECK(tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err) ==
                       VFX_OK, "%s", err);
             if (g_rank == 0) {
                 double d = max_diff(ref, img, n4);
@@ -319,7 +319,7 @@ static int test_render(int P)
         free(m.points); free(m.scalar); free(m.tets);
         free(g.points); free(g.scalar); free(g.tets);
     }
-    vfx_tet_mpi_destroy(ctx);
+    tet_mpi_destroy(ctx);
     free(all);
     free(ref);
     free(img);

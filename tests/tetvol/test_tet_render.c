@@ -17,7 +17,7 @@ static const float cube_pts[8 * 3] = {-1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1
 static const uint32_t cube_tets[5 * 4] = {0, 1, 3, 4, 1, 2, 3, 6, 1, 4, 5, 6,
                                           3, 4, 6, 7, 1, 3, 4, 6};
 
-static void make_cube(vfx_tet_mesh *m, float *pts, float *sc, uint32_t *tets)
+static void make_cube(tet_mesh *m, float *pts, float *sc, uint32_t *tets)
 {
     memset(m, 0, sizeof *m);
     memcpy(pts, cube_pts, sizeof cube_pts);
@@ -32,7 +32,7 @@ static void make_cube(vfx_tet_mesh *m, float *pts, float *sc, uint32_t *tets)
 }
 
 /* camera at (0,0,dist) looking down -z, 60 degree vertical fov */
-static void make_cam(vfx_tet_camera *c, int w, int h, float dist, float near)
+static void make_cam(tet_camera *c, int w, int h, float dist, float near)
 {
     memset(c, 0, sizeof *c);
     c->width = w;
@@ -47,7 +47,7 @@ static void make_cam(vfx_tet_camera *c, int w, int h, float dist, float near)
     c->proj[14] = 2 * far * near / (near - far);
 }
 
-static void make_tf(vfx_tet_tf *tf, float tau)
+static void make_tf(tet_tf *tf, float tau)
 {
     memset(tf, 0, sizeof *tf);
     tf->smin = 0;
@@ -60,7 +60,7 @@ static void make_tf(vfx_tet_tf *tf, float tau)
 
 /* float64 reference: emission-absorption along each pixel ray, the scalar interpolated linearly
  * in the containing tet, midpoint rule with n steps through the bounding cube. */
-static void reference_range(const vfx_tet_mesh *m, const vfx_tet_camera *c, const vfx_tet_tf *tf,
+static void reference_range(const tet_mesh *m, const tet_camera *c, const tet_tf *tf,
                             double dist, double near, double tmax, int n, double *out)
 {
     int W = c->width, H = c->height;
@@ -124,14 +124,14 @@ static void reference_range(const vfx_tet_mesh *m, const vfx_tet_camera *c, cons
 }
 
 /* the rays end behind the [-1,1]^3 scene */
-static void reference(const vfx_tet_mesh *m, const vfx_tet_camera *c, const vfx_tet_tf *tf,
+static void reference(const tet_mesh *m, const tet_camera *c, const tet_tf *tf,
                       double dist, double near, int n, double *out)
 {
     reference_range(m, c, tf, dist, near, dist + 2.0, n, out);
 }
 
 /* An N^3 grid of cubes over [-1,1]^3, 5 tets each, alternating so faces match. */
-static void make_grid(int N, vfx_tet_mesh *m, float **pts_out, float **sc_out, uint32_t **tets_out)
+static void make_grid(int N, tet_mesh *m, float **pts_out, float **sc_out, uint32_t **tets_out)
 {
     const int NP = (N + 1) * (N + 1) * (N + 1), NT = N * N * N * 5;
     float *pts = malloc((size_t)NP * 3 * sizeof *pts), *sc = malloc((size_t)NP * sizeof *sc);
@@ -180,9 +180,9 @@ static void make_grid(int N, vfx_tet_mesh *m, float **pts_out, float **sc_out, u
 static void test_cube_vs_reference(void **state)
 {
     (void)state;
-    vfx_tet_mesh m; float pts[24], sc[8]; uint32_t tets[20];
+    tet_mesh m; float pts[24], sc[8]; uint32_t tets[20];
     make_cube(&m, pts, sc, tets);
-    vfx_tet_camera cam; make_cam(&cam, 24, 24, 4.0f, 0.1f);
+    tet_camera cam; make_cam(&cam, 24, 24, 4.0f, 0.1f);
     /* tilt the cube so segments cross several tets: rotate the view about x and y */
     float ca = cosf(0.5f), sa = sinf(0.5f), cb = cosf(0.7f), sb = sinf(0.7f);
     /* view = T(0,0,-4) * Rx(a) * Ry(b), column-major */
@@ -190,19 +190,19 @@ static void test_cube_vs_reference(void **state)
     for (int c = 0; c < 3; c++)
         for (int r = 0; r < 3; r++)
             cam.view[c * 4 + r] = R[c * 3 + r];
-    vfx_tet_tf tf; make_tf(&tf, 1.0f);
-    vfx_tet_options o; vfx_tet_options_default(&o); o.ert = 0;
+    tet_tf tf; make_tf(&tf, 1.0f);
+    tet_options o; tet_options_default(&o); o.ert = 0;
     float *img = calloc(24 * 24 * 4, sizeof *img);
     double *ref = calloc(24 * 24 * 4, sizeof *ref);
     char err[256];
-    vfx_tet_counters cnt;
-    assert_int_equal(vfx_tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    tet_counters cnt;
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
     /* reference in the rotated frame: rotate the points instead of the camera */
     float rp[24];
     for (int i = 0; i < 8; i++)
         for (int r = 0; r < 3; r++)
             rp[3 * i + r] = R[0 * 3 + r] * pts[3 * i] + R[1 * 3 + r] * pts[3 * i + 1] + R[2 * 3 + r] * pts[3 * i + 2];
-    vfx_tet_mesh mr = m; mr.points = rp;
+    tet_mesh mr = m; mr.points = rp;
     reference(&mr, &cam, &tf, 4.0, 0.1, 2000, ref);
     double se = 0, mx = 0, amax = 0;
     for (int i = 0; i < 24 * 24 * 4; i++) {
@@ -229,23 +229,23 @@ static void test_ert_threshold(void **state)
     (void)state;
     /* a 6x6x6 grid of cubes, 5 tets each */
     enum { N = 6, NT = N * N * N * 5 };
-    vfx_tet_mesh m;
+    tet_mesh m;
     float *pts, *sc;
     uint32_t *tets;
     make_grid(N, &m, &pts, &sc, &tets);
-    vfx_tet_camera cam; make_cam(&cam, 40, 40, 4.0f, 0.1f);
-    vfx_tet_tf tf; make_tf(&tf, 20.0f);
-    vfx_tet_options o; vfx_tet_options_default(&o); o.tiles_d = 8; o.update_c = 50;
+    tet_camera cam; make_cam(&cam, 40, 40, 4.0f, 0.1f);
+    tet_tf tf; make_tf(&tf, 20.0f);
+    tet_options o; tet_options_default(&o); o.tiles_d = 8; o.update_c = 50;
     float *a = calloc(40 * 40 * 4, sizeof *a), *b = calloc(40 * 40 * 4, sizeof *b);
     char err[256];
-    vfx_tet_counters c0, c1, c2;
+    tet_counters c0, c1, c2;
     o.ert = 0; o.ert_threshold = 1.0f; /* same merge stop as the ERT 1.0 run */
-    assert_int_equal(vfx_tet_render(&m, &cam, &tf, &o, a, &c0, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, a, &c0, err), 0);
     o.ert = 1; o.ert_threshold = 1.0f;
-    assert_int_equal(vfx_tet_render(&m, &cam, &tf, &o, b, &c1, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, b, &c1, err), 0);
     assert_memory_equal(a, b, 40 * 40 * 4 * sizeof *a);
     o.ert_threshold = 0.9f;
-    assert_int_equal(vfx_tet_render(&m, &cam, &tf, &o, b, &c2, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, b, &c2, err), 0);
     double mx = 0;
     for (int i = 0; i < 40 * 40 * 4; i++)
         mx = fmax(mx, fabs(a[i] - b[i]));
@@ -259,10 +259,10 @@ static void test_ert_threshold(void **state)
      * ~100 float32 ulps of values <= 1. With ERT 0.9, SHARE/DLB on/off only change which
      * hidden cells are skipped, so each stays within 0.1 of the no-ERT image. */
     float *c = calloc(40 * 40 * 4, sizeof *c);
-    vfx_tet_counters pw[4];
+    tet_counters pw[4];
     for (int mode = 0; mode < 4; mode++) {
         o.ert = 0; o.ert_threshold = 1.0f; o.workers = 4; o.share = mode & 1; o.dlb = (mode >> 1) & 1;
-        assert_int_equal(vfx_tet_render_workers(&m, &cam, &tf, &o, c, &c1, pw, err), 0);
+        assert_int_equal(tet_render_workers(&m, &cam, &tf, &o, c, &c1, pw, err), 0);
         double dmax = 0;
         for (int i = 0; i < 40 * 40 * 4; i++)
             dmax = fmax(dmax, fabs(a[i] - c[i]));
@@ -272,7 +272,7 @@ static void test_ert_threshold(void **state)
             sum += pw[i].cells_scanned;
         assert_int_equal(sum, c0.cells_scanned);
         o.ert = 1; o.ert_threshold = 0.9f;
-        assert_int_equal(vfx_tet_render_workers(&m, &cam, &tf, &o, c, &c1, pw, err), 0);
+        assert_int_equal(tet_render_workers(&m, &cam, &tf, &o, c, &c1, pw, err), 0);
         dmax = 0;
         for (int i = 0; i < 40 * 40 * 4; i++)
             dmax = fmax(dmax, fabs(a[i] - c[i]));
@@ -293,16 +293,16 @@ static void test_ert_threshold(void **state)
 static void test_camera_inside_and_nan(void **state)
 {
     (void)state;
-    vfx_tet_mesh m; float pts[24], sc[8]; uint32_t tets[20];
+    tet_mesh m; float pts[24], sc[8]; uint32_t tets[20];
     make_cube(&m, pts, sc, tets);
-    vfx_tet_camera cam; make_cam(&cam, 16, 16, 0.5f, 0.05f); /* eye at z = 0.5, inside */
-    vfx_tet_tf tf; make_tf(&tf, 1.0f);
-    vfx_tet_options o; vfx_tet_options_default(&o);
+    tet_camera cam; make_cam(&cam, 16, 16, 0.5f, 0.05f); /* eye at z = 0.5, inside */
+    tet_tf tf; make_tf(&tf, 1.0f);
+    tet_options o; tet_options_default(&o);
     float img[16 * 16 * 4];
     double ref[16 * 16 * 4];
     char err[256];
-    vfx_tet_counters cnt;
-    assert_int_equal(vfx_tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    tet_counters cnt;
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
     assert_true(cnt.cells_near_crossing > 0);
     reference(&m, &cam, &tf, 0.5, 0.05, 2000, ref);
     double mx = 0;
@@ -315,14 +315,14 @@ static void test_camera_inside_and_nan(void **state)
     assert_true(mx < 0.05); /* same midpoint-rule bound as the cube test */
     /* everything behind the camera: nothing drawn, all counted */
     make_cam(&cam, 16, 16, -3.0f, 0.05f);
-    assert_int_equal(vfx_tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
     assert_int_equal(cnt.cells_behind, 5);
     for (int i = 0; i < 16 * 16 * 4; i++)
         assert_true(img[i] == 0.0f);
     /* NaN scalar at one vertex: its cells are skipped and counted, the rest renders */
     sc[6] = NAN;
     make_cam(&cam, 16, 16, 4.0f, 0.1f);
-    assert_int_equal(vfx_tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
     assert_true(cnt.cells_nan >= 1);
     for (int i = 0; i < 16 * 16 * 4; i++)
         assert_false(isnan(img[i]));
@@ -330,16 +330,16 @@ static void test_camera_inside_and_nan(void **state)
 
 /* Renders m without ERT and compares with the float64 reference; returns the max abs error and
  * stores the RMSE in *rmse. */
-static double vs_reference(const vfx_tet_mesh *m, const vfx_tet_camera *cam, const vfx_tet_tf *tf,
+static double vs_reference(const tet_mesh *m, const tet_camera *cam, const tet_tf *tf,
                            double dist, double near, double tmax, int steps, double *rmse,
-                           vfx_tet_counters *cnt)
+                           tet_counters *cnt)
 {
     const int n = cam->width * cam->height * 4;
     float *img = calloc((size_t)n, sizeof *img);
     double *ref = calloc((size_t)n, sizeof *ref);
-    vfx_tet_options o; vfx_tet_options_default(&o); o.ert = 0;
+    tet_options o; tet_options_default(&o); o.ert = 0;
     char err[256];
-    assert_int_equal(vfx_tet_render(m, cam, tf, &o, img, cnt, err), 0);
+    assert_int_equal(tet_render(m, cam, tf, &o, img, cnt, err), 0);
     reference_range(m, cam, tf, dist, near, tmax, steps, ref);
     double se = 0, mx = 0;
     for (int i = 0; i < n; i++) {
@@ -386,16 +386,16 @@ static void test_visibility_cycle(void **state)
     }
     /* the cycle is real: where rods i and i+1 cross (the triangle corner at distance 2r from
      * the centre), rod i's centre line is at depth +k r sqrt3 and rod i+1's at -k r sqrt3 */
-    vfx_tet_mesh m = {0};
+    tet_mesh m = {0};
     m.point_count = 12; m.tet_count = 3; m.points = pts; m.tets = tets; m.scalar = sc;
-    vfx_tet_camera cam; make_cam(&cam, 48, 48, 3.0f, 0.1f);
-    vfx_tet_tf tf; make_tf(&tf, 20.0f);
+    tet_camera cam; make_cam(&cam, 48, 48, 3.0f, 0.1f);
+    tet_tf tf; make_tf(&tf, 20.0f);
     tf.tau_lo = tf.tau_hi = 20.0f; /* every rod equally dense; colour tells them apart */
-    vfx_tet_counters cnt;
+    tet_counters cnt;
     float img[48 * 48 * 4];
-    vfx_tet_options o; vfx_tet_options_default(&o); o.ert = 0;
+    tet_options o; tet_options_default(&o); o.ert = 0;
     char err[256];
-    assert_int_equal(vfx_tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
     double *ref = calloc(48 * 48 * 4, sizeof *ref);
     reference_range(&m, &cam, &tf, 3.0, 2.4, 3.6, 1500, ref);
     double se = 0, mx = 0;
@@ -420,10 +420,10 @@ static void test_visibility_cycle(void **state)
     float one[3][48 * 48 * 4];
     double nearest[3];
     for (int i = 0; i < 3; i++) {
-        vfx_tet_mesh mi = m;
+        tet_mesh mi = m;
         mi.tets = &tets[4 * i];
         mi.tet_count = 1;
-        assert_int_equal(vfx_tet_render(&mi, &cam, &tf, &o, one[i], &cnt, err), 0);
+        assert_int_equal(tet_render(&mi, &cam, &tf, &o, one[i], &cnt, err), 0);
         nearest[i] = INFINITY;
         for (int j = 0; j < 4; j++)
             nearest[i] = fmin(nearest[i], 3.0 - pts[3 * (4 * i + j) + 2]);
@@ -461,15 +461,15 @@ static void test_coincident_vertices(void **state)
                         -0.7f, -0.6f, 0.9f, 0.8f, 0.8f, 0.8f, 0.9f, -0.7f, -0.6f};
     float sc[6] = {0, 0.3f, 0.6f, 1.0f, 0.5f, 0.3f};
     uint32_t deg[4] = {0, 1, 2, 5}; /* vertices 1 and 5 coincide */
-    vfx_tet_mesh m = {0};
+    tet_mesh m = {0};
     m.point_count = 6; m.tet_count = 1; m.points = pts; m.tets = deg; m.scalar = sc;
-    vfx_tet_camera cam; make_cam(&cam, 24, 24, 4.0f, 0.1f);
-    vfx_tet_tf tf; make_tf(&tf, 2.0f);
-    vfx_tet_options o; vfx_tet_options_default(&o);
+    tet_camera cam; make_cam(&cam, 24, 24, 4.0f, 0.1f);
+    tet_tf tf; make_tf(&tf, 2.0f);
+    tet_options o; tet_options_default(&o);
     float img[24 * 24 * 4];
     char err[256];
-    vfx_tet_counters cnt;
-    assert_int_equal(vfx_tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    tet_counters cnt;
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
     assert_int_equal(cnt.cells_degenerate, 1);
     assert_int_equal(cnt.cells_scanned, 0);
     for (int i = 0; i < 24 * 24 * 4; i++)
@@ -479,9 +479,9 @@ static void test_coincident_vertices(void **state)
     float alone[24 * 24 * 4];
     m.tets = two;
     m.tet_count = 1;
-    assert_int_equal(vfx_tet_render(&m, &cam, &tf, &o, alone, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, alone, &cnt, err), 0);
     m.tet_count = 2;
-    assert_int_equal(vfx_tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
     assert_int_equal(cnt.cells_degenerate, 1);
     assert_memory_equal(img, alone, sizeof img);
     /* shared face (1,2,3) between (0,1,2,3) and (4,1,3,2) (both positively oriented), the
@@ -525,23 +525,23 @@ static void test_opacity_extremes(void **state)
 {
     (void)state;
     enum { N = 4 };
-    vfx_tet_mesh m;
+    tet_mesh m;
     float *pts, *sc;
     uint32_t *tets;
     make_grid(N, &m, &pts, &sc, &tets);
-    vfx_tet_camera cam; make_cam(&cam, 24, 24, 4.0f, 0.1f);
-    vfx_tet_tf tf; make_tf(&tf, 0.0f);
-    vfx_tet_options o; vfx_tet_options_default(&o); o.tiles_d = 6; o.update_c = 50;
+    tet_camera cam; make_cam(&cam, 24, 24, 4.0f, 0.1f);
+    tet_tf tf; make_tf(&tf, 0.0f);
+    tet_options o; tet_options_default(&o); o.tiles_d = 6; o.update_c = 50;
     float img[24 * 24 * 4];
     char err[256];
-    vfx_tet_counters cnt;
-    assert_int_equal(vfx_tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    tet_counters cnt;
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
     assert_true(cnt.segments_made > 0);
     assert_int_equal(cnt.cells_skipped_ert, 0);
     for (int i = 0; i < 24 * 24 * 4; i++)
         assert_true(img[i] == 0.0f);
     tf.tau_lo = tf.tau_hi = 1e30f;
-    assert_int_equal(vfx_tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
     int covered = 0;
     for (int p = 0; p < 24 * 24; p++) {
         for (int c = 0; c < 4; c++)

@@ -21,26 +21,26 @@
 #define W 48
 #define H 36
 
-static vfx_app *g_app;
+static game_app *g_app;
 static float *g_points, *g_scalar;
 static uint32_t *g_tets, g_np, g_nt;
 
 static int setup(void **state)
 {
     (void)state;
-    vfx_app_desc d = {.mode = VFX_GL_HEADLESS, .width = W, .height = H};
-    if (vfx_app_create(&d, &g_app) != VFX_OK)
+    game_app_desc d = {.mode = RT_GL_HEADLESS, .width = W, .height = H};
+    if (game_app_create(&d, &g_app) != VFX_OK)
         exit(VFX_TEST_SKIP);
-    vfx_ref_camera cam = {{0.3, 0.4, 3.5}, {0, 0, 0}, {0, 1, 0}, 0.9, W, H, 0.05, 50};
-    assert_int_equal(vfx_app_set_camera(g_app, &cam), VFX_OK);
-    vfx_scene_volume sv;
+    ref_camera cam = {{0.3, 0.4, 3.5}, {0, 0, 0}, {0, 1, 0}, 0.9, W, H, 0.05, 50};
+    assert_int_equal(game_app_set_camera(g_app, &cam), VFX_OK);
+    rt_scene_volume sv;
     memset(&sv, 0, sizeof sv);
     sv.generated = true;
     sv.gen_cells = 4;
     for (int k = 0; k < 3; ++k)
         sv.gen_min[k] = -0.7f, sv.gen_max[k] = 0.7f;
     char err[256];
-    assert_int_equal(vfx_scene_volume_generate(&sv, &g_points, &g_np, &g_tets, &g_nt, &g_scalar, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_scene_volume_generate(&sv, &g_points, &g_np, &g_tets, &g_nt, &g_scalar, err, sizeof err), VFX_OK);
     vfx_volume_view *v = &g_app->volumes[0];
     *v = (vfx_volume_view){.size = sizeof *v, .version = VFX_VOLUME_VIEW_VERSION, .point_count = g_np,
                            .tet_count = g_nt, .points = g_points, .tets = g_tets, .scalar = g_scalar,
@@ -52,14 +52,14 @@ static int setup(void **state)
 static int teardown(void **state)
 {
     (void)state;
-    vfx_app_destroy(g_app);
+    game_app_destroy(g_app);
     free(g_points), free(g_scalar), free(g_tets);
     return 0;
 }
 
 static float *render_alpha(void)
 {
-    assert_int_equal(vfx_app_frame(g_app, 0.f), VFX_OK);
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     float *a = malloc(W * H * sizeof(float));
     assert_int_equal(g_app->api->read_raw(g_app->ctx, VFX_EFFECT_VOLUME, a, W * H), VFX_OK);
     return a;
@@ -68,18 +68,18 @@ static float *render_alpha(void)
 /* The CPU renderer called directly, same camera, same default transfer function as the effect. */
 static float *direct_alpha(void)
 {
-    vfx_tet_mesh m = {.point_count = g_np, .tet_count = g_nt, .points = g_points, .tets = g_tets, .scalar = g_scalar};
-    vfx_tet_camera cam = {.width = W, .height = H};
-    vfx_ref_camera_matrices(&g_app->camera, cam.view, cam.proj);
-    vfx_tet_tf tf = {.smin = 0, .smax = 1, .tau_lo = 0.2f, .tau_hi = 3.0f, .color_lo = {0.1f, 0.3f, 0.9f},
+    tet_mesh m = {.point_count = g_np, .tet_count = g_nt, .points = g_points, .tets = g_tets, .scalar = g_scalar};
+    tet_camera cam = {.width = W, .height = H};
+    ref_camera_matrices(&g_app->camera, cam.view, cam.proj);
+    tet_tf tf = {.smin = 0, .smax = 1, .tau_lo = 0.2f, .tau_hi = 3.0f, .color_lo = {0.1f, 0.3f, 0.9f},
                      .color_hi = {1.0f, 0.85f, 0.3f}};
-    vfx_tet_options o;
-    vfx_tet_options_default(&o);
+    tet_options o;
+    tet_options_default(&o);
     o.ert_threshold = 0.9f;
     o.workers = 1;
     float *rgba = malloc(W * H * 4 * sizeof(float)), *a = malloc(W * H * sizeof(float));
     char err[256];
-    assert_int_equal(vfx_tet_render_workers(&m, &cam, &tf, &o, rgba, NULL, NULL, err), VFX_OK);
+    assert_int_equal(tet_render_workers(&m, &cam, &tf, &o, rgba, NULL, NULL, err), VFX_OK);
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x)
             a[y * W + x] = rgba[4 * ((H - 1 - y) * W + x) + 3];
@@ -107,16 +107,16 @@ static void test_hidden_by_depth(void **state)
     (void)state;
     /* a wall in front of the whole volume, covering everything left of x = 0.1 */
     float *open = render_alpha();
-    vfx_entity e;
-    assert_int_equal(vfx_app_add_box(g_app, (float[3]){-5, -5, 1.0f}, (float[3]){0.1f, 5, 1.2f},
+    rt_entity e;
+    assert_int_equal(game_app_add_box(g_app, (float[3]){-5, -5, 1.0f}, (float[3]){0.1f, 5, 1.2f},
                                      (float[3]){0.5f, 0.5f, 0.5f}, &e), VFX_OK);
     float *a = render_alpha();
-    vfx_app_mesh *m = vfx_world_get(g_app->world, e, g_app->mesh_comp, 0);
-    vfx_mesh_gpu_destroy(&m->gpu);
-    assert_int_equal(vfx_world_despawn(g_app->world, e), VFX_OK);
+    game_app_mesh *m = rt_world_get(g_app->world, e, g_app->mesh_comp, 0);
+    rt_mesh_gpu_destroy(&m->gpu);
+    assert_int_equal(rt_world_despawn(g_app->world, e), VFX_OK);
     /* the wall's edge (x = 0.1, z = 1.2) projected to a pixel column */
     float view[16], proj[16];
-    vfx_ref_camera_matrices(&g_app->camera, view, proj);
+    ref_camera_matrices(&g_app->camera, view, proj);
     double p[4] = {0.1, 0.0, 1.2, 1.0}, v[4] = {0}, c[4] = {0};
     for (int r = 0; r < 4; ++r)
         for (int k = 0; k < 4; ++k)
@@ -147,13 +147,13 @@ static void test_bad_view_and_absence(void **state)
     uint32_t saved = g_tets[5];
     g_tets[5] = g_np + 7;
     g_app->volumes[0].revision = 2;
-    assert_int_not_equal(vfx_app_frame(g_app, 0.f), VFX_OK);
+    assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "volume[0]: tet 1 uses point"));
     g_tets[5] = saved;
     g_app->volumes[0].revision = 3;
-    assert_int_equal(vfx_app_frame(g_app, 0.f), VFX_OK);
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     g_app->volume_count = 0;
-    assert_int_equal(vfx_app_frame(g_app, 0.f), VFX_OK);
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_null(g_app->ctx->effect_state[VFX_EFFECT_VOLUME]);
     g_app->volume_count = 1;
 }

@@ -11,10 +11,10 @@
 #include "ecs/world.h"
 #include "test_util.h"
 
-static vfx_world *make_world(vfx_test_log *log)
+static rt_world *make_world(test_log *log)
 {
-    vfx_world_desc d = {.logger = {vfx_test_log_fn, log}};
-    vfx_world *w = vfx_world_create(&d);
+    rt_world_desc d = {.logger = {test_log_fn, log}};
+    rt_world *w = rt_world_create(&d);
     assert_non_null(w);
     return w;
 }
@@ -22,155 +22,155 @@ static vfx_world *make_world(vfx_test_log *log)
 static void test_ids_and_reuse(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
-    vfx_world *w = make_world(&log);
-    vfx_component pos;
-    assert_int_equal(vfx_world_register(w, &(vfx_component_desc){"pos", 12, 4, 3}, &pos), VFX_OK);
-    vfx_entity e[3];
-    assert_int_equal(vfx_world_spawn(w, 3, &pos, 1, e), VFX_OK);
-    assert_true(vfx_world_alive(w, e[1]));
-    assert_int_equal(vfx_world_despawn(w, e[1]), VFX_OK);
-    assert_false(vfx_world_alive(w, e[1]));
+    test_log log = {0};
+    rt_world *w = make_world(&log);
+    rt_component pos;
+    assert_int_equal(rt_world_register(w, &(rt_component_desc){"pos", 12, 4, 3}, &pos), VFX_OK);
+    rt_entity e[3];
+    assert_int_equal(rt_world_spawn(w, 3, &pos, 1, e), VFX_OK);
+    assert_true(rt_world_alive(w, e[1]));
+    assert_int_equal(rt_world_despawn(w, e[1]), VFX_OK);
+    assert_false(rt_world_alive(w, e[1]));
     /* a stale id is refused with a message, never silently accepted */
-    assert_int_equal(vfx_world_despawn(w, e[1]), VFX_ERR_NOT_FOUND);
-    assert_non_null(strstr(vfx_world_last_error(w), "not alive"));
-    vfx_entity again;
-    assert_int_equal(vfx_world_spawn(w, 1, &pos, 1, &again), VFX_OK);
+    assert_int_equal(rt_world_despawn(w, e[1]), VFX_ERR_NOT_FOUND);
+    assert_non_null(strstr(rt_world_last_error(w), "not alive"));
+    rt_entity again;
+    assert_int_equal(rt_world_spawn(w, 1, &pos, 1, &again), VFX_OK);
     /* index reused, generation bumped: the old id stays dead */
-    assert_int_equal(vfx_entity_index(again), vfx_entity_index(e[1]));
-    assert_int_not_equal(vfx_entity_generation(again), vfx_entity_generation(e[1]));
-    assert_false(vfx_world_alive(w, e[1]));
-    assert_true(vfx_world_alive(w, again));
-    assert_false(vfx_world_alive(w, VFX_ENTITY_NULL));
-    assert_int_equal(vfx_world_entity_count(w), 3);
-    vfx_world_destroy(w);
+    assert_int_equal(rt_entity_index(again), rt_entity_index(e[1]));
+    assert_int_not_equal(rt_entity_generation(again), rt_entity_generation(e[1]));
+    assert_false(rt_world_alive(w, e[1]));
+    assert_true(rt_world_alive(w, again));
+    assert_false(rt_world_alive(w, RT_ENTITY_NULL));
+    assert_int_equal(rt_world_entity_count(w), 3);
+    rt_world_destroy(w);
 }
 
 static void test_register_errors(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
-    vfx_world *w = make_world(&log);
-    vfx_component c;
-    assert_int_equal(vfx_world_register(w, &(vfx_component_desc){"a", 4, 4, 1}, &c), VFX_OK);
-    assert_int_equal(vfx_world_register(w, &(vfx_component_desc){"a", 4, 4, 1}, &c), VFX_ERR_INVALID_ARGUMENT);
+    test_log log = {0};
+    rt_world *w = make_world(&log);
+    rt_component c;
+    assert_int_equal(rt_world_register(w, &(rt_component_desc){"a", 4, 4, 1}, &c), VFX_OK);
+    assert_int_equal(rt_world_register(w, &(rt_component_desc){"a", 4, 4, 1}, &c), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(log.last, "already registered"));
-    assert_int_equal(vfx_world_register(w, &(vfx_component_desc){"b", 10, 4, 3}, &c), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_world_register(w, &(rt_component_desc){"b", 10, 4, 3}, &c), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(log.last, "multiple"));
-    assert_int_equal(vfx_world_register(w, &(vfx_component_desc){"c", 4, 3, 1}, &c), VFX_ERR_INVALID_ARGUMENT);
-    assert_int_equal(vfx_world_register(w, &(vfx_component_desc){NULL, 4, 4, 1}, &c), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_world_register(w, &(rt_component_desc){"c", 4, 3, 1}, &c), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_world_register(w, &(rt_component_desc){NULL, 4, 4, 1}, &c), VFX_ERR_INVALID_ARGUMENT);
     /* unknown component ids are refused at spawn */
-    vfx_component bad = 77;
-    assert_int_equal(vfx_world_spawn(w, 1, &bad, 1, NULL), VFX_ERR_INVALID_ARGUMENT);
-    vfx_world_destroy(w);
+    rt_component bad = 77;
+    assert_int_equal(rt_world_spawn(w, 1, &bad, 1, NULL), VFX_ERR_INVALID_ARGUMENT);
+    rt_world_destroy(w);
 }
 
 static void test_soa_columns(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
-    vfx_world *w = make_world(&log);
-    vfx_particle_components pc;
-    assert_int_equal(vfx_particles_register(w, &pc), VFX_OK);
+    test_log log = {0};
+    rt_world *w = make_world(&log);
+    rt_particle_components pc;
+    assert_int_equal(rt_particles_register(w, &pc), VFX_OK);
     enum { N = 1000 };
     float x[N], y[N], z[N];
     for (int i = 0; i < N; ++i)
         x[i] = (float)i, y[i] = (float)(2 * i), z[i] = (float)(-i);
-    assert_int_equal(vfx_particles_spawn(w, &pc, N, x, y, z, false), VFX_OK);
-    vfx_query_iter it = vfx_query_begin(w, &pc.position, 1);
-    assert_true(vfx_query_next(&it));
+    assert_int_equal(rt_particles_spawn(w, &pc, N, x, y, z, false), VFX_OK);
+    rt_query_iter it = rt_query_begin(w, &pc.position, 1);
+    assert_true(rt_query_next(&it));
     assert_int_equal(it.rows, N);
-    float *cx = vfx_query_column(&it, pc.position, 0);
-    float *cy = vfx_query_column(&it, pc.position, 1);
-    float *cz = vfx_query_column(&it, pc.position, 2);
+    float *cx = rt_query_column(&it, pc.position, 0);
+    float *cy = rt_query_column(&it, pc.position, 1);
+    float *cz = rt_query_column(&it, pc.position, 2);
     /* one contiguous, aligned column per field: the GPU can take it in one upload */
     assert_int_equal((uintptr_t)cx % 64, 0);
     for (int i = 0; i < N; ++i) {
         assert_true(cx[i] == x[i] && cy[i] == y[i] && cz[i] == z[i]);
     }
-    assert_null(vfx_query_column(&it, pc.radius, 0)); /* not in this table */
-    assert_null(vfx_query_column(&it, pc.position, 3)); /* no such field */
-    assert_false(vfx_query_next(&it));
+    assert_null(rt_query_column(&it, pc.radius, 0)); /* not in this table */
+    assert_null(rt_query_column(&it, pc.position, 3)); /* no such field */
+    assert_false(rt_query_next(&it));
     /* NaN positions are refused, naming the particle */
     y[17] = NAN;
-    assert_int_equal(vfx_particles_spawn(w, &pc, N, x, y, z, false), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_particles_spawn(w, &pc, N, x, y, z, false), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(log.last, "particle 17"));
-    vfx_world_destroy(w);
+    rt_world_destroy(w);
 }
 
 static void test_column_stability_and_moves(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
-    vfx_world *w = make_world(&log);
-    vfx_component a, b, tag;
-    assert_int_equal(vfx_world_register(w, &(vfx_component_desc){"a", 4, 4, 1}, &a), VFX_OK);
-    assert_int_equal(vfx_world_register(w, &(vfx_component_desc){"b", 8, 8, 1}, &b), VFX_OK);
-    assert_int_equal(vfx_world_register(w, &(vfx_component_desc){"tag", 0, 0, 0}, &tag), VFX_OK);
-    vfx_entity e[10];
-    assert_int_equal(vfx_world_spawn(w, 10, &a, 1, e), VFX_OK);
+    test_log log = {0};
+    rt_world *w = make_world(&log);
+    rt_component a, b, tag;
+    assert_int_equal(rt_world_register(w, &(rt_component_desc){"a", 4, 4, 1}, &a), VFX_OK);
+    assert_int_equal(rt_world_register(w, &(rt_component_desc){"b", 8, 8, 1}, &b), VFX_OK);
+    assert_int_equal(rt_world_register(w, &(rt_component_desc){"tag", 0, 0, 0}, &tag), VFX_OK);
+    rt_entity e[10];
+    assert_int_equal(rt_world_spawn(w, 10, &a, 1, e), VFX_OK);
     for (int i = 0; i < 10; ++i)
-        *(int32_t *)vfx_world_get(w, e[i], a, 0) = 100 + i;
-    int32_t *col_before = vfx_world_get(w, e[0], a, 0);
+        *(int32_t *)rt_world_get(w, e[i], a, 0) = 100 + i;
+    int32_t *col_before = rt_world_get(w, e[0], a, 0);
     /* structural change in ANOTHER table leaves this table's column where it was */
-    vfx_component ab[2] = {a, b};
-    assert_int_equal(vfx_world_spawn(w, 500, ab, 2, NULL), VFX_OK);
-    assert_ptr_equal(vfx_world_get(w, e[0], a, 0), col_before);
+    rt_component ab[2] = {a, b};
+    assert_int_equal(rt_world_spawn(w, 500, ab, 2, NULL), VFX_OK);
+    assert_ptr_equal(rt_world_get(w, e[0], a, 0), col_before);
     /* moving an entity to another table keeps its data; swap-remove keeps the rest right */
-    assert_int_equal(vfx_world_add(w, e[3], b), VFX_OK);
-    assert_true(vfx_world_has(w, e[3], b));
-    assert_int_equal(*(int32_t *)vfx_world_get(w, e[3], a, 0), 103);
-    assert_int_equal(*(double *)vfx_world_get(w, e[3], b, 0), 0.0); /* added zeroed */
-    assert_int_equal(vfx_world_add(w, e[3], tag), VFX_OK);
-    assert_null(vfx_world_get(w, e[3], tag, 0)); /* tags have no column */
-    assert_true(vfx_world_has(w, e[3], tag));
-    assert_int_equal(vfx_world_remove(w, e[3], b), VFX_OK);
-    assert_false(vfx_world_has(w, e[3], b));
+    assert_int_equal(rt_world_add(w, e[3], b), VFX_OK);
+    assert_true(rt_world_has(w, e[3], b));
+    assert_int_equal(*(int32_t *)rt_world_get(w, e[3], a, 0), 103);
+    assert_int_equal(*(double *)rt_world_get(w, e[3], b, 0), 0.0); /* added zeroed */
+    assert_int_equal(rt_world_add(w, e[3], tag), VFX_OK);
+    assert_null(rt_world_get(w, e[3], tag, 0)); /* tags have no column */
+    assert_true(rt_world_has(w, e[3], tag));
+    assert_int_equal(rt_world_remove(w, e[3], b), VFX_OK);
+    assert_false(rt_world_has(w, e[3], b));
     for (int i = 0; i < 10; ++i)
-        assert_int_equal(*(int32_t *)vfx_world_get(w, e[i], a, 0), 100 + i);
-    assert_int_equal(vfx_world_despawn(w, e[5]), VFX_OK);
+        assert_int_equal(*(int32_t *)rt_world_get(w, e[i], a, 0), 100 + i);
+    assert_int_equal(rt_world_despawn(w, e[5]), VFX_OK);
     for (int i = 0; i < 10; ++i)
         if (i != 5)
-            assert_int_equal(*(int32_t *)vfx_world_get(w, e[i], a, 0), 100 + i);
+            assert_int_equal(*(int32_t *)rt_world_get(w, e[i], a, 0), 100 + i);
     /* queries: count over all tables with `a`, and only the ones with both */
-    assert_int_equal(vfx_query_count(w, &a, 1), 9 + 500);
-    assert_int_equal(vfx_query_count(w, ab, 2), 500);
-    vfx_world_destroy(w);
+    assert_int_equal(rt_query_count(w, &a, 1), 9 + 500);
+    assert_int_equal(rt_query_count(w, ab, 2), 500);
+    rt_world_destroy(w);
 }
 
 static void test_permute(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
-    vfx_world *w = make_world(&log);
-    vfx_component a;
-    assert_int_equal(vfx_world_register(w, &(vfx_component_desc){"a", 4, 4, 1}, &a), VFX_OK);
-    vfx_entity e[4];
-    assert_int_equal(vfx_world_spawn(w, 4, &a, 1, e), VFX_OK);
+    test_log log = {0};
+    rt_world *w = make_world(&log);
+    rt_component a;
+    assert_int_equal(rt_world_register(w, &(rt_component_desc){"a", 4, 4, 1}, &a), VFX_OK);
+    rt_entity e[4];
+    assert_int_equal(rt_world_spawn(w, 4, &a, 1, e), VFX_OK);
     for (int i = 0; i < 4; ++i)
-        *(int32_t *)vfx_world_get(w, e[i], a, 0) = i;
+        *(int32_t *)rt_world_get(w, e[i], a, 0) = i;
     uint32_t perm[4] = {3, 1, 0, 2};
-    vfx_query_iter it = vfx_query_begin(w, &a, 1);
-    assert_true(vfx_query_next(&it));
-    uint64_t rev = vfx_world_table_revision(w, it.table);
-    assert_int_equal(vfx_world_table_permute(w, it.table, perm), VFX_OK);
-    assert_true(vfx_world_table_revision(w, it.table) > rev);
-    int32_t *col = vfx_query_column(&it, a, 0);
+    rt_query_iter it = rt_query_begin(w, &a, 1);
+    assert_true(rt_query_next(&it));
+    uint64_t rev = rt_world_table_revision(w, it.table);
+    assert_int_equal(rt_world_table_permute(w, it.table, perm), VFX_OK);
+    assert_true(rt_world_table_revision(w, it.table) > rev);
+    int32_t *col = rt_query_column(&it, a, 0);
     assert_int_equal(col[0], 3);
     assert_int_equal(col[2], 0);
     for (int i = 0; i < 4; ++i) /* entity records follow their rows */
-        assert_int_equal(*(int32_t *)vfx_world_get(w, e[i], a, 0), i);
+        assert_int_equal(*(int32_t *)rt_world_get(w, e[i], a, 0), i);
     uint32_t bad[4] = {0, 0, 1, 2};
-    assert_int_equal(vfx_world_table_permute(w, it.table, bad), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_world_table_permute(w, it.table, bad), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(log.last, "repeated"));
-    vfx_world_destroy(w);
+    rt_world_destroy(w);
 }
 
 typedef struct order_log {
     char seq[64];
 } order_log;
 
-static vfx_result sys_append(vfx_world *w, const vfx_system_ctx *ctx)
+static vfx_result sys_append(rt_world *w, const rt_system_ctx *ctx)
 {
     (void)w;
     order_log *l = ctx->user;
@@ -178,7 +178,7 @@ static vfx_result sys_append(vfx_world *w, const vfx_system_ctx *ctx)
     return VFX_OK;
 }
 
-static vfx_result sys_fail(vfx_world *w, const vfx_system_ctx *ctx)
+static vfx_result sys_fail(rt_world *w, const rt_system_ctx *ctx)
 {
     (void)w, (void)ctx;
     return VFX_ERR_NUMERIC;
@@ -187,30 +187,30 @@ static vfx_result sys_fail(vfx_world *w, const vfx_system_ctx *ctx)
 static void test_system_order(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
-    vfx_world *w = make_world(&log);
+    test_log log = {0};
+    rt_world *w = make_world(&log);
     order_log ol = {{0}};
-    vfx_component a;
-    assert_int_equal(vfx_world_register(w, &(vfx_component_desc){"a", 4, 4, 1}, &a), VFX_OK);
+    rt_component a;
+    assert_int_equal(rt_world_register(w, &(rt_component_desc){"a", 4, 4, 1}, &a), VFX_OK);
     /* registered out of phase order: execution is phase first, then registration order */
-    const struct { const char *n; vfx_phase p; } s[] = {
-        {"D", VFX_PHASE_POST_RENDER}, {"B", VFX_PHASE_PRE_RENDER}, {"A", VFX_PHASE_SIMULATE},
-        {"C", VFX_PHASE_PRE_RENDER}, {"E", VFX_PHASE_SIMULATE}};
+    const struct { const char *n; rt_phase p; } s[] = {
+        {"D", RT_PHASE_POST_RENDER}, {"B", RT_PHASE_PRE_RENDER}, {"A", RT_PHASE_SIMULATE},
+        {"C", RT_PHASE_PRE_RENDER}, {"E", RT_PHASE_SIMULATE}};
     for (size_t i = 0; i < 5; ++i) {
-        vfx_system_desc d = {.name = s[i].n, .phase = s[i].p, .reads = &a, .read_count = 1,
+        rt_system_desc d = {.name = s[i].n, .phase = s[i].p, .reads = &a, .read_count = 1,
                              .fn = sys_append, .user = &ol};
-        assert_int_equal(vfx_world_add_system(w, &d), VFX_OK);
+        assert_int_equal(rt_world_add_system(w, &d), VFX_OK);
     }
-    assert_int_equal(vfx_world_progress(w, 0.0, 0.016f), VFX_OK);
+    assert_int_equal(rt_world_progress(w, 0.0, 0.016f), VFX_OK);
     assert_string_equal(ol.seq, "AEBCD");
-    vfx_component unknown = 99;
-    vfx_system_desc bad = {.name = "bad", .writes = &unknown, .write_count = 1, .fn = sys_append};
-    assert_int_equal(vfx_world_add_system(w, &bad), VFX_ERR_INVALID_ARGUMENT);
-    vfx_system_desc f = {.name = "exploder", .phase = VFX_PHASE_RENDER, .fn = sys_fail};
-    assert_int_equal(vfx_world_add_system(w, &f), VFX_OK);
-    assert_int_equal(vfx_world_progress(w, 0.0, 0.016f), VFX_ERR_NUMERIC);
-    assert_non_null(strstr(vfx_world_last_error(w), "exploder"));
-    vfx_world_destroy(w);
+    rt_component unknown = 99;
+    rt_system_desc bad = {.name = "bad", .writes = &unknown, .write_count = 1, .fn = sys_append};
+    assert_int_equal(rt_world_add_system(w, &bad), VFX_ERR_INVALID_ARGUMENT);
+    rt_system_desc f = {.name = "exploder", .phase = RT_PHASE_RENDER, .fn = sys_fail};
+    assert_int_equal(rt_world_add_system(w, &f), VFX_OK);
+    assert_int_equal(rt_world_progress(w, 0.0, 0.016f), VFX_ERR_NUMERIC);
+    assert_non_null(strstr(rt_world_last_error(w), "exploder"));
+    rt_world_destroy(w);
 }
 
 int main(void)

@@ -17,7 +17,7 @@ static void test_pfm_roundtrip(void **state)
     (void)state;
     float data[6] = {1, 2, 3, 4, 5, 6}; /* 3x2, top row 1 2 3 */
     char err[128];
-    assert_int_equal(vfx_write_pfm("t.pfm", 3, 2, data, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_write_pfm("t.pfm", 3, 2, data, err, sizeof err), VFX_OK);
     FILE *f = fopen("t.pfm", "rb");
     char hdr[32];
     assert_non_null(fgets(hdr, sizeof hdr, f));
@@ -30,7 +30,7 @@ static void test_pfm_roundtrip(void **state)
     fclose(f);
     uint32_t w, h;
     float *back;
-    assert_int_equal(vfx_read_pfm("t.pfm", &w, &h, &back, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_read_pfm("t.pfm", &w, &h, &back, err, sizeof err), VFX_OK);
     assert_int_equal(w, 3);
     assert_int_equal(h, 2);
     assert_memory_equal(back, data, sizeof data);
@@ -38,7 +38,7 @@ static void test_pfm_roundtrip(void **state)
     f = fopen("bad.pfm", "wb");
     fputs("P6\n1 1\n255\n", f);
     fclose(f);
-    assert_int_equal(vfx_read_pfm("bad.pfm", &w, &h, &back, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(rt_read_pfm("bad.pfm", &w, &h, &back, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "bad.pfm"));
 }
 
@@ -49,7 +49,7 @@ static void test_png_valid(void **state)
     for (int i = 0; i < 64; ++i)
         rgba[i] = (uint8_t)(i * 3);
     char err[128];
-    assert_int_equal(vfx_write_png("t.png", 4, 4, rgba, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_write_png("t.png", 4, 4, rgba, err, sizeof err), VFX_OK);
     FILE *f = fopen("t.png", "rb");
     uint8_t buf[4096];
     size_t n = fread(buf, 1, sizeof buf, f);
@@ -67,31 +67,31 @@ static void test_png_valid(void **state)
         assert_int_equal(raw[y * 17], 0);
         assert_memory_equal(raw + y * 17 + 1, rgba + y * 16, 16);
     }
-    assert_int_equal(vfx_write_png("/nonexistent/dir/x.png", 4, 4, rgba, err, sizeof err), VFX_ERR_IO);
+    assert_int_equal(rt_write_png("/nonexistent/dir/x.png", 4, 4, rgba, err, sizeof err), VFX_ERR_IO);
     assert_non_null(strstr(err, "/nonexistent/dir/x.png"));
 }
 
 static void test_shader_log_rewrite(void **state)
 {
     (void)state;
-    int idx = vfx_shader_index("common/fullscreen.vert");
+    int idx = volfx_shader_index("common/fullscreen.vert");
     assert_true(idx >= 0);
     char log[128], out[256];
     /* Mesa's and NVIDIA's formats both come back as file:line */
     snprintf(log, sizeof log, "%d:7(12): error: syntax error\n", idx);
-    vfx_shader_rewrite_log(log, out, sizeof out, "x");
+    volfx_shader_rewrite_log(log, out, sizeof out, "x");
     assert_non_null(strstr(out, "common/fullscreen.vert:7: error: syntax error"));
     snprintf(log, sizeof log, "%d(9) : error C0000: bad\n", idx);
-    vfx_shader_rewrite_log(log, out, sizeof out, "x");
+    volfx_shader_rewrite_log(log, out, sizeof out, "x");
     assert_non_null(strstr(out, "common/fullscreen.vert:9:"));
     /* Mesa prints source string 0 whatever #line said: the file comes from the line number */
-    snprintf(log, sizeof log, "0:%ld(3): error: x\n", vfx_shader_line_base(idx) + 42);
-    vfx_shader_rewrite_log(log, out, sizeof out, "x");
+    snprintf(log, sizeof log, "0:%ld(3): error: x\n", volfx_shader_line_base(idx) + 42);
+    volfx_shader_rewrite_log(log, out, sizeof out, "x");
     assert_non_null(strstr(out, "common/fullscreen.vert:42: error: x"));
     char err[128];
-    assert_null(vfx_shader_expand("nope/missing.frag", NULL, err, sizeof err));
+    assert_null(volfx_shader_expand("nope/missing.frag", NULL, err, sizeof err));
     assert_non_null(strstr(err, "nope/missing.frag"));
-    char *src = vfx_shader_expand("common/fullscreen.vert", "#define X 1", err, sizeof err);
+    char *src = volfx_shader_expand("common/fullscreen.vert", "#define X 1", err, sizeof err);
     assert_non_null(src);
     assert_true(strncmp(src, "#version 450 core\n#define X 1\n", 30) == 0);
     free(src);

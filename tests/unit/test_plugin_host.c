@@ -13,40 +13,40 @@
 
 static const char *g_plugin, *g_nosym, *g_badver;
 
-static vfx_host_api host_with(vfx_test_log *log)
+static vfx_host_api host_with(test_log *log)
 {
     return (vfx_host_api){.size = sizeof(vfx_host_api), .version = VFX_HOST_API_VERSION,
-                          .user = log, .log = vfx_test_log_fn};
+                          .user = log, .log = test_log_fn};
 }
 
 static void test_good_plugin(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
+    test_log log = {0};
     vfx_host_api host = host_with(&log);
-    vfx_logger lg = {vfx_test_log_fn, &log};
-    vfx_plugin_host *h = NULL;
-    assert_int_equal(vfx_plugin_host_load(g_plugin, &host, &lg, &h), VFX_OK);
-    const vfx_plugin_api *api = vfx_plugin_host_api(h);
+    rt_logger lg = {test_log_fn, &log};
+    rt_plugin_host *h = NULL;
+    assert_int_equal(rt_plugin_host_load(g_plugin, &host, &lg, &h), VFX_OK);
+    const vfx_plugin_api *api = rt_plugin_host_api(h);
     assert_int_equal(api->version, VFX_PLUGIN_API_VERSION);
     assert_int_equal(api->size, sizeof(vfx_plugin_api));
     assert_string_equal(api->name, "volfx");
     assert_non_null(api->create);
     assert_non_null(api->render);
-    vfx_plugin_host_unload(h);
+    rt_plugin_host_unload(h);
     /* the static entry is the same code */
-    assert_int_equal(vfx_plugin_host_load_static(vfx_plugin_entry, &host, &lg, &h), VFX_OK);
-    vfx_plugin_host_unload(h);
+    assert_int_equal(rt_plugin_host_load_static(vfx_plugin_entry, &host, &lg, &h), VFX_OK);
+    rt_plugin_host_unload(h);
 }
 
 static void test_wrong_abi_refused(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
+    test_log log = {0};
     vfx_host_api host = host_with(&log);
-    vfx_logger lg = {vfx_test_log_fn, &log};
-    vfx_plugin_host *h = NULL;
-    assert_int_equal(vfx_plugin_host_load_as(g_plugin, VFX_ABI_VERSION + 1, &host, &lg, &h), VFX_ERR_ABI);
+    rt_logger lg = {test_log_fn, &log};
+    rt_plugin_host *h = NULL;
+    assert_int_equal(rt_plugin_host_load_as(g_plugin, VFX_ABI_VERSION + 1, &host, &lg, &h), VFX_ERR_ABI);
     assert_null(h);
     /* the plugin's own message names both versions */
     char want[96];
@@ -54,7 +54,7 @@ static void test_wrong_abi_refused(void **state)
     assert_true(log.errors >= 2); /* plugin's message + host's */
     assert_non_null(strstr(log.last, "host ABI 2"));
     vfx_plugin_api api = {.size = sizeof api};
-    vfx_test_log log2 = {0};
+    test_log log2 = {0};
     vfx_host_api host2 = host_with(&log2);
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION + 1, &host2, &api), VFX_ERR_ABI);
     assert_non_null(strstr(log2.last, want));
@@ -66,11 +66,11 @@ static void test_wrong_abi_refused(void **state)
 static void test_missing_symbol(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
+    test_log log = {0};
     vfx_host_api host = host_with(&log);
-    vfx_logger lg = {vfx_test_log_fn, &log};
-    vfx_plugin_host *h = NULL;
-    assert_int_equal(vfx_plugin_host_load(g_nosym, &host, &lg, &h), VFX_ERR_NOT_FOUND);
+    rt_logger lg = {test_log_fn, &log};
+    rt_plugin_host *h = NULL;
+    assert_int_equal(rt_plugin_host_load(g_nosym, &host, &lg, &h), VFX_ERR_NOT_FOUND);
     assert_null(h);
     assert_non_null(strstr(log.last, "vfx_plugin_entry"));
 }
@@ -78,22 +78,22 @@ static void test_missing_symbol(void **state)
 static void test_table_version_refused(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
+    test_log log = {0};
     vfx_host_api host = host_with(&log);
-    vfx_logger lg = {vfx_test_log_fn, &log};
-    vfx_plugin_host *h = NULL;
-    assert_int_equal(vfx_plugin_host_load(g_badver, &host, &lg, &h), VFX_ERR_ABI);
+    rt_logger lg = {test_log_fn, &log};
+    rt_plugin_host *h = NULL;
+    assert_int_equal(rt_plugin_host_load(g_badver, &host, &lg, &h), VFX_ERR_ABI);
     assert_non_null(strstr(log.last, "plugin API version 99"));
 }
 
 static void test_missing_file(void **state)
 {
     (void)state;
-    vfx_test_log log = {0};
+    test_log log = {0};
     vfx_host_api host = host_with(&log);
-    vfx_logger lg = {vfx_test_log_fn, &log};
-    vfx_plugin_host *h = NULL;
-    assert_int_equal(vfx_plugin_host_load("/nonexistent/libvolfx.so", &host, &lg, &h), VFX_ERR_IO);
+    rt_logger lg = {test_log_fn, &log};
+    rt_plugin_host *h = NULL;
+    assert_int_equal(rt_plugin_host_load("/nonexistent/libvolfx.so", &host, &lg, &h), VFX_ERR_IO);
     assert_non_null(strstr(log.last, "/nonexistent/libvolfx.so"));
 }
 
@@ -103,7 +103,7 @@ static void test_create_refuses_bad_host(void **state)
     vfx_plugin_api api = {.size = sizeof api};
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     vfx_context *ctx = NULL;
-    vfx_test_log log = {0};
+    test_log log = {0};
     vfx_host_api host = host_with(&log);
     host.version = 7; /* a host api of another version */
     assert_int_equal(api.create(&host, &ctx), VFX_ERR_ABI);

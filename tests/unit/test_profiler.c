@@ -34,15 +34,15 @@ static double frame_time(uint32_t i, uint64_t *rng)
 
 static void check_against_sort(uint32_t ring, uint32_t frames, uint32_t skip, double rel)
 {
-    vfx_profiler *p = vfx_profiler_create(ring);
+    rt_profiler *p = rt_profiler_create(ring);
     assert_non_null(p);
     double *t = malloc(frames * sizeof *t);
     uint64_t rng = 12345;
     for (uint32_t i = 0; i < frames; ++i) {
         t[i] = frame_time(i, &rng);
-        vfx_profiler_frame_add(p, t[i]);
+        rt_profiler_frame_add(p, t[i]);
     }
-    vfx_frame_summary s = vfx_profiler_summary(p, skip);
+    rt_frame_summary s = rt_profiler_summary(p, skip);
     uint32_t n = frames - skip;
     double sum = 0;
     for (uint32_t i = skip; i < frames; ++i)
@@ -57,7 +57,7 @@ static void check_against_sort(uint32_t ring, uint32_t frames, uint32_t skip, do
         assert_true(fabs(got[k] - want) <= rel * want);
     }
     free(t);
-    vfx_profiler_destroy(p);
+    rt_profiler_destroy(p);
 }
 
 /* Inside the ring the summary is exact (rel 0). */
@@ -81,19 +81,19 @@ static void test_histogram_past_ring(void **s)
 static void test_skip_capped(void **s)
 {
     (void)s;
-    vfx_profiler *p = vfx_profiler_create(16);
+    rt_profiler *p = rt_profiler_create(16);
     for (int i = 0; i < 1000; ++i)
-        vfx_profiler_frame_add(p, 10.0);
-    vfx_frame_summary r = vfx_profiler_summary(p, 600);
+        rt_profiler_frame_add(p, 10.0);
+    rt_frame_summary r = rt_profiler_summary(p, 600);
     assert_int_equal(r.frames, 1000 - 256);
     assert_true(fabs(r.p50_ms - 10.0) <= 5.0005e-4 * 10.0);
     /* bad times count as 0, never NaN in the sums */
-    vfx_profiler_frame_add(p, NAN);
-    vfx_profiler_frame_add(p, -3.0);
-    r = vfx_profiler_summary(p, 0);
+    rt_profiler_frame_add(p, NAN);
+    rt_profiler_frame_add(p, -3.0);
+    r = rt_profiler_summary(p, 0);
     assert_int_equal(r.frames, 1002);
     assert_false(isnan(r.mean_ms));
-    vfx_profiler_destroy(p);
+    rt_profiler_destroy(p);
 }
 
 int main(void)

@@ -19,7 +19,7 @@
 #include "water/water_ref.h"
 
 typedef struct scene {
-    vfx_test_log log;
+    test_log log;
     float *x, *y, *z;
     uint32_t n, chunk; /* particles per chunk: several chunks exercise the concatenation */
     vfx_water_params params;
@@ -51,12 +51,12 @@ static vfx_result water_params(void *user, vfx_water_params *out)
 }
 
 /* Renders the scene with the plugin and the reference; returns the error; *stats optional. */
-static vfx_water_ref_error render_and_compare(scene *s, const vfx_ref_camera *cam, vfx_stats *stats_out)
+static ref_water_error render_and_compare(scene *s, const ref_camera *cam, vfx_stats *stats_out)
 {
     vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = s,
-                         .log = vfx_test_log_fn, .particle_chunk_count = chunk_count,
+                         .log = test_log_fn, .particle_chunk_count = chunk_count,
                          .particle_chunk = chunk_view, .water_params = water_params};
-    /* the logger's user is the scene, whose first member is the vfx_test_log */
+    /* the logger's user is the scene, whose first member is the test_log */
     vfx_plugin_api api = {.size = sizeof api};
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     vfx_context *ctx;
@@ -72,24 +72,24 @@ static vfx_water_ref_error render_and_compare(scene *s, const vfx_ref_camera *ca
                          .width = w, .height = h, .fov_y = (float)cam->fov_y, .near_plane = 0.1f,
                          .far_plane = 100.0f};
     for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam->eye[k];
-    vfx_ref_camera_matrices(cam, fv.view, fv.proj);
+    ref_camera_matrices(cam, fv.view, fv.proj);
     assert_int_equal(api.update(ctx, 0.0, 0.0f), VFX_OK);
     assert_int_equal(api.render(ctx, &fv), VFX_OK);
     float *gpu = malloc((size_t)w * h * sizeof *gpu), *ref = malloc((size_t)w * h * sizeof *ref);
-    vfx_water_ref_error e;
+    ref_water_error e;
     memset(&e, 0, sizeof e);
     if (s->n) {
         assert_int_equal(api.read_raw(ctx, VFX_EFFECT_WATER, gpu, (size_t)w * h), VFX_OK);
         double fwd[3], right[3], up[3];
-        vfx_ref_camera_basis(cam, fwd, right, up);
-        vfx_water_ref_camera rc = {{cam->eye[0], cam->eye[1], cam->eye[2]}, {fwd[0], fwd[1], fwd[2]},
+        ref_camera_basis(cam, fwd, right, up);
+        ref_water_camera rc = {{cam->eye[0], cam->eye[1], cam->eye[2]}, {fwd[0], fwd[1], fwd[2]},
                                    {up[0], up[1], up[2]}, cam->fov_y, w, h};
-        vfx_water_ref_params rp = vfx_water_ref_default_params();
+        ref_water_params rp = ref_water_default_params();
         rp.h = s->params.h > 0 ? s->params.h : 0.61;
         rp.step = rp.h / 32;
         char err[256];
-        assert_int_equal(vfx_water_ref_render(&rc, s->x, s->y, s->z, s->n, &rp, ref, NULL, NULL, err), 0);
-        assert_int_equal(vfx_water_ref_compare(gpu, NULL, ref, NULL, (size_t)w * h, rp.h, &e), 0);
+        assert_int_equal(ref_water_render(&rc, s->x, s->y, s->z, s->n, &rp, ref, NULL, NULL, err), 0);
+        assert_int_equal(ref_water_compare(gpu, NULL, ref, NULL, (size_t)w * h, rp.h, &e), 0);
     }
     if (stats_out) {
         stats_out->size = sizeof *stats_out;
@@ -128,20 +128,20 @@ static scene make_scene(uint32_t n)
 
 static void free_scene(scene *s) { free(s->x); free(s->y); free(s->z); }
 
-/* The blob scene of most tests: 300 particles in 4 blobs (vfx_water_ref_blobs, seed 7) drawn
+/* The blob scene of most tests: 300 particles in 4 blobs (ref_water_blobs, seed 7) drawn
  * by method. */
 static scene blob_scene(uint32_t method)
 {
     scene s = make_scene(300);
     s.params.method = method;
-    vfx_water_ref_blobs(s.n, 4, 1.0, 0.35, 7, s.x, s.y, s.z);
+    ref_water_blobs(s.n, 4, 1.0, 0.35, 7, s.x, s.y, s.z);
     return s;
 }
 
 /* The view of the blob scene, size x size pixels. */
-static vfx_ref_camera blob_camera(uint32_t size)
+static ref_camera blob_camera(uint32_t size)
 {
-    return (vfx_ref_camera){{0.5, 1.0, 5.0}, {0, 0, 0}, {0, 1, 0}, 0.8, size, size, 0.1, 100};
+    return (ref_camera){{0.5, 1.0, 5.0}, {0, 0, 0}, {0, 1, 0}, 0.8, size, size, 0.1, 100};
 }
 
 /* The h-extreme tests' scene: 64 particles on a 4x4x4 lattice of spacing 0.3 around the
@@ -160,9 +160,9 @@ static scene lattice_scene(uint32_t method, float h)
 }
 
 /* The lattice seen from (0.2, 0.3, dist) at 48x48. */
-static vfx_ref_camera lattice_camera(double dist)
+static ref_camera lattice_camera(double dist)
 {
-    return (vfx_ref_camera){{0.2, 0.3, dist}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
+    return (ref_camera){{0.2, 0.3, dist}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
 }
 
 /* Blobs at 64x64 in 4 chunks: the brute-force march (step h/8, cap 64, 3 regula falsi
@@ -171,9 +171,9 @@ static void test_blobs_vs_reference(void **state)
 {
     (void)state;
     scene s = blob_scene(VFX_WATER_METHOD_BRUTE);
-    vfx_ref_camera cam = blob_camera(64);
+    ref_camera cam = blob_camera(64);
     vfx_stats st;
-    vfx_water_ref_error e = render_and_compare(&s, &cam, &st);
+    ref_water_error e = render_and_compare(&s, &cam, &st);
     print_message("blobs: ref hits %u holes %.4f false %.4f dist mean %.2e p99 %.2e (x h)\n",
                   e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_mean_rel_h, e.dist_p99_rel_h);
     assert_true(e.ref_hits > 400);
@@ -197,12 +197,12 @@ static void test_one_particle_and_camera_inside(void **state)
     scene s = make_scene(1);
     s.params.method = m; /* PAPER, BRUTE, GRID */
     s.x[0] = s.y[0] = s.z[0] = 0;
-    vfx_ref_camera cam = {{0, 0, 1.0}, {0, 0, 0}, {0, 1, 0}, 0.5, 48, 48, 0.1, 100};
-    vfx_water_ref_error e = render_and_compare(&s, &cam, NULL);
+    ref_camera cam = {{0, 0, 1.0}, {0, 0, 0}, {0, 1, 0}, 0.5, 48, 48, 0.1, 100};
+    ref_water_error e = render_and_compare(&s, &cam, NULL);
     assert_true(e.ref_hits > 50);
     assert_true(e.hole_rate < 0.05 && e.false_hit_rate < 0.01); /* only grazing pixels */
     assert_true(e.dist_p99_rel_h < 1e-2);
-    vfx_ref_camera inside = {{0.01, 0, 0.02}, {0, 0, -5}, {0, 1, 0}, 0.8, 32, 32, 0.1, 100};
+    ref_camera inside = {{0.01, 0, 0.02}, {0, 0, -5}, {0, 1, 0}, 0.8, 32, 32, 0.1, 100};
     e = render_and_compare(&s, &inside, NULL);
     assert_int_equal(e.ref_hits, 32 * 32);
     assert_true(e.hole_rate == 0.0 && e.dist_p99_rel_h < 1e-6);
@@ -221,9 +221,9 @@ static void test_coincident_and_nan(void **state)
     for (uint32_t k = 0; k < 12; ++k) s.x[k] = s.y[k] = s.z[k] = 0.25f;
     s.x[3] = NAN;
     s.y[7] = INFINITY;
-    vfx_ref_camera cam = {{0, 0, 3.0}, {0.25, 0.25, 0.25}, {0, 1, 0}, 0.6, 48, 48, 0.1, 100};
+    ref_camera cam = {{0, 0, 3.0}, {0.25, 0.25, 0.25}, {0, 1, 0}, 0.6, 48, 48, 0.1, 100};
     vfx_stats st;
-    vfx_water_ref_error e = render_and_compare(&s, &cam, &st);
+    ref_water_error e = render_and_compare(&s, &cam, &st);
     assert_true(stat_of(&st, "water.nan_skipped") == 2);
     assert_true(e.ref_hits > 50);
     assert_true(e.hole_rate < 0.05 && e.false_hit_rate < 0.01);
@@ -241,8 +241,8 @@ static void test_h_huge_and_tiny(void **state)
     const float hs[2] = {3.0f, 0.08f};
     for (int k = 0; k < 2; ++k) {
         scene s = lattice_scene(VFX_WATER_METHOD_PAPER, hs[k]);
-        vfx_ref_camera cam = lattice_camera(k == 0 ? 9.0 : 1.6);
-        vfx_water_ref_error e = render_and_compare(&s, &cam, NULL);
+        ref_camera cam = lattice_camera(k == 0 ? 9.0 : 1.6);
+        ref_water_error e = render_and_compare(&s, &cam, NULL);
         print_message("h %.2f: ref hits %u holes %.4f false %.4f dist p99 %.2e (x h)\n", hs[k],
                       e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_p99_rel_h);
         assert_true(e.ref_hits > 20);
@@ -259,9 +259,9 @@ static void test_paper_blobs_vs_reference(void **state)
 {
     (void)state;
     scene s = blob_scene(VFX_WATER_METHOD_PAPER);
-    vfx_ref_camera cam = blob_camera(64);
+    ref_camera cam = blob_camera(64);
     vfx_stats st;
-    vfx_water_ref_error e = render_and_compare(&s, &cam, &st);
+    ref_water_error e = render_and_compare(&s, &cam, &st);
     print_message("paper blobs: ref hits %u holes %.4f false %.4f dist mean %.2e p99 %.2e (x h) samples %.0f culled %.0f\n",
                   e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_mean_rel_h, e.dist_p99_rel_h,
                   stat_of(&st, "water.samples"), stat_of(&st, "water.fragments_culled"));
@@ -283,9 +283,9 @@ static void test_paper_ablation_bits(void **state)
         scene s = make_scene(200);
         s.params.method = VFX_WATER_METHOD_PAPER;
         s.params.disable = bits[b];
-        vfx_water_ref_blobs(s.n, 3, 0.8, 0.3, 11, s.x, s.y, s.z);
-        vfx_ref_camera cam = {{0.3, 0.8, 4.0}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
-        vfx_water_ref_error e = render_and_compare(&s, &cam, NULL);
+        ref_water_blobs(s.n, 3, 0.8, 0.3, 11, s.x, s.y, s.z);
+        ref_camera cam = {{0.3, 0.8, 4.0}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
+        ref_water_error e = render_and_compare(&s, &cam, NULL);
         print_message("disable 0x%x: ref hits %u holes %.4f false %.4f dist mean %.2e p99 %.2e (x h)\n",
                       bits[b], e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_mean_rel_h, e.dist_p99_rel_h);
         assert_true(e.ref_hits > 200);
@@ -312,9 +312,9 @@ static void test_grid_blobs_vs_reference(void **state)
     for (int k = 0; k < 2; ++k) {
         scene s = blob_scene(VFX_WATER_METHOD_GRID);
         s.params.disable = k ? VFX_WATER_NO_SKIP : 0;
-        vfx_ref_camera cam = blob_camera(64);
+        ref_camera cam = blob_camera(64);
         vfx_stats st;
-        vfx_water_ref_error e = render_and_compare(&s, &cam, &st);
+        ref_water_error e = render_and_compare(&s, &cam, &st);
         samples[k] = stat_of(&st, "water.samples");
         print_message("grid blobs%s: ref hits %u holes %.4f false %.4f dist mean %.2e p99 %.2e (x h) samples %.0f cells %.0f visited %.0f\n",
                       k ? " (no skip)" : "", e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_mean_rel_h,
@@ -344,9 +344,9 @@ static void test_grid_h_extremes(void **state)
     const float hs[2] = {3.0f, 0.08f};
     for (int k = 0; k < 2; ++k) {
         scene s = lattice_scene(VFX_WATER_METHOD_GRID, hs[k]);
-        vfx_ref_camera cam = lattice_camera(k == 0 ? 9.0 : 1.6);
+        ref_camera cam = lattice_camera(k == 0 ? 9.0 : 1.6);
         vfx_stats st;
-        vfx_water_ref_error e = render_and_compare(&s, &cam, &st);
+        ref_water_error e = render_and_compare(&s, &cam, &st);
         print_message("grid h %.2f: ref hits %u holes %.4f false %.4f dist p99 %.2e (x h), %.0f cells\n", hs[k],
                       e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_p99_rel_h, stat_of(&st, "water.grid_cells"));
         assert_true(e.ref_hits > 20);
@@ -364,9 +364,9 @@ static void test_grid_h_extremes(void **state)
     s.x[1] = 1000.0f;
     s.y[1] = s.z[1] = 0;
     /* sphere radius h(1 - T) = 2.3e-4 seen from 1e-2 away: about 18 pixels across */
-    vfx_ref_camera cam = {{0, 0, 1e-2}, {0, 0, 0}, {0, 1, 0}, 0.06, 32, 32, 1e-4, 100};
+    ref_camera cam = {{0, 0, 1e-2}, {0, 0, 0}, {0, 1, 0}, 0.06, 32, 32, 1e-4, 100};
     vfx_stats st;
-    vfx_water_ref_error e = render_and_compare(&s, &cam, &st);
+    ref_water_error e = render_and_compare(&s, &cam, &st);
     print_message("grid h 1e-3, 1000 apart: ref hits %u holes %.4f false %.4f dist p99 %.2e (x h), cell %.3g, %.0f cells\n",
                   e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_p99_rel_h,
                   stat_of(&st, "water.grid_cell_size"), stat_of(&st, "water.grid_cells"));
@@ -390,9 +390,9 @@ static void test_grid_all_nan(void **state)
     s.params.method = VFX_WATER_METHOD_GRID;
     for (uint32_t k = 0; k < 5; ++k) s.x[k] = s.y[k] = s.z[k] = 0;
     s.x[0] = NAN; s.y[1] = INFINITY; s.z[2] = -INFINITY; s.x[3] = NAN; s.y[4] = NAN;
-    vfx_ref_camera cam = {{0, 0, 2.0}, {0, 0, 0}, {0, 1, 0}, 0.6, 16, 16, 0.1, 100};
+    ref_camera cam = {{0, 0, 2.0}, {0, 0, 0}, {0, 1, 0}, 0.6, 16, 16, 0.1, 100};
     vfx_stats st;
-    vfx_water_ref_error e = render_and_compare(&s, &cam, &st);
+    ref_water_error e = render_and_compare(&s, &cam, &st);
     assert_int_equal(e.ref_hits, 0);
     assert_true(e.false_hit_rate == 0.0);
     assert_true(stat_of(&st, "water.nan_skipped") == 5);
@@ -410,10 +410,10 @@ static void test_loop_budget_4096(void **state)
     for (uint32_t m = 1; m < 3; ++m) {
         scene s = make_scene(4096);
         s.params.method = m;
-        vfx_water_ref_layers(s.n, 0.3, s.x, s.y, s.z);
+        ref_water_layers(s.n, 0.3, s.x, s.y, s.z);
         double top = (double)((s.n - 1) / 576) * 0.3;
-        vfx_ref_camera cam = {{0, top + 4.0, 8.0}, {0, top * 0.5, 0}, {0, 1, 0}, 0.9, 20, 20, 0.1, 100};
-        vfx_water_ref_error e = render_and_compare(&s, &cam, NULL);
+        ref_camera cam = {{0, top + 4.0, 8.0}, {0, top * 0.5, 0}, {0, 1, 0}, 0.9, 20, 20, 0.1, 100};
+        ref_water_error e = render_and_compare(&s, &cam, NULL);
         print_message("%s 4096 layers: ref hits %u holes %.4f false %.4f dist p99 %.2e (x h)\n", m == 1 ? "brute" : "grid",
                       e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_p99_rel_h);
         assert_true(e.ref_hits > 100);
@@ -431,17 +431,17 @@ static void test_unknown_method(void **state)
     s.params.method = 7;
     for (uint32_t k = 0; k < 3; ++k) s.x[k] = s.y[k] = s.z[k] = 0.1f * (float)k;
     vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &s,
-                         .log = vfx_test_log_fn, .particle_chunk_count = chunk_count,
+                         .log = test_log_fn, .particle_chunk_count = chunk_count,
                          .particle_chunk = chunk_view, .water_params = water_params};
     vfx_plugin_api api = {.size = sizeof api};
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     vfx_context *ctx;
     assert_int_equal(api.create(&host, &ctx), VFX_OK);
-    vfx_ref_camera cam = {{0, 0, 3.0}, {0, 0, 0}, {0, 1, 0}, 0.6, 16, 16, 0.1, 100};
+    ref_camera cam = {{0, 0, 3.0}, {0, 0, 0}, {0, 1, 0}, 0.6, 16, 16, 0.1, 100};
     vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = 0,
                          .width = 16, .height = 16, .fov_y = 0.6f, .near_plane = 0.1f, .far_plane = 100.0f};
     fv.eye[2] = 3.0f;
-    vfx_ref_camera_matrices(&cam, fv.view, fv.proj);
+    ref_camera_matrices(&cam, fv.view, fv.proj);
     assert_int_equal(api.update(ctx, 0.0, 0.0f), VFX_OK);
     assert_int_equal(api.render(ctx, &fv), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(api.last_error(ctx), "unknown method 7"));
@@ -454,7 +454,7 @@ static void test_zero_particles(void **state)
 {
     (void)state;
     scene s = make_scene(0);
-    vfx_ref_camera cam = {{0, 0, 3.0}, {0, 0, 0}, {0, 1, 0}, 0.6, 16, 16, 0.1, 100};
+    ref_camera cam = {{0, 0, 3.0}, {0, 0, 0}, {0, 1, 0}, 0.6, 16, 16, 0.1, 100};
     vfx_stats st;
     render_and_compare(&s, &cam, &st);
     assert_int_equal(st.count, 0);
@@ -462,7 +462,7 @@ static void test_zero_particles(void **state)
 }
 
 /* ------------------------------------------------ shading, chunking, counters (several frames)
- * The surface gradient (vfx_water_debug_gradient) against the reference normals, shaded pixels
+ * The surface gradient (volfx_water_debug_gradient) against the reference normals, shaded pixels
  * against the shading formula on those normals, multi-buffer chunking against one buffer,
  * counters through the asynchronous ring. */
 
@@ -476,13 +476,13 @@ typedef struct session {
     float host[4];
 } session;
 
-static void session_open(session *ss, scene *s, const vfx_ref_camera *cam, const float host[4],
+static void session_open(session *ss, scene *s, const ref_camera *cam, const float host[4],
                          uint32_t buffer_cap, bool sync)
 {
     memset(ss, 0, sizeof *ss);
     /* the plugin keeps a copy of the table */
     vfx_host_api host_api = {.size = sizeof host_api, .version = VFX_HOST_API_VERSION, .user = s,
-                             .log = vfx_test_log_fn, .particle_chunk_count = chunk_count,
+                             .log = test_log_fn, .particle_chunk_count = chunk_count,
                              .particle_chunk = chunk_view, .water_params = water_params};
     ss->api.size = sizeof ss->api;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
@@ -502,7 +502,7 @@ static void session_open(session *ss, scene *s, const vfx_ref_camera *cam, const
                               .color_texture = ss->scene_col, .width = w, .height = h,
                               .fov_y = (float)cam->fov_y, .near_plane = 0.1f, .far_plane = 100.0f};
     for (int k = 0; k < 3; ++k) ss->fv.eye[k] = (float)cam->eye[k];
-    vfx_ref_camera_matrices(cam, ss->fv.view, ss->fv.proj);
+    ref_camera_matrices(cam, ss->fv.view, ss->fv.proj);
 }
 
 static vfx_result session_frame(session *ss)
@@ -532,17 +532,17 @@ static void session_close(session *ss)
     glDeleteTextures(2, t);
 }
 
-static void reference_image(const scene *s, const vfx_ref_camera *cam, float *dist, float *normal)
+static void reference_image(const scene *s, const ref_camera *cam, float *dist, float *normal)
 {
     double fwd[3], right[3], up[3];
-    vfx_ref_camera_basis(cam, fwd, right, up);
-    vfx_water_ref_camera rc = {{cam->eye[0], cam->eye[1], cam->eye[2]}, {fwd[0], fwd[1], fwd[2]},
+    ref_camera_basis(cam, fwd, right, up);
+    ref_water_camera rc = {{cam->eye[0], cam->eye[1], cam->eye[2]}, {fwd[0], fwd[1], fwd[2]},
                                {up[0], up[1], up[2]}, cam->fov_y, cam->width, cam->height};
-    vfx_water_ref_params rp = vfx_water_ref_default_params();
+    ref_water_params rp = ref_water_default_params();
     rp.h = s->params.h > 0 ? s->params.h : 0.61;
     rp.step = rp.h / 32;
     char err[256];
-    assert_int_equal(vfx_water_ref_render(&rc, s->x, s->y, s->z, s->n, &rp, dist, normal, NULL, err), 0);
+    assert_int_equal(ref_water_render(&rc, s->x, s->y, s->z, s->n, &rp, dist, normal, NULL, err), 0);
 }
 
 static double stat_of_ctx(session *ss, const char *name)
@@ -559,7 +559,7 @@ static void test_normals_vs_reference(void **state)
     (void)state;
     for (uint32_t m = 0; m < 2; ++m) {
         scene s = blob_scene(m);
-        vfx_ref_camera cam = blob_camera(64);
+        ref_camera cam = blob_camera(64);
         const size_t n = 64 * 64;
         static const float black[4] = {0, 0, 0, 1};
         session ss;
@@ -568,7 +568,7 @@ static void test_normals_vs_reference(void **state)
         float *dist = malloc(n * 4), *grad = malloc(n * 16), *nrm = malloc(n * 12);
         float *rdist = malloc(n * 4), *rnrm = malloc(n * 12);
         assert_int_equal(ss.api.read_raw(ss.ctx, VFX_EFFECT_WATER, dist, n), VFX_OK);
-        assert_int_equal(vfx_water_debug_gradient(ss.ctx, grad, n * 4), VFX_OK);
+        assert_int_equal(volfx_water_debug_gradient(ss.ctx, grad, n * 4), VFX_OK);
         double pot_err = 0;
         const double T = 0.765625;
         for (size_t i = 0; i < n; ++i) {
@@ -584,8 +584,8 @@ static void test_normals_vs_reference(void **state)
             }
         }
         reference_image(&s, &cam, rdist, rnrm);
-        vfx_water_ref_error e;
-        assert_int_equal(vfx_water_ref_compare(dist, nrm, rdist, rnrm, n, 0.61, &e), 0);
+        ref_water_error e;
+        assert_int_equal(ref_water_compare(dist, nrm, rdist, rnrm, n, 0.61, &e), 0);
         print_message("method %u normals: both hit %u, angle mean %.3f deg p99 %.3f deg, max |sqrt(sum P) - T| %.2e, "
                       "normal frags %.0f culled %.0f\n", m, e.both_hit, e.normal_mean_deg, e.normal_p99_deg, pot_err,
                       stat_of_ctx(&ss, "water.normal_fragments"), stat_of_ctx(&ss, "water.normal_fragments_culled"));
@@ -633,13 +633,13 @@ static void test_shading_pixels(void **state)
     for (int part = 0; part < 2; ++part) {
         scene s = make_scene(part == 0 ? 300 : 1);
         s.params.method = VFX_WATER_METHOD_PAPER;
-        vfx_ref_camera cam = blob_camera(64);
+        ref_camera cam = blob_camera(64);
         if (part == 0) {
-            vfx_water_ref_blobs(s.n, 4, 1.0, 0.35, 7, s.x, s.y, s.z);
+            ref_water_blobs(s.n, 4, 1.0, 0.35, 7, s.x, s.y, s.z);
             s.params.color[0] = s.params.color[1] = s.params.color[2] = 1.0f;
         } else {
             s.x[0] = s.y[0] = s.z[0] = 0;
-            cam = (vfx_ref_camera){{0, 0, 1.0}, {0, 0, 0}, {0, 1, 0}, 0.5, 48, 48, 0.1, 100};
+            cam = (ref_camera){{0, 0, 1.0}, {0, 0, 0}, {0, 1, 0}, 0.5, 48, 48, 0.1, 100};
             s.params.color[0] = 0.2f; s.params.color[1] = 0.5f; s.params.color[2] = 0.8f;
             s.params.absorption = 4.0f;
         }
@@ -671,7 +671,7 @@ static void test_shading_pixels(void **state)
                     continue;
                 }
                 double dir[3], nr[3] = {rnrm[3 * q], rnrm[3 * q + 1], rnrm[3 * q + 2]}, behind[3], want[3];
-                vfx_ref_pixel_ray(&cam, i, j, dir);
+                ref_pixel_ray(&cam, i, j, dir);
                 double thick = 0;
                 if (part == 1) {
                     /* chord of the sphere of radius rho around the origin along this ray */
@@ -717,8 +717,8 @@ static void test_chunked_buffers(void **state)
     (void)state;
     scene s = make_scene(3000);
     s.params.method = VFX_WATER_METHOD_PAPER;
-    vfx_water_ref_blobs(s.n, 5, 1.2, 0.4, 3, s.x, s.y, s.z);
-    vfx_ref_camera cam = {{0.4, 1.2, 6.0}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
+    ref_water_blobs(s.n, 5, 1.2, 0.4, 3, s.x, s.y, s.z);
+    ref_camera cam = {{0.4, 1.2, 6.0}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
     const size_t n = 48 * 48;
     static const float host[4] = {0.2f, 0.4f, 0.6f, 1.0f};
     float *dist[2], *grad[2], *px[2];
@@ -732,7 +732,7 @@ static void test_chunked_buffers(void **state)
         dist[k] = malloc(n * 4);
         grad[k] = malloc(n * 16);
         assert_int_equal(ss.api.read_raw(ss.ctx, VFX_EFFECT_WATER, dist[k], n), VFX_OK);
-        assert_int_equal(vfx_water_debug_gradient(ss.ctx, grad[k], n * 4), VFX_OK);
+        assert_int_equal(volfx_water_debug_gradient(ss.ctx, grad[k], n * 4), VFX_OK);
         px[k] = session_pixels(&ss);
         frags[k] = stat_of_ctx(&ss, "water.potential_fragments");
         samples[k] = stat_of_ctx(&ss, "water.samples");
@@ -764,7 +764,7 @@ static void test_chunked_buffers(void **state)
 /* A host whose chunk counts overflow: refused in update with a message naming the total and
  * the limit, before any buffer is made or any position read (the columns point at 1 float). */
 typedef struct huge_host {
-    vfx_test_log log;
+    test_log log;
     uint32_t chunks, count;
     float one;
 } huge_host;
@@ -792,7 +792,7 @@ static void test_count_overflow_refused(void **state)
         hh.chunks = chunks[k];
         hh.count = counts[k];
         vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &hh,
-                             .log = vfx_test_log_fn, .particle_chunk_count = huge_chunk_count,
+                             .log = test_log_fn, .particle_chunk_count = huge_chunk_count,
                              .particle_chunk = huge_chunk};
         vfx_plugin_api api = {.size = sizeof api};
         assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
@@ -822,7 +822,7 @@ static void test_async_counters(void **state)
     const uint32_t methods[2] = {VFX_WATER_METHOD_PAPER, VFX_WATER_METHOD_GRID};
     for (int m = 0; m < 2; ++m) {
         scene s = blob_scene(methods[m]);
-        vfx_ref_camera cam = blob_camera(48);
+        ref_camera cam = blob_camera(48);
         static const float host[4] = {0, 0, 0, 1};
         double exact[5], got[5];
         session ss;
@@ -862,7 +862,7 @@ static void test_paper_sample_cap_counted(void **state)
     for (int c = 0; c < 2; ++c) {
         scene s = blob_scene(VFX_WATER_METHOD_PAPER);
         s.params.max_samples = caps[c];
-        vfx_ref_camera cam = blob_camera(48);
+        ref_camera cam = blob_camera(48);
         const size_t n = 48 * 48;
         static const float host[4] = {0, 0, 0, 1};
         session ss;
@@ -871,7 +871,7 @@ static void test_paper_sample_cap_counted(void **state)
         float *dist = malloc(n * 4), *rdist = malloc(n * 4), *rnrm = malloc(n * 12);
         uint8_t *cls = malloc(n);
         assert_int_equal(ss.api.read_raw(ss.ctx, VFX_EFFECT_WATER, dist, n), VFX_OK);
-        assert_int_equal(vfx_water_debug_pixel_class(ss.ctx, cls, n), VFX_OK);
+        assert_int_equal(volfx_water_debug_pixel_class(ss.ctx, cls, n), VFX_OK);
         reference_image(&s, &cam, rdist, rnrm);
         uint32_t count[4] = {0}, ref_hits = 0, holes = 0, holes_cap = 0;
         for (size_t i = 0; i < n; ++i) {
@@ -915,7 +915,7 @@ static void test_grid_rebuild_only_on_change(void **state)
     (void)state;
     scene s = blob_scene(VFX_WATER_METHOD_GRID);
     s.rev = 1;
-    vfx_ref_camera cam = blob_camera(48);
+    ref_camera cam = blob_camera(48);
     const size_t n = 48 * 48;
     static const float host[4] = {0.2f, 0.3f, 0.4f, 1};
     session ss;
@@ -937,7 +937,7 @@ static void test_grid_rebuild_only_on_change(void **state)
         samples[f] = stat_of_ctx(&ss, "water.samples");
     }
     uint8_t cls[1];
-    assert_int_equal(vfx_water_debug_pixel_class(ss.ctx, cls, 1), VFX_ERR_NOT_FOUND); /* PAPER only */
+    assert_int_equal(volfx_water_debug_pixel_class(ss.ctx, cls, 1), VFX_ERR_NOT_FOUND); /* PAPER only */
     assert_memory_equal(dist[0], dist[1], n * 4);
     assert_memory_equal(px[0], px[1], n * 16);
     assert_true(samples[0] == samples[1] && samples[0] > 0);
@@ -945,8 +945,8 @@ static void test_grid_rebuild_only_on_change(void **state)
     for (size_t i = 0; i < n; ++i) changed += (dist[0][i] >= 0) != (dist[2][i] >= 0);
     float *rdist = malloc(n * 4), *rnrm = malloc(n * 12);
     reference_image(&s, &cam, rdist, rnrm);
-    vfx_water_ref_error e;
-    assert_int_equal(vfx_water_ref_compare(dist[2], NULL, rdist, NULL, n, 0.61, &e), 0);
+    ref_water_error e;
+    assert_int_equal(ref_water_compare(dist[2], NULL, rdist, NULL, n, 0.61, &e), 0);
     print_message("grid rebuild: %u pixels changed coverage after the move; moved frame holes %.4f false %.4f p99 %.2e h\n",
                   changed, e.hole_rate, e.false_hit_rate, e.dist_p99_rel_h);
     /* the lone sphere of radius h(1 - T) = 0.14 at ~5.5 from the eye covers ~5 pixels here,
@@ -974,7 +974,7 @@ static void test_grid_rebuild_only_on_change(void **state)
 
 int main(void)
 {
-    vfx_gl_context *gl = vfx_test_gl_or_skip();
+    rt_gl_context *gl = test_gl_or_skip();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_blobs_vs_reference),
         cmocka_unit_test(test_normals_vs_reference),
@@ -997,6 +997,6 @@ int main(void)
         cmocka_unit_test(test_loop_budget_4096),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
-    vfx_gl_context_destroy(gl); /* LeakSanitizer in CI's sanitizer run checks this */
+    rt_gl_context_destroy(gl); /* LeakSanitizer in CI's sanitizer run checks this */
     return rc;
 }

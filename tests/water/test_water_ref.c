@@ -11,9 +11,9 @@
 
 #include "water/water_ref.h"
 
-static vfx_water_ref_camera camera_z(uint32_t w, uint32_t h, double eye_z, double fov_deg)
+static ref_water_camera camera_z(uint32_t w, uint32_t h, double eye_z, double fov_deg)
 {
-    vfx_water_ref_camera c = {{0, 0, eye_z}, {0, 0, -1}, {0, 1, 0}, fov_deg * M_PI / 180.0, w, h};
+    ref_water_camera c = {{0, 0, eye_z}, {0, 0, -1}, {0, 1, 0}, fov_deg * M_PI / 180.0, w, h};
     return c;
 }
 
@@ -21,18 +21,18 @@ static vfx_water_ref_camera camera_z(uint32_t w, uint32_t h, double eye_z, doubl
 static void test_single_particle_is_sphere(void **state)
 {
     (void)state;
-    vfx_water_ref_params p = vfx_water_ref_default_params();
+    ref_water_params p = ref_water_default_params();
     const float x = 0.1f, y = -0.05f, z = 0.0f;
-    vfx_water_ref_camera cam = camera_z(64, 64, 1.0, 30.0);
+    ref_water_camera cam = camera_z(64, 64, 1.0, 30.0);
     float *dist = malloc(64 * 64 * sizeof *dist), *nrm = malloc(3 * 64 * 64 * sizeof *nrm);
     char err[256];
-    assert_int_equal(vfx_water_ref_render(&cam, &x, &y, &z, 1, &p, dist, nrm, NULL, err), 0);
+    assert_int_equal(ref_water_render(&cam, &x, &y, &z, 1, &p, dist, nrm, NULL, err), 0);
     double R = p.h * (1.0 - p.threshold), c[3] = {x, y, z};
     uint32_t hits = 0;
     for (uint32_t j = 0; j < 64; ++j)
         for (uint32_t i = 0; i < 64; ++i) {
             double d[3], oc[3];
-            vfx_water_ref_pixel_dir(&cam, i, j, d);
+            ref_water_pixel_dir(&cam, i, j, d);
             for (int k = 0; k < 3; ++k) oc[k] = cam.eye[k] - c[k];
             double b = oc[0] * d[0] + oc[1] * d[1] + oc[2] * d[2];
             double disc = b * b - (oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2] - R * R);
@@ -64,20 +64,20 @@ static void test_single_particle_is_sphere(void **state)
 static void test_two_particles_waist(void **state)
 {
     (void)state;
-    vfx_water_ref_params p = vfx_water_ref_default_params();
+    ref_water_params p = ref_water_default_params();
     double d = 0.4;
     float x[2] = {(float)(-d / 2), (float)(d / 2)}, y[2] = {0, 0}, z[2] = {0, 0};
-    vfx_water_ref_camera cam = camera_z(33, 33, 2.0, 20.0);
+    ref_water_camera cam = camera_z(33, 33, 2.0, 20.0);
     float dist[33 * 33];
     char err[256];
-    assert_int_equal(vfx_water_ref_render(&cam, x, y, z, 2, &p, dist, NULL, NULL, err), 0);
+    assert_int_equal(ref_water_render(&cam, x, y, z, 2, &p, dist, NULL, NULL, err), 0);
     double dd = (double)x[1] - x[0];
     double r = p.h * (1 - p.threshold / sqrt(2.0));
     double s = sqrt(r * r - dd * dd / 4);
     assert_true(fabs(dist[16 * 33 + 16] - (2.0 - s)) < 1e-6);
     /* Separated (d > 2h): two spheres, the gap at x = 0 is a miss. */
     x[0] = -0.7f; x[1] = 0.7f;
-    assert_int_equal(vfx_water_ref_render(&cam, x, y, z, 2, &p, dist, NULL, NULL, err), 0);
+    assert_int_equal(ref_water_render(&cam, x, y, z, 2, &p, dist, NULL, NULL, err), 0);
     assert_true(dist[16 * 33 + 16] < 0);
 }
 
@@ -89,20 +89,20 @@ static void test_blobs_against_brute_force_field(void **state)
     (void)state;
     enum { N = 300, W = 48, H = 40 };
     float x[N], y[N], z[N];
-    vfx_water_ref_blobs(N, 4, 1.0, 0.35, 7, x, y, z);
-    vfx_water_ref_params p = vfx_water_ref_default_params();
-    vfx_water_ref_camera cam = {{0.3, 0.5, 4.0}, {-0.05, -0.1, -1}, {0, 1, 0}, 0.9, W, H};
+    ref_water_blobs(N, 4, 1.0, 0.35, 7, x, y, z);
+    ref_water_params p = ref_water_default_params();
+    ref_water_camera cam = {{0.3, 0.5, 4.0}, {-0.05, -0.1, -1}, {0, 1, 0}, 0.9, W, H};
     float dist[W * H], nrm[3 * W * H], dist2[W * H];
     char err[256];
-    vfx_water_ref_stats st;
-    assert_int_equal(vfx_water_ref_render(&cam, x, y, z, N, &p, dist, nrm, &st, err), 0);
+    ref_water_stats st;
+    assert_int_equal(ref_water_render(&cam, x, y, z, N, &p, dist, nrm, &st, err), 0);
     assert_true(st.hits > W * H / 10);
     for (uint32_t pix = 0; pix < W * H; ++pix) {
         if (dist[pix] < 0) continue;
         double dir[3], q[3], g[3];
-        vfx_water_ref_pixel_dir(&cam, pix % W, pix / W, dir);
+        ref_water_pixel_dir(&cam, pix % W, pix / W, dir);
         for (int k = 0; k < 3; ++k) q[k] = cam.eye[k] + dist[pix] * dir[k];
-        double f = vfx_water_ref_field(x, y, z, N, &p, q, g);
+        double f = ref_water_field(x, y, z, N, &p, q, g);
         /* float32 t (rel 6e-8 of t ~ 4) times |grad I| (<= a few / h): well under 1e-4 */
         assert_true(fabs(f) < 1e-4);
         double gl = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
@@ -110,9 +110,9 @@ static void test_blobs_against_brute_force_field(void **state)
         assert_true(dot > 1 - 1e-3);
     }
     p.step = p.h / 64;
-    assert_int_equal(vfx_water_ref_render(&cam, x, y, z, N, &p, dist2, NULL, NULL, err), 0);
-    vfx_water_ref_error e;
-    assert_int_equal(vfx_water_ref_compare(dist, NULL, dist2, NULL, W * H, p.h, &e), 0);
+    assert_int_equal(ref_water_render(&cam, x, y, z, N, &p, dist2, NULL, NULL, err), 0);
+    ref_water_error e;
+    assert_int_equal(ref_water_compare(dist, NULL, dist2, NULL, W * H, p.h, &e), 0);
     /* Halving the step only finds features thinner than h/32: at most a few pixels. */
     assert_true(e.hole_rate < 0.01);
     assert_true(e.false_hit_rate == 0.0);
@@ -125,14 +125,14 @@ static void test_nan_particles_skipped(void **state)
     (void)state;
     float x[3] = {0, NAN, 0.2f}, y[3] = {0, 0, INFINITY}, z[3] = {0, 0, 0};
     float xs[1] = {0}, ys[1] = {0}, zs[1] = {0};
-    vfx_water_ref_params p = vfx_water_ref_default_params();
-    vfx_water_ref_camera cam = camera_z(32, 32, 1.0, 30.0);
+    ref_water_params p = ref_water_default_params();
+    ref_water_camera cam = camera_z(32, 32, 1.0, 30.0);
     float a[32 * 32], b[32 * 32];
-    vfx_water_ref_stats st;
+    ref_water_stats st;
     char err[256];
-    assert_int_equal(vfx_water_ref_render(&cam, x, y, z, 3, &p, a, NULL, &st, err), 0);
+    assert_int_equal(ref_water_render(&cam, x, y, z, 3, &p, a, NULL, &st, err), 0);
     assert_int_equal(st.nan_skipped, 2);
-    assert_int_equal(vfx_water_ref_render(&cam, xs, ys, zs, 1, &p, b, NULL, NULL, err), 0);
+    assert_int_equal(ref_water_render(&cam, xs, ys, zs, 1, &p, b, NULL, NULL, err), 0);
     assert_memory_equal(a, b, sizeof a);
     assert_true(st.hits > 0);
 }
@@ -140,22 +140,22 @@ static void test_nan_particles_skipped(void **state)
 static void test_zero_particles_and_eye_inside(void **state)
 {
     (void)state;
-    vfx_water_ref_params p = vfx_water_ref_default_params();
-    vfx_water_ref_camera cam = camera_z(16, 16, 0.0, 60.0);
+    ref_water_params p = ref_water_default_params();
+    ref_water_camera cam = camera_z(16, 16, 0.0, 60.0);
     float d[256];
     char err[256];
-    vfx_water_ref_stats st;
-    assert_int_equal(vfx_water_ref_render(&cam, NULL, NULL, NULL, 0, &p, d, NULL, &st, err), 0);
+    ref_water_stats st;
+    assert_int_equal(ref_water_render(&cam, NULL, NULL, NULL, 0, &p, d, NULL, &st, err), 0);
     for (int k = 0; k < 256; ++k) assert_true(d[k] == -1.0f);
     assert_int_equal(st.samples, 0);
     /* Eye at the centre of one particle: I > 0 at the eye, every ray starts inside: t = 0. */
     float x = 0, y = 0, z = 0;
-    assert_int_equal(vfx_water_ref_render(&cam, &x, &y, &z, 1, &p, d, NULL, NULL, err), 0);
+    assert_int_equal(ref_water_render(&cam, &x, &y, &z, 1, &p, d, NULL, NULL, err), 0);
     for (int k = 0; k < 256; ++k) assert_true(d[k] == 0.0f);
     /* Bad camera: refused with a message. */
     cam.width = 0;
     err[0] = 0;
-    assert_int_equal(vfx_water_ref_render(&cam, &x, &y, &z, 1, &p, d, NULL, NULL, err), -1);
+    assert_int_equal(ref_water_render(&cam, &x, &y, &z, 1, &p, d, NULL, NULL, err), -1);
     assert_true(strstr(err, "camera") != NULL);
 }
 
@@ -164,14 +164,14 @@ static void test_zero_particles_and_eye_inside(void **state)
 static void test_tiny_h(void **state)
 {
     (void)state;
-    vfx_water_ref_params p = vfx_water_ref_default_params();
+    ref_water_params p = ref_water_default_params();
     p.h = 1e-3;
     p.step = p.h / 32;
     float x[2] = {0, 1000}, y[2] = {0, 1000}, z[2] = {0, -1000};
-    vfx_water_ref_camera cam = camera_z(9, 9, 0.01, 1.0);
+    ref_water_camera cam = camera_z(9, 9, 0.01, 1.0);
     float d[81];
     char err[256];
-    assert_int_equal(vfx_water_ref_render(&cam, x, y, z, 2, &p, d, NULL, NULL, err), 0);
+    assert_int_equal(ref_water_render(&cam, x, y, z, 2, &p, d, NULL, NULL, err), 0);
     double R = p.h * (1 - p.threshold);
     assert_true(fabs(d[4 * 9 + 4] - (0.01 - R)) < 1e-7);
 }
@@ -181,8 +181,8 @@ static void test_compare_metrics(void **state)
     (void)state;
     float ref[4] = {1.0f, 2.0f, -1.0f, -1.0f}, got[4] = {1.061f, -1.0f, 3.0f, -1.0f};
     float rn[12] = {0, 0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 0}, gn[12] = {0, 1, 1, 0, 0, 1, 0, 0, 0, 0, 0, 0};
-    vfx_water_ref_error e;
-    assert_int_equal(vfx_water_ref_compare(got, gn, ref, rn, 4, 0.61, &e), 0);
+    ref_water_error e;
+    assert_int_equal(ref_water_compare(got, gn, ref, rn, 4, 0.61, &e), 0);
     assert_true(fabs(e.hole_rate - 0.5) < 1e-12);
     assert_true(fabs(e.false_hit_rate - 0.5) < 1e-12);
     assert_true(fabs(e.dist_mean_rel_h - 0.1) < 1e-5);
@@ -195,7 +195,7 @@ static void test_layers(void **state)
     (void)state;
     enum { N = 4096 };
     float *x = malloc(N * sizeof *x), *y = malloc(N * sizeof *y), *z = malloc(N * sizeof *z);
-    vfx_water_ref_layers(N, 0.3, x, y, z);
+    ref_water_layers(N, 0.3, x, y, z);
     assert_true(fabs(x[0] + 11.5f * 0.3f) < 1e-6 && fabs(x[23] - 11.5f * 0.3f) < 1e-6);
     assert_true(y[575] == 0.0f && fabs(y[576] - 0.3f) < 1e-6);
     assert_true(fabs(y[N - 1] - 7 * 0.3f) < 1e-6); /* 4096 = 7 full layers + 64 */
