@@ -14,7 +14,7 @@
 #include "gfx/renderer.h"
 #include "host/plugin_host.h"
 #include "profile/profiler.h"
-#include "reference/reference.h"
+#include "camera_ref.h"
 
 #define GAME_APP_MAX_BEAMS 1024
 #define GAME_APP_MAX_VOLUMES 4

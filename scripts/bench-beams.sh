@@ -9,7 +9,7 @@
 set -e
 cd "$(dirname "$0")/.."
 B=${1:-${VFX_BUILD_DIR:-build}}
-bench="$B/sample_game/volfx-bench"
+bench="$B/bench/volfx-bench"
 py=/usr/bin/python3
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')
 if [ "${VFX_BEAMS_DOC_ONLY:-0}" = 1 ]; then
@@ -19,7 +19,7 @@ $(head -1 docs/img/beams-cpu.jsonl | sed 's/^# //')
 HEAD
   when="$when_d $when_t UTC"; load=$(echo "$load" | tr , ' '); load_end=$(echo "$load_end" | tr , ' ')
 else
-  ninja -C "$B" sample_game/volfx-bench >/dev/null
+  ninja -C "$B" bench/volfx-bench >/dev/null
   when=$(date -u +%Y-%m-%d\ %H:%M\ UTC)
   load=$(cut -d' ' -f1-3 /proc/loadavg)
   "$bench" beams --reps 5 --json > docs/img/beams-cpu.jsonl.tmp
@@ -53,7 +53,7 @@ its float32 inputs allow.
 
 \`volfx-bench beams --reps 5 --json\` (docs/img/beams-cpu.jsonl), median of 5 runs. Scene:
 pinhole camera, 60 degrees, beams of L = 2.5, R = 0.6, a = b = 0.3, eps = 0 fired across the view
-(sample_game/beams/bench_beams.c). Ray marching: midpoint rule with n samples over the part of the
+(bench/bench_beams.c). Ray marching: midpoint rule with n samples over the part of the
 ray inside the beams' bounding spheres, density in float64, sum in float32. "x closed": time
 ratio to the closed form in the same run.
 
@@ -67,7 +67,7 @@ cat <<'MID'
 
 `volfx-bench beams --gpu --frames 6 --json` (docs/img/beams-gpu.jsonl). GPU ms: median of the
 `beams.integrate` / `beams.march` timestamp queries over 6 frames. Beams fired across the view,
-L = 3, R = 0.5, a = b = 0.3, eps = 0 (sample_game/beams/bench_beams_gpu.c).
+L = 3, R = 0.5, a = b = 0.3, eps = 0 (bench/bench_beams_gpu.c).
 
 MID
 $py scripts/beams-tables.py gpu docs/img/beams-gpu.jsonl
@@ -76,7 +76,7 @@ cat <<END
 The first table is Table 4.2 with the marching baseline; the second is 100 and 1,000 beams at
 1920x1080 (\`volfx-bench beams --gpu --timing-only --sets 100,1000 --size 1920x1080 --frames 6\`):
 closed form only, no reference, beams spread over the view on a grid (short, thin beams, so a
-16x16 tile sees a few of them; sample_game/beams/bench_beams_gpu.c), frame wall time (the headless
+16x16 tile sees a few of them; bench/bench_beams_gpu.c), frame wall time (the headless
 host waits for the GPU) and the last delivered pass timer; on llvmpipe the per-pixel base cost
 dominates, so 1,000 thin beams need not cost more than 100 thicker ones. The third is the cost
 under animation (every frame changes a, b, M, D, L and R; each configuration is drawn, then drawn

@@ -7,7 +7,7 @@
 set -eu
 cd "$(dirname "$0")/.."
 build=${1:-${VFX_BUILD_DIR:-build-sim}}
-bench="$build/sample_game/volfx-bench"
+bench="$build/bench/volfx-bench"
 [ -x "$bench" ] || { echo "build $bench first (meson setup $build && ninja -C $build)" >&2; exit 1; }
 out=$(mktemp)
 trap 'rm -f "$out"' EXIT

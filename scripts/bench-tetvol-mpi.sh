@@ -10,14 +10,14 @@ set -eu
 cd "$(dirname "$0")/.."
 BUILD=${BUILD:-${VFX_BUILD_DIR:-build}}
 out=${1:-$BUILD/bench-tetvol-mpi.jsonl}
-ninja -C "$BUILD" sample_game/tetvol/volfx-tetvol-mpi
+ninja -C "$BUILD" bench/volfx-tetvol-mpi
 pipe=${VFX_SHARED_DATA:-../shared/data}/tets/pipe_RCR_init_flow.vtu
 if [ -f "$pipe" ]; then mesh="--vtu $pipe --field Velocity"; else mesh="--grid 40"; fi
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 : > "$out"
 for np in ${NPS:-1 2 4 8}; do
   # shellcheck disable=SC2086
-  mpirun --oversubscribe ${MPIRUN_ARGS---mca mpi_yield_when_idle 0} -np "$np" "$BUILD/sample_game/tetvol/volfx-tetvol-mpi" \
+  mpirun --oversubscribe ${MPIRUN_ARGS---mca mpi_yield_when_idle 0} -np "$np" "$BUILD/bench/volfx-tetvol-mpi" \
     $mesh --size "${SIZE:-300}" --view "${VIEW:-Z}" --tau "${TAU:-200}" --repeat "${REPEAT:-3}" \
     >> "$out"
 done

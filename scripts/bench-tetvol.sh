@@ -12,7 +12,7 @@ OUT=$B/bench-tetvol
 PIPE=${PIPE:-${VFX_SHARED_DATA:-../shared/data}/tets/pipe_RCR_init_flow.vtu}
 REPS=${REPS:-5}
 TORUS_REPS=${TORUS_REPS:-3}
-ninja -C "$B" sample_game/volfx-bench >/dev/null
+ninja -C "$B" bench/volfx-bench >/dev/null
 mkdir -p "$OUT"
 [ -f "$B/tetmesh/torus.ele" ] || scripts/make-tet-mesh.sh "$B/tetmesh/torus" >/dev/null
 {
@@ -29,7 +29,7 @@ run() {
     "$@" > "$OUT/$name.jsonl.tmp"
     mv "$OUT/$name.jsonl.tmp" "$OUT/$name.jsonl"
 }
-BENCH=$B/sample_game/volfx-bench
+BENCH=$B/bench/volfx-bench
 HAVE_VTK=
 if command -v xvfb-run >/dev/null && /usr/bin/python3 -c 'import vtk, numpy' 2>/dev/null; then
     HAVE_VTK=1

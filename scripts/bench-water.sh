@@ -17,7 +17,7 @@ SKIPPED="paper 65536 at 512^2 (~5 min a frame); brute 4096 at 256^2 and 512^2, 1
 run() { # section, then volfx-bench metaballs options
   sec=$1; shift
   echo "  $sec: $*" >&2
-  "$B/sample_game/volfx-bench" metaballs --reference "$@" 2>/dev/null | sed "s/^{/{\"section\":\"$sec\",/" >> "$OUT"
+  "$B/bench/volfx-bench" metaballs --reference "$@" 2>/dev/null | sed "s/^{/{\"section\":\"$sec\",/" >> "$OUT"
 }
 want() { [ -z "$SECTION" ] || [ "$SECTION" = "$1" ]; }
 if [ -z "$PLOT_ONLY" ]; then

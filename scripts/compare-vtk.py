@@ -8,7 +8,7 @@ Not part of CI or a README command; needs Debian's VTK, numpy and an X server:
 Usage (from the repository root, after `ninja -C build`):
     xvfb-run -a -s '-screen 0 640x480x24' /usr/bin/python3 scripts/compare-vtk.py \
         --mesh ../shared/data/tets/pipe_RCR_init_flow.vtu [--scalar Velocity] [--view across,axis]
-        [--size 300] [--reps 5] [--bench build/sample_game/volfx-bench] [--png-dir DIR]
+        [--size 300] [--reps 5] [--bench build/bench/volfx-bench] [--png-dir DIR]
 
 volfx-bench tetvol --only image gives the camera (eye, centre, up, fovy, near, far), the
 transfer function and our images (PFM); this script builds the same camera and transfer function
@@ -257,7 +257,7 @@ def main():
     ap.add_argument('--size', type=int, default=300)
     ap.add_argument('--reps', type=int, default=5)
     ap.add_argument('--tau', default='4')
-    ap.add_argument('--bench', default='build/sample_game/volfx-bench')
+    ap.add_argument('--bench', default='build/bench/volfx-bench')
     ap.add_argument('--mappers', default='ZSweep,RayCast,PT')
     ap.add_argument('--integrator', default='homogeneous',
                     choices=['homogeneous', 'linear', 'preintegration', 'default'])

@@ -15,7 +15,7 @@ if [ "${1:-}" != "--skip-effects" ]; then
     "$s"
   done
 fi
-bench="$build/sample_game/volfx-bench"
+bench="$build/bench/volfx-bench"
 ecs=$("$bench" ecs --json 2>/dev/null | tail -1)
 load0=$(cut -d' ' -f1-3 /proc/loadavg)
 frame=$("$bench" frame --frames 20 --json 2>/dev/null | tail -1)

@@ -7,6 +7,7 @@
 
 #include "beams/beam_field.h"
 #include "gpu/gpu.h"
+#include "effect.h"
 
 #define TILE_PX 16
 #define MAX_BEAMS (1u << 20)

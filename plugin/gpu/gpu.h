@@ -4,7 +4,7 @@
 #define VOLFX_GPU_H
 
 #include <epoxy/gl.h>
-#include "plugin_internal.h"
+#include "context.h"
 
 /* Makes the helper state; needs a current GL 4.5 context (checked, VFX_ERR_GL_UNSUPPORTED). */
 vfx_result volfx_gpu_create(vfx_context *ctx, volfx_gpu **out);

@@ -10,7 +10,8 @@
 
 #include "water/water_effect.h"
 #include "gpu/gpu.h"
-#include "plugin_internal.h"
+#include "effect.h"
+#include "context.h"
 #include "water_grid.h"
 
 /* Counter readback ring: frames the GPU may run behind before a result is dropped. */

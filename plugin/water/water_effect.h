@@ -2,7 +2,7 @@
 #ifndef VOLFX_WATER_EFFECT_H
 #define VOLFX_WATER_EFFECT_H
 
-#include "plugin_internal.h"
+#include "context.h"
 
 /* Copies the surface gradient target of the last water render: 4 floats per pixel, top row
  * first, (grad sum P, sum P) at the found surface point, zeros where no water. The shading

@@ -5,7 +5,7 @@
 #define VOLFX_WATER_GRID_H
 
 #include <epoxy/gl.h>
-#include "plugin_internal.h"
+#include "effect.h"
 
 typedef struct volfx_water_grid volfx_water_grid;
 

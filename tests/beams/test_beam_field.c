@@ -1,5 +1,5 @@
 /* test_beam_field.c — the closed form of plugin/beams/beam_field.c against the float64
- * adaptive quadrature of the raw density (sample_game/beams/beams_ref.c): a torture set of
+ * adaptive quadrature of the raw density (reference/beams_ref.c): a torture set of
  * singular and near-singular rays plus seeded random beams and rays.
  *
  * Tolerances.
@@ -24,7 +24,7 @@
 #include <string.h>
 
 #include "beams/beam_field.h"
-#include "beams/beams_ref.h"
+#include "beams_ref.h"
 
 typedef struct tcase {
     const char *name;

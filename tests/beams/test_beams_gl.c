@@ -13,8 +13,8 @@
 #include <string.h>
 
 #include "app.h"
-#include "beams/beams_ref.h"
-#include "plugin_internal.h"
+#include "beams_ref.h"
+#include "debug.h"
 #include "test_util.h"
 
 #define W 64

@@ -8,7 +8,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "tetvol/tet_io.h"
+#include "scene/volume_file.h"
 
 static int write_file(const char *path, const uint8_t *data, size_t size)
 {
@@ -46,7 +46,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     const char *names[2] = {NULL, "attr0"};
     for (int i = 0; i < 2; i++) {
         tet_mesh mesh;
-        if (tet_load_tetgen(base, names[i], &mesh, err, sizeof err) == VFX_OK)
+        if (rt_volume_load_tetgen(base, names[i], &mesh, err, sizeof err) == VFX_OK)
             tet_mesh_free(&mesh);
     }
     return 0;

@@ -3,7 +3,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 
-#include "tetvol/tet_io.h"
+#include "scene/volume_file.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
@@ -12,7 +12,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     const char *names[2] = {NULL, "Velocity"};
     for (int i = 0; i < 2; i++) {
         tet_mesh mesh;
-        if (tet_load_vtu_mem(data, size, names[i], &mesh, err, sizeof err) == VFX_OK)
+        if (rt_volume_load_vtu_mem(data, size, names[i], &mesh, err, sizeof err) == VFX_OK)
             tet_mesh_free(&mesh);
     }
     return 0;

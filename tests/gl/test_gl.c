@@ -14,7 +14,7 @@
 
 #include "app.h"
 #include "gpu/gpu.h"
-#include "plugin_internal.h"
+#include "debug.h"
 #include "test_util.h"
 
 static rt_gl_context *g_gl;

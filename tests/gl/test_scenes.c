@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "demo_scene.h"
-#include "plugin_internal.h"
+#include "debug.h"
 #include "test_util.h"
 
 static void run_scene(const char *file, bool expect_water, bool expect_beams, bool expect_volume)

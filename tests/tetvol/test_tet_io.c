@@ -11,7 +11,7 @@
 #include <string.h>
 #include <zlib.h>
 
-#include "tetvol/tet_io.h"
+#include "scene/volume_file.h"
 
 /* One tet, positively oriented, plus a second one written inverted. */
 #define HEAD "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" " \
@@ -39,7 +39,7 @@ static char *make_ascii(const char *npts, const char *p5, const char *x5, const 
 
 static vfx_result load_str(const char *s, const char *field, tet_mesh *m, char *err)
 {
-    return tet_load_vtu_mem(s, strlen(s), field, m, err, 256);
+    return rt_volume_load_vtu_mem(s, strlen(s), field, m, err, 256);
 }
 
 static void test_ascii_good(void **st)
@@ -130,15 +130,15 @@ static void test_empty_and_not_xml(void **st)
     (void)st;
     tet_mesh m;
     char err[256];
-    assert_int_equal(tet_load_vtu_mem("", 0, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(rt_volume_load_vtu_mem("", 0, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "empty"));
     assert_int_equal(load_str("solid cube\nfacet normal 0 0 1\n", NULL, &m, err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "not valid XML"));
     const char *s = make_ascii("5", "5", "2 2 2", "4", "10");
-    assert_int_equal(tet_load_vtu_mem(s, strlen(s) / 2, NULL, &m, err, sizeof err),
+    assert_int_equal(rt_volume_load_vtu_mem(s, strlen(s) / 2, NULL, &m, err, sizeof err),
                      VFX_ERR_FORMAT); /* truncated */
     assert_non_null(strstr(err, "not valid XML"));
-    assert_int_equal(tet_load_vtu("/nonexistent/x.vtu", NULL, &m, err, sizeof err),
+    assert_int_equal(rt_volume_load_vtu("/nonexistent/x.vtu", NULL, &m, err, sizeof err),
                      VFX_ERR_IO);
 }
 
@@ -245,7 +245,7 @@ static void test_binary_encodings(void **st)
             size_t n = build_binary(buf, sizeof buf, enc, z, 0);
             tet_mesh m;
             char err[256];
-            vfx_result r = tet_load_vtu_mem(buf, n, "P", &m, err, sizeof err);
+            vfx_result r = rt_volume_load_vtu_mem(buf, n, "P", &m, err, sizeof err);
             if (r != VFX_OK)
                 fail_msg("enc %d zlib %d: %s", enc, z, err);
             assert_int_equal(m.tet_count, 2);
@@ -256,19 +256,19 @@ static void test_binary_encodings(void **st)
             tet_mesh_free(&m);
             if (enc != ENC_RAW) {
                 n = build_binary(buf, sizeof buf, enc, z, 1);
-                assert_int_equal(tet_load_vtu_mem(buf, n, "P", &m, err, sizeof err),
+                assert_int_equal(rt_volume_load_vtu_mem(buf, n, "P", &m, err, sizeof err),
                                  VFX_ERR_FORMAT);
                 assert_non_null(strstr(err, "connectivity"));
             }
             if (z) {
                 n = build_binary(buf, sizeof buf, enc, z, 2);
-                assert_int_equal(tet_load_vtu_mem(buf, n, "P", &m, err, sizeof err),
+                assert_int_equal(rt_volume_load_vtu_mem(buf, n, "P", &m, err, sizeof err),
                                  VFX_ERR_FORMAT);
                 assert_non_null(strstr(err, "zlib block 0"));
             }
             if (enc == ENC_RAW) { /* truncated appended data */
                 n = build_binary(buf, sizeof buf, enc, z, 0);
-                assert_int_equal(tet_load_vtu_mem(buf, n - 40, "P", &m, err, sizeof err),
+                assert_int_equal(rt_volume_load_vtu_mem(buf, n - 40, "P", &m, err, sizeof err),
                                  VFX_ERR_FORMAT);
             }
         }
@@ -282,7 +282,7 @@ static void test_pipe(void **st)
     snprintf(path, sizeof path, "%s/tets/pipe_RCR_init_flow.vtu", dir ? dir : "../shared/data");
     tet_mesh m;
     char err[256];
-    vfx_result r = tet_load_vtu(path, "Velocity", &m, err, sizeof err);
+    vfx_result r = rt_volume_load_vtu(path, "Velocity", &m, err, sizeof err);
     if (r != VFX_OK)
         fail_msg("%s", err);
     assert_int_equal(m.point_count, 30211);
@@ -316,31 +316,31 @@ static void test_tetgen(void **st)
                   "5 2 2 2 5\n");
     snprintf(p, sizeof p, "%s.ele", base);
     write_file(p, "2 4 0\n1 1 2 3 4\n2 1 3 2 5\n");
-    assert_int_equal(tet_load_tetgen(base, "attr0", &m, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_volume_load_tetgen(base, "attr0", &m, err, sizeof err), VFX_OK);
     assert_int_equal(m.tet_count, 2);
     assert_int_equal(m.tets[6], 4); /* flipped: q2<->q3 */ /* 1-based 5 -> 4 */
     assert_int_equal(m.inverted_fixed, 1);
     assert_float_equal(m.scalar_min, 1.5f, 0.0f);
     tet_mesh_free(&m);
-    assert_int_equal(tet_load_tetgen(base, "attr3", &m, err, sizeof err), VFX_ERR_NOT_FOUND);
+    assert_int_equal(rt_volume_load_tetgen(base, "attr3", &m, err, sizeof err), VFX_ERR_NOT_FOUND);
     assert_non_null(strstr(err, "attr0..attr0"));
     write_file(p, "2 4 0\n1 1 2 3 4\n2 1 3 2 9\n");
-    assert_int_equal(tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "tetrahedron 1 vertex 3 index 9 out of range"));
     write_file(p, "3 4 0\n1 1 2 3 4\n2 1 3 2 5\n");
-    assert_int_equal(tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "truncated: 2 of 3"));
     write_file(p, "2 4 0\n1 1 2 3 4\n2 1 3 x 5\n");
-    assert_int_equal(tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, ":3: tetrahedron 1"));
     write_file(p, "");
-    assert_int_equal(tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "missing or bad header"));
     snprintf(p, sizeof p, "%s.node", base);
     write_file(p, "5 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 inf\n4 2 2 2\n");
     snprintf(p, sizeof p, "%s.ele", base);
     write_file(p, "1 4 0\n0 0 1 2 3\n");
-    assert_int_equal(tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_NUMERIC);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_NUMERIC);
     assert_non_null(strstr(err, "point 3"));
     remove(p);
     snprintf(p, sizeof p, "%s.node", base);
@@ -387,7 +387,7 @@ static void test_more_malformed(void **st)
     char *mark = strstr(app, "<AppendedData encoding=\"raw\">\n_");
     assert_non_null(mark);
     mark[strlen("<AppendedData encoding=\"raw\">\n")] = 'X';
-    assert_int_equal(tet_load_vtu_mem(app, n, "P", &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(rt_volume_load_vtu_mem(app, n, "P", &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "without its '_' marker"));
     /* point 4 placed on point 0: the second tet (0,2,1,4) has two identical vertices */
     assert_int_equal(load_str(make_ascii("5", "5", "0 0 0", "4", "10"), "P", &m, err), VFX_OK);
@@ -401,12 +401,12 @@ static void test_more_malformed(void **st)
     char p[64];
     snprintf(p, sizeof p, "%s.node", base);
     write_file(p, "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n");
-    assert_int_equal(tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_IO);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_IO);
     assert_non_null(strstr(err, ".ele: cannot open"));
     write_file(p, "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1\n3 0 0 1\n");
     snprintf(p, sizeof p, "%s.ele", base);
     write_file(p, "1 4 0\n0 0 1 2 3\n");
-    assert_int_equal(tet_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, ":4: point 2 has 3 numbers, expected 4"));
     remove(p);
     snprintf(p, sizeof p, "%s.node", base);
@@ -439,7 +439,7 @@ static int run_generated(void)
              base);
     int rc = system(cmd);
     tet_mesh m;
-    vfx_result r = rc == 0 ? tet_load_tetgen(base, "attr0", &m, err, sizeof err) : VFX_ERR_IO;
+    vfx_result r = rc == 0 ? rt_volume_load_tetgen(base, "attr0", &m, err, sizeof err) : VFX_ERR_IO;
     int ok = r == VFX_OK && m.point_count == 2000 && m.tet_count > 5 * 2000 &&
              m.scalar_min >= 0.0f && m.scalar_max <= 2.0f;
     if (r == VFX_OK) {

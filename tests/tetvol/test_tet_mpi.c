@@ -12,9 +12,9 @@
 #include <string.h>
 #include <mpi.h>
 
-#include "tetvol/tet_mpi.h"
-#include "tetvol/tet_render.h"
-#include "tetvol/tet_testmesh.h"
+#include "tet_mpi.h"
+#include "tet_render.h"
+#include "tet_testmesh.h"
 
 
 static int g_rank;

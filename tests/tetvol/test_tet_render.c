@@ -9,7 +9,7 @@
 #include <string.h>
 #include <cmocka.h>
 
-#include "tetvol/tet_render.h"
+#include "tet_render.h"
 
 /* cube [-1,1]^3 split into 5 tets (a corner-cut decomposition), scalar = x+y+z+3 scaled */
 static const float cube_pts[8 * 3] = {-1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1,

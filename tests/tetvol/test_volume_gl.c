@@ -13,10 +13,10 @@
 #include <string.h>
 
 #include "app.h"
-#include "plugin_internal.h"
+#include "debug.h"
 #include "scene/scene.h"
 #include "test_util.h"
-#include "tetvol/tet_render.h"
+#include "tet_render.h"
 
 #define W 48
 #define H 36

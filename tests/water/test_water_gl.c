@@ -1,4 +1,4 @@
-/* GL tests of the water effect against the float64 reference (sample_game/water/water_ref.c):
+/* GL tests of the water effect against the float64 reference (reference/water_ref.c):
  * the GPU distance image (read_raw) is compared pixel by pixel, for the paper's method and the
  * two compute baselines (BRUTE over all particles, GRID over a uniform grid). */
 #include <setjmp.h>
@@ -12,11 +12,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "plugin_internal.h"
-#include "reference/reference.h"
+#include "debug.h"
+#include "camera_ref.h"
 #include "test_util.h"
 #include "water/water_effect.h"
-#include "water/water_ref.h"
+#include "water_ref.h"
 
 typedef struct scene {
     test_log log;

@@ -1,4 +1,4 @@
-/* Tests of the float64 metaball reference itself (sample_game/water/water_ref.c) against
+/* Tests of the float64 metaball reference itself (reference/water_ref.c) against
  * closed forms: one particle is a sphere of radius h(1 - T); two particles' merged waist. */
 #include <math.h>
 #include <setjmp.h>
@@ -9,7 +9,7 @@
 #include <string.h>
 #include <cmocka.h>
 
-#include "water/water_ref.h"
+#include "water_ref.h"
 
 static ref_water_camera camera_z(uint32_t w, uint32_t h, double eye_z, double fov_deg)
 {

@@ -9,7 +9,7 @@
 
 #include "app.h"
 #include "beams/beam_field.h"
-#include "beams/beams_ref.h"
+#include "beams_ref.h"
 
 int bench_beams_gpu(int argc, char **argv);
 

@@ -1,5 +1,5 @@
 /* beams_ref.c — adaptive G7K15 with breakpoints. */
-#include "beams/beams_ref.h"
+#include "beams_ref.h"
 
 #include <float.h>
 #include <math.h>

@@ -1,6 +1,6 @@
 /* tet_validate.c — checks shared by every tet loader. Orientation uses float64 so that the sign of
  * thin but valid cells is not decided by float32 rounding. */
-#include "tet_io.h"
+#include "tet_mesh.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -16,7 +16,7 @@
 #include <time.h>
 
 #include "beams/beam_field.h"
-#include "beams/beams_ref.h"
+#include "beams_ref.h"
 
 typedef struct bench_scene {
     volfx_beam_d beams[10];

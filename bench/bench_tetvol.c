@@ -16,10 +16,10 @@
 #include <string.h>
 #include <time.h>
 
-#include "tetvol/tet_clock.h"
-#include "tetvol/tet_io.h"
-#include "tetvol/tet_render.h"
-#include "tetvol/tet_testmesh.h"
+#include "tet_clock.h"
+#include "scene/volume_file.h"
+#include "tet_render.h"
+#include "tet_testmesh.h"
 
 typedef struct view {
     const char *name;
@@ -256,14 +256,14 @@ int bench_tetvol(int argc, char **argv)
         size_t l = strlen(mesh_path);
         int r;
         if (l > 4 && !strcmp(mesh_path + l - 4, ".vtu")) {
-            r = tet_load_vtu(mesh_path, scalar ? scalar : "Velocity", &m, err, sizeof err);
+            r = rt_volume_load_vtu(mesh_path, scalar ? scalar : "Velocity", &m, err, sizeof err);
         } else {
             char base[1024];
             snprintf(base, sizeof base, "%s", mesh_path);
             l = strlen(base);
             if (l > 5 && (!strcmp(base + l - 5, ".node") || !strcmp(base + l - 4, ".ele")))
                 base[!strcmp(base + l - 4, ".ele") ? l - 4 : l - 5] = 0;
-            r = tet_load_tetgen(base, scalar ? scalar : "attr0", &m, err, sizeof err);
+            r = rt_volume_load_tetgen(base, scalar ? scalar : "attr0", &m, err, sizeof err);
         }
         if (r != 0) { fprintf(stderr, "bench tetvol: %s\n", err); return 1; }
         const char *sl = strrchr(mesh_path, '/');

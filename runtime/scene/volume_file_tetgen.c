@@ -1,6 +1,6 @@
-/* tet_io_tetgen.c — TetGen .node/.ele reader. The first node's index decides 0- or 1-based
+/* volume_file_tetgen.c — TetGen .node/.ele reader. The first node's index decides 0- or 1-based
  * numbering, as TetGen itself does. */
-#include "tet_io.h"
+#include "scene/volume_file.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -88,7 +88,7 @@ static int parse_numbers(char *s, double *v, int maxn)
 
 #define TG_MAXCOL 64
 
-vfx_result tet_load_tetgen(const char *path_base, const char *scalar_name,
+vfx_result rt_volume_load_tetgen(const char *path_base, const char *scalar_name,
                                tet_mesh *out, char *err, size_t errlen)
 {
     if (!path_base || !out) {

@@ -1,5 +1,5 @@
 /* bench.c — volfx-bench: one headless benchmark program; each effect adds its subcommand
- * (sample_game/<effect>/bench_*.c). Prints one JSON object per configuration. */
+ * (bench/bench_<system>.c). Prints one JSON object per configuration. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,7 +1,7 @@
-/* tet_io_vtu.c — VTK XML UnstructuredGrid reader (expat + zlib). Appended raw data is not XML,
+/* volume_file_vtu.c — VTK XML UnstructuredGrid reader (expat + zlib). Appended raw data is not XML,
  * so expat is fed only the text before <AppendedData> (never finalised) and the arrays are then
  * decoded from the bytes after its '_' marker. */
-#include "tet_io.h"
+#include "scene/volume_file.h"
 
 #include <expat.h>
 #include <math.h>
@@ -371,7 +371,7 @@ static const vtu_array *find(const vtu_state *s, int section, const char *name)
     return NULL;
 }
 
-vfx_result tet_load_vtu_mem(const void *data, size_t size, const char *scalar_name,
+vfx_result rt_volume_load_vtu_mem(const void *data, size_t size, const char *scalar_name,
                                 tet_mesh *out, char *err, size_t errlen)
 {
     if (!data || !out || !err) {
@@ -516,7 +516,7 @@ done:
     return r;
 }
 
-vfx_result tet_load_vtu(const char *path, const char *scalar_name, tet_mesh *out,
+vfx_result rt_volume_load_vtu(const char *path, const char *scalar_name, tet_mesh *out,
                             char *err, size_t errlen)
 {
     if (!path || !out) {
@@ -541,7 +541,7 @@ vfx_result tet_load_vtu(const char *path, const char *scalar_name, tet_mesh *out
     }
     fclose(f);
     char inner[256];
-    vfx_result r = tet_load_vtu_mem(buf, (size_t)n, scalar_name, out, inner, sizeof inner);
+    vfx_result r = rt_volume_load_vtu_mem(buf, (size_t)n, scalar_name, out, inner, sizeof inner);
     if (r != VFX_OK)
         snprintf(err, errlen, "%s: %s", path, inner);
     free(buf);

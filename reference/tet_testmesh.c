@@ -1,5 +1,5 @@
 /* tet_testmesh.c — see tet_testmesh.h. */
-#include "tetvol/tet_testmesh.h"
+#include "tet_testmesh.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -11,10 +11,10 @@
 #include <time.h>
 
 #include "gfx/gl_context.h"
-#include "plugin_internal.h"
+#include "debug.h"
 #include "profile/profiler.h"
-#include "reference/reference.h"
-#include "water/water_ref.h"
+#include "camera_ref.h"
+#include "water_ref.h"
 
 typedef struct bench_scene {
     float *x, *y, *z;

@@ -1,5 +1,5 @@
 /* reference.c — camera basis and pixel rays in float64. */
-#include "reference/reference.h"
+#include "camera_ref.h"
 
 #include <math.h>
 #include <string.h>

@@ -16,10 +16,10 @@
 #include <unistd.h>
 #include <mpi.h>
 
-#include "tetvol/tet_io.h"
-#include "tetvol/tet_mpi.h"
-#include "tetvol/tet_render.h"
-#include "tetvol/tet_testmesh.h"
+#include "scene/volume_file.h"
+#include "tet_mpi.h"
+#include "tet_render.h"
+#include "tet_testmesh.h"
 
 /* Frames the mesh's bounding sphere: view = T(0,0,-dist) Rx(pitch) Ry(yaw) T(-centre). */
 static void camera(tet_camera *c, const tet_mesh *m, int w, int h, float yaw,
@@ -160,10 +160,10 @@ int main(int argc, char **argv)
     const char *src = "grid";
     if (vtu) {
         src = vtu;
-        rc = tet_load_vtu(vtu, field ? field : "Velocity", &m, err, sizeof err);
+        rc = rt_volume_load_vtu(vtu, field ? field : "Velocity", &m, err, sizeof err);
     } else if (tetgen) {
         src = tetgen;
-        rc = tet_load_tetgen(tetgen, field ? field : "attr0", &m, err, sizeof err);
+        rc = rt_volume_load_tetgen(tetgen, field ? field : "attr0", &m, err, sizeof err);
     } else if (ref_testmesh_grid(grid, &m) != 0) {
         rc = VFX_ERR_OUT_OF_MEMORY;
         snprintf(err, sizeof err, "out of memory for a %d^3 grid", grid);

@@ -8,7 +8,8 @@
 #include <unistd.h>
 
 #include "gpu/gpu.h"
-#include "tetvol/tet_render.h"
+#include "effect.h"
+#include "tet_render.h"
 
 typedef struct volume_state {
     GLuint prog, tex;
@@ -45,7 +46,7 @@ static vfx_result volume_create(vfx_context *ctx, void **out)
     volume_state *s = volfx_alloc(ctx, sizeof *s);
     if (!s)
         return VFX_ERR_OUT_OF_MEMORY;
-    s->prog = volfx_gpu_program(ctx, "common/fullscreen.vert", "tetvol/composite.frag", NULL);
+    s->prog = volfx_gpu_program(ctx, "common/fullscreen.vert", "volume/composite.frag", NULL);
     if (!s->prog) {
         volume_destroy(ctx, s);
         return VFX_ERR_GL;

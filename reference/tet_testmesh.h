@@ -4,7 +4,7 @@
 #ifndef REF_TET_TESTMESH_H
 #define REF_TET_TESTMESH_H
 
-#include "tetvol/tet_render.h"
+#include "tet_render.h"
 
 /* Fills m with n^3 cubes x 5 tets over [-1,1]^3 (alternate cubes mirrored so faces match),
  * scalar 0.5 + 0.5 sin(3x) cos(2y) cos(1.5z) at the points, range [0, 1], named "grid"; the

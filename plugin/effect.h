@@ -1,0 +1,48 @@
+/* effect.h — what an effect implements (its ops table, registered in entry.c) and the targets
+ * effects share during one render. */
+#ifndef VOLFX_EFFECT_H
+#define VOLFX_EFFECT_H
+
+#include "context.h"
+
+/* Targets shared between effects during one render. Effects run in a fixed order:
+ * water (writes water_dist), volume (over, clipped by scene depth and water), beams (additive,
+ * integrated up to the nearer of scene and water). */
+typedef struct volfx_frame_targets {
+    unsigned scene_depth;  /* host depth texture (window depth [0,1]) */
+    unsigned scene_color;  /* host colour texture */
+    unsigned water_dist;   /* R32F distance along the view ray to water, -1 miss; 0 = no water */
+    float inv_view_proj[16];
+} volfx_frame_targets;
+
+struct volfx_effect_ops {
+    const char *name;
+    vfx_effect_kind kind;
+    /* True when the host's world holds this effect now (asks the host api; allocates nothing). */
+    bool (*present)(vfx_context *ctx);
+    /* Makes the effect's state: programs, buffers. Called the first frame it is present. */
+    vfx_result (*create)(vfx_context *ctx, void **state);
+    /* Frees every GL object and allocation of the state. */
+    void (*destroy)(vfx_context *ctx, void *state);
+    /* Reallocates size-dependent targets. */
+    vfx_result (*resize)(vfx_context *ctx, void *state, uint32_t width, uint32_t height);
+    /* Pulls host data (uploads columns, meshes). */
+    vfx_result (*update)(vfx_context *ctx, void *state, double time, float dt);
+    /* Draws into frame->framebuffer. */
+    vfx_result (*render)(vfx_context *ctx, void *state, const vfx_frame_view *frame,
+                         volfx_frame_targets *targets);
+    /* Copies the raw quantity of the last render, top row first. */
+    vfx_result (*read_raw)(vfx_context *ctx, void *state, float *out, size_t count);
+};
+
+#if VFX_WITH_WATER
+extern const volfx_effect_ops volfx_water_ops;
+#endif
+#if VFX_WITH_BEAMS
+extern const volfx_effect_ops volfx_beams_ops;
+#endif
+#if VFX_WITH_TETVOL
+extern const volfx_effect_ops volfx_volume_ops;
+#endif
+
+#endif
