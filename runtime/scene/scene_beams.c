@@ -1,0 +1,238 @@
+/* scene_beams.c — the beams section of a scene (docs/scene-format.md): beams, their keyframe
+ * tracks and settings, and their evaluation at a time. */
+#include "scene/scene_parse.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *const beam_param_names[RT_BEAM_PARAM_COUNT + 1] = {
+    "head", "dir", "length", "radius", "a", "b", "eps", "color", NULL};
+static const int beam_param_dim[RT_BEAM_PARAM_COUNT] = {3, 3, 1, 1, 1, 1, 1, 4};
+
+static range beam_param_range(int k)
+{
+    switch (k) {
+    case RT_BEAM_PARAM_HEAD:
+    case RT_BEAM_PARAM_DIR: return COORD;
+    case RT_BEAM_PARAM_RADIUS: return POSITIVE;
+    case RT_BEAM_PARAM_COLOR: return (range){0, 1000, false};
+    default: return NONNEG;
+    }
+}
+
+static float *beam_param_ptr(vfx_beam *b, int k)
+{
+    switch (k) {
+    case RT_BEAM_PARAM_HEAD: return b->head;
+    case RT_BEAM_PARAM_DIR: return b->dir;
+    case RT_BEAM_PARAM_LENGTH: return &b->length;
+    case RT_BEAM_PARAM_RADIUS: return &b->radius;
+    case RT_BEAM_PARAM_A: return &b->a;
+    case RT_BEAM_PARAM_B: return &b->b;
+    case RT_BEAM_PARAM_EPS: return &b->eps;
+    default: return b->color;
+    }
+}
+
+bool scene_is_zero3(const float *v)
+{
+    return (double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2] < 1e-24;
+}
+
+static vfx_result parse_track(pctx *c, const cJSON *v, const char *P, int k, rt_scene_track *tr)
+{
+    static const char *const keys[] = {"t", "value", NULL};
+    if (!cJSON_IsArray(v))
+        return scene_failf(c, VFX_ERR_FORMAT, P, "expected an array of {\"t\", \"value\"} keyframes, got %s", scene_type_name(v));
+    int n = cJSON_GetArraySize(v);
+    if (n < 1 || n > RT_SCENE_MAX_KEYS)
+        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, P, "%d keyframes; must be 1 to %d", n, RT_SCENE_MAX_KEYS);
+    int dim = beam_param_dim[k];
+    tr->dim = (uint32_t)dim;
+    tr->times = malloc((size_t)n * sizeof(float));
+    tr->values = malloc((size_t)n * (size_t)dim * sizeof(float));
+    if (!tr->times || !tr->values)
+        return scene_failf(c, VFX_ERR_OUT_OF_MEMORY, P, "out of memory");
+    int i = 0;
+    for (const cJSON *e = v->child; e; e = e->next, ++i) {
+        char PI[JPATH], PV[JPATH];
+        scene_join_index(PI, P, i);
+        vfx_result r = scene_expect_object(c, e, PI);
+        if (r)
+            return r;
+        scene_check_keys(c, e, PI, keys);
+        if ((r = scene_get_float(c, e, PI, "t", true, COORD, &tr->times[i])))
+            return r;
+        if (i > 0 && !(tr->times[i] > tr->times[i - 1])) {
+            char PT[JPATH];
+            scene_join(PT, PI, "t");
+            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PT, "keyframe times must increase strictly (%g after %g)",
+                         tr->times[i], tr->times[i - 1]);
+        }
+        scene_join(PV, PI, "value");
+        const cJSON *val = cJSON_GetObjectItemCaseSensitive(e, "value");
+        float *dst = &tr->values[(size_t)i * (size_t)dim];
+        if (!val)
+            return scene_failf(c, VFX_ERR_FORMAT, PV, "required value missing");
+        if (dim == 1) {
+            double d;
+            if ((r = scene_number_value(c, val, PV, beam_param_range(k), &d)))
+                return r;
+            dst[0] = (float)d;
+        } else if ((r = scene_vec_value(c, val, PV, dim, beam_param_range(k), dst))) {
+            return r;
+        }
+        if (k == RT_BEAM_PARAM_DIR && scene_is_zero3(dst))
+            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PV, "direction must not be the zero vector");
+        tr->count = (uint32_t)i + 1;
+    }
+    return VFX_OK;
+}
+
+vfx_result scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
+{
+    static const char *const keys[] = {"head", "dir", "length", "radius", "a", "b", "eps", "color",
+                                       "keyframes", "loop_s", NULL};
+    int n;
+    vfx_result ra = scene_alloc_array(c, v, "beams", RT_SCENE_MAX_BEAMS, sizeof *s->beams, (void **)&s->beams, &n);
+    if (ra || n == 0)
+        return ra;
+    int i = 0;
+    for (const cJSON *e = v->child; e; e = e->next, ++i) {
+        char P[JPATH];
+        scene_join_index(P, "beams", i);
+        rt_scene_beam *o = &s->beams[i];
+        s->beam_count = (uint32_t)i + 1; /* so that free() sees tracks of a half-parsed beam */
+        vfx_beam *b = &o->base;
+        *b = (vfx_beam){.length = 1.0f, .radius = 0.5f, .a = 0.05f, .b = 0.03f, .eps = 0.02f, .color = {1, 1, 1, 1}};
+        vfx_result r = scene_expect_object(c, e, P);
+        if (r)
+            return r;
+        scene_check_keys(c, e, P, keys);
+        const cJSON *kf = cJSON_GetObjectItemCaseSensitive(e, "keyframes");
+        if (kf) {
+            char PK[JPATH];
+            scene_join(PK, P, "keyframes");
+            if ((r = scene_expect_object(c, kf, PK)))
+                return r;
+            scene_check_keys(c, kf, PK, beam_param_names);
+        }
+        for (int k = 0; k < RT_BEAM_PARAM_COUNT; ++k) {
+            const char *name = beam_param_names[k];
+            const cJSON *track = kf ? cJSON_GetObjectItemCaseSensitive(kf, name) : NULL;
+            /* head and dir are required unless animated (then the first key is the base) */
+            bool required = (k == RT_BEAM_PARAM_HEAD || k == RT_BEAM_PARAM_DIR) && !track;
+            float *dst = beam_param_ptr(b, k);
+            if (beam_param_dim[k] == 1)
+                r = scene_get_float(c, e, P, name, required, beam_param_range(k), dst);
+            else
+                r = scene_get_vec(c, e, P, name, beam_param_dim[k], required, beam_param_range(k), dst);
+            if (r)
+                return r;
+            if (track) {
+                char PT[JPATH], PK[JPATH];
+                scene_join(PK, P, "keyframes");
+                scene_join(PT, PK, name);
+                if ((r = parse_track(c, track, PT, k, &o->tracks[k])))
+                    return r;
+                if (!cJSON_GetObjectItemCaseSensitive(e, name))
+                    memcpy(dst, o->tracks[k].values, (size_t)beam_param_dim[k] * sizeof(float));
+            }
+        }
+        if (scene_is_zero3(b->dir)) {
+            char PD[JPATH];
+            scene_join(PD, P, "dir");
+            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PD, "direction must not be the zero vector");
+        }
+        if ((r = scene_get_float(c, e, P, "loop_s", false, NONNEG, &o->loop_s)))
+            return r;
+    }
+    return VFX_OK;
+}
+
+vfx_result scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv)
+{
+    static const char *const keys[] = {"saturation", "c", "far_distance", "method", "march_samples", NULL};
+    static const char *const sat[] = {"clamp", "smooth", NULL};
+    static const char *const meth[] = {"closed_form", "march", NULL};
+    const char *P = "beam_settings";
+    vfx_result r = scene_expect_object(c, v, P);
+    if (r)
+        return r;
+    scene_check_keys(c, v, P, keys);
+    r = scene_get_enum(c, v, P, "saturation", false, sat, &bv->saturation);
+    if (!r) r = scene_get_float(c, v, P, "c", false, POSITIVE, &bv->saturate_c);
+    if (!r) r = scene_get_float(c, v, P, "far_distance", false, NONNEG, &bv->far_distance);
+    if (!r) r = scene_get_enum(c, v, P, "method", false, meth, &bv->method);
+    if (!r) r = scene_get_uint(c, v, P, "march_samples", false, 1, 4096, &bv->march_samples);
+    return r;
+}
+
+/* ------------------------------------------------------------------ animation */
+
+/* Index of the last key with time <= t (0 when t is before the first). */
+static uint32_t key_before(const rt_scene_track *tr, double t)
+{
+    uint32_t lo = 0, hi = tr->count - 1;
+    if (t <= tr->times[0])
+        return 0;
+    if (t >= tr->times[hi])
+        return hi;
+    while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (tr->times[mid] <= t)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+void rt_scene_track_eval(const rt_scene_track *tr, double t, float *out)
+{
+    if (!tr || tr->count == 0)
+        return;
+    uint32_t i = key_before(tr, t), d = tr->dim;
+    const float *v0 = &tr->values[(size_t)i * d];
+    if (i + 1 >= tr->count || t <= tr->times[0]) {
+        memcpy(out, v0, d * sizeof(float));
+        return;
+    }
+    const float *v1 = v0 + d;
+    double f = (t - tr->times[i]) / ((double)tr->times[i + 1] - tr->times[i]);
+    for (uint32_t k = 0; k < d; ++k)
+        out[k] = (float)(v0[k] + f * ((double)v1[k] - v0[k]));
+}
+
+uint32_t rt_scene_beams_at(const rt_scene *scene, double time, vfx_beam *out, uint32_t n)
+{
+    if (!scene || !out)
+        return 0;
+    uint32_t count = scene->beam_count < n ? scene->beam_count : n;
+    if (!isfinite(time))
+        time = 0;
+    for (uint32_t i = 0; i < count; ++i) {
+        const rt_scene_beam *b = &scene->beams[i];
+        double t = time;
+        if (b->loop_s > 0) {
+            t = fmod(t, b->loop_s);
+            if (t < 0)
+                t += b->loop_s;
+        }
+        out[i] = b->base;
+        for (int k = 0; k < RT_BEAM_PARAM_COUNT; ++k) {
+            const rt_scene_track *tr = &b->tracks[k];
+            if (!tr->count)
+                continue;
+            float *dst = beam_param_ptr(&out[i], k);
+            rt_scene_track_eval(tr, t, dst);
+            /* opposite direction keys pass through zero: hold the earlier key's direction */
+            if (k == RT_BEAM_PARAM_DIR && scene_is_zero3(dst))
+                memcpy(dst, &tr->values[(size_t)key_before(tr, t) * 3], 3 * sizeof(float));
+        }
+    }
+    return count;
+}

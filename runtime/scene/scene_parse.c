@@ -1,0 +1,339 @@
+/* scene_parse.c — see scene_parse.h: every value is validated where it is read, so the message can
+ * carry its JSON path; ranges are checked on the double before any cast. */
+#include "scene/scene_parse.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/file.h"
+vfx_result scene_failf(pctx *c, vfx_result r, const char *path, const char *fmt, ...)
+{
+    if (c->err && c->errlen) {
+        char msg[512];
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(msg, sizeof msg, fmt, ap);
+        va_end(ap);
+        snprintf(c->err, c->errlen, "%s: %s", path && *path ? path : "(root)", msg);
+    }
+    return r;
+}
+
+/* JSON paths longer than JPATH are cut: the message stays readable, the check unaffected. */
+void scene_join(char *out, const char *parent, const char *key)
+{
+    int n = parent && *parent ? snprintf(out, JPATH, "%s.%s", parent, key) : snprintf(out, JPATH, "%s", key);
+    if (n < 0)
+        out[0] = 0;
+}
+
+void scene_join_index(char *out, const char *parent, int i)
+{
+    if (snprintf(out, JPATH, "%s[%d]", parent, i) < 0)
+        out[0] = 0;
+}
+
+const char *scene_type_name(const cJSON *v)
+{
+    if (!v) return "nothing";
+    if (cJSON_IsNumber(v)) return "a number";
+    if (cJSON_IsString(v)) return "a string";
+    if (cJSON_IsBool(v)) return "a boolean";
+    if (cJSON_IsNull(v)) return "null";
+    if (cJSON_IsArray(v)) return "an array";
+    if (cJSON_IsObject(v)) return "an object";
+    return "an invalid value";
+}
+
+/* Unknown keys are warnings (a typo should be visible, a newer file should still load);
+ * a duplicated key is a warning too because cJSON would silently take the first. */
+void scene_check_keys(pctx *c, const cJSON *obj, const char *path, const char *const *allowed)
+{
+    int index = 0;
+    for (const cJSON *it = obj->child; it; it = it->next, ++index) {
+        const char *k = it->string ? it->string : "";
+        bool known = false;
+        for (const char *const *a = allowed; *a; ++a)
+            if (strcmp(*a, k) == 0)
+                known = true;
+        char p[JPATH];
+        scene_join(p, path, k);
+        if (!known)
+            rt_logf(c->log, VFX_LOG_WARN, "%s: unknown key ignored", p);
+        /* duplicates: quadratic, but only for the first 64 keys of an object */
+        if (index < 64)
+            for (const cJSON *prev = obj->child; prev != it; prev = prev->next)
+                if (prev->string && strcmp(prev->string, k) == 0) {
+                    rt_logf(c->log, VFX_LOG_WARN, "%s: duplicate key, the first one is used", p);
+                    break;
+                }
+    }
+}
+
+vfx_result scene_expect_object(pctx *c, const cJSON *v, const char *path)
+{
+    if (!cJSON_IsObject(v))
+        return scene_failf(c, VFX_ERR_FORMAT, path, "expected an object, got %s", scene_type_name(v));
+    return VFX_OK;
+}
+
+
+vfx_result scene_check_range(pctx *c, const char *path, double v, range rg)
+{
+    if (!isfinite(v))
+        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be finite, got %.9g", v);
+    if (rg.lo_open ? !(v > rg.lo) : !(v >= rg.lo))
+        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be %s %.9g, got %.9g", rg.lo_open ? ">" : ">=",
+                     rg.lo, v);
+    if (v > rg.hi)
+        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be <= %.9g, got %.9g", rg.hi, v);
+    return VFX_OK;
+}
+
+vfx_result scene_number_value(pctx *c, const cJSON *v, const char *path, range rg, double *out)
+{
+    if (!cJSON_IsNumber(v))
+        return scene_failf(c, VFX_ERR_FORMAT, path, "expected a number, got %s", scene_type_name(v));
+    vfx_result r = scene_check_range(c, path, v->valuedouble, rg);
+    if (!r)
+        *out = v->valuedouble;
+    return r;
+}
+
+/* Optional number `key` of `obj`: *out keeps its default when absent. */
+vfx_result scene_get_float(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+                            range rg, float *out)
+{
+    char p[JPATH];
+    scene_join(p, path, key);
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v)
+        return required ? scene_failf(c, VFX_ERR_FORMAT, p, "required number missing") : VFX_OK;
+    double d = 0; /* set by number_value on success; -O3 cannot see that */
+    vfx_result r = scene_number_value(c, v, p, rg, &d);
+    if (!r)
+        *out = (float)d;
+    return r;
+}
+
+vfx_result scene_get_uint(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+                           double lo, double hi, uint32_t *out)
+{
+    char p[JPATH];
+    scene_join(p, path, key);
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v)
+        return required ? scene_failf(c, VFX_ERR_FORMAT, p, "required integer missing") : VFX_OK;
+    double d = 0; /* set by number_value on success; -O3 cannot see that */
+    vfx_result r = scene_number_value(c, v, p, (range){lo, hi, false}, &d);
+    if (r)
+        return r;
+    if (d != floor(d))
+        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "must be an integer, got %g", d);
+    *out = (uint32_t)d;
+    return VFX_OK;
+}
+
+vfx_result scene_vec_value(pctx *c, const cJSON *v, const char *p, int n, range rg, float *out)
+{
+    if (!cJSON_IsArray(v))
+        return scene_failf(c, VFX_ERR_FORMAT, p, "expected an array of %d numbers, got %s", n, scene_type_name(v));
+    int size = cJSON_GetArraySize(v);
+    if (size != n)
+        return scene_failf(c, VFX_ERR_FORMAT, p, "expected %d numbers, got %d", n, size);
+    int i = 0;
+    for (const cJSON *e = v->child; e; e = e->next, ++i) {
+        char pi[JPATH];
+        scene_join_index(pi, p, i);
+        double d = 0;
+        vfx_result r = scene_number_value(c, e, pi, rg, &d);
+        if (r)
+            return r;
+        out[i] = (float)d;
+    }
+    return VFX_OK;
+}
+
+vfx_result scene_get_vec(pctx *c, const cJSON *obj, const char *path, const char *key, int n,
+                          bool required, range rg, float *out)
+{
+    char p[JPATH];
+    scene_join(p, path, key);
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v)
+        return required ? scene_failf(c, VFX_ERR_FORMAT, p, "required array of %d numbers missing", n) : VFX_OK;
+    return scene_vec_value(c, v, p, n, rg, out);
+}
+
+vfx_result scene_get_bool(pctx *c, const cJSON *obj, const char *path, const char *key, bool *out)
+{
+    char p[JPATH];
+    scene_join(p, path, key);
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v)
+        return VFX_OK;
+    if (!cJSON_IsBool(v))
+        return scene_failf(c, VFX_ERR_FORMAT, p, "expected true or false, got %s", scene_type_name(v));
+    *out = cJSON_IsTrue(v);
+    return VFX_OK;
+}
+
+vfx_result scene_get_string(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+                             char *out, size_t outlen)
+{
+    char p[JPATH];
+    scene_join(p, path, key);
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v)
+        return required ? scene_failf(c, VFX_ERR_FORMAT, p, "required string missing") : VFX_OK;
+    if (!cJSON_IsString(v) || !v->valuestring)
+        return scene_failf(c, VFX_ERR_FORMAT, p, "expected a string, got %s", scene_type_name(v));
+    size_t len = strlen(v->valuestring);
+    if (len >= outlen)
+        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "string of %zu bytes is longer than %zu", len, outlen - 1);
+    memcpy(out, v->valuestring, len + 1);
+    return VFX_OK;
+}
+
+/* A string that must be one of `names` (NULL-terminated); *out gets its index. */
+vfx_result scene_get_enum(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+                           const char *const *names, uint32_t *out)
+{
+    char buf[64] = "";
+    vfx_result r = scene_get_string(c, obj, path, key, required, buf, sizeof buf);
+    if (r)
+        return r;
+    if (!cJSON_GetObjectItemCaseSensitive(obj, key))
+        return VFX_OK;
+    for (uint32_t i = 0; names[i]; ++i)
+        if (strcmp(names[i], buf) == 0) {
+            *out = i;
+            return VFX_OK;
+        }
+    char p[JPATH], list[256] = "";
+    scene_join(p, path, key);
+    for (uint32_t i = 0; names[i]; ++i) {
+        size_t l = strlen(list);
+        snprintf(list + l, sizeof list - l, "%s\"%s\"", i ? ", " : "", names[i]);
+    }
+    return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "unknown value \"%s\"; expected one of %s", buf, list);
+}
+
+/* An array of flag names -> bit mask. */
+vfx_result scene_get_flags(pctx *c, const cJSON *obj, const char *path, const char *key,
+                            const char *const *names, const uint32_t *bits, uint32_t *out)
+{
+    char p[JPATH];
+    scene_join(p, path, key);
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v)
+        return VFX_OK;
+    if (!cJSON_IsArray(v))
+        return scene_failf(c, VFX_ERR_FORMAT, p, "expected an array of strings, got %s", scene_type_name(v));
+    uint32_t mask = 0;
+    int i = 0;
+    for (const cJSON *e = v->child; e; e = e->next, ++i) {
+        char pi[JPATH];
+        scene_join_index(pi, p, i);
+        if (!cJSON_IsString(e))
+            return scene_failf(c, VFX_ERR_FORMAT, pi, "expected a string, got %s", scene_type_name(e));
+        bool found = false;
+        for (uint32_t k = 0; names[k]; ++k)
+            if (strcmp(names[k], e->valuestring) == 0)
+                mask |= bits[k], found = true;
+        if (!found)
+            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, pi, "unknown flag \"%.64s\"", e->valuestring);
+    }
+    *out = mask;
+    return VFX_OK;
+}
+
+vfx_result scene_resolve_path(pctx *c, const char *p, const char *rel, char *out)
+{
+    if (!*rel)
+        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "empty path");
+    int n;
+    if (rel[0] == '/' || !c->base_dir || !*c->base_dir)
+        n = snprintf(out, RT_SCENE_PATH_MAX, "%s", rel);
+    else
+        n = snprintf(out, RT_SCENE_PATH_MAX, "%s/%s", c->base_dir, rel);
+    if (n < 0 || n >= RT_SCENE_PATH_MAX)
+        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "resolved path longer than %d bytes", RT_SCENE_PATH_MAX - 1);
+    return VFX_OK;
+}
+
+vfx_result scene_get_path(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+                           char *out)
+{
+    char raw[RT_SCENE_PATH_MAX] = "", p[JPATH];
+    vfx_result r = scene_get_string(c, obj, path, key, required, raw, sizeof raw);
+    if (r || !cJSON_GetObjectItemCaseSensitive(obj, key))
+        return r;
+    scene_join(p, path, key);
+    return scene_resolve_path(c, p, raw, out);
+}
+
+
+/* ------------------------------------------------------------------ transforms */
+
+void scene_mat_identity(float m[16])
+{
+    memset(m, 0, 16 * sizeof(float));
+    m[0] = m[5] = m[10] = m[15] = 1;
+}
+
+/* M = T * Rz * Ry * Rx * S, column-major; computed in double for the trig. */
+void scene_mat_trs(const float t[3], const float rdeg[3], const float s[3], float m[16])
+{
+    double rx = rdeg[0] * M_PI / 180, ry = rdeg[1] * M_PI / 180, rz = rdeg[2] * M_PI / 180;
+    double cx = cos(rx), sx = sin(rx), cy = cos(ry), sy = sin(ry), cz = cos(rz), sz = sin(rz);
+    /* rows of Rz*Ry*Rx */
+    double r[3][3] = {
+        {cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx},
+        {sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx},
+        {-sy, cy * sx, cy * cx},
+    };
+    scene_mat_identity(m);
+    for (int col = 0; col < 3; ++col)
+        for (int row = 0; row < 3; ++row)
+            m[col * 4 + row] = (float)(r[row][col] * s[col]);
+    m[12] = t[0], m[13] = t[1], m[14] = t[2];
+}
+
+vfx_result scene_parse_transform(pctx *c, const cJSON *obj, const char *path, float model[16])
+{
+    const cJSON *mv = cJSON_GetObjectItemCaseSensitive(obj, "matrix");
+    bool trs = cJSON_GetObjectItemCaseSensitive(obj, "translate") || cJSON_GetObjectItemCaseSensitive(obj, "rotate_deg") ||
+               cJSON_GetObjectItemCaseSensitive(obj, "scale");
+    if (mv) {
+        char p[JPATH];
+        scene_join(p, path, "matrix");
+        if (trs)
+            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "give either matrix or translate/rotate_deg/scale, not both");
+        return scene_vec_value(c, mv, p, 16, COORD, model);
+    }
+    float t[3] = {0, 0, 0}, rdeg[3] = {0, 0, 0}, s[3] = {1, 1, 1};
+    vfx_result r = scene_get_vec(c, obj, path, "translate", 3, false, COORD, t);
+    if (!r) r = scene_get_vec(c, obj, path, "rotate_deg", 3, false, (range){-36000, 36000, false}, rdeg);
+    if (r)
+        return r;
+    const cJSON *sv = cJSON_GetObjectItemCaseSensitive(obj, "scale");
+    if (sv) {
+        char p[JPATH];
+        scene_join(p, path, "scale");
+        const range sr = {0, COORD_MAX, true};
+        if (cJSON_IsNumber(sv)) {
+            double d;
+            if ((r = scene_number_value(c, sv, p, sr, &d)))
+                return r;
+            s[0] = s[1] = s[2] = (float)d;
+        } else if ((r = scene_vec_value(c, sv, p, 3, sr, s))) {
+            return r;
+        }
+    }
+    scene_mat_trs(t, rdeg, s, model);
+    return VFX_OK;
+}

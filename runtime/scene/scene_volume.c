@@ -1,0 +1,206 @@
+/* scene_volume.c — the volume section of a scene (docs/scene-format.md), its transfer function
+ * and generated volumes. */
+#include "scene/scene_parse.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+bool scene_ends_with(const char *s, const char *suffix)
+{
+    size_t a = strlen(s), b = strlen(suffix);
+    return a >= b && strcmp(s + a - b, suffix) == 0;
+}
+
+vfx_result scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol)
+{
+    static const char *const keys[] = {"path", "generator", "scalar", "transfer", "transfer_normalized",
+                                       "ert_threshold", "tiles", "update_c", "workers", "disable",
+                                       "translate", "rotate_deg", "scale", "matrix", NULL};
+    const char *P = "volume";
+    vfx_result r = scene_expect_object(c, v, P);
+    if (r)
+        return r;
+    scene_check_keys(c, v, P, keys);
+    const cJSON *path = cJSON_GetObjectItemCaseSensitive(v, "path"), *gen = cJSON_GetObjectItemCaseSensitive(v, "generator");
+    if (!path == !gen)
+        return scene_failf(c, VFX_ERR_FORMAT, P, "needs exactly one of \"path\" (.vtu or .node) or \"generator\"");
+    if (path) {
+        if ((r = scene_get_path(c, v, P, "path", true, vol->path)))
+            return r;
+        if (!scene_ends_with(vol->path, ".vtu") && !scene_ends_with(vol->path, ".node"))
+            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "volume.path",
+                         "\"%.200s\" is neither a .vtu nor a TetGen .node file", vol->path);
+    } else {
+        static const char *const gkeys[] = {"cells", "min", "max", NULL};
+        const char *PG = "volume.generator";
+        if ((r = scene_expect_object(c, gen, PG)))
+            return r;
+        scene_check_keys(c, gen, PG, gkeys);
+        vol->generated = true;
+        vol->gen_cells = 8;
+        vol->gen_min[0] = vol->gen_min[1] = vol->gen_min[2] = -1;
+        vol->gen_max[0] = vol->gen_max[1] = vol->gen_max[2] = 1;
+        r = scene_get_uint(c, gen, PG, "cells", false, 1, RT_SCENE_MAX_VOLUME_CELLS, &vol->gen_cells);
+        if (!r) r = scene_get_vec(c, gen, PG, "min", 3, false, COORD, vol->gen_min);
+        if (!r) r = scene_get_vec(c, gen, PG, "max", 3, false, COORD, vol->gen_max);
+        for (int k = 0; k < 3 && !r; ++k)
+            if (!(vol->gen_max[k] > vol->gen_min[k]))
+                r = scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "volume.generator.max",
+                          "must exceed min on every axis (axis %d: %g <= %g)", k, vol->gen_max[k], vol->gen_min[k]);
+        if (r)
+            return r;
+    }
+    r = scene_get_string(c, v, P, "scalar", false, vol->scalar, sizeof vol->scalar);
+    if (!r) r = scene_get_bool(c, v, P, "transfer_normalized", &vol->transfer_normalized);
+    if (!r) r = scene_get_float(c, v, P, "ert_threshold", false, (range){0, 1, true}, &vol->ert_threshold);
+    if (!r) r = scene_get_uint(c, v, P, "tiles", false, 1, 1024, &vol->tiles);
+    if (!r) r = scene_get_uint(c, v, P, "update_c", false, 1, 1u << 20, &vol->update_c);
+    if (!r) r = scene_get_uint(c, v, P, "workers", false, 0, 256, &vol->workers);
+    if (!r) {
+        static const char *const flags[] = {"ert", "share", "dlb", NULL};
+        static const uint32_t bits[] = {VFX_VOLUME_NO_ERT, VFX_VOLUME_NO_SHARE, VFX_VOLUME_NO_DLB};
+        r = scene_get_flags(c, v, P, "disable", flags, bits, &vol->disable);
+    }
+    if (!r) r = scene_parse_transform(c, v, P, vol->model);
+    if (r)
+        return r;
+    const cJSON *tf = cJSON_GetObjectItemCaseSensitive(v, "transfer");
+    if (!tf)
+        return VFX_OK;
+    const char *PT = "volume.transfer";
+    if (!cJSON_IsArray(tf))
+        return scene_failf(c, VFX_ERR_FORMAT, PT, "expected an array of {\"scalar\", \"rgba\"}, got %s", scene_type_name(tf));
+    int n = cJSON_GetArraySize(tf);
+    if (n < 1 || n > RT_SCENE_MAX_TRANSFER)
+        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PT, "%d control points; must be 1 to %d", n, RT_SCENE_MAX_TRANSFER);
+    int i = 0;
+    for (const cJSON *e = tf->child; e; e = e->next, ++i) {
+        static const char *const tkeys[] = {"scalar", "rgba", NULL};
+        char PI[JPATH];
+        scene_join_index(PI, PT, i);
+        rt_scene_transfer_point *tp = &vol->transfer[i];
+        if ((r = scene_expect_object(c, e, PI)))
+            return r;
+        scene_check_keys(c, e, PI, tkeys);
+        r = scene_get_float(c, e, PI, "scalar", true, vol->transfer_normalized ? UNIT : (range){-1e30, 1e30, false}, &tp->scalar);
+        if (!r) r = scene_get_vec(c, e, PI, "rgba", 4, true, (range){0, 1e3, false}, tp->rgba);
+        if (r)
+            return r;
+        if (i > 0 && !(tp->scalar > vol->transfer[i - 1].scalar)) {
+            char PS[JPATH];
+            scene_join(PS, PI, "scalar");
+            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PS, "control points must increase strictly (%g after %g)",
+                         tp->scalar, vol->transfer[i - 1].scalar);
+        }
+        vol->transfer_count = (uint32_t)i + 1;
+    }
+    return VFX_OK;
+}
+
+void rt_scene_transfer_sample(const rt_scene_volume *v, uint32_t n, float *rgba, float *smin, float *smax)
+{
+    if (!v || !rgba || n < 2)
+        return;
+    uint32_t m = v->transfer_count;
+    const rt_scene_transfer_point *tp = v->transfer;
+    if (smin) *smin = 0;
+    if (smax) *smax = 0;
+    if (m == 0) { /* grey ramp, opacity rising with the scalar */
+        for (uint32_t j = 0; j < n; ++j) {
+            float f = (float)j / (float)(n - 1);
+            rgba[4 * j] = rgba[4 * j + 1] = rgba[4 * j + 2] = f, rgba[4 * j + 3] = f;
+        }
+        return;
+    }
+    double lo = tp[0].scalar, hi = tp[m - 1].scalar;
+    if (!v->transfer_normalized) {
+        if (smin) *smin = (float)lo;
+        if (smax) *smax = (float)hi;
+    }
+    uint32_t seg = 0;
+    for (uint32_t j = 0; j < n; ++j) {
+        double s = lo + (hi - lo) * j / (n - 1);
+        while (seg + 1 < m - 1 && s > tp[seg + 1].scalar)
+            ++seg;
+        float *o = &rgba[4 * j];
+        if (m == 1 || s <= tp[0].scalar) {
+            memcpy(o, tp[0].rgba, 4 * sizeof(float));
+        } else if (s >= tp[m - 1].scalar) {
+            memcpy(o, tp[m - 1].rgba, 4 * sizeof(float));
+        } else {
+            double f = (s - tp[seg].scalar) / ((double)tp[seg + 1].scalar - tp[seg].scalar);
+            for (int k = 0; k < 4; ++k)
+                o[k] = (float)(tp[seg].rgba[k] + f * ((double)tp[seg + 1].rgba[k] - tp[seg].rgba[k]));
+        }
+    }
+}
+
+vfx_result rt_scene_volume_generate(const rt_scene_volume *v, float **points, uint32_t *point_count,
+                                     uint32_t **tets, uint32_t *tet_count, float **scalar, char *err, size_t errlen)
+{
+    if (!v || !points || !point_count || !tets || !tet_count || !scalar || !v->generated || v->gen_cells == 0 ||
+        v->gen_cells > RT_SCENE_MAX_VOLUME_CELLS) {
+        if (err && errlen)
+            snprintf(err, errlen, "volume.generator: NULL argument, not a generated volume or cells out of range");
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    uint32_t n = v->gen_cells, np1 = n + 1;
+    size_t np = (size_t)np1 * np1 * np1, nt = (size_t)6 * n * n * n;
+    float *P = malloc(np * 3 * sizeof(float)), *S = malloc(np * sizeof(float));
+    uint32_t *T = malloc(nt * 4 * sizeof(uint32_t));
+    if (!P || !S || !T) {
+        free(P), free(S), free(T);
+        if (err && errlen)
+            snprintf(err, errlen, "volume.generator: out of memory");
+        return VFX_ERR_OUT_OF_MEMORY;
+    }
+    double c[3], half = 0;
+    for (int k = 0; k < 3; ++k) {
+        c[k] = 0.5 * ((double)v->gen_min[k] + v->gen_max[k]);
+        half += 0.25 * ((double)v->gen_max[k] - v->gen_min[k]) * ((double)v->gen_max[k] - v->gen_min[k]);
+    }
+    half = sqrt(half);
+    for (uint32_t z = 0, i = 0; z < np1; ++z)
+        for (uint32_t y = 0; y < np1; ++y)
+            for (uint32_t x = 0; x < np1; ++x, ++i) {
+                uint32_t q[3] = {x, y, z};
+                double d2 = 0;
+                for (int k = 0; k < 3; ++k) {
+                    double p = v->gen_min[k] + ((double)v->gen_max[k] - v->gen_min[k]) * q[k] / n;
+                    P[3 * (size_t)i + k] = (float)p;
+                    d2 += (p - c[k]) * (p - c[k]);
+                }
+                S[i] = (float)(1.0 - sqrt(d2) / half);
+            }
+    /* Kuhn (Freudenthal) subdivision: 6 tets along the cube's main diagonal, one per axis order;
+     * neighbouring cubes then share their face triangulations (a conforming mesh). */
+    static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    size_t t = 0;
+    for (uint32_t z = 0; z < n; ++z)
+        for (uint32_t y = 0; y < n; ++y)
+            for (uint32_t x = 0; x < n; ++x)
+                for (int pi = 0; pi < 6; ++pi, ++t) {
+                    uint32_t q[3] = {x, y, z}, *o = &T[4 * t];
+                    for (int s = 0; s < 4; ++s) {
+                        if (s > 0)
+                            q[perms[pi][s - 1]]++;
+                        o[s] = (q[2] * np1 + q[1]) * np1 + q[0];
+                    }
+                    const float *a = &P[3 * (size_t)o[0]], *b = &P[3 * (size_t)o[1]], *cc = &P[3 * (size_t)o[2]],
+                                *d = &P[3 * (size_t)o[3]];
+                    double u[3], w[3], e[3];
+                    for (int k = 0; k < 3; ++k)
+                        u[k] = (double)b[k] - a[k], w[k] = (double)cc[k] - a[k], e[k] = (double)d[k] - a[k];
+                    double vol = u[0] * (w[1] * e[2] - w[2] * e[1]) - u[1] * (w[0] * e[2] - w[2] * e[0]) +
+                                 u[2] * (w[0] * e[1] - w[1] * e[0]);
+                    if (vol < 0) {
+                        uint32_t tmp = o[2];
+                        o[2] = o[3], o[3] = tmp;
+                    }
+                }
+    *points = P, *point_count = (uint32_t)np, *tets = T, *tet_count = (uint32_t)nt, *scalar = S;
+    return VFX_OK;
+}

@@ -1,0 +1,276 @@
+/* scene_water.c — the water section of a scene (docs/scene-format.md) and the particles it
+ * generates or loads. */
+#include "scene/scene_parse.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene/particle_file.h"
+
+vfx_result scene_parse_box(pctx *c, const cJSON *obj, const char *path, const char *key, float mn[3], float mx[3])
+{
+    static const char *const keys[] = {"min", "max", NULL};
+    char P[JPATH];
+    scene_join(P, path, key);
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v)
+        return scene_failf(c, VFX_ERR_FORMAT, P, "required {\"min\", \"max\"} box missing");
+    vfx_result r = scene_expect_object(c, v, P);
+    if (r)
+        return r;
+    scene_check_keys(c, v, P, keys);
+    r = scene_get_vec(c, v, P, "min", 3, true, COORD, mn);
+    if (!r) r = scene_get_vec(c, v, P, "max", 3, true, COORD, mx);
+    for (int k = 0; k < 3 && !r; ++k)
+        if (!(mx[k] > mn[k])) {
+            char PM[JPATH];
+            scene_join(PM, P, "max");
+            r = scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PM, "must exceed min on every axis (axis %d: %g <= %g)", k, mx[k], mn[k]);
+        }
+    return r;
+}
+
+vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
+{
+    static const char *const keys[] = {"source", "path", "generator", "simulation", "h", "threshold",
+                                       "quality", "color", "absorption", "ior", NULL};
+    static const char *const sources[] = {"file", "generator", "simulation", NULL};
+    const char *P = "water";
+    vfx_result r = scene_expect_object(c, v, P);
+    if (r)
+        return r;
+    scene_check_keys(c, v, P, keys);
+    uint32_t src = 0;
+    if ((r = scene_get_enum(c, v, P, "source", true, sources, &src)))
+        return r;
+    w->source = (rt_scene_water_source)src;
+    w->layer_side = 24;
+    w->spacing = 0.1f;
+    w->dt = 0.004f;
+    w->gravity[1] = -9.81f;
+    w->paddle_amplitude = 0.2f;
+    w->paddle_period_s = 2.0f;
+    if (w->source == RT_SCENE_WATER_FILE) {
+        if ((r = scene_get_path(c, v, P, "path", true, w->path)))
+            return r;
+    } else if (w->source == RT_SCENE_WATER_GENERATOR) {
+        static const char *const gkeys[] = {"kind", "count", "origin", "spacing", "layer_side", "min", "max",
+                                            "center", "radius", NULL};
+        static const char *const kinds[] = {"layers", "box", "sphere", NULL};
+        const char *PG = "water.generator";
+        const cJSON *g = cJSON_GetObjectItemCaseSensitive(v, "generator");
+        if (!g)
+            return scene_failf(c, VFX_ERR_FORMAT, PG, "required for source \"generator\"");
+        if ((r = scene_expect_object(c, g, PG)))
+            return r;
+        scene_check_keys(c, g, PG, gkeys);
+        uint32_t kind = 0;
+        r = scene_get_enum(c, g, PG, "kind", true, kinds, &kind);
+        if (!r) r = scene_get_uint(c, g, PG, "count", true, 0, RT_SCENE_MAX_PARTICLES, &w->count);
+        if (r)
+            return r;
+        w->generator = (rt_scene_generator)kind;
+        if (kind == RT_SCENE_GEN_LAYERS) {
+            r = scene_get_vec(c, g, PG, "origin", 3, false, COORD, w->origin);
+            if (!r) r = scene_get_float(c, g, PG, "spacing", false, POSITIVE, &w->spacing);
+            if (!r) r = scene_get_uint(c, g, PG, "layer_side", false, 1, 4096, &w->layer_side);
+        } else if (kind == RT_SCENE_GEN_BOX) {
+            r = scene_get_vec(c, g, PG, "min", 3, true, COORD, w->box_min);
+            if (!r) r = scene_get_vec(c, g, PG, "max", 3, true, COORD, w->box_max);
+            for (int k = 0; k < 3 && !r; ++k)
+                if (!(w->box_max[k] > w->box_min[k]))
+                    r = scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.generator.max",
+                              "must exceed min on every axis (axis %d: %g <= %g)", k, w->box_max[k], w->box_min[k]);
+        } else {
+            r = scene_get_vec(c, g, PG, "center", 3, false, COORD, w->center);
+            if (!r) r = scene_get_float(c, g, PG, "radius", true, POSITIVE, &w->radius);
+        }
+        if (r)
+            return r;
+    } else {
+        static const char *const skeys[] = {"tank", "fluid", "particle_count", "gravity", "dt", "paddle", "no_slip", NULL};
+        const char *PS = "water.simulation";
+        const cJSON *s = cJSON_GetObjectItemCaseSensitive(v, "simulation");
+        if (!s)
+            return scene_failf(c, VFX_ERR_FORMAT, PS, "required for source \"simulation\"");
+        if ((r = scene_expect_object(c, s, PS)))
+            return r;
+        scene_check_keys(c, s, PS, skeys);
+        r = scene_parse_box(c, s, PS, "tank", w->tank_min, w->tank_max);
+        if (!r) r = scene_parse_box(c, s, PS, "fluid", w->box_min, w->box_max);
+        for (int k = 0; k < 3 && !r; ++k)
+            if (w->box_min[k] < w->tank_min[k] || w->box_max[k] > w->tank_max[k])
+                r = scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.simulation.fluid", "must lie inside the tank (axis %d)", k);
+        if (!r) r = scene_get_uint(c, s, PS, "particle_count", true, 0, RT_SCENE_MAX_PARTICLES, &w->count);
+        if (!r) r = scene_get_vec(c, s, PS, "gravity", 3, false, (range){-1000, 1000, false}, w->gravity);
+        if (!r) r = scene_get_float(c, s, PS, "dt", false, (range){0, 0.1, true}, &w->dt);
+        if (!r) r = scene_get_bool(c, s, PS, "no_slip", &w->no_slip);
+        if (r)
+            return r;
+        const cJSON *pd = cJSON_GetObjectItemCaseSensitive(s, "paddle");
+        if (pd) {
+            static const char *const pkeys[] = {"axis", "amplitude", "period_s", NULL};
+            static const char *const axes[] = {"x", "y", "z", NULL};
+            const char *PP = "water.simulation.paddle";
+            if ((r = scene_expect_object(c, pd, PP)))
+                return r;
+            scene_check_keys(c, pd, PP, pkeys);
+            w->paddle = true;
+            r = scene_get_enum(c, pd, PP, "axis", false, axes, &w->paddle_axis);
+            if (!r) r = scene_get_float(c, pd, PP, "amplitude", false, NONNEG, &w->paddle_amplitude);
+            if (!r) r = scene_get_float(c, pd, PP, "period_s", false, (range){0, 1e4, true}, &w->paddle_period_s);
+            if (r)
+                return r;
+        }
+    }
+    vfx_water_params *wp = &w->params;
+    *wp = (vfx_water_params){.size = sizeof *wp, .version = VFX_WATER_PARAMS_VERSION};
+    r = scene_get_float(c, v, P, "h", false, (range){0, 1e3, true}, &wp->h);
+    if (!r) r = scene_get_float(c, v, P, "threshold", false, (range){0, 1e3, true}, &wp->threshold);
+    if (!r) r = scene_get_vec(c, v, P, "color", 3, false, UNIT, wp->color);
+    if (!r) r = scene_get_float(c, v, P, "absorption", false, (range){0, 1e3, false}, &wp->absorption);
+    if (!r) r = scene_get_float(c, v, P, "ior", false, (range){1, 3, false}, &wp->ior);
+    if (r)
+        return r;
+    const cJSON *q = cJSON_GetObjectItemCaseSensitive(v, "quality");
+    if (q) {
+        static const char *const qkeys[] = {"max_samples", "step", "refine_iters", "pyramid_level", "method",
+                                            "disable", NULL};
+        static const char *const methods[] = {"paper", "brute", "grid", NULL};
+        static const char *const flags[] = {"billboard_init", "skip", "blend", "pack4", "pyramid", "refine",
+                                            "shading", NULL};
+        static const uint32_t bits[] = {VFX_WATER_NO_BILLBOARD_INIT, VFX_WATER_NO_SKIP, VFX_WATER_NO_BLEND,
+                                        VFX_WATER_NO_PACK4, VFX_WATER_NO_PYRAMID, VFX_WATER_NO_REFINE,
+                                        VFX_WATER_NO_SHADING};
+        const char *PQ = "water.quality";
+        if ((r = scene_expect_object(c, q, PQ)))
+            return r;
+        scene_check_keys(c, q, PQ, qkeys);
+        r = scene_get_uint(c, q, PQ, "max_samples", false, 1, 4096, &wp->max_samples);
+        if (!r) r = scene_get_float(c, q, PQ, "step", false, (range){0, 1e3, true}, &wp->step);
+        if (!r) r = scene_get_uint(c, q, PQ, "refine_iters", false, 1, 64, &wp->refine_iters);
+        if (!r) r = scene_get_uint(c, q, PQ, "pyramid_level", false, 1, 12, &wp->pyramid_level);
+        if (!r) r = scene_get_enum(c, q, PQ, "method", false, methods, &wp->method);
+        if (!r) r = scene_get_flags(c, q, PQ, "disable", flags, bits, &wp->disable);
+    }
+    return r;
+}
+
+/* ------------------------------------------------------------------ water and volume data */
+
+static vfx_result lattice_box(const float mn[3], const float mx[3], uint32_t count, float *xyz)
+{
+    double e[3] = {(double)mx[0] - mn[0], (double)mx[1] - mn[1], (double)mx[2] - mn[2]};
+    double d = cbrt(e[0] * e[1] * e[2] / count);
+    uint32_t nk[3];
+    for (int iter = 0; iter < 100000; ++iter) {
+        double prod = 1;
+        for (int k = 0; k < 3; ++k) {
+            double q = floor(e[k] / d) + 1;
+            nk[k] = q > 1e7 ? 10000000u : (uint32_t)q;
+            prod *= nk[k];
+        }
+        if (prod >= count)
+            break;
+        d *= 0.99;
+    }
+    uint32_t i = 0;
+    /* bottom layers first, so a partial last layer sits on top like a fluid surface */
+    for (uint32_t y = 0; y < nk[1] && i < count; ++y)
+        for (uint32_t x = 0; x < nk[0] && i < count; ++x)
+            for (uint32_t z = 0; z < nk[2] && i < count; ++z, ++i) {
+                xyz[3 * (size_t)i] = (float)(mn[0] + x * d);
+                xyz[3 * (size_t)i + 1] = (float)(mn[1] + y * d);
+                xyz[3 * (size_t)i + 2] = (float)(mn[2] + z * d);
+            }
+    return i == count ? VFX_OK : VFX_ERR_NUMERIC;
+}
+
+static vfx_result lattice_sphere(const float c[3], float r, uint32_t count, float *xyz)
+{
+    double d = cbrt(4.0 / 3.0 * M_PI * (double)r * r * r / count);
+    long m = 0;
+    for (int iter = 0; iter < 10000; ++iter) {
+        m = (long)floor(r / d);
+        double inside = 0;
+        for (long y = -m; y <= m; ++y)
+            for (long x = -m; x <= m; ++x) {
+                double q = (double)r * r - (x * d) * (x * d) - (y * d) * (y * d);
+                if (q >= 0)
+                    inside += 2 * floor(sqrt(q) / d) + 1;
+            }
+        if (inside >= count)
+            break;
+        d *= 0.98;
+    }
+    uint32_t i = 0;
+    for (long y = -m; y <= m && i < count; ++y)
+        for (long x = -m; x <= m && i < count; ++x)
+            for (long z = -m; z <= m && i < count; ++z) {
+                double q = (x * d) * (x * d) + (y * d) * (y * d) + (z * d) * (z * d);
+                if (q > (double)r * r)
+                    continue;
+                xyz[3 * (size_t)i] = (float)(c[0] + x * d);
+                xyz[3 * (size_t)i + 1] = (float)(c[1] + y * d);
+                xyz[3 * (size_t)i + 2] = (float)(c[2] + z * d);
+                ++i;
+            }
+    return i == count ? VFX_OK : VFX_ERR_NUMERIC;
+}
+
+vfx_result rt_scene_water_particles(const rt_scene_water *w, float **xyz, uint32_t *count, char *err,
+                                     size_t errlen)
+{
+    if (!w || !xyz || !count) {
+        if (err && errlen)
+            snprintf(err, errlen, "water: NULL argument");
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    *xyz = NULL;
+    *count = 0;
+    if (w->source == RT_SCENE_WATER_FILE)
+        return rt_particle_file_load(w->path, xyz, count, err, errlen);
+    uint32_t n = w->count;
+    if (n == 0)
+        return VFX_OK;
+    if (n > RT_SCENE_MAX_PARTICLES) {
+        if (err && errlen)
+            snprintf(err, errlen, "water: %u particles, above the cap of %u", n, RT_SCENE_MAX_PARTICLES);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    float *p = malloc((size_t)n * 3 * sizeof(float));
+    if (!p) {
+        if (err && errlen)
+            snprintf(err, errlen, "water: out of memory for %u particles", n);
+        return VFX_ERR_OUT_OF_MEMORY;
+    }
+    vfx_result r = VFX_OK;
+    if (w->source == RT_SCENE_WATER_GENERATOR && w->generator == RT_SCENE_GEN_LAYERS) {
+        uint32_t side = w->layer_side ? w->layer_side : 24, per = side * side;
+        for (uint32_t i = 0; i < n; ++i) {
+            uint32_t layer = i / per, q = i % per;
+            p[3 * (size_t)i] = w->origin[0] + (float)(q % side) * w->spacing;
+            p[3 * (size_t)i + 1] = w->origin[1] + (float)layer * w->spacing;
+            p[3 * (size_t)i + 2] = w->origin[2] + (float)(q / side) * w->spacing;
+        }
+    } else if (w->source == RT_SCENE_WATER_GENERATOR && w->generator == RT_SCENE_GEN_SPHERE) {
+        r = lattice_sphere(w->center, w->radius, n, p);
+    } else {
+        r = lattice_box(w->box_min, w->box_max, n, p);
+    }
+    for (size_t i = 0; i < 3 * (size_t)n && !r; ++i)
+        if (!isfinite(p[i]))
+            r = VFX_ERR_NUMERIC;
+    if (r) {
+        free(p);
+        if (err && errlen)
+            snprintf(err, errlen, "water.generator: could not place %u finite particles", n);
+        return r;
+    }
+    *xyz = p;
+    *count = n;
+    return VFX_OK;
+}
