@@ -3,6 +3,8 @@
 #ifndef VOLFX_EFFECT_H
 #define VOLFX_EFFECT_H
 
+#include <stdbool.h>
+
 #include "context.h"
 
 /* Targets shared between effects during one render. Effects run in a fixed order:
@@ -12,7 +14,14 @@ typedef struct volfx_frame_targets {
     unsigned scene_depth;  /* host depth texture (window depth [0,1]) */
     unsigned scene_color;  /* host colour texture */
     unsigned water_dist;   /* R32F distance along the view ray to water, -1 miss; 0 = no water */
-    float inv_view_proj[16];
+    /* Made once per frame in entry.c from the frame view, so no effect multiplies or inverts. */
+    float view_proj[16];     /* proj * view */
+    float inv_view_proj[16]; /* window/NDC -> world */
+    float inv_view[16];      /* eye space -> world */
+    /* Version 2 fields (defaults when the host passed version 1). */
+    double origin[3];        /* positions are relative to this */
+    bool color_hdr;          /* framebuffer colour is float: write linear radiance */
+    unsigned environment_cubemap; /* 0 -> procedural sky */
 } volfx_frame_targets;
 
 struct volfx_effect_ops {

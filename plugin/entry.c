@@ -138,9 +138,15 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
 {
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
-    if (!frame || frame->size < sizeof(vfx_frame_view) || frame->version != VFX_FRAME_VIEW_VERSION)
-        return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view missing or of version %u (need %u)",
-                        frame ? frame->version : 0, VFX_FRAME_VIEW_VERSION);
+    if (!frame)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view is NULL");
+    if (frame->version != VFX_FRAME_VIEW_VERSION && frame->version != VFX_FRAME_VIEW2_VERSION)
+        return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view of version %u (this plugin reads %u and %u)",
+                          frame->version, VFX_FRAME_VIEW_VERSION, VFX_FRAME_VIEW2_VERSION);
+    size_t need = frame->version == VFX_FRAME_VIEW2_VERSION ? sizeof(vfx_frame_view2) : sizeof(vfx_frame_view);
+    if (frame->size < need)
+        return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view of version %u has size %u (need %zu)",
+                          frame->version, frame->size, need);
     if (frame->width == 0 || frame->height == 0)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame is %ux%u", frame->width,
                         frame->height);
@@ -156,10 +162,21 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
     memset(&targets, 0, sizeof targets);
     targets.scene_depth = frame->depth_texture;
     targets.scene_color = frame->color_texture;
-    float vp[16];
-    volfx_mat4_mul(frame->proj, frame->view, vp);
-    if (!volfx_mat4_invert(vp, targets.inv_view_proj))
+    volfx_mat4_mul(frame->proj, frame->view, targets.view_proj);
+    if (!volfx_mat4_invert(targets.view_proj, targets.inv_view_proj))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: view*projection is singular");
+    if (!volfx_mat4_invert(frame->view, targets.inv_view))
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: view matrix is singular");
+    if (frame->version == VFX_FRAME_VIEW2_VERSION) {
+        const vfx_frame_view2 *f2 = (const vfx_frame_view2 *)frame;
+        for (int i = 0; i < 3; ++i) {
+            if (!isfinite(f2->origin[i]))
+                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view origin[%d] is not finite", i);
+            targets.origin[i] = f2->origin[i];
+        }
+        targets.color_hdr = f2->color_hdr != 0;
+        targets.environment_cubemap = f2->environment_cubemap;
+    }
 
     ctx->stats.count = 0;
     uint32_t mask = frame->effects ? frame->effects : 0xffffffffu;

@@ -7,7 +7,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "gpu/gpu.h"
+#include "gpu/pass.h"
 #include "effect.h"
 #include "tet_render.h"
 
@@ -195,20 +195,9 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
     volfx_stat_set(ctx, "volume.segments", (double)c.segments_made);
     volfx_stat_set(ctx, "volume.t_sc_ms", c.t_sc_ms);
     volfx_stat_set(ctx, "volume.t_update_ms", c.t_update_ms);
-    volfx_gpu_pass_begin(ctx, "volume.composite");
     glTextureSubImage2D(s->tex, 0, 0, 0, (GLsizei)s->width, (GLsizei)s->height, GL_RGBA, GL_FLOAT, s->rgba);
-    glBindFramebuffer(GL_FRAMEBUFFER, frame->framebuffer);
-    glViewport(0, 0, (GLsizei)frame->width, (GLsizei)frame->height);
-    glDisable(GL_DEPTH_TEST);
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-    glUseProgram(s->prog);
-    glUniform1i(glGetUniformLocation(s->prog, "u_image"), 0);
     glBindTextureUnit(0, s->tex);
-    volfx_gpu_fullscreen(ctx);
-    glDisable(GL_BLEND);
-    glUseProgram(0);
-    volfx_gpu_pass_end(ctx);
+    volfx_composite(ctx, frame, "volume.composite", s->prog, VOLFX_BLEND_OVER_PREMUL);
     const char *e = volfx_gpu_error_string();
     return e ? volfx_fail(ctx, VFX_ERR_GL, "volume render: %s", e) : VFX_OK;
 }

@@ -1,6 +1,6 @@
 // Composites the CPU cell-projection image (premultiplied RGBA, already clipped by the host's
 // depth) over the host frame: blend ONE, ONE_MINUS_SRC_ALPHA.
-uniform sampler2D u_image;
+layout(binding = 0) uniform sampler2D u_image;
 out vec4 o_color;
 
 void main()

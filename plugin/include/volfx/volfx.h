@@ -227,6 +227,22 @@ typedef struct vfx_frame_view {
     uint32_t _reserved;
 } vfx_frame_view;
 
+/* Version 2 of the frame view: version 1 as its first member (never edited), then what large
+ * worlds, HDR hosts and reflections need. The host sets v1.size = sizeof(vfx_frame_view2) and
+ * v1.version = VFX_FRAME_VIEW2_VERSION and passes &view.v1 to render(); a plugin that knows only
+ * version 1 refuses it, this one reads both. */
+#define VFX_FRAME_VIEW2_VERSION 2u
+typedef struct vfx_frame_view2 {
+    vfx_frame_view v1;
+    double origin[3];             /* world position every position in this frame is relative to
+                                     (view, eye, particles, beams, volumes): large worlds keep
+                                     float32 precise near the camera; all 0 -> the world origin */
+    uint32_t color_hdr;           /* 1: `framebuffer`'s colour is a float target and effects write
+                                     linear radiance into it; 0: 8-bit display colour */
+    uint32_t environment_cubemap; /* GL cubemap the water reflects; 0 -> a procedural sky */
+    uint32_t _reserved[4];
+} vfx_frame_view2;
+
 #define VFX_STATS_MAX 64
 typedef struct vfx_stat {
     char name[40];  /* "water.gpu_ms.accumulate", "beams.tiles_culled", ... */

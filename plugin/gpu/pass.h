@@ -1,0 +1,67 @@
+/* pass.h — GL state for a pass in one place (sokol style: a desc struct where zero means
+ * default), std140 uniform blocks uploaded once per frame, uniform locations resolved when a
+ * program is made, and the one composite every effect ends with. Nothing here looks anything up
+ * by name on the frame path. */
+#ifndef VOLFX_PASS_H
+#define VOLFX_PASS_H
+
+#include <stdbool.h>
+#include "gpu/gpu.h"
+
+typedef enum volfx_blend {
+    VOLFX_BLEND_NONE = 0,    /* blending off */
+    VOLFX_BLEND_ADD,         /* ONE, ONE */
+    VOLFX_BLEND_OVER_PREMUL, /* ONE, ONE_MINUS_SRC_ALPHA: premultiplied colour over the target */
+    VOLFX_BLEND_MAX,         /* equation MAX */
+    VOLFX_BLEND_MIN,         /* equation MIN */
+} volfx_blend;
+
+typedef enum volfx_depth {
+    VOLFX_DEPTH_NONE = 0,    /* no depth test, no depth write */
+    VOLFX_DEPTH_TEST,        /* LESS test, no write */
+    VOLFX_DEPTH_TEST_WRITE,  /* LESS test and write */
+} volfx_depth;
+
+typedef struct volfx_pass_desc {
+    const char *name;        /* "effect.pass": debug group and GPU timer; required */
+    GLuint framebuffer;      /* 0 -> the default framebuffer */
+    uint32_t width, height;  /* viewport; 0 -> the context's size */
+    bool clear_color;        /* clear colour attachments to clear_rgba first */
+    float clear_rgba[4];
+    bool clear_depth;        /* clear depth to clear_depth_value (0 -> 1.0) first */
+    float clear_depth_value;
+    volfx_blend blend;
+    volfx_depth depth;
+    bool no_framebuffer;     /* compute-only pass: leave the framebuffer and viewport alone */
+} volfx_pass_desc;
+
+/* Opens a timed, labelled pass and applies its framebuffer, viewport, clears, blend and depth. */
+void volfx_pass_begin(vfx_context *ctx, const volfx_pass_desc *desc);
+/* Closes the innermost pass; leaves blending and depth testing off (the effect state rule). */
+void volfx_pass_end(vfx_context *ctx);
+
+/* A std140 uniform block: a buffer the effect fills from a C struct mirroring the GLSL block. */
+typedef struct volfx_ubo {
+    GLuint buffer;
+    uint32_t bytes;
+} volfx_ubo;
+
+/* Makes a uniform buffer of `bytes` (a multiple of 16, as std140 pads); false with an error. */
+bool volfx_ubo_create(vfx_context *ctx, volfx_ubo *ubo, uint32_t bytes, const char *label);
+/* Uploads `bytes` (<= ubo->bytes) from data; once per frame per block. */
+void volfx_ubo_update(const volfx_ubo *ubo, const void *data, uint32_t bytes);
+/* Binds the block at `binding` (the GLSL `layout(std140, binding = N)`). */
+void volfx_ubo_bind(const volfx_ubo *ubo, uint32_t binding);
+/* Deletes the buffer; a zeroed ubo is allowed. */
+void volfx_ubo_destroy(volfx_ubo *ubo);
+
+/* Resolves n uniform names of prog into locs at program creation; a name the linker dropped
+ * gets -1 (GL ignores it). Never call it on the frame path. */
+void volfx_program_uniforms(GLuint prog, const char *const *names, GLint *locs, uint32_t n);
+
+/* Draws `prog` (which uses common/fullscreen.vert) over the whole of frame->framebuffer with
+ * `blend`, timed as `name`, textures bound by the caller: the final pass of every effect. */
+void volfx_composite(vfx_context *ctx, const vfx_frame_view *frame, const char *name, GLuint prog,
+                     volfx_blend blend);
+
+#endif
