@@ -26,30 +26,23 @@ static void *host_proc(void *user, const char *name)
 
 static rt_component particle_terms(const game_app *app) { return app->particles.position; }
 
-static uint32_t host_particle_chunk_count(void *user)
+/* The plugin asks for the count and then for each chunk in turn: one query walk per frame
+ * fills the views, and each chunk call reads its slot (no walk per index). */
+static vfx_result particle_chunks_collect(game_app *app)
 {
-    game_app *app = user;
-    if (!app->water_enabled)
-        return 0;
     rt_component t = particle_terms(app);
     uint32_t n = 0;
     rt_query_iter it = rt_query_begin(app->world, &t, 1);
-    while (rt_query_next(&it))
-        ++n;
-    return n;
-}
-
-static vfx_result host_particle_chunk(void *user, uint32_t index, vfx_particle_view *out)
-{
-    game_app *app = user;
-    if (!out || out->size < sizeof *out)
-        return VFX_ERR_ABI;
-    rt_component t = particle_terms(app);
-    rt_query_iter it = rt_query_begin(app->world, &t, 1);
-    uint32_t i = 0;
     while (rt_query_next(&it)) {
-        if (i++ != index)
-            continue;
+        if (n == app->chunk_cap) {
+            uint32_t cap = app->chunk_cap ? app->chunk_cap * 2 : 8;
+            vfx_particle_view *p = realloc(app->chunks, cap * sizeof *p);
+            if (!p)
+                return VFX_ERR_OUT_OF_MEMORY;
+            app->chunks = p;
+            app->chunk_cap = cap;
+        }
+        vfx_particle_view *out = &app->chunks[n++];
         memset(out, 0, sizeof *out);
         out->size = sizeof *out;
         out->version = VFX_PARTICLE_VIEW_VERSION;
@@ -61,9 +54,38 @@ static vfx_result host_particle_chunk(void *user, uint32_t index, vfx_particle_v
         out->density = rt_query_column(&it, app->particles.density, 0);
         out->radius = rt_query_column(&it, app->particles.radius, 0);
         out->revision = rt_world_table_revision(app->world, it.table);
-        return VFX_OK;
     }
-    return VFX_ERR_NOT_FOUND;
+    app->chunk_count = n;
+    app->chunks_valid = true;
+    return VFX_OK;
+}
+
+static uint32_t host_particle_chunk_count(void *user)
+{
+    game_app *app = user;
+    if (!app->water_enabled)
+        return 0;
+    if (particle_chunks_collect(app) != VFX_OK) {
+        rt_logf(&app->log, VFX_LOG_ERROR, "particle chunks: out of memory");
+        return 0;
+    }
+    return app->chunk_count;
+}
+
+static vfx_result host_particle_chunk(void *user, uint32_t index, vfx_particle_view *out)
+{
+    game_app *app = user;
+    if (!out || out->size < sizeof *out)
+        return VFX_ERR_ABI;
+    if (!app->chunks_valid) {
+        vfx_result r = particle_chunks_collect(app);
+        if (r)
+            return r;
+    }
+    if (index >= app->chunk_count)
+        return VFX_ERR_NOT_FOUND;
+    *out = app->chunks[index];
+    return VFX_OK;
 }
 
 static vfx_result host_water_params(void *user, vfx_water_params *out)
@@ -187,6 +209,7 @@ void game_app_destroy(game_app *app)
     if (app->ctx)
         app->api->destroy(app->ctx);
     rt_plugin_host_unload(app->plugin);
+    free(app->chunks);
     if (app->world) {
         rt_query_iter it = rt_query_begin(app->world, &app->mesh_comp, 1);
         while (rt_query_next(&it)) {
@@ -260,7 +283,10 @@ vfx_result game_app_frame(game_app *app, float dt)
     if (r)
         return r;
     double t0 = rt_now_ms();
-    if ((r = app->api->update(app->ctx, app->time, dt))) {
+    app->chunks_valid = false; /* the systems above may have moved or resized tables */
+    r = app->api->update(app->ctx, app->time, dt);
+    app->chunks_valid = false; /* render-phase systems may change tables before the next call */
+    if (r) {
         rt_logf(&app->log, VFX_LOG_ERROR, "plugin update: %s", app->api->last_error(app->ctx));
         return r;
     }
@@ -277,8 +303,13 @@ vfx_result game_app_frame(game_app *app, float dt)
         for (uint32_t i = 0; i < it.rows; ++i)
             rt_renderer_draw_mesh(app->renderer, &m[i].gpu, xf + 16 * (size_t)i, m[i].color);
     }
-    vfx_frame_view frame;
-    rt_renderer_end_scene(app->renderer, &frame);
+    rt_renderer_targets tg;
+    rt_renderer_end_scene(app->renderer, &tg);
+    vfx_frame_view frame = {.size = sizeof frame, .version = VFX_FRAME_VIEW_VERSION,
+                            .framebuffer = tg.output_framebuffer, .color_texture = tg.scene_color,
+                            .depth_texture = tg.scene_depth, .width = tg.width, .height = tg.height};
+    memcpy(frame.view, view, sizeof frame.view);
+    memcpy(frame.proj, proj, sizeof frame.proj);
     for (int k = 0; k < 3; ++k)
         frame.eye[k] = (float)app->camera.eye[k];
     frame.near_plane = (float)app->camera.near_plane;

@@ -61,6 +61,11 @@ typedef struct game_app {
     uint32_t volume_count;
     double time;
     uint64_t frame;
+    /* particle chunk views of this frame (host_particle_chunk_count fills them; a world
+     * change since then clears chunks_valid) */
+    vfx_particle_view *chunks;
+    uint32_t chunk_count, chunk_cap;
+    bool chunks_valid;
 } game_app;
 
 /* Creates the context (window or headless), world, renderer and plugin. */

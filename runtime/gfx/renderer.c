@@ -185,7 +185,7 @@ void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float 
     glBindVertexArray(0);
 }
 
-void rt_renderer_end_scene(rt_renderer *r, vfx_frame_view *frame)
+void rt_renderer_end_scene(rt_renderer *r, rt_renderer_targets *out)
 {
     glPopDebugGroup();
     glBlitNamedFramebuffer(r->scene_fbo, r->out_fbo, 0, 0, (GLint)r->width, (GLint)r->height, 0, 0,
@@ -194,16 +194,8 @@ void rt_renderer_end_scene(rt_renderer *r, vfx_frame_view *frame)
     glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
     glDisable(GL_DEPTH_TEST);
     glUseProgram(0);
-    memset(frame, 0, sizeof *frame);
-    frame->size = sizeof *frame;
-    frame->version = VFX_FRAME_VIEW_VERSION;
-    frame->framebuffer = r->out_fbo;
-    frame->color_texture = r->scene_color;
-    frame->depth_texture = r->scene_depth;
-    frame->width = r->width;
-    frame->height = r->height;
-    memcpy(frame->view, r->view, sizeof frame->view);
-    memcpy(frame->proj, r->proj, sizeof frame->proj);
+    *out = (rt_renderer_targets){.output_framebuffer = r->out_fbo, .scene_color = r->scene_color,
+                                 .scene_depth = r->scene_depth, .width = r->width, .height = r->height};
 }
 
 vfx_result rt_renderer_read_rgba(rt_renderer *r, uint8_t *rgba)

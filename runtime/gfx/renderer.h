@@ -23,8 +23,15 @@ void rt_renderer_begin_scene(rt_renderer *r, const float view[16], const float p
 /* Draws a mesh with a model matrix and a colour into the scene target. */
 void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float model[16],
                             const float rgb[3]);
-/* Copies scene colour and depth into the output target and fills `frame` for the plugin. */
-void rt_renderer_end_scene(rt_renderer *r, vfx_frame_view *frame);
+/* The targets of a finished scene: the output framebuffer effects draw into, and the scene's
+ * colour and depth textures they sample (never attached to the output: no feedback loop). */
+typedef struct rt_renderer_targets {
+    unsigned output_framebuffer, scene_color, scene_depth;
+    uint32_t width, height;
+} rt_renderer_targets;
+
+/* Copies scene colour and depth into the output target and says where they are. */
+void rt_renderer_end_scene(rt_renderer *r, rt_renderer_targets *out);
 /* Reads the output colour, RGBA8, top row first (width*height*4 bytes). */
 vfx_result rt_renderer_read_rgba(rt_renderer *r, uint8_t *rgba);
 /* Blits the output to the default framebuffer of the current window. */

@@ -52,10 +52,10 @@ static void test_render_readback(void **state)
     static const float id[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     rt_renderer_begin_scene(r, view, proj, clear);
     rt_renderer_draw_mesh(r, &gpu, id, red);
-    vfx_frame_view fv;
+    rt_renderer_targets fv;
     rt_renderer_end_scene(r, &fv);
     assert_int_equal(fv.width, 64);
-    assert_int_not_equal(fv.depth_texture, 0);
+    assert_int_not_equal(fv.scene_depth, 0);
     uint8_t *px = malloc(64 * 48 * 4);
     assert_int_equal(rt_renderer_read_rgba(r, px), VFX_OK);
     const uint8_t *centre = px + (24 * 64 + 32) * 4, *corner = px;
@@ -63,7 +63,7 @@ static void test_render_readback(void **state)
     assert_true(corner[2] == 255 && corner[0] == 0); /* the clear colour */
     /* the depth the plugin will read: the box front face at z = 1 is 4 units from the eye */
     float *depth = malloc(64 * 48 * sizeof(float));
-    glGetTextureImage(fv.depth_texture, 0, GL_DEPTH_COMPONENT, GL_FLOAT, 64 * 48 * 4, depth);
+    glGetTextureImage(fv.scene_depth, 0, GL_DEPTH_COMPONENT, GL_FLOAT, 64 * 48 * 4, depth);
     double n = 0.1, f = 100, d = depth[24 * 64 + 32];
     double z_eye = 2.0 * n * f / (f + n - (2.0 * d - 1.0) * (f - n));
     assert_true(fabs(z_eye - 4.0) < 1e-3); /* depth32F keeps this to ~1e-5 relative */
