@@ -9,7 +9,6 @@
 #include <string.h>
 #include <time.h>
 
-#include "ecs/particles.h"
 
 #define COLUMN_ALIGN 64u
 
@@ -61,10 +60,7 @@ struct rt_world {
     char error[256];
 };
 
-static vfx_result world_fail(rt_world *w, vfx_result r, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-
-static vfx_result world_fail(rt_world *w, vfx_result r, const char *fmt, ...)
+vfx_result rt_world_fail(rt_world *w, vfx_result r, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -140,27 +136,27 @@ const char *rt_world_last_error(const rt_world *w) { return w ? w->error : "no w
 vfx_result rt_world_register(rt_world *w, const rt_component_desc *desc, rt_component *out)
 {
     if (!w || !desc || !desc->name || !desc->name[0])
-        return w ? world_fail(w, VFX_ERR_INVALID_ARGUMENT, "register: component needs a name")
+        return w ? rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT, "register: component needs a name")
                  : VFX_ERR_INVALID_ARGUMENT;
     if (strlen(desc->name) >= sizeof w->comps[0].name)
-        return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "register: name '%.40s...' longer than %zu",
+        return rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT, "register: name '%.40s...' longer than %zu",
                           desc->name, sizeof w->comps[0].name - 1);
     if (rt_world_lookup(w, desc->name) != RT_COMPONENT_NONE)
-        return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "register: component '%s' already registered",
+        return rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT, "register: component '%s' already registered",
                           desc->name);
     if (w->comp_count >= RT_MAX_COMPONENTS)
-        return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "register: more than %d components",
+        return rt_world_fail(w, VFX_ERR_OUT_OF_MEMORY, "register: more than %d components",
                           RT_MAX_COMPONENTS);
     uint32_t fields = desc->fields ? desc->fields : 1;
     if (desc->size % fields != 0)
-        return world_fail(w, VFX_ERR_INVALID_ARGUMENT,
+        return rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT,
                           "register '%s': size %u is not a multiple of its %u fields", desc->name,
                           desc->size, fields);
     if (desc->align && (desc->align & (desc->align - 1)))
-        return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "register '%s': align %u not a power of two",
+        return rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT, "register '%s': align %u not a power of two",
                           desc->name, desc->align);
     if (desc->align > COLUMN_ALIGN)
-        return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "register '%s': align %u above %u",
+        return rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT, "register '%s': align %u above %u",
                           desc->name, desc->align, COLUMN_ALIGN);
     component_info *ci = &w->comps[w->comp_count];
     ci->desc = *desc;
@@ -233,7 +229,7 @@ static vfx_result table_find_or_make(rt_world *w, const rt_component *set, uint3
         }
     }
     if (!grow((void **)&w->tables, &w->table_capacity, w->table_count + 1, sizeof(table)))
-        return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "out of memory making a table");
+        return rt_world_fail(w, VFX_ERR_OUT_OF_MEMORY, "out of memory making a table");
     table *t = &w->tables[w->table_count];
     memset(t, 0, sizeof *t);
     t->comp_count = n;
@@ -250,7 +246,7 @@ static vfx_result table_find_or_make(rt_world *w, const rt_component *set, uint3
     if (!t->columns || !t->column_size) {
         free(t->columns);
         free(t->column_size);
-        return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "out of memory making a table");
+        return rt_world_fail(w, VFX_ERR_OUT_OF_MEMORY, "out of memory making a table");
     }
     for (uint32_t i = 0; i < n; ++i) {
         const component_info *ci = &w->comps[set[i]];
@@ -272,11 +268,11 @@ static vfx_result table_reserve(rt_world *w, table *t, uint32_t need)
     while (cap < need)
         cap *= 2;
     if (cap > UINT32_MAX)
-        return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "table of %u rows too large", need);
+        return rt_world_fail(w, VFX_ERR_OUT_OF_MEMORY, "table of %u rows too large", need);
     for (uint32_t c = 0; c < t->column_count; ++c) {
         void *p = aligned_zalloc((size_t)cap * t->column_size[c]);
         if (!p)
-            return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "out of memory for %llu rows",
+            return rt_world_fail(w, VFX_ERR_OUT_OF_MEMORY, "out of memory for %llu rows",
                               (unsigned long long)cap);
         if (t->columns[c])
             memcpy(p, t->columns[c], (size_t)t->rows * t->column_size[c]);
@@ -285,7 +281,7 @@ static vfx_result table_reserve(rt_world *w, table *t, uint32_t need)
     }
     rt_entity *e = realloc(t->entities, (size_t)cap * sizeof *e);
     if (!e)
-        return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "out of memory for %llu rows",
+        return rt_world_fail(w, VFX_ERR_OUT_OF_MEMORY, "out of memory for %llu rows",
                           (unsigned long long)cap);
     t->entities = e;
     t->capacity = (uint32_t)cap;
@@ -321,10 +317,10 @@ static vfx_result new_entity(rt_world *w, uint32_t table_index, uint32_t row, rt
         idx = w->free_indices[--w->free_count];
     } else {
         if (w->record_count == UINT32_MAX)
-            return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "entity index space exhausted");
+            return rt_world_fail(w, VFX_ERR_OUT_OF_MEMORY, "entity index space exhausted");
         if (!grow((void **)&w->records, &w->record_capacity, w->record_count + 1,
                   sizeof(entity_record)))
-            return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "out of memory for entity records");
+            return rt_world_fail(w, VFX_ERR_OUT_OF_MEMORY, "out of memory for entity records");
         idx = w->record_count++;
         w->records[idx].generation = 0;
     }
@@ -348,27 +344,27 @@ vfx_result rt_world_spawn(rt_world *w, uint32_t count, const rt_component *comps
     if (count == 0)
         return VFX_OK;
     if (comp_count && !comps)
-        return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "spawn: NULL component list");
+        return rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT, "spawn: NULL component list");
     rt_component set[RT_MAX_TABLE_COMPONENTS];
     int n = normalize_set(w, comps, comp_count, set);
     if (n < 0)
-        return world_fail(w, VFX_ERR_INVALID_ARGUMENT,
+        return rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT,
                           "spawn: unknown component id or more than %d components",
                           RT_MAX_TABLE_COMPONENTS);
     if ((uint64_t)w->alive_count + count > UINT32_MAX - 1)
-        return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "spawn: %u entities exceed the id space", count);
+        return rt_world_fail(w, VFX_ERR_OUT_OF_MEMORY, "spawn: %u entities exceed the id space", count);
     uint32_t ti;
     vfx_result r = table_find_or_make(w, set, (uint32_t)n, &ti);
     if (r)
         return r;
     table *t = &w->tables[ti];
     if ((uint64_t)t->rows + count > UINT32_MAX)
-        return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "spawn: table would exceed 2^32 rows");
+        return rt_world_fail(w, VFX_ERR_OUT_OF_MEMORY, "spawn: table would exceed 2^32 rows");
     if ((r = table_reserve(w, t, t->rows + count)))
         return r;
     if (!grow((void **)&w->records, &w->record_capacity, w->record_count + count,
               sizeof(entity_record)))
-        return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "spawn: out of memory for %u records", count);
+        return rt_world_fail(w, VFX_ERR_OUT_OF_MEMORY, "spawn: out of memory for %u records", count);
     for (uint32_t i = 0; i < count; ++i) {
         rt_entity e = RT_ENTITY_NULL;
         if ((r = new_entity(w, ti, t->rows, &e)))
@@ -402,12 +398,12 @@ vfx_result rt_world_despawn(rt_world *w, rt_entity e)
         return VFX_ERR_INVALID_ARGUMENT;
     entity_record *rec = live_record(w, e);
     if (!rec)
-        return world_fail(w, VFX_ERR_NOT_FOUND, "despawn: entity %u (generation %u) is not alive",
+        return rt_world_fail(w, VFX_ERR_NOT_FOUND, "despawn: entity %u (generation %u) is not alive",
                           rt_entity_index(e), rt_entity_generation(e));
     table_swap_remove(w, &w->tables[rec->table], rec->row);
     rec->alive = false;
     if (!grow((void **)&w->free_indices, &w->free_capacity, w->free_count + 1, sizeof(uint32_t)))
-        return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "despawn: out of memory for the free list");
+        return rt_world_fail(w, VFX_ERR_OUT_OF_MEMORY, "despawn: out of memory for the free list");
     w->free_indices[w->free_count++] = rt_entity_index(e);
     w->alive_count--;
     return VFX_OK;
@@ -470,14 +466,14 @@ vfx_result rt_world_add(rt_world *w, rt_entity e, rt_component c)
         return VFX_ERR_INVALID_ARGUMENT;
     entity_record *rec = live_record(w, e);
     if (!rec)
-        return world_fail(w, VFX_ERR_NOT_FOUND, "add: entity %u is not alive", rt_entity_index(e));
+        return rt_world_fail(w, VFX_ERR_NOT_FOUND, "add: entity %u is not alive", rt_entity_index(e));
     if (c >= w->comp_count)
-        return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "add: unknown component id %u", c);
+        return rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT, "add: unknown component id %u", c);
     const table *t = &w->tables[rec->table];
     if (table_comp_slot(t, c) >= 0)
         return VFX_OK;
     if (t->comp_count >= RT_MAX_TABLE_COMPONENTS)
-        return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "add: entity already has %d components",
+        return rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT, "add: entity already has %d components",
                           RT_MAX_TABLE_COMPONENTS);
     rt_component set[RT_MAX_TABLE_COMPONENTS];
     memcpy(set, t->comps, t->comp_count * sizeof *set);
@@ -493,7 +489,7 @@ vfx_result rt_world_remove(rt_world *w, rt_entity e, rt_component c)
         return VFX_ERR_INVALID_ARGUMENT;
     entity_record *rec = live_record(w, e);
     if (!rec)
-        return world_fail(w, VFX_ERR_NOT_FOUND, "remove: entity %u is not alive",
+        return rt_world_fail(w, VFX_ERR_NOT_FOUND, "remove: entity %u is not alive",
                           rt_entity_index(e));
     const table *t = &w->tables[rec->table];
     if (table_comp_slot(t, c) < 0)
@@ -583,7 +579,7 @@ uint64_t rt_world_table_revision(const rt_world *w, uint32_t table_index)
 vfx_result rt_world_table_permute(rt_world *w, uint32_t ti, const uint32_t *perm)
 {
     if (!w || ti >= w->table_count || !perm)
-        return w ? world_fail(w, VFX_ERR_INVALID_ARGUMENT, "permute: bad table %u or NULL perm", ti)
+        return w ? rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT, "permute: bad table %u or NULL perm", ti)
                  : VFX_ERR_INVALID_ARGUMENT;
     table *t = &w->tables[ti];
     if (t->rows == 0)
@@ -591,11 +587,11 @@ vfx_result rt_world_table_permute(rt_world *w, uint32_t ti, const uint32_t *perm
     /* Check it is a permutation before touching anything. */
     uint8_t *seen = calloc(t->rows, 1);
     if (!seen)
-        return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "permute: out of memory");
+        return rt_world_fail(w, VFX_ERR_OUT_OF_MEMORY, "permute: out of memory");
     for (uint32_t i = 0; i < t->rows; ++i) {
         if (perm[i] >= t->rows || seen[perm[i]]) {
             free(seen);
-            return world_fail(w, VFX_ERR_INVALID_ARGUMENT,
+            return rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT,
                               "permute: perm[%u] = %u is out of range or repeated", i, perm[i]);
         }
         seen[perm[i]] = 1;
@@ -607,7 +603,7 @@ vfx_result rt_world_table_permute(rt_world *w, uint32_t ti, const uint32_t *perm
             max_size = t->column_size[c];
     char *tmp = malloc((size_t)t->rows * max_size);
     if (!tmp)
-        return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "permute: out of memory");
+        return rt_world_fail(w, VFX_ERR_OUT_OF_MEMORY, "permute: out of memory");
     for (uint32_t c = 0; c < t->column_count; ++c) {
         uint32_t s = t->column_size[c];
         const char *src = t->columns[c];
@@ -631,26 +627,26 @@ vfx_result rt_world_table_permute(rt_world *w, uint32_t ti, const uint32_t *perm
 vfx_result rt_world_add_system(rt_world *w, const rt_system_desc *d)
 {
     if (!w || !d || !d->fn)
-        return w ? world_fail(w, VFX_ERR_INVALID_ARGUMENT, "add_system: NULL function")
+        return w ? rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT, "add_system: NULL function")
                  : VFX_ERR_INVALID_ARGUMENT;
     const char *name = d->name ? d->name : "(unnamed)";
     if ((unsigned)d->phase >= RT_PHASE_COUNT)
-        return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "add_system '%s': phase %d out of range",
+        return rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT, "add_system '%s': phase %d out of range",
                           name, (int)d->phase);
     if (d->read_count > RT_MAX_QUERY_TERMS || d->write_count > RT_MAX_QUERY_TERMS)
-        return world_fail(w, VFX_ERR_INVALID_ARGUMENT, "add_system '%s': more than %d reads/writes",
+        return rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT, "add_system '%s': more than %d reads/writes",
                           name, RT_MAX_QUERY_TERMS);
     for (uint32_t i = 0; i < d->read_count; ++i)
         if (d->reads[i] >= w->comp_count)
-            return world_fail(w, VFX_ERR_INVALID_ARGUMENT,
+            return rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT,
                               "add_system '%s': reads unregistered component %u", name, d->reads[i]);
     for (uint32_t i = 0; i < d->write_count; ++i)
         if (d->writes[i] >= w->comp_count)
-            return world_fail(w, VFX_ERR_INVALID_ARGUMENT,
+            return rt_world_fail(w, VFX_ERR_INVALID_ARGUMENT,
                               "add_system '%s': writes unregistered component %u", name,
                               d->writes[i]);
     if (!grow((void **)&w->systems, &w->system_capacity, w->system_count + 1, sizeof(system_entry)))
-        return world_fail(w, VFX_ERR_OUT_OF_MEMORY, "add_system: out of memory");
+        return rt_world_fail(w, VFX_ERR_OUT_OF_MEMORY, "add_system: out of memory");
     system_entry *s = &w->systems[w->system_count];
     memset(s, 0, sizeof *s);
     s->desc = *d;
@@ -712,7 +708,7 @@ vfx_result rt_world_run_phase(rt_world *w, rt_phase phase, double time, float dt
         if (r != VFX_OK) {
             char msg[sizeof w->error];
             snprintf(msg, sizeof msg, "%s", w->error);
-            return world_fail(w, r, "system '%s' failed: %s%s%s", s->name, vfx_result_name(r),
+            return rt_world_fail(w, r, "system '%s' failed: %s%s%s", s->name, vfx_result_name(r),
                               msg[0] ? ": " : "", msg);
         }
     }
@@ -736,68 +732,7 @@ const char *rt_world_system_name(const rt_world *w, uint32_t i)
     return (w && i < w->system_count) ? w->systems[i].name : NULL;
 }
 
-/* ---------------------------------------------------------------------- particles */
-
-vfx_result rt_particles_register(rt_world *w, rt_particle_components *out)
+uint32_t rt_world_table_component_count(const rt_world *w, uint32_t ti)
 {
-    static const struct { const char *name; uint32_t fields; } defs[4] = {
-        {RT_PARTICLE_POSITION, 3}, {RT_PARTICLE_VELOCITY, 3},
-        {RT_PARTICLE_DENSITY, 1}, {RT_PARTICLE_RADIUS, 1}};
-    rt_component ids[4];
-    for (int i = 0; i < 4; ++i) {
-        ids[i] = rt_world_lookup(w, defs[i].name);
-        if (ids[i] != RT_COMPONENT_NONE)
-            continue;
-        rt_component_desc d = {defs[i].name, 4 * defs[i].fields, 4, defs[i].fields};
-        vfx_result r = rt_world_register(w, &d, &ids[i]);
-        if (r)
-            return r;
-    }
-    out->position = ids[0];
-    out->velocity = ids[1];
-    out->density = ids[2];
-    out->radius = ids[3];
-    return VFX_OK;
-}
-
-vfx_result rt_particles_spawn(rt_world *w, const rt_particle_components *pc, uint32_t n,
-                               const float *x, const float *y, const float *z, bool with_radius)
-{
-    if (!w || !pc)
-        return VFX_ERR_INVALID_ARGUMENT;
-    for (uint32_t i = 0; i < n; ++i) {
-        float v[3] = {x ? x[i] : 0.f, y ? y[i] : 0.f, z ? z[i] : 0.f};
-        for (int k = 0; k < 3; ++k)
-            if (!isfinite(v[k]))
-                return world_fail(w, VFX_ERR_INVALID_ARGUMENT,
-                                  "particles: position %c of particle %u is not finite",
-                                  "xyz"[k], i);
-    }
-    rt_component comps[4] = {pc->position, pc->velocity, pc->density, pc->radius};
-    /* Spawn in bulk, then fill the new rows (the last n of the particle table). */
-    vfx_result r = rt_world_spawn(w, n, comps, with_radius ? 4 : 3, NULL);
-    if (r || n == 0)
-        return r;
-    rt_query_iter it = rt_query_begin(w, comps, with_radius ? 4 : 3);
-    while (rt_query_next(&it)) {
-        table *t = &w->tables[it.table];
-        if (t->comp_count != (with_radius ? 4u : 3u))
-            continue;
-        uint32_t base = t->rows - n;
-        float *px = rt_query_column(&it, pc->position, 0);
-        float *py = rt_query_column(&it, pc->position, 1);
-        float *pz = rt_query_column(&it, pc->position, 2);
-        for (uint32_t i = 0; i < n; ++i) {
-            px[base + i] = x ? x[i] : 0.f;
-            py[base + i] = y ? y[i] : 0.f;
-            pz[base + i] = z ? z[i] : 0.f;
-        }
-        if (with_radius) {
-            float *rad = rt_query_column(&it, pc->radius, 0);
-            for (uint32_t i = 0; i < n; ++i)
-                rad[base + i] = 1.f;
-        }
-        return VFX_OK;
-    }
-    return world_fail(w, VFX_ERR_NOT_FOUND, "particles: spawned table not found");
+    return w && ti < w->table_count ? w->tables[ti].comp_count : 0;
 }

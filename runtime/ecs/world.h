@@ -128,6 +128,12 @@ uint32_t rt_query_count(rt_world *world, const rt_component *terms, uint32_t ter
 /* Increments each time a table's content may have changed (structural change or a system that
  * declared a write to one of its components ran): hosts use it as an upload revision. */
 uint64_t rt_world_table_revision(const rt_world *world, uint32_t table);
+/* Number of components of a table (0 for an index out of range). */
+uint32_t rt_world_table_component_count(const rt_world *world, uint32_t table);
+/* Records an error on the world (rt_world_last_error, logged) and returns r; for modules built
+ * on the world, such as ecs/particles.c. */
+vfx_result rt_world_fail(rt_world *world, vfx_result r, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
 
 /* Permutes the rows of a table: new row i takes old row perm[i] (a permutation of
  * 0..rows-1, checked). Entity records follow. For simulations that sort for locality. */
