@@ -71,9 +71,9 @@ typedef enum vfx_log_level {
 } vfx_log_level;
 
 typedef enum vfx_effect_kind {
-    VFX_EFFECT_WATER = 0,  /* seed 000: metaball ray casting of particles */
-    VFX_EFFECT_BEAMS = 1,  /* seed 003: closed-form line integrals of beam densities */
-    VFX_EFFECT_VOLUME = 2, /* seed 002: cell projection of tetrahedral volumes */
+    VFX_EFFECT_WATER = 0,  /* metaball water ray cast from particles (docs/water.md) */
+    VFX_EFFECT_BEAMS = 1,  /* energy beams: closed-form line integrals of their densities (docs/beams.md) */
+    VFX_EFFECT_VOLUME = 2, /* translucent tetrahedral volumes by cell projection (docs/tetvol.md) */
     VFX_EFFECT_COUNT = 3,
 } vfx_effect_kind;
 
@@ -96,7 +96,7 @@ typedef struct vfx_particle_view {
     uint64_t revision;
 } vfx_particle_view;
 
-/* Bits of vfx_water_params.disable: each switches one technique of seed 000 off (ablation). */
+/* Bits of vfx_water_params.disable: each switches one technique of the billboard ray caster (docs/water.md) off, for ablations. */
 enum {
     VFX_WATER_NO_BILLBOARD_INIT = 1u << 0, /* technique 1: start every ray at the near plane */
     VFX_WATER_NO_SKIP = 1u << 1,           /* technique 2: fixed steps, no gap jumping */
@@ -108,7 +108,7 @@ enum {
 };
 
 typedef enum vfx_water_method {
-    VFX_WATER_METHOD_PAPER = 0,     /* billboards + blending, seed 000 (default) */
+    VFX_WATER_METHOD_PAPER = 0,     /* billboards + blended potentials, the published method (docs/water.md) */
     VFX_WATER_METHOD_BRUTE = 1,     /* baseline: per-pixel march over all particles (compute) */
     VFX_WATER_METHOD_GRID = 2,      /* baseline: per-pixel march over a uniform grid (compute) */
 } vfx_water_method;
@@ -130,7 +130,7 @@ typedef struct vfx_water_params {
     float _reserved[3];
 } vfx_water_params;
 
-/* One beam; the field is defined exactly in docs/beams.md (issue 5):
+/* One beam; the field is defined exactly in docs/beams.md:
  * head rho_h = a / sqrt(|P-M|^2 + eps^2) inside radius R, trail rho_t = b / sqrt(r^2 + eps^2)
  * around the segment M..M+L*D inside radius R. */
 typedef struct vfx_beam {
