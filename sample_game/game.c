@@ -26,7 +26,7 @@ typedef struct game_options {
 static void usage(void)
 {
     puts("usage: volfx-game [--headless|--window] [--frames N] [--seconds S] [--size WxH]\n"
-         "                  [--png FILE] [--csv FILE] [--trace FILE] [--plugin libvolfx.so]\n"
+         "                  [--png FILE] [--csv FILE] [--trace FILE] [--plugin libvolfx.so.1|PATH]\n"
          "                  [--scene FILE.json] [--no-water] [--no-beams] [--no-volume] [--debug-gl]\n"
          "                  [--mem-every N] [--dump-raw water|beams|volume FILE.pfm]\n"
          "Without a display it runs headless (EGL) for 30 frames and writes volfx-game.png.\n"

@@ -1,4 +1,5 @@
 /* plugin_host.c — dlopen/dlsym, version handshake, table validation. */
+#define _GNU_SOURCE /* dladdr: which file the loader picked for a bare soname */
 #include "host/plugin_host.h"
 
 #include <dlfcn.h>
@@ -62,6 +63,9 @@ vfx_result rt_plugin_host_load_as(const char *path, uint32_t abi, const vfx_host
         return VFX_ERR_OUT_OF_MEMORY;
     }
     h->handle = handle;
+    Dl_info where;
+    if (dladdr(sym, &where) && where.dli_fname)
+        rt_logf(log, VFX_LOG_INFO, "plugin '%s' loaded from %s", path, where.dli_fname);
     vfx_result r = handshake(entry, abi, host, log, h, path);
     if (r != VFX_OK) {
         rt_plugin_host_unload(h);

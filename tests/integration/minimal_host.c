@@ -1,6 +1,9 @@
 /* minimal_host.c — a game engine's view of volfx: its own EGL context, its own framebuffers,
- * plain C arrays for particles and beams, the plugin loaded with dlopen. Nothing from runtime/.
- * usage: minimal_host path/to/libvolfx.so
+ * plain C arrays for particles and beams. Nothing from runtime/.
+ * usage: minimal_host [libvolfx.so.1 | path/to/libvolfx.so]
+ * With an argument the plugin is loaded with dlopen (a bare soname goes through the loader's
+ * search path); without one the host calls the vfx_plugin_entry it was linked against
+ * (cc minimal_host.c $(pkg-config --cflags --libs volfx) ...).
  * Exits 0 when every effect the plugin has built drew something where expected, 77 when no
  * GL context can be made. */
 #include <dlfcn.h>
@@ -63,10 +66,6 @@ static bool make_context(void)
 
 int main(int argc, char **argv)
 {
-    if (argc < 2) {
-        fprintf(stderr, "usage: minimal_host libvolfx.so\n");
-        return 2;
-    }
     if (!make_context()) {
         fprintf(stderr, "no GL 4.5 context: skipping\n");
         return 77;
@@ -82,14 +81,17 @@ int main(int argc, char **argv)
     vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &g,
                          .gl_get_proc_address = on_proc, .log = on_log, .particle_chunk_count = on_chunks,
                          .particle_chunk = on_chunk, .beams = on_beams};
-    void *lib = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
-    void *sym = lib ? dlsym(lib, VFX_ENTRY_SYMBOL) : NULL;
-    if (!sym) {
-        fprintf(stderr, "cannot load %s: %s\n", argv[1], dlerror());
-        return 1;
+    vfx_plugin_entry_fn entry = vfx_plugin_entry; /* linked: -lvolfx */
+    void *lib = NULL;
+    if (argc > 1) {
+        lib = dlopen(argv[1], RTLD_NOW | RTLD_LOCAL);
+        void *sym = lib ? dlsym(lib, VFX_ENTRY_SYMBOL) : NULL;
+        if (!sym) {
+            fprintf(stderr, "cannot load %s: %s\n", argv[1], dlerror());
+            return 1;
+        }
+        memcpy(&entry, &sym, sizeof entry); /* object-to-function pointer, as POSIX allows */
     }
-    vfx_plugin_entry_fn entry;
-    memcpy(&entry, &sym, sizeof entry);
     vfx_plugin_api api = {.size = sizeof api};
     if (entry(VFX_ABI_VERSION, &host, &api) != VFX_OK)
         return 1;
@@ -138,7 +140,8 @@ int main(int argc, char **argv)
     printf("effects built 0x%x, %d of %d pixels lit, %u stats, %d errors\n", api.effects_built, lit,
            W * H, st.count, g.errors);
     api.destroy(ctx);
-    dlclose(lib);
+    if (lib)
+        dlclose(lib);
     if (g.errors)
         return 1;
     /* with an effect built, something must be drawn; with none, nothing may be */

@@ -23,6 +23,9 @@ extern "C" {
 
 #define VFX_ABI_VERSION 1u
 #define VFX_ENTRY_SYMBOL "vfx_plugin_entry"
+/* The installed library's soname (libvolfx.so.<VFX_ABI_VERSION>): dlopen(VFX_SONAME, ...) finds
+ * it through the loader's search path, as the game's --plugin does. */
+#define VFX_SONAME "libvolfx.so.1"
 
 #if defined(_WIN32)
 #define VFX_EXPORT __declspec(dllexport)

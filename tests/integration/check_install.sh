@@ -1,0 +1,53 @@
+#!/bin/sh
+# Installs the build into a DESTDIR and uses it the way an integrator would use any Debian
+# library: the minimal host is compiled against the installed tree with pkg-config alone (no
+# -I into the source tree), linked with -lvolfx and also loaded by soname with dlopen, and the
+# installed game's --plugin finds libvolfx.so.<ABI> through the loader's search path.
+# usage: check_install.sh BUILD_DIR SOURCE_DIR PREFIX LIBDIR [SANITIZE]
+# SANITIZE (meson's b_sanitize, e.g. address,undefined) is passed to cc: an instrumented
+# libvolfx needs an instrumented host.
+# Exits 77 when no GL context can be made (the hosts say so).
+set -eu
+build=$1 src=$2 prefix=$3 libdir=$4 san=${5:-none}
+san_flags=
+[ "$san" = none ] || san_flags="-fsanitize=$san"
+dest=$(mktemp -d "${TMPDIR:-/tmp}/volfx-install.XXXXXX")
+trap 'rm -rf "$dest"' EXIT
+fail() { echo "check_install: $*" >&2; exit 1; }
+
+meson install -C "$build" --no-rebuild --quiet --destdir "$dest" >/dev/null
+case $libdir in /*) lib=$dest$libdir ;; *) lib=$dest$prefix/$libdir ;; esac
+for f in "$lib/libvolfx.so.1" "$lib/libvolfx.so" "$lib/pkgconfig/volfx.pc" "$dest$prefix/include/volfx/volfx.h"; do
+  [ -e "$f" ] || fail "not installed: ${f#"$dest"}"
+done
+soname=$(readelf -d "$lib/libvolfx.so.1" | sed -n 's/.*Library soname: \[\(.*\)\]/\1/p')
+header_soname=$(sed -n 's/^#define VFX_SONAME "\(.*\)"/\1/p' "$dest$prefix/include/volfx/volfx.h")
+abi=$(sed -n 's/^#define VFX_ABI_VERSION \([0-9]*\)u/\1/p' "$dest$prefix/include/volfx/volfx.h")
+[ "$soname" = "libvolfx.so.$abi" ] || fail "soname '$soname', ABI version $abi"
+[ "$soname" = "$header_soname" ] || fail "soname '$soname', VFX_SONAME '$header_soname'"
+
+# pkg-config sees only the installed tree (the sysroot maps its /usr/local paths into DESTDIR).
+export PKG_CONFIG_PATH="$lib/pkgconfig" PKG_CONFIG_SYSROOT_DIR="$dest"
+flags=$(pkg-config --cflags --libs volfx) || fail "pkg-config cannot find volfx"
+echo "pkg-config --cflags --libs volfx: $flags"
+# The host's own GL context comes from libepoxy/EGL: that is the host's business, not ours.
+# shellcheck disable=SC2086
+cc -std=c11 -D_POSIX_C_SOURCE=200809L $san_flags -o "$dest/minimal_host" "$src/tests/integration/minimal_host.c" \
+  $flags $(pkg-config --cflags --libs epoxy) -ldl -lm || fail "minimal host does not build against the installed tree"
+# shellcheck disable=SC2086
+cc -std=c11 -M $flags $(pkg-config --cflags epoxy) "$src/tests/integration/minimal_host.c" | tr ' ' '\n' \
+  | grep -q "^$dest.*/include/volfx/volfx.h$" || fail "volfx.h did not come from the installed tree"
+readelf -d "$dest/minimal_host" | grep -q "NEEDED.*\[$soname\]" || fail "minimal host does not need $soname"
+
+export LD_LIBRARY_PATH="$lib"
+rc=0; "$dest/minimal_host" || rc=$?
+[ $rc -eq 77 ] && exit 77
+[ $rc -eq 0 ] || fail "linked minimal host failed ($rc)"
+"$dest/minimal_host" "$soname" || fail "minimal host cannot dlopen $soname"
+
+# The installed game, its plugin found by soname, reports where the loader found it.
+out=$("$dest$prefix/bin/volfx-game" --headless --frames 2 --size 64x36 --no-volume --png "$dest/g.png" \
+      --plugin "$soname" 2>&1) || { echo "$out"; fail "installed volfx-game --plugin $soname failed"; }
+echo "$out" | grep "loaded from" || { echo "$out"; fail "the game did not report the plugin's path"; }
+echo "$out" | grep -q "loaded from $lib/libvolfx.so.1" || fail "plugin not loaded from the DESTDIR"
+echo "install ok"
