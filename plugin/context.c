@@ -97,6 +97,15 @@ void volfx_stat_set(vfx_context *ctx, const char *name, double value)
         e->value = value;
 }
 
+bool volfx_stat_has(const vfx_context *ctx, const char *name)
+{
+    const vfx_stats *s = &ctx->stats;
+    for (uint32_t i = 0; i < s->count; ++i)
+        if (strncmp(s->entries[i].name, name, sizeof s->entries[i].name - 1) == 0)
+            return true;
+    return false;
+}
+
 void volfx_stat_add(vfx_context *ctx, const char *name, double value)
 {
     vfx_stat *e = stat_slot(ctx, name);

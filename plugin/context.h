@@ -43,6 +43,8 @@ void *volfx_alloc(vfx_context *ctx, size_t size);
 void volfx_free(vfx_context *ctx, void *ptr);
 /* Sets a named counter of the current frame (adds an entry or overwrites it). */
 void volfx_stat_set(vfx_context *ctx, const char *name, double value);
+/* True when the current frame already has a counter of this name. */
+bool volfx_stat_has(const vfx_context *ctx, const char *name);
 /* Adds to a named counter of the current frame. */
 void volfx_stat_add(vfx_context *ctx, const char *name, double value);
 /* Column-major 4x4 inverse (false when singular or not finite). */

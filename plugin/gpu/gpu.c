@@ -21,6 +21,7 @@ typedef struct program_entry {
 typedef struct timer_frame {
     GLuint queries[GPU_MAX_PASSES * 2];
     char names[GPU_MAX_PASSES][40];
+    uint8_t depth[GPU_MAX_PASSES]; /* passes open around it when it began */
     uint32_t count;
 } timer_frame;
 
@@ -213,6 +214,7 @@ void volfx_gpu_pass_begin(vfx_context *ctx, const char *name)
     }
     uint32_t slot = f->count++;
     snprintf(f->names[slot], sizeof f->names[slot], "%s", name);
+    f->depth[slot] = (uint8_t)g->open_count;
     glQueryCounter(f->queries[slot * 2], GL_TIMESTAMP);
     g->open[g->open_count++] = slot;
 }
@@ -236,6 +238,8 @@ void volfx_gpu_frame_end(vfx_context *ctx)
     /* The oldest slot was recorded GPU_RING-1 frames ago: read it only if it is ready. */
     uint32_t oldest = (g->frame + 1) % GPU_RING;
     timer_frame *f = &g->ring[oldest];
+    GLuint64 frame_t0 = 0; /* the frame's first timestamp: pass starts are relative to it */
+    bool have_t0 = false;
     for (uint32_t i = 0; i < f->count; ++i) {
         GLint ready = 0;
         glGetQueryObjectiv(f->queries[i * 2 + 1], GL_QUERY_RESULT_AVAILABLE, &ready);
@@ -244,11 +248,28 @@ void volfx_gpu_frame_end(vfx_context *ctx)
         GLuint64 t0 = 0, t1 = 0;
         glGetQueryObjectui64v(f->queries[i * 2], GL_QUERY_RESULT, &t0);
         glGetQueryObjectui64v(f->queries[i * 2 + 1], GL_QUERY_RESULT, &t1);
+        if (i == 0) {
+            frame_t0 = t0;
+            have_t0 = true;
+        }
         char name[48];
         snprintf(name, sizeof name, "%s.gpu_ms", f->names[i]);
-        /* a pass run several times in one frame (the paper's march loop) reports its total */
+        /* A pass run several times in one frame (the paper's march loop) reports its total, and
+         * where its first run began: a profiler nests the passes by these starts (a pass opened
+         * inside another starts inside it), which the sums alone cannot tell. */
+        bool first = !volfx_stat_has(ctx, name);
         volfx_stat_add(ctx, name, t1 > t0 ? (double)(t1 - t0) * 1e-6 : 0.0);
+        if (first && have_t0) {
+            snprintf(name, sizeof name, "%s.gpu_start_ms", f->names[i]);
+            volfx_stat_set(ctx, name, t0 > frame_t0 ? (double)(t0 - frame_t0) * 1e-6 : 0.0);
+        }
+        if (first && f->depth[i]) { /* only nested passes: the stats have 64 slots */
+            snprintf(name, sizeof name, "%s.gpu_depth", f->names[i]);
+            volfx_stat_set(ctx, name, f->depth[i]);
+        }
     }
+    if (f->count)
+        volfx_stat_set(ctx, "gpu.timer_lag_frames", GPU_RING - 1);
     f->count = 0;
     g->frame = oldest;
 }

@@ -20,8 +20,10 @@ GLuint volfx_gpu_program(vfx_context *ctx, const char *vert, const char *frag, c
 GLuint volfx_gpu_compute(vfx_context *ctx, const char *comp, const char *defines);
 
 /* Opens a named pass: a debug group (RenderDoc shows it) and a timestamp pair. Names are
- * "effect.pass", e.g. "water.accumulate"; the GPU ms of the pass reach the stats as
- * "<name>.gpu_ms" a few frames later, without stalling (passes of one name in a frame summed). */
+ * "effect.pass", e.g. "water.potential"; the GPU ms of the pass reach the stats as
+ * "<name>.gpu_ms" gpu.timer_lag_frames frames later, without stalling (passes of one name in a
+ * frame summed), "<name>.gpu_start_ms", the start of its first run after the frame's first
+ * timestamp, and for a pass opened inside others "<name>.gpu_depth", how many were open. */
 void volfx_gpu_pass_begin(vfx_context *ctx, const char *name);
 /* Closes the innermost open pass. */
 void volfx_gpu_pass_end(vfx_context *ctx);

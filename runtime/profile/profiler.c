@@ -1,16 +1,31 @@
 /* profiler.c — fixed table of named series x frames; no allocation per frame. */
+#define _GNU_SOURCE /* program_invocation_short_name: the trace's process name */
 #include "profile/profiler.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
+typedef enum series_kind { SERIES_CPU, SERIES_GPU, SERIES_COUNTER } series_kind;
+
 typedef struct series {
     char name[48];
-    bool gpu;
+    series_kind kind;
+    int depth; /* GPU: passes open around this one (the plugin's <pass>.gpu_depth; 0 absent) */
 } series;
+
+/* Plugin counters drawn as counter tracks in the trace (with fps from the frame times). */
+static const struct {
+    const char *stat, *track;
+} counter_tracks[] = {
+    {"water.particles", "particles"},
+    {"water.pixels_sample_cap", "water holes (rays at the sample cap)"},
+    {"volume.cells_skipped_ert", "volume cells skipped (ERT)"},
+};
+#define N_COUNTER_TRACKS (sizeof counter_tracks / sizeof counter_tracks[0])
 
 /* Frames kept exactly at the start of a run, so a summary can drop up to this many warm-up
  * frames after the ring has rolled past them. */
@@ -23,8 +38,12 @@ struct rt_profiler {
     double *frame_ms;       /* ring of max_frames */
     double *frame_t0;       /* start time of each frame (trace) */
     double *values;         /* ring: max_frames x RT_PROFILER_MAX_SERIES, NAN when absent */
-    double *starts;         /* span start offsets within the frame (trace) */
-    double cursor;          /* CPU time of the current frame's spans laid end to end */
+    double *starts;         /* CPU: span start in ms after frame start; GPU: the plugin's
+                               <pass>.gpu_start_ms; NAN when absent (trace) */
+    uint8_t *order;         /* ring: the order in which each series was recorded in its frame
+                               (the plugin's stats come in pass submission order) */
+    uint8_t recorded;       /* series recorded in the current frame */
+    uint32_t gpu_lag;       /* gpu.timer_lag_frames: GPU times arrive this many frames late */
     series series[RT_PROFILER_MAX_SERIES];
     uint32_t series_count;
     /* Whole-run frame times in bounded memory (a game runs for hours): a log histogram of every
@@ -74,7 +93,8 @@ rt_profiler *rt_profiler_create(uint32_t max_frames)
     p->values = malloc((size_t)max_frames * RT_PROFILER_MAX_SERIES * sizeof(double));
     p->starts = malloc((size_t)max_frames * RT_PROFILER_MAX_SERIES * sizeof(double));
     p->hist = calloc(RT_PROF_BUCKETS, sizeof *p->hist);
-    if (!p->frame_ms || !p->frame_t0 || !p->values || !p->starts || !p->hist) {
+    p->order = calloc((size_t)max_frames * RT_PROFILER_MAX_SERIES, 1);
+    if (!p->frame_ms || !p->frame_t0 || !p->values || !p->starts || !p->hist || !p->order) {
         rt_profiler_destroy(p);
         return NULL;
     }
@@ -101,6 +121,7 @@ void rt_profiler_destroy(rt_profiler *p)
     free(p->values);
     free(p->starts);
     free(p->hist);
+    free(p->order);
     free(p);
 }
 
@@ -114,10 +135,11 @@ void rt_profiler_frame_begin(rt_profiler *p)
     if (!p)
         return;
     p->frame_start = rt_now_ms();
-    p->cursor = 0;
     double *r = row(p, p->frame);
+    double *st = &p->starts[(size_t)(p->frame % p->max_frames) * RT_PROFILER_MAX_SERIES];
     for (int i = 0; i < RT_PROFILER_MAX_SERIES; ++i)
-        r[i] = NAN;
+        r[i] = st[i] = NAN;
+    p->recorded = 0;
 }
 
 double rt_profiler_frame_end(rt_profiler *p)
@@ -146,29 +168,41 @@ void rt_profiler_frame_add(rt_profiler *p, double ms)
     p->frame++;
 }
 
-static int series_index(rt_profiler *p, const char *name, bool gpu)
+static int series_index(rt_profiler *p, const char *name, size_t len, series_kind kind)
 {
     for (uint32_t i = 0; i < p->series_count; ++i)
-        if (strcmp(p->series[i].name, name) == 0)
+        if (strncmp(p->series[i].name, name, len) == 0 && p->series[i].name[len] == 0)
             return (int)i;
-    if (p->series_count >= RT_PROFILER_MAX_SERIES)
+    if (p->series_count >= RT_PROFILER_MAX_SERIES || len >= sizeof p->series[0].name)
         return -1;
     series *s = &p->series[p->series_count];
-    snprintf(s->name, sizeof s->name, "%s", name);
-    s->gpu = gpu;
+    memcpy(s->name, name, len);
+    s->name[len] = 0;
+    s->kind = kind;
     return (int)p->series_count++;
 }
 
-static void record(rt_profiler *p, const char *name, double ms, bool gpu)
+/* The ring index of series i in the current frame; notes the order it was first recorded in. */
+static size_t at_of(rt_profiler *p, int i)
 {
-    int i = series_index(p, name, gpu);
+    size_t at = (size_t)(p->frame % p->max_frames) * RT_PROFILER_MAX_SERIES + (size_t)i;
+    if (isnan(p->values[at]) && isnan(p->starts[at]))
+        p->order[at] = p->recorded++;
+    return at;
+}
+
+static void record(rt_profiler *p, const char *name, double ms, series_kind kind)
+{
+    int i = series_index(p, name, strlen(name), kind);
     if (i < 0)
         return;
-    size_t at = (size_t)(p->frame % p->max_frames) * RT_PROFILER_MAX_SERIES + (size_t)i;
+    size_t at = at_of(p, i);
     p->values[at] = ms;
-    if (!gpu) {
-        p->starts[at] = p->cursor;
-        p->cursor += ms;
+    if (kind == SERIES_CPU) {
+        /* Called as the span ends: it began ms ago. Nested spans (a RENDER-phase system inside
+         * plugin.render) then lie inside their parent in the trace. */
+        double start = rt_now_ms() - p->frame_start - ms;
+        p->starts[at] = start > 0 ? start : 0;
     }
 }
 
@@ -176,24 +210,50 @@ void rt_profiler_on_system(void *user, const char *name, rt_phase phase, double 
 {
     (void)phase;
     if (user)
-        record(user, name, cpu_ms, false);
+        record(user, name, cpu_ms, SERIES_CPU);
 }
 
 void rt_profiler_cpu(rt_profiler *p, const char *name, double cpu_ms)
 {
     if (p)
-        record(p, name, cpu_ms, false);
+        record(p, name, cpu_ms, SERIES_CPU);
 }
 
 void rt_profiler_gpu_stats(rt_profiler *p, const vfx_stats *stats)
 {
     if (!p || !stats)
         return;
+    static const char start_sfx[] = ".gpu_start_ms";
+    const size_t start_len = sizeof start_sfx - 1;
     for (uint32_t i = 0; i < stats->count && i < VFX_STATS_MAX; ++i) {
         const char *n = stats->entries[i].name;
+        double v = stats->entries[i].value;
         size_t len = strnlen(n, sizeof stats->entries[i].name);
-        if (len > 7 && strcmp(n + len - 7, ".gpu_ms") == 0)
-            record(p, n, stats->entries[i].value, true);
+        if (len == sizeof stats->entries[i].name)
+            continue; /* not terminated: not a name we know */
+        if (len > 7 && strcmp(n + len - 7, ".gpu_ms") == 0) {
+            int k = series_index(p, n, len, SERIES_GPU);
+            if (k >= 0)
+                p->values[at_of(p, k)] = v;
+        } else if (len > start_len && strcmp(n + len - start_len, start_sfx) == 0) {
+            char dur[48]; /* the start belongs to the series "<pass>.gpu_ms" */
+            int w = snprintf(dur, sizeof dur, "%.*s.gpu_ms", (int)(len - start_len), n);
+            int k = w > 0 && (size_t)w < sizeof dur ? series_index(p, dur, (size_t)w, SERIES_GPU) : -1;
+            if (k >= 0)
+                p->starts[at_of(p, k)] = v;
+        } else if (len > 10 && strcmp(n + len - 10, ".gpu_depth") == 0) {
+            char dur[48];
+            int w = snprintf(dur, sizeof dur, "%.*s.gpu_ms", (int)(len - 10), n);
+            int k = w > 0 && (size_t)w < sizeof dur ? series_index(p, dur, (size_t)w, SERIES_GPU) : -1;
+            if (k >= 0)
+                p->series[k].depth = v >= 0 && v < 15 ? (int)v : 0;
+        } else if (strcmp(n, "gpu.timer_lag_frames") == 0) {
+            p->gpu_lag = v >= 0 && v < 64 ? (uint32_t)v : 0;
+        } else {
+            for (size_t c = 0; c < N_COUNTER_TRACKS; ++c)
+                if (strcmp(n, counter_tracks[c].stat) == 0)
+                    record(p, n, v, SERIES_COUNTER);
+        }
     }
 }
 
@@ -359,32 +419,152 @@ vfx_result rt_profiler_write_csv(const rt_profiler *p, const char *path)
     return fclose(f) == 0 ? VFX_OK : VFX_ERR_IO;
 }
 
+/* One slice of a track as the trace will show it. */
+typedef struct slice {
+    double start, dur; /* ms after the frame's (or GPU frame's) start */
+    uint32_t series;
+    uint32_t order;    /* recording order: of two slices starting together, the first opened
+                          is the parent (a pass and its first child share a timestamp) */
+    int depth;         /* GPU passes: nesting depth the plugin reported; -1 (CPU spans): the
+                          parent is the innermost slice still open at the start */
+} slice;
+
+static int cmp_slice(const void *a, const void *b)
+{
+    const slice *x = a, *y = b;
+    if (x->start != y->start)
+        return (x->start > y->start) - (x->start < y->start);
+    return (x->order > y->order) - (x->order < y->order);
+}
+
+/* Timestamps are ns integers turned into ms doubles: a pass that starts where the last ended
+ * may read up to rounding before that end. */
+#define NEST_EPS_MS 1e-6
+
+/* Makes the slices of one track properly nested: sorted by start, each slice lies inside its
+ * parent (for a GPU pass the last pass one level up, by the plugin's depth; for a CPU span the
+ * innermost slice still open at its start), and siblings do not overlap. A pass run several
+ * times in a frame (the water march loop's four passes) arrives as one total and the start of
+ * its first run, so its siblings' totals, laid from their starts, would overlap: each is moved
+ * just past its previous sibling and kept inside its parent. Returns the end of the last slice. */
+static double nest_slices(slice *s, uint32_t n, double frame_end)
+{
+    qsort(s, n, sizeof *s, cmp_slice);
+    struct open {
+        double start, end, cursor; /* cursor: end of the last child placed */
+    } stack[16];
+    int depth = 0;
+    stack[0] = (struct open){0, frame_end, 0};
+    double last = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        if (s[i].depth >= 0) {
+            if (s[i].depth < depth)
+                depth = s[i].depth;
+        } else {
+            while (depth > 0 && s[i].start >= stack[depth].end - NEST_EPS_MS)
+                --depth;
+        }
+        struct open *parent = &stack[depth];
+        double start = fmax(s[i].start, parent->cursor);
+        double room = parent->end - parent->start;
+        double dur = fmin(s[i].dur, room);
+        if (start + dur > parent->end)
+            start = parent->end - dur;
+        if (start < parent->start)
+            start = parent->start;
+        s[i].start = start;
+        s[i].dur = dur;
+        parent->cursor = start + dur;
+        if (start + dur > last)
+            last = start + dur;
+        if (depth + 1 < (int)(sizeof stack / sizeof stack[0]))
+            stack[++depth] = (struct open){start, start + dur, start};
+    }
+    return last;
+}
+
+/* The trace name of a series: a GPU pass without the stat's ".gpu_ms" suffix. */
+static int trace_name_len(const series *s)
+{
+    size_t len = strlen(s->name);
+    return (int)(s->kind == SERIES_GPU && len > 7 ? len - 7 : len);
+}
+
 vfx_result rt_profiler_write_trace(const rt_profiler *p, const char *path)
 {
     FILE *f = fopen(path, "w");
     if (!f)
         return VFX_ERR_IO;
-    fprintf(f, "{\"traceEvents\":[\n");
-    fprintf(f, "{\"name\":\"thread_name\",\"ph\":\"M\",\"pid\":1,\"tid\":1,\"args\":{\"name\":\"CPU\"}},\n");
-    fprintf(f, "{\"name\":\"thread_name\",\"ph\":\"M\",\"pid\":1,\"tid\":2,\"args\":{\"name\":\"GPU\"}}");
+    fprintf(f, "{\"displayTimeUnit\":\"ms\",\"traceEvents\":[\n");
+    fprintf(f, "{\"name\":\"process_name\",\"ph\":\"M\",\"pid\":1,\"args\":{\"name\":\"%s\"}},\n",
+            program_invocation_short_name);
+    fprintf(f, "{\"name\":\"thread_name\",\"ph\":\"M\",\"pid\":1,\"tid\":1,\"args\":{\"name\":\"CPU (frame thread)\"}},\n");
+    fprintf(f, "{\"name\":\"thread_name\",\"ph\":\"M\",\"pid\":1,\"tid\":2,\"args\":{\"name\":\"GPU (volfx passes)\"}},\n");
+    fprintf(f, "{\"name\":\"thread_sort_index\",\"ph\":\"M\",\"pid\":1,\"tid\":1,\"args\":{\"sort_index\":1}},\n");
+    fprintf(f, "{\"name\":\"thread_sort_index\",\"ph\":\"M\",\"pid\":1,\"tid\":2,\"args\":{\"sort_index\":2}}");
     uint32_t kept = p->frame < p->max_frames ? p->frame : p->max_frames;
     double origin = kept ? p->frame_t0[(p->frame - kept) % p->max_frames] : 0;
+    int render = -1; /* GPU work of a frame is issued in its plugin.render */
+    for (uint32_t i = 0; i < p->series_count; ++i)
+        if (p->series[i].kind == SERIES_CPU && strcmp(p->series[i].name, "plugin.render") == 0)
+            render = (int)i;
+    slice sl[RT_PROFILER_MAX_SERIES];
+    double gpu_free = -INFINITY; /* the GPU runs one frame after another */
     for (uint32_t fr = p->frame - kept; fr < p->frame; ++fr) {
         double t0 = (p->frame_t0[fr % p->max_frames] - origin) * 1000.0; /* us */
-        fprintf(f, ",\n{\"name\":\"frame %u\",\"ph\":\"X\",\"pid\":1,\"tid\":1,\"ts\":%.3f,\"dur\":%.3f}",
-                fr, t0, p->frame_ms[fr % p->max_frames] * 1000.0);
+        double fms = p->frame_ms[fr % p->max_frames];
+        fprintf(f, ",\n{\"name\":\"frame %u\",\"cat\":\"frame\",\"ph\":\"X\",\"pid\":1,\"tid\":1,\"ts\":%.3f,\"dur\":%.3f}",
+                fr, t0, fms * 1000.0);
+        fprintf(f, ",\n{\"name\":\"fps\",\"cat\":\"counter\",\"ph\":\"C\",\"pid\":1,\"ts\":%.3f,\"args\":{\"fps\":%.3f}}",
+                t0, fms > 0 ? 1000.0 / fms : 0.0);
         const double *r = row(p, fr);
         const double *st = &p->starts[(size_t)(fr % p->max_frames) * RT_PROFILER_MAX_SERIES];
-        double gpu_cursor = 0;
+        const uint8_t *ord = &p->order[(size_t)(fr % p->max_frames) * RT_PROFILER_MAX_SERIES];
+        uint32_t n = 0;
+        for (uint32_t i = 0; i < p->series_count; ++i)
+            if (p->series[i].kind == SERIES_CPU && !isnan(r[i]))
+                sl[n++] = (slice){isnan(st[i]) ? 0 : st[i], r[i], i, ord[i], -1};
+        nest_slices(sl, n, fms);
+        for (uint32_t k = 0; k < n; ++k)
+            fprintf(f, ",\n{\"name\":\"%s\",\"cat\":\"cpu\",\"ph\":\"X\",\"pid\":1,\"tid\":1,\"ts\":%.3f,\"dur\":%.3f}",
+                    p->series[sl[k].series].name, t0 + sl[k].start * 1000.0, sl[k].dur * 1000.0);
+        for (size_t c = 0; c < N_COUNTER_TRACKS; ++c)
+            for (uint32_t i = 0; i < p->series_count; ++i)
+                if (p->series[i].kind == SERIES_COUNTER && !isnan(r[i])
+                    && strcmp(p->series[i].name, counter_tracks[c].stat) == 0)
+                    fprintf(f, ",\n{\"name\":\"%s\",\"cat\":\"counter\",\"ph\":\"C\",\"pid\":1,\"ts\":%.3f,\"args\":{\"value\":%.17g}}",
+                            counter_tracks[c].track, t0, r[i]);
+        /* GPU times recorded in this frame belong to the frame gpu_lag frames back: drawn from
+         * that frame's plugin.render (when the commands were issued), or later if the GPU was
+         * still busy with the frame before. Passes without a start (an old plugin) are laid end
+         * to end. */
+        if (fr < p->frame - kept + p->gpu_lag)
+            continue;
+        uint32_t issued = fr - p->gpu_lag;
+        const double *ist = &p->starts[(size_t)(issued % p->max_frames) * RT_PROFILER_MAX_SERIES];
+        double at = (p->frame_t0[issued % p->max_frames] - origin)
+                    + (render >= 0 && !isnan(ist[render]) ? ist[render] : 0);
+        n = 0;
+        double lay = 0, span = 0;
         for (uint32_t i = 0; i < p->series_count; ++i) {
-            if (isnan(r[i]))
+            if (p->series[i].kind != SERIES_GPU || isnan(r[i]))
                 continue;
-            /* GPU passes are laid end to end: their absolute start times are not read back. */
-            double start = p->series[i].gpu ? gpu_cursor : st[i];
-            if (p->series[i].gpu)
-                gpu_cursor += r[i];
-            fprintf(f, ",\n{\"name\":\"%s\",\"ph\":\"X\",\"pid\":1,\"tid\":%d,\"ts\":%.3f,\"dur\":%.3f}",
-                    p->series[i].name, p->series[i].gpu ? 2 : 1, t0 + start * 1000.0, r[i] * 1000.0);
+            double start = isnan(st[i]) ? lay : st[i];
+            lay = fmax(lay, start + r[i]);
+            sl[n++] = (slice){start, r[i], i, ord[i], p->series[i].depth};
+            span = fmax(span, start + r[i]);
+        }
+        if (n == 0)
+            continue;
+        at = fmax(at, gpu_free);
+        span = nest_slices(sl, n, span);
+        gpu_free = at + span;
+        fprintf(f, ",\n{\"name\":\"gpu frame %u\",\"cat\":\"frame\",\"ph\":\"X\",\"pid\":1,\"tid\":2,\"ts\":%.3f,\"dur\":%.3f}",
+                issued, at * 1000.0, span * 1000.0);
+        for (uint32_t k = 0; k < n; ++k) {
+            const series *se = &p->series[sl[k].series];
+            fprintf(f, ",\n{\"name\":\"%.*s\",\"cat\":\"gpu\",\"ph\":\"X\",\"pid\":1,\"tid\":2,\"ts\":%.3f,\"dur\":%.3f,\"args\":{\"gpu_ms\":%.4f}}",
+                    trace_name_len(se), se->name, (at + sl[k].start) * 1000.0, sl[k].dur * 1000.0, r[sl[k].series]);
         }
     }
     fprintf(f, "\n]}\n");

@@ -35,7 +35,9 @@ void rt_profiler_frame_add(rt_profiler *p, double ms);
 void rt_profiler_on_system(void *profiler, const char *name, rt_phase phase, double cpu_ms);
 /* Records a CPU span by name with its own timing (for host work outside systems). */
 void rt_profiler_cpu(rt_profiler *p, const char *name, double cpu_ms);
-/* Records every "*.gpu_ms" entry of the plugin's stats for the current frame. */
+/* Records the plugin's stats for the current frame: every "<pass>.gpu_ms" (a GPU series) with
+ * its "<pass>.gpu_start_ms", gpu.timer_lag_frames, and the counters drawn as counter tracks
+ * (water.particles, water.pixels_sample_cap, volume.cells_skipped_ert). */
 void rt_profiler_gpu_stats(rt_profiler *p, const vfx_stats *stats);
 /* Summary over frames [skip, end): skip drops warm-up frames. Exact while those frames are all
  * in the ring of max_frames; beyond, from a bounded histogram (percentiles within 0.05%, mean and
@@ -43,9 +45,16 @@ void rt_profiler_gpu_stats(rt_profiler *p, const vfx_stats *stats);
 rt_frame_summary rt_profiler_summary(const rt_profiler *p, uint32_t skip);
 /* Median of a named series over kept frames (NAN when never recorded). */
 double rt_profiler_series_median(const rt_profiler *p, const char *name);
-/* Writes frame,frame_ms,<series...> one row per kept frame. */
+/* Writes frame,frame_ms,<series...> one row per kept frame (CPU and GPU series in ms, the
+ * counter series as counts). */
 vfx_result rt_profiler_write_csv(const rt_profiler *p, const char *path);
-/* Writes Chrome trace-event JSON (complete events "ph":"X", pid 1, tid 1 CPU, tid 2 GPU). */
+/* Writes Chrome trace-event JSON for Perfetto/chrome://tracing: process and thread names, a
+ * "frame N" slice per frame on the CPU thread (tid 1) with the CPU spans nested inside it at
+ * their measured starts, a "gpu frame N" slice per frame on the GPU thread (tid 2) starting when
+ * that frame's plugin.render issued it (or when the GPU finished the frame before) with the
+ * passes nested by their gpu_start_ms (names without ".gpu_ms"; repeated passes as one slice of
+ * their total, moved past an overlapping sibling), categories frame/cpu/gpu/counter, and counter
+ * tracks fps, particles, water holes, volume cells skipped. */
 vfx_result rt_profiler_write_trace(const rt_profiler *p, const char *path);
 /* Median of v[0..n) (sorts v in place); NAN when n is 0. */
 double rt_median(double *v, uint32_t n);
