@@ -1,0 +1,230 @@
+/* sph_internal.h — the solver's state and the functions its files share (not installed; the
+ * API is sph.h). One file per concern: sph_pool.c (worker threads), sph_params.c (defaults,
+ * lattice calibration, create/destroy), sph_storage.c (columns, adding particles),
+ * sph_collide.c (colliders, mesh distance fields), sph_grid.c (cell sort, volume fraction),
+ * sph_wall.c (wall integrals, wall law, wall terms of the passes), sph_kernels.c (the
+ * per-chunk passes and their SSE2 pair loops), sph_emit.c (emitters), sph_step.c (substeps). */
+#ifndef RT_SIM_SPH_INTERNAL_H
+#define RT_SIM_SPH_INTERNAL_H
+
+#include "sim/sph.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+
+#define SPH_CHUNK 1024u          /* particles per work item: fixed, so sums do not depend on threads */
+#define SPH_MAX_COLLIDERS 64u
+#define SPH_MAX_EMITTERS 16u
+#define SPH_MAX_MESH_TRIANGLES 20000u
+#define SPH_MESH_GRID 64
+#define SPH_MAX_CELLS (1u << 26)
+#define SPH_PI 3.14159265358979323846
+
+typedef struct sph_chunk_out {
+    float v2_max, a2_max, c2_max;
+    float rho_err_max;
+    double rho_err_sum, ke, pe, ie;
+    uint64_t pairs, skin_pairs;
+    float disp2_max;   /* max squared displacement since the last rebuild (integration pass) */
+    uint32_t bad;      /* first failing row in the chunk, UINT32_MAX when none */
+    int bad_kind;      /* 1 non-finite, 2 speed, 3 density change */
+    float bad_value;
+} sph_chunk_out;
+
+typedef struct sph_collider_state {
+    rt_sph_collider c;
+    float pos[3], vel[3]; /* at the current substep */
+    /* triangle mesh: signed distance sampled on a grid (positive outside), trilinear */
+    float *sdf;
+    int sdf_n[3];
+    float sdf_lo[3], sdf_h[3];
+} sph_collider_state;
+
+typedef struct sph_emitter_state {
+    rt_sph_emitter e;
+    float u[3], w[3];     /* basis of the nozzle plane */
+    double travelled;     /* distance moved by the last layer */
+    uint32_t emitted;
+    bool started;
+} sph_emitter_state;
+
+typedef void (*sph_chunk_fn)(rt_sph *s, uint32_t chunk);
+
+struct rt_sph {
+    rt_sph_desc p;
+    float mass, H, H2, h, inv_cell;
+    float k_poly6, k_spiky;          /* W = k_poly6 (H^2-r^2)^3, |grad W| = k_spiky (H-r)^2 */
+    float wall_scale;                /* lattice calibration of the wall density fraction */
+    float fric_scale;                /* lattice calibration of the wall-law shear (see create) */
+    bool friction;                   /* some face or collider is no-slip */
+    float B, c0;
+    double time;
+    uint32_t n, cap, next_id, clamped_on_add;
+    /* columns */
+    float *x, *y, *z, *vx, *vy, *vz, *rho, *pr, *ax, *ay, *az, *drho;
+    float *xn, *yn, *zn, *vxn, *vyn, *vzn, *tmp;
+    uint32_t *id, *idtmp, *key, *perm;
+    /* grid */
+    int nx, ny, nz;
+    uint32_t ncells;
+    uint32_t *cell_start; /* ncells + 1 */
+    /* boundaries */
+    sph_collider_state col[SPH_MAX_COLLIDERS];
+    uint32_t ncol;
+    sph_emitter_state em[SPH_MAX_EMITTERS];
+    uint32_t nem;
+    /* per-chunk reductions */
+    sph_chunk_out *out;
+    uint32_t out_cap;
+    float dt_try;
+    bool want_energy; /* the closing density pass also sums the EOS internal energy */
+    /* neighbour lists found by the density pass and reused by the force pass: one growing
+     * buffer per chunk (a chunk is only ever run by one thread), offsets per particle */
+    uint32_t **cnb, *cnb_cap, *nb_start, *nb_count;
+    uint32_t cnb_chunks;
+    atomic_bool nb_oom;
+    /* Verlet lists: every pair within H + skin at the last rebuild, per chunk like cnb (rows
+     * are only re-sorted at a rebuild, so a row's chunk is stable between rebuilds), and the
+     * positions at that rebuild. Valid while 2 max|x - x0| < skin. */
+    bool verlet;                 /* false with RT_SPH_REBUILD_EVERY_SUBSTEP */
+    bool lists_valid;
+    int dens_mode;               /* density pass: 0 cell scan, 1 cell scan recording the Verlet
+                                  * lists, 2 walk the Verlet lists */
+    float skin, S2;              /* skin [m], (H + skin)^2 */
+    float disp2_max;             /* of the last integration, over all particles */
+    float *x0, *y0, *z0;
+    uint32_t **snb, *snb_cap, *snb_used, *sk_start, *sk_count;
+    /* thread pool */
+    pthread_t *threads;
+    uint32_t nthreads; /* workers besides the caller */
+    pthread_mutex_t mu;
+    pthread_cond_t cv_start, cv_done;
+    uint64_t gen;
+    uint32_t busy;
+    bool quit;
+    sph_chunk_fn job;
+    atomic_uint next_chunk;
+    uint32_t nchunks;
+    char err[512];
+};
+
+/* Rows [*b, *e) of a work item. */
+static inline void sph_chunk_rows(const rt_sph *s, uint32_t chunk, uint32_t *b, uint32_t *e)
+{
+    *b = chunk * SPH_CHUNK;
+    *e = *b + SPH_CHUNK < s->n ? *b + SPH_CHUNK : s->n;
+}
+
+static inline uint32_t sph_chunk_count(const rt_sph *s) { return (s->n + SPH_CHUNK - 1) / SPH_CHUNK; }
+
+static inline float sph_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+static inline bool sph_finite3(const float *v) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
+static inline int sph_cell_coord(float v, float lo, float inv, int n)
+{
+    int c = (int)((v - lo) * inv);
+    return c < 0 ? 0 : (c >= n ? n - 1 : c);
+}
+
+typedef struct sph_ranges {
+    uint32_t lo[49], hi[49]; /* up to 7x7 rows of cells */
+    int count;
+} sph_ranges;
+
+/* The particle index ranges of the (2R+1)^3 cells of H/2 around p (R <= 3): one range per row
+ * of x-adjacent cells, rows with no particle left out. */
+static inline void sph_neighbor_ranges(const rt_sph *s, float px, float py, float pz, int R, sph_ranges *r)
+{
+    const float *lo = s->p.domain_min;
+    int cx = sph_cell_coord(px, lo[0], s->inv_cell, s->nx);
+    int cy = sph_cell_coord(py, lo[1], s->inv_cell, s->ny);
+    int cz = sph_cell_coord(pz, lo[2], s->inv_cell, s->nz);
+    int x0 = cx >= R ? cx - R : 0, x1 = cx + R < s->nx ? cx + R : s->nx - 1;
+    r->count = 0;
+    for (int z = cz - R; z <= cz + R; ++z) {
+        if (z < 0 || z >= s->nz)
+            continue;
+        for (int y = cy - R; y <= cy + R; ++y) {
+            if (y < 0 || y >= s->ny)
+                continue;
+            uint32_t row = (uint32_t)((z * s->ny + y) * s->nx);
+            uint32_t a = s->cell_start[row + (uint32_t)x0], b = s->cell_start[row + (uint32_t)x1 + 1];
+            if (b > a) {
+                r->lo[r->count] = a;
+                r->hi[r->count] = b;
+                r->count++;
+            }
+        }
+    }
+}
+
+
+/* Walls of the domain box and every collider: density fraction and force integral. */
+typedef struct sph_wall_hit {
+    float n[3], d, vel[3];
+    bool is_box, no_slip;
+} sph_wall_hit;
+
+
+#define SPH_MAX_WALLS (6 + SPH_MAX_COLLIDERS)
+
+/* Number of leading box walls in a gather_walls list (they come before the colliders). */
+static inline int sph_walls_box(const sph_wall_hit *w, int nw)
+{
+    int k = 0;
+    while (k < nw && w[k].is_box)
+        k++;
+    return k;
+}
+
+/* sph_params.c */
+void sph_set_err(rt_sph *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* sph_pool.c: starts the workers (fewer when a thread cannot be made: p.threads then says how
+ * many run; out of memory for their handles is an error); stops and joins them */
+vfx_result sph_pool_start(rt_sph *s);
+void sph_pool_stop(rt_sph *s);
+/* Runs fn over every chunk on all threads. The density pass starts the chunk reductions
+ * afresh (fresh); later passes of the same substep add to them and only reset the failure slot. */
+void sph_parallel(rt_sph *s, sph_chunk_fn fn, bool fresh);
+
+/* sph_storage.c */
+/* Grows every per-particle and per-chunk buffer to hold `want` particles. */
+vfx_result sph_reserve(rt_sph *s, uint64_t want);
+void sph_free_columns(rt_sph *s);
+/* Exchanges the state columns with the integration buffers (xn ...). */
+void sph_swap_state(rt_sph *s);
+
+/* sph_collide.c */
+/* Signed distance of p to a collider surface (positive on the fluid side), outward normal in n. */
+float sph_collider_distance(const sph_collider_state *st, float px, float py, float pz, float n[3]);
+/* Moves every collider to its position and velocity at time t. */
+void sph_update_colliders(rt_sph *s, double t);
+
+/* sph_grid.c: sorts the particles by cell (all columns follow), cell_start is rebuilt */
+void sph_build_grid(rt_sph *s);
+
+/* sph_wall.c */
+/* The walls within H of p (box faces first, then colliders); their number. */
+int sph_gather_walls(const rt_sph *s, float px, float py, float pz, sph_wall_hit *w, int max);
+/* Kernel share of the walls: inside = prod over box walls of (1 - f), extra = sum over
+ * colliders of f; each wall's f in fr[] when fr is not NULL. */
+void sph_wall_share(const rt_sph *s, const sph_wall_hit *w, int nw, float *fr, float *inside,
+                    float *extra);
+/* Wall terms of the force pass for particle (p, v) with pressure term pri, density rhoi:
+ * adds the mirror-image pressure and viscosity to a, divides by the fluid share, adds the
+ * wall-law friction of no-slip walls (gravity not included). */
+void sph_wall_accel(const rt_sph *s, const float p[3], const float vel[3], float pri, float rhoi,
+                    float a[3], sph_wall_hit *walls);
+
+/* sph_kernels.c: the passes run by sph_parallel */
+void sph_density_chunk(rt_sph *s, uint32_t chunk);
+void sph_force_chunk(rt_sph *s, uint32_t chunk);
+void sph_integrate_chunk(rt_sph *s, uint32_t chunk);
+void sph_disp_chunk(rt_sph *s, uint32_t chunk);
+
+/* sph_emit.c: runs the emitters for dt (0 on the first substep); count added to *emitted */
+vfx_result sph_emit(rt_sph *s, double dt, uint32_t *emitted);
+
+#endif

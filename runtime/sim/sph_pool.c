@@ -1,0 +1,106 @@
+/* sph_pool.c — the solver's worker threads: every pass is split into fixed chunks of
+ * SPH_CHUNK particles taken from a shared counter, so sums do not depend on the thread count. */
+#include "sim/sph_internal.h"
+
+#include <stdlib.h>
+
+static void run_chunks(rt_sph *s)
+{
+    for (;;) {
+        uint32_t c = atomic_fetch_add(&s->next_chunk, 1u);
+        if (c >= s->nchunks)
+            break;
+        s->job(s, c);
+    }
+}
+
+static void *worker_main(void *arg)
+{
+    rt_sph *s = arg;
+    uint64_t seen = 0;
+    for (;;) {
+        pthread_mutex_lock(&s->mu);
+        while (!s->quit && s->gen == seen)
+            pthread_cond_wait(&s->cv_start, &s->mu);
+        if (s->quit) {
+            pthread_mutex_unlock(&s->mu);
+            return NULL;
+        }
+        seen = s->gen;
+        pthread_mutex_unlock(&s->mu);
+        run_chunks(s);
+        pthread_mutex_lock(&s->mu);
+        if (--s->busy == 0)
+            pthread_cond_signal(&s->cv_done);
+        pthread_mutex_unlock(&s->mu);
+    }
+}
+
+vfx_result sph_pool_start(rt_sph *s)
+{
+    pthread_mutex_init(&s->mu, NULL);
+    pthread_cond_init(&s->cv_start, NULL);
+    pthread_cond_init(&s->cv_done, NULL);
+    atomic_init(&s->next_chunk, 0u);
+    uint32_t workers = s->p.threads - 1;
+    if (!workers)
+        return VFX_OK;
+    s->threads = calloc(workers, sizeof *s->threads);
+    if (!s->threads)
+        return VFX_ERR_OUT_OF_MEMORY;
+    for (uint32_t i = 0; i < workers; ++i) {
+        if (pthread_create(&s->threads[i], NULL, worker_main, s) != 0) {
+            s->p.threads = 1 + i; /* run with the ones we have */
+            break;
+        }
+        s->nthreads++;
+    }
+    return VFX_OK;
+}
+
+void sph_pool_stop(rt_sph *s)
+{
+    pthread_mutex_lock(&s->mu);
+    s->quit = true;
+    pthread_cond_broadcast(&s->cv_start);
+    pthread_mutex_unlock(&s->mu);
+    for (uint32_t i = 0; i < s->nthreads; ++i)
+        pthread_join(s->threads[i], NULL);
+    free(s->threads);
+    s->threads = NULL;
+    s->nthreads = 0;
+    pthread_mutex_destroy(&s->mu);
+    pthread_cond_destroy(&s->cv_start);
+    pthread_cond_destroy(&s->cv_done);
+}
+
+void sph_parallel(rt_sph *s, sph_chunk_fn fn, bool fresh)
+{
+    uint32_t nchunks = sph_chunk_count(s);
+    for (uint32_t c = 0; c < nchunks; ++c) {
+        if (fresh) {
+            s->out[c] = (sph_chunk_out){.bad = UINT32_MAX};
+        } else {
+            s->out[c].bad = UINT32_MAX;
+            s->out[c].ke = s->out[c].pe = 0.0;
+            s->out[c].disp2_max = 0.f;
+        }
+    }
+    s->job = fn;
+    s->nchunks = nchunks;
+    atomic_store(&s->next_chunk, 0u);
+    if (s->nthreads == 0 || nchunks < 2) {
+        run_chunks(s);
+        return;
+    }
+    pthread_mutex_lock(&s->mu);
+    s->busy = s->nthreads;
+    s->gen++;
+    pthread_cond_broadcast(&s->cv_start);
+    pthread_mutex_unlock(&s->mu);
+    run_chunks(s);
+    pthread_mutex_lock(&s->mu);
+    while (s->busy > 0)
+        pthread_cond_wait(&s->cv_done, &s->mu);
+    pthread_mutex_unlock(&s->mu);
+}

@@ -1,0 +1,247 @@
+/* sph_storage.c — the particle columns: growth, adding particles, the views the API hands out. */
+#include "sim/sph_internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void sph_free_columns(rt_sph *s)
+{
+    float **f[] = {&s->x, &s->y, &s->z, &s->vx, &s->vy, &s->vz, &s->rho, &s->pr, &s->ax, &s->ay,
+                   &s->az, &s->drho, &s->xn, &s->yn, &s->zn, &s->vxn, &s->vyn, &s->vzn, &s->tmp,
+                   &s->x0, &s->y0, &s->z0};
+    for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) {
+        free(*f[i]);
+        *f[i] = NULL;
+    }
+    free(s->id), free(s->idtmp), free(s->key), free(s->perm), free(s->nb_start), free(s->nb_count);
+    free(s->sk_start), free(s->sk_count);
+    s->id = s->idtmp = s->key = s->perm = s->nb_start = s->nb_count = NULL;
+    s->sk_start = s->sk_count = NULL;
+    for (uint32_t c = 0; c < s->cnb_chunks; ++c) {
+        free(s->cnb[c]);
+        if (s->snb)
+            free(s->snb[c]);
+    }
+    free(s->cnb), free(s->cnb_cap), free(s->snb), free(s->snb_cap), free(s->snb_used);
+    s->cnb = NULL, s->cnb_cap = NULL, s->cnb_chunks = 0;
+    s->snb = NULL, s->snb_cap = NULL, s->snb_used = NULL;
+    s->lists_valid = false;
+}
+
+size_t rt_sph_memory_bytes(const rt_sph *s)
+{
+    if (!s)
+        return 0;
+    size_t lists = 0;
+    for (uint32_t c = 0; c < s->cnb_chunks; ++c)
+        lists += ((size_t)s->cnb_cap[c] + s->snb_cap[c]) * sizeof(uint32_t) + 3 * sizeof(uint32_t) +
+                 2 * sizeof(uint32_t *);
+    return sizeof *s + lists + (size_t)s->cap * (22 * sizeof(float) + 8 * sizeof(uint32_t)) +
+           ((size_t)s->ncells + 1) * sizeof(uint32_t) + (size_t)s->out_cap * sizeof(sph_chunk_out);
+}
+
+float rt_sph_pressure(const rt_sph *s, uint32_t i)
+{
+    if (!s || i >= s->n)
+        return 0.f;
+    return s->pr[i] * s->rho[i] * s->rho[i];
+}
+
+rt_sph_columns rt_sph_get_columns(rt_sph *s)
+{
+    if (!s)
+        return (rt_sph_columns){0};
+    return (rt_sph_columns){s->n, s->x, s->y, s->z, s->vx, s->vy, s->vz, s->rho, s->id};
+}
+
+vfx_result sph_reserve(rt_sph *s, uint64_t want)
+{
+    if (want > s->p.max_particles) {
+        sph_set_err(s, "rt_sph: %llu particles requested, capacity bound is %u (desc.max_particles)",
+                (unsigned long long)want, s->p.max_particles);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    if (want <= s->cap)
+        return VFX_OK;
+    uint64_t cap = s->cap ? s->cap : 1024;
+    while (cap < want)
+        cap *= 2;
+    if (cap > s->p.max_particles)
+        cap = s->p.max_particles;
+    float **f[] = {&s->x, &s->y, &s->z, &s->vx, &s->vy, &s->vz, &s->rho, &s->pr, &s->ax, &s->ay,
+                   &s->az, &s->drho, &s->xn, &s->yn, &s->zn, &s->vxn, &s->vyn, &s->vzn, &s->tmp,
+                   &s->x0, &s->y0, &s->z0};
+    for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) {
+        float *np = realloc(*f[i], (size_t)cap * sizeof(float));
+        if (!np)
+            goto oom;
+        *f[i] = np;
+    }
+    uint32_t **u[] = {&s->id, &s->idtmp, &s->key, &s->perm, &s->nb_start, &s->nb_count,
+                      &s->sk_start, &s->sk_count};
+    for (size_t i = 0; i < sizeof u / sizeof u[0]; ++i) {
+        uint32_t *np = realloc(*u[i], (size_t)cap * sizeof(uint32_t));
+        if (!np)
+            goto oom;
+        *u[i] = np;
+    }
+    uint32_t chunks = (uint32_t)((cap + SPH_CHUNK - 1) / SPH_CHUNK);
+    sph_chunk_out *no = realloc(s->out, (size_t)chunks * sizeof *no);
+    if (!no)
+        goto oom;
+    s->out = no;
+    s->out_cap = chunks;
+    if (chunks > s->cnb_chunks) {
+        uint32_t **nl = realloc(s->cnb, (size_t)chunks * sizeof *nl);
+        if (!nl)
+            goto oom;
+        s->cnb = nl;
+        uint32_t *nc = realloc(s->cnb_cap, (size_t)chunks * sizeof *nc);
+        if (!nc)
+            goto oom;
+        s->cnb_cap = nc;
+        uint32_t **sl = realloc(s->snb, (size_t)chunks * sizeof *sl);
+        if (!sl)
+            goto oom;
+        s->snb = sl;
+        uint32_t *sc = realloc(s->snb_cap, (size_t)chunks * sizeof *sc);
+        if (!sc)
+            goto oom;
+        s->snb_cap = sc;
+        uint32_t *su = realloc(s->snb_used, (size_t)chunks * sizeof *su);
+        if (!su)
+            goto oom;
+        s->snb_used = su;
+        for (uint32_t c = s->cnb_chunks; c < chunks; ++c)
+            s->cnb[c] = NULL, s->cnb_cap[c] = 0, s->snb[c] = NULL, s->snb_cap[c] = 0, s->snb_used[c] = 0;
+        s->cnb_chunks = chunks;
+    }
+    s->cap = (uint32_t)cap;
+    return VFX_OK;
+oom:
+    sph_set_err(s, "rt_sph: out of memory growing to %llu particles", (unsigned long long)cap);
+    return VFX_ERR_OUT_OF_MEMORY;
+}
+
+vfx_result rt_sph_add_particles(rt_sph *s, uint32_t n, const float *x, const float *y,
+                                 const float *z, const float *vx, const float *vy, const float *vz)
+{
+    if (!s)
+        return VFX_ERR_INVALID_ARGUMENT;
+    s->err[0] = 0;
+    if (n == 0)
+        return VFX_OK;
+    if (!x || !y || !z) {
+        sph_set_err(s, "rt_sph_add_particles: position array is NULL for %u particles", n);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    if ((uint64_t)s->n + n > s->p.max_particles) {
+        sph_set_err(s, "rt_sph_add_particles: %u + %u particles exceed the capacity bound %u "
+                "(desc.max_particles)", s->n, n, s->p.max_particles);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    const float *arr[6] = {x, y, z, vx, vy, vz};
+    static const char *nm[6] = {"x", "y", "z", "vx", "vy", "vz"};
+    for (uint32_t i = 0; i < n; ++i)
+        for (int a = 0; a < 6; ++a)
+            if (arr[a] && !isfinite(arr[a][i])) {
+                sph_set_err(s, "rt_sph_add_particles: particle %u (of %u in this batch) has a "
+                        "non-finite %s (%g); batch refused", i, n, nm[a], (double)arr[a][i]);
+                return VFX_ERR_INVALID_ARGUMENT;
+            }
+    vfx_result r = sph_reserve(s, (uint64_t)s->n + n);
+    if (r)
+        return r;
+    /* keep fresh particles a quarter spacing inside the walls, where the clamp would put them */
+    float m = 0.25f * s->p.spacing;
+    for (uint32_t i = 0; i < n; ++i) {
+        uint32_t k = s->n + i;
+        float px = sph_clampf(x[i], s->p.domain_min[0] + m, s->p.domain_max[0] - m);
+        float py = sph_clampf(y[i], s->p.domain_min[1] + m, s->p.domain_max[1] - m);
+        float pz = sph_clampf(z[i], s->p.domain_min[2] + m, s->p.domain_max[2] - m);
+        if (px != x[i] || py != y[i] || pz != z[i])
+            s->clamped_on_add++;
+        s->x[k] = px, s->y[k] = py, s->z[k] = pz;
+        s->vx[k] = vx ? vx[i] : 0.f;
+        s->vy[k] = vy ? vy[i] : 0.f;
+        s->vz[k] = vz ? vz[i] : 0.f;
+        s->rho[k] = s->p.rest_density;
+        s->pr[k] = 0.f;
+        s->id[k] = s->next_id++;
+    }
+    s->n += n;
+    s->lists_valid = false; /* new rows are in no list */
+    return VFX_OK;
+}
+
+void rt_sph_clear(rt_sph *s)
+{
+    if (!s)
+        return;
+    s->n = 0;
+    s->next_id = 0;
+    s->lists_valid = false;
+}
+
+vfx_result rt_sph_add_block(rt_sph *s, const float lo[3], const float hi[3], uint32_t *added)
+{
+    if (added)
+        *added = 0;
+    if (!s || !lo || !hi)
+        return VFX_ERR_INVALID_ARGUMENT;
+    float dx = s->p.spacing;
+    uint64_t c[3];
+    for (int a = 0; a < 3; ++a) {
+        if (!isfinite(lo[a]) || !isfinite(hi[a]) || hi[a] < lo[a]) {
+            sph_set_err(s, "rt_sph_add_block: bad bounds on axis %d (%g..%g)", a, (double)lo[a], (double)hi[a]);
+            return VFX_ERR_INVALID_ARGUMENT;
+        }
+        c[a] = (uint64_t)floor((hi[a] - lo[a]) / dx + 1e-4);
+    }
+    uint64_t total = c[0] * c[1] * c[2];
+    if (total == 0)
+        return VFX_OK;
+    vfx_result r = sph_reserve(s, s->n + total);
+    if (r)
+        return r;
+    uint32_t base = s->n;
+    for (uint64_t k = 0; k < c[2]; ++k)
+        for (uint64_t j = 0; j < c[1]; ++j)
+            for (uint64_t i = 0; i < c[0]; ++i) {
+                uint32_t q = s->n++;
+                s->x[q] = lo[0] + ((float)i + 0.5f) * dx;
+                s->y[q] = lo[1] + ((float)j + 0.5f) * dx;
+                s->z[q] = lo[2] + ((float)k + 0.5f) * dx;
+                s->vx[q] = s->vy[q] = s->vz[q] = 0.f;
+                s->rho[q] = s->p.rest_density;
+                s->pr[q] = 0.f;
+                s->id[q] = s->next_id++;
+            }
+    /* out-of-domain lattice points are clamped like any other input */
+    float m = 0.25f * dx;
+    for (uint32_t q = base; q < s->n; ++q) {
+        float px = sph_clampf(s->x[q], s->p.domain_min[0] + m, s->p.domain_max[0] - m);
+        float py = sph_clampf(s->y[q], s->p.domain_min[1] + m, s->p.domain_max[1] - m);
+        float pz = sph_clampf(s->z[q], s->p.domain_min[2] + m, s->p.domain_max[2] - m);
+        if (px != s->x[q] || py != s->y[q] || pz != s->z[q])
+            s->clamped_on_add++;
+        s->x[q] = px, s->y[q] = py, s->z[q] = pz;
+    }
+    s->lists_valid = false;
+    if (added)
+        *added = (uint32_t)total;
+    return VFX_OK;
+}
+
+void sph_swap_state(rt_sph *s)
+{
+    float *t;
+#define SW(a, b) (t = s->a, s->a = s->b, s->b = t)
+    SW(x, xn);
+    SW(y, yn);
+    SW(z, zn);
+    SW(vx, vxn);
+    SW(vy, vyn);
+    SW(vz, vzn);
+#undef SW
+}
