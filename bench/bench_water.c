@@ -1,7 +1,7 @@
 /* bench_water.c — volfx-bench metaballs: frame time of the water effect on the paper's layout
  * (24x24 square layers stacked, spacing 0.3), one JSON object per configuration.
  * Options: --particles N (repeatable) --size S (repeatable) --frames F --reference
- * --method paper|brute|grid --disable BITS (VFX_WATER_NO_*) --samples CAP --step W (in units of h)
+ * --method paper|brute|grid|tile --disable BITS (VFX_WATER_NO_*) --samples CAP --step W (in units of h)
  * --refine ITERS --pyramid LEVEL --warmup 0|1 (default 1: one untimed frame first, which
  * compiles the shaders). Per-pass GPU ms (counters *.gpu_ms) need at least 4 frames. */
 #include <epoxy/gl.h>
@@ -59,7 +59,7 @@ static double now_ms(void)
     return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
 }
 
-static const char *method_name(uint32_t m) { return m == 0 ? "paper" : m == 1 ? "brute" : "grid"; }
+static const char *method_name(uint32_t m) { return m == 0 ? "paper" : m == 1 ? "brute" : m == 2 ? "grid" : "tile"; }
 
 static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, const bench_scene *opt)
 {
@@ -162,8 +162,9 @@ int bench_metaballs(int argc, char **argv)
         else if (!strcmp(argv[i], "--reference")) reference = 1;
         else if (!strcmp(argv[i], "--method") && i + 1 < argc) {
             ++i;
-            method = !strcmp(argv[i], "brute") ? 1 : !strcmp(argv[i], "grid") ? 2 : !strcmp(argv[i], "paper") ? 0 : 99;
-            if (method == 99) { fprintf(stderr, "metaballs: --method paper|brute|grid, not %s\n", argv[i]); return 2; }
+            method = !strcmp(argv[i], "brute") ? 1 : !strcmp(argv[i], "grid") ? 2 : !strcmp(argv[i], "paper") ? 0
+                   : !strcmp(argv[i], "tile") ? 3 : 99;
+            if (method == 99) { fprintf(stderr, "metaballs: --method paper|brute|grid|tile, not %s\n", argv[i]); return 2; }
         }
         else if (!strcmp(argv[i], "--disable") && i + 1 < argc) opt.disable = (uint32_t)strtoul(argv[++i], NULL, 0);
         else if (!strcmp(argv[i], "--samples") && i + 1 < argc) opt.max_samples = (uint32_t)atoi(argv[++i]);

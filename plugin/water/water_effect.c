@@ -13,11 +13,13 @@
 #include "effect.h"
 #include "context.h"
 #include "water_grid.h"
+#include "water_tile.h"
 
 /* Counter readback ring: frames the GPU may run behind before a result is dropped. */
 #define WATER_COUNTER_RING 3
-/* march.comp's 8 (PAPER and the gradient pass) and GRID's cells visited and sphere tests */
-#define WATER_COUNTERS 10
+/* march.comp's 8 (PAPER and the gradient pass), GRID's cells visited and sphere tests, and
+ * tile.comp's 8 (TILE and the paper method's finishing pass) */
+#define WATER_COUNTERS 18
 /* Particles the effect takes at most: positions are 12 bytes each (12 GiB at the limit) and a
  * particle index must fit the int of gl_InstanceID and of the draw's instance count. */
 #define WATER_MAX_PARTICLES (1u << 30)
@@ -45,6 +47,7 @@ typedef struct water_state {
     uint32_t width, height;
     vfx_water_params params;
     volfx_water_grid *grid;  /* GRID baseline state, made the first time GRID is asked for */
+    volfx_water_tile *tile;  /* TILE lists (TILE, and PAPER's finishing pass), made when needed */
     float lo[3], hi[3];    /* box of the finite particles */
     /* upload skipping: the host's per-chunk revisions of the last upload (0 = untracked: the
      * host gives none, so every frame uploads); data_rev counts uploads, which GRID keys on */
@@ -149,6 +152,7 @@ static void water_destroy(vfx_context *ctx, void *state)
     groups_free(ctx, s);
     paper_free(s);
     volfx_water_grid_destroy(ctx, s->grid);
+    volfx_water_tile_destroy(ctx, s->tile);
     volfx_free(ctx, s->chunk_rev);
     glDeleteVertexArrays(1, &s->vao);
     for (int k = 0; k < WATER_COUNTER_RING; ++k)
@@ -587,6 +591,27 @@ static void publish_counters(vfx_context *ctx, water_state *s)
         volfx_stat_set(ctx, "water.pixels_sample_cap", c[4]);
         volfx_stat_set(ctx, "water.pixels_left", c[5]);
     }
+    const int tile = s->last_method == VFX_WATER_METHOD_TILE;
+    if (tile) {
+        volfx_stat_set(ctx, "water.samples", c[2]);
+        volfx_stat_set(ctx, "water.pixels_found", c[3]);
+        volfx_stat_set(ctx, "water.pixels_left", c[5]);
+        volfx_stat_set(ctx, "water.pixels_undecided", c[12]);
+        volfx_stat_set(ctx, "water.tile_dense_pixels", c[13]);
+        volfx_stat_set(ctx, "water.tile_subdivision_samples", c[15]);
+    }
+    if (paper) {
+        /* the cap pixels the finishing pass took (0 with VFX_WATER_NO_FINISH), and what is left
+         * undecided: cap pixels not finished plus those the finishing march could not decide */
+        volfx_stat_set(ctx, "water.pixels_finished", c[11]);
+        volfx_stat_set(ctx, "water.pixels_undecided", (double)c[4] - c[11] + c[12]);
+    }
+    if (tile || (paper && c[11])) {
+        volfx_stat_set(ctx, "water.tile_entries", c[10]);
+        volfx_stat_set(ctx, "water.tile_sphere_tests", c[14]);
+        volfx_stat_set(ctx, "water.tile_global_particles", c[16]);
+        volfx_stat_set(ctx, "water.tile_overflow_pixels", c[17]);
+    }
     if (grid) {
         volfx_stat_set(ctx, "water.grid_cells_visited", c[8]);
         volfx_stat_set(ctx, "water.grid_sphere_tests", c[9]);
@@ -788,6 +813,34 @@ static vfx_result grid_march(vfx_context *ctx, water_state *s, const vfx_frame_v
     return volfx_water_grid_render(ctx, s->grid, &in, frame, targets);
 }
 
+static vfx_result tile_lists(vfx_context *ctx, water_state *s, volfx_water_tile_input *in,
+                             const vfx_frame_view *frame)
+{
+    if (!s->tile && !(s->tile = volfx_water_tile_create(ctx)))
+        return VFX_ERR_OUT_OF_MEMORY;
+    *in = (volfx_water_tile_input){s->cols, s->count, &s->params, s->width, s->height, ctx->water_dist_tex,
+                                   s->counters, s->have_last ? s->last[10] : 0, s->view_proj, s->lo, s->hi,
+                                   frame->eye};
+    return volfx_water_tile_bin(ctx, s->tile, in);
+}
+
+static vfx_result tile_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
+                             const volfx_frame_targets *targets)
+{
+    volfx_water_tile_input in;
+    vfx_result r = tile_lists(ctx, s, &in, frame);
+    return r ? r : volfx_water_tile_march(ctx, s->tile, &in, frame, targets, s->grad, s->back);
+}
+
+/* The paper method's sample-cap pixels, finished by TILE's march from where they stopped. */
+static vfx_result paper_finish(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
+                               const volfx_frame_targets *targets)
+{
+    volfx_water_tile_input in;
+    vfx_result r = tile_lists(ctx, s, &in, frame);
+    return r ? r : volfx_water_tile_finish(ctx, s->tile, &in, frame, targets, s->st, s->cur);
+}
+
 static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
                                volfx_frame_targets *targets)
 {
@@ -809,17 +862,25 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     volfx_stat_set(ctx, "water.upload_skipped", s->upload_skipped);
     s->last_method_drawn = UINT32_MAX; /* until this frame completes: nothing for debug_pixel_class */
     vfx_result r;
-    if (p->method == VFX_WATER_METHOD_PAPER)
+    if (p->method == VFX_WATER_METHOD_PAPER) {
         r = paper_march(ctx, s, frame, targets);
+        /* the tile lists read one position buffer: with several, the cap pixels stay holes
+         * (counted in water.pixels_undecided) */
+        if (r == VFX_OK && !(p->disable & VFX_WATER_NO_FINISH) && s->group_count == 1)
+            r = paper_finish(ctx, s, frame, targets);
+    } else if (p->method == VFX_WATER_METHOD_TILE)
+        r = tile_march(ctx, s, frame, targets);
     else if (p->method == VFX_WATER_METHOD_BRUTE)
         r = brute_march(ctx, s, frame, targets);
     else if (p->method == VFX_WATER_METHOD_GRID)
         r = grid_march(ctx, s, frame, targets);
     else
-        r = volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: unknown method %u in vfx_water_params (0 paper, 1 brute, 2 grid)", p->method);
+        r = volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: unknown method %u in vfx_water_params (0 paper, 1 brute, 2 grid, 3 tile)", p->method);
     if (r != VFX_OK)
         return r;
-    if (!(p->disable & VFX_WATER_NO_SHADING) && (r = surface_passes(ctx, s, frame, targets)) != VFX_OK)
+    /* TILE wrote the gradient and back distance from its own lists */
+    if (!(p->disable & VFX_WATER_NO_SHADING) && p->method != VFX_WATER_METHOD_TILE &&
+        (r = surface_passes(ctx, s, frame, targets)) != VFX_OK)
         return r;
 
     GLuint shade = volfx_gpu_program(ctx, "common/fullscreen.vert", "water/shade.frag", NULL);

@@ -127,7 +127,8 @@ vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
         }
     }
     vfx_water_params *wp = &w->params;
-    *wp = (vfx_water_params){.size = sizeof *wp, .version = VFX_WATER_PARAMS_VERSION};
+    /* ours (TILE) unless water.quality.method names another */
+    *wp = (vfx_water_params){.size = sizeof *wp, .version = VFX_WATER_PARAMS_VERSION, .method = VFX_WATER_METHOD_TILE};
     r = scene_get_float(c, v, P, "h", false, (range){0, 1e3, true}, &wp->h);
     if (!r) r = scene_get_float(c, v, P, "threshold", false, (range){0, 1e3, true}, &wp->threshold);
     if (!r) r = scene_get_vec(c, v, P, "color", 3, false, UNIT, wp->color);
@@ -139,12 +140,13 @@ vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
     if (q) {
         static const char *const qkeys[] = {"max_samples", "step", "refine_iters", "pyramid_level", "method",
                                             "disable", NULL};
-        static const char *const methods[] = {"paper", "brute", "grid", NULL};
+        static const char *const methods[] = {"paper", "brute", "grid", "tile", NULL};
         static const char *const flags[] = {"billboard_init", "skip", "blend", "pack4", "pyramid", "refine",
-                                            "shading", NULL};
+                                            "shading", "finish", "local_list", "subdivide", "tiles", NULL};
         static const uint32_t bits[] = {VFX_WATER_NO_BILLBOARD_INIT, VFX_WATER_NO_SKIP, VFX_WATER_NO_BLEND,
                                         VFX_WATER_NO_PACK4, VFX_WATER_NO_PYRAMID, VFX_WATER_NO_REFINE,
-                                        VFX_WATER_NO_SHADING};
+                                        VFX_WATER_NO_SHADING, VFX_WATER_NO_FINISH, VFX_WATER_NO_LOCAL_LIST,
+                                        VFX_WATER_NO_SUBDIVIDE, VFX_WATER_NO_TILES};
         const char *PQ = "water.quality";
         if ((r = scene_expect_object(c, q, PQ)))
             return r;

@@ -858,10 +858,15 @@ static void test_async_counters(void **state)
 static void test_paper_sample_cap_counted(void **state)
 {
     (void)state;
-    const uint32_t caps[2] = {16, 64};
-    for (int c = 0; c < 2; ++c) {
+    /* the seed's method as it is (NO_FINISH) at caps 16 and 64, then cap 16 with the cap pixels
+     * finished by TILE's march (the default) */
+    const uint32_t caps[3] = {16, 64, 16};
+    for (int c = 0; c < 3; ++c) {
+        const int finish = c == 2;
         scene s = blob_scene(VFX_WATER_METHOD_PAPER);
         s.params.max_samples = caps[c];
+        if (!finish)
+            s.params.disable |= VFX_WATER_NO_FINISH;
         ref_camera cam = blob_camera(48);
         const size_t n = 48 * 48;
         static const float host[4] = {0, 0, 0, 1};
@@ -873,11 +878,14 @@ static void test_paper_sample_cap_counted(void **state)
         assert_int_equal(ss.api.read_raw(ss.ctx, VFX_EFFECT_WATER, dist, n), VFX_OK);
         assert_int_equal(volfx_water_debug_pixel_class(ss.ctx, cls, n), VFX_OK);
         reference_image(&s, &cam, rdist, rnrm);
-        uint32_t count[4] = {0}, ref_hits = 0, holes = 0, holes_cap = 0;
+        uint32_t count[4] = {0}, ref_hits = 0, holes = 0, holes_cap = 0, cap_found = 0;
         for (size_t i = 0; i < n; ++i) {
             assert_true(cls[i] >= 1 && cls[i] <= 3);
             ++count[cls[i]];
-            assert_true((dist[i] >= 0) == (cls[i] == 1)); /* found <=> a distance was written */
+            /* found <=> a distance was written; a finished cap pixel may have one */
+            if (cls[i] != 3 || !finish)
+                assert_true((dist[i] >= 0) == (cls[i] == 1));
+            cap_found += cls[i] == 3 && dist[i] >= 0;
             ref_hits += rdist[i] >= 0;
             if (rdist[i] >= 0 && dist[i] < 0) {
                 ++holes;
@@ -885,9 +893,11 @@ static void test_paper_sample_cap_counted(void **state)
             }
         }
         double found = stat_of_ctx(&ss, "water.pixels_found"), cap = stat_of_ctx(&ss, "water.pixels_sample_cap"),
-               left = stat_of_ctx(&ss, "water.pixels_left");
-        print_message("paper cap %u: ref hits %u, holes %u (%u of them cap pixels); found %.0f cap %.0f left %.0f\n",
-                      caps[c], ref_hits, holes, holes_cap, found, cap, left);
+               left = stat_of_ctx(&ss, "water.pixels_left"), fin = stat_of_ctx(&ss, "water.pixels_finished"),
+               und = stat_of_ctx(&ss, "water.pixels_undecided");
+        print_message("paper cap %u%s: ref hits %u, holes %u (%u of them cap pixels); found %.0f cap %.0f left %.0f, "
+                      "finished %.0f (%u with water), undecided %.0f\n",
+                      caps[c], finish ? " + finish" : "", ref_hits, holes, holes_cap, found, cap, left, fin, cap_found, und);
         assert_true(found == count[1] && left == count[2] && cap == count[3]);
         assert_true(found + cap + left == (double)n);
         assert_true(ref_hits > 300);
@@ -897,6 +907,14 @@ static void test_paper_sample_cap_counted(void **state)
              * hits, 287 of them cap pixels; cap 64: 2 holes, no cap pixel) */
             assert_true(holes > ref_hits / 10);
             assert_true(cap >= holes_cap && holes_cap > 0);
+            assert_true(fin == 0 && und == cap);
+        }
+        if (finish) {
+            /* every cap pixel finished and decided. Measured: 2 holes of 1006 hits, 1 of them
+             * a cap pixel: as at cap 64 (2 holes, none a cap pixel) the paper's h/8 steps passed a
+             * feature thinner than a step before the finish started from its next sample */
+            assert_true(cap > 0 && fin == cap && und == 0);
+            assert_true(holes <= 3 && holes_cap <= 1);
         }
         assert_true(holes - holes_cap <= ref_hits / 50);
         free(dist); free(rdist); free(rnrm); free(cls);

@@ -108,12 +108,24 @@ enum {
     VFX_WATER_NO_PYRAMID = 1u << 4,        /* technique 5: no min/max pyramid culling */
     VFX_WATER_NO_REFINE = 1u << 5,         /* technique 6: linear interpolation only */
     VFX_WATER_NO_SHADING = 1u << 6,        /* flat colour: for tests that compare coverage */
+    /* PAPER: leave the pixels that spent max_samples undecided (holes), as the seed does,
+     * instead of finishing them with TILE's march */
+    VFX_WATER_NO_FINISH = 1u << 7,
+    /* TILE (ablation): evaluate the field over the tile's whole list at every sample */
+    VFX_WATER_NO_LOCAL_LIST = 1u << 8,
+    /* TILE (ablation): plain steps, no bound-driven subdivision (features thinner than a step
+     * can be missed) */
+    VFX_WATER_NO_SUBDIVIDE = 1u << 9,
+    /* TILE (ablation): no screen tiles: every pixel reads every particle */
+    VFX_WATER_NO_TILES = 1u << 10,
 };
 
 typedef enum vfx_water_method {
     VFX_WATER_METHOD_PAPER = 0,     /* billboards + blended potentials, the published method (docs/water.md) */
     VFX_WATER_METHOD_BRUTE = 1,     /* baseline: per-pixel march over all particles (compute) */
     VFX_WATER_METHOD_GRID = 2,      /* baseline: per-pixel march over a uniform grid (compute) */
+    VFX_WATER_METHOD_TILE = 3,      /* ours (recommended; scenes default to it): per-pixel march
+                                       over screen-tile particle lists, no sample cap */
 } vfx_water_method;
 
 #define VFX_WATER_PARAMS_VERSION 1u

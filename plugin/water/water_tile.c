@@ -1,0 +1,259 @@
+/* water_tile.c — method TILE (ours): screen-tile binning of the particles on the GPU and the
+ * per-pixel march over the tile lists (shaders/water/tile.comp). The tile lists hold positions
+ * (16 bytes an entry) in a buffer of bounded capacity: a tile whose list does not fit reads
+ * every particle instead (correct, slower; its pixels are counted, water.tile_overflow_pixels),
+ * and the capacity grows to what a recent frame needed (water.tile_entries), up to
+ * TILE_MAX_ENTRIES.
+ * The prefix sum is grid.comp's (MODE_SCAN / SCAN_TOP / SCAN_ADD). */
+#include <math.h>
+#include <string.h>
+
+#include "gpu/gpu.h"
+#include "water_tile.h"
+
+#define TILE_PX 8
+/* the two-level scan of grid.comp: 1024 blocks of 1024 */
+#define TILE_MAX_TILES ((1u << 20) - 1u)
+/* 256 MiB of entries at most */
+#define TILE_MAX_ENTRIES (1u << 24)
+/* a particle whose cube covers more tiles than this (128x128 pixels) goes to the global list,
+ * scanned by every pixel: one near the eye would otherwise loop over every tile */
+#define TILE_GLOBAL_TILES 256u
+/* depth slabs per tile (fewer when tiles * slabs would pass the scan's limit) */
+#define TILE_SLABS 32u
+
+struct volfx_water_tile {
+    GLuint count, start, blocks, entries, globals;
+    uint32_t tile_cap;   /* entries count/start hold */
+    uint32_t entry_cap;  /* entries `entries` holds */
+    uint32_t global_cap; /* particles `globals` holds */
+    uint32_t tiles_x, tiles_y, slabs;
+    float d0, ds;        /* slab k starts at distance d0 + k ds from the eye */
+};
+
+volfx_water_tile *volfx_water_tile_create(vfx_context *ctx)
+{
+    volfx_water_tile *t = volfx_alloc(ctx, sizeof *t);
+    if (!t)
+        return NULL;
+    glCreateBuffers(1, &t->blocks);
+    glNamedBufferStorage(t->blocks, 1024 * sizeof(uint32_t), NULL, 0);
+    volfx_gpu_label(GL_BUFFER, t->blocks, "water.tile_blocks");
+    return t;
+}
+
+void volfx_water_tile_destroy(vfx_context *ctx, volfx_water_tile *t)
+{
+    if (!t)
+        return;
+    GLuint b[] = {t->count, t->start, t->blocks, t->entries, t->globals};
+    for (int k = 0; k < 5; ++k)
+        if (b[k])
+            glDeleteBuffers(1, &b[k]);
+    volfx_free(ctx, t);
+}
+
+static GLuint storage(GLsizeiptr bytes, const char *label)
+{
+    GLuint b;
+    glCreateBuffers(1, &b);
+    glNamedBufferStorage(b, bytes, NULL, GL_DYNAMIC_STORAGE_BIT);
+    volfx_gpu_label(GL_BUFFER, b, label);
+    return b;
+}
+
+static void tile_uniforms(GLuint prog, const volfx_water_tile *t, const volfx_water_tile_input *in, uint32_t n)
+{
+    glUniform1ui(glGetUniformLocation(prog, "u_count"), in->count);
+    glUniform1ui(glGetUniformLocation(prog, "u_n"), n);
+    glUniform1ui(glGetUniformLocation(prog, "u_cap"), (in->params->disable & VFX_WATER_NO_TILES) ? 0u : t->entry_cap);
+    glUniform1ui(glGetUniformLocation(prog, "u_global_tiles"), TILE_GLOBAL_TILES);
+    glUniform2i(glGetUniformLocation(prog, "u_tiles"), (GLint)t->tiles_x, (GLint)t->tiles_y);
+    glUniform2i(glGetUniformLocation(prog, "u_size"), (GLint)in->width, (GLint)in->height);
+    glUniform1f(glGetUniformLocation(prog, "u_h"), in->params->h);
+    glUniform1ui(glGetUniformLocation(prog, "u_slabs"), t->slabs);
+    glUniform1f(glGetUniformLocation(prog, "u_d0"), t->d0);
+    glUniform1f(glGetUniformLocation(prog, "u_ds"), t->ds);
+}
+
+static void bind_buffers(const volfx_water_tile *t, const volfx_water_tile_input *in)
+{
+    for (int k = 0; k < 3; ++k)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, in->cols[k]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, t->count);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, in->counters);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, t->start);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, t->blocks);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, t->entries);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, t->globals);
+}
+
+vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in)
+{
+    t->tiles_x = (in->width + TILE_PX - 1) / TILE_PX;
+    t->tiles_y = (in->height + TILE_PX - 1) / TILE_PX;
+    uint64_t tiles = (uint64_t)t->tiles_x * t->tiles_y;
+    if (tiles > TILE_MAX_TILES)
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, "water tile: %ux%u pixels make %llu tiles of %dx%d, more than %u",
+                          in->width, in->height, (unsigned long long)tiles, TILE_PX, TILE_PX, TILE_MAX_TILES);
+    t->slabs = TILE_SLABS;
+    while (t->slabs > 1 && tiles * t->slabs > TILE_MAX_TILES)
+        t->slabs /= 2;
+    /* the particles' distances from the eye: from the box (0 when the eye is inside) to its
+     * farthest corner */
+    double dmin2 = 0, dmax2 = 0;
+    for (int k = 0; k < 3; ++k) {
+        double e = in->eye[k], a = in->lo[k], b = in->hi[k];
+        double n = e < a ? a - e : e > b ? e - b : 0, f = fabs(e - a) > fabs(e - b) ? e - a : e - b;
+        dmin2 += n * n;
+        dmax2 += f * f;
+    }
+    double dmin = sqrt(dmin2), span = sqrt(dmax2) - dmin;
+    t->d0 = (float)dmin;
+    t->ds = (float)(span > 1e-30 ? span / t->slabs * (1.0 + 1e-6) : 1.0);
+    uint32_t nscan = (uint32_t)(tiles * t->slabs) + 1;
+    uint32_t need = (nscan + 1023u) & ~1023u;
+    if (need > t->tile_cap) {
+        if (t->count) glDeleteBuffers(1, &t->count);
+        if (t->start) glDeleteBuffers(1, &t->start);
+        t->count = storage((GLsizeiptr)need * 4, "water.tile_count");
+        t->start = storage((GLsizeiptr)need * 4, "water.tile_start");
+        t->tile_cap = need;
+    }
+    /* entries: 16 per particle to start with (a particle of 2h ~ 16 pixels covers 4-9 tiles),
+     * then what a recent frame needed plus a quarter, within TILE_MAX_ENTRIES */
+    uint64_t want = (uint64_t)in->count * 16u + 65536u;
+    if (in->last_entries) {
+        uint64_t w2 = (uint64_t)in->last_entries + in->last_entries / 4u + 1024u;
+        if (w2 > want) want = w2;
+    }
+    if (want > TILE_MAX_ENTRIES) want = TILE_MAX_ENTRIES;
+    if (!t->entries || want > t->entry_cap) {
+        if (t->entries) glDeleteBuffers(1, &t->entries);
+        t->entries = storage((GLsizeiptr)want * 16, "water.tile_entries");
+        t->entry_cap = (uint32_t)want;
+    }
+    uint32_t np = in->count ? in->count : 1;
+    if (!t->globals || np > t->global_cap) {
+        if (t->globals) glDeleteBuffers(1, &t->globals);
+        t->globals = storage(16 + (GLsizeiptr)np * 16, "water.tile_globals");
+        t->global_cap = np;
+    }
+    const char *e = volfx_gpu_error_string();
+    if (e)
+        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water tile: buffers for %llu tiles and %u entries: %s",
+                          (unsigned long long)tiles, t->entry_cap, e);
+    GLuint count = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_COUNT\n");
+    GLuint scatter = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_SCATTER\n");
+    GLuint scan = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n");
+    GLuint top = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n#define SCAN_TOP\n");
+    GLuint add = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN_ADD\n");
+    if (!count || !scatter || !scan || !top || !add)
+        return VFX_ERR_GL;
+    bind_buffers(t, in);
+    GLuint groups = (in->count + 63u) / 64u, blocks = need / 1024u;
+    GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
+    volfx_gpu_pass_begin(ctx, "water.tile_bin");
+    glClearNamedBufferSubData(t->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
+    glClearNamedBufferSubData(t->globals, GL_R32UI, 0, 16, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
+    glUseProgram(count);
+    tile_uniforms(count, t, in, nscan);
+    glUniformMatrix4fv(glGetUniformLocation(count, "u_view_proj"), 1, GL_FALSE, in->view_proj);
+    glUniform3fv(glGetUniformLocation(count, "u_eye_bin"), 1, in->eye);
+    if (groups)
+        glDispatchCompute(gx, gy, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glUseProgram(scan);
+    tile_uniforms(scan, t, in, nscan);
+    glDispatchCompute(blocks, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glUseProgram(top);
+    tile_uniforms(top, t, in, blocks);
+    glDispatchCompute(1, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    glUseProgram(add);
+    tile_uniforms(add, t, in, nscan);
+    glDispatchCompute((nscan + 255u) / 256u, 1, 1);
+    /* the counts are spent: the same buffer becomes the per-tile fill cursor of the scatter,
+     * and ends holding each tile's count again */
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    glClearNamedBufferSubData(t->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
+    glUseProgram(scatter);
+    tile_uniforms(scatter, t, in, nscan);
+    glUniformMatrix4fv(glGetUniformLocation(scatter, "u_view_proj"), 1, GL_FALSE, in->view_proj);
+    glUniform3fv(glGetUniformLocation(scatter, "u_eye_bin"), 1, in->eye);
+    if (groups)
+        glDispatchCompute(gx, gy, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    volfx_gpu_pass_end(ctx);
+    volfx_stat_set(ctx, "water.tile_entry_capacity", t->entry_cap);
+    return VFX_OK;
+}
+
+static void march_uniforms(GLuint prog, const volfx_water_tile *t, const volfx_water_tile_input *in,
+                           const vfx_frame_view *frame, const volfx_frame_targets *targets)
+{
+    const vfx_water_params *p = in->params;
+    tile_uniforms(prog, t, in, 0);
+    glBindImageTexture(0, in->dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    glBindTextureUnit(1, frame->depth_texture);
+    glUniformMatrix4fv(glGetUniformLocation(prog, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
+    glUniform3fv(glGetUniformLocation(prog, "u_eye"), 1, frame->eye);
+    glUniform1f(glGetUniformLocation(prog, "u_T"), p->threshold);
+    glUniform1f(glGetUniformLocation(prog, "u_step"), p->step);
+    /* a window of 2h holds the spheres one ray meets near its first entry (16 to 30 in dense
+     * water at a spacing of h/2); the local list takes 32 */
+    glUniform1f(glGetUniformLocation(prog, "u_window"), 2.0f * p->h);
+    float rho = p->h * (1.0f - p->threshold);
+    glUniform1f(glGetUniformLocation(prog, "u_rho"), rho > 0 ? rho : 0.0f);
+    glUniform1ui(glGetUniformLocation(prog, "u_refine_iters"), (p->disable & VFX_WATER_NO_REFINE) ? 0u : p->refine_iters);
+    glUniform1i(glGetUniformLocation(prog, "u_has_depth"), frame->depth_texture != 0);
+    glUniform1i(glGetUniformLocation(prog, "u_subdivide"), !(p->disable & VFX_WATER_NO_SUBDIVIDE));
+    glUniform1i(glGetUniformLocation(prog, "u_local"), !(p->disable & VFX_WATER_NO_LOCAL_LIST));
+}
+
+vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
+                                  const vfx_frame_view *frame, const volfx_frame_targets *targets,
+                                  GLuint grad_tex, GLuint back_tex)
+{
+    GLuint prog = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_MARCH\n");
+    if (!prog)
+        return VFX_ERR_GL;
+    volfx_gpu_pass_begin(ctx, "water.tile_march");
+    glUseProgram(prog);
+    bind_buffers(t, in);
+    march_uniforms(prog, t, in, frame, targets);
+    glBindImageTexture(1, grad_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(2, back_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    glDispatchCompute((in->width + 7) / 8, (in->height + 7) / 8, 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    volfx_gpu_pass_end(ctx);
+    const char *e = volfx_gpu_error_string();
+    if (e)
+        return volfx_fail(ctx, VFX_ERR_GL, "water tile march %ux%u: %s", in->width, in->height, e);
+    return VFX_OK;
+}
+
+vfx_result volfx_water_tile_finish(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
+                                   const vfx_frame_view *frame, const volfx_frame_targets *targets,
+                                   GLuint st_tex, GLuint next_tex)
+{
+    GLuint prog = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_FINISH\n");
+    if (!prog)
+        return VFX_ERR_GL;
+    volfx_gpu_pass_begin(ctx, "water.finish");
+    glUseProgram(prog);
+    bind_buffers(t, in);
+    march_uniforms(prog, t, in, frame, targets);
+    glBindImageTexture(1, st_tex, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+    glBindImageTexture(2, next_tex, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
+    glDispatchCompute((in->width + 7) / 8, (in->height + 7) / 8, 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                    GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    volfx_gpu_pass_end(ctx);
+    const char *e = volfx_gpu_error_string();
+    if (e)
+        return volfx_fail(ctx, VFX_ERR_GL, "water finish %ux%u: %s", in->width, in->height, e);
+    return VFX_OK;
+}

@@ -1,0 +1,426 @@
+// Method TILE (ours, the default in scenes): particles binned per 8x8 screen tile on the GPU,
+// then a per-pixel march over the tile's list that cannot end undecided. One MODE_* per dispatch:
+//   MODE_COUNT    per particle: the tiles its cube of half-size h projects onto; count[tile] += 1
+//                 (a particle over more than u_global_tiles tiles goes to the global list instead)
+//   (prefix sum: grid.comp MODE_SCAN / SCAN_TOP / SCAN_ADD on the same buffers)
+//   MODE_SCATTER  per particle: entries[start[tile] + fill[tile]++] = position (while it fits
+//                 the capacity; a tile that does not fit reads every particle instead)
+//   MODE_MARCH    per pixel: exact ray interval from the tile's list (first sphere entry), then
+//                 windows along the ray, each with a local list of the spheres that overlap it
+//                 (exact potential there), steps of w with a per-interval upper bound of the
+//                 field that opens dyadic subintervals where a feature could hide between two
+//                 samples; regula falsi; gradient and back distance from the same lists.
+//   MODE_FINISH   per pixel of the paper method that spent its sample cap: the same march from
+//                 the paper's next sample, its last outside sample as the bracket's start.
+// Every loop is bounded by a constant or by a list length; see docs/water.md (method TILE).
+#include "common/depth.glsl"
+#if defined(MODE_MARCH) || defined(MODE_FINISH)
+layout(local_size_x = 8, local_size_y = 8) in;
+#else
+layout(local_size_x = 64) in;
+#endif
+layout(std430, binding = 0) readonly buffer PX { float px[]; };
+layout(std430, binding = 1) readonly buffer PY { float py[]; };
+layout(std430, binding = 2) readonly buffer PZ { float pz[]; };
+layout(std430, binding = 3) buffer Count { uint tcount[]; };   // counts, then the scatter fill
+// the water effect's counter buffer (march.comp's first 8 slots, grid.comp's next 2)
+layout(std430, binding = 4) buffer Counters {
+    uint c_culled_, c_frags_, c_samples, c_found, c_cap, c_left, c_gculled_, c_gfrags_, c_cells_, c_tests_,
+         c_entries, c_finished, c_undecided, c_dense, c_tile_tests, c_subdiv, c_global, c_overflow;
+};
+layout(std430, binding = 5) buffer Start { uint tstart[]; };
+layout(std430, binding = 7) buffer Entries { vec4 entries[]; };
+layout(std430, binding = 8) buffer Globals { uint gcount, gpad0, gpad1, gpad2; vec4 globals[]; };
+uniform uint u_count;        // particles in the columns (non-finite included)
+uniform uint u_cap;          // entries the Entries buffer holds
+uniform uint u_global_tiles; // a particle covering more tiles goes to the global list
+uniform ivec2 u_tiles;       // tiles across, down
+uniform ivec2 u_size;        // pixels
+uniform float u_h;
+// Depth slabs: within a tile the entries are in slab order of the distance from the eye (key
+// tile * u_slabs + slab), each entry's w the near bound of its slab, so a scan that only needs
+// spheres entering before some distance stops at the first entry whose slab starts past it.
+uniform uint u_slabs;
+uniform float u_d0, u_ds;
+
+#if defined(MODE_COUNT) || defined(MODE_SCATTER)
+uniform mat4 u_view_proj;
+uniform vec3 u_eye_bin;
+
+// Tiles whose pixel centres the cube p +- h can cover (it bounds the sphere of influence, so a
+// ray through a centre outside the rectangle misses the sphere). false: off screen or behind.
+bool tile_rect(vec3 p, out ivec4 r)
+{
+    vec2 lo = vec2(3.0e38), hi = vec2(-3.0e38);
+    int behind = 0, near = 0;
+    for (int k = 0; k < 8; ++k) {
+        vec3 c = p + u_h * (vec3(k & 1, (k >> 1) & 1, k >> 2) * 2.0 - 1.0);
+        vec4 q = u_view_proj * vec4(c, 1.0);
+        if (q.w <= 0.0) { ++behind; continue; }
+        if (q.w < 1.0e-6 * (abs(q.x) + abs(q.y) + 1.0e-30)) { ++near; continue; }
+        vec2 ndc = q.xy / q.w;
+        lo = min(lo, ndc);
+        hi = max(hi, ndc);
+    }
+    if (behind == 8) return false;
+    vec2 sz = vec2(u_size);
+    if (behind + near > 0) {   // the cube crosses the eye plane: every tile
+        lo = vec2(-1.0);
+        hi = vec2(1.0);
+    }
+    // pixel-centre coordinates, clamped in float before any int conversion
+    vec2 plo = clamp(floor((lo * 0.5 + 0.5) * sz - 0.5), vec2(-1.0), sz);
+    vec2 phi = clamp(ceil((hi * 0.5 + 0.5) * sz - 0.5), vec2(-1.0), sz);
+    if (phi.x < 0.0 || phi.y < 0.0 || plo.x > sz.x - 1.0 || plo.y > sz.y - 1.0) return false;
+    ivec2 a = ivec2(max(plo, vec2(0.0))) >> 3, b = ivec2(min(phi, sz - 1.0)) >> 3;
+    r = ivec4(a, min(b, u_tiles - 1));
+    return true;
+}
+#endif
+
+#if defined(MODE_MARCH) || defined(MODE_FINISH)
+layout(r32f, binding = 0) uniform writeonly image2D u_dist;
+layout(binding = 1) uniform sampler2D u_scene_depth;
+#if defined(MODE_MARCH)
+layout(rgba32f, binding = 1) uniform writeonly image2D u_grad;
+layout(r32f, binding = 2) uniform writeonly image2D u_back;
+#else
+layout(rgba32f, binding = 1) uniform readonly image2D u_st;    // the paper's pixel state
+layout(r32f, binding = 2) uniform readonly image2D u_next;     // the paper's next sample
+#endif
+uniform mat4 u_inv_view_proj;
+uniform vec3 u_eye;
+uniform float u_T, u_step, u_window, u_rho;
+uniform uint u_refine_iters;
+uniform bool u_has_depth, u_subdivide, u_local;
+#ifndef LOCAL_K
+#define LOCAL_K 32
+#endif
+#define SUB_DEPTH 4
+
+// The pixel's list: its tile's entries (or every particle when the tile did not fit) and then
+// the global list.
+uint g_start, g_n, g_total;
+bool g_over;
+vec3 g_dir;
+
+vec4 fetch(uint i)
+{
+    if (i < g_n)
+        return g_over ? vec4(px[i], py[i], pz[i], 0.0) : entries[g_start + i];
+    return vec4(globals[i - g_n].xyz, 0.0);
+}
+
+// The local list of one window: per sphere (perpendicular offset of its centre from the ray,
+// closest-approach distance tc), its squared offset and its entry distance.
+vec4 L[LOCAL_K];
+float Lb[LOCAL_K], Le[LOCAL_K];
+uint g_nl;
+bool g_dense;   // evaluate over the whole list (a window could not hold its spheres)
+
+// One term: closest approach tc, squared offset b2; at distance t (value) and its upper bound
+// over [t0, t1] (the point of the interval nearest tc).
+#define TERM(tc, b2) { float d = t - (tc); float r2 = (b2) + d * d; \
+    if (r2 < h2) { float q = 1.0 - sqrt(r2) * ih; s += q * q; } \
+    float dm = max(0.0, max(t0 - (tc), (tc) - t)); float rm = (b2) + dm * dm; \
+    if (rm < h2) { float q = 1.0 - sqrt(rm) * ih; u += q * q; } }
+
+// Sum P at t and the bound of sum P over [t0, t]: u >= sum P anywhere in [t0, t].
+vec2 field(float t, float t0)
+{
+    float s = 0.0, u = 0.0, h2 = u_h * u_h, ih = 1.0 / u_h;
+    if (!g_dense) {
+        for (uint j = 0u; j < g_nl; ++j) TERM(L[j].w, Lb[j])
+    } else {
+        for (uint i = 0u; i < g_total; ++i) {
+            vec4 pe = fetch(i); vec3 oc = pe.xyz - u_eye;
+            float tc = dot(oc, g_dir);
+            vec3 pp = oc - tc * g_dir;
+            TERM(tc, dot(pp, pp))
+        }
+    }
+    return vec2(s, u);
+}
+
+// grad sum P and sum P at distance t (the same spheres as field()).
+vec4 gradient(float t)
+{
+    vec4 g = vec4(0.0);
+    float h2 = u_h * u_h;
+    uint n = g_dense ? g_total : g_nl;
+    for (uint j = 0u; j < n; ++j) {
+        vec3 pp; float tc;
+        if (g_dense) { vec3 oc = fetch(j).xyz - u_eye; tc = dot(oc, g_dir); pp = oc - tc * g_dir; }
+        else { pp = L[j].xyz; tc = L[j].w; }
+        vec3 d = (t - tc) * g_dir - pp;   // x - p
+        float r2 = dot(d, d);
+        if (r2 < h2 && r2 > 0.0) {
+            float r = sqrt(r2), q = 1.0 - r / u_h;
+            g.xyz += (-2.0 * q / (u_h * r)) * d;
+            g.w += q * q;
+        } else if (r2 == 0.0) {
+            g.w += 1.0;
+        }
+    }
+    return g;
+}
+
+// Collects the spheres overlapping [lo, b) into L, keeping those that enter first when they do
+// not all fit: b shrinks to the entry of the first sphere left out, so L holds every sphere that
+// overlaps [lo, b). Returns the nearest entry >= b of a sphere left out (3e38 if none).
+float collect(float lo, inout float b, inout uint tests)
+{
+    g_nl = 0u;
+    float next_e = 3.0e38, h2 = u_h * u_h, emax = -3.0e38;
+    uint jmax = 0u;
+    for (uint i = 0u; i < g_total; ++i) {
+        ++tests;
+        vec4 pe = fetch(i);
+        if (!g_over && i < g_n && pe.w - u_h >= b) {
+            // this and every later entry of the tile enter at or after b
+            next_e = min(next_e, pe.w - u_h);
+            i = g_n - 1u;
+            continue;
+        }
+        vec3 oc = pe.xyz - u_eye;
+        float tc = dot(oc, g_dir);
+        vec3 pp = oc - tc * g_dir;
+        float b2 = dot(pp, pp);
+        if (!(b2 < h2)) continue;          // misses the ray (or NaN)
+        float hc = sqrt(h2 - b2), e = tc - hc;
+        if (tc + hc <= lo) continue;       // behind the window
+        if (e >= b) { next_e = min(next_e, e); continue; }
+        uint j = g_nl;
+        if (g_nl == uint(LOCAL_K)) {
+            // full: the latest entry leaves (or the new one is not taken); b becomes its entry
+            float out_e = max(e, emax);
+            b = out_e;
+            next_e = min(next_e, out_e);
+            if (e >= emax) continue;
+            j = jmax;
+        } else {
+            ++g_nl;
+        }
+        L[j] = vec4(pp, tc); Lb[j] = b2; Le[j] = e;
+        if (g_nl == uint(LOCAL_K)) {
+            // the slot of the latest entry among those with entry < b
+            emax = -3.0e38;
+            for (uint q = 0u; q < uint(LOCAL_K); ++q)
+                if (Le[q] > emax) { emax = Le[q]; jmax = q; }
+        }
+    }
+    return next_e;
+}
+
+// Farthest exit of the balls of radius rad around the pixel's spheres: the tile's entries from
+// the far end, stopping once no nearer slab can reach past the best exit found.
+float last_exit(float rad)
+{
+    float best = 0.0, r2 = rad * rad;
+    for (uint i = g_total; i > 0u; --i) {
+        vec4 pe = fetch(i - 1u);
+        if (!g_over && i - 1u < g_n && pe.w + u_ds + rad <= best) break;
+        vec3 oc = pe.xyz - u_eye;
+        float tc = dot(oc, g_dir);
+        vec3 pp = oc - tc * g_dir;
+        float b2 = dot(pp, pp);
+        if (b2 < r2) best = max(best, tc + sqrt(r2 - b2));
+    }
+    return best;
+}
+
+// Nearest entry >= t among the local list's spheres (3e38 if none).
+float next_local_entry(float t)
+{
+    float e = 3.0e38;
+    for (uint j = 0u; j < g_nl; ++j)
+        if (Le[j] >= t) e = min(e, Le[j]);
+    return e;
+}
+#endif
+
+void main()
+{
+#if defined(MODE_COUNT) || defined(MODE_SCATTER)
+    uint i = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 64u;
+    if (i >= u_count) return;
+    vec3 p = vec3(px[i], py[i], pz[i]);
+    if (any(isnan(p)) || any(isinf(p))) return; // skipped (counted on the CPU)
+    ivec4 r;
+    if (!tile_rect(p, r)) return;
+    uint area = uint(r.z - r.x + 1) * uint(r.w - r.y + 1);
+    float dist = length(p - u_eye_bin);
+    uint slab = uint(clamp(floor((dist - u_d0) / u_ds), 0.0, float(u_slabs - 1u)));
+    float slab_lo = u_d0 + float(slab) * u_ds;
+    if (area > u_global_tiles) {
+#if defined(MODE_SCATTER)
+        uint g = atomicAdd(gcount, 1u);   // the buffer holds every particle: always fits
+        globals[g] = vec4(p, 0.0);
+        atomicAdd(c_global, 1u);
+#endif
+        return;
+    }
+#if defined(MODE_COUNT)
+    atomicAdd(c_entries, area);
+#endif
+    for (int y = r.y; y <= r.w; ++y)
+        for (int x = r.x; x <= r.z; ++x) {
+            uint tile = uint(y * u_tiles.x + x) * u_slabs + slab;
+#if defined(MODE_COUNT)
+            atomicAdd(tcount[tile], 1u);
+#else
+            uint k = tstart[tile] + atomicAdd(tcount[tile], 1u);
+            if (k < u_cap) entries[k] = vec4(p, slab_lo);
+#endif
+        }
+#elif defined(MODE_MARCH) || defined(MODE_FINISH)
+    ivec2 pix = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(pix, u_size))) return;
+#if defined(MODE_FINISH)
+    vec4 st = imageLoad(u_st, pix);
+    if (st.x != 3.0) return;     // only the paper's sample-cap pixels
+#endif
+    uint ti = uint((pix.y >> 3) * u_tiles.x + (pix.x >> 3)) * u_slabs;
+    g_start = tstart[ti];
+    g_n = tstart[ti + u_slabs] - g_start;
+    g_over = g_start + g_n > u_cap;
+    uint ng = gcount;
+    if (g_over) { g_n = u_count; ng = 0u; }   // the tile did not fit: every particle
+    g_total = g_n + ng;
+    g_dense = !u_local;
+    vec2 ndc = (vec2(pix) + 0.5) / vec2(u_size) * 2.0 - 1.0;
+    g_dir = volfx_ray_dir(u_inv_view_proj, u_eye, ndc);
+    float t_lim = u_has_depth ? volfx_depth_distance(u_inv_view_proj, u_eye, ndc, texelFetch(u_scene_depth, pix, 0).r) : 3.0e38;
+    uint tests = 0u, nsamp = 0u, nsub = 0u;
+
+    bool have_prev = false;
+    float tp = 0.0, fp = 0.0, t = 0.0;
+#if defined(MODE_MARCH)
+    t = 0.0;           // the first window finds the first sphere entry
+    float lo = 0.0;
+#else
+    t = imageLoad(u_next, pix).r;
+    if (st.w > 0.0) { have_prev = true; tp = st.y; fp = st.z; }
+    // the first window also covers the bracket's start (the paper's last outside sample)
+    float lo = have_prev ? min(tp, t - u_step) : t - u_step;
+#endif
+    int state = 2;     // 1 found, 2 left (past the list or the host depth), 4 undecided
+    float result = -1.0;
+    float fa = 0.0, fb = 0.0, ta = 0.0, tb = 0.0;
+    // Bounds: each window advances t by at least one step or jumps a gap to the next sphere
+    // entry (every sphere is entered once); each window's steps are at most window / step + 1.
+    const int MAX_WINDOWS = 4096, MAX_STEPS = 1 << 15;
+    int steps = 0;
+    for (int win = 0; win < MAX_WINDOWS && state == 2; ++win) {
+        if (t > t_lim || t >= 3.0e38) break;   // 3e38: no sphere ahead
+        // the window is as long as its K spheres reach: b is the entry of the first left out
+        float b = 3.0e38;
+        float next_e = 3.0e38;
+        if (!g_dense) {
+            next_e = collect(min(lo, t - u_step), b, tests);
+            lo = 3.0e38;
+#if defined(MODE_MARCH)
+            if (win == 0) {
+                // exact start: the first sphere entry (0 when the eye is inside one); the field
+                // is 0 there (L holds the spheres that enter first)
+                float e0 = 3.0e38;
+                for (uint j = 0u; j < g_nl; ++j) e0 = min(e0, Le[j]);
+                if (e0 >= 3.0e38) break;
+                t = max(e0, 0.0);
+                if (t > 0.0) { have_prev = true; tp = t; fp = -u_T; }
+            }
+#endif
+            if (b - t < u_step) {
+                g_dense = true;
+                atomicAdd(c_dense, 1u);
+                t_lim = min(t_lim, last_exit(u_h));
+            }
+        }
+        if (!g_dense && g_nl == 0u) {
+            // nothing overlaps the window: the field is 0 up to the next entry
+            if (next_e >= 3.0e38) break;
+            t = next_e; tp = t; fp = -u_T; have_prev = true;
+            continue;
+        }
+        float b_end = g_dense ? t_lim + u_step : b;
+        if (!g_dense && b >= 3.0e38) b_end = 3.0e38;
+        while (t < b_end && t <= t_lim && steps < MAX_STEPS) {
+            ++steps;
+            vec2 su = field(t, have_prev ? tp : t);
+            ++nsamp;
+            float f = sqrt(su.x) - u_T;
+            if (f >= 0.0) {
+                state = 1; ta = tp; fa = fp; tb = t; fb = f;
+                if (!have_prev) { ta = t; fa = f; }
+                break;
+            }
+            // both ends outside but the bound allows an inside point between them: open the
+            // dyadic subintervals of [tp, t] whose bound allows one, left first, to depth 4
+            if (u_subdivide && have_prev && su.y >= u_T * u_T) {
+                // node (d, k) is [tp + w k / 2^d, tp + w (k + 1) / 2^d]; the value at its left
+                // end is always known (tp's, or the right end of the node visited before it)
+                float w = t - tp, lf = fp;
+                int d = 1, k = 0;
+                for (int it = 0; it < 2 << SUB_DEPTH; ++it) {
+                    float n0 = tp + w * float(k) / float(1 << d), n1 = tp + w * float(k + 1) / float(1 << d);
+                    vec2 v = field(n1, n0);
+                    ++nsub;
+                    float fv = sqrt(v.x) - u_T;
+                    if (v.y >= u_T * u_T && d < SUB_DEPTH) { ++d; k *= 2; continue; } // open it
+                    if (fv >= 0.0) {
+                        state = 1; ta = n0; fa = lf; tb = n1; fb = fv;
+                        break;
+                    }
+                    lf = fv;
+                    // next node: climb while this one is a right child, then the right sibling
+                    while ((k & 1) == 1 && d > 1) { k >>= 1; --d; }
+                    if ((k & 1) == 1) break;   // (1, 1) done: the whole interval
+                    ++k;
+                }
+                if (state == 1) break;
+            }
+            tp = t; fp = f; have_prev = true;
+            if (su.x == 0.0 && !g_dense) {
+                // no sphere at t: the field is 0 up to the next local entry (or the window end)
+                float e = next_local_entry(t);
+                if (e >= b) { t = b; break; }
+                tp = e; fp = -u_T;
+                t = e + u_step;
+            } else {
+                t += u_step;
+            }
+        }
+        if (steps >= MAX_STEPS) { state = 4; break; }
+        if (g_dense && state == 2) break;   // the dense march went to the end
+    }
+    if (state == 2 && steps >= MAX_STEPS) state = 4;
+    if (state == 1) {
+        // eq. 5 then regula falsi on the bracket (the window's spheres cover it)
+        float tt = fb == fa ? 0.5 * (ta + tb) : (ta * fb - tb * fa) / (fb - fa);
+        for (uint k = 0u; k < u_refine_iters && ta != tb; ++k) {
+            float ft = sqrt(field(tt, tt).x) - u_T;
+            if (ft > 0.0) { tb = tt; fb = ft; } else { ta = tt; fa = ft; }
+            tt = fb == fa ? 0.5 * (ta + tb) : (ta * fb - tb * fa) / (fb - fa);
+        }
+        result = tt;
+        if (!(result <= t_lim)) { result = -1.0; state = 2; }
+    }
+    imageStore(u_dist, pix, vec4(result));
+#if defined(MODE_MARCH)
+    if (state == 1) {
+        imageStore(u_grad, pix, gradient(result));
+        imageStore(u_back, pix, vec4(last_exit(u_rho)));
+    }
+    atomicAdd(c_samples, nsamp + nsub);
+    if (state == 1) atomicAdd(c_found, 1u);
+    else if (state == 4) atomicAdd(c_undecided, 1u);
+    else atomicAdd(c_left, 1u);
+#else
+    atomicAdd(c_finished, 1u);
+    if (state == 4) atomicAdd(c_undecided, 1u);
+#endif
+    atomicAdd(c_tile_tests, tests);
+    atomicAdd(c_subdiv, nsub);
+    if (g_over) atomicAdd(c_overflow, 1u);
+#endif
+}
