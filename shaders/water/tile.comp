@@ -298,6 +298,21 @@ void main()
 #if defined(MODE_MARCH)
     t = 0.0;           // the first window finds the first sphere entry
     float lo = 0.0;
+    if (g_dense) {
+        // no local lists (ablation): the first entry and the last exit from the whole list
+        float e0 = 3.0e38, h2 = u_h * u_h;
+        for (uint i = 0u; i < g_total; ++i) {
+            vec3 oc = fetch(i).xyz - u_eye;
+            float tc = dot(oc, g_dir);
+            vec3 pp = oc - tc * g_dir;
+            float b2 = dot(pp, pp);
+            if (b2 < h2) { float hc = sqrt(h2 - b2); if (tc + hc > 0.0) e0 = min(e0, max(tc - hc, 0.0)); }
+        }
+        tests += g_total;
+        t = e0;
+        if (t > 0.0 && t < 3.0e38) { have_prev = true; tp = t; fp = -u_T; }
+        t_lim = min(t_lim, last_exit(u_h));
+    }
 #else
     t = imageLoad(u_next, pix).r;
     if (st.w > 0.0) { have_prev = true; tp = st.y; fp = st.z; }
