@@ -298,7 +298,8 @@ int bench_tetvol(int argc, char **argv)
 
     float thin = bmax[lo] - bmin[lo];
     float tau_hi = tau / thin;
-    tet_tf tf = {m.scalar_min, m.scalar_max, 0.2f * tau_hi, tau_hi, {0.1f, 0.3f, 1.0f}, {1.0f, 0.6f, 0.1f}};
+    tet_tf tf = {.smin = m.scalar_min, .smax = m.scalar_max, .tau_lo = 0.2f * tau_hi, .tau_hi = tau_hi,
+                 .color_lo = {0.1f, 0.3f, 1.0f}, .color_hi = {1.0f, 0.6f, 0.1f}};
     size_t npx = (size_t)w * h * 4;
     float *ref = malloc(npx * sizeof *ref), *img = malloc(npx * sizeof *img);
     run_result *runs = malloc(64 * sizeof *runs), *res = malloc(sizeof *res);

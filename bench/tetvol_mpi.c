@@ -188,8 +188,8 @@ int main(int argc, char **argv)
         camera(&cam, &m, size, size, 0.785f, 0.6155f, &radius);
     /* extinction per world unit scaled by the mesh's size: tau is the optical depth across
      * one bounding radius at the top of the scalar range */
-    tet_tf tf = {m.scalar_min, m.scalar_max, 0.1f * tau / radius, tau / radius,
-                     {0.1f, 0.3f, 1.0f}, {1.0f, 0.6f, 0.1f}};
+    tet_tf tf = {.smin = m.scalar_min, .smax = m.scalar_max, .tau_lo = 0.1f * tau / radius,
+                 .tau_hi = tau / radius, .color_lo = {0.1f, 0.3f, 1.0f}, .color_hi = {1.0f, 0.6f, 0.1f}};
     const size_t n4 = (size_t)size * size * 4;
     float *img = rank == 0 ? malloc(n4 * sizeof *img) : NULL;
     float *ref = rank == 0 ? malloc(n4 * sizeof *ref) : NULL;

@@ -14,12 +14,37 @@ typedef struct tet_camera {
     int width, height;
 } tet_camera;
 
-/* Linear transfer function over the normalised scalar u = (s - smin) / (smax - smin) clamped to
- * [0,1]: extinction tau = tau_lo + (tau_hi - tau_lo) u per world unit, colour lerped. */
+/* Most breakpoints a transfer function table may have. */
+#define TET_TF_MAX_POINTS 1024
+
+/* How a ray segment's colour and opacity come from the transfer function. */
+enum {
+    TET_TF_SPLIT = 0,        /* exact: the segment is split at the table's breakpoints (the
+                              * scalar is linear along it), each piece integrated on its own */
+    TET_TF_PREINTEGRATED,    /* pre-integrated lookup (Engel et al. 2001): cumulative integrals
+                              * of tau and tau*colour over a grid, no self-attenuation */
+    TET_TF_MIDPOINT,         /* one evaluation at the segment's midpoint scalar (coarse) */
+};
+
+/* One breakpoint of a piecewise-linear transfer function. */
+typedef struct tet_tf_point {
+    float s;        /* scalar (data units), strictly increasing along the table */
+    float rgb[3];
+    float tau;      /* extinction per world unit */
+} tet_tf_point;
+
+/* Transfer function of the scalar. With count == 0 it is linear over the normalised scalar
+ * u = (s - smin) / (smax - smin) clamped to [0,1]: extinction tau = tau_lo + (tau_hi - tau_lo) u
+ * per world unit, colour lerped. With count >= 2, points[0..count) is piecewise linear in s,
+ * clamped to its end values outside [points[0].s, points[count-1].s] (smin..colour_hi unused). */
 typedef struct tet_tf {
     float smin, smax;
     float tau_lo, tau_hi;
     float color_lo[3], color_hi[3];
+    const tet_tf_point *points;
+    int count;              /* 0 or 2..TET_TF_MAX_POINTS */
+    int method;             /* TET_TF_*; 0 = split */
+    int pre_size;           /* TET_TF_PREINTEGRATED: grid cells, 0 -> 1024 */
 } tet_tf;
 
 typedef struct tet_options {
@@ -45,7 +70,9 @@ typedef struct tet_counters {
     uint64_t segments_merged;    /* of those, merged by partial compositing on insert */
     uint64_t table_updates;
     double t_sc_ms, t_update_ms, t_composite_ms;
+    uint64_t tf_pieces;          /* ray pieces integrated (segments split at TF breakpoints) */
     double cpu_ms;               /* CPU time of the worker thread (scan + updates); totals: sum */
+    double t_wait_ms;            /* waiting for other workers at the end of the scan phase */
 } tet_counters;
 
 /* Fills opts with the paper's defaults (ERT on, threshold 0.9, D = 20, C = 100, partial on,
@@ -64,5 +91,24 @@ int tet_render_workers(const tet_mesh *mesh, const tet_camera *cam,
                            const tet_tf *tf, const tet_options *opts, float *rgba,
                            tet_counters *counters, tet_counters *per_worker,
                            char err[256]);
+
+/* A persistent pool of render workers: workers - 1 threads created once that wait for frames,
+ * plus the calling thread, with their segment lists and tables kept between frames. */
+typedef struct tet_pool tet_pool;
+
+/* Creates a pool of workers (<= 0 means 1, at most 64). Returns VFX_OK or an error code with a
+ * message in err. A thread that cannot be started is not fatal: its share runs on the caller. */
+int tet_pool_create(int workers, tet_pool **out, char err[256]);
+/* Stops the threads and frees the pool; NULL allowed. */
+void tet_pool_destroy(tet_pool *pool);
+/* Workers of the pool (threads started + the caller). */
+int tet_pool_workers(const tet_pool *pool);
+/* Threads started since creation (workers - 1 when all started; never grows with frames). */
+int tet_pool_threads(const tet_pool *pool);
+
+/* As tet_render_workers on the pool's workers (opts->workers is ignored). */
+int tet_render_pool(tet_pool *pool, const tet_mesh *mesh, const tet_camera *cam,
+                    const tet_tf *tf, const tet_options *opts, float *rgba,
+                    tet_counters *counters, tet_counters *per_worker, char err[256]);
 
 #endif
