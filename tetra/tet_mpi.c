@@ -477,6 +477,93 @@ static int ask_for_work(rank_scan *R)
     return 1;
 }
 
+/* 64-bit hash of n 32-bit words (multiply-xorshift per word: fast enough to run every frame). */
+static uint64_t hash_words(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *b = data;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t w;
+        memcpy(&w, b + 4 * i, sizeof w);
+        h = (h ^ w) * 0x9e3779b97f4a7c15ull;
+        h ^= h >> 29;
+    }
+    return h;
+}
+
+/* What every rank must agree on before a render: the mesh (counts and checksums of points,
+ * tets and scalars) and the image and table sizes that shape the collectives. */
+enum { FP_POINTS, FP_TETS, FP_SCALAR, FP_H_POINTS, FP_H_TETS, FP_H_SCALAR, FP_W, FP_H, FP_D, FP_N };
+
+static void fingerprint(const tet_mesh *mesh, const tet_camera *cam, const tet_options *opts,
+                        uint64_t fp[FP_N])
+{
+    memset(fp, 0, FP_N * sizeof *fp);
+    if (mesh) {
+        fp[FP_POINTS] = mesh->point_count;
+        fp[FP_TETS] = mesh->tet_count;
+        fp[FP_SCALAR] = mesh->scalar != NULL;
+        if (mesh->points)
+            fp[FP_H_POINTS] = hash_words(1, mesh->points, (size_t)mesh->point_count * 3);
+        if (mesh->tets)
+            fp[FP_H_TETS] = hash_words(2, mesh->tets, (size_t)mesh->tet_count * 4);
+        if (mesh->scalar)
+            fp[FP_H_SCALAR] = hash_words(3, mesh->scalar, mesh->point_count);
+    }
+    if (cam)
+        fp[FP_W] = (uint64_t)(int64_t)cam->width, fp[FP_H] = (uint64_t)(int64_t)cam->height;
+    if (opts)
+        fp[FP_D] = (uint64_t)(int64_t)opts->tiles_d;
+}
+
+/* Collective: VFX_OK when every rank holds the same mesh, image size and table size as rank 0,
+ * else VFX_ERR_INVALID_ARGUMENT on every rank with the differing ranks named in err. Ranks
+ * with a stale copy of a mesh would otherwise scan cells the others never sorted (a crash in
+ * the scan) or composite different data into one image. */
+static int check_same_input(MPI_Comm comm, int P, const tet_mesh *mesh, const tet_camera *cam,
+                            const tet_options *opts, char err[256])
+{
+    uint64_t mine[FP_N];
+    fingerprint(mesh, cam, opts, mine);
+    uint64_t *all = malloc((size_t)P * FP_N * sizeof *all);
+    int have = all != NULL, every = 0;
+    MPI_Request rq;
+    MPI_Iallreduce(&have, &every, 1, MPI_INT, MPI_MIN, comm, &rq);
+    wait_polite(1, &rq);
+    if (!every) {
+        free(all);
+        snprintf(err, 256, "tet_mpi: out of memory for %d ranks' mesh checksums", P);
+        return VFX_ERR_OUT_OF_MEMORY;
+    }
+    MPI_Iallgather(mine, FP_N, MPI_UINT64_T, all, FP_N, MPI_UINT64_T, comm, &rq);
+    wait_polite(1, &rq);
+    char list[128] = "";
+    size_t len = 0;
+    int bad = 0, first = -1;
+    for (int r = 1; r < P; r++) {
+        if (memcmp(all + (size_t)r * FP_N, all, FP_N * sizeof *all) == 0)
+            continue;
+        if (first < 0)
+            first = r;
+        if (bad++ < 8 && len < sizeof list - 16)
+            len += (size_t)snprintf(list + len, sizeof list - len, "%s%d", bad > 1 ? ", " : "", r);
+    }
+    if (bad) {
+        const uint64_t *f = all + (size_t)first * FP_N;
+        const char *what = f[FP_POINTS] != all[FP_POINTS] || f[FP_TETS] != all[FP_TETS] ? "counts"
+                           : f[FP_H_POINTS] != all[FP_H_POINTS] ? "points"
+                           : f[FP_H_TETS] != all[FP_H_TETS] ? "tets"
+                           : f[FP_H_SCALAR] != all[FP_H_SCALAR] || f[FP_SCALAR] != all[FP_SCALAR] ? "scalars"
+                           : "image or table size";
+        snprintf(err, 256, "tet_mpi: rank%s %s%s hold%s a different mesh from rank 0 (%s differ; "
+                 "rank %d: %llu points, %llu tets; rank 0: %llu points, %llu tets)",
+                 bad > 1 ? "s" : "", list, bad > 8 ? ", ..." : "", bad > 1 ? "" : "s", what, first,
+                 (unsigned long long)f[FP_POINTS], (unsigned long long)f[FP_TETS],
+                 (unsigned long long)all[FP_POINTS], (unsigned long long)all[FP_TETS]);
+    }
+    free(all);
+    return bad ? VFX_ERR_INVALID_ARGUMENT : VFX_OK;
+}
+
 int tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
                        const tet_tf *tf, const tet_options *opts, float *rgba,
                        tet_mpi_stats *mine, tet_mpi_stats *all, char err[256])
@@ -498,7 +585,10 @@ int tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
     R.st = &st;
     /* rank 0 gathers the statistics even when the caller wants none */
     tet_mpi_stats *gather_tmp = rank == 0 && !all ? malloc((size_t)P * sizeof *gather_tmp) : NULL;
-    int rc = tet_local_create(mesh, cam, tf, opts, P, rank, &R.L, err);
+    int rc = check_same_input(comm, P, mesh, cam, opts, err);
+    if (rc != VFX_OK)
+        goto done;
+    rc = tet_local_create(mesh, cam, tf, opts, P, rank, &R.L, err);
     if (rc == VFX_OK && rank == 0 && !all && !gather_tmp) {
         snprintf(err, 256, "tet_mpi: out of memory for %d ranks' statistics", P);
         rc = VFX_ERR_OUT_OF_MEMORY;

@@ -326,6 +326,61 @@ static int test_render(int P)
     return 0;
 }
 
+/* Ranks holding different meshes (a stale copy at the same path): every rank must get the
+ * same error naming the ranks that differ, for a different tet count (which crashed the scan)
+ * and for the same counts with one changed scalar (which gave a wrong image with exit 0). */
+static int test_mismatch(int P)
+{
+    enum { W = 24, H = 20 };
+    tet_camera cam;
+    make_cam(&cam, W, H, 0.6f, 0.4f, 4.0f);
+    tet_tf tf;
+    memset(&tf, 0, sizeof tf);
+    tf.smax = 1;
+    tf.tau_lo = 4.0f;
+    tf.tau_hi = 20.0f;
+    tf.color_hi[0] = 1.0f;
+    char err[256];
+    tet_mpi *ctx;
+    CHECK(tet_mpi_create(MPI_COMM_WORLD, &ctx, err) == VFX_OK, "%s", err);
+    float *img = calloc((size_t)W * H * 4, sizeof *img);
+    CHECK(img, "memory");
+    tet_options o;
+    tet_options_default(&o);
+    o.tiles_d = 8;
+    for (int dlb = 0; dlb <= 1; dlb++) {
+        o.dlb = dlb;
+        /* rank 0 has a 4^3 grid, the others a 7^3 one */
+        tet_mesh m;
+        make_grid(g_rank == 0 ? 4 : 7, 0, &m);
+        int rc = tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, NULL, err);
+        CHECK(rc == VFX_ERR_INVALID_ARGUMENT, "rank %d: counts differ, rc %d: %s", g_rank, rc, err);
+        CHECK(strstr(err, P > 2 ? "ranks 1, 2" : "rank 1") && strstr(err, "counts"),
+              "rank %d: message does not name the ranks: %s", g_rank, err);
+        free(m.points); free(m.scalar); free(m.tets);
+        /* same counts, one scalar changed on the last rank */
+        make_grid(7, 0, &m);
+        if (g_rank == P - 1)
+            m.scalar[m.point_count / 2] += 0.25f;
+        rc = tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, NULL, err);
+        char want[32];
+        snprintf(want, sizeof want, "rank %d ", P - 1);
+        CHECK(rc == VFX_ERR_INVALID_ARGUMENT && strstr(err, want) && strstr(err, "scalars"),
+              "rank %d: scalars differ, rc %d: %s", g_rank, rc, err);
+        /* and the same mesh everywhere renders */
+        if (g_rank == P - 1)
+            m.scalar[m.point_count / 2] -= 0.25f;
+        rc = tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, NULL, err);
+        CHECK(rc == VFX_OK, "rank %d: same mesh, rc %d: %s", g_rank, rc, err);
+        free(m.points); free(m.scalar); free(m.tets);
+    }
+    if (g_rank == 0)
+        printf("P=%d: different meshes refused on every rank: %s\n", P, err);
+    tet_mpi_destroy(ctx);
+    free(img);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     MPI_Init(&argc, &argv);
@@ -335,6 +390,8 @@ int main(int argc, char **argv)
     const char *mode = argc > 1 ? argv[1] : "render";
     if (strcmp(mode, "swap") == 0)
         test_swap(P);
+    else if (strcmp(mode, "mismatch") == 0)
+        test_mismatch(P);
     else
         test_render(P);
     MPI_Barrier(MPI_COMM_WORLD);
