@@ -123,7 +123,15 @@ static vfx_result host_volume(void *user, uint32_t index, vfx_volume_view *out)
         return VFX_ERR_ABI;
     if (index >= app->volume_count)
         return VFX_ERR_NOT_FOUND;
-    *out = app->volumes[index];
+    /* a plugin that offers version 2 gets it (the version-1 part first), an older one version 1 */
+    if (out->size >= sizeof(vfx_volume_view2) && out->version == VFX_VOLUME_VIEW2_VERSION) {
+        vfx_volume_view2 *o2 = (vfx_volume_view2 *)out;
+        *o2 = app->volumes[index];
+        o2->v1.size = sizeof *o2;
+        o2->v1.version = VFX_VOLUME_VIEW2_VERSION;
+        return VFX_OK;
+    }
+    *out = app->volumes[index].v1;
     out->size = sizeof *out;
     out->version = VFX_VOLUME_VIEW_VERSION;
     return VFX_OK;

@@ -57,7 +57,7 @@ typedef struct game_app {
     vfx_beam beams[GAME_APP_MAX_BEAMS];
     uint32_t beam_count;
     vfx_beams_view beams_view; /* parameters; beams/count filled per call */
-    vfx_volume_view volumes[GAME_APP_MAX_VOLUMES];
+    vfx_volume_view2 volumes[GAME_APP_MAX_VOLUMES]; /* the plugin gets version 2 or 1 */
     uint32_t volume_count;
     double time;
     uint64_t frame;

@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "scene/volume_file.h"
+
 extern const char game_default_scene_json[];
 extern const unsigned long game_default_scene_json_len;
 
@@ -99,42 +101,103 @@ done:
     return r;
 }
 
+/* The volume's mesh: a generated grid, or a .vtu / TetGen file through the host-side loaders.
+ * A missing or malformed file is an error naming it that stops the load. */
+static vfx_result volume_mesh(game_app *app, game_demo *demo, const rt_scene_volume *v)
+{
+    char err[512];
+    vfx_result r;
+    if (v->generated) {
+        r = rt_scene_volume_generate(v, &demo->vol_points, &demo->vol_point_count, &demo->vol_tets,
+                                     &demo->vol_tet_count, &demo->vol_scalar, err, sizeof err);
+        if (r)
+            rt_logf(&app->log, VFX_LOG_ERROR, "scene volume: %s", err);
+        return r;
+    }
+    tet_mesh m;
+    size_t len = strlen(v->path);
+    bool vtu = len > 4 && !strcmp(v->path + len - 4, ".vtu");
+    if (vtu) {
+        r = rt_volume_load_vtu(v->path, v->scalar, &m, err, sizeof err);
+        if (r == VFX_ERR_NOT_FOUND && !v->scalar[0]) /* the loader lists the point fields */
+            rt_logf(&app->log, VFX_LOG_ERROR, "scene volume.scalar: name the point field of %s (%s)", v->path,
+                    strstr(err, "present:") ? strstr(err, "present:") : err);
+        else if (r)
+            rt_logf(&app->log, VFX_LOG_ERROR, "scene volume.path: %s", err);
+    } else {
+        char base[RT_SCENE_PATH_MAX];
+        snprintf(base, sizeof base, "%.*s", (int)(len - 5), v->path); /* without ".node" */
+        r = rt_volume_load_tetgen(base, v->scalar, &m, err, sizeof err);
+        if (r)
+            rt_logf(&app->log, VFX_LOG_ERROR, "scene volume.path: %s", err);
+    }
+    if (r)
+        return r;
+    if (!m.scalar) {
+        rt_logf(&app->log, VFX_LOG_ERROR, "scene volume.path: %s has no point field to render", v->path);
+        tet_mesh_free(&m);
+        return VFX_ERR_FORMAT;
+    }
+    demo->vol_points = m.points, demo->vol_tets = m.tets, demo->vol_scalar = m.scalar;
+    demo->vol_point_count = m.point_count, demo->vol_tet_count = m.tet_count;
+    rt_logf(&app->log, VFX_LOG_INFO, "scene volume %s: %u points, %u tets, field %s in [%g, %g]", v->path,
+            m.point_count, m.tet_count, m.scalar_name, (double)m.scalar_min, (double)m.scalar_max);
+    return VFX_OK;
+}
+
+/* The scene's transfer function as the plugin's table: every control point (one point is a
+ * constant), at its position in [0,1] of the domain (version-2 view). */
+static void volume_transfer(game_demo *demo, const rt_scene_volume *v, vfx_volume_view2 *vv)
+{
+    uint32_t n = v->transfer_count;
+    if (n == 0)
+        return;
+    const rt_scene_transfer_point *tp = v->transfer;
+    double lo = tp[0].scalar, hi = tp[n - 1].scalar;
+    if (!v->transfer_normalized)
+        vv->v1.scalar_min = (float)lo, vv->v1.scalar_max = (float)hi;
+    for (uint32_t i = 0; i < n; ++i) {
+        memcpy(&demo->vol_transfer[4 * i], tp[i].rgba, 4 * sizeof(float));
+        demo->vol_transfer_pos[i] = v->transfer_normalized ? tp[i].scalar
+                                    : n > 1 ? (float)((tp[i].scalar - lo) / (hi - lo)) : 0.f;
+    }
+    if (!v->transfer_normalized && n > 1)
+        demo->vol_transfer_pos[0] = 0.f, demo->vol_transfer_pos[n - 1] = 1.f;
+    if (n == 1) { /* a constant: the same entry at both ends */
+        memcpy(&demo->vol_transfer[4], tp[0].rgba, 4 * sizeof(float));
+        demo->vol_transfer_pos[0] = 0.f, demo->vol_transfer_pos[1] = 1.f;
+        n = 2;
+    }
+    vv->v1.transfer_rgba = demo->vol_transfer;
+    vv->v1.transfer_count = n;
+    vv->transfer_scalar = demo->vol_transfer_pos;
+}
+
 /* The volume's mesh stays with the demo; the host api hands the plugin pointers into it. */
 static vfx_result load_volume(game_app *app, game_demo *demo, const rt_scene *sc)
 {
     const rt_scene_volume *v = &sc->volume;
-    if (!v->generated) {
-        rt_logf(&app->log, VFX_LOG_INFO, "scene volume %s: file volumes are not wired into the game yet", v->path);
-        return VFX_OK;
-    }
-    char err[256];
-    vfx_result r = rt_scene_volume_generate(v, &demo->vol_points, &demo->vol_point_count, &demo->vol_tets,
-                                             &demo->vol_tet_count, &demo->vol_scalar, err, sizeof err);
-    if (r) {
-        rt_logf(&app->log, VFX_LOG_ERROR, "scene volume: %s", err);
+    vfx_result r = volume_mesh(app, demo, v);
+    if (r)
         return r;
-    }
-    vfx_volume_view *vv = &app->volumes[0];
+    vfx_volume_view2 *vv = &app->volumes[0];
     memset(vv, 0, sizeof *vv);
-    vv->size = sizeof *vv;
-    vv->version = VFX_VOLUME_VIEW_VERSION;
-    vv->point_count = demo->vol_point_count;
-    vv->tet_count = demo->vol_tet_count;
-    vv->points = demo->vol_points;
-    vv->tets = demo->vol_tets;
-    vv->scalar = demo->vol_scalar;
-    if (v->transfer_count) {
-        rt_scene_transfer_sample(v, 64, demo->vol_transfer, &vv->scalar_min, &vv->scalar_max);
-        vv->transfer_rgba = demo->vol_transfer;
-        vv->transfer_count = 64;
-    }
-    vv->ert_threshold = v->ert_threshold;
-    vv->tiles = v->tiles;
-    vv->update_c = v->update_c;
-    vv->workers = v->workers;
-    vv->disable = v->disable;
-    memcpy(vv->model, v->model, sizeof vv->model);
-    vv->revision = 1;
+    vv->v1.size = sizeof *vv;
+    vv->v1.version = VFX_VOLUME_VIEW2_VERSION;
+    vv->v1.point_count = demo->vol_point_count;
+    vv->v1.tet_count = demo->vol_tet_count;
+    vv->v1.points = demo->vol_points;
+    vv->v1.tets = demo->vol_tets;
+    vv->v1.scalar = demo->vol_scalar;
+    volume_transfer(demo, v, vv);
+    vv->transfer_method = v->transfer_method;
+    vv->v1.ert_threshold = v->ert_threshold;
+    vv->v1.tiles = v->tiles;
+    vv->v1.update_c = v->update_c;
+    vv->v1.workers = v->workers;
+    vv->v1.disable = v->disable;
+    memcpy(vv->v1.model, v->model, sizeof vv->v1.model);
+    vv->v1.revision = 1;
     app->volume_count = 1;
     return VFX_OK;
 }

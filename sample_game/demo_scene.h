@@ -18,7 +18,8 @@ typedef struct game_demo {
     bool mouse_down;
     double mouse_x, mouse_y;
     rt_sim_system *sim;       /* SPH writing the particle columns (NULL without water) */
-    float *vol_points, *vol_scalar, vol_transfer[64 * 4];
+    float *vol_points, *vol_scalar;
+    float vol_transfer[RT_SCENE_MAX_TRANSFER * 4], vol_transfer_pos[RT_SCENE_MAX_TRANSFER];
     uint32_t *vol_tets, vol_point_count, vol_tet_count;
 } game_demo;
 

@@ -1,7 +1,13 @@
-/* volume_effect.c — seed 002 in the plugin: the host's tetrahedral volume is rendered by the CPU
- * cell-projection renderer (tet_render.c: ERT, subscreen termination, threaded workers with
- * weak sharing and load balancing), clipped per pixel by the host's depth and the water's ray
- * distance, then composited "over" the host frame by one fullscreen pass. */
+/* volume_effect.c — translucent tetrahedral volumes in the plugin: the host's mesh is rendered
+ * by the CPU cell-projection renderer (tetra/: ERT, subscreen termination, a persistent pool of
+ * workers with weak sharing and load balancing), clipped per pixel by the ray distance to the
+ * nearest opaque thing, then composited "over" the host frame.
+ *
+ * The clip distance comes from a GPU pass (host depth -> ray distance, min with the water's
+ * distance) read back through a pixel-pack buffer and a fence: the CPU uses the previous
+ * frame's distances, so it never waits for the GPU (the first frame after a resize waits
+ * once). When neither the mesh, the scalars, the transfer function, the camera nor the clip
+ * distances changed since the last render, the render is skipped and the last image reused. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -11,16 +17,31 @@
 #include "effect.h"
 #include "tet_render.h"
 
+/* std140 mirror of shaders/volume/distance.frag's block */
+typedef struct volume_dist_ubo {
+    float proj[4];   /* P[0], P[5], P[8], P[9]: pixel -> view ray */
+    float depth[4];  /* P[10], P[14], has_water, 0: window depth -> view depth */
+    float size[4];   /* width, height */
+} volume_dist_ubo;
+
 typedef struct volume_state {
     GLuint prog, tex;
+    GLuint dist_prog, dist_tex, dist_fbo;
+    GLuint pbo[2];
+    GLsync fence[2];
+    uint64_t frame;             /* frames rendered since the last resize */
+    volfx_ubo ubo;
     uint32_t width, height;
-    float *rgba;        /* width*height*4, premultiplied, row 0 = bottom */
-    float *max_dist;    /* width*height ray distances to the nearest host surface */
-    float *depth;       /* read-back host depth */
-    vfx_volume_view view;
-    tet_mesh mesh;  /* points into the host's arrays (no copy) */
+    float *rgba;                /* width*height*4, premultiplied, row 0 = bottom */
+    float *max_dist;            /* width*height ray distances to the nearest opaque surface */
+    vfx_volume_view2 view;
+    tet_mesh mesh;              /* points into the host's arrays (no copy) */
     uint64_t revision;
     float data_min, data_max;
+    tet_tf_point tf_points[VFX_VOLUME_MAX_TRANSFER];
+    tet_pool *pool;
+    uint64_t last_key;          /* inputs of the image in rgba; 0 = none */
+    uint64_t skipped;           /* renders skipped since creation */
     bool warned_many;
 } volume_state;
 
@@ -29,15 +50,31 @@ static bool volume_present(vfx_context *ctx)
     return ctx->host.volume_count && ctx->host.volume && ctx->host.volume_count(ctx->host.user) > 0;
 }
 
+static void release_targets(vfx_context *ctx, volume_state *s)
+{
+    for (int k = 0; k < 2; ++k) {
+        if (s->fence[k])
+            glDeleteSync(s->fence[k]);
+        s->fence[k] = 0;
+    }
+    glDeleteBuffers(2, s->pbo);
+    glDeleteFramebuffers(1, &s->dist_fbo);
+    glDeleteTextures(1, &s->dist_tex);
+    glDeleteTextures(1, &s->tex);
+    s->pbo[0] = s->pbo[1] = s->dist_fbo = s->dist_tex = s->tex = 0;
+    volfx_free(ctx, s->rgba);
+    volfx_free(ctx, s->max_dist);
+    s->rgba = s->max_dist = NULL;
+}
+
 static void volume_destroy(vfx_context *ctx, void *state)
 {
     volume_state *s = state;
     if (!s)
         return;
-    glDeleteTextures(1, &s->tex);
-    volfx_free(ctx, s->rgba);
-    volfx_free(ctx, s->max_dist);
-    volfx_free(ctx, s->depth);
+    release_targets(ctx, s);
+    volfx_ubo_destroy(&s->ubo);
+    tet_pool_destroy(s->pool);
     volfx_free(ctx, s);
 }
 
@@ -47,7 +84,8 @@ static vfx_result volume_create(vfx_context *ctx, void **out)
     if (!s)
         return VFX_ERR_OUT_OF_MEMORY;
     s->prog = volfx_gpu_program(ctx, "common/fullscreen.vert", "volume/composite.frag", NULL);
-    if (!s->prog) {
+    s->dist_prog = volfx_gpu_program(ctx, "common/fullscreen.vert", "volume/distance.frag", NULL);
+    if (!s->prog || !s->dist_prog || !volfx_ubo_create(ctx, &s->ubo, sizeof(volume_dist_ubo), "volume.dist_ubo")) {
         volume_destroy(ctx, s);
         return VFX_ERR_GL;
     }
@@ -58,19 +96,74 @@ static vfx_result volume_create(vfx_context *ctx, void **out)
 static vfx_result volume_resize(vfx_context *ctx, void *state, uint32_t w, uint32_t h)
 {
     volume_state *s = state;
-    glDeleteTextures(1, &s->tex);
+    release_targets(ctx, s);
     glCreateTextures(GL_TEXTURE_2D, 1, &s->tex);
     glTextureStorage2D(s->tex, 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
     volfx_gpu_label(GL_TEXTURE, s->tex, "volume.image");
-    volfx_free(ctx, s->rgba);
-    volfx_free(ctx, s->max_dist);
-    volfx_free(ctx, s->depth);
+    glCreateTextures(GL_TEXTURE_2D, 1, &s->dist_tex);
+    glTextureStorage2D(s->dist_tex, 1, GL_R32F, (GLsizei)w, (GLsizei)h);
+    volfx_gpu_label(GL_TEXTURE, s->dist_tex, "volume.distance");
+    glCreateFramebuffers(1, &s->dist_fbo);
+    glNamedFramebufferTexture(s->dist_fbo, GL_COLOR_ATTACHMENT0, s->dist_tex, 0);
     size_t n = (size_t)w * h;
+    glCreateBuffers(2, s->pbo);
+    for (int k = 0; k < 2; ++k) {
+        glNamedBufferStorage(s->pbo[k], (GLsizeiptr)(n * sizeof(float)), NULL, GL_MAP_READ_BIT);
+        volfx_gpu_label(GL_BUFFER, s->pbo[k], "volume.distance_readback");
+    }
     s->rgba = volfx_alloc(ctx, n * 4 * sizeof(float));
     s->max_dist = volfx_alloc(ctx, n * sizeof(float));
-    s->depth = volfx_alloc(ctx, n * sizeof(float));
     s->width = w, s->height = h;
-    return s->rgba && s->max_dist && s->depth ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
+    s->frame = 0;
+    s->last_key = 0;
+    if (glCheckNamedFramebufferStatus(s->dist_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        return volfx_fail(ctx, VFX_ERR_GL, "volume: distance target %ux%u incomplete", w, h);
+    return s->rgba && s->max_dist ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
+}
+
+/* The host's view of volume 0 as version 2 (a version-1 host leaves the version-2 fields 0). */
+static vfx_result fetch_view(vfx_context *ctx, vfx_volume_view2 *v)
+{
+    memset(v, 0, sizeof *v);
+    v->v1.size = sizeof *v;
+    v->v1.version = VFX_VOLUME_VIEW2_VERSION;
+    if (ctx->host.volume(ctx->host.user, 0, &v->v1) != VFX_OK)
+        return volfx_fail(ctx, VFX_ERR_ABI, "volume[0]: the host's volume callback failed");
+    const uint32_t ver = v->v1.version;
+    if (ver == VFX_VOLUME_VIEW_VERSION) {
+        memset((char *)v + sizeof v->v1, 0, sizeof *v - sizeof v->v1);
+        return VFX_OK;
+    }
+    if (ver != VFX_VOLUME_VIEW2_VERSION)
+        return volfx_fail(ctx, VFX_ERR_ABI, "volume[0]: host view of version %u (this plugin reads %u and %u)",
+                          ver, VFX_VOLUME_VIEW_VERSION, VFX_VOLUME_VIEW2_VERSION);
+    return VFX_OK;
+}
+
+static vfx_result check_transfer(vfx_context *ctx, const vfx_volume_view2 *v)
+{
+    const vfx_volume_view *v1 = &v->v1;
+    if (!v1->transfer_rgba)
+        return VFX_OK;
+    if (v1->transfer_count < 2 || v1->transfer_count > VFX_VOLUME_MAX_TRANSFER)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: transfer function of %u entries (need 2..%u)",
+                          v1->transfer_count, VFX_VOLUME_MAX_TRANSFER);
+    for (uint32_t i = 0; i < 4 * v1->transfer_count; ++i)
+        if (!isfinite(v1->transfer_rgba[i]) || (i % 4 == 3 && v1->transfer_rgba[i] < 0))
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                              "volume[0]: transfer_rgba[%u] component %u is %g (finite, alpha >= 0)", i / 4, i % 4,
+                              (double)v1->transfer_rgba[i]);
+    if (v->transfer_scalar)
+        for (uint32_t i = 0; i < v1->transfer_count; ++i) {
+            float t = v->transfer_scalar[i];
+            if (!(t >= 0 && t <= 1) || (i > 0 && !(t > v->transfer_scalar[i - 1])))
+                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                                  "volume[0]: transfer_scalar[%u] = %g (need increasing values in [0, 1])", i,
+                                  (double)t);
+        }
+    if (v->transfer_method > VFX_VOLUME_TRANSFER_PREINTEGRATED)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: transfer_method %u unknown", v->transfer_method);
+    return VFX_OK;
 }
 
 static vfx_result volume_update(vfx_context *ctx, void *state, double time, float dt)
@@ -82,78 +175,171 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
         volfx_log(ctx, VFX_LOG_WARN, "volume: the host has %u volumes; only the first is drawn", n);
         s->warned_many = true;
     }
-    vfx_volume_view v = {.size = sizeof v, .version = VFX_VOLUME_VIEW_VERSION};
-    if (ctx->host.volume(ctx->host.user, 0, &v) != VFX_OK || v.version != VFX_VOLUME_VIEW_VERSION)
-        return volfx_fail(ctx, VFX_ERR_ABI, "volume: host view of version %u (need %u)", v.version,
-                        VFX_VOLUME_VIEW_VERSION);
-    if (!v.points || !v.tets || !v.scalar || v.point_count == 0 || v.tet_count == 0)
+    vfx_volume_view2 v;
+    vfx_result r = fetch_view(ctx, &v);
+    if (r != VFX_OK)
+        return r;
+    const vfx_volume_view *v1 = &v.v1;
+    if (!v1->points || !v1->tets || !v1->scalar || v1->point_count == 0 || v1->tet_count == 0)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
-                        "volume[0]: needs points, tets and scalar arrays and counts > 0 (%u points, %u tets)",
-                        v.point_count, v.tet_count);
-    if (v.transfer_rgba && v.transfer_count < 2)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: transfer function needs >= 2 entries");
-    if (!(v.ert_threshold >= 0 && v.ert_threshold <= 1))
+                          "volume[0]: needs points, tets and scalar arrays and counts > 0 (%u points, %u tets)",
+                          v1->point_count, v1->tet_count);
+    if ((r = check_transfer(ctx, &v)) != VFX_OK)
+        return r;
+    if (!(v1->ert_threshold >= 0 && v1->ert_threshold <= 1))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: ert_threshold %g outside [0, 1]",
-                        (double)v.ert_threshold);
+                          (double)v1->ert_threshold);
     /* tet indices are checked once per revision: the renderer trusts them */
-    if (v.revision != s->revision || v.tets != s->view.tets || v.scalar != s->view.scalar) {
-        for (uint64_t i = 0; i < (uint64_t)v.tet_count * 4; ++i)
-            if (v.tets[i] >= v.point_count)
+    const vfx_volume_view *old = &s->view.v1;
+    if (v1->revision != s->revision || v1->tets != old->tets || v1->scalar != old->scalar ||
+        v1->points != old->points || v1->point_count != old->point_count || v1->tet_count != old->tet_count) {
+        for (uint64_t i = 0; i < (uint64_t)v1->tet_count * 4; ++i)
+            if (v1->tets[i] >= v1->point_count)
                 return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: tet %llu uses point %u of %u",
-                                (unsigned long long)(i / 4), v.tets[i], v.point_count);
+                                  (unsigned long long)(i / 4), v1->tets[i], v1->point_count);
         s->data_min = INFINITY, s->data_max = -INFINITY;
-        for (uint32_t i = 0; i < v.point_count; ++i)
-            if (isfinite(v.scalar[i])) {
-                s->data_min = fminf(s->data_min, v.scalar[i]);
-                s->data_max = fmaxf(s->data_max, v.scalar[i]);
+        for (uint32_t i = 0; i < v1->point_count; ++i)
+            if (isfinite(v1->scalar[i])) {
+                s->data_min = fminf(s->data_min, v1->scalar[i]);
+                s->data_max = fmaxf(s->data_max, v1->scalar[i]);
             }
-        s->revision = v.revision;
+        s->revision = v1->revision;
+        s->last_key = 0; /* new data: never reuse the old image, whatever the key says */
     }
     s->view = v;
     memset(&s->mesh, 0, sizeof s->mesh);
-    s->mesh.point_count = v.point_count;
-    s->mesh.tet_count = v.tet_count;
-    s->mesh.points = (float *)v.points; /* read only: the renderer takes a const mesh */
-    s->mesh.tets = (uint32_t *)v.tets;
-    s->mesh.scalar = (float *)v.scalar;
+    s->mesh.point_count = v1->point_count;
+    s->mesh.tet_count = v1->tet_count;
+    s->mesh.points = (float *)v1->points; /* read only: the renderer takes a const mesh */
+    s->mesh.tets = (uint32_t *)v1->tets;
+    s->mesh.scalar = (float *)v1->scalar;
     return VFX_OK;
+}
+
+/* GPU: the ray distance to the host's depth (the renderer's own ray model: view depth from the
+ * projection, times |(dx, dy, -1)|), min with the water's distance, into dist_tex, copied into
+ * this frame's pack buffer and fenced. */
+static void distance_pass(vfx_context *ctx, volume_state *s, const vfx_frame_view *frame,
+                          const volfx_frame_targets *targets, int slot)
+{
+    const float *P = frame->proj;
+    volume_dist_ubo u = {{P[0], P[5], P[8], P[9]}, {P[10], P[14], targets->water_dist ? 1.f : 0.f, 0},
+                         {(float)s->width, (float)s->height, 0, 0}};
+    volfx_ubo_update(&s->ubo, &u, sizeof u);
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "volume.distance", .framebuffer = s->dist_fbo,
+                                             .width = s->width, .height = s->height});
+    glUseProgram(s->dist_prog);
+    volfx_ubo_bind(&s->ubo, 0);
+    glBindTextureUnit(0, targets->scene_depth);
+    glBindTextureUnit(1, targets->water_dist ? targets->water_dist : targets->scene_depth);
+    volfx_gpu_fullscreen(ctx);
+    glUseProgram(0);
+    volfx_pass_end(ctx);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, s->pbo[slot]);
+    glGetTextureImage(s->dist_tex, 0, GL_RED, GL_FLOAT, (GLsizei)((size_t)s->width * s->height * sizeof(float)), NULL);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    if (s->fence[slot])
+        glDeleteSync(s->fence[slot]);
+    s->fence[slot] = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+}
+
+/* Copies the distances of slot into max_dist once its fence has signalled (waiting only when
+ * it is this frame's slot, the first frame after a resize). */
+static vfx_result read_distances(vfx_context *ctx, volume_state *s, int slot)
+{
+    const GLuint64 forever = 5000000000ull; /* 5 s */
+    GLenum st = glClientWaitSync(s->fence[slot], GL_SYNC_FLUSH_COMMANDS_BIT, forever);
+    if (st != GL_ALREADY_SIGNALED && st != GL_CONDITION_SATISFIED)
+        return volfx_fail(ctx, VFX_ERR_GL, "volume: distance readback did not complete (0x%x)", st);
+    size_t bytes = (size_t)s->width * s->height * sizeof(float);
+    const void *p = glMapNamedBufferRange(s->pbo[slot], 0, (GLsizeiptr)bytes, GL_MAP_READ_BIT);
+    if (!p)
+        return volfx_fail(ctx, VFX_ERR_GL, "volume: cannot map the distance readback");
+    memcpy(s->max_dist, p, bytes);
+    glUnmapNamedBuffer(s->pbo[slot]);
+    return VFX_OK;
+}
+
+/* The renderer's transfer function from the view: the default ramp, or every table entry
+ * (evenly spaced, or at transfer_scalar) over the domain. */
+static void make_tf(volume_state *s, tet_tf *tf)
+{
+    const vfx_volume_view *v = &s->view.v1;
+    *tf = (tet_tf){.smin = v->scalar_min, .smax = v->scalar_max, .tau_lo = 0.2f, .tau_hi = 3.0f,
+                   .color_lo = {0.1f, 0.3f, 0.9f}, .color_hi = {1.0f, 0.85f, 0.3f}};
+    if (!(v->scalar_max > v->scalar_min))
+        tf->smin = s->data_min, tf->smax = s->data_max > s->data_min ? s->data_max : s->data_min + 1;
+    tf->method = s->view.transfer_method == VFX_VOLUME_TRANSFER_PREINTEGRATED ? TET_TF_PREINTEGRATED : TET_TF_SPLIT;
+    if (!v->transfer_rgba)
+        return;
+    const uint32_t n = v->transfer_count;
+    const double range = (double)tf->smax - tf->smin;
+    for (uint32_t i = 0; i < n; ++i) {
+        tet_tf_point *p = &s->tf_points[i];
+        double t = s->view.transfer_scalar ? s->view.transfer_scalar[i] : (double)i / (n - 1);
+        p->s = i == 0 ? tf->smin : i == n - 1 ? tf->smax : (float)(tf->smin + range * t);
+        memcpy(p->rgb, v->transfer_rgba + 4 * i, sizeof p->rgb);
+        p->tau = v->transfer_rgba[4 * i + 3];
+    }
+    /* a domain so narrow that float rounding merges breakpoints: keep them increasing */
+    for (uint32_t i = 1; i < n; ++i)
+        if (!(s->tf_points[i].s > s->tf_points[i - 1].s))
+            s->tf_points[i].s = nextafterf(s->tf_points[i - 1].s, INFINITY);
+    tf->points = s->tf_points;
+    tf->count = (int)n;
+}
+
+static uint64_t hash_bytes(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *b = data;
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        uint64_t w;
+        memcpy(&w, b + i, sizeof w);
+        h = (h ^ w) * 0x9e3779b97f4a7c15ull;
+        h ^= h >> 31;
+    }
+    for (; i < n; ++i)
+        h = (h ^ b[i]) * 0x100000001b3ull;
+    return h;
+}
+
+/* Everything the image depends on besides the mesh arrays (whose changes bump the revision). */
+static uint64_t render_key(const volume_state *s, const tet_camera *cam, const tet_tf *tf, const tet_options *o)
+{
+    const vfx_volume_view *v = &s->view.v1;
+    uint64_t h = 0x51ed270b0a1f3c5dull;
+    const void *ptrs[3] = {v->points, v->tets, v->scalar};
+    h = hash_bytes(h, &v->revision, sizeof v->revision);
+    h = hash_bytes(h, ptrs, sizeof ptrs);
+    h = hash_bytes(h, cam, sizeof *cam);
+    h = hash_bytes(h, tf, offsetof(tet_tf, points));
+    h = hash_bytes(h, &tf->count, sizeof tf->count);
+    h = hash_bytes(h, &tf->method, sizeof tf->method);
+    if (tf->count)
+        h = hash_bytes(h, tf->points, (size_t)tf->count * sizeof *tf->points);
+    tet_options oo = *o;
+    oo.max_dist = NULL;
+    h = hash_bytes(h, &oo, sizeof oo);
+    h = hash_bytes(h, s->max_dist, (size_t)s->width * s->height * sizeof(float));
+    return h ? h : 1;
 }
 
 static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
                                 volfx_frame_targets *targets)
 {
     volume_state *s = state;
-    const vfx_volume_view *v = &s->view;
-    size_t n = (size_t)s->width * s->height;
-    /* Ray distance to the nearest opaque thing: the host's depth, and the water when present. */
-    glGetTextureImage(targets->scene_depth, 0, GL_DEPTH_COMPONENT, GL_FLOAT, (GLsizei)(n * sizeof(float)), s->depth);
-    double eye[3];
-    for (int k = 0; k < 3; ++k)
-        eye[k] = -((double)frame->view[k * 4 + 0] * frame->view[12] + (double)frame->view[k * 4 + 1] * frame->view[13]
-                   + (double)frame->view[k * 4 + 2] * frame->view[14]);
-    const float *m = targets->inv_view_proj;
-    for (uint32_t y = 0; y < s->height; ++y)
-        for (uint32_t x = 0; x < s->width; ++x) {
-            size_t p = (size_t)y * s->width + x;
-            float d = s->depth[p];
-            if (d >= 1.f) {
-                s->max_dist[p] = INFINITY;
-                continue;
-            }
-            double ndc[4] = {(x + 0.5) / s->width * 2 - 1, (y + 0.5) / s->height * 2 - 1, d * 2.0 - 1, 1};
-            double w[4] = {0, 0, 0, 0};
-            for (int r = 0; r < 4; ++r)
-                for (int c = 0; c < 4; ++c)
-                    w[r] += m[c * 4 + r] * ndc[c];
-            double dx = w[0] / w[3] - eye[0], dy = w[1] / w[3] - eye[1], dz = w[2] / w[3] - eye[2];
-            s->max_dist[p] = (float)sqrt(dx * dx + dy * dy + dz * dz);
-        }
-    if (targets->water_dist) {
-        glGetTextureImage(targets->water_dist, 0, GL_RED, GL_FLOAT, (GLsizei)(n * sizeof(float)), s->depth);
-        for (size_t p = 0; p < n; ++p)
-            if (s->depth[p] >= 0 && s->depth[p] < s->max_dist[p])
-                s->max_dist[p] = s->depth[p];
-    }
+    const vfx_volume_view *v = &s->view.v1;
+    /* this frame's distances go to one pack buffer; the render uses the previous frame's */
+    const int slot = (int)(s->frame & 1u), prev = slot ^ 1;
+    distance_pass(ctx, s, frame, targets, slot);
+    const bool late = s->frame > 0 && s->fence[prev];
+    vfx_result r = read_distances(ctx, s, late ? prev : slot);
+    if (r != VFX_OK)
+        return r;
+    s->frame++;
+    volfx_stat_set(ctx, "volume.clip_frames_late", late ? 1 : 0);
+
     tet_camera cam;
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     bool has_model = false;
@@ -162,18 +348,8 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
     volfx_mat4_mul(frame->view, has_model ? v->model : identity, cam.view);
     memcpy(cam.proj, frame->proj, sizeof cam.proj);
     cam.width = (int)s->width, cam.height = (int)s->height;
-    /* The renderer's transfer function is linear between two ends: the view's table gives its
-     * first and last entries (alpha = extinction per unit length). */
-    tet_tf tf = {.smin = v->scalar_min, .smax = v->scalar_max, .tau_lo = 0.2f, .tau_hi = 3.0f,
-                     .color_lo = {0.1f, 0.3f, 0.9f}, .color_hi = {1.0f, 0.85f, 0.3f}};
-    if (!(v->scalar_max > v->scalar_min))
-        tf.smin = s->data_min, tf.smax = s->data_max > s->data_min ? s->data_max : s->data_min + 1;
-    if (v->transfer_rgba) {
-        const float *lo = v->transfer_rgba, *hi = v->transfer_rgba + 4 * (v->transfer_count - 1);
-        memcpy(tf.color_lo, lo, sizeof tf.color_lo);
-        memcpy(tf.color_hi, hi, sizeof tf.color_hi);
-        tf.tau_lo = lo[3], tf.tau_hi = hi[3];
-    }
+    tet_tf tf;
+    make_tf(s, &tf);
     tet_options o;
     tet_options_default(&o);
     o.ert = !(v->disable & VFX_VOLUME_NO_ERT);
@@ -185,17 +361,35 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     o.workers = v->workers ? (int)v->workers : (int)(cores > 0 ? (cores < 64 ? cores : 64) : 1);
     o.max_dist = s->max_dist;
-    tet_counters c;
     char err[256];
-    int r = tet_render_workers(&s->mesh, &cam, &tf, &o, s->rgba, &c, NULL, err);
-    if (r != VFX_OK)
-        return volfx_fail(ctx, (vfx_result)r, "volume[0]: %s", err);
-    volfx_stat_set(ctx, "volume.cells_scanned", (double)c.cells_scanned);
-    volfx_stat_set(ctx, "volume.cells_skipped_ert", (double)c.cells_skipped_ert);
-    volfx_stat_set(ctx, "volume.segments", (double)c.segments_made);
-    volfx_stat_set(ctx, "volume.t_sc_ms", c.t_sc_ms);
-    volfx_stat_set(ctx, "volume.t_update_ms", c.t_update_ms);
-    glTextureSubImage2D(s->tex, 0, 0, 0, (GLsizei)s->width, (GLsizei)s->height, GL_RGBA, GL_FLOAT, s->rgba);
+    if (s->pool && tet_pool_workers(s->pool) != (o.workers > 64 ? 64 : o.workers)) {
+        tet_pool_destroy(s->pool);
+        s->pool = NULL;
+    }
+    if (!s->pool && (r = (vfx_result)tet_pool_create(o.workers, &s->pool, err)) != VFX_OK)
+        return volfx_fail(ctx, r, "volume[0]: %s", err);
+
+    const uint64_t key = render_key(s, &cam, &tf, &o);
+    if (key == s->last_key) {
+        s->skipped++;
+        volfx_stat_set(ctx, "volume.render_skipped", 1);
+    } else {
+        tet_counters c;
+        s->last_key = 0;
+        int rr = tet_render_pool(s->pool, &s->mesh, &cam, &tf, &o, s->rgba, &c, NULL, err);
+        if (rr != VFX_OK)
+            return volfx_fail(ctx, (vfx_result)rr, "volume[0]: %s", err);
+        s->last_key = key;
+        volfx_stat_set(ctx, "volume.render_skipped", 0);
+        volfx_stat_set(ctx, "volume.cells_scanned", (double)c.cells_scanned);
+        volfx_stat_set(ctx, "volume.cells_skipped_ert", (double)c.cells_skipped_ert);
+        volfx_stat_set(ctx, "volume.segments", (double)c.segments_made);
+        volfx_stat_set(ctx, "volume.tf_pieces", (double)c.tf_pieces);
+        volfx_stat_set(ctx, "volume.t_sc_ms", c.t_sc_ms);
+        volfx_stat_set(ctx, "volume.t_update_ms", c.t_update_ms);
+        glTextureSubImage2D(s->tex, 0, 0, 0, (GLsizei)s->width, (GLsizei)s->height, GL_RGBA, GL_FLOAT, s->rgba);
+    }
+    volfx_stat_set(ctx, "volume.renders_skipped_total", (double)s->skipped);
     glBindTextureUnit(0, s->tex);
     volfx_composite(ctx, frame, "volume.composite", s->prog, VOLFX_BLEND_OVER_PREMUL);
     const char *e = volfx_gpu_error_string();

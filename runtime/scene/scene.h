@@ -115,6 +115,7 @@ typedef struct rt_scene_volume {
     float gen_min[3], gen_max[3];
     bool transfer_normalized;        /* control-point scalars are in [0,1] of the data range */
     uint32_t transfer_count;         /* 0 = the plugin's default ramp */
+    uint32_t transfer_method;        /* vfx_volume_transfer_method ("exact", "preintegrated") */
     rt_scene_transfer_point transfer[RT_SCENE_MAX_TRANSFER];
     float ert_threshold;             /* 0 -> plugin default */
     uint32_t tiles, update_c, workers, disable;

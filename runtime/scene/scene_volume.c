@@ -18,7 +18,7 @@ vfx_result scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol)
 {
     static const char *const keys[] = {"path", "generator", "scalar", "transfer", "transfer_normalized",
                                        "ert_threshold", "tiles", "update_c", "workers", "disable",
-                                       "translate", "rotate_deg", "scale", "matrix", NULL};
+                                       "translate", "rotate_deg", "scale", "matrix", "transfer_method", NULL};
     const char *P = "volume";
     vfx_result r = scene_expect_object(c, v, P);
     if (r)
@@ -63,6 +63,15 @@ vfx_result scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol)
         static const char *const flags[] = {"ert", "share", "dlb", NULL};
         static const uint32_t bits[] = {VFX_VOLUME_NO_ERT, VFX_VOLUME_NO_SHARE, VFX_VOLUME_NO_DLB};
         r = scene_get_flags(c, v, P, "disable", flags, bits, &vol->disable);
+    }
+    if (!r) {
+        char method[32] = "exact";
+        r = scene_get_string(c, v, P, "transfer_method", false, method, sizeof method);
+        if (!r && !strcmp(method, "preintegrated"))
+            vol->transfer_method = VFX_VOLUME_TRANSFER_PREINTEGRATED;
+        else if (!r && strcmp(method, "exact"))
+            r = scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "volume.transfer_method",
+                            "\"%.40s\" is neither \"exact\" nor \"preintegrated\"", method);
     }
     if (!r) r = scene_parse_transform(c, v, P, vol->model);
     if (r)

@@ -188,17 +188,44 @@ typedef struct vfx_volume_view {
     const uint32_t *tets;         /* 4 point indices per tetrahedron */
     const float *scalar;          /* one value per point */
     float scalar_min, scalar_max; /* transfer function domain; equal -> data range */
-    const float *transfer_rgba;   /* transfer_count RGBA entries over the domain; alpha is
-                                     opacity per unit length; NULL -> a default ramp */
+    const float *transfer_rgba;   /* transfer_count RGBA entries evenly spaced over the domain,
+                                     linear between entries; alpha is extinction per unit
+                                     length; NULL -> a default ramp; at most
+                                     VFX_VOLUME_MAX_TRANSFER */
     uint32_t transfer_count;
     float ert_threshold;          /* opacity that terminates a ray; 0 -> 0.9 */
-    uint32_t tiles;               /* D of the DxD termination table; 0 -> 16 */
-    uint32_t update_c;            /* table updated every remaining/C cells; 0 -> 16 */
+    uint32_t tiles;               /* D of the DxD termination table; 0 -> 20 */
+    uint32_t update_c;            /* table updated every remaining/C cells; 0 -> 100 */
     uint32_t workers;             /* threads; 0 -> number of cores */
     uint32_t disable;             /* VFX_VOLUME_NO_* bits */
     float model[16];              /* model matrix; all zero -> identity */
     uint64_t revision;            /* changes when the mesh or scalars change */
 } vfx_volume_view;
+
+/* Most entries a transfer function table may have. */
+#define VFX_VOLUME_MAX_TRANSFER 1024u
+
+/* How a volume's transfer function is integrated along a ray segment. */
+typedef enum vfx_volume_transfer_method {
+    VFX_VOLUME_TRANSFER_EXACT = 0,         /* split at the table's breakpoints (default) */
+    VFX_VOLUME_TRANSFER_PREINTEGRATED = 1, /* pre-integrated lookup table (faster, approximate) */
+} vfx_volume_transfer_method;
+
+/* Version 2 of the volume view: version 1 as its first member (never edited), then
+ * non-uniform transfer-function breakpoints. The plugin offers one with v1.size =
+ * sizeof(vfx_volume_view2) and v1.version = VFX_VOLUME_VIEW2_VERSION; a host that knows
+ * version 2 fills all of it and keeps version 2, a version-1 host writes a vfx_volume_view
+ * (version 1). Points, scalars and the table may change every frame: bump v1.revision when
+ * points or scalars change (the table is compared by value). */
+#define VFX_VOLUME_VIEW2_VERSION 2u
+typedef struct vfx_volume_view2 {
+    vfx_volume_view v1;
+    const float *transfer_scalar; /* v1.transfer_count breakpoints in [0,1] of the domain
+                                     [scalar_min, scalar_max], strictly increasing; NULL ->
+                                     evenly spaced (as version 1) */
+    uint32_t transfer_method;     /* vfx_volume_transfer_method */
+    uint32_t _reserved[5];
+} vfx_volume_view2;
 
 /* -------------------------------------------------------------------------- host api */
 
