@@ -160,20 +160,20 @@ static double max_diff(const float *a, const float *b, size_t n)
     return m;
 }
 
+/* blue (thin) to orange (dense) over the scalar's [0, 1] */
+static tet_tf test_tf(void)
+{
+    return (tet_tf){.smin = 0, .smax = 1, .tau_lo = 4.0f, .tau_hi = 20.0f,
+                    .color_lo = {0.1f, 0.3f, 1.0f}, .color_hi = {1.0f, 0.6f, 0.1f}};
+}
+
 static int test_render(int P)
 {
     enum { W = 48, H = 40 };
     const size_t n4 = (size_t)W * H * 4;
     tet_camera cam;
     make_cam(&cam, W, H, 0.6f, 0.4f, 4.0f);
-    tet_tf tf;
-    memset(&tf, 0, sizeof tf);
-    tf.smin = 0;
-    tf.smax = 1;
-    tf.tau_lo = 4.0f;
-    tf.tau_hi = 20.0f;
-    tf.color_lo[0] = 0.1f; tf.color_lo[1] = 0.3f; tf.color_lo[2] = 1.0f;
-    tf.color_hi[0] = 1.0f; tf.color_hi[1] = 0.6f; tf.color_hi[2] = 0.1f;
+    tet_tf tf = test_tf();
     char err[256];
     tet_mpi *ctx;
     CHECK(tet_mpi_create(MPI_COMM_WORLD, &ctx, err) == VFX_OK, "%s", err);
@@ -334,12 +334,7 @@ static int test_mismatch(int P)
     enum { W = 24, H = 20 };
     tet_camera cam;
     make_cam(&cam, W, H, 0.6f, 0.4f, 4.0f);
-    tet_tf tf;
-    memset(&tf, 0, sizeof tf);
-    tf.smax = 1;
-    tf.tau_lo = 4.0f;
-    tf.tau_hi = 20.0f;
-    tf.color_hi[0] = 1.0f;
+    tet_tf tf = test_tf();
     char err[256];
     tet_mpi *ctx;
     CHECK(tet_mpi_create(MPI_COMM_WORLD, &ctx, err) == VFX_OK, "%s", err);
