@@ -5,10 +5,16 @@
 #include <stddef.h>
 #include <volfx/volfx.h>
 
-/* Reads `path` into a malloc'd buffer with a NUL after the last byte (*size excludes it). A file
- * above max_bytes is refused before anything is allocated for it, with "PATH: N bytes, above the
- * cap of CAP" (CAP = cap_text). Errors name the path: cannot open (VFX_ERR_IO), not a regular
- * file, short read, out of memory. */
+/* Fails (VFX_ERR_IO) unless `path` names a regular file, without opening it: "PATH: is a
+ * directory", "is a FIFO", "is a character device", ... or "cannot open: <errno text>". */
+vfx_result rt_check_regular_file(const char *path, char *err, size_t errlen);
+
+/* Reads `path` into a malloc'd buffer with a NUL after the last byte (*size excludes it).
+ * Anything but a regular file is refused before it is opened (rt_check_regular_file), and it is
+ * opened non-blocking, so a FIFO swapped in between cannot hang the read. A file above
+ * max_bytes, by its size or by what reading it gives (a /proc file reports size 0), is refused
+ * with "PATH: N bytes, above the cap of CAP" (CAP = cap_text, VFX_ERR_INVALID_ARGUMENT) before
+ * more than max_bytes + 1 are held. Other errors name the path: short read, out of memory. */
 vfx_result rt_read_file(const char *path, size_t max_bytes, const char *cap_text, char **out,
                          size_t *size, char *err, size_t errlen);
 

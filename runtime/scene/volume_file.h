@@ -6,6 +6,14 @@
 #include <stddef.h>
 #include "tet_mesh.h" /* tetra/: the mesh type and tet_validate */
 
+/* Documented caps (docs/tetvol-input.md); each refusal names the cap it hit. Claimed counts are
+ * also bounded by what the file can hold before anything is allocated for them. */
+#define RT_VOLUME_MAX_FILE_BYTES (1u << 30) /* a .vtu, .node or .ele file is read whole: 1 GiB */
+#define RT_VOLUME_MAX_POINTS (1u << 24)     /* 16,777,216 points */
+#define RT_VOLUME_MAX_TETS (1u << 24)       /* 16,777,216 tetrahedra */
+#define RT_VTU_MAX_DECODED_BYTES (1u << 30) /* base64-decoded plus inflated array bytes, per file */
+#define RT_ZLIB_MAX_RATIO 1032u             /* deflate cannot expand a byte beyond this */
+
 /* Loads a VTK XML UnstructuredGrid file (tetrahedra only); scalar_name NULL -> no scalar.
  * A vector point field gives its magnitude. On error *out is left zeroed. */
 vfx_result rt_volume_load_vtu(const char *path, const char *scalar_name, tet_mesh *out,

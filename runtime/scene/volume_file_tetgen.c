@@ -1,8 +1,10 @@
 /* volume_file_tetgen.c — TetGen .node/.ele reader. The first node's index decides 0- or 1-based
  * numbering, as TetGen itself does. */
 #include "scene/volume_file.h"
+#include "core/file.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,34 +16,23 @@ typedef struct {
     const char *name;
 } tg_reader;
 
-static char *read_file(const char *path, size_t *size)
+/* The text is parsed as a C string: a NUL inside would silently end it early. */
+static vfx_result read_whole(const char *path, char **buf, size_t *size, char *err, size_t errlen)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    size_t cap = 1 << 16, n = 0;
-    char *b = malloc(cap + 1);
-    while (b) {
-        size_t r = fread(b + n, 1, cap - n, f);
-        n += r;
-        if (n < cap)
-            break;
-        char *nb = realloc(b, 2 * cap + 1);
-        if (!nb) {
-            free(b);
-            b = NULL;
-            break;
-        }
-        b = nb;
-        cap *= 2;
+    vfx_result r = rt_read_file(path, RT_VOLUME_MAX_FILE_BYTES,
+                                "1 GiB for a volume file (RT_VOLUME_MAX_FILE_BYTES)", buf, size, err, errlen);
+    const char *z = r ? NULL : memchr(*buf, 0, *size);
+    if (z) {
+        snprintf(err, errlen, "%s: byte %zu is a NUL byte (not a text file?)", path, (size_t)(z - *buf));
+        free(*buf);
+        *buf = NULL;
+        return VFX_ERR_FORMAT;
     }
-    fclose(f);
-    if (b) {
-        b[n] = 0;
-        *size = n;
-    }
-    return b;
+    return r;
 }
+
+/* Header counts are whole numbers: 2.5 points is a damaged header, not 2. */
+static int whole(double x) { return x == floor(x); }
 
 /* Next non-empty, comment-stripped line into *line (NUL-terminated in place); 0 at end. */
 static int next_line(tg_reader *r, char **line)
@@ -98,8 +89,10 @@ vfx_result rt_volume_load_tetgen(const char *path_base, const char *scalar_name,
     memset(out, 0, sizeof *out);
     size_t plen = strlen(path_base);
     char *path = malloc(plen + 8);
-    if (!path)
+    if (!path) {
+        snprintf(err, errlen, "%s: out of memory for the path", path_base);
         return VFX_ERR_OUT_OF_MEMORY;
+    }
     vfx_result res = VFX_OK;
     char *nodebuf = NULL, *elebuf = NULL;
     double v[TG_MAXCOL];
@@ -107,12 +100,8 @@ vfx_result rt_volume_load_tetgen(const char *path_base, const char *scalar_name,
     char *line;
 
     snprintf(path, plen + 8, "%s.node", path_base);
-    nodebuf = read_file(path, &sz);
-    if (!nodebuf) {
-        snprintf(err, errlen, "%s: cannot open", path);
-        res = VFX_ERR_IO;
+    if ((res = read_whole(path, &nodebuf, &sz, err, errlen)))
         goto done;
-    }
     tg_reader r = {nodebuf, nodebuf, 0, path};
     int n;
     if (!next_line(&r, &line) || (n = parse_numbers(line, v, TG_MAXCOL)) < 1) {
@@ -122,10 +111,16 @@ vfx_result rt_volume_load_tetgen(const char *path_base, const char *scalar_name,
     }
     double np = v[0], dim = n > 1 ? v[1] : 3, nattr = n > 2 ? v[2] : 0, nmark = n > 3 ? v[3] : 0;
     if (np < 4 || np > 1e9 || dim != 3 || nattr < 0 || nattr > TG_MAXCOL - 5 || nmark < 0 ||
-        nmark > 1) {
+        nmark > 1 || !whole(np) || !whole(nattr) || !whole(nmark)) {
         snprintf(err, errlen,
                  "%s:%d: bad header (points %g, dimension %g, attributes %g, markers %g)", path,
                  r.line, np, dim, nattr, nmark);
+        res = VFX_ERR_FORMAT;
+        goto done;
+    }
+    if (np > RT_VOLUME_MAX_POINTS) {
+        snprintf(err, errlen, "%s: header claims %.0f points, above the cap of %u "
+                 "(RT_VOLUME_MAX_POINTS)", path, np, RT_VOLUME_MAX_POINTS);
         res = VFX_ERR_FORMAT;
         goto done;
     }
@@ -166,6 +161,7 @@ vfx_result rt_volume_load_tetgen(const char *path_base, const char *scalar_name,
         snprintf(out->scalar_name, sizeof out->scalar_name, "attr%d", attr_index);
     }
     if (!out->points || (attr_index >= 0 && !out->scalar)) {
+        snprintf(err, errlen, "%s: out of memory for %u points", path, out->point_count);
         res = VFX_ERR_OUT_OF_MEMORY;
         goto done;
     }
@@ -199,19 +195,31 @@ vfx_result rt_volume_load_tetgen(const char *path_base, const char *scalar_name,
             res = VFX_ERR_FORMAT;
             goto done;
         }
-        for (int k = 0; k < 3; k++)
+        /* Checked here, as float32, so the message has the file and line (1e39 is finite as a
+         * double and Inf as the float the renderer uses). */
+        for (int k = 0; k < 3; k++) {
             out->points[3 * (size_t)i + k] = (float)v[1 + k];
-        if (attr_index >= 0)
+            if (!isfinite(out->points[3 * (size_t)i + k])) {
+                snprintf(err, errlen, "%s:%d: point %u coordinate %c = %g is not finite as float32",
+                         path, r.line, i, "xyz"[k], v[1 + k]);
+                res = VFX_ERR_NUMERIC;
+                goto done;
+            }
+        }
+        if (attr_index >= 0) {
             out->scalar[i] = (float)v[4 + attr_index];
+            if (!isfinite(out->scalar[i])) {
+                snprintf(err, errlen, "%s:%d: point %u attribute %d = %g is not finite as float32",
+                         path, r.line, i, attr_index, v[4 + attr_index]);
+                res = VFX_ERR_NUMERIC;
+                goto done;
+            }
+        }
     }
 
     snprintf(path, plen + 8, "%s.ele", path_base);
-    elebuf = read_file(path, &sz);
-    if (!elebuf) {
-        snprintf(err, errlen, "%s: cannot open", path);
-        res = VFX_ERR_IO;
+    if ((res = read_whole(path, &elebuf, &sz, err, errlen)))
         goto done;
-    }
     r = (tg_reader){elebuf, elebuf, 0, path};
     if (!next_line(&r, &line) || (n = parse_numbers(line, v, TG_MAXCOL)) < 1) {
         snprintf(err, errlen, "%s: missing or bad header line", path);
@@ -219,9 +227,16 @@ vfx_result rt_volume_load_tetgen(const char *path_base, const char *scalar_name,
         goto done;
     }
     double nt = v[0], npt = n > 1 ? v[1] : 4, neattr = n > 2 ? v[2] : 0;
-    if (nt < 1 || nt > 1e9 || (npt != 4 && npt != 10) || neattr < 0 || neattr > TG_MAXCOL - 12) {
+    if (nt < 1 || nt > 1e9 || (npt != 4 && npt != 10) || neattr < 0 || neattr > TG_MAXCOL - 12 ||
+        !whole(nt) || !whole(neattr)) {
         snprintf(err, errlen, "%s:%d: bad header (tetrahedra %g, nodes per tet %g, attributes %g)",
                  path, r.line, nt, npt, neattr);
+        res = VFX_ERR_FORMAT;
+        goto done;
+    }
+    if (nt > RT_VOLUME_MAX_TETS) {
+        snprintf(err, errlen, "%s: header claims %.0f tetrahedra, above the cap of %u "
+                 "(RT_VOLUME_MAX_TETS)", path, nt, RT_VOLUME_MAX_TETS);
         res = VFX_ERR_FORMAT;
         goto done;
     }
@@ -235,6 +250,7 @@ vfx_result rt_volume_load_tetgen(const char *path_base, const char *scalar_name,
     out->tet_count = (uint32_t)nt;
     out->tets = malloc(sizeof(uint32_t) * 4 * (size_t)nt);
     if (!out->tets) {
+        snprintf(err, errlen, "%s: out of memory for %u tetrahedra", path, out->tet_count);
         res = VFX_ERR_OUT_OF_MEMORY;
         goto done;
     }
@@ -264,7 +280,10 @@ vfx_result rt_volume_load_tetgen(const char *path_base, const char *scalar_name,
             out->tets[4 * (size_t)t + k] = (uint32_t)idx;
         }
     }
-    res = tet_validate(out, err, errlen);
+    char inner[256] = "";
+    res = tet_validate(out, inner, sizeof inner);
+    if (res)
+        snprintf(err, errlen, "%s.node/.ele: %s", path_base, inner);
 done:
     if (res != VFX_OK)
         tet_mesh_free(out);

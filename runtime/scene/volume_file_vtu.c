@@ -2,9 +2,13 @@
  * so expat is fed only the text before <AppendedData> (never finalised) and the arrays are then
  * decoded from the bytes after its '_' marker. */
 #include "scene/volume_file.h"
+#include "core/file.h"
 
 #include <expat.h>
+#include <limits.h>
 #include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -20,6 +24,7 @@ typedef struct {
     int section, type, format, ncomp;
     size_t offset;            /* appended */
     size_t text_begin, text_end; /* inline text: byte range in the input */
+    double tuples;            /* NumberOfTuples when given, else -1 */
 } vtu_array;
 
 typedef struct {
@@ -31,6 +36,7 @@ typedef struct {
     int header64, zlib, appended_base64, has_grid;
     vtu_array arr[VTU_MAXARR];
     int narr, cur;
+    size_t decoded; /* bytes decoded or inflated so far, against RT_VTU_MAX_DECODED_BYTES */
     char *err;
     size_t errlen;
     int failed;
@@ -49,6 +55,32 @@ static size_t type_size(int t)
 {
     static const size_t sz[] = {0, 1, 1, 2, 2, 4, 4, 8, 8, 4, 8};
     return sz[t];
+}
+
+static const char *const TYPE_NAMES[] = {"?", "Int8", "UInt8", "Int16", "UInt16", "Int32",
+                                          "UInt32", "Int64", "UInt64", "Float32", "Float64"};
+
+/* Every error path writes its text through here (the caller prints err whatever the code). */
+static vfx_result errf(vtu_state *s, vfx_result r, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static vfx_result errf(vtu_state *s, vfx_result r, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(s->err, s->errlen, fmt, ap);
+    va_end(ap);
+    return r;
+}
+
+/* A whole-string decimal number (strtod), or -1 when absent; *ok 0 when present but malformed. */
+static double attr_number(const char *v, int *ok)
+{
+    if (!v)
+        return -1;
+    char *e = NULL;
+    double x = strtod(v, &e);
+    *ok = e != v && *e == 0 && isfinite(x);
+    return x;
 }
 
 static void fail(vtu_state *s, const char *msg)
@@ -90,13 +122,21 @@ static void XMLCALL on_start(void *ud, const XML_Char *el, const XML_Char **a)
         if (++s->pieces > 1)
             return fail(s, "more than one Piece is not supported");
         const char *p = attr(a, "NumberOfPoints"), *c = attr(a, "NumberOfCells");
-        char *e1 = NULL, *e2 = NULL;
-        s->npoints = p ? strtod(p, &e1) : -1;
-        s->ncells = c ? strtod(c, &e2) : -1;
-        if (!p || !c || *e1 || *e2 || !(s->npoints >= 1 && s->npoints < 4e9) ||
-            !(s->ncells >= 1 && s->ncells < 1e9) || s->npoints != floor(s->npoints) ||
-            s->ncells != floor(s->ncells))
+        int ok1 = 1, ok2 = 1;
+        s->npoints = attr_number(p, &ok1);
+        s->ncells = attr_number(c, &ok2);
+        if (!p || !c || !ok1 || !ok2 || !(s->npoints >= 1) || !(s->ncells >= 1) ||
+            s->npoints != floor(s->npoints) || s->ncells != floor(s->ncells))
             return fail(s, "Piece NumberOfPoints/NumberOfCells missing or out of range");
+        char msg[160];
+        if (s->npoints > RT_VOLUME_MAX_POINTS || s->ncells > RT_VOLUME_MAX_TETS) {
+            snprintf(msg, sizeof msg, "Piece %s %.0f above the cap of %u (%s)",
+                     s->npoints > RT_VOLUME_MAX_POINTS ? "NumberOfPoints" : "NumberOfCells",
+                     s->npoints > RT_VOLUME_MAX_POINTS ? s->npoints : s->ncells,
+                     s->npoints > RT_VOLUME_MAX_POINTS ? RT_VOLUME_MAX_POINTS : RT_VOLUME_MAX_TETS,
+                     s->npoints > RT_VOLUME_MAX_POINTS ? "RT_VOLUME_MAX_POINTS" : "RT_VOLUME_MAX_TETS");
+            return fail(s, msg);
+        }
     } else if (!strcmp(el, "Points")) {
         s->section = SEC_POINTS;
     } else if (!strcmp(el, "Cells")) {
@@ -115,9 +155,18 @@ static void XMLCALL on_start(void *ud, const XML_Char *el, const XML_Char **a)
         d->type = t ? type_of(t) : T_BAD;
         if (d->type == T_BAD)
             return fail(s, "DataArray type missing or unknown");
-        d->ncomp = nc ? atoi(nc) : 1;
-        if (d->ncomp < 1 || d->ncomp > 9)
-            return fail(s, "DataArray NumberOfComponents out of range 1..9");
+        int okc = 1, okt = 1;
+        double ncd = nc ? attr_number(nc, &okc) : 1;
+        if (!okc || !(ncd >= 1 && ncd <= 9) || ncd != floor(ncd)) {
+            char msg[160];
+            snprintf(msg, sizeof msg, "DataArray '%.64s' NumberOfComponents \"%.32s\" is not an "
+                     "integer in 1..9", d->name, nc);
+            return fail(s, msg);
+        }
+        d->ncomp = (int)ncd;
+        d->tuples = attr_number(attr(a, "NumberOfTuples"), &okt);
+        if (!okt || (d->tuples >= 0 && d->tuples != floor(d->tuples)))
+            return fail(s, "DataArray NumberOfTuples is not an integer");
         if (!f || !strcmp(f, "ascii"))
             d->format = F_ASCII;
         else if (!strcmp(f, "binary"))
@@ -163,15 +212,15 @@ static void XMLCALL on_text(void *ud, const XML_Char *txt, int len)
 }
 
 /* Decodes base64 from [src, src+n), skipping whitespace; '=' padding ends a 4-char group and
- * decoding resumes, so separately encoded header and data blocks concatenate. Returns bytes
- * written or (size_t)-1 on an invalid character. */
-static size_t b64_decode(const char *src, size_t n, unsigned char *dst, int *bad)
+ * decoding resumes, so separately encoded header and data blocks concatenate. Stops once `limit`
+ * bytes are out (dst holds limit + 3). Returns bytes written; *bad on an invalid character. */
+static size_t b64_decode(const char *src, size_t n, unsigned char *dst, size_t limit, int *bad)
 {
     *bad = 0;
     size_t o = 0;
     unsigned v = 0;
     int k = 0, pad = 0;
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = 0; i < n && o < limit; i++) {
         char c = src[i];
         int x;
         if (c >= 'A' && c <= 'Z') x = c - 'A';
@@ -196,7 +245,7 @@ static size_t b64_decode(const char *src, size_t n, unsigned char *dst, int *bad
             pad = 0;
         }
     }
-    if (k)
+    if (k && o < limit)
         *bad = 1;
     return o;
 }
@@ -210,63 +259,197 @@ static uint64_t rd_header(const unsigned char *p, int h64)
     return v;
 }
 
-/* From encoded-binary bytes [b, b+n) (header + payload), produce the raw payload of want bytes. */
+static uint64_t sat_add(uint64_t a, uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
+static uint64_t sat_mul(uint64_t a, uint64_t b) { return b && a > UINT64_MAX / b ? UINT64_MAX : a * b; }
+
+/* Bytes of encoded block (header + payload) that the headers in b[0..n) say it takes; more than
+ * n when the prefix is too short to tell (then call again with that many). */
+static uint64_t block_bytes(const vtu_state *s, const unsigned char *b, size_t n)
+{
+    uint64_t hs = s->header64 ? 8 : 4;
+    if (!s->zlib)
+        return n < hs ? hs : sat_add(hs, rd_header(b, s->header64));
+    if (n < 3 * hs)
+        return 3 * hs;
+    uint64_t nb = rd_header(b, s->header64), head = sat_add(3 * hs, sat_mul(nb, hs));
+    if (n < head)
+        return head;
+    uint64_t total = head;
+    for (uint64_t i = 0; i < nb; i++)
+        total = sat_add(total, rd_header(b + 3 * hs + i * hs, s->header64));
+    return total;
+}
+
+/* From encoded-binary bytes [b, b+n) (header + payload), produce the raw payload of want bytes
+ * (malloc'd) and the bytes of b it used. Every claim is checked against n before allocating. */
 static vfx_result unpack(vtu_state *s, const unsigned char *b, size_t n, size_t want,
-                         unsigned char **out, const char *what)
+                         unsigned char **out, size_t *used, const char *what)
 {
     size_t hs = s->header64 ? 8 : 4;
     *out = NULL;
     if (!s->zlib) {
         if (n < hs) goto trunc;
         uint64_t len = rd_header(b, s->header64);
-        if (len != want) {
-            snprintf(s->err, s->errlen, "%s: block holds %llu bytes, expected %zu", what,
-                     (unsigned long long)len, want);
-            return VFX_ERR_FORMAT;
-        }
+        if (len != want)
+            return errf(s, VFX_ERR_FORMAT, "%s: block holds %llu bytes, expected %zu", what,
+                        (unsigned long long)len, want);
         if (n - hs < want) goto trunc;
         *out = malloc(want ? want : 1);
-        if (!*out) return VFX_ERR_OUT_OF_MEMORY;
+        if (!*out)
+            return errf(s, VFX_ERR_OUT_OF_MEMORY, "%s: out of memory for %zu bytes", what, want);
         memcpy(*out, b + hs, want);
+        *used = hs + want;
         return VFX_OK;
     }
     if (n < 3 * hs) goto trunc;
     uint64_t nb = rd_header(b, s->header64), bs = rd_header(b + hs, s->header64);
     uint64_t last = rd_header(b + 2 * hs, s->header64);
-    if (nb > (n - 3 * hs) / hs || bs == 0 || last > bs) {
-        snprintf(s->err, s->errlen, "%s: bad zlib block header (%llu blocks of %llu)", what,
-                 (unsigned long long)nb, (unsigned long long)bs);
-        return VFX_ERR_FORMAT;
-    }
-    uint64_t total = nb == 0 ? 0 : (nb - 1) * bs + (last ? last : bs);
-    if (total != want) {
-        snprintf(s->err, s->errlen, "%s: compressed data holds %llu bytes, expected %zu", what,
-                 (unsigned long long)total, want);
-        return VFX_ERR_FORMAT;
-    }
-    *out = malloc(want ? want : 1);
-    if (!*out) return VFX_ERR_OUT_OF_MEMORY;
-    size_t pos = 3 * hs + nb * hs, o = 0;
+    if (nb > (n - 3 * hs) / hs || bs == 0 || last > bs)
+        return errf(s, VFX_ERR_FORMAT, "%s: bad zlib block header (%llu blocks of %llu)", what,
+                    (unsigned long long)nb, (unsigned long long)bs);
+    uint64_t total = nb == 0 ? 0 : sat_add(sat_mul(nb - 1, bs), last ? last : bs);
+    if (total != want)
+        return errf(s, VFX_ERR_FORMAT, "%s: compressed data holds %llu bytes, expected %zu", what,
+                    (unsigned long long)total, want);
+    /* What the file can hold: every compressed block present, and none claiming to inflate
+     * beyond the deflate ratio, before the output is allocated. */
+    size_t pos = 3 * hs + nb * hs;
     for (uint64_t i = 0; i < nb; i++) {
         uint64_t cs = rd_header(b + 3 * hs + i * hs, s->header64);
-        if (cs > n - pos) { free(*out); *out = NULL; goto trunc; }
+        uint64_t dl = i + 1 == nb && last ? last : bs;
+        if (cs > n - pos) goto trunc;
+        if (dl > sat_mul(cs, RT_ZLIB_MAX_RATIO))
+            return errf(s, VFX_ERR_FORMAT, "%s: zlib block %llu of %llu bytes claims %llu "
+                        "bytes inflated, beyond the deflate ratio of %u", what,
+                        (unsigned long long)i, (unsigned long long)cs, (unsigned long long)dl,
+                        RT_ZLIB_MAX_RATIO);
+        pos += cs;
+    }
+    *out = malloc(want ? want : 1);
+    if (!*out)
+        return errf(s, VFX_ERR_OUT_OF_MEMORY, "%s: out of memory for %zu bytes", what, want);
+    pos = 3 * hs + nb * hs;
+    size_t o = 0;
+    for (uint64_t i = 0; i < nb; i++) {
+        uint64_t cs = rd_header(b + 3 * hs + i * hs, s->header64);
         uLongf dl = (uLongf)(i + 1 == nb && last ? last : bs);
         uLongf expect = dl;
         int zr = uncompress(*out + o, &dl, b + pos, (uLong)cs);
         if (zr != Z_OK || dl != expect) {
-            snprintf(s->err, s->errlen, "%s: zlib block %llu failed to inflate (%s)", what,
-                     (unsigned long long)i, zr == Z_OK ? "short block" : zError(zr));
             free(*out);
             *out = NULL;
-            return VFX_ERR_FORMAT;
+            return errf(s, VFX_ERR_FORMAT, "%s: zlib block %llu failed to inflate (%s)", what,
+                        (unsigned long long)i, zr == Z_OK ? "short block" : zError(zr));
         }
         o += dl;
         pos += cs;
     }
+    *used = pos;
     return VFX_OK;
 trunc:
-    snprintf(s->err, s->errlen, "%s: data truncated", what);
-    return VFX_ERR_FORMAT;
+    return errf(s, VFX_ERR_FORMAT, "%s: data truncated", what);
+}
+
+static int is_space(char c) { return c == ' ' || c == '\n' || c == '\r' || c == '\t'; }
+
+/* One ASCII value: the token [p, q) of any length, whole, and for an integer type integral and
+ * in the type's range. */
+static vfx_result ascii_value(vtu_state *s, const vtu_array *d, const char *what, const char *p,
+                              const char *q, size_t i, size_t nv, double *out)
+{
+    size_t len = (size_t)(q - p);
+    char small[128], *tok = len < sizeof small ? small : malloc(len + 1);
+    if (!tok)
+        return errf(s, VFX_ERR_OUT_OF_MEMORY, "%s: out of memory for a %zu-byte value", what, len);
+    memcpy(tok, p, len);
+    tok[len] = 0;
+    char *end;
+    double x = strtod(tok, &end);
+    vfx_result r = VFX_OK;
+    char pos[64] = "";
+    if (d->ncomp > 1)
+        snprintf(pos, sizeof pos, " (tuple %zu component %zu)", i / (size_t)d->ncomp,
+                 i % (size_t)d->ncomp);
+    if (*end || end == tok)
+        r = errf(s, VFX_ERR_FORMAT, "%s: value %zu of %zu%s \"%.32s%s\" is not a number", what, i,
+                 nv, pos, tok, len > 32 ? "..." : "");
+    else if (d->type < T_F32) {
+        static const double lo[] = {0, -128, 0, -32768, 0, -2147483648.0, 0, -9223372036854775808.0, 0};
+        static const double hi[] = {0, 127, 255, 32767, 65535, 2147483647.0, 4294967295.0,
+                                    9223372036854775807.0, 18446744073709551615.0};
+        if (x != floor(x) || x < lo[d->type] || x > hi[d->type])
+            r = errf(s, VFX_ERR_FORMAT, "%s: value %zu of %zu%s \"%.32s%s\" is not an integer "
+                     "of type %s", what, i, nv, pos, tok, len > 32 ? "..." : "",
+                     TYPE_NAMES[d->type]);
+    }
+    if (tok != small)
+        free(tok);
+    *out = x;
+    return r;
+}
+
+static vfx_result read_ascii(vtu_state *s, const vtu_array *d, const char *what, size_t nv,
+                             double **vals)
+{
+    const char *p = s->data + d->text_begin, *e = s->data + d->text_end;
+    size_t len = d->text_end - d->text_begin;
+    /* Every value takes a character and a separator: a claim beyond that is refused before
+     * allocating for it. */
+    if (nv > len / 2 + 1)
+        return errf(s, VFX_ERR_FORMAT, "%s: %zu values expected, its %zu bytes of text hold at "
+                    "most %zu (too few values)", what, nv, len, len / 2 + 1);
+    double *v = malloc(sizeof(double) * (nv ? nv : 1));
+    if (!v)
+        return errf(s, VFX_ERR_OUT_OF_MEMORY, "%s: out of memory for %zu values", what, nv);
+    for (size_t i = 0; i < nv; i++) {
+        while (p < e && is_space(*p)) p++;
+        const char *q = p;
+        while (q < e && !is_space(*q)) q++;
+        if (q == p) {
+            free(v);
+            return errf(s, VFX_ERR_FORMAT, "%s: value %zu of %zu missing (too few values)", what,
+                        i, nv);
+        }
+        vfx_result r = ascii_value(s, d, what, p, q, i, nv, &v[i]);
+        if (r) {
+            free(v);
+            return r;
+        }
+        p = q;
+    }
+    while (p < e && is_space(*p)) p++;
+    if (p < e) {
+        const char *q = p;
+        while (q < e && !is_space(*q) && q - p < 32) q++;
+        free(v);
+        return errf(s, VFX_ERR_FORMAT, "%s: surplus values: %zu expected (count x "
+                    "NumberOfComponents %d), value %zu is \"%.*s\"", what, nv, d->ncomp, nv,
+                    (int)(q - p), p);
+    }
+    *vals = v;
+    return VFX_OK;
+}
+
+/* Decodes base64 text [src, src+n) whole, or (appended, running on into the next arrays) far
+ * enough for one encoded block (header + payload). */
+static vfx_result b64_block(vtu_state *s, const char *src, size_t n, int whole, unsigned char **dec,
+                            size_t *dn, int *bad, const char *what)
+{
+    size_t most = n / 4 * 3 + 3, limit = s->zlib ? 3 * (s->header64 ? 8 : 4) : (s->header64 ? 8 : 4);
+    if (whole)
+        limit = most;
+    for (int pass = 0; pass < 4; pass++) {
+        free(*dec);
+        *dec = malloc((limit < most ? limit : most) + 3);
+        if (!*dec)
+            return errf(s, VFX_ERR_OUT_OF_MEMORY, "%s: out of memory for %zu bytes", what, limit);
+        *dn = b64_decode(src, n, *dec, limit, bad);
+        uint64_t need = block_bytes(s, *dec, *dn);
+        if (need <= *dn || *dn < limit || limit >= most)
+            break; /* complete, or the text ended: unpack says which */
+        limit = need < most ? (size_t)need : most;
+    }
+    return VFX_OK;
 }
 
 /* Reads count*ncomp values of an array as doubles into *vals (malloc'd). */
@@ -275,33 +458,21 @@ static vfx_result read_array(vtu_state *s, const vtu_array *d, size_t count, dou
 {
     char what[128];
     snprintf(what, sizeof what, "DataArray '%s'", d->name);
+    *vals = NULL;
+    if (d->tuples >= 0 && d->tuples != (double)count)
+        return errf(s, VFX_ERR_FORMAT, "%s: NumberOfTuples %.0f, expected %zu", what, d->tuples,
+                    count);
     size_t nv = count * (size_t)d->ncomp, ts = type_size(d->type);
-    double *v = malloc(sizeof(double) * (nv ? nv : 1));
+    if (d->format == F_ASCII)
+        return read_ascii(s, d, what, nv, vals);
+    size_t want = nv * ts;
+    if (want > RT_VTU_MAX_DECODED_BYTES - s->decoded)
+        return errf(s, VFX_ERR_FORMAT, "%s: %zu bytes of data, above the cap of %u bytes decoded "
+                    "per file (RT_VTU_MAX_DECODED_BYTES, %zu already)", what, want,
+                    RT_VTU_MAX_DECODED_BYTES, s->decoded);
+    s->decoded += want;
     unsigned char *raw = NULL, *dec = NULL;
     vfx_result r = VFX_OK;
-    if (!v) return VFX_ERR_OUT_OF_MEMORY;
-    if (d->format == F_ASCII) {
-        const char *p = s->data + d->text_begin, *e = s->data + d->text_end;
-        for (size_t i = 0; i < nv; i++) {
-            while (p < e && (*p == ' ' || *p == '\n' || *p == '\r' || *p == '\t')) p++;
-            char buf[64];
-            size_t k = 0;
-            while (p < e && k < sizeof buf - 1 && !(*p == ' ' || *p == '\n' || *p == '\r' || *p == '\t'))
-                buf[k++] = *p++;
-            buf[k] = 0;
-            char *end;
-            v[i] = strtod(buf, &end);
-            if (k == 0 || *end) {
-                snprintf(s->err, s->errlen, "%s: value %zu of %zu %s", what, i, nv,
-                         k ? "is not a number" : "missing (too few values)");
-                free(v);
-                return VFX_ERR_FORMAT;
-            }
-        }
-        *vals = v;
-        return VFX_OK;
-    }
-    size_t want = nv * ts;
     if (d->format == F_BINARY || s->appended_base64) {
         const char *src;
         size_t n;
@@ -315,26 +486,36 @@ static vfx_result read_array(vtu_state *s, const vtu_array *d, size_t count, dou
             const char *lt = memchr(src, '<', n);
             if (lt) n = (size_t)(lt - src);
         }
-        dec = malloc(n / 4 * 3 + 4);
-        if (!dec) { free(v); return VFX_ERR_OUT_OF_MEMORY; }
-        int bad;
-        size_t dn = b64_decode(src, n, dec, &bad);
+        int bad = 0;
+        size_t dn = 0, used = 0;
+        if ((r = b64_block(s, src, n, d->format == F_BINARY, &dec, &dn, &bad, what)))
+            goto out;
         /* Appended base64 runs on into the next arrays: a bad character there only matters
          * when this array's bytes are not complete before it. */
         if (bad && d->format == F_BINARY) {
-            snprintf(s->err, s->errlen, "%s: invalid base64", what);
-            r = VFX_ERR_FORMAT;
+            r = errf(s, VFX_ERR_FORMAT, "%s: invalid base64", what);
             goto out;
         }
-        r = unpack(s, dec, dn, want, &raw, what);
+        r = unpack(s, dec, dn, want, &raw, &used, what);
         if (r == VFX_ERR_FORMAT && bad)
-            snprintf(s->err, s->errlen, "%s: invalid base64", what);
+            errf(s, r, "%s: invalid base64", what);
+        if (!r && d->format == F_BINARY && used < dn) {
+            r = errf(s, VFX_ERR_FORMAT, "%s: surplus data: %zu bytes after the %zu the block "
+                     "header describes", what, dn - used, used);
+            goto out;
+        }
     } else {
+        size_t used;
         if (app_start == 0 || app_start + d->offset > s->size) goto trunc;
         r = unpack(s, (const unsigned char *)s->data + app_start + d->offset,
-                   s->size - app_start - d->offset, want, &raw, what);
+                   s->size - app_start - d->offset, want, &raw, &used, what);
     }
     if (r != VFX_OK) goto out;
+    double *v = malloc(sizeof(double) * (nv ? nv : 1));
+    if (!v) {
+        r = errf(s, VFX_ERR_OUT_OF_MEMORY, "%s: out of memory for %zu values", what, nv);
+        goto out;
+    }
     for (size_t i = 0; i < nv; i++) {
         const unsigned char *p = raw + i * ts;
         switch (d->type) {
@@ -350,17 +531,14 @@ static vfx_result read_array(vtu_state *s, const vtu_array *d, size_t count, dou
         default: { double x; memcpy(&x, p, 8); v[i] = x; } break;
         }
     }
+    *vals = v;
 out:
     free(dec);
     free(raw);
-    if (r != VFX_OK) free(v);
-    else *vals = v;
     return r;
 trunc:
-    free(v);
-    snprintf(s->err, s->errlen, "%s: appended offset %zu beyond the end of the file", what,
-             d->offset);
-    return VFX_ERR_FORMAT;
+    return errf(s, VFX_ERR_FORMAT, "%s: appended offset %zu beyond the end of the file", what,
+                d->offset);
 }
 
 static const vtu_array *find(const vtu_state *s, int section, const char *name)
@@ -384,7 +562,10 @@ vfx_result rt_volume_load_vtu_mem(const void *data, size_t size, const char *sca
         return VFX_ERR_FORMAT;
     }
     vtu_state *s = calloc(1, sizeof *s);
-    if (!s) return VFX_ERR_OUT_OF_MEMORY;
+    if (!s) {
+        snprintf(err, errlen, "out of memory for the parser state");
+        return VFX_ERR_OUT_OF_MEMORY;
+    }
     s->data = data;
     s->size = size;
     s->cur = -1;
@@ -412,7 +593,7 @@ vfx_result rt_volume_load_vtu_mem(const void *data, size_t size, const char *sca
         xml_len = (size_t)(gt + 1 - (const char *)data);
     }
     s->parser = XML_ParserCreate(NULL);
-    if (!s->parser) { r = VFX_ERR_OUT_OF_MEMORY; goto done; }
+    if (!s->parser) { r = errf(s, VFX_ERR_OUT_OF_MEMORY, "out of memory for the XML parser"); goto done; }
     XML_SetUserData(s->parser, s);
     XML_SetElementHandler(s->parser, on_start, on_end);
     XML_SetCharacterDataHandler(s->parser, on_text);
@@ -482,7 +663,10 @@ vfx_result rt_volume_load_vtu_mem(const void *data, size_t size, const char *sca
     out->points = malloc(sizeof(float) * 3 * np);
     out->tets = malloc(sizeof(uint32_t) * 4 * nc);
     if (as) out->scalar = malloc(sizeof(float) * np);
-    if (!out->points || !out->tets || (as && !out->scalar)) { r = VFX_ERR_OUT_OF_MEMORY; goto done; }
+    if (!out->points || !out->tets || (as && !out->scalar)) {
+        r = errf(s, VFX_ERR_OUT_OF_MEMORY, "out of memory for %zu points and %zu tetrahedra", np, nc);
+        goto done;
+    }
     for (size_t i = 0; i < 3 * np; i++)
         out->points[i] = (float)pts[i];
     for (size_t i = 0; i < 4 * nc; i++) {
@@ -490,6 +674,11 @@ vfx_result rt_volume_load_vtu_mem(const void *data, size_t size, const char *sca
             snprintf(err, errlen, "cell %zu vertex %zu: index %g out of range (%zu points)",
                      i / 4, i % 4, conn[i], np);
             r = VFX_ERR_FORMAT;
+            goto done;
+        }
+        if (conn[i] != floor(conn[i])) { /* a Float connectivity array */
+            r = errf(s, VFX_ERR_FORMAT, "DataArray 'connectivity': value %zu (cell %zu vertex %zu) "
+                     "index %.17g is not an integer", i, i / 4, i % 4, conn[i]);
             goto done;
         }
         out->tets[i] = (uint32_t)conn[i];
@@ -524,24 +713,14 @@ vfx_result rt_volume_load_vtu(const char *path, const char *scalar_name, tet_mes
         return VFX_ERR_INVALID_ARGUMENT;
     }
     memset(out, 0, sizeof *out);
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        snprintf(err, errlen, "%s: cannot open", path);
-        return VFX_ERR_IO;
-    }
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *buf = n >= 0 ? malloc((size_t)n + 1) : NULL;
-    if (!buf || fread(buf, 1, (size_t)n, f) != (size_t)n) {
-        fclose(f);
-        free(buf);
-        snprintf(err, errlen, "%s: cannot read", path);
-        return VFX_ERR_IO;
-    }
-    fclose(f);
-    char inner[256];
-    vfx_result r = rt_volume_load_vtu_mem(buf, (size_t)n, scalar_name, out, inner, sizeof inner);
+    char *buf;
+    size_t n;
+    vfx_result rr = rt_read_file(path, RT_VOLUME_MAX_FILE_BYTES,
+                                 "1 GiB for a volume file (RT_VOLUME_MAX_FILE_BYTES)", &buf, &n, err, errlen);
+    if (rr)
+        return rr;
+    char inner[512] = "";
+    vfx_result r = rt_volume_load_vtu_mem(buf, n, scalar_name, out, inner, sizeof inner);
     if (r != VFX_OK)
         snprintf(err, errlen, "%s: %s", path, inner);
     free(buf);

@@ -1,3 +1,4 @@
+#define _GNU_SOURCE /* memmem */
 /* test_tet_io.c — loaders: good files in each encoding, the real pipe mesh, and each malformed
  * input giving a specific code and a message naming what went wrong. */
 #include <setjmp.h>
@@ -5,10 +6,16 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <cmocka.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include "scene/volume_file.h"
@@ -209,6 +216,8 @@ static size_t build_binary(char *buf, size_t cap, int enc, int zlib, int corrupt
             b64(e, en, t);
             if (corrupt == 1 && i == 1)
                 t[5] = '!';
+            if (corrupt == 3 && i == 4)
+                strcat(t, "AAAA"); /* 3 bytes after the block */
             n += (size_t)snprintf(buf + n, cap - n, "%s format=\"binary\">%s%s", decl[i], t,
                                   close[i]);
         } else {
@@ -414,6 +423,288 @@ static void test_more_malformed(void **st)
     remove(base);
 }
 
+/* ---------------------------------------------------------------- issue 18 (hardening) */
+
+/* An error must come with its own text: err is preset and must be overwritten, non-empty. */
+#define SENTINEL "SENTINEL-UNWRITTEN"
+static void preset(char *err, size_t n) { snprintf(err, n, SENTINEL); }
+static void assert_msg(const char *err, const char *part)
+{
+    if (!err[0] || strstr(err, SENTINEL) || !strstr(err, part))
+        fail_msg("message \"%s\" lacks \"%s\"", err, part);
+}
+
+/* Length-changing replacement in a buffer that may hold NUL bytes (appended raw data). */
+static size_t replace_mem(char *buf, size_t n, size_t cap, const char *from, const char *to)
+{
+    size_t fl = strlen(from), tl = strlen(to);
+    for (size_t i = 0; i + fl <= n; i++)
+        if (!memcmp(buf + i, from, fl)) {
+            assert_true(n - fl + tl <= cap);
+            memmove(buf + i + tl, buf + i + fl, n - i - fl);
+            memcpy(buf + i, to, tl);
+            return n - fl + tl;
+        }
+    fail_msg("'%s' not found", from);
+    return n;
+}
+
+/* The attack files of defect 2: small files claiming huge counts. Each must be refused with a
+ * FORMAT error and its text, without allocating for the claim. */
+static int claimed_count_cases(int verbose)
+{
+    int bad = 0;
+    char err[256];
+    tet_mesh m;
+    struct { const char *npts; const char *part; } asc[] = {
+        {"3999999999", "RT_VOLUME_MAX_POINTS"}, /* ~96 GB of doubles before the fix */
+        {"16000000", "hold at most"},           /* under the cap, but 700 bytes cannot hold it */
+    };
+    for (int i = 0; i < 2; i++) {
+        preset(err, sizeof err);
+        vfx_result r = load_str(make_ascii(asc[i].npts, "5", "2 2 2", "4", "10"), NULL, &m, err);
+        if (r != VFX_ERR_FORMAT || !err[0] || strstr(err, SENTINEL) || !strstr(err, asc[i].part)) {
+            if (verbose) printf("ascii %s: code %d, \"%s\"\n", asc[i].npts, r, err);
+            bad++;
+        }
+    }
+    for (int z = 0; z < 2; z++) {
+        static char buf[8192];
+        size_t n = build_binary(buf, sizeof buf, ENC_RAW, z, 0);
+        n = replace_mem(buf, n, sizeof buf, "NumberOfPoints=\"5\"", "NumberOfPoints=\"16000000\"");
+        if (z) { /* the zlib header claims 192 MB in one block of a few bytes */
+            char *us = memmem(buf, n, "\n_", 2);
+            uint32_t h[3] = {1, 16000000u * 12, 16000000u * 12};
+            memcpy(us + 2, h, sizeof h);
+        }
+        preset(err, sizeof err);
+        vfx_result r = rt_volume_load_vtu_mem(buf, n, NULL, &m, err, sizeof err);
+        const char *part = z ? "beyond the deflate ratio" : "expected 192000000";
+        if (r != VFX_ERR_FORMAT || !err[0] || strstr(err, SENTINEL) || !strstr(err, part)) {
+            if (verbose) printf("raw zlib %d: code %d, \"%s\"\n", z, r, err);
+            bad++;
+        }
+    }
+    return bad;
+}
+
+static void test_claimed_counts(void **st)
+{
+    (void)st;
+    assert_int_equal(claimed_count_cases(1), 0);
+#if !defined(__SANITIZE_ADDRESS__)
+    /* Again with the address space limited to 256 MB above what the process holds: an
+     * allocation for any claim fails there, and the old out-of-memory path wrote no text. */
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        FILE *f = fopen("/proc/self/statm", "r");
+        unsigned long pages = 0;
+        if (!f || fscanf(f, "%lu", &pages) != 1)
+            _exit(3);
+        fclose(f);
+        struct rlimit rl = {(rlim_t)pages * 4096 + (256u << 20), (rlim_t)pages * 4096 + (256u << 20)};
+        if (setrlimit(RLIMIT_AS, &rl) != 0)
+            _exit(3);
+        _exit(claimed_count_cases(1) ? 1 : 0);
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    assert_true(WIFEXITED(status));
+    assert_int_equal(WEXITSTATUS(status), 0);
+#endif
+}
+
+/* Defects 3 and 4: non-regular files refused before opening, without blocking; the file cap
+ * named; /proc files read for what they hold. alarm() turns a hang into a failure. */
+static void test_special_files(void **st)
+{
+    (void)st;
+    alarm(30);
+    char dir[] = "/tmp/vfx_sp_XXXXXX", p[128], base[128], err[512];
+    assert_non_null(mkdtemp(dir));
+    tet_mesh m;
+    snprintf(p, sizeof p, "%s/fifo.vtu", dir);
+    assert_int_equal(mkfifo(p, 0600), 0);
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_vtu(p, NULL, &m, err, sizeof err), VFX_ERR_IO);
+    assert_msg(err, "is a FIFO");
+    snprintf(base, sizeof base, "%s/fifo", dir);
+    snprintf(p, sizeof p, "%s/fifo.node", dir);
+    assert_int_equal(mkfifo(p, 0600), 0);
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_IO);
+    assert_msg(err, "fifo.node: is a FIFO");
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_vtu(dir, NULL, &m, err, sizeof err), VFX_ERR_IO);
+    assert_msg(err, "is a directory");
+    snprintf(base, sizeof base, "%s/zero", dir);
+    snprintf(p, sizeof p, "%s/zero.node", dir);
+    assert_int_equal(symlink("/dev/zero", p), 0);
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_IO);
+    assert_msg(err, "is a character device");
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_vtu("/dev/zero", NULL, &m, err, sizeof err), VFX_ERR_IO);
+    assert_msg(err, "is a character device");
+    /* /proc says size 0 and holds text: read as what it is, not as an empty file */
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_vtu("/proc/self/status", NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_msg(err, "not valid XML");
+    /* above the whole-file cap: a sparse file, refused from its size */
+    snprintf(p, sizeof p, "%s/huge.vtu", dir);
+    int fd = open(p, O_CREAT | O_WRONLY, 0600);
+    assert_true(fd >= 0);
+    assert_int_equal(ftruncate(fd, (off_t)RT_VOLUME_MAX_FILE_BYTES + 1), 0);
+    close(fd);
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_vtu(p, NULL, &m, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_msg(err, "RT_VOLUME_MAX_FILE_BYTES");
+    snprintf(base, sizeof base, "%s/huge", dir);
+    snprintf(p, sizeof p, "%s/huge.node", dir);
+    assert_int_equal(rename((snprintf(err, sizeof err, "%s/huge.vtu", dir), err), p), 0);
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_msg(err, "huge.node: 1073741825 bytes, above the cap of 1 GiB");
+    char cmd[256];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+    alarm(0);
+}
+
+/* Defect 5: ASCII tokens of any length, surplus values, NumberOfComponents and counts against
+ * the data, fractional connectivity; each an error naming the array and the value, or right. */
+static void test_ascii_strict(void **st)
+{
+    (void)st;
+    tet_mesh m;
+    char err[256], tok[80], x5[128];
+    /* a 70-character 0.5: was cut at 63 characters into "0.5000..." and "000...", shifting
+     * every later value by one */
+    snprintf(tok, sizeof tok, "0.5%067d", 0);
+    assert_int_equal(strlen(tok), 70);
+    snprintf(x5, sizeof x5, "2 %s 2", tok);
+    preset(err, sizeof err);
+    vfx_result r = load_str(make_ascii("5", "5", x5, "4", "10"), "P", &m, err);
+    if (r) fail_msg("%s", err);
+    assert_float_equal(m.points[12], 2.0f, 0.0f);
+    assert_float_equal(m.points[13], 0.5f, 0.0f);
+    assert_float_equal(m.points[14], 2.0f, 0.0f);
+    tet_mesh_free(&m);
+    /* surplus point coordinates (NumberOfPoints smaller than the data) */
+    preset(err, sizeof err);
+    assert_int_equal(load_str(make_ascii("5", "5", "2 2 2 7", "4", "10"), NULL, &m, err), VFX_ERR_FORMAT);
+    assert_msg(err, "DataArray '': surplus values: 15 expected");
+    assert_msg(err, "value 15 is \"7\"");
+    /* an extra scalar */
+    preset(err, sizeof err);
+    assert_int_equal(load_str(make_ascii("5", "5 6", "2 2 2", "4", "10"), "P", &m, err), VFX_ERR_FORMAT);
+    assert_msg(err, "DataArray 'P': surplus values: 5 expected");
+    /* NumberOfCells smaller than the data */
+    const char *good = make_ascii("5", "5", "2 2 2", "4", "10");
+    char copy[4096];
+    snprintf(copy, sizeof copy, "%s", good);
+    preset(err, sizeof err);
+    assert_int_equal(load_str(replace_once(copy, "NumberOfCells=\"2\"", "NumberOfCells=\"1\""), NULL, &m, err),
+                     VFX_ERR_FORMAT);
+    assert_msg(err, "surplus values: 1 expected");
+    /* NumberOfComponents 2 on a field holding 3 per point */
+    preset(err, sizeof err);
+    assert_int_equal(load_str(replace_once(copy, "Name=\"V\" NumberOfComponents=\"3\"",
+                                           "Name=\"V\" NumberOfComponents=\"2\""), "V", &m, err),
+                     VFX_ERR_FORMAT);
+    assert_msg(err, "DataArray 'V': surplus values: 10 expected (count x NumberOfComponents 2)");
+    preset(err, sizeof err);
+    assert_int_equal(load_str(replace_once(copy, "Name=\"V\" NumberOfComponents=\"3\"",
+                                           "Name=\"V\" NumberOfComponents=\"3x\""), "V", &m, err),
+                     VFX_ERR_FORMAT);
+    assert_msg(err, "NumberOfComponents \"3x\" is not an integer");
+    /* fractional connectivity in an Int64 array, and in a Float32 one */
+    preset(err, sizeof err);
+    assert_int_equal(load_str(make_ascii("5", "5", "2 2 2", "0.5", "10"), NULL, &m, err), VFX_ERR_FORMAT);
+    assert_msg(err, "DataArray 'connectivity': value 7 of 8 \"0.5\" is not an integer of type Int64");
+    preset(err, sizeof err);
+    assert_int_equal(load_str(replace_once(make_ascii("5", "5", "2 2 2", "0.5", "10"),
+                                           "\"Int64\" Name=\"connectivity\"",
+                                           "\"Float32\" Name=\"connectivity\""), NULL, &m, err),
+                     VFX_ERR_FORMAT);
+    assert_msg(err, "DataArray 'connectivity': value 7 (cell 1 vertex 3) index 0.5 is not an integer");
+    /* out of the type's range */
+    preset(err, sizeof err);
+    assert_int_equal(load_str(make_ascii("5", "5", "2 2 2", "4", "266"), NULL, &m, err), VFX_ERR_FORMAT);
+    assert_msg(err, "DataArray 'types': value 1 of 2 \"266\" is not an integer of type UInt8");
+    /* NumberOfTuples, when given, must match */
+    preset(err, sizeof err);
+    assert_int_equal(load_str(replace_once(copy, "Name=\"P\"", "Name=\"P\" NumberOfTuples=\"4\""), "P", &m, err),
+                     VFX_ERR_FORMAT);
+    assert_msg(err, "DataArray 'P': NumberOfTuples 4, expected 5");
+    /* inline binary with bytes after the block the header describes */
+    char buf[8192];
+    size_t n = build_binary(buf, sizeof buf, ENC_BINARY, 0, 3);
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_vtu_mem(buf, n, "P", &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_msg(err, "DataArray 'P': surplus data: 3 bytes after the 44");
+}
+
+/* Defect 10 (TetGen): fractional header counts, the file named with a non-finite coordinate,
+ * a NUL byte, a count above the cap. */
+static void test_tetgen_strict(void **st)
+{
+    (void)st;
+    char base[] = "/tmp/vfx_tg3_XXXXXX";
+    int fd = mkstemp(base);
+    assert_true(fd >= 0);
+    close(fd);
+    char node[64], ele[64], err[512];
+    tet_mesh m;
+    snprintf(node, sizeof node, "%s.node", base);
+    snprintf(ele, sizeof ele, "%s.ele", base);
+    write_file(ele, "1 4 0\n0 0 1 2 3\n");
+    write_file(node, "4.5 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n");
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_msg(err, "bad header (points 4.5");
+    write_file(node, "4 3 0.5 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n");
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_msg(err, "attributes 0.5");
+    write_file(node, "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n");
+    write_file(ele, "1.5 4 0\n0 0 1 2 3\n");
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_msg(err, "bad header (tetrahedra 1.5");
+    write_file(ele, "1 4 0\n0 0 1 2 3\n");
+    write_file(node, "4 3 0 0\n0 0 0 0\n1 nan 0 0\n2 0 1 0\n3 0 0 1\n");
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_NUMERIC);
+    assert_msg(err, ".node:3: point 1 coordinate x");
+    write_file(node, "4 3 0 0\n0 0 0 0\n1 1e39 0 0\n2 0 1 0\n3 0 0 1\n"); /* Inf as float32 */
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_NUMERIC);
+    assert_msg(err, ".node:3: point 1 coordinate x = 1e+39 is not finite as float32");
+    write_file(node, "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n");
+    FILE *f = fopen(node, "ab");
+    fputc(0, f);
+    fputs("5 9 9 9\n", f);
+    fclose(f);
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_msg(err, ".node: byte 40 is a NUL byte");
+    write_file(node, "20000000 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n");
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_msg(err, "RT_VOLUME_MAX_POINTS");
+    /* a validation failure names the files too */
+    write_file(node, "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n");
+    write_file(ele, "0 4 0\n");
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_msg(err, ".ele");
+    remove(node);
+    remove(ele);
+    remove(base);
+}
+
 static int pipe_present(void)
 {
     const char *dir = getenv("VFX_SHARED_DATA");
@@ -473,7 +764,9 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_nan_coordinate),    cmocka_unit_test(test_nan_scalar),
         cmocka_unit_test(test_wrong_counts),      cmocka_unit_test(test_empty_and_not_xml),
         cmocka_unit_test(test_binary_encodings),  cmocka_unit_test(test_tetgen),
-        cmocka_unit_test(test_more_malformed),
+        cmocka_unit_test(test_more_malformed),    cmocka_unit_test(test_claimed_counts),
+        cmocka_unit_test(test_special_files),     cmocka_unit_test(test_ascii_strict),
+        cmocka_unit_test(test_tetgen_strict),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
