@@ -2,6 +2,9 @@
  * little-endian on any host. */
 #include "scene/particle_file.h"
 #include "core/file.h"
+#include "scene/scene.h"
+
+_Static_assert(RT_PARTICLE_FILE_MAX_COUNT == RT_SCENE_MAX_PARTICLES, "one particle cap");
 
 #include <errno.h>
 #include <math.h>
@@ -49,7 +52,8 @@ static vfx_result parse_named(const char *name, const void *data, size_t size, f
     }
     size_t n = size / 12;
     if (n > RT_PARTICLE_FILE_MAX_COUNT) {
-        set_err(err, errlen, "%s: %llu particles, above the cap of 16777216", name, (unsigned long long)n);
+        set_err(err, errlen, "%s: %llu particles, above the cap of %u (RT_PARTICLE_FILE_MAX_COUNT)", name, (unsigned long long)n,
+                RT_PARTICLE_FILE_MAX_COUNT);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     if (n == 0)
@@ -97,7 +101,7 @@ vfx_result rt_particle_file_load(const char *path, float **xyz, uint32_t *count,
     char *buf;
     size_t size;
     char tmp[512];
-    vfx_result rr = rt_read_file(path, (size_t)RT_PARTICLE_FILE_MAX_COUNT * 12, "16777216 particles", &buf,
+    vfx_result rr = rt_read_file(path, (size_t)RT_PARTICLE_FILE_MAX_COUNT * 12, "4194304 particles (RT_PARTICLE_FILE_MAX_COUNT)", &buf,
                                   &size, tmp, sizeof tmp);
     if (rr) {
         set_err(err, errlen, "%s", tmp);

@@ -7,8 +7,10 @@
 #include <stdint.h>
 #include <volfx/volfx.h>
 
-/* Files holding more particles than this are refused before anything is read (201 MB). */
-#define RT_PARTICLE_FILE_MAX_COUNT (1u << 24)
+/* Files holding more particles than this are refused before anything is read (50 MB). The same
+ * number as a scene's particle cap (RT_SCENE_MAX_PARTICLES), so a scene's water from a file
+ * and from a generator are bounded alike. */
+#define RT_PARTICLE_FILE_MAX_COUNT (1u << 22) /* 4,194,304 */
 
 /* Decodes `size` bytes into a malloc'd xyz array (NULL when count is 0). Errors: size not a
  * multiple of 12 (VFX_ERR_FORMAT, names the size), NaN/Inf (VFX_ERR_FORMAT, names the particle

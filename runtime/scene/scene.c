@@ -187,6 +187,16 @@ void rt_scene_free(rt_scene *scene)
     free(scene);
 }
 
+static void line_col(const char *text, size_t off, unsigned *line, unsigned *col)
+{
+    *line = *col = 1;
+    for (size_t i = 0; i < off; ++i)
+        if (text[i] == '\n')
+            ++*line, *col = 1;
+        else
+            ++*col;
+}
+
 vfx_result rt_scene_load_mem(const char *json, size_t len, const char *base_dir, const rt_logger *logger,
                               rt_scene **out, char *err, size_t errlen)
 {
@@ -207,18 +217,24 @@ vfx_result rt_scene_load_mem(const char *json, size_t len, const char *base_dir,
     if (len)
         memcpy(text, json, len);
     text[len] = 0;
+    /* cJSON stops at a NUL and the rest would pass as trailing whitespace */
+    const char *nul = memchr(text, 0, len);
+    if (nul) {
+        unsigned line, col;
+        size_t at = (size_t)(nul - text);
+        line_col(text, at, &line, &col);
+        free(text);
+        return scene_failf(&c, VFX_ERR_FORMAT, "scene", "NUL byte at line %u, column %u (byte %zu): not JSON text",
+                           line, col, at);
+    }
     const char *end = NULL;
     cJSON *root = cJSON_ParseWithLengthOpts(text, len + 1, &end, false);
     if (!root) {
         size_t off = end && end >= text && end <= text + len ? (size_t)(end - text) : len;
         if (memchr(text, 0, len))
             off = strlen(text) < off ? strlen(text) : off;
-        unsigned line = 1, col = 1;
-        for (size_t i = 0; i < off; ++i)
-            if (text[i] == '\n')
-                line++, col = 1;
-            else
-                col++;
+        unsigned line, col;
+        line_col(text, off, &line, &col);
         vfx_result r = scene_failf(&c, VFX_ERR_FORMAT, "scene", "JSON syntax error at line %u, column %u (byte %zu)%s",
                              line, col, off, off >= len ? ": unexpected end of input" : "");
         free(text);
@@ -230,12 +246,8 @@ vfx_result rt_scene_load_mem(const char *json, size_t len, const char *base_dir,
         ++p;
     if (p && p < text + len) {
         size_t off = (size_t)(p - text);
-        unsigned line = 1, col = 1;
-        for (size_t i = 0; i < off; ++i)
-            if (text[i] == '\n')
-                line++, col = 1;
-            else
-                col++;
+        unsigned line, col;
+        line_col(text, off, &line, &col);
         cJSON_Delete(root);
         free(text);
         return scene_failf(&c, VFX_ERR_FORMAT, "scene", "JSON syntax error at line %u, column %u (byte %zu): text after the scene object",
@@ -272,7 +284,7 @@ vfx_result rt_scene_load_file(const char *path, const rt_logger *logger, rt_scen
     *out = NULL;
     char *buf, tmp[512];
     size_t size;
-    vfx_result rr = rt_read_file(path, RT_SCENE_MAX_BYTES, "16 MiB for a scene", &buf, &size, tmp, sizeof tmp);
+    vfx_result rr = rt_read_file(path, RT_SCENE_MAX_BYTES, "16 MiB for a scene file (RT_SCENE_MAX_BYTES)", &buf, &size, tmp, sizeof tmp);
     if (rr) {
         if (err && errlen)
             snprintf(err, errlen, "%s", tmp);

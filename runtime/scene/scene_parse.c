@@ -2,6 +2,7 @@
  * carry its JSON path; ranges are checked on the double before any cast. */
 #include "scene/scene_parse.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -93,13 +94,29 @@ vfx_result scene_check_range(pctx *c, const char *path, double v, range rg)
     return VFX_OK;
 }
 
+/* Every number a scene gives is stored as float32, so the range is checked on that float, not
+ * on the double JSON gave: 1e-320 is > 0 as a double and 0 as a float, 1e39 is finite as a
+ * double and Inf as a float. A float32 subnormal is refused too: it keeps almost no digits and
+ * its reciprocal or cube is Inf or 0 in the float code that uses it. */
 vfx_result scene_number_value(pctx *c, const cJSON *v, const char *path, range rg, double *out)
 {
     if (!cJSON_IsNumber(v))
         return scene_failf(c, VFX_ERR_FORMAT, path, "expected a number, got %s", scene_type_name(v));
-    vfx_result r = scene_check_range(c, path, v->valuedouble, rg);
+    double d = v->valuedouble;
+    vfx_result r = scene_check_range(c, path, d, rg);
+    if (r)
+        return r;
+    if (fabs(d) > FLT_MAX)
+        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be finite as float32, got %.9g", d);
+    float f = (float)d;
+    if (f != 0 && fabsf(f) < FLT_MIN)
+        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "%g is subnormal as float32 (magnitude "
+                           "below %.9g): give 0 or a larger value", d, (double)FLT_MIN);
+    if (d != 0 && f == 0) /* only reached with d below FLT_MIN/2 */
+        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "%.3g is 0 as float32", d);
+    r = scene_check_range(c, path, (double)f, rg);
     if (!r)
-        *out = v->valuedouble;
+        *out = (double)f;
     return r;
 }
 
@@ -127,8 +144,11 @@ vfx_result scene_get_uint(pctx *c, const cJSON *obj, const char *path, const cha
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!v)
         return required ? scene_failf(c, VFX_ERR_FORMAT, p, "required integer missing") : VFX_OK;
-    double d = 0; /* set by number_value on success; -O3 cannot see that */
-    vfx_result r = scene_number_value(c, v, p, (range){lo, hi, false}, &d);
+    /* integers stay doubles: as a float 16777217 would round to a different integer */
+    if (!cJSON_IsNumber(v))
+        return scene_failf(c, VFX_ERR_FORMAT, p, "expected a number, got %s", scene_type_name(v));
+    double d = v->valuedouble;
+    vfx_result r = scene_check_range(c, p, d, (range){lo, hi, false});
     if (r)
         return r;
     if (d != floor(d))

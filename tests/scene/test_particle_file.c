@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "scene/particle_file.h"
@@ -107,7 +108,8 @@ static void test_non_finite(void **state)
 static void test_cap_and_io(void **state)
 {
     (void)state;
-    /* a sparse file one particle above the cap: refused from its size, nothing read */
+    /* a sparse file one particle above the cap (4,194,305, the scene's cap + 1; it loaded before
+     * the caps were unified): refused from its size, nothing read */
     const char *p = tmp("huge.bin");
     int fd = open(p, O_CREAT | O_WRONLY | O_TRUNC, 0600);
     assert_true(fd >= 0);
@@ -117,11 +119,23 @@ static void test_cap_and_io(void **state)
     float *got = NULL;
     uint32_t n = 0;
     assert_int_equal(rt_particle_file_load(p, &got, &n, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(err, "above the cap of 16777216 particles"));
+    assert_non_null(strstr(err, "50331660 bytes")); /* 12 x 4,194,305 */
+    assert_non_null(strstr(err, "above the cap of 4194304 particles (RT_PARTICLE_FILE_MAX_COUNT)"));
     unlink(p);
     assert_int_equal(rt_particle_file_load(tmp("missing.bin"), &got, &n, err, sizeof err), VFX_ERR_IO);
     assert_non_null(strstr(err, "missing.bin: cannot open"));
-    assert_int_equal(rt_particle_file_load(dir, &got, &n, err, sizeof err) != VFX_OK, 1);
+    assert_int_equal(rt_particle_file_load(dir, &got, &n, err, sizeof err), VFX_ERR_IO);
+    assert_non_null(strstr(err, "is a directory"));
+    /* a FIFO is refused before it is opened: opening it for reading would block forever */
+    alarm(30);
+    const char *fifo = tmp("fifo.bin");
+    assert_int_equal(mkfifo(fifo, 0600), 0);
+    assert_int_equal(rt_particle_file_load(fifo, &got, &n, err, sizeof err), VFX_ERR_IO);
+    assert_non_null(strstr(err, "is a FIFO"));
+    unlink(fifo);
+    alarm(0);
+    assert_int_equal(rt_particle_file_load("/dev/zero", &got, &n, err, sizeof err), VFX_ERR_IO);
+    assert_non_null(strstr(err, "is a character device"));
     assert_int_equal(rt_particle_file_save("/nonexistent-dir/x.bin", got, 0, err, sizeof err), VFX_ERR_IO);
     assert_int_equal(rt_particle_file_parse(NULL, 12, &got, &n, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
 }

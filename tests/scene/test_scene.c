@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "scene/particle_file.h"
@@ -243,6 +244,27 @@ static const bad_case bad_cases[] = {
      "volume.transfer[0].rgba[2]: must be >= 0, got -1"},
     {"{\"volume\":{\"path\":\"a.vtu\",\"ert_threshold\":1.5}}", VFX_ERR_INVALID_ARGUMENT, "volume.ert_threshold: must be <= 1"},
     {"{\"volume\":{\"path\":\"a.vtu\",\"tiles\":0}}", VFX_ERR_INVALID_ARGUMENT, "volume.tiles: must be >= 1, got 0"},
+    /* issue 18, defect 6: ranges are checked on the float32 the scene stores, not the double */
+    {"{\"water\":{\"source\":\"generator\",\"generator\":{\"kind\":\"sphere\",\"count\":10,\"radius\":1e-320}}}",
+     VFX_ERR_INVALID_ARGUMENT, "water.generator.radius: 1e-320 is 0 as float32"},
+    {"{\"water\":{\"source\":\"generator\",\"generator\":{\"kind\":\"layers\",\"count\":10,\"spacing\":1e-320}}}",
+     VFX_ERR_INVALID_ARGUMENT, "water.generator.spacing: 1e-320 is 0 as float32"},
+    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"h\":1e-320}}", VFX_ERR_INVALID_ARGUMENT, "water.h: 1e-320 is 0 as float32"},
+    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"h\":1e-40}}", VFX_ERR_INVALID_ARGUMENT,
+     "water.h: 1e-40 is subnormal as float32"},
+    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"step\":1e-320}}}", VFX_ERR_INVALID_ARGUMENT,
+     "water.quality.step: 1e-320 is 0 as float32"},
+    {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
+     "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"dt\":1e-320}}}",
+     VFX_ERR_INVALID_ARGUMENT, "water.simulation.dt: 1e-320 is 0 as float32"},
+    {"{\"volume\":{\"path\":\"a.vtu\",\"ert_threshold\":1e-320}}", VFX_ERR_INVALID_ARGUMENT,
+     "volume.ert_threshold: 1e-320 is 0 as float32"},
+    {"{\"beam_settings\":{\"c\":1e-320}}", VFX_ERR_INVALID_ARGUMENT, "beam_settings.c: 1e-320 is 0 as float32"},
+    {"{\"meshes\":[{\"path\":\"a\",\"scale\":1e-320}]}", VFX_ERR_INVALID_ARGUMENT, "meshes[0].scale: 1e-320 is 0 as float32"},
+    {"{\"meshes\":[{\"path\":\"a\",\"scale\":[1,1e-320,1]}]}", VFX_ERR_INVALID_ARGUMENT, "meshes[0].scale[1]: 1e-320 is 0"},
+    {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"keyframes\":{\"radius\":[{\"t\":0,\"value\":1e-320}]}}]}",
+     VFX_ERR_INVALID_ARGUMENT, "beams[0].keyframes.radius[0].value: 1e-320 is 0 as float32"},
+    {"{\"camera\":{\"width\":16777217}}", VFX_ERR_INVALID_ARGUMENT, "camera.width: must be <= 16384, got 16777217"},
     {"{\"volume\":{\"path\":\"a.vtu\",\"scalar\":\"0123456789012345678901234567890123456789012345678901234567890123456789\"}}",
      VFX_ERR_INVALID_ARGUMENT, "volume.scalar: string of 70 bytes is longer than 63"},
 };
@@ -260,6 +282,31 @@ static void test_bad_inputs(void **state)
                      bad_cases[i].code, bad_cases[i].needle);
         assert_null(s);
     }
+}
+
+/* A NUL inside the text was skipped as whitespace by cJSON (it parses to the given length). */
+static void test_nul_byte(void **state)
+{
+    (void)state;
+    static const char json[] = "{\"version\":1,\0\"name\":\"x\"}";
+    rt_scene *s = NULL;
+    char err[256] = "";
+    assert_int_equal(rt_scene_load_mem(json, sizeof json - 1, NULL, NULL, &s, err, sizeof err), VFX_ERR_FORMAT);
+    assert_non_null(strstr(err, "NUL byte at line 1, column 14 (byte 13)"));
+    assert_null(s);
+    /* a scene path that is a FIFO or a directory: refused, without blocking */
+    char dir[] = "/tmp/vfx_scfifo_XXXXXX", p[64];
+    assert_non_null(mkdtemp(dir));
+    snprintf(p, sizeof p, "%s/s.json", dir);
+    assert_int_equal(mkfifo(p, 0600), 0);
+    alarm(30);
+    assert_int_equal(rt_scene_load_file(p, NULL, &s, err, sizeof err), VFX_ERR_IO);
+    assert_non_null(strstr(err, "is a FIFO"));
+    alarm(0);
+    assert_int_equal(rt_scene_load_file(dir, NULL, &s, err, sizeof err), VFX_ERR_IO);
+    assert_non_null(strstr(err, "is a directory"));
+    unlink(p);
+    rmdir(dir);
 }
 
 static void test_too_many_beams(void **state)
@@ -596,6 +643,7 @@ int main(void)
         cmocka_unit_test(test_defaults),
         cmocka_unit_test(test_bad_inputs),
         cmocka_unit_test(test_too_many_beams),
+        cmocka_unit_test(test_nul_byte),
         cmocka_unit_test(test_syntax_errors),
         cmocka_unit_test(test_unknown_keys_warn),
         cmocka_unit_test(test_keyframes),
