@@ -28,6 +28,8 @@ struct vfx_context {
     vfx_stats last_stats;       /* counters of the last finished frame */
     char last_error[512];
     unsigned water_dist_tex;    /* shared target owned by the context */
+    unsigned no_depth_tex;      /* far depth for a frame view without depth_texture (frame_check.c) */
+    uint32_t no_depth_w, no_depth_h;
     volfx_debug_knobs debug;
 };
 

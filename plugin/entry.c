@@ -9,6 +9,7 @@
 #include "gpu/gpu.h"
 #include "effect.h"
 #include "context.h"
+#include "frame_check.h"
 
 #ifndef VFX_HAS_WATER_OPS
 #define VFX_HAS_WATER_OPS 0
@@ -45,6 +46,7 @@ static void plugin_destroy(vfx_context *ctx)
             ctx->effect_ops[k]->destroy(ctx, ctx->effect_state[k]);
             ctx->effect_state[k] = NULL;
         }
+    volfx_frame_check_destroy(ctx);
     volfx_gpu_destroy(ctx, ctx->gpu);
     vfx_host_api host = ctx->host;
     if (host.free)
@@ -62,6 +64,12 @@ static vfx_result plugin_create(const vfx_host_api *host, vfx_context **out)
         if (host && host->log)
             host->log(host->user, VFX_LOG_ERROR, "volfx create: host api is NULL or of another version");
         return VFX_ERR_ABI;
+    }
+    char msg[160];
+    if (volfx_check_host(host, msg, sizeof msg)) {
+        if (host->log)
+            host->log(host->user, VFX_LOG_ERROR, msg);
+        return VFX_ERR_INVALID_ARGUMENT;
     }
     vfx_context *ctx = host->alloc ? host->alloc(host->user, sizeof *ctx, 64) : malloc(sizeof *ctx);
     if (!ctx)
@@ -106,6 +114,9 @@ static vfx_result plugin_update(vfx_context *ctx, double time, float dt)
     if (!isfinite(time) || !isfinite(dt))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "update: time %g or dt %g is not finite",
                         time, (double)dt);
+    char msg[160];
+    if (volfx_check_host(&ctx->host, msg, sizeof msg))
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "update: %s", msg);
     for (int k = 0; k < VFX_EFFECT_COUNT; ++k) {
         const volfx_effect_ops *ops = ctx->effect_ops[k];
         if (!ops)
@@ -178,8 +189,17 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
         targets.environment_cubemap = f2->environment_cubemap;
     }
 
-    ctx->stats.count = 0;
     uint32_t mask = frame->effects ? frame->effects : 0xffffffffu;
+    bool drawing = false;
+    for (int k = 0; k < VFX_EFFECT_COUNT; ++k)
+        drawing |= ctx->effect_state[k] && (mask & VFX_EFFECT_BIT(k));
+    vfx_frame_view2 checked; /* what the effects read: validated, near/far filled */
+    vfx_result cr = volfx_check_frame(ctx, frame, drawing, &checked, &targets);
+    if (cr)
+        return cr;
+    frame = &checked.v1;
+
+    ctx->stats.count = 0;
     static const vfx_effect_kind order[VFX_EFFECT_COUNT] = {VFX_EFFECT_WATER, VFX_EFFECT_VOLUME,
                                                             VFX_EFFECT_BEAMS};
     vfx_result result = VFX_OK;
@@ -196,8 +216,10 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
 
 static vfx_result plugin_get_stats(vfx_context *ctx, vfx_stats *out)
 {
-    if (!ctx || !out)
+    if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
+    if (!out)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "get_stats: out is NULL");
     if (out->size < sizeof(vfx_stats))
         return volfx_fail(ctx, VFX_ERR_ABI, "get_stats: stats struct size %u < %zu", out->size,
                         sizeof(vfx_stats));
@@ -209,8 +231,10 @@ static const char *plugin_last_error(vfx_context *ctx) { return ctx ? ctx->last_
 
 static vfx_result plugin_read_raw(vfx_context *ctx, vfx_effect_kind effect, float *out, size_t count)
 {
-    if (!ctx || !out)
+    if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
+    if (!out)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "read_raw: out is NULL (count %zu)", count);
     if ((unsigned)effect >= VFX_EFFECT_COUNT)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "read_raw: effect %d out of range", (int)effect);
     if (!ctx->effect_ops[effect])

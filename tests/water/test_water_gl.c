@@ -69,8 +69,8 @@ static ref_water_error render_and_compare(scene *s, const ref_camera *cam, vfx_s
     glCreateFramebuffers(1, &fbo);
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, col, 0);
     vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = fbo,
-                         .width = w, .height = h, .fov_y = (float)cam->fov_y, .near_plane = 0.1f,
-                         .far_plane = 100.0f};
+                         .width = w, .height = h, .fov_y = (float)cam->fov_y,
+                         .near_plane = (float)cam->near_plane, .far_plane = (float)cam->far_plane};
     for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam->eye[k];
     ref_camera_matrices(cam, fv.view, fv.proj);
     assert_int_equal(api.update(ctx, 0.0, 0.0f), VFX_OK);
@@ -500,7 +500,8 @@ static void session_open(session *ss, scene *s, const ref_camera *cam, const flo
     glNamedFramebufferTexture(ss->fbo, GL_COLOR_ATTACHMENT0, ss->col, 0);
     ss->fv = (vfx_frame_view){.size = sizeof ss->fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = ss->fbo,
                               .color_texture = ss->scene_col, .width = w, .height = h,
-                              .fov_y = (float)cam->fov_y, .near_plane = 0.1f, .far_plane = 100.0f};
+                              .fov_y = (float)cam->fov_y, .near_plane = (float)cam->near_plane,
+                              .far_plane = (float)cam->far_plane};
     for (int k = 0; k < 3; ++k) ss->fv.eye[k] = (float)cam->eye[k];
     ref_camera_matrices(cam, ss->fv.view, ss->fv.proj);
 }

@@ -1,0 +1,275 @@
+/* test_frame_check.c — issue 18, defects 7 and 8: what the plugin checks at the ABI. Host
+ * callback pairs at create and update; every frame-view field: texture names, targets, formats
+ * and sizes (GL queries), the framebuffer, near/far against the projection, the effects mask;
+ * depth_texture 0 drawing as "nothing occludes" (the beams vanished before); read_raw and
+ * get_stats with NULL writing their own error instead of leaving a stale one. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <epoxy/gl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "camera_ref.h"
+#include "debug.h"
+#include "gpu/gpu.h"
+#include "test_util.h"
+
+#define W 32
+#define H 32
+
+static rt_gl_context *g_gl;
+
+static vfx_result one_beam(void *user, vfx_beams_view *out)
+{
+    (void)user;
+    static const vfx_beam b = {.head = {-1, 0, 0}, .length = 2, .dir = {1, 0, 0}, .radius = 0.6f,
+                               .a = 0.5f, .b = 0.5f, .eps = 0.05f, .color = {1, 1, 1, 1}};
+    *out = (vfx_beams_view){.size = sizeof *out, .version = VFX_BEAMS_VIEW_VERSION, .count = 1, .beams = &b};
+    return VFX_OK;
+}
+static uint32_t one_chunk(void *user) { (void)user; return 1; }
+static uint32_t one_volume(void *user) { (void)user; return 1; }
+static void host_free(void *user, void *p) { (void)user; free(p); }
+
+static const vfx_plugin_api *plugin_api(void)
+{
+    static vfx_plugin_api api;
+    api.size = sizeof api;
+    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
+    return &api;
+}
+
+static vfx_host_api beams_host(test_log *log)
+{
+    return (vfx_host_api){.size = sizeof(vfx_host_api), .version = VFX_HOST_API_VERSION, .user = log,
+                          .log = test_log_fn, .beams = one_beam};
+}
+
+typedef struct fixture {
+    GLuint color, depth, far_depth, out_tex, fbo, small, cube;
+    vfx_frame_view fv;
+} fixture;
+
+static void make_fixture(fixture *f)
+{
+    glCreateTextures(GL_TEXTURE_2D, 1, &f->color);
+    glTextureStorage2D(f->color, 1, GL_RGBA8, W, H);
+    glCreateTextures(GL_TEXTURE_2D, 1, &f->depth);
+    glTextureStorage2D(f->depth, 1, GL_DEPTH_COMPONENT32F, W, H);
+    const float one = 1.0f;
+    glClearTexImage(f->depth, 0, GL_DEPTH_COMPONENT, GL_FLOAT, &one);
+    glCreateTextures(GL_TEXTURE_2D, 1, &f->small);
+    glTextureStorage2D(f->small, 1, GL_DEPTH_COMPONENT32F, W / 2, H / 2);
+    glCreateTextures(GL_TEXTURE_CUBE_MAP, 1, &f->cube);
+    glTextureStorage2D(f->cube, 1, GL_RGBA8, 8, 8);
+    glCreateTextures(GL_TEXTURE_2D, 1, &f->out_tex);
+    glTextureStorage2D(f->out_tex, 1, GL_RGBA8, W, H);
+    glCreateFramebuffers(1, &f->fbo);
+    glNamedFramebufferTexture(f->fbo, GL_COLOR_ATTACHMENT0, f->out_tex, 0);
+    ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8, W, H, 0.1, 100};
+    f->fv = (vfx_frame_view){.size = sizeof(vfx_frame_view), .version = VFX_FRAME_VIEW_VERSION,
+                             .framebuffer = f->fbo, .color_texture = f->color, .depth_texture = f->depth,
+                             .width = W, .height = H, .eye = {0, 0, 5}, .near_plane = 0.1f,
+                             .far_plane = 100.0f, .fov_y = 0.8f};
+    ref_camera_matrices(&cam, f->fv.view, f->fv.proj);
+}
+
+static void free_fixture(fixture *f)
+{
+    GLuint t[] = {f->color, f->depth, f->small, f->cube, f->out_tex};
+    glDeleteTextures(5, t);
+    glDeleteFramebuffers(1, &f->fbo);
+}
+
+static double max_h(const vfx_plugin_api *api, vfx_context *ctx)
+{
+    static float h[W * H];
+    assert_int_equal(api->read_raw(ctx, VFX_EFFECT_BEAMS, h, W * H), VFX_OK);
+    double m = 0;
+    for (int i = 0; i < W * H; ++i)
+        m = h[i] > m ? h[i] : m;
+    return m;
+}
+
+/* Renders fv and expects `code` and a message containing `part` (NULL: expect VFX_OK). */
+static void expect(const vfx_plugin_api *api, vfx_context *ctx, const vfx_frame_view *fv, vfx_result code,
+                   const char *part)
+{
+    vfx_result r = api->render(ctx, fv);
+    const char *msg = api->last_error(ctx);
+    if (r != code || (part && !strstr(msg, part)))
+        fail_msg("render: got %d \"%s\", want %d containing \"%s\"", r, msg, code, part ? part : "");
+    assert_null(volfx_gpu_error_string()); /* the checks leave no GL error behind */
+}
+
+static void test_frame_fields(void **state)
+{
+    (void)state;
+    test_log log = {0};
+    vfx_host_api host = beams_host(&log);
+    const vfx_plugin_api *api = plugin_api();
+    vfx_context *ctx;
+    assert_int_equal(api->create(&host, &ctx), VFX_OK);
+    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_OK);
+    fixture f;
+    make_fixture(&f);
+    expect(api, ctx, &f.fv, VFX_OK, NULL);
+    double h_ref = max_h(api, ctx);
+    assert_true(h_ref > 0.1); /* the beam is in view */
+    vfx_frame_view v = f.fv;
+    /* depth_texture 0: no host depth, nothing occludes; the beams drew nothing before */
+    v.depth_texture = 0;
+    expect(api, ctx, &v, VFX_OK, NULL);
+    assert_true(fabs(max_h(api, ctx) - h_ref) <= 1e-6 * h_ref);
+    v = f.fv;
+    v.depth_texture = f.color; /* a colour format as depth */
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "depth_texture");
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "not a depth format");
+    v = f.fv;
+    v.color_texture = f.depth;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "color_texture");
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "not a colour format");
+    v = f.fv;
+    v.depth_texture = 4242;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "frame view depth_texture 4242 is not a texture name");
+    v = f.fv;
+    v.depth_texture = f.small;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "depth_texture");
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "is 16x16, the frame view 32x32");
+    v = f.fv;
+    v.color_texture = f.cube;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "is a GL_TEXTURE_CUBE_MAP texture, need GL_TEXTURE_2D");
+    /* a frame view four times larger than its textures */
+    v = f.fv;
+    v.width = 2 * W, v.height = 2 * H;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "framebuffer");
+    v.framebuffer = 0;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "color_texture");
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "is 32x32, the frame view 64x64");
+    v = f.fv;
+    v.framebuffer = 777;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "framebuffer 777 is not a framebuffer name");
+    /* near/far: swapped fields; fields that disagree with the projection; a projection built
+     * with near > far (two frames of that took 4 minutes in the water march) */
+    v = f.fv;
+    v.near_plane = 100, v.far_plane = 0.1f;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "far_plane 0.1 must be finite and > near_plane 100");
+    v = f.fv;
+    v.near_plane = 0.5f;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "near_plane 0.5, but proj has near 0.1");
+    v = f.fv;
+    v.far_plane = 50;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "far_plane 50, but proj has far 100");
+    v = f.fv;
+    ref_camera bad = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8, W, H, 100, 0.1};
+    ref_camera_matrices(&bad, v.view, v.proj);
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "proj maps near");
+    v = f.fv;
+    v.near_plane = v.far_plane = 0; /* both 0: taken from the projection */
+    expect(api, ctx, &v, VFX_OK, NULL);
+    assert_true(fabs(max_h(api, ctx) - h_ref) <= 1e-6 * h_ref);
+    v = f.fv;
+    v.near_plane = NAN;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "near_plane nan must be > 0");
+    v = f.fv;
+    v.fov_y = 4;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "fov_y 4 outside [0, pi)");
+    v = f.fv;
+    v.eye[1] = INFINITY;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "eye[1] is not finite");
+    v = f.fv;
+    v.effects = 1u << 9;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "effects 0x200 has bits of no effect");
+    /* version 2: the cubemap must be one */
+    vfx_frame_view2 v2 = {.v1 = f.fv};
+    v2.v1.size = sizeof v2, v2.v1.version = VFX_FRAME_VIEW2_VERSION;
+    v2.environment_cubemap = f.color;
+    expect(api, ctx, &v2.v1, VFX_ERR_INVALID_ARGUMENT,
+           "environment_cubemap");
+    expect(api, ctx, &v2.v1, VFX_ERR_INVALID_ARGUMENT, "is a GL_TEXTURE_2D texture, need GL_TEXTURE_CUBE_MAP");
+    v2.environment_cubemap = f.cube;
+    expect(api, ctx, &v2.v1, VFX_OK, NULL);
+    /* a frame view of the wrong size is reported as that */
+    v = f.fv;
+    v.size = 8;
+    expect(api, ctx, &v, VFX_ERR_ABI, "frame view of version 1 has size 8 (need");
+    /* the last good frame still renders */
+    expect(api, ctx, &f.fv, VFX_OK, NULL);
+    /* NULL outputs: their own error, not the last one */
+    assert_int_equal(api->render(ctx, &v), VFX_ERR_ABI);
+    assert_int_equal(api->read_raw(ctx, VFX_EFFECT_BEAMS, NULL, 0), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(api->last_error(ctx), "read_raw: out is NULL"));
+    assert_int_equal(api->get_stats(ctx, NULL), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(api->last_error(ctx), "get_stats: out is NULL"));
+    api->destroy(ctx);
+    free_fixture(&f);
+    assert_null(volfx_gpu_error_string());
+}
+
+/* No effect will draw: nothing is queried (an absent effect costs nothing), but the planes are
+ * still checked. */
+static void test_nothing_drawn(void **state)
+{
+    (void)state;
+    test_log log = {0};
+    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &log, .log = test_log_fn};
+    const vfx_plugin_api *api = plugin_api();
+    vfx_context *ctx;
+    assert_int_equal(api->create(&host, &ctx), VFX_OK);
+    fixture f;
+    make_fixture(&f);
+    vfx_frame_view v = f.fv;
+    v.depth_texture = 4242;
+    expect(api, ctx, &v, VFX_OK, NULL);
+    v.near_plane = 100, v.far_plane = 0.1f;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "far_plane");
+    api->destroy(ctx);
+    free_fixture(&f);
+}
+
+/* Defect 7: a callback without its partner called through NULL (particle_chunk_count set,
+ * particle_chunk NULL). Refused at create, naming both; at update when the copy changed. */
+static void test_callback_pairs(void **state)
+{
+    (void)state;
+    test_log log = {0};
+    const vfx_plugin_api *api = plugin_api();
+    vfx_context *ctx = (vfx_context *)&log;
+    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &log, .log = test_log_fn,
+                         .particle_chunk_count = one_chunk};
+    assert_int_equal(api->create(&host, &ctx), VFX_ERR_INVALID_ARGUMENT);
+    assert_null(ctx);
+    assert_non_null(strstr(log.last, "particle_chunk_count is set but particle_chunk is NULL"));
+    host.particle_chunk_count = NULL;
+    host.volume_count = one_volume;
+    assert_int_equal(api->create(&host, &ctx), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(log.last, "volume_count is set but volume is NULL"));
+    host.volume_count = NULL;
+    host.free = host_free;
+    assert_int_equal(api->create(&host, &ctx), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(log.last, "free is set but alloc is NULL"));
+    host.free = NULL;
+    assert_int_equal(api->create(&host, &ctx), VFX_OK);
+    ctx->host.particle_chunk_count = one_chunk; /* the copy damaged after create */
+    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(api->last_error(ctx), "update: host api: particle_chunk_count is set"));
+    api->destroy(ctx);
+}
+
+int main(void)
+{
+    g_gl = test_gl_or_skip();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_frame_fields),
+        cmocka_unit_test(test_nothing_drawn),
+        cmocka_unit_test(test_callback_pairs),
+    };
+    int rc = cmocka_run_group_tests(tests, NULL, NULL);
+    rt_gl_context_destroy(g_gl);
+    return rc;
+}
