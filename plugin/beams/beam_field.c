@@ -24,24 +24,32 @@ static double log1p_over_d(double z) { return z > 0 ? log1p(z) / z : 1.0; }
 #define R_SQRT sqrtf
 #define R_FMA fmaf
 #define R_LOG1P_OVER log1p_over_f
+#define R_EDGE_TERMS 12   /* (1/4)^12 = 6e-8 */
+#define R_SERIES_TERMS 24 /* (1/2)^24 = 6e-8: under float epsilon */
 #include "beam_field_impl.inc"
 #undef REAL
 #undef SFX
 #undef R_SQRT
 #undef R_FMA
 #undef R_LOG1P_OVER
+#undef R_SERIES_TERMS
+#undef R_EDGE_TERMS
 
 #define REAL double
 #define SFX(n) n##_d
 #define R_SQRT sqrt
 #define R_FMA fma
 #define R_LOG1P_OVER log1p_over_d
+#define R_EDGE_TERMS 27   /* (1/4)^27 = 6e-17 */
+#define R_SERIES_TERMS 54 /* (1/2)^54 = 6e-17: under double epsilon */
 #include "beam_field_impl.inc"
 #undef REAL
 #undef SFX
 #undef R_SQRT
 #undef R_FMA
 #undef R_LOG1P_OVER
+#undef R_SERIES_TERMS
+#undef R_EDGE_TERMS
 
 vfx_result volfx_beam_validate(const vfx_beam *in, volfx_beam_d *out, char *err, size_t errlen)
 {
@@ -73,6 +81,7 @@ vfx_result volfx_beam_validate(const vfx_beam *in, volfx_beam_d *out, char *err,
     out->a = in->a;
     out->b = in->b;
     out->eps = in->eps;
+    out->smooth = 0; /* a v1 beam has the hard support; volfx_beam_validate2 sets the falloff */
     return VFX_OK;
 }
 
@@ -81,12 +90,21 @@ float volfx_beam_integral_f(const volfx_beam_d *bm, const float O[3], const floa
     float M[3] = {(float)bm->head[0], (float)bm->head[1], (float)bm->head[2]};
     float D[3] = {(float)bm->dir[0], (float)bm->dir[1], (float)bm->dir[2]};
     return beam_integral_f(M, D, (float)bm->length, (float)bm->radius, (float)bm->a, (float)bm->b,
-                           (float)bm->eps, O, V, t0, t1);
+                           (float)bm->eps, bm->smooth, O, V, t0, t1);
 }
 
 double volfx_beam_integral_d(const volfx_beam_d *bm, const double O[3], const double V[3], double t0, double t1)
 {
-    return beam_integral_d(bm->head, bm->dir, bm->length, bm->radius, bm->a, bm->b, bm->eps, O, V, t0, t1);
+    return beam_integral_d(bm->head, bm->dir, bm->length, bm->radius, bm->a, bm->b, bm->eps, bm->smooth, O, V, t0, t1);
+}
+
+/* w(r) = (1 - r^2/R^2)^2 for the smooth support, 1 for the hard one (r^2 <= R^2 here). */
+static double falloff_d(const volfx_beam_d *bm, double r2)
+{
+    if (!bm->smooth)
+        return 1.0;
+    double q = 1.0 - r2 / (bm->radius * bm->radius);
+    return q * q;
 }
 
 double volfx_beam_density_d(const volfx_beam_d *bm, const double p[3])
@@ -100,7 +118,7 @@ double volfx_beam_density_d(const volfx_beam_d *bm, const double p[3])
     }
     double R2 = bm->radius * bm->radius, rho = 0;
     if (d2 <= R2)
-        rho += bm->a / sqrt(d2 + e * e);
+        rho += bm->a * falloff_d(bm, d2) / sqrt(d2 + e * e);
     double r2;
     if (u < 0) {
         r2 = d2;
@@ -118,6 +136,6 @@ double volfx_beam_density_d(const volfx_beam_d *bm, const double p[3])
         }
     }
     if (r2 <= R2)
-        rho += bm->b / sqrt(r2 + e * e);
+        rho += bm->b * falloff_d(bm, r2) / sqrt(r2 + e * e);
     return rho;
 }

@@ -23,6 +23,7 @@
 typedef struct volfx_beam_d {
     double head[3], dir[3];
     double length, radius, a, b, eps;
+    int smooth; /* 1: densities times w(r) = (1 - (r/R)^2)^2 (the smooth support), 0: hard */
 } volfx_beam_d;
 
 /* Checks a beam (finite, L >= 0, R > 0, a, b, eps >= 0, D not zero) and normalises D into out;
@@ -33,6 +34,11 @@ vfx_result volfx_beam_validate(const vfx_beam *in, volfx_beam_d *out, char *err,
  * cancellation: float and double versions of the same code. */
 float volfx_beam_segment_integral_f(float x0, float x1, float s, float beta, float Q);
 double volfx_beam_segment_integral_d(double x0, double x1, double s, double beta, double Q);
+/* The smooth support's piece: integral over x in [x0, x1] of (h^2 - y^2)^2 / sqrt(y^2 + Q^2),
+ * y = s x + beta, for |y| <= h (values in units of R, h and Q of order 1 or less). */
+float volfx_beam_segment_integral_smooth_f(float x0, float x1, float s, float beta, float Q, float h);
+double volfx_beam_segment_integral_smooth_d(double x0, double x1, double s, double beta, double Q,
+                                            double h);
 
 /* H of one beam along the ray origin + t*dir (|dir| = 1), t in [t0, t1]. _f is float32
  * throughout (it mirrors the GLSL), _d float64. */

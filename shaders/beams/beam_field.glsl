@@ -55,6 +55,86 @@ float volfx_segment_integral(float x0, float x1, float s, float beta, float Q)
     return volfx_same_sign(y0, y1, dx, s, Q);
 }
 
+// the smooth support's piece (beam_field_impl.inc smooth_same_sign): 0 <= lo <= hi <= h, units
+// of R; edge series near the support edge, binomial series when grazing, closed form elsewhere
+const int VOLFX_EDGE_TERMS = 12;
+const int VOLFX_SERIES_TERMS = 24;
+float volfx_smooth_same_sign(float lo, float hi, float dx, float s, float Q, float h)
+{
+    hi = min(hi, h);
+    lo = min(lo, hi);
+    float Q2 = Q * Q, h2 = h * h, rho = sqrt(h2 + Q2);
+    if (4.0 * (h - lo) <= rho) {
+        float x = h / rho, zl = (h - lo) / rho, zh = (h - hi) / rho;
+        float e3 = zl * zl + zl * zh + zh * zh, pw = zh * zh * zh;
+        float e4 = zl * e3 + pw;
+        pw *= zh;
+        float e5 = zl * e4 + pw;
+        pw *= zh;
+        float P = 1.0, Pm = 0.0, sum = 0.0;
+        for (int n = 0; n < VOLFX_EDGE_TERMS; ++n) {
+            float k = float(n + 3);
+            sum += P * (4.0 * x * x * e3 / k - 4.0 * x * e4 / (k + 1.0) + e5 / (k + 2.0));
+            e3 = e4;
+            e4 = e5;
+            e5 = zl * e5 + pw;
+            pw *= zh;
+            float Pn = (float(2 * n + 1) * x * P - float(n) * Pm) / float(n + 1);
+            Pm = P;
+            P = Pn;
+        }
+        return dx * rho * rho * rho * sum;
+    }
+    if (2.0 * h2 < Q2) {
+        float u0 = lo / h, u1 = hi / h, m = h2 / Q2;
+        float E0 = 1.0, P = u0, u11 = u1 * u1, us = u1 + u0, u00 = u0 * u0;
+        float E1 = u11 * E0 + P * us;
+        P *= u00;
+        float E2 = u11 * E1 + P * us;
+        P *= u00;
+        float c = 1.0, mn = 1.0, sum = 0.0;
+        for (int n = 0; n < VOLFX_SERIES_TERMS; ++n) {
+            float k = float(2 * n + 1);
+            sum += c * mn * (E0 / k - 2.0 * E1 / (k + 2.0) + E2 / (k + 4.0));
+            E0 = E1;
+            E1 = E2;
+            E2 = u11 * E1 + P * us;
+            P *= u00;
+            c *= -float(2 * n + 1) / float(2 * n + 2);
+            mn *= m;
+        }
+        return h2 * h2 * dx / Q * sum;
+    }
+    float c0 = h2 * h2 + h2 * Q2 + 0.375 * Q2 * Q2, kappa = h2 + 0.375 * Q2;
+    float S0 = sqrt(lo * lo + Q2), S1 = sqrt(hi * hi + Q2);
+    float dT = S1 + lo * (hi + lo) / (S1 + S0);
+    float g = dT * (hi * hi * 0.25 - kappa) + lo * S0 * (hi + lo) * 0.25;
+    return c0 * volfx_same_sign(lo, hi, dx, s, Q) + dx * g;
+}
+
+float volfx_segment_integral_smooth(float x0, float x1, float s, float beta, float Q, float h)
+{
+    float dx = x1 - x0;
+    if (!(dx > 0.0) || !(Q > 0.0) || !(h > 0.0))
+        return 0.0;
+    float y0 = s * x0 + beta, y1 = s * x1 + beta;
+    if (y0 < 0.0 && y1 > 0.0) {
+        float xa = dx * (-y0) / (y1 - y0);
+        return volfx_smooth_same_sign(0.0, -y0, xa, s, Q, h) + volfx_smooth_same_sign(0.0, y1, dx - xa, s, Q, h);
+    }
+    if (y1 <= 0.0)
+        return volfx_smooth_same_sign(-y1, -y0, dx, s, Q, h);
+    return volfx_smooth_same_sign(y0, y1, dx, s, Q, h);
+}
+
+float volfx_piece(float x0, float x1, float s, float beta, float Q, float h, float R, bool smooth)
+{
+    if (!smooth)
+        return volfx_segment_integral(x0, x1, s, beta, Q);
+    float ir = 1.0 / R;
+    return volfx_segment_integral_smooth(x0, x1, s * ir, beta * ir, Q * ir, h * ir) * ir;
+}
+
 // restricts [lo, hi] to u0 + c x in [umin, umax) (half-open: a ray in a boundary plane counts once)
 void volfx_clip_linear(float u0, float c, float umin, float umax, inout float lo, inout float hi)
 {
@@ -74,7 +154,7 @@ void volfx_clip_linear(float u0, float c, float umin, float umax, inout float lo
 }
 
 float volfx_sphere_piece(vec3 g, vec3 V, float R, float eps, float ta, float tb, float u0, float c,
-                       float umin, float umax)
+                       float umin, float umax, bool smooth)
 {
     float gv = dot(g, V);
     vec3 gp = g - gv * V;
@@ -85,17 +165,17 @@ float volfx_sphere_piece(vec3 g, vec3 V, float R, float eps, float ta, float tb,
     float lo = ta, hi = tb;
     volfx_clip_linear(u0, c, umin, umax, lo, hi);
     float slo = max(lo + gv, -h), shi = min(hi + gv, h);
-    return volfx_segment_integral(slo, shi, 1.0, 0.0, sqrt(dd + eps * eps));
+    return volfx_piece(slo, shi, 1.0, 0.0, sqrt(dd + eps * eps), h, R, smooth);
 }
 
 float volfx_cylinder_piece(vec3 wp, vec3 V, vec3 D, float L, float R, float eps, float ta, float tb,
-                         float u0, float c)
+                         float u0, float c, bool smooth)
 {
     float wd = dot(wp, D);
     vec3 a = wp - wd * D;
     vec3 b = volfx_cross_acc(volfx_cross_acc(D, V), D);
     float s = sqrt(dot(b, b));
-    float beta = 0.0, rr, lo = ta, hi = tb;
+    float beta = 0.0, rr, hc, lo = ta, hi = tb;
     if (s > 0.0) {
         vec3 bh = b / s;
         beta = dot(a, bh);
@@ -103,20 +183,21 @@ float volfx_cylinder_piece(vec3 wp, vec3 V, vec3 D, float L, float R, float eps,
         rr = dot(q, q);
         if (rr >= R * R)
             return 0.0;
-        float hc = sqrt(R * R - rr);
+        hc = sqrt(R * R - rr);
         volfx_clip_linear(beta, s, -hc, hc, lo, hi);
     } else {
         rr = dot(a, a);
         if (rr > R * R)
             return 0.0;
+        hc = sqrt(R * R - rr);
     }
     volfx_clip_linear(u0, c, 0.0, L, lo, hi);
-    return volfx_segment_integral(lo, hi, s, beta, sqrt(rr + eps * eps));
+    return volfx_piece(lo, hi, s, beta, sqrt(rr + eps * eps), hc, R, smooth);
 }
 
 // H of one beam along t*V (origin = eye = 0), t in [t0, t1]; M is relative to the eye.
-float volfx_beam_integral(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, vec3 V,
-                        float t0, float t1)
+float volfx_beam_integral(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, bool smooth,
+                        vec3 V, float t0, float t1)
 {
     if (!(t1 > t0))
         return 0.0;
@@ -128,27 +209,30 @@ float volfx_beam_integral(vec3 M, vec3 D, float L, float R, float a, float b, fl
     float c = dot(V, D), u0 = dot(wp, D);
     float H = 0.0;
     if (a > 0.0)
-        H += a * volfx_sphere_piece(wp, V, R, eps, ta, tb, 0.0, 0.0, -1.0, 1.0);
+        H += a * volfx_sphere_piece(wp, V, R, eps, ta, tb, 0.0, 0.0, -1.0, 1.0, smooth);
     if (b > 0.0) {
         const float inf = 1e30;
-        H += b * volfx_sphere_piece(wp, V, R, eps, ta, tb, u0, c, -inf, 0.0);
-        H += b * volfx_cylinder_piece(wp, V, D, L, R, eps, ta, tb, u0, c);
-        H += b * volfx_sphere_piece(wp - L * D, V, R, eps, ta, tb, u0, c, L, inf);
+        H += b * volfx_sphere_piece(wp, V, R, eps, ta, tb, u0, c, -inf, 0.0, smooth);
+        H += b * volfx_cylinder_piece(wp, V, D, L, R, eps, ta, tb, u0, c, smooth);
+        H += b * volfx_sphere_piece(wp - L * D, V, R, eps, ta, tb, u0, c, L, inf, smooth);
     }
     return H;
 }
 
 // the raw density (for the ray-marching baseline), P relative to the eye
-float volfx_beam_density(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, vec3 P)
+float volfx_beam_density(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, bool smooth,
+                         vec3 P)
 {
     float eps = max(eps_in, VOLFX_BEAM_EPS_FLOOR * R);
     vec3 d = P - M;
     float d2 = dot(d, d), u = dot(d, D), rho = 0.0;
+    float wh = smooth ? (1.0 - d2 / (R * R)) * (1.0 - d2 / (R * R)) : 1.0;
     if (d2 <= R * R)
-        rho += a / sqrt(d2 + eps * eps);
+        rho += a * wh / sqrt(d2 + eps * eps);
     vec3 q = u < 0.0 ? d : (u > L ? d - L * D : d - u * D);
     float r2 = dot(q, q);
+    float wt = smooth ? (1.0 - r2 / (R * R)) * (1.0 - r2 / (R * R)) : 1.0;
     if (r2 <= R * R)
-        rho += b / sqrt(r2 + eps * eps);
+        rho += b * wt / sqrt(r2 + eps * eps);
     return rho;
 }
