@@ -1,29 +1,55 @@
 /* beams_effect.c — seed 003 on the GPU: beams binned to screen tiles on the CPU, one
  * fullscreen pass integrating the closed form per pixel up to the host's depth (and the
- * water's), one pass adding the light into the host frame. */
+ * water's) and turning it into linear radiance (RGBA16F), an optional bloom chain over that
+ * light, one pass adding it into the host frame. Host views of version 1 and 2 are read. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "beams/beam_field.h"
 #include "gpu/gpu.h"
+#include "gpu/pass.h"
 #include "effect.h"
 
 #define TILE_PX 16
 #define MAX_BEAMS (1u << 20)
+#define MAX_BLOOM_LEVELS 8
 
+/* std430, mirrors struct Beam in shaders/beams/integrate.frag */
 typedef struct beam_gpu {
-    float m_l[4], d_r[4], ab_eps[4], color[4];
+    float m_l[4], d_r[4], ab_eps[4], color[4], look[4];
+    uint32_t mode[4];
 } beam_gpu;
 
+/* std140, mirrors BeamsFrame in shaders/beams/frame.glsl */
+typedef struct beams_block {
+    float inv_rot_view_proj[16];
+    float far, c;
+    int32_t tile_px, tiles_x, samples, has_water, smooth_saturation, bloom;
+    float bloom_gain, _pad[3];
+} beams_block;
+
+/* The look of one beam, resolved from a version 2 beam or version 1 defaults. */
+typedef struct beam_look {
+    float intensity, exposure, flow_amount, flow_speed, flow_scale;
+    float color[4];  /* the beam's colour; all 0 -> white */
+    bool thesis;
+} beam_look;
+
 typedef struct beams_state {
-    GLuint prog_closed, prog_march, prog_composite;
+    GLuint prog_closed, prog_march, prog_composite, prog_down, prog_up;
     GLuint beam_buf, range_buf, list_buf;
     size_t beam_cap, range_cap, list_cap; /* bytes */
-    GLuint acc_tex, acc_fbo;
+    GLuint acc_tex, light_tex, acc_fbo;   /* H (R32F) and light (RGBA16F), one framebuffer */
+    GLuint bloom_tex[MAX_BLOOM_LEVELS + 1], bloom_fbo[MAX_BLOOM_LEVELS + 1]; /* [1..levels] */
+    uint32_t bloom_w[MAX_BLOOM_LEVELS + 1], bloom_h[MAX_BLOOM_LEVELS + 1];
+    uint32_t bloom_levels;                /* allocated levels */
+    volfx_ubo ubo;
     uint32_t width, height, tiles_x, tiles_y;
-    vfx_beams_view view;
+    vfx_beams_view2 view;                 /* the host's answer; v1 answers padded with defaults */
+    double time;
     volfx_beam_d *beams;        /* validated, normalised */
+    beam_look *looks;
     beam_gpu *gpu;
     uint32_t (*rects)[4];     /* per beam: its tile rectangle this frame */
     bool *visible;            /* per beam: on screen this frame */
@@ -32,10 +58,32 @@ typedef struct beams_state {
     uint32_t list_capacity;
 } beams_state;
 
+/* Asks the host for its view, offering version 2; a version 1 answer leaves the rest zero. */
+static vfx_result query_view(vfx_context *ctx, vfx_beams_view2 *v)
+{
+    memset(v, 0, sizeof *v);
+    v->v1.size = sizeof *v;
+    v->v1.version = VFX_BEAMS_VIEW2_VERSION;
+    vfx_result r = ctx->host.beams(ctx->host.user, &v->v1);
+    if (r == VFX_OK && v->v1.version == VFX_BEAMS_VIEW_VERSION)
+        memset((char *)v + sizeof v->v1, 0, sizeof *v - sizeof v->v1); /* nothing a v1 host wrote */
+    return r;
+}
+
 static bool beams_present(vfx_context *ctx)
 {
-    vfx_beams_view v = {.size = sizeof v, .version = VFX_BEAMS_VIEW_VERSION};
-    return ctx->host.beams && ctx->host.beams(ctx->host.user, &v) == VFX_OK && v.count > 0;
+    vfx_beams_view2 v;
+    return ctx->host.beams && query_view(ctx, &v) == VFX_OK && v.v1.count > 0;
+}
+
+static void free_bloom(beams_state *s)
+{
+    for (uint32_t i = 1; i <= s->bloom_levels; ++i) {
+        glDeleteTextures(1, &s->bloom_tex[i]);
+        glDeleteFramebuffers(1, &s->bloom_fbo[i]);
+        s->bloom_tex[i] = s->bloom_fbo[i] = 0;
+    }
+    s->bloom_levels = 0;
 }
 
 static void beams_destroy(vfx_context *ctx, void *state)
@@ -46,8 +94,12 @@ static void beams_destroy(vfx_context *ctx, void *state)
     GLuint bufs[3] = {s->beam_buf, s->range_buf, s->list_buf};
     glDeleteBuffers(3, bufs);
     glDeleteTextures(1, &s->acc_tex);
+    glDeleteTextures(1, &s->light_tex);
     glDeleteFramebuffers(1, &s->acc_fbo);
+    free_bloom(s);
+    volfx_ubo_destroy(&s->ubo);
     volfx_free(ctx, s->beams);
+    volfx_free(ctx, s->looks);
     volfx_free(ctx, s->gpu);
     volfx_free(ctx, s->rects);
     volfx_free(ctx, s->visible);
@@ -63,7 +115,10 @@ static vfx_result beams_create(vfx_context *ctx, void **out)
         return VFX_ERR_OUT_OF_MEMORY;
     s->prog_closed = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag", NULL);
     s->prog_composite = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/composite.frag", NULL);
-    if (!s->prog_closed || !s->prog_composite) {
+    s->prog_down = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/bloom_down.frag", NULL);
+    s->prog_up = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/bloom_up.frag", NULL);
+    if (!s->prog_closed || !s->prog_composite || !s->prog_down || !s->prog_up
+        || !volfx_ubo_create(ctx, &s->ubo, sizeof(beams_block), "beams.frame")) {
         beams_destroy(ctx, s);
         return VFX_ERR_GL;
     }
@@ -77,16 +132,50 @@ static vfx_result beams_create(vfx_context *ctx, void **out)
     return VFX_OK;
 }
 
+static GLuint make_target(GLenum fmt, uint32_t w, uint32_t h, bool linear, const char *label)
+{
+    GLuint t;
+    glCreateTextures(GL_TEXTURE_2D, 1, &t);
+    glTextureStorage2D(t, 1, fmt, (GLsizei)w, (GLsizei)h);
+    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, linear ? GL_LINEAR : GL_NEAREST);
+    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, linear ? GL_LINEAR : GL_NEAREST);
+    glTextureParameteri(t, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(t, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    volfx_gpu_label(GL_TEXTURE, t, label);
+    return t;
+}
+
+/* (Re)makes the bloom chain: level i is the light at 1/2^i of the size, RGBA16F, bilinear. */
+static vfx_result make_bloom(vfx_context *ctx, beams_state *s, uint32_t levels)
+{
+    free_bloom(s);
+    for (uint32_t i = 1; i <= levels; ++i) {
+        uint32_t w = s->width >> i, h = s->height >> i;
+        s->bloom_w[i] = w ? w : 1, s->bloom_h[i] = h ? h : 1;
+        s->bloom_tex[i] = make_target(GL_RGBA16F, s->bloom_w[i], s->bloom_h[i], true, "beams.bloom");
+        glCreateFramebuffers(1, &s->bloom_fbo[i]);
+        glNamedFramebufferTexture(s->bloom_fbo[i], GL_COLOR_ATTACHMENT0, s->bloom_tex[i], 0);
+        s->bloom_levels = i;
+        if (glCheckNamedFramebufferStatus(s->bloom_fbo[i], GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+            return volfx_fail(ctx, VFX_ERR_GL, "beams: bloom level %u incomplete", i);
+    }
+    return VFX_OK;
+}
+
 static vfx_result beams_resize(vfx_context *ctx, void *state, uint32_t w, uint32_t h)
 {
     beams_state *s = state;
     glDeleteTextures(1, &s->acc_tex);
+    glDeleteTextures(1, &s->light_tex);
     glDeleteFramebuffers(1, &s->acc_fbo);
-    glCreateTextures(GL_TEXTURE_2D, 1, &s->acc_tex);
-    glTextureStorage2D(s->acc_tex, 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
-    volfx_gpu_label(GL_TEXTURE, s->acc_tex, "beams.H");
+    free_bloom(s);
+    s->acc_tex = make_target(GL_R32F, w, h, false, "beams.H");
+    s->light_tex = make_target(GL_RGBA16F, w, h, true, "beams.light");
     glCreateFramebuffers(1, &s->acc_fbo);
     glNamedFramebufferTexture(s->acc_fbo, GL_COLOR_ATTACHMENT0, s->acc_tex, 0);
+    glNamedFramebufferTexture(s->acc_fbo, GL_COLOR_ATTACHMENT1, s->light_tex, 0);
+    static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glNamedFramebufferDrawBuffers(s->acc_fbo, 2, bufs);
     if (glCheckNamedFramebufferStatus(s->acc_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
         return volfx_fail(ctx, VFX_ERR_GL, "beams: H target %ux%u incomplete", w, h);
     s->width = w, s->height = h;
@@ -97,45 +186,86 @@ static vfx_result beams_resize(vfx_context *ctx, void *state, uint32_t w, uint32
     return s->ranges ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
 }
 
+/* The look of a version 2 beam, checked; a version 1 beam gets version 1's look. */
+static vfx_result beam_look_of(vfx_context *ctx, uint32_t i, const vfx_beam2 *b2, beam_look *out)
+{
+    *out = (beam_look){.intensity = 1.f, .thesis = true};
+    if (!b2)
+        return VFX_OK;
+    if (b2->falloff > VFX_BEAM_FALLOFF_HARD || b2->ramp > VFX_BEAM_RAMP_THESIS)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: falloff %u / ramp %u unknown", i,
+                          b2->falloff, b2->ramp);
+    if (!(b2->intensity >= 0) || !isfinite(b2->intensity) || !isfinite(b2->exposure)
+        || fabsf(b2->exposure) > 64.f || !(b2->flow_amount >= 0 && b2->flow_amount <= 1)
+        || !isfinite(b2->flow_speed) || !(b2->flow_scale >= 0) || !isfinite(b2->flow_scale))
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                          "beams[%u]: needs intensity >= 0, |exposure| <= 64, flow_amount in [0, 1], finite "
+                          "flow_speed, flow_scale >= 0 (got %g, %g, %g, %g, %g)", i, (double)b2->intensity,
+                          (double)b2->exposure, (double)b2->flow_amount, (double)b2->flow_speed,
+                          (double)b2->flow_scale);
+    out->intensity = b2->intensity > 0 ? b2->intensity : 1.f;
+    out->exposure = b2->exposure;
+    out->flow_amount = b2->flow_amount;
+    out->flow_speed = b2->flow_speed;
+    out->flow_scale = b2->flow_scale;
+    out->thesis = b2->ramp == VFX_BEAM_RAMP_THESIS;
+    return VFX_OK;
+}
+
 static vfx_result beams_update(vfx_context *ctx, void *state, double time, float dt)
 {
-    (void)time, (void)dt;
+    (void)dt;
     beams_state *s = state;
-    vfx_beams_view v = {.size = sizeof v, .version = VFX_BEAMS_VIEW_VERSION};
-    vfx_result r = ctx->host.beams(ctx->host.user, &v);
-    if (r || v.version != VFX_BEAMS_VIEW_VERSION)
-        return volfx_fail(ctx, VFX_ERR_ABI, "beams: host view of version %u (need %u)", v.version,
-                        VFX_BEAMS_VIEW_VERSION);
-    if (v.count > MAX_BEAMS || !v.beams)
+    vfx_beams_view2 v;
+    vfx_result r = query_view(ctx, &v);
+    uint32_t ver = v.v1.version;
+    if (r || (ver != VFX_BEAMS_VIEW_VERSION && ver != VFX_BEAMS_VIEW2_VERSION))
+        return volfx_fail(ctx, VFX_ERR_ABI, "beams: host view of version %u (need %u or %u)", ver,
+                          VFX_BEAMS_VIEW_VERSION, VFX_BEAMS_VIEW2_VERSION);
+    const vfx_beam2 *b2 = ver == VFX_BEAMS_VIEW2_VERSION ? v.beams : NULL;
+    if (v.v1.count > MAX_BEAMS || (!v.v1.beams && !b2))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: %u beams (at most %u, non-NULL array)",
-                        v.count, MAX_BEAMS);
-    if (!(v.saturate_c >= 0) || !isfinite(v.saturate_c) || !(v.far_distance >= 0) || !isfinite(v.far_distance))
+                          v.v1.count, MAX_BEAMS);
+    if (!(v.v1.saturate_c >= 0) || !isfinite(v.v1.saturate_c) || !(v.v1.far_distance >= 0)
+        || !isfinite(v.v1.far_distance))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: saturate_c and far_distance must be finite and >= 0");
-    if (v.count > s->capacity) {
+    if (v.bloom > VFX_BEAMS_BLOOM_OFF || v.bloom_levels > MAX_BLOOM_LEVELS || !(v.bloom_strength >= 0)
+        || !isfinite(v.bloom_strength))
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                          "beams: bloom %u (0..2), bloom_levels %u (0..%u), bloom_strength %g (finite, >= 0)",
+                          v.bloom, v.bloom_levels, MAX_BLOOM_LEVELS, (double)v.bloom_strength);
+    uint32_t n = v.v1.count;
+    if (n > s->capacity) {
         volfx_free(ctx, s->beams);
+        volfx_free(ctx, s->looks);
         volfx_free(ctx, s->gpu);
         volfx_free(ctx, s->rects);
         volfx_free(ctx, s->visible);
-        s->beams = volfx_alloc(ctx, v.count * sizeof *s->beams);
-        s->gpu = volfx_alloc(ctx, v.count * sizeof *s->gpu);
-        s->rects = volfx_alloc(ctx, v.count * sizeof *s->rects);
-        s->visible = volfx_alloc(ctx, v.count * sizeof *s->visible);
-        s->capacity = (s->beams && s->gpu && s->rects && s->visible) ? v.count : 0;
+        s->beams = volfx_alloc(ctx, n * sizeof *s->beams);
+        s->looks = volfx_alloc(ctx, n * sizeof *s->looks);
+        s->gpu = volfx_alloc(ctx, n * sizeof *s->gpu);
+        s->rects = volfx_alloc(ctx, n * sizeof *s->rects);
+        s->visible = volfx_alloc(ctx, n * sizeof *s->visible);
+        s->capacity = (s->beams && s->looks && s->gpu && s->rects && s->visible) ? n : 0;
         if (!s->capacity)
             return VFX_ERR_OUT_OF_MEMORY;
     }
     char err[200];
-    for (uint32_t i = 0; i < v.count; ++i)
-        if (volfx_beam_validate(&v.beams[i], &s->beams[i], err, sizeof err))
+    for (uint32_t i = 0; i < n; ++i) {
+        const vfx_beam *b = b2 ? &b2[i].v1 : &v.v1.beams[i];
+        if (volfx_beam_validate(b, &s->beams[i], err, sizeof err))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: %s", i, err);
-    s->count = v.count;
-    s->view = v;
-    for (uint32_t i = 0; i < v.count; ++i) {
-        const float *c = v.beams[i].color;
+        if ((r = beam_look_of(ctx, i, b2 ? &b2[i] : NULL, &s->looks[i])))
+            return r;
+        s->beams[i].smooth = b2 && b2[i].falloff != VFX_BEAM_FALLOFF_HARD;
+        const float *c = b->color;
         bool none = c[0] == 0 && c[1] == 0 && c[2] == 0;
         for (int k = 0; k < 4; ++k)
-            s->gpu[i].color[k] = none ? 1.f : c[k];
+            s->looks[i].color[k] = none ? 1.f : c[k];
     }
+    s->count = n;
+    s->view = v;
+    s->time = time;
     return VFX_OK;
 }
 
@@ -200,6 +330,7 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
     for (int k = 0; k < 3; ++k)
         eye[k] = -((double)frame->view[k * 4 + 0] * frame->view[12] + (double)frame->view[k * 4 + 1] * frame->view[13]
                    + (double)frame->view[k * 4 + 2] * frame->view[14]);
+    float c = s->view.v1.saturate_c > 0 ? s->view.v1.saturate_c : 1.f;
     uint32_t ntiles = s->tiles_x * s->tiles_y;
     uint32_t (*rects)[4] = s->rects; /* sized with the beams in update: no per-frame allocation */
     bool *visible = s->visible;
@@ -216,7 +347,19 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
             g->d_r[k] = (float)b->dir[k];
         }
         g->m_l[3] = (float)b->length, g->d_r[3] = (float)b->radius;
-        g->ab_eps[0] = (float)b->a, g->ab_eps[1] = (float)b->b, g->ab_eps[2] = (float)b->eps, g->ab_eps[3] = 0;
+        const beam_look *lk = &s->looks[i];
+        float gain = exp2f(lk->exposure), wavelength = lk->flow_scale > 0 ? lk->flow_scale : 2.f * (float)b->radius;
+        g->ab_eps[0] = (float)b->a, g->ab_eps[1] = (float)b->b, g->ab_eps[2] = (float)b->eps;
+        g->ab_eps[3] = 1.f / wavelength;
+        g->look[0] = lk->intensity;
+        g->look[1] = gain / c;
+        g->look[2] = lk->flow_amount;
+        /* the phase wraps at 2^12 wavelengths so float32 keeps its fraction after hours */
+        g->look[3] = (float)fmod(s->time * lk->flow_speed / wavelength, 4096.0);
+        g->mode[0] = (uint32_t)b->smooth, g->mode[1] = lk->thesis, g->mode[2] = g->mode[3] = 0;
+        /* the thesis ramp tints with colour x intensity x 2^exposure (the v1 colour for v1 beams) */
+        for (int k = 0; k < 4; ++k)
+            g->color[k] = lk->color[k] * (lk->thesis && k < 3 ? lk->intensity * gain : 1.f);
         visible[i] = beam_tiles(s, vp_rot, centre, 0.5 * b->length + b->radius, rects[i]);
         if (!visible[i])
             continue;
@@ -262,54 +405,72 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
         || (r = upload(ctx, s->list_buf, &s->list_cap, s->list, pairs * sizeof(uint32_t))))
         return r;
 
-    bool march = s->view.method == 1;
+    bool march = s->view.v1.method == 1;
     GLuint prog = s->prog_closed;
     if (march) {
         if (!s->prog_march)
             s->prog_march = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
-                                            "#define VOLFX_BEAMS_MARCH 1");
+                                              "#define VOLFX_BEAMS_MARCH 1");
         if (!(prog = s->prog_march))
             return VFX_ERR_GL;
     }
-    float far = s->view.far_distance > 0 ? s->view.far_distance : frame->far_plane;
+    /* bloom: on by default for version 2 hosts, off for version 1 ones (their image as it was) */
+    bool v2 = s->view.v1.version == VFX_BEAMS_VIEW2_VERSION;
+    bool bloom = v2 && s->view.bloom != VFX_BEAMS_BLOOM_OFF;
+    uint32_t levels = s->view.bloom_levels ? s->view.bloom_levels : 5;
+    while (levels > 1 && ((s->width >> levels) == 0 || (s->height >> levels) == 0))
+        levels--; /* a tiny target: no level below 1x1 */
+    if (bloom && levels != s->bloom_levels && (r = make_bloom(ctx, s, levels)))
+        return r;
+    float strength = s->view.bloom_strength > 0 ? s->view.bloom_strength : 0.6f;
+    float far = s->view.v1.far_distance > 0 ? s->view.v1.far_distance : frame->far_plane;
     if (!(far > 0))
         far = 1e30f;
-    volfx_gpu_pass_begin(ctx, march ? "beams.march" : "beams.integrate");
-    glBindFramebuffer(GL_FRAMEBUFFER, s->acc_fbo);
-    glViewport(0, 0, (GLsizei)s->width, (GLsizei)s->height);
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
+    beams_block blk = {.far = far, .c = c, .tile_px = TILE_PX, .tiles_x = (int32_t)s->tiles_x,
+                       .samples = (int32_t)(s->view.v1.march_samples ? s->view.v1.march_samples : 32),
+                       .has_water = targets->water_dist != 0,
+                       .smooth_saturation = s->view.v1.saturation == VFX_SATURATE_SMOOTH,
+                       .bloom = bloom, .bloom_gain = strength / (float)levels};
+    memcpy(blk.inv_rot_view_proj, inv, sizeof inv);
+    volfx_ubo_update(&s->ubo, &blk, sizeof blk);
+    volfx_ubo_bind(&s->ubo, 3);
+
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = march ? "beams.march" : "beams.integrate",
+                                             .framebuffer = s->acc_fbo, .width = s->width, .height = s->height});
     glUseProgram(prog);
-    glUniformMatrix4fv(glGetUniformLocation(prog, "u_inv_rot_view_proj"), 1, GL_FALSE, inv);
-    glUniform1f(glGetUniformLocation(prog, "u_far"), far);
-    glUniform1i(glGetUniformLocation(prog, "u_tile_px"), TILE_PX);
-    glUniform1i(glGetUniformLocation(prog, "u_tiles_x"), (GLint)s->tiles_x);
-    glUniform1i(glGetUniformLocation(prog, "u_samples"), (GLint)(s->view.march_samples ? s->view.march_samples : 32));
-    glUniform1i(glGetUniformLocation(prog, "u_has_water"), targets->water_dist != 0);
-    glUniform1i(glGetUniformLocation(prog, "u_scene_depth"), 0);
-    glUniform1i(glGetUniformLocation(prog, "u_water_dist"), 1);
     glBindTextureUnit(0, targets->scene_depth);
     glBindTextureUnit(1, targets->water_dist);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s->beam_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s->range_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s->list_buf);
     volfx_gpu_fullscreen(ctx);
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
 
-    volfx_gpu_pass_begin(ctx, "beams.composite");
-    glBindFramebuffer(GL_FRAMEBUFFER, frame->framebuffer);
-    glViewport(0, 0, (GLsizei)frame->width, (GLsizei)frame->height);
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE);
-    glUseProgram(s->prog_composite);
-    glUniform1i(glGetUniformLocation(s->prog_composite, "u_acc"), 0);
-    glUniform1f(glGetUniformLocation(s->prog_composite, "u_c"), s->view.saturate_c > 0 ? s->view.saturate_c : 1.f);
-    glUniform1i(glGetUniformLocation(s->prog_composite, "u_smooth"), s->view.saturation == VFX_SATURATE_SMOOTH);
-    glBindTextureUnit(0, s->acc_tex);
-    volfx_gpu_fullscreen(ctx);
-    glDisable(GL_BLEND);
-    glUseProgram(0);
-    volfx_gpu_pass_end(ctx);
+    if (bloom) {
+        /* down: light -> 1/2 -> ... -> 1/2^levels; up: each level's tent added onto the next
+         * larger, so level 1 ends holding the sum of all levels */
+        for (uint32_t i = 1; i <= levels; ++i) {
+            volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "beams.bloom_down", .framebuffer = s->bloom_fbo[i],
+                                                     .width = s->bloom_w[i], .height = s->bloom_h[i]});
+            glUseProgram(s->prog_down);
+            glBindTextureUnit(0, i == 1 ? s->light_tex : s->bloom_tex[i - 1]);
+            volfx_gpu_fullscreen(ctx);
+            volfx_pass_end(ctx);
+        }
+        for (uint32_t i = levels; i > 1; --i) {
+            volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "beams.bloom_up", .framebuffer = s->bloom_fbo[i - 1],
+                                                     .width = s->bloom_w[i - 1], .height = s->bloom_h[i - 1],
+                                                     .blend = VOLFX_BLEND_ADD});
+            glUseProgram(s->prog_up);
+            glBindTextureUnit(0, s->bloom_tex[i]);
+            volfx_gpu_fullscreen(ctx);
+            volfx_pass_end(ctx);
+        }
+    }
+    volfx_stat_set(ctx, "beams.bloom_levels", bloom ? levels : 0);
+    glBindTextureUnit(0, s->light_tex);
+    glBindTextureUnit(1, bloom ? s->bloom_tex[1] : s->light_tex);
+    volfx_composite(ctx, frame, "beams.composite", s->prog_composite, VOLFX_BLEND_ADD);
     const char *e = volfx_gpu_error_string();
     return e ? volfx_fail(ctx, VFX_ERR_GL, "beams render: %s", e) : VFX_OK;
 }
@@ -320,7 +481,7 @@ static vfx_result beams_read_raw(vfx_context *ctx, void *state, float *out, size
     size_t n = (size_t)s->width * s->height;
     if (count < n)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams read_raw: %zu floats < %zu", count, n);
-    return volfx_gpu_read_top_first(ctx, s->acc_tex, GL_RGBA, 4, 0, s->width, s->height, out);
+    return volfx_gpu_read_top_first(ctx, s->acc_tex, GL_RED, 1, 0, s->width, s->height, out);
 }
 
 const volfx_effect_ops volfx_beams_ops = {

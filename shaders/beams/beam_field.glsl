@@ -127,9 +127,9 @@ float volfx_segment_integral_smooth(float x0, float x1, float s, float beta, flo
     return volfx_smooth_same_sign(y0, y1, dx, s, Q, h);
 }
 
-float volfx_piece(float x0, float x1, float s, float beta, float Q, float h, float R, bool smooth)
+float volfx_piece(float x0, float x1, float s, float beta, float Q, float h, float R, bool soft)
 {
-    if (!smooth)
+    if (!soft)
         return volfx_segment_integral(x0, x1, s, beta, Q);
     float ir = 1.0 / R;
     return volfx_segment_integral_smooth(x0, x1, s * ir, beta * ir, Q * ir, h * ir) * ir;
@@ -154,7 +154,7 @@ void volfx_clip_linear(float u0, float c, float umin, float umax, inout float lo
 }
 
 float volfx_sphere_piece(vec3 g, vec3 V, float R, float eps, float ta, float tb, float u0, float c,
-                       float umin, float umax, bool smooth)
+                       float umin, float umax, bool soft)
 {
     float gv = dot(g, V);
     vec3 gp = g - gv * V;
@@ -165,11 +165,11 @@ float volfx_sphere_piece(vec3 g, vec3 V, float R, float eps, float ta, float tb,
     float lo = ta, hi = tb;
     volfx_clip_linear(u0, c, umin, umax, lo, hi);
     float slo = max(lo + gv, -h), shi = min(hi + gv, h);
-    return volfx_piece(slo, shi, 1.0, 0.0, sqrt(dd + eps * eps), h, R, smooth);
+    return volfx_piece(slo, shi, 1.0, 0.0, sqrt(dd + eps * eps), h, R, soft);
 }
 
 float volfx_cylinder_piece(vec3 wp, vec3 V, vec3 D, float L, float R, float eps, float ta, float tb,
-                         float u0, float c, bool smooth)
+                         float u0, float c, bool soft)
 {
     float wd = dot(wp, D);
     vec3 a = wp - wd * D;
@@ -192,11 +192,11 @@ float volfx_cylinder_piece(vec3 wp, vec3 V, vec3 D, float L, float R, float eps,
         hc = sqrt(R * R - rr);
     }
     volfx_clip_linear(u0, c, 0.0, L, lo, hi);
-    return volfx_piece(lo, hi, s, beta, sqrt(rr + eps * eps), hc, R, smooth);
+    return volfx_piece(lo, hi, s, beta, sqrt(rr + eps * eps), hc, R, soft);
 }
 
 // H of one beam along t*V (origin = eye = 0), t in [t0, t1]; M is relative to the eye.
-float volfx_beam_integral(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, bool smooth,
+float volfx_beam_integral(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, bool soft,
                         vec3 V, float t0, float t1)
 {
     if (!(t1 > t0))
@@ -209,29 +209,29 @@ float volfx_beam_integral(vec3 M, vec3 D, float L, float R, float a, float b, fl
     float c = dot(V, D), u0 = dot(wp, D);
     float H = 0.0;
     if (a > 0.0)
-        H += a * volfx_sphere_piece(wp, V, R, eps, ta, tb, 0.0, 0.0, -1.0, 1.0, smooth);
+        H += a * volfx_sphere_piece(wp, V, R, eps, ta, tb, 0.0, 0.0, -1.0, 1.0, soft);
     if (b > 0.0) {
         const float inf = 1e30;
-        H += b * volfx_sphere_piece(wp, V, R, eps, ta, tb, u0, c, -inf, 0.0, smooth);
-        H += b * volfx_cylinder_piece(wp, V, D, L, R, eps, ta, tb, u0, c, smooth);
-        H += b * volfx_sphere_piece(wp - L * D, V, R, eps, ta, tb, u0, c, L, inf, smooth);
+        H += b * volfx_sphere_piece(wp, V, R, eps, ta, tb, u0, c, -inf, 0.0, soft);
+        H += b * volfx_cylinder_piece(wp, V, D, L, R, eps, ta, tb, u0, c, soft);
+        H += b * volfx_sphere_piece(wp - L * D, V, R, eps, ta, tb, u0, c, L, inf, soft);
     }
     return H;
 }
 
 // the raw density (for the ray-marching baseline), P relative to the eye
-float volfx_beam_density(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, bool smooth,
+float volfx_beam_density(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, bool soft,
                          vec3 P)
 {
     float eps = max(eps_in, VOLFX_BEAM_EPS_FLOOR * R);
     vec3 d = P - M;
     float d2 = dot(d, d), u = dot(d, D), rho = 0.0;
-    float wh = smooth ? (1.0 - d2 / (R * R)) * (1.0 - d2 / (R * R)) : 1.0;
+    float wh = soft ? (1.0 - d2 / (R * R)) * (1.0 - d2 / (R * R)) : 1.0;
     if (d2 <= R * R)
         rho += a * wh / sqrt(d2 + eps * eps);
     vec3 q = u < 0.0 ? d : (u > L ? d - L * D : d - u * D);
     float r2 = dot(q, q);
-    float wt = smooth ? (1.0 - r2 / (R * R)) * (1.0 - r2 / (R * R)) : 1.0;
+    float wt = soft ? (1.0 - r2 / (R * R)) * (1.0 - r2 / (R * R)) : 1.0;
     if (r2 <= R * R)
         rho += b * wt / sqrt(r2 + eps * eps);
     return rho;

@@ -1,17 +1,18 @@
-// Adds the beams' light to the host frame: intensity from H by clamping at c (the thesis) or a
-// smooth saturation 1 - exp(-H/c), coloured by the H-weighted tint of the beams in the pixel.
-uniform sampler2D u_acc;
-uniform float u_c;
-uniform int u_smooth;
+// Adds the beams' light (linear radiance) and, when on, the bloom chain's top level into the
+// host frame (blend ONE, ONE): an HDR host keeps it linear, an 8-bit one clamps.
+#include "beams/frame.glsl"
+
+layout(binding = 0) uniform sampler2D u_light;
+layout(binding = 1) uniform sampler2D u_bloom_tex;
+in vec2 v_uv;
 out vec4 o_color;
 
 void main()
 {
-    vec4 a = texelFetch(u_acc, ivec2(gl_FragCoord.xy), 0);
-    float H = a.x;
-    if (!(H > 0.0))
+    vec3 L = texelFetch(u_light, ivec2(gl_FragCoord.xy), 0).rgb;
+    if (u_bloom != 0)
+        L += u_bloom_gain * texture(u_bloom_tex, v_uv).rgb;
+    if (!(L.r + L.g + L.b > 0.0))
         discard;
-    vec3 tint = a.yzw / H;
-    float I = u_smooth != 0 ? 1.0 - exp(-H / u_c) : min(H / u_c, 1.0);
-    o_color = vec4(tint * I, 0.0);
+    o_color = vec4(L, 0.0);
 }

@@ -1,29 +1,49 @@
 // Per pixel: H = sum over the beams binned to this pixel's tile of the closed-form integral
 // from the eye to the first surface (host depth, water), or the ray-marching baseline when
-// VOLFX_BEAMS_MARCH is defined. Writes (H, H-weighted tint) to an RGBA32F target.
+// VOLFX_BEAMS_MARCH is defined. Writes H (R32F, read_raw) and the beams' linear radiance
+// (RGBA16F): each hot-ramp beam through its own ramp, the thesis-ramp beams through the clamp
+// of their summed H (docs/beams.md "Emission").
 #include "beams/beam_field.glsl"
+#include "beams/frame.glsl"
 
 in vec2 v_ndc;
-layout(location = 0) out vec4 o_acc;
+layout(location = 0) out float o_acc;
+layout(location = 1) out vec4 o_light;
 
 struct Beam {
     vec4 m_l;    // head relative to the eye, length
     vec4 d_r;    // unit direction, support radius
-    vec4 ab_eps; // a, b, eps, unused
-    vec4 color;
+    vec4 ab_eps; // a, b, eps, 1 / flow wavelength
+    vec4 color;  // rgb (thesis ramp: times intensity and 2^exposure)
+    vec4 look;   // intensity, 2^exposure / c, flow amount, flow phase
+    uvec4 mode;  // smooth falloff, thesis ramp
 };
 layout(std430, binding = 0) readonly buffer Beams { Beam beams[]; };
 layout(std430, binding = 1) readonly buffer Ranges { uvec2 ranges[]; };
 layout(std430, binding = 2) readonly buffer List { uint list[]; };
 
-uniform mat4 u_inv_rot_view_proj; // inverse(proj * view without translation): eye at 0
-uniform sampler2D u_scene_depth;
-uniform sampler2D u_water_dist;
-uniform bool u_has_water;
-uniform float u_far;
-uniform int u_tile_px;
-uniform int u_tiles_x;
-uniform int u_samples;
+layout(binding = 0) uniform sampler2D u_scene_depth;
+layout(binding = 1) uniform sampler2D u_water_dist;
+
+float volfx_hash(float n) { return fract(sin(n * 12.9898) * 43758.5453); }
+
+// value noise in [0, 1], two octaves, smooth in x
+float volfx_flow_noise(float x)
+{
+    float i = floor(x), f = fract(x), u = f * f * (3.0 - 2.0 * f);
+    float n = mix(volfx_hash(i), volfx_hash(i + 1.0), u);
+    float x2 = 2.03 * x + 17.0, i2 = floor(x2), f2 = fract(x2), u2 = f2 * f2 * (3.0 - 2.0 * f2);
+    return 0.65 * n + 0.35 * mix(volfx_hash(i2), volfx_hash(i2 + 1.0), u2);
+}
+
+// the beam coordinate u (from the head along D, clamped to [0, L]) where the ray t V passes
+// nearest the axis: the flow's noise is sampled there, so H stays the exact integral
+float volfx_nearest_u(vec3 M, vec3 D, float L, vec3 V)
+{
+    float b = dot(V, D), d = dot(V, -M), e = dot(D, -M), den = 1.0 - b * b;
+    float u = den > 1e-6 ? (e - b * d) / den : e;
+    return clamp(u, 0.0, L);
+}
 
 void main()
 {
@@ -36,16 +56,17 @@ void main()
         vec4 s = u_inv_rot_view_proj * vec4(v_ndc, depth * 2.0 - 1.0, 1.0);
         tmax = min(tmax, length(s.xyz / s.w));
     }
-    if (u_has_water) {
+    if (u_has_water != 0) {
         float wd = texelFetch(u_water_dist, px, 0).r;
         if (wd >= 0.0)
             tmax = min(tmax, wd);
     }
     uvec2 range = ranges[(px.y / u_tile_px) * u_tiles_x + px.x / u_tile_px];
-    float H = 0.0;
-    vec3 tint = vec3(0.0);
+    float H = 0.0, Hth = 0.0;
+    vec3 tint = vec3(0.0), light = vec3(0.0);
     for (uint k = 0u; k < range.y; ++k) {
         Beam bm = beams[list[range.x + k]];
+        bool soft = bm.mode.x != 0u;
         float h;
 #ifdef VOLFX_BEAMS_MARCH
         // baseline: midpoint samples over the ray's chord through the beam's bounding sphere
@@ -59,14 +80,31 @@ void main()
             float dt = (tb - ta) / float(u_samples);
             for (int i = 0; i < u_samples && tb > ta; ++i)
                 h += volfx_beam_density(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x,
-                                      bm.ab_eps.y, bm.ab_eps.z, (ta + (float(i) + 0.5) * dt) * V) * dt;
+                                        bm.ab_eps.y, bm.ab_eps.z, soft,
+                                        (ta + (float(i) + 0.5) * dt) * V) * dt;
         }
 #else
         h = volfx_beam_integral(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
-                              bm.ab_eps.z, V, 0.0, tmax);
+                                bm.ab_eps.z, soft, V, 0.0, tmax);
 #endif
         H += h;
-        tint += h * bm.color.rgb;
+        if (bm.mode.y != 0u) {
+            Hth += h;
+            tint += h * bm.color.rgb;
+        } else if (h > 0.0) {
+            float x = h * bm.look.y;
+            if (bm.look.z > 0.0) {
+                float u = volfx_nearest_u(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, V);
+                x *= 1.0 + bm.look.z * (2.0 * volfx_flow_noise(u * bm.ab_eps.w - bm.look.w) - 1.0);
+            }
+            float x2 = x * x;
+            light += bm.look.x * x * (bm.color.rgb + (1.0 - bm.color.rgb) * (x2 / (x2 + 4.0)));
+        }
     }
-    o_acc = vec4(H, tint);
+    if (Hth > 0.0) {
+        float I = u_smooth_saturation != 0 ? 1.0 - exp(-Hth / u_c) : min(Hth / u_c, 1.0);
+        light += tint / Hth * I;
+    }
+    o_acc = H;
+    o_light = vec4(light, 0.0);
 }

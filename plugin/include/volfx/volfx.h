@@ -173,6 +173,61 @@ typedef struct vfx_beams_view {
     uint32_t march_samples;/* ray-marching baseline samples; 0 -> 32 */
 } vfx_beams_view;
 
+/* Support falloff of a vfx_beam2 (docs/beams.md "Smooth support"): the hard one is version 1's
+ * field; the smooth one multiplies both densities by w(r) = (1 - (r/R)^2)^2, r < R. */
+typedef enum vfx_beam_falloff {
+    VFX_BEAM_FALLOFF_DEFAULT = 0, /* smooth */
+    VFX_BEAM_FALLOFF_SMOOTH = 1,
+    VFX_BEAM_FALLOFF_HARD = 2,
+} vfx_beam_falloff;
+
+/* How a vfx_beam2's line integral H becomes light (docs/beams.md "Emission"). */
+typedef enum vfx_beam_ramp {
+    VFX_BEAM_RAMP_DEFAULT = 0, /* hot */
+    /* x = 2^exposure H / c; radiance = intensity x (C + (1 - C) x^2 / (x^2 + 4)): transparent
+     * where H -> 0, the beam's colour C, then white-hot and brighter than 1 in the core */
+    VFX_BEAM_RAMP_HOT = 1,
+    /* version 1's: the pixel's summed H of such beams, clamped (or smoothly saturated) at c,
+     * times their H-weighted colour x intensity x 2^exposure */
+    VFX_BEAM_RAMP_THESIS = 2,
+} vfx_beam_ramp;
+
+/* Version 2 of a beam: version 1 as its first member (never edited), then the look. */
+typedef struct vfx_beam2 {
+    vfx_beam v1;
+    uint32_t falloff;      /* vfx_beam_falloff */
+    uint32_t ramp;         /* vfx_beam_ramp */
+    float intensity;       /* radiance multiplier > 0; 0 -> 1 */
+    float exposure;        /* stops applied to H before the ramp (finite; 0 -> none) */
+    float flow_amount;     /* 0..1: the ramp's x is scaled by 1 + amount (2 n - 1), n a noise in
+                              [0, 1] of the beam coordinate at the ray's nearest approach to the
+                              axis, moving at flow_speed; H itself stays exact; 0 -> off */
+    float flow_speed;      /* units per second along D (the plugin's update time) */
+    float flow_scale;      /* noise wavelength along the beam; 0 -> 2 R */
+    uint32_t _reserved[9];
+} vfx_beam2;
+
+/* Bloom of the beams' own light (a downsample/upsample chain), for hosts that have none. */
+typedef enum vfx_beams_bloom {
+    VFX_BEAMS_BLOOM_DEFAULT = 0, /* on */
+    VFX_BEAMS_BLOOM_ON = 1,
+    VFX_BEAMS_BLOOM_OFF = 2,
+} vfx_beams_bloom;
+
+/* Version 2 of the beams view: version 1 as its first member. The plugin passes &view.v1 with
+ * v1.size = sizeof(vfx_beams_view2) and v1.version = VFX_BEAMS_VIEW2_VERSION; a host that
+ * knows version 2 fills all of it and answers version 2, one that knows only version 1 fills
+ * v1 and answers version 1 (its beams then get the hard falloff and the thesis ramp). */
+#define VFX_BEAMS_VIEW2_VERSION 2u
+typedef struct vfx_beams_view2 {
+    vfx_beams_view v1;       /* v1.beams is ignored (may be NULL) when beams is set */
+    const vfx_beam2 *beams;  /* v1.count beams */
+    uint32_t bloom;          /* vfx_beams_bloom */
+    uint32_t bloom_levels;   /* 1..8 halvings; 0 -> 5 */
+    float bloom_strength;    /* bloom added x this (>= 0); 0 -> 0.6 */
+    uint32_t _reserved[7];
+} vfx_beams_view2;
+
 /* Bits of vfx_volume_view.disable. */
 enum {
     VFX_VOLUME_NO_ERT = 1u << 0,   /* no early ray termination at all */
