@@ -106,6 +106,20 @@ static vfx_result host_beams(void *user, vfx_beams_view *out)
         return VFX_ERR_ABI;
     if (app->beam_count == 0)
         return VFX_ERR_NOT_FOUND;
+    if (app->beams_v2 && out->version >= VFX_BEAMS_VIEW2_VERSION && out->size >= sizeof(vfx_beams_view2)) {
+        vfx_beams_view2 *v2 = (vfx_beams_view2 *)out;
+        *v2 = app->beams_view2;
+        v2->v1 = app->beams_view;
+        v2->v1.size = sizeof *v2;
+        v2->v1.version = VFX_BEAMS_VIEW2_VERSION;
+        v2->v1.count = app->beam_count;
+        v2->v1.beams = NULL;
+        v2->beams = app->beams2;
+        return VFX_OK;
+    }
+    if (app->beams_v2) /* a version 1 plugin: the v1 part of each beam */
+        for (uint32_t i = 0; i < app->beam_count; ++i)
+            app->beams[i] = app->beams2[i].v1;
     *out = app->beams_view;
     out->size = sizeof *out;
     out->version = VFX_BEAMS_VIEW_VERSION;
@@ -184,7 +198,8 @@ vfx_result game_app_create(const game_app_desc *desc, game_app **out)
     if ((r = rt_renderer_create(&app->log, &app->renderer)))
         goto fail;
     app->camera = (ref_camera){{0, 2, 6}, {0, 0.5, 0}, {0, 1, 0}, 60.0 * M_PI / 180.0, w, h, 0.05, 200.0};
-    if ((r = rt_renderer_resize(app->renderer, w, h)))
+    if ((r = rt_renderer_set_hdr(app->renderer, !app->desc.ldr, app->desc.exposure))
+        || (r = rt_renderer_resize(app->renderer, w, h)))
         goto fail;
     app->clear_color[0] = 0.05f, app->clear_color[1] = 0.06f, app->clear_color[2] = 0.09f;
     app->host = (vfx_host_api){
@@ -313,9 +328,12 @@ vfx_result game_app_frame(game_app *app, float dt)
     }
     rt_renderer_targets tg;
     rt_renderer_end_scene(app->renderer, &tg);
-    vfx_frame_view frame = {.size = sizeof frame, .version = VFX_FRAME_VIEW_VERSION,
-                            .framebuffer = tg.output_framebuffer, .color_texture = tg.scene_color,
-                            .depth_texture = tg.scene_depth, .width = tg.width, .height = tg.height};
+    /* version 2: says whether the output is an HDR target */
+    vfx_frame_view2 frame2 = {.v1 = {.size = sizeof frame2, .version = VFX_FRAME_VIEW2_VERSION,
+                                     .framebuffer = tg.output_framebuffer, .color_texture = tg.scene_color,
+                                     .depth_texture = tg.scene_depth, .width = tg.width, .height = tg.height},
+                              .color_hdr = tg.color_hdr};
+    vfx_frame_view frame = frame2.v1;
     memcpy(frame.view, view, sizeof frame.view);
     memcpy(frame.proj, proj, sizeof frame.proj);
     for (int k = 0; k < 3; ++k)
@@ -327,7 +345,8 @@ vfx_result game_app_frame(game_app *app, float dt)
     t0 = rt_now_ms();
     if ((r = rt_world_run_phase(app->world, RT_PHASE_RENDER, app->time, dt)))
         return r;
-    if ((r = app->api->render(app->ctx, &frame))) {
+    frame2.v1 = frame;
+    if ((r = app->api->render(app->ctx, &frame2.v1))) {
         rt_logf(&app->log, VFX_LOG_ERROR, "plugin render: %s", app->api->last_error(app->ctx));
         return r;
     }

@@ -25,6 +25,8 @@ typedef struct game_app_desc {
     bool debug_gl;
     const char *plugin_path;   /* NULL -> the statically linked plugin */
     uint32_t profile_frames;   /* frames kept for CSV/trace; 0 -> 4096 */
+    bool ldr;                  /* 8-bit output without tone mapping; default: HDR (RGBA16F, ACES) */
+    float exposure;            /* HDR tone-map exposure; 0 -> 1 */
     rt_logger logger;
 } game_app_desc;
 
@@ -57,6 +59,9 @@ typedef struct game_app {
     vfx_beam beams[GAME_APP_MAX_BEAMS];
     uint32_t beam_count;
     vfx_beams_view beams_view; /* parameters; beams/count filled per call */
+    bool beams_v2;             /* answer version 2 views from beams2 and beams_view2 */
+    vfx_beam2 beams2[GAME_APP_MAX_BEAMS];
+    vfx_beams_view2 beams_view2; /* bloom settings; its v1 member is beams_view */
     vfx_volume_view2 volumes[GAME_APP_MAX_VOLUMES]; /* the plugin gets version 2 or 1 */
     uint32_t volume_count;
     double time;

@@ -228,7 +228,9 @@ vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path
     if (sc->beam_count && !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_BEAMS))) {
         demo->beam_base_count = sc->beam_count < GAME_APP_MAX_BEAMS ? sc->beam_count : GAME_APP_MAX_BEAMS;
         app->beams_view = sc->beams_view;
-        app->beam_count = rt_scene_beams_at(sc, 0.0, app->beams, demo->beam_base_count);
+        app->beams_view2 = sc->beams_view2;
+        app->beams_v2 = true;
+        app->beam_count = rt_scene_beams2_at(sc, 0.0, app->beams2, demo->beam_base_count);
     }
     if (sc->has_volume && !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_VOLUME)) && (r = load_volume(app, demo, sc)))
         return r;
@@ -244,7 +246,7 @@ void game_demo_animate(game_app *app, game_demo *demo, float dt)
 {
     (void)dt;
     if (demo->scene && app->beam_count) /* keyframed: grow, thicken, move, turn */
-        app->beam_count = rt_scene_beams_at(demo->scene, app->time, app->beams, demo->beam_base_count);
+        app->beam_count = rt_scene_beams2_at(demo->scene, app->time, app->beams2, demo->beam_base_count);
 }
 
 void game_demo_toggle(game_app *app, game_demo *demo, vfx_effect_kind kind)

@@ -1,5 +1,7 @@
-/* renderer.c — host scene target (RGBA8 + DEPTH32F textures) and output target. The plugin
- * samples the scene textures while drawing into the output, so it never reads what it writes. */
+/* renderer.c — host scene target (RGBA8, or RGBA16F in HDR mode, + DEPTH32F textures) and
+ * output target. The plugin samples the scene textures while drawing into the output, so it
+ * never reads what it writes. In HDR mode the output holds linear radiance and is tone-mapped
+ * (ACES) into an 8-bit display target for read-back and presenting. */
 #include "gfx/renderer.h"
 
 #include <epoxy/gl.h>
@@ -14,6 +16,10 @@ struct rt_renderer {
     GLint u_model, u_view_proj, u_color, u_light;
     GLuint scene_fbo, scene_color, scene_depth;
     GLuint out_fbo, out_color, out_depth;
+    bool hdr;
+    float exposure;
+    GLuint tone_prog, tone_vao, disp_fbo, disp_color;
+    GLint u_exposure;
     uint32_t width, height;
     float view[16], proj[16];
 };
@@ -74,6 +80,7 @@ vfx_result rt_renderer_create(const rt_logger *logger, rt_renderer **out)
         return VFX_ERR_GL;
     }
     glObjectLabel(GL_PROGRAM, r->mesh_prog, -1, "host.mesh");
+    r->exposure = 1.f;
     r->u_model = glGetUniformLocation(r->mesh_prog, "u_model");
     r->u_view_proj = glGetUniformLocation(r->mesh_prog, "u_view_proj");
     r->u_color = glGetUniformLocation(r->mesh_prog, "u_color");
@@ -84,12 +91,79 @@ vfx_result rt_renderer_create(const rt_logger *logger, rt_renderer **out)
 
 static void free_targets(rt_renderer *r)
 {
-    GLuint tex[4] = {r->scene_color, r->scene_depth, r->out_color, r->out_depth};
-    glDeleteTextures(4, tex);
-    GLuint fbo[2] = {r->scene_fbo, r->out_fbo};
-    glDeleteFramebuffers(2, fbo);
-    r->scene_color = r->scene_depth = r->out_color = r->out_depth = 0;
-    r->scene_fbo = r->out_fbo = 0;
+    GLuint tex[5] = {r->scene_color, r->scene_depth, r->out_color, r->out_depth, r->disp_color};
+    glDeleteTextures(5, tex);
+    GLuint fbo[3] = {r->scene_fbo, r->out_fbo, r->disp_fbo};
+    glDeleteFramebuffers(3, fbo);
+    r->scene_color = r->scene_depth = r->out_color = r->out_depth = r->disp_color = 0;
+    r->scene_fbo = r->out_fbo = r->disp_fbo = 0;
+}
+
+/* The tone-mapping program (common/fullscreen.vert + host/tonemap.frag) and its empty VAO. */
+static vfx_result make_tonemap(rt_renderer *r)
+{
+    GLuint vs = compile(&r->log, GL_VERTEX_SHADER, "common/fullscreen.vert");
+    GLuint fs = compile(&r->log, GL_FRAGMENT_SHADER, "host/tonemap.frag");
+    if (!vs || !fs) {
+        glDeleteShader(vs);
+        glDeleteShader(fs);
+        return VFX_ERR_GL;
+    }
+    r->tone_prog = glCreateProgram();
+    glAttachShader(r->tone_prog, vs);
+    glAttachShader(r->tone_prog, fs);
+    glLinkProgram(r->tone_prog);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint ok = 0;
+    glGetProgramiv(r->tone_prog, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        rt_logf(&r->log, VFX_LOG_ERROR, "host tone-map program link failed");
+        glDeleteProgram(r->tone_prog);
+        r->tone_prog = 0;
+        return VFX_ERR_GL;
+    }
+    glObjectLabel(GL_PROGRAM, r->tone_prog, -1, "host.tonemap");
+    r->u_exposure = glGetUniformLocation(r->tone_prog, "u_exposure");
+    glUseProgram(r->tone_prog);
+    glUniform1i(glGetUniformLocation(r->tone_prog, "u_hdr"), 0);
+    glUseProgram(0);
+    glCreateVertexArrays(1, &r->tone_vao);
+    return VFX_OK;
+}
+
+vfx_result rt_renderer_set_hdr(rt_renderer *r, bool hdr, float exposure)
+{
+    if (!r || !(exposure >= 0) || exposure > 1e6f)
+        return VFX_ERR_INVALID_ARGUMENT;
+    vfx_result res;
+    if (hdr && !r->tone_prog && (res = make_tonemap(r)))
+        return res;
+    r->exposure = exposure > 0 ? exposure : 1.f;
+    if (hdr == r->hdr)
+        return VFX_OK;
+    r->hdr = hdr;
+    uint32_t w = r->width, h = r->height;
+    r->width = r->height = 0; /* targets change format: remake them at the same size */
+    return w ? rt_renderer_resize(r, w, h) : VFX_OK;
+}
+
+/* HDR mode: the output through the tone map into the display target. */
+static void tonemap(rt_renderer *r)
+{
+    glPushDebugGroup(GL_DEBUG_SOURCE_APPLICATION, 0, -1, "host.tonemap");
+    glBindFramebuffer(GL_FRAMEBUFFER, r->disp_fbo);
+    glViewport(0, 0, (GLsizei)r->width, (GLsizei)r->height);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glUseProgram(r->tone_prog);
+    glUniform1f(r->u_exposure, r->exposure);
+    glBindTextureUnit(0, r->out_color);
+    glBindVertexArray(r->tone_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    glPopDebugGroup();
 }
 
 void rt_renderer_destroy(rt_renderer *r)
@@ -98,6 +172,8 @@ void rt_renderer_destroy(rt_renderer *r)
         return;
     free_targets(r);
     glDeleteProgram(r->mesh_prog);
+    glDeleteProgram(r->tone_prog);
+    glDeleteVertexArrays(1, &r->tone_vao);
     free(r);
 }
 
@@ -131,16 +207,24 @@ vfx_result rt_renderer_resize(rt_renderer *r, uint32_t w, uint32_t h)
     if (w == r->width && h == r->height && r->scene_fbo)
         return VFX_OK;
     free_targets(r);
-    r->scene_color = make_tex(GL_RGBA8, w, h, "host.scene_color");
+    GLenum fmt = r->hdr ? GL_RGBA16F : GL_RGBA8;
+    r->scene_color = make_tex(fmt, w, h, "host.scene_color");
     r->scene_depth = make_tex(GL_DEPTH_COMPONENT32F, w, h, "host.scene_depth");
-    r->out_color = make_tex(GL_RGBA8, w, h, "host.out_color");
+    r->out_color = make_tex(fmt, w, h, "host.out_color");
+    if (r->hdr) {
+        r->disp_color = make_tex(GL_RGBA8, w, h, "host.display_color");
+        glCreateFramebuffers(1, &r->disp_fbo);
+        glNamedFramebufferTexture(r->disp_fbo, GL_COLOR_ATTACHMENT0, r->disp_color, 0);
+        glObjectLabel(GL_FRAMEBUFFER, r->disp_fbo, -1, "host.display");
+    }
     r->out_depth = make_tex(GL_DEPTH_COMPONENT32F, w, h, "host.out_depth");
     r->scene_fbo = make_fbo(r->scene_color, r->scene_depth, "host.scene");
     r->out_fbo = make_fbo(r->out_color, r->out_depth, "host.out");
     r->width = w;
     r->height = h;
     if (glCheckNamedFramebufferStatus(r->scene_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE
-        || glCheckNamedFramebufferStatus(r->out_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        || glCheckNamedFramebufferStatus(r->out_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE
+        || (r->hdr && glCheckNamedFramebufferStatus(r->disp_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)) {
         rt_logf(&r->log, VFX_LOG_ERROR, "host targets %ux%u incomplete", w, h);
         return VFX_ERR_GL;
     }
@@ -195,7 +279,8 @@ void rt_renderer_end_scene(rt_renderer *r, rt_renderer_targets *out)
     glDisable(GL_DEPTH_TEST);
     glUseProgram(0);
     *out = (rt_renderer_targets){.output_framebuffer = r->out_fbo, .scene_color = r->scene_color,
-                                 .scene_depth = r->scene_depth, .width = r->width, .height = r->height};
+                                 .scene_depth = r->scene_depth, .width = r->width, .height = r->height,
+                                 .color_hdr = r->hdr};
 }
 
 vfx_result rt_renderer_read_rgba(rt_renderer *r, uint8_t *rgba)
@@ -206,7 +291,10 @@ vfx_result rt_renderer_read_rgba(rt_renderer *r, uint8_t *rgba)
     uint8_t *tmp = malloc(row * r->height);
     if (!tmp)
         return VFX_ERR_OUT_OF_MEMORY;
-    glGetTextureImage(r->out_color, 0, GL_RGBA, GL_UNSIGNED_BYTE, (GLsizei)(row * r->height), tmp);
+    if (r->hdr)
+        tonemap(r);
+    glGetTextureImage(r->hdr ? r->disp_color : r->out_color, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                      (GLsizei)(row * r->height), tmp);
     for (uint32_t y = 0; y < r->height; ++y) /* GL rows are bottom-up */
         memcpy(rgba + y * row, tmp + (r->height - 1 - y) * row, row);
     free(tmp);
@@ -215,6 +303,8 @@ vfx_result rt_renderer_read_rgba(rt_renderer *r, uint8_t *rgba)
 
 void rt_renderer_present(rt_renderer *r, uint32_t ww, uint32_t wh)
 {
-    glBlitNamedFramebuffer(r->out_fbo, 0, 0, 0, (GLint)r->width, (GLint)r->height, 0, 0, (GLint)ww,
+    if (r->hdr)
+        tonemap(r);
+    glBlitNamedFramebuffer(r->hdr ? r->disp_fbo : r->out_fbo, 0, 0, 0, (GLint)r->width, (GLint)r->height, 0, 0, (GLint)ww,
                            (GLint)wh, GL_COLOR_BUFFER_BIT, GL_LINEAR);
 }

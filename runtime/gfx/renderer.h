@@ -4,6 +4,7 @@
 #ifndef RT_RENDERER_H
 #define RT_RENDERER_H
 
+#include <stdbool.h>
 #include <stdint.h>
 #include <volfx/volfx.h>
 #include "core/log.h"
@@ -28,11 +29,16 @@ void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float 
 typedef struct rt_renderer_targets {
     unsigned output_framebuffer, scene_color, scene_depth;
     uint32_t width, height;
+    bool color_hdr; /* colour targets are RGBA16F linear radiance (rt_renderer_set_hdr) */
 } rt_renderer_targets;
 
 /* Copies scene colour and depth into the output target and says where they are. */
 void rt_renderer_end_scene(rt_renderer *r, rt_renderer_targets *out);
-/* Reads the output colour, RGBA8, top row first (width*height*4 bytes). */
+/* HDR mode on or off (off at creation): colour targets RGBA16F holding linear radiance,
+ * tone-mapped (ACES fit, times `exposure`, 0 -> 1) for read-back and presenting. Remakes the
+ * targets at the current size. */
+vfx_result rt_renderer_set_hdr(rt_renderer *r, bool hdr, float exposure);
+/* Reads the output colour, RGBA8 (tone-mapped in HDR mode), top row first (width*height*4 bytes). */
 vfx_result rt_renderer_read_rgba(rt_renderer *r, uint8_t *rgba);
 /* Blits the output to the default framebuffer of the current window. */
 void rt_renderer_present(rt_renderer *r, uint32_t window_w, uint32_t window_h);

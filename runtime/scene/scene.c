@@ -156,7 +156,7 @@ static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
         return r;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "beams")) && (r = scene_parse_beams(c, v, s)))
         return r;
-    if ((v = cJSON_GetObjectItemCaseSensitive(root, "beam_settings")) && (r = scene_parse_beam_settings(c, v, &s->beams_view)))
+    if ((v = cJSON_GetObjectItemCaseSensitive(root, "beam_settings")) && (r = scene_parse_beam_settings(c, v, &s->beams_view, &s->beams_view2)))
         return r;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "water"))) {
         s->has_water = true;

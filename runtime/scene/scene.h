@@ -49,6 +49,8 @@ typedef enum rt_scene_beam_param {
     RT_BEAM_PARAM_B,          /* 1 */
     RT_BEAM_PARAM_EPS,        /* 1 */
     RT_BEAM_PARAM_COLOR,      /* 4 */
+    RT_BEAM_PARAM_INTENSITY,  /* 1 (vfx_beam2) */
+    RT_BEAM_PARAM_EXPOSURE,   /* 1 (vfx_beam2) */
     RT_BEAM_PARAM_COUNT
 } rt_scene_beam_param;
 
@@ -63,6 +65,7 @@ typedef struct rt_scene_beam {
     vfx_beam base;                                  /* values when not animated */
     rt_scene_track tracks[RT_BEAM_PARAM_COUNT];   /* count 0 = not animated */
     float loop_s;                                   /* >0: time wraps modulo loop_s */
+    vfx_beam2 look;     /* falloff, ramp, intensity, exposure, flow; its v1 member is unused */
 } rt_scene_beam;
 
 typedef enum rt_scene_water_source {
@@ -131,6 +134,7 @@ typedef struct rt_scene {
     uint32_t beam_count;
     rt_scene_beam *beams;
     vfx_beams_view beams_view;       /* saturation, saturate_c, far_distance, method, samples */
+    vfx_beams_view2 beams_view2;     /* bloom settings (its v1 member is unused: beams_view) */
     bool has_water;
     rt_scene_water water;
     bool has_volume;
@@ -150,6 +154,8 @@ void rt_scene_free(rt_scene *scene);
 /* Writes the beams at `time` (keyframes interpolated linearly, clamped at the ends, wrapped by
  * loop_s) into out[0..n); returns how many were written (min(n, beam_count)). */
 uint32_t rt_scene_beams_at(const rt_scene *scene, double time, vfx_beam *out, uint32_t n);
+/* The same as version 2 beams: with falloff, ramp, intensity, exposure and flow. */
+uint32_t rt_scene_beams2_at(const rt_scene *scene, double time, vfx_beam2 *out, uint32_t n);
 /* Linear interpolation of one track at time t into out[0..dim); clamped at the ends. */
 void rt_scene_track_eval(const rt_scene_track *track, double t, float *out);
 

@@ -9,8 +9,8 @@
 #include <string.h>
 
 static const char *const beam_param_names[RT_BEAM_PARAM_COUNT + 1] = {
-    "head", "dir", "length", "radius", "a", "b", "eps", "color", NULL};
-static const int beam_param_dim[RT_BEAM_PARAM_COUNT] = {3, 3, 1, 1, 1, 1, 1, 4};
+    "head", "dir", "length", "radius", "a", "b", "eps", "color", "intensity", "exposure", NULL};
+static const int beam_param_dim[RT_BEAM_PARAM_COUNT] = {3, 3, 1, 1, 1, 1, 1, 4, 1, 1};
 
 static range beam_param_range(int k)
 {
@@ -19,13 +19,17 @@ static range beam_param_range(int k)
     case RT_BEAM_PARAM_DIR: return COORD;
     case RT_BEAM_PARAM_RADIUS: return POSITIVE;
     case RT_BEAM_PARAM_COLOR: return (range){0, 1000, false};
+    case RT_BEAM_PARAM_INTENSITY: return (range){0, 1e6, true};
+    case RT_BEAM_PARAM_EXPOSURE: return (range){-64, 64, false};
     default: return NONNEG;
     }
 }
 
-static float *beam_param_ptr(vfx_beam *b, int k)
+static float *beam_param_ptr(vfx_beam *b, vfx_beam2 *look, int k)
 {
     switch (k) {
+    case RT_BEAM_PARAM_INTENSITY: return &look->intensity;
+    case RT_BEAM_PARAM_EXPOSURE: return &look->exposure;
     case RT_BEAM_PARAM_HEAD: return b->head;
     case RT_BEAM_PARAM_DIR: return b->dir;
     case RT_BEAM_PARAM_LENGTH: return &b->length;
@@ -92,9 +96,39 @@ static vfx_result parse_track(pctx *c, const cJSON *v, const char *P, int k, rt_
     return VFX_OK;
 }
 
+/* falloff, ramp and flow of one beam (intensity and exposure are parameters, keyframable). */
+static vfx_result parse_look(pctx *c, const cJSON *e, const char *P, vfx_beam2 *look)
+{
+    static const char *const falloffs[] = {"smooth", "hard", NULL};
+    static const char *const ramps[] = {"hot", "thesis", NULL};
+    static const char *const flow_keys[] = {"amount", "speed", "scale", NULL};
+    uint32_t f = 0, rp = 0;
+    vfx_result r = scene_get_enum(c, e, P, "falloff", false, falloffs, &f);
+    if (!r)
+        r = scene_get_enum(c, e, P, "ramp", false, ramps, &rp);
+    if (r)
+        return r;
+    look->falloff = f == 1 ? VFX_BEAM_FALLOFF_HARD : VFX_BEAM_FALLOFF_SMOOTH;
+    look->ramp = rp == 1 ? VFX_BEAM_RAMP_THESIS : VFX_BEAM_RAMP_HOT;
+    const cJSON *flow = cJSON_GetObjectItemCaseSensitive(e, "flow");
+    if (!flow)
+        return VFX_OK;
+    char PF[JPATH];
+    scene_join(PF, P, "flow");
+    if ((r = scene_expect_object(c, flow, PF)))
+        return r;
+    scene_check_keys(c, flow, PF, flow_keys);
+    look->flow_amount = 0.5f;
+    if (!r) r = scene_get_float(c, flow, PF, "amount", false, (range){0, 1, false}, &look->flow_amount);
+    if (!r) r = scene_get_float(c, flow, PF, "speed", false, COORD, &look->flow_speed);
+    if (!r) r = scene_get_float(c, flow, PF, "scale", false, NONNEG, &look->flow_scale);
+    return r;
+}
+
 vfx_result scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
 {
     static const char *const keys[] = {"head", "dir", "length", "radius", "a", "b", "eps", "color",
+                                       "intensity", "exposure", "falloff", "ramp", "flow",
                                        "keyframes", "loop_s", NULL};
     int n;
     vfx_result ra = scene_alloc_array(c, v, "beams", RT_SCENE_MAX_BEAMS, sizeof *s->beams, (void **)&s->beams, &n);
@@ -108,6 +142,7 @@ vfx_result scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
         s->beam_count = (uint32_t)i + 1; /* so that free() sees tracks of a half-parsed beam */
         vfx_beam *b = &o->base;
         *b = (vfx_beam){.length = 1.0f, .radius = 0.5f, .a = 0.05f, .b = 0.03f, .eps = 0.02f, .color = {1, 1, 1, 1}};
+        o->look = (vfx_beam2){.falloff = VFX_BEAM_FALLOFF_SMOOTH, .ramp = VFX_BEAM_RAMP_HOT, .intensity = 1.0f};
         vfx_result r = scene_expect_object(c, e, P);
         if (r)
             return r;
@@ -125,7 +160,7 @@ vfx_result scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
             const cJSON *track = kf ? cJSON_GetObjectItemCaseSensitive(kf, name) : NULL;
             /* head and dir are required unless animated (then the first key is the base) */
             bool required = (k == RT_BEAM_PARAM_HEAD || k == RT_BEAM_PARAM_DIR) && !track;
-            float *dst = beam_param_ptr(b, k);
+            float *dst = beam_param_ptr(b, &o->look, k);
             if (beam_param_dim[k] == 1)
                 r = scene_get_float(c, e, P, name, required, beam_param_range(k), dst);
             else
@@ -147,15 +182,16 @@ vfx_result scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
             scene_join(PD, P, "dir");
             return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PD, "direction must not be the zero vector");
         }
-        if ((r = scene_get_float(c, e, P, "loop_s", false, NONNEG, &o->loop_s)))
+        if ((r = scene_get_float(c, e, P, "loop_s", false, NONNEG, &o->loop_s)) || (r = parse_look(c, e, P, &o->look)))
             return r;
     }
     return VFX_OK;
 }
 
-vfx_result scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv)
+vfx_result scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv, vfx_beams_view2 *bv2)
 {
-    static const char *const keys[] = {"saturation", "c", "far_distance", "method", "march_samples", NULL};
+    static const char *const keys[] = {"saturation", "c", "far_distance", "method", "march_samples",
+                                       "bloom", "bloom_strength", "bloom_levels", NULL};
     static const char *const sat[] = {"clamp", "smooth", NULL};
     static const char *const meth[] = {"closed_form", "march", NULL};
     const char *P = "beam_settings";
@@ -168,6 +204,13 @@ vfx_result scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv
     if (!r) r = scene_get_float(c, v, P, "far_distance", false, NONNEG, &bv->far_distance);
     if (!r) r = scene_get_enum(c, v, P, "method", false, meth, &bv->method);
     if (!r) r = scene_get_uint(c, v, P, "march_samples", false, 1, 4096, &bv->march_samples);
+    bool bloom = true;
+    if (!r && cJSON_GetObjectItemCaseSensitive(v, "bloom")) {
+        r = scene_get_bool(c, v, P, "bloom", &bloom);
+        bv2->bloom = bloom ? VFX_BEAMS_BLOOM_ON : VFX_BEAMS_BLOOM_OFF;
+    }
+    if (!r) r = scene_get_float(c, v, P, "bloom_strength", false, NONNEG, &bv2->bloom_strength);
+    if (!r) r = scene_get_uint(c, v, P, "bloom_levels", false, 1, 8, &bv2->bloom_levels);
     return r;
 }
 
@@ -207,32 +250,48 @@ void rt_scene_track_eval(const rt_scene_track *tr, double t, float *out)
         out[k] = (float)(v0[k] + f * ((double)v1[k] - v0[k]));
 }
 
+/* One beam at `time` (finite): keyframes interpolated, wrapped by loop_s. */
+static void beam_at(const rt_scene_beam *b, double time, vfx_beam2 *out)
+{
+    double t = time;
+    if (b->loop_s > 0) {
+        t = fmod(t, b->loop_s);
+        if (t < 0)
+            t += b->loop_s;
+    }
+    *out = b->look;
+    out->v1 = b->base;
+    for (int k = 0; k < RT_BEAM_PARAM_COUNT; ++k) {
+        const rt_scene_track *tr = &b->tracks[k];
+        if (!tr->count)
+            continue;
+        float *dst = beam_param_ptr(&out->v1, out, k);
+        rt_scene_track_eval(tr, t, dst);
+        /* opposite direction keys pass through zero: hold the earlier key's direction */
+        if (k == RT_BEAM_PARAM_DIR && scene_is_zero3(dst))
+            memcpy(dst, &tr->values[(size_t)key_before(tr, t) * 3], 3 * sizeof(float));
+    }
+}
+
+uint32_t rt_scene_beams2_at(const rt_scene *scene, double time, vfx_beam2 *out, uint32_t n)
+{
+    if (!scene || !out)
+        return 0;
+    uint32_t count = scene->beam_count < n ? scene->beam_count : n;
+    for (uint32_t i = 0; i < count; ++i)
+        beam_at(&scene->beams[i], isfinite(time) ? time : 0, &out[i]);
+    return count;
+}
+
 uint32_t rt_scene_beams_at(const rt_scene *scene, double time, vfx_beam *out, uint32_t n)
 {
     if (!scene || !out)
         return 0;
     uint32_t count = scene->beam_count < n ? scene->beam_count : n;
-    if (!isfinite(time))
-        time = 0;
     for (uint32_t i = 0; i < count; ++i) {
-        const rt_scene_beam *b = &scene->beams[i];
-        double t = time;
-        if (b->loop_s > 0) {
-            t = fmod(t, b->loop_s);
-            if (t < 0)
-                t += b->loop_s;
-        }
-        out[i] = b->base;
-        for (int k = 0; k < RT_BEAM_PARAM_COUNT; ++k) {
-            const rt_scene_track *tr = &b->tracks[k];
-            if (!tr->count)
-                continue;
-            float *dst = beam_param_ptr(&out[i], k);
-            rt_scene_track_eval(tr, t, dst);
-            /* opposite direction keys pass through zero: hold the earlier key's direction */
-            if (k == RT_BEAM_PARAM_DIR && scene_is_zero3(dst))
-                memcpy(dst, &tr->values[(size_t)key_before(tr, t) * 3], 3 * sizeof(float));
-        }
+        vfx_beam2 b2;
+        beam_at(&scene->beams[i], isfinite(time) ? time : 0, &b2);
+        out[i] = b2.v1;
     }
     return count;
 }

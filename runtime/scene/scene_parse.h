@@ -62,7 +62,7 @@ vfx_result scene_resolve_path(pctx *c, const char *p, const char *rel, char *out
 const char *scene_type_name(const cJSON *v);
 vfx_result scene_vec_value(pctx *c, const cJSON *v, const char *p, int n, range rg, float *out);
 vfx_result scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s);
-vfx_result scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv);
+vfx_result scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv, vfx_beams_view2 *bv2);
 vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w);
 vfx_result scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol);
 bool scene_ends_with(const char *s, const char *suffix);

@@ -98,7 +98,7 @@ void main()
                 x *= 1.0 + bm.look.z * (2.0 * volfx_flow_noise(u * bm.ab_eps.w - bm.look.w) - 1.0);
             }
             float x2 = x * x;
-            light += bm.look.x * x * (bm.color.rgb + (1.0 - bm.color.rgb) * (x2 / (x2 + 4.0)));
+            light += bm.look.x * x * (bm.color.rgb + (1.0 - bm.color.rgb) * (x2 / (x2 + 9.0)));
         }
     }
     if (Hth > 0.0) {

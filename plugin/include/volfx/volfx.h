@@ -184,7 +184,7 @@ typedef enum vfx_beam_falloff {
 /* How a vfx_beam2's line integral H becomes light (docs/beams.md "Emission"). */
 typedef enum vfx_beam_ramp {
     VFX_BEAM_RAMP_DEFAULT = 0, /* hot */
-    /* x = 2^exposure H / c; radiance = intensity x (C + (1 - C) x^2 / (x^2 + 4)): transparent
+    /* x = 2^exposure H / c; radiance = intensity x (C + (1 - C) x^2 / (x^2 + 9)): transparent
      * where H -> 0, the beam's colour C, then white-hot and brighter than 1 in the core */
     VFX_BEAM_RAMP_HOT = 1,
     /* version 1's: the pixel's summed H of such beams, clamped (or smoothly saturated) at c,
