@@ -48,6 +48,35 @@ static GLuint compile(const rt_logger *log, GLenum stage, const char *path)
     return s;
 }
 
+/* Compiles and links an embedded vertex + fragment shader pair; 0 with the error logged. */
+static GLuint link_program(const rt_logger *log, const char *vert, const char *frag, const char *label)
+{
+    GLuint vs = compile(log, GL_VERTEX_SHADER, vert);
+    GLuint fs = compile(log, GL_FRAGMENT_SHADER, frag);
+    if (!vs || !fs) {
+        glDeleteShader(vs);
+        glDeleteShader(fs);
+        return 0;
+    }
+    GLuint p = glCreateProgram();
+    glAttachShader(p, vs);
+    glAttachShader(p, fs);
+    glLinkProgram(p);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint ok = 0;
+    glGetProgramiv(p, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char text[2048];
+        glGetProgramInfoLog(p, sizeof text, NULL, text);
+        rt_logf(log, VFX_LOG_ERROR, "%s program link failed: %s", label, text);
+        glDeleteProgram(p);
+        return 0;
+    }
+    glObjectLabel(GL_PROGRAM, p, -1, label);
+    return p;
+}
+
 vfx_result rt_renderer_create(const rt_logger *logger, rt_renderer **out)
 {
     rt_renderer *r = calloc(1, sizeof *r);
@@ -55,31 +84,11 @@ vfx_result rt_renderer_create(const rt_logger *logger, rt_renderer **out)
         return VFX_ERR_OUT_OF_MEMORY;
     if (logger)
         r->log = *logger;
-    GLuint vs = compile(&r->log, GL_VERTEX_SHADER, "host/mesh.vert");
-    GLuint fs = compile(&r->log, GL_FRAGMENT_SHADER, "host/mesh.frag");
-    if (!vs || !fs) {
-        glDeleteShader(vs);
-        glDeleteShader(fs);
+    r->mesh_prog = link_program(&r->log, "host/mesh.vert", "host/mesh.frag", "host.mesh");
+    if (!r->mesh_prog) {
         free(r);
         return VFX_ERR_GL;
     }
-    r->mesh_prog = glCreateProgram();
-    glAttachShader(r->mesh_prog, vs);
-    glAttachShader(r->mesh_prog, fs);
-    glLinkProgram(r->mesh_prog);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    GLint ok = 0;
-    glGetProgramiv(r->mesh_prog, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[2048];
-        glGetProgramInfoLog(r->mesh_prog, sizeof log, NULL, log);
-        rt_logf(&r->log, VFX_LOG_ERROR, "host mesh program link failed: %s", log);
-        glDeleteProgram(r->mesh_prog);
-        free(r);
-        return VFX_ERR_GL;
-    }
-    glObjectLabel(GL_PROGRAM, r->mesh_prog, -1, "host.mesh");
     r->exposure = 1.f;
     r->u_model = glGetUniformLocation(r->mesh_prog, "u_model");
     r->u_view_proj = glGetUniformLocation(r->mesh_prog, "u_view_proj");
@@ -102,28 +111,9 @@ static void free_targets(rt_renderer *r)
 /* The tone-mapping program (common/fullscreen.vert + host/tonemap.frag) and its empty VAO. */
 static vfx_result make_tonemap(rt_renderer *r)
 {
-    GLuint vs = compile(&r->log, GL_VERTEX_SHADER, "common/fullscreen.vert");
-    GLuint fs = compile(&r->log, GL_FRAGMENT_SHADER, "host/tonemap.frag");
-    if (!vs || !fs) {
-        glDeleteShader(vs);
-        glDeleteShader(fs);
+    r->tone_prog = link_program(&r->log, "common/fullscreen.vert", "host/tonemap.frag", "host.tonemap");
+    if (!r->tone_prog)
         return VFX_ERR_GL;
-    }
-    r->tone_prog = glCreateProgram();
-    glAttachShader(r->tone_prog, vs);
-    glAttachShader(r->tone_prog, fs);
-    glLinkProgram(r->tone_prog);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    GLint ok = 0;
-    glGetProgramiv(r->tone_prog, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        rt_logf(&r->log, VFX_LOG_ERROR, "host tone-map program link failed");
-        glDeleteProgram(r->tone_prog);
-        r->tone_prog = 0;
-        return VFX_ERR_GL;
-    }
-    glObjectLabel(GL_PROGRAM, r->tone_prog, -1, "host.tonemap");
     r->u_exposure = glGetUniformLocation(r->tone_prog, "u_exposure");
     glUseProgram(r->tone_prog);
     glUniform1i(glGetUniformLocation(r->tone_prog, "u_hdr"), 0);
