@@ -201,6 +201,155 @@ static int run_cfg(const tet_mesh *m, const tet_camera *cam, const tet_tf *tf,
     return 0;
 }
 
+/* --only tf: the transfer-function integrators on this mesh and view, one worker, no ERT:
+ * tables of 2, 5 and 64 points (a smooth map with a narrow spike), each by the exact split,
+ * the pre-integrated lookup and the midpoint rule, interleaved rep by rep; median CPU ms and
+ * the pieces integrated, and the error against the exact image (the exact method agrees with
+ * the float64 ray march to ~1e-4 RMSE, tests/tetvol/test_tet_transfer.c). */
+static int bench_tf(const tet_mesh *m, const tet_camera *cam, const tet_tf *base, int reps,
+                    const char *mesh_name, const char *view_name)
+{
+    static tet_tf_point tabs[3][64];
+    const int counts[3] = {2, 5, 64};
+    for (int t = 0; t < 3; t++)
+        for (int i = 0; i < counts[t]; i++) {
+            double u = (double)i / (counts[t] - 1);
+            if (t == 2 && (i == 38 || i == 39 || i == 40)) /* a spike of 1% of the range */
+                u = 0.6 + 0.005 * (i - 39);
+            else if (t == 2 && i > 40)
+                u = 0.61 + 0.39 * (i - 41) / 22.0;
+            else if (t == 2)
+                u = 0.59 * i / 37.0;
+            tet_tf_point *p = &tabs[t][i];
+            p->s = (float)(base->smin + (base->smax - base->smin) * u);
+            for (int c = 0; c < 3; c++)
+                p->rgb[c] = (float)(base->color_lo[c] + (base->color_hi[c] - base->color_lo[c]) * u);
+            p->tau = (float)(base->tau_lo + (base->tau_hi - base->tau_lo) * u);
+            if (t == 1 && i == 2) /* a dip in the middle */
+                p->tau *= 0.1f;
+            if (t == 2 && i == 39) {
+                p->rgb[0] = p->rgb[1] = p->rgb[2] = 1.0f;
+                p->tau = 20 * base->tau_hi;
+            }
+        }
+    const size_t n = (size_t)cam->width * cam->height * 4;
+    float *ref = malloc(n * sizeof *ref), *img = malloc(n * sizeof *img);
+    double *cpu = malloc((size_t)reps * 9 * sizeof *cpu);
+    if (!ref || !img || !cpu) return -1;
+    tet_options o;
+    tet_options_default(&o);
+    o.ert = 0;
+    tet_pool *pool;
+    char err[256];
+    if (tet_pool_create(1, &pool, err) != VFX_OK) return -1;
+    double rmse[9] = {0}, mx[9] = {0};
+    uint64_t pieces[9] = {0}, segs = 0;
+    for (int r = 0; r <= reps; r++)
+        for (int t = 0; t < 3; t++) {
+            tet_tf tf = {.points = tabs[t], .count = counts[t], .method = TET_TF_EXACT};
+            if (r == 0 && tet_render_pool(pool, m, cam, &tf, &o, ref, NULL, NULL, err) != VFX_OK) goto fail;
+            for (int k = 0; k < 3; k++) {
+                tf.method = k;
+                tet_counters c;
+                double c0 = tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID);
+                if (tet_render_pool(pool, m, cam, &tf, &o, img, &c, NULL, err) != VFX_OK) goto fail;
+                if (r > 0) cpu[(size_t)(r - 1) * 9 + t * 3 + k] = tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID) - c0;
+                if (r == 0) {
+                    diff(ref, img, n, &rmse[t * 3 + k], &mx[t * 3 + k]);
+                    pieces[t * 3 + k] = c.tf_pieces;
+                    segs = c.segments_made;
+                }
+            }
+        }
+    static const char *const mname[3] = {"exact", "preintegrated", "midpoint"};
+    for (int t = 0; t < 3; t++)
+        for (int k = 0; k < 3; k++) {
+            double v[64];
+            for (int r = 0; r < reps; r++) v[r] = cpu[(size_t)r * 9 + t * 3 + k];
+            qsort(v, (size_t)reps, sizeof *v, cmp_d);
+            printf("{\"effect\":\"tetvol\",\"mesh\":\"%s\",\"view\":\"%s\",\"test\":\"tf\",\"points\":%d,\"method\":\"%s\","
+                   "\"cpu_ms\":%.2f,\"segments\":%llu,\"pieces\":%llu,\"rmse_vs_exact\":%.3g,\"max_vs_exact\":%.3g}\n",
+                   mesh_name, view_name, counts[t], mname[k], v[reps / 2], (unsigned long long)segs,
+                   (unsigned long long)pieces[t * 3 + k], rmse[t * 3 + k], mx[t * 3 + k]);
+        }
+    tet_pool_destroy(pool);
+    free(ref); free(img); free(cpu);
+    return 0;
+fail:
+    fprintf(stderr, "bench tetvol tf: %s\n", err);
+    tet_pool_destroy(pool);
+    free(ref); free(img); free(cpu);
+    return -1;
+}
+
+/* --only threads: 1 against 2 workers of persistent pools (created once, as in the plugin),
+ * interleaved rep by rep, no ERT and ERT+SHARE+DLB at 0.9: median wall and process CPU ms,
+ * and where the second worker's time goes (scan, table updates, waiting at the end of the
+ * scan, the composite, the serial set-up on the caller). */
+static int bench_threads(const tet_mesh *m, const tet_camera *cam, const tet_tf *tf, int reps,
+                         const char *mesh_name, const char *view_name)
+{
+    const size_t n = (size_t)cam->width * cam->height * 4;
+    float *img = malloc(n * sizeof *img);
+    tet_pool *pools[2];
+    char err[256];
+    if (!img || tet_pool_create(1, &pools[0], err) != VFX_OK || tet_pool_create(2, &pools[1], err) != VFX_OK)
+        return -1;
+    for (int cfg = 0; cfg < 2; cfg++) {
+        tet_options o;
+        tet_options_default(&o);
+        o.ert = cfg;
+        double wall[2][64], cpu[2][64];
+        tet_counters pw[2][64][2], tot[2][64];
+        for (int r = 0; r <= reps; r++)
+            for (int p = 0; p < 2; p++) {
+                tet_counters c, w[2];
+                double t0 = tet_now_ms(), c0 = tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID);
+                if (tet_render_pool(pools[p], m, cam, tf, &o, img, &c, w, err) != VFX_OK) {
+                    fprintf(stderr, "bench tetvol threads: %s\n", err);
+                    return -1;
+                }
+                if (r == 0) continue; /* warm-up */
+                wall[p][r - 1] = tet_now_ms() - t0;
+                cpu[p][r - 1] = tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID) - c0;
+                tot[p][r - 1] = c;
+                pw[p][r - 1][0] = w[0];
+                pw[p][r - 1][1] = p ? w[1] : w[0];
+            }
+        double ws[2][64], cs[2][64];
+        memcpy(ws, wall, sizeof ws);
+        memcpy(cs, cpu, sizeof cs);
+        for (int p = 0; p < 2; p++) {
+            qsort(ws[p], (size_t)reps, sizeof(double), cmp_d);
+            qsort(cs[p], (size_t)reps, sizeof(double), cmp_d);
+        }
+        /* the breakdown of the 2-worker run of median wall time */
+        int med = 0;
+        for (int r = 0; r < reps; r++)
+            if (wall[1][r] == ws[1][reps / 2]) med = r;
+        const tet_counters *T = &tot[1][med];
+        printf("{\"effect\":\"tetvol\",\"mesh\":\"%s\",\"view\":\"%s\",\"test\":\"threads\",\"ert\":%d,\"reps\":%d,"
+               "\"wall_ms_1\":%.2f,\"wall_ms_2\":%.2f,\"speedup_wall\":%.3f,\"cpu_ms_1\":%.2f,\"cpu_ms_2\":%.2f,"
+               "\"setup_ms\":%.2f,\"composite_ms\":%.2f,\"workers\":[",
+               mesh_name, view_name, cfg, reps, ws[0][reps / 2], ws[1][reps / 2], ws[1][reps / 2] > 0 ? ws[0][reps / 2] / ws[1][reps / 2] : 0,
+               cs[0][reps / 2], cs[1][reps / 2], T->t_setup_ms, T->t_composite_ms);
+        for (int k = 0; k < 2; k++) {
+            const tet_counters *c = &pw[1][med][k];
+            printf("%s{\"scan_ms\":%.2f,\"update_ms\":%.2f,\"wait_ms\":%.2f,\"cpu_ms\":%.2f,\"cells\":%llu,\"skipped\":%llu}",
+                   k ? "," : "", c->t_sc_ms, c->t_update_ms, c->t_wait_ms, c->cpu_ms,
+                   (unsigned long long)c->cells_scanned, (unsigned long long)c->cells_skipped_ert);
+        }
+        const tet_counters *one = &tot[0][med];
+        printf("],\"one_worker\":{\"setup_ms\":%.2f,\"scan_ms\":%.2f,\"update_ms\":%.2f,\"composite_ms\":%.2f},\"threads_started\":%d}\n",
+               one->t_setup_ms, one->t_sc_ms, one->t_update_ms, one->t_composite_ms, tet_pool_threads(pools[1]));
+        fflush(stdout);
+    }
+    tet_pool_destroy(pools[0]);
+    tet_pool_destroy(pools[1]);
+    free(img);
+    return 0;
+}
+
 static int has(const char *list, const char *item)
 {
     size_t l = strlen(item);
@@ -213,7 +362,7 @@ static int has(const char *list, const char *item)
 static void usage(void)
 {
     fputs("volfx-bench tetvol [--mesh FILE.vtu|TETGEN_BASE] [--scalar NAME] [--grid N] [--size PX]\n"
-          "  [--view across,axis] [--only table1,ert,D,C,table2,image] [--workers N] [--reps R]\n"
+          "  [--view across,axis] [--only table1,ert,D,C,table2,image|tf|threads] [--workers N] [--reps R]\n"
           "  [--tau T] [--out PREFIX] [--c-nopartial-max C] [--json]\n"
           "--tau: optical depth through the mesh's thinnest box extent at the top of the transfer\n"
           "function (default 4). --out writes PREFIX_<view>.rgb.pfm (premultiplied) and .alpha.pfm\n"
@@ -357,6 +506,11 @@ int bench_tetvol(int argc, char **argv)
             tet_options_default(&o);
             o.ert = 0; o.workers = 1;
         }
+        if (strcmp(only, "all") && has(only, "tf") && (rc = bench_tf(&m, &cam, &tf, reps, mesh_name, vw->name)) != 0)
+            break;
+        if (strcmp(only, "all") && has(only, "threads") &&
+            (rc = bench_threads(&m, &cam, &tf, reps, mesh_name, vw->name)) != 0)
+            break;
         if (has(only, "table1")) {
             for (int e = 0; e < 2; e++) {
                 o.ert = e; o.ert_threshold = 0.9f;

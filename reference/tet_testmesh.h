@@ -18,4 +18,16 @@ int ref_testmesh_grid(int n, tet_mesh *m);
 void ref_testmesh_orbit(tet_camera *c, int w, int h, float yaw, float pitch, float f,
                             float nearp, float farp);
 
+/* Extinction and colour of tf at scalar s in float64 (an independent reading of tet_tf:
+ * piecewise linear between its points or between its two ends, clamped outside). */
+void ref_tf_eval(const tet_tf *tf, double s, double *tau, double rgb[3]);
+
+/* Float64 emission-absorption ray march through a mesh made by ref_testmesh_grid(n): per pixel
+ * (centre rays of the renderer's camera model) the ray's span inside [-1,1]^3 is cut into
+ * `steps` equal pieces, the scalar at each midpoint interpolated linearly in the containing tet
+ * (found from the cube it lies in), colour and extinction from ref_tf_eval, composited front to
+ * back. out: width*height*4 premultiplied RGBA, row 0 = bottom. */
+void ref_testmesh_raymarch(int n, const tet_mesh *m, const tet_camera *c, const tet_tf *tf,
+                           int steps, double *out);
+
 #endif

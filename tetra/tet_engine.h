@@ -107,10 +107,10 @@ int tet_check_view(const tet_mesh *mesh, const tet_camera *cam, const tet_tf *tf
                    double *near_d, char err[256]);
 /* First tet referencing a point out of range: VFX_ERR_INVALID_ARGUMENT naming it, or VFX_OK. */
 int tet_check_indices(const tet_mesh *mesh, char err[256]);
-/* Transforms every point to view space with its scalar and pixel coordinates (pixel k's
+/* Transforms points [i0, i1) to view space with their scalar and pixel coordinates (pixel k's
  * centre at k); every engine uses it so all see bit-identical vertices. */
 void tet_view_vertices(const tet_mesh *mesh, const float *V, const float *P, int W, int H,
-                       pvert *vp);
+                       uint32_t i0, uint32_t i1, pvert *vp);
 /* Keys of cells [c0, c1) sorted front to back by nearest depth into keys (tmp: scratch of as
  * many); cells with a NaN depth or scalar are left out and counted in *nan. Returns the count. */
 uint32_t tet_build_keys(const tet_mesh *mesh, const pvert *vp, uint32_t c0, uint32_t c1,

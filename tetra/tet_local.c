@@ -81,7 +81,7 @@ int tet_local_create(const tet_mesh *mesh, const tet_camera *cam,
         tet_local_destroy(L);
         return rc;
     }
-    tet_view_vertices(mesh, V, P, W, H, L->vp);
+    tet_view_vertices(mesh, V, P, W, H, 0, np, L->vp);
     for (int pi = 0; pi <= parts; pi++)
         L->bounds[pi] = (uint32_t)((uint64_t)nt * pi / parts);
     scan_ctx X = {mesh, &L->tf, opts, L->vp, P, near_d, W, H, D};

@@ -19,11 +19,14 @@ typedef struct tet_camera {
 
 /* How a ray segment's colour and opacity come from the transfer function. */
 enum {
-    TET_TF_SPLIT = 0,        /* exact: the segment is split at the table's breakpoints (the
-                              * scalar is linear along it), each piece integrated on its own */
+    TET_TF_EXACT = 0,        /* the segment is split at the table's breakpoints (the scalar is
+                              * linear along it, so tau and colour are linear along each piece)
+                              * and each piece's emission-absorption integral is evaluated
+                              * (opacity exactly, colour to ~1e-6) */
     TET_TF_PREINTEGRATED,    /* pre-integrated lookup (Engel et al. 2001): cumulative integrals
                               * of tau and tau*colour over a grid, no self-attenuation */
-    TET_TF_MIDPOINT,         /* one evaluation at the segment's midpoint scalar (coarse) */
+    TET_TF_MIDPOINT,         /* one evaluation at the segment's midpoint scalar, colour times
+                              * the segment's opacity (the renderer's rule before tables) */
 };
 
 /* One breakpoint of a piecewise-linear transfer function. */
@@ -43,7 +46,7 @@ typedef struct tet_tf {
     float color_lo[3], color_hi[3];
     const tet_tf_point *points;
     int count;              /* 0 or 2..TET_TF_MAX_POINTS */
-    int method;             /* TET_TF_*; 0 = split */
+    int method;             /* TET_TF_*; 0 = exact */
     int pre_size;           /* TET_TF_PREINTEGRATED: grid cells, 0 -> 1024 */
 } tet_tf;
 
@@ -73,6 +76,7 @@ typedef struct tet_counters {
     uint64_t tf_pieces;          /* ray pieces integrated (segments split at TF breakpoints) */
     double cpu_ms;               /* CPU time of the worker thread (scan + updates); totals: sum */
     double t_wait_ms;            /* waiting for other workers at the end of the scan phase */
+    double t_setup_ms;           /* projection and front-to-back sort before the scan */
 } tet_counters;
 
 /* Fills opts with the paper's defaults (ERT on, threshold 0.9, D = 20, C = 100, partial on,

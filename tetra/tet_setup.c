@@ -46,8 +46,12 @@ int tet_check_view(const tet_mesh *mesh, const tet_camera *cam, const tet_tf *tf
                  tf->count, TET_TF_MAX_POINTS);
         return VFX_ERR_INVALID_ARGUMENT;
     }
-    if (tf->method < TET_TF_SPLIT || tf->method > TET_TF_MIDPOINT) {
+    if (tf->method < TET_TF_EXACT || tf->method > TET_TF_MIDPOINT) {
         snprintf(err, 256, "tet_render: unknown transfer-function method %d", tf->method);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    if (tf->pre_size < 0 || tf->pre_size > (1 << 20)) {
+        snprintf(err, 256, "tet_render: pre-integrated table of %d cells (0..%d)", tf->pre_size, 1 << 20);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     *near_d = (double)P[14] / ((double)P[10] - 1.0);
@@ -69,9 +73,9 @@ int tet_check_indices(const tet_mesh *mesh, char err[256])
 }
 
 void tet_view_vertices(const tet_mesh *mesh, const float *V, const float *P, int W, int H,
-                       pvert *vp)
+                       uint32_t i0, uint32_t i1, pvert *vp)
 {
-    for (uint32_t i = 0; i < mesh->point_count; i++) {
+    for (uint32_t i = i0; i < i1; i++) {
         const float *x = &mesh->points[3 * i];
         double e[3];
         for (int r = 0; r < 3; r++)

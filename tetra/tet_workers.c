@@ -286,14 +286,43 @@ static void scan_worker(worker *w)
 
 typedef struct frame_job {
     shared *sh;
+    const tet_mesh *mesh;
+    const tet_camera *cam;
+    pvert *vp;
+    cellkey *keys, *ktmp;
     float *rgba;
     double t_scan_end[64];   /* wall clock when each worker finished scanning */
 } frame_job;
 
+/* Phase 1: worker i projects its share of the points. */
+static void project_job(void *arg, int i)
+{
+    frame_job *j = arg;
+    const uint32_t np = j->mesh->point_count, nw = (uint32_t)j->sh->nw;
+    tet_view_vertices(j->mesh, j->cam->view, j->cam->proj, j->cam->width, j->cam->height,
+                      (uint32_t)((uint64_t)np * i / nw), (uint32_t)((uint64_t)np * (i + 1) / nw), j->vp);
+}
+
+/* Phase 2: worker i sorts its partition front to back by nearest depth, then scans. The
+ * initial assignment is contiguous ranges of the mesh's cell order (the data layout, which
+ * keeps neighbouring cells on one worker as in the paper's fig. 8); partition i's keys live at
+ * its cells' offset. Visibility cycles do no harm: pixel lists are depth sorted. A worker
+ * that runs dry before another has published its keys finds nothing to take there and stops:
+ * balance suffers, never correctness. */
 static void scan_job(void *arg, int i)
 {
     frame_job *j = arg;
-    scan_worker(&j->sh->w[i]);
+    worker *w = &j->sh->w[i];
+    const uint32_t nt = j->mesh->tet_count, nw = (uint32_t)j->sh->nw;
+    const uint32_t c0 = (uint32_t)((uint64_t)nt * i / nw), c1 = (uint32_t)((uint64_t)nt * (i + 1) / nw);
+    double t0 = tet_now_ms();
+    uint32_t n = tet_build_keys(j->mesh, j->vp, c0, c1, j->keys + c0, j->ktmp + c0, &w->cnt.cells_nan);
+    pthread_mutex_lock(&w->lock);
+    w->next = c0;
+    w->end = c0 + n;
+    pthread_mutex_unlock(&w->lock);
+    w->cnt.t_setup_ms = tet_now_ms() - t0;
+    scan_worker(w);
     j->t_scan_end[i] = tet_now_ms();
 }
 
@@ -342,6 +371,7 @@ static void sum_counters(tet_counters *cnt, const tet_counters *c)
     cnt->segments_merged += c->segments_merged;
     cnt->table_updates += c->table_updates;
     cnt->tf_pieces += c->tf_pieces;
+    cnt->cells_nan += c->cells_nan;
     cnt->cpu_ms += c->cpu_ms;
     if (c->t_sc_ms > cnt->t_sc_ms) cnt->t_sc_ms = c->t_sc_ms;
     if (c->t_update_ms > cnt->t_update_ms) cnt->t_update_ms = c->t_update_ms;
@@ -387,18 +417,6 @@ int tet_render_pool(tet_pool *pool, const tet_mesh *mesh, const tet_camera *cam,
             rc = VFX_ERR_OUT_OF_MEMORY;
             goto done;
         }
-    tet_view_vertices(mesh, cam->view, cam->proj, W, H, pool->vp);
-    /* Initial assignment: contiguous ranges of the mesh's cell order (the data layout, which
-     * keeps neighbouring cells on one worker as in the paper's fig. 8), each sorted front to
-     * back by nearest depth (visibility cycles do no harm: pixel lists are depth sorted). */
-    uint32_t nk = 0;
-    for (int wi = 0; wi < nw; wi++) {
-        uint32_t c0 = (uint32_t)((uint64_t)nt * wi / nw), c1 = (uint32_t)((uint64_t)nt * (wi + 1) / nw);
-        uint32_t k0 = nk;
-        nk += tet_build_keys(mesh, pool->vp, c0, c1, pool->keys + k0, pool->ktmp, &cnt.cells_nan);
-        ws[wi].next = k0;
-        ws[wi].end = nk;
-    }
     scan_ctx X = {mesh, &pool->tf, opts, pool->vp, cam->proj, near_d, W, H, D};
     sh.X = &X;
     sh.keys = pool->keys;
@@ -407,11 +425,18 @@ int tet_render_pool(tet_pool *pool, const tet_mesh *mesh, const tet_camera *cam,
     sh.table = pool->table;
     for (int i = 0; i < nw; i++)
         ws[i].sh = &sh;
-    frame_job job = {.sh = &sh, .rgba = rgba};
+    frame_job job = {.sh = &sh, .mesh = mesh, .cam = cam, .vp = pool->vp, .keys = pool->keys,
+                     .ktmp = pool->ktmp, .rgba = rgba};
+    const double t_setup = tet_now_ms();
+    pool_run(pool, project_job, &job);
+    cnt.t_setup_ms = tet_now_ms() - t_setup;
     pool_run(pool, scan_job, &job);
-    double t_all = 0;
-    for (int i = 0; i < nw; i++)
+    double t_all = 0, t_keys = 0;
+    for (int i = 0; i < nw; i++) {
         t_all = fmax(t_all, job.t_scan_end[i]);
+        t_keys = fmax(t_keys, ws[i].cnt.t_setup_ms);
+    }
+    cnt.t_setup_ms += t_keys;
     for (int i = 0; i < nw; i++)
         ws[i].cnt.t_wait_ms = t_all - job.t_scan_end[i];
     for (int i = 0; i < nw; i++)

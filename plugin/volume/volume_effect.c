@@ -269,7 +269,7 @@ static void make_tf(volume_state *s, tet_tf *tf)
                    .color_lo = {0.1f, 0.3f, 0.9f}, .color_hi = {1.0f, 0.85f, 0.3f}};
     if (!(v->scalar_max > v->scalar_min))
         tf->smin = s->data_min, tf->smax = s->data_max > s->data_min ? s->data_max : s->data_min + 1;
-    tf->method = s->view.transfer_method == VFX_VOLUME_TRANSFER_PREINTEGRATED ? TET_TF_PREINTEGRATED : TET_TF_SPLIT;
+    tf->method = s->view.transfer_method == VFX_VOLUME_TRANSFER_PREINTEGRATED ? TET_TF_PREINTEGRATED : TET_TF_EXACT;
     if (!v->transfer_rgba)
         return;
     const uint32_t n = v->transfer_count;
