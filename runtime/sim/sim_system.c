@@ -6,54 +6,102 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define SIM_NO_TABLE UINT32_MAX
+/* The world bumps a table's revision once per component a system declared as written when
+ * that system has run (world.c); this system writes position, velocity and density. */
+#define SIM_OWN_BUMPS 3u
+
 struct rt_sim_system {
+    rt_world *world;
     rt_sph *sph;
     rt_particle_components pc;
     rt_sph_report report;
-    /* import buffers (world order) */
-    float *x, *y, *z, *vx, *vy, *vz;
-    uint32_t cap;
-    /* first global (query order) index of each visited table, to write back by id */
-    uint32_t *table_base, *table_rows, *table_index;
-    uint32_t table_cap;
+    /* The table whose columns the solver steps in place, and the revision it will have when
+     * nobody else touched it since our last run (anything else: bind again). */
+    uint32_t table;
+    uint64_t revision;
+    bool bound;
     char err[512];
 };
 
-static vfx_result grow(rt_sim_system *s, uint32_t n)
+/* The columns of `table` (count 0 when it is empty or unknown). */
+static void table_columns(rt_sim_system *s, uint32_t table, rt_sph_columns *c)
 {
-    if (n <= s->cap)
-        return VFX_OK;
-    uint32_t cap = s->cap ? s->cap : 1024;
-    while (cap < n)
-        cap *= 2;
-    float **b[] = {&s->x, &s->y, &s->z, &s->vx, &s->vy, &s->vz};
-    for (int i = 0; i < 6; ++i) {
-        float *p = realloc(*b[i], (size_t)cap * sizeof(float));
-        if (!p) {
-            snprintf(s->err, sizeof s->err, "vfx.sim.sph: out of memory importing %u particles", n);
-            return VFX_ERR_OUT_OF_MEMORY;
-        }
-        *b[i] = p;
+    *c = (rt_sph_columns){0};
+    rt_component terms[3] = {s->pc.position, s->pc.velocity, s->pc.density};
+    rt_query_iter it = rt_query_begin(s->world, terms, 3);
+    while (rt_query_next(&it)) {
+        if (it.table != table)
+            continue;
+        *c = (rt_sph_columns){it.rows,
+                              rt_query_column(&it, s->pc.position, 0), rt_query_column(&it, s->pc.position, 1),
+                              rt_query_column(&it, s->pc.position, 2), rt_query_column(&it, s->pc.velocity, 0),
+                              rt_query_column(&it, s->pc.velocity, 1), rt_query_column(&it, s->pc.velocity, 2),
+                              rt_query_column(&it, s->pc.density, 0), NULL};
+        return;
     }
-    s->cap = cap;
+}
+
+/* rt_sph_host: the solver's cell sort reorders the whole table. */
+static vfx_result host_permute(void *user, const uint32_t *perm, rt_sph_columns *c)
+{
+    rt_sim_system *s = user;
+    vfx_result r = rt_world_table_permute(s->world, s->table, perm);
+    if (r)
+        return r;
+    table_columns(s, s->table, c);
     return VFX_OK;
 }
 
-static vfx_result grow_tables(rt_sim_system *s, uint32_t n)
+/* rt_sph_host: particles the emitters (or rt_sph_add_*) make are new entities of the table. */
+static vfx_result host_append(void *user, uint32_t add, rt_sph_columns *c)
 {
-    if (n <= s->table_cap)
-        return VFX_OK;
-    uint32_t cap = s->table_cap ? s->table_cap * 2 : 16;
-    while (cap < n)
-        cap *= 2;
-    uint32_t **b[] = {&s->table_base, &s->table_rows, &s->table_index};
-    for (int i = 0; i < 3; ++i) {
-        uint32_t *p = realloc(*b[i], (size_t)cap * sizeof(uint32_t));
-        if (!p)
-            return VFX_ERR_OUT_OF_MEMORY;
-        *b[i] = p;
+    rt_sim_system *s = user;
+    rt_component terms[4] = {s->pc.position, s->pc.velocity, s->pc.density, s->pc.radius};
+    uint32_t nterms = 3;
+    rt_query_iter it = rt_query_begin(s->world, terms, 3);
+    while (rt_query_next(&it))
+        if (it.table == s->table && rt_query_column(&it, s->pc.radius, 0))
+            nterms = 4; /* same component set, same table */
+    rt_entity *ids = malloc((size_t)add * sizeof *ids);
+    if (!ids)
+        return VFX_ERR_OUT_OF_MEMORY;
+    vfx_result r = rt_world_spawn(s->world, add, terms, nterms, ids);
+    uint32_t table = SIM_NO_TABLE;
+    it = rt_query_begin(s->world, terms, 3);
+    while (!r && rt_query_next(&it))
+        if (it.rows >= add && it.entities[it.rows - 1] == ids[add - 1])
+            table = it.table;
+    free(ids);
+    if (r)
+        return r;
+    table_columns(s, s->table, c);
+    if (s->table != SIM_NO_TABLE && table != s->table && c->count) {
+        snprintf(s->err, sizeof s->err, "vfx.sim.sph: emitted particles landed in another table "
+                 "than the simulated ones (they carry other components)");
+        return VFX_ERR_UNSUPPORTED;
     }
-    s->table_cap = cap;
+    s->table = table;
+    table_columns(s, table, c);
+    return VFX_OK;
+}
+
+/* The one table holding the simulated particles (SIM_NO_TABLE when none has rows); an error
+ * when they are spread over several. */
+static vfx_result find_table(rt_sim_system *s, uint32_t *table)
+{
+    rt_component terms[3] = {s->pc.position, s->pc.velocity, s->pc.density};
+    uint32_t tables = 0;
+    *table = SIM_NO_TABLE;
+    rt_query_iter it = rt_query_begin(s->world, terms, 3);
+    while (rt_query_next(&it))
+        if (tables++ == 0)
+            *table = it.table;
+    if (tables > 1) {
+        snprintf(s->err, sizeof s->err, "vfx.sim.sph: the particles are in %u tables (entities "
+                 "with different component sets); the solver steps one table in place", tables);
+        return VFX_ERR_UNSUPPORTED;
+    }
     return VFX_OK;
 }
 
@@ -61,100 +109,35 @@ static vfx_result sim_run(rt_world *w, const rt_system_ctx *ctx)
 {
     rt_sim_system *s = ctx->user;
     s->err[0] = 0;
-    rt_component terms[3] = {s->pc.position, s->pc.velocity, s->pc.density};
-    uint32_t n = rt_query_count(w, terms, 3);
-    vfx_result r = grow(s, n);
+    uint32_t table;
+    vfx_result r = find_table(s, &table);
     if (r)
         return r;
-    /* import, remembering where each table starts in the global order */
-    uint32_t k = 0, nt = 0;
-    rt_query_iter it = rt_query_begin(w, terms, 3);
-    while (rt_query_next(&it)) {
-        if (grow_tables(s, nt + 1)) {
-            snprintf(s->err, sizeof s->err, "vfx.sim.sph: out of memory");
-            return VFX_ERR_OUT_OF_MEMORY;
-        }
-        s->table_base[nt] = k;
-        s->table_rows[nt] = it.rows;
-        s->table_index[nt] = it.table;
-        nt++;
-        const float *c[6] = {rt_query_column(&it, s->pc.position, 0), rt_query_column(&it, s->pc.position, 1),
-                             rt_query_column(&it, s->pc.position, 2), rt_query_column(&it, s->pc.velocity, 0),
-                             rt_query_column(&it, s->pc.velocity, 1), rt_query_column(&it, s->pc.velocity, 2)};
-        float *d[6] = {s->x + k, s->y + k, s->z + k, s->vx + k, s->vy + k, s->vz + k};
-        for (int f = 0; f < 6; ++f)
-            memcpy(d[f], c[f], (size_t)it.rows * sizeof(float));
-        k += it.rows;
-    }
-    /* Nothing changed since the last write-back (same count, every imported value the solver's
-     * own, by id): keep the solver's state, and with it its Verlet lists and grid order (a
-     * clear and add would force a rebuild every frame). Any edit, spawn or despawn re-imports. */
-    rt_sph_columns c0 = rt_sph_get_columns(s->sph);
-    bool same = k > 0 && c0.count == k;
-    for (uint32_t i = 0; same && i < c0.count; ++i) {
-        uint32_t id = c0.id[i];
-        same = id < k && s->x[id] == c0.x[i] && s->y[id] == c0.y[i] && s->z[id] == c0.z[i] &&
-               s->vx[id] == c0.vx[i] && s->vy[id] == c0.vy[i] && s->vz[id] == c0.vz[i];
-    }
+    if (table == SIM_NO_TABLE)
+        table = s->table; /* emptied (or never made): emitters refill the same table */
+    /* The solver's columns are the table's, so value edits between frames are already in them
+     * (moves are caught by the step's displacement check). A structural change (spawn,
+     * despawn, reorder) or a write by another system moves the revision: bind again, which
+     * checks the values and rebuilds the neighbour lists. */
+    bool same = s->bound && table == s->table &&
+                (table == SIM_NO_TABLE || rt_world_table_revision(w, table) == s->revision);
     if (!same) {
-        rt_sph_clear(s->sph);
-        r = rt_sph_add_particles(s->sph, k, s->x, s->y, s->z, s->vx, s->vy, s->vz);
-        if (r) {
+        s->table = table;
+        rt_sph_columns c;
+        table_columns(s, table, &c);
+        rt_sph_host host = {s, host_permute, host_append};
+        if ((r = rt_sph_bind(s->sph, &host, &c))) {
             snprintf(s->err, sizeof s->err, "vfx.sim.sph: %s", rt_sph_last_error(s->sph));
             return r;
         }
+        s->bound = true;
     }
+    /* A failed step leaves the last good (finite) state in the columns. */
     r = rt_sph_step(s->sph, ctx->dt, &s->report);
-    if (r)
+    if (r && !s->err[0])
         snprintf(s->err, sizeof s->err, "vfx.sim.sph: %s", rt_sph_last_error(s->sph));
-    /* write back (even after a numeric failure: the solver then holds the last good state,
-     * which is finite). Solver rows are sorted by grid cell; id is the import index. */
-    rt_sph_columns c = rt_sph_get_columns(s->sph);
-    uint32_t t = 0;
-    it = rt_query_begin(w, terms, 3);
-    while (rt_query_next(&it) && t < nt) {
-        /* same tables in the same order as the import (nothing structural happened between) */
-        float *o[7] = {rt_query_column(&it, s->pc.position, 0), rt_query_column(&it, s->pc.position, 1),
-                       rt_query_column(&it, s->pc.position, 2), rt_query_column(&it, s->pc.velocity, 0),
-                       rt_query_column(&it, s->pc.velocity, 1), rt_query_column(&it, s->pc.velocity, 2),
-                       rt_query_column(&it, s->pc.density, 0)};
-        uint32_t base = s->table_base[t], rows = s->table_rows[t];
-        const float *src[7] = {c.x, c.y, c.z, c.vx, c.vy, c.vz, c.density};
-        for (uint32_t i = 0; i < c.count; ++i) {
-            uint32_t id = c.id[i];
-            if (id < base || id >= base + rows)
-                continue;
-            for (int f = 0; f < 7; ++f)
-                o[f][id - base] = src[f][i];
-        }
-        t++;
-    }
-    /* particles the emitters made: new entities */
-    uint32_t extra = c.count > k ? c.count - k : 0;
-    if (extra && r == VFX_OK) {
-        rt_entity *ids = malloc((size_t)extra * sizeof *ids);
-        if (!ids)
-            return VFX_ERR_OUT_OF_MEMORY;
-        r = rt_world_spawn(w, extra, terms, 3, ids);
-        if (!r) {
-            for (uint32_t i = 0; i < c.count; ++i) {
-                if (c.id[i] < k)
-                    continue;
-                rt_entity e = ids[c.id[i] - k];
-                float vals[7] = {c.x[i], c.y[i], c.z[i], c.vx[i], c.vy[i], c.vz[i], c.density[i]};
-                for (int f = 0; f < 7; ++f) {
-                    float *p = rt_world_get(w, e, f < 3 ? s->pc.position : f < 6 ? s->pc.velocity : s->pc.density,
-                                             (uint32_t)(f < 6 ? f % 3 : 0));
-                    if (p)
-                        *p = vals[f];
-                }
-            }
-        } else {
-            snprintf(s->err, sizeof s->err, "vfx.sim.sph: spawning %u emitted particles: %s", extra,
-                     rt_world_last_error(w));
-        }
-        free(ids);
-    }
+    if (s->table != SIM_NO_TABLE)
+        s->revision = rt_world_table_revision(w, s->table) + SIM_OWN_BUMPS;
     return r;
 }
 
@@ -175,6 +158,8 @@ vfx_result rt_sim_system_create(rt_world *world, const rt_sph_desc *desc, rt_sim
         snprintf(err, err_len, "rt_sim_system_create: out of memory");
         return VFX_ERR_OUT_OF_MEMORY;
     }
+    s->world = world;
+    s->table = SIM_NO_TABLE;
     vfx_result r = rt_particles_register(world, &s->pc);
     if (r) {
         snprintf(err, err_len, "rt_sim_system_create: %s", rt_world_last_error(world));
@@ -188,7 +173,7 @@ vfx_result rt_sim_system_create(rt_world *world, const rt_sph_desc *desc, rt_sim
     }
     rt_component rw[3] = {s->pc.position, s->pc.velocity, s->pc.density};
     rt_system_desc sd = {.name = "vfx.sim.sph", .phase = RT_PHASE_SIMULATE, .reads = rw, .read_count = 3,
-                          .writes = rw, .write_count = 3, .fn = sim_run, .user = s};
+                          .writes = rw, .write_count = SIM_OWN_BUMPS, .fn = sim_run, .user = s};
     r = rt_world_add_system(world, &sd);
     if (r) {
         snprintf(err, err_len, "rt_sim_system_create: %s", rt_world_last_error(world));
@@ -204,8 +189,6 @@ void rt_sim_system_destroy(rt_sim_system *s)
     if (!s)
         return;
     rt_sph_destroy(s->sph);
-    free(s->x), free(s->y), free(s->z), free(s->vx), free(s->vy), free(s->vz);
-    free(s->table_base), free(s->table_rows), free(s->table_index);
     free(s);
 }
 

@@ -1,11 +1,14 @@
 /* sim_system.h — the SPH solver as an ECS system: "vfx.sim.sph" in the simulate phase reads
  * and writes the particle components of runtime/ecs/particles.h.
  *
- * The world is the source of truth: every frame the system imports all entities that have
- * position, velocity and density (in query order), steps the solver by the frame dt, and
- * writes position, velocity and density back to the same rows. So the game may spawn,
- * despawn or move particles between frames. Particles made by the solver's emitters are
- * spawned as new particle entities after the step. */
+ * The world is the source of truth and the only copy: the solver steps the columns of the
+ * table holding position, velocity and density in place (rt_sph_bind), sorting its rows by grid
+ * cell (rt_world_table_permute: rows move, follow particles by entity) and appending the
+ * particles its emitters make as new entities of that table. The game may spawn, despawn or
+ * edit particles between frames: edited values are the solver's at once; a change of the
+ * table's revision (structural change, or a write by another system) makes the system bind
+ * again (values checked, neighbour lists rebuilt). The particles must all be in one table
+ * (VFX_ERR_UNSUPPORTED otherwise). */
 #ifndef RT_SIM_SYSTEM_H
 #define RT_SIM_SYSTEM_H
 
@@ -20,7 +23,7 @@ typedef struct rt_sim_system rt_sim_system;
  * will not run again (the world keeps a pointer to it). */
 vfx_result rt_sim_system_create(rt_world *world, const rt_sph_desc *desc, rt_sim_system **out,
                                  char *err, size_t err_len);
-/* Frees the solver and the system's buffers. NULL allowed. */
+/* Frees the solver (the world keeps the particles). NULL allowed. */
 void rt_sim_system_destroy(rt_sim_system *sys);
 /* The solver (add colliders and emitters through it; particles come from the world). */
 rt_sph *rt_sim_system_solver(rt_sim_system *sys);

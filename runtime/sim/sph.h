@@ -20,7 +20,10 @@
  * at the start of every rt_sph_step).
  * Column pointers returned by rt_sph_columns stay valid until the next add or step (particles
  * are reordered by grid cell at every rebuild for locality; `id` says which input particle a row
- * is). No global state; one rt_sph is not thread-safe, it uses its own worker threads. */
+ * is). The state columns (x..vz, density) are the solver's own, or a host's bound with
+ * rt_sph_bind (an ECS table: the solver then steps them in place and reorders and appends rows
+ * through the host). No global state; one rt_sph is not thread-safe, it uses its own worker
+ * threads. */
 #ifndef RT_SIM_SPH_H
 #define RT_SIM_SPH_H
 
@@ -154,7 +157,26 @@ float rt_sph_support(const rt_sph *sim);
  * in rt_sph_clamped_on_add). n = 0 is a no-op. */
 vfx_result rt_sph_add_particles(rt_sph *sim, uint32_t n, const float *x, const float *y,
                                  const float *z, const float *vx, const float *vy, const float *vz);
-/* Removes every particle (capacity, colliders, emitters and time are kept); ids restart at 0. */
+/* Host-owned state columns (rt_sph_bind). Each call leaves the columns as they are afterwards in
+ * *cols (pointers may move; id is ignored). */
+typedef struct rt_sph_host {
+    void *user;
+    /* Reorders the rows: new row i = old row perm[i] (a permutation of 0..count-1). */
+    vfx_result (*permute)(void *user, const uint32_t *perm, rt_sph_columns *cols);
+    /* Appends `add` rows at the end (the solver then writes their values). */
+    vfx_result (*append)(void *user, uint32_t add, rt_sph_columns *cols);
+} rt_sph_host;
+
+/* Steps the host's columns (cols: count rows of x..vz and density) in place from now on; the
+ * solver's own particles are dropped. Checks them like rt_sph_add_particles (a NaN/Inf refuses
+ * the binding, naming the row; positions are moved into the domain), sets density to rho0, ids
+ * restart at 0 in row order and the neighbour lists are rebuilt at the next substep. Bind again
+ * after the host changed its rows (count or order); edited values need no call (moves are seen
+ * by the displacement check of rt_sph_step). Adds and emitters append through the host; the
+ * host and its columns must outlive the binding, which rt_sph_clear ends. */
+vfx_result rt_sph_bind(rt_sph *sim, const rt_sph_host *host, const rt_sph_columns *cols);
+/* Removes every particle (capacity, colliders, emitters and time are kept); ids restart at 0.
+ * Ends a binding (the host's rows are left alone). */
 void rt_sph_clear(rt_sph *sim);
 /* Adds a lattice of spacing dx filling [lo, hi] (cell centres), at rest; count in *added. */
 vfx_result rt_sph_add_block(rt_sph *sim, const float lo[3], const float hi[3], uint32_t *added);

@@ -17,7 +17,7 @@ static void key_chunk(rt_sph *s, uint32_t chunk)
     }
 }
 
-/* Gathers the state columns into the (free) integration buffers in sorted order. */
+/* Gathers the own state columns into the (free) integration buffers in sorted order. */
 static void permute_chunk(rt_sph *s, uint32_t chunk)
 {
     uint32_t b, e;
@@ -31,11 +31,20 @@ static void permute_chunk(rt_sph *s, uint32_t chunk)
     }
 }
 
+/* The ids alone (the host reorders the bound state columns). */
+static void permute_ids_chunk(rt_sph *s, uint32_t chunk)
+{
+    uint32_t b, e;
+    sph_chunk_rows(s, chunk, &b, &e);
+    for (uint32_t i = b; i < e; ++i)
+        s->idtmp[i] = s->id[s->perm[i]];
+}
+
 /* Counting sort of the particles by cell, then every per-particle column permuted so that a
  * cell's particles are contiguous (and a row of x-adjacent cells is one range). Stable, so
  * the order — and every sum over neighbours — does not depend on the thread count. Keys and
  * the permutation run on all threads; the histogram and the scatter are serial (O(n + cells)). */
-void sph_build_grid(rt_sph *s)
+vfx_result sph_build_grid(rt_sph *s)
 {
     uint32_t n = s->n;
     sph_parallel(s, key_chunk, false);
@@ -50,11 +59,27 @@ void sph_build_grid(rt_sph *s)
     for (uint32_t c = s->ncells; c > 0; --c)
         s->cell_start[c] = s->cell_start[c - 1];
     s->cell_start[0] = 0;
-    sph_parallel(s, permute_chunk, false);
-    sph_swap_state(s);
+    if (s->bound) {
+        /* the host's table reorders every one of its columns (density and whatever else it
+         * holds) with the same permutation */
+        rt_sph_columns c = {0};
+        vfx_result r = s->host.permute(s->host.user, s->perm, &c);
+        if (r || c.count != n) {
+            sph_set_err(s, "rt_sph_step: the host could not reorder its %u rows by grid cell (%s)", n,
+                        r ? vfx_result_name(r) : "wrong row count back");
+            s->lists_valid = false;
+            return r ? r : VFX_ERR_INVALID_ARGUMENT;
+        }
+        sph_take_columns(s, &c);
+        sph_parallel(s, permute_ids_chunk, false);
+    } else {
+        sph_parallel(s, permute_chunk, false);
+        sph_swap_state(s);
+    }
     uint32_t *t = s->id;
     s->id = s->idtmp;
     s->idtmp = t;
+    return VFX_OK;
 }
 
 float rt_sph_volume_fraction(const rt_sph *s, const float p[3])

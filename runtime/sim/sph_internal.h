@@ -61,7 +61,10 @@ struct rt_sph {
     float B, c0;
     double time;
     uint32_t n, cap, next_id, clamped_on_add;
-    /* columns */
+    /* columns: the state (x..vz, rho) is the host's while bound, the rest is always ours */
+    bool bound;
+    rt_sph_host host;
+    uint32_t state_cap; /* rows of our own state columns (0 while bound) */
     float *x, *y, *z, *vx, *vy, *vz, *rho, *pr, *ax, *ay, *az, *drho;
     float *xn, *yn, *zn, *vxn, *vyn, *vzn, *tmp;
     uint32_t *id, *idtmp, *key, *perm;
@@ -193,8 +196,12 @@ void sph_parallel(rt_sph *s, sph_chunk_fn fn, bool fresh);
 /* Grows every per-particle and per-chunk buffer to hold `want` particles. */
 vfx_result sph_reserve(rt_sph *s, uint64_t want);
 void sph_free_columns(rt_sph *s);
-/* Exchanges the state columns with the integration buffers (xn ...). */
+/* Exchanges the state columns with the integration buffers (xn ...); own state only. */
 void sph_swap_state(rt_sph *s);
+/* Makes the integration buffers the state: a swap, or a copy into the host's columns. */
+void sph_commit_state(rt_sph *s);
+/* Takes the host's column pointers. */
+void sph_take_columns(rt_sph *s, const rt_sph_columns *c);
 
 /* sph_collide.c */
 /* Signed distance of p to a collider surface (positive on the fluid side), outward normal in n. */
@@ -202,8 +209,9 @@ float sph_collider_distance(const sph_collider_state *st, float px, float py, fl
 /* Moves every collider to its position and velocity at time t. */
 void sph_update_colliders(rt_sph *s, double t);
 
-/* sph_grid.c: sorts the particles by cell (all columns follow), cell_start is rebuilt */
-void sph_build_grid(rt_sph *s);
+/* sph_grid.c: sorts the particles by cell (all columns follow, through the host when bound),
+ * cell_start is rebuilt; an error when the host could not reorder (nothing changed then) */
+vfx_result sph_build_grid(rt_sph *s);
 
 /* sph_wall.c */
 /* The walls within H of p (box faces first, then colliders); their number. */

@@ -17,12 +17,16 @@ static uint32_t first_bad(const rt_sph *s, uint32_t nchunks, const sph_chunk_out
 /* The density pass of a substep (or the closing one): with Verlet lists, a walk of them while
  * every particle has moved less than skin/2 since the rebuild (then no pair can have come
  * within H unlisted: each side moved < skin/2), otherwise a rebuild: sort by cell, scan the
- * cells, record the lists. Returns true when it rebuilt. */
-static bool density_pass(rt_sph *s)
+ * cells, record the lists. Counts a rebuild in the report; an error when the host could not
+ * reorder its rows (then nothing was computed). */
+static vfx_result density_pass(rt_sph *s, rt_sph_report *rep)
 {
     bool rebuild = !s->verlet || !s->lists_valid || !(4.f * s->disp2_max < s->skin * s->skin);
     if (rebuild) {
-        sph_build_grid(s);
+        vfx_result r = sph_build_grid(s);
+        if (r)
+            return r;
+        rep->neighbor_rebuilds++;
         s->dens_mode = s->verlet ? 1 : 0;
     } else {
         s->dens_mode = 2;
@@ -32,7 +36,7 @@ static bool density_pass(rt_sph *s)
         s->lists_valid = !atomic_load(&s->nb_oom);
         s->disp2_max = 0.f;
     }
-    return rebuild;
+    return VFX_OK;
 }
 
 static void reduce_disp(rt_sph *s)
@@ -44,8 +48,10 @@ static void reduce_disp(rt_sph *s)
     s->disp2_max = d2;
 }
 
-static void finish_report(rt_sph *s, rt_sph_report *rep)
+/* The closing density pass and the end-state figures of the report. */
+static vfx_result finish_report(rt_sph *s, rt_sph_report *rep)
 {
+    vfx_result r = VFX_OK;
     uint32_t nchunks = sph_chunk_count(s);
     float emax = 0.f, v2 = 0.f;
     double esum = 0.0, ke = 0.0, pe = 0.0, ie = 0.0;
@@ -53,12 +59,11 @@ static void finish_report(rt_sph *s, rt_sph_report *rep)
     const float *g = s->p.gravity, *lo = s->p.domain_min;
     if (s->n) {
         s->want_energy = true;
-        if (density_pass(s))
-            rep->neighbor_rebuilds++;
+        r = density_pass(s, rep);
         s->want_energy = false;
         if (atomic_exchange(&s->nb_oom, false))
             s->lists_valid = false; /* the sums below are partial; the next substep says why */
-        for (uint32_t c = 0; c < nchunks; ++c) {
+        for (uint32_t c = 0; !r && c < nchunks; ++c) {
             if (s->out[c].rho_err_max > emax)
                 emax = s->out[c].rho_err_max;
             esum += s->out[c].rho_err_sum;
@@ -78,6 +83,7 @@ static void finish_report(rt_sph *s, rt_sph_report *rep)
     rep->kinetic_energy = ke;
     rep->potential_energy = pe;
     rep->internal_energy = ie;
+    return r;
 }
 
 /* Maxima of the force pass over the chunks (speed, acceleration, sound speed); the pair
@@ -154,8 +160,9 @@ static vfx_result integrate_redo(rt_sph *s, double *dt, rt_sph_report *rep)
 static vfx_result substep(rt_sph *s, double remaining, rt_sph_report *rep, double *dt,
                           rt_sph_dt_limit *lim)
 {
-    if (density_pass(s))
-        rep->neighbor_rebuilds++;
+    vfx_result res = density_pass(s, rep);
+    if (res)
+        return res;
     if (atomic_exchange(&s->nb_oom, false)) {
         s->lists_valid = false;
         sph_set_err(s, "rt_sph_step: out of memory for the neighbour lists of %u particles", s->n);
@@ -173,10 +180,9 @@ static vfx_result substep(rt_sph *s, double remaining, rt_sph_report *rep, doubl
     double vmax, amax, cmax;
     reduce_forces(s, rep, &vmax, &amax, &cmax);
     *dt = select_dt(s, remaining, vmax, amax, cmax, lim);
-    vfx_result res = integrate_redo(s, dt, rep);
-    if (res)
+    if ((res = integrate_redo(s, dt, rep)))
         return res;
-    sph_swap_state(s);
+    sph_commit_state(s);
     if (s->verlet)
         reduce_disp(s);
     return VFX_OK;
@@ -230,7 +236,9 @@ vfx_result rt_sph_step(rt_sph *s, float frame_dt, rt_sph_report *report)
     if (rep.substeps == 0)
         rep.dt_min = 0.0;
     rep.simulated_time = t;
-    finish_report(s, &rep);
+    vfx_result fr = finish_report(s, &rep);
+    if (!res)
+        res = fr;
     if (report)
         *report = rep;
     return res;

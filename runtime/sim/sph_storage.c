@@ -4,11 +4,28 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The state columns (the host's while bound) and the solver's scratch columns. */
+#define SPH_STATE_COLUMNS(s) {&s->x, &s->y, &s->z, &s->vx, &s->vy, &s->vz, &s->rho}
+#define SPH_SCRATCH_COLUMNS(s)                                                                     \
+    {&s->pr, &s->ax, &s->ay, &s->az, &s->drho, &s->xn, &s->yn, &s->zn, &s->vxn, &s->vyn, &s->vzn, \
+     &s->tmp, &s->x0, &s->y0, &s->z0}
+
+/* Frees the own state columns (none while bound: those are the host's) and forgets them. */
+static void drop_state(rt_sph *s)
+{
+    float **f[] = SPH_STATE_COLUMNS(s);
+    for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) {
+        if (!s->bound)
+            free(*f[i]);
+        *f[i] = NULL;
+    }
+    s->state_cap = 0;
+}
+
 void sph_free_columns(rt_sph *s)
 {
-    float **f[] = {&s->x, &s->y, &s->z, &s->vx, &s->vy, &s->vz, &s->rho, &s->pr, &s->ax, &s->ay,
-                   &s->az, &s->drho, &s->xn, &s->yn, &s->zn, &s->vxn, &s->vyn, &s->vzn, &s->tmp,
-                   &s->x0, &s->y0, &s->z0};
+    drop_state(s);
+    float **f[] = SPH_SCRATCH_COLUMNS(s);
     for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) {
         free(*f[i]);
         *f[i] = NULL;
@@ -36,7 +53,8 @@ size_t rt_sph_memory_bytes(const rt_sph *s)
     for (uint32_t c = 0; c < s->cnb_chunks; ++c)
         lists += ((size_t)s->cnb_cap[c] + s->snb_cap[c]) * sizeof(uint32_t) + 3 * sizeof(uint32_t) +
                  2 * sizeof(uint32_t *);
-    return sizeof *s + lists + (size_t)s->cap * (22 * sizeof(float) + 8 * sizeof(uint32_t)) +
+    size_t scratch = (size_t)s->cap * (15 * sizeof(float) + 8 * sizeof(uint32_t));
+    return sizeof *s + lists + scratch + (size_t)s->state_cap * 7 * sizeof(float) +
            ((size_t)s->ncells + 1) * sizeof(uint32_t) + (size_t)s->out_cap * sizeof(sph_chunk_out);
 }
 
@@ -61,16 +79,26 @@ vfx_result sph_reserve(rt_sph *s, uint64_t want)
                 (unsigned long long)want, s->p.max_particles);
         return VFX_ERR_INVALID_ARGUMENT;
     }
-    if (want <= s->cap)
+    if (want <= s->cap && (s->bound || want <= s->state_cap))
         return VFX_OK;
     uint64_t cap = s->cap ? s->cap : 1024;
     while (cap < want)
         cap *= 2;
     if (cap > s->p.max_particles)
         cap = s->p.max_particles;
-    float **f[] = {&s->x, &s->y, &s->z, &s->vx, &s->vy, &s->vz, &s->rho, &s->pr, &s->ax, &s->ay,
-                   &s->az, &s->drho, &s->xn, &s->yn, &s->zn, &s->vxn, &s->vyn, &s->vzn, &s->tmp,
-                   &s->x0, &s->y0, &s->z0};
+    if (!s->bound && s->state_cap < cap) {
+        float **f[] = SPH_STATE_COLUMNS(s);
+        for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) {
+            float *np = realloc(*f[i], (size_t)cap * sizeof(float));
+            if (!np)
+                goto oom;
+            *f[i] = np;
+        }
+        s->state_cap = (uint32_t)cap;
+    }
+    if (cap == s->cap)
+        return VFX_OK;
+    float **f[] = SPH_SCRATCH_COLUMNS(s);
     for (size_t i = 0; i < sizeof f / sizeof f[0]; ++i) {
         float *np = realloc(*f[i], (size_t)cap * sizeof(float));
         if (!np)
@@ -123,6 +151,67 @@ oom:
     return VFX_ERR_OUT_OF_MEMORY;
 }
 
+/* Refuses n rows when any of the arrays (NULL ones skipped) holds a NaN/Inf, naming the row. */
+static vfx_result check_finite(rt_sph *s, const char *who, const char *of, const char *what,
+                               uint32_t n, const float *const arr[6])
+{
+    static const char *nm[6] = {"x", "y", "z", "vx", "vy", "vz"};
+    for (uint32_t i = 0; i < n; ++i)
+        for (int a = 0; a < 6; ++a)
+            if (arr[a] && !isfinite(arr[a][i])) {
+                sph_set_err(s, "%s: particle %u (of %u %s) has a non-finite %s (%g); %s refused", who,
+                            i, n, of, nm[a], (double)arr[a][i], what);
+                return VFX_ERR_INVALID_ARGUMENT;
+            }
+    return VFX_OK;
+}
+
+void sph_take_columns(rt_sph *s, const rt_sph_columns *c)
+{
+    s->x = c->x, s->y = c->y, s->z = c->z;
+    s->vx = c->vx, s->vy = c->vy, s->vz = c->vz;
+    s->rho = c->density;
+}
+
+/* Room for `add` more rows (n is not changed): our buffers, and the host's rows when bound. */
+static vfx_result grow_rows(rt_sph *s, uint32_t add)
+{
+    vfx_result r = sph_reserve(s, (uint64_t)s->n + add);
+    if (r || !s->bound)
+        return r;
+    rt_sph_columns c = {0};
+    r = s->host.append(s->host.user, add, &c);
+    if (r || c.count != s->n + add) {
+        sph_set_err(s, "rt_sph: the host could not append %u rows to its %u (%s)", add, s->n,
+                    r ? vfx_result_name(r) : "wrong row count back");
+        return r ? r : VFX_ERR_INVALID_ARGUMENT;
+    }
+    sph_take_columns(s, &c);
+    return VFX_OK;
+}
+
+/* Rows base..end-1 (room made by grow_rows, positions and velocities written) become particles:
+ * moved a quarter spacing inside the walls, where the clamp would put them, at rest density,
+ * with the next ids. */
+static void fresh_rows(rt_sph *s, uint32_t base, uint32_t end)
+{
+    float m = 0.25f * s->p.spacing;
+    const float *lo = s->p.domain_min, *hi = s->p.domain_max;
+    for (uint32_t q = base; q < end; ++q) {
+        float px = sph_clampf(s->x[q], lo[0] + m, hi[0] - m);
+        float py = sph_clampf(s->y[q], lo[1] + m, hi[1] - m);
+        float pz = sph_clampf(s->z[q], lo[2] + m, hi[2] - m);
+        if (px != s->x[q] || py != s->y[q] || pz != s->z[q])
+            s->clamped_on_add++;
+        s->x[q] = px, s->y[q] = py, s->z[q] = pz;
+        s->rho[q] = s->p.rest_density;
+        s->pr[q] = 0.f;
+        s->id[q] = s->next_id++;
+    }
+    s->n = end;
+    s->lists_valid = false; /* new rows are in no list */
+}
+
 vfx_result rt_sph_add_particles(rt_sph *s, uint32_t n, const float *x, const float *y,
                                  const float *z, const float *vx, const float *vy, const float *vz)
 {
@@ -141,36 +230,20 @@ vfx_result rt_sph_add_particles(rt_sph *s, uint32_t n, const float *x, const flo
         return VFX_ERR_INVALID_ARGUMENT;
     }
     const float *arr[6] = {x, y, z, vx, vy, vz};
-    static const char *nm[6] = {"x", "y", "z", "vx", "vy", "vz"};
-    for (uint32_t i = 0; i < n; ++i)
-        for (int a = 0; a < 6; ++a)
-            if (arr[a] && !isfinite(arr[a][i])) {
-                sph_set_err(s, "rt_sph_add_particles: particle %u (of %u in this batch) has a "
-                        "non-finite %s (%g); batch refused", i, n, nm[a], (double)arr[a][i]);
-                return VFX_ERR_INVALID_ARGUMENT;
-            }
-    vfx_result r = sph_reserve(s, (uint64_t)s->n + n);
+    vfx_result r = check_finite(s, "rt_sph_add_particles", "in this batch", "batch", n, arr);
     if (r)
         return r;
-    /* keep fresh particles a quarter spacing inside the walls, where the clamp would put them */
-    float m = 0.25f * s->p.spacing;
+    uint32_t base = s->n;
+    if ((r = grow_rows(s, n)))
+        return r;
     for (uint32_t i = 0; i < n; ++i) {
-        uint32_t k = s->n + i;
-        float px = sph_clampf(x[i], s->p.domain_min[0] + m, s->p.domain_max[0] - m);
-        float py = sph_clampf(y[i], s->p.domain_min[1] + m, s->p.domain_max[1] - m);
-        float pz = sph_clampf(z[i], s->p.domain_min[2] + m, s->p.domain_max[2] - m);
-        if (px != x[i] || py != y[i] || pz != z[i])
-            s->clamped_on_add++;
-        s->x[k] = px, s->y[k] = py, s->z[k] = pz;
+        uint32_t k = base + i;
+        s->x[k] = x[i], s->y[k] = y[i], s->z[k] = z[i];
         s->vx[k] = vx ? vx[i] : 0.f;
         s->vy[k] = vy ? vy[i] : 0.f;
         s->vz[k] = vz ? vz[i] : 0.f;
-        s->rho[k] = s->p.rest_density;
-        s->pr[k] = 0.f;
-        s->id[k] = s->next_id++;
     }
-    s->n += n;
-    s->lists_valid = false; /* new rows are in no list */
+    fresh_rows(s, base, base + n);
     return VFX_OK;
 }
 
@@ -178,6 +251,10 @@ void rt_sph_clear(rt_sph *s)
 {
     if (!s)
         return;
+    if (s->bound) {
+        drop_state(s); /* the host's columns are not ours to keep */
+        s->bound = false;
+    }
     s->n = 0;
     s->next_id = 0;
     s->lists_valid = false;
@@ -201,33 +278,22 @@ vfx_result rt_sph_add_block(rt_sph *s, const float lo[3], const float hi[3], uin
     uint64_t total = c[0] * c[1] * c[2];
     if (total == 0)
         return VFX_OK;
-    vfx_result r = sph_reserve(s, s->n + total);
+    if (total > s->p.max_particles - s->n)
+        return sph_reserve(s, s->n + total); /* names the capacity bound */
+    uint32_t base = s->n;
+    vfx_result r = grow_rows(s, (uint32_t)total);
     if (r)
         return r;
-    uint32_t base = s->n;
+    uint32_t q = base;
     for (uint64_t k = 0; k < c[2]; ++k)
         for (uint64_t j = 0; j < c[1]; ++j)
-            for (uint64_t i = 0; i < c[0]; ++i) {
-                uint32_t q = s->n++;
+            for (uint64_t i = 0; i < c[0]; ++i, ++q) {
                 s->x[q] = lo[0] + ((float)i + 0.5f) * dx;
                 s->y[q] = lo[1] + ((float)j + 0.5f) * dx;
                 s->z[q] = lo[2] + ((float)k + 0.5f) * dx;
                 s->vx[q] = s->vy[q] = s->vz[q] = 0.f;
-                s->rho[q] = s->p.rest_density;
-                s->pr[q] = 0.f;
-                s->id[q] = s->next_id++;
             }
-    /* out-of-domain lattice points are clamped like any other input */
-    float m = 0.25f * dx;
-    for (uint32_t q = base; q < s->n; ++q) {
-        float px = sph_clampf(s->x[q], s->p.domain_min[0] + m, s->p.domain_max[0] - m);
-        float py = sph_clampf(s->y[q], s->p.domain_min[1] + m, s->p.domain_max[1] - m);
-        float pz = sph_clampf(s->z[q], s->p.domain_min[2] + m, s->p.domain_max[2] - m);
-        if (px != s->x[q] || py != s->y[q] || pz != s->z[q])
-            s->clamped_on_add++;
-        s->x[q] = px, s->y[q] = py, s->z[q] = pz;
-    }
-    s->lists_valid = false;
+    fresh_rows(s, base, base + (uint32_t)total); /* out-of-domain lattice points are clamped like any other input */
     if (added)
         *added = (uint32_t)total;
     return VFX_OK;
@@ -244,4 +310,45 @@ void sph_swap_state(rt_sph *s)
     SW(vy, vyn);
     SW(vz, vzn);
 #undef SW
+}
+
+void sph_commit_state(rt_sph *s)
+{
+    if (!s->bound) {
+        sph_swap_state(s);
+        return;
+    }
+    /* the host's columns stay where they are: the integrated state is copied into them */
+    const size_t bytes = (size_t)s->n * sizeof(float);
+    memcpy(s->x, s->xn, bytes), memcpy(s->y, s->yn, bytes), memcpy(s->z, s->zn, bytes);
+    memcpy(s->vx, s->vxn, bytes), memcpy(s->vy, s->vyn, bytes), memcpy(s->vz, s->vzn, bytes);
+}
+
+vfx_result rt_sph_bind(rt_sph *s, const rt_sph_host *host, const rt_sph_columns *c)
+{
+    if (!s)
+        return VFX_ERR_INVALID_ARGUMENT;
+    s->err[0] = 0;
+    if (!host || !host->permute || !host->append || !c ||
+        (c->count && (!c->x || !c->y || !c->z || !c->vx || !c->vy || !c->vz || !c->density))) {
+        sph_set_err(s, "rt_sph_bind: need a host with permute and append, and every column of "
+                    "its %u rows", c ? c->count : 0);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    const float *arr[6] = {c->x, c->y, c->z, c->vx, c->vy, c->vz};
+    vfx_result r = check_finite(s, "rt_sph_bind", "bound rows", "binding", c->count, arr);
+    if (r)
+        return r;
+    drop_state(s); /* our own particles, or the previous binding's pointers */
+    s->bound = true;
+    s->host = *host;
+    s->n = 0;
+    s->next_id = 0;
+    if ((r = sph_reserve(s, c->count))) {
+        rt_sph_clear(s);
+        return r;
+    }
+    sph_take_columns(s, c);
+    fresh_rows(s, 0, c->count);
+    return VFX_OK;
 }

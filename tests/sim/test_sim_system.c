@@ -74,9 +74,12 @@ static void test_system_writes_columns(void **state)
     }
     print_message("20 frames of 1e-4 s with the world unchanged: %u rebuilds\n", rebuilds);
     assert_true(rebuilds < 10);
-    /* ... and an edit by the game is seen: a particle moved 4 cm sideways lands there */
+    /* ... and an edit by the game is seen: a particle moved 4 cm sideways lands there. The
+     * solver steps the table in place and sorts its rows by grid cell, so the particle is
+     * followed by entity, not by row. */
     it = rt_query_begin(w, terms, 3);
     assert_true(rt_query_next(&it));
+    rt_entity edited = it.entities[0];
     float *qx = rt_query_column(&it, pc.position, 0);
     float *qy = rt_query_column(&it, pc.position, 1);
     float *qv[3] = {rt_query_column(&it, pc.velocity, 0), rt_query_column(&it, pc.velocity, 1),
@@ -85,13 +88,27 @@ static void test_system_writes_columns(void **state)
     qx[0] = x_new, qy[0] = 0.15f;
     qv[0][0] = qv[1][0] = qv[2][0] = 0.f; /* at rest, in the air above the fluid */
     assert_int_equal(rt_world_run_phase(w, RT_PHASE_SIMULATE, 26 / 60.0, 1.f / 60.f), VFX_OK);
-    it = rt_query_begin(w, terms, 3);
-    assert_true(rt_query_next(&it));
-    qx = rt_query_column(&it, pc.position, 0);
-    qy = rt_query_column(&it, pc.position, 1);
+    qx = rt_world_get(w, edited, pc.position, 0);
+    qy = rt_world_get(w, edited, pc.position, 1);
+    assert_non_null(qx);
+    assert_non_null(qy);
     /* in 1/60 s from rest it falls g t^2 / 2 = 1.4 mm and does not move sideways */
     print_message("edited particle: x %.4f (set %.4f), y %.4f (set 0.15)\n", qx[0], x_new, qy[0]);
     assert_true(fabsf(qx[0] - x_new) < 0.002f && qy[0] > 0.147f && qy[0] < 0.1495f);
+    /* The particle is held once: the solver's state columns are the table's. */
+    it = rt_query_begin(w, terms, 3);
+    assert_true(rt_query_next(&it));
+    rt_sph_columns sc = rt_sph_get_columns(rt_sim_system_solver(sys));
+    assert_int_equal(sc.count, it.rows);
+    assert_ptr_equal(sc.x, rt_query_column(&it, pc.position, 0));
+    assert_ptr_equal(sc.vz, rt_query_column(&it, pc.velocity, 2));
+    assert_ptr_equal(sc.density, rt_query_column(&it, pc.density, 0));
+    /* A structural change moves the table's revision: the system binds again (the despawned
+     * row is gone from the solver, the lists are rebuilt at once). */
+    assert_int_equal(rt_world_despawn(w, it.entities[3]), VFX_OK);
+    assert_int_equal(rt_world_run_phase(w, RT_PHASE_SIMULATE, 27 / 60.0, 1e-4f), VFX_OK);
+    assert_int_equal(rt_sph_get_columns(rt_sim_system_solver(sys)).count, N + 19);
+    assert_true(rt_sim_system_report(sys)->neighbor_rebuilds >= 1);
     rt_world_destroy(w);
     rt_sim_system_destroy(sys);
 }
