@@ -78,12 +78,14 @@ void volfx_free(vfx_context *ctx, void *ptr)
 
 static vfx_stat *stat_slot(vfx_context *ctx, const char *name)
 {
-    vfx_stats *s = &ctx->stats;
+    vfx_stats2 *s = &ctx->stats;
     for (uint32_t i = 0; i < s->count; ++i)
         if (strncmp(s->entries[i].name, name, sizeof s->entries[i].name - 1) == 0)
             return &s->entries[i];
-    if (s->count >= VFX_STATS_MAX)
+    if (s->count >= VFX_STATS2_MAX) {
+        s->dropped++;
         return NULL;
+    }
     vfx_stat *e = &s->entries[s->count++];
     snprintf(e->name, sizeof e->name, "%s", name);
     e->value = 0;
@@ -99,7 +101,7 @@ void volfx_stat_set(vfx_context *ctx, const char *name, double value)
 
 bool volfx_stat_has(const vfx_context *ctx, const char *name)
 {
-    const vfx_stats *s = &ctx->stats;
+    const vfx_stats2 *s = &ctx->stats;
     for (uint32_t i = 0; i < s->count; ++i)
         if (strncmp(s->entries[i].name, name, sizeof s->entries[i].name - 1) == 0)
             return true;

@@ -24,8 +24,8 @@ struct vfx_context {
     uint32_t width, height;
     void *effect_state[VFX_EFFECT_COUNT];
     const volfx_effect_ops *effect_ops[VFX_EFFECT_COUNT];
-    vfx_stats stats;            /* counters of the frame being made */
-    vfx_stats last_stats;       /* counters of the last finished frame */
+    vfx_stats2 stats;           /* counters of the frame being made */
+    vfx_stats2 last_stats;      /* counters of the last finished frame */
     char last_error[512];
     unsigned water_dist_tex;    /* shared target owned by the context */
     unsigned no_depth_tex;      /* far depth for a frame view without depth_texture (frame_check.c) */

@@ -76,8 +76,8 @@ static vfx_result plugin_create(const vfx_host_api *host, vfx_context **out)
         return VFX_ERR_OUT_OF_MEMORY;
     memset(ctx, 0, sizeof *ctx);
     ctx->host = *host;
-    ctx->stats.size = ctx->last_stats.size = sizeof(vfx_stats);
-    ctx->stats.version = ctx->last_stats.version = VFX_STATS_VERSION;
+    ctx->stats.size = ctx->last_stats.size = sizeof(vfx_stats2);
+    ctx->stats.version = ctx->last_stats.version = VFX_STATS2_VERSION;
     register_effects(ctx);
     vfx_result r = volfx_gpu_create(ctx, &ctx->gpu);
     if (r != VFX_OK) {
@@ -200,6 +200,7 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
     frame = &checked.v1;
 
     ctx->stats.count = 0;
+    ctx->stats.dropped = 0;
     static const vfx_effect_kind order[VFX_EFFECT_COUNT] = {VFX_EFFECT_WATER, VFX_EFFECT_VOLUME,
                                                             VFX_EFFECT_BEAMS};
     vfx_result result = VFX_OK;
@@ -220,10 +221,20 @@ static vfx_result plugin_get_stats(vfx_context *ctx, vfx_stats *out)
         return VFX_ERR_INVALID_ARGUMENT;
     if (!out)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "get_stats: out is NULL");
-    if (out->size < sizeof(vfx_stats))
-        return volfx_fail(ctx, VFX_ERR_ABI, "get_stats: stats struct size %u < %zu", out->size,
-                        sizeof(vfx_stats));
-    *out = ctx->last_stats;
+    if (out->version == VFX_STATS2_VERSION) {
+        if (out->size < sizeof(vfx_stats2))
+            return volfx_fail(ctx, VFX_ERR_ABI, "get_stats: stats of version 2 have size %u (need %zu)",
+                              out->size, sizeof(vfx_stats2));
+        *(vfx_stats2 *)out = ctx->last_stats;
+        return VFX_OK;
+    }
+    if (out->version != VFX_STATS_VERSION || out->size < sizeof(vfx_stats))
+        return volfx_fail(ctx, VFX_ERR_ABI, "get_stats: stats of version %u, size %u (this plugin writes "
+                          "version 1 of size %zu and version 2 of size %zu)", out->version, out->size,
+                          sizeof(vfx_stats), sizeof(vfx_stats2));
+    /* version 1: the first VFX_STATS_MAX entries */
+    out->count = ctx->last_stats.count < VFX_STATS_MAX ? ctx->last_stats.count : VFX_STATS_MAX;
+    memcpy(out->entries, ctx->last_stats.entries, out->count * sizeof out->entries[0]);
     return VFX_OK;
 }
 

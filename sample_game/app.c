@@ -361,9 +361,9 @@ vfx_result game_app_frame(game_app *app, float dt)
     } else {
         glFinish(); /* headless: make the frame time include the GPU work */
     }
-    vfx_stats stats = {.size = sizeof stats, .version = VFX_STATS_VERSION};
-    if (app->api->get_stats(app->ctx, &stats) == VFX_OK)
-        rt_profiler_gpu_stats(app->profiler, &stats);
+    vfx_stats2 stats = {.size = sizeof stats, .version = VFX_STATS2_VERSION};
+    if (app->api->get_stats(app->ctx, (vfx_stats *)&stats) == VFX_OK)
+        rt_profiler_gpu_stats(app->profiler, (const vfx_stats *)&stats);
     rt_profiler_frame_end(app->profiler);
     app->frame++;
     return VFX_OK;

@@ -271,8 +271,8 @@ void game_demo_print_profile(game_app *app, FILE *out)
             fprintf(out, " %s %.3f", series[i], m);
     }
     fprintf(out, "\n");
-    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
-    if (app->api->get_stats(app->ctx, &st) == VFX_OK && st.count) {
+    vfx_stats2 st = {.size = sizeof st, .version = VFX_STATS2_VERSION};
+    if (app->api->get_stats(app->ctx, (vfx_stats *)&st) == VFX_OK && st.count) {
         fprintf(out, "plugin stats (last frame):");
         for (uint32_t i = 0; i < st.count; ++i)
             fprintf(out, " %s=%.4g", st.entries[i].name, st.entries[i].value);

@@ -225,7 +225,8 @@ void rt_profiler_gpu_stats(rt_profiler *p, const vfx_stats *stats)
         return;
     static const char start_sfx[] = ".gpu_start_ms";
     const size_t start_len = sizeof start_sfx - 1;
-    for (uint32_t i = 0; i < stats->count && i < VFX_STATS_MAX; ++i) {
+    const uint32_t cap = stats->version == VFX_STATS2_VERSION ? VFX_STATS2_MAX : VFX_STATS_MAX;
+    for (uint32_t i = 0; i < stats->count && i < cap; ++i) {
         const char *n = stats->entries[i].name;
         double v = stats->entries[i].value;
         size_t len = strnlen(n, sizeof stats->entries[i].name);

@@ -120,6 +120,28 @@ static void test_timestamps_and_empty_world(void **state)
             }
     }
     assert_true(seen);
+    /* more counters than version 1 holds: version 1 readers get the first VFX_STATS_MAX,
+     * version 2 readers all of them up to VFX_STATS2_MAX, and the rest are counted */
+    ctx->stats.count = 0;
+    ctx->stats.dropped = 0;
+    for (int i = 0; i < VFX_STATS2_MAX + 3; ++i) {
+        char name[32];
+        snprintf(name, sizeof name, "test.c%d", i);
+        volfx_stat_set(ctx, name, i);
+    }
+    ctx->last_stats = ctx->stats;
+    vfx_stats v1 = {.size = sizeof v1, .version = VFX_STATS_VERSION};
+    assert_int_equal(api->get_stats(ctx, &v1), VFX_OK);
+    assert_int_equal(v1.count, VFX_STATS_MAX);
+    assert_string_equal(v1.entries[VFX_STATS_MAX - 1].name, "test.c63");
+    static vfx_stats2 v2;
+    v2 = (vfx_stats2){.size = sizeof v2, .version = VFX_STATS2_VERSION};
+    assert_int_equal(api->get_stats(ctx, (vfx_stats *)&v2), VFX_OK);
+    assert_int_equal(v2.count, VFX_STATS2_MAX);
+    assert_int_equal(v2.dropped, 3);
+    assert_true(v2.entries[VFX_STATS2_MAX - 1].value == VFX_STATS2_MAX - 1);
+    v2.size = sizeof(vfx_stats); /* a version 2 header on a version 1 buffer is refused */
+    assert_int_equal(api->get_stats(ctx, (vfx_stats *)&v2), VFX_ERR_ABI);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glDeleteFramebuffers(1, &fbo);
     glDeleteTextures(1, &tex);

@@ -354,6 +354,18 @@ typedef struct vfx_stats {
     vfx_stat entries[VFX_STATS_MAX];
 } vfx_stats;
 
+/* Version 2 of the stats: room for every pass's timings and every counter of a frame with all
+ * effects on (version 1 keeps the first VFX_STATS_MAX). The host sets size = sizeof(vfx_stats2)
+ * and version = VFX_STATS2_VERSION and passes (vfx_stats *)&stats to get_stats. */
+#define VFX_STATS2_MAX 512
+#define VFX_STATS2_VERSION 2u
+typedef struct vfx_stats2 {
+    uint32_t size, version;
+    uint32_t count;
+    uint32_t dropped;  /* entries the frame made beyond VFX_STATS2_MAX (0 normally) */
+    vfx_stat entries[VFX_STATS2_MAX];
+} vfx_stats2;
+
 /* ---------------------------------------------------------------------- plugin api */
 
 typedef struct vfx_context vfx_context;
