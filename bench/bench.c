@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "app.h"
+#include "core/args.h"
 #include "demo_scene.h"
 
 /* Weak: an effect left out of the build (or not written yet) leaves its entry NULL. */
@@ -21,10 +22,18 @@ static int bench_frame(int argc, char **argv)
 {
     uint32_t frames = 60, w = 0, h = 0;
     const char *scene = NULL, *raw_effect = NULL, *raw_path = NULL;
+    char e[200];
     for (int i = 1; i < argc; ++i) {
-        if (!strcmp(argv[i], "--frames") && i + 1 < argc) frames = (uint32_t)strtoul(argv[++i], NULL, 10);
-        else if (!strcmp(argv[i], "--size") && i + 1 < argc) {
-            if (sscanf(argv[++i], "%ux%u", &w, &h) != 2) { fprintf(stderr, "--size wants WxH\n"); return 2; }
+        if (!strcmp(argv[i], "--frames") && i + 1 < argc) {
+            if (!rt_arg_u32("--frames", argv[++i], 1, 10000000, &frames, e, sizeof e)) {
+                fprintf(stderr, "volfx-bench frame: %s\n", e);
+                return 2;
+            }
+        } else if (!strcmp(argv[i], "--size") && i + 1 < argc) {
+            if (!rt_arg_size("--size", argv[++i], 16384, &w, &h, e, sizeof e)) {
+                fprintf(stderr, "volfx-bench frame: %s\n", e);
+                return 2;
+            }
         } else if (!strcmp(argv[i], "--scene") && i + 1 < argc) {
             scene = argv[++i];
         } else if (!strcmp(argv[i], "--dump-raw") && i + 2 < argc) {
@@ -43,6 +52,10 @@ static int bench_frame(int argc, char **argv)
                    : !strcmp(raw_effect, "volume") ? VFX_EFFECT_VOLUME : VFX_EFFECT_COUNT;
         if (raw_kind == VFX_EFFECT_COUNT) {
             fprintf(stderr, "volfx-bench frame: --dump-raw wants water, beams or volume, got '%s'\n", raw_effect);
+            return 2;
+        }
+        if (!rt_arg_writable("--dump-raw", raw_path, e, sizeof e)) {
+            fprintf(stderr, "volfx-bench frame: %s\n", e);
             return 2;
         }
     }

@@ -10,6 +10,7 @@
 #define _POSIX_C_SOURCE 199309L
 #endif
 #include <math.h>
+#include "core/args.h"
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -381,21 +382,26 @@ int bench_tetvol(int argc, char **argv)
         if (!strcmp(a, "--help")) { usage(); return 0; }
         if (!v) { fprintf(stderr, "bench tetvol: %s needs a value\n", a); usage(); return 2; }
         i++;
-        if (!strcmp(a, "--grid")) n = atoi(v);
-        else if (!strcmp(a, "--size")) w = h = atoi(v);
-        else if (!strcmp(a, "--tau")) tau = (float)atof(v);
-        else if (!strcmp(a, "--workers")) maxw = atoi(v);
-        else if (!strcmp(a, "--reps")) reps = atoi(v);
+        char e[200];
+        uint32_t u = 0;
+        double d = 0;
+#define U32(lo, hi, dst) do { if (!rt_arg_u32(a, v, lo, hi, &u, e, sizeof e)) goto bad; dst = (int)u; } while (0)
+        if (!strcmp(a, "--grid")) U32(1, 200, n);
+        else if (!strcmp(a, "--size")) { U32(1, 4096, w); h = w; }
+        else if (!strcmp(a, "--tau")) { if (!rt_arg_double(a, v, 1e-6, 1e6, &d, e, sizeof e)) goto bad; tau = (float)d; }
+        else if (!strcmp(a, "--workers")) U32(1, 64, maxw);
+        else if (!strcmp(a, "--reps")) U32(1, 63, reps);
         else if (!strcmp(a, "--mesh")) mesh_path = v;
         else if (!strcmp(a, "--scalar")) scalar = v;
         else if (!strcmp(a, "--view")) views_opt = v;
         else if (!strcmp(a, "--only")) only = v;
         else if (!strcmp(a, "--out")) out_prefix = v;
-        else if (!strcmp(a, "--c-nopartial-max")) cnp_max = atoi(v);
+        else if (!strcmp(a, "--c-nopartial-max")) U32(1, 1000000, cnp_max);
         else { fprintf(stderr, "bench tetvol: unknown option '%s'\n", a); usage(); return 2; }
-    }
-    if (n < 1 || n > 200 || w < 1 || w > 4096 || maxw < 1 || maxw > 64 || reps < 1 || reps > 63 || !(tau > 0)) {
-        fprintf(stderr, "bench tetvol: --grid 1..200, --size 1..4096, --workers 1..64, --reps 1..63, --tau > 0\n");
+#undef U32
+        continue;
+    bad:
+        fprintf(stderr, "bench tetvol: %s\n", e);
         return 2;
     }
     tet_mesh m;
@@ -447,6 +453,12 @@ int bench_tetvol(int argc, char **argv)
 
     float thin = bmax[lo] - bmin[lo];
     float tau_hi = tau / thin;
+    if (!(thin > 0) || !isfinite(tau_hi)) { /* a flat mesh wrote "inf" into the JSON */
+        fprintf(stderr, "bench tetvol: %s is flat (extent %g along %c): tau/thinnest extent is not finite\n",
+                mesh_name, (double)thin, "xyz"[lo]);
+        tet_mesh_free(&m);
+        return 1;
+    }
     tet_tf tf = {.smin = m.scalar_min, .smax = m.scalar_max, .tau_lo = 0.2f * tau_hi, .tau_hi = tau_hi,
                  .color_lo = {0.1f, 0.3f, 1.0f}, .color_hi = {1.0f, 0.6f, 0.1f}};
     size_t npx = (size_t)w * h * 4;

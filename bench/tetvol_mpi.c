@@ -7,6 +7,7 @@
  *        attrK] | --grid N] [--size S] [--view A|B|Z] [--tau T] [--repeat R] [--modes a,b,..]
  *        [--threshold X] [--tiles-d D] [--update-c C] [--ppm OUT] (OUT: the last image) */
 #include <math.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -16,6 +17,7 @@
 #include <unistd.h>
 #include <mpi.h>
 
+#include "core/args.h"
 #include "scene/volume_file.h"
 #include "tet_mpi.h"
 #include "tet_render.h"
@@ -76,6 +78,43 @@ static const mode modes[] = {
     {"ert_share", 1, 1, 0}, {"ert_dlb", 1, 0, 1}, {"ert_share_dlb", 1, 1, 1},
 };
 
+static bool arg_int(const char *opt, const char *v, uint32_t lo, uint32_t hi, int *out, char *e, size_t n)
+{
+    uint32_t u = 0;
+    bool ok = rt_arg_u32(opt, v, lo, hi, &u, e, n);
+    if (ok) *out = (int)u;
+    return ok;
+}
+
+static bool arg_float(const char *opt, const char *v, double lo, double hi, float *out, char *e, size_t n)
+{
+    double d = 0;
+    bool ok = rt_arg_double(opt, v, lo, hi, &d, e, n);
+    if (ok) *out = (float)d;
+    return ok;
+}
+
+/* Every comma-separated entry of --modes must name a mode (an unknown one rendered nothing and
+ * exited 0). */
+static bool check_modes(const char *list, char *e, size_t n)
+{
+    for (const char *p = list;;) {
+        const char *c = strchr(p, ',');
+        size_t len = c ? (size_t)(c - p) : strlen(p);
+        bool found = false;
+        for (size_t k = 0; k < sizeof modes / sizeof modes[0]; k++)
+            found |= strlen(modes[k].name) == len && !strncmp(p, modes[k].name, len);
+        if (!found) {
+            snprintf(e, n, "--modes: unknown mode '%.*s' (known: base, dlb, ert, ert_share, ert_dlb, "
+                     "ert_share_dlb)", (int)len, p);
+            return false;
+        }
+        if (!c)
+            return true;
+        p = c + 1;
+    }
+}
+
 static void print_array_u(const char *key, const tet_mpi_stats *all, int P, size_t off)
 {
     printf(",\"%s\":[", key);
@@ -123,22 +162,30 @@ int main(int argc, char **argv)
             return 2;
         }
         i++;
+        char e[200] = "";
+        bool ok = true;
         if (!strcmp(a, "--vtu")) vtu = v;
         else if (!strcmp(a, "--tetgen")) tetgen = v;
         else if (!strcmp(a, "--field")) field = v;
         else if (!strcmp(a, "--ppm")) ppm = v;
-        else if (!strcmp(a, "--grid")) grid = atoi(v);
-        else if (!strcmp(a, "--size")) size = atoi(v);
+        else if (!strcmp(a, "--grid")) ok = arg_int(a, v, 1, 200, &grid, e, sizeof e);
+        else if (!strcmp(a, "--size")) ok = arg_int(a, v, 1, 4096, &size, e, sizeof e);
         else if (!strcmp(a, "--view")) view = v;
-        else if (!strcmp(a, "--tau")) tau = (float)atof(v);
-        else if (!strcmp(a, "--repeat")) repeat = atoi(v);
-        else if (!strcmp(a, "--modes")) mode_list = v;
-        else if (!strcmp(a, "--threshold")) threshold = (float)atof(v);
-        else if (!strcmp(a, "--tiles-d")) tiles_d = atoi(v);
-        else if (!strcmp(a, "--update-c")) update_c = atoi(v);
+        else if (!strcmp(a, "--tau")) ok = arg_float(a, v, 1e-6, 1e6, &tau, e, sizeof e);
+        else if (!strcmp(a, "--repeat")) ok = arg_int(a, v, 1, 100, &repeat, e, sizeof e);
+        else if (!strcmp(a, "--modes")) ok = check_modes(v, e, sizeof e), mode_list = v;
+        else if (!strcmp(a, "--threshold")) ok = arg_float(a, v, 1e-6, 1, &threshold, e, sizeof e);
+        else if (!strcmp(a, "--tiles-d")) ok = arg_int(a, v, 1, 1000, &tiles_d, e, sizeof e);
+        else if (!strcmp(a, "--update-c")) ok = arg_int(a, v, 1, 1000000, &update_c, e, sizeof e);
         else {
             if (rank == 0)
                 fprintf(stderr, "volfx-tetvol-mpi: unknown option %s\n", a);
+            MPI_Finalize();
+            return 2;
+        }
+        if (!ok) {
+            if (rank == 0)
+                fprintf(stderr, "volfx-tetvol-mpi: %s\n", e);
             MPI_Finalize();
             return 2;
         }

@@ -9,6 +9,7 @@
 
 #include "app.h"
 #include "demo_scene.h"
+#include "core/args.h"
 #include "profile/resources.h"
 
 typedef struct game_options {
@@ -21,6 +22,7 @@ typedef struct game_options {
     uint32_t effects_off;
     uint32_t mem_every;        /* print RSS and GL object counts every N frames (0 = never) */
     const char *raw_effect, *raw_path;
+    vfx_effect_kind raw_kind;
 } game_options;
 
 static void usage(void)
@@ -34,43 +36,57 @@ static void usage(void)
          "             Tab cycle water quality (16/32/54/64 samples), P pause, N single step, Esc quit.");
 }
 
+static vfx_effect_kind effect_named(const char *s)
+{
+    return !strcmp(s, "water") ? VFX_EFFECT_WATER : !strcmp(s, "beams") ? VFX_EFFECT_BEAMS
+           : !strcmp(s, "volume") ? VFX_EFFECT_VOLUME : VFX_EFFECT_COUNT;
+}
+
+/* Everything is checked here, before the first frame: a bad value must not cost a whole run. */
 static bool parse(int argc, char **argv, game_options *o)
 {
     memset(o, 0, sizeof *o);
+    char err[256];
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
 #define NEED_ARG() do { if (!v) { fprintf(stderr, "volfx-game: %s needs a value\n", a); return false; } ++i; } while (0)
         if (!strcmp(a, "--headless")) o->mode = RT_GL_HEADLESS;
         else if (!strcmp(a, "--window")) o->mode = RT_GL_WINDOW;
-        else if (!strcmp(a, "--frames")) { NEED_ARG(); o->frames = (uint32_t)strtoul(v, NULL, 10); }
-        else if (!strcmp(a, "--seconds")) { NEED_ARG(); o->seconds = strtod(v, NULL); }
-        else if (!strcmp(a, "--size")) {
-            NEED_ARG();
-            if (sscanf(v, "%ux%u", &o->width, &o->height) != 2 || !o->width || !o->height) {
-                fprintf(stderr, "volfx-game: --size wants WxH, got '%s'\n", v);
-                return false;
-            }
-        }
-        else if (!strcmp(a, "--png")) { NEED_ARG(); o->png = v; }
-        else if (!strcmp(a, "--csv")) { NEED_ARG(); o->csv = v; }
-        else if (!strcmp(a, "--trace")) { NEED_ARG(); o->trace = v; }
+#define CHECK(x) do { if (!(x)) { fprintf(stderr, "volfx-game: %s\n", err); return false; } } while (0)
+        else if (!strcmp(a, "--frames")) { NEED_ARG(); CHECK(rt_arg_u32(a, v, 1, UINT32_MAX - 1, &o->frames, err, sizeof err)); }
+        else if (!strcmp(a, "--seconds")) { NEED_ARG(); CHECK(rt_arg_double(a, v, 1e-3, 1e7, &o->seconds, err, sizeof err)); }
+        else if (!strcmp(a, "--size")) { NEED_ARG(); CHECK(rt_arg_size(a, v, 16384, &o->width, &o->height, err, sizeof err)); }
+        else if (!strcmp(a, "--png")) { NEED_ARG(); CHECK(rt_arg_writable(a, v, err, sizeof err)); o->png = v; }
+        else if (!strcmp(a, "--csv")) { NEED_ARG(); CHECK(rt_arg_writable(a, v, err, sizeof err)); o->csv = v; }
+        else if (!strcmp(a, "--trace")) { NEED_ARG(); CHECK(rt_arg_writable(a, v, err, sizeof err)); o->trace = v; }
         else if (!strcmp(a, "--plugin")) { NEED_ARG(); o->plugin = v; }
         else if (!strcmp(a, "--scene")) { NEED_ARG(); o->scene = v; }
         else if (!strcmp(a, "--no-water")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_WATER);
         else if (!strcmp(a, "--no-beams")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_BEAMS);
         else if (!strcmp(a, "--no-volume")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_VOLUME);
         else if (!strcmp(a, "--debug-gl")) o->debug = true;
-        else if (!strcmp(a, "--mem-every")) { NEED_ARG(); o->mem_every = (uint32_t)strtoul(v, NULL, 10); }
+        else if (!strcmp(a, "--mem-every")) { NEED_ARG(); CHECK(rt_arg_u32(a, v, 0, UINT32_MAX, &o->mem_every, err, sizeof err)); }
         else if (!strcmp(a, "--dump-raw")) {
             NEED_ARG();
             o->raw_effect = v;
+            o->raw_kind = effect_named(v);
+            if (o->raw_kind == VFX_EFFECT_COUNT) {
+                fprintf(stderr, "volfx-game: --dump-raw wants water, beams or volume, got '%s'\n", v);
+                return false;
+            }
             if (i + 1 >= argc) { fprintf(stderr, "volfx-game: --dump-raw needs EFFECT FILE\n"); return false; }
             o->raw_path = argv[++i];
+            CHECK(rt_arg_writable(a, o->raw_path, err, sizeof err));
         }
         else if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(); exit(0); }
         else { fprintf(stderr, "volfx-game: unknown option '%s'\n", a); usage(); return false; }
+#undef CHECK
 #undef NEED_ARG
+    }
+    if (o->raw_effect && (o->effects_off & VFX_EFFECT_BIT(o->raw_kind))) {
+        fprintf(stderr, "volfx-game: --dump-raw %s with --no-%s: nothing to dump\n", o->raw_effect, o->raw_effect);
+        return false;
     }
     return true;
 }
@@ -175,6 +191,12 @@ int main(int argc, char **argv)
             rc = 1;
             break;
         }
+        if (f == 0 && o.raw_effect && frames > 1 && game_app_dump_raw(app, o.raw_kind, o.raw_path) != VFX_OK) {
+            /* the effect is absent from this scene: say so now, not after the whole run */
+            fprintf(stderr, "volfx-game: cannot dump '%s' to %s\n", o.raw_effect, o.raw_path);
+            rc = 1;
+            break;
+        }
         if (o.mem_every && (f % o.mem_every) == 0) {
             rt_gl_object_counts c = rt_gl_count_objects(4096);
             printf("mem frame %u rss_kb %llu gl_objects %u (buffers %u textures %u programs %u queries %u)\n", f,
@@ -202,10 +224,7 @@ int main(int argc, char **argv)
             rc = 1;
     }
     if (o.raw_effect && rc == 0) {
-        vfx_effect_kind k = !strcmp(o.raw_effect, "water") ? VFX_EFFECT_WATER
-                            : !strcmp(o.raw_effect, "beams") ? VFX_EFFECT_BEAMS
-                            : !strcmp(o.raw_effect, "volume") ? VFX_EFFECT_VOLUME : VFX_EFFECT_COUNT;
-        if (k == VFX_EFFECT_COUNT || game_app_dump_raw(app, k, o.raw_path) != VFX_OK) {
+        if (game_app_dump_raw(app, o.raw_kind, o.raw_path) != VFX_OK) {
             fprintf(stderr, "volfx-game: cannot dump '%s' to %s\n", o.raw_effect, o.raw_path);
             rc = 1;
         } else {
