@@ -1,22 +1,41 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets in a separate clang build dir and runs each for a bounded time.
+# Builds the libFuzzer targets in a separate clang build dir and runs each for a bounded time on
+# its seed corpus (tests/fuzz/corpus/<target>/, plus what earlier runs found in
+# build-fuzz/corpus-<target>/). Exits non-zero when a target does not build, or a run crashes,
+# leaks, times out or runs out of memory (libFuzzer's exit status or an artifact), so CI
+# (.ci/run) fails with it.
 # usage: [FUZZ_TARGETS="vtu tetgen"] scripts/fuzz.sh [seconds per target, default 60]
+# Environment: FUZZ_BUILD_DIR (default build-fuzz).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 secs=${1:-60}
-[ -f build-fuzz/build.ninja ] || CC=clang meson setup build-fuzz -Dfuzz=true -Db_lundef=false \
+dir=${FUZZ_BUILD_DIR:-build-fuzz}
+[ -f "$dir/build.ninja" ] || CC=clang meson setup "$dir" -Dfuzz=true -Db_lundef=false \
   -Dmetaballs=false -Dbeams=false -Dtetvol=false >/dev/null
-targets="${FUZZ_TARGETS:-scene particle_file vtu tetgen assimp}"
-ninja -C build-fuzz $(for t in $targets; do printf 'tests/fuzz/fuzz_%s ' "$t"; done)
+# every target in the tree unless told otherwise: a new tests/fuzz/fuzz_X.c is run without
+# anyone remembering to list it here
+all=$(ls tests/fuzz/fuzz_*.c | sed 's|tests/fuzz/fuzz_||; s|\.c$||' | tr '\n' ' ')
+targets="${FUZZ_TARGETS:-$all}"
+ninja -C "$dir" $(for t in $targets; do printf 'tests/fuzz/fuzz_%s ' "$t"; done)
+status=0
 for t in $targets; do
-  work=build-fuzz/corpus-$t; mkdir -p "$work"
-  log=build-fuzz/fuzz-$t.log
+  work=$dir/corpus-$t; mkdir -p "$work"
+  log=$dir/fuzz-$t.log
   # a fresh artifact folder per target and run: crash-*, oom-*, leak-*, timeout-* all count
-  art=build-fuzz/artifacts-$t; rm -rf "$art"; mkdir -p "$art"
+  art=$dir/artifacts-$t; rm -rf "$art"; mkdir -p "$art"
+  seeds=tests/fuzz/corpus/$t
+  [ -d "$seeds" ] || { echo "fuzz_$t: no seed corpus $seeds"; status=1; continue; }
   set +e
-  build-fuzz/tests/fuzz/fuzz_$t -max_total_time="$secs" -max_len=8192 -artifact_prefix="$art/" "$work" "tests/fuzz/corpus/$t" >"$log" 2>&1
+  "$dir/tests/fuzz/fuzz_$t" -max_total_time="$secs" -max_len=8192 -timeout=20 -rss_limit_mb=2560 \
+    -artifact_prefix="$art/" "$work" "$seeds" >"$log" 2>&1
   rc=$?
   set -e
   runs=$(grep -o 'Done [0-9]* runs' "$log" | tail -1 || true)
-  echo "fuzz_$t: ${runs:-no summary} rc=$rc findings=$(find "$art" -type f | wc -l) (in $art)"
+  found=$(find "$art" -type f | wc -l)
+  echo "fuzz_$t: ${runs:-no summary} rc=$rc findings=$found (in $art, log $log)"
+  if [ "$rc" -ne 0 ] || [ "$found" -ne 0 ]; then
+    status=1
+    grep -m3 -E 'ERROR|SUMMARY|runtime error' "$log" || true
+  fi
 done
+exit $status

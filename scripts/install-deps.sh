@@ -14,6 +14,7 @@ pkgs=(
   assimp-testmodels tetgen
   xvfb xauth
   python3-matplotlib   # scripts/bench-water.sh plots with /usr/bin/python3
+  clang libclang-rt-14-dev  # scripts/fuzz.sh (CI's third step): libFuzzer and the sanitizer runtimes
   "$@"
 )
 missing=()
