@@ -189,6 +189,17 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
     if (!(v1->ert_threshold >= 0 && v1->ert_threshold <= 1))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: ert_threshold %g outside [0, 1]",
                           (double)v1->ert_threshold);
+    /* the scene file's caps (scene_volume.c): tiles sizes a DxD table per worker, so 65,535
+     * asked for 4.3e9 entries each (issue 18) */
+    if (v1->tiles > 1024 || v1->update_c > (1u << 20) || v1->workers > 256)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: tiles %u (0..1024), update_c %u (0..%u), "
+                          "workers %u (0..256)", v1->tiles, v1->update_c, 1u << 20, v1->workers);
+    for (int i = 0; i < 16; ++i)
+        if (!isfinite(v1->model[i]))
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: model[%d] is not finite", i);
+    if (!isfinite(v1->scalar_min) || !isfinite(v1->scalar_max))
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: scalar_min %g / scalar_max %g not finite",
+                          (double)v1->scalar_min, (double)v1->scalar_max);
     /* tet indices are checked once per revision: the renderer trusts them */
     const vfx_volume_view *old = &s->view.v1;
     if (v1->revision != s->revision || v1->tets != old->tets || v1->scalar != old->scalar ||
@@ -383,6 +394,7 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
         volfx_stat_set(ctx, "volume.render_skipped", 0);
         volfx_stat_set(ctx, "volume.cells_scanned", (double)c.cells_scanned);
         volfx_stat_set(ctx, "volume.cells_skipped_ert", (double)c.cells_skipped_ert);
+        volfx_stat_set(ctx, "volume.cells_nan", (double)c.cells_nan); /* skipped: NaN point or scalar */
         volfx_stat_set(ctx, "volume.segments", (double)c.segments_made);
         volfx_stat_set(ctx, "volume.tf_pieces", (double)c.tf_pieces);
         volfx_stat_set(ctx, "volume.t_sc_ms", c.t_sc_ms);

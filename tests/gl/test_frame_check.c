@@ -261,6 +261,187 @@ static void test_callback_pairs(void **state)
     api->destroy(ctx);
 }
 
+/* ------------------------------------------------------------------ attacks on the v2 views */
+
+typedef struct attack_host {
+    vfx_beams_view2 bv;
+    vfx_beam2 beam;
+    vfx_volume_view2 vv;
+    bool volume_v2;
+} attack_host;
+
+static vfx_result attack_beams(void *user, vfx_beams_view *out)
+{
+    attack_host *a = user;
+    if (out->version != VFX_BEAMS_VIEW2_VERSION || out->size < sizeof(vfx_beams_view2))
+        return VFX_ERR_NOT_FOUND;
+    *(vfx_beams_view2 *)out = a->bv;
+    return VFX_OK;
+}
+static uint32_t attack_volume_count(void *user) { (void)user; return 1; }
+static vfx_result attack_volume(void *user, uint32_t index, vfx_volume_view *out)
+{
+    attack_host *a = user;
+    (void)index;
+    if (a->volume_v2 && out->size >= sizeof(vfx_volume_view2))
+        *(vfx_volume_view2 *)out = a->vv;
+    else
+        *out = a->vv.v1, out->size = sizeof *out, out->version = VFX_VOLUME_VIEW_VERSION;
+    return VFX_OK;
+}
+
+static const float k_pts[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+static const uint32_t k_tet[4] = {0, 1, 2, 3}, k_bad_tet[4] = {0, 1, 2, 9};
+static const float k_scalar[4] = {0, 1, 2, 3};
+static const float k_rgba[8] = {0, 0, 0, 0, 1, 1, 1, 2};
+
+static void good_views(attack_host *a)
+{
+    memset(a, 0, sizeof *a);
+    a->beam = (vfx_beam2){.v1 = {.head = {-1, 0, 0}, .length = 2, .dir = {1, 0, 0}, .radius = 0.6f, .a = 0.5f,
+                                 .b = 0.5f, .eps = 0.05f, .color = {1, 1, 1, 1}}};
+    a->bv = (vfx_beams_view2){.v1 = {.size = sizeof(vfx_beams_view2), .version = VFX_BEAMS_VIEW2_VERSION, .count = 1},
+                              .beams = &a->beam};
+    a->vv = (vfx_volume_view2){.v1 = {.size = sizeof(vfx_volume_view2), .version = VFX_VOLUME_VIEW2_VERSION,
+                                      .point_count = 4, .tet_count = 1, .points = k_pts, .tets = k_tet,
+                                      .scalar = k_scalar, .transfer_rgba = k_rgba, .transfer_count = 2}};
+    a->volume_v2 = true;
+}
+
+/* One update + render with the attack host's views; expects `code` and `part` in the message. */
+static void attack(const vfx_plugin_api *api, attack_host *a, const fixture *f, vfx_result code, const char *part)
+{
+    test_log log = {0};
+    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = a, .log = NULL,
+                         .beams = attack_beams, .volume_count = attack_volume_count, .volume = attack_volume};
+    (void)log;
+    vfx_context *ctx;
+    assert_int_equal(api->create(&host, &ctx), VFX_OK);
+    vfx_result r = api->update(ctx, 0.0, 0.0f);
+    if (r == VFX_OK)
+        r = api->render(ctx, &f->fv);
+    const char *msg = api->last_error(ctx);
+    if (r != code || (part && !strstr(msg, part)))
+        fail_msg("attack: got %d \"%s\", want %d containing \"%s\"", r, msg, code, part ? part : "");
+    api->destroy(ctx);
+    assert_null(volfx_gpu_error_string());
+}
+
+/* Renders the attack host's views, expects OK, stat `name` == value and a finite raw image. */
+static void check_counted(const vfx_plugin_api *api, attack_host *a, const fixture *f, const char *name, double value)
+{
+    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = a,
+                         .volume_count = attack_volume_count, .volume = attack_volume};
+    vfx_context *ctx;
+    assert_int_equal(api->create(&host, &ctx), VFX_OK);
+    ctx->debug.sync_counters = true;
+    if (api->update(ctx, 0.0, 0.0f) || api->render(ctx, &f->fv))
+        fail_msg("%s", api->last_error(ctx));
+    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+    assert_int_equal(api->get_stats(ctx, &st), VFX_OK);
+    double got = -1;
+    for (uint32_t i = 0; i < st.count; ++i)
+        if (!strcmp(st.entries[i].name, name))
+            got = st.entries[i].value;
+    if (got != value) {
+        for (uint32_t i = 0; i < st.count; ++i)
+            printf("  %s = %g\n", st.entries[i].name, st.entries[i].value);
+        fail_msg("%s = %g, want %g", name, got, value);
+    }
+    static float raw[W * H];
+    assert_int_equal(api->read_raw(ctx, VFX_EFFECT_VOLUME, raw, W * H), VFX_OK);
+    for (int i = 0; i < W * H; ++i)
+        assert_true(isfinite(raw[i]));
+    api->destroy(ctx);
+}
+
+static void test_v2_views(void **state)
+{
+    (void)state;
+    const vfx_plugin_api *api = plugin_api();
+    fixture f;
+    make_fixture(&f);
+    attack_host a;
+    good_views(&a);
+    bool vol = api->effects_built & VFX_EFFECT_BIT(VFX_EFFECT_VOLUME);
+    if (!vol)
+        a.vv.v1.point_count = 0, a.vv.v1.tet_count = 0;
+    attack(api, &a, &f, VFX_OK, NULL);
+    /* beams v2: each field out of range, named */
+    struct { const char *field; void (*set)(attack_host *); } beam_cases[] = {
+        {"ramp 7", NULL}, {"falloff 9", NULL}, {"intensity", NULL}, {"exposure", NULL}, {"flow_amount", NULL},
+    };
+    (void)beam_cases;
+    good_views(&a); a.beam.ramp = 7;
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "beams[0]: falloff 0 / ramp 7 unknown");
+    good_views(&a); a.beam.falloff = 9;
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "falloff 9");
+    good_views(&a); a.beam.intensity = NAN;
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "beams[0]: needs intensity >= 0");
+    good_views(&a); a.beam.exposure = 1e30f;
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "|exposure| <= 64");
+    good_views(&a); a.beam.flow_amount = 2;
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "flow_amount in [0, 1]");
+    good_views(&a); a.beam.flow_scale = -1;
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "flow_scale >= 0");
+    good_views(&a); a.bv.bloom_levels = 99;
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "bloom_levels 99");
+    good_views(&a); a.bv.bloom_strength = -1;
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "bloom_strength -1");
+    good_views(&a); a.bv.bloom = 5;
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "bloom 5");
+    good_views(&a); a.bv.beams = NULL;
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "non-NULL array");
+    good_views(&a); a.bv.v1.count = 1u << 30;
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "1073741824 beams (at most");
+    good_views(&a); a.beam.v1.radius = NAN;
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "beams[0]:");
+    if (vol) {
+        /* volume v2 */
+        good_views(&a); a.vv.v1.tets = k_bad_tet;
+        attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "volume[0]: tet 0 uses point 9 of 4");
+        static const float dec[2] = {0.5f, 0.25f}, nan2[2] = {0, NAN};
+        good_views(&a); a.vv.transfer_scalar = dec;
+        attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "transfer_scalar[1] = 0.25");
+        good_views(&a); a.vv.transfer_scalar = nan2;
+        attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "transfer_scalar[1] = nan");
+        good_views(&a); a.vv.transfer_method = 9;
+        attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "transfer_method 9 unknown");
+        good_views(&a); a.vv.v1.transfer_count = VFX_VOLUME_MAX_TRANSFER + 1;
+        attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "transfer function of 1025 entries");
+        good_views(&a); a.vv.v1.ert_threshold = 2;
+        attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "ert_threshold 2 outside [0, 1]");
+        /* a DxD termination table of 65,535^2 entries per worker: refused, not allocated */
+        good_views(&a); a.vv.v1.tiles = 65535;
+        attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "volume[0]: tiles 65535 (0..1024)");
+        good_views(&a); a.vv.v1.workers = 100000;
+        attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "workers 100000 (0..256)");
+        good_views(&a); a.vv.v1.update_c = 1u << 31;
+        attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "update_c 2147483648 (0..1048576)");
+        good_views(&a); a.vv.v1.model[0] = NAN;
+        attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "volume[0]: model[0] is not finite");
+        good_views(&a); a.vv.v1.scalar_min = NAN;
+        attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "volume[0]: scalar_min nan");
+        /* a NaN or Inf coordinate: that cell is skipped, the good one drawn, the image finite */
+        good_views(&a);
+        check_counted(api, &a, &f, "volume.cells_scanned", 1);
+        static float bad_pts[15];
+        static const uint32_t two[8] = {0, 1, 2, 3, 0, 1, 2, 4};
+        static const float sc5[5] = {0, 1, 2, 3, 4};
+        for (int inf = 0; inf < 2; ++inf) {
+            memcpy(bad_pts, k_pts, sizeof k_pts);
+            bad_pts[12] = 0, bad_pts[13] = 0, bad_pts[14] = inf ? INFINITY : NAN;
+            good_views(&a);
+            a.vv.v1.points = bad_pts, a.vv.v1.point_count = 5, a.vv.v1.tets = two, a.vv.v1.tet_count = 2;
+            a.vv.v1.scalar = sc5;
+            check_counted(api, &a, &f, "volume.cells_scanned", 1); /* the good cell still drawn */
+        }
+        good_views(&a); a.vv.v1.version = 7;
+        attack(api, &a, &f, VFX_ERR_ABI, "host view of version 7");
+    }
+    free_fixture(&f);
+}
+
 int main(void)
 {
     g_gl = test_gl_or_skip();
@@ -268,6 +449,7 @@ int main(void)
         cmocka_unit_test(test_frame_fields),
         cmocka_unit_test(test_nothing_drawn),
         cmocka_unit_test(test_callback_pairs),
+        cmocka_unit_test(test_v2_views),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     rt_gl_context_destroy(g_gl);
