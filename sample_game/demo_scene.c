@@ -171,6 +171,31 @@ static void volume_transfer(game_demo *demo, const rt_scene_volume *v, vfx_volum
     vv->v1.transfer_rgba = demo->vol_transfer;
     vv->v1.transfer_count = n;
     vv->transfer_scalar = demo->vol_transfer_pos;
+    demo->vol_transfer_count = n;
+}
+
+/* Keeps the loaded points and scalars when the scene animates them (each frame starts there). */
+static vfx_result volume_prepare_animation(game_demo *demo, const rt_scene_volume *v)
+{
+    const rt_scene_volume_animation *an = &v->anim;
+    demo->vol_animated = an->ripple_amplitude > 0 || an->glow_gain > 0 || an->pulse_period_s > 0;
+    if (!demo->vol_animated)
+        return VFX_OK;
+    size_t np = demo->vol_point_count;
+    demo->vol_base_points = malloc(np * 3 * sizeof(float));
+    demo->vol_base_scalar = malloc(np * sizeof(float));
+    if (!demo->vol_base_points || !demo->vol_base_scalar)
+        return VFX_ERR_OUT_OF_MEMORY;
+    memcpy(demo->vol_base_points, demo->vol_points, np * 3 * sizeof(float));
+    memcpy(demo->vol_base_scalar, demo->vol_scalar, np * sizeof(float));
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < np; ++i)
+        for (int k = 0; k < 3; ++k)
+            lo[k] = fminf(lo[k], demo->vol_points[3 * i + k]), hi[k] = fmaxf(hi[k], demo->vol_points[3 * i + k]);
+    for (int k = 0; k < 3; ++k)
+        demo->vol_center[k] = 0.5f * (lo[k] + hi[k]);
+    demo->vol_center[1] = lo[1]; /* a dome ripples out from its floor */
+    return VFX_OK;
 }
 
 /* The volume's mesh stays with the demo; the host api hands the plugin pointers into it. */
@@ -198,8 +223,105 @@ static vfx_result load_volume(game_app *app, game_demo *demo, const rt_scene *sc
     vv->v1.disable = v->disable;
     memcpy(vv->v1.model, v->model, sizeof vv->v1.model);
     vv->v1.revision = 1;
+    if ((r = volume_prepare_animation(demo, v)))
+        return r;
     app->volume_count = 1;
     return VFX_OK;
+}
+
+/* The beams' light on the volume: per point, a Gaussian of its distance to each beam's axis
+ * segment [M, M + L D] (in beam radii), scaled by gain. */
+static float beam_glow(const game_app *app, const rt_scene_volume_animation *an, const float w[3])
+{
+    float g = 0;
+    for (uint32_t b = 0; b < app->beam_count; ++b) {
+        const vfx_beam *bm = &app->beams2[b].v1;
+        float d[3] = {w[0] - bm->head[0], w[1] - bm->head[1], w[2] - bm->head[2]};
+        float dl = sqrtf(bm->dir[0] * bm->dir[0] + bm->dir[1] * bm->dir[1] + bm->dir[2] * bm->dir[2]);
+        if (!(dl > 0))
+            continue;
+        float u = (d[0] * bm->dir[0] + d[1] * bm->dir[1] + d[2] * bm->dir[2]) / dl;
+        u = u < 0 ? 0 : u > bm->length ? bm->length : u;
+        float r2 = 0;
+        for (int k = 0; k < 3; ++k) {
+            float e = d[k] - u * bm->dir[k] / dl;
+            r2 += e * e;
+        }
+        float s = an->glow_reach * bm->radius;
+        g += an->glow_gain * expf(-r2 / (s * s));
+    }
+    return g;
+}
+
+/* One frame of the volume's animation through the ABI: rippled points and beam-lit scalars
+ * (new revision), and the transfer function with a bright band at this frame's position. */
+static void animate_volume(game_app *app, game_demo *demo)
+{
+    const rt_scene_volume *v = &demo->scene->volume;
+    const rt_scene_volume_animation *an = &v->anim;
+    vfx_volume_view2 *vv = &app->volumes[0];
+    const double t = app->time;
+    if (an->ripple_amplitude > 0 || an->glow_gain > 0) {
+        const float *M = v->model, *c = demo->vol_center;
+        const double w = 2 * M_PI / an->ripple_period_s, k = 2 * M_PI / an->ripple_wavelength;
+        bool identity = true;
+        for (int i = 0; i < 16; ++i)
+            identity &= M[i] == 0;
+        for (uint32_t i = 0; i < demo->vol_point_count; ++i) {
+            const float *p = &demo->vol_base_points[3 * i];
+            float *q = &demo->vol_points[3 * i];
+            float f = an->ripple_amplitude > 0
+                          ? (float)(1 + an->ripple_amplitude * sin(k * (p[1] - c[1]) - w * t)) : 1.f;
+            for (int j = 0; j < 3; ++j)
+                q[j] = c[j] + (p[j] - c[j]) * f;
+            float s = demo->vol_base_scalar[i];
+            if (an->glow_gain > 0 && app->beam_count) {
+                float wp[3];
+                for (int r = 0; r < 3; ++r)
+                    wp[r] = identity ? q[r] : M[r] * q[0] + M[4 + r] * q[1] + M[8 + r] * q[2] + M[12 + r];
+                s += beam_glow(app, an, wp);
+            }
+            demo->vol_scalar[i] = s;
+        }
+        vv->v1.revision++;
+    }
+    if (an->pulse_period_s > 0 && demo->vol_transfer_count >= 2) {
+        /* the scene's table with 3 entries inserted: the band's edges (the table's own values
+         * there) and its peak, sweeping the domain once per period */
+        uint32_t n = demo->vol_transfer_count;
+        float *rgba = demo->vol_transfer, *pos = demo->vol_transfer_pos, hw = an->pulse_width;
+        float u = (float)(fmod(t / an->pulse_period_s, 1.0) * (1 + 4 * hw) - 2 * hw);
+        float band[3] = {u - hw, u, u + hw}, out_rgba[3][4];
+        for (int b = 0; b < 3; ++b) { /* the table at the band's points, before inserting */
+            uint32_t j = 0;
+            while (j + 2 < n && pos[j + 1] <= band[b])
+                ++j;
+            float f = (band[b] - pos[j]) / (pos[j + 1] - pos[j]);
+            f = f < 0 ? 0 : f > 1 ? 1 : f;
+            for (int q = 0; q < 4; ++q)
+                out_rgba[b][q] = rgba[4 * j + q] + f * (rgba[4 * (j + 1) + q] - rgba[4 * j + q]);
+        }
+        memcpy(out_rgba[1], an->pulse_rgba, sizeof out_rgba[1]);
+        float nr[(RT_SCENE_MAX_TRANSFER + 3) * 4], np_[RT_SCENE_MAX_TRANSFER + 3];
+        uint32_t m = 0, b = 0;
+        for (uint32_t j = 0; j < n; ++j) {
+            for (; b < 3 && band[b] <= pos[j]; ++b)
+                if (band[b] > 0 && band[b] < 1 && (m == 0 || band[b] > np_[m - 1])) {
+                    np_[m] = band[b];
+                    memcpy(&nr[4 * m++], out_rgba[b], 4 * sizeof(float));
+                }
+            if (m == 0 || pos[j] > np_[m - 1]) {
+                np_[m] = pos[j];
+                memcpy(&nr[4 * m++], &rgba[4 * j], 4 * sizeof(float));
+            }
+        }
+        /* the animated table lives beside the scene's, which stays for the next frame */
+        memcpy(demo->vol_anim_transfer, nr, (size_t)m * 4 * sizeof(float));
+        memcpy(demo->vol_anim_pos, np_, (size_t)m * sizeof(float));
+        vv->v1.transfer_rgba = demo->vol_anim_transfer;
+        vv->transfer_scalar = demo->vol_anim_pos;
+        vv->v1.transfer_count = m;
+    }
 }
 
 vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path, uint32_t effects_off)
@@ -247,6 +369,8 @@ void game_demo_animate(game_app *app, game_demo *demo, float dt)
     (void)dt;
     if (demo->scene && app->beam_count) /* keyframed: grow, thicken, move, turn */
         app->beam_count = rt_scene_beams2_at(demo->scene, app->time, app->beams2, demo->beam_base_count);
+    if (demo->scene && demo->vol_animated && app->volume_count) /* after the beams: they light it */
+        animate_volume(app, demo);
 }
 
 void game_demo_toggle(game_app *app, game_demo *demo, vfx_effect_kind kind)
@@ -293,5 +417,7 @@ void game_demo_free(game_app *app, game_demo *demo)
     free(demo->vol_points);
     free(demo->vol_tets);
     free(demo->vol_scalar);
+    free(demo->vol_base_points);
+    free(demo->vol_base_scalar);
     memset(demo, 0, sizeof *demo);
 }

@@ -19,7 +19,13 @@ typedef struct game_demo {
     double mouse_x, mouse_y;
     rt_sim_system *sim;       /* SPH writing the particle columns (NULL without water) */
     float *vol_points, *vol_scalar;
+    /* the volume's table (the animated pulse adds 3 entries) and, when the scene animates the
+     * volume, its loaded points and scalars that each frame starts from */
     float vol_transfer[RT_SCENE_MAX_TRANSFER * 4], vol_transfer_pos[RT_SCENE_MAX_TRANSFER];
+    uint32_t vol_transfer_count;
+    float vol_anim_transfer[(RT_SCENE_MAX_TRANSFER + 3) * 4], vol_anim_pos[RT_SCENE_MAX_TRANSFER + 3];
+    float *vol_base_points, *vol_base_scalar, vol_center[3];
+    bool vol_animated;
     uint32_t *vol_tets, vol_point_count, vol_tet_count;
 } game_demo;
 

@@ -110,6 +110,19 @@ typedef struct rt_scene_transfer_point {
     float rgba[4];   /* alpha is opacity per unit length */
 } rt_scene_transfer_point;
 
+/* How the game animates a volume each frame (volume.animate): vertices ripple, the beams light
+ * the scalar where they pass, and a bright band sweeps through the transfer function. */
+typedef struct rt_scene_volume_animation {
+    float ripple_amplitude;          /* radial displacement, fraction of the distance to the centre */
+    float ripple_wavelength;         /* model units along the height */
+    float ripple_period_s;
+    float glow_gain;                 /* scalar added at a beam's axis */
+    float glow_reach;                /* Gaussian reach in beam radii */
+    float pulse_rgba[4];             /* the band's colour and extinction */
+    float pulse_width;               /* half width in [0,1] of the transfer domain */
+    float pulse_period_s;            /* one sweep from the domain's low to high end */
+} rt_scene_volume_animation;
+
 typedef struct rt_scene_volume {
     bool generated;                  /* a generated grid instead of a file */
     char path[RT_SCENE_PATH_MAX];   /* .vtu, or .node (its .ele beside it) */
@@ -123,6 +136,7 @@ typedef struct rt_scene_volume {
     float ert_threshold;             /* 0 -> plugin default */
     uint32_t tiles, update_c, workers, disable;
     float model[16];
+    rt_scene_volume_animation anim;  /* per-frame changes (none when all zero) */
 } rt_scene_volume;
 
 typedef struct rt_scene {

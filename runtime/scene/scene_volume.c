@@ -14,11 +14,67 @@ bool scene_ends_with(const char *s, const char *suffix)
     return a >= b && strcmp(s + a - b, suffix) == 0;
 }
 
+/* volume.animate: {"ripple": {amplitude, wavelength, period_s}, "beam_glow": {gain, reach},
+ * "transfer_pulse": {rgba, width, period_s}}; absent parts stay 0 (off). */
+static vfx_result parse_animation(pctx *c, const cJSON *a, rt_scene_volume_animation *an)
+{
+    if (!a)
+        return VFX_OK;
+    static const char *const keys[] = {"ripple", "beam_glow", "transfer_pulse", NULL};
+    const char *P = "volume.animate";
+    vfx_result r = scene_expect_object(c, a, P);
+    if (r)
+        return r;
+    scene_check_keys(c, a, P, keys);
+    const cJSON *rp = cJSON_GetObjectItemCaseSensitive(a, "ripple");
+    if (rp) {
+        static const char *const k[] = {"amplitude", "wavelength", "period_s", NULL};
+        const char *PR = "volume.animate.ripple";
+        if ((r = scene_expect_object(c, rp, PR)))
+            return r;
+        scene_check_keys(c, rp, PR, k);
+        an->ripple_wavelength = 0.5f, an->ripple_period_s = 1.5f;
+        r = scene_get_float(c, rp, PR, "amplitude", true, (range){0, 0.5, false}, &an->ripple_amplitude);
+        if (!r) r = scene_get_float(c, rp, PR, "wavelength", false, POSITIVE, &an->ripple_wavelength);
+        if (!r) r = scene_get_float(c, rp, PR, "period_s", false, POSITIVE, &an->ripple_period_s);
+        if (r)
+            return r;
+    }
+    const cJSON *g = cJSON_GetObjectItemCaseSensitive(a, "beam_glow");
+    if (g) {
+        static const char *const k[] = {"gain", "reach", NULL};
+        const char *PG = "volume.animate.beam_glow";
+        if ((r = scene_expect_object(c, g, PG)))
+            return r;
+        scene_check_keys(c, g, PG, k);
+        an->glow_reach = 2.0f;
+        r = scene_get_float(c, g, PG, "gain", true, (range){0, 1e3, false}, &an->glow_gain);
+        if (!r) r = scene_get_float(c, g, PG, "reach", false, (range){0, 100, true}, &an->glow_reach);
+        if (r)
+            return r;
+    }
+    const cJSON *tp = cJSON_GetObjectItemCaseSensitive(a, "transfer_pulse");
+    if (tp) {
+        static const char *const k[] = {"rgba", "width", "period_s", NULL};
+        const char *PT = "volume.animate.transfer_pulse";
+        if ((r = scene_expect_object(c, tp, PT)))
+            return r;
+        scene_check_keys(c, tp, PT, k);
+        an->pulse_width = 0.03f, an->pulse_period_s = 3.0f;
+        r = scene_get_vec(c, tp, PT, "rgba", 4, true, (range){0, 1e3, false}, an->pulse_rgba);
+        if (!r) r = scene_get_float(c, tp, PT, "width", false, (range){0, 0.25, true}, &an->pulse_width);
+        if (!r) r = scene_get_float(c, tp, PT, "period_s", false, POSITIVE, &an->pulse_period_s);
+        if (r)
+            return r;
+    }
+    return VFX_OK;
+}
+
 vfx_result scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol)
 {
     static const char *const keys[] = {"path", "generator", "scalar", "transfer", "transfer_normalized",
                                        "ert_threshold", "tiles", "update_c", "workers", "disable",
-                                       "translate", "rotate_deg", "scale", "matrix", "transfer_method", NULL};
+                                       "translate", "rotate_deg", "scale", "matrix", "transfer_method", "animate", NULL};
     const char *P = "volume";
     vfx_result r = scene_expect_object(c, v, P);
     if (r)
@@ -73,6 +129,7 @@ vfx_result scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol)
             r = scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "volume.transfer_method",
                             "\"%.40s\" is neither \"exact\" nor \"preintegrated\"", method);
     }
+    if (!r) r = parse_animation(c, cJSON_GetObjectItemCaseSensitive(v, "animate"), &vol->anim);
     if (!r) r = scene_parse_transform(c, v, P, vol->model);
     if (r)
         return r;

@@ -25,6 +25,7 @@
 #define H 36
 
 static game_app *g_app;
+static const char *g_showcase; /* sample_game/scenes/volume-showcase.json (argv[1]) */
 static float *g_points, *g_scalar;
 static uint32_t *g_tets, g_np, g_nt;
 
@@ -254,8 +255,8 @@ static void write_grid_vtu(const char *path, int n, tet_mesh *m)
 
 /* A user's .vtu in a scene file with a 64-point transfer function (a smooth map with a narrow
  * spike), loaded by the game's scene code, rendered by the plugin, against the float64 ray
- * march. Then a missing file: an error naming it that stops the load. Runs last: it replaces
- * the app's camera and volume. */
+ * march. Then a missing file: an error naming it that stops the load. Runs after the tests of
+ * the app's own volume: it replaces the camera and the volume. */
 static void test_file_volume_in_scene(void **state)
 {
     (void)state;
@@ -326,14 +327,48 @@ static void test_file_volume_in_scene(void **state)
     free(grid.points), free(grid.scalar), free(grid.tets);
 }
 
-int main(void)
+/* The showcase scene: its dome loads, and the animation changes points, scalars and the table
+ * through the ABI every frame (a new revision each time, no frame skipped, a different image). */
+static void test_showcase_animates(void **state)
 {
+    (void)state;
+    if (!g_showcase)
+        skip();
+    g_app->volume_count = 0;
+    game_demo demo;
+    assert_int_equal(game_demo_load(g_app, &demo, g_showcase, VFX_EFFECT_BIT(VFX_EFFECT_WATER)), VFX_OK);
+    assert_true(demo.vol_animated);
+    uint64_t rev = g_app->volumes[0].v1.revision;
+    float *prev = NULL;
+    for (int f = 0; f < 3; ++f) {
+        g_app->time = 2.6 + 0.1 * f; /* the beam crosses the dome */
+        game_demo_animate(g_app, &demo, 0.1f);
+        float *a = render_alpha();
+        assert_true(g_app->volumes[0].v1.revision == rev + 1 + (uint64_t)f);
+        if (prev) {
+            assert_true(stat("volume.render_skipped") == 0);
+            double d = 0;
+            for (int p = 0; p < W * H; ++p)
+                d = fmax(d, fabs(a[p] - prev[p]));
+            assert_true(d > 1e-3);
+        }
+        free(prev);
+        prev = a;
+    }
+    free(prev);
+    game_demo_free(g_app, &demo);
+}
+
+int main(int argc, char **argv)
+{
+    g_showcase = argc > 1 ? argv[1] : NULL;
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_matches_renderer),
         cmocka_unit_test(test_hidden_by_depth),
         cmocka_unit_test(test_bad_view_and_absence),
         cmocka_unit_test(test_skip_when_unchanged),
         cmocka_unit_test(test_file_volume_in_scene),
+        cmocka_unit_test(test_showcase_animates), /* last: it leaves the scene's meshes */
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
