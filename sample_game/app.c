@@ -164,6 +164,19 @@ vfx_result game_app_set_camera(game_app *app, const ref_camera *cam)
     return rt_renderer_resize(app->renderer, cam->width, cam->height);
 }
 
+vfx_result game_app_set_environment(game_app *app, bool sky, const float sun_dir[3], float fog)
+{
+    rt_renderer_environment env = {.sky = sky, .fog_density = fog};
+    if (sun_dir)
+        memcpy(env.sun_dir, sun_dir, sizeof env.sun_dir);
+    vfx_result r = rt_renderer_set_environment(app->renderer, &env);
+    if (r)
+        rt_logf(&app->log, VFX_LOG_ERROR, "environment: the sky's shader could not be made");
+    else
+        app->environment = env;
+    return r;
+}
+
 vfx_result game_app_create(const game_app_desc *desc, game_app **out)
 {
     *out = NULL;
@@ -317,6 +330,11 @@ vfx_result game_app_frame(game_app *app, float dt)
     float view[16], proj[16];
     ref_camera_matrices(&app->camera, view, proj);
     t0 = rt_now_ms();
+    if (app->environment.sky) { /* the fog is seen from the camera */
+        for (int k = 0; k < 3; ++k)
+            app->environment.eye[k] = (float)app->camera.eye[k];
+        rt_renderer_set_environment(app->renderer, &app->environment);
+    }
     rt_renderer_begin_scene(app->renderer, view, proj, app->clear_color);
     rt_component draw_terms[2] = {app->mesh_comp, app->transform_comp};
     rt_query_iter it = rt_query_begin(app->world, draw_terms, 2);

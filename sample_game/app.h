@@ -52,6 +52,7 @@ typedef struct game_app {
     vfx_host_api host;
     ref_camera camera;
     float clear_color[3];
+    rt_renderer_environment environment; /* sky, sun and fog (zero: clear colour) */
     rt_component mesh_comp, transform_comp; /* scene meshes are entities of the world */
     uint32_t mesh_count;
     bool water_enabled;        /* particles are drawn as water when true */
@@ -73,6 +74,9 @@ typedef struct game_app {
     bool chunks_valid;
 } game_app;
 
+/* Sets the world around the meshes: the procedural sky (or the clear colour), the sun's
+ * direction (towards it) and fog per metre. VFX_ERR_GL when the sky's shader fails. */
+vfx_result game_app_set_environment(game_app *app, bool sky, const float sun_dir[3], float fog);
 /* Creates the context (window or headless), world, renderer and plugin. */
 vfx_result game_app_create(const game_app_desc *desc, game_app **out);
 /* Destroys everything in reverse order. NULL allowed. */

@@ -343,6 +343,9 @@ vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path
                           {c->up[0], c->up[1], c->up[2]}, c->fov_y_deg * M_PI / 180.0,
                           app->desc.width ? app->desc.width : c->width, app->desc.height ? app->desc.height : c->height,
                           c->near_plane, c->far_plane};
+    if (sc->environment.sky
+        && (r = game_app_set_environment(app, true, sc->environment.sun_dir, sc->environment.fog)))
+        return r;
     if ((r = game_app_set_camera(app, &cam)) || (r = load_meshes(app, sc)))
         return r;
     if (sc->has_water && !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_WATER)) && (r = load_water(app, demo, sc)))

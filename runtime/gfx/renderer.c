@@ -4,6 +4,7 @@
  * (ACES) into an 8-bit display target for read-back and presenting. */
 #include "gfx/renderer.h"
 
+#include <cglm/cglm.h>
 #include <epoxy/gl.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,7 +14,10 @@
 struct rt_renderer {
     rt_logger log;
     GLuint mesh_prog;
-    GLint u_model, u_view_proj, u_color, u_light;
+    GLint u_model, u_view_proj, u_color, u_light, u_environment, u_eye, u_fog;
+    rt_renderer_environment env;
+    GLuint sky_prog, sky_vao;
+    GLint u_sky_inv_view_proj, u_sky_sun;
     GLuint scene_fbo, scene_color, scene_depth;
     GLuint out_fbo, out_color, out_depth;
     bool hdr;
@@ -94,6 +98,9 @@ vfx_result rt_renderer_create(const rt_logger *logger, rt_renderer **out)
     r->u_view_proj = glGetUniformLocation(r->mesh_prog, "u_view_proj");
     r->u_color = glGetUniformLocation(r->mesh_prog, "u_color");
     r->u_light = glGetUniformLocation(r->mesh_prog, "u_light_dir");
+    r->u_environment = glGetUniformLocation(r->mesh_prog, "u_environment");
+    r->u_eye = glGetUniformLocation(r->mesh_prog, "u_eye");
+    r->u_fog = glGetUniformLocation(r->mesh_prog, "u_fog");
     *out = r;
     return VFX_OK;
 }
@@ -162,6 +169,8 @@ void rt_renderer_destroy(rt_renderer *r)
         return;
     free_targets(r);
     glDeleteProgram(r->mesh_prog);
+    glDeleteProgram(r->sky_prog);
+    glDeleteVertexArrays(1, &r->sky_vao);
     glDeleteProgram(r->tone_prog);
     glDeleteVertexArrays(1, &r->tone_vao);
     free(r);
@@ -221,6 +230,48 @@ vfx_result rt_renderer_resize(rt_renderer *r, uint32_t w, uint32_t h)
     return VFX_OK;
 }
 
+vfx_result rt_renderer_set_environment(rt_renderer *r, const rt_renderer_environment *env)
+{
+    if (!r || !env)
+        return VFX_ERR_INVALID_ARGUMENT;
+    if (env->sky && !r->sky_prog) {
+        r->sky_prog = link_program(&r->log, "common/fullscreen.vert", "host/sky.frag", "host.sky");
+        if (!r->sky_prog)
+            return VFX_ERR_GL;
+        r->u_sky_inv_view_proj = glGetUniformLocation(r->sky_prog, "u_inv_view_proj");
+        r->u_sky_sun = glGetUniformLocation(r->sky_prog, "u_sun_dir");
+        glCreateVertexArrays(1, &r->sky_vao);
+    }
+    r->env = *env;
+    return VFX_OK;
+}
+
+/* proj * view with cglm (column-major float[16] is cglm's mat4 layout). */
+static void view_proj(const rt_renderer *r, mat4 vp)
+{
+    mat4 v, p;
+    memcpy(v, r->view, sizeof v);
+    memcpy(p, r->proj, sizeof p);
+    glm_mat4_mul(p, v, vp);
+}
+
+/* The sky behind everything: depth stays at the far plane, so meshes and effects cover it. */
+static void draw_sky(rt_renderer *r)
+{
+    mat4 vp, inv;
+    view_proj(r, vp);
+    glm_mat4_inv(vp, inv);
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    glUseProgram(r->sky_prog);
+    glUniformMatrix4fv(r->u_sky_inv_view_proj, 1, GL_FALSE, (const float *)inv);
+    glUniform3fv(r->u_sky_sun, 1, r->env.sun_dir);
+    glBindVertexArray(r->sky_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+    glDepthMask(GL_TRUE);
+}
+
 void rt_renderer_begin_scene(rt_renderer *r, const float view[16], const float proj[16],
                               const float clear_rgb[3])
 {
@@ -233,27 +284,31 @@ void rt_renderer_begin_scene(rt_renderer *r, const float view[16], const float p
     glClearDepth(1.0);
     glDepthMask(GL_TRUE);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    if (r->env.sky)
+        draw_sky(r);
 }
 
 void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float model[16],
                             const float rgb[3])
 {
-    float vp[16];
-    for (int c = 0; c < 4; ++c)
-        for (int row = 0; row < 4; ++row) {
-            float s = 0;
-            for (int k = 0; k < 4; ++k)
-                s += r->proj[k * 4 + row] * r->view[c * 4 + k];
-            vp[c * 4 + row] = s;
-        }
+    mat4 vp;
+    view_proj(r, vp);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDisable(GL_CULL_FACE);
     glUseProgram(r->mesh_prog);
     glUniformMatrix4fv(r->u_model, 1, GL_FALSE, model);
-    glUniformMatrix4fv(r->u_view_proj, 1, GL_FALSE, vp);
+    glUniformMatrix4fv(r->u_view_proj, 1, GL_FALSE, (const float *)vp);
     glUniform3fv(r->u_color, 1, rgb);
-    glUniform3f(r->u_light, 0.4f, 0.8f, 0.45f);
+    if (r->env.sky) {
+        glUniform3fv(r->u_light, 1, r->env.sun_dir);
+        glUniform1i(r->u_environment, 1);
+        glUniform3fv(r->u_eye, 1, r->env.eye);
+        glUniform1f(r->u_fog, r->env.fog_density);
+    } else {
+        glUniform3f(r->u_light, 0.4f, 0.8f, 0.45f);
+        glUniform1i(r->u_environment, 0);
+    }
     glBindVertexArray(mesh->vao);
     glDrawElements(GL_TRIANGLES, (GLsizei)mesh->index_count, GL_UNSIGNED_INT, NULL);
     glBindVertexArray(0);

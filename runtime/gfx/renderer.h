@@ -21,6 +21,20 @@ vfx_result rt_renderer_resize(rt_renderer *r, uint32_t width, uint32_t height);
 /* Clears the scene target and sets the camera (column-major view and projection). */
 void rt_renderer_begin_scene(rt_renderer *r, const float view[16], const float proj[16],
                               const float clear_rgb[3]);
+/* The world around the meshes. Zeroed (the default): a clear colour behind lit, checkered
+ * meshes. With `sky`: the procedural dusk sky of shaders/common/sky.glsl behind everything
+ * (the water reflects the same sky), stone-tiled meshes lit by the sun at sun_dir (towards the
+ * sun) and the sky, fog of fog_density per metre towards the horizon seen from eye. */
+typedef struct rt_renderer_environment {
+    bool sky;
+    float sun_dir[3];
+    float fog_density;
+    float eye[3];
+} rt_renderer_environment;
+
+/* Sets the environment for the frames that follow (the eye moves with the camera: call it when
+ * the camera moves). VFX_ERR_GL when the sky's shader cannot be made. */
+vfx_result rt_renderer_set_environment(rt_renderer *r, const rt_renderer_environment *env);
 /* Draws a mesh with a model matrix and a colour into the scene target. */
 void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float model[16],
                             const float rgb[3]);

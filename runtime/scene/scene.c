@@ -123,10 +123,30 @@ static vfx_result parse_meshes(pctx *c, const cJSON *v, rt_scene *s)
 }
 
 
+static vfx_result parse_environment(pctx *c, const cJSON *v, rt_scene_environment *env)
+{
+    static const char *const keys[] = {"sky", "sun_dir", "fog", NULL};
+    static const char *const skies[] = {"none", "dusk", NULL};
+    vfx_result r = scene_expect_object(c, v, "environment");
+    if (r)
+        return r;
+    scene_check_keys(c, v, "environment", keys);
+    uint32_t sky = 1;
+    env->sun_dir[0] = -0.45f, env->sun_dir[1] = 0.35f, env->sun_dir[2] = -0.82f;
+    if ((r = scene_get_enum(c, v, "environment", "sky", false, skies, &sky)))
+        return r;
+    env->sky = sky == 1;
+    if ((r = scene_get_vec(c, v, "environment", "sun_dir", 3, false, COORD, env->sun_dir)))
+        return r;
+    if (!(fabsf(env->sun_dir[0]) + fabsf(env->sun_dir[1]) + fabsf(env->sun_dir[2]) > 1e-6f))
+        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "environment.sun_dir", "must not be the zero vector");
+    return scene_get_float(c, v, "environment", "fog", false, (range){0, 10, false}, &env->fog);
+}
+
 static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
 {
     static const char *const keys[] = {"version", "name", "description", "camera", "meshes", "beams",
-                                       "beam_settings", "water", "volume", NULL};
+                                       "beam_settings", "water", "volume", "environment", NULL};
     vfx_result r = scene_expect_object(c, root, "");
     if (r)
         return r;
@@ -163,6 +183,8 @@ static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
         if ((r = scene_parse_water(c, v, &s->water)))
             return r;
     }
+    if ((v = cJSON_GetObjectItemCaseSensitive(root, "environment")) && (r = parse_environment(c, v, &s->environment)))
+        return r;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "volume"))) {
         s->has_volume = true;
         if ((r = scene_parse_volume(c, v, &s->volume)))

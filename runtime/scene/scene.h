@@ -139,6 +139,13 @@ typedef struct rt_scene_volume {
     rt_scene_volume_animation anim;  /* per-frame changes (none when all zero) */
 } rt_scene_volume;
 
+/* "environment": the world around the meshes (absent: a clear colour, checkered meshes). */
+typedef struct rt_scene_environment {
+    bool sky;           /* "sky": "dusk" (the default) or "none" */
+    float sun_dir[3];   /* "sun_dir": towards the sun; default (-0.45, 0.35, -0.82), low */
+    float fog;          /* "fog": density per metre, 0..10; default 0 */
+} rt_scene_environment;
+
 typedef struct rt_scene {
     char name[128];
     char base_dir[RT_SCENE_PATH_MAX];
@@ -153,6 +160,7 @@ typedef struct rt_scene {
     rt_scene_water water;
     bool has_volume;
     rt_scene_volume volume;
+    rt_scene_environment environment;
 } rt_scene;
 
 /* Parses `len` bytes of JSON (no NUL needed). Relative paths resolve against `base_dir`

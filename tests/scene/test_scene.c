@@ -284,6 +284,42 @@ static void test_bad_inputs(void **state)
     }
 }
 
+/* "environment": the defaults, every key read, and bad values refused with their path. */
+static void test_environment(void **state)
+{
+    (void)state;
+    test_log log = {0};
+    rt_scene *s = NULL;
+    char err[512] = "";
+    assert_int_equal(load("{\"environment\": {}}", &log, &s, err, sizeof err), VFX_OK);
+    assert_true(s->environment.sky);
+    assert_true(s->environment.sun_dir[1] > 0 && s->environment.fog == 0);
+    rt_scene_free(s);
+    assert_int_equal(load("{}", &log, &s, err, sizeof err), VFX_OK);
+    assert_false(s->environment.sky); /* no environment: the clear colour, as before */
+    rt_scene_free(s);
+    assert_int_equal(load("{\"environment\": {\"sky\": \"none\", \"sun_dir\": [0, 1, 0], \"fog\": 0.5}}",
+                          &log, &s, err, sizeof err), VFX_OK);
+    assert_false(s->environment.sky);
+    assert_true(s->environment.sun_dir[1] == 1 && s->environment.fog == 0.5f);
+    rt_scene_free(s);
+    static const struct { const char *json, *needle; } bad[] = {
+        {"{\"environment\": {\"sky\": \"noon\"}}", "environment.sky"},
+        {"{\"environment\": {\"sun_dir\": [0, 0, 0]}}", "environment.sun_dir"},
+        {"{\"environment\": {\"fog\": -1}}", "environment.fog"},
+        {"{\"environment\": {\"fog\": 11}}", "environment.fog"},
+        {"{\"environment\": 3}", "environment"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        s = NULL;
+        err[0] = 0;
+        assert_int_not_equal(load(bad[i].json, &log, &s, err, sizeof err), VFX_OK);
+        if (!strstr(err, bad[i].needle))
+            fail_msg("%s: error \"%s\" does not name %s", bad[i].json, err, bad[i].needle);
+        assert_null(s);
+    }
+}
+
 /* A NUL inside the text was skipped as whitespace by cJSON (it parses to the given length). */
 static void test_nul_byte(void **state)
 {
@@ -644,6 +680,7 @@ int main(void)
         cmocka_unit_test(test_bad_inputs),
         cmocka_unit_test(test_too_many_beams),
         cmocka_unit_test(test_nul_byte),
+        cmocka_unit_test(test_environment),
         cmocka_unit_test(test_syntax_errors),
         cmocka_unit_test(test_unknown_keys_warn),
         cmocka_unit_test(test_keyframes),
