@@ -1,5 +1,6 @@
 /* demo_scene.c — turns a scene (runtime/scene) into app content and animates it. */
 #include "demo_scene.h"
+#include "core/file.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -22,12 +23,13 @@ static vfx_result load_meshes(game_app *app, const rt_scene *sc)
             memcpy(rt_world_get(app->world, e, app->transform_comp, 0), m->model, sizeof m->model);
             continue;
         }
-        FILE *f = fopen(m->path, "rb");
-        if (!f) { /* a missing decoration is not worth refusing the scene for */
-            rt_logf(&app->log, VFX_LOG_WARN, "scene meshes[%u]: %s not found, skipped", i, m->path);
+        /* a missing decoration is not worth refusing the scene for; stat, not fopen: opening
+         * a FIFO for reading blocks forever */
+        char why[RT_SCENE_PATH_MAX + 64];
+        if (rt_check_regular_file(m->path, why, sizeof why)) {
+            rt_logf(&app->log, VFX_LOG_WARN, "scene meshes[%u]: %s, skipped", i, why);
             continue;
         }
-        fclose(f);
         if ((r = game_app_add_mesh_file(app, m->path, m->model, m->color, NULL)))
             return r;
     }

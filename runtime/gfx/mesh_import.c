@@ -1,6 +1,7 @@
 /* mesh_import.c — Assimp scene flattening; node transforms applied on the CPU so one draw
  * per file is enough. */
 #include "gfx/mesh_import.h"
+#include "core/file.h"
 
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
@@ -138,13 +139,12 @@ vfx_result rt_mesh_import(const char *path, rt_mesh_data *out, char *err, size_t
 {
     if (!path || !out)
         return VFX_ERR_INVALID_ARGUMENT;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
+    /* checked before Assimp opens it: a FIFO would block, a directory or device is no mesh */
+    vfx_result r = rt_check_regular_file(path, err, errlen);
+    if (r) {
         memset(out, 0, sizeof *out);
-        snprintf(err, errlen, "%s: cannot open", path);
-        return VFX_ERR_IO;
+        return r;
     }
-    fclose(f);
     return from_scene(aiImportFile(path, IMPORT_FLAGS), path, out, err, errlen);
 }
 
