@@ -1,6 +1,7 @@
 /* plugin_host.c — dlopen/dlsym, version handshake, table validation. */
 #define _GNU_SOURCE /* dladdr: which file the loader picked for a bare soname */
 #include "host/plugin_host.h"
+#include "core/file.h"
 
 #include <dlfcn.h>
 #include <stdlib.h>
@@ -44,6 +45,13 @@ vfx_result rt_plugin_host_load_as(const char *path, uint32_t abi, const vfx_host
     if (!path || !out)
         return VFX_ERR_INVALID_ARGUMENT;
     *out = NULL;
+    /* A path (not a soname the loader searches) is checked first: dlopen of a FIFO blocks
+     * forever in open(), a directory gives only "cannot read file data". */
+    char why[512];
+    if (strchr(path, '/') && rt_check_regular_file(path, why, sizeof why)) {
+        rt_logf(log, VFX_LOG_ERROR, "plugin %s", why);
+        return VFX_ERR_IO;
+    }
     void *handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
     if (!handle) {
         rt_logf(log, VFX_LOG_ERROR, "plugin '%s' cannot be loaded: %s", path, dlerror());

@@ -1,3 +1,4 @@
+#define _POSIX_C_SOURCE 200809L /* mkdtemp, mkfifo */
 /* Plugin loading: the real plugin loads; a wrong ABI version, a missing entry symbol, a
  * table of another version and a missing file are refused with messages naming what. */
 #include <setjmp.h>
@@ -6,7 +7,10 @@
 #include <stdint.h>
 #include <cmocka.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+#include <sys/stat.h>
 
 #include "host/plugin_host.h"
 #include "test_util.h"
@@ -97,6 +101,29 @@ static void test_missing_file(void **state)
     assert_non_null(strstr(log.last, "/nonexistent/libvolfx.so"));
 }
 
+/* issue 18: a plugin path that is a FIFO blocked forever in dlopen's open(); a directory gave
+ * only the loader's "cannot read file data". Both refused by stat first, naming what they are. */
+static void test_special_file_plugin(void **state)
+{
+    (void)state;
+    test_log log = {0};
+    vfx_host_api host = host_with(&log);
+    rt_logger lg = {test_log_fn, &log};
+    rt_plugin_host *h = NULL;
+    char dir[] = "/tmp/vfx_plug_XXXXXX", fifo[64];
+    assert_non_null(mkdtemp(dir));
+    snprintf(fifo, sizeof fifo, "%s/libvolfx.so.1", dir);
+    assert_int_equal(mkfifo(fifo, 0600), 0);
+    alarm(30);
+    assert_int_equal(rt_plugin_host_load(fifo, &host, &lg, &h), VFX_ERR_IO);
+    assert_non_null(strstr(log.last, "is a FIFO"));
+    alarm(0);
+    assert_int_equal(rt_plugin_host_load(dir, &host, &lg, &h), VFX_ERR_IO);
+    assert_non_null(strstr(log.last, "is a directory"));
+    unlink(fifo);
+    rmdir(dir);
+}
+
 static void test_create_refuses_bad_host(void **state)
 {
     (void)state;
@@ -124,6 +151,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_missing_symbol),
         cmocka_unit_test(test_table_version_refused),
         cmocka_unit_test(test_missing_file),
+        cmocka_unit_test(test_special_file_plugin),
         cmocka_unit_test(test_create_refuses_bad_host),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
