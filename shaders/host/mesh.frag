@@ -25,10 +25,13 @@ float stone(vec3 p, vec3 n)
     uv *= 2.0;
     vec2 cell = floor(uv);
     vec2 f = fract(uv);
+    // far away a pixel covers many stones: fade the pattern to its mean instead of aliasing
+    vec2 w = fwidth(uv);
+    float aa = max(w.x, w.y);
     float edge = min(min(f.x, 1.0 - f.x), min(f.y, 1.0 - f.y));
-    float grout = smoothstep(0.015, 0.05, edge);
-    float tone = 0.82 + 0.22 * hash2(cell) + 0.05 * hash2(floor(uv * 7.0));
-    return mix(0.45, tone, grout);
+    float grout = smoothstep(0.015, 0.05 + aa, edge);
+    float tone = 0.82 + 0.22 * hash2(cell) + 0.05 * hash2(floor(uv * 7.0)) * (1.0 - smoothstep(0.05, 0.15, aa));
+    return mix(0.86, mix(0.45, tone, grout), 1.0 - smoothstep(0.12, 0.45, aa));
 }
 
 void main()
