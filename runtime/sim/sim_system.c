@@ -128,6 +128,8 @@ static vfx_result sim_run(rt_world *w, const rt_system_ctx *ctx)
         rt_sph_host host = {s, host_permute, host_append};
         if ((r = rt_sph_bind(s->sph, &host, &c))) {
             snprintf(s->err, sizeof s->err, "vfx.sim.sph: %s", rt_sph_last_error(s->sph));
+            rt_sph_clear(s->sph); /* the old binding's columns may have moved */
+            s->bound = false;
             return r;
         }
         s->bound = true;
