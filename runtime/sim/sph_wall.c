@@ -89,26 +89,6 @@ int sph_gather_walls(const rt_sph *s, float px, float py, float pz, sph_wall_hit
     return k;
 }
 
-void sph_wall_share(const rt_sph *s, const sph_wall_hit *w, int nw, float *fr, float *inside,
-                    float *extra)
-{
-    /* The box walls are perpendicular: the region beyond them is a union of half-spaces,
-     * counted as 1 - prod(1 - f) (exact for a separable kernel, close for poly6) so the
-     * edges and corners are not compressed by double counting. Colliders just add. */
-    int nb = sph_walls_box(w, nw);
-    float in = 1.f, ex = 0.f;
-    for (int k = 0; k < nw; ++k) {
-        float f = s->wall_scale * (float)rt_sph_wall_density_fraction(w[k].d, s->H);
-        if (fr)
-            fr[k] = f;
-        if (k < nb)
-            in *= 1.f - f;
-        else
-            ex += f;
-    }
-    *inside = in, *extra = ex;
-}
-
 void sph_wall_accel(const rt_sph *s, const float p[3], const float vel[3], float pri, float rhoi,
                     float a[3], sph_wall_hit *walls)
 {
