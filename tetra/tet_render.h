@@ -74,7 +74,9 @@ typedef struct tet_counters {
     uint64_t table_updates;
     double t_sc_ms, t_update_ms, t_composite_ms;
     uint64_t tf_pieces;          /* ray pieces integrated (segments split at TF breakpoints) */
-    double cpu_ms;               /* CPU time of the worker thread (scan + updates); totals: sum */
+    double cpu_ms;               /* CPU time of the worker thread in the frame (its share of the
+                                  * projection, its sort, scan, table updates and its rows of
+                                  * the composite); totals: sum */
     double t_wait_ms;            /* waiting for other workers at the end of the scan phase */
     double t_setup_ms;           /* projection and front-to-back sort before the scan */
 } tet_counters;

@@ -281,7 +281,7 @@ static void scan_worker(worker *w)
         }
     }
     w->cnt.t_sc_ms = tet_now_ms() - t0 - w->cnt.t_update_ms;
-    w->cnt.cpu_ms = tet_thread_cpu_ms() - c0;
+    w->cnt.cpu_ms += tet_thread_cpu_ms() - c0;
 }
 
 typedef struct frame_job {
@@ -299,8 +299,10 @@ static void project_job(void *arg, int i)
 {
     frame_job *j = arg;
     const uint32_t np = j->mesh->point_count, nw = (uint32_t)j->sh->nw;
+    double c0 = tet_thread_cpu_ms();
     tet_view_vertices(j->mesh, j->cam->view, j->cam->proj, j->cam->width, j->cam->height,
                       (uint32_t)((uint64_t)np * i / nw), (uint32_t)((uint64_t)np * (i + 1) / nw), j->vp);
+    j->sh->w[i].cnt.cpu_ms += tet_thread_cpu_ms() - c0;
 }
 
 /* Phase 2: worker i sorts its partition front to back by nearest depth, then scans. The
@@ -315,13 +317,14 @@ static void scan_job(void *arg, int i)
     worker *w = &j->sh->w[i];
     const uint32_t nt = j->mesh->tet_count, nw = (uint32_t)j->sh->nw;
     const uint32_t c0 = (uint32_t)((uint64_t)nt * i / nw), c1 = (uint32_t)((uint64_t)nt * (i + 1) / nw);
-    double t0 = tet_now_ms();
+    double t0 = tet_now_ms(), cpu0 = tet_thread_cpu_ms();
     uint32_t n = tet_build_keys(j->mesh, j->vp, c0, c1, j->keys + c0, j->ktmp + c0, &w->cnt.cells_nan);
     pthread_mutex_lock(&w->lock);
     w->next = c0;
     w->end = c0 + n;
     pthread_mutex_unlock(&w->lock);
     w->cnt.t_setup_ms = tet_now_ms() - t0;
+    w->cnt.cpu_ms += tet_thread_cpu_ms() - cpu0;
     scan_worker(w);
     j->t_scan_end[i] = tet_now_ms();
 }
@@ -330,7 +333,9 @@ static void composite_job(void *arg, int i)
 {
     frame_job *j = arg;
     const int H = j->sh->X->H, nw = j->sh->nw;
+    double c0 = tet_thread_cpu_ms();
     tet_composite_rows(j->sh, j->rgba, H * i / nw, H * (i + 1) / nw);
+    j->sh->w[i].cnt.cpu_ms += tet_thread_cpu_ms() - c0;
 }
 
 /* Sizes the pool's frame buffers for np points, nt tets and D*D tiles. */
