@@ -68,7 +68,7 @@ typedef struct tet_counters {
     uint64_t cells_behind;       /* cells wholly behind the near plane (skipped) */
     uint64_t cells_near_crossing;/* cells crossing the near plane (ray-clipped at near) */
     uint64_t cells_degenerate;   /* zero-volume cells (skipped) */
-    uint64_t cells_nan;          /* cells with a NaN scalar or coordinate (skipped) */
+    uint64_t cells_nan;          /* cells with a NaN or Inf scalar or coordinate (skipped) */
     uint64_t segments_made;      /* ray segments produced by scan conversion */
     uint64_t segments_merged;    /* of those, merged by partial compositing on insert */
     uint64_t table_updates;

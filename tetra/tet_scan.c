@@ -187,6 +187,8 @@ static int row_span(const cell *C, int y, int *x0, int *x1)
     double pad = 1e-6 * (1.0 + fabs(lo) + fabs(hi));
     lo -= pad;
     hi += pad;
+    if (lo > *x1 || hi < *x0) /* off the box: also keeps iceil/ifloor within int (fuzz_tet_render) */
+        return 0;
     if (lo > *x0) *x0 = iceil(lo);
     if (hi < *x1) *x1 = ifloor(hi);
     return *x1 >= *x0;

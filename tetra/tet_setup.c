@@ -134,7 +134,8 @@ uint32_t tet_build_keys(const tet_mesh *mesh, const pvert *vp, uint32_t c0, uint
         float nearest = INFINITY;
         for (int k = 0; k < 4; k++) {
             double z = -vp[t[k]].z;
-            if (isnan(z) || isnan(mesh->scalar[t[k]]))
+            /* !isfinite, not isnan: an Inf scalar or depth made NaN pixels (fuzz_tet_render) */
+            if (!isfinite(z) || !isfinite(mesh->scalar[t[k]]))
                 bad = 1;
             if (z < nearest)
                 nearest = (float)z;

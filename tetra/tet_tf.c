@@ -11,6 +11,7 @@
 #include "tet_engine.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -71,11 +72,22 @@ static void piece_exact(const tf_prep *tf, double S0, double Sb, double ta_, dou
     tf_eval(tf, S0 + Sb * ta_, &tau_a, ca);
     tf_eval(tf, S0 + Sb * tb_, &tau_b, cb);
     const double l = (tb_ - ta_) * L, h = l / K;
+    if (!(l > 0)) { /* an empty piece (a breakpoint clamped onto the segment's end): the
+                     * l-divisions below made it NaN (fuzz_tet_render, scalars near 1e22) */
+        *alpha = 0;
+        rgb[0] = rgb[1] = rgb[2] = 0;
+        return;
+    }
     const double d0 = h * (tau_a + (tau_b - tau_a) * h / (2 * l)); /* phi step of sub-piece 0 */
     const double dd = (tau_b - tau_a) * h * h / l;                  /* growth of the step */
     const double e0 = exp(-d0), r = exp(-dd);
+    /* a steeply falling tau (huge extinction) makes r overflow while e0 underflows, and 0 * Inf
+     * was a NaN pixel (fuzz_tet_render): then each sub-piece's exp is taken directly */
+    const bool direct = !(r < 1e300) || !(e0 > 0);
     double T = 1, I = 0, step = d0, e = e0;
     for (int j = 0; j < K; j++) {
+        if (direct)
+            e = exp(-step);
         double Tn = T * e;
         I += step > 1e-9 ? h * (T - Tn) / step : h * T * (1 - 0.5 * step);
         T = Tn;
@@ -234,12 +246,33 @@ static int build_preintegrated(tf_prep *tf, int cells, char err[256])
     return VFX_OK;
 }
 
+#define TET_TF_MAX_RGB 1e6
+static int rgb_ok(const float *c)
+{
+    for (int k = 0; k < 3; k++)
+        if (!(c[k] >= 0 && c[k] <= TET_TF_MAX_RGB))
+            return 0;
+    return 1;
+}
+
 int tet_tf_prepare(const tet_tf *in, tf_prep *tf, char err[256])
 {
     tf->method = in->method;
     tf->pre_T = tf->pre_K = NULL;
     tf->pre_n = 0;
     if (in->count == 0) {
+        /* found by fuzz_tet_render: a NaN domain or extinction rendered NaN pixels as success */
+        if (!isfinite(in->smin) || !isfinite(in->smax) || !isfinite(in->tau_lo) || !isfinite(in->tau_hi) ||
+            !(in->tau_lo >= 0) || !(in->tau_hi >= 0)) {
+            snprintf(err, 256, "tet_render: linear transfer function smin %g smax %g tau_lo %g tau_hi %g "
+                     "(finite, tau >= 0)", (double)in->smin, (double)in->smax, (double)in->tau_lo,
+                     (double)in->tau_hi);
+            return VFX_ERR_INVALID_ARGUMENT;
+        }
+        if (!rgb_ok(in->color_lo) || !rgb_ok(in->color_hi)) {
+            snprintf(err, 256, "tet_render: linear transfer function colour outside [0, %g]", TET_TF_MAX_RGB);
+            return VFX_ERR_INVALID_ARGUMENT;
+        }
         tf->n = 2;
         tf->s[0] = in->smin, tf->s[1] = in->smax;
         tf->tau[0] = in->tau_lo, tf->tau[1] = in->tau_hi;
@@ -249,9 +282,11 @@ int tet_tf_prepare(const tet_tf *in, tf_prep *tf, char err[256])
         tf->n = in->count;
         for (int i = 0; i < in->count; i++) {
             const tet_tf_point *p = &in->points[i];
-            if (!isfinite(p->s) || !isfinite(p->tau) || !(p->tau >= 0) || !isfinite(p->rgb[0]) ||
-                !isfinite(p->rgb[1]) || !isfinite(p->rgb[2])) {
-                snprintf(err, 256, "tet_render: transfer function point %d is not finite or has tau < 0", i);
+            /* colours in [0, TET_TF_MAX_RGB]: a finite 2e37 still summed to Inf pixels
+             * (fuzz_tet_render) */
+            if (!isfinite(p->s) || !isfinite(p->tau) || !(p->tau >= 0) || !rgb_ok(p->rgb)) {
+                snprintf(err, 256, "tet_render: transfer function point %d is not finite, has tau < 0 or a "
+                         "colour outside [0, %g]", i, TET_TF_MAX_RGB);
                 return VFX_ERR_INVALID_ARGUMENT;
             }
             if (i > 0 && !(p->s > in->points[i - 1].s)) {
