@@ -6,7 +6,8 @@
  * The clip distance comes from a GPU pass (host depth -> ray distance, min with the water's
  * distance) read back through a pixel-pack buffer and a fence: the CPU uses the previous
  * frame's distances, so it never waits for the GPU (the first frame after a resize waits
- * once). When neither the mesh, the scalars, the transfer function, the camera nor the clip
+ * once). The renderer writes its image straight into a persistently mapped upload buffer (two,
+ * alternating, each fenced) from which the texture is filled. When neither the mesh, the scalars, the transfer function, the camera nor the clip
  * distances changed since the last render, the render is skipped and the last image reused. */
 #include <math.h>
 #include <stdio.h>
@@ -32,7 +33,12 @@ typedef struct volume_state {
     uint64_t frame;             /* frames rendered since the last resize */
     volfx_ubo ubo;
     uint32_t width, height;
-    float *rgba;                /* width*height*4, premultiplied, row 0 = bottom */
+    float *rgba;                /* the last image: width*height*4, premultiplied, row 0 = bottom */
+    float *heap_rgba;           /* the image when the upload buffers cannot be mapped */
+    GLuint up_pbo[2];           /* persistently mapped upload buffers the renderer writes into */
+    float *up_map[2];
+    GLsync up_fence[2];         /* the texture upload from up_pbo[k] is done once signalled */
+    int up_slot;                /* buffer holding the last image */
     float *max_dist;            /* width*height ray distances to the nearest opaque surface */
     vfx_volume_view2 view;
     tet_mesh mesh;              /* points into the host's arrays (no copy) */
@@ -58,13 +64,23 @@ static void release_targets(vfx_context *ctx, volume_state *s)
         s->fence[k] = 0;
     }
     glDeleteBuffers(2, s->pbo);
+    for (int k = 0; k < 2; ++k) {
+        if (s->up_fence[k])
+            glDeleteSync(s->up_fence[k]);
+        s->up_fence[k] = 0;
+        if (s->up_map[k])
+            glUnmapNamedBuffer(s->up_pbo[k]);
+        s->up_map[k] = NULL;
+    }
+    glDeleteBuffers(2, s->up_pbo);
+    s->up_pbo[0] = s->up_pbo[1] = 0;
     glDeleteFramebuffers(1, &s->dist_fbo);
     glDeleteTextures(1, &s->dist_tex);
     glDeleteTextures(1, &s->tex);
     s->pbo[0] = s->pbo[1] = s->dist_fbo = s->dist_tex = s->tex = 0;
-    volfx_free(ctx, s->rgba);
+    volfx_free(ctx, s->heap_rgba);
     volfx_free(ctx, s->max_dist);
-    s->rgba = s->max_dist = NULL;
+    s->rgba = s->heap_rgba = s->max_dist = NULL;
 }
 
 static void volume_destroy(vfx_context *ctx, void *state)
@@ -111,14 +127,29 @@ static vfx_result volume_resize(vfx_context *ctx, void *state, uint32_t w, uint3
         glNamedBufferStorage(s->pbo[k], (GLsizeiptr)(n * sizeof(float)), NULL, GL_MAP_READ_BIT);
         volfx_gpu_label(GL_BUFFER, s->pbo[k], "volume.distance_readback");
     }
-    s->rgba = volfx_alloc(ctx, n * 4 * sizeof(float));
+    /* the renderer writes straight into a mapped buffer and the texture is filled from it on
+     * the GPU's side: no copy of the image through the driver on the frame path */
+    const GLbitfield map = GL_MAP_READ_BIT | GL_MAP_WRITE_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
+    glCreateBuffers(2, s->up_pbo);
+    for (int k = 0; k < 2; ++k) {
+        glNamedBufferStorage(s->up_pbo[k], (GLsizeiptr)(n * 4 * sizeof(float)), NULL, map);
+        s->up_map[k] = glMapNamedBufferRange(s->up_pbo[k], 0, (GLsizeiptr)(n * 4 * sizeof(float)), map);
+        volfx_gpu_label(GL_BUFFER, s->up_pbo[k], "volume.image_upload");
+    }
+    if (!s->up_map[0] || !s->up_map[1]) /* cannot map: render into memory, upload by copy */
+        s->heap_rgba = volfx_alloc(ctx, n * 4 * sizeof(float));
+    s->up_slot = 0;
+    s->rgba = s->heap_rgba ? s->heap_rgba : s->up_map[0];
+    if (!s->rgba)
+        return VFX_ERR_OUT_OF_MEMORY;
+    memset(s->rgba, 0, n * 4 * sizeof(float));
     s->max_dist = volfx_alloc(ctx, n * sizeof(float));
     s->width = w, s->height = h;
     s->frame = 0;
     s->last_key = 0;
     if (glCheckNamedFramebufferStatus(s->dist_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
         return volfx_fail(ctx, VFX_ERR_GL, "volume: distance target %ux%u incomplete", w, h);
-    return s->rgba && s->max_dist ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
+    return s->max_dist ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
 }
 
 /* The host's view of volume 0 as version 2 (a version-1 host leaves the version-2 fields 0). */
@@ -387,7 +418,18 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
     } else {
         tet_counters c;
         s->last_key = 0;
-        int rr = tet_render_pool(s->pool, &s->mesh, &cam, &tf, &o, s->rgba, &c, NULL, err);
+        /* the other upload buffer, once the GPU has read it (two renders ago) */
+        const int up = s->up_slot ^ 1;
+        float *dst = s->heap_rgba;
+        if (!dst) {
+            if (s->up_fence[up]) {
+                glClientWaitSync(s->up_fence[up], GL_SYNC_FLUSH_COMMANDS_BIT, 5000000000ull);
+                glDeleteSync(s->up_fence[up]);
+                s->up_fence[up] = 0;
+            }
+            dst = s->up_map[up];
+        }
+        int rr = tet_render_pool(s->pool, &s->mesh, &cam, &tf, &o, dst, &c, NULL, err);
         if (rr != VFX_OK)
             return volfx_fail(ctx, (vfx_result)rr, "volume[0]: %s", err);
         s->last_key = key;
@@ -399,7 +441,16 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
         volfx_stat_set(ctx, "volume.tf_pieces", (double)c.tf_pieces);
         volfx_stat_set(ctx, "volume.t_sc_ms", c.t_sc_ms);
         volfx_stat_set(ctx, "volume.t_update_ms", c.t_update_ms);
-        glTextureSubImage2D(s->tex, 0, 0, 0, (GLsizei)s->width, (GLsizei)s->height, GL_RGBA, GL_FLOAT, s->rgba);
+        s->rgba = dst;
+        if (s->heap_rgba) {
+            glTextureSubImage2D(s->tex, 0, 0, 0, (GLsizei)s->width, (GLsizei)s->height, GL_RGBA, GL_FLOAT, dst);
+        } else {
+            glBindBuffer(GL_PIXEL_UNPACK_BUFFER, s->up_pbo[up]);
+            glTextureSubImage2D(s->tex, 0, 0, 0, (GLsizei)s->width, (GLsizei)s->height, GL_RGBA, GL_FLOAT, NULL);
+            glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+            s->up_fence[up] = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+            s->up_slot = up;
+        }
     }
     volfx_stat_set(ctx, "volume.renders_skipped_total", (double)s->skipped);
     glBindTextureUnit(0, s->tex);
