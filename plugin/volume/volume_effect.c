@@ -319,7 +319,9 @@ static void make_tf(volume_state *s, tet_tf *tf)
     for (uint32_t i = 0; i < n; ++i) {
         tet_tf_point *p = &s->tf_points[i];
         double t = s->view.transfer_scalar ? s->view.transfer_scalar[i] : (double)i / (n - 1);
-        p->s = i == 0 ? tf->smin : i == n - 1 ? tf->smax : (float)(tf->smin + range * t);
+        /* evenly spaced: the ends exactly at the domain's ends (no rounding of smin + range) */
+        bool end = !s->view.transfer_scalar && (i == 0 || i == n - 1);
+        p->s = end ? (i == 0 ? tf->smin : tf->smax) : (float)(tf->smin + range * t);
         memcpy(p->rgb, v->transfer_rgba + 4 * i, sizeof p->rgb);
         p->tau = v->transfer_rgba[4 * i + 3];
     }

@@ -226,6 +226,45 @@ static void test_skip_when_unchanged(void **state)
     free(a), free(b), free(c);
 }
 
+/* A version-2 view with breakpoints at transfer_scalar (in [0,1] of the domain, not spanning
+ * all of it): the plugin's opacity equals the renderer given the same table directly. */
+static void test_view2_breakpoints(void **state)
+{
+    (void)state;
+    vfx_volume_view2 *v2 = &g_app->volumes[0];
+    float rgba[3 * 4] = {0.2f, 0.4f, 1.0f, 0.5f, 1, 1, 1, 9.0f, 1.0f, 0.5f, 0.1f, 2.0f};
+    float pos[3] = {0.2f, 0.5f, 0.9f};
+    v2->v1.transfer_rgba = rgba;
+    v2->v1.transfer_count = 3;
+    v2->transfer_scalar = pos;
+    float *gpu = render_alpha();
+    tet_mesh m = {.point_count = g_np, .tet_count = g_nt, .points = g_points, .tets = g_tets, .scalar = g_scalar};
+    tet_camera cam = {.width = W, .height = H};
+    ref_camera_matrices(&g_app->camera, cam.view, cam.proj);
+    tet_tf_point pts[3];
+    for (int i = 0; i < 3; ++i) /* the view's domain is [0, 1] */
+        pts[i] = (tet_tf_point){pos[i], {rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2]}, rgba[4 * i + 3]};
+    tet_tf tf = {.points = pts, .count = 3};
+    tet_options o;
+    tet_options_default(&o);
+    o.workers = 1;
+    float *img = malloc(W * H * 4 * sizeof(float));
+    char err[256];
+    assert_int_equal(tet_render_workers(&m, &cam, &tf, &o, img, NULL, NULL, err), VFX_OK);
+    double d = 0, amax = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            d = fmax(d, fabs(gpu[y * W + x] - img[4 * ((H - 1 - y) * W + x) + 3]));
+            amax = fmax(amax, gpu[y * W + x]);
+        }
+    printf("view 2 breakpoints 0.2/0.5/0.9: plugin vs renderer max |d alpha| %.3g (max alpha %.3f)\n", d, amax);
+    assert_true(amax > 0.3 && d < 1e-6);
+    v2->v1.transfer_rgba = NULL;
+    v2->v1.transfer_count = 0;
+    v2->transfer_scalar = NULL;
+    free(gpu), free(img);
+}
+
 /* Writes the ref_testmesh_grid(n) mesh as an ASCII .vtu with the point field "f". */
 static void write_grid_vtu(const char *path, int n, tet_mesh *m)
 {
@@ -368,6 +407,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_hidden_by_depth),
         cmocka_unit_test(test_bad_view_and_absence),
         cmocka_unit_test(test_skip_when_unchanged),
+        cmocka_unit_test(test_view2_breakpoints),
         cmocka_unit_test(test_file_volume_in_scene),
         cmocka_unit_test(test_showcase_animates), /* last: it leaves the scene's meshes */
     };
