@@ -3,14 +3,20 @@
  * Options: --particles N (repeatable) --size S (repeatable) --frames F --reference
  * --method paper|brute|grid|tile --disable BITS (VFX_WATER_NO_*) --samples CAP --step W (in units of h)
  * --refine ITERS --pyramid LEVEL --warmup 0|1 (default 1: one untimed frame first, which
- * compiles the shaders). Per-pass GPU ms (counters *.gpu_ms) need at least 4 frames. */
+ * compiles the shaders) --height H (width = size) --layout layers|pool (pool: a wide slab 4
+ * layers deep, seen from above and in front) --png FILE (the shaded frame over black) --dist FILE
+ * (distance image, PFM) --points FILE (positions as raw float32 xyz). cpu_ms_per_frame is the
+ * process's CPU time over the timed frames (all llvmpipe threads) divided by the frames. Per-pass GPU ms (counters *.gpu_ms) need at least 4 frames. */
 #include <epoxy/gl.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <sys/resource.h>
 
 #include "gfx/gl_context.h"
+#include "gfx/image.h"
 #include "debug.h"
 #include "profile/profiler.h"
 #include "camera_ref.h"
@@ -22,6 +28,11 @@ typedef struct bench_scene {
     uint32_t method, disable, max_samples, refine, pyramid;
     float step_h; /* step in units of h; 0 -> default (1/8) */
     int no_warmup;
+    uint32_t height;     /* 0: square */
+    int pool;            /* layout: 0 the paper's 24x24 layers, 1 a wide pool 4 layers deep */
+    const char *png;     /* the shaded frame (over a black host image) */
+    const char *points;  /* raw float32 x y z per particle, for scripts/compare-vtk-fluid.py */
+    const char *dist;    /* the distance image (PFM) */
 } bench_scene;
 
 static uint32_t bench_chunks(void *user) { return ((bench_scene *)user)->n ? 1 : 0; }
@@ -59,7 +70,30 @@ static double now_ms(void)
     return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
 }
 
+/* CPU time of the whole process (every llvmpipe thread included), ms: on a machine shared with
+ * other jobs it varies far less than wall time */
+static double cpu_ms(void)
+{
+    struct rusage u;
+    getrusage(RUSAGE_SELF, &u);
+    return (u.ru_utime.tv_sec + u.ru_stime.tv_sec) * 1e3 + (u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-3;
+}
+
 static const char *method_name(uint32_t m) { return m == 0 ? "paper" : m == 1 ? "brute" : m == 2 ? "grid" : "tile"; }
+
+/* A pool: side x side columns at spacing 0.3, 4 layers deep (the last layer partly filled),
+ * centred on x and z, its floor at y = 0. */
+static void pool_layout(uint32_t n, float *x, float *y, float *z)
+{
+    uint32_t side = 1;
+    while ((uint64_t)side * side * 4 < n) ++side;
+    for (uint32_t i = 0; i < n; ++i) {
+        uint32_t layer = i / (side * side), k = i % (side * side);
+        x[i] = 0.3f * ((float)(k % side) - 0.5f * (float)(side - 1));
+        z[i] = 0.3f * ((float)(k / side) - 0.5f * (float)(side - 1));
+        y[i] = 0.3f * (float)layer;
+    }
+}
 
 static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, const bench_scene *opt)
 {
@@ -68,9 +102,26 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
     s.y = malloc(n * 4);
     s.z = malloc(n * 4);
     s.n = n;
-    ref_water_layers(n, 0.3, s.x, s.y, s.z);
-    double top = (double)((n - 1) / 576) * 0.3;
-    ref_camera cam = {{0, top + 4.0, 8.0}, {0, top * 0.5, 0}, {0, 1, 0}, 0.9, size, size, 0.1, 100};
+    uint32_t width = size, height = opt->height ? opt->height : size;
+    ref_camera cam;
+    if (s.pool) {
+        pool_layout(n, s.x, s.y, s.z);
+        double side = 0.3 * ceil(sqrt(n / 4.0));
+        cam = (ref_camera){{0, 0.55 * side, 0.95 * side}, {0, 0, -0.1 * side}, {0, 1, 0}, 0.9, width, height, 0.1, 100};
+    } else {
+        ref_water_layers(n, 0.3, s.x, s.y, s.z);
+        double top = (double)((n - 1) / 576) * 0.3;
+        cam = (ref_camera){{0, top + 4.0, 8.0}, {0, top * 0.5, 0}, {0, 1, 0}, 0.9, width, height, 0.1, 100};
+    }
+    if (s.points) {
+        FILE *f = fopen(s.points, "wb");
+        for (uint32_t i = 0; f && i < n; ++i) {
+            float q[3] = {s.x[i], s.y[i], s.z[i]};
+            fwrite(q, 4, 3, f);
+        }
+        if (f) fclose(f);
+        else fprintf(stderr, "metaballs: cannot write %s\n", s.points);
+    }
     vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &s,
                          .particle_chunk_count = bench_chunks, .particle_chunk = bench_chunk,
                          .water_params = bench_params};
@@ -82,11 +133,12 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
     }
     GLuint fbo, col;
     glCreateTextures(GL_TEXTURE_2D, 1, &col);
-    glTextureStorage2D(col, 1, GL_RGBA8, (GLsizei)size, (GLsizei)size);
+    glTextureStorage2D(col, 1, GL_RGBA8, (GLsizei)width, (GLsizei)height);
     glCreateFramebuffers(1, &fbo);
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, col, 0);
     vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = fbo,
-                         .width = size, .height = size, .fov_y = 0.9f, .near_plane = 0.1f, .far_plane = 100.f};
+                         .width = width, .height = height, .fov_y = 0.9f, .near_plane = 0.1f, .far_plane = 100.f};
+    static const float black[4] = {0, 0, 0, 1};
     for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam.eye[k];
     ref_camera_matrices(&cam, fv.view, fv.proj);
     double *ms = malloc(frames * sizeof *ms);
@@ -96,7 +148,9 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
         rc = 1;
     }
     glFinish();
+    double cpu0 = cpu_ms();
     for (uint32_t f = 0; f < frames && rc == 0; ++f) {
+        glClearNamedFramebufferfv(fbo, GL_COLOR, 0, black);
         double t0 = now_ms();
         if (api.update(ctx, f / 60.0, 1.f / 60.f) != VFX_OK || api.render(ctx, &fv) != VFX_OK) {
             fprintf(stderr, "metaballs: frame failed: %s\n", api.last_error(ctx));
@@ -105,13 +159,14 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
         glFinish();
         ms[f] = now_ms() - t0;
     }
+    double cpu_per_frame = (cpu_ms() - cpu0) / frames;
     rt_frame_pcts fp = rt_frame_percentiles(ms, frames);
     double p50 = fp.p50;
     printf("{\"effect\":\"metaballs\",\"method\":\"%s\",\"disable\":%u,\"max_samples\":%u,\"step_h\":%.4g,"
            "\"refine\":%u,\"pyramid\":%u,\"particles\":%u,\"width\":%u,\"height\":%u,"
-           "\"frames\":%u,\"warmup\":%d,\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"fps\":%.3g,\"gl_renderer\":\"%s\"",
+           "\"frames\":%u,\"warmup\":%d,\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"cpu_ms_per_frame\":%.2f,\"fps\":%.3g,\"gl_renderer\":\"%s\"",
            method_name(s.method), s.disable, s.max_samples ? s.max_samples : 64, s.step_h > 0 ? s.step_h : 0.125,
-           s.refine ? s.refine : 3, s.pyramid ? s.pyramid : 3, n, size, size, frames, !s.no_warmup, p50, fp.p95, fp.p99, 1000.0 / p50,
+           s.refine ? s.refine : 3, s.pyramid ? s.pyramid : 3, n, width, height, frames, !s.no_warmup, p50, fp.p95, fp.p99, cpu_per_frame, 1000.0 / p50,
            (const char *)glGetString(GL_RENDERER));
     vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
     if (api.get_stats(ctx, &st) == VFX_OK) {
@@ -121,18 +176,18 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
         printf("}");
     }
     if (reference && rc == 0) {
-        float *gpu = malloc((size_t)size * size * 4), *ref = malloc((size_t)size * size * 4);
-        api.read_raw(ctx, VFX_EFFECT_WATER, gpu, (size_t)size * size);
+        float *gpu = malloc((size_t)width * height * 4), *ref = malloc((size_t)width * height * 4);
+        api.read_raw(ctx, VFX_EFFECT_WATER, gpu, (size_t)width * height);
         double fwd[3], right[3], up[3];
         ref_camera_basis(&cam, fwd, right, up);
         ref_water_camera rc2 = {{cam.eye[0], cam.eye[1], cam.eye[2]}, {fwd[0], fwd[1], fwd[2]},
-                                    {up[0], up[1], up[2]}, cam.fov_y, size, size};
+                                    {up[0], up[1], up[2]}, cam.fov_y, width, height};
         ref_water_params rp = ref_water_default_params();
         ref_water_error e;
         char err[256];
         double r0 = now_ms();
         if (ref_water_render(&rc2, s.x, s.y, s.z, n, &rp, ref, NULL, NULL, err) == 0 &&
-            ref_water_compare(gpu, NULL, ref, NULL, (size_t)size * size, rp.h, &e) == 0)
+            ref_water_compare(gpu, NULL, ref, NULL, (size_t)width * height, rp.h, &e) == 0)
             printf(",\"reference_ms\":%.1f,\"ref_hits\":%u,\"hole_rate\":%.5f,\"false_hit_rate\":%.5f,"
                    "\"dist_mean_rel_h\":%.2e,\"dist_p99_rel_h\":%.2e",
                    now_ms() - r0, e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_mean_rel_h, e.dist_p99_rel_h);
@@ -141,6 +196,24 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
     }
     printf("}\n");
     fflush(stdout);
+    char err[256];
+    if (s.png && rc == 0) {
+        uint8_t *px = malloc((size_t)width * height * 4), *top = malloc((size_t)width * height * 4);
+        glGetTextureImage(col, 0, GL_RGBA, GL_UNSIGNED_BYTE, (GLsizei)(width * height * 4), px);
+        for (uint32_t r = 0; r < height; ++r) /* GL's rows are bottom first */
+            memcpy(top + (size_t)r * width * 4, px + (size_t)(height - 1 - r) * width * 4, (size_t)width * 4);
+        if (rt_write_png(s.png, width, height, top, err, sizeof err) != VFX_OK)
+            fprintf(stderr, "metaballs: %s\n", err);
+        free(px);
+        free(top);
+    }
+    if (s.dist && rc == 0) {
+        float *d = malloc((size_t)width * height * 4);
+        api.read_raw(ctx, VFX_EFFECT_WATER, d, (size_t)width * height);
+        if (rt_write_pfm(s.dist, width, height, d, err, sizeof err) != VFX_OK)
+            fprintf(stderr, "metaballs: %s\n", err);
+        free(d);
+    }
     free(ms);
     api.destroy(ctx);
     glDeleteFramebuffers(1, &fbo);
@@ -172,6 +245,15 @@ int bench_metaballs(int argc, char **argv)
         else if (!strcmp(argv[i], "--refine") && i + 1 < argc) opt.refine = (uint32_t)atoi(argv[++i]);
         else if (!strcmp(argv[i], "--pyramid") && i + 1 < argc) opt.pyramid = (uint32_t)atoi(argv[++i]);
         else if (!strcmp(argv[i], "--warmup") && i + 1 < argc) opt.no_warmup = atoi(argv[++i]) == 0;
+        else if (!strcmp(argv[i], "--height") && i + 1 < argc) opt.height = (uint32_t)atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--layout") && i + 1 < argc) {
+            ++i;
+            if (strcmp(argv[i], "layers") && strcmp(argv[i], "pool")) { fprintf(stderr, "metaballs: --layout layers|pool, not %s\n", argv[i]); return 2; }
+            opt.pool = !strcmp(argv[i], "pool");
+        }
+        else if (!strcmp(argv[i], "--png") && i + 1 < argc) opt.png = argv[++i];
+        else if (!strcmp(argv[i], "--points") && i + 1 < argc) opt.points = argv[++i];
+        else if (!strcmp(argv[i], "--dist") && i + 1 < argc) opt.dist = argv[++i];
         else if (!strcmp(argv[i], "--json")) continue;
         else { fprintf(stderr, "metaballs: unknown option %s\n", argv[i]); return 2; }
     }
@@ -187,7 +269,7 @@ int bench_metaballs(int argc, char **argv)
     int rc = 0;
     for (uint32_t a = 0; a < np && !rc; ++a)
         for (uint32_t b = 0; b < ns && !rc; ++b) {
-            if (parts[a] == 0 || sizes[b] == 0 || sizes[b] > 4096) {
+            if (parts[a] == 0 || sizes[b] == 0 || sizes[b] > 4096 || opt.height > 4096) {
                 fprintf(stderr, "metaballs: bad size %u or particle count %u\n", sizes[b], parts[a]);
                 rc = 2;
                 break;

@@ -820,7 +820,7 @@ static vfx_result tile_lists(vfx_context *ctx, water_state *s, volfx_water_tile_
         return VFX_ERR_OUT_OF_MEMORY;
     *in = (volfx_water_tile_input){s->cols, s->count, &s->params, s->width, s->height, ctx->water_dist_tex,
                                    s->counters, s->have_last ? s->last[10] : 0, s->view_proj, s->lo, s->hi,
-                                   frame->eye};
+                                   frame->eye, fabsf(frame->proj[5]) * 0.5f * (float)s->height};
     return volfx_water_tile_bin(ctx, s->tile, in);
 }
 

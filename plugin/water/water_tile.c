@@ -16,9 +16,9 @@
 #define TILE_MAX_TILES ((1u << 20) - 1u)
 /* 256 MiB of entries at most */
 #define TILE_MAX_ENTRIES (1u << 24)
-/* a particle whose cube covers more tiles than this (128x128 pixels) goes to the global list,
+/* a particle whose cube covers more tiles than this (512x512 pixels) goes to the global list,
  * scanned by every pixel: one near the eye would otherwise loop over every tile */
-#define TILE_GLOBAL_TILES 256u
+#define TILE_GLOBAL_TILES 4096u
 /* depth slabs per tile (fewer when tiles * slabs would pass the scan's limit) */
 #define TILE_SLABS 32u
 
@@ -120,9 +120,17 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
         t->start = storage((GLsizeiptr)need * 4, "water.tile_start");
         t->tile_cap = need;
     }
-    /* entries: 16 per particle to start with (a particle of 2h ~ 16 pixels covers 4-9 tiles),
-     * then what a recent frame needed plus a quarter, within TILE_MAX_ENTRIES */
-    uint64_t want = (uint64_t)in->count * 16u + 65536u;
+    /* entries: a particle's cube of 2h seen from the box's nearest distance spans at most
+     * (2h f / d) / 8 + 2 tiles a side (f the focal length in pixels): the first frame's lists
+     * fit unless the box reaches the eye; or what a recent frame needed plus a quarter. A tile
+     * that does not fit reads every particle (right, but slow). */
+    double fpx = (double)in->focal_px;
+    double span_px = dmin > 2.0 * in->params->h ? 2.0 * sqrt(3.0) * in->params->h * fpx / (dmin - in->params->h) : 1e9;
+    double per = span_px / TILE_PX + 2.0;
+    per = per * per;
+    if (per > (double)tiles) per = (double)tiles;
+    if (per > TILE_GLOBAL_TILES) per = TILE_GLOBAL_TILES;
+    uint64_t want = (uint64_t)fmin((double)in->count * per + 65536.0, (double)TILE_MAX_ENTRIES);
     if (in->last_entries) {
         uint64_t w2 = (uint64_t)in->last_entries + in->last_entries / 4u + 1024u;
         if (w2 > want) want = w2;

@@ -24,6 +24,7 @@ typedef struct volfx_water_tile_input {
     const float *view_proj;          /* proj * view, column-major */
     const float *lo, *hi;            /* box of the finite particles (depth slabs) */
     const float *eye;                /* this frame's eye */
+    float focal_px;                  /* pixels per unit at distance 1 (proj[5] * height / 2) */
 } volfx_water_tile_input;
 
 /* Makes the (empty) tile state; NULL on allocation failure. */

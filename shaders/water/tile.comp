@@ -94,7 +94,7 @@ uniform float u_T, u_step, u_window, u_rho;
 uniform uint u_refine_iters;
 uniform bool u_has_depth, u_subdivide, u_local;
 #ifndef LOCAL_K
-#define LOCAL_K 32
+#define LOCAL_K 16
 #endif
 #define SUB_DEPTH 4
 
