@@ -4,7 +4,7 @@
  * --method paper|brute|grid|tile --disable BITS (VFX_WATER_NO_*) --samples CAP --step W (in units of h)
  * --refine ITERS --pyramid LEVEL --warmup 0|1 (default 1: one untimed frame first, which
  * compiles the shaders) --height H (width = size) --layout layers|pool (pool: a wide slab 4
- * layers deep, seen from above and in front) --png FILE (the shaded frame over black) --dist FILE
+ * layers deep, seen from above and in front) --png FILE (the shaded frame over a grey-blue host image) --dist FILE
  * (distance image, PFM) --points FILE (positions as raw float32 xyz). cpu_ms_per_frame is the
  * process's CPU time over the timed frames (all llvmpipe threads) divided by the frames. Per-pass GPU ms (counters *.gpu_ms) need at least 4 frames. */
 #include <epoxy/gl.h>
@@ -138,7 +138,7 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, col, 0);
     vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = fbo,
                          .width = width, .height = height, .fov_y = 0.9f, .near_plane = 0.1f, .far_plane = 100.f};
-    static const float black[4] = {0, 0, 0, 1};
+    static const float black[4] = {0.35f, 0.4f, 0.5f, 1}; /* the host image the water refracts (compare-vtk-fluid.py gives VTK the same background) */
     for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam.eye[k];
     ref_camera_matrices(&cam, fv.view, fv.proj);
     double *ms = malloc(frames * sizeof *ms);
@@ -168,6 +168,10 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
            method_name(s.method), s.disable, s.max_samples ? s.max_samples : 64, s.step_h > 0 ? s.step_h : 0.125,
            s.refine ? s.refine : 3, s.pyramid ? s.pyramid : 3, n, width, height, frames, !s.no_warmup, p50, fp.p95, fp.p99, cpu_per_frame, 1000.0 / p50,
            (const char *)glGetString(GL_RENDERER));
+    printf(",\"camera\":{\"eye\":[%.9g,%.9g,%.9g],\"center\":[%.9g,%.9g,%.9g],\"up\":[0,1,0],\"fovy_deg\":%.9g,"
+           "\"near\":%.9g,\"far\":%.9g},\"h\":0.61",
+           cam.eye[0], cam.eye[1], cam.eye[2], cam.target[0], cam.target[1], cam.target[2], cam.fov_y * 57.29577951308232,
+           cam.near_plane, cam.far_plane);
     vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
     if (api.get_stats(ctx, &st) == VFX_OK) {
         printf(",\"counters\":{");
