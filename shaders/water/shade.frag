@@ -1,8 +1,9 @@
-// Water shading from the distance image and the two billboard passes run at the surface:
-// normal = -grad sum P normalised (PASS_GRAD, blended: no loop over the particles here),
-// Schlick Fresnel between a sky reflection and the refracted host colour, absorbed with
-// Beer-Lambert over the thickness to the back of the water (PASS_BACK), clipped at the host
-// depth. Misses are discarded so the host image shows through unchanged.
+// Water shading from the distance image and the gradient / back-distance targets (the two
+// billboard passes, or TILE's march from its lists): normal = -grad sum P normalised, Schlick
+// Fresnel between a sky reflection and the refracted host colour, absorbed with Beer-Lambert over
+// the thickness to the back of the water (clipped at the host depth) with the absorbed part
+// partly scattered back as the tint (WATER_SCATTER), plus a fixed sun's highlight. Misses are
+// discarded so the host image shows through unchanged.
 #include "common/depth.glsl"
 layout(binding = 0) uniform sampler2D u_dist;
 layout(binding = 1) uniform sampler2D u_scene_color;
@@ -15,6 +16,8 @@ uniform float u_absorption, u_ior;
 uniform vec3 u_tint;
 uniform bool u_flat, u_has_color, u_has_depth;
 out vec4 o_color;
+#define WATER_SCATTER 0.35
+const vec3 WATER_SUN = vec3(0.3487, 0.8137, 0.4650); // normalize(0.3, 0.7, 0.4)
 
 void main()
 {
@@ -42,6 +45,11 @@ void main()
     if (u_has_depth)
         back = min(back, volfx_depth_distance(u_inv_view_proj, u_eye, ndc, texelFetch(u_scene_depth, pix, 0).r));
     float thickness = max(back - t, 0.0);
-    vec3 absorbed = behind * exp(-u_absorption * thickness * (vec3(1.0) - u_tint));
-    o_color = vec4(mix(absorbed, sky, fresnel), 1.0);
+    // what the water takes out of the light from behind it comes back partly as its own
+    // colour (light scattered in the body): a deep pool reads as tinted water, not black
+    vec3 trans = exp(-u_absorption * thickness * (vec3(1.0) - u_tint));
+    vec3 body = behind * trans + WATER_SCATTER * u_tint * (vec3(1.0) - trans);
+    // a sun highlight on the reflected ray (procedural sky: a fixed sun)
+    float sun = pow(max(dot(reflect(dir, n), WATER_SUN), 0.0), 400.0);
+    o_color = vec4(min(mix(body, sky, fresnel) + vec3(2.0 * sun), vec3(1.0)), 1.0);
 }
