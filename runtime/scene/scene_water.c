@@ -33,6 +33,26 @@ vfx_result scene_parse_box(pctx *c, const cJSON *obj, const char *path, const ch
     return r;
 }
 
+/* No "h" given: h = 2 x the particle spacing, the seed's ratio (h = 0.61 at its spacing of 0.3),
+ * where h/spacing sets how many neighbours a point's field sums (~33 at 2: a surface without the
+ * single spheres showing, a sheet one particle thick still closed). The spacing is the layers'
+ * own or the cube root of the volume per particle of the generated box or sphere or of the
+ * simulation's initial fluid box; a file gives none (0: the plugin's default, 0.61). */
+static float water_h_from_spacing(const rt_scene_water *w)
+{
+    double vol = 0;
+    if (w->count == 0)
+        return 0;
+    if (w->source == RT_SCENE_WATER_GENERATOR && w->generator == RT_SCENE_GEN_LAYERS)
+        return w->spacing > 0 ? 2.0f * w->spacing : 0.0f;
+    if (w->source == RT_SCENE_WATER_GENERATOR && w->generator == RT_SCENE_GEN_SPHERE)
+        vol = 4.0 / 3.0 * 3.14159265358979 * (double)w->radius * w->radius * w->radius;
+    else if (w->source != RT_SCENE_WATER_FILE)
+        vol = ((double)w->box_max[0] - w->box_min[0]) * ((double)w->box_max[1] - w->box_min[1]) *
+              ((double)w->box_max[2] - w->box_min[2]);
+    return vol > 0 ? (float)(2.0 * cbrt(vol / w->count)) : 0.0f;
+}
+
 vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
 {
     static const char *const keys[] = {"source", "path", "generator", "simulation", "h", "threshold",
@@ -136,6 +156,8 @@ vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
     if (!r) r = scene_get_float(c, v, P, "ior", false, (range){1, 3, false}, &wp->ior);
     if (r)
         return r;
+    if (wp->h == 0)
+        wp->h = water_h_from_spacing(w);
     const cJSON *q = cJSON_GetObjectItemCaseSensitive(v, "quality");
     if (q) {
         static const char *const qkeys[] = {"max_samples", "step", "refine_iters", "pyramid_level", "method",
