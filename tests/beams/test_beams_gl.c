@@ -22,6 +22,7 @@
 
 static game_app *g_app;
 static test_log g_log;
+static int g_smooth; /* the falloff the references integrate (set with use_v2) */
 
 static const vfx_beam k_beam = {.head = {-1.5f, 0.1f, 0.0f}, .dir = {1, 0.2f, 0}, .length = 2.5f,
                                 .radius = 0.5f, .a = 0.4f, .b = 0.25f, .eps = 0.05f};
@@ -62,6 +63,7 @@ static double ref_pixel(uint32_t i, uint32_t j, double t1)
     volfx_beam_d b;
     char err[128];
     assert_int_equal(volfx_beam_validate(&g_app->beams[0], &b, err, sizeof err), VFX_OK);
+    b.smooth = g_smooth;
     double dir[3];
     ref_pixel_ray(&g_app->camera, i, j, dir);
     return ref_beams_integral(&b, 1, g_app->camera.eye, dir, 0.0, t1, 1e-10, NULL);
@@ -97,6 +99,7 @@ static int compare_image(const float *gpu, double (*t1_of)(uint32_t, uint32_t), 
     volfx_beam_d b;
     char err[128];
     assert_int_equal(volfx_beam_validate(&g_app->beams[0], &b, err, sizeof err), VFX_OK);
+    b.smooth = g_smooth;
     int bad = 0;
     double *ref = malloc(W * H * sizeof(double)), hmax = 0;
     for (uint32_t j = 0; j < H; ++j)
@@ -347,6 +350,129 @@ static void test_bad_input_and_absence(void **state)
     g_app->beam_count = 1;
 }
 
+/* The game answers version 2 views from beams2 (k_beam with this falloff, the hot ramp, bloom
+ * as given), or version 1 ones again (v2 = false). */
+static void use_v2(bool v2, bool smooth, bool bloom)
+{
+    g_app->beams_v2 = v2;
+    g_smooth = v2 && smooth;
+    g_app->beams[0] = k_beam;
+    g_app->beams2[0] = (vfx_beam2){.v1 = k_beam, .falloff = smooth ? VFX_BEAM_FALLOFF_SMOOTH : VFX_BEAM_FALLOFF_HARD,
+                                   .ramp = VFX_BEAM_RAMP_HOT, .intensity = 1.f};
+    g_app->beams2[0].v1.color[0] = 0.2f, g_app->beams2[0].v1.color[1] = 0.5f, g_app->beams2[0].v1.color[2] = 1.f;
+    g_app->beams2[0].v1.color[3] = 1.f;
+    g_app->beams_view2 = (vfx_beams_view2){.bloom = bloom ? VFX_BEAMS_BLOOM_ON : VFX_BEAMS_BLOOM_OFF};
+}
+
+static double stat_of(const char *name)
+{
+    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+    assert_int_equal(g_app->api->get_stats(g_app->ctx, &st), VFX_OK);
+    for (uint32_t k = 0; k < st.count; ++k)
+        if (!strcmp(st.entries[k].name, name))
+            return st.entries[k].value;
+    return -1;
+}
+
+/* The smooth support through a version 2 view: every pixel against the quadrature of the
+ * smooth field, with compare_image's bound (1e-5 + the inputs' conditioning). */
+static void test_smooth_matches_reference(void **state)
+{
+    (void)state;
+    use_v2(true, true, false);
+    float *raw = render_raw();
+    image_errors ie;
+    assert_int_equal(compare_image(raw, t_far, &ie), 0);
+    print_errors("open sky, smooth support", &ie);
+    assert_true(ie.max_rel_wc <= 1e-5);
+    free(raw);
+    use_v2(false, false, false);
+}
+
+/* Final colours (tone-mapped RGBA8) of one frame. */
+static uint8_t *render_rgba(void)
+{
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
+    uint8_t *px = malloc(W * H * 4);
+    assert_int_equal(rt_renderer_read_rgba(g_app->renderer, px), VFX_OK);
+    return px;
+}
+
+/* Emission: outside the support (H = 0) the frame is exactly the background without bloom and
+ * brighter with it (glow spills past the field); the core is white-hot (channels near equal and
+ * bright) while the glow's edge keeps the beam's blue; the bloom passes are timed; a version 1
+ * view keeps version 1's image (no bloom). */
+static void test_emission_and_bloom(void **state)
+{
+    (void)state;
+    g_app->beam_count = 0;
+    uint8_t *bg = render_rgba();
+    g_app->beam_count = 1;
+    use_v2(true, true, false);
+    g_app->beams2[0].exposure = 3.f; /* x = 8 H: the core (H ~ 0.6) is well past the white point */
+    float *raw = render_raw();
+    uint8_t *plain = render_rgba();
+    use_v2(true, true, true);
+    g_app->beams2[0].exposure = 3.f;
+    uint8_t *glow = render_rgba();
+    int outside = 0, spilled = 0, kmax = 0;
+    /* raw (read_raw) and the RGBA read-back are both top row first: index k is one pixel */
+    for (int k = 0; k < W * H; ++k) {
+        if (raw[k] > raw[kmax])
+            kmax = k;
+        if (raw[k] != 0.f)
+            continue;
+        outside++;
+        for (int c = 0; c < 3; ++c)
+            assert_int_equal(plain[4 * k + c], bg[4 * k + c]);
+        spilled += glow[4 * k + 2] > bg[4 * k + 2] + 2;
+    }
+    const uint8_t *core = &plain[4 * kmax];
+    printf("emission: %d pixels outside the support, %d brightened by bloom; core rgb %u %u %u\n", outside,
+           spilled, core[0], core[1], core[2]);
+    assert_true(outside > 100 && spilled > outside / 20);
+    assert_true(core[0] > 200 && core[1] > 200 && core[2] > 200); /* white-hot */
+    /* the glow's edge: the dimmest lit pixel keeps the beam's colour (blue over red) */
+    int kedge = -1;
+    for (int k = 0; k < W * H; ++k)
+        if (raw[k] > 0.02f * raw[kmax] && raw[k] < 0.1f * raw[kmax] && plain[4 * k + 2] > bg[4 * k + 2] + 8)
+            kedge = k;
+    assert_true(kedge >= 0);
+    assert_true(plain[4 * kedge + 2] - bg[4 * kedge + 2] > 2 * (plain[4 * kedge + 0] - bg[4 * kedge + 0]));
+    /* the bloom passes are timed (results arrive a few frames later) */
+    for (int f = 0; f < 5; ++f)
+        assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
+    printf("GPU ms: integrate %.3g, bloom_down %.3g, bloom_up %.3g, composite %.3g; %g levels\n",
+           stat_of("beams.integrate.gpu_ms"), stat_of("beams.bloom_down.gpu_ms"), stat_of("beams.bloom_up.gpu_ms"),
+           stat_of("beams.composite.gpu_ms"), stat_of("beams.bloom_levels"));
+    assert_true(stat_of("beams.bloom_down.gpu_ms") >= 0 && stat_of("beams.bloom_up.gpu_ms") >= 0);
+    assert_true(stat_of("beams.bloom_levels") >= 1);
+    use_v2(false, false, false);
+    free(render_rgba());
+    assert_true(stat_of("beams.bloom_levels") == 0);
+    free(bg), free(raw), free(plain), free(glow);
+}
+
+/* A bad version 2 beam is refused with its index and field; a v1 view then works again. */
+static void test_bad_v2_input(void **state)
+{
+    (void)state;
+    use_v2(true, true, true);
+    g_app->beams2[0].falloff = 7;
+    assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
+    assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "beams[0]: falloff"));
+    use_v2(true, true, true);
+    g_app->beams2[0].flow_amount = 2.f;
+    assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
+    assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "flow_amount"));
+    use_v2(true, true, true);
+    g_app->beams_view2.bloom_levels = 99;
+    assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
+    assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "bloom_levels"));
+    use_v2(false, false, false);
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -356,6 +482,9 @@ int main(void)
         cmocka_unit_test(test_mz_sweep),
         cmocka_unit_test(test_marching_baseline),
         cmocka_unit_test(test_bad_input_and_absence),
+        cmocka_unit_test(test_smooth_matches_reference),
+        cmocka_unit_test(test_emission_and_bloom),
+        cmocka_unit_test(test_bad_v2_input),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
