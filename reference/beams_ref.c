@@ -114,52 +114,87 @@ static void sphere_breaks(const double *o, const double *v, const double *c, dou
     }
 }
 
+/* Adds the slab planes u = 0 and u = L of the segment A + u D, and for its infinite cylinder
+ * the closest approach (graded) and the crossings of |r| = R. */
+static void segment_breaks(const double *o, const double *v, const double *A, const double *D, double L,
+                           double R, double eps, double t0, double t1, double *br, int *m)
+{
+    double c = v[0] * D[0] + v[1] * D[1] + v[2] * D[2];
+    double u0 = (o[0] - A[0]) * D[0] + (o[1] - A[1]) * D[1] + (o[2] - A[2]) * D[2];
+    if (c != 0) {
+        br[(*m)++] = -u0 / c;
+        br[(*m)++] = (L - u0) / c;
+    }
+    double vp[3], wp[3];
+    for (int k = 0; k < 3; ++k) {
+        vp[k] = v[k] - c * D[k];
+        wp[k] = (o[k] - A[k]) - u0 * D[k];
+    }
+    double Aq = vp[0] * vp[0] + vp[1] * vp[1] + vp[2] * vp[2];
+    if (Aq > 0) {
+        double B = wp[0] * vp[0] + wp[1] * vp[1] + wp[2] * vp[2];
+        br[(*m)++] = -B / Aq;
+        double dd = 0;
+        for (int k = 0; k < 3; ++k)
+            dd += (wp[k] - B / Aq * vp[k]) * (wp[k] - B / Aq * vp[k]);
+        /* peak width along the ray: sqrt(d^2 + eps^2) / |v_perp| */
+        peak_breaks(-B / Aq, sqrt((dd + eps * eps) / Aq), t0, t1, br, m);
+        double disc = R * R - dd; /* as in sphere_breaks: no B^2 - A C */
+        if (disc > 0) {
+            br[(*m)++] = -B / Aq - sqrt(disc / Aq);
+            br[(*m)++] = -B / Aq + sqrt(disc / Aq);
+        }
+    }
+}
+
+/* Breakpoints sphere_breaks and segment_breaks can add, at most. */
+#define SPHERE_BREAKS (3 + 2 * 64)
+#define SEGMENT_BREAKS (5 + 2 * 64)
+
 double ref_beams_integral(const volfx_beam_d *beams, uint32_t n, const double o[3], const double v[3],
                               double t0, double t1, double rel_tol, uint64_t *evals)
 {
     if (!(t1 > t0))
         return 0;
-    int cap = 2 + (12 + 3 * 128) * (int)n, m = 0;
-    double *br = malloc((size_t)cap * sizeof(double));
+    size_t cap = 2;
+    for (uint32_t i = 0; i < n; ++i) {
+        int nj = beams[i].joint_count >= 2 ? beams[i].joint_count : 2;
+        cap += (size_t)nj * SPHERE_BREAKS + (size_t)(nj - 1) * SEGMENT_BREAKS;
+    }
+    int m = 0;
+    double *br = malloc(cap * sizeof(double));
     if (!br)
         return NAN;
     br[m++] = t0;
     br[m++] = t1;
+    /* Kinks where the polyline's nearest segment changes are left to the adaptive bisection:
+     * no switch point of the closed form is used here, so the reference stays independent. */
     for (uint32_t i = 0; i < n; ++i) {
         const volfx_beam_d *b = &beams[i];
+        double eps = b->eps > VOLFX_BEAM_EPS_FLOOR * b->radius ? b->eps : VOLFX_BEAM_EPS_FLOOR * b->radius;
+        if (b->joint_count >= 2) {
+            for (int k = 0; k < b->joint_count; ++k)
+                sphere_breaks(o, v, b->joints[k], b->radius, eps, t0, t1, br, &m);
+            for (int k = 0; k + 1 < b->joint_count; ++k) {
+                double D[3], L = 0;
+                for (int c = 0; c < 3; ++c) {
+                    D[c] = b->joints[k + 1][c] - b->joints[k][c];
+                    L += D[c] * D[c];
+                }
+                L = sqrt(L);
+                if (!(L > 0))
+                    continue;
+                for (int c = 0; c < 3; ++c)
+                    D[c] /= L;
+                segment_breaks(o, v, b->joints[k], D, L, b->radius, eps, t0, t1, br, &m);
+            }
+            continue;
+        }
         double e[3] = {b->head[0] + b->length * b->dir[0], b->head[1] + b->length * b->dir[1],
                        b->head[2] + b->length * b->dir[2]};
-        double eps = b->eps > VOLFX_BEAM_EPS_FLOOR * b->radius ? b->eps : VOLFX_BEAM_EPS_FLOOR * b->radius;
         sphere_breaks(o, v, b->head, b->radius, eps, t0, t1, br, &m);
         sphere_breaks(o, v, e, b->radius, eps, t0, t1, br, &m);
-        /* slab planes u = 0 and u = L */
-        double c = v[0] * b->dir[0] + v[1] * b->dir[1] + v[2] * b->dir[2];
-        double u0 = (o[0] - b->head[0]) * b->dir[0] + (o[1] - b->head[1]) * b->dir[1] + (o[2] - b->head[2]) * b->dir[2];
-        if (c != 0) {
-            br[m++] = -u0 / c;
-            br[m++] = (b->length - u0) / c;
-        }
-        /* infinite cylinder: closest approach and |r| = R */
-        double vp[3], wp[3];
-        for (int k = 0; k < 3; ++k) {
-            vp[k] = v[k] - c * b->dir[k];
-            wp[k] = (o[k] - b->head[k]) - u0 * b->dir[k];
-        }
-        double A = vp[0] * vp[0] + vp[1] * vp[1] + vp[2] * vp[2];
-        if (A > 0) {
-            double B = wp[0] * vp[0] + wp[1] * vp[1] + wp[2] * vp[2];
-            br[m++] = -B / A;
-            double dd = 0;
-            for (int k = 0; k < 3; ++k)
-                dd += (wp[k] - B / A * vp[k]) * (wp[k] - B / A * vp[k]);
-            /* peak width along the ray: sqrt(d^2 + eps^2) / |v_perp| */
-            peak_breaks(-B / A, sqrt((dd + eps * eps) / A), t0, t1, br, &m);
-            double disc = b->radius * b->radius - dd; /* as in sphere_breaks: no B^2 - A C */
-            if (disc > 0) {
-                br[m++] = -B / A - sqrt(disc / A);
-                br[m++] = -B / A + sqrt(disc / A);
-            }
-        }
+        segment_breaks(o, v, b->head, b->dir, b->length, b->radius, eps, t0, t1, br, &m);
     }
     qsort(br, (size_t)m, sizeof(double), cmp);
     quad_ctx q = {beams, n, o, v, 0};
@@ -188,13 +223,22 @@ double ref_beams_cond_abs(const volfx_beam_d *beams, uint32_t n, const double ey
             b.head[k] -= eye[k];
             scale = fmax(scale, fmax(fabs(eye[k]), fabs(b.head[k])));
         }
+        for (int j = 0; j < b.joint_count; ++j)
+            for (int k = 0; k < 3; ++k) {
+                b.joints[j][k] -= eye[k];
+                scale = fmax(scale, fabs(b.joints[j][k]));
+            }
         double h = volfx_beam_integral_d(&b, zero, dir, t0, t1), worst = 0;
-        for (int k = 0; k < 6; ++k)
+        /* a polyline's inputs are its joints (each rounded to float32 relative to the eye) */
+        int nin = 3 + 3 * (b.joint_count >= 2 ? b.joint_count : 1);
+        for (int k = 0; k < nin; ++k)
             for (int sgn = -1; sgn <= 1; sgn += 2) {
                 double d[3] = {dir[0], dir[1], dir[2]};
                 volfx_beam_d bp = b;
                 if (k < 3)
                     d[k] += sgn * ulps * FLT_EPSILON;
+                else if (b.joint_count >= 2)
+                    bp.joints[(k - 3) / 3][(k - 3) % 3] += sgn * ulps * FLT_EPSILON * scale;
                 else
                     bp.head[k - 3] += sgn * ulps * FLT_EPSILON * scale;
                 double nd = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);

@@ -115,6 +115,8 @@ static vfx_result host_beams(void *user, vfx_beams_view *out)
         v2->v1.count = app->beam_count;
         v2->v1.beams = NULL;
         v2->beams = app->beams2;
+        v2->joints = &app->joints[0][0];
+        v2->joint_count = app->joint_count;
         return VFX_OK;
     }
     if (app->beams_v2) /* a version 1 plugin: the v1 part of each beam */

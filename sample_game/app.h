@@ -17,6 +17,7 @@
 #include "camera_ref.h"
 
 #define GAME_APP_MAX_BEAMS 1024
+#define GAME_APP_MAX_JOINTS 4096
 #define GAME_APP_MAX_VOLUMES 4
 
 typedef struct game_app_desc {
@@ -63,6 +64,8 @@ typedef struct game_app {
     bool beams_v2;             /* answer version 2 views from beams2 and beams_view2 */
     vfx_beam2 beams2[GAME_APP_MAX_BEAMS];
     vfx_beams_view2 beams_view2; /* bloom settings; its v1 member is beams_view */
+    float joints[GAME_APP_MAX_JOINTS][3]; /* bending beams' joints (beams2[i].joint_first) */
+    uint32_t joint_count;
     vfx_volume_view2 volumes[GAME_APP_MAX_VOLUMES]; /* the plugin gets version 2 or 1 */
     uint32_t volume_count;
     double time;

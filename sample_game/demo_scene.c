@@ -357,7 +357,8 @@ vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path
         app->beams_view = sc->beams_view;
         app->beams_view2 = sc->beams_view2;
         app->beams_v2 = true;
-        app->beam_count = rt_scene_beams2_at(sc, 0.0, app->beams2, demo->beam_base_count);
+        app->beam_count = rt_scene_beams2_at(sc, 0.0, app->beams2, demo->beam_base_count, &app->joints[0][0],
+                                             GAME_APP_MAX_JOINTS, &app->joint_count);
     }
     if (sc->has_volume && !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_VOLUME)) && (r = load_volume(app, demo, sc)))
         return r;
@@ -373,7 +374,8 @@ void game_demo_animate(game_app *app, game_demo *demo, float dt)
 {
     (void)dt;
     if (demo->scene && app->beam_count) /* keyframed: grow, thicken, move, turn */
-        app->beam_count = rt_scene_beams2_at(demo->scene, app->time, app->beams2, demo->beam_base_count);
+        app->beam_count = rt_scene_beams2_at(demo->scene, app->time, app->beams2, demo->beam_base_count,
+                                             &app->joints[0][0], GAME_APP_MAX_JOINTS, &app->joint_count);
     if (demo->scene && demo->vol_animated && app->volume_count) /* after the beams: they light it */
         animate_volume(app, demo);
 }

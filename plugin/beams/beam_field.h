@@ -18,17 +18,25 @@
 #include <volfx/volfx.h>
 
 #define VOLFX_BEAM_EPS_FLOOR 1e-6
+#define VOLFX_BEAM_MAX_JOINTS 6 /* polyline joints J0..J5 (docs/beams.md "Bending beams") */
 
 /* Beam in float64, normalised (unit D), as the integrals use it. */
 typedef struct volfx_beam_d {
     double head[3], dir[3];
     double length, radius, a, b, eps;
     int smooth; /* 1: densities times w(r) = (1 - (r/R)^2)^2 (the smooth support), 0: hard */
+    int joint_count;                           /* 0: straight; 2..MAX: a polyline, head at J0 */
+    double joints[VOLFX_BEAM_MAX_JOINTS][3];
 } volfx_beam_d;
 
 /* Checks a beam (finite, L >= 0, R > 0, a, b, eps >= 0, D not zero) and normalises D into out;
  * VFX_ERR_INVALID_ARGUMENT with a message naming the field otherwise. */
 vfx_result volfx_beam_validate(const vfx_beam *in, volfx_beam_d *out, char *err, size_t errlen);
+
+/* Makes a validated beam the polyline xyz[0..3 count) (count 0: straight again; else 2 to
+ * VOLFX_BEAM_MAX_JOINTS finite joints): head = J0, dir and length those of the first segment.
+ * VFX_ERR_INVALID_ARGUMENT with a message otherwise. */
+vfx_result volfx_beam_set_joints(volfx_beam_d *bm, const float *xyz, uint32_t count, char *err, size_t errlen);
 
 /* Integral over x in [x0, x1] of 1/sqrt((s x + beta)^2 + Q^2), s >= 0, Q > 0, without
  * cancellation: float and double versions of the same code. */

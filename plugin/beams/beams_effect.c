@@ -38,8 +38,10 @@ typedef struct beam_look {
 
 typedef struct beams_state {
     GLuint prog_closed, prog_march, prog_composite, prog_down, prog_up;
-    GLuint beam_buf, range_buf, list_buf;
-    size_t beam_cap, range_cap, list_cap; /* bytes */
+    GLuint beam_buf, range_buf, list_buf, joint_buf;
+    size_t beam_cap, range_cap, list_cap, joint_cap; /* bytes */
+    float (*joint_xyz)[4];      /* polyline joints this frame, eye-relative (capacity: beams x max) */
+    uint32_t joint_used;
     GLuint acc_tex, light_tex, acc_fbo;   /* H (R32F) and light (RGBA16F), one framebuffer */
     GLuint bloom_tex[MAX_BLOOM_LEVELS + 1], bloom_fbo[MAX_BLOOM_LEVELS + 1]; /* [1..levels] */
     uint32_t bloom_w[MAX_BLOOM_LEVELS + 1], bloom_h[MAX_BLOOM_LEVELS + 1];
@@ -91,8 +93,8 @@ static void beams_destroy(vfx_context *ctx, void *state)
     beams_state *s = state;
     if (!s)
         return;
-    GLuint bufs[3] = {s->beam_buf, s->range_buf, s->list_buf};
-    glDeleteBuffers(3, bufs);
+    GLuint bufs[4] = {s->beam_buf, s->range_buf, s->list_buf, s->joint_buf};
+    glDeleteBuffers(4, bufs);
     glDeleteTextures(1, &s->acc_tex);
     glDeleteTextures(1, &s->light_tex);
     glDeleteFramebuffers(1, &s->acc_fbo);
@@ -100,6 +102,7 @@ static void beams_destroy(vfx_context *ctx, void *state)
     volfx_ubo_destroy(&s->ubo);
     volfx_free(ctx, s->beams);
     volfx_free(ctx, s->looks);
+    volfx_free(ctx, s->joint_xyz);
     volfx_free(ctx, s->gpu);
     volfx_free(ctx, s->rects);
     volfx_free(ctx, s->visible);
@@ -122,9 +125,10 @@ static vfx_result beams_create(vfx_context *ctx, void **out)
         beams_destroy(ctx, s);
         return VFX_ERR_GL;
     }
-    GLuint bufs[3];
-    glCreateBuffers(3, bufs);
-    s->beam_buf = bufs[0], s->range_buf = bufs[1], s->list_buf = bufs[2];
+    GLuint bufs[4];
+    glCreateBuffers(4, bufs);
+    s->beam_buf = bufs[0], s->range_buf = bufs[1], s->list_buf = bufs[2], s->joint_buf = bufs[3];
+    volfx_gpu_label(GL_BUFFER, s->joint_buf, "beams.joints");
     volfx_gpu_label(GL_BUFFER, s->beam_buf, "beams.beams");
     volfx_gpu_label(GL_BUFFER, s->range_buf, "beams.tile_ranges");
     volfx_gpu_label(GL_BUFFER, s->list_buf, "beams.tile_lists");
@@ -238,26 +242,41 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
     if (n > s->capacity) {
         volfx_free(ctx, s->beams);
         volfx_free(ctx, s->looks);
+        volfx_free(ctx, s->joint_xyz);
         volfx_free(ctx, s->gpu);
         volfx_free(ctx, s->rects);
         volfx_free(ctx, s->visible);
         s->beams = volfx_alloc(ctx, n * sizeof *s->beams);
         s->looks = volfx_alloc(ctx, n * sizeof *s->looks);
+        s->joint_xyz = volfx_alloc(ctx, (size_t)n * VOLFX_BEAM_MAX_JOINTS * sizeof *s->joint_xyz);
         s->gpu = volfx_alloc(ctx, n * sizeof *s->gpu);
         s->rects = volfx_alloc(ctx, n * sizeof *s->rects);
         s->visible = volfx_alloc(ctx, n * sizeof *s->visible);
-        s->capacity = (s->beams && s->looks && s->gpu && s->rects && s->visible) ? n : 0;
+        s->capacity = (s->beams && s->looks && s->joint_xyz && s->gpu && s->rects && s->visible) ? n : 0;
         if (!s->capacity)
             return VFX_ERR_OUT_OF_MEMORY;
     }
     char err[200];
     for (uint32_t i = 0; i < n; ++i) {
         const vfx_beam *b = b2 ? &b2[i].v1 : &v.v1.beams[i];
+        vfx_beam straight;
+        if (b2 && b2[i].joint_count) { /* a bending beam's head, dir and length are ignored */
+            straight = *b;
+            straight.dir[0] = 1.f, straight.dir[1] = straight.dir[2] = 0.f;
+            straight.head[0] = straight.head[1] = straight.head[2] = straight.length = 0.f;
+            b = &straight;
+        }
         if (volfx_beam_validate(b, &s->beams[i], err, sizeof err))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: %s", i, err);
         if ((r = beam_look_of(ctx, i, b2 ? &b2[i] : NULL, &s->looks[i])))
             return r;
         s->beams[i].smooth = b2 && b2[i].falloff != VFX_BEAM_FALLOFF_HARD;
+        uint32_t jc = b2 ? b2[i].joint_count : 0, jf = b2 ? b2[i].joint_first : 0;
+        if (jc && (!v.joints || jf > v.joint_count || jc > v.joint_count - jf))
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: joints %u..%u outside the view's %u joints",
+                              i, jf, jf + jc, v.joints ? v.joint_count : 0);
+        if (jc && volfx_beam_set_joints(&s->beams[i], v.joints + 3 * (size_t)jf, jc, err, sizeof err))
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: %s", i, err);
         const float *c = b->color;
         bool none = c[0] == 0 && c[1] == 0 && c[2] == 0;
         for (int k = 0; k < 4; ++k)
@@ -336,17 +355,41 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
     bool *visible = s->visible;
     memset(s->ranges, 0, (size_t)ntiles * 2 * sizeof(uint32_t));
     uint64_t pairs = 0;
+    s->joint_used = 0;
     for (uint32_t i = 0; i < s->count; ++i) {
         const volfx_beam_d *b = &s->beams[i];
         beam_gpu *g = &s->gpu[i];
-        double rel[3], centre[3];
+        double rel[3], centre[3], half = 0.5 * b->length;
         for (int k = 0; k < 3; ++k) {
             rel[k] = b->head[k] - eye[k];
             centre[k] = rel[k] + 0.5 * b->length * b->dir[k];
             g->m_l[k] = (float)rel[k];
             g->d_r[k] = (float)b->dir[k];
         }
-        g->m_l[3] = (float)b->length, g->d_r[3] = (float)b->radius;
+        uint32_t jfirst = s->joint_used;
+        if (b->joint_count >= 2) {
+            /* joints camera-relative like the head; the bounding sphere of their box stands in
+             * for (M, D, L) where only bounds are used (culling, the marching chord) */
+            double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+            for (int j = 0; j < b->joint_count; ++j) {
+                float *out = s->joint_xyz[s->joint_used++];
+                for (int k = 0; k < 3; ++k) {
+                    double x = b->joints[j][k] - eye[k];
+                    out[k] = (float)x;
+                    lo[k] = fmin(lo[k], x), hi[k] = fmax(hi[k], x);
+                }
+                out[3] = 0.f;
+            }
+            half = 0;
+            for (int k = 0; k < 3; ++k) {
+                centre[k] = 0.5 * (lo[k] + hi[k]);
+                half += 0.25 * (hi[k] - lo[k]) * (hi[k] - lo[k]);
+            }
+            half = sqrt(half);
+            for (int k = 0; k < 3; ++k)
+                g->m_l[k] = (float)(centre[k] - (k == 0 ? half : 0.0)), g->d_r[k] = k == 0 ? 1.f : 0.f;
+        }
+        g->m_l[3] = (float)(2.0 * half), g->d_r[3] = (float)b->radius;
         const beam_look *lk = &s->looks[i];
         float gain = exp2f(lk->exposure), wavelength = lk->flow_scale > 0 ? lk->flow_scale : 2.f * (float)b->radius;
         g->ab_eps[0] = (float)b->a, g->ab_eps[1] = (float)b->b, g->ab_eps[2] = (float)b->eps;
@@ -356,11 +399,12 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
         g->look[2] = lk->flow_amount;
         /* the phase wraps at 2^12 wavelengths so float32 keeps its fraction after hours */
         g->look[3] = (float)fmod(s->time * lk->flow_speed / wavelength, 4096.0);
-        g->mode[0] = (uint32_t)b->smooth, g->mode[1] = lk->thesis, g->mode[2] = g->mode[3] = 0;
+        g->mode[0] = (uint32_t)b->smooth, g->mode[1] = lk->thesis;
+        g->mode[2] = jfirst, g->mode[3] = (uint32_t)b->joint_count;
         /* the thesis ramp tints with colour x intensity x 2^exposure (the v1 colour for v1 beams) */
         for (int k = 0; k < 4; ++k)
             g->color[k] = lk->color[k] * (lk->thesis && k < 3 ? lk->intensity * gain : 1.f);
-        visible[i] = beam_tiles(s, vp_rot, centre, 0.5 * b->length + b->radius, rects[i]);
+        visible[i] = beam_tiles(s, vp_rot, centre, half + b->radius, rects[i]);
         if (!visible[i])
             continue;
         for (uint32_t ty = rects[i][1]; ty <= rects[i][3]; ++ty)
@@ -402,7 +446,8 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
     vfx_result r;
     if ((r = upload(ctx, s->beam_buf, &s->beam_cap, s->gpu, s->count * sizeof(beam_gpu)))
         || (r = upload(ctx, s->range_buf, &s->range_cap, s->ranges, (size_t)ntiles * 2 * sizeof(uint32_t)))
-        || (r = upload(ctx, s->list_buf, &s->list_cap, s->list, pairs * sizeof(uint32_t))))
+        || (r = upload(ctx, s->list_buf, &s->list_cap, s->list, pairs * sizeof(uint32_t)))
+        || (r = upload(ctx, s->joint_buf, &s->joint_cap, s->joint_xyz, s->joint_used * sizeof s->joint_xyz[0])))
         return r;
 
     bool march = s->view.v1.method == 1;
@@ -443,6 +488,7 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s->beam_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s->range_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s->list_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->joint_buf);
     volfx_gpu_fullscreen(ctx);
     volfx_pass_end(ctx);
 

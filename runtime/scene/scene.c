@@ -204,6 +204,10 @@ void rt_scene_free(rt_scene *scene)
             free(scene->beams[i].tracks[k].times);
             free(scene->beams[i].tracks[k].values);
         }
+    for (uint32_t i = 0; i < scene->beam_count; ++i) {
+        free(scene->beams[i].joint_track.times);
+        free(scene->beams[i].joint_track.values);
+    }
     free(scene->beams);
     free(scene->meshes);
     free(scene);

@@ -18,6 +18,7 @@
 #define RT_SCENE_MAX_BYTES (16u << 20)        /* scene files above 16 MiB are refused */
 #define RT_SCENE_MAX_MESHES 64
 #define RT_SCENE_MAX_BEAMS 256
+#define RT_SCENE_MAX_JOINTS 6 /* joints of a bending beam (the plugin's limit) */
 #define RT_SCENE_MAX_KEYS 4096                /* keyframes per animated parameter */
 #define RT_SCENE_MAX_TRANSFER 256             /* transfer-function control points */
 #define RT_SCENE_MAX_PARTICLES (1u << 22)     /* generated or simulated particles (4,194,304) */
@@ -66,6 +67,9 @@ typedef struct rt_scene_beam {
     rt_scene_track tracks[RT_BEAM_PARAM_COUNT];   /* count 0 = not animated */
     float loop_s;                                   /* >0: time wraps modulo loop_s */
     vfx_beam2 look;     /* falloff, ramp, intensity, exposure, flow; its v1 member is unused */
+    uint32_t joint_count;                  /* 0 straight, 2..RT_SCENE_MAX_JOINTS: bending beam */
+    float joints[RT_SCENE_MAX_JOINTS][3];  /* values when not animated */
+    rt_scene_track joint_track;            /* dim 3 * joint_count; count 0 = not animated */
 } rt_scene_beam;
 
 typedef enum rt_scene_water_source {
@@ -176,8 +180,12 @@ void rt_scene_free(rt_scene *scene);
 /* Writes the beams at `time` (keyframes interpolated linearly, clamped at the ends, wrapped by
  * loop_s) into out[0..n); returns how many were written (min(n, beam_count)). */
 uint32_t rt_scene_beams_at(const rt_scene *scene, double time, vfx_beam *out, uint32_t n);
-/* The same as version 2 beams: with falloff, ramp, intensity, exposure and flow. */
-uint32_t rt_scene_beams2_at(const rt_scene *scene, double time, vfx_beam2 *out, uint32_t n);
+/* The same as version 2 beams: with falloff, ramp, intensity, exposure and flow; the joints of
+ * bending beams go to joints (xyz triples, room for joint_cap of them; beams whose joints do
+ * not fit are left straight), each beam's joint_first indexing into it; *joint_count (may be
+ * NULL) gets how many were written. */
+uint32_t rt_scene_beams2_at(const rt_scene *scene, double time, vfx_beam2 *out, uint32_t n, float *joints,
+                            uint32_t joint_cap, uint32_t *joint_count);
 /* Linear interpolation of one track at time t into out[0..dim); clamped at the ends. */
 void rt_scene_track_eval(const rt_scene_track *track, double t, float *out);
 

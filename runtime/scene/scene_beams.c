@@ -11,6 +11,8 @@
 static const char *const beam_param_names[RT_BEAM_PARAM_COUNT + 1] = {
     "head", "dir", "length", "radius", "a", "b", "eps", "color", "intensity", "exposure", NULL};
 static const int beam_param_dim[RT_BEAM_PARAM_COUNT] = {3, 3, 1, 1, 1, 1, 1, 4, 1, 1};
+static const char *const beam_keyframe_names[] = {
+    "head", "dir", "length", "radius", "a", "b", "eps", "color", "intensity", "exposure", "joints", NULL};
 
 static range beam_param_range(int k)
 {
@@ -46,7 +48,28 @@ bool scene_is_zero3(const float *v)
     return (double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2] < 1e-24;
 }
 
-static vfx_result parse_track(pctx *c, const cJSON *v, const char *P, int k, rt_scene_track *tr)
+/* A joints value: an array of n [x, y, z] (n = *count when given, else 2..RT_SCENE_MAX_JOINTS). */
+static vfx_result joints_value(pctx *c, const cJSON *v, const char *P, uint32_t *count, float *dst)
+{
+    int n = cJSON_IsArray(v) ? cJSON_GetArraySize(v) : -1;
+    if (n < 2 || n > RT_SCENE_MAX_JOINTS)
+        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, P, "expected an array of 2 to %d [x, y, z] joints", RT_SCENE_MAX_JOINTS);
+    if (*count && (uint32_t)n != *count)
+        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, P, "%d joints; every key of a beam has the same count (%u)", n, *count);
+    int i = 0;
+    for (const cJSON *e = v->child; e; e = e->next, ++i) {
+        char PI[JPATH];
+        scene_join_index(PI, P, i);
+        vfx_result r = scene_vec_value(c, e, PI, 3, COORD, dst + 3 * i);
+        if (r)
+            return r;
+    }
+    *count = (uint32_t)n;
+    return VFX_OK;
+}
+
+/* Keyframes of parameter k (k = RT_BEAM_PARAM_COUNT: the joints, dim 3 * *joints). */
+static vfx_result parse_track(pctx *c, const cJSON *v, const char *P, int k, uint32_t *joints, rt_scene_track *tr)
 {
     static const char *const keys[] = {"t", "value", NULL};
     if (!cJSON_IsArray(v))
@@ -54,7 +77,7 @@ static vfx_result parse_track(pctx *c, const cJSON *v, const char *P, int k, rt_
     int n = cJSON_GetArraySize(v);
     if (n < 1 || n > RT_SCENE_MAX_KEYS)
         return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, P, "%d keyframes; must be 1 to %d", n, RT_SCENE_MAX_KEYS);
-    int dim = beam_param_dim[k];
+    int dim = k < RT_BEAM_PARAM_COUNT ? beam_param_dim[k] : 3 * RT_SCENE_MAX_JOINTS;
     tr->dim = (uint32_t)dim;
     tr->times = malloc((size_t)n * sizeof(float));
     tr->values = malloc((size_t)n * (size_t)dim * sizeof(float));
@@ -81,7 +104,10 @@ static vfx_result parse_track(pctx *c, const cJSON *v, const char *P, int k, rt_
         float *dst = &tr->values[(size_t)i * (size_t)dim];
         if (!val)
             return scene_failf(c, VFX_ERR_FORMAT, PV, "required value missing");
-        if (dim == 1) {
+        if (k == RT_BEAM_PARAM_COUNT) {
+            if ((r = joints_value(c, val, PV, joints, dst)))
+                return r;
+        } else if (dim == 1) {
             double d;
             if ((r = scene_number_value(c, val, PV, beam_param_range(k), &d)))
                 return r;
@@ -93,7 +119,37 @@ static vfx_result parse_track(pctx *c, const cJSON *v, const char *P, int k, rt_
             return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PV, "direction must not be the zero vector");
         tr->count = (uint32_t)i + 1;
     }
+    if (k == RT_BEAM_PARAM_COUNT) { /* pack the keys to the beam's joint count */
+        uint32_t d3 = 3 * *joints;
+        for (int j = 1; j < n; ++j)
+            memmove(&tr->values[(size_t)j * d3], &tr->values[(size_t)j * (size_t)dim], d3 * sizeof(float));
+        tr->dim = d3;
+    }
     return VFX_OK;
+}
+
+/* A beam's joints: the static value and/or the keyframes (the first key is the base). */
+static vfx_result parse_joints(pctx *c, const cJSON *e, const cJSON *kf, const char *P, rt_scene_beam *o)
+{
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(e, "joints");
+    const cJSON *track = kf ? cJSON_GetObjectItemCaseSensitive(kf, "joints") : NULL;
+    vfx_result r = VFX_OK;
+    if (v) {
+        char PJ[JPATH];
+        scene_join(PJ, P, "joints");
+        if ((r = joints_value(c, v, PJ, &o->joint_count, &o->joints[0][0])))
+            return r;
+    }
+    if (track) {
+        char PK[JPATH], PT[JPATH];
+        scene_join(PK, P, "keyframes");
+        scene_join(PT, PK, "joints");
+        if ((r = parse_track(c, track, PT, RT_BEAM_PARAM_COUNT, &o->joint_count, &o->joint_track)))
+            return r;
+        if (!v)
+            memcpy(o->joints, o->joint_track.values, o->joint_track.dim * sizeof(float));
+    }
+    return r;
 }
 
 /* falloff, ramp and flow of one beam (intensity and exposure are parameters, keyframable). */
@@ -128,7 +184,7 @@ static vfx_result parse_look(pctx *c, const cJSON *e, const char *P, vfx_beam2 *
 vfx_result scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
 {
     static const char *const keys[] = {"head", "dir", "length", "radius", "a", "b", "eps", "color",
-                                       "intensity", "exposure", "falloff", "ramp", "flow",
+                                       "intensity", "exposure", "falloff", "ramp", "flow", "joints",
                                        "keyframes", "loop_s", NULL};
     int n;
     vfx_result ra = scene_alloc_array(c, v, "beams", RT_SCENE_MAX_BEAMS, sizeof *s->beams, (void **)&s->beams, &n);
@@ -153,13 +209,16 @@ vfx_result scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
             scene_join(PK, P, "keyframes");
             if ((r = scene_expect_object(c, kf, PK)))
                 return r;
-            scene_check_keys(c, kf, PK, beam_param_names);
+            scene_check_keys(c, kf, PK, beam_keyframe_names);
         }
+        if ((r = parse_joints(c, e, kf, P, o)))
+            return r;
         for (int k = 0; k < RT_BEAM_PARAM_COUNT; ++k) {
             const char *name = beam_param_names[k];
             const cJSON *track = kf ? cJSON_GetObjectItemCaseSensitive(kf, name) : NULL;
-            /* head and dir are required unless animated (then the first key is the base) */
-            bool required = (k == RT_BEAM_PARAM_HEAD || k == RT_BEAM_PARAM_DIR) && !track;
+            /* head and dir are required unless animated (then the first key is the base) or the
+             * beam bends (its joints give them) */
+            bool required = (k == RT_BEAM_PARAM_HEAD || k == RT_BEAM_PARAM_DIR) && !track && !o->joint_count;
             float *dst = beam_param_ptr(b, &o->look, k);
             if (beam_param_dim[k] == 1)
                 r = scene_get_float(c, e, P, name, required, beam_param_range(k), dst);
@@ -171,11 +230,20 @@ vfx_result scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
                 char PT[JPATH], PK[JPATH];
                 scene_join(PK, P, "keyframes");
                 scene_join(PT, PK, name);
-                if ((r = parse_track(c, track, PT, k, &o->tracks[k])))
+                if ((r = parse_track(c, track, PT, k, NULL, &o->tracks[k])))
                     return r;
                 if (!cJSON_GetObjectItemCaseSensitive(e, name))
                     memcpy(dst, o->tracks[k].values, (size_t)beam_param_dim[k] * sizeof(float));
             }
+        }
+        if (o->joint_count) { /* a bending beam: its v1 part describes the first segment */
+            for (int k = 0; k < 3; ++k) {
+                b->head[k] = o->joints[0][k];
+                b->dir[k] = o->joints[1][k] - o->joints[0][k];
+            }
+            b->length = sqrtf(b->dir[0] * b->dir[0] + b->dir[1] * b->dir[1] + b->dir[2] * b->dir[2]);
+            if (scene_is_zero3(b->dir))
+                b->dir[0] = 1.f;
         }
         if (scene_is_zero3(b->dir)) {
             char PD[JPATH];
@@ -250,15 +318,22 @@ void rt_scene_track_eval(const rt_scene_track *tr, double t, float *out)
         out[k] = (float)(v0[k] + f * ((double)v1[k] - v0[k]));
 }
 
-/* One beam at `time` (finite): keyframes interpolated, wrapped by loop_s. */
-static void beam_at(const rt_scene_beam *b, double time, vfx_beam2 *out)
+/* Time within a beam's loop. */
+static double beam_time(const rt_scene_beam *b, double time)
 {
-    double t = time;
+    double t = isfinite(time) ? time : 0;
     if (b->loop_s > 0) {
         t = fmod(t, b->loop_s);
         if (t < 0)
             t += b->loop_s;
     }
+    return t;
+}
+
+/* One beam at `time`: keyframes interpolated, wrapped by loop_s. */
+static void beam_at(const rt_scene_beam *b, double time, vfx_beam2 *out)
+{
+    double t = beam_time(b, time);
     *out = b->look;
     out->v1 = b->base;
     for (int k = 0; k < RT_BEAM_PARAM_COUNT; ++k) {
@@ -273,13 +348,30 @@ static void beam_at(const rt_scene_beam *b, double time, vfx_beam2 *out)
     }
 }
 
-uint32_t rt_scene_beams2_at(const rt_scene *scene, double time, vfx_beam2 *out, uint32_t n)
+uint32_t rt_scene_beams2_at(const rt_scene *scene, double time, vfx_beam2 *out, uint32_t n, float *joints,
+                            uint32_t joint_cap, uint32_t *joint_count)
 {
+    uint32_t used = 0;
+    if (joint_count)
+        *joint_count = 0;
     if (!scene || !out)
         return 0;
     uint32_t count = scene->beam_count < n ? scene->beam_count : n;
-    for (uint32_t i = 0; i < count; ++i)
-        beam_at(&scene->beams[i], isfinite(time) ? time : 0, &out[i]);
+    for (uint32_t i = 0; i < count; ++i) {
+        const rt_scene_beam *b = &scene->beams[i];
+        beam_at(b, time, &out[i]);
+        if (!b->joint_count || !joints || joint_cap - used < b->joint_count)
+            continue;
+        float *dst = joints + 3 * (size_t)used;
+        memcpy(dst, b->joints, 3 * b->joint_count * sizeof(float));
+        if (b->joint_track.count)
+            rt_scene_track_eval(&b->joint_track, beam_time(b, time), dst);
+        out[i].joint_first = used;
+        out[i].joint_count = b->joint_count;
+        used += b->joint_count;
+    }
+    if (joint_count)
+        *joint_count = used;
     return count;
 }
 
@@ -290,7 +382,7 @@ uint32_t rt_scene_beams_at(const rt_scene *scene, double time, vfx_beam *out, ui
     uint32_t count = scene->beam_count < n ? scene->beam_count : n;
     for (uint32_t i = 0; i < count; ++i) {
         vfx_beam2 b2;
-        beam_at(&scene->beams[i], isfinite(time) ? time : 0, &b2);
+        beam_at(&scene->beams[i], time, &b2);
         out[i] = b2.v1;
     }
     return count;

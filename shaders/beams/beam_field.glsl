@@ -236,3 +236,178 @@ float volfx_beam_density(vec3 M, vec3 D, float L, float R, float a, float b, flo
         rho += b * wt / sqrt(r2 + eps * eps);
     return rho;
 }
+
+// ---------------------------------------------------------------- bending beams (polylines)
+// beam_field_impl.inc polyline_integral, line for line: the nearest primitive (joint or segment
+// interior) per interval between switch points. The includer defines
+// `vec3 volfx_joint(uint i)` (the i-th joint, relative to the eye) before including this file
+// with VOLFX_BEAMS_POLYLINE.
+#ifdef VOLFX_BEAMS_POLYLINE
+const int VOLFX_BEAM_MAX_JOINTS = 6;
+const int VOLFX_POLY_MAX_PRIMS = 2 * VOLFX_BEAM_MAX_JOINTS - 1;
+const int VOLFX_POLY_MAX_BREAKS = VOLFX_POLY_MAX_PRIMS * (VOLFX_POLY_MAX_PRIMS - 1) + 2 * VOLFX_BEAM_MAX_JOINTS + 2;
+
+vec3 volfx_prim_quad(vec3 V, vec3 C, vec3 D, bool seg)
+{
+    vec3 w = -C;
+    if (!seg)
+        return vec3(dot(V, V), dot(w, V), dot(w, w));
+    vec3 vx = volfx_cross_acc(V, D), wx = volfx_cross_acc(w, D);
+    return vec3(dot(vx, vx), dot(wx, vx), dot(wx, wx));
+}
+
+float volfx_prim_dist2(vec3 V, vec3 C, vec3 D, float L, bool seg, float t)
+{
+    vec3 p = t * V - C;
+    if (!seg)
+        return dot(p, p);
+    float u = dot(p, D);
+    if (u < 0.0 || u > L)
+        return 1e30;
+    vec3 q = p - u * D;
+    return dot(q, q);
+}
+
+float volfx_prim_piece(vec3 V, vec3 C, vec3 D, float L, bool seg, float R, float eps, float ta, float tb, bool soft)
+{
+    vec3 w = -C;
+    vec3 wp = volfx_cross_acc(V, volfx_cross_acc(w, V));
+    float wv = dot(w, V);
+    if (!seg)
+        return volfx_sphere_piece(wp, V, R, eps, ta + wv, tb + wv, 0.0, 0.0, -1.0, 1.0, soft);
+    return volfx_cylinder_piece(wp, V, D, L, R, eps, ta + wv, tb + wv, dot(wp, D), dot(V, D), soft);
+}
+
+float volfx_polyline_integral(uint first, int nj, float R, float a, float b, float eps_in, bool soft, vec3 V,
+                              float t0, float t1)
+{
+    if (!(t1 > t0) || nj < 1)
+        return 0.0;
+    float eps = max(eps_in, VOLFX_BEAM_EPS_FLOOR * R);
+    float H = a > 0.0 ? a * volfx_prim_piece(V, volfx_joint(first), vec3(0.0), 0.0, false, R, eps, t0, t1, soft) : 0.0;
+    if (!(b > 0.0))
+        return H;
+    vec3 C[VOLFX_POLY_MAX_PRIMS], D[VOLFX_POLY_MAX_PRIMS], Q[VOLFX_POLY_MAX_PRIMS];
+    float L[VOLFX_POLY_MAX_PRIMS];
+    bool seg[VOLFX_POLY_MAX_PRIMS];
+    int m = 0;
+    for (int k = 0; k < 2 * nj - 1; ++k) {
+        int j = k < nj ? k : k - nj;
+        bool s = k >= nj;
+        vec3 Cj = volfx_joint(first + uint(j)), d = vec3(0.0);
+        float len = 0.0;
+        if (s) {
+            d = volfx_joint(first + uint(j + 1)) - Cj;
+            len = sqrt(dot(d, d));
+            if (!(len > 0.0))
+                continue;
+            d /= len;
+        }
+        vec3 q = volfx_prim_quad(V, Cj, d, s);
+        float dmin = q.x > 0.0 ? q.z - q.y * q.y / q.x : q.z;
+        if (dmin > R * R)
+            continue;
+        C[m] = Cj;
+        D[m] = d;
+        Q[m] = q;
+        L[m] = len;
+        seg[m] = s;
+        m++;
+    }
+    if (m == 0)
+        return H;
+    float br[VOLFX_POLY_MAX_BREAKS];
+    int nb = 0;
+    br[nb++] = t0;
+    br[nb++] = t1;
+    for (int i = 0; i < m; ++i) {
+        if (seg[i]) {
+            float c = dot(V, D[i]), u0 = dot(-C[i], D[i]);
+            if (c != 0.0) {
+                float ta = -u0 / c, tb = (L[i] - u0) / c;
+                if (ta > t0 && ta < t1) br[nb++] = ta;
+                if (tb > t0 && tb < t1) br[nb++] = tb;
+            }
+        }
+        for (int j = i + 1; j < m; ++j) {
+            float A = Q[i].x - Q[j].x, B = Q[i].y - Q[j].y, G = Q[i].z - Q[j].z;
+            float r0 = 0.0, r1 = 0.0;
+            int nr = 0;
+            if (!(abs(A) > 1e-6 * (Q[i].x + Q[j].x))) {
+                if (B != 0.0) {
+                    r0 = -G / (2.0 * B);
+                    nr = 1;
+                }
+            } else {
+                float disc = B * B - A * G;
+                if (disc >= 0.0) {
+                    float sq = sqrt(disc), qq = -(B + (B >= 0.0 ? sq : -sq));
+                    if (qq != 0.0) {
+                        r0 = qq / A;
+                        r1 = G / qq;
+                        nr = 2;
+                    } else {
+                        nr = 1;
+                    }
+                }
+            }
+            if (nr > 0 && r0 > t0 && r0 < t1 && nb < VOLFX_POLY_MAX_BREAKS) br[nb++] = r0;
+            if (nr > 1 && r1 > t0 && r1 < t1 && nb < VOLFX_POLY_MAX_BREAKS) br[nb++] = r1;
+        }
+    }
+    for (int i = 1; i < nb; ++i) {
+        float x = br[i];
+        int j = i - 1;
+        while (j >= 0 && br[j] > x) {
+            br[j + 1] = br[j];
+            j--;
+        }
+        br[j + 1] = x;
+    }
+    int cur = -1;
+    float run0 = t0;
+    for (int k = 0; k + 1 < nb; ++k) {
+        if (!(br[k + 1] > br[k]))
+            continue;
+        float mid = 0.5 * (br[k] + br[k + 1]), best = 1e30;
+        int arg = -1;
+        for (int i = 0; i < m; ++i) {
+            float f = volfx_prim_dist2(V, C[i], D[i], L[i], seg[i], mid);
+            if (f < best) {
+                best = f;
+                arg = i;
+            }
+        }
+        if (arg != cur) {
+            if (cur >= 0)
+                H += b * volfx_prim_piece(V, C[cur], D[cur], L[cur], seg[cur], R, eps, run0, br[k], soft);
+            cur = arg;
+            run0 = br[k];
+        }
+    }
+    if (cur >= 0)
+        H += b * volfx_prim_piece(V, C[cur], D[cur], L[cur], seg[cur], R, eps, run0, t1, soft);
+    return H;
+}
+
+// the raw polyline density (ray-marching baseline)
+float volfx_polyline_density(uint first, int nj, float R, float a, float b, float eps_in, bool soft, vec3 P)
+{
+    float eps = max(eps_in, VOLFX_BEAM_EPS_FLOOR * R), rho = 0.0;
+    vec3 d0 = P - volfx_joint(first);
+    float d2 = dot(d0, d0), r2 = 1e30;
+    for (int k = 0; k + 1 < nj; ++k) {
+        vec3 A = volfx_joint(first + uint(k)), e = volfx_joint(first + uint(k + 1)) - A, w = P - A;
+        float ee = dot(e, e), u = ee > 0.0 ? clamp(dot(w, e) / ee, 0.0, 1.0) : 0.0;
+        vec3 q = w - u * e;
+        r2 = min(r2, dot(q, q));
+    }
+    float wh = soft ? (1.0 - d2 / (R * R)) * (1.0 - d2 / (R * R)) : 1.0;
+    float wt = soft ? (1.0 - r2 / (R * R)) * (1.0 - r2 / (R * R)) : 1.0;
+    if (d2 <= R * R)
+        rho += a * wh / sqrt(d2 + eps * eps);
+    if (r2 <= R * R)
+        rho += b * wt / sqrt(r2 + eps * eps);
+    return rho;
+}
+#endif

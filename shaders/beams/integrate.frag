@@ -3,6 +3,9 @@
 // VOLFX_BEAMS_MARCH is defined. Writes H (R32F, read_raw) and the beams' linear radiance
 // (RGBA16F): each hot-ramp beam through its own ramp, the thesis-ramp beams through the clamp
 // of their summed H (docs/beams.md "Emission").
+layout(std430, binding = 4) readonly buffer Joints { vec4 joints[]; }; // xyz relative to the eye
+vec3 volfx_joint(uint i) { return joints[i].xyz; }
+#define VOLFX_BEAMS_POLYLINE 1
 #include "beams/beam_field.glsl"
 #include "beams/frame.glsl"
 
@@ -16,7 +19,7 @@ struct Beam {
     vec4 ab_eps; // a, b, eps, 1 / flow wavelength
     vec4 color;  // rgb (thesis ramp: times intensity and 2^exposure)
     vec4 look;   // intensity, 2^exposure / c, flow amount, flow phase
-    uvec4 mode;  // smooth falloff, thesis ramp
+    uvec4 mode;  // smooth falloff, thesis ramp, first joint, joint count (>= 2: a polyline)
 };
 layout(std430, binding = 0) readonly buffer Beams { Beam beams[]; };
 layout(std430, binding = 1) readonly buffer Ranges { uvec2 ranges[]; };
@@ -45,6 +48,29 @@ float volfx_nearest_u(vec3 M, vec3 D, float L, vec3 V)
     return clamp(u, 0.0, L);
 }
 
+// the same for a polyline: arc length from J0 at the nearest approach to the nearest segment
+float volfx_poly_nearest_u(uint first, int nj, vec3 V)
+{
+    float best = 1e30, u = 0.0, s = 0.0;
+    for (int k = 0; k + 1 < nj; ++k) {
+        vec3 A = volfx_joint(first + uint(k)), e = volfx_joint(first + uint(k + 1)) - A;
+        float len = length(e);
+        if (!(len > 0.0))
+            continue;
+        vec3 D = e / len;
+        float uk = volfx_nearest_u(A, D, len, V);
+        vec3 P = A + uk * D;
+        float t = max(dot(P, V), 0.0);
+        float d2 = dot(t * V - P, t * V - P);
+        if (d2 < best) {
+            best = d2;
+            u = s + uk;
+        }
+        s += len;
+    }
+    return u;
+}
+
 void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
@@ -67,6 +93,7 @@ void main()
     for (uint k = 0u; k < range.y; ++k) {
         Beam bm = beams[list[range.x + k]];
         bool soft = bm.mode.x != 0u;
+        bool poly = bm.mode.w >= 2u;
         float h;
 #ifdef VOLFX_BEAMS_MARCH
         // baseline: midpoint samples over the ray's chord through the beam's bounding sphere
@@ -78,14 +105,21 @@ void main()
         if (disc > 0.0) {
             float ta = max(tc - sqrt(disc), 0.0), tb = min(tc + sqrt(disc), tmax);
             float dt = (tb - ta) / float(u_samples);
-            for (int i = 0; i < u_samples && tb > ta; ++i)
-                h += volfx_beam_density(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x,
-                                        bm.ab_eps.y, bm.ab_eps.z, soft,
-                                        (ta + (float(i) + 0.5) * dt) * V) * dt;
+            for (int i = 0; i < u_samples && tb > ta; ++i) {
+                vec3 P = (ta + (float(i) + 0.5) * dt) * V;
+                h += (poly ? volfx_polyline_density(bm.mode.z, int(bm.mode.w), bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
+                                                    bm.ab_eps.z, soft, P)
+                           : volfx_beam_density(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x,
+                                                bm.ab_eps.y, bm.ab_eps.z, soft, P)) * dt;
+            }
         }
 #else
-        h = volfx_beam_integral(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
-                                bm.ab_eps.z, soft, V, 0.0, tmax);
+        if (poly)
+            h = volfx_polyline_integral(bm.mode.z, int(bm.mode.w), bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
+                                        bm.ab_eps.z, soft, V, 0.0, tmax);
+        else
+            h = volfx_beam_integral(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
+                                    bm.ab_eps.z, soft, V, 0.0, tmax);
 #endif
         H += h;
         if (bm.mode.y != 0u) {
@@ -94,7 +128,8 @@ void main()
         } else if (h > 0.0) {
             float x = h * bm.look.y;
             if (bm.look.z > 0.0) {
-                float u = volfx_nearest_u(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, V);
+                float u = poly ? volfx_poly_nearest_u(bm.mode.z, int(bm.mode.w), V)
+                               : volfx_nearest_u(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, V);
                 x *= 1.0 + bm.look.z * (2.0 * volfx_flow_noise(u * bm.ab_eps.w - bm.look.w) - 1.0);
             }
             float x2 = x * x;

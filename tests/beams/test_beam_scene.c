@@ -34,7 +34,7 @@ static void test_defaults_and_values(void **state)
                        err, sizeof err);
     assert_non_null(s);
     vfx_beam2 b[2];
-    assert_int_equal(rt_scene_beams2_at(s, 1.0, b, 2), 2);
+    assert_int_equal(rt_scene_beams2_at(s, 1.0, b, 2, NULL, 0, NULL), 2);
     /* defaults: the smooth support, the hot ramp, intensity 1, no exposure, no flow */
     assert_int_equal(b[0].falloff, VFX_BEAM_FALLOFF_SMOOTH);
     assert_int_equal(b[0].ramp, VFX_BEAM_RAMP_HOT);
@@ -85,11 +85,63 @@ static void test_bad_values(void **state)
     assert_non_null(strstr(err, "beam_settings.bloom"));
 }
 
+/* Bending beams: static joints, keyframed joints (interpolated per joint), the joints array
+ * filled with joint_first indices, a beam whose joints do not fit left straight, bad joints. */
+static void test_joints(void **state)
+{
+    (void)state;
+    char err[256] = "";
+    rt_scene *s = load("{\"version\": 1, \"beams\": ["
+                       "{\"joints\": [[0, 0, 0], [1, 0, 0], [1, 1, 0]]},"
+                       "{\"loop_s\": 2, \"keyframes\": {\"joints\": [{\"t\": 0, \"value\": [[0, 0, 0], [2, 0, 0]]},"
+                       " {\"t\": 2, \"value\": [[0, 2, 0], [2, 4, 0]]}]}}]}",
+                       err, sizeof err);
+    if (!s)
+        printf("%s\n", err);
+    assert_non_null(s);
+    vfx_beam2 b[2];
+    float j[8][3];
+    uint32_t nj = 99;
+    assert_int_equal(rt_scene_beams2_at(s, 1.0, b, 2, &j[0][0], 8, &nj), 2);
+    assert_int_equal(nj, 5);
+    assert_int_equal(b[0].joint_first, 0);
+    assert_int_equal(b[0].joint_count, 3);
+    assert_int_equal(b[1].joint_first, 3);
+    assert_int_equal(b[1].joint_count, 2);
+    assert_true(j[2][1] == 1.f);
+    assert_true(j[3][1] == 1.f && j[4][0] == 2.f && j[4][1] == 2.f); /* halfway */
+    /* room for 4 joints: the second beam does not fit and stays straight */
+    assert_int_equal(rt_scene_beams2_at(s, 1.0, b, 2, &j[0][0], 4, &nj), 2);
+    assert_int_equal(nj, 3);
+    assert_int_equal(b[1].joint_count, 0);
+    rt_scene_free(s);
+    static const struct {
+        const char *beam, *msg;
+    } bad[] = {
+        {"\"joints\": [[0, 0, 0]]", "beams[0].joints: expected an array of 2 to 6"},
+        {"\"joints\": [[0, 0, 0], [1, 0]]", "beams[0].joints[1]"},
+        {"\"joints\": [[0,0,0],[1,0,0],[2,0,0],[3,0,0],[4,0,0],[5,0,0],[6,0,0]]", "beams[0].joints"},
+        {"\"joints\": [[0, 0, 0], [1, 0, 0]], \"keyframes\": {\"joints\": [{\"t\": 0, \"value\": [[0, 0, 0], [1, 0, 0], [2, 0, 0]]}]}",
+         "beams[0].keyframes.joints[0].value: 3 joints; every key"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        char json[512];
+        snprintf(json, sizeof json, "{\"version\": 1, \"beams\": [{%s}]}", bad[i].beam);
+        err[0] = 0;
+        rt_scene *t = load(json, err, sizeof err);
+        if (t || !strstr(err, bad[i].msg))
+            printf("case %s: got \"%s\"\n", bad[i].beam, err);
+        assert_null(t);
+        assert_non_null(strstr(err, bad[i].msg));
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_defaults_and_values),
         cmocka_unit_test(test_bad_values),
+        cmocka_unit_test(test_joints),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -23,6 +23,7 @@
 static game_app *g_app;
 static test_log g_log;
 static int g_smooth; /* the falloff the references integrate (set with use_v2) */
+static uint32_t g_nj;  /* joints of the bending beam the references integrate (0: straight) */
 
 static const vfx_beam k_beam = {.head = {-1.5f, 0.1f, 0.0f}, .dir = {1, 0.2f, 0}, .length = 2.5f,
                                 .radius = 0.5f, .a = 0.4f, .b = 0.25f, .eps = 0.05f};
@@ -64,6 +65,7 @@ static double ref_pixel(uint32_t i, uint32_t j, double t1)
     char err[128];
     assert_int_equal(volfx_beam_validate(&g_app->beams[0], &b, err, sizeof err), VFX_OK);
     b.smooth = g_smooth;
+    assert_int_equal(volfx_beam_set_joints(&b, &g_app->joints[0][0], g_nj, err, sizeof err), VFX_OK);
     double dir[3];
     ref_pixel_ray(&g_app->camera, i, j, dir);
     return ref_beams_integral(&b, 1, g_app->camera.eye, dir, 0.0, t1, 1e-10, NULL);
@@ -100,6 +102,7 @@ static int compare_image(const float *gpu, double (*t1_of)(uint32_t, uint32_t), 
     char err[128];
     assert_int_equal(volfx_beam_validate(&g_app->beams[0], &b, err, sizeof err), VFX_OK);
     b.smooth = g_smooth;
+    assert_int_equal(volfx_beam_set_joints(&b, &g_app->joints[0][0], g_nj, err, sizeof err), VFX_OK);
     int bad = 0;
     double *ref = malloc(W * H * sizeof(double)), hmax = 0;
     for (uint32_t j = 0; j < H; ++j)
@@ -389,6 +392,31 @@ static void test_smooth_matches_reference(void **state)
     use_v2(false, false, false);
 }
 
+/* A bending beam (a bend of 60 degrees and a slight one) through a version 2 view: every
+ * pixel's H against the quadrature of the raw polyline field, compare_image's bound. */
+static void test_polyline_matches_reference(void **state)
+{
+    (void)state;
+    static const float J[4][3] = {{-1.6f, -0.2f, 0}, {-0.3f, 0.1f, 0.2f}, {0.4f, 0.9f, 0.1f}, {1.5f, 1.0f, -0.3f}};
+    for (int smooth = 0; smooth < 2; ++smooth) {
+        use_v2(true, smooth, false);
+        memcpy(g_app->joints, J, sizeof J);
+        g_app->joint_count = 4;
+        g_app->beams2[0].joint_first = 0;
+        g_app->beams2[0].joint_count = 4;
+        g_nj = 4;
+        float *raw = render_raw();
+        image_errors ie;
+        assert_int_equal(compare_image(raw, t_far, &ie), 0);
+        print_errors(smooth ? "bending beam, smooth support" : "bending beam, hard support", &ie);
+        assert_true(ie.max_rel_wc <= 1e-5);
+        free(raw);
+    }
+    g_nj = 0;
+    g_app->joint_count = 0;
+    use_v2(false, false, false);
+}
+
 /* Final colours (tone-mapped RGBA8) of one frame. */
 static uint8_t *render_rgba(void)
 {
@@ -483,6 +511,7 @@ int main(void)
         cmocka_unit_test(test_marching_baseline),
         cmocka_unit_test(test_bad_input_and_absence),
         cmocka_unit_test(test_smooth_matches_reference),
+        cmocka_unit_test(test_polyline_matches_reference),
         cmocka_unit_test(test_emission_and_bloom),
         cmocka_unit_test(test_bad_v2_input),
     };

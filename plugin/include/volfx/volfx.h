@@ -204,7 +204,11 @@ typedef struct vfx_beam2 {
                               axis, moving at flow_speed; H itself stays exact; 0 -> off */
     float flow_speed;      /* units per second along D (the plugin's update time) */
     float flow_scale;      /* noise wavelength along the beam; 0 -> 2 R */
-    uint32_t _reserved[9];
+    /* A bending beam: joint_count (2..6) joints J0.. from the view's joints[joint_first..];
+     * the trail's r is the distance to the polyline, the head is at J0, and head, dir and
+     * length above are ignored. 0 -> the straight beam of v1. */
+    uint32_t joint_first, joint_count;
+    uint32_t _reserved[7];
 } vfx_beam2;
 
 /* Bloom of the beams' own light (a downsample/upsample chain), for hosts that have none. */
@@ -225,7 +229,9 @@ typedef struct vfx_beams_view2 {
     uint32_t bloom;          /* vfx_beams_bloom */
     uint32_t bloom_levels;   /* 1..8 halvings; 0 -> 5 */
     float bloom_strength;    /* bloom added x this (>= 0); 0 -> 0.6 */
-    uint32_t _reserved[7];
+    uint32_t joint_count;    /* xyz triples in joints (bending beams index into them) */
+    const float *joints;
+    uint32_t _reserved[4];
 } vfx_beams_view2;
 
 /* Bits of vfx_volume_view.disable. */
