@@ -101,12 +101,16 @@ static int cmp_d(const void *a, const void *b)
 }
 
 int bench_beams_gpu(int argc, char **argv);
+int bench_beams_panel(int argc, char **argv);
 
 int bench_beams(int argc, char **argv)
 {
-    for (int i = 1; i < argc; ++i)
+    for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--gpu"))
             return bench_beams_gpu(argc, argv);
+        if (!strcmp(argv[i], "--panel"))
+            return bench_beams_panel(argc, argv);
+    }
     int reps = 5;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--reps") && i + 1 < argc) reps = atoi(argv[++i]);
