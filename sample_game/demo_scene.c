@@ -11,6 +11,17 @@
 extern const char game_default_scene_json[];
 extern const unsigned long game_default_scene_json_len;
 
+/* The built-in default scene's relative paths (its dome mesh) resolve against
+ * VFX_SCENE_DIR when set, else the scenes folder of the tree the game was built from. */
+static const char *default_scene_dir(void)
+{
+    const char *env = getenv("VFX_SCENE_DIR");
+#ifndef GAME_SCENE_DIR
+#define GAME_SCENE_DIR "."
+#endif
+    return env && *env ? env : GAME_SCENE_DIR;
+}
+
 static vfx_result load_meshes(game_app *app, const rt_scene *sc)
 {
     for (uint32_t i = 0; i < sc->mesh_count; ++i) {
@@ -333,7 +344,7 @@ vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path
     char err[512];
     vfx_result r = scene_path
                        ? rt_scene_load_file(scene_path, &app->log, &demo->scene, err, sizeof err)
-                       : rt_scene_load_mem(game_default_scene_json, game_default_scene_json_len, NULL,
+                       : rt_scene_load_mem(game_default_scene_json, game_default_scene_json_len, default_scene_dir(),
                                             &app->log, &demo->scene, err, sizeof err);
     if (r) {
         rt_logf(&app->log, VFX_LOG_ERROR, "scene %s: %s", scene_path ? scene_path : "(built-in default)", err);

@@ -10,7 +10,9 @@ EPS = 0.002  # us: the trace's %.3f
 game = sys.argv[1]
 with tempfile.TemporaryDirectory() as d:
     trace = os.path.join(d, "t.json")
-    r = subprocess.run([game, "--headless", "--frames", "8", "--size", "96x54", "--png", os.path.join(d, "g.png"),
+    # a scene on the published water method: its march loop nests passes inside water.march
+    scene = os.path.join(os.environ.get("VFX_SOURCE_ROOT", "."), "sample_game", "scenes", "volume-showcase.json")
+    r = subprocess.run([game, "--headless", "--scene", scene, "--frames", "8", "--size", "96x54", "--png", os.path.join(d, "g.png"),
                         "--trace", trace], capture_output=True, text=True)
     if r.returncode != 0:
         print(r.stdout, r.stderr)
