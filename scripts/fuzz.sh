@@ -25,8 +25,12 @@ for t in $targets; do
   art=$dir/artifacts-$t; rm -rf "$art"; mkdir -p "$art"
   seeds=tests/fuzz/corpus/$t
   [ -d "$seeds" ] || { echo "fuzz_$t: no seed corpus $seeds"; status=1; continue; }
+  # Assimp (the system library) itself leaks 1,408 bytes when its OBJ importer throws on a bad
+  # index (shown with valgrind on a plain C program, no volfx code; docs/robustness.md): leak
+  # detection is off for that target only, crashes and UB still count
+  leaks=1; [ "$t" = assimp ] && leaks=0
   set +e
-  "$dir/tests/fuzz/fuzz_$t" -max_total_time="$secs" -max_len=8192 -timeout=20 -rss_limit_mb=2560 \
+  ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=$leaks" "$dir/tests/fuzz/fuzz_$t" -detect_leaks=$leaks -max_total_time="$secs" -max_len=8192 -timeout=20 -rss_limit_mb=2560 \
     -artifact_prefix="$art/" "$work" "$seeds" >"$log" 2>&1
   rc=$?
   set -e
