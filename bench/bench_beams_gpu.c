@@ -49,6 +49,25 @@ static void make_beams(game_app *app, uint32_t n)
     app->beam_count = n;
 }
 
+/* Issue 15's options: the beams go to the plugin as version 2 beams (the v1 fields as set, this
+ * falloff, the hot ramp) with bloom on or off. falloff 0: version 1 views as before. */
+static int g_falloff, g_bloom;
+static void sync_v2(game_app *app)
+{
+    app->beams_v2 = g_falloff != 0;
+    if (!app->beams_v2)
+        return;
+    for (uint32_t i = 0; i < app->beam_count; ++i)
+        app->beams2[i] = (vfx_beam2){.v1 = app->beams[i], .falloff = (uint32_t)g_falloff, .ramp = VFX_BEAM_RAMP_HOT};
+    app->beams_view2 = (vfx_beams_view2){.bloom = g_bloom ? VFX_BEAMS_BLOOM_ON : VFX_BEAMS_BLOOM_OFF};
+}
+
+static vfx_result frame(game_app *app)
+{
+    sync_v2(app);
+    return game_app_frame(app, 0.f);
+}
+
 int bench_beams_gpu(int argc, char **argv)
 {
     uint32_t sets[8] = {1, 5, 10}, nsets = 3, sizes[4][2] = {{256, 256}, {512, 512}}, nsizes = 2, frames = 8;
@@ -70,8 +89,18 @@ int bench_beams_gpu(int argc, char **argv)
             nsizes = 1;
         } else if (!strcmp(argv[i], "--frames") && i + 1 < argc) {
             frames = (uint32_t)strtoul(argv[++i], NULL, 10);
+        } else if (!strcmp(argv[i], "--falloff") && i + 1 < argc) {
+            const char *f = argv[++i];
+            g_falloff = !strcmp(f, "smooth") ? VFX_BEAM_FALLOFF_SMOOTH : !strcmp(f, "hard") ? VFX_BEAM_FALLOFF_HARD : -1;
+            if (g_falloff < 0) {
+                fprintf(stderr, "volfx-bench beams --gpu: --falloff smooth|hard, got '%s'\n", f);
+                return 2;
+            }
+        } else if (!strcmp(argv[i], "--bloom")) {
+            g_bloom = 1;
         } else if (strcmp(argv[i], "--gpu") && strcmp(argv[i], "--json")) {
-            fprintf(stderr, "volfx-bench beams --gpu: unknown option '%s' (--sets 1,5,10 --size WxH --frames N --timing-only)\n", argv[i]);
+            fprintf(stderr, "volfx-bench beams --gpu: unknown option '%s' (--sets 1,5,10 --size WxH --frames N "
+                            "--timing-only --falloff smooth|hard --bloom)\n", argv[i]);
             return 2;
         }
     }
@@ -97,8 +126,10 @@ int bench_beams_gpu(int argc, char **argv)
             make_beams(app, sets[si]);
             volfx_beam_d bd[GAME_APP_MAX_BEAMS];
             char err[128];
-            for (uint32_t i = 0; i < sets[si]; ++i)
+            for (uint32_t i = 0; i < sets[si]; ++i) {
                 volfx_beam_validate(&app->beams[i], &bd[i], err, sizeof err);
+                bd[i].smooth = g_falloff == VFX_BEAM_FALLOFF_SMOOTH;
+            }
             if (timing_only) {
                 /* large sets: closed form only, frame wall times (the headless host waits for the
                  * GPU), no reference; the pass timer is reported when its ring has delivered */
@@ -106,7 +137,7 @@ int bench_beams_gpu(int argc, char **argv)
                 double g = NAN;
                 for (uint32_t f = 0; f < frames; ++f) {
                     double t0 = rt_now_ms();
-                    if (game_app_frame(app, 0.f))
+                    if (frame(app))
                         return 1;
                     fr[f] = rt_now_ms() - t0;
                     double gf = stat_of(app, "beams.integrate.gpu_ms");
@@ -154,7 +185,7 @@ int bench_beams_gpu(int argc, char **argv)
                     }
                     for (int rep = 0; rep < 2; ++rep) {
                         double t0 = rt_now_ms();
-                        if (game_app_frame(app, 0.f))
+                        if (frame(app))
                             return 1;
                         (rep ? still : moved)[f] = rt_now_ms() - t0;
                     }
@@ -176,7 +207,7 @@ int bench_beams_gpu(int argc, char **argv)
                 uint32_t n = 0;
                 for (uint32_t f = 0; f < frames + 4; ++f) { /* 4 more: the timer ring's latency */
                     double t0 = rt_now_ms();
-                    if (game_app_frame(app, 0.f))
+                    if (frame(app))
                         return 1;
                     double t = rt_now_ms() - t0, g = stat_of(app, pass);
                     if (f >= 4 && !isnan(g)) {
@@ -204,9 +235,12 @@ int bench_beams_gpu(int argc, char **argv)
                        "\"samples\":%u,\"frames\":%u,\"gpu_ms_p50\":%.4f,\"frame_ms_p50\":%.4f,"
                        "\"frame_ms\":{\"p50\":%.4f,\"p95\":%.4f,\"p99\":%.4f},"
                        "\"max_rel_err\":%.4g,\"mean_rel_err\":%.4g,\"above_1e-5\":%u,\"max_rel_where_cond_below_1e-5\":%.4g,"
-                       "\"max_err_over_1e-5_plus_cond\":%.4g,\"pixels\":%u,\"gl_renderer\":\"%s\"}\n",
+                       "\"max_err_over_1e-5_plus_cond\":%.4g,\"pixels\":%u,\"falloff\":\"%s\",\"bloom\":%s,"
+                       "\"bloom_ms\":%.4f,\"gl_renderer\":\"%s\"}\n",
                        sets[si], w, h, samples[mi] ? "march" : "closed", samples[mi], n, rt_median(ms, n),
                        fp.p50, fp.p50, fp.p95, fp.p99, emax, ne ? esum / ne : 0.0, above, emax_wc, ratio, ne,
+                       g_falloff == VFX_BEAM_FALLOFF_SMOOTH ? "smooth" : "hard", g_bloom ? "true" : "false",
+                       g_bloom ? stat_of(app, "beams.bloom_down.gpu_ms") + stat_of(app, "beams.bloom_up.gpu_ms") : 0.0,
                        rt_gl_context_renderer(app->gl));
                 fflush(stdout);
             }

@@ -156,7 +156,7 @@ int bench_beams_panel(int argc, char **argv)
     /* equal time: the march sample count whose integrate time is nearest the closed form's */
     uint32_t best = 1;
     double best_gap = INFINITY;
-    for (uint32_t n = 1; n <= 64; n *= 2) {
+    for (uint32_t n = 1; n <= 1024; n *= 2) {
         variant m = {"march-probe", VFX_BEAM_FALLOFF_SMOOTH, VFX_BEAMS_BLOOM_OFF, n};
         app->time = t;
         game_demo_animate(app, &demo, 0.f);

@@ -37,7 +37,8 @@ typedef struct beam_look {
 } beam_look;
 
 typedef struct beams_state {
-    GLuint prog_closed, prog_march, prog_composite, prog_down, prog_up;
+    GLuint prog_integrate[8]; /* [march | smooth << 1 | polyline << 2]: code only where a beam needs it */
+    GLuint prog_composite, prog_down, prog_up;
     GLuint beam_buf, range_buf, list_buf, joint_buf;
     size_t beam_cap, range_cap, list_cap, joint_cap; /* bytes */
     float (*joint_xyz)[4];      /* polyline joints this frame, eye-relative (capacity: beams x max) */
@@ -116,11 +117,10 @@ static vfx_result beams_create(vfx_context *ctx, void **out)
     beams_state *s = volfx_alloc(ctx, sizeof *s);
     if (!s)
         return VFX_ERR_OUT_OF_MEMORY;
-    s->prog_closed = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag", NULL);
     s->prog_composite = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/composite.frag", NULL);
     s->prog_down = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/bloom_down.frag", NULL);
     s->prog_up = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/bloom_up.frag", NULL);
-    if (!s->prog_closed || !s->prog_composite || !s->prog_down || !s->prog_up
+    if (!s->prog_composite || !s->prog_down || !s->prog_up
         || !volfx_ubo_create(ctx, &s->ubo, sizeof(beams_block), "beams.frame")) {
         beams_destroy(ctx, s);
         return VFX_ERR_GL;
@@ -450,13 +450,21 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
         || (r = upload(ctx, s->joint_buf, &s->joint_cap, s->joint_xyz, s->joint_used * sizeof s->joint_xyz[0])))
         return r;
 
-    bool march = s->view.v1.method == 1;
-    GLuint prog = s->prog_closed;
-    if (march) {
-        if (!s->prog_march)
-            s->prog_march = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
-                                              "#define VOLFX_BEAMS_MARCH 1");
-        if (!(prog = s->prog_march))
+    bool march = s->view.v1.method == 1, any_smooth = false, any_poly = false;
+    for (uint32_t i = 0; i < s->count; ++i)
+        any_smooth |= s->beams[i].smooth != 0, any_poly |= s->beams[i].joint_count >= 2;
+    unsigned variant = (unsigned)march | (unsigned)any_smooth << 1 | (unsigned)any_poly << 2;
+    GLuint prog = s->prog_integrate[variant];
+    if (!prog) {
+        static const char *const defs[8] = {
+            NULL, "#define VOLFX_BEAMS_MARCH 1", "#define VOLFX_BEAMS_SMOOTH 1",
+            "#define VOLFX_BEAMS_MARCH 1\n#define VOLFX_BEAMS_SMOOTH 1", "#define VOLFX_BEAMS_POLYLINE 1",
+            "#define VOLFX_BEAMS_MARCH 1\n#define VOLFX_BEAMS_POLYLINE 1",
+            "#define VOLFX_BEAMS_SMOOTH 1\n#define VOLFX_BEAMS_POLYLINE 1",
+            "#define VOLFX_BEAMS_MARCH 1\n#define VOLFX_BEAMS_SMOOTH 1\n#define VOLFX_BEAMS_POLYLINE 1"};
+        prog = s->prog_integrate[variant] = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
+                                                              defs[variant]);
+        if (!prog)
             return VFX_ERR_GL;
     }
     /* bloom: on by default for version 2 hosts, off for version 1 ones (their image as it was) */

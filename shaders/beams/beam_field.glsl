@@ -55,10 +55,12 @@ float volfx_segment_integral(float x0, float x1, float s, float beta, float Q)
     return volfx_same_sign(y0, y1, dx, s, Q);
 }
 
+#ifdef VOLFX_BEAMS_SMOOTH
 // the smooth support's piece (beam_field_impl.inc smooth_same_sign): 0 <= lo <= hi <= h, units
 // of R; edge series near the support edge, binomial series when grazing, closed form elsewhere
 const int VOLFX_EDGE_TERMS = 12;
-const int VOLFX_SERIES_TERMS = 24;
+const int VOLFX_SERIES_TERMS = 12;
+const float VOLFX_GRAZING_M = 0.25; // as the float path of beam_field_impl.inc
 float volfx_smooth_same_sign(float lo, float hi, float dx, float s, float Q, float h)
 {
     hi = min(hi, h);
@@ -85,7 +87,7 @@ float volfx_smooth_same_sign(float lo, float hi, float dx, float s, float Q, flo
         }
         return dx * rho * rho * rho * sum;
     }
-    if (2.0 * h2 < Q2) {
+    if (h2 < VOLFX_GRAZING_M * Q2) {
         float u0 = lo / h, u1 = hi / h, m = h2 / Q2;
         float E0 = 1.0, P = u0, u11 = u1 * u1, us = u1 + u0, u00 = u0 * u0;
         float E1 = u11 * E0 + P * us;
@@ -127,12 +129,19 @@ float volfx_segment_integral_smooth(float x0, float x1, float s, float beta, flo
     return volfx_smooth_same_sign(y0, y1, dx, s, Q, h);
 }
 
+#endif
+
+// The smooth and polyline code is compiled in only when a beam of the frame needs it
+// (VOLFX_BEAMS_SMOOTH, VOLFX_BEAMS_POLYLINE): llvmpipe pays for code a lane skips.
 float volfx_piece(float x0, float x1, float s, float beta, float Q, float h, float R, bool soft)
 {
-    if (!soft)
-        return volfx_segment_integral(x0, x1, s, beta, Q);
-    float ir = 1.0 / R;
-    return volfx_segment_integral_smooth(x0, x1, s * ir, beta * ir, Q * ir, h * ir) * ir;
+#ifdef VOLFX_BEAMS_SMOOTH
+    if (soft) {
+        float ir = 1.0 / R;
+        return volfx_segment_integral_smooth(x0, x1, s * ir, beta * ir, Q * ir, h * ir) * ir;
+    }
+#endif
+    return volfx_segment_integral(x0, x1, s, beta, Q);
 }
 
 // restricts [lo, hi] to u0 + c x in [umin, umax) (half-open: a ray in a boundary plane counts once)

@@ -5,7 +5,6 @@
 // of their summed H (docs/beams.md "Emission").
 layout(std430, binding = 4) readonly buffer Joints { vec4 joints[]; }; // xyz relative to the eye
 vec3 volfx_joint(uint i) { return joints[i].xyz; }
-#define VOLFX_BEAMS_POLYLINE 1
 #include "beams/beam_field.glsl"
 #include "beams/frame.glsl"
 
@@ -48,6 +47,7 @@ float volfx_nearest_u(vec3 M, vec3 D, float L, vec3 V)
     return clamp(u, 0.0, L);
 }
 
+#ifdef VOLFX_BEAMS_POLYLINE
 // the same for a polyline: arc length from J0 at the nearest approach to the nearest segment
 float volfx_poly_nearest_u(uint first, int nj, vec3 V)
 {
@@ -70,6 +70,7 @@ float volfx_poly_nearest_u(uint first, int nj, vec3 V)
     }
     return u;
 }
+#endif
 
 void main()
 {
@@ -93,7 +94,9 @@ void main()
     for (uint k = 0u; k < range.y; ++k) {
         Beam bm = beams[list[range.x + k]];
         bool soft = bm.mode.x != 0u;
+#ifdef VOLFX_BEAMS_POLYLINE
         bool poly = bm.mode.w >= 2u;
+#endif
         float h;
 #ifdef VOLFX_BEAMS_MARCH
         // baseline: midpoint samples over the ray's chord through the beam's bounding sphere
@@ -107,17 +110,23 @@ void main()
             float dt = (tb - ta) / float(u_samples);
             for (int i = 0; i < u_samples && tb > ta; ++i) {
                 vec3 P = (ta + (float(i) + 0.5) * dt) * V;
-                h += (poly ? volfx_polyline_density(bm.mode.z, int(bm.mode.w), bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
-                                                    bm.ab_eps.z, soft, P)
-                           : volfx_beam_density(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x,
-                                                bm.ab_eps.y, bm.ab_eps.z, soft, P)) * dt;
+#ifdef VOLFX_BEAMS_POLYLINE
+                if (poly)
+                    h += volfx_polyline_density(bm.mode.z, int(bm.mode.w), bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
+                                                bm.ab_eps.z, soft, P) * dt;
+                else
+#endif
+                    h += volfx_beam_density(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x,
+                                            bm.ab_eps.y, bm.ab_eps.z, soft, P) * dt;
             }
         }
 #else
+#ifdef VOLFX_BEAMS_POLYLINE
         if (poly)
             h = volfx_polyline_integral(bm.mode.z, int(bm.mode.w), bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
                                         bm.ab_eps.z, soft, V, 0.0, tmax);
         else
+#endif
             h = volfx_beam_integral(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
                                     bm.ab_eps.z, soft, V, 0.0, tmax);
 #endif
@@ -128,8 +137,12 @@ void main()
         } else if (h > 0.0) {
             float x = h * bm.look.y;
             if (bm.look.z > 0.0) {
+#ifdef VOLFX_BEAMS_POLYLINE
                 float u = poly ? volfx_poly_nearest_u(bm.mode.z, int(bm.mode.w), V)
                                : volfx_nearest_u(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, V);
+#else
+                float u = volfx_nearest_u(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, V);
+#endif
                 x *= 1.0 + bm.look.z * (2.0 * volfx_flow_noise(u * bm.ab_eps.w - bm.look.w) - 1.0);
             }
             float x2 = x * x;
