@@ -16,6 +16,11 @@
 typedef struct program_entry {
     char *key; /* "vert|frag|defines", whole: ablation sweeps differ only late in the defines */
     GLuint program;
+    /* every active uniform's name and location, read once when the program is linked, so the
+     * frame path never asks GL by name (volfx_gpu_uniform) */
+    uint32_t uniform_count;
+    char (*uniform_names)[48];
+    GLint *uniform_locs;
 } program_entry;
 
 typedef struct timer_frame {
@@ -83,6 +88,8 @@ void volfx_gpu_destroy(vfx_context *ctx, volfx_gpu *g)
     for (uint32_t i = 0; i < g->program_count; ++i) {
         glDeleteProgram(g->programs[i].program);
         free(g->programs[i].key);
+        volfx_free(ctx, g->programs[i].uniform_names);
+        volfx_free(ctx, g->programs[i].uniform_locs);
     }
     for (int f = 0; f < GPU_RING; ++f)
         glDeleteQueries(GPU_MAX_PASSES * 2, g->ring[f].queries);
@@ -139,6 +146,30 @@ GLuint volfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *s
     return prog;
 }
 
+/* Reads the linked program's active uniforms (arrays by their base name) into the entry. */
+static void read_uniforms(vfx_context *ctx, program_entry *e)
+{
+    GLint n = 0;
+    glGetProgramiv(e->program, GL_ACTIVE_UNIFORMS, &n);
+    if (n <= 0)
+        return;
+    e->uniform_names = volfx_alloc(ctx, (size_t)n * sizeof *e->uniform_names);
+    e->uniform_locs = volfx_alloc(ctx, (size_t)n * sizeof *e->uniform_locs);
+    if (!e->uniform_names || !e->uniform_locs)
+        return; /* error recorded; volfx_gpu_uniform then answers -1 */
+    for (GLint k = 0; k < n; ++k) {
+        char *name = e->uniform_names[e->uniform_count];
+        glGetActiveUniformName(e->program, (GLuint)k, (GLsizei)sizeof e->uniform_names[0], NULL, name);
+        GLint loc = glGetUniformLocation(e->program, name);
+        if (loc < 0)
+            continue; /* in a uniform block: set through its buffer */
+        char *bracket = strstr(name, "[0]");
+        if (bracket)
+            *bracket = 0;
+        e->uniform_locs[e->uniform_count++] = loc;
+    }
+}
+
 static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const char *const *paths,
                           const char *defines)
 {
@@ -180,10 +211,26 @@ static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const c
     program_entry *e = &g->programs[g->program_count++];
     e->key = key;
     e->program = prog;
+    read_uniforms(ctx, e);
     char label[96];
     snprintf(label, sizeof label, "volfx.%s", n > 1 ? paths[1] : paths[0]);
     volfx_gpu_label(GL_PROGRAM, prog, label);
     return prog;
+}
+
+GLint volfx_gpu_uniform(vfx_context *ctx, GLuint prog, const char *name)
+{
+    volfx_gpu *g = ctx->gpu;
+    for (uint32_t i = g->program_count; i-- > 0;) {
+        const program_entry *e = &g->programs[i];
+        if (e->program != prog)
+            continue;
+        for (uint32_t k = 0; k < e->uniform_count; ++k)
+            if (strcmp(e->uniform_names[k], name) == 0)
+                return e->uniform_locs[k];
+        return -1; /* optimised out or misspelt: GL ignores location -1 */
+    }
+    return -1;
 }
 
 GLuint volfx_gpu_program(vfx_context *ctx, const char *vert, const char *frag, const char *defines)

@@ -18,6 +18,9 @@ void volfx_gpu_destroy(vfx_context *ctx, volfx_gpu *gpu);
 GLuint volfx_gpu_program(vfx_context *ctx, const char *vert, const char *frag, const char *defines);
 /* Same for a compute shader. */
 GLuint volfx_gpu_compute(vfx_context *ctx, const char *comp, const char *defines);
+/* Location of a uniform of a program made by volfx_gpu_program/compute, from the table read
+ * when it was linked (no GL call); -1 when the program has no such active uniform. */
+GLint volfx_gpu_uniform(vfx_context *ctx, GLuint prog, const char *name);
 
 /* Opens a named pass: a debug group (RenderDoc shows it) and a timestamp pair. Names are
  * "effect.pass", e.g. "water.potential"; the GPU ms of the pass reach the stats as

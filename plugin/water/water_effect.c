@@ -363,22 +363,22 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
 }
 
 
-static void set_common(GLuint prog, const water_state *s, const vfx_frame_view *frame,
+static void set_common(vfx_context *ctx, GLuint prog, const water_state *s, const vfx_frame_view *frame,
                        const volfx_frame_targets *targets, float t_end)
 {
     const vfx_water_params *p = &s->params;
-    glUniformMatrix4fv(glGetUniformLocation(prog, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
-    glUniform3fv(glGetUniformLocation(prog, "u_eye"), 1, frame->eye);
-    glUniform1f(glGetUniformLocation(prog, "u_h"), p->h);
-    glUniform1f(glGetUniformLocation(prog, "u_T"), p->threshold);
-    glUniform1f(glGetUniformLocation(prog, "u_step"), p->step);
-    glUniform1f(glGetUniformLocation(prog, "u_t_end"), t_end);
-    glUniform1f(glGetUniformLocation(prog, "u_near"), frame->near_plane > 0 ? frame->near_plane : 0.01f);
-    glUniform1ui(glGetUniformLocation(prog, "u_max_samples"), p->max_samples);
-    glUniform1ui(glGetUniformLocation(prog, "u_count"), s->count);
-    glUniform1i(glGetUniformLocation(prog, "u_has_depth"), frame->depth_texture != 0);
-    glUniform2i(glGetUniformLocation(prog, "u_size"), (GLint)s->width, (GLint)s->height);
-    glUniform2f(glGetUniformLocation(prog, "u_sizef"), (float)s->width, (float)s->height);
+    glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
+    glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_eye"), 1, frame->eye);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_h"), p->h);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_T"), p->threshold);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_step"), p->step);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_t_end"), t_end);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_near"), frame->near_plane > 0 ? frame->near_plane : 0.01f);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_max_samples"), p->max_samples);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_count"), s->count);
+    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_has_depth"), frame->depth_texture != 0);
+    glUniform2i(volfx_gpu_uniform(ctx, prog, "u_size"), (GLint)s->width, (GLint)s->height);
+    glUniform2f(volfx_gpu_uniform(ctx, prog, "u_sizef"), (float)s->width, (float)s->height);
     if (frame->depth_texture)
         glBindTextureUnit(1, frame->depth_texture);
 }
@@ -391,11 +391,11 @@ static void dispatch(const water_state *s)
 
 /* Min/max pyramid of the distances in `src` (level 0 from `pyr0`, 2x2 reductions by `pyrd`
  * down to `level`): the tiles the billboard passes cull against. */
-static void build_pyramid(const water_state *s, GLuint pyr0, GLuint pyrd, const vfx_frame_view *frame,
+static void build_pyramid(vfx_context *ctx, const water_state *s, GLuint pyr0, GLuint pyrd, const vfx_frame_view *frame,
                           const volfx_frame_targets *targets, float t_end, GLuint src, int level)
 {
     glUseProgram(pyr0);
-    set_common(pyr0, s, frame, targets, t_end);
+    set_common(ctx, pyr0, s, frame, targets, t_end);
     glBindImageTexture(2, src, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
     glBindImageTexture(5, s->pyr, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
     dispatch(s);
@@ -438,8 +438,8 @@ static vfx_result brute_march(vfx_context *ctx, water_state *s, const vfx_frame_
     glUseProgram(prog);
     for (int k = 0; k < 3; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, s->cols[k]);
-    volfx_water_march_bind(prog, ctx->water_dist_tex, &s->params, frame, targets);
-    glUniform1ui(glGetUniformLocation(prog, "u_count"), s->count);
+    volfx_water_march_bind(ctx, prog, ctx->water_dist_tex, &s->params, frame, targets);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_count"), s->count);
     glDispatchCompute((s->width + 7) / 8, (s->height + 7) / 8, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     volfx_gpu_pass_end(ctx);
@@ -459,7 +459,7 @@ static vfx_result potential_pass(vfx_context *ctx, water_state *s, const vfx_fra
         if (!prog)
             return VFX_ERR_GL;
         glUseProgram(prog);
-        set_common(prog, s, frame, targets, t_end);
+        set_common(ctx, prog, s, frame, targets, t_end);
         glBindImageTexture(2, at, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
         glBindImageTexture(5, s->pot, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
         dispatch(s);
@@ -478,15 +478,15 @@ static vfx_result potential_pass(vfx_context *ctx, water_state *s, const vfx_fra
     glBlendFunc(GL_ONE, GL_ONE);
     glBlendEquation(GL_FUNC_ADD);
     glUseProgram(prog);
-    set_common(prog, s, frame, targets, t_end);
-    glUniformMatrix4fv(glGetUniformLocation(prog, "u_view_proj"), 1, GL_FALSE, s->view_proj);
+    set_common(ctx, prog, s, frame, targets, t_end);
+    glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_view_proj"), 1, GL_FALSE, s->view_proj);
     glBindTextureUnit(0, at);
     glBindTextureUnit(1, s->pyr);
     int level = (int)s->params.pyramid_level;
     if (level >= s->pyr_levels)
         level = s->pyr_levels - 1;
-    glUniform1i(glGetUniformLocation(prog, "u_pyr_level"), level);
-    glUniform1i(glGetUniformLocation(prog, "u_cull"), cull);
+    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_pyr_level"), level);
+    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_cull"), cull);
     draw_billboards(ctx, s);
     glDisable(GL_BLEND);
     return VFX_OK;
@@ -509,8 +509,8 @@ static void nearest_face_pass(vfx_context *ctx, const water_state *s, GLuint pro
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
     glUseProgram(prog);
-    set_common(prog, s, frame, targets, t_end);
-    glUniformMatrix4fv(glGetUniformLocation(prog, "u_view_proj"), 1, GL_FALSE, vp);
+    set_common(ctx, prog, s, frame, targets, t_end);
+    glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_view_proj"), 1, GL_FALSE, vp);
     if (after)
         glBindTextureUnit(0, after);
     draw_billboards(ctx, s);
@@ -539,7 +539,7 @@ static vfx_result surface_passes(vfx_context *ctx, water_state *s, const vfx_fra
 
     volfx_gpu_pass_begin(ctx, "water.normal");
     if (cull)
-        build_pyramid(s, pyr0, pyrd, frame, targets, 0, ctx->water_dist_tex, level);
+        build_pyramid(ctx, s, pyr0, pyrd, frame, targets, 0, ctx->water_dist_tex, level);
     glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_grad);
     glViewport(0, 0, (GLsizei)s->width, (GLsizei)s->height);
     glClearNamedFramebufferfv(s->fbo_grad, GL_COLOR, 0, zero);
@@ -548,10 +548,10 @@ static vfx_result surface_passes(vfx_context *ctx, water_state *s, const vfx_fra
     glBlendFunc(GL_ONE, GL_ONE);
     glBlendEquation(GL_FUNC_ADD);
     glUseProgram(grad);
-    set_common(grad, s, frame, targets, 0);
-    glUniformMatrix4fv(glGetUniformLocation(grad, "u_view_proj"), 1, GL_FALSE, s->view_proj);
-    glUniform1i(glGetUniformLocation(grad, "u_pyr_level"), level);
-    glUniform1i(glGetUniformLocation(grad, "u_cull"), cull);
+    set_common(ctx, grad, s, frame, targets, 0);
+    glUniformMatrix4fv(volfx_gpu_uniform(ctx, grad, "u_view_proj"), 1, GL_FALSE, s->view_proj);
+    glUniform1i(volfx_gpu_uniform(ctx, grad, "u_pyr_level"), level);
+    glUniform1i(volfx_gpu_uniform(ctx, grad, "u_cull"), cull);
     glBindTextureUnit(0, ctx->water_dist_tex);
     glBindTextureUnit(1, s->pyr);
     draw_billboards(ctx, s);
@@ -562,12 +562,12 @@ static vfx_result surface_passes(vfx_context *ctx, water_state *s, const vfx_fra
     glClearNamedFramebufferfv(s->fbo_back, GL_COLOR, 0, zero);
     glBlendEquation(GL_MAX);
     glUseProgram(back);
-    set_common(back, s, frame, targets, 0);
-    glUniformMatrix4fv(glGetUniformLocation(back, "u_view_proj"), 1, GL_FALSE, s->view_proj);
+    set_common(ctx, back, s, frame, targets, 0);
+    glUniformMatrix4fv(volfx_gpu_uniform(ctx, back, "u_view_proj"), 1, GL_FALSE, s->view_proj);
     /* every point within h(1 - T) of a particle is inside (one term alone reaches T^2), so
      * these balls lie in the water: exact for a lone particle, short of a merged body's back */
     float rho = p->h * (1.0f - p->threshold);
-    glUniform1f(glGetUniformLocation(back, "u_rho"), rho > 0 ? rho : 0.0f);
+    glUniform1f(volfx_gpu_uniform(ctx, back, "u_rho"), rho > 0 ? rho : 0.0f);
     glBindTextureUnit(0, ctx->water_dist_tex);
     draw_billboards(ctx, s);
     glBlendEquation(GL_FUNC_ADD);
@@ -729,7 +729,7 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
         /* (5) min/max pyramid of the current samples, 2x2 reductions down to `level` */
         if (cull) {
             volfx_gpu_pass_begin(ctx, "water.pyramid");
-            build_pyramid(s, pyr0, pyrd, frame, targets, t_end, s->cur, level);
+            build_pyramid(ctx, s, pyr0, pyrd, frame, targets, t_end, s->cur, level);
             volfx_gpu_pass_end(ctx);
         }
         /* (3)+(4) potentials at NS consecutive samples */
@@ -741,7 +741,7 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
         /* inside/outside, stop flag, t'_next = t + NS w (eq. 2) into buffer 1 */
         volfx_gpu_pass_begin(ctx, "water.update");
         glUseProgram(upd);
-        set_common(upd, s, frame, targets, t_end);
+        set_common(ctx, upd, s, frame, targets, t_end);
         glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
         glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
         glBindImageTexture(2, s->cur, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
@@ -773,7 +773,7 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
     if (!interp || !refine || !fin)
         return VFX_ERR_GL;
     glUseProgram(interp);
-    set_common(interp, s, frame, targets, t_end);
+    set_common(ctx, interp, s, frame, targets, t_end);
     glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
@@ -784,7 +784,7 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
         if (r)
             return r;
         glUseProgram(refine);
-        set_common(refine, s, frame, targets, t_end);
+        set_common(ctx, refine, s, frame, targets, t_end);
         glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
         glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
         glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
@@ -792,7 +792,7 @@ static vfx_result paper_march(vfx_context *ctx, water_state *s, const vfx_frame_
         dispatch(s);
     }
     glUseProgram(fin);
-    set_common(fin, s, frame, targets, t_end);
+    set_common(ctx, fin, s, frame, targets, t_end);
     glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
@@ -897,14 +897,14 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     glBindTextureUnit(2, s->grad);
     glBindTextureUnit(3, s->back);
     glBindTextureUnit(4, frame->depth_texture);
-    glUniformMatrix4fv(glGetUniformLocation(shade, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
-    glUniform3fv(glGetUniformLocation(shade, "u_eye"), 1, frame->eye);
-    glUniform1f(glGetUniformLocation(shade, "u_absorption"), p->absorption);
-    glUniform1f(glGetUniformLocation(shade, "u_ior"), p->ior);
-    glUniform3fv(glGetUniformLocation(shade, "u_tint"), 1, p->color);
-    glUniform1i(glGetUniformLocation(shade, "u_flat"), (p->disable & VFX_WATER_NO_SHADING) != 0);
-    glUniform1i(glGetUniformLocation(shade, "u_has_color"), frame->color_texture != 0);
-    glUniform1i(glGetUniformLocation(shade, "u_has_depth"), frame->depth_texture != 0);
+    glUniformMatrix4fv(volfx_gpu_uniform(ctx, shade, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
+    glUniform3fv(volfx_gpu_uniform(ctx, shade, "u_eye"), 1, frame->eye);
+    glUniform1f(volfx_gpu_uniform(ctx, shade, "u_absorption"), p->absorption);
+    glUniform1f(volfx_gpu_uniform(ctx, shade, "u_ior"), p->ior);
+    glUniform3fv(volfx_gpu_uniform(ctx, shade, "u_tint"), 1, p->color);
+    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_flat"), (p->disable & VFX_WATER_NO_SHADING) != 0);
+    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_color"), frame->color_texture != 0);
+    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_depth"), frame->depth_texture != 0);
     volfx_gpu_fullscreen(ctx);
     volfx_gpu_pass_end(ctx);
     counters_frame_end(ctx, s, p->method);

@@ -83,29 +83,29 @@ static GLuint storage(GLsizeiptr bytes, const char *label)
     return b;
 }
 
-static void grid_uniforms(GLuint prog, const volfx_water_grid_input *in, const float g0[3], float cs,
+static void grid_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_grid_input *in, const float g0[3], float cs,
                           const int dims[3], uint32_t n)
 {
-    glUniform1ui(glGetUniformLocation(prog, "u_count"), in->count);
-    glUniform1ui(glGetUniformLocation(prog, "u_n"), n);
-    glUniform3fv(glGetUniformLocation(prog, "u_g0"), 1, g0);
-    glUniform1f(glGetUniformLocation(prog, "u_cs"), cs);
-    glUniform3iv(glGetUniformLocation(prog, "u_dims"), 1, dims);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_count"), in->count);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_n"), n);
+    glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_g0"), 1, g0);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_cs"), cs);
+    glUniform3iv(volfx_gpu_uniform(ctx, prog, "u_dims"), 1, dims);
 }
 
-void volfx_water_march_bind(GLuint prog, GLuint dist_tex, const vfx_water_params *p,
+void volfx_water_march_bind(vfx_context *ctx, GLuint prog, GLuint dist_tex, const vfx_water_params *p,
                           const vfx_frame_view *frame, const volfx_frame_targets *targets)
 {
     glBindImageTexture(0, dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     glBindTextureUnit(1, frame->depth_texture);
-    glUniformMatrix4fv(glGetUniformLocation(prog, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
-    glUniform3fv(glGetUniformLocation(prog, "u_eye"), 1, frame->eye);
-    glUniform1f(glGetUniformLocation(prog, "u_h"), p->h);
-    glUniform1f(glGetUniformLocation(prog, "u_T"), p->threshold);
-    glUniform1f(glGetUniformLocation(prog, "u_step"), p->step);
-    glUniform1ui(glGetUniformLocation(prog, "u_max_samples"), p->max_samples);
-    glUniform1ui(glGetUniformLocation(prog, "u_refine_iters"), (p->disable & VFX_WATER_NO_REFINE) ? 0u : p->refine_iters);
-    glUniform1i(glGetUniformLocation(prog, "u_has_depth"), frame->depth_texture != 0);
+    glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
+    glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_eye"), 1, frame->eye);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_h"), p->h);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_T"), p->threshold);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_step"), p->step);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_max_samples"), p->max_samples);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_refine_iters"), (p->disable & VFX_WATER_NO_REFINE) ? 0u : p->refine_iters);
+    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_has_depth"), frame->depth_texture != 0);
 }
 
 vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const volfx_water_grid_input *in,
@@ -161,26 +161,26 @@ vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const 
         volfx_gpu_pass_begin(ctx, "water.grid_build");
         glClearNamedBufferSubData(g->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
         glUseProgram(count);
-        grid_uniforms(count, in, g0, cs, dims, nscan);
+        grid_uniforms(ctx, count, in, g0, cs, dims, nscan);
         if (groups)
             glDispatchCompute(gx, gy, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         glUseProgram(scan);
-        grid_uniforms(scan, in, g0, cs, dims, nscan);
+        grid_uniforms(ctx, scan, in, g0, cs, dims, nscan);
         glDispatchCompute(blocks, 1, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         glUseProgram(top);
-        grid_uniforms(top, in, g0, cs, dims, blocks);
+        grid_uniforms(ctx, top, in, g0, cs, dims, blocks);
         glDispatchCompute(1, 1, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         glUseProgram(add);
-        grid_uniforms(add, in, g0, cs, dims, nscan);
+        grid_uniforms(ctx, add, in, g0, cs, dims, nscan);
         glDispatchCompute((nscan + 255u) / 256u, 1, 1);
         /* the counts are spent: the same buffer becomes the per-cell fill cursor of the scatter */
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
         glClearNamedBufferSubData(g->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
         glUseProgram(scatter);
-        grid_uniforms(scatter, in, g0, cs, dims, nscan);
+        grid_uniforms(ctx, scatter, in, g0, cs, dims, nscan);
         if (groups)
             glDispatchCompute(gx, gy, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -194,19 +194,19 @@ vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const 
     /* the counters were cleared by the effect at the start of the frame */
     volfx_gpu_pass_begin(ctx, "water.grid_march");
     glUseProgram(march);
-    grid_uniforms(march, in, g0, cs, dims, nscan);
+    grid_uniforms(ctx, march, in, g0, cs, dims, nscan);
     float blo[3], bhi[3];
     for (int k = 0; k < 3; ++k) {
         blo[k] = in->finite ? in->lo[k] - p->h : 0.0f;
         bhi[k] = in->finite ? in->hi[k] + p->h : -1.0f; /* empty box: every ray misses */
     }
-    glUniform3fv(glGetUniformLocation(march, "u_blo"), 1, blo);
-    glUniform3fv(glGetUniformLocation(march, "u_bhi"), 1, bhi);
-    volfx_water_march_bind(march, in->dist_tex, p, frame, targets);
+    glUniform3fv(volfx_gpu_uniform(ctx, march, "u_blo"), 1, blo);
+    glUniform3fv(volfx_gpu_uniform(ctx, march, "u_bhi"), 1, bhi);
+    volfx_water_march_bind(ctx, march, in->dist_tex, p, frame, targets);
     /* the paper's technique bits mean the same here: 1 = start at the box entry instead of the
      * first sphere entry, 2 = fixed steps after the start (no jump over empty space) */
-    glUniform1i(glGetUniformLocation(march, "u_seek_init"), !(p->disable & VFX_WATER_NO_BILLBOARD_INIT));
-    glUniform1i(glGetUniformLocation(march, "u_seek_gaps"), !(p->disable & VFX_WATER_NO_SKIP));
+    glUniform1i(volfx_gpu_uniform(ctx, march, "u_seek_init"), !(p->disable & VFX_WATER_NO_BILLBOARD_INIT));
+    glUniform1i(volfx_gpu_uniform(ctx, march, "u_seek_gaps"), !(p->disable & VFX_WATER_NO_SKIP));
     glDispatchCompute((in->width + 7) / 8, (in->height + 7) / 8, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);

@@ -37,7 +37,7 @@ vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const 
  * program prog: dist_tex as image 0, the scene depth on unit 1, the ray (inverse view-projection,
  * eye), the sampling rule (h, T, step, sample cap), refinement (off with VFX_WATER_NO_REFINE)
  * and whether there is scene depth. */
-void volfx_water_march_bind(GLuint prog, GLuint dist_tex, const vfx_water_params *p,
+void volfx_water_march_bind(vfx_context *ctx, GLuint prog, GLuint dist_tex, const vfx_water_params *p,
                           const vfx_frame_view *frame, const volfx_frame_targets *targets);
 
 #endif

@@ -62,18 +62,18 @@ static GLuint storage(GLsizeiptr bytes, const char *label)
     return b;
 }
 
-static void tile_uniforms(GLuint prog, const volfx_water_tile *t, const volfx_water_tile_input *in, uint32_t n)
+static void tile_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_tile *t, const volfx_water_tile_input *in, uint32_t n)
 {
-    glUniform1ui(glGetUniformLocation(prog, "u_count"), in->count);
-    glUniform1ui(glGetUniformLocation(prog, "u_n"), n);
-    glUniform1ui(glGetUniformLocation(prog, "u_cap"), (in->params->disable & VFX_WATER_NO_TILES) ? 0u : t->entry_cap);
-    glUniform1ui(glGetUniformLocation(prog, "u_global_tiles"), TILE_GLOBAL_TILES);
-    glUniform2i(glGetUniformLocation(prog, "u_tiles"), (GLint)t->tiles_x, (GLint)t->tiles_y);
-    glUniform2i(glGetUniformLocation(prog, "u_size"), (GLint)in->width, (GLint)in->height);
-    glUniform1f(glGetUniformLocation(prog, "u_h"), in->params->h);
-    glUniform1ui(glGetUniformLocation(prog, "u_slabs"), t->slabs);
-    glUniform1f(glGetUniformLocation(prog, "u_d0"), t->d0);
-    glUniform1f(glGetUniformLocation(prog, "u_ds"), t->ds);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_count"), in->count);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_n"), n);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_cap"), (in->params->disable & VFX_WATER_NO_TILES) ? 0u : t->entry_cap);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_global_tiles"), TILE_GLOBAL_TILES);
+    glUniform2i(volfx_gpu_uniform(ctx, prog, "u_tiles"), (GLint)t->tiles_x, (GLint)t->tiles_y);
+    glUniform2i(volfx_gpu_uniform(ctx, prog, "u_size"), (GLint)in->width, (GLint)in->height);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_h"), in->params->h);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_slabs"), t->slabs);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_d0"), t->d0);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_ds"), t->ds);
 }
 
 static void bind_buffers(const volfx_water_tile *t, const volfx_water_tile_input *in)
@@ -165,31 +165,31 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
     glClearNamedBufferSubData(t->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     glClearNamedBufferSubData(t->globals, GL_R32UI, 0, 16, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     glUseProgram(count);
-    tile_uniforms(count, t, in, nscan);
-    glUniformMatrix4fv(glGetUniformLocation(count, "u_view_proj"), 1, GL_FALSE, in->view_proj);
-    glUniform3fv(glGetUniformLocation(count, "u_eye_bin"), 1, in->eye);
+    tile_uniforms(ctx, count, t, in, nscan);
+    glUniformMatrix4fv(volfx_gpu_uniform(ctx, count, "u_view_proj"), 1, GL_FALSE, in->view_proj);
+    glUniform3fv(volfx_gpu_uniform(ctx, count, "u_eye_bin"), 1, in->eye);
     if (groups)
         glDispatchCompute(gx, gy, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     glUseProgram(scan);
-    tile_uniforms(scan, t, in, nscan);
+    tile_uniforms(ctx, scan, t, in, nscan);
     glDispatchCompute(blocks, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     glUseProgram(top);
-    tile_uniforms(top, t, in, blocks);
+    tile_uniforms(ctx, top, t, in, blocks);
     glDispatchCompute(1, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     glUseProgram(add);
-    tile_uniforms(add, t, in, nscan);
+    tile_uniforms(ctx, add, t, in, nscan);
     glDispatchCompute((nscan + 255u) / 256u, 1, 1);
     /* the counts are spent: the same buffer becomes the per-tile fill cursor of the scatter,
      * and ends holding each tile's count again */
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     glClearNamedBufferSubData(t->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     glUseProgram(scatter);
-    tile_uniforms(scatter, t, in, nscan);
-    glUniformMatrix4fv(glGetUniformLocation(scatter, "u_view_proj"), 1, GL_FALSE, in->view_proj);
-    glUniform3fv(glGetUniformLocation(scatter, "u_eye_bin"), 1, in->eye);
+    tile_uniforms(ctx, scatter, t, in, nscan);
+    glUniformMatrix4fv(volfx_gpu_uniform(ctx, scatter, "u_view_proj"), 1, GL_FALSE, in->view_proj);
+    glUniform3fv(volfx_gpu_uniform(ctx, scatter, "u_eye_bin"), 1, in->eye);
     if (groups)
         glDispatchCompute(gx, gy, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -198,26 +198,26 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
     return VFX_OK;
 }
 
-static void march_uniforms(GLuint prog, const volfx_water_tile *t, const volfx_water_tile_input *in,
+static void march_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_tile *t, const volfx_water_tile_input *in,
                            const vfx_frame_view *frame, const volfx_frame_targets *targets)
 {
     const vfx_water_params *p = in->params;
-    tile_uniforms(prog, t, in, 0);
+    tile_uniforms(ctx, prog, t, in, 0);
     glBindImageTexture(0, in->dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     glBindTextureUnit(1, frame->depth_texture);
-    glUniformMatrix4fv(glGetUniformLocation(prog, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
-    glUniform3fv(glGetUniformLocation(prog, "u_eye"), 1, frame->eye);
-    glUniform1f(glGetUniformLocation(prog, "u_T"), p->threshold);
-    glUniform1f(glGetUniformLocation(prog, "u_step"), p->step);
+    glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
+    glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_eye"), 1, frame->eye);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_T"), p->threshold);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_step"), p->step);
     /* a window of 2h holds the spheres one ray meets near its first entry (16 to 30 in dense
      * water at a spacing of h/2); the local list takes 32 */
-    glUniform1f(glGetUniformLocation(prog, "u_window"), 2.0f * p->h);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_window"), 2.0f * p->h);
     float rho = p->h * (1.0f - p->threshold);
-    glUniform1f(glGetUniformLocation(prog, "u_rho"), rho > 0 ? rho : 0.0f);
-    glUniform1ui(glGetUniformLocation(prog, "u_refine_iters"), (p->disable & VFX_WATER_NO_REFINE) ? 0u : p->refine_iters);
-    glUniform1i(glGetUniformLocation(prog, "u_has_depth"), frame->depth_texture != 0);
-    glUniform1i(glGetUniformLocation(prog, "u_subdivide"), !(p->disable & VFX_WATER_NO_SUBDIVIDE));
-    glUniform1i(glGetUniformLocation(prog, "u_local"), !(p->disable & VFX_WATER_NO_LOCAL_LIST));
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_rho"), rho > 0 ? rho : 0.0f);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_refine_iters"), (p->disable & VFX_WATER_NO_REFINE) ? 0u : p->refine_iters);
+    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_has_depth"), frame->depth_texture != 0);
+    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_subdivide"), !(p->disable & VFX_WATER_NO_SUBDIVIDE));
+    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_local"), !(p->disable & VFX_WATER_NO_LOCAL_LIST));
 }
 
 vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
@@ -230,7 +230,7 @@ vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const v
     volfx_gpu_pass_begin(ctx, "water.tile_march");
     glUseProgram(prog);
     bind_buffers(t, in);
-    march_uniforms(prog, t, in, frame, targets);
+    march_uniforms(ctx, prog, t, in, frame, targets);
     glBindImageTexture(1, grad_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glBindImageTexture(2, back_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     glDispatchCompute((in->width + 7) / 8, (in->height + 7) / 8, 1);
@@ -253,7 +253,7 @@ vfx_result volfx_water_tile_finish(vfx_context *ctx, volfx_water_tile *t, const 
     volfx_gpu_pass_begin(ctx, "water.finish");
     glUseProgram(prog);
     bind_buffers(t, in);
-    march_uniforms(prog, t, in, frame, targets);
+    march_uniforms(ctx, prog, t, in, frame, targets);
     glBindImageTexture(1, st_tex, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
     glBindImageTexture(2, next_tex, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
     glDispatchCompute((in->width + 7) / 8, (in->height + 7) / 8, 1);
