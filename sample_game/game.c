@@ -33,7 +33,7 @@ static void usage(void)
          "                  [--mem-every N] [--dump-raw water|beams|volume FILE.pfm]\n"
          "Without a display it runs headless (EGL) for 30 frames and writes volfx-game.png.\n"
          "Window keys: WASD/QE fly, mouse drag orbit, 1/2/3 toggle water/beams/volume,\n"
-         "             Tab cycle water quality (16/32/54/64 samples), P pause, N single step, Esc quit.");
+         "             Tab cycle water method (tile; paper at 16/32/54/64 samples), P pause, N single step, Esc quit.");
 }
 
 static vfx_effect_kind effect_named(const char *s)
@@ -109,13 +109,21 @@ static void handle_input(game_app *app, game_demo *demo, bool *paused, bool *ste
     }
     bool tab = glfwGetKey(w, GLFW_KEY_TAB) == GLFW_PRESS;
     if (tab && !demo->key_latch[5]) {
-        static const uint32_t presets[4] = {16, 32, 54, 64}; /* the paper's sample caps */
-        uint32_t cur = app->water.max_samples, next = presets[0];
-        for (int k = 0; k < 4; ++k)
-            if (presets[k] == cur)
-                next = presets[(k + 1) % 4];
-        app->water.max_samples = next;
-        printf("water quality: %u samples per pixel\n", next);
+        /* TILE (ours, the default) first, then the published method at the paper's sample
+         * caps, whose cost and quality the cap sets, then back */
+        static const struct { uint32_t method, samples; const char *name; } steps[5] = {
+            {VFX_WATER_METHOD_TILE, 0, "tile"}, {VFX_WATER_METHOD_PAPER, 16, "paper, 16 samples"},
+            {VFX_WATER_METHOD_PAPER, 32, "paper, 32 samples"}, {VFX_WATER_METHOD_PAPER, 54, "paper, 54 samples"},
+            {VFX_WATER_METHOD_PAPER, 64, "paper, 64 samples"}};
+        int cur = 0;
+        for (int k = 0; k < 5; ++k)
+            if (steps[k].method == app->water.method
+                && (steps[k].method != VFX_WATER_METHOD_PAPER || steps[k].samples == app->water.max_samples))
+                cur = k;
+        int next = (cur + 1) % 5;
+        app->water.method = steps[next].method;
+        app->water.max_samples = steps[next].samples;
+        printf("water: %s\n", steps[next].name);
     }
     demo->key_latch[5] = tab;
     bool p = glfwGetKey(w, GLFW_KEY_P) == GLFW_PRESS, n = glfwGetKey(w, GLFW_KEY_N) == GLFW_PRESS;
