@@ -348,7 +348,7 @@ typedef struct vfx_frame_view2 {
 
 #define VFX_STATS_MAX 64
 typedef struct vfx_stat {
-    char name[40];  /* "water.gpu_ms.accumulate", "beams.tiles_culled", ... */
+    char name[40];  /* "water.potential.gpu_ms", "beams.pairs_culled", ...: docs/stats.md lists all */
     double value;
 } vfx_stat;
 
