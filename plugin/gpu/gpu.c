@@ -285,8 +285,6 @@ void volfx_gpu_frame_end(vfx_context *ctx)
     /* The oldest slot was recorded GPU_RING-1 frames ago: read it only if it is ready. */
     uint32_t oldest = (g->frame + 1) % GPU_RING;
     timer_frame *f = &g->ring[oldest];
-    GLuint64 frame_t0 = 0; /* the frame's first timestamp: pass starts are relative to it */
-    bool have_t0 = false;
     for (uint32_t i = 0; i < f->count; ++i) {
         GLint ready = 0;
         glGetQueryObjectiv(f->queries[i * 2 + 1], GL_QUERY_RESULT_AVAILABLE, &ready);
@@ -295,22 +293,15 @@ void volfx_gpu_frame_end(vfx_context *ctx)
         GLuint64 t0 = 0, t1 = 0;
         glGetQueryObjectui64v(f->queries[i * 2], GL_QUERY_RESULT, &t0);
         glGetQueryObjectui64v(f->queries[i * 2 + 1], GL_QUERY_RESULT, &t1);
-        if (i == 0) {
-            frame_t0 = t0;
-            have_t0 = true;
-        }
         char name[48];
         snprintf(name, sizeof name, "%s.gpu_ms", f->names[i]);
-        /* A pass run several times in one frame (the paper's march loop) reports its total, and
-         * where its first run began: a profiler nests the passes by these starts (a pass opened
-         * inside another starts inside it), which the sums alone cannot tell. */
+        /* A pass run several times in one frame (the paper's march loop) reports its total. The
+         * stats keep the order of the first runs, and a pass opened inside another says how
+         * deep: with these a profiler nests the passes, which the sums alone cannot tell. Start
+         * times are not sent: the 64 stat slots are too few for one more entry per pass. */
         bool first = !volfx_stat_has(ctx, name);
         volfx_stat_add(ctx, name, t1 > t0 ? (double)(t1 - t0) * 1e-6 : 0.0);
-        if (first && have_t0) {
-            snprintf(name, sizeof name, "%s.gpu_start_ms", f->names[i]);
-            volfx_stat_set(ctx, name, t0 > frame_t0 ? (double)(t0 - frame_t0) * 1e-6 : 0.0);
-        }
-        if (first && f->depth[i]) { /* only nested passes: the stats have 64 slots */
+        if (first && f->depth[i]) {
             snprintf(name, sizeof name, "%s.gpu_depth", f->names[i]);
             volfx_stat_set(ctx, name, f->depth[i]);
         }

@@ -25,8 +25,8 @@ GLint volfx_gpu_uniform(vfx_context *ctx, GLuint prog, const char *name);
 /* Opens a named pass: a debug group (RenderDoc shows it) and a timestamp pair. Names are
  * "effect.pass", e.g. "water.potential"; the GPU ms of the pass reach the stats as
  * "<name>.gpu_ms" gpu.timer_lag_frames frames later, without stalling (passes of one name in a
- * frame summed), "<name>.gpu_start_ms", the start of its first run after the frame's first
- * timestamp, and for a pass opened inside others "<name>.gpu_depth", how many were open. */
+ * frame summed; the stats in the order of the first runs), and for a pass opened inside
+ * others "<name>.gpu_depth", how many were open. */
 void volfx_gpu_pass_begin(vfx_context *ctx, const char *name);
 /* Closes the innermost open pass. */
 void volfx_gpu_pass_end(vfx_context *ctx);

@@ -38,8 +38,7 @@ struct rt_profiler {
     double *frame_ms;       /* ring of max_frames */
     double *frame_t0;       /* start time of each frame (trace) */
     double *values;         /* ring: max_frames x RT_PROFILER_MAX_SERIES, NAN when absent */
-    double *starts;         /* CPU: span start in ms after frame start; GPU: the plugin's
-                               <pass>.gpu_start_ms; NAN when absent (trace) */
+    double *starts;         /* CPU spans: start in ms after the frame's start; NAN when absent */
     uint8_t *order;         /* ring: the order in which each series was recorded in its frame
                                (the plugin's stats come in pass submission order) */
     uint8_t recorded;       /* series recorded in the current frame */
@@ -223,8 +222,6 @@ void rt_profiler_gpu_stats(rt_profiler *p, const vfx_stats *stats)
 {
     if (!p || !stats)
         return;
-    static const char start_sfx[] = ".gpu_start_ms";
-    const size_t start_len = sizeof start_sfx - 1;
     const uint32_t cap = stats->version == VFX_STATS2_VERSION ? VFX_STATS2_MAX : VFX_STATS_MAX;
     for (uint32_t i = 0; i < stats->count && i < cap; ++i) {
         const char *n = stats->entries[i].name;
@@ -236,14 +233,8 @@ void rt_profiler_gpu_stats(rt_profiler *p, const vfx_stats *stats)
             int k = series_index(p, n, len, SERIES_GPU);
             if (k >= 0)
                 p->values[at_of(p, k)] = v;
-        } else if (len > start_len && strcmp(n + len - start_len, start_sfx) == 0) {
-            char dur[48]; /* the start belongs to the series "<pass>.gpu_ms" */
-            int w = snprintf(dur, sizeof dur, "%.*s.gpu_ms", (int)(len - start_len), n);
-            int k = w > 0 && (size_t)w < sizeof dur ? series_index(p, dur, (size_t)w, SERIES_GPU) : -1;
-            if (k >= 0)
-                p->starts[at_of(p, k)] = v;
         } else if (len > 10 && strcmp(n + len - 10, ".gpu_depth") == 0) {
-            char dur[48];
+            char dur[48]; /* the depth of the series "<pass>.gpu_ms" */
             int w = snprintf(dur, sizeof dur, "%.*s.gpu_ms", (int)(len - 10), n);
             int k = w > 0 && (size_t)w < sizeof dur ? series_index(p, dur, (size_t)w, SERIES_GPU) : -1;
             if (k >= 0)
@@ -425,7 +416,7 @@ typedef struct slice {
     double start, dur; /* ms after the frame's (or GPU frame's) start */
     uint32_t series;
     uint32_t order;    /* recording order: of two slices starting together, the first opened
-                          is the parent (a pass and its first child share a timestamp) */
+                          is the parent (GPU passes all start at 0: their order is the stats') */
     int depth;         /* GPU passes: nesting depth the plugin reported; -1 (CPU spans): the
                           parent is the innermost slice still open at the start */
 } slice;
@@ -438,16 +429,16 @@ static int cmp_slice(const void *a, const void *b)
     return (x->order > y->order) - (x->order < y->order);
 }
 
-/* Timestamps are ns integers turned into ms doubles: a pass that starts where the last ended
- * may read up to rounding before that end. */
+/* Clock readings in ms: a span that starts where the last ended may read a hair before it. */
 #define NEST_EPS_MS 1e-6
 
-/* Makes the slices of one track properly nested: sorted by start, each slice lies inside its
- * parent (for a GPU pass the last pass one level up, by the plugin's depth; for a CPU span the
- * innermost slice still open at its start), and siblings do not overlap. A pass run several
- * times in a frame (the water march loop's four passes) arrives as one total and the start of
- * its first run, so its siblings' totals, laid from their starts, would overlap: each is moved
- * just past its previous sibling and kept inside its parent. Returns the end of the last slice. */
+/* Makes the slices of one track properly nested: sorted by start (then recording order), each
+ * slice lies inside its parent (for a GPU pass the last pass one level up, by the plugin's
+ * depth; for a CPU span the innermost slice still open at its start) and no earlier than the end
+ * of its previous sibling, clamped into the parent. GPU passes come as totals without start
+ * times (a pass run several times in a frame, like the water march loop's four, as one total),
+ * so they are laid end to end inside their parent in the plugin's order. Returns the end of the
+ * last slice. */
 static double nest_slices(slice *s, uint32_t n, double frame_end)
 {
     qsort(s, n, sizeof *s, cmp_slice);
@@ -537,8 +528,7 @@ vfx_result rt_profiler_write_trace(const rt_profiler *p, const char *path)
                             counter_tracks[c].track, t0, r[i]);
         /* GPU times recorded in this frame belong to the frame gpu_lag frames back: drawn from
          * that frame's plugin.render (when the commands were issued), or later if the GPU was
-         * still busy with the frame before. Passes without a start (an old plugin) are laid end
-         * to end. */
+         * still busy with the frame before; the frame lasts as long as its outermost passes. */
         if (fr < p->frame - kept + p->gpu_lag)
             continue;
         uint32_t issued = fr - p->gpu_lag;
@@ -546,14 +536,13 @@ vfx_result rt_profiler_write_trace(const rt_profiler *p, const char *path)
         double at = (p->frame_t0[issued % p->max_frames] - origin)
                     + (render >= 0 && !isnan(ist[render]) ? ist[render] : 0);
         n = 0;
-        double lay = 0, span = 0;
+        double span = 0;
         for (uint32_t i = 0; i < p->series_count; ++i) {
             if (p->series[i].kind != SERIES_GPU || isnan(r[i]))
                 continue;
-            double start = isnan(st[i]) ? lay : st[i];
-            lay = fmax(lay, start + r[i]);
-            sl[n++] = (slice){start, r[i], i, ord[i], p->series[i].depth};
-            span = fmax(span, start + r[i]);
+            sl[n++] = (slice){0, r[i], i, ord[i], p->series[i].depth};
+            if (p->series[i].depth == 0)
+                span += r[i];
         }
         if (n == 0)
             continue;

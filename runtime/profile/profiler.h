@@ -35,10 +35,10 @@ void rt_profiler_frame_add(rt_profiler *p, double ms);
 void rt_profiler_on_system(void *profiler, const char *name, rt_phase phase, double cpu_ms);
 /* Records a CPU span by name with its own timing (for host work outside systems). */
 void rt_profiler_cpu(rt_profiler *p, const char *name, double cpu_ms);
-/* Records the plugin's stats for the current frame: every "<pass>.gpu_ms" (a GPU series) with
- * its "<pass>.gpu_start_ms", gpu.timer_lag_frames, and the counters drawn as counter tracks
- * (water.particles, water.pixels_sample_cap, volume.cells_skipped_ert). Version 1 or 2 stats
- * (a vfx_stats2 passed as vfx_stats: its entries are read up to VFX_STATS2_MAX). */
+/* Records the plugin's stats for the current frame: every "<pass>.gpu_ms" (a GPU series, in the
+ * stats' order) with its "<pass>.gpu_depth", gpu.timer_lag_frames, and the counters drawn as
+ * counter tracks (water.particles, water.pixels_sample_cap, volume.cells_skipped_ert). Version 1
+ * or 2 stats (a vfx_stats2 passed as vfx_stats: its entries are read up to VFX_STATS2_MAX). */
 void rt_profiler_gpu_stats(rt_profiler *p, const vfx_stats *stats);
 /* Summary over frames [skip, end): skip drops warm-up frames. Exact while those frames are all
  * in the ring of max_frames; beyond, from a bounded histogram (percentiles within 0.05%, mean and
@@ -53,9 +53,9 @@ vfx_result rt_profiler_write_csv(const rt_profiler *p, const char *path);
  * "frame N" slice per frame on the CPU thread (tid 1) with the CPU spans nested inside it at
  * their measured starts, a "gpu frame N" slice per frame on the GPU thread (tid 2) starting when
  * that frame's plugin.render issued it (or when the GPU finished the frame before) with the
- * passes nested by their gpu_start_ms (names without ".gpu_ms"; repeated passes as one slice of
- * their total, moved past an overlapping sibling), categories frame/cpu/gpu/counter, and counter
- * tracks fps, particles, water holes, volume cells skipped. */
+ * passes laid end to end inside their parent by the plugin's order and depth (names without
+ * ".gpu_ms"; a repeated pass as one slice of its total), categories frame/cpu/gpu/counter, and
+ * counter tracks fps, particles, water holes, volume cells skipped. */
 vfx_result rt_profiler_write_trace(const rt_profiler *p, const char *path);
 /* Median of v[0..n) (sorts v in place); NAN when n is 0. */
 double rt_median(double *v, uint32_t n);

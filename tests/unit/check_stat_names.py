@@ -10,7 +10,7 @@ import glob, json, os, re, subprocess, sys
 root = sys.argv[1]
 bench = sys.argv[2] if len(sys.argv) > 2 else None
 NS = r"(?:water|beams|volume|gpu)\.[a-z0-9_]+"
-SFX = (".gpu_ms", ".gpu_start_ms", ".gpu_depth")
+SFX = (".gpu_ms", ".gpu_depth")
 
 code = ""
 for f in glob.glob(os.path.join(root, "plugin", "**", "*.c"), recursive=True):

@@ -1,10 +1,9 @@
-/* The profiler's Chrome trace: fed stats shaped like the plugin's (the water march loop's four
- * passes repeated, their totals laid from their first starts overlapping each other; a pass of
- * zero length sharing a timestamp with the next; a parent and its first child starting
- * together), the written JSON is read back and checked as Perfetto would lay it out: on each
- * thread every two slices are disjoint or one contains the other; each pass lies inside the
- * parent the plugin reported; GPU frames follow one another; names, categories, process and
- * thread names and counter tracks are there. */
+/* The profiler's Chrome trace: fed stats shaped like the plugin's (totals in the order of the
+ * passes' first runs, the water march loop's four passes with their depth, a pass of zero length
+ * before another), the written JSON is read back and checked as Perfetto would lay it out: on
+ * each thread every two slices are disjoint or one contains the other; each pass lies inside the
+ * parent the plugin reported, after its previous sibling; GPU frames follow one another; names,
+ * categories, process and thread names and counter tracks are there. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -37,7 +36,8 @@ static void add_stat(vfx_stats *s, const char *name, double v)
     s->entries[s->count++].value = v;
 }
 
-/* The stats of one GPU frame in the plugin's order: totals, first starts, depths of nested passes. */
+/* The stats of one GPU frame in the plugin's order: totals and the depths of nested passes (the
+ * start column is where each pass begins when they are laid end to end). */
 static void gpu_frame_stats(vfx_stats *s, double scale)
 {
     static const struct {
@@ -47,10 +47,10 @@ static void gpu_frame_stats(vfx_stats *s, double scale)
     } passes[] = {
         {"water.init", 0, 1, 0},
         {"water.march", 1, 10, 0},
-        {"water.pyramid", 1, 2, 1},   /* starts with its parent */
-        {"water.potential", 1.5, 4, 1}, /* totals of 4 runs: laid from their first starts */
-        {"water.update", 2, 1, 1},      /* they would overlap each other */
-        {"water.skip", 2.2, 2.5, 1},
+        {"water.pyramid", 1, 2, 1},   /* totals of four runs each, inside water.march */
+        {"water.potential", 3, 4, 1},
+        {"water.update", 7, 1, 1},
+        {"water.skip", 8, 2.5, 1},
         {"water.refine", 11, 2, 0},
         {"volume.composite", 13, 0, 0}, /* zero length, next pass starts at the same time */
         {"beams.integrate", 13, 1, 0},
@@ -60,8 +60,6 @@ static void gpu_frame_stats(vfx_stats *s, double scale)
     for (size_t i = 0; i < sizeof passes / sizeof passes[0]; ++i) {
         snprintf(name, sizeof name, "%s.gpu_ms", passes[i].pass);
         add_stat(s, name, passes[i].ms * scale);
-        snprintf(name, sizeof name, "%s.gpu_start_ms", passes[i].pass);
-        add_stat(s, name, passes[i].start * scale);
         if (passes[i].depth) {
             snprintf(name, sizeof name, "%s.gpu_depth", passes[i].pass);
             add_stat(s, name, passes[i].depth);
@@ -191,7 +189,12 @@ static void test_trace_nested(void **state)
             bool loop = !strcmp(x->name, "water.pyramid") || !strcmp(x->name, "water.potential")
                         || !strcmp(x->name, "water.update") || !strcmp(x->name, "water.skip");
             if (loop) {
-                assert_non_null(find_parent(ev, n, x, "water.march"));
+                const xev *m = find_parent(ev, n, x, "water.march");
+                assert_non_null(m);
+                /* laid end to end from the start of water.march, in the plugin's order */
+                double at = !strcmp(x->name, "water.pyramid") ? 1 : !strcmp(x->name, "water.potential") ? 3
+                            : !strcmp(x->name, "water.update") ? 7 : 8;
+                assert_true(fabs(x->ts - (m->ts + (at - 1) * 4.0 * 1000.0)) < EPS_US);
                 assert_true(fabs(x->dur - 1000.0 * 4.0 * (!strcmp(x->name, "water.pyramid") ? 2 : !strcmp(x->name, "water.potential") ? 4 : !strcmp(x->name, "water.update") ? 1 : 2.5)) < EPS_US);
                 ++loop_children;
             }
