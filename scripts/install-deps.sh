@@ -13,6 +13,7 @@ pkgs=(
   libopenmpi-dev openmpi-bin
   assimp-testmodels tetgen
   xvfb xauth
+  libsdl2-dev          # tests/integration/sdl_host.c, the second host
   python3-matplotlib   # scripts/bench-water.sh plots with /usr/bin/python3
   clang libclang-rt-14-dev  # scripts/fuzz.sh (CI's third step): libFuzzer and the sanitizer runtimes
   "$@"
