@@ -19,7 +19,8 @@ stats = set(re.findall(r'volfx_stat_(?:set|add)\(\s*ctx\s*,\s*"(%s)"' % NS, code
 passes = set()
 for args in re.findall(r"volfx_gpu_pass_begin\(\s*ctx\s*,([^;]*)\)\s*;", code):
     passes |= set(re.findall(r'"(%s)"' % NS, args))
-passes |= set(re.findall(r'\.name\s*=\s*"(%s)"' % NS, code))
+for expr in re.findall(r"\.name\s*=\s*([^,}]*)", code):  # a pass desc's name, maybe a ?: of two
+    passes |= set(re.findall(r'"(%s)"' % NS, expr))
 passes |= set(re.findall(r'volfx_composite\(\s*ctx\s*,[^,]+,\s*"(%s)"' % NS, code))
 
 doc = open(os.path.join(root, "docs", "stats.md")).read()
