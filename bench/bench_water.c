@@ -7,6 +7,7 @@
  * layers deep, seen from above and in front) --png FILE (the shaded frame over a grey-blue host image) --dist FILE
  * (distance image, PFM) --points FILE (positions as raw float32 xyz). cpu_ms_per_frame is the
  * process's CPU time over the timed frames (all llvmpipe threads) divided by the frames. Per-pass GPU ms (counters *.gpu_ms) need at least 4 frames. */
+#include <epoxy/egl.h>
 #include <epoxy/gl.h>
 #include <math.h>
 #include <stdio.h>
@@ -34,6 +35,8 @@ typedef struct bench_scene {
     const char *points;  /* raw float32 x y z per particle, for scripts/compare-vtk-fluid.py */
     const char *dist;    /* the distance image (PFM) */
 } bench_scene;
+
+static void *bench_gl_proc(void *user, const char *name) { (void)user; return (void *)eglGetProcAddress(name); }
 
 static uint32_t bench_chunks(void *user) { return ((bench_scene *)user)->n ? 1 : 0; }
 
@@ -122,7 +125,7 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
         if (f) fclose(f);
         else fprintf(stderr, "metaballs: cannot write %s\n", s.points);
     }
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &s,
+    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = bench_gl_proc, .user = &s,
                          .particle_chunk_count = bench_chunks, .particle_chunk = bench_chunk,
                          .water_params = bench_params};
     vfx_plugin_api api = {.size = sizeof api};

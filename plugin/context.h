@@ -8,6 +8,7 @@
 #include <volfx/volfx.h>
 
 typedef struct volfx_gpu volfx_gpu;
+struct volfx_gl_table; /* gpu/volfx_gl.h, generated: the GL commands, resolved at create */
 typedef struct volfx_effect_ops volfx_effect_ops;
 
 /* Knobs that only tests and benchmarks set (through this header: hosts of the shared library
@@ -21,6 +22,7 @@ typedef struct volfx_debug_knobs {
 struct vfx_context {
     vfx_host_api host;          /* copy of the host's table */
     volfx_gpu *gpu;               /* program cache, timers, fullscreen VAO */
+    struct volfx_gl_table *gl;    /* every GL command, through host.gl_get_proc_address */
     uint32_t width, height;
     void *effect_state[VFX_EFFECT_COUNT];
     const volfx_effect_ops *effect_ops[VFX_EFFECT_COUNT];

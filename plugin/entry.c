@@ -23,6 +23,39 @@
 
 /* --------------------------------------------------------------------- lifecycle */
 
+/* Binds this context's GL table to the calling thread for the call (gpu/gl.h says why). */
+static void gl_bind(vfx_context *ctx)
+{
+    volfx_gl_current = ctx->gl;
+}
+
+/* Resolves every GL command the plugin uses through the host's loader; a missing one is refused
+ * with its name. The version is checked first when it can be, since a 3.3 context missing 4.5
+ * commands says more as "needs 4.5, got 3.3". */
+static vfx_result gl_load(vfx_context *ctx)
+{
+    ctx->gl = volfx_alloc(ctx, sizeof *ctx->gl);
+    if (!ctx->gl)
+        return VFX_ERR_OUT_OF_MEMORY;
+    const char *missing = NULL;
+    unsigned lookups = volfx_gl_load(ctx->gl, ctx->host.gl_get_proc_address, ctx->host.user, &missing);
+    gl_bind(ctx);
+    if (missing && ctx->gl->GetString && ctx->gl->GetIntegerv) {
+        GLint major = 0, minor = 0;
+        glGetIntegerv(GL_MAJOR_VERSION, &major);
+        glGetIntegerv(GL_MINOR_VERSION, &minor);
+        if (major * 10 + minor < 45)
+            return volfx_fail(ctx, VFX_ERR_GL_UNSUPPORTED, "volfx needs desktop GL 4.5, the current context is %s",
+                              glGetString(GL_VERSION) ? (const char *)glGetString(GL_VERSION) : "(none)");
+    }
+    if (missing)
+        return volfx_fail(ctx, VFX_ERR_GL_UNSUPPORTED,
+                          "host gl_get_proc_address found no '%s' (one of the %u GL 4.5 commands volfx uses)",
+                          missing, lookups);
+    volfx_log(ctx, VFX_LOG_DEBUG, "%u GL commands resolved through the host's gl_get_proc_address", lookups);
+    return VFX_OK;
+}
+
 static void register_effects(vfx_context *ctx)
 {
 #if VFX_WITH_WATER && VFX_HAS_WATER_OPS
@@ -46,8 +79,13 @@ static void plugin_destroy(vfx_context *ctx)
             ctx->effect_ops[k]->destroy(ctx, ctx->effect_state[k]);
             ctx->effect_state[k] = NULL;
         }
-    volfx_frame_check_destroy(ctx);
-    volfx_gpu_destroy(ctx, ctx->gpu);
+    if (ctx->gl) {
+        gl_bind(ctx);
+        volfx_frame_check_destroy(ctx);
+        volfx_gpu_destroy(ctx, ctx->gpu);
+        volfx_gl_current = NULL; /* nothing may call GL through a freed table */
+        volfx_free(ctx, ctx->gl);
+    }
     vfx_host_api host = ctx->host;
     if (host.free)
         host.free(host.user, ctx);
@@ -79,7 +117,12 @@ static vfx_result plugin_create(const vfx_host_api *host, vfx_context **out)
     ctx->stats.size = ctx->last_stats.size = sizeof(vfx_stats2);
     ctx->stats.version = ctx->last_stats.version = VFX_STATS2_VERSION;
     register_effects(ctx);
-    vfx_result r = volfx_gpu_create(ctx, &ctx->gpu);
+    vfx_result r = host->gl_get_proc_address
+                       ? gl_load(ctx)
+                       : volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volfx create: host api has no gl_get_proc_address "
+                                    "(the plugin resolves every GL command through it)");
+    if (r == VFX_OK)
+        r = volfx_gpu_create(ctx, &ctx->gpu);
     if (r != VFX_OK) {
         /* keep the message: the caller has no context to ask */
         plugin_destroy(ctx);
@@ -93,6 +136,7 @@ static vfx_result plugin_resize(vfx_context *ctx, uint32_t width, uint32_t heigh
 {
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
+    gl_bind(ctx);
     if (width == 0 || height == 0 || width > 16384 || height > 16384)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
                         "resize: %ux%u outside 1..16384 in each direction", width, height);
@@ -111,6 +155,7 @@ static vfx_result plugin_update(vfx_context *ctx, double time, float dt)
 {
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
+    gl_bind(ctx);
     if (!isfinite(time) || !isfinite(dt))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "update: time %g or dt %g is not finite",
                         time, (double)dt);
@@ -149,6 +194,7 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
 {
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
+    gl_bind(ctx);
     if (!frame)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view is NULL");
     if (frame->version != VFX_FRAME_VIEW_VERSION && frame->version != VFX_FRAME_VIEW2_VERSION)
@@ -244,6 +290,7 @@ static vfx_result plugin_read_raw(vfx_context *ctx, vfx_effect_kind effect, floa
 {
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
+    gl_bind(ctx);
     if (!out)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "read_raw: out is NULL (count %zu)", count);
     if ((unsigned)effect >= VFX_EFFECT_COUNT)

@@ -41,6 +41,8 @@ struct volfx_gpu {
     bool has_debug;
 };
 
+unsigned volfx_gl_command_count(void) { return VOLFX_GL_COMMAND_COUNT; }
+
 const char *volfx_gpu_error_string(void)
 {
     switch (glGetError()) {
@@ -60,8 +62,10 @@ vfx_result volfx_gpu_create(vfx_context *ctx, volfx_gpu **out)
     const GLubyte *version = glGetString(GL_VERSION);
     if (!version)
         return volfx_fail(ctx, VFX_ERR_GL, "volfx needs a current GL context on the calling thread");
-    int ver = epoxy_gl_version();
-    if (ver < 45 || !epoxy_is_desktop_gl())
+    GLint major = 0, minor = 0;
+    glGetIntegerv(GL_MAJOR_VERSION, &major);
+    glGetIntegerv(GL_MINOR_VERSION, &minor);
+    if (major * 10 + minor < 45 || strncmp((const char *)version, "OpenGL ES", 9) == 0)
         return volfx_fail(ctx, VFX_ERR_GL_UNSUPPORTED,
                         "volfx needs desktop GL 4.5, the current context is %s", (const char *)version);
     volfx_gpu *g = volfx_alloc(ctx, sizeof *g);

@@ -3,7 +3,7 @@
 #ifndef VOLFX_GPU_H
 #define VOLFX_GPU_H
 
-#include <epoxy/gl.h>
+#include "gpu/gl.h"
 #include "context.h"
 
 /* Makes the helper state; needs a current GL 4.5 context (checked, VFX_ERR_GL_UNSUPPORTED). */
@@ -40,6 +40,9 @@ void volfx_gpu_fullscreen(vfx_context *ctx);
  * else that one component (w*h floats). VFX_ERR_OUT_OF_MEMORY when the staging copy fails. */
 vfx_result volfx_gpu_read_top_first(vfx_context *ctx, GLuint tex, GLenum format, uint32_t comps,
                                   int channel, uint32_t w, uint32_t h, float *out);
+/* How many GL commands create resolves through the host's gl_get_proc_address (the generated
+ * table's size; tests count the lookups against it). */
+unsigned volfx_gl_command_count(void);
 /* Labels a GL object for debuggers (no-op without KHR_debug). */
 void volfx_gpu_label(GLenum kind, GLuint object, const char *label);
 /* Returns a GL error as a string, or NULL when glGetError() is GL_NO_ERROR. */

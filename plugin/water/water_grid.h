@@ -4,7 +4,7 @@
 #ifndef VOLFX_WATER_GRID_H
 #define VOLFX_WATER_GRID_H
 
-#include <epoxy/gl.h>
+#include "gpu/gl.h"
 #include "effect.h"
 
 typedef struct volfx_water_grid volfx_water_grid;

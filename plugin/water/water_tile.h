@@ -7,7 +7,7 @@
 #ifndef VOLFX_WATER_TILE_H
 #define VOLFX_WATER_TILE_H
 
-#include <epoxy/gl.h>
+#include "gpu/gl.h"
 #include "effect.h"
 
 typedef struct volfx_water_tile volfx_water_tile;

@@ -1,6 +1,8 @@
 /* test_util.c — see test_util.h. */
 #include "test_util.h"
 
+#include <epoxy/egl.h>
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -39,4 +41,10 @@ void test_log_fn(void *user, vfx_log_level level, const char *message)
         l->errors++;
     else if (level == VFX_LOG_WARN)
         l->warnings++;
+}
+
+void *test_gl_proc(void *user, const char *name)
+{
+    (void)user;
+    return (void *)eglGetProcAddress(name);
 }

@@ -10,6 +10,9 @@
 rt_gl_context *test_gl_or_skip(void);
 /* Path of the shared test data file `rel` (under VFX_SHARED_DATA), or exits 77 when absent. */
 const char *test_shared_data_or_skip(const char *rel, char *buf, unsigned buflen);
+/* vfx_host_api.gl_get_proc_address for the headless context of test_gl_or_skip (eglGetProcAddress;
+ * user unused). */
+void *test_gl_proc(void *user, const char *name);
 /* A logger for tests that records the last message, so tests can assert on error text. */
 typedef struct test_log {
     char last[1024];

@@ -46,7 +46,7 @@ static const vfx_plugin_api *plugin_api(void)
 
 static vfx_host_api beams_host(test_log *log)
 {
-    return (vfx_host_api){.size = sizeof(vfx_host_api), .version = VFX_HOST_API_VERSION, .user = log,
+    return (vfx_host_api){.size = sizeof(vfx_host_api), .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = log,
                           .log = test_log_fn, .beams = one_beam};
 }
 
@@ -217,7 +217,7 @@ static void test_nothing_drawn(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &log, .log = test_log_fn};
+    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = &log, .log = test_log_fn};
     const vfx_plugin_api *api = plugin_api();
     vfx_context *ctx;
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
@@ -240,7 +240,7 @@ static void test_callback_pairs(void **state)
     test_log log = {0};
     const vfx_plugin_api *api = plugin_api();
     vfx_context *ctx = (vfx_context *)&log;
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &log, .log = test_log_fn,
+    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = &log, .log = test_log_fn,
                          .particle_chunk_count = one_chunk};
     assert_int_equal(api->create(&host, &ctx), VFX_ERR_INVALID_ARGUMENT);
     assert_null(ctx);

@@ -21,7 +21,7 @@ static rt_gl_context *g_gl;
 
 static vfx_host_api empty_host(test_log *log)
 {
-    return (vfx_host_api){.size = sizeof(vfx_host_api), .version = VFX_HOST_API_VERSION,
+    return (vfx_host_api){.size = sizeof(vfx_host_api), .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
                           .user = log, .log = test_log_fn};
 }
 

@@ -19,7 +19,7 @@ static const char *g_plugin, *g_nosym, *g_badver;
 
 static vfx_host_api host_with(test_log *log)
 {
-    return (vfx_host_api){.size = sizeof(vfx_host_api), .version = VFX_HOST_API_VERSION,
+    return (vfx_host_api){.size = sizeof(vfx_host_api), .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
                           .user = log, .log = test_log_fn};
 }
 

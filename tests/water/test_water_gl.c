@@ -53,7 +53,7 @@ static vfx_result water_params(void *user, vfx_water_params *out)
 /* Renders the scene with the plugin and the reference; returns the error; *stats optional. */
 static ref_water_error render_and_compare(scene *s, const ref_camera *cam, vfx_stats *stats_out)
 {
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = s,
+    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = s,
                          .log = test_log_fn, .particle_chunk_count = chunk_count,
                          .particle_chunk = chunk_view, .water_params = water_params};
     /* the logger's user is the scene, whose first member is the test_log */
@@ -430,7 +430,7 @@ static void test_unknown_method(void **state)
     scene s = make_scene(3);
     s.params.method = 7;
     for (uint32_t k = 0; k < 3; ++k) s.x[k] = s.y[k] = s.z[k] = 0.1f * (float)k;
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &s,
+    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = &s,
                          .log = test_log_fn, .particle_chunk_count = chunk_count,
                          .particle_chunk = chunk_view, .water_params = water_params};
     vfx_plugin_api api = {.size = sizeof api};
@@ -481,7 +481,7 @@ static void session_open(session *ss, scene *s, const ref_camera *cam, const flo
 {
     memset(ss, 0, sizeof *ss);
     /* the plugin keeps a copy of the table */
-    vfx_host_api host_api = {.size = sizeof host_api, .version = VFX_HOST_API_VERSION, .user = s,
+    vfx_host_api host_api = {.size = sizeof host_api, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = s,
                              .log = test_log_fn, .particle_chunk_count = chunk_count,
                              .particle_chunk = chunk_view, .water_params = water_params};
     ss->api.size = sizeof ss->api;
@@ -803,7 +803,7 @@ static void test_count_overflow_refused(void **state)
         memset(&hh, 0, sizeof hh);
         hh.chunks = chunks[k];
         hh.count = counts[k];
-        vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &hh,
+        vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = &hh,
                              .log = test_log_fn, .particle_chunk_count = huge_chunk_count,
                              .particle_chunk = huge_chunk};
         vfx_plugin_api api = {.size = sizeof api};
