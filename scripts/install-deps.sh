@@ -14,6 +14,8 @@ pkgs=(
   assimp-testmodels tetgen
   xvfb xauth
   libsdl2-dev          # tests/integration/sdl_host.c, the second host
+  khronos-api          # gl.xml: the plugin's GL loader is generated from it (plugin/gpu/gen_gl.py)
+  glslang-tools        # glslangValidator: every shader variant validated at build time
   python3-matplotlib   # scripts/bench-water.sh plots with /usr/bin/python3
   clang libclang-rt-14-dev  # scripts/fuzz.sh (CI's third step): libFuzzer and the sanitizer runtimes
   "$@"

@@ -71,7 +71,7 @@ static void test_render_readback(void **state)
     free(px);
     rt_mesh_gpu_destroy(&gpu);
     rt_renderer_destroy(r);
-    assert_null(volfx_gpu_error_string());
+    assert_int_equal(glGetError(), GL_NO_ERROR);
 }
 
 static void test_timestamps_and_empty_world(void **state)
@@ -216,7 +216,7 @@ static void test_lifecycle_many(void **state)
         api->destroy(ctx);
     }
     assert_int_equal(log.errors, 0);
-    assert_null(volfx_gpu_error_string());
+    assert_int_equal(glGetError(), GL_NO_ERROR);
 }
 
 static void test_app_frame(void **state)
