@@ -352,6 +352,7 @@ vfx_result game_app_frame(game_app *app, float dt)
     vfx_frame_view2 frame2 = {.v1 = {.size = sizeof frame2, .version = VFX_FRAME_VIEW2_VERSION,
                                      .framebuffer = tg.output_framebuffer, .color_texture = tg.scene_color,
                                      .depth_texture = tg.scene_depth, .width = tg.width, .height = tg.height},
+                              .origin = {app->origin[0], app->origin[1], app->origin[2]},
                               .color_hdr = tg.color_hdr};
     vfx_frame_view frame = frame2.v1;
     memcpy(frame.view, view, sizeof frame.view);

@@ -69,6 +69,8 @@ typedef struct game_app {
     vfx_volume_view2 volumes[GAME_APP_MAX_VOLUMES]; /* the plugin gets version 2 or 1 */
     uint32_t volume_count;
     double time;
+    double origin[3];          /* large worlds: what every position the game holds is relative to
+                                  (the scene's "origin"), handed to the plugin in frame view 2 */
     uint64_t frame;
     /* particle chunk views of this frame (host_particle_chunk_count fills them; a world
      * change since then clears chunks_valid) */

@@ -351,6 +351,7 @@ vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path
         return r;
     }
     const rt_scene *sc = demo->scene;
+    memcpy(app->origin, sc->origin, sizeof app->origin);
     const rt_scene_camera *c = &sc->camera;
     ref_camera cam = {{c->eye[0], c->eye[1], c->eye[2]}, {c->target[0], c->target[1], c->target[2]},
                           {c->up[0], c->up[1], c->up[2]}, c->fov_y_deg * M_PI / 180.0,

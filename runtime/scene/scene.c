@@ -16,6 +16,39 @@
 
 /* ------------------------------------------------------------------ sections */
 
+/* "origin": [x, y, z] or "camera" (the camera's eye), in double: every position the scene holds
+ * is stored as its difference to it, so a scene 1e5 units out keeps float32 digits near the
+ * camera; the game hands the origin to the plugin in frame view 2. Absent: the world origin. */
+static vfx_result parse_origin(pctx *c, const cJSON *root, rt_scene *s)
+{
+    const cJSON *o = cJSON_GetObjectItemCaseSensitive(root, "origin");
+    if (!o)
+        return VFX_OK;
+    const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
+    const cJSON *src = o;
+    const char *P = "origin";
+    if (cJSON_IsString(o)) {
+        if (strcmp(o->valuestring, "camera") != 0)
+            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, P, "expected [x, y, z] or \"camera\", got \"%s\"", o->valuestring);
+        src = cJSON_IsObject(cam) ? cJSON_GetObjectItemCaseSensitive(cam, "eye") : NULL;
+        P = "camera.eye";
+        if (!src)
+            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "origin", "\"camera\" needs camera.eye");
+    }
+    if (!cJSON_IsArray(src) || cJSON_GetArraySize(src) != 3)
+        return scene_failf(c, VFX_ERR_FORMAT, P, "expected an array of 3 numbers, got %s", scene_type_name(src));
+    int i = 0;
+    for (const cJSON *e = src->child; e; e = e->next, ++i) {
+        char pi[JPATH];
+        scene_join_index(pi, P, i);
+        vfx_result r = scene_number_value(c, e, pi, COORD, &c->origin[i]);
+        if (r)
+            return r;
+        s->origin[i] = c->origin[i] = e->valuedouble; /* in double, unrounded */
+    }
+    return VFX_OK;
+}
+
 static vfx_result parse_camera(pctx *c, const cJSON *v, rt_scene_camera *cam)
 {
     static const char *const keys[] = {"eye", "target", "up", "fov_y_deg", "width", "height", "near", "far", NULL};
@@ -24,8 +57,8 @@ static vfx_result parse_camera(pctx *c, const cJSON *v, rt_scene_camera *cam)
     if (r)
         return r;
     scene_check_keys(c, v, P, keys);
-    if (!r) r = scene_get_vec(c, v, P, "eye", 3, false, COORD, cam->eye);
-    if (!r) r = scene_get_vec(c, v, P, "target", 3, false, COORD, cam->target);
+    if (!r) r = scene_get_point(c, v, P, "eye", false, cam->eye);
+    if (!r) r = scene_get_point(c, v, P, "target", false, cam->target);
     if (!r) r = scene_get_vec(c, v, P, "up", 3, false, COORD, cam->up);
     if (!r) r = scene_get_float(c, v, P, "fov_y_deg", false, (range){0, 179, true}, &cam->fov_y_deg);
     if (!r) r = scene_get_uint(c, v, P, "width", false, 1, 16384, &cam->width);
@@ -102,7 +135,7 @@ static vfx_result parse_meshes(pctx *c, const cJSON *v, rt_scene *s)
                 return r;
             scene_check_keys(c, box, PB, bkeys);
             o->is_box = true;
-            r = scene_get_vec(c, box, PB, "min", 3, true, COORD, o->box_min);
+            r = scene_get_vec(c, box, PB, "min", 3, true, COORD, o->box_min); /* model space */
             if (!r) r = scene_get_vec(c, box, PB, "max", 3, true, COORD, o->box_max);
             for (int k = 0; k < 3 && !r; ++k)
                 if (!(o->box_max[k] > o->box_min[k])) {
@@ -145,7 +178,7 @@ static vfx_result parse_environment(pctx *c, const cJSON *v, rt_scene_environmen
 
 static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
 {
-    static const char *const keys[] = {"version", "name", "description", "camera", "meshes", "beams",
+    static const char *const keys[] = {"version", "origin", "name", "description", "camera", "meshes", "beams",
                                        "beam_settings", "water", "volume", "environment", NULL};
     vfx_result r = scene_expect_object(c, root, "");
     if (r)
@@ -165,6 +198,8 @@ static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
     if (!r) r = scene_get_string(c, root, "", "description", false, desc, sizeof desc);
     if (r)
         return r;
+    if ((r = parse_origin(c, root, s)))
+        return r;
     s->camera = (rt_scene_camera){.eye = {0, 2, 6}, .target = {0, 0.5f, 0}, .up = {0, 1, 0}, .fov_y_deg = 60,
                                    .width = 640, .height = 360, .near_plane = 0.05f, .far_plane = 200};
     s->beams_view = (vfx_beams_view){.size = sizeof s->beams_view, .version = VFX_BEAMS_VIEW_VERSION,
@@ -182,6 +217,7 @@ static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
         s->has_water = true;
         if ((r = scene_parse_water(c, v, &s->water)))
             return r;
+        memcpy(s->water.scene_origin, s->origin, sizeof s->origin);
     }
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "environment")) && (r = parse_environment(c, v, &s->environment)))
         return r;

@@ -86,6 +86,7 @@ typedef enum rt_scene_generator {
 
 typedef struct rt_scene_water {
     rt_scene_water_source source;
+    double scene_origin[3];          /* the scene's origin, subtracted from a particle file */
     char path[RT_SCENE_PATH_MAX];   /* FILE */
     /* GENERATOR */
     rt_scene_generator generator;
@@ -153,6 +154,8 @@ typedef struct rt_scene_environment {
 typedef struct rt_scene {
     char name[128];
     char base_dir[RT_SCENE_PATH_MAX];
+    double origin[3];                /* "origin": every position below (camera, meshes, water,
+                                        beams, volume, particle files) is relative to it */
     rt_scene_camera camera;
     uint32_t mesh_count;
     rt_scene_mesh *meshes;

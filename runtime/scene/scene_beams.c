@@ -112,7 +112,8 @@ static vfx_result parse_track(pctx *c, const cJSON *v, const char *P, int k, uin
             if ((r = scene_number_value(c, val, PV, beam_param_range(k), &d)))
                 return r;
             dst[0] = (float)d;
-        } else if ((r = scene_vec_value(c, val, PV, dim, beam_param_range(k), dst))) {
+        } else if ((r = k == RT_BEAM_PARAM_HEAD ? scene_point_value(c, val, PV, dim, dst) /* a position */
+                                                : scene_vec_value(c, val, PV, dim, beam_param_range(k), dst))) {
             return r;
         }
         if (k == RT_BEAM_PARAM_DIR && scene_is_zero3(dst))
@@ -222,6 +223,8 @@ vfx_result scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
             float *dst = beam_param_ptr(b, &o->look, k);
             if (beam_param_dim[k] == 1)
                 r = scene_get_float(c, e, P, name, required, beam_param_range(k), dst);
+            else if (k == RT_BEAM_PARAM_HEAD)
+                r = scene_get_point(c, e, P, name, required, dst);
             else
                 r = scene_get_vec(c, e, P, name, beam_param_dim[k], required, beam_param_range(k), dst);
             if (r)

@@ -177,6 +177,39 @@ vfx_result scene_vec_value(pctx *c, const cJSON *v, const char *p, int n, range 
     return VFX_OK;
 }
 
+vfx_result scene_point_value(pctx *c, const cJSON *v, const char *p, int n, float *out)
+{
+    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != n)
+        return scene_vec_value(c, v, p, n, COORD, out); /* its message names what is wrong */
+    int i = 0;
+    for (const cJSON *e = v->child; e; e = e->next, ++i) {
+        char pi[JPATH];
+        scene_join_index(pi, p, i);
+        double d = 0;
+        vfx_result r = scene_number_value(c, e, pi, COORD, &d); /* checks it as float32 too */
+        if (r)
+            return r;
+        d = e->valuedouble; /* but keeps the digits: the difference is what becomes float32 */
+        if (n == 3)
+            d -= c->origin[i];
+        else if (i >= 12 && i < 15)
+            d -= c->origin[i - 12];
+        out[i] = (float)d;
+    }
+    return VFX_OK;
+}
+
+vfx_result scene_get_point(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+                            float out[3])
+{
+    char p[JPATH];
+    scene_join(p, path, key);
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!v)
+        return required ? scene_failf(c, VFX_ERR_FORMAT, p, "required array of 3 numbers missing") : VFX_OK;
+    return scene_point_value(c, v, p, 3, out);
+}
+
 vfx_result scene_get_vec(pctx *c, const cJSON *obj, const char *path, const char *key, int n,
                           bool required, range rg, float *out)
 {
@@ -333,10 +366,12 @@ vfx_result scene_parse_transform(pctx *c, const cJSON *obj, const char *path, fl
         scene_join(p, path, "matrix");
         if (trs)
             return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "give either matrix or translate/rotate_deg/scale, not both");
-        return scene_vec_value(c, mv, p, 16, COORD, model);
+        return scene_point_value(c, mv, p, 16, model);
     }
-    float t[3] = {0, 0, 0}, rdeg[3] = {0, 0, 0}, s[3] = {1, 1, 1};
-    vfx_result r = scene_get_vec(c, obj, path, "translate", 3, false, COORD, t);
+    /* no translate: at the world origin, which is -origin from the scene's origin */
+    float t[3] = {(float)-c->origin[0], (float)-c->origin[1], (float)-c->origin[2]};
+    float rdeg[3] = {0, 0, 0}, s[3] = {1, 1, 1};
+    vfx_result r = scene_get_point(c, obj, path, "translate", false, t);
     if (!r) r = scene_get_vec(c, obj, path, "rotate_deg", 3, false, (range){-36000, 36000, false}, rdeg);
     if (r)
         return r;

@@ -17,6 +17,7 @@ typedef struct pctx {
     char *err;
     size_t errlen;
     const char *base_dir;
+    double origin[3]; /* the scene's origin: positions are stored relative to it (scene.h) */
 } pctx;
 typedef struct range {
     double lo, hi;
@@ -61,6 +62,11 @@ vfx_result scene_parse_transform(pctx *c, const cJSON *obj, const char *path, fl
 vfx_result scene_resolve_path(pctx *c, const char *p, const char *rel, char *out);
 const char *scene_type_name(const cJSON *v);
 vfx_result scene_vec_value(pctx *c, const cJSON *v, const char *p, int n, range rg, float *out);
+/* A world position (n = 3), or a model matrix (n = 16) whose translation is one: read in double
+ * and stored as the difference to the scene's origin, so far-out scenes keep float32 digits. */
+vfx_result scene_point_value(pctx *c, const cJSON *v, const char *p, int n, float *out);
+vfx_result scene_get_point(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+                            float out[3]);
 vfx_result scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s);
 vfx_result scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv, vfx_beams_view2 *bv2);
 vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w);

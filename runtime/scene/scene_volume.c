@@ -100,7 +100,7 @@ vfx_result scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol)
         vol->gen_min[0] = vol->gen_min[1] = vol->gen_min[2] = -1;
         vol->gen_max[0] = vol->gen_max[1] = vol->gen_max[2] = 1;
         r = scene_get_uint(c, gen, PG, "cells", false, 1, RT_SCENE_MAX_VOLUME_CELLS, &vol->gen_cells);
-        if (!r) r = scene_get_vec(c, gen, PG, "min", 3, false, COORD, vol->gen_min);
+        if (!r) r = scene_get_vec(c, gen, PG, "min", 3, false, COORD, vol->gen_min); /* model space */
         if (!r) r = scene_get_vec(c, gen, PG, "max", 3, false, COORD, vol->gen_max);
         for (int k = 0; k < 3 && !r; ++k)
             if (!(vol->gen_max[k] > vol->gen_min[k]))

@@ -22,8 +22,8 @@ vfx_result scene_parse_box(pctx *c, const cJSON *obj, const char *path, const ch
     if (r)
         return r;
     scene_check_keys(c, v, P, keys);
-    r = scene_get_vec(c, v, P, "min", 3, true, COORD, mn);
-    if (!r) r = scene_get_vec(c, v, P, "max", 3, true, COORD, mx);
+    r = scene_get_point(c, v, P, "min", true, mn);
+    if (!r) r = scene_get_point(c, v, P, "max", true, mx);
     for (int k = 0; k < 3 && !r; ++k)
         if (!(mx[k] > mn[k])) {
             char PM[JPATH];
@@ -94,18 +94,18 @@ vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
             return r;
         w->generator = (rt_scene_generator)kind;
         if (kind == RT_SCENE_GEN_LAYERS) {
-            r = scene_get_vec(c, g, PG, "origin", 3, false, COORD, w->origin);
+            r = scene_get_point(c, g, PG, "origin", false, w->origin);
             if (!r) r = scene_get_float(c, g, PG, "spacing", false, POSITIVE, &w->spacing);
             if (!r) r = scene_get_uint(c, g, PG, "layer_side", false, 1, 4096, &w->layer_side);
         } else if (kind == RT_SCENE_GEN_BOX) {
-            r = scene_get_vec(c, g, PG, "min", 3, true, COORD, w->box_min);
-            if (!r) r = scene_get_vec(c, g, PG, "max", 3, true, COORD, w->box_max);
+            r = scene_get_point(c, g, PG, "min", true, w->box_min);
+            if (!r) r = scene_get_point(c, g, PG, "max", true, w->box_max);
             for (int k = 0; k < 3 && !r; ++k)
                 if (!(w->box_max[k] > w->box_min[k]))
                     r = scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.generator.max",
                               "must exceed min on every axis (axis %d: %g <= %g)", k, w->box_max[k], w->box_min[k]);
         } else {
-            r = scene_get_vec(c, g, PG, "center", 3, false, COORD, w->center);
+            r = scene_get_point(c, g, PG, "center", false, w->center);
             if (!r) r = scene_get_float(c, g, PG, "radius", true, POSITIVE, &w->radius);
         }
         if (r)
@@ -255,8 +255,14 @@ vfx_result rt_scene_water_particles(const rt_scene_water *w, float **xyz, uint32
     }
     *xyz = NULL;
     *count = 0;
-    if (w->source == RT_SCENE_WATER_FILE)
-        return rt_particle_file_load(w->path, xyz, count, err, errlen);
+    if (w->source == RT_SCENE_WATER_FILE) {
+        vfx_result r = rt_particle_file_load(w->path, xyz, count, err, errlen);
+        if (r == VFX_OK && (w->scene_origin[0] != 0 || w->scene_origin[1] != 0 || w->scene_origin[2] != 0))
+            for (uint32_t i = 0; i < *count; ++i) /* in double, as the scene's own positions */
+                for (int k = 0; k < 3; ++k)
+                    (*xyz)[3 * i + k] = (float)((double)(*xyz)[3 * i + k] - w->scene_origin[k]);
+        return r;
+    }
     uint32_t n = w->count;
     if (n == 0)
         return VFX_OK;
