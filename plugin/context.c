@@ -3,6 +3,7 @@
  * the two 4x4 helpers the frame set-up needs. */
 #include "context.h"
 
+#include <cglm/cglm.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -116,6 +117,9 @@ void volfx_stat_add(vfx_context *ctx, const char *name, double value)
 }
 
 
+/* Kept by hand: cglm's glm_mat4_inv works in float and never says "singular"; the plugin inverts
+ * view*projection, whose cofactors lose their digits in float for near/far ratios of 1e5, and
+ * must refuse a singular camera with an error. */
 bool volfx_mat4_invert(const float m[16], float out[16])
 {
     double a[16], inv[16];
@@ -147,11 +151,11 @@ bool volfx_mat4_invert(const float m[16], float out[16])
 
 void volfx_mat4_mul(const float a[16], const float b[16], float out[16])
 {
-    for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) {
-            float s = 0;
-            for (int k = 0; k < 4; ++k)
-                s += a[k * 4 + r] * b[c * 4 + k];
-            out[c * 4 + r] = s;
-        }
+    /* cglm, header-inline; through aligned copies (its SIMD loads want mat4 alignment) and a
+     * temporary, so out may be a or b */
+    mat4 A, B, C;
+    memcpy(A, a, sizeof A);
+    memcpy(B, b, sizeof B);
+    glm_mat4_mul(A, B, C);
+    memcpy(out, C, sizeof C);
 }

@@ -51,9 +51,9 @@ void volfx_stat_set(vfx_context *ctx, const char *name, double value);
 bool volfx_stat_has(const vfx_context *ctx, const char *name);
 /* Adds to a named counter of the current frame. */
 void volfx_stat_add(vfx_context *ctx, const char *name, double value);
-/* Column-major 4x4 inverse (false when singular or not finite). */
+/* Column-major 4x4 inverse in double (false when singular or not finite): what cglm lacks. */
 bool volfx_mat4_invert(const float m[16], float out[16]);
-/* out = a * b, column-major. */
+/* out = a * b, column-major (cglm's glm_mat4_mul; out may alias a or b). */
 void volfx_mat4_mul(const float a[16], const float b[16], float out[16]);
 
 #endif

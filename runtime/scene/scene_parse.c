@@ -2,6 +2,8 @@
  * carry its JSON path; ranges are checked on the double before any cast. */
 #include "scene/scene_parse.h"
 
+#include <cglm/cglm.h>
+
 #include <float.h>
 #include <math.h>
 #include <stdarg.h>
@@ -334,26 +336,20 @@ vfx_result scene_get_path(pctx *c, const cJSON *obj, const char *path, const cha
 
 void scene_mat_identity(float m[16])
 {
-    memset(m, 0, 16 * sizeof(float));
-    m[0] = m[5] = m[10] = m[15] = 1;
+    mat4 id = GLM_MAT4_IDENTITY_INIT;
+    memcpy(m, id, sizeof id);
 }
 
-/* M = T * Rz * Ry * Rx * S, column-major; computed in double for the trig. */
+/* M = T * Rz * Ry * Rx * S, column-major, with cglm. */
 void scene_mat_trs(const float t[3], const float rdeg[3], const float s[3], float m[16])
 {
-    double rx = rdeg[0] * M_PI / 180, ry = rdeg[1] * M_PI / 180, rz = rdeg[2] * M_PI / 180;
-    double cx = cos(rx), sx = sin(rx), cy = cos(ry), sy = sin(ry), cz = cos(rz), sz = sin(rz);
-    /* rows of Rz*Ry*Rx */
-    double r[3][3] = {
-        {cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx},
-        {sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx},
-        {-sy, cy * sx, cy * cx},
-    };
-    scene_mat_identity(m);
-    for (int col = 0; col < 3; ++col)
-        for (int row = 0; row < 3; ++row)
-            m[col * 4 + row] = (float)(r[row][col] * s[col]);
-    m[12] = t[0], m[13] = t[1], m[14] = t[2];
+    mat4 M;
+    glm_translate_make(M, (vec3){t[0], t[1], t[2]});
+    glm_rotate_z(M, glm_rad(rdeg[2]), M);
+    glm_rotate_y(M, glm_rad(rdeg[1]), M);
+    glm_rotate_x(M, glm_rad(rdeg[0]), M);
+    glm_scale(M, (vec3){s[0], s[1], s[2]});
+    memcpy(m, M, sizeof M);
 }
 
 vfx_result scene_parse_transform(pctx *c, const cJSON *obj, const char *path, float model[16])

@@ -9,8 +9,8 @@ echo "only vfx_plugin_entry exported"
 # No GL loader of its own: every GL command comes through the host's gl_get_proc_address, so the
 # library needs no GL, EGL, GLX or libepoxy library and calls no such symbol.
 needed=$(readelf -d "$1" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p')
-if echo "$needed" | grep -q -E 'epoxy|libGL|libEGL|libOpenGL|libGLX'; then
-  echo "$1 needs a GL library:"; echo "$needed"; exit 1
+if echo "$needed" | grep -q -E 'epoxy|libGL|libEGL|libOpenGL|libGLX|cglm'; then
+  echo "$1 needs a GL library or libcglm (cglm is used header-inline):"; echo "$needed"; exit 1
 fi
 gl=$(nm -D --undefined-only "$1" | awk '{print $2}' | grep -E '^(gl[A-Z]|egl|glX|epoxy)' || true)
 if [ -n "$gl" ]; then
