@@ -203,17 +203,18 @@ methods=$("$bench" metaballs --method '?' 2>&1 | sed -n 's/.*--method \([a-z|_]*
 [ -n "$methods" ] || methods="paper brute grid"
 F="--disable 64" # flat shading, as scripts/bench-water.sh: shading is not what is compared
 if [ $small = 1 ]; then
-  run water-table1 60 metaballs --method paper --particles 1024 --size 32 --size 48x27 --frames 2 $F
-  for m in $methods; do run water-methods 60 metaballs --method "$m" --particles 1024 --size 48x27 --frames 2 --reference $F; done
+  run water-table1 60 metaballs --method paper --particles 1024 --size 32 --frames 2 $F
+  run water-table1 60 metaballs --method paper --particles 1024 --size 48 --height 27 --frames 2 $F
+  for m in $methods; do run water-methods 60 metaballs --method "$m" --particles 1024 --size 48 --height 27 --frames 2 --reference $F; done
   run beams-1080p 60 beams --gpu --timing-only --sets 1,10 --size 64x36 --frames 2 --json
   run default-scene-1080p 60 frame --size 64x36 --frames 2 --json
 else
   run water-table1 120 metaballs --method paper --particles 4096 --particles 16384 --particles 65536 \
       --size 128 --size 256 --size 512 --frames 8 $F
-  run water-table1 90 metaballs --method paper --particles 262144 --size 1920x1080 --frames 5 $F
-  run water-table1 90 metaballs --method paper --particles 1048576 --size 1920x1080 --frames 3 $F
+  run water-table1 90 metaballs --method paper --particles 262144 --size 1920 --height 1080 --frames 5 $F
+  run water-table1 90 metaballs --method paper --particles 1048576 --size 1920 --height 1080 --frames 3 $F
   for m in $methods; do # same particles, camera and size for every method; then their error
-    run water-methods 40 metaballs --method "$m" --particles 65536 --size 1920x1080 --frames 5 $F
+    run water-methods 40 metaballs --method "$m" --particles 65536 --size 1920 --height 1080 --frames 5 $F
     run water-methods 30 metaballs --method "$m" --particles 4096 --size 256 --frames 3 --reference $F
   done
   run beams-1080p 60 beams --gpu --timing-only --sets 100,1000 --size 1920x1080 --frames 20 --json
