@@ -124,7 +124,7 @@ static void test_shifted_worlds(void **state)
         lit_b += ref.beams[i] > 1e-3f, lit_v += ref.volume[i] > 1e-3f;
     diff self = compare(&ref, &ref);
     printf("at the origin: %u water hits, %u beam pixels, %u volume pixels\n", self.water_hits, lit_b, lit_v);
-    assert_true(self.water_hits > 200 && lit_b > 200 && lit_v > 100); /* every effect is in view */
+    assert_true(self.water_hits > 50 && lit_b > 200 && lit_v > 100); /* every effect is in view */
     static const double shifts[2] = {1e4, 1e5};
     for (int k = 0; k < 2; ++k) {
         render_scene(shifts[k], "\"camera\"", &r);
