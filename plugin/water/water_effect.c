@@ -905,6 +905,10 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_flat"), (p->disable & VFX_WATER_NO_SHADING) != 0);
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_color"), frame->color_texture != 0);
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_depth"), frame->depth_texture != 0);
+    if (targets->environment_cubemap)
+        glBindTextureUnit(5, targets->environment_cubemap);
+    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_env"), targets->environment_cubemap != 0);
+    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_hdr"), targets->color_hdr);
     volfx_gpu_fullscreen(ctx);
     volfx_gpu_pass_end(ctx);
     counters_frame_end(ctx, s, p->method);

@@ -606,8 +606,36 @@ static void test_normals_vs_reference(void **state)
     }
 }
 
+/* volfx_sky of shaders/common/sky.glsl in double. */
+static void sky_d(const double d0[3], const double sun0[3], double out[3])
+{
+    double ld = sqrt(d0[0] * d0[0] + d0[1] * d0[1] + d0[2] * d0[2]);
+    double ls = sqrt(sun0[0] * sun0[0] + sun0[1] * sun0[1] + sun0[2] * sun0[2]);
+    double d[3] = {d0[0] / ld, d0[1] / ld, d0[2] / ld}, sun[3] = {sun0[0] / ls, sun0[1] / ls, sun0[2] / ls};
+    const double zenith[3] = {0.045, 0.075, 0.19}, horizon[3] = {0.62, 0.36, 0.24}, ground[3] = {0.07, 0.06, 0.06};
+    double up = d[1];
+    double hx = d[0] + 1e-6, hz = d[2] + 1e-6, sx = sun[0] + 1e-6, sz = sun[2] + 1e-6;
+    double hl = sqrt(hx * hx + 1e-12 + hz * hz), sl = sqrt(sx * sx + 1e-12 + sz * sz);
+    double side = fmax((hx * sx + 1e-12 + hz * sz) / (hl * sl), 0.0);
+    double s = fmax(d[0] * sun[0] + d[1] * sun[1] + d[2] * sun[2], 0.0);
+    const double glow[3] = {0.35, 0.14, 0.04}, disc[3] = {1.0, 0.62, 0.32};
+    for (int k = 0; k < 3; ++k) {
+        double c;
+        if (up >= 0) {
+            double a = pow(fmin(up, 1.0), 0.45);
+            c = horizon[k] + (zenith[k] - horizon[k]) * a;
+        } else {
+            double x = fmin(fmax(-up / 0.35, 0.0), 1.0), a = x * x * (3 - 2 * x);
+            c = horizon[k] + (ground[k] - horizon[k]) * a;
+        }
+        c += glow[k] * pow(side, 3.0) * exp(-fabs(up) * 6.0);
+        c += disc[k] * (0.22 * pow(s, 12.0) + 14.0 * pow(s, 2400.0));
+        out[k] = c;
+    }
+}
+
 /* The shading formula of shaders/water/shade.frag, in double, for a checked pixel; returns the
- * sun highlight's share. */
+ * share of the sun (highlight and the sky's disc), whose pixels the caller leaves out. */
 static double expected_shade(const double dir[3], const double n[3], double ior, const double behind[3],
                            double out[3])
 {
@@ -615,18 +643,16 @@ static double expected_shade(const double dir[3], const double n[3], double ior,
     c = c < 0 ? 0 : c > 1 ? 1 : c;
     double r0 = pow((ior - 1) / (ior + 1), 2), f = r0 + (1 - r0) * pow(1 - c, 5);
     double dn = dir[0] * n[0] + dir[1] * n[1] + dir[2] * n[2];
-    double ry = dir[1] - 2 * dn * n[1];
-    ry = ry < 0 ? 0 : ry > 1 ? 1 : ry;
-    const double lo[3] = {0.55, 0.65, 0.75}, hi[3] = {0.9, 0.95, 1.0};
-    const double sun[3] = {0.3487, 0.8137, 0.4650};
-    double rs = 0;
-    for (int k = 0; k < 3; ++k) rs += (dir[k] - 2 * dn * n[k]) * sun[k];
-    double spec = 2.0 * pow(rs > 0 ? rs : 0, 400.0);
-    for (int k = 0; k < 3; ++k) {
-        double sky = lo[k] + (hi[k] - lo[k]) * ry;
-        out[k] = fmin(behind[k] + (sky - behind[k]) * f + spec, 1.0);
-    }
-    return spec;
+    double r[3] = {dir[0] - 2 * dn * n[0], dir[1] - 2 * dn * n[1], dir[2] - 2 * dn * n[2]};
+    const double sun[3] = {-0.4653, 0.3619, -0.8079};
+    double rs = r[0] * sun[0] + r[1] * sun[1] + r[2] * sun[2];
+    double spec = pow(rs > 0 ? rs : 0, 400.0), disc = 14.0 * pow(rs > 0 ? rs : 0, 2400.0);
+    double sky[3];
+    sky_d(r, sun, sky);
+    const double glint[3] = {2.0, 1.5, 1.1};
+    for (int k = 0; k < 3; ++k)
+        out[k] = fmin(behind[k] + (sky[k] - behind[k]) * f + glint[k] * spec, 1.0);
+    return 2.0 * spec + disc;
 }
 
 /* Shaded pixels: (a) the blob scene with a white tint (no absorption): every water pixel is
