@@ -220,48 +220,46 @@ static void march_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_tile
     glUniform1i(volfx_gpu_uniform(ctx, prog, "u_local"), !(p->disable & VFX_WATER_NO_LOCAL_LIST));
 }
 
-vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
-                                  const vfx_frame_view *frame, const volfx_frame_targets *targets,
-                                  GLuint grad_tex, GLuint back_tex)
+/* The march over the tile lists: MODE_MARCH writes gradient and back distance for every pixel,
+ * MODE_FINISH reads the paper method's state and next step and finishes its sample-cap pixels.
+ * The two differ only in the define, the pass name and how images 1 and 2 are bound. */
+static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
+                                const vfx_frame_view *frame, const volfx_frame_targets *targets,
+                                bool finish, GLuint img1, GLuint img2)
 {
-    GLuint prog = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_MARCH\n");
+    const char *defines = finish ? "#define MODE_FINISH\n"
+                                 : "#define MODE_MARCH\n";
+    GLuint prog = volfx_gpu_compute(ctx, "water/tile.comp", defines);
     if (!prog)
         return VFX_ERR_GL;
-    volfx_gpu_pass_begin(ctx, "water.tile_march");
+    const char *name = finish ? "water.finish" : "water.tile_march";
+    GLenum access = finish ? GL_READ_ONLY : GL_WRITE_ONLY;
+    volfx_gpu_pass_begin(ctx, name);
     glUseProgram(prog);
     bind_buffers(t, in);
     march_uniforms(ctx, prog, t, in, frame, targets);
-    glBindImageTexture(1, grad_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindImageTexture(2, back_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    glBindImageTexture(1, img1, 0, GL_FALSE, 0, access, GL_RGBA32F);
+    glBindImageTexture(2, img2, 0, GL_FALSE, 0, access, GL_R32F);
     glDispatchCompute((in->width + 7) / 8, (in->height + 7) / 8, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     volfx_gpu_pass_end(ctx);
     const char *e = volfx_gpu_error_string();
     if (e)
-        return volfx_fail(ctx, VFX_ERR_GL, "water tile march %ux%u: %s", in->width, in->height, e);
+        return volfx_fail(ctx, VFX_ERR_GL, "%s %ux%u: %s", name, in->width, in->height, e);
     return VFX_OK;
+}
+
+vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
+                                  const vfx_frame_view *frame, const volfx_frame_targets *targets,
+                                  GLuint grad_tex, GLuint back_tex)
+{
+    return tile_dispatch(ctx, t, in, frame, targets, false, grad_tex, back_tex);
 }
 
 vfx_result volfx_water_tile_finish(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
                                    const vfx_frame_view *frame, const volfx_frame_targets *targets,
                                    GLuint st_tex, GLuint next_tex)
 {
-    GLuint prog = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_FINISH\n");
-    if (!prog)
-        return VFX_ERR_GL;
-    volfx_gpu_pass_begin(ctx, "water.finish");
-    glUseProgram(prog);
-    bind_buffers(t, in);
-    march_uniforms(ctx, prog, t, in, frame, targets);
-    glBindImageTexture(1, st_tex, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
-    glBindImageTexture(2, next_tex, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
-    glDispatchCompute((in->width + 7) / 8, (in->height + 7) / 8, 1);
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
-                    GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    volfx_gpu_pass_end(ctx);
-    const char *e = volfx_gpu_error_string();
-    if (e)
-        return volfx_fail(ctx, VFX_ERR_GL, "water finish %ux%u: %s", in->width, in->height, e);
-    return VFX_OK;
+    return tile_dispatch(ctx, t, in, frame, targets, true, st_tex, next_tex);
 }
