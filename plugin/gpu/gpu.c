@@ -343,3 +343,12 @@ vfx_result volfx_gpu_read_top_first(vfx_context *ctx, GLuint tex, GLenum format,
     volfx_free(ctx, tmp);
     return VFX_OK;
 }
+
+GLuint volfx_gpu_storage(GLsizeiptr bytes, const char *label)
+{
+    GLuint b;
+    glCreateBuffers(1, &b);
+    glNamedBufferStorage(b, bytes, NULL, GL_DYNAMIC_STORAGE_BIT);
+    volfx_gpu_label(GL_BUFFER, b, label);
+    return b;
+}

@@ -43,6 +43,8 @@ vfx_result volfx_gpu_read_top_first(vfx_context *ctx, GLuint tex, GLenum format,
 /* How many GL commands create resolves through the host's gl_get_proc_address (the generated
  * table's size; tests count the lookups against it). */
 unsigned volfx_gl_command_count(void);
+/* A labelled storage buffer of `bytes`, updatable with glNamedBufferSubData. */
+GLuint volfx_gpu_storage(GLsizeiptr bytes, const char *label);
 /* Labels a GL object for debuggers (no-op without KHR_debug). */
 void volfx_gpu_label(GLenum kind, GLuint object, const char *label);
 /* Returns a GL error as a string, or NULL when glGetError() is GL_NO_ERROR. */

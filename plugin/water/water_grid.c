@@ -30,9 +30,7 @@ volfx_water_grid *volfx_water_grid_create(vfx_context *ctx)
     volfx_water_grid *g = volfx_alloc(ctx, sizeof *g);
     if (!g)
         return NULL;
-    glCreateBuffers(1, &g->blocks);
-    glNamedBufferStorage(g->blocks, 1024 * sizeof(uint32_t), NULL, 0);
-    volfx_gpu_label(GL_BUFFER, g->blocks, "water.grid_blocks");
+    g->blocks = volfx_gpu_storage(1024 * sizeof(uint32_t), "water.grid_blocks");
     return g;
 }
 
@@ -74,14 +72,6 @@ static void grid_layout(const volfx_water_grid_input *in, float g0[3], float *cs
     *cs_out = (float)cs;
 }
 
-static GLuint storage(GLsizeiptr bytes, const char *label)
-{
-    GLuint b;
-    glCreateBuffers(1, &b);
-    glNamedBufferStorage(b, bytes, NULL, GL_DYNAMIC_STORAGE_BIT);
-    volfx_gpu_label(GL_BUFFER, b, label);
-    return b;
-}
 
 static void grid_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_grid_input *in, const float g0[3], float cs,
                           const int dims[3], uint32_t n)
@@ -121,15 +111,15 @@ vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const 
     if (need > g->cell_cap) {
         if (g->count) glDeleteBuffers(1, &g->count);
         if (g->start) glDeleteBuffers(1, &g->start);
-        g->count = storage((GLsizeiptr)need * 4, "water.grid_count");
-        g->start = storage((GLsizeiptr)need * 4, "water.grid_start");
+        g->count = volfx_gpu_storage((GLsizeiptr)need * 4, "water.grid_count");
+        g->start = volfx_gpu_storage((GLsizeiptr)need * 4, "water.grid_start");
         g->cell_cap = need;
         g->built = 0;
     }
     uint32_t np = in->count ? in->count : 1;
     if (np > g->sorted_cap) {
         if (g->sorted) glDeleteBuffers(1, &g->sorted);
-        g->sorted = storage((GLsizeiptr)np * 16, "water.grid_sorted");
+        g->sorted = volfx_gpu_storage((GLsizeiptr)np * 16, "water.grid_sorted");
         g->sorted_cap = np;
         g->built = 0;
     }

@@ -36,9 +36,7 @@ volfx_water_tile *volfx_water_tile_create(vfx_context *ctx)
     volfx_water_tile *t = volfx_alloc(ctx, sizeof *t);
     if (!t)
         return NULL;
-    glCreateBuffers(1, &t->blocks);
-    glNamedBufferStorage(t->blocks, 1024 * sizeof(uint32_t), NULL, 0);
-    volfx_gpu_label(GL_BUFFER, t->blocks, "water.tile_blocks");
+    t->blocks = volfx_gpu_storage(1024 * sizeof(uint32_t), "water.tile_blocks");
     return t;
 }
 
@@ -53,14 +51,6 @@ void volfx_water_tile_destroy(vfx_context *ctx, volfx_water_tile *t)
     volfx_free(ctx, t);
 }
 
-static GLuint storage(GLsizeiptr bytes, const char *label)
-{
-    GLuint b;
-    glCreateBuffers(1, &b);
-    glNamedBufferStorage(b, bytes, NULL, GL_DYNAMIC_STORAGE_BIT);
-    volfx_gpu_label(GL_BUFFER, b, label);
-    return b;
-}
 
 static void tile_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_tile *t, const volfx_water_tile_input *in, uint32_t n)
 {
@@ -116,8 +106,8 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
     if (need > t->tile_cap) {
         if (t->count) glDeleteBuffers(1, &t->count);
         if (t->start) glDeleteBuffers(1, &t->start);
-        t->count = storage((GLsizeiptr)need * 4, "water.tile_count");
-        t->start = storage((GLsizeiptr)need * 4, "water.tile_start");
+        t->count = volfx_gpu_storage((GLsizeiptr)need * 4, "water.tile_count");
+        t->start = volfx_gpu_storage((GLsizeiptr)need * 4, "water.tile_start");
         t->tile_cap = need;
     }
     /* entries: a particle's cube of 2h seen from the box's nearest distance spans at most
@@ -138,13 +128,13 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
     if (want > TILE_MAX_ENTRIES) want = TILE_MAX_ENTRIES;
     if (!t->entries || want > t->entry_cap) {
         if (t->entries) glDeleteBuffers(1, &t->entries);
-        t->entries = storage((GLsizeiptr)want * 16, "water.tile_entries");
+        t->entries = volfx_gpu_storage((GLsizeiptr)want * 16, "water.tile_entries");
         t->entry_cap = (uint32_t)want;
     }
     uint32_t np = in->count ? in->count : 1;
     if (!t->globals || np > t->global_cap) {
         if (t->globals) glDeleteBuffers(1, &t->globals);
-        t->globals = storage(16 + (GLsizeiptr)np * 16, "water.tile_globals");
+        t->globals = volfx_gpu_storage(16 + (GLsizeiptr)np * 16, "water.tile_globals");
         t->global_cap = np;
     }
     const char *e = volfx_gpu_error_string();
