@@ -222,9 +222,8 @@ static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const vol
     GLuint prog = volfx_gpu_compute(ctx, "water/tile.comp", defines);
     if (!prog)
         return VFX_ERR_GL;
-    const char *name = finish ? "water.finish" : "water.tile_march";
     GLenum access = finish ? GL_READ_ONLY : GL_WRITE_ONLY;
-    volfx_gpu_pass_begin(ctx, name);
+    volfx_gpu_pass_begin(ctx, finish ? "water.finish" : "water.tile_march");
     glUseProgram(prog);
     bind_buffers(t, in);
     march_uniforms(ctx, prog, t, in, frame, targets);
@@ -236,7 +235,8 @@ static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const vol
     volfx_gpu_pass_end(ctx);
     const char *e = volfx_gpu_error_string();
     if (e)
-        return volfx_fail(ctx, VFX_ERR_GL, "%s %ux%u: %s", name, in->width, in->height, e);
+        return volfx_fail(ctx, VFX_ERR_GL, "%s %ux%u: %s", finish ? "water finish" : "water tile march",
+                          in->width, in->height, e);
     return VFX_OK;
 }
 
