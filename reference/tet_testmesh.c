@@ -6,6 +6,36 @@
 #include <stdlib.h>
 #include <string.h>
 
+double ref_testmesh_tet_scalar(const tet_mesh *m, const uint32_t tt[4], const double p[3])
+{
+    double v[4][3];
+    for (int j = 0; j < 4; j++)
+        for (int r = 0; r < 3; r++)
+            v[j][r] = m->points[3 * tt[j] + r];
+    double lam[4], vol = 0;
+    for (int j = 0; j < 4; j++) { /* barycentric by signed volumes */
+        double q4[4][3];
+        memcpy(q4, v, sizeof q4);
+        memcpy(q4[j], p, sizeof q4[j]);
+        double a[3], b[3], e[3];
+        for (int r = 0; r < 3; r++) {
+            a[r] = q4[1][r] - q4[0][r];
+            b[r] = q4[2][r] - q4[0][r];
+            e[r] = q4[3][r] - q4[0][r];
+        }
+        lam[j] = a[0] * (b[1] * e[2] - b[2] * e[1]) - a[1] * (b[0] * e[2] - b[2] * e[0]) +
+                 a[2] * (b[0] * e[1] - b[1] * e[0]);
+        vol += lam[j];
+    }
+    for (int j = 0; j < 4; j++)
+        if (lam[j] / vol < -1e-12)
+            return NAN;
+    double s = 0;
+    for (int j = 0; j < 4; j++)
+        s += lam[j] / vol * m->scalar[tt[j]];
+    return s;
+}
+
 /* one cube's 5 tets over the corners numbered x + 2y + 4z */
 static const uint32_t cube5[20] = {0, 1, 3, 4, 1, 2, 3, 6, 1, 4, 5, 6, 3, 4, 6, 7, 1, 3, 4, 6};
 
@@ -103,34 +133,9 @@ static double grid_scalar(int n, const tet_mesh *m, const double p[3])
     }
     const uint32_t *tt = &m->tets[(size_t)5 * 4 * ((cell[2] * n + cell[1]) * n + cell[0])];
     for (int q = 0; q < 5; q++, tt += 4) {
-        double v[4][3];
-        for (int j = 0; j < 4; j++)
-            for (int r = 0; r < 3; r++)
-                v[j][r] = m->points[3 * tt[j] + r];
-        double lam[4], vol = 0;
-        for (int j = 0; j < 4; j++) { /* barycentric by signed volumes */
-            double q4[4][3];
-            memcpy(q4, v, sizeof q4);
-            memcpy(q4[j], p, sizeof q4[j]);
-            double a[3], b[3], e[3];
-            for (int r = 0; r < 3; r++) {
-                a[r] = q4[1][r] - q4[0][r];
-                b[r] = q4[2][r] - q4[0][r];
-                e[r] = q4[3][r] - q4[0][r];
-            }
-            lam[j] = a[0] * (b[1] * e[2] - b[2] * e[1]) - a[1] * (b[0] * e[2] - b[2] * e[0]) +
-                     a[2] * (b[0] * e[1] - b[1] * e[0]);
-            vol += lam[j];
-        }
-        int in = 1;
-        for (int j = 0; j < 4; j++)
-            if (lam[j] / vol < -1e-12) in = 0;
-        if (in) {
-            double s = 0;
-            for (int j = 0; j < 4; j++)
-                s += lam[j] / vol * m->scalar[tt[j]];
+        double s = ref_testmesh_tet_scalar(m, tt, p);
+        if (!isnan(s))
             return s;
-        }
     }
     return NAN;
 }

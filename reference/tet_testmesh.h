@@ -22,6 +22,9 @@ void ref_testmesh_orbit(tet_camera *c, int w, int h, float yaw, float pitch, flo
  * piecewise linear between its points or between its two ends, clamped outside). */
 void ref_tf_eval(const tet_tf *tf, double s, double *tau, double rgb[3]);
 
+/* The scalar of tet tt (4 point indices of m) at p by barycentric interpolation, in double;
+ * NaN when p is outside it. */
+double ref_testmesh_tet_scalar(const tet_mesh *m, const uint32_t tt[4], const double p[3]);
 /* Float64 emission-absorption ray march through a mesh made by ref_testmesh_grid(n): per pixel
  * (centre rays of the renderer's camera model) the ray's span inside [-1,1]^3 is cut into
  * `steps` equal pieces, the scalar at each midpoint interpolated linearly in the containing tet

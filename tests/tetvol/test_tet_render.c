@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include "tet_render.h"
+#include "tet_testmesh.h"
 
 /* cube [-1,1]^3 split into 5 tets (a corner-cut decomposition), scalar = x+y+z+3 scaled */
 static const float cube_pts[8 * 3] = {-1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1,
@@ -78,34 +79,9 @@ static void reference_range(const tet_mesh *m, const tet_camera *c, const tet_tf
                 double s = NAN;
                 for (uint32_t k = 0; k < m->tet_count && isnan(s); k++) {
                     const uint32_t *tt = &m->tets[4 * k];
-                    double v[4][3];
-                    for (int j = 0; j < 4; j++)
-                        for (int r = 0; r < 3; r++)
-                            v[j][r] = m->points[3 * tt[j] + r];
-                    /* barycentric by signed volumes */
-                    double lam[4], vol = 0;
-                    for (int j = 0; j < 4; j++) {
-                        double q[4][3];
-                        memcpy(q, v, sizeof q);
-                        memcpy(q[j], p, sizeof q[j]);
-                        double a[3], b[3], e[3];
-                        for (int r = 0; r < 3; r++) {
-                            a[r] = q[1][r] - q[0][r];
-                            b[r] = q[2][r] - q[0][r];
-                            e[r] = q[3][r] - q[0][r];
-                        }
-                        lam[j] = a[0] * (b[1] * e[2] - b[2] * e[1]) - a[1] * (b[0] * e[2] - b[2] * e[0]) +
-                                 a[2] * (b[0] * e[1] - b[1] * e[0]);
-                        vol += lam[j];
-                    }
-                    int in = 1;
-                    for (int j = 0; j < 4; j++)
-                        if (lam[j] / vol < -1e-12) in = 0;
-                    if (in) {
-                        s = 0;
-                        for (int j = 0; j < 4; j++)
-                            s += lam[j] / vol * m->scalar[tt[j]];
-                    }
+                    double sk = ref_testmesh_tet_scalar(m, tt, p);
+                    if (!isnan(sk))
+                        s = sk;
                 }
                 if (isnan(s))
                     continue;
