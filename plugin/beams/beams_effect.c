@@ -89,6 +89,17 @@ static void free_bloom(beams_state *s)
     s->bloom_levels = 0;
 }
 
+/* The arrays sized by the beam count (remade when the count outgrows them). */
+static void free_per_beam(vfx_context *ctx, beams_state *s)
+{
+    volfx_free(ctx, s->beams);
+    volfx_free(ctx, s->looks);
+    volfx_free(ctx, s->joint_xyz);
+    volfx_free(ctx, s->gpu);
+    volfx_free(ctx, s->rects);
+    volfx_free(ctx, s->visible);
+}
+
 static void beams_destroy(vfx_context *ctx, void *state)
 {
     beams_state *s = state;
@@ -101,12 +112,7 @@ static void beams_destroy(vfx_context *ctx, void *state)
     glDeleteFramebuffers(1, &s->acc_fbo);
     free_bloom(s);
     volfx_ubo_destroy(&s->ubo);
-    volfx_free(ctx, s->beams);
-    volfx_free(ctx, s->looks);
-    volfx_free(ctx, s->joint_xyz);
-    volfx_free(ctx, s->gpu);
-    volfx_free(ctx, s->rects);
-    volfx_free(ctx, s->visible);
+    free_per_beam(ctx, s);
     volfx_free(ctx, s->ranges);
     volfx_free(ctx, s->list);
     volfx_free(ctx, s); /* programs belong to the shared cache */
@@ -240,12 +246,7 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
                           v.bloom, v.bloom_levels, MAX_BLOOM_LEVELS, (double)v.bloom_strength);
     uint32_t n = v.v1.count;
     if (n > s->capacity) {
-        volfx_free(ctx, s->beams);
-        volfx_free(ctx, s->looks);
-        volfx_free(ctx, s->joint_xyz);
-        volfx_free(ctx, s->gpu);
-        volfx_free(ctx, s->rects);
-        volfx_free(ctx, s->visible);
+        free_per_beam(ctx, s);
         s->beams = volfx_alloc(ctx, n * sizeof *s->beams);
         s->looks = volfx_alloc(ctx, n * sizeof *s->looks);
         s->joint_xyz = volfx_alloc(ctx, (size_t)n * VOLFX_BEAM_MAX_JOINTS * sizeof *s->joint_xyz);
