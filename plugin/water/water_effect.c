@@ -898,7 +898,10 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     glBindTextureUnit(3, s->back);
     glBindTextureUnit(4, frame->depth_texture);
     glUniformMatrix4fv(volfx_gpu_uniform(ctx, shade, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
+    glUniformMatrix4fv(volfx_gpu_uniform(ctx, shade, "u_view_proj"), 1, GL_FALSE, targets->view_proj);
     glUniform3fv(volfx_gpu_uniform(ctx, shade, "u_eye"), 1, frame->eye);
+    glUniform1f(volfx_gpu_uniform(ctx, shade, "u_h"), p->h);
+    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_refract_view"), (p->disable & VFX_WATER_NO_REFRACT_TRACE) != 0);
     glUniform1f(volfx_gpu_uniform(ctx, shade, "u_absorption"), p->absorption);
     glUniform1f(volfx_gpu_uniform(ctx, shade, "u_ior"), p->ior);
     glUniform3fv(volfx_gpu_uniform(ctx, shade, "u_tint"), 1, p->color);

@@ -1,11 +1,14 @@
 // Water shading from the distance image and the gradient / back-distance targets (the two
 // billboard passes, or TILE's march from its lists): normal = -grad sum P normalised, Schlick
 // Fresnel between the reflected environment (the host's cubemap, else the procedural dusk sky
-// the sample host draws behind its scene, shaders/common/sky.glsl) and the refracted host colour, absorbed with Beer-Lambert over
-// the thickness to the back of the water (clipped at the host depth) with the absorbed part
-// partly scattered back as the tint (WATER_SCATTER), plus the sun's highlight. Misses are
-// discarded so the host image shows through unchanged. An HDR host gets the highlight unclamped
-// (it blooms); a display-colour host gets everything clamped to 1.
+// the sample host draws behind its scene, shaders/common/sky.glsl) and the light that comes
+// through the water: the refracted ray is traced in screen space through the water's volume
+// (between the front distance and the back distance of the pixel it crosses, clipped at the
+// host depth) until it leaves it, so the thickness is the one along the refracted ray and the
+// host colour is looked up where that ray leaves (REFRACT_*); Beer-Lambert over that thickness
+// with the absorbed part partly scattered back as the tint (WATER_SCATTER), plus the sun's
+// highlight. Misses are discarded so the host image shows through unchanged. An HDR host gets
+// the highlight unclamped (it blooms); a display-colour host gets everything clamped to 1.
 #include "common/depth.glsl"
 #include "common/sky.glsl"
 layout(binding = 0) uniform sampler2D u_dist;
@@ -14,8 +17,10 @@ layout(binding = 2) uniform sampler2D u_grad;   // xyz = grad sum P, w = sum P
 layout(binding = 3) uniform sampler2D u_back;   // farthest ball exit along the ray
 layout(binding = 4) uniform sampler2D u_scene_depth;
 layout(binding = 5) uniform samplerCube u_env;  // the host's environment (frame view 2)
-uniform mat4 u_inv_view_proj;
+uniform mat4 u_inv_view_proj, u_view_proj;
 uniform vec3 u_eye;
+uniform float u_h;                  // kernel radius: the smallest thickness the trace resolves
+uniform bool u_refract_view;        // ablation: the view ray's thickness and a fixed offset
 uniform float u_absorption, u_ior;
 uniform vec3 u_tint;
 uniform bool u_flat, u_has_color, u_has_depth, u_has_env, u_hdr;
@@ -23,6 +28,51 @@ out vec4 o_color;
 #define WATER_SCATTER 0.35
 // the sample host's default sun (scene environment.sun_dir), normalised
 const vec3 WATER_SUN = vec3(-0.4653, 0.3619, -0.8079);
+// The refracted ray's trace: REFRACT_STEPS even steps over twice the view ray's thickness (plus
+// h), then REFRACT_BISECT halvings of the step where it left; both bounds hold for any input.
+#define REFRACT_STEPS 16
+#define REFRACT_BISECT 6
+
+vec2 g_size;
+
+// Is the point inside the water's screen-space volume? false off screen too; *pix its pixel.
+bool in_water(vec3 y, out ivec2 pix)
+{
+    vec4 q = u_view_proj * vec4(y, 1.0);
+    pix = ivec2(-1);
+    if (!(q.w > 0.0)) return false;
+    vec3 ndc = q.xyz / q.w;
+    if (any(greaterThan(abs(ndc.xy), vec2(1.0)))) return false;
+    pix = clamp(ivec2((ndc.xy * 0.5 + 0.5) * g_size), ivec2(0), ivec2(g_size) - 1);
+    float d = length(y - u_eye);
+    float front = texelFetch(u_dist, pix, 0).r;
+    if (front < 0.0 || d < front || d > texelFetch(u_back, pix, 0).r) return false;
+    // behind the host surface at that pixel: the ray has reached the pool's floor or a wall
+    if (u_has_depth && ndc.z * 0.5 + 0.5 > texelFetch(u_scene_depth, pix, 0).r) return false;
+    return true;
+}
+
+// Length of the refracted ray x + s rd inside the water, up to s_max; *exit_pix the pixel where
+// it leaves (-1 when it leaves the screen, and then the length is where it did).
+float refracted_thickness(vec3 x, vec3 rd, float s_max, out ivec2 exit_pix)
+{
+    float ds = s_max / float(REFRACT_STEPS), s0 = 0.0;
+    ivec2 pix;
+    exit_pix = ivec2(-1);
+    for (int k = 1; k <= REFRACT_STEPS; ++k) {
+        float s1 = ds * float(k);
+        if (in_water(x + s1 * rd, pix)) { s0 = s1; continue; }
+        // left between s0 and s1: halve the step (the first sample sits just inside the front)
+        exit_pix = pix;
+        for (int b = 0; b < REFRACT_BISECT; ++b) {
+            float sm = 0.5 * (s0 + s1);
+            if (in_water(x + sm * rd, pix)) s0 = sm;
+            else { s1 = sm; exit_pix = pix; }
+        }
+        return 0.5 * (s0 + s1);
+    }
+    return s_max;
+}
 
 void main()
 {
@@ -42,15 +92,21 @@ void main()
     vec3 r = reflect(dir, n);
     vec3 sky = u_has_env ? texture(u_env, r).rgb : volfx_sky(r, WATER_SUN);
     vec3 behind = vec3(0.1, 0.15, 0.2);
-    if (u_has_color) {
-        vec3 rd = refract(dir, n, 1.0 / u_ior);
-        vec2 uv = (vec2(pix) + 0.5) / size + rd.xy * 0.03;
-        behind = texture(u_scene_color, uv).rgb;
-    }
     float back = texelFetch(u_back, pix, 0).r;
     if (u_has_depth)
         back = min(back, volfx_depth_distance(u_inv_view_proj, u_eye, ndc, texelFetch(u_scene_depth, pix, 0).r));
     float thickness = max(back - t, 0.0);
+    vec3 rd = refract(dir, n, 1.0 / u_ior);
+    if (u_refract_view || dot(rd, rd) == 0.0) {
+        if (u_has_color) behind = texture(u_scene_color, (vec2(pix) + 0.5) / size + rd.xy * 0.03).rgb;
+    } else {
+        g_size = size;
+        ivec2 ep;
+        // a step past the front so the first sample is inside (the front's refine tolerance)
+        vec3 x = u_eye + (t + 1.0e-3 * u_h) * dir;
+        thickness = refracted_thickness(x, rd, 2.0 * thickness + u_h, ep);
+        if (u_has_color) behind = texelFetch(u_scene_color, ep.x < 0 ? pix : ep, 0).rgb;
+    }
     // what the water takes out of the light from behind it comes back partly as its own
     // colour (light scattered in the body): a deep pool reads as tinted water, not black
     vec3 trans = exp(-u_absorption * thickness * (vec3(1.0) - u_tint));

@@ -118,6 +118,9 @@ enum {
     VFX_WATER_NO_SUBDIVIDE = 1u << 9,
     /* TILE (ablation): no screen tiles: every pixel reads every particle */
     VFX_WATER_NO_TILES = 1u << 10,
+    /* shading (ablation): absorb over the view ray's thickness and look the host colour up at a
+     * fixed screen offset, instead of tracing the refracted ray through the water */
+    VFX_WATER_NO_REFRACT_TRACE = 1u << 11,
 };
 
 typedef enum vfx_water_method {
