@@ -74,13 +74,16 @@ static void plugin_destroy(vfx_context *ctx)
 {
     if (!ctx)
         return;
+    /* the effects free GL objects: through this context's table (another context's destroy may
+     * have cleared the thread's) */
+    if (ctx->gl)
+        gl_bind(ctx);
     for (int k = 0; k < VFX_EFFECT_COUNT; ++k)
         if (ctx->effect_state[k] && ctx->effect_ops[k]) {
             ctx->effect_ops[k]->destroy(ctx, ctx->effect_state[k]);
             ctx->effect_state[k] = NULL;
         }
     if (ctx->gl) {
-        gl_bind(ctx);
         volfx_frame_check_destroy(ctx);
         volfx_gpu_destroy(ctx, ctx->gpu);
         volfx_gl_current = NULL; /* nothing may call GL through a freed table */

@@ -18,8 +18,8 @@
 /* Counter readback ring: frames the GPU may run behind before a result is dropped. */
 #define WATER_COUNTER_RING 3
 /* march.comp's 8 (PAPER and the gradient pass), GRID's cells visited and sphere tests, and
- * tile.comp's 8 (TILE and the paper method's finishing pass) */
-#define WATER_COUNTERS 18
+ * tile.comp's 14 (TILE and the paper method's finishing pass) */
+#define WATER_COUNTERS 24
 /* Particles the effect takes at most: positions are 12 bytes each (12 GiB at the limit) and a
  * particle index must fit the int of gl_InstanceID and of the draw's instance count. */
 #define WATER_MAX_PARTICLES (1u << 30)
@@ -599,6 +599,13 @@ static void publish_counters(vfx_context *ctx, water_state *s)
         volfx_stat_set(ctx, "water.pixels_undecided", c[12]);
         volfx_stat_set(ctx, "water.tile_dense_pixels", c[13]);
         volfx_stat_set(ctx, "water.tile_subdivision_samples", c[15]);
+        volfx_stat_set(ctx, "water.tile_temporal_reused", c[18]);
+        volfx_stat_set(ctx, "water.tile_temporal_fallback", c[19]);
+        volfx_stat_set(ctx, "water.tile_temporal_steps_skipped", c[20]);
+        volfx_stat_set(ctx, "water.tile_temporal_proof_samples", c[21]);
+        volfx_stat_set(ctx, "water.tile_temporal_samples_saved", (double)c[20] - c[21]);
+        volfx_stat_set(ctx, "water.tile_half_upsampled", c[22]);
+        volfx_stat_set(ctx, "water.tile_half_remarched", c[23]);
     }
     if (paper) {
         /* the cap pixels the finishing pass took (0 with VFX_WATER_NO_FINISH), and what is left
@@ -820,7 +827,7 @@ static vfx_result tile_lists(vfx_context *ctx, water_state *s, volfx_water_tile_
         return VFX_ERR_OUT_OF_MEMORY;
     *in = (volfx_water_tile_input){s->cols, s->count, &s->params, s->width, s->height, ctx->water_dist_tex,
                                    s->counters, s->have_last ? s->last[10] : 0, s->view_proj, s->lo, s->hi,
-                                   frame->eye, fabsf(frame->proj[5]) * 0.5f * (float)s->height};
+                                   frame->eye, fabsf(frame->proj[5]) * 0.5f * (float)s->height, s->frame_no};
     return volfx_water_tile_bin(ctx, s->tile, in);
 }
 

@@ -29,6 +29,15 @@ struct volfx_water_tile {
     uint32_t global_cap; /* particles `globals` holds */
     uint32_t tiles_x, tiles_y, slabs;
     float d0, ds;        /* slab k starts at distance d0 + k ds from the eye */
+    /* temporal reuse: each pixel's hit point of the frame `hits_frame` (world space), and this
+     * frame's reprojected guesses; valid for the next frame only, at the same size and field */
+    GLuint hits, guess;
+    uint32_t hits_px;    /* pixels the two buffers hold */
+    uint32_t hits_w, hits_h;
+    int hits_valid;
+    uint64_t hits_frame;
+    float hits_field[3]; /* h, T, step of those hits */
+    float hits_eye[3], hits_fwd[3];
 };
 
 volfx_water_tile *volfx_water_tile_create(vfx_context *ctx)
@@ -44,8 +53,8 @@ void volfx_water_tile_destroy(vfx_context *ctx, volfx_water_tile *t)
 {
     if (!t)
         return;
-    GLuint b[] = {t->count, t->start, t->blocks, t->entries, t->globals};
-    for (int k = 0; k < 5; ++k)
+    GLuint b[] = {t->count, t->start, t->blocks, t->entries, t->globals, t->hits, t->guess};
+    for (int k = 0; k < 7; ++k)
         if (b[k])
             glDeleteBuffers(1, &b[k]);
     volfx_free(ctx, t);
@@ -76,6 +85,10 @@ static void bind_buffers(const volfx_water_tile *t, const volfx_water_tile_input
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, t->blocks);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, t->entries);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, t->globals);
+    if (t->hits) {
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, t->hits);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 13, t->guess);
+    }
 }
 
 vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in)
@@ -215,21 +228,36 @@ static void march_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_tile
  * The two differ only in the define, the pass name and how images 1 and 2 are bound. */
 static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
                                 const vfx_frame_view *frame, const volfx_frame_targets *targets,
-                                bool finish, GLuint img1, GLuint img2)
+                                bool finish, GLuint img1, GLuint img2, int half, bool temporal, bool reuse)
 {
     const char *defines = finish ? "#define MODE_FINISH\n"
                                  : "#define MODE_MARCH\n";
     GLuint prog = volfx_gpu_compute(ctx, "water/tile.comp", defines);
     if (!prog)
         return VFX_ERR_GL;
-    GLenum access = finish ? GL_READ_ONLY : GL_WRITE_ONLY;
-    volfx_gpu_pass_begin(ctx, finish ? "water.finish" : "water.tile_march");
+    GLenum access = finish ? GL_READ_ONLY : GL_READ_WRITE;
+    volfx_gpu_pass_begin(ctx, finish ? "water.finish" : half == 2 ? "water.tile_upsample" : "water.tile_march");
     glUseProgram(prog);
     bind_buffers(t, in);
     march_uniforms(ctx, prog, t, in, frame, targets);
     glBindImageTexture(1, img1, 0, GL_FALSE, 0, access, GL_RGBA32F);
     glBindImageTexture(2, img2, 0, GL_FALSE, 0, access, GL_R32F);
-    glDispatchCompute((in->width + 7) / 8, (in->height + 7) / 8, 1);
+    uint32_t w = in->width, h = in->height;
+    if (!finish) {
+        glBindImageTexture(0, in->dist_tex, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+        glUniform1i(volfx_gpu_uniform(ctx, prog, "u_half"), half);
+        glUniform1i(volfx_gpu_uniform(ctx, prog, "u_temporal"), temporal);
+        glUniform1i(volfx_gpu_uniform(ctx, prog, "u_reuse"), reuse);
+        /* the neighbours' tangent planes agree within a quarter step (the march's own bracket
+         * is one step wide before regula falsi) and their normals within 18 degrees */
+        glUniform1f(volfx_gpu_uniform(ctx, prog, "u_half_tol"), 0.25f * in->params->step);
+        glUniform1f(volfx_gpu_uniform(ctx, prog, "u_half_cos"), 0.95f);
+        if (half == 1) {
+            w = (w + 1) / 2;
+            h = (h + 1) / 2;
+        }
+    }
+    glDispatchCompute((w + 7) / 8, (h + 7) / 8, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     volfx_gpu_pass_end(ctx);
@@ -240,16 +268,88 @@ static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const vol
     return VFX_OK;
 }
 
+/* A camera cut: the previous frame's hits would be reprojected exactly, but few would land on
+ * this frame's surface; the eye moved by more than half its distance to the particles' box
+ * centre, or the view turned by more than 30 degrees. */
+static bool camera_cut(const volfx_water_tile *t, const volfx_water_tile_input *in, const float fwd[3])
+{
+    double moved = 0, dist = 0, cosang = 0;
+    for (int k = 0; k < 3; ++k) {
+        double m = (double)in->eye[k] - t->hits_eye[k], c = 0.5 * ((double)in->lo[k] + in->hi[k]) - t->hits_eye[k];
+        moved += m * m;
+        dist += c * c;
+        cosang += (double)fwd[k] * t->hits_fwd[k];
+    }
+    return moved > 0.25 * dist || cosang < 0.866;
+}
+
 vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
                                   const vfx_frame_view *frame, const volfx_frame_targets *targets,
                                   GLuint grad_tex, GLuint back_tex)
 {
-    return tile_dispatch(ctx, t, in, frame, targets, false, grad_tex, back_tex);
+    const vfx_water_params *p = in->params;
+    bool temporal = !(p->disable & VFX_WATER_NO_TEMPORAL);
+    bool half = !(p->disable & VFX_WATER_NO_HALF_RES);
+    uint32_t px = in->width * in->height;
+    if (temporal && (!t->hits || px > t->hits_px)) {
+        if (t->hits) glDeleteBuffers(1, &t->hits);
+        if (t->guess) glDeleteBuffers(1, &t->guess);
+        t->hits = volfx_gpu_storage((GLsizeiptr)px * 16, "water.tile_hits");
+        t->guess = volfx_gpu_storage((GLsizeiptr)px * 4, "water.tile_guess");
+        t->hits_px = px;
+        t->hits_valid = 0;
+        const char *e = volfx_gpu_error_string();
+        if (e)
+            return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water tile: temporal buffers for %ux%u pixels: %s",
+                              in->width, in->height, e);
+    }
+    /* the view's forward direction: -(third row of the view rotation) */
+    const float fwd[3] = {-frame->view[2], -frame->view[6], -frame->view[10]};
+    /* last frame's hits hold for this one if they are of the previous water frame (a method or
+     * ablation switch in between skips a frame), the same image size and the same field; the
+     * particles may have moved (every frame in a game): each guess is only a start, proven or
+     * rejected per pixel */
+    bool reuse = temporal && t->hits_valid && t->hits_frame + 1 == in->frame_no && t->hits_w == in->width &&
+                 t->hits_h == in->height && t->hits_field[0] == p->h && t->hits_field[1] == p->threshold &&
+                 t->hits_field[2] == p->step;
+    bool cut = reuse && camera_cut(t, in, fwd);
+    reuse = reuse && !cut;
+    volfx_stat_set(ctx, "water.tile_temporal_valid", reuse);
+    volfx_stat_set(ctx, "water.tile_temporal_cut", cut);
+    if (reuse) {
+        GLuint prog = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_REPROJECT\n");
+        if (!prog)
+            return VFX_ERR_GL;
+        volfx_gpu_pass_begin(ctx, "water.tile_reproject");
+        const uint32_t none = 0xffffffffu;
+        glClearNamedBufferSubData(t->guess, GL_R32UI, 0, (GLsizeiptr)px * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &none);
+        glUseProgram(prog);
+        bind_buffers(t, in);
+        glUniform2i(volfx_gpu_uniform(ctx, prog, "u_size"), (GLint)in->width, (GLint)in->height);
+        glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_view_proj"), 1, GL_FALSE, in->view_proj);
+        glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_eye"), 1, in->eye);
+        glDispatchCompute((in->width + 7) / 8, (in->height + 7) / 8, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        volfx_gpu_pass_end(ctx);
+    }
+    vfx_result r = tile_dispatch(ctx, t, in, frame, targets, false, grad_tex, back_tex, half ? 1 : 0, temporal, reuse);
+    if (r == VFX_OK && half)
+        r = tile_dispatch(ctx, t, in, frame, targets, false, grad_tex, back_tex, 2, temporal, reuse);
+    t->hits_valid = temporal && r == VFX_OK;
+    t->hits_frame = in->frame_no;
+    t->hits_w = in->width;
+    t->hits_h = in->height;
+    t->hits_field[0] = p->h;
+    t->hits_field[1] = p->threshold;
+    t->hits_field[2] = p->step;
+    memcpy(t->hits_eye, in->eye, sizeof t->hits_eye);
+    memcpy(t->hits_fwd, fwd, sizeof t->hits_fwd);
+    return r;
 }
 
 vfx_result volfx_water_tile_finish(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
                                    const vfx_frame_view *frame, const volfx_frame_targets *targets,
                                    GLuint st_tex, GLuint next_tex)
 {
-    return tile_dispatch(ctx, t, in, frame, targets, true, st_tex, next_tex);
+    return tile_dispatch(ctx, t, in, frame, targets, true, st_tex, next_tex, 0, false, false);
 }

@@ -25,6 +25,7 @@ typedef struct volfx_water_tile_input {
     const float *lo, *hi;            /* box of the finite particles (depth slabs) */
     const float *eye;                /* this frame's eye */
     float focal_px;                  /* pixels per unit at distance 1 (proj[5] * height / 2) */
+    uint64_t frame_no;               /* the water effect's frame: temporal reuse needs the last one */
 } volfx_water_tile_input;
 
 /* Makes the (empty) tile state; NULL on allocation failure. */
@@ -34,7 +35,10 @@ void volfx_water_tile_destroy(vfx_context *ctx, volfx_water_tile *t);
 /* Bins the particles into the screen tiles of this frame (pass water.tile_bin). */
 vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in);
 /* Per-pixel march (pass water.tile_march): writes in->dist_tex, and at found pixels the
- * gradient (xyz grad sum P, w sum P) into grad_tex and the back distance into back_tex. */
+ * gradient (xyz grad sum P, w sum P) into grad_tex and the back distance into back_tex.
+ * Unless disabled: starts from the previous frame's hits reprojected (pass water.tile_reproject,
+ * each start proven by the field bound), and marches one ray per 2x2 block, then upsamples or
+ * marches the other pixels (pass water.tile_upsample). */
 vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
                                   const vfx_frame_view *frame, const volfx_frame_targets *targets,
                                   GLuint grad_tex, GLuint back_tex);

@@ -12,9 +12,14 @@
 //                 samples; regula falsi; gradient and back distance from the same lists.
 //   MODE_FINISH   per pixel of the paper method that spent its sample cap: the same march from
 //                 the paper's next sample, its last outside sample as the bracket's start.
+//   MODE_REPROJECT per pixel of the previous frame: its hit point (world space, kept by the
+//                 march) projected with this frame's camera; the 2x2 pixels around it take the
+//                 nearest distance (atomicMin), each pixel's guess for MODE_MARCH (temporal reuse).
+// MODE_MARCH's u_half: 0 every pixel; 1 the coarse pass (pixels with even x and y); 2 the other
+// pixels, upsampled from their coarse neighbours where those agree, else marched.
 // Every loop is bounded by a constant or by a list length; see docs/water.md (method TILE).
 #include "common/depth.glsl"
-#if defined(MODE_MARCH) || defined(MODE_FINISH)
+#if defined(MODE_MARCH) || defined(MODE_FINISH) || defined(MODE_REPROJECT)
 layout(local_size_x = 8, local_size_y = 8) in;
 #else
 layout(local_size_x = 64) in;
@@ -26,7 +31,8 @@ layout(std430, binding = 3) buffer Count { uint tcount[]; };   // counts, then t
 // the water effect's counter buffer (march.comp's first 8 slots, grid.comp's next 2)
 layout(std430, binding = 4) buffer Counters {
     uint c_culled_, c_frags_, c_samples, c_found, c_cap, c_left, c_gculled_, c_gfrags_, c_cells_, c_tests_,
-         c_entries, c_finished, c_undecided, c_dense, c_tile_tests, c_subdiv, c_global, c_overflow;
+         c_entries, c_finished, c_undecided, c_dense, c_tile_tests, c_subdiv, c_global, c_overflow,
+         c_reused, c_fallback, c_skipped, c_proof, c_upsampled, c_remarched;
 };
 layout(std430, binding = 5) buffer Start { uint tstart[]; };
 layout(std430, binding = 7) buffer Entries { vec4 entries[]; };
@@ -42,6 +48,12 @@ uniform float u_h;
 // spheres entering before some distance stops at the first entry whose slab starts past it.
 uniform uint u_slabs;
 uniform float u_d0, u_ds;
+#if defined(MODE_MARCH) || defined(MODE_REPROJECT)
+// temporal reuse: last frame's hit point per pixel (w = 1 hit, 0 none), this frame's guesses
+// (the float bits of a distance along the ray; 0xffffffff none)
+layout(std430, binding = 12) buffer Hits { vec4 hits[]; };
+layout(std430, binding = 13) buffer Guess { uint guess[]; };
+#endif
 
 #if defined(MODE_COUNT) || defined(MODE_SCATTER)
 uniform mat4 u_view_proj;
@@ -78,13 +90,26 @@ bool tile_rect(vec3 p, out ivec4 r)
 }
 #endif
 
+#if defined(MODE_REPROJECT)
+uniform mat4 u_view_proj;
+uniform vec3 u_eye;
+uniform ivec2 u_prev_size;
+#endif
+
 #if defined(MODE_MARCH) || defined(MODE_FINISH)
-layout(r32f, binding = 0) uniform writeonly image2D u_dist;
 layout(binding = 1) uniform sampler2D u_scene_depth;
 #if defined(MODE_MARCH)
-layout(rgba32f, binding = 1) uniform writeonly image2D u_grad;
-layout(r32f, binding = 2) uniform writeonly image2D u_back;
+// read back by u_half 2 at the coarse pixels (written by the u_half 1 dispatch before it)
+layout(r32f, binding = 0) uniform image2D u_dist;
+layout(rgba32f, binding = 1) uniform image2D u_grad;
+layout(r32f, binding = 2) uniform image2D u_back;
+uniform bool u_temporal;     // write this frame's hit points
+uniform bool u_reuse;        // the guesses are this frame's (reprojected from the last)
+uniform int u_half;
+uniform float u_half_tol;    // upsample: the neighbours' plane predictions agree within this
+uniform float u_half_cos;    // upsample: the neighbours' normals agree within this cosine
 #else
+layout(r32f, binding = 0) uniform writeonly image2D u_dist;
 layout(rgba32f, binding = 1) uniform readonly image2D u_st;    // the paper's pixel state
 layout(r32f, binding = 2) uniform readonly image2D u_next;     // the paper's next sample
 #endif
@@ -97,6 +122,8 @@ uniform bool u_has_depth, u_subdivide, u_local;
 #define LOCAL_K 16
 #endif
 #define SUB_DEPTH 4
+// temporal reuse: the proof's dyadic depth (an interval of up to 32 steps down to w/2)
+#define PROOF_DEPTH 6
 
 // The pixel's list: its tile's entries (or every particle when the tile did not fit) and then
 // the global list.
@@ -239,6 +266,73 @@ float next_local_entry(float t)
 }
 #endif
 
+#if defined(MODE_MARCH)
+// u_half 2: the pixel from its 2 (same row or column) or 4 (diagonal) coarse neighbours when all
+// of them are empty rays (they met no sphere of influence: a miss), or all hit one smooth
+// surface: each neighbour's tangent plane predicts this ray's distance, the predictions agree
+// within u_half_tol and the normals within u_half_cos; then the mean prediction and the mean
+// gradient and back distance. false: the pixel is marched (edges, silhouettes, thin features).
+bool upsample(ivec2 pix, float t_lim, uint pidx)
+{
+    ivec2 nb[4];
+    int nn = 2;
+    if ((pix.x & 1) == 1 && (pix.y & 1) == 1) {
+        nb[0] = pix + ivec2(-1, -1); nb[1] = pix + ivec2(1, -1); nb[2] = pix + ivec2(-1, 1); nb[3] = pix + ivec2(1, 1);
+        nn = 4;
+    } else if ((pix.x & 1) == 1) {
+        nb[0] = pix - ivec2(1, 0); nb[1] = pix + ivec2(1, 0);
+    } else {
+        nb[0] = pix - ivec2(0, 1); nb[1] = pix + ivec2(0, 1);
+    }
+    int hit = 0, empty = 0;
+    float pmin = 3.0e38, pmax = -3.0e38, psum = 0.0, bsum = 0.0;
+    vec4 gsum = vec4(0.0);
+    vec3 n0 = vec3(0.0);
+    bool ok = true;
+    for (int i = 0; i < nn; ++i) {
+        if (any(greaterThanEqual(nb[i], u_size))) return false;
+        float d = imageLoad(u_dist, nb[i]).r;
+        float bk = imageLoad(u_back, nb[i]).r;
+        if (d < 0.0) {
+            if (bk < 0.0) ++empty;
+            continue;
+        }
+        ++hit;
+        vec4 g = imageLoad(u_grad, nb[i]);
+        if (!(dot(g.xyz, g.xyz) > 0.0)) { ok = false; continue; }
+        vec3 n = -normalize(g.xyz);
+        if (hit == 1) n0 = n;
+        else if (dot(n, n0) < u_half_cos) ok = false;
+        vec3 dir = volfx_ray_dir(u_inv_view_proj, u_eye, (vec2(nb[i]) + 0.5) / vec2(u_size) * 2.0 - 1.0);
+        float den = dot(g_dir, n);
+        if (abs(den) < 0.05) { ok = false; continue; }   // a plane seen edge-on predicts nothing
+        float pred = d * dot(dir, n) / den;
+        pmin = min(pmin, pred);
+        pmax = max(pmax, pred);
+        psum += pred;
+        gsum += g;
+        bsum += bk;
+    }
+    float dist = -1.0;
+    if (empty == nn) {
+        dist = -1.0;
+    } else if (hit == nn && ok && pmax - pmin <= u_half_tol) {
+        dist = psum / float(nn);
+        if (!(dist > 0.0 && dist <= t_lim)) return false;
+        imageStore(u_grad, pix, gsum / float(nn));
+        imageStore(u_back, pix, vec4(max(bsum / float(nn), dist)));
+    } else {
+        return false;
+    }
+    imageStore(u_dist, pix, vec4(dist));
+    if (u_temporal) hits[pidx] = dist >= 0.0 ? vec4(u_eye + dist * g_dir, 1.0) : vec4(0.0);
+    atomicAdd(c_upsampled, 1u);
+    if (dist >= 0.0) atomicAdd(c_found, 1u);
+    else atomicAdd(c_left, 1u);
+    return true;
+}
+#endif
+
 void main()
 {
 #if defined(MODE_COUNT) || defined(MODE_SCATTER)
@@ -273,8 +367,29 @@ void main()
             if (k < u_cap) entries[k] = vec4(p, slab_lo);
 #endif
         }
+#elif defined(MODE_REPROJECT)
+    // the previous frame's hit point (same size: a resize invalidates) onto this frame's pixels
+    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
+    if (any(greaterThanEqual(q, u_size))) return;
+    vec4 hp = hits[q.y * u_size.x + q.x];
+    if (hp.w == 0.0) return;
+    vec4 c = u_view_proj * vec4(hp.xyz, 1.0);
+    if (!(c.w > 0.0)) return;
+    vec2 sp = (c.xy / c.w * 0.5 + 0.5) * vec2(u_size) - 0.5;   // pixel-centre coordinates
+    if (!(all(greaterThan(sp, vec2(-1.0))) && all(lessThan(sp, vec2(u_size))))) return;
+    // the four pixels around it: a start for each (a guess, proven or rejected by the march)
+    ivec2 b = ivec2(floor(sp));
+    uint d = floatBitsToUint(length(hp.xyz - u_eye));
+    for (int k = 0; k < 4; ++k) {
+        ivec2 p = b + ivec2(k & 1, k >> 1);
+        if (all(greaterThanEqual(p, ivec2(0))) && all(lessThan(p, u_size)))
+            atomicMin(guess[p.y * u_size.x + p.x], d);
+    }
 #elif defined(MODE_MARCH) || defined(MODE_FINISH)
     ivec2 pix = ivec2(gl_GlobalInvocationID.xy);
+#if defined(MODE_MARCH)
+    if (u_half == 1) pix *= 2;   // the coarse pass: one ray per 2x2 block
+#endif
     if (any(greaterThanEqual(pix, u_size))) return;
 #if defined(MODE_FINISH)
     vec4 st = imageLoad(u_st, pix);
@@ -291,7 +406,17 @@ void main()
     vec2 ndc = (vec2(pix) + 0.5) / vec2(u_size) * 2.0 - 1.0;
     g_dir = volfx_ray_dir(u_inv_view_proj, u_eye, ndc);
     float t_lim = u_has_depth ? volfx_depth_distance(u_inv_view_proj, u_eye, ndc, texelFetch(u_scene_depth, pix, 0).r) : 3.0e38;
-    uint tests = 0u, nsamp = 0u, nsub = 0u;
+    uint tests = 0u, nsamp = 0u, nsub = 0u, nproof = 0u, nskip = 0u;
+    int reuse = 0;     // temporal: 1 the guess was used, 2 it was rejected (0 none)
+    bool g_empty = false;  // the ray meets no sphere of influence at all
+#if defined(MODE_MARCH)
+    uint pidx = uint(pix.y * u_size.x + pix.x);
+    if (u_half == 2) {
+        if (((pix.x | pix.y) & 1) == 0) return;   // a coarse pixel: done by the u_half 1 pass
+        if (upsample(pix, t_lim, pidx)) return;
+        atomicAdd(c_remarched, 1u);
+    }
+#endif
 
     bool have_prev = false;
     float tp = 0.0, fp = 0.0, t = 0.0;
@@ -310,6 +435,7 @@ void main()
         }
         tests += g_total;
         t = e0;
+        g_empty = e0 >= 3.0e38;
         if (t > 0.0 && t < 3.0e38) { have_prev = true; tp = t; fp = -u_T; }
         t_lim = min(t_lim, last_exit(u_h));
     }
@@ -340,7 +466,7 @@ void main()
                 // is 0 there (L holds the spheres that enter first)
                 float e0 = 3.0e38;
                 for (uint j = 0u; j < g_nl; ++j) e0 = min(e0, Le[j]);
-                if (e0 >= 3.0e38) break;
+                if (e0 >= 3.0e38) { g_empty = true; break; }
                 t = max(e0, 0.0);
                 if (t > 0.0) { have_prev = true; tp = t; fp = -u_T; }
             }
@@ -359,6 +485,43 @@ void main()
         }
         float b_end = g_dense ? t_lim + u_step : b;
         if (!g_dense && b >= 3.0e38) b_end = 3.0e38;
+#if defined(MODE_MARCH)
+        if (win == 0 && u_reuse && guess[pidx] != 0xffffffffu) {
+            // Temporal reuse: jump from the first sphere entry t towards last frame's surface
+            // (reprojected) once [t, x] is proven empty of surface by the field's upper bound,
+            // dyadically (depth PROOF_DEPTH) where the bound over a node allows an inside
+            // point. A node that cannot be proven ends the proof: the march goes on from the
+            // proven prefix as it would have from t. x: half a step before the guess, inside
+            // the window (its local list is exact there) and the host depth.
+            float x = min(min(uintBitsToFloat(guess[pidx]) - 0.5 * u_step, b_end - u_step),
+                          min(t_lim, t + 32.0 * u_step));
+            reuse = 2;
+            if (have_prev && !g_dense && x >= t + u_step) {
+                float w0 = x - t, lf = fp, done = t, T2 = u_T * u_T;
+                int d = 0, k = 0;
+                for (int it = 0; it < 2 << PROOF_DEPTH; ++it) {
+                    float n0 = t + w0 * float(k) / float(1 << d), n1 = t + w0 * float(k + 1) / float(1 << d);
+                    vec2 v = field(n1, n0);
+                    ++nproof;
+                    if (v.y >= T2 && d < PROOF_DEPTH) { ++d; k *= 2; continue; }   // open it
+                    float fv = sqrt(v.x) - u_T;
+                    if (fv >= 0.0) { state = 1; ta = n0; fa = lf; tb = n1; fb = fv; break; }
+                    if (v.y >= T2) break;   // not provable: [t, n0] is
+                    done = n1; lf = fv;
+                    while ((k & 1) == 1 && d > 0) { k >>= 1; --d; }
+                    if (d == 0) break;      // the whole interval
+                    ++k;
+                }
+                if (state == 1) done = ta;
+                if (state == 1 || done >= t + u_step) {
+                    reuse = 1;
+                    nskip = uint((done - t) / u_step);
+                    tp = done; fp = lf; t = done + u_step;
+                }
+            }
+            if (state == 1) break;
+        }
+#endif
         while (t < b_end && t <= t_lim && steps < MAX_STEPS) {
             ++steps;
             vec2 su = field(t, have_prev ? tp : t);
@@ -425,8 +588,15 @@ void main()
     if (state == 1) {
         imageStore(u_grad, pix, gradient(result));
         imageStore(u_back, pix, vec4(last_exit(u_rho)));
+    } else if (u_half == 1) {
+        imageStore(u_back, pix, vec4(g_empty ? -1.0 : 0.0));   // the upsample's empty-ray flag
     }
-    atomicAdd(c_samples, nsamp + nsub);
+    if (u_temporal) hits[pidx] = state == 1 ? vec4(u_eye + result * g_dir, 1.0) : vec4(0.0);
+    if (reuse == 1) atomicAdd(c_reused, 1u);
+    else if (reuse == 2) atomicAdd(c_fallback, 1u);
+    if (nskip > 0u) atomicAdd(c_skipped, nskip);
+    if (nproof > 0u) atomicAdd(c_proof, nproof);
+    atomicAdd(c_samples, nsamp + nsub + nproof);
     if (state == 1) atomicAdd(c_found, 1u);
     else if (state == 4) atomicAdd(c_undecided, 1u);
     else atomicAdd(c_left, 1u);

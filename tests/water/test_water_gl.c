@@ -993,6 +993,39 @@ static void test_paper_sample_cap_counted(void **state)
  * give the same surface: NO_TILES (every pixel reads every particle: the overflow path),
  * NO_LOCAL_LIST (the whole list summed at every sample); NO_SUBDIVIDE may lose spray pixels
  * (measured below), which is what the subdivision is for. */
+/* The scenes of the TILE tests (sc 0 blobs, 1 spray, 2 sheet edge-on), drawn by TILE. */
+static const char *tile_scene(int sc, scene *s, ref_camera *cam)
+{
+    const char *name;
+    if (sc == 0) {
+        *s = blob_scene(VFX_WATER_METHOD_TILE);
+        *cam = blob_camera(64);
+        name = "blobs";
+    } else if (sc == 1) {
+        /* 30 drops on a 6x5 grid 1.3 apart (more than 2h = 1.22: no two overlap) */
+        *s = make_scene(30);
+        for (uint32_t i = 0; i < 30; ++i) {
+            s->x[i] = 1.3f * (float)(i % 6) - 3.25f + 0.037f * (float)(i % 3);
+            s->y[i] = 1.3f * (float)(i / 6) - 2.6f + 0.031f * (float)(i % 4);
+            s->z[i] = -0.3f * (float)(i % 5);
+        }
+        *cam = (ref_camera){{0.3, 0.2, 5.5}, {0, 0, 0}, {0, 1, 0}, 0.9, 64, 64, 0.1, 100};
+        name = "spray";
+    } else {
+        /* a 24x24 sheet at spacing 0.3 in the plane y = 0, the eye 0.05 above it */
+        *s = make_scene(576);
+        for (uint32_t i = 0; i < 576; ++i) {
+            s->x[i] = 0.3f * (float)(i % 24) - 3.45f;
+            s->y[i] = 0.0f;
+            s->z[i] = 0.3f * (float)(i / 24) - 3.45f;
+        }
+        *cam = (ref_camera){{0.1, 0.05, 6.0}, {0, 0.02, 0}, {0, 1, 0}, 0.8, 64, 48, 0.1, 100};
+        name = "sheet edge-on";
+    }
+    s->params.method = VFX_WATER_METHOD_TILE;
+    return name;
+}
+
 static void test_tile_vs_reference(void **state)
 {
     (void)state;
@@ -1000,35 +1033,10 @@ static void test_tile_vs_reference(void **state)
         for (int ab = 0; ab < 4; ++ab) {
             scene s;
             ref_camera cam;
-            const char *name;
-            if (sc == 0) {
-                s = blob_scene(VFX_WATER_METHOD_TILE);
-                cam = blob_camera(64);
-                name = "blobs";
-            } else if (sc == 1) {
-                /* 30 drops on a 6x5 grid 1.3 apart (more than 2h = 1.22: no two overlap) */
-                s = make_scene(30);
-                for (uint32_t i = 0; i < 30; ++i) {
-                    s.x[i] = 1.3f * (float)(i % 6) - 3.25f + 0.037f * (float)(i % 3);
-                    s.y[i] = 1.3f * (float)(i / 6) - 2.6f + 0.031f * (float)(i % 4);
-                    s.z[i] = -0.3f * (float)(i % 5);
-                }
-                cam = (ref_camera){{0.3, 0.2, 5.5}, {0, 0, 0}, {0, 1, 0}, 0.9, 64, 64, 0.1, 100};
-                name = "spray";
-            } else {
-                /* a 24x24 sheet at spacing 0.3 in the plane y = 0, the eye 0.05 above it */
-                s = make_scene(576);
-                for (uint32_t i = 0; i < 576; ++i) {
-                    s.x[i] = 0.3f * (float)(i % 24) - 3.45f;
-                    s.y[i] = 0.0f;
-                    s.z[i] = 0.3f * (float)(i / 24) - 3.45f;
-                }
-                cam = (ref_camera){{0.1, 0.05, 6.0}, {0, 0.02, 0}, {0, 1, 0}, 0.8, 64, 48, 0.1, 100};
-                name = "sheet edge-on";
-            }
-            s.params.method = VFX_WATER_METHOD_TILE;
+            const char *name = tile_scene(sc, &s, &cam);
             static const uint32_t bits[4] = {0, VFX_WATER_NO_TILES, VFX_WATER_NO_LOCAL_LIST, VFX_WATER_NO_SUBDIVIDE};
-            s.params.disable = bits[ab];
+            /* the full-resolution march (the half-resolution path has its own test) */
+            s.params.disable = bits[ab] | VFX_WATER_NO_HALF_RES;
             vfx_stats st;
             ref_water_error e = render_and_compare(&s, &cam, &st);
             double found = stat_of(&st, "water.pixels_found"), left = stat_of(&st, "water.pixels_left"),
@@ -1053,8 +1061,219 @@ static void test_tile_vs_reference(void **state)
             }
             if (bits[ab] == VFX_WATER_NO_TILES)
                 assert_true(stat_of(&st, "water.tile_overflow_pixels") == (double)cam.width * cam.height);
+            /* one frame: nothing to reuse yet */
+            assert_true(stat_of(&st, "water.tile_temporal_valid") == 0 && stat_of(&st, "water.tile_temporal_reused") == 0);
             free_scene(&s);
         }
+    }
+}
+
+/* Normals (-grad normalised) of the gradient image at the pixels dist hits (0 elsewhere). */
+static void grad_normals(const float *dist, const float *grad, float *nrm, size_t n)
+{
+    for (size_t i = 0; i < n; ++i) {
+        double g[3] = {grad[4 * i], grad[4 * i + 1], grad[4 * i + 2]};
+        double len = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        for (int k = 0; k < 3; ++k) nrm[3 * i + k] = dist[i] >= 0 && len > 0 ? (float)(-g[k] / len) : 0.0f;
+    }
+}
+
+/* The blobs moving: every particle drifts by up to 0.06 (0.1 h, about a step of h/8) a frame
+ * and every tenth by 0.15 (more than a step: its guesses are wrong), the eye drifts sideways. */
+static void blobs_move(scene *s, const float *x0, const float *y0, int f, ref_camera *cam)
+{
+    for (uint32_t i = 0; i < s->n; ++i) {
+        float a = (i % 10 == 0) ? 0.15f : 0.06f;
+        s->x[i] = x0[i] + a * (float)f * sinf(0.7f * (float)i);
+        s->y[i] = y0[i] + a * (float)f * cosf(1.3f * (float)i);
+    }
+    cam->eye[0] = 0.5 + 0.04 * f;
+}
+
+/* Temporal reuse on a moving scene: the previous frame's hits reprojected as proven starting
+ * points give the surface of the march without them (the same pixels hit; distances within the
+ * refine tolerance) and no hole against the reference, in fewer samples. */
+static void test_tile_temporal_moving(void **state)
+{
+    (void)state;
+    scene s[2] = {blob_scene(VFX_WATER_METHOD_TILE), blob_scene(VFX_WATER_METHOD_TILE)};
+    s[0].params.disable = VFX_WATER_NO_HALF_RES;
+    s[1].params.disable = VFX_WATER_NO_HALF_RES | VFX_WATER_NO_TEMPORAL;
+    ref_camera cam = blob_camera(64);
+    const size_t n = 64 * 64;
+    float *x0 = malloc(300 * 4), *y0 = malloc(300 * 4);
+    memcpy(x0, s[0].x, 300 * 4);
+    memcpy(y0, s[0].y, 300 * 4);
+    static const float host[4] = {0.2f, 0.3f, 0.4f, 1};
+    session ss[2];
+    for (int k = 0; k < 2; ++k) session_open(&ss[k], &s[k], &cam, host, 0, true);
+    float *d[2] = {malloc(n * 4), malloc(n * 4)}, *rdist = malloc(n * 4), *rnrm = malloc(n * 12);
+    double reused_total = 0, found_total = 0, samples[2] = {0, 0};
+    for (int f = 0; f < 5; ++f) {
+        for (int k = 0; k < 2; ++k) {
+            blobs_move(&s[k], x0, y0, f, &cam);
+            for (int q = 0; q < 3; ++q) ss[k].fv.eye[q] = (float)cam.eye[q];
+            ref_camera_matrices(&cam, ss[k].fv.view, ss[k].fv.proj);
+            assert_int_equal(session_frame(&ss[k]), VFX_OK);
+            assert_int_equal(ss[k].api.read_raw(ss[k].ctx, VFX_EFFECT_WATER, d[k], n), VFX_OK);
+            if (f > 0) samples[k] += stat_of_ctx(&ss[k], "water.samples");
+        }
+        double valid = stat_of_ctx(&ss[0], "water.tile_temporal_valid"), reused = stat_of_ctx(&ss[0], "water.tile_temporal_reused"),
+               fallback = stat_of_ctx(&ss[0], "water.tile_temporal_fallback"), found = stat_of_ctx(&ss[0], "water.pixels_found");
+        assert_true(valid == (f > 0 ? 1 : 0));
+        assert_true(stat_of_ctx(&ss[1], "water.tile_temporal_valid") == 0);
+        uint32_t cover_diff = 0, both = 0, over = 0;
+        double dmax = 0;
+        for (size_t i = 0; i < n; ++i) {
+            if ((d[0][i] >= 0) != (d[1][i] >= 0)) ++cover_diff;
+            else if (d[0][i] >= 0) {
+                double dd = fabs(d[0][i] - d[1][i]) / 0.61;
+                ++both;
+                over += dd > 1e-3;
+                if (dd > dmax) dmax = dd;
+            }
+        }
+        reference_image(&s[0], &cam, rdist, rnrm);
+        ref_water_error e;
+        assert_int_equal(ref_water_compare(d[0], NULL, rdist, NULL, n, 0.61, &e), 0);
+        print_message("temporal frame %d: valid %.0f reused %.0f fallback %.0f of %.0f found; skipped steps %.0f proof %.0f; "
+                      "vs off: coverage differs at %u, |dt| > 1e-3 h at %u of %u, max %.2e h; vs ref: hits %u holes %.4f false %.4f p99 %.2e h\n",
+                      f, valid, reused, fallback, found, stat_of_ctx(&ss[0], "water.tile_temporal_steps_skipped"),
+                      stat_of_ctx(&ss[0], "water.tile_temporal_proof_samples"), cover_diff, over, both, dmax, e.ref_hits,
+                      e.hole_rate, e.false_hit_rate, e.dist_p99_rel_h);
+        /* the same pixels hit; both brackets are a step or less wide and end in three regula
+         * falsi steps, which leave ~1e-4 h (the TILE test's p99 against the reference, 1.4e-4 h):
+         * within 1e-3 h at 99% of the pixels; the tail is grazing pixels, where regula falsi
+         * converges slowly from either bracket (the TILE test allows 2e-2 h there) */
+        assert_true(cover_diff == 0);
+        assert_true(over <= both / 100 && dmax < 5e-2);
+        assert_true(e.ref_hits > 1000 && e.hole_rate == 0.0 && e.false_hit_rate < 0.01);
+        if (f > 0) {
+            reused_total += reused;
+            found_total += found;
+        }
+        assert_true(stat_of_ctx(&ss[0], "water.pixels_undecided") == 0);
+    }
+    print_message("temporal: reused %.0f of %.0f found pixels over frames 1-4; samples %.0f on, %.0f off\n",
+                  reused_total, found_total, samples[0], samples[1]);
+    /* most of the surface starts from its guess, and that saves samples */
+    assert_true(reused_total > 0.5 * found_total);
+    assert_true(samples[0] < 0.9 * samples[1]);
+    for (int k = 0; k < 2; ++k) {
+        session_close(&ss[k]);
+        free(d[k]);
+        free_scene(&s[k]);
+    }
+    free(x0); free(y0); free(rdist); free(rnrm);
+}
+
+/* Temporal reuse falls back where its guesses are void: a camera cut (the eye teleported to
+ * the other side) drops them (nothing reused); particles teleported under a still camera make
+ * the guesses wrong, and the proof rejects them (fallback counted, no hole); a frame of another
+ * method in between drops them. */
+static void test_tile_temporal_fallback(void **state)
+{
+    (void)state;
+    scene s = blob_scene(VFX_WATER_METHOD_TILE);
+    s.params.disable = VFX_WATER_NO_HALF_RES;
+    ref_camera cam = blob_camera(64);
+    const size_t n = 64 * 64;
+    static const float host[4] = {0.2f, 0.3f, 0.4f, 1};
+    session ss;
+    session_open(&ss, &s, &cam, host, 0, true);
+    float *d = malloc(n * 4), *rdist = malloc(n * 4), *rnrm = malloc(n * 12);
+    for (int f = 0; f < 5; ++f) {
+        if (f == 1) cam.eye[2] = -5.0;                                /* teleport: behind the blobs */
+        if (f == 2) ref_water_blobs(s.n, 4, 1.0, 0.35, 11, s.x, s.y, s.z); /* other blobs */
+        s.params.method = f == 3 ? VFX_WATER_METHOD_GRID : VFX_WATER_METHOD_TILE;
+        for (int q = 0; q < 3; ++q) ss.fv.eye[q] = (float)cam.eye[q];
+        ref_camera_matrices(&cam, ss.fv.view, ss.fv.proj);
+        assert_int_equal(session_frame(&ss), VFX_OK);
+        if (f == 3) continue;
+        assert_int_equal(ss.api.read_raw(ss.ctx, VFX_EFFECT_WATER, d, n), VFX_OK);
+        reference_image(&s, &cam, rdist, rnrm);
+        ref_water_error e;
+        assert_int_equal(ref_water_compare(d, NULL, rdist, NULL, n, 0.61, &e), 0);
+        double valid = stat_of_ctx(&ss, "water.tile_temporal_valid"), cut = stat_of_ctx(&ss, "water.tile_temporal_cut"),
+               reused = stat_of_ctx(&ss, "water.tile_temporal_reused"), fallback = stat_of_ctx(&ss, "water.tile_temporal_fallback");
+        print_message("temporal fallback frame %d: valid %.0f cut %.0f reused %.0f fallback %.0f; hits %u holes %.4f false %.4f\n",
+                      f, valid, cut, reused, fallback, e.ref_hits, e.hole_rate, e.false_hit_rate);
+        assert_true(e.ref_hits > 1000 && e.hole_rate == 0.0 && e.false_hit_rate < 0.01);
+        if (f == 1) assert_true(cut == 1 && valid == 0 && reused == 0 && fallback == 0);
+        /* the old blobs' hits are guesses for pixels the new blobs' surface does not lie behind */
+        if (f == 2) assert_true(valid == 1 && fallback > 0);
+        if (f == 4) assert_true(valid == 0 && cut == 0 && reused == 0); /* GRID drew frame 3 */
+    }
+    session_close(&ss);
+    free(d); free(rdist); free(rnrm);
+    free_scene(&s);
+}
+
+/* The reduced-resolution march (one ray per 2x2 block; the other pixels upsampled where their
+ * coarse neighbours agree, else marched) against the full-resolution march and the reference,
+ * on the three TILE scenes: what it may lose is a feature between coarse rays that all agree
+ * (a drop whose whole sphere of influence passes between four rays two pixels apart, or one in
+ * front of a surface they all hit); the distance and normal errors are those of the tangent
+ * planes' disagreement bound (a quarter step). */
+static void test_tile_half_res(void **state)
+{
+    (void)state;
+    for (int sc = 0; sc < 3; ++sc) {
+        scene s;
+        ref_camera cam;
+        const char *name = tile_scene(sc, &s, &cam);
+        const size_t n = (size_t)cam.width * cam.height;
+        static const float host[4] = {0.2f, 0.3f, 0.4f, 1};
+        float *d[2] = {malloc(n * 4), malloc(n * 4)}, *grad = malloc(n * 16), *nrm[2] = {malloc(n * 12), malloc(n * 12)};
+        double up = 0, rem = 0;
+        for (int k = 0; k < 2; ++k) {
+            s.params.disable = VFX_WATER_NO_TEMPORAL | (k ? VFX_WATER_NO_HALF_RES : 0);
+            session ss;
+            session_open(&ss, &s, &cam, host, 0, true);
+            assert_int_equal(session_frame(&ss), VFX_OK);
+            assert_int_equal(ss.api.read_raw(ss.ctx, VFX_EFFECT_WATER, d[k], n), VFX_OK);
+            assert_int_equal(volfx_water_debug_gradient(ss.ctx, grad, n * 4), VFX_OK);
+            grad_normals(d[k], grad, nrm[k], n);
+            if (k == 0) {
+                up = stat_of_ctx(&ss, "water.tile_half_upsampled");
+                rem = stat_of_ctx(&ss, "water.tile_half_remarched");
+                double found = stat_of_ctx(&ss, "water.pixels_found"), left = stat_of_ctx(&ss, "water.pixels_left");
+                assert_true(found + left == (double)n && stat_of_ctx(&ss, "water.pixels_undecided") == 0);
+                /* the coarse rays, the upsampled and the marched pixels are every pixel */
+                double coarse = (double)((cam.width + 1) / 2) * ((cam.height + 1) / 2);
+                assert_true(up + rem + coarse == (double)n);
+            } else {
+                assert_true(stat_of_ctx(&ss, "water.tile_half_upsampled") == 0);
+            }
+            session_close(&ss);
+        }
+        uint32_t lost = 0, extra = 0;
+        for (size_t i = 0; i < n; ++i) {
+            lost += d[1][i] >= 0 && d[0][i] < 0;
+            extra += d[0][i] >= 0 && d[1][i] < 0;
+        }
+        float *rdist = malloc(n * 4), *rnrm = malloc(n * 12);
+        reference_image(&s, &cam, rdist, rnrm);
+        ref_water_error e[2];
+        for (int k = 0; k < 2; ++k)
+            assert_int_equal(ref_water_compare(d[k], nrm[k], rdist, rnrm, n, 0.61, &e[k]), 0);
+        print_message("half-res %s: upsampled %.0f marched %.0f of %zu; vs full: lost %u extra %u; vs ref: holes %.4f "
+                      "false %.4f dist mean %.2e p99 %.2e h, normal mean %.3f p99 %.3f deg (full: %.2e / %.2e h, %.3f / %.3f deg)\n",
+                      name, up, rem, n, lost, extra, e[0].hole_rate, e[0].false_hit_rate, e[0].dist_mean_rel_h,
+                      e[0].dist_p99_rel_h, e[0].normal_mean_deg, e[0].normal_p99_deg, e[1].dist_mean_rel_h,
+                      e[1].dist_p99_rel_h, e[1].normal_mean_deg, e[1].normal_p99_deg);
+        /* a miss is upsampled only between empty rays: the spray's spheres of influence
+         * (radius h, 7 pixels here) are mostly marched */
+        assert_true(up > (sc == 1 ? 0.05 : 0.2) * n);
+        assert_true(lost == 0 && e[0].hole_rate == 0.0);
+        assert_true(extra <= n / 200);
+        /* an upsampled distance is the mean of tangent-plane predictions that agree within a
+         * quarter step (h/32 = 3.1e-2 h): bounded by it; the normals within 18 degrees of each
+         * other, the mean of them is within that of the true one */
+        assert_true(e[0].dist_p99_rel_h < 3.2e-2 && e[0].dist_mean_rel_h < 5e-3);
+        assert_true(e[0].normal_p99_deg < 18.0);
+        free(d[0]); free(d[1]); free(nrm[0]); free(nrm[1]); free(grad); free(rdist); free(rnrm);
+        free_scene(&s);
     }
 }
 
@@ -1137,6 +1356,9 @@ int main(void)
         cmocka_unit_test(test_async_counters),
         cmocka_unit_test(test_paper_sample_cap_counted),
         cmocka_unit_test(test_tile_vs_reference),
+        cmocka_unit_test(test_tile_temporal_moving),
+        cmocka_unit_test(test_tile_temporal_fallback),
+        cmocka_unit_test(test_tile_half_res),
         cmocka_unit_test(test_grid_rebuild_only_on_change),
         cmocka_unit_test(test_one_particle_and_camera_inside),
         cmocka_unit_test(test_coincident_and_nan),

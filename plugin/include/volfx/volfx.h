@@ -121,6 +121,11 @@ enum {
     /* shading (ablation): absorb over the view ray's thickness and look the host colour up at a
      * fixed screen offset, instead of tracing the refracted ray through the water */
     VFX_WATER_NO_REFRACT_TRACE = 1u << 11,
+    /* TILE: no temporal reuse (the previous frame's hits, reprojected, as proven starting points) */
+    VFX_WATER_NO_TEMPORAL = 1u << 12,
+    /* TILE: no reduced-resolution march (one ray per 2x2 block, the rest upsampled where the
+     * block agrees and marched where it does not) */
+    VFX_WATER_NO_HALF_RES = 1u << 13,
 };
 
 typedef enum vfx_water_method {
