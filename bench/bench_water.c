@@ -5,7 +5,9 @@
  * --refine ITERS --pyramid LEVEL --warmup 0|1 (default 1: one untimed frame first, which
  * compiles the shaders) --height H (width = size) --layout layers|pool (pool: a wide slab 4
  * layers deep, seen from above and in front) --png FILE (the shaded frame over a grey-blue host image) --dist FILE
- * (distance image, PFM) --points FILE (positions as raw float32 xyz). cpu_ms_per_frame is the
+ * (distance image, PFM) --points FILE (positions as raw float32 xyz) --wave A (the particles move:
+ * every frame, warm-up included, y += A sin(2 x + 0.5 f) - A sin(2 x + 0.5 (f - 1)), a wave
+ * travelling along x, so temporal reuse meets a moving surface as in a game). cpu_ms_per_frame is the
  * process's CPU time over the timed frames (all llvmpipe threads) divided by the frames. Per-pass GPU ms (counters *.gpu_ms) need at least 4 frames. */
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
@@ -34,6 +36,7 @@ typedef struct bench_scene {
     const char *png;     /* the shaded frame (over a black host image) */
     const char *points;  /* raw float32 x y z per particle, for scripts/compare-vtk-fluid.py */
     const char *dist;    /* the distance image (PFM) */
+    float wave;          /* amplitude of the travelling wave the particles follow (0: still) */
 } bench_scene;
 
 static void *bench_gl_proc(void *user, const char *name) { (void)user; return (void *)eglGetProcAddress(name); }
@@ -98,6 +101,13 @@ static void pool_layout(uint32_t n, float *x, float *y, float *z)
     }
 }
 
+/* The wave of --wave at frame f (the positions drawn by that frame); y0 the layout's heights. */
+static void wave_frame(bench_scene *s, const float *y0, int f)
+{
+    for (uint32_t i = 0; s->wave != 0 && i < s->n; ++i)
+        s->y[i] = y0[i] + s->wave * sinf(2.0f * s->x[i] + 0.5f * (float)f);
+}
+
 static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, const bench_scene *opt)
 {
     bench_scene s = *opt;
@@ -145,6 +155,9 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
     for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam.eye[k];
     ref_camera_matrices(&cam, fv.view, fv.proj);
     double *ms = malloc(frames * sizeof *ms);
+    float *y0 = malloc(n * 4);
+    memcpy(y0, s.y, n * 4);
+    wave_frame(&s, y0, 0);
     int rc = 0;
     if (!s.no_warmup && (api.update(ctx, 0.0, 1.f / 60.f) != VFX_OK || api.render(ctx, &fv) != VFX_OK)) {
         fprintf(stderr, "metaballs: warm-up frame failed: %s\n", api.last_error(ctx));
@@ -153,6 +166,7 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
     glFinish();
     double cpu0 = cpu_ms();
     for (uint32_t f = 0; f < frames && rc == 0; ++f) {
+        wave_frame(&s, y0, (int)f + 1);
         glClearNamedFramebufferfv(fbo, GL_COLOR, 0, black);
         double t0 = now_ms();
         if (api.update(ctx, f / 60.0, 1.f / 60.f) != VFX_OK || api.render(ctx, &fv) != VFX_OK) {
@@ -167,9 +181,9 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
     double p50 = fp.p50;
     printf("{\"effect\":\"metaballs\",\"method\":\"%s\",\"disable\":%u,\"max_samples\":%u,\"step_h\":%.4g,"
            "\"refine\":%u,\"pyramid\":%u,\"particles\":%u,\"width\":%u,\"height\":%u,"
-           "\"frames\":%u,\"warmup\":%d,\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"cpu_ms_per_frame\":%.2f,\"fps\":%.3g,\"gl_renderer\":\"%s\"",
+           "\"frames\":%u,\"warmup\":%d,\"wave\":%.4g,\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"cpu_ms_per_frame\":%.2f,\"fps\":%.3g,\"gl_renderer\":\"%s\"",
            method_name(s.method), s.disable, s.max_samples ? s.max_samples : 64, s.step_h > 0 ? s.step_h : 0.125,
-           s.refine ? s.refine : 3, s.pyramid ? s.pyramid : 3, n, width, height, frames, !s.no_warmup, p50, fp.p95, fp.p99, cpu_per_frame, 1000.0 / p50,
+           s.refine ? s.refine : 3, s.pyramid ? s.pyramid : 3, n, width, height, frames, !s.no_warmup, s.wave, p50, fp.p95, fp.p99, cpu_per_frame, 1000.0 / p50,
            (const char *)glGetString(GL_RENDERER));
     printf(",\"camera\":{\"eye\":[%.9g,%.9g,%.9g],\"center\":[%.9g,%.9g,%.9g],\"up\":[0,1,0],\"fovy_deg\":%.9g,"
            "\"near\":%.9g,\"far\":%.9g},\"h\":0.61",
@@ -222,6 +236,7 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
         free(d);
     }
     free(ms);
+    free(y0);
     api.destroy(ctx);
     glDeleteFramebuffers(1, &fbo);
     glDeleteTextures(1, &col);
@@ -261,6 +276,7 @@ int bench_metaballs(int argc, char **argv)
         else if (!strcmp(argv[i], "--png") && i + 1 < argc) opt.png = argv[++i];
         else if (!strcmp(argv[i], "--points") && i + 1 < argc) opt.points = argv[++i];
         else if (!strcmp(argv[i], "--dist") && i + 1 < argc) opt.dist = argv[++i];
+        else if (!strcmp(argv[i], "--wave") && i + 1 < argc) opt.wave = (float)atof(argv[++i]);
         else if (!strcmp(argv[i], "--json")) continue;
         else { fprintf(stderr, "metaballs: unknown option %s\n", argv[i]); return 2; }
     }

@@ -33,6 +33,9 @@ struct volfx_water_tile {
      * frame's reprojected guesses; valid for the next frame only, at the same size and field */
     GLuint hits, guess;
     uint32_t hits_px;    /* pixels the two buffers hold */
+    /* reduced resolution: the pixels the upsample could not take (indirect dispatch args first) */
+    GLuint remarch;
+    uint32_t remarch_px;
     uint32_t hits_w, hits_h;
     int hits_valid;
     uint64_t hits_frame;
@@ -53,8 +56,8 @@ void volfx_water_tile_destroy(vfx_context *ctx, volfx_water_tile *t)
 {
     if (!t)
         return;
-    GLuint b[] = {t->count, t->start, t->blocks, t->entries, t->globals, t->hits, t->guess};
-    for (int k = 0; k < 7; ++k)
+    GLuint b[] = {t->count, t->start, t->blocks, t->entries, t->globals, t->hits, t->guess, t->remarch};
+    for (int k = 0; k < 8; ++k)
         if (b[k])
             glDeleteBuffers(1, &b[k]);
     volfx_free(ctx, t);
@@ -89,6 +92,8 @@ static void bind_buffers(const volfx_water_tile *t, const volfx_water_tile_input
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, t->hits);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 13, t->guess);
     }
+    if (t->remarch)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 14, t->remarch);
 }
 
 vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in)
@@ -236,7 +241,9 @@ static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const vol
     if (!prog)
         return VFX_ERR_GL;
     GLenum access = finish ? GL_READ_ONLY : GL_READ_WRITE;
-    volfx_gpu_pass_begin(ctx, finish ? "water.finish" : half == 2 ? "water.tile_upsample" : "water.tile_march");
+    volfx_gpu_pass_begin(ctx, finish ? "water.finish"
+                              : half == 2 ? "water.tile_upsample"
+                              : half == 3 ? "water.tile_remarch" : "water.tile_march");
     glUseProgram(prog);
     bind_buffers(t, in);
     march_uniforms(ctx, prog, t, in, frame, targets);
@@ -257,9 +264,16 @@ static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const vol
             h = (h + 1) / 2;
         }
     }
-    glDispatchCompute((w + 7) / 8, (h + 7) / 8, 1);
+    if (half == 3) {
+        glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, t->remarch);
+        glDispatchComputeIndirect(0);
+        glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
+    } else {
+        glDispatchCompute((w + 7) / 8, (h + 7) / 8, 1);
+    }
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
-                    GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+                    GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT |
+                    GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
     volfx_gpu_pass_end(ctx);
     const char *e = volfx_gpu_error_string();
     if (e)
@@ -332,9 +346,24 @@ vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const v
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         volfx_gpu_pass_end(ctx);
     }
+    if (half && (!t->remarch || px > t->remarch_px)) {
+        if (t->remarch) glDeleteBuffers(1, &t->remarch);
+        t->remarch = volfx_gpu_storage(16 + (GLsizeiptr)px * 4, "water.tile_remarch");
+        t->remarch_px = px;
+        const char *e = volfx_gpu_error_string();
+        if (e)
+            return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water tile: remarch list for %ux%u pixels: %s",
+                              in->width, in->height, e);
+    }
     vfx_result r = tile_dispatch(ctx, t, in, frame, targets, false, grad_tex, back_tex, half ? 1 : 0, temporal, reuse);
-    if (r == VFX_OK && half)
+    if (r == VFX_OK && half) {
+        /* no group, one row, one layer, no pixel */
+        const uint32_t args[4] = {0, 1, 1, 0};
+        glNamedBufferSubData(t->remarch, 0, sizeof args, args);
         r = tile_dispatch(ctx, t, in, frame, targets, false, grad_tex, back_tex, 2, temporal, reuse);
+        if (r == VFX_OK)
+            r = tile_dispatch(ctx, t, in, frame, targets, false, grad_tex, back_tex, 3, temporal, reuse);
+    }
     t->hits_valid = temporal && r == VFX_OK;
     t->hits_frame = in->frame_no;
     t->hits_w = in->width;

@@ -16,7 +16,8 @@
 //                 march) projected with this frame's camera; the 2x2 pixels around it take the
 //                 nearest distance (atomicMin), each pixel's guess for MODE_MARCH (temporal reuse).
 // MODE_MARCH's u_half: 0 every pixel; 1 the coarse pass (pixels with even x and y); 2 the other
-// pixels, upsampled from their coarse neighbours where those agree, else marched.
+// pixels, upsampled from their coarse neighbours where those agree, else appended to a list;
+// 3 the listed pixels marched (an indirect dispatch: whole groups of pixels that all march).
 // Every loop is bounded by a constant or by a list length; see docs/water.md (method TILE).
 #include "common/depth.glsl"
 #if defined(MODE_MARCH) || defined(MODE_FINISH) || defined(MODE_REPROJECT)
@@ -53,6 +54,11 @@ uniform float u_d0, u_ds;
 // (the float bits of a distance along the ray; 0xffffffff none)
 layout(std430, binding = 12) buffer Hits { vec4 hits[]; };
 layout(std430, binding = 13) buffer Guess { uint guess[]; };
+#endif
+#if defined(MODE_MARCH)
+// the pixels u_half 2 could not upsample: x groups of 64 for the indirect dispatch, the count,
+// then pixel indices
+layout(std430, binding = 14) buffer Remarch { uint rm_groups, rm_gy, rm_gz, rm_count; uint rm_pix[]; };
 #endif
 
 #if defined(MODE_COUNT) || defined(MODE_SCATTER)
@@ -122,8 +128,8 @@ uniform bool u_has_depth, u_subdivide, u_local;
 #define LOCAL_K 16
 #endif
 #define SUB_DEPTH 4
-// temporal reuse: the proof's dyadic depth (an interval of up to 32 steps down to w/2)
-#define PROOF_DEPTH 6
+// temporal reuse: the proof's dyadic depth at most (nodes of 2 steps or more)
+#define PROOF_DEPTH 4
 
 // The pixel's list: its tile's entries (or every particle when the tile did not fit) and then
 // the global list.
@@ -389,6 +395,11 @@ void main()
     ivec2 pix = ivec2(gl_GlobalInvocationID.xy);
 #if defined(MODE_MARCH)
     if (u_half == 1) pix *= 2;   // the coarse pass: one ray per 2x2 block
+    if (u_half == 3) {
+        uint k = gl_WorkGroupID.x * 64u + gl_LocalInvocationIndex;
+        if (k >= rm_count) return;
+        pix = ivec2(int(rm_pix[k] % uint(u_size.x)), int(rm_pix[k] / uint(u_size.x)));
+    }
 #endif
     if (any(greaterThanEqual(pix, u_size))) return;
 #if defined(MODE_FINISH)
@@ -414,7 +425,11 @@ void main()
     if (u_half == 2) {
         if (((pix.x | pix.y) & 1) == 0) return;   // a coarse pixel: done by the u_half 1 pass
         if (upsample(pix, t_lim, pidx)) return;
+        uint k = atomicAdd(rm_count, 1u);
+        rm_pix[k] = pidx;
+        if ((k & 63u) == 0u) atomicAdd(rm_groups, 1u);   // a new group of 64 begins
         atomicAdd(c_remarched, 1u);
+        return;
     }
 #endif
 
@@ -489,10 +504,11 @@ void main()
         if (win == 0 && u_reuse && guess[pidx] != 0xffffffffu) {
             // Temporal reuse: jump from the first sphere entry t towards last frame's surface
             // (reprojected) once [t, x] is proven empty of surface by the field's upper bound,
-            // dyadically (depth PROOF_DEPTH) where the bound over a node allows an inside
-            // point. A node that cannot be proven ends the proof: the march goes on from the
-            // proven prefix as it would have from t. x: half a step before the guess, inside
-            // the window (its local list is exact there) and the host depth.
+            // dyadically where the bound over a node allows an inside point, while its halves
+            // are 2 steps or longer (a shorter node costs the march as few evaluations). A node
+            // that cannot be proven (or holds an inside point) ends the proof: the march goes on
+            // from the proven prefix as it would have from t. x: half a step before the guess,
+            // inside the window (its local list is exact there) and the host depth.
             float x = min(min(uintBitsToFloat(guess[pidx]) - 0.5 * u_step, b_end - u_step),
                           min(t_lim, t + 32.0 * u_step));
             reuse = 2;
@@ -503,23 +519,19 @@ void main()
                     float n0 = t + w0 * float(k) / float(1 << d), n1 = t + w0 * float(k + 1) / float(1 << d);
                     vec2 v = field(n1, n0);
                     ++nproof;
-                    if (v.y >= T2 && d < PROOF_DEPTH) { ++d; k *= 2; continue; }   // open it
-                    float fv = sqrt(v.x) - u_T;
-                    if (fv >= 0.0) { state = 1; ta = n0; fa = lf; tb = n1; fb = fv; break; }
-                    if (v.y >= T2) break;   // not provable: [t, n0] is
-                    done = n1; lf = fv;
+                    if (v.y >= T2 && d < PROOF_DEPTH && w0 >= 4.0 * u_step * float(1 << d)) { ++d; k *= 2; continue; }
+                    if (v.y >= T2) break;   // not provable (or inside at n1): [t, n0] is
+                    done = n1; lf = sqrt(v.x) - u_T;
                     while ((k & 1) == 1 && d > 0) { k >>= 1; --d; }
                     if (d == 0) break;      // the whole interval
                     ++k;
                 }
-                if (state == 1) done = ta;
-                if (state == 1 || done >= t + u_step) {
+                if (done >= t + u_step) {
                     reuse = 1;
                     nskip = uint((done - t) / u_step);
                     tp = done; fp = lf; t = done + u_step;
                 }
             }
-            if (state == 1) break;
         }
 #endif
         while (t < b_end && t <= t_lim && steps < MAX_STEPS) {
