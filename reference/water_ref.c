@@ -75,6 +75,22 @@ static void accumulate(const float *x, const float *y, const float *z, const uin
         uint32_t j = idx ? idx[k] : k;
         if (!idx && !finite3(x[j], y[j], z[j])) continue;
         double d[3] = {pos[0] - x[j], pos[1] - y[j], pos[2] - z[j]};
+        if (p->G) { /* y = G d; grad P(|y|) = P'(r) G y / r */
+            const double *m = p->G + 6 * (size_t)j;
+            double yv[3] = {m[0] * d[0] + m[1] * d[1] + m[2] * d[2], m[1] * d[0] + m[3] * d[1] + m[4] * d[2],
+                            m[2] * d[0] + m[4] * d[1] + m[5] * d[2]};
+            double r2 = yv[0] * yv[0] + yv[1] * yv[1] + yv[2] * yv[2];
+            if (r2 >= h2) continue;
+            double r = sqrt(r2);
+            *sum += p->kernel.value(r, p->h);
+            if (g && r > 0) {
+                double s = p->kernel.deriv(r, p->h) / r;
+                g[0] += s * (m[0] * yv[0] + m[1] * yv[1] + m[2] * yv[2]);
+                g[1] += s * (m[1] * yv[0] + m[3] * yv[1] + m[4] * yv[2]);
+                g[2] += s * (m[2] * yv[0] + m[4] * yv[1] + m[5] * yv[2]);
+            }
+            continue;
+        }
         double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         if (r2 >= h2) continue;
         double r = sqrt(r2);
@@ -250,8 +266,15 @@ int ref_water_render(const ref_water_camera *cam, const float *x, const float *y
         return -1;
     }
     double step = p->step > 0 ? p->step : p->h / 32.0;
+    /* the farthest a particle's kernel reaches: h / the smallest eigenvalue of its G */
+    double reach = p->h;
+    for (uint32_t j = 0; p->G && j < n; ++j) {
+        double ev[3], V[9];
+        ref_water_eigen_sym3(p->G + 6 * (size_t)j, ev, V);
+        if (ev[0] > 0 && p->h / ev[0] > reach) reach = p->h / ev[0];
+    }
     ref_grid gr;
-    if (grid_build(&gr, x, y, z, n, p->h, &st.nan_skipped) != 0) {
+    if (grid_build(&gr, x, y, z, n, reach, &st.nan_skipped) != 0) {
         grid_free(&gr);
         snprintf(err, 256, "water_ref_render: out of memory for the grid of %u particles", n);
         return -1;
@@ -263,7 +286,7 @@ int ref_water_render(const ref_water_camera *cam, const float *x, const float *y
         for (uint32_t i = 0; i < cam->width; ++i) {
             double d[3], t0, t1;
             ref_water_pixel_dir(cam, i, j, d);
-            if (!ray_box(cam->eye, d, gr.lo, gr.hi, p->h, &t0, &t1)) continue;
+            if (!ray_box(cam->eye, d, gr.lo, gr.hi, reach, &t0, &t1)) continue;
             if (p->t_max > 0 && t1 > p->t_max) t1 = p->t_max;
             double tprev = t0, fprev = 0, thit = -1;
             for (double t = t0; t <= t1 + step; t += step) {
@@ -401,5 +424,98 @@ void ref_water_blobs(uint32_t n, uint32_t blobs, double extent, double sigma, ui
         x[k] = (float)(c[0] + sigma * g[0]);
         y[k] = (float)(c[1] + sigma * g[1]);
         z[k] = (float)(c[2] + sigma * g[2]);
+    }
+}
+
+void ref_water_eigen_sym3(const double a[6], double ev[3], double V[9])
+{
+    double A[3][3] = {{a[0], a[1], a[2]}, {a[1], a[3], a[4]}, {a[2], a[4], a[5]}};
+    double Q[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int sweep = 0; sweep < 64; ++sweep) {
+        double off = fabs(A[0][1]) + fabs(A[0][2]) + fabs(A[1][2]);
+        double diag = fabs(A[0][0]) + fabs(A[1][1]) + fabs(A[2][2]);
+        if (!(off > 1e-300) || off <= 1e-18 * diag) break;
+        for (int p = 0; p < 2; ++p)
+            for (int q = p + 1; q < 3; ++q) {
+                if (A[p][q] == 0.0) continue;
+                double th = (A[q][q] - A[p][p]) / (2.0 * A[p][q]);
+                double t = (th >= 0 ? 1.0 : -1.0) / (fabs(th) + sqrt(th * th + 1.0));
+                double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
+                for (int k = 0; k < 3; ++k) {
+                    double akp = A[k][p], akq = A[k][q];
+                    A[k][p] = c * akp - s * akq;
+                    A[k][q] = s * akp + c * akq;
+                }
+                for (int k = 0; k < 3; ++k) {
+                    double apk = A[p][k], aqk = A[q][k];
+                    A[p][k] = c * apk - s * aqk;
+                    A[q][k] = s * apk + c * aqk;
+                }
+                for (int k = 0; k < 3; ++k) {
+                    double qkp = Q[k][p], qkq = Q[k][q];
+                    Q[k][p] = c * qkp - s * qkq;
+                    Q[k][q] = s * qkp + c * qkq;
+                }
+            }
+    }
+    int o[3] = {0, 1, 2}; /* ascending */
+    for (int i = 0; i < 3; ++i)
+        for (int j = i + 1; j < 3; ++j)
+            if (A[o[j]][o[j]] < A[o[i]][o[i]]) { int t = o[i]; o[i] = o[j]; o[j] = t; }
+    for (int i = 0; i < 3; ++i) {
+        ev[i] = A[o[i]][o[i]];
+        for (int k = 0; k < 3; ++k) V[3 * k + i] = Q[k][o[i]];
+    }
+}
+
+void ref_water_aniso_kernels(const float *x, const float *y, const float *z, uint32_t n,
+                             const ref_water_aniso_params *p, double *centre, double *G, uint32_t *nbrs)
+{
+    double R = p->radius * p->h, R2 = R * R;
+    for (uint32_t i = 0; i < n; ++i) {
+        double pi[3] = {x[i], y[i], z[i]};
+        double axes[3] = {1, 1, 1}, V[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+        uint32_t nb = 0;
+        for (int k = 0; k < 3; ++k) centre[3 * (size_t)i + k] = pi[k];
+        if (finite3(x[i], y[i], z[i])) {
+            double W = 0, s1[3] = {0, 0, 0}, s2[6] = {0, 0, 0, 0, 0, 0};
+            for (uint32_t j = 0; j < n; ++j) { /* brute force: every particle */
+                if (!finite3(x[j], y[j], z[j])) continue;
+                double d[3] = {(double)x[j] - pi[0], (double)y[j] - pi[1], (double)z[j] - pi[2]};
+                double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                if (!(r2 < R2)) continue;
+                double r = sqrt(r2) / R, w = 1.0 - r * r * r;
+                W += w;
+                for (int k = 0; k < 3; ++k) s1[k] += w * d[k];
+                s2[0] += w * d[0] * d[0]; s2[1] += w * d[0] * d[1]; s2[2] += w * d[0] * d[2];
+                s2[3] += w * d[1] * d[1]; s2[4] += w * d[1] * d[2]; s2[5] += w * d[2] * d[2];
+                if (j != i) ++nb;
+            }
+            double m[3] = {s1[0] / W, s1[1] / W, s1[2] / W};
+            for (int k = 0; k < 3; ++k) centre[3 * (size_t)i + k] = pi[k] + p->smoothing * m[k];
+            if (nb >= p->min_neighbours) {
+                double C[6] = {s2[0] / W - m[0] * m[0], s2[1] / W - m[0] * m[1], s2[2] / W - m[0] * m[2],
+                               s2[3] / W - m[1] * m[1], s2[4] / W - m[1] * m[2], s2[5] / W - m[2] * m[2]};
+                double ev[3];
+                ref_water_eigen_sym3(C, ev, V);
+                double e1 = ev[2];
+                if (e1 > 1e-12 * R2) {
+                    double s[3], prod = 1;
+                    for (int k = 0; k < 3; ++k) { s[k] = ev[k] > e1 / p->max_stretch ? ev[k] : e1 / p->max_stretch; prod *= s[k]; }
+                    for (int k = 0; k < 3; ++k) axes[k] = s[k] / cbrt(prod) * p->scale;
+                } else {
+                    for (int k = 0; k < 9; ++k) V[k] = k % 4 == 0;
+                }
+            }
+        }
+        if (nbrs) nbrs[i] = nb;
+        /* G = V diag(1 / axes) V^T */
+        double *g = G + 6 * (size_t)i;
+        int idx[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
+        for (int e = 0; e < 6; ++e) {
+            double acc = 0;
+            for (int k = 0; k < 3; ++k) acc += V[3 * idx[e][0] + k] * V[3 * idx[e][1] + k] / axes[k];
+            g[e] = acc;
+        }
     }
 }

@@ -30,6 +30,9 @@ typedef struct ref_water_params {
     double step;         /* dense sampling step along the ray; 0 -> h/32 */
     double t_max;        /* farthest distance searched; 0 -> no limit beyond the particles' box */
     ref_water_kernel kernel;
+    /* per-particle kernels (NULL: isotropic): 6 doubles a particle (xx xy xz yy yz zz) of a
+     * symmetric positive definite G; particle j adds P(|G_j (x - p_j)|) */
+    const double *G;
 } ref_water_params;
 
 /* Paper defaults: h = 0.61, T = 0.765625, step h/32, paper kernel. */
@@ -55,6 +58,26 @@ double ref_water_field(const float *x, const float *y, const float *z, uint32_t 
 int ref_water_render(const ref_water_camera *cam, const float *x, const float *y,
                          const float *z, uint32_t n, const ref_water_params *p, float *dist,
                          float *normal, ref_water_stats *stats, char err[256]);
+
+/* Anisotropic kernels (Yu & Turk 2013) as the plugin defines them (docs/water.md), computed
+ * independently: brute-force neighbours, cyclic Jacobi to convergence, all in double. */
+typedef struct ref_water_aniso_params {
+    double h;                /* kernel radius */
+    double radius;           /* neighbourhood radius in units of h */
+    double max_stretch;      /* kr */
+    uint32_t min_neighbours; /* Ne: fewer -> isotropic */
+    double scale;            /* ks (stretched particles only) */
+    double smoothing;        /* lambda (0: none) */
+} ref_water_aniso_params;
+
+/* For each particle: centre[3 i..] (moved by the smoothing), G[6 i..] and its neighbours within
+ * the radius (nbrs, optional). Non-finite particles: no neighbour, the identity, centre as is. */
+void ref_water_aniso_kernels(const float *x, const float *y, const float *z, uint32_t n,
+                             const ref_water_aniso_params *p, double *centre, double *G, uint32_t *nbrs);
+
+/* Eigenvalues (ascending) and eigenvectors (columns of V, row-major 3x3) of the symmetric
+ * (xx xy xz yy yz zz), by cyclic Jacobi to convergence in double. */
+void ref_water_eigen_sym3(const double a[6], double ev[3], double V[9]);
 
 /* Error of a rendered image (dist, normal optional) against the reference (ref_dist, ref_normal). */
 typedef struct ref_water_error {

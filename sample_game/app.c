@@ -93,6 +93,16 @@ static vfx_result host_water_params(void *user, vfx_water_params *out)
     game_app *app = user;
     if (!out || out->size < sizeof *out)
         return VFX_ERR_ABI;
+    if (out->version == VFX_WATER_PARAMS2_VERSION && out->size >= sizeof(vfx_water_params2)) {
+        vfx_water_params2 *p2 = (vfx_water_params2 *)out;
+        memset(p2, 0, sizeof *p2);
+        p2->v1 = app->water;
+        p2->v1.size = sizeof *p2;
+        p2->v1.version = VFX_WATER_PARAMS2_VERSION;
+        /* the anisotropic kernel is TILE's; the paper method (Tab cycles to it) draws the seed's */
+        p2->kernel = app->water.method == VFX_WATER_METHOD_TILE ? app->water_kernel : VFX_WATER_KERNEL_ISOTROPIC;
+        return VFX_OK;
+    }
     *out = app->water;
     out->size = sizeof *out;
     out->version = VFX_WATER_PARAMS_VERSION;

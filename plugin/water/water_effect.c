@@ -14,12 +14,13 @@
 #include "context.h"
 #include "water_grid.h"
 #include "water_tile.h"
+#include "water_aniso.h"
 
 /* Counter readback ring: frames the GPU may run behind before a result is dropped. */
 #define WATER_COUNTER_RING 3
-/* march.comp's 8 (PAPER and the gradient pass), GRID's cells visited and sphere tests, and
- * tile.comp's 14 (TILE and the paper method's finishing pass) */
-#define WATER_COUNTERS 24
+/* march.comp's 8 (PAPER and the gradient pass), GRID's cells visited and sphere tests,
+ * tile.comp's 14 (TILE and the paper method's finishing pass) and aniso.comp's 2 */
+#define WATER_COUNTERS 26
 /* Particles the effect takes at most: positions are 12 bytes each (12 GiB at the limit) and a
  * particle index must fit the int of gl_InstanceID and of the draw's instance count. */
 #define WATER_MAX_PARTICLES (1u << 30)
@@ -46,6 +47,8 @@ typedef struct water_state {
     uint32_t nan_count;
     uint32_t width, height;
     vfx_water_params params;
+    volfx_water_kernel_params kp; /* the kernel (vfx_water_params2), checked */
+    volfx_water_aniso *aniso; /* per-particle kernels (TILE), made when asked for or given */
     volfx_water_grid *grid;  /* GRID baseline state, made the first time GRID is asked for */
     volfx_water_tile *tile;  /* TILE lists (TILE, and PAPER's finishing pass), made when needed */
     float lo[3], hi[3];    /* box of the finite particles */
@@ -153,6 +156,7 @@ static void water_destroy(vfx_context *ctx, void *state)
     paper_free(s);
     volfx_water_grid_destroy(ctx, s->grid);
     volfx_water_tile_destroy(ctx, s->tile);
+    volfx_water_aniso_destroy(ctx, s->aniso);
     volfx_free(ctx, s->chunk_rev);
     glDeleteVertexArrays(1, &s->vao);
     for (int k = 0; k < WATER_COUNTER_RING; ++k)
@@ -260,32 +264,56 @@ static vfx_result ensure_groups(vfx_context *ctx, water_state *s, uint32_t total
     return VFX_OK;
 }
 
+/* Asks the host for chunk `c`, offering version 2; a version-1 answer has no kernel column. */
+static vfx_result query_chunk(vfx_context *ctx, uint32_t c, vfx_particle_view2 *v)
+{
+    memset(v, 0, sizeof *v);
+    v->v1.size = sizeof *v;
+    v->v1.version = VFX_PARTICLE_VIEW2_VERSION;
+    vfx_result r = ctx->host.particle_chunk(ctx->host.user, c, &v->v1);
+    if (r == VFX_OK && !(v->v1.version == VFX_PARTICLE_VIEW2_VERSION && v->v1.size >= sizeof *v))
+        v->kernel = NULL; /* nothing a version-1 host wrote */
+    return r;
+}
+
 static vfx_result water_update(vfx_context *ctx, void *state, double time, float dt)
 {
     (void)time;
     (void)dt;
     water_state *s = state;
-    memset(&s->params, 0, sizeof s->params);
-    s->params.size = sizeof s->params;
-    s->params.version = VFX_WATER_PARAMS_VERSION;
+    /* version 2 offered; a version-1 host writes only v1 (the rest stays 0: defaults) */
+    vfx_water_params2 p2;
+    memset(&p2, 0, sizeof p2);
+    p2.v1.size = sizeof p2;
+    p2.v1.version = VFX_WATER_PARAMS2_VERSION;
     if (ctx->host.water_params) {
-        vfx_result r = ctx->host.water_params(ctx->host.user, &s->params);
+        vfx_result r = ctx->host.water_params(ctx->host.user, &p2.v1);
         if (r != VFX_OK && r != VFX_ERR_NOT_FOUND)
             return volfx_fail(ctx, r, "water: host water_params failed (%d)", (int)r);
-        if (r == VFX_ERR_NOT_FOUND) {
-            memset(&s->params, 0, sizeof s->params);
-        }
+        if (r == VFX_ERR_NOT_FOUND)
+            memset(&p2, 0, sizeof p2);
     }
+    s->params = p2.v1;
     water_defaults(&s->params);
+    uint32_t pver = p2.v1.version == VFX_WATER_PARAMS2_VERSION && p2.v1.size >= sizeof p2 ? VFX_WATER_PARAMS2_VERSION
+                                                                                         : VFX_WATER_PARAMS_VERSION;
+    vfx_result kr = volfx_water_kernel_params_check(ctx, &p2, pver, &s->kp);
+    if (kr)
+        return kr;
     uint32_t chunks = ctx->host.particle_chunk_count(ctx->host.user);
     uint64_t total = 0;
     /* every chunk with the nonzero revision of the last upload (0: the host tracks none) */
     int revs_same = s->chunk_rev != NULL && s->chunk_rev_count == chunks;
+    bool any_radius = false, any_kernel = false;
     for (uint32_t c = 0; c < chunks; ++c) {
-        vfx_particle_view v = {.size = sizeof v, .version = VFX_PARTICLE_VIEW_VERSION};
-        vfx_result r = ctx->host.particle_chunk(ctx->host.user, c, &v);
+        vfx_particle_view2 v2;
+        vfx_particle_view v;
+        vfx_result r = query_chunk(ctx, c, &v2);
+        v = v2.v1;
         if (r)
             return volfx_fail(ctx, r, "water: particle chunk %u of %u failed (%d)", c, chunks, (int)r);
+        any_radius = any_radius || (v.count && v.radius);
+        any_kernel = any_kernel || (v.count && v2.kernel);
         if (v.count && (!v.pos[0] || !v.pos[1] || !v.pos[2]))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u has %u particles but a NULL position column", c, v.count);
         total += v.count;
@@ -319,11 +347,19 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
     if (chunks)
         memset(s->chunk_rev, 0, chunks * sizeof *s->chunk_rev);
     ++s->data_rev;
+    if ((any_radius || any_kernel) && !s->aniso && !(s->aniso = volfx_water_aniso_create(ctx)))
+        return VFX_ERR_OUT_OF_MEMORY;
+    if (s->aniso) {
+        vfx_result r = volfx_water_aniso_columns_begin(ctx, s->aniso, (uint32_t)total, any_radius, any_kernel);
+        if (r)
+            return r;
+    }
     uint32_t off = 0, nan_count = 0;
     int seen = 0;
     for (uint32_t c = 0; c < chunks; ++c) {
-        vfx_particle_view v = {.size = sizeof v, .version = VFX_PARTICLE_VIEW_VERSION};
-        vfx_result r = ctx->host.particle_chunk(ctx->host.user, c, &v);
+        vfx_particle_view2 v2;
+        vfx_result r = query_chunk(ctx, c, &v2);
+        vfx_particle_view v = v2.v1;
         if (r || off + (uint64_t)v.count > total)
             return volfx_fail(ctx, r ? r : VFX_ERR_INVALID_ARGUMENT,
                             "water: particle chunk %u changed between the count and the upload", c);
@@ -351,6 +387,8 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
             }
             seen = 1;
         }
+        if (s->aniso && (r = volfx_water_aniso_columns_chunk(ctx, s->aniso, c, off, v.count, v.radius, v2.kernel)))
+            return r;
         off += v.count;
         s->chunk_rev[c] = v.revision;
     }
@@ -619,6 +657,10 @@ static void publish_counters(vfx_context *ctx, water_state *s)
         volfx_stat_set(ctx, "water.tile_global_particles", c[16]);
         volfx_stat_set(ctx, "water.tile_overflow_pixels", c[17]);
     }
+    if (tile && c[24] + c[25] > 0) {
+        volfx_stat_set(ctx, "water.aniso_stretched", c[24]);
+        volfx_stat_set(ctx, "water.aniso_isotropic", c[25]);
+    }
     if (grid) {
         volfx_stat_set(ctx, "water.grid_cells_visited", c[8]);
         volfx_stat_set(ctx, "water.grid_sphere_tests", c[9]);
@@ -827,7 +869,19 @@ static vfx_result tile_lists(vfx_context *ctx, water_state *s, volfx_water_tile_
         return VFX_ERR_OUT_OF_MEMORY;
     *in = (volfx_water_tile_input){s->cols, s->count, &s->params, s->width, s->height, ctx->water_dist_tex,
                                    s->counters, s->have_last ? s->last[10] : 0, s->view_proj, s->lo, s->hi,
-                                   frame->eye, fabsf(frame->proj[5]) * 0.5f * (float)s->height, s->frame_no};
+                                   frame->eye, fabsf(frame->proj[5]) * 0.5f * (float)s->height, s->frame_no, 0, 0.0f};
+    /* per-particle kernels: the anisotropic ones, or the host's radius / kernel columns */
+    if (s->params.method == VFX_WATER_METHOD_TILE &&
+        (s->kp.kernel == VFX_WATER_KERNEL_ANISOTROPIC || volfx_water_aniso_has_columns(s->aniso))) {
+        if (!s->aniso && !(s->aniso = volfx_water_aniso_create(ctx)))
+            return VFX_ERR_OUT_OF_MEMORY;
+        volfx_water_aniso_input ai = {s->cols, s->count, s->lo, s->hi, s->params.h, &s->kp, s->counters, s->data_rev};
+        vfx_result r = volfx_water_aniso_compute(ctx, s->aniso, &ai);
+        if (r)
+            return r;
+        in->kernels = volfx_water_aniso_kernels(s->aniso);
+        in->rbound = s->params.h * volfx_water_aniso_sigma_bound(s->aniso);
+    }
     return volfx_water_tile_bin(ctx, s->tile, in);
 }
 
@@ -869,6 +923,15 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     volfx_stat_set(ctx, "water.upload_skipped", s->upload_skipped);
     s->last_method_drawn = UINT32_MAX; /* until this frame completes: nothing for debug_pixel_class */
     vfx_result r;
+    /* the seed's method and the baselines draw the isotropic kernel of radius h only */
+    if (p->method != VFX_WATER_METHOD_TILE &&
+        (s->kp.kernel == VFX_WATER_KERNEL_ANISOTROPIC || volfx_water_aniso_has_columns(s->aniso)))
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED,
+                          "water: %s is drawn by method TILE (3) only; method %u draws the isotropic kernel of radius h "
+                          "(scene key water.quality.kernel / method)",
+                          s->kp.kernel == VFX_WATER_KERNEL_ANISOTROPIC ? "the anisotropic kernel (vfx_water_params2.kernel)"
+                                                                        : "a per-particle radius or kernel column (vfx_particle_view.radius, vfx_particle_view2.kernel)",
+                          p->method);
     if (p->method == VFX_WATER_METHOD_PAPER) {
         r = paper_march(ctx, s, frame, targets);
         /* the tile lists read one position buffer: with several, the cap pixels stay holes
@@ -956,6 +1019,21 @@ vfx_result volfx_water_debug_pixel_class(vfx_context *ctx, uint8_t *out, size_t 
         out[p] = (uint8_t)cls[p];
     volfx_free(ctx, cls);
     return r;
+}
+
+vfx_result volfx_water_debug_kernels(vfx_context *ctx, float *out, uint32_t *nbrs, size_t particles)
+{
+    water_state *s = ctx->effect_state[VFX_EFFECT_WATER];
+    GLuint kern = s ? volfx_water_aniso_kernels(s->aniso) : 0;
+    if (!kern)
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "water debug kernels: no per-particle kernels computed yet");
+    if (!out || particles < s->count)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water debug kernels: room for %zu particles, need %u", particles, s->count);
+    glGetNamedBufferSubData(kern, 0, (GLsizeiptr)s->count * VOLFX_WATER_KERNEL_STRIDE, out);
+    if (nbrs)
+        glGetNamedBufferSubData(volfx_water_aniso_neighbours(s->aniso), 0, (GLsizeiptr)s->count * 4, nbrs);
+    const char *e = volfx_gpu_error_string();
+    return e ? volfx_fail(ctx, VFX_ERR_GL, "water debug kernels: %s", e) : VFX_OK;
 }
 
 static vfx_result water_read_raw(vfx_context *ctx, void *state, float *out, size_t count)

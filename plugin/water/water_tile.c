@@ -24,6 +24,8 @@
 
 struct volfx_water_tile {
     GLuint count, start, blocks, entries, globals;
+    GLuint entry_ids;    /* ANISO: the particle of each entry (entry_cap of them) */
+    uint32_t id_cap;
     uint32_t tile_cap;   /* entries count/start hold */
     uint32_t entry_cap;  /* entries `entries` holds */
     uint32_t global_cap; /* particles `globals` holds */
@@ -56,8 +58,8 @@ void volfx_water_tile_destroy(vfx_context *ctx, volfx_water_tile *t)
 {
     if (!t)
         return;
-    GLuint b[] = {t->count, t->start, t->blocks, t->entries, t->globals, t->hits, t->guess, t->remarch};
-    for (int k = 0; k < 8; ++k)
+    GLuint b[] = {t->count, t->start, t->blocks, t->entries, t->globals, t->hits, t->guess, t->remarch, t->entry_ids};
+    for (int k = 0; k < 9; ++k)
         if (b[k])
             glDeleteBuffers(1, &b[k]);
     volfx_free(ctx, t);
@@ -88,6 +90,10 @@ static void bind_buffers(const volfx_water_tile *t, const volfx_water_tile_input
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, t->blocks);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, t->entries);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, t->globals);
+    if (in->kernels) {
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 9, in->kernels);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 10, t->entry_ids);
+    }
     if (t->hits) {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 12, t->hits);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 13, t->guess);
@@ -117,6 +123,12 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
         dmax2 += f * f;
     }
     double dmin = sqrt(dmin2), span = sqrt(dmax2) - dmin;
+    /* per-particle kernels are filed by dist - R_i + h (tile.comp), down to dmin - (rbound - h) */
+    double hx = in->kernels ? (double)in->rbound : (double)in->params->h;
+    if (in->kernels && hx > in->params->h) {
+        dmin -= hx - in->params->h;
+        span += hx - in->params->h;
+    }
     t->d0 = (float)dmin;
     t->ds = (float)(span > 1e-30 ? span / t->slabs * (1.0 + 1e-6) : 1.0);
     uint32_t nscan = (uint32_t)(tiles * t->slabs) + 1;
@@ -133,7 +145,7 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
      * fit unless the box reaches the eye; or what a recent frame needed plus a quarter. A tile
      * that does not fit reads every particle (right, but slow). */
     double fpx = (double)in->focal_px;
-    double span_px = dmin > 2.0 * in->params->h ? 2.0 * sqrt(3.0) * in->params->h * fpx / (dmin - in->params->h) : 1e9;
+    double span_px = dmin > 2.0 * hx ? 2.0 * sqrt(3.0) * hx * fpx / (dmin - hx) : 1e9;
     double per = span_px / TILE_PX + 2.0;
     per = per * per;
     if (per > (double)tiles) per = (double)tiles;
@@ -149,6 +161,11 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
         t->entries = volfx_gpu_storage((GLsizeiptr)want * 16, "water.tile_entries");
         t->entry_cap = (uint32_t)want;
     }
+    if (in->kernels && (!t->entry_ids || t->id_cap < t->entry_cap)) {
+        if (t->entry_ids) glDeleteBuffers(1, &t->entry_ids);
+        t->entry_ids = volfx_gpu_storage((GLsizeiptr)t->entry_cap * 4, "water.tile_entry_ids");
+        t->id_cap = t->entry_cap;
+    }
     uint32_t np = in->count ? in->count : 1;
     if (!t->globals || np > t->global_cap) {
         if (t->globals) glDeleteBuffers(1, &t->globals);
@@ -159,8 +176,14 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
     if (e)
         return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water tile: buffers for %llu tiles and %u entries: %s",
                           (unsigned long long)tiles, t->entry_cap, e);
-    GLuint count = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_COUNT\n");
-    GLuint scatter = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_SCATTER\n");
+    GLuint count, scatter;
+    if (in->kernels) {
+        count = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_COUNT\n#define ANISO\n");
+        scatter = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_SCATTER\n#define ANISO\n");
+    } else {
+        count = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_COUNT\n");
+        scatter = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_SCATTER\n");
+    }
     GLuint scan = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n");
     GLuint top = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n#define SCAN_TOP\n");
     GLuint add = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN_ADD\n");
@@ -226,6 +249,8 @@ static void march_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_tile
     glUniform1i(volfx_gpu_uniform(ctx, prog, "u_has_depth"), frame->depth_texture != 0);
     glUniform1i(volfx_gpu_uniform(ctx, prog, "u_subdivide"), !(p->disable & VFX_WATER_NO_SUBDIVIDE));
     glUniform1i(volfx_gpu_uniform(ctx, prog, "u_local"), !(p->disable & VFX_WATER_NO_LOCAL_LIST));
+    if (in->kernels)
+        glUniform1f(volfx_gpu_uniform(ctx, prog, "u_rbound"), in->rbound);
 }
 
 /* The march over the tile lists: MODE_MARCH writes gradient and back distance for every pixel,
@@ -235,9 +260,13 @@ static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const vol
                                 const vfx_frame_view *frame, const volfx_frame_targets *targets,
                                 bool finish, GLuint img1, GLuint img2, int half, bool temporal, bool reuse)
 {
-    const char *defines = finish ? "#define MODE_FINISH\n"
-                                 : "#define MODE_MARCH\n";
-    GLuint prog = volfx_gpu_compute(ctx, "water/tile.comp", defines);
+    GLuint prog;
+    if (finish) /* the paper method's kernel: isotropic */
+        prog = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_FINISH\n");
+    else if (in->kernels)
+        prog = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_MARCH\n#define ANISO\n");
+    else
+        prog = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_MARCH\n");
     if (!prog)
         return VFX_ERR_GL;
     GLenum access = finish ? GL_READ_ONLY : GL_READ_WRITE;

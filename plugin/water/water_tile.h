@@ -26,6 +26,10 @@ typedef struct volfx_water_tile_input {
     const float *eye;                /* this frame's eye */
     float focal_px;                  /* pixels per unit at distance 1 (proj[5] * height / 2) */
     uint64_t frame_no;               /* the water effect's frame: temporal reuse needs the last one */
+    /* per-particle kernels (water_aniso.h; 0: the isotropic kernel of radius h, the seed's):
+     * the ANISO variants of the passes read centres, matrices and boxes from it */
+    GLuint kernels;
+    float rbound;                    /* every particle's bounding radius is at most this */
 } volfx_water_tile_input;
 
 /* Makes the (empty) tile state; NULL on allocation failure. */

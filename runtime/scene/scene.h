@@ -108,6 +108,9 @@ typedef struct rt_scene_water {
     bool no_slip;                    /* tank walls (all six faces) with wall-law friction */
     /* rendering (seed 000), a full vfx_water_params with size/version filled */
     vfx_water_params params;
+    /* water.quality.kernel (vfx_water_params2.kernel): isotropic unless the scene says
+     * "anisotropic" (method TILE only) */
+    uint32_t kernel;
 } rt_scene_water;
 
 typedef struct rt_scene_transfer_point {

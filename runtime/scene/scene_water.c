@@ -161,7 +161,7 @@ vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
     const cJSON *q = cJSON_GetObjectItemCaseSensitive(v, "quality");
     if (q) {
         static const char *const qkeys[] = {"max_samples", "step", "refine_iters", "pyramid_level", "method",
-                                            "disable", NULL};
+                                            "disable", "kernel", NULL};
         static const char *const methods[] = {"paper", "brute", "grid", "tile", NULL};
         static const char *const flags[] = {"billboard_init", "skip", "blend", "pack4", "pyramid", "refine",
                                             "shading", "finish", "local_list", "subdivide", "tiles", "refract_trace",
@@ -181,7 +181,21 @@ vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
         if (!r) r = scene_get_uint(c, q, PQ, "pyramid_level", false, 1, 12, &wp->pyramid_level);
         if (!r) r = scene_get_enum(c, q, PQ, "method", false, methods, &wp->method);
         if (!r) r = scene_get_flags(c, q, PQ, "disable", flags, bits, &wp->disable);
+        if (!r && cJSON_GetObjectItemCaseSensitive(q, "kernel")) {
+            static const char *const kernels[] = {"isotropic", "anisotropic", NULL};
+            uint32_t k = 0;
+            r = scene_get_enum(c, q, PQ, "kernel", false, kernels, &k);
+            w->kernel = k == 1 ? VFX_WATER_KERNEL_ANISOTROPIC : VFX_WATER_KERNEL_ISOTROPIC;
+            if (!r && w->kernel == VFX_WATER_KERNEL_ANISOTROPIC && wp->method != VFX_WATER_METHOD_TILE)
+                r = scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.quality.kernel",
+                                "\"anisotropic\" is drawn by method \"tile\" only (method \"%s\" draws the seed's isotropic kernel)",
+                                methods[wp->method]);
+        }
     }
+    /* the default: the seed's isotropic kernel (the anisotropic one costs more on llvmpipe; see
+     * docs/water.md "Anisotropic kernels") */
+    if (!r && w->kernel == VFX_WATER_KERNEL_DEFAULT)
+        w->kernel = VFX_WATER_KERNEL_ISOTROPIC;
     return r;
 }
 

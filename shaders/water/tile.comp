@@ -18,6 +18,10 @@
 // MODE_MARCH's u_half: 0 every pixel; 1 the coarse pass (pixels with even x and y); 2 the other
 // pixels, upsampled from their coarse neighbours where those agree, else appended to a list;
 // 3 the listed pixels marched (an indirect dispatch: whole groups of pixels that all march).
+// ANISO (any mode): per-particle kernels (water_aniso.c): particle i adds P(|G_i (x - c_i)|)
+// around its centre c_i; along a ray |G (x - c)|^2 = a (t - tc)^2 + b2 with a = |G d|^2, so
+// every sphere test below is the same quadratic with a per-entry a (isotropic: a = 1). The
+// binning takes the ellipsoid's axis-aligned box and files it by its nearest possible entry.
 // Every loop is bounded by a constant or by a list length; see docs/water.md (method TILE).
 #include "common/depth.glsl"
 #if defined(MODE_MARCH) || defined(MODE_FINISH) || defined(MODE_REPROJECT)
@@ -38,6 +42,13 @@ layout(std430, binding = 4) buffer Counters {
 layout(std430, binding = 5) buffer Start { uint tstart[]; };
 layout(std430, binding = 7) buffer Entries { vec4 entries[]; };
 layout(std430, binding = 8) buffer Globals { uint gcount, gpad0, gpad1, gpad2; vec4 globals[]; };
+#if defined(ANISO)
+// per particle: centre (w bounding radius), G (xx xy xz yy), G (yz zz), half-extents
+layout(std430, binding = 9) readonly buffer Kern { vec4 kern[]; };
+layout(std430, binding = 10) buffer EntryId { uint eid[]; };   // the particle of each entry
+// a bound of every particle's bounding radius: last_exit's early stop
+uniform float u_rbound;
+#endif
 uniform uint u_count;        // particles in the columns (non-finite included)
 uniform uint u_cap;          // entries the Entries buffer holds
 uniform uint u_global_tiles; // a particle covering more tiles goes to the global list
@@ -65,14 +76,15 @@ layout(std430, binding = 14) buffer Remarch { uint rm_groups, rm_gy, rm_gz, rm_c
 uniform mat4 u_view_proj;
 uniform vec3 u_eye_bin;
 
-// Tiles whose pixel centres the cube p +- h can cover (it bounds the sphere of influence, so a
-// ray through a centre outside the rectangle misses the sphere). false: off screen or behind.
-bool tile_rect(vec3 p, out ivec4 r)
+// Tiles whose pixel centres the box p +- ext can cover (the cube of half-size h bounds the
+// sphere of influence, the ellipsoid's axis-aligned box its ellipsoid, so a ray through a
+// centre outside the rectangle misses it). false: off screen or behind.
+bool tile_rect(vec3 p, vec3 ext, out ivec4 r)
 {
     vec2 lo = vec2(3.0e38), hi = vec2(-3.0e38);
     int behind = 0, near = 0;
     for (int k = 0; k < 8; ++k) {
-        vec3 c = p + u_h * (vec3(k & 1, (k >> 1) & 1, k >> 2) * 2.0 - 1.0);
+        vec3 c = p + ext * (vec3(k & 1, (k >> 1) & 1, k >> 2) * 2.0 - 1.0);
         vec4 q = u_view_proj * vec4(c, 1.0);
         if (q.w <= 0.0) { ++behind; continue; }
         if (q.w < 1.0e-6 * (abs(q.x) + abs(q.y) + 1.0e-30)) { ++near; continue; }
@@ -139,13 +151,56 @@ vec3 g_dir;
 
 vec4 fetch(uint i)
 {
+#if defined(ANISO)
+    if (i < g_n)
+        return g_over ? vec4(kern[4u * i].xyz, 0.0) : entries[g_start + i];
+#else
     if (i < g_n)
         return g_over ? vec4(px[i], py[i], pz[i], 0.0) : entries[g_start + i];
+#endif
     return vec4(globals[i - g_n].xyz, 0.0);
 }
 
+// The ray against entry i's kernel at centre c: |G (x - c)|^2 = a (t - tc)^2 + b2 along the ray;
+// pp (isotropic only) the centre's offset from the ray. a = 1 for the isotropic kernel.
+#if defined(ANISO)
+uint fetch_id(uint i)
+{
+    if (i < g_n)
+        return g_over ? i : eid[g_start + i];
+    return floatBitsToUint(globals[i - g_n].w);
+}
+
+mat3 kernel_of(uint id)
+{
+    vec4 m0 = kern[4u * id + 1u], m1 = kern[4u * id + 2u];
+    return mat3(m0.x, m0.y, m0.z, m0.y, m0.w, m1.x, m0.z, m1.x, m1.y);
+}
+
+void ray_term(uint i, vec3 c, out float tc, out float b2, out float a, out vec3 pp)
+{
+    mat3 G = kernel_of(fetch_id(i));
+    vec3 u = G * g_dir, mo = G * (c - u_eye);
+    a = dot(u, u);
+    tc = dot(u, mo) / a;
+    vec3 w = mo - tc * u;   // perpendicular to u: b2 without the cancellation of |mo|^2 - a tc^2
+    b2 = dot(w, w);
+    pp = vec3(0.0);
+}
+#else
+void ray_term(uint i, vec3 c, out float tc, out float b2, out float a, out vec3 pp)
+{
+    vec3 oc = c - u_eye;
+    tc = dot(oc, g_dir);
+    pp = oc - tc * g_dir;
+    b2 = dot(pp, pp);
+    a = 1.0;
+}
+#endif
+
 // The local list of one window: per sphere (perpendicular offset of its centre from the ray,
-// closest-approach distance tc), its squared offset and its entry distance.
+// closest-approach distance tc), its squared offset and its entry distance. ANISO: L[j] is
+// (the particle's id bits, a, 0, tc).
 vec4 L[LOCAL_K];
 float Lb[LOCAL_K], Le[LOCAL_K];
 uint g_nl;
@@ -153,23 +208,27 @@ bool g_dense;   // evaluate over the whole list (a window could not hold its sph
 
 // One term: closest approach tc, squared offset b2; at distance t (value) and its upper bound
 // over [t0, t1] (the point of the interval nearest tc).
-#define TERM(tc, b2) { float d = t - (tc); float r2 = (b2) + d * d; \
+#define TERM(tc, b2, a) { float d = t - (tc); float r2 = (b2) + (a) * d * d; \
     if (r2 < h2) { float q = 1.0 - sqrt(r2) * ih; s += q * q; } \
-    float dm = max(0.0, max(t0 - (tc), (tc) - t)); float rm = (b2) + dm * dm; \
+    float dm = max(0.0, max(t0 - (tc), (tc) - t)); float rm = (b2) + (a) * dm * dm; \
     if (rm < h2) { float q = 1.0 - sqrt(rm) * ih; u += q * q; } }
+#if defined(ANISO)
+#define A_OF(j) L[j].y
+#else
+#define A_OF(j) 1.0
+#endif
 
 // Sum P at t and the bound of sum P over [t0, t]: u >= sum P anywhere in [t0, t].
 vec2 field(float t, float t0)
 {
     float s = 0.0, u = 0.0, h2 = u_h * u_h, ih = 1.0 / u_h;
     if (!g_dense) {
-        for (uint j = 0u; j < g_nl; ++j) TERM(L[j].w, Lb[j])
+        for (uint j = 0u; j < g_nl; ++j) TERM(L[j].w, Lb[j], A_OF(j))
     } else {
         for (uint i = 0u; i < g_total; ++i) {
-            vec4 pe = fetch(i); vec3 oc = pe.xyz - u_eye;
-            float tc = dot(oc, g_dir);
-            vec3 pp = oc - tc * g_dir;
-            TERM(tc, dot(pp, pp))
+            float tc, b2, a; vec3 pp;
+            ray_term(i, fetch(i).xyz, tc, b2, a, pp);
+            TERM(tc, b2, a)
         }
     }
     return vec2(s, u);
@@ -181,6 +240,24 @@ vec4 gradient(float t)
     vec4 g = vec4(0.0);
     float h2 = u_h * u_h;
     uint n = g_dense ? g_total : g_nl;
+#if defined(ANISO)
+    // grad P(|G (x - c)|) = P'(r) G y / r with y = G (x - c)
+    vec3 x = u_eye + t * g_dir;
+    for (uint j = 0u; j < n; ++j) {
+        uint id = g_dense ? fetch_id(j) : floatBitsToUint(L[j].x);
+        mat3 G = kernel_of(id);
+        vec3 y = G * (x - kern[4u * id].xyz);
+        float r2 = dot(y, y);
+        if (r2 < h2 && r2 > 0.0) {
+            float r = sqrt(r2), q = 1.0 - r / u_h;
+            g.xyz += (-2.0 * q / (u_h * r)) * (G * y);
+            g.w += q * q;
+        } else if (r2 == 0.0) {
+            g.w += 1.0;
+        }
+    }
+    return g;
+#endif
     for (uint j = 0u; j < n; ++j) {
         vec3 pp; float tc;
         if (g_dense) { vec3 oc = fetch(j).xyz - u_eye; tc = dot(oc, g_dir); pp = oc - tc * g_dir; }
@@ -215,12 +292,15 @@ float collect(float lo, inout float b, inout uint tests)
             i = g_n - 1u;
             continue;
         }
-        vec3 oc = pe.xyz - u_eye;
-        float tc = dot(oc, g_dir);
-        vec3 pp = oc - tc * g_dir;
-        float b2 = dot(pp, pp);
+        float tc, b2, a; vec3 pp;
+        ray_term(i, pe.xyz, tc, b2, a, pp);
         if (!(b2 < h2)) continue;          // misses the ray (or NaN)
+#if defined(ANISO)
+        float hc = sqrt((h2 - b2) / a), e = tc - hc;
+        pp = vec3(uintBitsToFloat(fetch_id(i)), a, 0.0);
+#else
         float hc = sqrt(h2 - b2), e = tc - hc;
+#endif
         if (tc + hc <= lo) continue;       // behind the window
         if (e >= b) { next_e = min(next_e, e); continue; }
         uint j = g_nl;
@@ -252,12 +332,15 @@ float last_exit(float rad)
     float best = 0.0, r2 = rad * rad;
     for (uint i = g_total; i > 0u; --i) {
         vec4 pe = fetch(i - 1u);
+#if defined(ANISO)
+        // an entry of key k = dist - R + h in [w, w + ds) exits by dist + R rad / h
+        if (!g_over && i - 1u < g_n && pe.w + u_ds - u_h + u_rbound * (1.0 + rad / u_h) <= best) break;
+#else
         if (!g_over && i - 1u < g_n && pe.w + u_ds + rad <= best) break;
-        vec3 oc = pe.xyz - u_eye;
-        float tc = dot(oc, g_dir);
-        vec3 pp = oc - tc * g_dir;
-        float b2 = dot(pp, pp);
-        if (b2 < r2) best = max(best, tc + sqrt(r2 - b2));
+#endif
+        float tc, b2, a; vec3 pp;
+        ray_term(i - 1u, pe.xyz, tc, b2, a, pp);
+        if (b2 < r2) best = max(best, tc + sqrt((r2 - b2) / a));
     }
     return best;
 }
@@ -347,15 +430,28 @@ void main()
     vec3 p = vec3(px[i], py[i], pz[i]);
     if (any(isnan(p)) || any(isinf(p))) return; // skipped (counted on the CPU)
     ivec4 r;
-    if (!tile_rect(p, r)) return;
-    uint area = uint(r.z - r.x + 1) * uint(r.w - r.y + 1);
+#if defined(ANISO)
+    vec4 kc = kern[4u * i];
+    p = kc.xyz;
+    if (!tile_rect(p, kern[4u * i + 3u].xyz, r)) return;
+    // filed by key = dist - R_i + h <= (its nearest entry) + h: the march's "w - h >= b" stops
+    // stay exact; the CPU's d0 is lowered by the largest R_i - h so that key >= d0
+    float dist = length(p - u_eye_bin) - kc.w + u_h;
+#else
+    if (!tile_rect(p, vec3(u_h), r)) return;
     float dist = length(p - u_eye_bin);
+#endif
+    uint area = uint(r.z - r.x + 1) * uint(r.w - r.y + 1);
     uint slab = uint(clamp(floor((dist - u_d0) / u_ds), 0.0, float(u_slabs - 1u)));
     float slab_lo = u_d0 + float(slab) * u_ds;
     if (area > u_global_tiles) {
 #if defined(MODE_SCATTER)
         uint g = atomicAdd(gcount, 1u);   // the buffer holds every particle: always fits
+#if defined(ANISO)
+        globals[g] = vec4(p, uintBitsToFloat(i));
+#else
         globals[g] = vec4(p, 0.0);
+#endif
         atomicAdd(c_global, 1u);
 #endif
         return;
@@ -371,6 +467,9 @@ void main()
 #else
             uint k = tstart[tile] + atomicAdd(tcount[tile], 1u);
             if (k < u_cap) entries[k] = vec4(p, slab_lo);
+#if defined(ANISO)
+            if (k < u_cap) eid[k] = i;
+#endif
 #endif
         }
 #elif defined(MODE_REPROJECT)
@@ -442,11 +541,9 @@ void main()
         // no local lists (ablation): the first entry and the last exit from the whole list
         float e0 = 3.0e38, h2 = u_h * u_h;
         for (uint i = 0u; i < g_total; ++i) {
-            vec3 oc = fetch(i).xyz - u_eye;
-            float tc = dot(oc, g_dir);
-            vec3 pp = oc - tc * g_dir;
-            float b2 = dot(pp, pp);
-            if (b2 < h2) { float hc = sqrt(h2 - b2); if (tc + hc > 0.0) e0 = min(e0, max(tc - hc, 0.0)); }
+            float tc, b2, a; vec3 pp;
+            ray_term(i, fetch(i).xyz, tc, b2, a, pp);
+            if (b2 < h2) { float hc = sqrt((h2 - b2) / a); if (tc + hc > 0.0) e0 = min(e0, max(tc - hc, 0.0)); }
         }
         tests += g_total;
         t = e0;

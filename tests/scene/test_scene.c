@@ -142,6 +142,20 @@ static void test_defaults(void **state)
     assert_false(s->has_volume);
     assert_int_equal(s->beams_view.saturation, VFX_SATURATE_SMOOTH);
     rt_scene_free(s);
+    /* water.quality.kernel: isotropic unless asked for */
+    static const struct { const char *json; uint32_t kernel; } kcases[] = {
+        {"{\"water\":{\"source\":\"file\",\"path\":\"p\"}}", VFX_WATER_KERNEL_ISOTROPIC},
+        {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"kernel\":\"anisotropic\"}}}", VFX_WATER_KERNEL_ANISOTROPIC},
+        {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"kernel\":\"isotropic\"}}}", VFX_WATER_KERNEL_ISOTROPIC},
+        {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"method\":\"paper\"}}}", VFX_WATER_KERNEL_ISOTROPIC},
+        {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"method\":\"grid\",\"kernel\":\"isotropic\"}}}",
+         VFX_WATER_KERNEL_ISOTROPIC},
+    };
+    for (size_t k = 0; k < sizeof kcases / sizeof kcases[0]; ++k) {
+        assert_int_equal(load(kcases[k].json, &log, &s, err, sizeof err), VFX_OK);
+        assert_int_equal(s->water.kernel, kcases[k].kernel);
+        rt_scene_free(s);
+    }
     /* beam defaults: only head and dir given */
     assert_int_equal(load("{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0]}]}", &log, &s, err, sizeof err), VFX_OK);
     assert_close(s->beams[0].base.radius, 0.5);
@@ -277,6 +291,10 @@ static const bad_case bad_cases[] = {
     {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"intensity\":1e-320}]}", VFX_ERR_INVALID_ARGUMENT,
      "beams[0].intensity: 1e-320 is 0 as float32"},
     {"{\"beam_settings\":{\"bloom_levels\":99}}", VFX_ERR_INVALID_ARGUMENT, "beam_settings.bloom_levels: must be <= 8, got 99"},
+    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"kernel\":\"ellipsoid\"}}}", VFX_ERR_INVALID_ARGUMENT,
+     "water.quality.kernel"},
+    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"method\":\"paper\",\"kernel\":\"anisotropic\"}}}",
+     VFX_ERR_INVALID_ARGUMENT, "water.quality.kernel: \"anisotropic\" is drawn by method \"tile\" only"},
     {"{\"beam_settings\":{\"bloom_strength\":1e-320}}", VFX_ERR_INVALID_ARGUMENT,
      "beam_settings.bloom_strength: 1e-320 is 0 as float32"},
     {"{\"volume\":{\"path\":\"a.vtu\",\"scalar\":\"0123456789012345678901234567890123456789012345678901234567890123456789\"}}",

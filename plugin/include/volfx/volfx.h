@@ -99,6 +99,23 @@ typedef struct vfx_particle_view {
     uint64_t revision;
 } vfx_particle_view;
 
+/* Version 2 of a particle chunk: version 1 as its first member (never edited), then an optional
+ * per-particle kernel. The plugin offers one with v1.size = sizeof(vfx_particle_view2) and
+ * v1.version = VFX_PARTICLE_VIEW2_VERSION; a host that knows version 2 fills all of it and
+ * keeps version 2, a version-1 host writes a vfx_particle_view (version 1: no kernel column).
+ * Method TILE honours v1.radius and `kernel`; the other methods refuse either (docs/water.md). */
+#define VFX_PARTICLE_VIEW2_VERSION 2u
+typedef struct vfx_particle_view2 {
+    vfx_particle_view v1;
+    /* optional: 6 floats per particle (xx, xy, xz, yy, yz, zz) of a symmetric positive
+     * definite matrix G; particle i adds P(|G (x - p_i)|) with P the isotropic kernel of radius
+     * h (identity: the isotropic kernel; the ellipsoid's semi-axes are h / the eigenvalues of
+     * G). Used instead of the kernels the plugin would compute (vfx_water_params2.kernel);
+     * v1.radius, when given too, divides G. Each eigenvalue must lie in [1e-3, 1e3]. */
+    const float *kernel;
+    uint32_t _reserved[4];
+} vfx_particle_view2;
+
 /* Bits of vfx_water_params.disable: each switches one technique of the billboard ray caster (docs/water.md) off, for ablations. */
 enum {
     VFX_WATER_NO_BILLBOARD_INIT = 1u << 0, /* technique 1: start every ray at the near plane */
@@ -152,6 +169,36 @@ typedef struct vfx_water_params {
     float ior;             /* 0 -> 1.333 */
     float _reserved[3];
 } vfx_water_params;
+
+/* The kernel each particle adds to the field (vfx_water_params2.kernel). */
+typedef enum vfx_water_kernel {
+    VFX_WATER_KERNEL_DEFAULT = 0,     /* isotropic (the seed's) */
+    VFX_WATER_KERNEL_ISOTROPIC = 1,   /* P(|x - p|), every method */
+    /* Yu & Turk 2013: an ellipsoid per particle from the weighted covariance of its
+     * neighbours, computed on the GPU each frame (docs/water.md "Anisotropic kernels"); flat
+     * water is flat and thin sheets stay sheets. Method TILE only (the others refuse it). */
+    VFX_WATER_KERNEL_ANISOTROPIC = 2,
+} vfx_water_kernel;
+
+/* Version 2 of the water parameters: version 1 as its first member (never edited), then the
+ * kernel. The plugin offers one with v1.size = sizeof(vfx_water_params2) and v1.version =
+ * VFX_WATER_PARAMS2_VERSION; a host that knows version 2 fills all of it and keeps version 2,
+ * a version-1 host writes a vfx_water_params (version 1: the isotropic kernel). Zero means
+ * default in every field; out-of-range values are refused with the field's name. */
+#define VFX_WATER_PARAMS2_VERSION 2u
+typedef struct vfx_water_params2 {
+    vfx_water_params v1;
+    uint32_t kernel;               /* vfx_water_kernel */
+    /* defaults measured on a flat pool (docs/water.md "Anisotropic kernels") */
+    float aniso_radius;            /* neighbourhood radius in units of h, 0.5..4; 0 -> 1.5 */
+    float aniso_max_stretch;       /* kr: the longest axis over the shortest, 1..64; 0 -> 4 */
+    uint32_t aniso_min_neighbours; /* Ne: fewer neighbours -> isotropic, <= 10000; 0 -> 16 */
+    float aniso_scale;             /* ks: every axis of a stretched kernel times this, 0.25..4; 0 -> 1.3 */
+    /* lambda of the Laplacian smoothing of the centres (centre = (1 - lambda) p + lambda x
+     * weighted mean of the neighbours), 0..1; 0 -> none (the default) */
+    float aniso_smoothing;
+    uint32_t _reserved[6];
+} vfx_water_params2;
 
 /* One beam; the field is defined exactly in docs/beams.md:
  * head rho_h = a / sqrt(|P-M|^2 + eps^2) inside radius R, trail rho_t = b / sqrt(r^2 + eps^2)
@@ -311,8 +358,10 @@ typedef struct vfx_host_api {
     void (*free)(void *user, void *ptr);
     /* Particles (water). count 0 -> no water: the plugin allocates nothing for it. */
     uint32_t (*particle_chunk_count)(void *user);
+    /* The plugin offers a vfx_particle_view2 (see there); `out` points at its v1. */
     vfx_result (*particle_chunk)(void *user, uint32_t index, vfx_particle_view *out);
-    /* Water parameters; VFX_ERR_NOT_FOUND -> defaults. NULL callback -> defaults. */
+    /* Water parameters; VFX_ERR_NOT_FOUND -> defaults. NULL callback -> defaults. The plugin
+     * offers a vfx_water_params2 (see there); `out` points at its v1. */
     vfx_result (*water_params)(void *user, vfx_water_params *out);
     /* Beams; count 0 or VFX_ERR_NOT_FOUND -> no beams pass. */
     vfx_result (*beams)(void *user, vfx_beams_view *out);

@@ -1,0 +1,346 @@
+/* water_aniso.c — per-particle kernels for method TILE (see water_aniso.h): the host columns'
+ * checks and upload, and the GPU pass of shaders/water/aniso.comp (hashed grid by counting sort
+ * with grid.comp's prefix sum, then one kernel per particle). */
+#include <math.h>
+#include <string.h>
+
+#include "gpu/gpu.h"
+#include "water_aniso.h"
+
+/* the two-level scan of grid.comp holds 2^20 entries: buckets + 1 must fit */
+#define ANISO_MAX_BUCKETS (1u << 19)
+/* the columns a host may give: radius and kernel eigenvalues in this range */
+#define COLUMN_MIN 1e-3
+#define COLUMN_MAX 1e3
+
+struct volfx_water_aniso {
+    GLuint count, start, blocks, sorted, kern, nbr, radius, hostg;
+    uint32_t bucket_cap, particle_cap, column_cap;
+    bool has_radius, has_kernel;
+    float radius_max;      /* largest radius column value (1 without one) */
+    float host_sigma_max;  /* largest 1 / eigenvalue of the host kernels */
+    /* what the last pass computed from: skip it when nothing changed */
+    uint64_t done_rev;
+    uint32_t done_count;
+    float done_h;
+    volfx_water_kernel_params done_kp;
+    bool done_radius, done_kernel, done;
+};
+
+vfx_result volfx_water_kernel_params_check(vfx_context *ctx, const vfx_water_params2 *in, uint32_t version,
+                                           volfx_water_kernel_params *out)
+{
+    vfx_water_params2 z;
+    if (version < VFX_WATER_PARAMS2_VERSION) {
+        memset(&z, 0, sizeof z);
+        in = &z;
+    }
+    if (in->kernel > VFX_WATER_KERNEL_ANISOTROPIC)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                          "water: vfx_water_params2.kernel %u unknown (0 default, 1 isotropic, 2 anisotropic)", in->kernel);
+    struct { const char *name; float v, lo, hi, def; float *dst; } f[] = {
+        {"aniso_radius", in->aniso_radius, 0.5f, 4.0f, 1.5f, &out->radius},
+        {"aniso_max_stretch", in->aniso_max_stretch, 1.0f, 64.0f, 4.0f, &out->max_stretch},
+        {"aniso_scale", in->aniso_scale, 0.25f, 4.0f, 1.3f, &out->scale},
+        {"aniso_smoothing", in->aniso_smoothing, 0.0f, 1.0f, 0.0f, &out->smoothing},
+    };
+    for (size_t k = 0; k < sizeof f / sizeof f[0]; ++k) {
+        float v = f[k].v;
+        if (v == 0.0f) {
+            *f[k].dst = f[k].def;
+            continue;
+        }
+        if (!(v >= f[k].lo && v <= f[k].hi))
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params2.%s %g outside [%g, %g] (0: default %g)",
+                              f[k].name, v, f[k].lo, f[k].hi, f[k].def);
+        *f[k].dst = v;
+    }
+    if (in->aniso_min_neighbours > 10000)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params2.aniso_min_neighbours %u above 10000",
+                          in->aniso_min_neighbours);
+    out->min_neighbours = in->aniso_min_neighbours ? in->aniso_min_neighbours : 16;
+    out->kernel = in->kernel == VFX_WATER_KERNEL_ANISOTROPIC ? VFX_WATER_KERNEL_ANISOTROPIC : VFX_WATER_KERNEL_ISOTROPIC;
+    return VFX_OK;
+}
+
+volfx_water_aniso *volfx_water_aniso_create(vfx_context *ctx)
+{
+    volfx_water_aniso *a = volfx_alloc(ctx, sizeof *a);
+    if (!a)
+        return NULL;
+    a->blocks = volfx_gpu_storage(1024 * sizeof(uint32_t), "water.aniso_blocks");
+    a->radius_max = 1.0f;
+    return a;
+}
+
+void volfx_water_aniso_destroy(vfx_context *ctx, volfx_water_aniso *a)
+{
+    if (!a)
+        return;
+    GLuint b[] = {a->count, a->start, a->blocks, a->sorted, a->kern, a->nbr, a->radius, a->hostg};
+    for (size_t k = 0; k < sizeof b / sizeof b[0]; ++k)
+        if (b[k])
+            glDeleteBuffers(1, &b[k]);
+    volfx_free(ctx, a);
+}
+
+/* Eigenvalues of the symmetric 3x3 (xx xy xz yy yz zz) by cyclic Jacobi in double. */
+static void eigen_sym3(const double g[6], double ev[3])
+{
+    double A[3][3] = {{g[0], g[1], g[2]}, {g[1], g[3], g[4]}, {g[2], g[4], g[5]}};
+    for (int sweep = 0; sweep < 32; ++sweep) {
+        double off = fabs(A[0][1]) + fabs(A[0][2]) + fabs(A[1][2]);
+        if (!(off > 1e-300))
+            break;
+        for (int p = 0; p < 2; ++p)
+            for (int q = p + 1; q < 3; ++q) {
+                if (A[p][q] == 0.0)
+                    continue;
+                double th = (A[q][q] - A[p][p]) / (2.0 * A[p][q]);
+                double t = (th >= 0 ? 1.0 : -1.0) / (fabs(th) + sqrt(th * th + 1.0));
+                double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
+                for (int k = 0; k < 3; ++k) { /* A J */
+                    double akp = A[k][p], akq = A[k][q];
+                    A[k][p] = c * akp - s * akq;
+                    A[k][q] = s * akp + c * akq;
+                }
+                for (int k = 0; k < 3; ++k) { /* J^T (A J) */
+                    double apk = A[p][k], aqk = A[q][k];
+                    A[p][k] = c * apk - s * aqk;
+                    A[q][k] = s * apk + c * aqk;
+                }
+            }
+    }
+    for (int k = 0; k < 3; ++k)
+        ev[k] = A[k][k];
+}
+
+static GLuint regrow(GLuint b, GLsizeiptr bytes, const char *label)
+{
+    if (b)
+        glDeleteBuffers(1, &b);
+    return volfx_gpu_storage(bytes, label);
+}
+
+vfx_result volfx_water_aniso_columns_begin(vfx_context *ctx, volfx_water_aniso *a, uint32_t total, bool radius,
+                                           bool kernel)
+{
+    a->has_radius = radius;
+    a->has_kernel = kernel;
+    a->radius_max = 1.0f;
+    a->host_sigma_max = 0.0f;
+    if (!radius && !kernel)
+        return VFX_OK;
+    uint32_t n = total ? total : 1;
+    if (n > a->column_cap || !a->radius || !a->hostg) {
+        a->radius = regrow(a->radius, (GLsizeiptr)n * 4, "water.aniso_radius");
+        a->hostg = regrow(a->hostg, (GLsizeiptr)n * 24, "water.aniso_host_kernel");
+        a->column_cap = n;
+    }
+    const char *e = volfx_gpu_error_string();
+    if (e)
+        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water: kernel columns for %u particles: %s", total, e);
+    return VFX_OK;
+}
+
+vfx_result volfx_water_aniso_columns_chunk(vfx_context *ctx, volfx_water_aniso *a, uint32_t chunk, uint32_t first,
+                                           uint32_t count, const float *radius, const float *kernel)
+{
+    if ((!a->has_radius && !a->has_kernel) || count == 0)
+        return VFX_OK;
+    for (uint32_t i = 0; radius && i < count; ++i)
+        if (!(radius[i] >= COLUMN_MIN && radius[i] <= COLUMN_MAX))
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                              "water: particle chunk %u, particle %u: radius %g (vfx_particle_view.radius) must be finite and in [%g, %g]",
+                              chunk, i, radius[i], COLUMN_MIN, COLUMN_MAX);
+    for (uint32_t i = 0; kernel && i < count; ++i) {
+        double g[6], ev[3];
+        for (int k = 0; k < 6; ++k) {
+            g[k] = kernel[6 * (size_t)i + k];
+            if (!isfinite(g[k]))
+                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                                  "water: particle chunk %u, particle %u: kernel (vfx_particle_view2.kernel) entry %d is %g",
+                                  chunk, i, k, g[k]);
+        }
+        eigen_sym3(g, ev);
+        for (int k = 0; k < 3; ++k) {
+            if (!(ev[k] >= COLUMN_MIN && ev[k] <= COLUMN_MAX))
+                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                                  "water: particle chunk %u, particle %u: kernel (vfx_particle_view2.kernel) has eigenvalue %g, "
+                                  "outside [%g, %g] (symmetric positive definite, xx xy xz yy yz zz)",
+                                  chunk, i, ev[k], COLUMN_MIN, COLUMN_MAX);
+            double s = (radius ? radius[i] : 1.0) / ev[k];
+            if (s > a->host_sigma_max)
+                a->host_sigma_max = (float)s;
+        }
+    }
+    for (uint32_t i = 0; radius && i < count; ++i)
+        if (radius[i] > a->radius_max)
+            a->radius_max = radius[i];
+    if (radius) {
+        glNamedBufferSubData(a->radius, (GLintptr)first * 4, (GLsizeiptr)count * 4, radius);
+    } else {
+        float one = 1.0f;
+        glClearNamedBufferSubData(a->radius, GL_R32F, (GLintptr)first * 4, (GLsizeiptr)count * 4, GL_RED, GL_FLOAT, &one);
+    }
+    if (kernel) {
+        glNamedBufferSubData(a->hostg, (GLintptr)first * 24, (GLsizeiptr)count * 24, kernel);
+    } else if (a->has_kernel) {
+        /* this chunk gives none: the identity (the isotropic kernel) */
+        float *id = volfx_alloc(ctx, (size_t)count * 24);
+        if (!id)
+            return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water: identity kernels for chunk %u (%u particles)", chunk, count);
+        for (uint32_t i = 0; i < count; ++i) {
+            float *g = id + 6 * (size_t)i;
+            g[0] = g[3] = g[5] = 1.0f;
+            g[1] = g[2] = g[4] = 0.0f;
+            float s = radius ? radius[i] : 1.0f;
+            if (s > a->host_sigma_max)
+                a->host_sigma_max = s;
+        }
+        glNamedBufferSubData(a->hostg, (GLintptr)first * 24, (GLsizeiptr)count * 24, id);
+        volfx_free(ctx, id);
+    }
+    return VFX_OK;
+}
+
+bool volfx_water_aniso_has_columns(const volfx_water_aniso *a)
+{
+    return a && (a->has_radius || a->has_kernel);
+}
+
+GLuint volfx_water_aniso_kernels(const volfx_water_aniso *a) { return a ? a->kern : 0; }
+GLuint volfx_water_aniso_neighbours(const volfx_water_aniso *a) { return a ? a->nbr : 0; }
+
+static float sigma_bound_of(const volfx_water_aniso *a, const volfx_water_kernel_params *kp)
+{
+    if (a->has_kernel)
+        return a->host_sigma_max > 0 ? a->host_sigma_max : 1.0f;
+    float s = 1.0f;
+    if (kp && kp->kernel == VFX_WATER_KERNEL_ANISOTROPIC) {
+        /* axes with s1 s2 s3 = 1 and each >= s_max / kr: s_max^3 / kr^2 <= 1, then times ks */
+        float stretch = cbrtf(kp->max_stretch * kp->max_stretch) * kp->scale;
+        if (stretch > s) s = stretch;
+    }
+    /* rounding of the normalisation in float: a little room */
+    return s * a->radius_max * 1.001f;
+}
+
+float volfx_water_aniso_sigma_bound(const volfx_water_aniso *a)
+{
+    return a ? sigma_bound_of(a, a->done ? &a->done_kp : NULL) : 1.0f;
+}
+
+static void aniso_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_aniso_input *in, uint32_t buckets,
+                           float cs, uint32_t n)
+{
+    const volfx_water_kernel_params *kp = in->kp;
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_count"), in->count);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_n"), n);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_buckets"), buckets);
+    glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_g0"), 1, in->lo);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_cs"), cs);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_h"), in->h);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_kr"), kp->max_stretch);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_ks"), kp->scale);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_lambda"), kp->smoothing);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_ne"), kp->min_neighbours);
+}
+
+vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, const volfx_water_aniso_input *in)
+{
+    const volfx_water_kernel_params *kp = in->kp;
+    bool aniso = kp->kernel == VFX_WATER_KERNEL_ANISOTROPIC && !a->has_kernel;
+    if (a->done && a->done_rev == in->data_rev && in->data_rev && a->done_count == in->count && a->done_h == in->h &&
+        !memcmp(&a->done_kp, kp, sizeof *kp) && a->done_radius == a->has_radius && a->done_kernel == a->has_kernel) {
+        volfx_stat_set(ctx, "water.aniso_skipped", 1);
+        return VFX_OK;
+    }
+    volfx_stat_set(ctx, "water.aniso_skipped", 0);
+    uint32_t n = in->count ? in->count : 1;
+    uint32_t buckets = 1024;
+    while (buckets < 2u * n && buckets < ANISO_MAX_BUCKETS)
+        buckets *= 2;
+    uint32_t nscan = buckets + 1, need = (nscan + 1023u) & ~1023u;
+    if (need > a->bucket_cap) {
+        a->count = regrow(a->count, (GLsizeiptr)need * 4, "water.aniso_count");
+        a->start = regrow(a->start, (GLsizeiptr)need * 4, "water.aniso_start");
+        a->bucket_cap = need;
+    }
+    if (n > a->particle_cap || !a->kern) {
+        a->sorted = regrow(a->sorted, (GLsizeiptr)n * 16, "water.aniso_sorted");
+        a->kern = regrow(a->kern, (GLsizeiptr)n * VOLFX_WATER_KERNEL_STRIDE, "water.aniso_kernels");
+        a->nbr = regrow(a->nbr, (GLsizeiptr)n * 4, "water.aniso_neighbours");
+        a->particle_cap = n;
+    }
+    if (!a->radius) /* bound even when unused */
+        a->radius = regrow(a->radius, 4, "water.aniso_radius");
+    if (!a->hostg)
+        a->hostg = regrow(a->hostg, 24, "water.aniso_host_kernel");
+    const char *e = volfx_gpu_error_string();
+    if (e)
+        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water aniso: buffers for %u particles: %s", in->count, e);
+    GLuint kern = volfx_gpu_compute(ctx, "water/aniso.comp", "#define MODE_KERNEL\n");
+    GLuint count = volfx_gpu_compute(ctx, "water/aniso.comp", "#define MODE_COUNT\n");
+    GLuint scatter = volfx_gpu_compute(ctx, "water/aniso.comp", "#define MODE_SCATTER\n");
+    GLuint scan = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n");
+    GLuint top = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n#define SCAN_TOP\n");
+    GLuint add = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN_ADD\n");
+    if (!kern || !count || !scatter || !scan || !top || !add)
+        return VFX_ERR_GL;
+    GLuint bind[] = {in->cols[0], in->cols[1], in->cols[2], a->count, in->counters, a->start, a->blocks, a->sorted,
+                     a->kern, a->nbr, a->radius, a->hostg};
+    for (GLuint k = 0; k < sizeof bind / sizeof bind[0]; ++k)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, k, bind[k]);
+    float cs = kp->radius * in->h;
+    GLuint groups = (in->count + 63u) / 64u, blocks = need / 1024u;
+    GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
+    volfx_gpu_pass_begin(ctx, "water.aniso");
+    if (aniso) {
+        glClearNamedBufferSubData(a->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
+        glUseProgram(count);
+        aniso_uniforms(ctx, count, in, buckets, cs, nscan);
+        if (groups)
+            glDispatchCompute(gx, gy, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        glUseProgram(scan);
+        aniso_uniforms(ctx, scan, in, buckets, cs, nscan);
+        glDispatchCompute(blocks, 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        glUseProgram(top);
+        aniso_uniforms(ctx, top, in, buckets, cs, blocks);
+        glDispatchCompute(1, 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        glUseProgram(add);
+        aniso_uniforms(ctx, add, in, buckets, cs, nscan);
+        glDispatchCompute((nscan + 255u) / 256u, 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+        glClearNamedBufferSubData(a->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
+        glUseProgram(scatter);
+        aniso_uniforms(ctx, scatter, in, buckets, cs, nscan);
+        if (groups)
+            glDispatchCompute(gx, gy, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
+    glUseProgram(kern);
+    aniso_uniforms(ctx, kern, in, buckets, cs, nscan);
+    glUniform1i(volfx_gpu_uniform(ctx, kern, "u_radius"), a->has_radius);
+    glUniform1i(volfx_gpu_uniform(ctx, kern, "u_host"), a->has_kernel);
+    glUniform1i(volfx_gpu_uniform(ctx, kern, "u_aniso"), aniso);
+    if (groups)
+        glDispatchCompute(gx, gy, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    volfx_gpu_pass_end(ctx);
+    e = volfx_gpu_error_string();
+    if (e)
+        return volfx_fail(ctx, VFX_ERR_GL, "water aniso pass over %u particles: %s", in->count, e);
+    a->done = true;
+    a->done_rev = in->data_rev;
+    a->done_count = in->count;
+    a->done_h = in->h;
+    a->done_kp = *kp;
+    a->done_radius = a->has_radius;
+    a->done_kernel = a->has_kernel;
+    volfx_stat_set(ctx, "water.aniso_buckets", aniso ? buckets : 0);
+    return VFX_OK;
+}
