@@ -537,8 +537,8 @@ static void test_refused(void **state)
     }
 }
 
-/* The isotropic kernel asked for by a version-2 host is the version-1 host's image bit for bit
- * (the seed's path, no kernel pass), and the anisotropic one differs from it on the pool. */
+/* The isotropic kernel asked for by a version-2 host is the version-1 host's image (the seed's
+ * path, no kernel pass), and the anisotropic one differs from it on the pool. */
 static void test_isotropic_unchanged(void **state)
 {
     (void)state;
@@ -555,7 +555,13 @@ static void test_isotropic_unchanged(void **state)
     assert_null(r1.kern);
     assert_null(r2.kern);
     assert_non_null(r3.kern);
-    assert_memory_equal(r1.dist, r2.dist, 40 * 32 * 4);
+    /* the same program and inputs; the order of the spheres within a tile slab follows the
+     * atomics of the scatter (docs/water.md), so two runs agree to float rounding, not bit for
+     * bit: equal coverage, distances within 1e-5 h */
+    for (size_t p = 0; p < 40 * 32; ++p) {
+        assert_true((r1.dist[p] >= 0) == (r2.dist[p] >= 0));
+        assert_true(fabsf(r1.dist[p] - r2.dist[p]) <= 1e-5f * 0.2f);
+    }
     assert_true(stat_of(&r1, "water.aniso_stretched") < 0);
     uint32_t differ = 0;
     for (size_t p = 0; p < 40 * 32; ++p) differ += fabsf(r1.dist[p] - r3.dist[p]) > 1e-3f * 0.2f;
