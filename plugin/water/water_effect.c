@@ -15,6 +15,7 @@
 #include "water_grid.h"
 #include "water_tile.h"
 #include "water_aniso.h"
+#include "water_spray.h"
 
 /* Counter readback ring: frames the GPU may run behind before a result is dropped. */
 #define WATER_COUNTER_RING 3
@@ -51,6 +52,7 @@ typedef struct water_state {
     volfx_water_aniso *aniso; /* per-particle kernels (TILE), made when asked for or given */
     volfx_water_grid *grid;  /* GRID baseline state, made the first time GRID is asked for */
     volfx_water_tile *tile;  /* TILE lists (TILE, and PAPER's finishing pass), made when needed */
+    volfx_water_spray *spray; /* spray and foam from the host's velocities */
     float lo[3], hi[3];    /* box of the finite particles */
     /* upload skipping: the host's per-chunk revisions of the last upload (0 = untracked: the
      * host gives none, so every frame uploads); data_rev counts uploads, which GRID keys on */
@@ -157,6 +159,7 @@ static void water_destroy(vfx_context *ctx, void *state)
     volfx_water_grid_destroy(ctx, s->grid);
     volfx_water_tile_destroy(ctx, s->tile);
     volfx_water_aniso_destroy(ctx, s->aniso);
+    volfx_water_spray_destroy(ctx, s->spray);
     volfx_free(ctx, s->chunk_rev);
     glDeleteVertexArrays(1, &s->vao);
     for (int k = 0; k < WATER_COUNTER_RING; ++k)
@@ -354,6 +357,10 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
         if (r)
             return r;
     }
+    if (!s->spray && !(s->spray = volfx_water_spray_create(ctx)))
+        return VFX_ERR_OUT_OF_MEMORY;
+    if ((gr = volfx_water_spray_begin(ctx, s->spray, (uint32_t)total)))
+        return gr;
     uint32_t off = 0, nan_count = 0;
     int seen = 0;
     for (uint32_t c = 0; c < chunks; ++c) {
@@ -388,6 +395,8 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
             seen = 1;
         }
         if (s->aniso && (r = volfx_water_aniso_columns_chunk(ctx, s->aniso, c, off, v.count, v.radius, v2.kernel)))
+            return r;
+        if ((r = volfx_water_spray_chunk(ctx, s->spray, off, &v)))
             return r;
         off += v.count;
         s->chunk_rev[c] = v.revision;
@@ -984,6 +993,9 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_hdr"), targets->color_hdr);
     volfx_gpu_fullscreen(ctx);
     volfx_gpu_pass_end(ctx);
+    if (!(p->disable & (VFX_WATER_NO_SPRAY | VFX_WATER_NO_SHADING)) && s->spray && s->group_count == 1 &&
+        (r = volfx_water_spray_draw(ctx, s->spray, s->cols, s->count, p, frame, targets, ctx->water_dist_tex, s->vao)))
+        return r;
     counters_frame_end(ctx, s, p->method);
     s->last_method_drawn = p->method;
     const char *e = volfx_gpu_error_string();

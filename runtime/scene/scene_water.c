@@ -165,12 +165,12 @@ vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
         static const char *const methods[] = {"paper", "brute", "grid", "tile", NULL};
         static const char *const flags[] = {"billboard_init", "skip", "blend", "pack4", "pyramid", "refine",
                                             "shading", "finish", "local_list", "subdivide", "tiles", "refract_trace",
-                                            "temporal", "half_res", NULL};
+                                            "temporal", "half_res", "spray", NULL};
         static const uint32_t bits[] = {VFX_WATER_NO_BILLBOARD_INIT, VFX_WATER_NO_SKIP, VFX_WATER_NO_BLEND,
                                         VFX_WATER_NO_PACK4, VFX_WATER_NO_PYRAMID, VFX_WATER_NO_REFINE,
                                         VFX_WATER_NO_SHADING, VFX_WATER_NO_FINISH, VFX_WATER_NO_LOCAL_LIST,
                                         VFX_WATER_NO_SUBDIVIDE, VFX_WATER_NO_TILES, VFX_WATER_NO_REFRACT_TRACE,
-                                        VFX_WATER_NO_TEMPORAL, VFX_WATER_NO_HALF_RES};
+                                        VFX_WATER_NO_TEMPORAL, VFX_WATER_NO_HALF_RES, VFX_WATER_NO_SPRAY};
         const char *PQ = "water.quality";
         if ((r = scene_expect_object(c, q, PQ)))
             return r;

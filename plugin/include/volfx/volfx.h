@@ -93,8 +93,8 @@ typedef struct vfx_particle_view {
     uint32_t count;
     uint32_t _reserved;
     const float *pos[3];  /* x[], y[], z[] */
-    const float *vel[3];  /* optional */
-    const float *density; /* optional */
+    const float *vel[3];  /* optional: velocities; the fast particles show as spray and foam */
+    const float *density; /* optional; not read by this version */
     const float *radius;  /* optional: per-particle scale of h (1 = h) */
     uint64_t revision;
 } vfx_particle_view;
@@ -143,6 +143,8 @@ enum {
     /* TILE: no reduced-resolution march (one ray per 2x2 block, the rest upsampled where the
      * block agrees and marched where it does not) */
     VFX_WATER_NO_HALF_RES = 1u << 13,
+    /* shading: no spray and foam (the fast particles drawn white; needs the velocity columns) */
+    VFX_WATER_NO_SPRAY = 1u << 14,
 };
 
 typedef enum vfx_water_method {
