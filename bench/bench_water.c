@@ -7,7 +7,8 @@
  * layers deep, seen from above and in front) --png FILE (the shaded frame over a grey-blue host image) --dist FILE
  * (distance image, PFM) --points FILE (positions as raw float32 xyz) --wave A (the particles move:
  * every frame, warm-up included, y += A sin(2 x + 0.5 f) - A sin(2 x + 0.5 (f - 1)), a wave
- * travelling along x, so temporal reuse meets a moving surface as in a game). cpu_ms_per_frame is the
+ * travelling along x, so temporal reuse meets a moving surface as in a game) --kernel isotropic|anisotropic
+ * (vfx_water_params2.kernel; TILE only). cpu_ms_per_frame is the
  * process's CPU time over the timed frames (all llvmpipe threads) divided by the frames. Per-pass GPU ms (counters *.gpu_ms) need at least 4 frames. */
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
@@ -37,6 +38,7 @@ typedef struct bench_scene {
     const char *points;  /* raw float32 x y z per particle, for scripts/compare-vtk-fluid.py */
     const char *dist;    /* the distance image (PFM) */
     float wave;          /* amplitude of the travelling wave the particles follow (0: still) */
+    uint32_t kernel;     /* vfx_water_kernel (0: the plugin's default, isotropic) */
 } bench_scene;
 
 static void *bench_gl_proc(void *user, const char *name) { (void)user; return (void *)eglGetProcAddress(name); }
@@ -57,9 +59,16 @@ static vfx_result bench_chunk(void *user, uint32_t index, vfx_particle_view *out
 static vfx_result bench_params(void *user, vfx_water_params *out)
 {
     bench_scene *s = user;
-    memset(out, 0, sizeof *out);
-    out->size = sizeof *out;
-    out->version = VFX_WATER_PARAMS_VERSION;
+    if (out->version == VFX_WATER_PARAMS2_VERSION && out->size >= sizeof(vfx_water_params2)) {
+        memset(out, 0, sizeof(vfx_water_params2));
+        ((vfx_water_params2 *)out)->kernel = s->kernel;
+        out->size = sizeof(vfx_water_params2);
+        out->version = VFX_WATER_PARAMS2_VERSION;
+    } else {
+        memset(out, 0, sizeof *out);
+        out->size = sizeof *out;
+        out->version = VFX_WATER_PARAMS_VERSION;
+    }
     out->method = s->method;
     out->disable = s->disable;
     out->max_samples = s->max_samples;
@@ -181,9 +190,10 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
     double p50 = fp.p50;
     printf("{\"effect\":\"metaballs\",\"method\":\"%s\",\"disable\":%u,\"max_samples\":%u,\"step_h\":%.4g,"
            "\"refine\":%u,\"pyramid\":%u,\"particles\":%u,\"width\":%u,\"height\":%u,"
-           "\"frames\":%u,\"warmup\":%d,\"wave\":%.4g,\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"cpu_ms_per_frame\":%.2f,\"fps\":%.3g,\"gl_renderer\":\"%s\"",
+           "\"frames\":%u,\"warmup\":%d,\"wave\":%.4g,\"kernel\":\"%s\",\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"cpu_ms_per_frame\":%.2f,\"fps\":%.3g,\"gl_renderer\":\"%s\"",
            method_name(s.method), s.disable, s.max_samples ? s.max_samples : 64, s.step_h > 0 ? s.step_h : 0.125,
-           s.refine ? s.refine : 3, s.pyramid ? s.pyramid : 3, n, width, height, frames, !s.no_warmup, s.wave, p50, fp.p95, fp.p99, cpu_per_frame, 1000.0 / p50,
+           s.refine ? s.refine : 3, s.pyramid ? s.pyramid : 3, n, width, height, frames, !s.no_warmup, s.wave,
+           s.kernel == VFX_WATER_KERNEL_ANISOTROPIC ? "anisotropic" : "isotropic", p50, fp.p95, fp.p99, cpu_per_frame, 1000.0 / p50,
            (const char *)glGetString(GL_RENDERER));
     printf(",\"camera\":{\"eye\":[%.9g,%.9g,%.9g],\"center\":[%.9g,%.9g,%.9g],\"up\":[0,1,0],\"fovy_deg\":%.9g,"
            "\"near\":%.9g,\"far\":%.9g},\"h\":0.61",
@@ -207,13 +217,27 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
         ref_water_error e;
         char err[256];
         double r0 = now_ms();
-        if (ref_water_render(&rc2, s.x, s.y, s.z, n, &rp, ref, NULL, NULL, err) == 0 &&
+        /* the anisotropic kernel: the reference's own matrices (brute force, double), with the
+         * plugin's documented defaults */
+        float *rx = s.x, *ry = s.y, *rz = s.z;
+        double *rG = NULL, *rc3 = NULL;
+        if (s.kernel == VFX_WATER_KERNEL_ANISOTROPIC) {
+            ref_water_aniso_params ap = {rp.h, 1.5, 2.0, 16, 1.15, 0.0};
+            rG = malloc((size_t)n * 6 * sizeof *rG);
+            rc3 = malloc((size_t)n * 3 * sizeof *rc3);
+            rx = malloc((size_t)n * 4); ry = malloc((size_t)n * 4); rz = malloc((size_t)n * 4);
+            ref_water_aniso_kernels(s.x, s.y, s.z, n, &ap, rc3, rG, NULL);
+            for (uint32_t i = 0; i < n; ++i) { rx[i] = (float)rc3[3 * i]; ry[i] = (float)rc3[3 * i + 1]; rz[i] = (float)rc3[3 * i + 2]; }
+            rp.G = rG;
+        }
+        if (ref_water_render(&rc2, rx, ry, rz, n, &rp, ref, NULL, NULL, err) == 0 &&
             ref_water_compare(gpu, NULL, ref, NULL, (size_t)width * height, rp.h, &e) == 0)
             printf(",\"reference_ms\":%.1f,\"ref_hits\":%u,\"hole_rate\":%.5f,\"false_hit_rate\":%.5f,"
                    "\"dist_mean_rel_h\":%.2e,\"dist_p99_rel_h\":%.2e",
                    now_ms() - r0, e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_mean_rel_h, e.dist_p99_rel_h);
         free(gpu);
         free(ref);
+        if (rG) { free(rG); free(rc3); free(rx); free(ry); free(rz); }
     }
     printf("}\n");
     fflush(stdout);
@@ -277,6 +301,11 @@ int bench_metaballs(int argc, char **argv)
         else if (!strcmp(argv[i], "--points") && i + 1 < argc) opt.points = argv[++i];
         else if (!strcmp(argv[i], "--dist") && i + 1 < argc) opt.dist = argv[++i];
         else if (!strcmp(argv[i], "--wave") && i + 1 < argc) opt.wave = (float)atof(argv[++i]);
+        else if (!strcmp(argv[i], "--kernel") && i + 1 < argc) {
+            ++i;
+            if (strcmp(argv[i], "isotropic") && strcmp(argv[i], "anisotropic")) { fprintf(stderr, "metaballs: --kernel isotropic|anisotropic, not %s\n", argv[i]); return 2; }
+            opt.kernel = !strcmp(argv[i], "anisotropic") ? VFX_WATER_KERNEL_ANISOTROPIC : VFX_WATER_KERNEL_ISOTROPIC;
+        }
         else if (!strcmp(argv[i], "--json")) continue;
         else { fprintf(stderr, "metaballs: unknown option %s\n", argv[i]); return 2; }
     }

@@ -40,8 +40,8 @@ vfx_result volfx_water_kernel_params_check(vfx_context *ctx, const vfx_water_par
                           "water: vfx_water_params2.kernel %u unknown (0 default, 1 isotropic, 2 anisotropic)", in->kernel);
     struct { const char *name; float v, lo, hi, def; float *dst; } f[] = {
         {"aniso_radius", in->aniso_radius, 0.5f, 4.0f, 1.5f, &out->radius},
-        {"aniso_max_stretch", in->aniso_max_stretch, 1.0f, 64.0f, 4.0f, &out->max_stretch},
-        {"aniso_scale", in->aniso_scale, 0.25f, 4.0f, 1.3f, &out->scale},
+        {"aniso_max_stretch", in->aniso_max_stretch, 1.0f, 64.0f, 2.0f, &out->max_stretch},
+        {"aniso_scale", in->aniso_scale, 0.25f, 4.0f, 1.15f, &out->scale},
         {"aniso_smoothing", in->aniso_smoothing, 0.0f, 1.0f, 0.0f, &out->smoothing},
     };
     for (size_t k = 0; k < sizeof f / sizeof f[0]; ++k) {

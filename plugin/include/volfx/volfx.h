@@ -193,9 +193,9 @@ typedef struct vfx_water_params2 {
     uint32_t kernel;               /* vfx_water_kernel */
     /* defaults measured on a flat pool (docs/water.md "Anisotropic kernels") */
     float aniso_radius;            /* neighbourhood radius in units of h, 0.5..4; 0 -> 1.5 */
-    float aniso_max_stretch;       /* kr: the longest axis over the shortest, 1..64; 0 -> 4 */
+    float aniso_max_stretch;       /* kr: the longest axis over the shortest, 1..64; 0 -> 2 */
     uint32_t aniso_min_neighbours; /* Ne: fewer neighbours -> isotropic, <= 10000; 0 -> 16 */
-    float aniso_scale;             /* ks: every axis of a stretched kernel times this, 0.25..4; 0 -> 1.3 */
+    float aniso_scale;             /* ks: every axis of a stretched kernel times this, 0.25..4; 0 -> 1.15 */
     /* lambda of the Laplacian smoothing of the centres (centre = (1 - lambda) p + lambda x
      * weighted mean of the neighbours), 0..1; 0 -> none (the default) */
     float aniso_smoothing;
