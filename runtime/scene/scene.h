@@ -108,8 +108,8 @@ typedef struct rt_scene_water {
     bool no_slip;                    /* tank walls (all six faces) with wall-law friction */
     /* rendering (seed 000), a full vfx_water_params with size/version filled */
     vfx_water_params params;
-    /* water.quality.kernel (vfx_water_params2.kernel): isotropic unless the scene says
-     * "anisotropic" (method TILE only) */
+    /* water.quality.kernel (vfx_water_params2.kernel): anisotropic for method TILE unless the
+     * scene says "isotropic"; isotropic for the other methods (they draw no other) */
     uint32_t kernel;
 } rt_scene_water;
 

@@ -142,9 +142,9 @@ static void test_defaults(void **state)
     assert_false(s->has_volume);
     assert_int_equal(s->beams_view.saturation, VFX_SATURATE_SMOOTH);
     rt_scene_free(s);
-    /* water.quality.kernel: isotropic unless asked for */
+    /* water.quality.kernel: anisotropic for TILE (the default method), isotropic for the others */
     static const struct { const char *json; uint32_t kernel; } kcases[] = {
-        {"{\"water\":{\"source\":\"file\",\"path\":\"p\"}}", VFX_WATER_KERNEL_ISOTROPIC},
+        {"{\"water\":{\"source\":\"file\",\"path\":\"p\"}}", VFX_WATER_KERNEL_ANISOTROPIC},
         {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"kernel\":\"anisotropic\"}}}", VFX_WATER_KERNEL_ANISOTROPIC},
         {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"kernel\":\"isotropic\"}}}", VFX_WATER_KERNEL_ISOTROPIC},
         {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"method\":\"paper\"}}}", VFX_WATER_KERNEL_ISOTROPIC},

@@ -19,6 +19,7 @@
 #include "test_util.h"
 #include "water/water_effect.h"
 #include "water_ref.h"
+#include "water_test_host.h"
 
 typedef struct scene {
     test_log log;
@@ -31,17 +32,13 @@ typedef struct scene {
 static uint32_t chunk_count(void *user)
 {
     scene *s = user;
-    return s->n ? (s->n + s->chunk - 1) / s->chunk : 0;
+    return water_test_chunk_count(s->n, s->chunk);
 }
 
 static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
 {
     scene *s = user;
-    uint32_t first = index * s->chunk, count = s->n - first < s->chunk ? s->n - first : s->chunk;
-    out->count = count;
-    out->pos[0] = s->x + first;
-    out->pos[1] = s->y + first;
-    out->pos[2] = s->z + first;
+    uint32_t first = water_test_chunk(s->x, s->y, s->z, s->n, s->chunk, index, out);
     out->radius = s->radius ? s->radius + first : NULL;
     if (out->version == VFX_PARTICLE_VIEW2_VERSION && out->size >= sizeof(vfx_particle_view2))
         ((vfx_particle_view2 *)out)->kernel = s->kernel ? s->kernel + 6 * (size_t)first : NULL;
