@@ -21,7 +21,7 @@
 #define WATER_COUNTER_RING 3
 /* march.comp's 8 (PAPER and the gradient pass), GRID's cells visited and sphere tests,
  * tile.comp's 14 (TILE and the paper method's finishing pass) and aniso.comp's 2 */
-#define WATER_COUNTERS 26
+#define WATER_COUNTERS 27
 /* Particles the effect takes at most: positions are 12 bytes each (12 GiB at the limit) and a
  * particle index must fit the int of gl_InstanceID and of the draw's instance count. */
 #define WATER_MAX_PARTICLES (1u << 30)
@@ -654,6 +654,7 @@ static void publish_counters(vfx_context *ctx, water_state *s)
         volfx_stat_set(ctx, "water.tile_half_upsampled", c[22]);
         volfx_stat_set(ctx, "water.tile_half_remarched", c[23]);
     }
+    volfx_stat_set(ctx, "water.spray_isolated", c[26]);
     if (paper) {
         /* the cap pixels the finishing pass took (0 with VFX_WATER_NO_FINISH), and what is left
          * undecided: cap pixels not finished plus those the finishing march could not decide */
@@ -994,7 +995,9 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     volfx_gpu_fullscreen(ctx);
     volfx_gpu_pass_end(ctx);
     if (!(p->disable & (VFX_WATER_NO_SPRAY | VFX_WATER_NO_SHADING)) && s->spray && s->group_count == 1 &&
-        (r = volfx_water_spray_draw(ctx, s->spray, s->cols, s->count, p, frame, targets, ctx->water_dist_tex, s->vao)))
+        (r = volfx_water_spray_draw(ctx, s->spray, s->cols, s->count, p, frame, targets, ctx->water_dist_tex, s->vao,
+                                     s->kp.kernel == VFX_WATER_KERNEL_ANISOTROPIC ? volfx_water_aniso_neighbours(s->aniso) : 0,
+                                     s->kp.min_neighbours)))
         return r;
     counters_frame_end(ctx, s, p->method);
     s->last_method_drawn = p->method;

@@ -14,6 +14,9 @@
 #define SPRAY_SPEED_HI 2.6f
 /* billboard radius in units of h: about a particle's spacing (h = 2 x spacing) */
 #define SPRAY_RADIUS_H 0.45f
+/* an isolated particle (fewer neighbours than the anisotropic kernels' Ne) at this speed or
+ * more is a drop in flight: spray, even below SPRAY_SPEED_LO */
+#define SPRAY_SPEED_ISOLATED 0.3f
 
 struct volfx_water_spray {
     GLuint speed;       /* one float a particle */
@@ -90,11 +93,14 @@ vfx_result volfx_water_spray_chunk(vfx_context *ctx, volfx_water_spray *sp, uint
 
 vfx_result volfx_water_spray_draw(vfx_context *ctx, volfx_water_spray *sp, const GLuint cols[3], uint32_t count,
                                   const vfx_water_params *p, const vfx_frame_view *frame,
-                                  const volfx_frame_targets *targets, GLuint dist_tex, GLuint vao)
+                                  const volfx_frame_targets *targets, GLuint dist_tex, GLuint vao,
+                                  GLuint neighbours, uint32_t min_neighbours)
 {
     uint32_t drawn = sp->has_vel ? sp->fast : 0;
     volfx_stat_set(ctx, "water.spray_particles", drawn);
-    if (!drawn || !count || count > sp->cap)
+    if (!neighbours)
+        min_neighbours = 0;
+    if ((!drawn && !min_neighbours) || !sp->has_vel || !count || count > sp->cap)
         return VFX_OK;
     GLuint prog = volfx_gpu_program(ctx, "water/spray.vert", "water/spray.frag", NULL);
     if (!prog)
@@ -106,6 +112,10 @@ vfx_result volfx_water_spray_draw(vfx_context *ctx, volfx_water_spray *sp, const
     for (int k = 0; k < 3; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, cols[k]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, sp->speed);
+    if (min_neighbours)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, neighbours);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_min_nb"), min_neighbours);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_speed_isolated"), SPRAY_SPEED_ISOLATED);
     glBindTextureUnit(0, dist_tex);
     glBindTextureUnit(1, frame->depth_texture);
     glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_view_proj"), 1, GL_FALSE, targets->view_proj);

@@ -21,9 +21,12 @@ vfx_result volfx_water_spray_begin(vfx_context *ctx, volfx_water_spray *sp, uint
 vfx_result volfx_water_spray_chunk(vfx_context *ctx, volfx_water_spray *sp, uint32_t first,
                                    const vfx_particle_view *v);
 /* Draws the spray over frame->framebuffer (pass water.spray) from the position columns `cols`
- * (`count` particles); dist_tex is the water's distance image. Sets water.spray_particles. */
+ * (`count` particles): the fast ones, and with a neighbour buffer (a uint a particle; 0: none)
+ * the moving ones with fewer than min_neighbours (counted in slot 26 of the counter buffer bound
+ * at SSBO binding 4). dist_tex is the water's distance image. Sets water.spray_particles. */
 vfx_result volfx_water_spray_draw(vfx_context *ctx, volfx_water_spray *sp, const GLuint cols[3], uint32_t count,
                                   const vfx_water_params *p, const vfx_frame_view *frame,
-                                  const volfx_frame_targets *targets, GLuint dist_tex, GLuint vao);
+                                  const volfx_frame_targets *targets, GLuint dist_tex, GLuint vao,
+                                  GLuint neighbours, uint32_t min_neighbours);
 
 #endif

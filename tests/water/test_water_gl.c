@@ -23,6 +23,7 @@ typedef struct scene {
     test_log log;
     float *x, *y, *z;
     float *vel[3];     /* optional velocity columns (spray) */
+    uint32_t kernel;   /* vfx_water_params2.kernel when nonzero (the plugin offers version 2) */
     uint32_t n, chunk; /* particles per chunk: several chunks exercise the concatenation */
     vfx_water_params params;
     uint64_t rev; /* the chunks' revision: 0 (untracked, every frame uploads) unless a test sets it */
@@ -46,7 +47,15 @@ static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
 
 static vfx_result water_params(void *user, vfx_water_params *out)
 {
-    *out = ((scene *)user)->params;
+    const scene *s = user;
+    uint32_t offered = out->size;
+    *out = s->params;
+    if (s->kernel && offered >= sizeof(vfx_water_params2)) {
+        vfx_water_params2 *p2 = (vfx_water_params2 *)out;
+        p2->v1.size = sizeof *p2;
+        p2->v1.version = VFX_WATER_PARAMS2_VERSION;
+        p2->kernel = s->kernel;
+    }
     return VFX_OK;
 }
 
@@ -839,6 +848,26 @@ static void test_spray(void **state)
      * ~1e-6 in r^2 at a pixel) and the blend rounds in the RGBA32F target only */
     assert_true(worst < 1e-5);
     for (int c = 0; c < 5; ++c) free(img[c]);
+
+    /* drops in flight: two lone particles at 0.5 (below the spray speed, above the isolated
+     * drops') count as isolated spray with the anisotropic kernel (its neighbour counts), not
+     * with the isotropic one (no counts) */
+    for (int k = 0; k < 2; ++k) {
+        scene s = make_scene(2);
+        s.params.method = VFX_WATER_METHOD_TILE;
+        s.kernel = k ? VFX_WATER_KERNEL_ANISOTROPIC : VFX_WATER_KERNEL_ISOTROPIC;
+        s.x[0] = -0.3f, s.x[1] = 0.3f;
+        s.y[0] = s.y[1] = s.z[0] = s.z[1] = 0;
+        float vx[2] = {0.5f, 0.5f}, zero[2] = {0, 0};
+        s.vel[0] = vx, s.vel[1] = s.vel[2] = zero;
+        session ss;
+        session_open(&ss, &s, &cam, host, 0, true);
+        assert_int_equal(session_frame(&ss), VFX_OK);
+        assert_true(stat_of_ctx(&ss, "water.spray_particles") == 0);
+        assert_true(stat_of_ctx(&ss, "water.spray_isolated") == (k ? 2 : 0));
+        session_close(&ss);
+        free_scene(&s);
+    }
 }
 
 /* Multi-buffer chunking: 3000 particles (in host chunks of 97, so chunks straddle buffers)
