@@ -1,0 +1,94 @@
+/* water_internal.h — the water effect's state, shared by its files: water_effect.c (create,
+ * upload, render, counters) and water_paper.c (the seed's billboard method and the BRUTE
+ * baseline). Nothing outside plugin/water includes it. */
+#ifndef VOLFX_WATER_INTERNAL_H
+#define VOLFX_WATER_INTERNAL_H
+
+#include "gpu/gl.h"
+#include "effect.h"
+#include "water_grid.h"
+#include "water_tile.h"
+#include "water_aniso.h"
+#include "water_spray.h"
+
+/* Counter readback ring: frames the GPU may run behind before a result is dropped. */
+#define WATER_COUNTER_RING 3
+/* march.comp's 8 (PAPER and the gradient pass), GRID's cells visited and sphere tests,
+ * tile.comp's 14 (TILE and the paper method's finishing pass) and aniso.comp's 2 */
+#define WATER_COUNTERS 27
+/* Particles the effect takes at most: positions are 12 bytes each (12 GiB at the limit) and a
+ * particle index must fit the int of gl_InstanceID and of the draw's instance count. */
+#define WATER_MAX_PARTICLES (1u << 30)
+/* The gradient target accumulates signed terms up to 2/h that partly cancel at the surface:
+ * RGBA16F rounds each add to ~5e-4 relative. Measured on the blob test with the brute-force
+ * surface (exact to 1e-5 h): mean normal error 0.025 deg in RGBA16F, 0.002 deg in RGBA32F.
+ * The pass runs once per frame, not per march iteration, so the wider format costs little. */
+#define WATER_GRAD_FORMAT GL_RGBA32F
+
+/* One position buffer triple: particles [first, first + count) of the concatenated chunks. */
+typedef struct water_group {
+    GLuint cols[3];
+    uint32_t first, count;
+} water_group;
+
+typedef struct water_state {
+    GLuint cols[3];        /* group 0's columns: the compute paths (brute, NO_BLEND) read only it */
+    water_group *groups;   /* position buffers of at most buffer_cap particles each */
+    uint32_t group_count;
+    uint32_t gl_cap;       /* particles one SSBO binding holds (GL_MAX_SHADER_STORAGE_BLOCK_SIZE) */
+    uint32_t buffer_cap;   /* particles per buffer in use: gl_cap or the lower debug knob */
+    uint32_t capacity;     /* particles the groups hold */
+    uint32_t count;        /* particles uploaded (NaN ones included: the shaders skip them) */
+    uint32_t nan_count;
+    uint32_t width, height;
+    vfx_water_params params;
+    volfx_water_kernel_params kp; /* the kernel (vfx_water_params2), checked */
+    volfx_water_aniso *aniso; /* per-particle kernels (TILE), made when asked for or given */
+    volfx_water_grid *grid;  /* GRID baseline state, made the first time GRID is asked for */
+    volfx_water_tile *tile;  /* TILE lists (TILE, and PAPER's finishing pass), made when needed */
+    volfx_water_spray *spray; /* spray and foam from the host's velocities */
+    float lo[3], hi[3];    /* box of the finite particles */
+    /* upload skipping: the host's per-chunk revisions of the last upload (0 = untracked: the
+     * host gives none, so every frame uploads); data_rev counts uploads, which GRID keys on */
+    uint64_t *chunk_rev;
+    uint32_t chunk_rev_count;
+    uint64_t data_rev;
+    int upload_skipped;    /* this frame's update found every revision unchanged */
+    uint32_t last_method_drawn; /* method of the last frame: debug_pixel_class reads PAPER's state */
+    /* paper pipeline targets */
+    GLuint cur, next1, pot, st, br, reft, depth, pyr, fbo_dist, fbo_pot, counters;
+    GLuint grad, back, fbo_grad, fbo_back; /* surface gradient and back distance (shading) */
+    int pyr_levels;
+    /* counters: copied into ring[slot] and fenced each frame, read once the fence signals */
+    GLuint ring[WATER_COUNTER_RING];
+    GLsync fence[WATER_COUNTER_RING];
+    uint64_t ring_frame[WATER_COUNTER_RING];
+    uint32_t ring_method[WATER_COUNTER_RING];
+    uint64_t frame_no;
+    uint32_t last[WATER_COUNTERS];
+    uint64_t last_frame;   /* frame whose counters `last` holds */
+    uint32_t last_method;
+    int have_last;
+    uint32_t dropped;      /* counter results overwritten before the GPU finished them */
+    float view_proj[16];
+    GLuint vao; /* empty: billboards are built from gl_VertexID / gl_InstanceID */
+} water_state;
+
+/* An R/RG/RGBA texture of one or more levels with nearest filtering, labelled. */
+GLuint volfx_water_make_tex(GLenum fmt, uint32_t w, uint32_t h, int levels, const char *label);
+/* Sets the uniforms every water program shares (matrices, eye, kernel, host depth). */
+void volfx_water_set_common(vfx_context *ctx, GLuint prog, const water_state *s, const vfx_frame_view *frame,
+                            const volfx_frame_targets *targets, float t_end);
+/* One invocation per pixel in 8x8 groups, then a full barrier. */
+void volfx_water_dispatch(const water_state *s);
+/* Method BRUTE: the per-pixel march over every particle (pass water.brute). */
+vfx_result volfx_water_brute_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
+                                   volfx_frame_targets *targets);
+/* Method PAPER: billboard init, the sample loop and refinement (seed 000, eqs. 1-6). */
+vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
+                                   volfx_frame_targets *targets);
+/* The gradient and back-distance billboard passes that shade PAPER's, BRUTE's and GRID's hits. */
+vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
+                                      const volfx_frame_targets *targets);
+
+#endif
