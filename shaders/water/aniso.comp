@@ -124,10 +124,13 @@ void main()
             cand += e - a;
             for (uint j = a; j < e; ++j) {
                 vec4 q = sorted[j];
-                if (cell_of(q.xyz) != c) continue;   // another cell in the same bucket
                 vec3 d = q.xyz - p;                  // relative: no cancellation at large coordinates
                 float r2 = dot(d, d);
                 if (!(r2 < R2)) continue;
+                // a bucket can hold other cells (hash collisions; two of the 27 cells may even
+                // share one): a particle counts when its own cell is visited. Tested after the
+                // distance (those of far cells fail that first), so ~1 candidate in 6 pays it
+                if (cell_of(q.xyz) != c) continue;
                 float r = sqrt(r2) / R, w = 1.0 - r * r * r;
                 W += w;
                 s1 += w * d;
@@ -155,9 +158,8 @@ void main()
                 V = mat3(1.0);
             }
         }
-        nbr[i] = n;
     }
-    if (!u_host && !(u_aniso && finite)) nbr[i] = 0u;
+    nbr[i] = n;   // 0 without a neighbour search (isotropic with a radius column, host kernels)
     axes *= rho;
     // G = V diag(1 / axes) V^T; half-extent along axis k: h |row k of V diag(axes)|
     mat3 G = V * mat3(1.0 / axes.x, 0.0, 0.0, 0.0, 1.0 / axes.y, 0.0, 0.0, 0.0, 1.0 / axes.z) * transpose(V);

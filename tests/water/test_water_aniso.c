@@ -495,6 +495,9 @@ static void test_host_columns(void **state)
         run r = render_plugin(&s, &cam);
         assert_int_equal(r.render, VFX_OK);
         ref_water_error e = compare_dist(&s, &r, &k, &cam, v == 0 ? "radius column" : "radius + kernel columns");
+        assert_non_null(r.kern);
+        for (uint32_t i = 0; i < 30; ++i) /* no neighbour search ran: every count 0 */
+            assert_int_equal(r.nbrs[i], 0);
         assert_true(e.ref_hits > 30 && e.hole_rate == 0 && e.false_hit_rate < 0.01);
         assert_true(e.dist_mean_rel_h < 1e-3 && e.dist_p99_rel_h < 2e-2);
         /* the column changes the surface: the isotropic kernel of radius h covers less or more */
