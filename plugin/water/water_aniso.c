@@ -25,6 +25,7 @@ struct volfx_water_aniso {
     float done_h;
     volfx_water_kernel_params done_kp;
     bool done_radius, done_kernel, done;
+    bool searched;         /* the last pass counted neighbours (the anisotropic kernel, computed) */
 };
 
 vfx_result volfx_water_kernel_params_check(vfx_context *ctx, const vfx_water_params2 *in, uint32_t version,
@@ -210,7 +211,7 @@ bool volfx_water_aniso_has_columns(const volfx_water_aniso *a)
 }
 
 GLuint volfx_water_aniso_kernels(const volfx_water_aniso *a) { return a ? a->kern : 0; }
-GLuint volfx_water_aniso_neighbours(const volfx_water_aniso *a) { return a ? a->nbr : 0; }
+GLuint volfx_water_aniso_neighbours(const volfx_water_aniso *a) { return a && a->searched ? a->nbr : 0; }
 
 static float sigma_bound_of(const volfx_water_aniso *a, const volfx_water_kernel_params *kp)
 {
@@ -341,6 +342,7 @@ vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, con
     a->done_kp = *kp;
     a->done_radius = a->has_radius;
     a->done_kernel = a->has_kernel;
+    a->searched = aniso;
     volfx_stat_set(ctx, "water.aniso_buckets", aniso ? buckets : 0);
     return VFX_OK;
 }

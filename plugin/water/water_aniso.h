@@ -63,8 +63,9 @@ typedef struct volfx_water_aniso_input {
 vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, const volfx_water_aniso_input *in);
 /* The kernel buffer of the last pass (VOLFX_WATER_KERNEL_STRIDE bytes a particle); 0 before. */
 GLuint volfx_water_aniso_kernels(const volfx_water_aniso *a);
-/* A uint per particle: its neighbours within the neighbourhood radius in the last pass (0 for
- * the isotropic kernel and host kernels); fewer than Ne means isolated (spray). 0 before. */
+/* A uint per particle: its neighbours within the neighbourhood radius in the last pass; fewer
+ * than Ne means isolated (spray). 0 (no buffer) before a pass and when the last one searched no
+ * neighbours (the isotropic kernel with a radius column, host kernels). */
 GLuint volfx_water_aniso_neighbours(const volfx_water_aniso *a);
 /* A bound of every particle's bounding radius over h (kr^(2/3) ks times the largest radius
  * column value, or the host kernels' largest 1 / eigenvalue): the binning's depth slabs. */

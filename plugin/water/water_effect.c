@@ -611,14 +611,16 @@ vfx_result volfx_water_debug_pixel_class(vfx_context *ctx, uint8_t *out, size_t 
 vfx_result volfx_water_debug_kernels(vfx_context *ctx, float *out, uint32_t *nbrs, size_t particles)
 {
     water_state *s = ctx->effect_state[VFX_EFFECT_WATER];
-    GLuint kern = s ? volfx_water_aniso_kernels(s->aniso) : 0;
+    GLuint kern = s ? volfx_water_aniso_kernels(s->aniso) : 0, nb = s ? volfx_water_aniso_neighbours(s->aniso) : 0;
     if (!kern)
         return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "water debug kernels: no per-particle kernels computed yet");
     if (!out || particles < s->count)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water debug kernels: room for %zu particles, need %u", particles, s->count);
     glGetNamedBufferSubData(kern, 0, (GLsizeiptr)s->count * VOLFX_WATER_KERNEL_STRIDE, out);
-    if (nbrs)
-        glGetNamedBufferSubData(volfx_water_aniso_neighbours(s->aniso), 0, (GLsizeiptr)s->count * 4, nbrs);
+    if (nbrs && nb)
+        glGetNamedBufferSubData(nb, 0, (GLsizeiptr)s->count * 4, nbrs);
+    else if (nbrs)
+        memset(nbrs, 0, (size_t)s->count * 4); /* no neighbour search ran */
     const char *e = volfx_gpu_error_string();
     return e ? volfx_fail(ctx, VFX_ERR_GL, "water debug kernels: %s", e) : VFX_OK;
 }

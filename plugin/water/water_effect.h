@@ -16,7 +16,8 @@ vfx_result volfx_water_debug_pixel_class(vfx_context *ctx, uint8_t *out, size_t 
 
 /* Copies the per-particle kernels of the last TILE frame that used them: 16 floats a particle
  * (centre xyz, bounding radius; G xx xy xz yy; G yz zz 0 0; half-extents xyz 0; see
- * water_aniso.h) and, if nbrs != NULL, the neighbour counts. VFX_ERR_NOT_FOUND when none. */
+ * water_aniso.h) and, if nbrs != NULL, the neighbour counts (0s when no neighbour search ran).
+ * VFX_ERR_NOT_FOUND when none. */
 vfx_result volfx_water_debug_kernels(vfx_context *ctx, float *out, uint32_t *nbrs, size_t particles);
 
 #endif
