@@ -28,9 +28,8 @@ static void apply_blend(volfx_blend b)
     }
 }
 
-void volfx_pass_begin(vfx_context *ctx, const volfx_pass_desc *d)
+void volfx_pass_apply(vfx_context *ctx, const volfx_pass_desc *d)
 {
-    volfx_gpu_pass_begin(ctx, d->name);
     if (!d->no_framebuffer) {
         glBindFramebuffer(GL_FRAMEBUFFER, d->framebuffer);
         glViewport(0, 0, (GLsizei)(d->width ? d->width : ctx->width),
@@ -38,6 +37,7 @@ void volfx_pass_begin(vfx_context *ctx, const volfx_pass_desc *d)
         if (d->clear_color)
             glClearNamedFramebufferfv(d->framebuffer, GL_COLOR, 0, d->clear_rgba);
         if (d->clear_depth) {
+            glDepthMask(GL_TRUE); /* a clear honours the mask a DEPTH_NONE pass left off */
             float one = d->clear_depth_value != 0.f ? d->clear_depth_value : 1.f;
             glClearNamedFramebufferfv(d->framebuffer, GL_DEPTH, 0, &one);
         }
@@ -53,12 +53,23 @@ void volfx_pass_begin(vfx_context *ctx, const volfx_pass_desc *d)
     }
 }
 
-void volfx_pass_end(vfx_context *ctx)
+void volfx_pass_begin(vfx_context *ctx, const volfx_pass_desc *d)
+{
+    volfx_gpu_pass_begin(ctx, d->name);
+    volfx_pass_apply(ctx, d);
+}
+
+void volfx_pass_reset(void)
 {
     glDisable(GL_BLEND);
     glBlendEquation(GL_FUNC_ADD);
     glDisable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
+}
+
+void volfx_pass_end(vfx_context *ctx)
+{
+    volfx_pass_reset();
     volfx_gpu_pass_end(ctx);
 }
 

@@ -39,6 +39,11 @@ typedef struct volfx_pass_desc {
 void volfx_pass_begin(vfx_context *ctx, const volfx_pass_desc *desc);
 /* Closes the innermost pass; leaves blending and depth testing off (the effect state rule). */
 void volfx_pass_end(vfx_context *ctx);
+/* Applies a desc's framebuffer, viewport, clears, blend and depth without opening a timed pass
+ * (its name is not used): one draw among several inside a pass that volfx_pass_begin opened. */
+void volfx_pass_apply(vfx_context *ctx, const volfx_pass_desc *desc);
+/* Blending and depth testing off, depth writes on: the effect state rule, without closing a pass. */
+void volfx_pass_reset(void);
 
 /* A std140 uniform block: a buffer the effect fills from a C struct mirroring the GLSL block. */
 typedef struct volfx_ubo {

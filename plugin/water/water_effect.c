@@ -7,6 +7,7 @@
 
 #include "water/water_effect.h"
 #include "gpu/gpu.h"
+#include "gpu/pass.h"
 #include "effect.h"
 #include "context.h"
 
@@ -538,11 +539,8 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     GLuint shade = volfx_gpu_program(ctx, "common/fullscreen.vert", "water/shade.frag", NULL);
     if (!shade)
         return VFX_ERR_GL;
-    volfx_gpu_pass_begin(ctx, "water.shade");
-    glBindFramebuffer(GL_FRAMEBUFFER, frame->framebuffer);
-    glViewport(0, 0, (GLsizei)frame->width, (GLsizei)frame->height);
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.shade", .framebuffer = frame->framebuffer,
+                                             .width = frame->width, .height = frame->height});
     glUseProgram(shade);
     glBindTextureUnit(0, ctx->water_dist_tex);
     glBindTextureUnit(1, frame->color_texture);
@@ -565,7 +563,7 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_env"), targets->environment_cubemap != 0);
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_hdr"), targets->color_hdr);
     volfx_gpu_fullscreen(ctx);
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
     if (!(p->disable & (VFX_WATER_NO_SPRAY | VFX_WATER_NO_SHADING)) && s->spray && s->group_count == 1 &&
         (r = volfx_water_spray_draw(ctx, s->spray, s->cols, s->count, p, frame, targets, ctx->water_dist_tex, s->vao,
                                      s->kp.kernel == VFX_WATER_KERNEL_ANISOTROPIC ? volfx_water_aniso_neighbours(s->aniso) : 0,

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "gpu/gpu.h"
+#include "gpu/pass.h"
 #include "context.h"
 #include "water_internal.h"
 
@@ -129,14 +130,9 @@ static vfx_result potential_pass(vfx_context *ctx, water_state *s, const vfx_fra
     GLuint prog = volfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", defs);
     if (!prog)
         return VFX_ERR_GL;
-    glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_pot);
-    glViewport(0, 0, (GLsizei)s->width, (GLsizei)s->height);
-    float zero[4] = {0, 0, 0, 0};
-    glClearNamedFramebufferfv(s->fbo_pot, GL_COLOR, 0, zero);
-    glDisable(GL_DEPTH_TEST);
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE);
-    glBlendEquation(GL_FUNC_ADD);
+    /* inside the caller's timed pass (water.potential or water.refine) */
+    volfx_pass_apply(ctx, &(volfx_pass_desc){.framebuffer = s->fbo_pot, .width = s->width, .height = s->height,
+                                             .clear_color = true, .blend = VOLFX_BLEND_ADD});
     glUseProgram(prog);
     volfx_water_set_common(ctx, prog, s, frame, targets, t_end);
     glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_view_proj"), 1, GL_FALSE, s->view_proj);
@@ -148,7 +144,7 @@ static vfx_result potential_pass(vfx_context *ctx, water_state *s, const vfx_fra
     glUniform1i(volfx_gpu_uniform(ctx, prog, "u_pyr_level"), level);
     glUniform1i(volfx_gpu_uniform(ctx, prog, "u_cull"), cull);
     draw_billboards(ctx, s);
-    glDisable(GL_BLEND);
+    volfx_pass_reset();
     return VFX_OK;
 }
 
@@ -159,22 +155,17 @@ static void nearest_face_pass(vfx_context *ctx, const water_state *s, GLuint pro
                               const vfx_frame_view *frame, const volfx_frame_targets *targets,
                               float t_end, const float vp[16], GLuint after)
 {
-    static const float far4[4] = {1e30f, 1e30f, 1e30f, 1e30f};
-    glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_dist);
-    glViewport(0, 0, (GLsizei)s->width, (GLsizei)s->height);
-    glClearNamedFramebufferfv(s->fbo_dist, GL_COLOR, 0, far4);
-    glClearNamedFramebufferfi(s->fbo_dist, GL_DEPTH_STENCIL, 0, 1.0f, 0);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glDisable(GL_BLEND);
+    /* inside the caller's timed pass (water.init or water.skip) */
+    volfx_pass_apply(ctx, &(volfx_pass_desc){.framebuffer = s->fbo_dist, .width = s->width, .height = s->height,
+                                             .clear_color = true, .clear_rgba = {1e30f, 1e30f, 1e30f, 1e30f},
+                                             .clear_depth = true, .depth = VOLFX_DEPTH_TEST_WRITE});
     glUseProgram(prog);
     volfx_water_set_common(ctx, prog, s, frame, targets, t_end);
     glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_view_proj"), 1, GL_FALSE, vp);
     if (after)
         glBindTextureUnit(0, after);
     draw_billboards(ctx, s);
-    glDisable(GL_DEPTH_TEST);
+    volfx_pass_reset();
 }
 
 /* Shading inputs at the found surface, for every method: the gradient pass (additive
@@ -195,18 +186,11 @@ vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const vf
     GLuint back = volfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_BACK\n#define NS 1\n");
     if (!pyr0 || !pyrd || !grad || !back)
         return VFX_ERR_GL;
-    static const float zero[4] = {0, 0, 0, 0};
-
-    volfx_gpu_pass_begin(ctx, "water.normal");
+    /* the pyramid is compute: the gradient target's state applies to the draw after it */
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.normal", .framebuffer = s->fbo_grad, .width = s->width,
+                                             .height = s->height, .clear_color = true, .blend = VOLFX_BLEND_ADD});
     if (cull)
         build_pyramid(ctx, s, pyr0, pyrd, frame, targets, 0, ctx->water_dist_tex, level);
-    glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_grad);
-    glViewport(0, 0, (GLsizei)s->width, (GLsizei)s->height);
-    glClearNamedFramebufferfv(s->fbo_grad, GL_COLOR, 0, zero);
-    glDisable(GL_DEPTH_TEST);
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE);
-    glBlendEquation(GL_FUNC_ADD);
     glUseProgram(grad);
     volfx_water_set_common(ctx, grad, s, frame, targets, 0);
     glUniformMatrix4fv(volfx_gpu_uniform(ctx, grad, "u_view_proj"), 1, GL_FALSE, s->view_proj);
@@ -215,12 +199,10 @@ vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const vf
     glBindTextureUnit(0, ctx->water_dist_tex);
     glBindTextureUnit(1, s->pyr);
     draw_billboards(ctx, s);
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
 
-    volfx_gpu_pass_begin(ctx, "water.back");
-    glBindFramebuffer(GL_FRAMEBUFFER, s->fbo_back);
-    glClearNamedFramebufferfv(s->fbo_back, GL_COLOR, 0, zero);
-    glBlendEquation(GL_MAX);
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.back", .framebuffer = s->fbo_back, .width = s->width,
+                                             .height = s->height, .clear_color = true, .blend = VOLFX_BLEND_MAX});
     glUseProgram(back);
     volfx_water_set_common(ctx, back, s, frame, targets, 0);
     glUniformMatrix4fv(volfx_gpu_uniform(ctx, back, "u_view_proj"), 1, GL_FALSE, s->view_proj);
@@ -230,9 +212,7 @@ vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const vf
     glUniform1f(volfx_gpu_uniform(ctx, back, "u_rho"), rho > 0 ? rho : 0.0f);
     glBindTextureUnit(0, ctx->water_dist_tex);
     draw_billboards(ctx, s);
-    glBlendEquation(GL_FUNC_ADD);
-    glDisable(GL_BLEND);
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
     return VFX_OK;
 }
 
