@@ -10,6 +10,8 @@ Usage (from the repository root, after `ninja -C build`):
     xvfb-run -a -s '-screen 0 1280x720x24' /usr/bin/python3 scripts/compare-vtk-fluid.py \
         [--particles 16384] [--layout pool|layers] [--width 640] [--height 360] [--rounds 3]
         [--frames 3] [--methods tile,grid] [--radius 0.305] [--png-dir DIR] [--bench build/bench/volfx-bench]
+A method is a volfx-bench method with optional `+` parts: `+anisotropic` / `+isotropic` (--kernel)
+and `+no=BITS` (--disable BITS, VFX_WATER_NO_*), e.g. `tile+anisotropic,tile+anisotropic+no=12288`.
 
 Per round, each of our methods runs as one `volfx-bench metaballs` process (one untimed warm-up
 frame, then --frames frames, each uploading the positions again: revision 0), which reports
@@ -42,11 +44,20 @@ from vtk.util import numpy_support
 
 
 def run_ours(args, method, tmp, first):
+    parts = method.split('+')
     cmd = [args.bench, 'metaballs', '--particles', str(args.particles), '--size', str(args.width),
            '--height', str(args.height), '--layout', args.layout, '--frames', str(args.frames),
-           '--method', method, '--points', os.path.join(tmp, 'points.bin')]
+           '--method', parts[0], '--points', os.path.join(tmp, 'points.bin')]
+    for p in parts[1:]:
+        if p in ('anisotropic', 'isotropic'):
+            cmd += ['--kernel', p]
+        elif p.startswith('no='):
+            cmd += ['--disable', p[3:]]
+        else:
+            raise SystemExit(f'compare-vtk-fluid: unknown method part "{p}" in "{method}"')
     if first and args.png_dir:
-        cmd += ['--png', os.path.join(args.png_dir, f'water-vtk-{method}.png')]
+        name = method.replace('+', '-').replace('=', '')
+        cmd += ['--png', os.path.join(args.png_dir, f'water-vtk-{name}.png')]
     out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
     return json.loads([l for l in out.splitlines() if l.startswith('{')][-1])
 
