@@ -20,6 +20,7 @@ typedef struct game_options {
     rt_gl_mode mode;
     bool debug;
     uint32_t effects_off;
+    bool hide_water;           /* simulate the water but draw none (as key 1): the rest of the frame's cost */
     uint32_t mem_every;        /* print RSS and GL object counts every N frames (0 = never) */
     const char *raw_effect, *raw_path;
     vfx_effect_kind raw_kind;
@@ -29,7 +30,7 @@ static void usage(void)
 {
     puts("usage: volfx-game [--headless|--window] [--frames N] [--seconds S] [--size WxH]\n"
          "                  [--png FILE] [--csv FILE] [--trace FILE] [--plugin libvolfx.so.1|PATH]\n"
-         "                  [--scene FILE.json] [--no-water] [--no-beams] [--no-volume] [--debug-gl]\n"
+         "                  [--scene FILE.json] [--no-water] [--hide-water] [--no-beams] [--no-volume] [--debug-gl]\n"
          "                  [--mem-every N] [--dump-raw water|beams|volume FILE.pfm]\n"
          "Without a display it runs headless (EGL) for 30 frames and writes volfx-game.png.\n"
          "Window keys: WASD/QE fly, mouse drag orbit, 1/2/3 toggle water/beams/volume,\n"
@@ -63,6 +64,7 @@ static bool parse(int argc, char **argv, game_options *o)
         else if (!strcmp(a, "--plugin")) { NEED_ARG(); o->plugin = v; }
         else if (!strcmp(a, "--scene")) { NEED_ARG(); o->scene = v; }
         else if (!strcmp(a, "--no-water")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_WATER);
+        else if (!strcmp(a, "--hide-water")) o->hide_water = true;
         else if (!strcmp(a, "--no-beams")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_BEAMS);
         else if (!strcmp(a, "--no-volume")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_VOLUME);
         else if (!strcmp(a, "--debug-gl")) o->debug = true;
@@ -176,6 +178,8 @@ int main(int argc, char **argv)
         game_app_destroy(app);
         return 1;
     }
+    if (o.hide_water && !(demo.effects_off & VFX_EFFECT_BIT(VFX_EFFECT_WATER)))
+        game_demo_toggle(app, &demo, VFX_EFFECT_WATER);
     bool headless = !rt_gl_context_has_window(app->gl);
     /* headless default: 30 frames (the default scene runs at ~0.5 fps on llvmpipe) */
     uint32_t frames = o.frames ? o.frames : (headless && o.seconds <= 0 ? 30 : UINT32_MAX);

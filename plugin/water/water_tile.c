@@ -339,7 +339,7 @@ vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const v
     if (temporal && (!t->hits || px > t->hits_px)) {
         if (t->hits) glDeleteBuffers(1, &t->hits);
         if (t->guess) glDeleteBuffers(1, &t->guess);
-        t->hits = volfx_gpu_storage((GLsizeiptr)px * 16, "water.tile_hits");
+        t->hits = volfx_gpu_storage(16 + (GLsizeiptr)px * 16, "water.tile_hits");
         t->guess = volfx_gpu_storage((GLsizeiptr)px * 4, "water.tile_guess");
         t->hits_px = px;
         t->hits_valid = 0;
@@ -373,9 +373,17 @@ vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const v
         glUniform2i(volfx_gpu_uniform(ctx, prog, "u_size"), (GLint)in->width, (GLint)in->height);
         glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_view_proj"), 1, GL_FALSE, in->view_proj);
         glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_eye"), 1, in->eye);
-        glDispatchCompute((in->width + 7) / 8, (in->height + 7) / 8, 1);
+        /* one invocation per kept hit point (the march counted the groups) */
+        glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, t->hits);
+        glDispatchComputeIndirect(0);
+        glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         volfx_gpu_pass_end(ctx);
+    }
+    if (temporal) {
+        /* this frame's hit points replace last frame's: no group, one row, one layer, none */
+        const uint32_t args[4] = {0, 1, 1, 0};
+        glNamedBufferSubData(t->hits, 0, sizeof args, args);
     }
     if (half && (!t->remarch || px > t->remarch_px)) {
         if (t->remarch) glDeleteBuffers(1, &t->remarch);

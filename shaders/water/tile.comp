@@ -61,9 +61,11 @@ uniform float u_h;
 uniform uint u_slabs;
 uniform float u_d0, u_ds;
 #if defined(MODE_MARCH) || defined(MODE_REPROJECT)
-// temporal reuse: last frame's hit point per pixel (w = 1 hit, 0 none), this frame's guesses
-// (the float bits of a distance along the ray; 0xffffffff none)
-layout(std430, binding = 12) buffer Hits { vec4 hits[]; };
+// temporal reuse: last frame's hit points (world space; x groups of 64 for the indirect dispatch,
+// the count, then the points: only found pixels append, so a frame where the water covers a
+// small part of the screen reprojects only that part), this frame's guesses per pixel (the
+// float bits of a distance along the ray; 0xffffffff none)
+layout(std430, binding = 12) buffer Hits { uint hit_groups, hit_gy, hit_gz, hit_count; vec4 hits[]; };
 layout(std430, binding = 13) buffer Guess { uint guess[]; };
 #endif
 #if defined(MODE_MARCH)
@@ -356,6 +358,14 @@ float next_local_entry(float t)
 #endif
 
 #if defined(MODE_MARCH)
+// This frame's hit point, for the next frame's guesses (every pixel finds at most one).
+void keep_hit(vec3 x)
+{
+    uint k = atomicAdd(hit_count, 1u);
+    hits[k] = vec4(x, 1.0);
+    if ((k & 63u) == 0u) atomicAdd(hit_groups, 1u);   // a new group of 64 begins
+}
+
 // u_half 2: the pixel from its 2 (same row or column) or 4 (diagonal) coarse neighbours when all
 // of them are empty rays (they met no sphere of influence: a miss), or all hit one smooth
 // surface: each neighbour's tangent plane predicts this ray's distance, the predictions agree
@@ -363,6 +373,13 @@ float next_local_entry(float t)
 // gradient and back distance. false: the pixel is marched (edges, silhouettes, thin features).
 bool upsample(ivec2 pix, float t_lim, uint pidx)
 {
+    if (g_total == 0u) {
+        // no sphere reaches the tile: a miss without reading the neighbours
+        imageStore(u_dist, pix, vec4(-1.0));
+        atomicAdd(c_upsampled, 1u);
+        atomicAdd(c_left, 1u);
+        return true;
+    }
     ivec2 nb[4];
     int nn = 2;
     if ((pix.x & 1) == 1 && (pix.y & 1) == 1) {
@@ -414,7 +431,7 @@ bool upsample(ivec2 pix, float t_lim, uint pidx)
         return false;
     }
     imageStore(u_dist, pix, vec4(dist));
-    if (u_temporal) hits[pidx] = dist >= 0.0 ? vec4(u_eye + dist * g_dir, 1.0) : vec4(0.0);
+    if (u_temporal && dist >= 0.0) keep_hit(u_eye + dist * g_dir);
     atomicAdd(c_upsampled, 1u);
     if (dist >= 0.0) atomicAdd(c_found, 1u);
     else atomicAdd(c_left, 1u);
@@ -473,11 +490,10 @@ void main()
 #endif
         }
 #elif defined(MODE_REPROJECT)
-    // the previous frame's hit point (same size: a resize invalidates) onto this frame's pixels
-    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
-    if (any(greaterThanEqual(q, u_size))) return;
-    vec4 hp = hits[q.y * u_size.x + q.x];
-    if (hp.w == 0.0) return;
+    // one of the previous frame's hit points onto this frame's pixels
+    uint q = gl_WorkGroupID.x * 64u + gl_LocalInvocationIndex;
+    if (q >= hit_count) return;
+    vec4 hp = hits[q];
     vec4 c = u_view_proj * vec4(hp.xyz, 1.0);
     if (!(c.w > 0.0)) return;
     vec2 sp = (c.xy / c.w * 0.5 + 0.5) * vec2(u_size) - 0.5;   // pixel-centre coordinates
@@ -700,12 +716,13 @@ void main()
     } else if (u_half == 1) {
         imageStore(u_back, pix, vec4(g_empty ? -1.0 : 0.0));   // the upsample's empty-ray flag
     }
-    if (u_temporal) hits[pidx] = state == 1 ? vec4(u_eye + result * g_dir, 1.0) : vec4(0.0);
+    if (u_temporal && state == 1) keep_hit(u_eye + result * g_dir);
     if (reuse == 1) atomicAdd(c_reused, 1u);
     else if (reuse == 2) atomicAdd(c_fallback, 1u);
     if (nskip > 0u) atomicAdd(c_skipped, nskip);
     if (nproof > 0u) atomicAdd(c_proof, nproof);
-    atomicAdd(c_samples, nsamp + nsub + nproof);
+    // (an atomic of 0 is skipped: most pixels of a game frame see no water)
+    if (nsamp + nsub + nproof > 0u) atomicAdd(c_samples, nsamp + nsub + nproof);
     if (state == 1) atomicAdd(c_found, 1u);
     else if (state == 4) atomicAdd(c_undecided, 1u);
     else atomicAdd(c_left, 1u);
@@ -713,8 +730,8 @@ void main()
     atomicAdd(c_finished, 1u);
     if (state == 4) atomicAdd(c_undecided, 1u);
 #endif
-    atomicAdd(c_tile_tests, tests);
-    atomicAdd(c_subdiv, nsub);
+    if (tests > 0u) atomicAdd(c_tile_tests, tests);
+    if (nsub > 0u) atomicAdd(c_subdiv, nsub);
     if (g_over) atomicAdd(c_overflow, 1u);
 #endif
 }
