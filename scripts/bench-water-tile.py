@@ -22,6 +22,7 @@ CONFIGS = [
     ("brute", "brute (baseline)", "brute", 0),
     ("grid", "grid (baseline)", "grid", 0),
     ("tile", "**tile (ours), all on**", "tile", 0),
+    ("tile_aniso", "tile, anisotropic kernel (the scenes' default; Yu & Turk)", "tile", 0),
     ("no_temporal", "tile, NO_TEMPORAL (every ray from its first sphere entry)", "tile", NO_TEMPORAL),
     ("no_half", "tile, NO_HALF_RES (every pixel marched)", "tile", NO_HALF),
     ("no_both", "tile, NO_TEMPORAL + NO_HALF_RES", "tile", NO_TEMPORAL | NO_HALF),
@@ -29,6 +30,9 @@ CONFIGS = [
     ("no_subdivide", "tile, NO_SUBDIVIDE (plain steps)", "tile", NO_SUB),
     ("no_tiles", "tile, NO_TILES (every pixel reads every particle)", "tile", NO_TILES),
 ]
+# configurations that choose TILE's kernel (volfx-bench --kernel; the others get the ABI's default,
+# the seed's isotropic kernel)
+KERNEL = {"tile_aniso": "anisotropic"}
 
 
 def main():
@@ -58,6 +62,8 @@ def main():
                    "--frames", str(a.frames)]
             if a.height:
                 cmd += ["--height", str(a.height)]
+            if name in KERNEL:
+                cmd += ["--kernel", KERNEL[name]]
             if a.wave:
                 cmd += ["--wave", str(a.wave)]
             # the reference once (the last round): it does not change between rounds
