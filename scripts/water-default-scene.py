@@ -81,7 +81,7 @@ def main():
         if CONFIGS[n][2]:
             q["disable"] = CONFIGS[n][2]
         # next to default.json: its relative paths resolve the same
-        f = os.path.join(ROOT, "sample_game", "scenes", ".water-default-%s.json" % n)
+        f = os.path.join(ROOT, "sample_game", "scenes", ".water-default-%d-%s.json" % (os.getpid(), n))
         json.dump(s, open(f, "w"))
         files[n] = f
     if a.callgrind:
@@ -134,7 +134,7 @@ def callgrind(a, names, files, base, frames):
     env = dict(os.environ, LP_NUM_THREADS="0")
     counts = {}
     for n in names:
-        out = "/tmp/water-default-cg-%s.out" % n
+        out = "/tmp/water-default-cg-%d-%s.out" % (os.getpid(), n)
         for f in glob.glob(out + "*"):
             os.remove(f)
         cmd = ["valgrind", "--tool=callgrind", "--collect-atstart=no", "--toggle-collect=plugin_render",
