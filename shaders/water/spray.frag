@@ -33,7 +33,9 @@ void main()
     vec3 sun_h = normalize(vec3(SPRAY_SUN.x, 0.15, SPRAY_SUN.z));
     vec3 light = 0.5 * (volfx_sky(vec3(0.0, 1.0, 0.0), SPRAY_SUN) + volfx_sky(sun_h, SPRAY_SUN))
                + 0.35 * vec3(1.0, 0.62, 0.32);
-    vec3 col = 0.9 * light;
+    // white water stays white under a coloured sky: mostly the light's luminance, a little of its hue
+    float lum = dot(light, vec3(0.2126, 0.7152, 0.0722));
+    vec3 col = 1.2 * mix(vec3(lum), light, 0.25);
     if (!u_hdr) col = min(col, vec3(1.0));
     o_color = vec4(col * a, a);
 }

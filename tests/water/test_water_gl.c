@@ -822,7 +822,10 @@ static void test_spray(void **state)
     sky_d(up, sun, s_up);
     sky_d(sh, sun, s_h);
     const double sunc[3] = {1.0, 0.62, 0.32};
-    for (int k = 0; k < 3; ++k) light[k] = fmin(0.9 * (0.5 * (s_up[k] + s_h[k]) + 0.35 * sunc[k]), 1.0);
+    double l3[3];
+    for (int k = 0; k < 3; ++k) l3[k] = 0.5 * (s_up[k] + s_h[k]) + 0.35 * sunc[k];
+    double lum = 0.2126 * l3[0] + 0.7152 * l3[1] + 0.0722 * l3[2];
+    for (int k = 0; k < 3; ++k) light[k] = fmin(1.2 * (lum + 0.25 * (l3[k] - lum)), 1.0);
     uint32_t checked = 0;
     double worst = 0;
     for (uint32_t j = 0; j < cam.height; ++j)
