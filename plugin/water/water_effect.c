@@ -57,6 +57,8 @@ static bool water_present(vfx_context *ctx)
     return ctx->host.particle_chunk_count && ctx->host.particle_chunk_count(ctx->host.user) > 0;
 }
 
+static void water_destroy(vfx_context *ctx, void *state);
+
 static vfx_result water_create(vfx_context *ctx, void **out)
 {
     water_state *s = volfx_alloc(ctx, sizeof *s);
@@ -72,6 +74,11 @@ static vfx_result water_create(vfx_context *ctx, void **out)
     for (int k = 0; k < WATER_COUNTER_RING; ++k)
         glNamedBufferStorage(s->ring[k], WATER_COUNTERS * sizeof(uint32_t), NULL, GL_MAP_READ_BIT);
     *out = s;
+    if (!volfx_ubo_create(ctx, &s->frame_ubo, sizeof(water_frame_block), "water.frame")) {
+        water_destroy(ctx, s);
+        *out = NULL;
+        return VFX_ERR_GL;
+    }
     return VFX_OK;
 }
 
@@ -86,6 +93,7 @@ static void water_destroy(vfx_context *ctx, void *state)
     volfx_water_spray_destroy(ctx, s->spray);
     volfx_free(ctx, s->chunk_rev);
     glDeleteVertexArrays(1, &s->vao);
+    volfx_ubo_destroy(&s->frame_ubo);
     for (int k = 0; k < WATER_COUNTER_RING; ++k)
         if (s->fence[k])
             glDeleteSync(s->fence[k]);
@@ -499,6 +507,7 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
                         s->count, s->group_count, s->buffer_cap, p->method,
                         (p->disable & VFX_WATER_NO_BLEND) ? " with NO_BLEND" : "");
     volfx_mat4_mul(frame->proj, frame->view, s->view_proj);
+    volfx_water_frame_upload(s, frame, targets);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->counters);
     glClearNamedBufferData(s->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     volfx_stat_set(ctx, "water.particles", s->count);
@@ -516,7 +525,7 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
                                                                         : "a per-particle radius or kernel column (vfx_particle_view.radius, vfx_particle_view2.kernel)",
                           p->method);
     if (p->method == VFX_WATER_METHOD_PAPER) {
-        r = volfx_water_paper_march(ctx, s, frame, targets);
+        r = volfx_water_paper_march(ctx, s, frame);
         /* the tile lists read one position buffer: with several, the cap pixels stay holes
          * (counted in water.pixels_undecided) */
         if (r == VFX_OK && !(p->disable & VFX_WATER_NO_FINISH) && s->group_count == 1)
@@ -533,7 +542,7 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
         return r;
     /* TILE wrote the gradient and back distance from its own lists */
     if (!(p->disable & VFX_WATER_NO_SHADING) && p->method != VFX_WATER_METHOD_TILE &&
-        (r = volfx_water_surface_passes(ctx, s, frame, targets)) != VFX_OK)
+        (r = volfx_water_surface_passes(ctx, s, frame)) != VFX_OK)
         return r;
 
     GLuint shade = volfx_gpu_program(ctx, "common/fullscreen.vert", "water/shade.frag", NULL);

@@ -6,6 +6,7 @@
 
 #include "gpu/gl.h"
 #include "effect.h"
+#include "gpu/pass.h"
 #include "water_grid.h"
 #include "water_tile.h"
 #include "water_aniso.h"
@@ -24,6 +25,18 @@
  * surface (exact to 1e-5 h): mean normal error 0.025 deg in RGBA16F, 0.002 deg in RGBA32F.
  * The pass runs once per frame, not per march iteration, so the wider format costs little. */
 #define WATER_GRAD_FORMAT GL_RGBA32F
+
+/* The paper method's per-frame constants: shaders/water/frame.glsl's std140 block WaterFrame
+ * (binding 4), uploaded once a frame by volfx_water_frame_upload. */
+typedef struct water_frame_block {
+    float inv_view_proj[16], view_proj[16];
+    float eye[3], h;
+    float threshold, step, t_end, near_plane;
+    uint32_t max_samples, count, has_depth, pad0;
+    int32_t size[2];
+    float sizef[2];
+} water_frame_block;
+_Static_assert(sizeof(water_frame_block) == 192, "water_frame_block mirrors frame.glsl's std140 layout");
 
 /* One position buffer triple: particles [first, first + count) of the concatenated chunks. */
 typedef struct water_group {
@@ -72,23 +85,24 @@ typedef struct water_state {
     uint32_t dropped;      /* counter results overwritten before the GPU finished them */
     float view_proj[16];
     GLuint vao; /* empty: billboards are built from gl_VertexID / gl_InstanceID */
+    volfx_ubo frame_ubo; /* water_frame_block */
 } water_state;
 
 /* An R/RG/RGBA texture of one or more levels with nearest filtering, labelled. */
 GLuint volfx_water_make_tex(GLenum fmt, uint32_t w, uint32_t h, int levels, const char *label);
-/* Sets the uniforms every water program shares (matrices, eye, kernel, host depth). */
-void volfx_water_set_common(vfx_context *ctx, GLuint prog, const water_state *s, const vfx_frame_view *frame,
-                            const volfx_frame_targets *targets, float t_end);
+/* Fills and binds the WaterFrame block (binding 4) from this frame's camera, parameters and
+ * particle box (s->view_proj already this frame's). */
+void volfx_water_frame_upload(water_state *s, const vfx_frame_view *frame, const volfx_frame_targets *targets);
+/* Binds the host depth at texture unit 1 (the passes that clip at it); none: nothing bound. */
+void volfx_water_bind_depth(const vfx_frame_view *frame);
 /* One invocation per pixel in 8x8 groups, then a full barrier. */
 void volfx_water_dispatch(const water_state *s);
 /* Method BRUTE: the per-pixel march over every particle (pass water.brute). */
 vfx_result volfx_water_brute_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
                                    volfx_frame_targets *targets);
 /* Method PAPER: billboard init, the sample loop and refinement (seed 000, eqs. 1-6). */
-vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                                   volfx_frame_targets *targets);
+vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame);
 /* The gradient and back-distance billboard passes that shade PAPER's, BRUTE's and GRID's hits. */
-vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                                      const volfx_frame_targets *targets);
+vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const vfx_frame_view *frame);
 
 #endif

@@ -24,22 +24,33 @@ GLuint volfx_water_make_tex(GLenum fmt, uint32_t w, uint32_t h, int levels, cons
     return t;
 }
 
-void volfx_water_set_common(vfx_context *ctx, GLuint prog, const water_state *s, const vfx_frame_view *frame,
-                       const volfx_frame_targets *targets, float t_end)
+void volfx_water_frame_upload(water_state *s, const vfx_frame_view *frame, const volfx_frame_targets *targets)
 {
     const vfx_water_params *p = &s->params;
-    glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
-    glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_eye"), 1, frame->eye);
-    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_h"), p->h);
-    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_T"), p->threshold);
-    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_step"), p->step);
-    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_t_end"), t_end);
-    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_near"), frame->near_plane > 0 ? frame->near_plane : 0.01f);
-    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_max_samples"), p->max_samples);
-    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_count"), s->count);
-    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_has_depth"), frame->depth_texture != 0);
-    glUniform2i(volfx_gpu_uniform(ctx, prog, "u_size"), (GLint)s->width, (GLint)s->height);
-    glUniform2f(volfx_gpu_uniform(ctx, prog, "u_sizef"), (float)s->width, (float)s->height);
+    /* farthest point of the particles' box grown by h: beyond it no sample can be inside */
+    float t_end = 0;
+    for (int c = 0; c < 8; ++c) {
+        float d2 = 0;
+        for (int k = 0; k < 3; ++k) {
+            float v = ((c >> k) & 1 ? s->hi[k] + p->h : s->lo[k] - p->h) - frame->eye[k];
+            d2 += v * v;
+        }
+        if (d2 > t_end) t_end = d2;
+    }
+    water_frame_block blk = {
+        .h = p->h, .threshold = p->threshold, .step = p->step, .t_end = sqrtf(t_end),
+        .near_plane = frame->near_plane > 0 ? frame->near_plane : 0.01f, .max_samples = p->max_samples,
+        .count = s->count, .has_depth = frame->depth_texture != 0,
+        .size = {(int32_t)s->width, (int32_t)s->height}, .sizef = {(float)s->width, (float)s->height}};
+    memcpy(blk.inv_view_proj, targets->inv_view_proj, sizeof blk.inv_view_proj);
+    memcpy(blk.view_proj, s->view_proj, sizeof blk.view_proj);
+    memcpy(blk.eye, frame->eye, sizeof blk.eye);
+    volfx_ubo_update(&s->frame_ubo, &blk, sizeof blk);
+    volfx_ubo_bind(&s->frame_ubo, 4);
+}
+
+void volfx_water_bind_depth(const vfx_frame_view *frame)
+{
     if (frame->depth_texture)
         glBindTextureUnit(1, frame->depth_texture);
 }
@@ -52,11 +63,11 @@ void volfx_water_dispatch(const water_state *s)
 
 /* Min/max pyramid of the distances in `src` (level 0 from `pyr0`, 2x2 reductions by `pyrd`
  * down to `level`): the tiles the billboard passes cull against. */
-static void build_pyramid(vfx_context *ctx, const water_state *s, GLuint pyr0, GLuint pyrd, const vfx_frame_view *frame,
-                          const volfx_frame_targets *targets, float t_end, GLuint src, int level)
+static void build_pyramid(const water_state *s, GLuint pyr0, GLuint pyrd, const vfx_frame_view *frame, GLuint src,
+                          int level)
 {
     glUseProgram(pyr0);
-    volfx_water_set_common(ctx, pyr0, s, frame, targets, t_end);
+    volfx_water_bind_depth(frame);
     glBindImageTexture(2, src, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
     glBindImageTexture(5, s->pyr, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32F);
     volfx_water_dispatch(s);
@@ -109,9 +120,8 @@ vfx_result volfx_water_brute_march(vfx_context *ctx, water_state *s, const vfx_f
 
 /* Potentials at the current samples (tex `at`, NS samples from it) into s->pot: additive
  * blending of billboards (technique 3) or the compute-shader sum (VFX_WATER_NO_BLEND). */
-static vfx_result potential_pass(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                                 const volfx_frame_targets *targets, GLuint at, int ns, int cull,
-                                 float t_end)
+static vfx_result potential_pass(vfx_context *ctx, water_state *s, const vfx_frame_view *frame, GLuint at, int ns,
+                                 int cull)
 {
     char defs[96];
     if (s->params.disable & VFX_WATER_NO_BLEND) {
@@ -120,7 +130,7 @@ static vfx_result potential_pass(vfx_context *ctx, water_state *s, const vfx_fra
         if (!prog)
             return VFX_ERR_GL;
         glUseProgram(prog);
-        volfx_water_set_common(ctx, prog, s, frame, targets, t_end);
+        volfx_water_bind_depth(frame);
         glBindImageTexture(2, at, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
         glBindImageTexture(5, s->pot, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
         volfx_water_dispatch(s);
@@ -134,8 +144,7 @@ static vfx_result potential_pass(vfx_context *ctx, water_state *s, const vfx_fra
     volfx_pass_apply(ctx, &(volfx_pass_desc){.framebuffer = s->fbo_pot, .width = s->width, .height = s->height,
                                              .clear_color = true, .blend = VOLFX_BLEND_ADD});
     glUseProgram(prog);
-    volfx_water_set_common(ctx, prog, s, frame, targets, t_end);
-    glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_view_proj"), 1, GL_FALSE, s->view_proj);
+    volfx_water_bind_depth(frame);
     glBindTextureUnit(0, at);
     glBindTextureUnit(1, s->pyr);
     int level = (int)s->params.pyramid_level;
@@ -151,17 +160,15 @@ static vfx_result potential_pass(vfx_context *ctx, water_state *s, const vfx_fra
 /* A depth-tested billboard pass into the distance buffer: each pixel keeps its nearest cube
  * front face. With after = 0 that is the initial sample (eq. 1); with the t'_next texture bound
  * as `after`, the nearest candidate region at or beyond it (eqs. 3-4). */
-static void nearest_face_pass(vfx_context *ctx, const water_state *s, GLuint prog,
-                              const vfx_frame_view *frame, const volfx_frame_targets *targets,
-                              float t_end, const float vp[16], GLuint after)
+static void nearest_face_pass(vfx_context *ctx, const water_state *s, GLuint prog, const vfx_frame_view *frame,
+                              GLuint after)
 {
     /* inside the caller's timed pass (water.init or water.skip) */
     volfx_pass_apply(ctx, &(volfx_pass_desc){.framebuffer = s->fbo_dist, .width = s->width, .height = s->height,
                                              .clear_color = true, .clear_rgba = {1e30f, 1e30f, 1e30f, 1e30f},
                                              .clear_depth = true, .depth = VOLFX_DEPTH_TEST_WRITE});
     glUseProgram(prog);
-    volfx_water_set_common(ctx, prog, s, frame, targets, t_end);
-    glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_view_proj"), 1, GL_FALSE, vp);
+    volfx_water_bind_depth(frame);
     if (after)
         glBindTextureUnit(0, after);
     draw_billboards(ctx, s);
@@ -172,8 +179,7 @@ static void nearest_face_pass(vfx_context *ctx, const water_state *s, GLuint pro
  * blending of grad P and P at the surface point, tile-culled against the pyramid of the final
  * distances like the potential passes) and the back-distance pass (max blending of the ray's
  * exit from each particle's ball of radius h(1 - T)). */
-vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                                 const volfx_frame_targets *targets)
+vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const vfx_frame_view *frame)
 {
     const vfx_water_params *p = &s->params;
     const int cull = !(p->disable & VFX_WATER_NO_PYRAMID);
@@ -190,10 +196,9 @@ vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const vf
     volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.normal", .framebuffer = s->fbo_grad, .width = s->width,
                                              .height = s->height, .clear_color = true, .blend = VOLFX_BLEND_ADD});
     if (cull)
-        build_pyramid(ctx, s, pyr0, pyrd, frame, targets, 0, ctx->water_dist_tex, level);
+        build_pyramid(s, pyr0, pyrd, frame, ctx->water_dist_tex, level);
     glUseProgram(grad);
-    volfx_water_set_common(ctx, grad, s, frame, targets, 0);
-    glUniformMatrix4fv(volfx_gpu_uniform(ctx, grad, "u_view_proj"), 1, GL_FALSE, s->view_proj);
+    volfx_water_bind_depth(frame);
     glUniform1i(volfx_gpu_uniform(ctx, grad, "u_pyr_level"), level);
     glUniform1i(volfx_gpu_uniform(ctx, grad, "u_cull"), cull);
     glBindTextureUnit(0, ctx->water_dist_tex);
@@ -204,8 +209,7 @@ vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const vf
     volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.back", .framebuffer = s->fbo_back, .width = s->width,
                                              .height = s->height, .clear_color = true, .blend = VOLFX_BLEND_MAX});
     glUseProgram(back);
-    volfx_water_set_common(ctx, back, s, frame, targets, 0);
-    glUniformMatrix4fv(volfx_gpu_uniform(ctx, back, "u_view_proj"), 1, GL_FALSE, s->view_proj);
+    volfx_water_bind_depth(frame);
     /* every point within h(1 - T) of a particle is inside (one term alone reaches T^2), so
      * these balls lie in the water: exact for a lone particle, short of a merged body's back */
     float rho = p->h * (1.0f - p->threshold);
@@ -216,33 +220,12 @@ vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const vf
     return VFX_OK;
 }
 
-vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                              volfx_frame_targets *targets)
+vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame)
 {
     const vfx_water_params *p = &s->params;
     const uint32_t dis = p->disable;
     const int ns = (dis & VFX_WATER_NO_PACK4) ? 1 : 4;
     const int cull = !(dis & VFX_WATER_NO_PYRAMID);
-    /* farthest point of the particles' box grown by h: beyond it no sample can be inside */
-    float t_end = 0;
-    for (int c = 0; c < 8; ++c) {
-        float d2 = 0;
-        for (int k = 0; k < 3; ++k) {
-            float v = ((c >> k) & 1 ? s->hi[k] + p->h : s->lo[k] - p->h) - frame->eye[k];
-            d2 += v * v;
-        }
-        if (d2 > t_end) t_end = d2;
-    }
-    t_end = sqrtf(t_end);
-    float vp[16];
-    for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) {
-            float a = 0;
-            for (int k = 0; k < 4; ++k)
-                a += frame->proj[k * 4 + r] * frame->view[c * 4 + k];
-            vp[c * 4 + r] = a;
-        }
-    memcpy(s->view_proj, vp, sizeof vp);
     for (int k = 0; k < 3; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, s->cols[k]);
     float zero[4] = {0, 0, 0, 0};
@@ -259,7 +242,7 @@ vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_f
         GLuint prog = volfx_gpu_program(ctx, "water/billboard.vert", "water/billboard.frag", "#define PASS_INIT\n#define NS 1\n");
         if (!prog)
             return VFX_ERR_GL;
-        nearest_face_pass(ctx, s, prog, frame, targets, t_end, vp, 0);
+        nearest_face_pass(ctx, s, prog, frame, 0);
     }
     volfx_gpu_pass_end(ctx);
 
@@ -280,19 +263,19 @@ vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_f
         /* (5) min/max pyramid of the current samples, 2x2 reductions down to `level` */
         if (cull) {
             volfx_gpu_pass_begin(ctx, "water.pyramid");
-            build_pyramid(ctx, s, pyr0, pyrd, frame, targets, t_end, s->cur, level);
+            build_pyramid(s, pyr0, pyrd, frame, s->cur, level);
             volfx_gpu_pass_end(ctx);
         }
         /* (3)+(4) potentials at NS consecutive samples */
         volfx_gpu_pass_begin(ctx, "water.potential");
-        vfx_result r = potential_pass(ctx, s, frame, targets, s->cur, ns, cull, t_end);
+        vfx_result r = potential_pass(ctx, s, frame, s->cur, ns, cull);
         volfx_gpu_pass_end(ctx);
         if (r)
             return r;
         /* inside/outside, stop flag, t'_next = t + NS w (eq. 2) into buffer 1 */
         volfx_gpu_pass_begin(ctx, "water.update");
         glUseProgram(upd);
-        volfx_water_set_common(ctx, upd, s, frame, targets, t_end);
+        volfx_water_bind_depth(frame);
         glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
         glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
         glBindImageTexture(2, s->cur, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
@@ -309,7 +292,7 @@ vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_f
             s->next1 = t;
             glNamedFramebufferTexture(s->fbo_dist, GL_COLOR_ATTACHMENT0, s->cur, 0);
         } else {
-            nearest_face_pass(ctx, s, skip, frame, targets, t_end, vp, s->next1);
+            nearest_face_pass(ctx, s, skip, frame, s->next1);
         }
         volfx_gpu_pass_end(ctx);
     }
@@ -324,18 +307,18 @@ vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_f
     if (!interp || !refine || !fin)
         return VFX_ERR_GL;
     glUseProgram(interp);
-    volfx_water_set_common(ctx, interp, s, frame, targets, t_end);
+    volfx_water_bind_depth(frame);
     glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
     volfx_water_dispatch(s);
     uint32_t riters = (dis & VFX_WATER_NO_REFINE) ? 0 : p->refine_iters;
     for (uint32_t it = 0; it < riters; ++it) {
-        vfx_result r = potential_pass(ctx, s, frame, targets, s->reft, 1, 0, t_end);
+        vfx_result r = potential_pass(ctx, s, frame, s->reft, 1, 0);
         if (r)
             return r;
         glUseProgram(refine);
-        volfx_water_set_common(ctx, refine, s, frame, targets, t_end);
+        volfx_water_bind_depth(frame);
         glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
         glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
         glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
@@ -343,7 +326,7 @@ vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_f
         volfx_water_dispatch(s);
     }
     glUseProgram(fin);
-    volfx_water_set_common(ctx, fin, s, frame, targets, t_end);
+    volfx_water_bind_depth(frame);
     glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);

@@ -7,11 +7,9 @@
 //   PASS_BACK: farthest exit of the ray from the balls of radius u_rho around the particles
 //     (max blending): the back of the water for the absorption thickness.
 #include "common/depth.glsl"
+#include "water/frame.glsl"
 flat in vec3 v_p;
-uniform mat4 u_inv_view_proj;
-uniform vec3 u_eye;
-uniform float u_h, u_step, u_rho;
-uniform vec2 u_sizef;
+uniform float u_rho;
 layout(binding = 0) uniform sampler2D u_in;   // SKIP: t'_next; POT: sample; GRAD/BACK: surface
 layout(binding = 1) uniform sampler2D u_pyr;  // POT: min/max pyramid (RG)
 uniform int u_pyr_level;

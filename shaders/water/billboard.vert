@@ -4,9 +4,7 @@
 layout(std430, binding = 0) readonly buffer PX { float px[]; };
 layout(std430, binding = 1) readonly buffer PY { float py[]; };
 layout(std430, binding = 2) readonly buffer PZ { float pz[]; };
-uniform mat4 u_view_proj;
-uniform vec3 u_eye;
-uniform float u_h, u_near;
+#include "water/frame.glsl"
 flat out vec3 v_p;
 void main()
 {

@@ -3,16 +3,11 @@
 // host depth, 3 sample cap reached), y/z = distance and I of the last outside sample, w = samples
 // taken. br = (t_neg, I_neg, t_pos, I_pos), the bracket of eqs. 5-6.
 #include "common/depth.glsl"
+#include "water/frame.glsl"
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std430, binding = 4) buffer Counters {
     uint c_culled, c_frags, c_samples, c_found, c_cap, c_left, c_gculled, c_gfrags;
 };
-uniform mat4 u_inv_view_proj;
-uniform vec3 u_eye;
-uniform float u_T, u_step, u_t_end;
-uniform uint u_max_samples;
-uniform bool u_has_depth;
-uniform ivec2 u_size;
 layout(binding = 1) uniform sampler2D u_scene_depth;
 
 float scene_t(ivec2 pix)
@@ -49,8 +44,6 @@ layout(std430, binding = 1) readonly buffer PY { float py[]; };
 layout(std430, binding = 2) readonly buffer PZ { float pz[]; };
 layout(r32f, binding = 2) uniform readonly image2D u_cur;
 layout(rgba16f, binding = 5) uniform writeonly image2D u_potout;
-uniform uint u_count;
-uniform float u_h;
 #endif
 
 // eq. 5, guarded: equal values (flat bracket) give the midpoint.
