@@ -248,6 +248,18 @@ static void aniso_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_anis
     glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_ne"), kp->min_neighbours);
 }
 
+/* One step of the grid build: the program with the pass's uniforms, gx x gy groups (none when
+ * gx is 0: no particles), then `barrier`. */
+static void aniso_step(vfx_context *ctx, GLuint prog, const volfx_water_aniso_input *in, uint32_t buckets, float cs,
+                       uint32_t n, GLuint gx, GLuint gy, GLbitfield barrier)
+{
+    glUseProgram(prog);
+    aniso_uniforms(ctx, prog, in, buckets, cs, n);
+    if (gx)
+        glDispatchCompute(gx, gy, 1);
+    glMemoryBarrier(barrier);
+}
+
 vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, const volfx_water_aniso_input *in)
 {
     const volfx_water_kernel_params *kp = in->kp;
@@ -299,29 +311,13 @@ vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, con
     volfx_gpu_pass_begin(ctx, "water.aniso");
     if (aniso) {
         glClearNamedBufferSubData(a->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
-        glUseProgram(count);
-        aniso_uniforms(ctx, count, in, buckets, cs, nscan);
-        if (groups)
-            glDispatchCompute(gx, gy, 1);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        glUseProgram(scan);
-        aniso_uniforms(ctx, scan, in, buckets, cs, nscan);
-        glDispatchCompute(blocks, 1, 1);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        glUseProgram(top);
-        aniso_uniforms(ctx, top, in, buckets, cs, blocks);
-        glDispatchCompute(1, 1, 1);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        glUseProgram(add);
-        aniso_uniforms(ctx, add, in, buckets, cs, nscan);
-        glDispatchCompute((nscan + 255u) / 256u, 1, 1);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+        aniso_step(ctx, count, in, buckets, cs, nscan, gx, gy, GL_SHADER_STORAGE_BARRIER_BIT);
+        aniso_step(ctx, scan, in, buckets, cs, nscan, blocks, 1, GL_SHADER_STORAGE_BARRIER_BIT);
+        aniso_step(ctx, top, in, buckets, cs, blocks, 1, 1, GL_SHADER_STORAGE_BARRIER_BIT);
+        aniso_step(ctx, add, in, buckets, cs, nscan, (nscan + 255u) / 256u, 1,
+                   GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
         glClearNamedBufferSubData(a->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
-        glUseProgram(scatter);
-        aniso_uniforms(ctx, scatter, in, buckets, cs, nscan);
-        if (groups)
-            glDispatchCompute(gx, gy, 1);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        aniso_step(ctx, scatter, in, buckets, cs, nscan, gx, gy, GL_SHADER_STORAGE_BARRIER_BIT);
     }
     glUseProgram(kern);
     aniso_uniforms(ctx, kern, in, buckets, cs, nscan);

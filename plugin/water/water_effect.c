@@ -507,7 +507,8 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
                         s->count, s->group_count, s->buffer_cap, p->method,
                         (p->disable & VFX_WATER_NO_BLEND) ? " with NO_BLEND" : "");
     volfx_mat4_mul(frame->proj, frame->view, s->view_proj);
-    volfx_water_frame_upload(s, frame, targets);
+    if (p->method != VFX_WATER_METHOD_TILE) /* TILE's passes set their own uniforms */
+        volfx_water_frame_upload(s, frame, targets);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->counters);
     glClearNamedBufferData(s->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     volfx_stat_set(ctx, "water.particles", s->count);

@@ -220,6 +220,17 @@ vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const vf
     return VFX_OK;
 }
 
+/* The refinement's compute steps (eqs. 5-6) read and write the pixel state, the bracket and the
+ * refined distance at image units 0-2: prog in use with those bound and the host depth. */
+static void refine_step_begin(const water_state *s, GLuint prog, const vfx_frame_view *frame)
+{
+    glUseProgram(prog);
+    volfx_water_bind_depth(frame);
+    glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+}
+
 vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame)
 {
     const vfx_water_params *p = &s->params;
@@ -306,30 +317,18 @@ vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_f
     GLuint fin = volfx_gpu_compute(ctx, "water/march.comp", "#define MODE_FINAL\n#define NS 1\n");
     if (!interp || !refine || !fin)
         return VFX_ERR_GL;
-    glUseProgram(interp);
-    volfx_water_bind_depth(frame);
-    glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-    glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-    glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+    refine_step_begin(s, interp, frame);
     volfx_water_dispatch(s);
     uint32_t riters = (dis & VFX_WATER_NO_REFINE) ? 0 : p->refine_iters;
     for (uint32_t it = 0; it < riters; ++it) {
         vfx_result r = potential_pass(ctx, s, frame, s->reft, 1, 0);
         if (r)
             return r;
-        glUseProgram(refine);
-        volfx_water_bind_depth(frame);
-        glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-        glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-        glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+        refine_step_begin(s, refine, frame);
         glBindTextureUnit(0, s->pot);
         volfx_water_dispatch(s);
     }
-    glUseProgram(fin);
-    volfx_water_bind_depth(frame);
-    glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-    glBindImageTexture(1, s->br, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
-    glBindImageTexture(2, s->reft, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+    refine_step_begin(s, fin, frame);
     glBindImageTexture(3, ctx->water_dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     glBindImageTexture(4, s->cur, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
     volfx_water_dispatch(s);
