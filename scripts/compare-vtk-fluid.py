@@ -42,6 +42,8 @@ import numpy as np
 import vtk
 from vtk.util import numpy_support
 
+from vtk_view import gl_renderer, offscreen_window
+
 
 def run_ours(args, method, tmp, first):
     parts = method.split('+')
@@ -86,18 +88,8 @@ def vtk_scene(points, cam, args):
     ren.SetBackground(0.35, 0.4, 0.5)  # the host colour volfx-bench metaballs clears to
     ren.AddVolume(vol)
     ren.GetCullers().RemoveAllItems()  # the fluid mapper draws nothing with the frustum culler
-    win = vtk.vtkRenderWindow()
-    win.SetOffScreenRendering(1)
-    win.SetMultiSamples(0)  # with VTK's default 8x MSAA window the fluid mapper's result never shows
-    win.SetSize(args.width, args.height)
-    win.AddRenderer(ren)
-    c = ren.GetActiveCamera()
-    c.SetPosition(*cam['eye'])
-    c.SetFocalPoint(*cam['center'])
-    c.SetViewUp(*cam['up'])
-    c.SetViewAngle(cam['fovy_deg'])
-    c.SetClippingRange(cam['near'], cam['far'])
-    return win, poly
+    # no MSAA: with VTK's default 8x window the fluid mapper's result never shows
+    return offscreen_window(ren, args.width, args.height, cam, multisamples=0), poly
 
 
 def run_vtk(win, poly, frames):
@@ -165,7 +157,7 @@ def main():
             print(json.dumps({'round': r, 'method': 'vtk', 'cpu_ms_per_frame': c, 'wall_ms_p50': w}), flush=True)
             if r == 0 and args.png_dir:
                 save_vtk_png(win, os.path.join(args.png_dir, 'water-vtk-vtkfluid.png'))
-    vtk_gl = win.ReportCapabilities().split('OpenGL renderer string:')[-1].splitlines()[0].strip() if win else '?'
+    vtk_gl = gl_renderer(win) if win else '?'
     print(f'\n{args.particles} particles ({args.layout}), {args.width}x{args.height}, {args.rounds} rounds of '
           f'{args.frames} frames; ours: {renderer}; VTK {vtk.vtkVersion.GetVTKVersion()}: {vtk_gl}; '
           f'{os.cpu_count()} cores\n')

@@ -42,6 +42,8 @@ import numpy as np
 import vtk
 from vtk.util import numpy_support
 
+from vtk_view import gl_renderer, offscreen_window
+
 
 def read_pfm(path):
     with open(path, 'rb') as f:
@@ -152,16 +154,7 @@ def render(ug, tf, cam, name, integrator, reps, modified):
     ren = vtk.vtkRenderer()
     ren.SetBackground(0, 0, 0)
     ren.AddVolume(vol)
-    win = vtk.vtkRenderWindow()
-    win.SetOffScreenRendering(1)
-    win.SetSize(w, h)
-    win.AddRenderer(ren)
-    c = ren.GetActiveCamera()
-    c.SetPosition(*cam['eye'])
-    c.SetFocalPoint(*cam['center'])
-    c.SetViewUp(*cam['up'])
-    c.SetViewAngle(cam['fovy_deg'])
-    c.SetClippingRange(cam['near'], cam['far'])
+    win = offscreen_window(ren, w, h, cam)
     times, cpus = [], []
     for i in range(reps + 1):
         if modified:
@@ -177,7 +170,7 @@ def render(ug, tf, cam, name, integrator, reps, modified):
     grab.Update()
     img = grab.GetOutput()
     arr = numpy_support.vtk_to_numpy(img.GetPointData().GetScalars()).reshape(h, w, 3)
-    gl = win.ReportCapabilities().split('OpenGL renderer string:')[-1].split('\n')[0].strip()
+    gl = gl_renderer(win)
     win.Finalize()
     return (arr.astype(np.float64) / 255.0, statistics.median(times[1:]), times[0],
             statistics.median(cpus[1:]), gl)
