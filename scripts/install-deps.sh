@@ -16,6 +16,8 @@ pkgs=(
   libsdl2-dev          # tests/integration/sdl_host.c, the second host
   khronos-api          # gl.xml: the plugin's GL loader is generated from it (plugin/gpu/gen_gl.py)
   glslang-tools        # glslangValidator: every shader variant validated at build time
+  libvulkan-dev mesa-vulkan-drivers glslc vulkan-validationlayers  # tests/integration/vulkan_host.c: Vulkan (lavapipe), its SPIR-V, validation
+  cmake                # tests/integration/check_cmake_package.sh: find_package(volfx CONFIG)
   python3-matplotlib   # scripts/bench-water.sh plots with /usr/bin/python3
   clang libclang-rt-14-dev  # scripts/fuzz.sh (CI's third step): libFuzzer and the sanitizer runtimes
   "$@"
