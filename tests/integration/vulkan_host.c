@@ -16,6 +16,7 @@
  * image of the Vulkan path must match the GL path's.
  * usage: vulkan_host [--ppm PREFIX]  (writes PREFIX-vulkan.ppm and PREFIX-gl.ppm)
  * Exits 0 on a match, 1 on a mismatch or any error, 77 when no GL 4.5 context can be made. */
+#include <dlfcn.h>
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
 #include <math.h>
@@ -333,6 +334,13 @@ static bool has_layer(const char *name)
  * VFX_VK_VALIDATION is not 0: any validation error fails the test. */
 static bool vk_instance(vk *v)
 {
+    /* Leak checking only (VFX_EGL_KEEP_DRIVER, scripts/test-sanitize.sh): vkDestroyInstance
+     * unloads lavapipe and the layer, after which LeakSanitizer cannot name their
+     * process-lifetime allocations for tests/lsan-gl.supp; pinning them keeps the names. */
+    if (getenv("VFX_EGL_KEEP_DRIVER")) {
+        dlopen("libvulkan_lvp.so", RTLD_NOW | RTLD_NODELETE);
+        dlopen("libVkLayer_khronos_validation.so", RTLD_NOW | RTLD_NODELETE);
+    }
     const char *env = getenv("VFX_VK_VALIDATION");
     bool validate = (!env || strcmp(env, "0") != 0) && has_layer("VK_LAYER_KHRONOS_validation");
     const char *layers[] = {"VK_LAYER_KHRONOS_validation"};
