@@ -27,10 +27,20 @@ extern "C" {
  * it through the loader's search path, as the game's --plugin does. */
 #define VFX_SONAME "libvolfx.so.1"
 
+/* VFX_EXPORT marks the entry point. The plugin's own build defines VFX_BUILDING_PLUGIN (its
+ * meson.build does): the symbol is exported (dllexport, default visibility). A host leaves it
+ * undefined: on Windows the declaration is dllimport (linking the DLL's import library), or
+ * nothing when it links the static plugin and defines VFX_STATIC; elsewhere it is nothing. */
+#if defined(VFX_BUILDING_PLUGIN)
 #if defined(_WIN32)
 #define VFX_EXPORT __declspec(dllexport)
 #else
 #define VFX_EXPORT __attribute__((visibility("default")))
+#endif
+#elif defined(_WIN32) && !defined(VFX_STATIC)
+#define VFX_EXPORT __declspec(dllimport)
+#else
+#define VFX_EXPORT
 #endif
 
 typedef enum vfx_result {
