@@ -22,6 +22,7 @@ typedef struct game_options {
     uint32_t effects_off;
     bool hide_water;           /* simulate the water but draw none (as key 1): the rest of the frame's cost */
     uint32_t mem_every;        /* print RSS and GL object counts every N frames (0 = never) */
+    double progress_s;         /* a progress line on stderr every this many seconds (0 = never) */
     const char *raw_effect, *raw_path;
     vfx_effect_kind raw_kind;
 } game_options;
@@ -31,8 +32,9 @@ static void usage(void)
     puts("usage: volfx-game [--headless|--window] [--frames N] [--seconds S] [--size WxH]\n"
          "                  [--png FILE] [--csv FILE] [--trace FILE] [--plugin libvolfx.so.1|PATH]\n"
          "                  [--scene FILE.json] [--no-water] [--hide-water] [--no-beams] [--no-volume] [--debug-gl]\n"
-         "                  [--mem-every N] [--dump-raw water|beams|volume FILE.pfm]\n"
+         "                  [--mem-every N] [--progress S] [--dump-raw water|beams|volume FILE.pfm]\n"
          "Without a display it runs headless (EGL) for 30 frames and writes volfx-game.png.\n"
+         "A run longer than S seconds (default 5; 0 = never) prints a progress line to stderr every S.\n"
          "Window keys: WASD/QE fly, mouse drag orbit, 1/2/3 toggle water/beams/volume,\n"
          "             Tab cycle water method (tile; paper at 16/32/54/64 samples), P pause, N single step, Esc quit.");
 }
@@ -47,6 +49,7 @@ static vfx_effect_kind effect_named(const char *s)
 static bool parse(int argc, char **argv, game_options *o)
 {
     memset(o, 0, sizeof *o);
+    o->progress_s = 5.0;
     char err[256];
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i];
@@ -68,6 +71,7 @@ static bool parse(int argc, char **argv, game_options *o)
         else if (!strcmp(a, "--no-beams")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_BEAMS);
         else if (!strcmp(a, "--no-volume")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_VOLUME);
         else if (!strcmp(a, "--debug-gl")) o->debug = true;
+        else if (!strcmp(a, "--progress")) { NEED_ARG(); CHECK(rt_arg_double(a, v, 0, 1e6, &o->progress_s, err, sizeof err)); }
         else if (!strcmp(a, "--mem-every")) { NEED_ARG(); CHECK(rt_arg_u32(a, v, 0, UINT32_MAX, &o->mem_every, err, sizeof err)); }
         else if (!strcmp(a, "--dump-raw")) {
             NEED_ARG();
@@ -91,6 +95,20 @@ static bool parse(int argc, char **argv, game_options *o)
         return false;
     }
     return true;
+}
+
+/* A long run says where it is: frame, elapsed time, the fps of the last 60 frames and, when the
+ * frame count is known, the time left at that rate. stderr, so stdout's report stays as it was. */
+static void print_progress(const game_app *app, uint32_t frames, double elapsed_ms)
+{
+    uint32_t done = (uint32_t)app->frame;
+    rt_frame_summary s = rt_profiler_summary(app->profiler, done > 60 ? done - 60 : 0);
+    if (frames != UINT32_MAX && s.mean_fps > 0)
+        fprintf(stderr, "volfx-game: frame %u of %u, %.1f s, %.2f fps (last %u frames), about %.0f s left\n", done,
+                frames, elapsed_ms / 1000.0, s.mean_fps, s.frames, (double)(frames - done) / s.mean_fps);
+    else
+        fprintf(stderr, "volfx-game: frame %u, %.1f s, %.2f fps (last %u frames)\n", done, elapsed_ms / 1000.0,
+                s.mean_fps, s.frames);
 }
 
 /* Orbit camera and toggles for the window mode. */
@@ -188,6 +206,7 @@ int main(int argc, char **argv)
     const float dt = 1.0f / 60.0f; /* fixed simulation step: runs are repeatable */
     bool paused = false, step = false;
     double start = rt_now_ms();
+    double next_progress = start + o.progress_s * 1000.0;
     int rc = 0;
     for (uint32_t f = 0; f < frames; ++f) {
         if (o.seconds > 0 && (rt_now_ms() - start) > o.seconds * 1000.0)
@@ -208,6 +227,10 @@ int main(int argc, char **argv)
             fprintf(stderr, "volfx-game: cannot dump '%s' to %s\n", o.raw_effect, o.raw_path);
             rc = 1;
             break;
+        }
+        if (o.progress_s > 0 && rt_now_ms() >= next_progress) {
+            print_progress(app, frames, rt_now_ms() - start);
+            next_progress = rt_now_ms() + o.progress_s * 1000.0;
         }
         if (o.mem_every && (f % o.mem_every) == 0) {
             rt_gl_object_counts c = rt_gl_count_objects(4096);

@@ -404,8 +404,14 @@ vfx_result rt_profiler_write_csv(const rt_profiler *p, const char *path)
     for (uint32_t fr = p->frame - kept; fr < p->frame; ++fr) {
         fprintf(f, "%u,%.4f", fr, p->frame_ms[fr % p->max_frames]);
         const double *r = row(p, fr);
-        for (uint32_t i = 0; i < p->series_count; ++i)
-            isnan(r[i]) ? fprintf(f, ",") : fprintf(f, ",%.4f", r[i]);
+        /* A frame's GPU times arrive gpu_lag frames later (the plugin's timestamp ring): they
+         * were recorded in row fr + gpu_lag and are written here, in their own frame's row. The
+         * last gpu_lag frames' timers had not arrived when the run ended: empty cells. */
+        const double *g = fr + p->gpu_lag < p->frame ? row(p, fr + p->gpu_lag) : NULL;
+        for (uint32_t i = 0; i < p->series_count; ++i) {
+            double v = p->series[i].kind == SERIES_GPU ? (g ? g[i] : NAN) : r[i];
+            isnan(v) ? fprintf(f, ",") : fprintf(f, ",%.4f", v);
+        }
         fprintf(f, "\n");
     }
     return fclose(f) == 0 ? VFX_OK : VFX_ERR_IO;

@@ -47,7 +47,8 @@ rt_frame_summary rt_profiler_summary(const rt_profiler *p, uint32_t skip);
 /* Median of a named series over kept frames (NAN when never recorded). */
 double rt_profiler_series_median(const rt_profiler *p, const char *name);
 /* Writes frame,frame_ms,<series...> one row per kept frame (CPU and GPU series in ms, the
- * counter series as counts). */
+ * counter series as counts). Each row holds its own frame's GPU times (recorded
+ * gpu.timer_lag_frames frames later); the last lag rows' GPU cells are empty. */
 vfx_result rt_profiler_write_csv(const rt_profiler *p, const char *path);
 /* Writes Chrome trace-event JSON for Perfetto/chrome://tracing: process and thread names, a
  * "frame N" slice per frame on the CPU thread (tid 1) with the CPU spans nested inside it at

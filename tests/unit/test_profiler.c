@@ -6,7 +6,10 @@
 #include <stdint.h>
 #include <cmocka.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
 
 #include "profile/profiler.h"
 
@@ -96,12 +99,57 @@ static void test_skip_capped(void **s)
     rt_profiler_destroy(p);
 }
 
+/* The CSV puts each frame's GPU times in that frame's row: the plugin reports frame f's pass
+ * times in frame f + lag's stats (gpu.timer_lag_frames = lag), so row r must hold what frame
+ * r + lag reported, and the last lag rows (timers not yet arrived) stay empty; CPU series stay in
+ * the row they were recorded in. */
+static void test_csv_gpu_rows(void **s)
+{
+    (void)s;
+    enum { FRAMES = 8, LAG = 3 };
+    rt_profiler *p = rt_profiler_create(64);
+    for (int f = 0; f < FRAMES; ++f) {
+        vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+        snprintf(st.entries[st.count].name, sizeof st.entries[0].name, "gpu.timer_lag_frames");
+        st.entries[st.count++].value = LAG;
+        if (f >= LAG) { /* the timers of frame f - LAG have arrived */
+            snprintf(st.entries[st.count].name, sizeof st.entries[0].name, "water.march.gpu_ms");
+            st.entries[st.count++].value = 100.0 + (f - LAG);
+        }
+        rt_profiler_cpu(p, "sim", (double)f);
+        rt_profiler_gpu_stats(p, &st);
+        rt_profiler_frame_add(p, 16.0);
+    }
+    char path[] = "/tmp/vfx_test_csv_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    assert_int_equal(rt_profiler_write_csv(p, path), VFX_OK);
+    FILE *f = fopen(path, "r");
+    char line[512];
+    assert_non_null(fgets(line, sizeof line, f));
+    assert_string_equal(line, "frame,frame_ms,sim,water.march.gpu_ms\n");
+    for (int r = 0; r < FRAMES; ++r) {
+        assert_non_null(fgets(line, sizeof line, f));
+        char want[128];
+        if (r + LAG < FRAMES)
+            snprintf(want, sizeof want, "%d,16.0000,%.4f,%.4f\n", r, (double)r, 100.0 + r);
+        else
+            snprintf(want, sizeof want, "%d,16.0000,%.4f,\n", r, (double)r);
+        assert_string_equal(line, want);
+    }
+    fclose(f);
+    unlink(path);
+    rt_profiler_destroy(p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_exact_in_ring),
         cmocka_unit_test(test_histogram_past_ring),
         cmocka_unit_test(test_skip_capped),
+        cmocka_unit_test(test_csv_gpu_rows),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
