@@ -29,19 +29,19 @@ static vfx_result parse_origin(pctx *c, const cJSON *root, rt_scene *s)
     const char *P = "origin";
     if (cJSON_IsString(o)) {
         if (strcmp(o->valuestring, "camera") != 0)
-            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, P, "expected [x, y, z] or \"camera\", got \"%s\"", o->valuestring);
+            return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, P, "expected [x, y, z] or \"camera\", got \"%s\"", o->valuestring);
         src = cJSON_IsObject(cam) ? cJSON_GetObjectItemCaseSensitive(cam, "eye") : NULL;
         P = "camera.eye";
         if (!src)
-            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "origin", "\"camera\" needs camera.eye");
+            return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "origin", "\"camera\" needs camera.eye");
     }
     if (!cJSON_IsArray(src) || cJSON_GetArraySize(src) != 3)
-        return scene_failf(c, VFX_ERR_FORMAT, P, "expected an array of 3 numbers, got %s", scene_type_name(src));
+        return rt_scene_failf(c, VFX_ERR_FORMAT, P, "expected an array of 3 numbers, got %s", rt_scene_type_name(src));
     int i = 0;
     for (const cJSON *e = src->child; e; e = e->next, ++i) {
         char pi[JPATH];
-        scene_join_index(pi, P, i);
-        vfx_result r = scene_number_value(c, e, pi, COORD, &c->origin[i]);
+        rt_scene_join_index(pi, P, i);
+        vfx_result r = rt_scene_number_value(c, e, pi, COORD, &c->origin[i]);
         if (r)
             return r;
         s->origin[i] = c->origin[i] = e->valuedouble; /* in double, unrounded */
@@ -53,28 +53,28 @@ static vfx_result parse_camera(pctx *c, const cJSON *v, rt_scene_camera *cam)
 {
     static const char *const keys[] = {"eye", "target", "up", "fov_y_deg", "width", "height", "near", "far", NULL};
     const char *P = "camera";
-    vfx_result r = scene_expect_object(c, v, P);
+    vfx_result r = rt_scene_expect_object(c, v, P);
     if (r)
         return r;
-    scene_check_keys(c, v, P, keys);
-    if (!r) r = scene_get_point(c, v, P, "eye", false, cam->eye);
-    if (!r) r = scene_get_point(c, v, P, "target", false, cam->target);
-    if (!r) r = scene_get_vec(c, v, P, "up", 3, false, COORD, cam->up);
-    if (!r) r = scene_get_float(c, v, P, "fov_y_deg", false, (range){0, 179, true}, &cam->fov_y_deg);
-    if (!r) r = scene_get_uint(c, v, P, "width", false, 1, 16384, &cam->width);
-    if (!r) r = scene_get_uint(c, v, P, "height", false, 1, 16384, &cam->height);
-    if (!r) r = scene_get_float(c, v, P, "near", false, POSITIVE, &cam->near_plane);
-    if (!r) r = scene_get_float(c, v, P, "far", false, POSITIVE, &cam->far_plane);
+    rt_scene_check_keys(c, v, P, keys);
+    if (!r) r = rt_scene_get_point(c, v, P, "eye", false, cam->eye);
+    if (!r) r = rt_scene_get_point(c, v, P, "target", false, cam->target);
+    if (!r) r = rt_scene_get_vec(c, v, P, "up", 3, false, COORD, cam->up);
+    if (!r) r = rt_scene_get_float(c, v, P, "fov_y_deg", false, (range){0, 179, true}, &cam->fov_y_deg);
+    if (!r) r = rt_scene_get_uint(c, v, P, "width", false, 1, 16384, &cam->width);
+    if (!r) r = rt_scene_get_uint(c, v, P, "height", false, 1, 16384, &cam->height);
+    if (!r) r = rt_scene_get_float(c, v, P, "near", false, POSITIVE, &cam->near_plane);
+    if (!r) r = rt_scene_get_float(c, v, P, "far", false, POSITIVE, &cam->far_plane);
     if (r)
         return r;
     if (!(cam->far_plane > cam->near_plane))
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "camera.far", "must be > near (%g), got %g",
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "camera.far", "must be > near (%g), got %g",
                      cam->near_plane, cam->far_plane);
     double f[3], fl = 0, ul = 0, cr[3], cl = 0;
     for (int k = 0; k < 3; ++k)
         f[k] = (double)cam->target[k] - cam->eye[k], fl += f[k] * f[k], ul += (double)cam->up[k] * cam->up[k];
     if (fl < 1e-18)
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "camera.target", "equals camera.eye: no view direction");
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "camera.target", "equals camera.eye: no view direction");
     cr[0] = f[1] * cam->up[2] - f[2] * cam->up[1];
     cr[1] = f[2] * cam->up[0] - f[0] * cam->up[2];
     cr[2] = f[0] * cam->up[1] - f[1] * cam->up[0];
@@ -82,26 +82,26 @@ static vfx_result parse_camera(pctx *c, const cJSON *v, rt_scene_camera *cam)
         cl += cr[k] * cr[k];
     /* sin^2 of the angle between up and the view direction below 1e-10: no usable right vector */
     if (ul < 1e-18 || cl < 1e-10 * fl * ul)
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "camera.up", "zero or parallel to the view direction");
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "camera.up", "zero or parallel to the view direction");
     return VFX_OK;
 }
 
 /* The prologue every array of objects shares: `v` must be an array of at most `cap` items;
  * *out gets calloc'd room for them (NULL when empty). */
-vfx_result scene_alloc_array(pctx *c, const cJSON *v, const char *name, int cap, size_t elem,
+vfx_result rt_scene_alloc_array(pctx *c, const cJSON *v, const char *name, int cap, size_t elem,
                               void **out, int *count)
 {
     *out = NULL;
     *count = 0;
     if (!cJSON_IsArray(v))
-        return scene_failf(c, VFX_ERR_FORMAT, name, "expected an array, got %s", scene_type_name(v));
+        return rt_scene_failf(c, VFX_ERR_FORMAT, name, "expected an array, got %s", rt_scene_type_name(v));
     int n = cJSON_GetArraySize(v);
     if (n > cap)
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, name, "%d %s, above the cap of %d", n, name, cap);
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, name, "%d %s, above the cap of %d", n, name, cap);
     if (n == 0)
         return VFX_OK;
     if (!(*out = calloc((size_t)n, elem)))
-        return scene_failf(c, VFX_ERR_OUT_OF_MEMORY, name, "out of memory");
+        return rt_scene_failf(c, VFX_ERR_OUT_OF_MEMORY, name, "out of memory");
     *count = n;
     return VFX_OK;
 }
@@ -110,44 +110,44 @@ static vfx_result parse_meshes(pctx *c, const cJSON *v, rt_scene *s)
 {
     static const char *const keys[] = {"path", "box", "translate", "rotate_deg", "scale", "matrix", "color", NULL};
     int n;
-    vfx_result ra = scene_alloc_array(c, v, "meshes", RT_SCENE_MAX_MESHES, sizeof *s->meshes, (void **)&s->meshes, &n);
+    vfx_result ra = rt_scene_alloc_array(c, v, "meshes", RT_SCENE_MAX_MESHES, sizeof *s->meshes, (void **)&s->meshes, &n);
     if (ra || n == 0)
         return ra;
     int i = 0;
     for (const cJSON *m = v->child; m; m = m->next, ++i) {
         char P[JPATH];
-        scene_join_index(P, "meshes", i);
+        rt_scene_join_index(P, "meshes", i);
         rt_scene_mesh *o = &s->meshes[i];
-        vfx_result r = scene_expect_object(c, m, P);
+        vfx_result r = rt_scene_expect_object(c, m, P);
         if (r)
             return r;
-        scene_check_keys(c, m, P, keys);
+        rt_scene_check_keys(c, m, P, keys);
         const cJSON *path = cJSON_GetObjectItemCaseSensitive(m, "path"), *box = cJSON_GetObjectItemCaseSensitive(m, "box");
         if (!path == !box)
-            return scene_failf(c, VFX_ERR_FORMAT, P, "needs exactly one of \"path\" (a mesh file) or \"box\"");
+            return rt_scene_failf(c, VFX_ERR_FORMAT, P, "needs exactly one of \"path\" (a mesh file) or \"box\"");
         if (path) {
-            r = scene_get_path(c, m, P, "path", true, o->path);
+            r = rt_scene_get_path(c, m, P, "path", true, o->path);
         } else {
             char PB[JPATH];
-            scene_join(PB, P, "box");
+            rt_scene_join(PB, P, "box");
             static const char *const bkeys[] = {"min", "max", NULL};
-            if ((r = scene_expect_object(c, box, PB)))
+            if ((r = rt_scene_expect_object(c, box, PB)))
                 return r;
-            scene_check_keys(c, box, PB, bkeys);
+            rt_scene_check_keys(c, box, PB, bkeys);
             o->is_box = true;
-            r = scene_get_vec(c, box, PB, "min", 3, true, COORD, o->box_min); /* model space */
-            if (!r) r = scene_get_vec(c, box, PB, "max", 3, true, COORD, o->box_max);
+            r = rt_scene_get_vec(c, box, PB, "min", 3, true, COORD, o->box_min); /* model space */
+            if (!r) r = rt_scene_get_vec(c, box, PB, "max", 3, true, COORD, o->box_max);
             for (int k = 0; k < 3 && !r; ++k)
                 if (!(o->box_max[k] > o->box_min[k])) {
                     char PM[JPATH];
-                    scene_join(PM, PB, "max");
-                    r = scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PM, "must exceed min on every axis (axis %d: %g <= %g)",
+                    rt_scene_join(PM, PB, "max");
+                    r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PM, "must exceed min on every axis (axis %d: %g <= %g)",
                               k, o->box_max[k], o->box_min[k]);
                 }
         }
         o->color[0] = o->color[1] = o->color[2] = 0.7f;
-        if (!r) r = scene_get_vec(c, m, P, "color", 3, false, UNIT, o->color);
-        if (!r) r = scene_parse_transform(c, m, P, o->model);
+        if (!r) r = rt_scene_get_vec(c, m, P, "color", 3, false, UNIT, o->color);
+        if (!r) r = rt_scene_parse_transform(c, m, P, o->model);
         if (r)
             return r;
         s->mesh_count = (uint32_t)i + 1;
@@ -160,42 +160,42 @@ static vfx_result parse_environment(pctx *c, const cJSON *v, rt_scene_environmen
 {
     static const char *const keys[] = {"sky", "sun_dir", "fog", NULL};
     static const char *const skies[] = {"none", "dusk", NULL};
-    vfx_result r = scene_expect_object(c, v, "environment");
+    vfx_result r = rt_scene_expect_object(c, v, "environment");
     if (r)
         return r;
-    scene_check_keys(c, v, "environment", keys);
+    rt_scene_check_keys(c, v, "environment", keys);
     uint32_t sky = 1;
     env->sun_dir[0] = -0.45f, env->sun_dir[1] = 0.35f, env->sun_dir[2] = -0.82f;
-    if ((r = scene_get_enum(c, v, "environment", "sky", false, skies, &sky)))
+    if ((r = rt_scene_get_enum(c, v, "environment", "sky", false, skies, &sky)))
         return r;
     env->sky = sky == 1;
-    if ((r = scene_get_vec(c, v, "environment", "sun_dir", 3, false, COORD, env->sun_dir)))
+    if ((r = rt_scene_get_vec(c, v, "environment", "sun_dir", 3, false, COORD, env->sun_dir)))
         return r;
     if (!(fabsf(env->sun_dir[0]) + fabsf(env->sun_dir[1]) + fabsf(env->sun_dir[2]) > 1e-6f))
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "environment.sun_dir", "must not be the zero vector");
-    return scene_get_float(c, v, "environment", "fog", false, (range){0, 10, false}, &env->fog);
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "environment.sun_dir", "must not be the zero vector");
+    return rt_scene_get_float(c, v, "environment", "fog", false, (range){0, 10, false}, &env->fog);
 }
 
 static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
 {
     static const char *const keys[] = {"version", "origin", "name", "description", "camera", "meshes", "beams",
                                        "beam_settings", "water", "volume", "environment", NULL};
-    vfx_result r = scene_expect_object(c, root, "");
+    vfx_result r = rt_scene_expect_object(c, root, "");
     if (r)
         return r;
-    scene_check_keys(c, root, "", keys);
+    rt_scene_check_keys(c, root, "", keys);
     const cJSON *ver = cJSON_GetObjectItemCaseSensitive(root, "version");
     if (ver) {
         uint32_t version = 0;
-        if ((r = scene_get_uint(c, root, "", "version", false, 0, 1e9, &version)))
+        if ((r = rt_scene_get_uint(c, root, "", "version", false, 0, 1e9, &version)))
             return r;
         if (version != RT_SCENE_FORMAT_VERSION)
-            return scene_failf(c, VFX_ERR_UNSUPPORTED, "version", "scene format version %u is not supported (this build reads %d)",
+            return rt_scene_failf(c, VFX_ERR_UNSUPPORTED, "version", "scene format version %u is not supported (this build reads %d)",
                          version, RT_SCENE_FORMAT_VERSION);
     }
     char desc[512];
-    r = scene_get_string(c, root, "", "name", false, s->name, sizeof s->name);
-    if (!r) r = scene_get_string(c, root, "", "description", false, desc, sizeof desc);
+    r = rt_scene_get_string(c, root, "", "name", false, s->name, sizeof s->name);
+    if (!r) r = rt_scene_get_string(c, root, "", "description", false, desc, sizeof desc);
     if (r)
         return r;
     if ((r = parse_origin(c, root, s)))
@@ -209,13 +209,13 @@ static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
         return r;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "meshes")) && (r = parse_meshes(c, v, s)))
         return r;
-    if ((v = cJSON_GetObjectItemCaseSensitive(root, "beams")) && (r = scene_parse_beams(c, v, s)))
+    if ((v = cJSON_GetObjectItemCaseSensitive(root, "beams")) && (r = rt_scene_parse_beams(c, v, s)))
         return r;
-    if ((v = cJSON_GetObjectItemCaseSensitive(root, "beam_settings")) && (r = scene_parse_beam_settings(c, v, &s->beams_view, &s->beams_view2)))
+    if ((v = cJSON_GetObjectItemCaseSensitive(root, "beam_settings")) && (r = rt_scene_parse_beam_settings(c, v, &s->beams_view, &s->beams_view2)))
         return r;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "water"))) {
         s->has_water = true;
-        if ((r = scene_parse_water(c, v, &s->water)))
+        if ((r = rt_scene_parse_water(c, v, &s->water)))
             return r;
         memcpy(s->water.scene_origin, s->origin, sizeof s->origin);
     }
@@ -223,7 +223,7 @@ static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
         return r;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "volume"))) {
         s->has_volume = true;
-        if ((r = scene_parse_volume(c, v, &s->volume)))
+        if ((r = rt_scene_parse_volume(c, v, &s->volume)))
             return r;
     }
     return VFX_OK;
@@ -266,16 +266,16 @@ vfx_result rt_scene_load_mem(const char *json, size_t len, const char *base_dir,
     if (err && errlen)
         err[0] = 0;
     if (!out || (!json && len))
-        return scene_failf(&c, VFX_ERR_INVALID_ARGUMENT, "scene", "NULL argument");
+        return rt_scene_failf(&c, VFX_ERR_INVALID_ARGUMENT, "scene", "NULL argument");
     *out = NULL;
     if (len > RT_SCENE_MAX_BYTES)
-        return scene_failf(&c, VFX_ERR_INVALID_ARGUMENT, "scene", "%zu bytes, above the cap of %u", len, RT_SCENE_MAX_BYTES);
+        return rt_scene_failf(&c, VFX_ERR_INVALID_ARGUMENT, "scene", "%zu bytes, above the cap of %u", len, RT_SCENE_MAX_BYTES);
     if (base_dir && strlen(base_dir) >= RT_SCENE_PATH_MAX)
-        return scene_failf(&c, VFX_ERR_INVALID_ARGUMENT, "scene", "base directory longer than %d bytes", RT_SCENE_PATH_MAX - 1);
+        return rt_scene_failf(&c, VFX_ERR_INVALID_ARGUMENT, "scene", "base directory longer than %d bytes", RT_SCENE_PATH_MAX - 1);
     /* a private NUL-terminated copy: cJSON then never depends on the caller's termination */
     char *text = malloc(len + 1);
     if (!text)
-        return scene_failf(&c, VFX_ERR_OUT_OF_MEMORY, "scene", "out of memory");
+        return rt_scene_failf(&c, VFX_ERR_OUT_OF_MEMORY, "scene", "out of memory");
     if (len)
         memcpy(text, json, len);
     text[len] = 0;
@@ -286,7 +286,7 @@ vfx_result rt_scene_load_mem(const char *json, size_t len, const char *base_dir,
         size_t at = (size_t)(nul - text);
         line_col(text, at, &line, &col);
         free(text);
-        return scene_failf(&c, VFX_ERR_FORMAT, "scene", "NUL byte at line %u, column %u (byte %zu): not JSON text",
+        return rt_scene_failf(&c, VFX_ERR_FORMAT, "scene", "NUL byte at line %u, column %u (byte %zu): not JSON text",
                            line, col, at);
     }
     const char *end = NULL;
@@ -297,7 +297,7 @@ vfx_result rt_scene_load_mem(const char *json, size_t len, const char *base_dir,
             off = strlen(text) < off ? strlen(text) : off;
         unsigned line, col;
         line_col(text, off, &line, &col);
-        vfx_result r = scene_failf(&c, VFX_ERR_FORMAT, "scene", "JSON syntax error at line %u, column %u (byte %zu)%s",
+        vfx_result r = rt_scene_failf(&c, VFX_ERR_FORMAT, "scene", "JSON syntax error at line %u, column %u (byte %zu)%s",
                              line, col, off, off >= len ? ": unexpected end of input" : "");
         free(text);
         return r;
@@ -312,13 +312,13 @@ vfx_result rt_scene_load_mem(const char *json, size_t len, const char *base_dir,
         line_col(text, off, &line, &col);
         cJSON_Delete(root);
         free(text);
-        return scene_failf(&c, VFX_ERR_FORMAT, "scene", "JSON syntax error at line %u, column %u (byte %zu): text after the scene object",
+        return rt_scene_failf(&c, VFX_ERR_FORMAT, "scene", "JSON syntax error at line %u, column %u (byte %zu): text after the scene object",
                      line, col, off);
     }
     rt_scene *s = calloc(1, sizeof *s);
     vfx_result r = VFX_OK;
     if (!s) {
-        r = scene_failf(&c, VFX_ERR_OUT_OF_MEMORY, "scene", "out of memory");
+        r = rt_scene_failf(&c, VFX_ERR_OUT_OF_MEMORY, "scene", "out of memory");
     } else {
         if (base_dir)
             snprintf(s->base_dir, sizeof s->base_dir, "%s", base_dir);

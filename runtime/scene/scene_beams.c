@@ -43,7 +43,7 @@ static float *beam_param_ptr(vfx_beam *b, vfx_beam2 *look, int k)
     }
 }
 
-bool scene_is_zero3(const float *v)
+bool rt_scene_is_zero3(const float *v)
 {
     return (double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2] < 1e-24;
 }
@@ -53,14 +53,14 @@ static vfx_result joints_value(pctx *c, const cJSON *v, const char *P, uint32_t 
 {
     int n = cJSON_IsArray(v) ? cJSON_GetArraySize(v) : -1;
     if (n < 2 || n > RT_SCENE_MAX_JOINTS)
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, P, "expected an array of 2 to %d [x, y, z] joints", RT_SCENE_MAX_JOINTS);
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, P, "expected an array of 2 to %d [x, y, z] joints", RT_SCENE_MAX_JOINTS);
     if (*count && (uint32_t)n != *count)
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, P, "%d joints; every key of a beam has the same count (%u)", n, *count);
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, P, "%d joints; every key of a beam has the same count (%u)", n, *count);
     int i = 0;
     for (const cJSON *e = v->child; e; e = e->next, ++i) {
         char PI[JPATH];
-        scene_join_index(PI, P, i);
-        vfx_result r = scene_vec_value(c, e, PI, 3, COORD, dst + 3 * i);
+        rt_scene_join_index(PI, P, i);
+        vfx_result r = rt_scene_vec_value(c, e, PI, 3, COORD, dst + 3 * i);
         if (r)
             return r;
     }
@@ -73,51 +73,51 @@ static vfx_result parse_track(pctx *c, const cJSON *v, const char *P, int k, uin
 {
     static const char *const keys[] = {"t", "value", NULL};
     if (!cJSON_IsArray(v))
-        return scene_failf(c, VFX_ERR_FORMAT, P, "expected an array of {\"t\", \"value\"} keyframes, got %s", scene_type_name(v));
+        return rt_scene_failf(c, VFX_ERR_FORMAT, P, "expected an array of {\"t\", \"value\"} keyframes, got %s", rt_scene_type_name(v));
     int n = cJSON_GetArraySize(v);
     if (n < 1 || n > RT_SCENE_MAX_KEYS)
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, P, "%d keyframes; must be 1 to %d", n, RT_SCENE_MAX_KEYS);
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, P, "%d keyframes; must be 1 to %d", n, RT_SCENE_MAX_KEYS);
     int dim = k < RT_BEAM_PARAM_COUNT ? beam_param_dim[k] : 3 * RT_SCENE_MAX_JOINTS;
     tr->dim = (uint32_t)dim;
     tr->times = malloc((size_t)n * sizeof(float));
     tr->values = malloc((size_t)n * (size_t)dim * sizeof(float));
     if (!tr->times || !tr->values)
-        return scene_failf(c, VFX_ERR_OUT_OF_MEMORY, P, "out of memory");
+        return rt_scene_failf(c, VFX_ERR_OUT_OF_MEMORY, P, "out of memory");
     int i = 0;
     for (const cJSON *e = v->child; e; e = e->next, ++i) {
         char PI[JPATH], PV[JPATH];
-        scene_join_index(PI, P, i);
-        vfx_result r = scene_expect_object(c, e, PI);
+        rt_scene_join_index(PI, P, i);
+        vfx_result r = rt_scene_expect_object(c, e, PI);
         if (r)
             return r;
-        scene_check_keys(c, e, PI, keys);
-        if ((r = scene_get_float(c, e, PI, "t", true, COORD, &tr->times[i])))
+        rt_scene_check_keys(c, e, PI, keys);
+        if ((r = rt_scene_get_float(c, e, PI, "t", true, COORD, &tr->times[i])))
             return r;
         if (i > 0 && !(tr->times[i] > tr->times[i - 1])) {
             char PT[JPATH];
-            scene_join(PT, PI, "t");
-            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PT, "keyframe times must increase strictly (%g after %g)",
+            rt_scene_join(PT, PI, "t");
+            return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PT, "keyframe times must increase strictly (%g after %g)",
                          tr->times[i], tr->times[i - 1]);
         }
-        scene_join(PV, PI, "value");
+        rt_scene_join(PV, PI, "value");
         const cJSON *val = cJSON_GetObjectItemCaseSensitive(e, "value");
         float *dst = &tr->values[(size_t)i * (size_t)dim];
         if (!val)
-            return scene_failf(c, VFX_ERR_FORMAT, PV, "required value missing");
+            return rt_scene_failf(c, VFX_ERR_FORMAT, PV, "required value missing");
         if (k == RT_BEAM_PARAM_COUNT) {
             if ((r = joints_value(c, val, PV, joints, dst)))
                 return r;
         } else if (dim == 1) {
             double d;
-            if ((r = scene_number_value(c, val, PV, beam_param_range(k), &d)))
+            if ((r = rt_scene_number_value(c, val, PV, beam_param_range(k), &d)))
                 return r;
             dst[0] = (float)d;
-        } else if ((r = k == RT_BEAM_PARAM_HEAD ? scene_point_value(c, val, PV, dim, dst) /* a position */
-                                                : scene_vec_value(c, val, PV, dim, beam_param_range(k), dst))) {
+        } else if ((r = k == RT_BEAM_PARAM_HEAD ? rt_scene_point_value(c, val, PV, dim, dst) /* a position */
+                                                : rt_scene_vec_value(c, val, PV, dim, beam_param_range(k), dst))) {
             return r;
         }
-        if (k == RT_BEAM_PARAM_DIR && scene_is_zero3(dst))
-            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PV, "direction must not be the zero vector");
+        if (k == RT_BEAM_PARAM_DIR && rt_scene_is_zero3(dst))
+            return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PV, "direction must not be the zero vector");
         tr->count = (uint32_t)i + 1;
     }
     if (k == RT_BEAM_PARAM_COUNT) { /* pack the keys to the beam's joint count */
@@ -137,14 +137,14 @@ static vfx_result parse_joints(pctx *c, const cJSON *e, const cJSON *kf, const c
     vfx_result r = VFX_OK;
     if (v) {
         char PJ[JPATH];
-        scene_join(PJ, P, "joints");
+        rt_scene_join(PJ, P, "joints");
         if ((r = joints_value(c, v, PJ, &o->joint_count, &o->joints[0][0])))
             return r;
     }
     if (track) {
         char PK[JPATH], PT[JPATH];
-        scene_join(PK, P, "keyframes");
-        scene_join(PT, PK, "joints");
+        rt_scene_join(PK, P, "keyframes");
+        rt_scene_join(PT, PK, "joints");
         if ((r = parse_track(c, track, PT, RT_BEAM_PARAM_COUNT, &o->joint_count, &o->joint_track)))
             return r;
         if (!v)
@@ -160,9 +160,9 @@ static vfx_result parse_look(pctx *c, const cJSON *e, const char *P, vfx_beam2 *
     static const char *const ramps[] = {"hot", "thesis", NULL};
     static const char *const flow_keys[] = {"amount", "speed", "scale", NULL};
     uint32_t f = 0, rp = 0;
-    vfx_result r = scene_get_enum(c, e, P, "falloff", false, falloffs, &f);
+    vfx_result r = rt_scene_get_enum(c, e, P, "falloff", false, falloffs, &f);
     if (!r)
-        r = scene_get_enum(c, e, P, "ramp", false, ramps, &rp);
+        r = rt_scene_get_enum(c, e, P, "ramp", false, ramps, &rp);
     if (r)
         return r;
     look->falloff = f == 1 ? VFX_BEAM_FALLOFF_HARD : VFX_BEAM_FALLOFF_SMOOTH;
@@ -171,46 +171,46 @@ static vfx_result parse_look(pctx *c, const cJSON *e, const char *P, vfx_beam2 *
     if (!flow)
         return VFX_OK;
     char PF[JPATH];
-    scene_join(PF, P, "flow");
-    if ((r = scene_expect_object(c, flow, PF)))
+    rt_scene_join(PF, P, "flow");
+    if ((r = rt_scene_expect_object(c, flow, PF)))
         return r;
-    scene_check_keys(c, flow, PF, flow_keys);
+    rt_scene_check_keys(c, flow, PF, flow_keys);
     look->flow_amount = 0.5f;
-    if (!r) r = scene_get_float(c, flow, PF, "amount", false, (range){0, 1, false}, &look->flow_amount);
-    if (!r) r = scene_get_float(c, flow, PF, "speed", false, COORD, &look->flow_speed);
-    if (!r) r = scene_get_float(c, flow, PF, "scale", false, NONNEG, &look->flow_scale);
+    if (!r) r = rt_scene_get_float(c, flow, PF, "amount", false, (range){0, 1, false}, &look->flow_amount);
+    if (!r) r = rt_scene_get_float(c, flow, PF, "speed", false, COORD, &look->flow_speed);
+    if (!r) r = rt_scene_get_float(c, flow, PF, "scale", false, NONNEG, &look->flow_scale);
     return r;
 }
 
-vfx_result scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
+vfx_result rt_scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
 {
     static const char *const keys[] = {"head", "dir", "length", "radius", "a", "b", "eps", "color",
                                        "intensity", "exposure", "falloff", "ramp", "flow", "joints",
                                        "keyframes", "loop_s", NULL};
     int n;
-    vfx_result ra = scene_alloc_array(c, v, "beams", RT_SCENE_MAX_BEAMS, sizeof *s->beams, (void **)&s->beams, &n);
+    vfx_result ra = rt_scene_alloc_array(c, v, "beams", RT_SCENE_MAX_BEAMS, sizeof *s->beams, (void **)&s->beams, &n);
     if (ra || n == 0)
         return ra;
     int i = 0;
     for (const cJSON *e = v->child; e; e = e->next, ++i) {
         char P[JPATH];
-        scene_join_index(P, "beams", i);
+        rt_scene_join_index(P, "beams", i);
         rt_scene_beam *o = &s->beams[i];
         s->beam_count = (uint32_t)i + 1; /* so that free() sees tracks of a half-parsed beam */
         vfx_beam *b = &o->base;
         *b = (vfx_beam){.length = 1.0f, .radius = 0.5f, .a = 0.05f, .b = 0.03f, .eps = 0.02f, .color = {1, 1, 1, 1}};
         o->look = (vfx_beam2){.falloff = VFX_BEAM_FALLOFF_SMOOTH, .ramp = VFX_BEAM_RAMP_HOT, .intensity = 1.0f};
-        vfx_result r = scene_expect_object(c, e, P);
+        vfx_result r = rt_scene_expect_object(c, e, P);
         if (r)
             return r;
-        scene_check_keys(c, e, P, keys);
+        rt_scene_check_keys(c, e, P, keys);
         const cJSON *kf = cJSON_GetObjectItemCaseSensitive(e, "keyframes");
         if (kf) {
             char PK[JPATH];
-            scene_join(PK, P, "keyframes");
-            if ((r = scene_expect_object(c, kf, PK)))
+            rt_scene_join(PK, P, "keyframes");
+            if ((r = rt_scene_expect_object(c, kf, PK)))
                 return r;
-            scene_check_keys(c, kf, PK, beam_keyframe_names);
+            rt_scene_check_keys(c, kf, PK, beam_keyframe_names);
         }
         if ((r = parse_joints(c, e, kf, P, o)))
             return r;
@@ -222,17 +222,17 @@ vfx_result scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
             bool required = (k == RT_BEAM_PARAM_HEAD || k == RT_BEAM_PARAM_DIR) && !track && !o->joint_count;
             float *dst = beam_param_ptr(b, &o->look, k);
             if (beam_param_dim[k] == 1)
-                r = scene_get_float(c, e, P, name, required, beam_param_range(k), dst);
+                r = rt_scene_get_float(c, e, P, name, required, beam_param_range(k), dst);
             else if (k == RT_BEAM_PARAM_HEAD)
-                r = scene_get_point(c, e, P, name, required, dst);
+                r = rt_scene_get_point(c, e, P, name, required, dst);
             else
-                r = scene_get_vec(c, e, P, name, beam_param_dim[k], required, beam_param_range(k), dst);
+                r = rt_scene_get_vec(c, e, P, name, beam_param_dim[k], required, beam_param_range(k), dst);
             if (r)
                 return r;
             if (track) {
                 char PT[JPATH], PK[JPATH];
-                scene_join(PK, P, "keyframes");
-                scene_join(PT, PK, name);
+                rt_scene_join(PK, P, "keyframes");
+                rt_scene_join(PT, PK, name);
                 if ((r = parse_track(c, track, PT, k, NULL, &o->tracks[k])))
                     return r;
                 if (!cJSON_GetObjectItemCaseSensitive(e, name))
@@ -245,43 +245,43 @@ vfx_result scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
                 b->dir[k] = o->joints[1][k] - o->joints[0][k];
             }
             b->length = sqrtf(b->dir[0] * b->dir[0] + b->dir[1] * b->dir[1] + b->dir[2] * b->dir[2]);
-            if (scene_is_zero3(b->dir))
+            if (rt_scene_is_zero3(b->dir))
                 b->dir[0] = 1.f;
         }
-        if (scene_is_zero3(b->dir)) {
+        if (rt_scene_is_zero3(b->dir)) {
             char PD[JPATH];
-            scene_join(PD, P, "dir");
-            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PD, "direction must not be the zero vector");
+            rt_scene_join(PD, P, "dir");
+            return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PD, "direction must not be the zero vector");
         }
-        if ((r = scene_get_float(c, e, P, "loop_s", false, NONNEG, &o->loop_s)) || (r = parse_look(c, e, P, &o->look)))
+        if ((r = rt_scene_get_float(c, e, P, "loop_s", false, NONNEG, &o->loop_s)) || (r = parse_look(c, e, P, &o->look)))
             return r;
     }
     return VFX_OK;
 }
 
-vfx_result scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv, vfx_beams_view2 *bv2)
+vfx_result rt_scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv, vfx_beams_view2 *bv2)
 {
     static const char *const keys[] = {"saturation", "c", "far_distance", "method", "march_samples",
                                        "bloom", "bloom_strength", "bloom_levels", NULL};
     static const char *const sat[] = {"clamp", "smooth", NULL};
     static const char *const meth[] = {"closed_form", "march", NULL};
     const char *P = "beam_settings";
-    vfx_result r = scene_expect_object(c, v, P);
+    vfx_result r = rt_scene_expect_object(c, v, P);
     if (r)
         return r;
-    scene_check_keys(c, v, P, keys);
-    r = scene_get_enum(c, v, P, "saturation", false, sat, &bv->saturation);
-    if (!r) r = scene_get_float(c, v, P, "c", false, POSITIVE, &bv->saturate_c);
-    if (!r) r = scene_get_float(c, v, P, "far_distance", false, NONNEG, &bv->far_distance);
-    if (!r) r = scene_get_enum(c, v, P, "method", false, meth, &bv->method);
-    if (!r) r = scene_get_uint(c, v, P, "march_samples", false, 1, 4096, &bv->march_samples);
+    rt_scene_check_keys(c, v, P, keys);
+    r = rt_scene_get_enum(c, v, P, "saturation", false, sat, &bv->saturation);
+    if (!r) r = rt_scene_get_float(c, v, P, "c", false, POSITIVE, &bv->saturate_c);
+    if (!r) r = rt_scene_get_float(c, v, P, "far_distance", false, NONNEG, &bv->far_distance);
+    if (!r) r = rt_scene_get_enum(c, v, P, "method", false, meth, &bv->method);
+    if (!r) r = rt_scene_get_uint(c, v, P, "march_samples", false, 1, 4096, &bv->march_samples);
     bool bloom = true;
     if (!r && cJSON_GetObjectItemCaseSensitive(v, "bloom")) {
-        r = scene_get_bool(c, v, P, "bloom", &bloom);
+        r = rt_scene_get_bool(c, v, P, "bloom", &bloom);
         bv2->bloom = bloom ? VFX_BEAMS_BLOOM_ON : VFX_BEAMS_BLOOM_OFF;
     }
-    if (!r) r = scene_get_float(c, v, P, "bloom_strength", false, NONNEG, &bv2->bloom_strength);
-    if (!r) r = scene_get_uint(c, v, P, "bloom_levels", false, 1, 8, &bv2->bloom_levels);
+    if (!r) r = rt_scene_get_float(c, v, P, "bloom_strength", false, NONNEG, &bv2->bloom_strength);
+    if (!r) r = rt_scene_get_uint(c, v, P, "bloom_levels", false, 1, 8, &bv2->bloom_levels);
     return r;
 }
 
@@ -346,7 +346,7 @@ static void beam_at(const rt_scene_beam *b, double time, vfx_beam2 *out)
         float *dst = beam_param_ptr(&out->v1, out, k);
         rt_scene_track_eval(tr, t, dst);
         /* opposite direction keys pass through zero: hold the earlier key's direction */
-        if (k == RT_BEAM_PARAM_DIR && scene_is_zero3(dst))
+        if (k == RT_BEAM_PARAM_DIR && rt_scene_is_zero3(dst))
             memcpy(dst, &tr->values[(size_t)key_before(tr, t) * 3], 3 * sizeof(float));
     }
 }

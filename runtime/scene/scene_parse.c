@@ -12,7 +12,7 @@
 #include <string.h>
 
 #include "core/file.h"
-vfx_result scene_failf(pctx *c, vfx_result r, const char *path, const char *fmt, ...)
+vfx_result rt_scene_failf(pctx *c, vfx_result r, const char *path, const char *fmt, ...)
 {
     if (c->err && c->errlen) {
         char msg[512];
@@ -26,20 +26,20 @@ vfx_result scene_failf(pctx *c, vfx_result r, const char *path, const char *fmt,
 }
 
 /* JSON paths longer than JPATH are cut: the message stays readable, the check unaffected. */
-void scene_join(char *out, const char *parent, const char *key)
+void rt_scene_join(char *out, const char *parent, const char *key)
 {
     int n = parent && *parent ? snprintf(out, JPATH, "%s.%s", parent, key) : snprintf(out, JPATH, "%s", key);
     if (n < 0)
         out[0] = 0;
 }
 
-void scene_join_index(char *out, const char *parent, int i)
+void rt_scene_join_index(char *out, const char *parent, int i)
 {
     if (snprintf(out, JPATH, "%s[%d]", parent, i) < 0)
         out[0] = 0;
 }
 
-const char *scene_type_name(const cJSON *v)
+const char *rt_scene_type_name(const cJSON *v)
 {
     if (!v) return "nothing";
     if (cJSON_IsNumber(v)) return "a number";
@@ -53,7 +53,7 @@ const char *scene_type_name(const cJSON *v)
 
 /* Unknown keys are warnings (a typo should be visible, a newer file should still load);
  * a duplicated key is a warning too because cJSON would silently take the first. */
-void scene_check_keys(pctx *c, const cJSON *obj, const char *path, const char *const *allowed)
+void rt_scene_check_keys(pctx *c, const cJSON *obj, const char *path, const char *const *allowed)
 {
     int index = 0;
     for (const cJSON *it = obj->child; it; it = it->next, ++index) {
@@ -63,7 +63,7 @@ void scene_check_keys(pctx *c, const cJSON *obj, const char *path, const char *c
             if (strcmp(*a, k) == 0)
                 known = true;
         char p[JPATH];
-        scene_join(p, path, k);
+        rt_scene_join(p, path, k);
         if (!known)
             rt_logf(c->log, VFX_LOG_WARN, "%s: unknown key ignored", p);
         /* duplicates: quadratic, but only for the first 64 keys of an object */
@@ -76,23 +76,23 @@ void scene_check_keys(pctx *c, const cJSON *obj, const char *path, const char *c
     }
 }
 
-vfx_result scene_expect_object(pctx *c, const cJSON *v, const char *path)
+vfx_result rt_scene_expect_object(pctx *c, const cJSON *v, const char *path)
 {
     if (!cJSON_IsObject(v))
-        return scene_failf(c, VFX_ERR_FORMAT, path, "expected an object, got %s", scene_type_name(v));
+        return rt_scene_failf(c, VFX_ERR_FORMAT, path, "expected an object, got %s", rt_scene_type_name(v));
     return VFX_OK;
 }
 
 
-vfx_result scene_check_range(pctx *c, const char *path, double v, range rg)
+vfx_result rt_scene_check_range(pctx *c, const char *path, double v, range rg)
 {
     if (!isfinite(v))
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be finite, got %.9g", v);
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be finite, got %.9g", v);
     if (rg.lo_open ? !(v > rg.lo) : !(v >= rg.lo))
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be %s %.9g, got %.9g", rg.lo_open ? ">" : ">=",
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be %s %.9g, got %.9g", rg.lo_open ? ">" : ">=",
                      rg.lo, v);
     if (v > rg.hi)
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be <= %.9g, got %.9g", rg.hi, v);
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be <= %.9g, got %.9g", rg.hi, v);
     return VFX_OK;
 }
 
@@ -100,78 +100,78 @@ vfx_result scene_check_range(pctx *c, const char *path, double v, range rg)
  * on the double JSON gave: 1e-320 is > 0 as a double and 0 as a float, 1e39 is finite as a
  * double and Inf as a float. A float32 subnormal is refused too: it keeps almost no digits and
  * its reciprocal or cube is Inf or 0 in the float code that uses it. */
-vfx_result scene_number_value(pctx *c, const cJSON *v, const char *path, range rg, double *out)
+vfx_result rt_scene_number_value(pctx *c, const cJSON *v, const char *path, range rg, double *out)
 {
     if (!cJSON_IsNumber(v))
-        return scene_failf(c, VFX_ERR_FORMAT, path, "expected a number, got %s", scene_type_name(v));
+        return rt_scene_failf(c, VFX_ERR_FORMAT, path, "expected a number, got %s", rt_scene_type_name(v));
     double d = v->valuedouble;
-    vfx_result r = scene_check_range(c, path, d, rg);
+    vfx_result r = rt_scene_check_range(c, path, d, rg);
     if (r)
         return r;
     if (fabs(d) > FLT_MAX)
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be finite as float32, got %.9g", d);
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be finite as float32, got %.9g", d);
     float f = (float)d;
     if (f != 0 && fabsf(f) < FLT_MIN)
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "%g is subnormal as float32 (magnitude "
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "%g is subnormal as float32 (magnitude "
                            "below %.9g): give 0 or a larger value", d, (double)FLT_MIN);
     if (d != 0 && f == 0) /* only reached with d below FLT_MIN/2 */
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "%.3g is 0 as float32", d);
-    r = scene_check_range(c, path, (double)f, rg);
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "%.3g is 0 as float32", d);
+    r = rt_scene_check_range(c, path, (double)f, rg);
     if (!r)
         *out = (double)f;
     return r;
 }
 
 /* Optional number `key` of `obj`: *out keeps its default when absent. */
-vfx_result scene_get_float(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+vfx_result rt_scene_get_float(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
                             range rg, float *out)
 {
     char p[JPATH];
-    scene_join(p, path, key);
+    rt_scene_join(p, path, key);
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!v)
-        return required ? scene_failf(c, VFX_ERR_FORMAT, p, "required number missing") : VFX_OK;
+        return required ? rt_scene_failf(c, VFX_ERR_FORMAT, p, "required number missing") : VFX_OK;
     double d = 0; /* set by number_value on success; -O3 cannot see that */
-    vfx_result r = scene_number_value(c, v, p, rg, &d);
+    vfx_result r = rt_scene_number_value(c, v, p, rg, &d);
     if (!r)
         *out = (float)d;
     return r;
 }
 
-vfx_result scene_get_uint(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+vfx_result rt_scene_get_uint(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
                            double lo, double hi, uint32_t *out)
 {
     char p[JPATH];
-    scene_join(p, path, key);
+    rt_scene_join(p, path, key);
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!v)
-        return required ? scene_failf(c, VFX_ERR_FORMAT, p, "required integer missing") : VFX_OK;
+        return required ? rt_scene_failf(c, VFX_ERR_FORMAT, p, "required integer missing") : VFX_OK;
     /* integers stay doubles: as a float 16777217 would round to a different integer */
     if (!cJSON_IsNumber(v))
-        return scene_failf(c, VFX_ERR_FORMAT, p, "expected a number, got %s", scene_type_name(v));
+        return rt_scene_failf(c, VFX_ERR_FORMAT, p, "expected a number, got %s", rt_scene_type_name(v));
     double d = v->valuedouble;
-    vfx_result r = scene_check_range(c, p, d, (range){lo, hi, false});
+    vfx_result r = rt_scene_check_range(c, p, d, (range){lo, hi, false});
     if (r)
         return r;
     if (d != floor(d))
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "must be an integer, got %g", d);
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "must be an integer, got %g", d);
     *out = (uint32_t)d;
     return VFX_OK;
 }
 
-vfx_result scene_vec_value(pctx *c, const cJSON *v, const char *p, int n, range rg, float *out)
+vfx_result rt_scene_vec_value(pctx *c, const cJSON *v, const char *p, int n, range rg, float *out)
 {
     if (!cJSON_IsArray(v))
-        return scene_failf(c, VFX_ERR_FORMAT, p, "expected an array of %d numbers, got %s", n, scene_type_name(v));
+        return rt_scene_failf(c, VFX_ERR_FORMAT, p, "expected an array of %d numbers, got %s", n, rt_scene_type_name(v));
     int size = cJSON_GetArraySize(v);
     if (size != n)
-        return scene_failf(c, VFX_ERR_FORMAT, p, "expected %d numbers, got %d", n, size);
+        return rt_scene_failf(c, VFX_ERR_FORMAT, p, "expected %d numbers, got %d", n, size);
     int i = 0;
     for (const cJSON *e = v->child; e; e = e->next, ++i) {
         char pi[JPATH];
-        scene_join_index(pi, p, i);
+        rt_scene_join_index(pi, p, i);
         double d = 0;
-        vfx_result r = scene_number_value(c, e, pi, rg, &d);
+        vfx_result r = rt_scene_number_value(c, e, pi, rg, &d);
         if (r)
             return r;
         out[i] = (float)d;
@@ -179,16 +179,16 @@ vfx_result scene_vec_value(pctx *c, const cJSON *v, const char *p, int n, range 
     return VFX_OK;
 }
 
-vfx_result scene_point_value(pctx *c, const cJSON *v, const char *p, int n, float *out)
+vfx_result rt_scene_point_value(pctx *c, const cJSON *v, const char *p, int n, float *out)
 {
     if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != n)
-        return scene_vec_value(c, v, p, n, COORD, out); /* its message names what is wrong */
+        return rt_scene_vec_value(c, v, p, n, COORD, out); /* its message names what is wrong */
     int i = 0;
     for (const cJSON *e = v->child; e; e = e->next, ++i) {
         char pi[JPATH];
-        scene_join_index(pi, p, i);
+        rt_scene_join_index(pi, p, i);
         double d = 0;
-        vfx_result r = scene_number_value(c, e, pi, COORD, &d); /* checks it as float32 too */
+        vfx_result r = rt_scene_number_value(c, e, pi, COORD, &d); /* checks it as float32 too */
         if (r)
             return r;
         d = e->valuedouble; /* but keeps the digits: the difference is what becomes float32 */
@@ -201,64 +201,64 @@ vfx_result scene_point_value(pctx *c, const cJSON *v, const char *p, int n, floa
     return VFX_OK;
 }
 
-vfx_result scene_get_point(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+vfx_result rt_scene_get_point(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
                             float out[3])
 {
     char p[JPATH];
-    scene_join(p, path, key);
+    rt_scene_join(p, path, key);
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!v)
-        return required ? scene_failf(c, VFX_ERR_FORMAT, p, "required array of 3 numbers missing") : VFX_OK;
-    return scene_point_value(c, v, p, 3, out);
+        return required ? rt_scene_failf(c, VFX_ERR_FORMAT, p, "required array of 3 numbers missing") : VFX_OK;
+    return rt_scene_point_value(c, v, p, 3, out);
 }
 
-vfx_result scene_get_vec(pctx *c, const cJSON *obj, const char *path, const char *key, int n,
+vfx_result rt_scene_get_vec(pctx *c, const cJSON *obj, const char *path, const char *key, int n,
                           bool required, range rg, float *out)
 {
     char p[JPATH];
-    scene_join(p, path, key);
+    rt_scene_join(p, path, key);
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!v)
-        return required ? scene_failf(c, VFX_ERR_FORMAT, p, "required array of %d numbers missing", n) : VFX_OK;
-    return scene_vec_value(c, v, p, n, rg, out);
+        return required ? rt_scene_failf(c, VFX_ERR_FORMAT, p, "required array of %d numbers missing", n) : VFX_OK;
+    return rt_scene_vec_value(c, v, p, n, rg, out);
 }
 
-vfx_result scene_get_bool(pctx *c, const cJSON *obj, const char *path, const char *key, bool *out)
+vfx_result rt_scene_get_bool(pctx *c, const cJSON *obj, const char *path, const char *key, bool *out)
 {
     char p[JPATH];
-    scene_join(p, path, key);
+    rt_scene_join(p, path, key);
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!v)
         return VFX_OK;
     if (!cJSON_IsBool(v))
-        return scene_failf(c, VFX_ERR_FORMAT, p, "expected true or false, got %s", scene_type_name(v));
+        return rt_scene_failf(c, VFX_ERR_FORMAT, p, "expected true or false, got %s", rt_scene_type_name(v));
     *out = cJSON_IsTrue(v);
     return VFX_OK;
 }
 
-vfx_result scene_get_string(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+vfx_result rt_scene_get_string(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
                              char *out, size_t outlen)
 {
     char p[JPATH];
-    scene_join(p, path, key);
+    rt_scene_join(p, path, key);
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!v)
-        return required ? scene_failf(c, VFX_ERR_FORMAT, p, "required string missing") : VFX_OK;
+        return required ? rt_scene_failf(c, VFX_ERR_FORMAT, p, "required string missing") : VFX_OK;
     if (!cJSON_IsString(v) || !v->valuestring)
-        return scene_failf(c, VFX_ERR_FORMAT, p, "expected a string, got %s", scene_type_name(v));
+        return rt_scene_failf(c, VFX_ERR_FORMAT, p, "expected a string, got %s", rt_scene_type_name(v));
     size_t len = strlen(v->valuestring);
     if (len >= outlen)
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "string of %zu bytes is longer than %zu", len, outlen - 1);
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "string of %zu bytes is longer than %zu", len, outlen - 1);
     memcpy(out, v->valuestring, len + 1);
     return VFX_OK;
 }
 
 /* A string that must be one of `names` (NULL-terminated); *out gets its index. */
-vfx_result scene_get_enum(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+vfx_result rt_scene_get_enum(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
                            const char *const *names, uint32_t *out)
 {
     char buf[64] = "";
-    vfx_result r = scene_get_string(c, obj, path, key, required, buf, sizeof buf);
+    vfx_result r = rt_scene_get_string(c, obj, path, key, required, buf, sizeof buf);
     if (r)
         return r;
     if (!cJSON_GetObjectItemCaseSensitive(obj, key))
@@ -269,79 +269,79 @@ vfx_result scene_get_enum(pctx *c, const cJSON *obj, const char *path, const cha
             return VFX_OK;
         }
     char p[JPATH], list[256] = "";
-    scene_join(p, path, key);
+    rt_scene_join(p, path, key);
     for (uint32_t i = 0; names[i]; ++i) {
         size_t l = strlen(list);
         snprintf(list + l, sizeof list - l, "%s\"%s\"", i ? ", " : "", names[i]);
     }
-    return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "unknown value \"%s\"; expected one of %s", buf, list);
+    return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "unknown value \"%s\"; expected one of %s", buf, list);
 }
 
 /* An array of flag names -> bit mask. */
-vfx_result scene_get_flags(pctx *c, const cJSON *obj, const char *path, const char *key,
+vfx_result rt_scene_get_flags(pctx *c, const cJSON *obj, const char *path, const char *key,
                             const char *const *names, const uint32_t *bits, uint32_t *out)
 {
     char p[JPATH];
-    scene_join(p, path, key);
+    rt_scene_join(p, path, key);
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!v)
         return VFX_OK;
     if (!cJSON_IsArray(v))
-        return scene_failf(c, VFX_ERR_FORMAT, p, "expected an array of strings, got %s", scene_type_name(v));
+        return rt_scene_failf(c, VFX_ERR_FORMAT, p, "expected an array of strings, got %s", rt_scene_type_name(v));
     uint32_t mask = 0;
     int i = 0;
     for (const cJSON *e = v->child; e; e = e->next, ++i) {
         char pi[JPATH];
-        scene_join_index(pi, p, i);
+        rt_scene_join_index(pi, p, i);
         if (!cJSON_IsString(e))
-            return scene_failf(c, VFX_ERR_FORMAT, pi, "expected a string, got %s", scene_type_name(e));
+            return rt_scene_failf(c, VFX_ERR_FORMAT, pi, "expected a string, got %s", rt_scene_type_name(e));
         bool found = false;
         for (uint32_t k = 0; names[k]; ++k)
             if (strcmp(names[k], e->valuestring) == 0)
                 mask |= bits[k], found = true;
         if (!found)
-            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, pi, "unknown flag \"%.64s\"", e->valuestring);
+            return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, pi, "unknown flag \"%.64s\"", e->valuestring);
     }
     *out = mask;
     return VFX_OK;
 }
 
-vfx_result scene_resolve_path(pctx *c, const char *p, const char *rel, char *out)
+vfx_result rt_scene_resolve_path(pctx *c, const char *p, const char *rel, char *out)
 {
     if (!*rel)
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "empty path");
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "empty path");
     int n;
     if (rel[0] == '/' || !c->base_dir || !*c->base_dir)
         n = snprintf(out, RT_SCENE_PATH_MAX, "%s", rel);
     else
         n = snprintf(out, RT_SCENE_PATH_MAX, "%s/%s", c->base_dir, rel);
     if (n < 0 || n >= RT_SCENE_PATH_MAX)
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "resolved path longer than %d bytes", RT_SCENE_PATH_MAX - 1);
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "resolved path longer than %d bytes", RT_SCENE_PATH_MAX - 1);
     return VFX_OK;
 }
 
-vfx_result scene_get_path(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+vfx_result rt_scene_get_path(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
                            char *out)
 {
     char raw[RT_SCENE_PATH_MAX] = "", p[JPATH];
-    vfx_result r = scene_get_string(c, obj, path, key, required, raw, sizeof raw);
+    vfx_result r = rt_scene_get_string(c, obj, path, key, required, raw, sizeof raw);
     if (r || !cJSON_GetObjectItemCaseSensitive(obj, key))
         return r;
-    scene_join(p, path, key);
-    return scene_resolve_path(c, p, raw, out);
+    rt_scene_join(p, path, key);
+    return rt_scene_resolve_path(c, p, raw, out);
 }
 
 
 /* ------------------------------------------------------------------ transforms */
 
-void scene_mat_identity(float m[16])
+void rt_scene_mat_identity(float m[16])
 {
     mat4 id = GLM_MAT4_IDENTITY_INIT;
     memcpy(m, id, sizeof id);
 }
 
 /* M = T * Rz * Ry * Rx * S, column-major, with cglm. */
-void scene_mat_trs(const float t[3], const float rdeg[3], const float s[3], float m[16])
+void rt_scene_mat_trs(const float t[3], const float rdeg[3], const float s[3], float m[16])
 {
     mat4 M;
     glm_translate_make(M, (vec3){t[0], t[1], t[2]});
@@ -352,39 +352,39 @@ void scene_mat_trs(const float t[3], const float rdeg[3], const float s[3], floa
     memcpy(m, M, sizeof M);
 }
 
-vfx_result scene_parse_transform(pctx *c, const cJSON *obj, const char *path, float model[16])
+vfx_result rt_scene_parse_transform(pctx *c, const cJSON *obj, const char *path, float model[16])
 {
     const cJSON *mv = cJSON_GetObjectItemCaseSensitive(obj, "matrix");
     bool trs = cJSON_GetObjectItemCaseSensitive(obj, "translate") || cJSON_GetObjectItemCaseSensitive(obj, "rotate_deg") ||
                cJSON_GetObjectItemCaseSensitive(obj, "scale");
     if (mv) {
         char p[JPATH];
-        scene_join(p, path, "matrix");
+        rt_scene_join(p, path, "matrix");
         if (trs)
-            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "give either matrix or translate/rotate_deg/scale, not both");
-        return scene_point_value(c, mv, p, 16, model);
+            return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "give either matrix or translate/rotate_deg/scale, not both");
+        return rt_scene_point_value(c, mv, p, 16, model);
     }
     /* no translate: at the world origin, which is -origin from the scene's origin */
     float t[3] = {(float)-c->origin[0], (float)-c->origin[1], (float)-c->origin[2]};
     float rdeg[3] = {0, 0, 0}, s[3] = {1, 1, 1};
-    vfx_result r = scene_get_point(c, obj, path, "translate", false, t);
-    if (!r) r = scene_get_vec(c, obj, path, "rotate_deg", 3, false, (range){-36000, 36000, false}, rdeg);
+    vfx_result r = rt_scene_get_point(c, obj, path, "translate", false, t);
+    if (!r) r = rt_scene_get_vec(c, obj, path, "rotate_deg", 3, false, (range){-36000, 36000, false}, rdeg);
     if (r)
         return r;
     const cJSON *sv = cJSON_GetObjectItemCaseSensitive(obj, "scale");
     if (sv) {
         char p[JPATH];
-        scene_join(p, path, "scale");
+        rt_scene_join(p, path, "scale");
         const range sr = {0, COORD_MAX, true};
         if (cJSON_IsNumber(sv)) {
             double d;
-            if ((r = scene_number_value(c, sv, p, sr, &d)))
+            if ((r = rt_scene_number_value(c, sv, p, sr, &d)))
                 return r;
             s[0] = s[1] = s[2] = (float)d;
-        } else if ((r = scene_vec_value(c, sv, p, 3, sr, s))) {
+        } else if ((r = rt_scene_vec_value(c, sv, p, 3, sr, s))) {
             return r;
         }
     }
-    scene_mat_trs(t, rdeg, s, model);
+    rt_scene_mat_trs(t, rdeg, s, model);
     return VFX_OK;
 }

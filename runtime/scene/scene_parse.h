@@ -24,54 +24,54 @@ typedef struct range {
     bool lo_open; /* value must be > lo rather than >= lo */
 } range;
 
-vfx_result scene_alloc_array(pctx *c, const cJSON *v, const char *name, int cap, size_t elem,
+vfx_result rt_scene_alloc_array(pctx *c, const cJSON *v, const char *name, int cap, size_t elem,
                               void **out, int *count);
-void scene_check_keys(pctx *c, const cJSON *obj, const char *path, const char *const *allowed);
-vfx_result scene_check_range(pctx *c, const char *path, double v, range rg);
-vfx_result scene_expect_object(pctx *c, const cJSON *v, const char *path);
+void rt_scene_check_keys(pctx *c, const cJSON *obj, const char *path, const char *const *allowed);
+vfx_result rt_scene_check_range(pctx *c, const char *path, double v, range rg);
+vfx_result rt_scene_expect_object(pctx *c, const cJSON *v, const char *path);
 /* The ranges most keys use. */
 static const range COORD = {-COORD_MAX, COORD_MAX, false};
 static const range POSITIVE = {0, COORD_MAX, true};
 static const range NONNEG = {0, COORD_MAX, false};
 static const range UNIT = {0, 1, false};
 
-vfx_result scene_failf(pctx *c, vfx_result r, const char *path, const char *fmt, ...)
+vfx_result rt_scene_failf(pctx *c, vfx_result r, const char *path, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
-vfx_result scene_get_bool(pctx *c, const cJSON *obj, const char *path, const char *key, bool *out);
-vfx_result scene_get_enum(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+vfx_result rt_scene_get_bool(pctx *c, const cJSON *obj, const char *path, const char *key, bool *out);
+vfx_result rt_scene_get_enum(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
                            const char *const *names, uint32_t *out);
-vfx_result scene_get_flags(pctx *c, const cJSON *obj, const char *path, const char *key,
+vfx_result rt_scene_get_flags(pctx *c, const cJSON *obj, const char *path, const char *key,
                             const char *const *names, const uint32_t *bits, uint32_t *out);
-vfx_result scene_get_float(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+vfx_result rt_scene_get_float(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
                             range rg, float *out);
-vfx_result scene_get_path(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+vfx_result rt_scene_get_path(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
                            char *out);
-vfx_result scene_get_string(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+vfx_result rt_scene_get_string(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
                              char *out, size_t outlen);
-vfx_result scene_get_uint(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+vfx_result rt_scene_get_uint(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
                            double lo, double hi, uint32_t *out);
-vfx_result scene_get_vec(pctx *c, const cJSON *obj, const char *path, const char *key, int n,
+vfx_result rt_scene_get_vec(pctx *c, const cJSON *obj, const char *path, const char *key, int n,
                           bool required, range rg, float *out);
-bool scene_is_zero3(const float *v);
-void scene_join(char *out, const char *parent, const char *key);
-void scene_join_index(char *out, const char *parent, int i);
-void scene_mat_identity(float m[16]);
-void scene_mat_trs(const float t[3], const float rdeg[3], const float s[3], float m[16]);
-vfx_result scene_number_value(pctx *c, const cJSON *v, const char *path, range rg, double *out);
-vfx_result scene_parse_transform(pctx *c, const cJSON *obj, const char *path, float model[16]);
-vfx_result scene_resolve_path(pctx *c, const char *p, const char *rel, char *out);
-const char *scene_type_name(const cJSON *v);
-vfx_result scene_vec_value(pctx *c, const cJSON *v, const char *p, int n, range rg, float *out);
+bool rt_scene_is_zero3(const float *v);
+void rt_scene_join(char *out, const char *parent, const char *key);
+void rt_scene_join_index(char *out, const char *parent, int i);
+void rt_scene_mat_identity(float m[16]);
+void rt_scene_mat_trs(const float t[3], const float rdeg[3], const float s[3], float m[16]);
+vfx_result rt_scene_number_value(pctx *c, const cJSON *v, const char *path, range rg, double *out);
+vfx_result rt_scene_parse_transform(pctx *c, const cJSON *obj, const char *path, float model[16]);
+vfx_result rt_scene_resolve_path(pctx *c, const char *p, const char *rel, char *out);
+const char *rt_scene_type_name(const cJSON *v);
+vfx_result rt_scene_vec_value(pctx *c, const cJSON *v, const char *p, int n, range rg, float *out);
 /* A world position (n = 3), or a model matrix (n = 16) whose translation is one: read in double
  * and stored as the difference to the scene's origin, so far-out scenes keep float32 digits. */
-vfx_result scene_point_value(pctx *c, const cJSON *v, const char *p, int n, float *out);
-vfx_result scene_get_point(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
+vfx_result rt_scene_point_value(pctx *c, const cJSON *v, const char *p, int n, float *out);
+vfx_result rt_scene_get_point(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
                             float out[3]);
-vfx_result scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s);
-vfx_result scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv, vfx_beams_view2 *bv2);
-vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w);
-vfx_result scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol);
-bool scene_ends_with(const char *s, const char *suffix);
-vfx_result scene_parse_box(pctx *c, const cJSON *obj, const char *path, const char *key, float mn[3], float mx[3]);
+vfx_result rt_scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s);
+vfx_result rt_scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv, vfx_beams_view2 *bv2);
+vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w);
+vfx_result rt_scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol);
+bool rt_scene_ends_with(const char *s, const char *suffix);
+vfx_result rt_scene_parse_box(pctx *c, const cJSON *obj, const char *path, const char *key, float mn[3], float mx[3]);
 
 #endif

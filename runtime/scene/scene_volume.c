@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-bool scene_ends_with(const char *s, const char *suffix)
+bool rt_scene_ends_with(const char *s, const char *suffix)
 {
     size_t a = strlen(s), b = strlen(suffix);
     return a >= b && strcmp(s + a - b, suffix) == 0;
@@ -22,21 +22,21 @@ static vfx_result parse_animation(pctx *c, const cJSON *a, rt_scene_volume_anima
         return VFX_OK;
     static const char *const keys[] = {"ripple", "beam_glow", "transfer_pulse", NULL};
     const char *P = "volume.animate";
-    vfx_result r = scene_expect_object(c, a, P);
+    vfx_result r = rt_scene_expect_object(c, a, P);
     if (r)
         return r;
-    scene_check_keys(c, a, P, keys);
+    rt_scene_check_keys(c, a, P, keys);
     const cJSON *rp = cJSON_GetObjectItemCaseSensitive(a, "ripple");
     if (rp) {
         static const char *const k[] = {"amplitude", "wavelength", "period_s", NULL};
         const char *PR = "volume.animate.ripple";
-        if ((r = scene_expect_object(c, rp, PR)))
+        if ((r = rt_scene_expect_object(c, rp, PR)))
             return r;
-        scene_check_keys(c, rp, PR, k);
+        rt_scene_check_keys(c, rp, PR, k);
         an->ripple_wavelength = 0.5f, an->ripple_period_s = 1.5f;
-        r = scene_get_float(c, rp, PR, "amplitude", true, (range){0, 0.5, false}, &an->ripple_amplitude);
-        if (!r) r = scene_get_float(c, rp, PR, "wavelength", false, POSITIVE, &an->ripple_wavelength);
-        if (!r) r = scene_get_float(c, rp, PR, "period_s", false, POSITIVE, &an->ripple_period_s);
+        r = rt_scene_get_float(c, rp, PR, "amplitude", true, (range){0, 0.5, false}, &an->ripple_amplitude);
+        if (!r) r = rt_scene_get_float(c, rp, PR, "wavelength", false, POSITIVE, &an->ripple_wavelength);
+        if (!r) r = rt_scene_get_float(c, rp, PR, "period_s", false, POSITIVE, &an->ripple_period_s);
         if (r)
             return r;
     }
@@ -44,12 +44,12 @@ static vfx_result parse_animation(pctx *c, const cJSON *a, rt_scene_volume_anima
     if (g) {
         static const char *const k[] = {"gain", "reach", NULL};
         const char *PG = "volume.animate.beam_glow";
-        if ((r = scene_expect_object(c, g, PG)))
+        if ((r = rt_scene_expect_object(c, g, PG)))
             return r;
-        scene_check_keys(c, g, PG, k);
+        rt_scene_check_keys(c, g, PG, k);
         an->glow_reach = 2.0f;
-        r = scene_get_float(c, g, PG, "gain", true, (range){0, 1e3, false}, &an->glow_gain);
-        if (!r) r = scene_get_float(c, g, PG, "reach", false, (range){0, 100, true}, &an->glow_reach);
+        r = rt_scene_get_float(c, g, PG, "gain", true, (range){0, 1e3, false}, &an->glow_gain);
+        if (!r) r = rt_scene_get_float(c, g, PG, "reach", false, (range){0, 100, true}, &an->glow_reach);
         if (r)
             return r;
     }
@@ -57,80 +57,80 @@ static vfx_result parse_animation(pctx *c, const cJSON *a, rt_scene_volume_anima
     if (tp) {
         static const char *const k[] = {"rgba", "width", "period_s", NULL};
         const char *PT = "volume.animate.transfer_pulse";
-        if ((r = scene_expect_object(c, tp, PT)))
+        if ((r = rt_scene_expect_object(c, tp, PT)))
             return r;
-        scene_check_keys(c, tp, PT, k);
+        rt_scene_check_keys(c, tp, PT, k);
         an->pulse_width = 0.03f, an->pulse_period_s = 3.0f;
-        r = scene_get_vec(c, tp, PT, "rgba", 4, true, (range){0, 1e3, false}, an->pulse_rgba);
-        if (!r) r = scene_get_float(c, tp, PT, "width", false, (range){0, 0.25, true}, &an->pulse_width);
-        if (!r) r = scene_get_float(c, tp, PT, "period_s", false, POSITIVE, &an->pulse_period_s);
+        r = rt_scene_get_vec(c, tp, PT, "rgba", 4, true, (range){0, 1e3, false}, an->pulse_rgba);
+        if (!r) r = rt_scene_get_float(c, tp, PT, "width", false, (range){0, 0.25, true}, &an->pulse_width);
+        if (!r) r = rt_scene_get_float(c, tp, PT, "period_s", false, POSITIVE, &an->pulse_period_s);
         if (r)
             return r;
     }
     return VFX_OK;
 }
 
-vfx_result scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol)
+vfx_result rt_scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol)
 {
     static const char *const keys[] = {"path", "generator", "scalar", "transfer", "transfer_normalized",
                                        "ert_threshold", "tiles", "update_c", "workers", "disable",
                                        "translate", "rotate_deg", "scale", "matrix", "transfer_method", "animate", NULL};
     const char *P = "volume";
-    vfx_result r = scene_expect_object(c, v, P);
+    vfx_result r = rt_scene_expect_object(c, v, P);
     if (r)
         return r;
-    scene_check_keys(c, v, P, keys);
+    rt_scene_check_keys(c, v, P, keys);
     const cJSON *path = cJSON_GetObjectItemCaseSensitive(v, "path"), *gen = cJSON_GetObjectItemCaseSensitive(v, "generator");
     if (!path == !gen)
-        return scene_failf(c, VFX_ERR_FORMAT, P, "needs exactly one of \"path\" (.vtu or .node) or \"generator\"");
+        return rt_scene_failf(c, VFX_ERR_FORMAT, P, "needs exactly one of \"path\" (.vtu or .node) or \"generator\"");
     if (path) {
-        if ((r = scene_get_path(c, v, P, "path", true, vol->path)))
+        if ((r = rt_scene_get_path(c, v, P, "path", true, vol->path)))
             return r;
-        if (!scene_ends_with(vol->path, ".vtu") && !scene_ends_with(vol->path, ".node"))
-            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "volume.path",
+        if (!rt_scene_ends_with(vol->path, ".vtu") && !rt_scene_ends_with(vol->path, ".node"))
+            return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "volume.path",
                          "\"%.200s\" is neither a .vtu nor a TetGen .node file", vol->path);
     } else {
         static const char *const gkeys[] = {"cells", "min", "max", NULL};
         const char *PG = "volume.generator";
-        if ((r = scene_expect_object(c, gen, PG)))
+        if ((r = rt_scene_expect_object(c, gen, PG)))
             return r;
-        scene_check_keys(c, gen, PG, gkeys);
+        rt_scene_check_keys(c, gen, PG, gkeys);
         vol->generated = true;
         vol->gen_cells = 8;
         vol->gen_min[0] = vol->gen_min[1] = vol->gen_min[2] = -1;
         vol->gen_max[0] = vol->gen_max[1] = vol->gen_max[2] = 1;
-        r = scene_get_uint(c, gen, PG, "cells", false, 1, RT_SCENE_MAX_VOLUME_CELLS, &vol->gen_cells);
-        if (!r) r = scene_get_vec(c, gen, PG, "min", 3, false, COORD, vol->gen_min); /* model space */
-        if (!r) r = scene_get_vec(c, gen, PG, "max", 3, false, COORD, vol->gen_max);
+        r = rt_scene_get_uint(c, gen, PG, "cells", false, 1, RT_SCENE_MAX_VOLUME_CELLS, &vol->gen_cells);
+        if (!r) r = rt_scene_get_vec(c, gen, PG, "min", 3, false, COORD, vol->gen_min); /* model space */
+        if (!r) r = rt_scene_get_vec(c, gen, PG, "max", 3, false, COORD, vol->gen_max);
         for (int k = 0; k < 3 && !r; ++k)
             if (!(vol->gen_max[k] > vol->gen_min[k]))
-                r = scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "volume.generator.max",
+                r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "volume.generator.max",
                           "must exceed min on every axis (axis %d: %g <= %g)", k, vol->gen_max[k], vol->gen_min[k]);
         if (r)
             return r;
     }
-    r = scene_get_string(c, v, P, "scalar", false, vol->scalar, sizeof vol->scalar);
-    if (!r) r = scene_get_bool(c, v, P, "transfer_normalized", &vol->transfer_normalized);
-    if (!r) r = scene_get_float(c, v, P, "ert_threshold", false, (range){0, 1, true}, &vol->ert_threshold);
-    if (!r) r = scene_get_uint(c, v, P, "tiles", false, 1, 1024, &vol->tiles);
-    if (!r) r = scene_get_uint(c, v, P, "update_c", false, 1, 1u << 20, &vol->update_c);
-    if (!r) r = scene_get_uint(c, v, P, "workers", false, 0, 256, &vol->workers);
+    r = rt_scene_get_string(c, v, P, "scalar", false, vol->scalar, sizeof vol->scalar);
+    if (!r) r = rt_scene_get_bool(c, v, P, "transfer_normalized", &vol->transfer_normalized);
+    if (!r) r = rt_scene_get_float(c, v, P, "ert_threshold", false, (range){0, 1, true}, &vol->ert_threshold);
+    if (!r) r = rt_scene_get_uint(c, v, P, "tiles", false, 1, 1024, &vol->tiles);
+    if (!r) r = rt_scene_get_uint(c, v, P, "update_c", false, 1, 1u << 20, &vol->update_c);
+    if (!r) r = rt_scene_get_uint(c, v, P, "workers", false, 0, 256, &vol->workers);
     if (!r) {
         static const char *const flags[] = {"ert", "share", "dlb", NULL};
         static const uint32_t bits[] = {VFX_VOLUME_NO_ERT, VFX_VOLUME_NO_SHARE, VFX_VOLUME_NO_DLB};
-        r = scene_get_flags(c, v, P, "disable", flags, bits, &vol->disable);
+        r = rt_scene_get_flags(c, v, P, "disable", flags, bits, &vol->disable);
     }
     if (!r) {
         char method[32] = "exact";
-        r = scene_get_string(c, v, P, "transfer_method", false, method, sizeof method);
+        r = rt_scene_get_string(c, v, P, "transfer_method", false, method, sizeof method);
         if (!r && !strcmp(method, "preintegrated"))
             vol->transfer_method = VFX_VOLUME_TRANSFER_PREINTEGRATED;
         else if (!r && strcmp(method, "exact"))
-            r = scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "volume.transfer_method",
+            r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "volume.transfer_method",
                             "\"%.40s\" is neither \"exact\" nor \"preintegrated\"", method);
     }
     if (!r) r = parse_animation(c, cJSON_GetObjectItemCaseSensitive(v, "animate"), &vol->anim);
-    if (!r) r = scene_parse_transform(c, v, P, vol->model);
+    if (!r) r = rt_scene_parse_transform(c, v, P, vol->model);
     if (r)
         return r;
     const cJSON *tf = cJSON_GetObjectItemCaseSensitive(v, "transfer");
@@ -138,27 +138,27 @@ vfx_result scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol)
         return VFX_OK;
     const char *PT = "volume.transfer";
     if (!cJSON_IsArray(tf))
-        return scene_failf(c, VFX_ERR_FORMAT, PT, "expected an array of {\"scalar\", \"rgba\"}, got %s", scene_type_name(tf));
+        return rt_scene_failf(c, VFX_ERR_FORMAT, PT, "expected an array of {\"scalar\", \"rgba\"}, got %s", rt_scene_type_name(tf));
     int n = cJSON_GetArraySize(tf);
     if (n < 1 || n > RT_SCENE_MAX_TRANSFER)
-        return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PT, "%d control points; must be 1 to %d", n, RT_SCENE_MAX_TRANSFER);
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PT, "%d control points; must be 1 to %d", n, RT_SCENE_MAX_TRANSFER);
     int i = 0;
     for (const cJSON *e = tf->child; e; e = e->next, ++i) {
         static const char *const tkeys[] = {"scalar", "rgba", NULL};
         char PI[JPATH];
-        scene_join_index(PI, PT, i);
+        rt_scene_join_index(PI, PT, i);
         rt_scene_transfer_point *tp = &vol->transfer[i];
-        if ((r = scene_expect_object(c, e, PI)))
+        if ((r = rt_scene_expect_object(c, e, PI)))
             return r;
-        scene_check_keys(c, e, PI, tkeys);
-        r = scene_get_float(c, e, PI, "scalar", true, vol->transfer_normalized ? UNIT : (range){-1e30, 1e30, false}, &tp->scalar);
-        if (!r) r = scene_get_vec(c, e, PI, "rgba", 4, true, (range){0, 1e3, false}, tp->rgba);
+        rt_scene_check_keys(c, e, PI, tkeys);
+        r = rt_scene_get_float(c, e, PI, "scalar", true, vol->transfer_normalized ? UNIT : (range){-1e30, 1e30, false}, &tp->scalar);
+        if (!r) r = rt_scene_get_vec(c, e, PI, "rgba", 4, true, (range){0, 1e3, false}, tp->rgba);
         if (r)
             return r;
         if (i > 0 && !(tp->scalar > vol->transfer[i - 1].scalar)) {
             char PS[JPATH];
-            scene_join(PS, PI, "scalar");
-            return scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PS, "control points must increase strictly (%g after %g)",
+            rt_scene_join(PS, PI, "scalar");
+            return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PS, "control points must increase strictly (%g after %g)",
                          tp->scalar, vol->transfer[i - 1].scalar);
         }
         vol->transfer_count = (uint32_t)i + 1;

@@ -10,25 +10,25 @@
 
 #include "scene/particle_file.h"
 
-vfx_result scene_parse_box(pctx *c, const cJSON *obj, const char *path, const char *key, float mn[3], float mx[3])
+vfx_result rt_scene_parse_box(pctx *c, const cJSON *obj, const char *path, const char *key, float mn[3], float mx[3])
 {
     static const char *const keys[] = {"min", "max", NULL};
     char P[JPATH];
-    scene_join(P, path, key);
+    rt_scene_join(P, path, key);
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!v)
-        return scene_failf(c, VFX_ERR_FORMAT, P, "required {\"min\", \"max\"} box missing");
-    vfx_result r = scene_expect_object(c, v, P);
+        return rt_scene_failf(c, VFX_ERR_FORMAT, P, "required {\"min\", \"max\"} box missing");
+    vfx_result r = rt_scene_expect_object(c, v, P);
     if (r)
         return r;
-    scene_check_keys(c, v, P, keys);
-    r = scene_get_point(c, v, P, "min", true, mn);
-    if (!r) r = scene_get_point(c, v, P, "max", true, mx);
+    rt_scene_check_keys(c, v, P, keys);
+    r = rt_scene_get_point(c, v, P, "min", true, mn);
+    if (!r) r = rt_scene_get_point(c, v, P, "max", true, mx);
     for (int k = 0; k < 3 && !r; ++k)
         if (!(mx[k] > mn[k])) {
             char PM[JPATH];
-            scene_join(PM, P, "max");
-            r = scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PM, "must exceed min on every axis (axis %d: %g <= %g)", k, mx[k], mn[k]);
+            rt_scene_join(PM, P, "max");
+            r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PM, "must exceed min on every axis (axis %d: %g <= %g)", k, mx[k], mn[k]);
         }
     return r;
 }
@@ -53,18 +53,18 @@ static float water_h_from_spacing(const rt_scene_water *w)
     return vol > 0 ? (float)(2.0 * cbrt(vol / w->count)) : 0.0f;
 }
 
-vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
+vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
 {
     static const char *const keys[] = {"source", "path", "generator", "simulation", "h", "threshold",
                                        "quality", "color", "absorption", "ior", NULL};
     static const char *const sources[] = {"file", "generator", "simulation", NULL};
     const char *P = "water";
-    vfx_result r = scene_expect_object(c, v, P);
+    vfx_result r = rt_scene_expect_object(c, v, P);
     if (r)
         return r;
-    scene_check_keys(c, v, P, keys);
+    rt_scene_check_keys(c, v, P, keys);
     uint32_t src = 0;
-    if ((r = scene_get_enum(c, v, P, "source", true, sources, &src)))
+    if ((r = rt_scene_get_enum(c, v, P, "source", true, sources, &src)))
         return r;
     w->source = (rt_scene_water_source)src;
     w->layer_side = 24;
@@ -74,7 +74,7 @@ vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
     w->paddle_amplitude = 0.2f;
     w->paddle_period_s = 2.0f;
     if (w->source == RT_SCENE_WATER_FILE) {
-        if ((r = scene_get_path(c, v, P, "path", true, w->path)))
+        if ((r = rt_scene_get_path(c, v, P, "path", true, w->path)))
             return r;
     } else if (w->source == RT_SCENE_WATER_GENERATOR) {
         static const char *const gkeys[] = {"kind", "count", "origin", "spacing", "layer_side", "min", "max",
@@ -83,30 +83,30 @@ vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
         const char *PG = "water.generator";
         const cJSON *g = cJSON_GetObjectItemCaseSensitive(v, "generator");
         if (!g)
-            return scene_failf(c, VFX_ERR_FORMAT, PG, "required for source \"generator\"");
-        if ((r = scene_expect_object(c, g, PG)))
+            return rt_scene_failf(c, VFX_ERR_FORMAT, PG, "required for source \"generator\"");
+        if ((r = rt_scene_expect_object(c, g, PG)))
             return r;
-        scene_check_keys(c, g, PG, gkeys);
+        rt_scene_check_keys(c, g, PG, gkeys);
         uint32_t kind = 0;
-        r = scene_get_enum(c, g, PG, "kind", true, kinds, &kind);
-        if (!r) r = scene_get_uint(c, g, PG, "count", true, 0, RT_SCENE_MAX_PARTICLES, &w->count);
+        r = rt_scene_get_enum(c, g, PG, "kind", true, kinds, &kind);
+        if (!r) r = rt_scene_get_uint(c, g, PG, "count", true, 0, RT_SCENE_MAX_PARTICLES, &w->count);
         if (r)
             return r;
         w->generator = (rt_scene_generator)kind;
         if (kind == RT_SCENE_GEN_LAYERS) {
-            r = scene_get_point(c, g, PG, "origin", false, w->origin);
-            if (!r) r = scene_get_float(c, g, PG, "spacing", false, POSITIVE, &w->spacing);
-            if (!r) r = scene_get_uint(c, g, PG, "layer_side", false, 1, 4096, &w->layer_side);
+            r = rt_scene_get_point(c, g, PG, "origin", false, w->origin);
+            if (!r) r = rt_scene_get_float(c, g, PG, "spacing", false, POSITIVE, &w->spacing);
+            if (!r) r = rt_scene_get_uint(c, g, PG, "layer_side", false, 1, 4096, &w->layer_side);
         } else if (kind == RT_SCENE_GEN_BOX) {
-            r = scene_get_point(c, g, PG, "min", true, w->box_min);
-            if (!r) r = scene_get_point(c, g, PG, "max", true, w->box_max);
+            r = rt_scene_get_point(c, g, PG, "min", true, w->box_min);
+            if (!r) r = rt_scene_get_point(c, g, PG, "max", true, w->box_max);
             for (int k = 0; k < 3 && !r; ++k)
                 if (!(w->box_max[k] > w->box_min[k]))
-                    r = scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.generator.max",
+                    r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.generator.max",
                               "must exceed min on every axis (axis %d: %g <= %g)", k, w->box_max[k], w->box_min[k]);
         } else {
-            r = scene_get_point(c, g, PG, "center", false, w->center);
-            if (!r) r = scene_get_float(c, g, PG, "radius", true, POSITIVE, &w->radius);
+            r = rt_scene_get_point(c, g, PG, "center", false, w->center);
+            if (!r) r = rt_scene_get_float(c, g, PG, "radius", true, POSITIVE, &w->radius);
         }
         if (r)
             return r;
@@ -115,19 +115,19 @@ vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
         const char *PS = "water.simulation";
         const cJSON *s = cJSON_GetObjectItemCaseSensitive(v, "simulation");
         if (!s)
-            return scene_failf(c, VFX_ERR_FORMAT, PS, "required for source \"simulation\"");
-        if ((r = scene_expect_object(c, s, PS)))
+            return rt_scene_failf(c, VFX_ERR_FORMAT, PS, "required for source \"simulation\"");
+        if ((r = rt_scene_expect_object(c, s, PS)))
             return r;
-        scene_check_keys(c, s, PS, skeys);
-        r = scene_parse_box(c, s, PS, "tank", w->tank_min, w->tank_max);
-        if (!r) r = scene_parse_box(c, s, PS, "fluid", w->box_min, w->box_max);
+        rt_scene_check_keys(c, s, PS, skeys);
+        r = rt_scene_parse_box(c, s, PS, "tank", w->tank_min, w->tank_max);
+        if (!r) r = rt_scene_parse_box(c, s, PS, "fluid", w->box_min, w->box_max);
         for (int k = 0; k < 3 && !r; ++k)
             if (w->box_min[k] < w->tank_min[k] || w->box_max[k] > w->tank_max[k])
-                r = scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.simulation.fluid", "must lie inside the tank (axis %d)", k);
-        if (!r) r = scene_get_uint(c, s, PS, "particle_count", true, 0, RT_SCENE_MAX_PARTICLES, &w->count);
-        if (!r) r = scene_get_vec(c, s, PS, "gravity", 3, false, (range){-1000, 1000, false}, w->gravity);
-        if (!r) r = scene_get_float(c, s, PS, "dt", false, (range){0, 0.1, true}, &w->dt);
-        if (!r) r = scene_get_bool(c, s, PS, "no_slip", &w->no_slip);
+                r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.simulation.fluid", "must lie inside the tank (axis %d)", k);
+        if (!r) r = rt_scene_get_uint(c, s, PS, "particle_count", true, 0, RT_SCENE_MAX_PARTICLES, &w->count);
+        if (!r) r = rt_scene_get_vec(c, s, PS, "gravity", 3, false, (range){-1000, 1000, false}, w->gravity);
+        if (!r) r = rt_scene_get_float(c, s, PS, "dt", false, (range){0, 0.1, true}, &w->dt);
+        if (!r) r = rt_scene_get_bool(c, s, PS, "no_slip", &w->no_slip);
         if (r)
             return r;
         const cJSON *pd = cJSON_GetObjectItemCaseSensitive(s, "paddle");
@@ -135,13 +135,13 @@ vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
             static const char *const pkeys[] = {"axis", "amplitude", "period_s", NULL};
             static const char *const axes[] = {"x", "y", "z", NULL};
             const char *PP = "water.simulation.paddle";
-            if ((r = scene_expect_object(c, pd, PP)))
+            if ((r = rt_scene_expect_object(c, pd, PP)))
                 return r;
-            scene_check_keys(c, pd, PP, pkeys);
+            rt_scene_check_keys(c, pd, PP, pkeys);
             w->paddle = true;
-            r = scene_get_enum(c, pd, PP, "axis", false, axes, &w->paddle_axis);
-            if (!r) r = scene_get_float(c, pd, PP, "amplitude", false, NONNEG, &w->paddle_amplitude);
-            if (!r) r = scene_get_float(c, pd, PP, "period_s", false, (range){0, 1e4, true}, &w->paddle_period_s);
+            r = rt_scene_get_enum(c, pd, PP, "axis", false, axes, &w->paddle_axis);
+            if (!r) r = rt_scene_get_float(c, pd, PP, "amplitude", false, NONNEG, &w->paddle_amplitude);
+            if (!r) r = rt_scene_get_float(c, pd, PP, "period_s", false, (range){0, 1e4, true}, &w->paddle_period_s);
             if (r)
                 return r;
         }
@@ -149,11 +149,11 @@ vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
     vfx_water_params *wp = &w->params;
     /* ours (TILE) unless water.quality.method names another */
     *wp = (vfx_water_params){.size = sizeof *wp, .version = VFX_WATER_PARAMS_VERSION, .method = VFX_WATER_METHOD_TILE};
-    r = scene_get_float(c, v, P, "h", false, (range){0, 1e3, true}, &wp->h);
-    if (!r) r = scene_get_float(c, v, P, "threshold", false, (range){0, 1e3, true}, &wp->threshold);
-    if (!r) r = scene_get_vec(c, v, P, "color", 3, false, UNIT, wp->color);
-    if (!r) r = scene_get_float(c, v, P, "absorption", false, (range){0, 1e3, false}, &wp->absorption);
-    if (!r) r = scene_get_float(c, v, P, "ior", false, (range){1, 3, false}, &wp->ior);
+    r = rt_scene_get_float(c, v, P, "h", false, (range){0, 1e3, true}, &wp->h);
+    if (!r) r = rt_scene_get_float(c, v, P, "threshold", false, (range){0, 1e3, true}, &wp->threshold);
+    if (!r) r = rt_scene_get_vec(c, v, P, "color", 3, false, UNIT, wp->color);
+    if (!r) r = rt_scene_get_float(c, v, P, "absorption", false, (range){0, 1e3, false}, &wp->absorption);
+    if (!r) r = rt_scene_get_float(c, v, P, "ior", false, (range){1, 3, false}, &wp->ior);
     if (r)
         return r;
     if (wp->h == 0)
@@ -172,22 +172,22 @@ vfx_result scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
                                         VFX_WATER_NO_SUBDIVIDE, VFX_WATER_NO_TILES, VFX_WATER_NO_REFRACT_TRACE,
                                         VFX_WATER_NO_TEMPORAL, VFX_WATER_NO_HALF_RES, VFX_WATER_NO_SPRAY};
         const char *PQ = "water.quality";
-        if ((r = scene_expect_object(c, q, PQ)))
+        if ((r = rt_scene_expect_object(c, q, PQ)))
             return r;
-        scene_check_keys(c, q, PQ, qkeys);
-        r = scene_get_uint(c, q, PQ, "max_samples", false, 1, 4096, &wp->max_samples);
-        if (!r) r = scene_get_float(c, q, PQ, "step", false, (range){0, 1e3, true}, &wp->step);
-        if (!r) r = scene_get_uint(c, q, PQ, "refine_iters", false, 1, 64, &wp->refine_iters);
-        if (!r) r = scene_get_uint(c, q, PQ, "pyramid_level", false, 1, 12, &wp->pyramid_level);
-        if (!r) r = scene_get_enum(c, q, PQ, "method", false, methods, &wp->method);
-        if (!r) r = scene_get_flags(c, q, PQ, "disable", flags, bits, &wp->disable);
+        rt_scene_check_keys(c, q, PQ, qkeys);
+        r = rt_scene_get_uint(c, q, PQ, "max_samples", false, 1, 4096, &wp->max_samples);
+        if (!r) r = rt_scene_get_float(c, q, PQ, "step", false, (range){0, 1e3, true}, &wp->step);
+        if (!r) r = rt_scene_get_uint(c, q, PQ, "refine_iters", false, 1, 64, &wp->refine_iters);
+        if (!r) r = rt_scene_get_uint(c, q, PQ, "pyramid_level", false, 1, 12, &wp->pyramid_level);
+        if (!r) r = rt_scene_get_enum(c, q, PQ, "method", false, methods, &wp->method);
+        if (!r) r = rt_scene_get_flags(c, q, PQ, "disable", flags, bits, &wp->disable);
         if (!r && cJSON_GetObjectItemCaseSensitive(q, "kernel")) {
             static const char *const kernels[] = {"isotropic", "anisotropic", NULL};
             uint32_t k = 0;
-            r = scene_get_enum(c, q, PQ, "kernel", false, kernels, &k);
+            r = rt_scene_get_enum(c, q, PQ, "kernel", false, kernels, &k);
             w->kernel = k == 1 ? VFX_WATER_KERNEL_ANISOTROPIC : VFX_WATER_KERNEL_ISOTROPIC;
             if (!r && w->kernel == VFX_WATER_KERNEL_ANISOTROPIC && wp->method != VFX_WATER_METHOD_TILE)
-                r = scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.quality.kernel",
+                r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.quality.kernel",
                                 "\"anisotropic\" is drawn by method \"tile\" only (method \"%s\" draws the seed's isotropic kernel)",
                                 methods[wp->method]);
         }

@@ -10,35 +10,35 @@ vfx_result rt_sph_add_collider(rt_sph *s, const rt_sph_collider *c, uint32_t *in
     if (!s || !c)
         return VFX_ERR_INVALID_ARGUMENT;
     if (s->ncol >= SPH_MAX_COLLIDERS) {
-        sph_set_err(s, "rt_sph_add_collider: at most %u colliders", SPH_MAX_COLLIDERS);
+        rt_sph_set_err(s, "rt_sph_add_collider: at most %u colliders", SPH_MAX_COLLIDERS);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     rt_sph_collider k = *c;
     if (!sph_finite3(k.center) || !sph_finite3(k.normal) || !sph_finite3(k.half) || !sph_finite3(k.motion_axis) ||
         !isfinite(k.radius) || !isfinite(k.motion_amplitude) || !isfinite(k.motion_frequency)) {
-        sph_set_err(s, "rt_sph_add_collider: collider %u has a non-finite field", s->ncol);
+        rt_sph_set_err(s, "rt_sph_add_collider: collider %u has a non-finite field", s->ncol);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     if (k.kind == RT_SPH_PLANE) {
         float l = sqrtf(k.normal[0] * k.normal[0] + k.normal[1] * k.normal[1] + k.normal[2] * k.normal[2]);
         if (!(l > 1e-6f)) {
-            sph_set_err(s, "rt_sph_add_collider: plane %u has a zero normal", s->ncol);
+            rt_sph_set_err(s, "rt_sph_add_collider: plane %u has a zero normal", s->ncol);
             return VFX_ERR_INVALID_ARGUMENT;
         }
         for (int a = 0; a < 3; ++a)
             k.normal[a] /= l;
     } else if (k.kind == RT_SPH_SPHERE) {
         if (!(k.radius > 0.f)) {
-            sph_set_err(s, "rt_sph_add_collider: sphere %u needs radius > 0 (got %g)", s->ncol, (double)k.radius);
+            rt_sph_set_err(s, "rt_sph_add_collider: sphere %u needs radius > 0 (got %g)", s->ncol, (double)k.radius);
             return VFX_ERR_INVALID_ARGUMENT;
         }
     } else if (k.kind == RT_SPH_BOX) {
         if (!(k.half[0] > 0.f && k.half[1] > 0.f && k.half[2] > 0.f)) {
-            sph_set_err(s, "rt_sph_add_collider: box %u needs half extents > 0", s->ncol);
+            rt_sph_set_err(s, "rt_sph_add_collider: box %u needs half extents > 0", s->ncol);
             return VFX_ERR_INVALID_ARGUMENT;
         }
     } else {
-        sph_set_err(s, "rt_sph_add_collider: unknown kind %d", (int)k.kind);
+        rt_sph_set_err(s, "rt_sph_add_collider: unknown kind %d", (int)k.kind);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     float al = sqrtf(k.motion_axis[0] * k.motion_axis[0] + k.motion_axis[1] * k.motion_axis[1] +
@@ -134,16 +134,16 @@ vfx_result rt_sph_add_mesh_collider(rt_sph *s, const float *positions, uint32_t 
         return VFX_ERR_INVALID_ARGUMENT;
     s->err[0] = 0;
     if (s->ncol >= SPH_MAX_COLLIDERS) {
-        sph_set_err(s, "rt_sph_add_mesh_collider: at most %u colliders", SPH_MAX_COLLIDERS);
+        rt_sph_set_err(s, "rt_sph_add_mesh_collider: at most %u colliders", SPH_MAX_COLLIDERS);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     if (!positions || !indices || vertex_count == 0 || index_count < 3 || index_count % 3 != 0) {
-        sph_set_err(s, "rt_sph_add_mesh_collider: need vertices and a multiple of 3 indices (got %u "
+        rt_sph_set_err(s, "rt_sph_add_mesh_collider: need vertices and a multiple of 3 indices (got %u "
                 "vertices, %u indices)", vertex_count, index_count);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     if (index_count / 3 > SPH_MAX_MESH_TRIANGLES) {
-        sph_set_err(s, "rt_sph_add_mesh_collider: %u triangles, at most %u (the distance field is "
+        rt_sph_set_err(s, "rt_sph_add_mesh_collider: %u triangles, at most %u (the distance field is "
                 "built by brute force)", index_count / 3, SPH_MAX_MESH_TRIANGLES);
         return VFX_ERR_INVALID_ARGUMENT;
     }
@@ -152,7 +152,7 @@ vfx_result rt_sph_add_mesh_collider(rt_sph *s, const float *positions, uint32_t 
         for (int a = 0; a < 3; ++a) {
             float x = positions[3 * v + a];
             if (!isfinite(x)) {
-                sph_set_err(s, "rt_sph_add_mesh_collider: vertex %u is not finite", v);
+                rt_sph_set_err(s, "rt_sph_add_mesh_collider: vertex %u is not finite", v);
                 return VFX_ERR_INVALID_ARGUMENT;
             }
             lo[a] = x < lo[a] ? x : lo[a];
@@ -160,7 +160,7 @@ vfx_result rt_sph_add_mesh_collider(rt_sph *s, const float *positions, uint32_t 
         }
     for (uint32_t i = 0; i < index_count; ++i)
         if (indices[i] >= vertex_count) {
-            sph_set_err(s, "rt_sph_add_mesh_collider: triangle %u uses vertex %u of %u", i / 3,
+            rt_sph_set_err(s, "rt_sph_add_mesh_collider: triangle %u uses vertex %u of %u", i / 3,
                     indices[i], vertex_count);
             return VFX_ERR_INVALID_ARGUMENT;
         }
@@ -169,7 +169,7 @@ vfx_result rt_sph_add_mesh_collider(rt_sph *s, const float *positions, uint32_t 
         st.c = *motion;
         if (!sph_finite3(st.c.center) || !sph_finite3(st.c.motion_axis) || !isfinite(st.c.motion_amplitude) ||
             !isfinite(st.c.motion_frequency)) {
-            sph_set_err(s, "rt_sph_add_mesh_collider: motion has a non-finite field");
+            rt_sph_set_err(s, "rt_sph_add_mesh_collider: motion has a non-finite field");
             return VFX_ERR_INVALID_ARGUMENT;
         }
     }
@@ -195,7 +195,7 @@ vfx_result rt_sph_add_mesh_collider(rt_sph *s, const float *positions, uint32_t 
     }
     st.sdf = malloc(total * sizeof(float));
     if (!st.sdf) {
-        sph_set_err(s, "rt_sph_add_mesh_collider: out of memory for a %zu-node distance field", total);
+        rt_sph_set_err(s, "rt_sph_add_mesh_collider: out of memory for a %zu-node distance field", total);
         return VFX_ERR_OUT_OF_MEMORY;
     }
     uint32_t ntri = index_count / 3;
@@ -277,7 +277,7 @@ static float mesh_distance(const sph_collider_state *st, float px, float py, flo
     return d;
 }
 
-float sph_collider_distance(const sph_collider_state *st, float px, float py, float pz, float n[3])
+float rt_sph_surface_distance(const sph_collider_state *st, float px, float py, float pz, float n[3])
 {
     const rt_sph_collider *c = &st->c;
     if (st->sdf)
@@ -321,10 +321,10 @@ float rt_sph_collider_distance(const rt_sph *s, uint32_t index, const float p[3]
     if (!s || index >= s->ncol || !p)
         return NAN;
     float n[3];
-    return sph_collider_distance(&s->col[index], p[0], p[1], p[2], n);
+    return rt_sph_surface_distance(&s->col[index], p[0], p[1], p[2], n);
 }
 
-void sph_update_colliders(rt_sph *s, double t)
+void rt_sph_update_colliders(rt_sph *s, double t)
 {
     for (uint32_t i = 0; i < s->ncol; ++i) {
         sph_collider_state *st = &s->col[i];

@@ -8,7 +8,7 @@ vfx_result rt_sph_add_emitter(rt_sph *s, const rt_sph_emitter *e)
     if (!s || !e)
         return VFX_ERR_INVALID_ARGUMENT;
     if (s->nem >= SPH_MAX_EMITTERS) {
-        sph_set_err(s, "rt_sph_add_emitter: at most %u emitters", SPH_MAX_EMITTERS);
+        rt_sph_set_err(s, "rt_sph_add_emitter: at most %u emitters", SPH_MAX_EMITTERS);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     rt_sph_emitter k = *e;
@@ -16,7 +16,7 @@ vfx_result rt_sph_add_emitter(rt_sph *s, const rt_sph_emitter *e)
                     k.direction[2] * k.direction[2]);
     if (!sph_finite3(k.center) || !(l > 1e-6f) || !isfinite(l) || !(k.speed > 0.f) || !isfinite(k.speed) ||
         !(k.radius >= 0.5f * s->p.spacing) || !isfinite(k.radius)) {
-        sph_set_err(s, "rt_sph_add_emitter: emitter %u needs finite centre, non-zero direction, "
+        rt_sph_set_err(s, "rt_sph_add_emitter: emitter %u needs finite centre, non-zero direction, "
                 "speed > 0 and radius >= spacing/2", s->nem);
         return VFX_ERR_INVALID_ARGUMENT;
     }
@@ -40,7 +40,7 @@ vfx_result rt_sph_add_emitter(rt_sph *s, const rt_sph_emitter *e)
     return VFX_OK;
 }
 
-vfx_result sph_emit(rt_sph *s, double dt, uint32_t *emitted)
+vfx_result rt_sph_emit(rt_sph *s, double dt, uint32_t *emitted)
 {
     float dx = s->p.spacing;
     for (uint32_t k = 0; k < s->nem; ++k) {

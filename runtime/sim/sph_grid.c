@@ -44,10 +44,10 @@ static void permute_ids_chunk(rt_sph *s, uint32_t chunk)
  * cell's particles are contiguous (and a row of x-adjacent cells is one range). Stable, so
  * the order — and every sum over neighbours — does not depend on the thread count. Keys and
  * the permutation run on all threads; the histogram and the scatter are serial (O(n + cells)). */
-vfx_result sph_build_grid(rt_sph *s)
+vfx_result rt_sph_build_grid(rt_sph *s)
 {
     uint32_t n = s->n;
-    sph_parallel(s, key_chunk, false);
+    rt_sph_parallel(s, key_chunk, false);
     memset(s->cell_start, 0, ((size_t)s->ncells + 1) * sizeof *s->cell_start);
     for (uint32_t i = 0; i < n; ++i)
         s->cell_start[s->key[i] + 1]++;
@@ -65,16 +65,16 @@ vfx_result sph_build_grid(rt_sph *s)
         rt_sph_columns c = {0};
         vfx_result r = s->host.permute(s->host.user, s->perm, &c);
         if (r || c.count != n) {
-            sph_set_err(s, "rt_sph_step: the host could not reorder its %u rows by grid cell (%s)", n,
+            rt_sph_set_err(s, "rt_sph_step: the host could not reorder its %u rows by grid cell (%s)", n,
                         r ? vfx_result_name(r) : "wrong row count back");
             s->lists_valid = false;
             return r ? r : VFX_ERR_INVALID_ARGUMENT;
         }
-        sph_take_columns(s, &c);
-        sph_parallel(s, permute_ids_chunk, false);
+        rt_sph_take_columns(s, &c);
+        rt_sph_parallel(s, permute_ids_chunk, false);
     } else {
-        sph_parallel(s, permute_chunk, false);
-        sph_swap_state(s);
+        rt_sph_parallel(s, permute_chunk, false);
+        rt_sph_swap_state(s);
     }
     uint32_t *t = s->id;
     s->id = s->idtmp;
@@ -103,7 +103,7 @@ float rt_sph_volume_fraction(const rt_sph *s, const float p[3])
             }
         }
     sph_wall_hit walls[SPH_MAX_WALLS];
-    int nw = sph_gather_walls(s, p[0], p[1], p[2], walls, SPH_MAX_WALLS);
+    int nw = rt_sph_gather_walls(s, p[0], p[1], p[2], walls, SPH_MAX_WALLS);
     float inside, extra;
     sph_wall_share(s, walls, nw, NULL, &inside, &extra);
     float gam = inside - extra;

@@ -182,40 +182,40 @@ static inline int sph_walls_box(const sph_wall_hit *w, int nw)
 }
 
 /* sph_params.c */
-void sph_set_err(rt_sph *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+void rt_sph_set_err(rt_sph *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 /* sph_pool.c: starts the workers (fewer when a thread cannot be made: p.threads then says how
  * many run; out of memory for their handles is an error); stops and joins them */
-vfx_result sph_pool_start(rt_sph *s);
-void sph_pool_stop(rt_sph *s);
+vfx_result rt_sph_pool_start(rt_sph *s);
+void rt_sph_pool_stop(rt_sph *s);
 /* Runs fn over every chunk on all threads. The density pass starts the chunk reductions
  * afresh (fresh); later passes of the same substep add to them and only reset the failure slot. */
-void sph_parallel(rt_sph *s, sph_chunk_fn fn, bool fresh);
+void rt_sph_parallel(rt_sph *s, sph_chunk_fn fn, bool fresh);
 
 /* sph_storage.c */
 /* Grows every per-particle and per-chunk buffer to hold `want` particles. */
-vfx_result sph_reserve(rt_sph *s, uint64_t want);
-void sph_free_columns(rt_sph *s);
+vfx_result rt_sph_reserve(rt_sph *s, uint64_t want);
+void rt_sph_free_columns(rt_sph *s);
 /* Exchanges the state columns with the integration buffers (xn ...); own state only. */
-void sph_swap_state(rt_sph *s);
+void rt_sph_swap_state(rt_sph *s);
 /* Makes the integration buffers the state: a swap, or a copy into the host's columns. */
-void sph_commit_state(rt_sph *s);
+void rt_sph_commit_state(rt_sph *s);
 /* Takes the host's column pointers. */
-void sph_take_columns(rt_sph *s, const rt_sph_columns *c);
+void rt_sph_take_columns(rt_sph *s, const rt_sph_columns *c);
 
 /* sph_collide.c */
 /* Signed distance of p to a collider surface (positive on the fluid side), outward normal in n. */
-float sph_collider_distance(const sph_collider_state *st, float px, float py, float pz, float n[3]);
+float rt_sph_surface_distance(const sph_collider_state *st, float px, float py, float pz, float n[3]);
 /* Moves every collider to its position and velocity at time t. */
-void sph_update_colliders(rt_sph *s, double t);
+void rt_sph_update_colliders(rt_sph *s, double t);
 
 /* sph_grid.c: sorts the particles by cell (all columns follow, through the host when bound),
  * cell_start is rebuilt; an error when the host could not reorder (nothing changed then) */
-vfx_result sph_build_grid(rt_sph *s);
+vfx_result rt_sph_build_grid(rt_sph *s);
 
 /* sph_wall.c */
 /* The walls within H of p (box faces first, then colliders); their number. */
-int sph_gather_walls(const rt_sph *s, float px, float py, float pz, sph_wall_hit *w, int max);
+int rt_sph_gather_walls(const rt_sph *s, float px, float py, float pz, sph_wall_hit *w, int max);
 /* Kernel share of the walls: inside = prod over box walls of (1 - f), extra = sum over
  * colliders of f; each wall's f in fr[] when fr is not NULL. Inline: it runs per particle in
  * the density and force passes (out of line it cost ~2% of a substep's instructions). */
@@ -242,16 +242,16 @@ static inline void sph_wall_share(const rt_sph *s, const sph_wall_hit *w, int nw
 /* Wall terms of the force pass for particle (p, v) with pressure term pri, density rhoi:
  * adds the mirror-image pressure and viscosity to a, divides by the fluid share, adds the
  * wall-law friction of no-slip walls (gravity not included). */
-void sph_wall_accel(const rt_sph *s, const float p[3], const float vel[3], float pri, float rhoi,
+void rt_sph_wall_accel(const rt_sph *s, const float p[3], const float vel[3], float pri, float rhoi,
                     float a[3], sph_wall_hit *walls);
 
-/* sph_kernels.c: the passes run by sph_parallel */
-void sph_density_chunk(rt_sph *s, uint32_t chunk);
-void sph_force_chunk(rt_sph *s, uint32_t chunk);
-void sph_integrate_chunk(rt_sph *s, uint32_t chunk);
-void sph_disp_chunk(rt_sph *s, uint32_t chunk);
+/* sph_kernels.c: the passes run by rt_sph_parallel */
+void rt_sph_density_chunk(rt_sph *s, uint32_t chunk);
+void rt_sph_force_chunk(rt_sph *s, uint32_t chunk);
+void rt_sph_integrate_chunk(rt_sph *s, uint32_t chunk);
+void rt_sph_disp_chunk(rt_sph *s, uint32_t chunk);
 
 /* sph_emit.c: runs the emitters for dt (0 on the first substep); count added to *emitted */
-vfx_result sph_emit(rt_sph *s, double dt, uint32_t *emitted);
+vfx_result rt_sph_emit(rt_sph *s, double dt, uint32_t *emitted);
 
 #endif

@@ -47,7 +47,7 @@ density_tail(rt_sph *s, uint32_t i, float sum, uint32_t nn, float px, float py, 
     const float kp = s->k_poly6, m = s->mass, rho0 = s->p.rest_density;
     const float gam = s->p.gamma, B = s->B, c2_0 = s->c0 * s->c0;
     float rho = m * kp * sum;
-    int nw = sph_gather_walls(s, px, py, pz, walls, SPH_MAX_WALLS);
+    int nw = rt_sph_gather_walls(s, px, py, pz, walls, SPH_MAX_WALLS);
     float inside, extra;
     sph_wall_share(s, walls, nw, NULL, &inside, &extra);
     rho += rho0 * (1.f - inside + extra);
@@ -213,7 +213,7 @@ static void density_walk(rt_sph *s, uint32_t chunk)
     s->out[chunk] = acc;
 }
 
-void sph_density_chunk(rt_sph *s, uint32_t chunk)
+void rt_sph_density_chunk(rt_sph *s, uint32_t chunk)
 {
     if (s->dens_mode == 2)
         density_walk(s, chunk);
@@ -224,7 +224,7 @@ void sph_density_chunk(rt_sph *s, uint32_t chunk)
 }
 
 /* Squared displacement of every particle since the last rebuild (columns edited by hand). */
-void sph_disp_chunk(rt_sph *s, uint32_t chunk)
+void rt_sph_disp_chunk(rt_sph *s, uint32_t chunk)
 {
     uint32_t b, e;
     sph_chunk_rows(s, chunk, &b, &e);
@@ -252,7 +252,7 @@ static void coincident_dir(uint32_t a, uint32_t b, float out[3])
     out[0] = sg * sz * cosf(th), out[1] = sg * sz * sinf(th), out[2] = sg * cz;
 }
 
-void sph_force_chunk(rt_sph *s, uint32_t chunk)
+void rt_sph_force_chunk(rt_sph *s, uint32_t chunk)
 {
     uint32_t b, e;
     sph_chunk_rows(s, chunk, &b, &e);
@@ -363,7 +363,7 @@ void sph_force_chunk(rt_sph *s, uint32_t chunk)
          * kernel share, wall-law friction */
         {
             float p[3] = {px, py, pz}, v[3] = {vxi, vyi, vzi}, a[3] = {ax, ay, az};
-            sph_wall_accel(s, p, v, pri, rhoi, a, walls);
+            rt_sph_wall_accel(s, p, v, pri, rhoi, a, walls);
             ax = a[0], ay = a[1], az = a[2];
         }
         ax += g[0], ay += g[1], az += g[2];
@@ -380,7 +380,7 @@ void sph_force_chunk(rt_sph *s, uint32_t chunk)
     s->out[chunk] = acc;
 }
 
-void sph_integrate_chunk(rt_sph *s, uint32_t chunk)
+void rt_sph_integrate_chunk(rt_sph *s, uint32_t chunk)
 {
     uint32_t b, e;
     sph_chunk_rows(s, chunk, &b, &e);
@@ -400,7 +400,7 @@ void sph_integrate_chunk(rt_sph *s, uint32_t chunk)
         /* colliders: push back to the margin, remove the velocity into the solid (relative) */
         for (uint32_t c = 0; c < s->ncol; ++c) {
             float n[3];
-            float d = sph_collider_distance(&s->col[c], p[0], p[1], p[2], n);
+            float d = rt_sph_surface_distance(&s->col[c], p[0], p[1], p[2], n);
             if (d < margin) {
                 for (int a = 0; a < 3; ++a)
                     p[a] += (margin - d) * n[a];

@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <unistd.h>
 
-void sph_set_err(rt_sph *s, const char *fmt, ...)
+void rt_sph_set_err(rt_sph *s, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -223,7 +223,7 @@ vfx_result rt_sph_create(const rt_sph_desc *desc, rt_sph **out, char *err, size_
         return VFX_ERR_OUT_OF_MEMORY;
     }
     atomic_init(&s->nb_oom, false);
-    if (sph_pool_start(s)) {
+    if (rt_sph_pool_start(s)) {
         rt_sph_destroy(s);
         snprintf(err, err_len, "rt_sph_create: out of memory");
         return VFX_ERR_OUT_OF_MEMORY;
@@ -236,8 +236,8 @@ void rt_sph_destroy(rt_sph *s)
 {
     if (!s)
         return;
-    sph_pool_stop(s);
-    sph_free_columns(s);
+    rt_sph_pool_stop(s);
+    rt_sph_free_columns(s);
     free(s->cell_start);
     free(s->out);
     for (uint32_t c = 0; c < s->ncol; ++c)

@@ -36,7 +36,7 @@ static void *worker_main(void *arg)
     }
 }
 
-vfx_result sph_pool_start(rt_sph *s)
+vfx_result rt_sph_pool_start(rt_sph *s)
 {
     pthread_mutex_init(&s->mu, NULL);
     pthread_cond_init(&s->cv_start, NULL);
@@ -58,7 +58,7 @@ vfx_result sph_pool_start(rt_sph *s)
     return VFX_OK;
 }
 
-void sph_pool_stop(rt_sph *s)
+void rt_sph_pool_stop(rt_sph *s)
 {
     pthread_mutex_lock(&s->mu);
     s->quit = true;
@@ -74,7 +74,7 @@ void sph_pool_stop(rt_sph *s)
     pthread_cond_destroy(&s->cv_done);
 }
 
-void sph_parallel(rt_sph *s, sph_chunk_fn fn, bool fresh)
+void rt_sph_parallel(rt_sph *s, sph_chunk_fn fn, bool fresh)
 {
     uint32_t nchunks = sph_chunk_count(s);
     for (uint32_t c = 0; c < nchunks; ++c) {

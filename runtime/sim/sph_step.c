@@ -23,7 +23,7 @@ static vfx_result density_pass(rt_sph *s, rt_sph_report *rep)
 {
     bool rebuild = !s->verlet || !s->lists_valid || !(4.f * s->disp2_max < s->skin * s->skin);
     if (rebuild) {
-        vfx_result r = sph_build_grid(s);
+        vfx_result r = rt_sph_build_grid(s);
         if (r)
             return r;
         rep->neighbor_rebuilds++;
@@ -31,7 +31,7 @@ static vfx_result density_pass(rt_sph *s, rt_sph_report *rep)
     } else {
         s->dens_mode = 2;
     }
-    sph_parallel(s, sph_density_chunk, true);
+    rt_sph_parallel(s, rt_sph_density_chunk, true);
     if (s->verlet && rebuild) {
         s->lists_valid = !atomic_load(&s->nb_oom);
         s->disp2_max = 0.f;
@@ -135,14 +135,14 @@ static vfx_result integrate_redo(rt_sph *s, double *dt, rt_sph_report *rep)
     uint32_t nchunks = sph_chunk_count(s);
     for (uint32_t tries = 0;; ++tries) {
         s->dt_try = (float)*dt;
-        sph_parallel(s, sph_integrate_chunk, false);
+        rt_sph_parallel(s, rt_sph_integrate_chunk, false);
         const sph_chunk_out *bo = NULL;
         uint32_t bad = first_bad(s, nchunks, &bo);
         if (bad == UINT32_MAX)
             return VFX_OK;
         if (bo->bad_kind == 1 || tries >= s->p.max_redo) {
             static const char *what[] = {"", "non-finite state", "speed", "density change"};
-            sph_set_err(s, "rt_sph_step: particle %u (row %u) blew up: %s %g (limit %g) "
+            rt_sph_set_err(s, "rt_sph_step: particle %u (row %u) blew up: %s %g (limit %g) "
                         "after %u dt halvings (dt %.3g s) at t=%.6g s; state left at the "
                         "last good substep", s->id[bad], bad, what[bo->bad_kind],
                         (double)bo->bad_value,
@@ -165,14 +165,14 @@ static vfx_result substep(rt_sph *s, double remaining, rt_sph_report *rep, doubl
         return res;
     if (atomic_exchange(&s->nb_oom, false)) {
         s->lists_valid = false;
-        sph_set_err(s, "rt_sph_step: out of memory for the neighbour lists of %u particles", s->n);
+        rt_sph_set_err(s, "rt_sph_step: out of memory for the neighbour lists of %u particles", s->n);
         return VFX_ERR_OUT_OF_MEMORY;
     }
-    sph_parallel(s, sph_force_chunk, false);
+    rt_sph_parallel(s, rt_sph_force_chunk, false);
     const sph_chunk_out *bo = NULL;
     uint32_t bad = first_bad(s, sph_chunk_count(s), &bo);
     if (bad != UINT32_MAX) {
-        sph_set_err(s, "rt_sph_step: particle %u (row %u) has a non-finite density or "
+        rt_sph_set_err(s, "rt_sph_step: particle %u (row %u) has a non-finite density or "
                     "force (%g) at t=%.6g s; state left at the last good substep",
                     s->id[bad], bad, (double)bo->bad_value, s->time);
         return VFX_ERR_NUMERIC;
@@ -182,7 +182,7 @@ static vfx_result substep(rt_sph *s, double remaining, rt_sph_report *rep, doubl
     *dt = select_dt(s, remaining, vmax, amax, cmax, lim);
     if ((res = integrate_redo(s, dt, rep)))
         return res;
-    sph_commit_state(s);
+    rt_sph_commit_state(s);
     if (s->verlet)
         reduce_disp(s);
     return VFX_OK;
@@ -197,7 +197,7 @@ vfx_result rt_sph_step(rt_sph *s, float frame_dt, rt_sph_report *report)
         return VFX_ERR_INVALID_ARGUMENT;
     s->err[0] = 0;
     if (!isfinite(frame_dt) || frame_dt < 0.f) {
-        sph_set_err(s, "rt_sph_step: frame_dt %g must be finite and >= 0", (double)frame_dt);
+        rt_sph_set_err(s, "rt_sph_step: frame_dt %g must be finite and >= 0", (double)frame_dt);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     double t = 0.0;
@@ -205,7 +205,7 @@ vfx_result rt_sph_step(rt_sph *s, float frame_dt, rt_sph_report *report)
     vfx_result res = VFX_OK;
     if (s->verlet && s->lists_valid && s->n) {
         /* the columns are writable between steps: measure how far they were moved */
-        sph_parallel(s, sph_disp_chunk, false);
+        rt_sph_parallel(s, rt_sph_disp_chunk, false);
         reduce_disp(s);
     }
     while (t < (double)frame_dt * (1.0 - 1e-9)) {
@@ -214,11 +214,11 @@ vfx_result rt_sph_step(rt_sph *s, float frame_dt, rt_sph_report *report)
             break;
         }
         if (s->nem) {
-            res = sph_emit(s, rep.substeps ? rep.dt_last : 0.0, &rep.emitted);
+            res = rt_sph_emit(s, rep.substeps ? rep.dt_last : 0.0, &rep.emitted);
             if (res)
                 break;
         }
-        sph_update_colliders(s, s->time);
+        rt_sph_update_colliders(s, s->time);
         double dt = (double)frame_dt - t;
         rt_sph_dt_limit lim = RT_SPH_DT_FRAME;
         if (s->n && (res = substep(s, (double)frame_dt - t, &rep, &dt, &lim)))

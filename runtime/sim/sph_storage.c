@@ -22,7 +22,7 @@ static void drop_state(rt_sph *s)
     s->state_cap = 0;
 }
 
-void sph_free_columns(rt_sph *s)
+void rt_sph_free_columns(rt_sph *s)
 {
     drop_state(s);
     float **f[] = SPH_SCRATCH_COLUMNS(s);
@@ -72,10 +72,10 @@ rt_sph_columns rt_sph_get_columns(rt_sph *s)
     return (rt_sph_columns){s->n, s->x, s->y, s->z, s->vx, s->vy, s->vz, s->rho, s->id};
 }
 
-vfx_result sph_reserve(rt_sph *s, uint64_t want)
+vfx_result rt_sph_reserve(rt_sph *s, uint64_t want)
 {
     if (want > s->p.max_particles) {
-        sph_set_err(s, "rt_sph: %llu particles requested, capacity bound is %u (desc.max_particles)",
+        rt_sph_set_err(s, "rt_sph: %llu particles requested, capacity bound is %u (desc.max_particles)",
                 (unsigned long long)want, s->p.max_particles);
         return VFX_ERR_INVALID_ARGUMENT;
     }
@@ -147,7 +147,7 @@ vfx_result sph_reserve(rt_sph *s, uint64_t want)
     s->cap = (uint32_t)cap;
     return VFX_OK;
 oom:
-    sph_set_err(s, "rt_sph: out of memory growing to %llu particles", (unsigned long long)cap);
+    rt_sph_set_err(s, "rt_sph: out of memory growing to %llu particles", (unsigned long long)cap);
     return VFX_ERR_OUT_OF_MEMORY;
 }
 
@@ -159,14 +159,14 @@ static vfx_result check_finite(rt_sph *s, const char *who, const char *of, const
     for (uint32_t i = 0; i < n; ++i)
         for (int a = 0; a < 6; ++a)
             if (arr[a] && !isfinite(arr[a][i])) {
-                sph_set_err(s, "%s: particle %u (of %u %s) has a non-finite %s (%g); %s refused", who,
+                rt_sph_set_err(s, "%s: particle %u (of %u %s) has a non-finite %s (%g); %s refused", who,
                             i, n, of, nm[a], (double)arr[a][i], what);
                 return VFX_ERR_INVALID_ARGUMENT;
             }
     return VFX_OK;
 }
 
-void sph_take_columns(rt_sph *s, const rt_sph_columns *c)
+void rt_sph_take_columns(rt_sph *s, const rt_sph_columns *c)
 {
     s->x = c->x, s->y = c->y, s->z = c->z;
     s->vx = c->vx, s->vy = c->vy, s->vz = c->vz;
@@ -176,17 +176,17 @@ void sph_take_columns(rt_sph *s, const rt_sph_columns *c)
 /* Room for `add` more rows (n is not changed): our buffers, and the host's rows when bound. */
 static vfx_result grow_rows(rt_sph *s, uint32_t add)
 {
-    vfx_result r = sph_reserve(s, (uint64_t)s->n + add);
+    vfx_result r = rt_sph_reserve(s, (uint64_t)s->n + add);
     if (r || !s->bound)
         return r;
     rt_sph_columns c = {0};
     r = s->host.append(s->host.user, add, &c);
     if (r || c.count != s->n + add) {
-        sph_set_err(s, "rt_sph: the host could not append %u rows to its %u (%s)", add, s->n,
+        rt_sph_set_err(s, "rt_sph: the host could not append %u rows to its %u (%s)", add, s->n,
                     r ? vfx_result_name(r) : "wrong row count back");
         return r ? r : VFX_ERR_INVALID_ARGUMENT;
     }
-    sph_take_columns(s, &c);
+    rt_sph_take_columns(s, &c);
     return VFX_OK;
 }
 
@@ -221,11 +221,11 @@ vfx_result rt_sph_add_particles(rt_sph *s, uint32_t n, const float *x, const flo
     if (n == 0)
         return VFX_OK;
     if (!x || !y || !z) {
-        sph_set_err(s, "rt_sph_add_particles: position array is NULL for %u particles", n);
+        rt_sph_set_err(s, "rt_sph_add_particles: position array is NULL for %u particles", n);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     if ((uint64_t)s->n + n > s->p.max_particles) {
-        sph_set_err(s, "rt_sph_add_particles: %u + %u particles exceed the capacity bound %u "
+        rt_sph_set_err(s, "rt_sph_add_particles: %u + %u particles exceed the capacity bound %u "
                 "(desc.max_particles)", s->n, n, s->p.max_particles);
         return VFX_ERR_INVALID_ARGUMENT;
     }
@@ -270,7 +270,7 @@ vfx_result rt_sph_add_block(rt_sph *s, const float lo[3], const float hi[3], uin
     uint64_t c[3];
     for (int a = 0; a < 3; ++a) {
         if (!isfinite(lo[a]) || !isfinite(hi[a]) || hi[a] < lo[a]) {
-            sph_set_err(s, "rt_sph_add_block: bad bounds on axis %d (%g..%g)", a, (double)lo[a], (double)hi[a]);
+            rt_sph_set_err(s, "rt_sph_add_block: bad bounds on axis %d (%g..%g)", a, (double)lo[a], (double)hi[a]);
             return VFX_ERR_INVALID_ARGUMENT;
         }
         c[a] = (uint64_t)floor((hi[a] - lo[a]) / dx + 1e-4);
@@ -279,7 +279,7 @@ vfx_result rt_sph_add_block(rt_sph *s, const float lo[3], const float hi[3], uin
     if (total == 0)
         return VFX_OK;
     if (total > s->p.max_particles - s->n)
-        return sph_reserve(s, s->n + total); /* names the capacity bound */
+        return rt_sph_reserve(s, s->n + total); /* names the capacity bound */
     uint32_t base = s->n;
     vfx_result r = grow_rows(s, (uint32_t)total);
     if (r)
@@ -299,7 +299,7 @@ vfx_result rt_sph_add_block(rt_sph *s, const float lo[3], const float hi[3], uin
     return VFX_OK;
 }
 
-void sph_swap_state(rt_sph *s)
+void rt_sph_swap_state(rt_sph *s)
 {
     float *t;
 #define SW(a, b) (t = s->a, s->a = s->b, s->b = t)
@@ -312,10 +312,10 @@ void sph_swap_state(rt_sph *s)
 #undef SW
 }
 
-void sph_commit_state(rt_sph *s)
+void rt_sph_commit_state(rt_sph *s)
 {
     if (!s->bound) {
-        sph_swap_state(s);
+        rt_sph_swap_state(s);
         return;
     }
     /* the host's columns stay where they are: the integrated state is copied into them */
@@ -331,7 +331,7 @@ vfx_result rt_sph_bind(rt_sph *s, const rt_sph_host *host, const rt_sph_columns 
     s->err[0] = 0;
     if (!host || !host->permute || !host->append || !c ||
         (c->count && (!c->x || !c->y || !c->z || !c->vx || !c->vy || !c->vz || !c->density))) {
-        sph_set_err(s, "rt_sph_bind: need a host with permute and append, and every column of "
+        rt_sph_set_err(s, "rt_sph_bind: need a host with permute and append, and every column of "
                     "its %u rows", c ? c->count : 0);
         return VFX_ERR_INVALID_ARGUMENT;
     }
@@ -344,11 +344,11 @@ vfx_result rt_sph_bind(rt_sph *s, const rt_sph_host *host, const rt_sph_columns 
     s->host = *host;
     s->n = 0;
     s->next_id = 0;
-    if ((r = sph_reserve(s, c->count))) {
+    if ((r = rt_sph_reserve(s, c->count))) {
         rt_sph_clear(s);
         return r;
     }
-    sph_take_columns(s, c);
+    rt_sph_take_columns(s, c);
     fresh_rows(s, 0, c->count);
     return VFX_OK;
 }

@@ -59,7 +59,7 @@ double rt_sph_wall_friction_velocity(double ut, double y, double nu)
 
 /* ---- walls near a particle ----------------------------------------------------------------- */
 
-int sph_gather_walls(const rt_sph *s, float px, float py, float pz, sph_wall_hit *w, int max)
+int rt_sph_gather_walls(const rt_sph *s, float px, float py, float pz, sph_wall_hit *w, int max)
 {
     int k = 0;
     const float *lo = s->p.domain_min, *hi = s->p.domain_max;
@@ -79,7 +79,7 @@ int sph_gather_walls(const rt_sph *s, float px, float py, float pz, sph_wall_hit
     }
     for (uint32_t c = 0; c < s->ncol && k < max; ++c) {
         float n[3];
-        float d = sph_collider_distance(&s->col[c], px, py, pz, n);
+        float d = rt_sph_surface_distance(&s->col[c], px, py, pz, n);
         if (d < s->H) {
             w[k] = (sph_wall_hit){{n[0], n[1], n[2]}, d, {s->col[c].vel[0], s->col[c].vel[1], s->col[c].vel[2]},
                                   false, s->col[c].c.no_slip != 0};
@@ -89,7 +89,7 @@ int sph_gather_walls(const rt_sph *s, float px, float py, float pz, sph_wall_hit
     return k;
 }
 
-void sph_wall_accel(const rt_sph *s, const float p[3], const float vel[3], float pri, float rhoi,
+void rt_sph_wall_accel(const rt_sph *s, const float p[3], const float vel[3], float pri, float rhoi,
                     float a[3], sph_wall_hit *walls)
 {
     const float H = s->H, h = s->h, alpha = s->p.viscosity, c0 = s->c0, rho0 = s->p.rest_density;
@@ -111,7 +111,7 @@ void sph_wall_accel(const rt_sph *s, const float p[3], const float vel[3], float
      * Measured in a resting column (docs/simulation.md): the earlier single-sided form
      * p_i/rho_i^2 read +58% in the wall layer and +26% overall; (1) without the image
      * viscosity pumped energy into a resting tank; (2) alone compressed the wall layer. */
-    int nw = sph_gather_walls(s, p[0], p[1], p[2], walls, SPH_MAX_WALLS);
+    int nw = rt_sph_gather_walls(s, p[0], p[1], p[2], walls, SPH_MAX_WALLS);
     int nb = sph_walls_box(walls, nw);
     float fr[SPH_MAX_WALLS], gr[SPH_MAX_WALLS]; /* density fraction, its gradient */
     float inside, extra;
