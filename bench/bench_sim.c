@@ -51,10 +51,10 @@ static void cpu_model(char *out, size_t len)
 
 /* The timed call, out of line so that `valgrind --tool=callgrind --toggle-collect=bench_timed_step`
  * counts the timed substeps only (not the warm-up or the setup). */
-__attribute__((noinline)) vfx_result bench_timed_step(rt_sph *s, rt_sph_report *r);
-__attribute__((noinline)) vfx_result bench_timed_step(rt_sph *s, rt_sph_report *r)
+__attribute__((noinline)) vfx_result bench_timed_step(rt_sph *s, rt_sph_report *r, char *err, size_t errlen);
+__attribute__((noinline)) vfx_result bench_timed_step(rt_sph *s, rt_sph_report *r, char *err, size_t errlen)
 {
-    return rt_sph_step(s, 1.f, r);
+    return rt_sph_step(s, 1.f, r, err, errlen);
 }
 
 typedef struct bench_opts {
@@ -101,8 +101,9 @@ static int bench_size(uint32_t n_target, const uint32_t *threads, int nthreads, 
     uint32_t n = 0;
     rt_sph_report wr = {0};
     double tw = now_s();
-    if (rt_sph_add_block(w, lo, hi, &n) || (o->warmup_s > 0.0 && rt_sph_step(w, (float)o->warmup_s, &wr))) {
-        fprintf(stderr, "volfx-bench sim: warm-up: %s\n", rt_sph_last_error(w));
+    if (rt_sph_add_block(w, lo, hi, &n, err, sizeof err) ||
+        (o->warmup_s > 0.0 && rt_sph_step(w, (float)o->warmup_s, &wr, err, sizeof err))) {
+        fprintf(stderr, "volfx-bench sim: warm-up: %s\n", err);
         rt_sph_destroy(w);
         return 1;
     }
@@ -136,12 +137,12 @@ static int bench_size(uint32_t n_target, const uint32_t *threads, int nthreads, 
                 break;
             }
             thr_of[k] = rt_sph_thread_count(s[k]);
-            if (rt_sph_add_particles(s[k], wc.count, wc.x, wc.y, wc.z, wc.vx, wc.vy, wc.vz)) {
-                fprintf(stderr, "volfx-bench sim: %s\n", rt_sph_last_error(s[k]));
+            if (rt_sph_add_particles(s[k], wc.count, wc.x, wc.y, wc.z, wc.vx, wc.vy, wc.vz, err, sizeof err)) {
+                fprintf(stderr, "volfx-bench sim: %s\n", err);
                 rc = 1;
                 break;
             }
-            rt_sph_step(s[k], 1.f, &r[k]); /* untimed: pages touched, lists built */
+            rt_sph_step(s[k], 1.f, &r[k], NULL, 0); /* untimed: pages touched, lists built */
             ps[k] = calloc((size_t)reps, sizeof *ps[k]);
             is[k] = calloc((size_t)reps, sizeof *is[k]);
             ms[k] = calloc((size_t)reps, sizeof *ms[k]);
@@ -158,10 +159,10 @@ static int bench_size(uint32_t n_target, const uint32_t *threads, int nthreads, 
         for (int k = 0; k < nsol && !rc; ++k) {
             double t0 = now_s();
             /* frame_dt 1 s and a substep cap: exactly `substeps` substeps + one closing density pass */
-            vfx_result e = bench_timed_step(s[k], &r[k]);
+            vfx_result e = bench_timed_step(s[k], &r[k], err, sizeof err);
             double dt = now_s() - t0;
             if (e) {
-                fprintf(stderr, "volfx-bench sim: %s\n", rt_sph_last_error(s[k]));
+                fprintf(stderr, "volfx-bench sim: %s\n", err);
                 rc = 1;
                 break;
             }
@@ -280,10 +281,10 @@ static int dam_break(int res, uint32_t threads, double t_max, double settle_s, u
             rt_sph_destroy(s);
             return 1;
         }
-        rt_sph_add_block(gs, lo, hi, &n);
+        rt_sph_add_block(gs, lo, hi, &n, NULL, 0);
         rt_sph_report r;
-        if (rt_sph_step(gs, (float)settle_s, &r)) {
-            fprintf(stderr, "volfx-bench sim: settling: %s\n", rt_sph_last_error(gs));
+        if (rt_sph_step(gs, (float)settle_s, &r, err, sizeof err)) {
+            fprintf(stderr, "volfx-bench sim: settling: %s\n", err);
             rt_sph_destroy(gs);
             rt_sph_destroy(s);
             return 1;
@@ -292,10 +293,10 @@ static int dam_break(int res, uint32_t threads, double t_max, double settle_s, u
                "\"kinetic_energy_J\":%.3g,\"max_speed\":%.4f,\"max_density_error\":%.4f}\n",
                res, settle_s, r.kinetic_energy, r.max_speed, r.max_density_error);
         rt_sph_columns c = rt_sph_get_columns(gs);
-        rt_sph_add_particles(s, c.count, c.x, c.y, c.z, NULL, NULL, NULL); /* released at rest */
+        rt_sph_add_particles(s, c.count, c.x, c.y, c.z, NULL, NULL, NULL, NULL, 0); /* released at rest */
         rt_sph_destroy(gs);
     } else {
-        rt_sph_add_block(s, lo, hi, &n);
+        rt_sph_add_block(s, lo, hi, &n, NULL, 0);
     }
     double Ts = sqrt(2 * g / a), worst = 0.0;
     uint64_t substeps = 0;
@@ -304,8 +305,8 @@ static int dam_break(int res, uint32_t threads, double t_max, double settle_s, u
         if (mm_T[k] > t_max)
             break;
         rt_sph_report r;
-        if (rt_sph_step(s, (float)(mm_T[k] / Ts - rt_sph_time(s)), &r)) {
-            fprintf(stderr, "volfx-bench sim: %s\n", rt_sph_last_error(s));
+        if (rt_sph_step(s, (float)(mm_T[k] / Ts - rt_sph_time(s)), &r, err, sizeof err)) {
+            fprintf(stderr, "volfx-bench sim: %s\n", err);
             rc = 1;
             break;
         }

@@ -100,8 +100,10 @@ static vfx_result load_water(game_app *app, game_demo *demo, const rt_scene *sc)
             paddle.half[ax] = 0.5f * spacing;
             paddle.center[ax] = w->tank_min[ax] + w->paddle_amplitude + spacing;
             paddle.motion_axis[ax] = 1.0f;
-            if ((r = rt_sph_add_collider(rt_sim_system_solver(demo->sim), &paddle, NULL)))
+            if ((r = rt_sph_add_collider(rt_sim_system_solver(demo->sim), &paddle, NULL, err, sizeof err))) {
+                rt_logf(&app->log, VFX_LOG_ERROR, "scene water paddle: %s", err);
                 goto done;
+            }
         }
     }
     if ((r = rt_particles_spawn(app->world, &app->particles, n, px, py, pz, false)))

@@ -21,7 +21,6 @@ struct rt_sim_system {
     uint32_t table;
     uint64_t revision;
     bool bound;
-    char err[512];
 };
 
 /* The columns of `table` (count 0 when it is empty or unknown). */
@@ -77,9 +76,8 @@ static vfx_result host_append(void *user, uint32_t add, rt_sph_columns *c)
         return r;
     table_columns(s, s->table, c);
     if (s->table != SIM_NO_TABLE && table != s->table && c->count) {
-        snprintf(s->err, sizeof s->err, "vfx.sim.sph: emitted particles landed in another table "
-                 "than the simulated ones (they carry other components)");
-        return VFX_ERR_UNSUPPORTED;
+        return rt_world_fail(s->world, VFX_ERR_UNSUPPORTED, "vfx.sim.sph: emitted particles landed "
+                             "in another table than the simulated ones (they carry other components)");
     }
     s->table = table;
     table_columns(s, table, c);
@@ -98,9 +96,9 @@ static vfx_result find_table(rt_sim_system *s, uint32_t *table)
         if (tables++ == 0)
             *table = it.table;
     if (tables > 1) {
-        snprintf(s->err, sizeof s->err, "vfx.sim.sph: the particles are in %u tables (entities "
-                 "with different component sets); the solver steps one table in place", tables);
-        return VFX_ERR_UNSUPPORTED;
+        return rt_world_fail(s->world, VFX_ERR_UNSUPPORTED, "vfx.sim.sph: the particles are in %u "
+                             "tables (entities with different component sets); the solver steps "
+                             "one table in place", tables);
     }
     return VFX_OK;
 }
@@ -108,7 +106,7 @@ static vfx_result find_table(rt_sim_system *s, uint32_t *table)
 static vfx_result sim_run(rt_world *w, const rt_system_ctx *ctx)
 {
     rt_sim_system *s = ctx->user;
-    s->err[0] = 0;
+    char err[512] = "";
     uint32_t table;
     vfx_result r = find_table(s, &table);
     if (r)
@@ -126,21 +124,18 @@ static vfx_result sim_run(rt_world *w, const rt_system_ctx *ctx)
         rt_sph_columns c;
         table_columns(s, table, &c);
         rt_sph_host host = {s, host_permute, host_append};
-        if ((r = rt_sph_bind(s->sph, &host, &c))) {
-            snprintf(s->err, sizeof s->err, "vfx.sim.sph: %s", rt_sph_last_error(s->sph));
+        if ((r = rt_sph_bind(s->sph, &host, &c, err, sizeof err))) {
             rt_sph_clear(s->sph); /* the old binding's columns may have moved */
             s->bound = false;
-            return r;
+            return rt_world_fail(w, r, "vfx.sim.sph: %s", err);
         }
         s->bound = true;
     }
     /* A failed step leaves the last good (finite) state in the columns. */
-    r = rt_sph_step(s->sph, ctx->dt, &s->report);
-    if (r && !s->err[0])
-        snprintf(s->err, sizeof s->err, "vfx.sim.sph: %s", rt_sph_last_error(s->sph));
+    r = rt_sph_step(s->sph, ctx->dt, &s->report, err, sizeof err);
     if (s->table != SIM_NO_TABLE)
         s->revision = rt_world_table_revision(w, s->table) + SIM_OWN_BUMPS;
-    return r;
+    return r ? rt_world_fail(w, r, "vfx.sim.sph: %s", err) : VFX_OK;
 }
 
 vfx_result rt_sim_system_create(rt_world *world, const rt_sph_desc *desc, rt_sim_system **out,
@@ -196,4 +191,4 @@ void rt_sim_system_destroy(rt_sim_system *s)
 
 rt_sph *rt_sim_system_solver(rt_sim_system *s) { return s ? s->sph : NULL; }
 const rt_sph_report *rt_sim_system_report(const rt_sim_system *s) { return s ? &s->report : NULL; }
-const char *rt_sim_system_last_error(const rt_sim_system *s) { return s ? s->err : "rt_sim_system is NULL"; }
+

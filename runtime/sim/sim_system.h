@@ -8,7 +8,8 @@
  * edit particles between frames: edited values are the solver's at once; a change of the
  * table's revision (structural change, or a write by another system) makes the system bind
  * again (values checked, neighbour lists rebuilt). The particles must all be in one table
- * (VFX_ERR_UNSUPPORTED otherwise). */
+ * (VFX_ERR_UNSUPPORTED otherwise). A failed run returns its code to rt_world_run_phase and
+ * leaves its message, naming the particle or table, in rt_world_last_error. */
 #ifndef RT_SIM_SYSTEM_H
 #define RT_SIM_SYSTEM_H
 
@@ -29,7 +30,6 @@ void rt_sim_system_destroy(rt_sim_system *sys);
 rt_sph *rt_sim_system_solver(rt_sim_system *sys);
 /* Report of the last step (zeroed before the first). */
 const rt_sph_report *rt_sim_system_report(const rt_sim_system *sys);
-/* Last error message of the system or its solver ("" when none). */
-const char *rt_sim_system_last_error(const rt_sim_system *sys);
+
 
 #endif

@@ -138,13 +138,14 @@ typedef struct rt_sph_emitter {
 
 typedef struct rt_sph rt_sph;
 
-/* Creates a solver; NULL desc = defaults. On failure returns an error and, when err is not
- * NULL, a message in err (err_len bytes). */
-vfx_result rt_sph_create(const rt_sph_desc *desc, rt_sph **out, char *err, size_t err_len);
+/* Errors: every function that can fail returns a vfx_result and takes `char *err, size_t errlen`
+ * last (NULL allowed) for a message naming what failed (the particle, collider or bound);
+ * the solver keeps no message of its own (runtime/core/error.h). */
+
+/* Creates a solver; NULL desc = defaults. */
+vfx_result rt_sph_create(const rt_sph_desc *desc, rt_sph **out, char *err, size_t errlen);
 /* Stops the workers and frees everything. NULL allowed. */
 void rt_sph_destroy(rt_sph *sim);
-/* The last error message ("" when none). */
-const char *rt_sph_last_error(const rt_sph *sim);
 /* The resolved parameters (defaults filled in, c0 and B consistent). */
 const rt_sph_desc *rt_sph_params(const rt_sph *sim);
 /* Particle mass [kg] (calibrated so a lattice of `spacing` has the rest density). */
@@ -156,7 +157,8 @@ float rt_sph_support(const rt_sph *sim);
  * particle, when any value is NaN/Inf; positions outside the domain are moved inside (counted
  * in rt_sph_clamped_on_add). n = 0 is a no-op. */
 vfx_result rt_sph_add_particles(rt_sph *sim, uint32_t n, const float *x, const float *y,
-                                 const float *z, const float *vx, const float *vy, const float *vz);
+                                 const float *z, const float *vx, const float *vy, const float *vz,
+                                 char *err, size_t errlen);
 /* Host-owned state columns (rt_sph_bind). Each call leaves the columns as they are afterwards in
  * *cols (pointers may move; id is ignored). */
 typedef struct rt_sph_host {
@@ -174,16 +176,19 @@ typedef struct rt_sph_host {
  * after the host changed its rows (count or order); edited values need no call (moves are seen
  * by the displacement check of rt_sph_step). Adds and emitters append through the host; the
  * host and its columns must outlive the binding, which rt_sph_clear ends. */
-vfx_result rt_sph_bind(rt_sph *sim, const rt_sph_host *host, const rt_sph_columns *cols);
+vfx_result rt_sph_bind(rt_sph *sim, const rt_sph_host *host, const rt_sph_columns *cols,
+                       char *err, size_t errlen);
 /* Removes every particle (capacity, colliders, emitters and time are kept); ids restart at 0.
  * Ends a binding (the host's rows are left alone). */
 void rt_sph_clear(rt_sph *sim);
 /* Adds a lattice of spacing dx filling [lo, hi] (cell centres), at rest; count in *added. */
-vfx_result rt_sph_add_block(rt_sph *sim, const float lo[3], const float hi[3], uint32_t *added);
+vfx_result rt_sph_add_block(rt_sph *sim, const float lo[3], const float hi[3], uint32_t *added,
+                            char *err, size_t errlen);
 /* Number of particles that rt_sph_add_particles had to move into the domain so far. */
 uint32_t rt_sph_clamped_on_add(const rt_sph *sim);
 /* Adds a static or moving collider; its index in *index when not NULL. */
-vfx_result rt_sph_add_collider(rt_sph *sim, const rt_sph_collider *c, uint32_t *index);
+vfx_result rt_sph_add_collider(rt_sph *sim, const rt_sph_collider *c, uint32_t *index,
+                               char *err, size_t errlen);
 /* Adds a solid triangle mesh (closed, any winding; e.g. from rt_mesh_import) as a collider
  * (motion->no_slip makes it no-slip):
  * its signed distance is sampled once on a grid of ~H/2 (at most 64 nodes per axis, brute
@@ -191,17 +196,19 @@ vfx_result rt_sph_add_collider(rt_sph *sim, const rt_sph_collider *c, uint32_t *
  * motion (NULL = static) moves it rigidly: centre(t) - centre(0) is added to the mesh. */
 vfx_result rt_sph_add_mesh_collider(rt_sph *sim, const float *positions, uint32_t vertex_count,
                                      const uint32_t *indices, uint32_t index_count,
-                                     const rt_sph_collider *motion, uint32_t *index);
+                                     const rt_sph_collider *motion, uint32_t *index,
+                                     char *err, size_t errlen);
 /* Signed distance from p to collider `index` at the current time (positive on the fluid side;
  * +Inf beyond a mesh's grid); NaN for a bad index. */
 float rt_sph_collider_distance(const rt_sph *sim, uint32_t index, const float p[3]);
 /* Adds an emitter that injects disc-shaped layers of particles each time they have moved dx. */
-vfx_result rt_sph_add_emitter(rt_sph *sim, const rt_sph_emitter *e);
+vfx_result rt_sph_add_emitter(rt_sph *sim, const rt_sph_emitter *e, char *err, size_t errlen);
 
 /* Advances by frame_dt seconds in adaptive substeps (see the report). VFX_ERR_NUMERIC when a
  * substep cannot be made stable (message names the particle); the state is then the last good
  * one. frame_dt must be finite and >= 0. */
-vfx_result rt_sph_step(rt_sph *sim, float frame_dt, rt_sph_report *report);
+vfx_result rt_sph_step(rt_sph *sim, float frame_dt, rt_sph_report *report, char *err,
+                       size_t errlen);
 /* The SoA columns (see the validity note above). */
 rt_sph_columns rt_sph_get_columns(rt_sph *sim);
 /* Pressure [Pa] of row i from the last density pass (0 when i is out of range). */

@@ -5,41 +5,36 @@
 #include <stdlib.h>
 #include <string.h>
 
-vfx_result rt_sph_add_collider(rt_sph *s, const rt_sph_collider *c, uint32_t *index)
+vfx_result rt_sph_add_collider(rt_sph *s, const rt_sph_collider *c, uint32_t *index, char *err,
+                               size_t errlen)
 {
     if (!s || !c)
-        return VFX_ERR_INVALID_ARGUMENT;
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_collider: NULL solver or collider");
     if (s->ncol >= SPH_MAX_COLLIDERS) {
-        rt_sph_set_err(s, "rt_sph_add_collider: at most %u colliders", SPH_MAX_COLLIDERS);
-        return VFX_ERR_INVALID_ARGUMENT;
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_collider: at most %u colliders", SPH_MAX_COLLIDERS);
     }
     rt_sph_collider k = *c;
     if (!sph_finite3(k.center) || !sph_finite3(k.normal) || !sph_finite3(k.half) || !sph_finite3(k.motion_axis) ||
         !isfinite(k.radius) || !isfinite(k.motion_amplitude) || !isfinite(k.motion_frequency)) {
-        rt_sph_set_err(s, "rt_sph_add_collider: collider %u has a non-finite field", s->ncol);
-        return VFX_ERR_INVALID_ARGUMENT;
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_collider: collider %u has a non-finite field", s->ncol);
     }
     if (k.kind == RT_SPH_PLANE) {
         float l = sqrtf(k.normal[0] * k.normal[0] + k.normal[1] * k.normal[1] + k.normal[2] * k.normal[2]);
         if (!(l > 1e-6f)) {
-            rt_sph_set_err(s, "rt_sph_add_collider: plane %u has a zero normal", s->ncol);
-            return VFX_ERR_INVALID_ARGUMENT;
+            return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_collider: plane %u has a zero normal", s->ncol);
         }
         for (int a = 0; a < 3; ++a)
             k.normal[a] /= l;
     } else if (k.kind == RT_SPH_SPHERE) {
         if (!(k.radius > 0.f)) {
-            rt_sph_set_err(s, "rt_sph_add_collider: sphere %u needs radius > 0 (got %g)", s->ncol, (double)k.radius);
-            return VFX_ERR_INVALID_ARGUMENT;
+            return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_collider: sphere %u needs radius > 0 (got %g)", s->ncol, (double)k.radius);
         }
     } else if (k.kind == RT_SPH_BOX) {
         if (!(k.half[0] > 0.f && k.half[1] > 0.f && k.half[2] > 0.f)) {
-            rt_sph_set_err(s, "rt_sph_add_collider: box %u needs half extents > 0", s->ncol);
-            return VFX_ERR_INVALID_ARGUMENT;
+            return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_collider: box %u needs half extents > 0", s->ncol);
         }
     } else {
-        rt_sph_set_err(s, "rt_sph_add_collider: unknown kind %d", (int)k.kind);
-        return VFX_ERR_INVALID_ARGUMENT;
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_collider: unknown kind %d", (int)k.kind);
     }
     float al = sqrtf(k.motion_axis[0] * k.motion_axis[0] + k.motion_axis[1] * k.motion_axis[1] +
                      k.motion_axis[2] * k.motion_axis[2]);
@@ -128,49 +123,43 @@ static double tri_solid_angle(const double p[3], const double a0[3], const doubl
 
 vfx_result rt_sph_add_mesh_collider(rt_sph *s, const float *positions, uint32_t vertex_count,
                                      const uint32_t *indices, uint32_t index_count,
-                                     const rt_sph_collider *motion, uint32_t *index)
+                                     const rt_sph_collider *motion, uint32_t *index, char *err,
+                                     size_t errlen)
 {
     if (!s)
-        return VFX_ERR_INVALID_ARGUMENT;
-    s->err[0] = 0;
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_mesh_collider: NULL solver");
     if (s->ncol >= SPH_MAX_COLLIDERS) {
-        rt_sph_set_err(s, "rt_sph_add_mesh_collider: at most %u colliders", SPH_MAX_COLLIDERS);
-        return VFX_ERR_INVALID_ARGUMENT;
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_mesh_collider: at most %u colliders", SPH_MAX_COLLIDERS);
     }
     if (!positions || !indices || vertex_count == 0 || index_count < 3 || index_count % 3 != 0) {
-        rt_sph_set_err(s, "rt_sph_add_mesh_collider: need vertices and a multiple of 3 indices (got %u "
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_mesh_collider: need vertices and a multiple of 3 indices (got %u "
                 "vertices, %u indices)", vertex_count, index_count);
-        return VFX_ERR_INVALID_ARGUMENT;
     }
     if (index_count / 3 > SPH_MAX_MESH_TRIANGLES) {
-        rt_sph_set_err(s, "rt_sph_add_mesh_collider: %u triangles, at most %u (the distance field is "
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_mesh_collider: %u triangles, at most %u (the distance field is "
                 "built by brute force)", index_count / 3, SPH_MAX_MESH_TRIANGLES);
-        return VFX_ERR_INVALID_ARGUMENT;
     }
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (uint32_t v = 0; v < vertex_count; ++v)
         for (int a = 0; a < 3; ++a) {
             float x = positions[3 * v + a];
             if (!isfinite(x)) {
-                rt_sph_set_err(s, "rt_sph_add_mesh_collider: vertex %u is not finite", v);
-                return VFX_ERR_INVALID_ARGUMENT;
+                return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_mesh_collider: vertex %u is not finite", v);
             }
             lo[a] = x < lo[a] ? x : lo[a];
             hi[a] = x > hi[a] ? x : hi[a];
         }
     for (uint32_t i = 0; i < index_count; ++i)
         if (indices[i] >= vertex_count) {
-            rt_sph_set_err(s, "rt_sph_add_mesh_collider: triangle %u uses vertex %u of %u", i / 3,
+            return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_mesh_collider: triangle %u uses vertex %u of %u", i / 3,
                     indices[i], vertex_count);
-            return VFX_ERR_INVALID_ARGUMENT;
         }
     sph_collider_state st = {0};
     if (motion) {
         st.c = *motion;
         if (!sph_finite3(st.c.center) || !sph_finite3(st.c.motion_axis) || !isfinite(st.c.motion_amplitude) ||
             !isfinite(st.c.motion_frequency)) {
-            rt_sph_set_err(s, "rt_sph_add_mesh_collider: motion has a non-finite field");
-            return VFX_ERR_INVALID_ARGUMENT;
+            return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_mesh_collider: motion has a non-finite field");
         }
     }
     st.c.kind = RT_SPH_BOX; /* unused for meshes: the sdf decides */
@@ -195,8 +184,7 @@ vfx_result rt_sph_add_mesh_collider(rt_sph *s, const float *positions, uint32_t 
     }
     st.sdf = malloc(total * sizeof(float));
     if (!st.sdf) {
-        rt_sph_set_err(s, "rt_sph_add_mesh_collider: out of memory for a %zu-node distance field", total);
-        return VFX_ERR_OUT_OF_MEMORY;
+        return rt_errf(err, errlen, VFX_ERR_OUT_OF_MEMORY, "rt_sph_add_mesh_collider: out of memory for a %zu-node distance field", total);
     }
     uint32_t ntri = index_count / 3;
     for (int k = 0; k < st.sdf_n[2]; ++k)

@@ -3,22 +3,20 @@
 
 #include <string.h>
 
-vfx_result rt_sph_add_emitter(rt_sph *s, const rt_sph_emitter *e)
+vfx_result rt_sph_add_emitter(rt_sph *s, const rt_sph_emitter *e, char *err, size_t errlen)
 {
     if (!s || !e)
-        return VFX_ERR_INVALID_ARGUMENT;
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_emitter: NULL solver or emitter");
     if (s->nem >= SPH_MAX_EMITTERS) {
-        rt_sph_set_err(s, "rt_sph_add_emitter: at most %u emitters", SPH_MAX_EMITTERS);
-        return VFX_ERR_INVALID_ARGUMENT;
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_emitter: at most %u emitters", SPH_MAX_EMITTERS);
     }
     rt_sph_emitter k = *e;
     float l = sqrtf(k.direction[0] * k.direction[0] + k.direction[1] * k.direction[1] +
                     k.direction[2] * k.direction[2]);
     if (!sph_finite3(k.center) || !(l > 1e-6f) || !isfinite(l) || !(k.speed > 0.f) || !isfinite(k.speed) ||
         !(k.radius >= 0.5f * s->p.spacing) || !isfinite(k.radius)) {
-        rt_sph_set_err(s, "rt_sph_add_emitter: emitter %u needs finite centre, non-zero direction, "
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_emitter: emitter %u needs finite centre, non-zero direction, "
                 "speed > 0 and radius >= spacing/2", s->nem);
-        return VFX_ERR_INVALID_ARGUMENT;
     }
     sph_emitter_state *st = &s->em[s->nem++];
     memset(st, 0, sizeof *st);
@@ -40,7 +38,7 @@ vfx_result rt_sph_add_emitter(rt_sph *s, const rt_sph_emitter *e)
     return VFX_OK;
 }
 
-vfx_result rt_sph_emit(rt_sph *s, double dt, uint32_t *emitted)
+vfx_result rt_sph_emit(rt_sph *s, double dt, uint32_t *emitted, char *err, size_t errlen)
 {
     float dx = s->p.spacing;
     for (uint32_t k = 0; k < s->nem; ++k) {
@@ -70,7 +68,7 @@ vfx_result rt_sph_emit(rt_sph *s, double dt, uint32_t *emitted)
                                off * e->direction[c];
                         v[c] = e->speed * e->direction[c];
                     }
-                    vfx_result r = rt_sph_add_particles(s, 1, &p[0], &p[1], &p[2], &v[0], &v[1], &v[2]);
+                    vfx_result r = rt_sph_add_particles(s, 1, &p[0], &p[1], &p[2], &v[0], &v[1], &v[2], err, errlen);
                     if (r)
                         return r;
                     st->emitted++;

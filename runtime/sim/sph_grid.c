@@ -44,7 +44,7 @@ static void permute_ids_chunk(rt_sph *s, uint32_t chunk)
  * cell's particles are contiguous (and a row of x-adjacent cells is one range). Stable, so
  * the order — and every sum over neighbours — does not depend on the thread count. Keys and
  * the permutation run on all threads; the histogram and the scatter are serial (O(n + cells)). */
-vfx_result rt_sph_build_grid(rt_sph *s)
+vfx_result rt_sph_build_grid(rt_sph *s, char *err, size_t errlen)
 {
     uint32_t n = s->n;
     rt_sph_parallel(s, key_chunk, false);
@@ -65,10 +65,10 @@ vfx_result rt_sph_build_grid(rt_sph *s)
         rt_sph_columns c = {0};
         vfx_result r = s->host.permute(s->host.user, s->perm, &c);
         if (r || c.count != n) {
-            rt_sph_set_err(s, "rt_sph_step: the host could not reorder its %u rows by grid cell (%s)", n,
-                        r ? vfx_result_name(r) : "wrong row count back");
             s->lists_valid = false;
-            return r ? r : VFX_ERR_INVALID_ARGUMENT;
+            return rt_errf(err, errlen, r ? r : VFX_ERR_INVALID_ARGUMENT,
+                           "rt_sph_step: the host could not reorder its %u rows by grid cell (%s)", n,
+                           r ? vfx_result_name(r) : "wrong row count back");
         }
         rt_sph_take_columns(s, &c);
         rt_sph_parallel(s, permute_ids_chunk, false);

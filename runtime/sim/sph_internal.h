@@ -7,6 +7,7 @@
 #ifndef RT_SIM_SPH_INTERNAL_H
 #define RT_SIM_SPH_INTERNAL_H
 
+#include "core/error.h"
 #include "sim/sph.h"
 
 #include <math.h>
@@ -109,7 +110,6 @@ struct rt_sph {
     sph_chunk_fn job;
     atomic_uint next_chunk;
     uint32_t nchunks;
-    char err[512];
 };
 
 /* Rows [*b, *e) of a work item. */
@@ -181,9 +181,6 @@ static inline int sph_walls_box(const sph_wall_hit *w, int nw)
     return k;
 }
 
-/* sph_params.c */
-void rt_sph_set_err(rt_sph *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-
 /* sph_pool.c: starts the workers (fewer when a thread cannot be made: p.threads then says how
  * many run; out of memory for their handles is an error); stops and joins them */
 vfx_result rt_sph_pool_start(rt_sph *s);
@@ -194,7 +191,7 @@ void rt_sph_parallel(rt_sph *s, sph_chunk_fn fn, bool fresh);
 
 /* sph_storage.c */
 /* Grows every per-particle and per-chunk buffer to hold `want` particles. */
-vfx_result rt_sph_reserve(rt_sph *s, uint64_t want);
+vfx_result rt_sph_reserve(rt_sph *s, uint64_t want, char *err, size_t errlen);
 void rt_sph_free_columns(rt_sph *s);
 /* Exchanges the state columns with the integration buffers (xn ...); own state only. */
 void rt_sph_swap_state(rt_sph *s);
@@ -211,7 +208,7 @@ void rt_sph_update_colliders(rt_sph *s, double t);
 
 /* sph_grid.c: sorts the particles by cell (all columns follow, through the host when bound),
  * cell_start is rebuilt; an error when the host could not reorder (nothing changed then) */
-vfx_result rt_sph_build_grid(rt_sph *s);
+vfx_result rt_sph_build_grid(rt_sph *s, char *err, size_t errlen);
 
 /* sph_wall.c */
 /* The walls within H of p (box faces first, then colliders); their number. */
@@ -252,6 +249,6 @@ void rt_sph_integrate_chunk(rt_sph *s, uint32_t chunk);
 void rt_sph_disp_chunk(rt_sph *s, uint32_t chunk);
 
 /* sph_emit.c: runs the emitters for dt (0 on the first substep); count added to *emitted */
-vfx_result rt_sph_emit(rt_sph *s, double dt, uint32_t *emitted);
+vfx_result rt_sph_emit(rt_sph *s, double dt, uint32_t *emitted, char *err, size_t errlen);
 
 #endif

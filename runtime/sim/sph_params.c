@@ -2,18 +2,9 @@
  * gradient and wall terms, and the solver's creation and destruction. */
 #include "sim/sph_internal.h"
 
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <unistd.h>
-
-void rt_sph_set_err(rt_sph *s, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(s->err, sizeof s->err, fmt, ap);
-    va_end(ap);
-}
 
 static float def(float v, float d) { return v != 0.f ? v : d; }
 
@@ -245,7 +236,6 @@ void rt_sph_destroy(rt_sph *s)
     free(s);
 }
 
-const char *rt_sph_last_error(const rt_sph *s) { return s ? s->err : "rt_sph is NULL"; }
 const rt_sph_desc *rt_sph_params(const rt_sph *s) { return s ? &s->p : NULL; }
 float rt_sph_particle_mass(const rt_sph *s) { return s ? s->mass : 0.f; }
 float rt_sph_support(const rt_sph *s) { return s ? s->H : 0.f; }

@@ -19,11 +19,11 @@ static uint32_t first_bad(const rt_sph *s, uint32_t nchunks, const sph_chunk_out
  * within H unlisted: each side moved < skin/2), otherwise a rebuild: sort by cell, scan the
  * cells, record the lists. Counts a rebuild in the report; an error when the host could not
  * reorder its rows (then nothing was computed). */
-static vfx_result density_pass(rt_sph *s, rt_sph_report *rep)
+static vfx_result density_pass(rt_sph *s, rt_sph_report *rep, char *err, size_t errlen)
 {
     bool rebuild = !s->verlet || !s->lists_valid || !(4.f * s->disp2_max < s->skin * s->skin);
     if (rebuild) {
-        vfx_result r = rt_sph_build_grid(s);
+        vfx_result r = rt_sph_build_grid(s, err, errlen);
         if (r)
             return r;
         rep->neighbor_rebuilds++;
@@ -49,7 +49,7 @@ static void reduce_disp(rt_sph *s)
 }
 
 /* The closing density pass and the end-state figures of the report. */
-static vfx_result finish_report(rt_sph *s, rt_sph_report *rep)
+static vfx_result finish_report(rt_sph *s, rt_sph_report *rep, char *err, size_t errlen)
 {
     vfx_result r = VFX_OK;
     uint32_t nchunks = sph_chunk_count(s);
@@ -59,7 +59,7 @@ static vfx_result finish_report(rt_sph *s, rt_sph_report *rep)
     const float *g = s->p.gravity, *lo = s->p.domain_min;
     if (s->n) {
         s->want_energy = true;
-        r = density_pass(s, rep);
+        r = density_pass(s, rep, err, errlen);
         s->want_energy = false;
         if (atomic_exchange(&s->nb_oom, false))
             s->lists_valid = false; /* the sums below are partial; the next substep says why */
@@ -130,7 +130,8 @@ static double select_dt(const rt_sph *s, double remaining, double vmax, double a
 
 /* Integrates over *dt into the integration buffers, halving *dt while the result blows up;
  * an error (the state untouched) when it still does after max_redo halvings. */
-static vfx_result integrate_redo(rt_sph *s, double *dt, rt_sph_report *rep)
+static vfx_result integrate_redo(rt_sph *s, double *dt, rt_sph_report *rep, char *err,
+                                 size_t errlen)
 {
     uint32_t nchunks = sph_chunk_count(s);
     for (uint32_t tries = 0;; ++tries) {
@@ -142,14 +143,13 @@ static vfx_result integrate_redo(rt_sph *s, double *dt, rt_sph_report *rep)
             return VFX_OK;
         if (bo->bad_kind == 1 || tries >= s->p.max_redo) {
             static const char *what[] = {"", "non-finite state", "speed", "density change"};
-            rt_sph_set_err(s, "rt_sph_step: particle %u (row %u) blew up: %s %g (limit %g) "
+            return rt_errf(err, errlen, VFX_ERR_NUMERIC, "rt_sph_step: particle %u (row %u) blew up: %s %g (limit %g) "
                         "after %u dt halvings (dt %.3g s) at t=%.6g s; state left at the "
                         "last good substep", s->id[bad], bad, what[bo->bad_kind],
                         (double)bo->bad_value,
                         bo->bad_kind == 2 ? (double)s->p.velocity_limit
                                           : (double)s->p.density_change_limit,
                         tries, *dt, s->time);
-            return VFX_ERR_NUMERIC;
         }
         *dt *= 0.5;
         rep->redo_count++;
@@ -158,29 +158,27 @@ static vfx_result integrate_redo(rt_sph *s, double *dt, rt_sph_report *rep)
 
 /* The passes of one substep with particles: density, forces, dt, integration, commit. */
 static vfx_result substep(rt_sph *s, double remaining, rt_sph_report *rep, double *dt,
-                          rt_sph_dt_limit *lim)
+                          rt_sph_dt_limit *lim, char *err, size_t errlen)
 {
-    vfx_result res = density_pass(s, rep);
+    vfx_result res = density_pass(s, rep, err, errlen);
     if (res)
         return res;
     if (atomic_exchange(&s->nb_oom, false)) {
         s->lists_valid = false;
-        rt_sph_set_err(s, "rt_sph_step: out of memory for the neighbour lists of %u particles", s->n);
-        return VFX_ERR_OUT_OF_MEMORY;
+        return rt_errf(err, errlen, VFX_ERR_OUT_OF_MEMORY, "rt_sph_step: out of memory for the neighbour lists of %u particles", s->n);
     }
     rt_sph_parallel(s, rt_sph_force_chunk, false);
     const sph_chunk_out *bo = NULL;
     uint32_t bad = first_bad(s, sph_chunk_count(s), &bo);
     if (bad != UINT32_MAX) {
-        rt_sph_set_err(s, "rt_sph_step: particle %u (row %u) has a non-finite density or "
+        return rt_errf(err, errlen, VFX_ERR_NUMERIC, "rt_sph_step: particle %u (row %u) has a non-finite density or "
                     "force (%g) at t=%.6g s; state left at the last good substep",
                     s->id[bad], bad, (double)bo->bad_value, s->time);
-        return VFX_ERR_NUMERIC;
     }
     double vmax, amax, cmax;
     reduce_forces(s, rep, &vmax, &amax, &cmax);
     *dt = select_dt(s, remaining, vmax, amax, cmax, lim);
-    if ((res = integrate_redo(s, dt, rep)))
+    if ((res = integrate_redo(s, dt, rep, err, errlen)))
         return res;
     rt_sph_commit_state(s);
     if (s->verlet)
@@ -188,17 +186,15 @@ static vfx_result substep(rt_sph *s, double remaining, rt_sph_report *rep, doubl
     return VFX_OK;
 }
 
-vfx_result rt_sph_step(rt_sph *s, float frame_dt, rt_sph_report *report)
+vfx_result rt_sph_step(rt_sph *s, float frame_dt, rt_sph_report *report, char *err, size_t errlen)
 {
     rt_sph_report rep = {0};
     if (report)
         *report = rep;
     if (!s)
-        return VFX_ERR_INVALID_ARGUMENT;
-    s->err[0] = 0;
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_step: NULL solver");
     if (!isfinite(frame_dt) || frame_dt < 0.f) {
-        rt_sph_set_err(s, "rt_sph_step: frame_dt %g must be finite and >= 0", (double)frame_dt);
-        return VFX_ERR_INVALID_ARGUMENT;
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_step: frame_dt %g must be finite and >= 0", (double)frame_dt);
     }
     double t = 0.0;
     rep.dt_min = INFINITY;
@@ -214,14 +210,14 @@ vfx_result rt_sph_step(rt_sph *s, float frame_dt, rt_sph_report *report)
             break;
         }
         if (s->nem) {
-            res = rt_sph_emit(s, rep.substeps ? rep.dt_last : 0.0, &rep.emitted);
+            res = rt_sph_emit(s, rep.substeps ? rep.dt_last : 0.0, &rep.emitted, err, errlen);
             if (res)
                 break;
         }
         rt_sph_update_colliders(s, s->time);
         double dt = (double)frame_dt - t;
         rt_sph_dt_limit lim = RT_SPH_DT_FRAME;
-        if (s->n && (res = substep(s, (double)frame_dt - t, &rep, &dt, &lim)))
+        if (s->n && (res = substep(s, (double)frame_dt - t, &rep, &dt, &lim, err, errlen)))
             break;
         t += dt;
         s->time += dt;
@@ -236,7 +232,8 @@ vfx_result rt_sph_step(rt_sph *s, float frame_dt, rt_sph_report *report)
     if (rep.substeps == 0)
         rep.dt_min = 0.0;
     rep.simulated_time = t;
-    vfx_result fr = finish_report(s, &rep);
+    /* a failed step's message stays: the closing pass writes err only when the step succeeded */
+    vfx_result fr = finish_report(s, &rep, res ? NULL : err, res ? 0 : errlen);
     if (!res)
         res = fr;
     if (report)

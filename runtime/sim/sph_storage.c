@@ -72,12 +72,11 @@ rt_sph_columns rt_sph_get_columns(rt_sph *s)
     return (rt_sph_columns){s->n, s->x, s->y, s->z, s->vx, s->vy, s->vz, s->rho, s->id};
 }
 
-vfx_result rt_sph_reserve(rt_sph *s, uint64_t want)
+vfx_result rt_sph_reserve(rt_sph *s, uint64_t want, char *err, size_t errlen)
 {
     if (want > s->p.max_particles) {
-        rt_sph_set_err(s, "rt_sph: %llu particles requested, capacity bound is %u (desc.max_particles)",
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph: %llu particles requested, capacity bound is %u (desc.max_particles)",
                 (unsigned long long)want, s->p.max_particles);
-        return VFX_ERR_INVALID_ARGUMENT;
     }
     if (want <= s->cap && (s->bound || want <= s->state_cap))
         return VFX_OK;
@@ -147,21 +146,19 @@ vfx_result rt_sph_reserve(rt_sph *s, uint64_t want)
     s->cap = (uint32_t)cap;
     return VFX_OK;
 oom:
-    rt_sph_set_err(s, "rt_sph: out of memory growing to %llu particles", (unsigned long long)cap);
-    return VFX_ERR_OUT_OF_MEMORY;
+    return rt_errf(err, errlen, VFX_ERR_OUT_OF_MEMORY, "rt_sph: out of memory growing to %llu particles", (unsigned long long)cap);
 }
 
 /* Refuses n rows when any of the arrays (NULL ones skipped) holds a NaN/Inf, naming the row. */
-static vfx_result check_finite(rt_sph *s, const char *who, const char *of, const char *what,
-                               uint32_t n, const float *const arr[6])
+static vfx_result check_finite(const char *who, const char *of, const char *what,
+                               uint32_t n, const float *const arr[6], char *err, size_t errlen)
 {
     static const char *nm[6] = {"x", "y", "z", "vx", "vy", "vz"};
     for (uint32_t i = 0; i < n; ++i)
         for (int a = 0; a < 6; ++a)
             if (arr[a] && !isfinite(arr[a][i])) {
-                rt_sph_set_err(s, "%s: particle %u (of %u %s) has a non-finite %s (%g); %s refused", who,
+                return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "%s: particle %u (of %u %s) has a non-finite %s (%g); %s refused", who,
                             i, n, of, nm[a], (double)arr[a][i], what);
-                return VFX_ERR_INVALID_ARGUMENT;
             }
     return VFX_OK;
 }
@@ -174,17 +171,17 @@ void rt_sph_take_columns(rt_sph *s, const rt_sph_columns *c)
 }
 
 /* Room for `add` more rows (n is not changed): our buffers, and the host's rows when bound. */
-static vfx_result grow_rows(rt_sph *s, uint32_t add)
+static vfx_result grow_rows(rt_sph *s, uint32_t add, char *err, size_t errlen)
 {
-    vfx_result r = rt_sph_reserve(s, (uint64_t)s->n + add);
+    vfx_result r = rt_sph_reserve(s, (uint64_t)s->n + add, err, errlen);
     if (r || !s->bound)
         return r;
     rt_sph_columns c = {0};
     r = s->host.append(s->host.user, add, &c);
     if (r || c.count != s->n + add) {
-        rt_sph_set_err(s, "rt_sph: the host could not append %u rows to its %u (%s)", add, s->n,
-                    r ? vfx_result_name(r) : "wrong row count back");
-        return r ? r : VFX_ERR_INVALID_ARGUMENT;
+        return rt_errf(err, errlen, r ? r : VFX_ERR_INVALID_ARGUMENT,
+                       "rt_sph: the host could not append %u rows to its %u (%s)", add, s->n,
+                       r ? vfx_result_name(r) : "wrong row count back");
     }
     rt_sph_take_columns(s, &c);
     return VFX_OK;
@@ -213,28 +210,26 @@ static void fresh_rows(rt_sph *s, uint32_t base, uint32_t end)
 }
 
 vfx_result rt_sph_add_particles(rt_sph *s, uint32_t n, const float *x, const float *y,
-                                 const float *z, const float *vx, const float *vy, const float *vz)
+                                 const float *z, const float *vx, const float *vy, const float *vz,
+                                 char *err, size_t errlen)
 {
     if (!s)
-        return VFX_ERR_INVALID_ARGUMENT;
-    s->err[0] = 0;
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_particles: NULL solver");
     if (n == 0)
         return VFX_OK;
     if (!x || !y || !z) {
-        rt_sph_set_err(s, "rt_sph_add_particles: position array is NULL for %u particles", n);
-        return VFX_ERR_INVALID_ARGUMENT;
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_particles: position array is NULL for %u particles", n);
     }
     if ((uint64_t)s->n + n > s->p.max_particles) {
-        rt_sph_set_err(s, "rt_sph_add_particles: %u + %u particles exceed the capacity bound %u "
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_particles: %u + %u particles exceed the capacity bound %u "
                 "(desc.max_particles)", s->n, n, s->p.max_particles);
-        return VFX_ERR_INVALID_ARGUMENT;
     }
     const float *arr[6] = {x, y, z, vx, vy, vz};
-    vfx_result r = check_finite(s, "rt_sph_add_particles", "in this batch", "batch", n, arr);
+    vfx_result r = check_finite("rt_sph_add_particles", "in this batch", "batch", n, arr, err, errlen);
     if (r)
         return r;
     uint32_t base = s->n;
-    if ((r = grow_rows(s, n)))
+    if ((r = grow_rows(s, n, err, errlen)))
         return r;
     for (uint32_t i = 0; i < n; ++i) {
         uint32_t k = base + i;
@@ -260,18 +255,18 @@ void rt_sph_clear(rt_sph *s)
     s->lists_valid = false;
 }
 
-vfx_result rt_sph_add_block(rt_sph *s, const float lo[3], const float hi[3], uint32_t *added)
+vfx_result rt_sph_add_block(rt_sph *s, const float lo[3], const float hi[3], uint32_t *added,
+                            char *err, size_t errlen)
 {
     if (added)
         *added = 0;
     if (!s || !lo || !hi)
-        return VFX_ERR_INVALID_ARGUMENT;
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_block: NULL solver or bounds");
     float dx = s->p.spacing;
     uint64_t c[3];
     for (int a = 0; a < 3; ++a) {
         if (!isfinite(lo[a]) || !isfinite(hi[a]) || hi[a] < lo[a]) {
-            rt_sph_set_err(s, "rt_sph_add_block: bad bounds on axis %d (%g..%g)", a, (double)lo[a], (double)hi[a]);
-            return VFX_ERR_INVALID_ARGUMENT;
+            return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_block: bad bounds on axis %d (%g..%g)", a, (double)lo[a], (double)hi[a]);
         }
         c[a] = (uint64_t)floor((hi[a] - lo[a]) / dx + 1e-4);
     }
@@ -279,9 +274,9 @@ vfx_result rt_sph_add_block(rt_sph *s, const float lo[3], const float hi[3], uin
     if (total == 0)
         return VFX_OK;
     if (total > s->p.max_particles - s->n)
-        return rt_sph_reserve(s, s->n + total); /* names the capacity bound */
+        return rt_sph_reserve(s, s->n + total, err, errlen); /* names the capacity bound */
     uint32_t base = s->n;
-    vfx_result r = grow_rows(s, (uint32_t)total);
+    vfx_result r = grow_rows(s, (uint32_t)total, err, errlen);
     if (r)
         return r;
     uint32_t q = base;
@@ -324,19 +319,18 @@ void rt_sph_commit_state(rt_sph *s)
     memcpy(s->vx, s->vxn, bytes), memcpy(s->vy, s->vyn, bytes), memcpy(s->vz, s->vzn, bytes);
 }
 
-vfx_result rt_sph_bind(rt_sph *s, const rt_sph_host *host, const rt_sph_columns *c)
+vfx_result rt_sph_bind(rt_sph *s, const rt_sph_host *host, const rt_sph_columns *c, char *err,
+                       size_t errlen)
 {
     if (!s)
-        return VFX_ERR_INVALID_ARGUMENT;
-    s->err[0] = 0;
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_bind: NULL solver");
     if (!host || !host->permute || !host->append || !c ||
         (c->count && (!c->x || !c->y || !c->z || !c->vx || !c->vy || !c->vz || !c->density))) {
-        rt_sph_set_err(s, "rt_sph_bind: need a host with permute and append, and every column of "
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_bind: need a host with permute and append, and every column of "
                     "its %u rows", c ? c->count : 0);
-        return VFX_ERR_INVALID_ARGUMENT;
     }
     const float *arr[6] = {c->x, c->y, c->z, c->vx, c->vy, c->vz};
-    vfx_result r = check_finite(s, "rt_sph_bind", "bound rows", "binding", c->count, arr);
+    vfx_result r = check_finite("rt_sph_bind", "bound rows", "binding", c->count, arr, err, errlen);
     if (r)
         return r;
     drop_state(s); /* our own particles, or the previous binding's pointers */
@@ -344,7 +338,7 @@ vfx_result rt_sph_bind(rt_sph *s, const rt_sph_host *host, const rt_sph_columns 
     s->host = *host;
     s->n = 0;
     s->next_id = 0;
-    if ((r = rt_sph_reserve(s, c->count))) {
+    if ((r = rt_sph_reserve(s, c->count, err, errlen))) {
         rt_sph_clear(s);
         return r;
     }

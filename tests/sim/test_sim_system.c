@@ -35,7 +35,7 @@ static void test_system_writes_columns(void **state)
     assert_int_equal(rt_particles_spawn(w, &pc, N, x, y, z, false), VFX_OK);
     rt_sph_emitter e = {.center = {0.08f, 0.18f, 0.03f}, .direction = {0, -1, 0}, .speed = 1.f,
                          .radius = 0.01f, .max_emit = 20};
-    assert_int_equal(rt_sph_add_emitter(rt_sim_system_solver(sys), &e), VFX_OK);
+    assert_int_equal(rt_sph_add_emitter(rt_sim_system_solver(sys), &e, NULL, 0), VFX_OK);
     for (int f = 0; f < 20; ++f) {
         assert_int_equal(rt_world_run_phase(w, RT_PHASE_SIMULATE, f / 60.0, 1.f / 60.f), VFX_OK);
         assert_true(rt_sim_system_report(sys)->substeps > 0);
@@ -128,8 +128,8 @@ static void test_system_reports_bad_column(void **state)
     assert_true(rt_query_next(&it));
     ((float *)rt_query_column(&it, pc.velocity, 2))[1] = NAN;
     assert_int_equal(rt_world_run_phase(w, RT_PHASE_SIMULATE, 0.0, 1.f / 60.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(rt_sim_system_last_error(sys), "particle 1"));
-    assert_non_null(strstr(rt_sim_system_last_error(sys), "vz"));
+    assert_non_null(strstr(rt_world_last_error(w), "particle 1"));
+    assert_non_null(strstr(rt_world_last_error(w), "vz"));
     rt_world_destroy(w);
     rt_sim_system_destroy(sys);
 }

@@ -163,7 +163,7 @@ static void test_no_slip_slab(void **state)
         rt_sph *s = make(d);
         float lo[3] = {0.05f, 0, 0}, hi[3] = {0.05f + 20 * dx, 8 * dx, 8 * dx};
         uint32_t n;
-        assert_int_equal(rt_sph_add_block(s, lo, hi, &n), VFX_OK);
+        assert_int_equal(rt_sph_add_block(s, lo, hi, &n, NULL, 0), VFX_OK);
         rt_sph_columns c = rt_sph_get_columns(s);
         float *vx = calloc(n, sizeof *vx), *zero = calloc(n, sizeof *zero);
         for (uint32_t i = 0; i < n; ++i)
@@ -171,10 +171,10 @@ static void test_no_slip_slab(void **state)
         float *x = malloc(n * sizeof *x), *y = malloc(n * sizeof *y), *z = malloc(n * sizeof *z);
         memcpy(x, c.x, n * sizeof *x), memcpy(y, c.y, n * sizeof *y), memcpy(z, c.z, n * sizeof *z);
         rt_sph_clear(s);
-        assert_int_equal(rt_sph_add_particles(s, n, x, y, z, vx, zero, zero), VFX_OK);
+        assert_int_equal(rt_sph_add_particles(s, n, x, y, z, vx, zero, zero, NULL, 0), VFX_OK);
         double p0 = momentum_x(s), t = 0.002;
         rt_sph_report r;
-        assert_int_equal(rt_sph_step(s, (float)t, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, (float)t, &r, NULL, 0), VFX_OK);
         check_state(s);
         double p1 = momentum_x(s);
         const double area = 2.0 * (20 * dx) * (8 * dx); /* floor + ceiling under the slab */
@@ -213,9 +213,9 @@ static void test_volume_fraction(void **state)
     d.flags = RT_SPH_NO_GRAVITY;
     rt_sph *s = make(d);
     float lo[3] = {0, 0, 0}, hi[3] = {0.05f, 0.1f, 0.06f};
-    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
     rt_sph_report r;
-    assert_int_equal(rt_sph_step(s, 0.f, &r), VFX_OK); /* builds the grid, moves nothing */
+    assert_int_equal(rt_sph_step(s, 0.f, &r, NULL, 0), VFX_OK); /* builds the grid, moves nothing */
     /* on the lattice the mass is calibrated so that sum (m/rho0) W = 1; a particle next to a
      * wall misses exactly the calibrated wall share, which the fraction divides out */
     float in[3] = {0.025f, 0.055f, 0.035f}, wall[3] = {0.025f, 0.005f, 0.035f};
@@ -259,28 +259,28 @@ static void test_bad_desc_and_input(void **state)
     s = make(small_box());
     float x[5] = {0.05f, 0.05f, 0.05f, 0.05f, 0.05f}, y[5] = {0.05f, 0.06f, 0.07f, NAN, 0.09f};
     float z[5] = {0.03f, 0.03f, 0.03f, 0.03f, 0.03f};
-    assert_int_equal(rt_sph_add_particles(s, 5, x, y, z, NULL, NULL, NULL), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(rt_sph_last_error(s), "particle 3"));
-    assert_non_null(strstr(rt_sph_last_error(s), "non-finite y"));
+    assert_int_equal(rt_sph_add_particles(s, 5, x, y, z, NULL, NULL, NULL, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "particle 3"));
+    assert_non_null(strstr(err, "non-finite y"));
     assert_int_equal(rt_sph_get_columns(s).count, 0); /* whole batch refused */
     y[3] = 0.08f;
     float vz[5] = {0, 0, 0, 0, INFINITY};
-    assert_int_equal(rt_sph_add_particles(s, 5, x, y, z, NULL, NULL, vz), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(rt_sph_last_error(s), "particle 4"));
-    assert_non_null(strstr(rt_sph_last_error(s), "vz"));
-    assert_int_equal(rt_sph_add_particles(s, 5, NULL, y, z, NULL, NULL, NULL), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_sph_add_particles(s, 5, x, y, z, NULL, NULL, vz, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "particle 4"));
+    assert_non_null(strstr(err, "vz"));
+    assert_int_equal(rt_sph_add_particles(s, 5, NULL, y, z, NULL, NULL, NULL, NULL, 0), VFX_ERR_INVALID_ARGUMENT);
     /* a huge count is refused before any array is read */
-    assert_int_equal(rt_sph_add_particles(s, UINT32_MAX, x, y, z, NULL, NULL, NULL), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(rt_sph_last_error(s), "capacity"));
-    assert_int_equal(rt_sph_add_particles(s, 5, x, y, z, NULL, NULL, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_particles(s, UINT32_MAX, x, y, z, NULL, NULL, NULL, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "capacity"));
+    assert_int_equal(rt_sph_add_particles(s, 5, x, y, z, NULL, NULL, NULL, NULL, 0), VFX_OK);
     rt_sph_report r;
-    assert_int_equal(rt_sph_step(s, NAN, &r), VFX_ERR_INVALID_ARGUMENT);
-    assert_int_equal(rt_sph_step(s, -1.f, &r), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_sph_step(s, NAN, &r, NULL, 0), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_sph_step(s, -1.f, &r, NULL, 0), VFX_ERR_INVALID_ARGUMENT);
     rt_sph_collider c = {.kind = RT_SPH_SPHERE, .radius = 0.f};
-    assert_int_equal(rt_sph_add_collider(s, &c, NULL), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(rt_sph_last_error(s), "radius"));
+    assert_int_equal(rt_sph_add_collider(s, &c, NULL, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "radius"));
     rt_sph_emitter e = {.direction = {0, 0, 0}, .speed = 1, .radius = 0.02f};
-    assert_int_equal(rt_sph_add_emitter(s, &e), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_sph_add_emitter(s, &e, NULL, 0), VFX_ERR_INVALID_ARGUMENT);
     check_state(s);
     rt_sph_destroy(s);
 }
@@ -290,8 +290,8 @@ static void test_zero_particles(void **state)
     (void)state;
     rt_sph *s = make(small_box());
     rt_sph_report r;
-    assert_int_equal(rt_sph_add_particles(s, 0, NULL, NULL, NULL, NULL, NULL, NULL), VFX_OK);
-    assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+    assert_int_equal(rt_sph_add_particles(s, 0, NULL, NULL, NULL, NULL, NULL, NULL, NULL, 0), VFX_OK);
+    assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, NULL, 0), VFX_OK);
     assert_int_equal(rt_sph_get_columns(s).count, 0);
     assert_true(fabs(r.simulated_time - 1.0 / 60.0) < 1e-9);
     assert_false(r.cap_hit);
@@ -304,11 +304,11 @@ static void test_single_particle(void **state)
     (void)state;
     rt_sph *s = make(small_box());
     float x = 0.05f, y = 0.15f, z = 0.03f;
-    assert_int_equal(rt_sph_add_particles(s, 1, &x, &y, &z, NULL, NULL, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_particles(s, 1, &x, &y, &z, NULL, NULL, NULL, NULL, 0), VFX_OK);
     rt_sph_report r;
     double e0 = 0;
     for (int f = 0; f < 30; ++f) {
-        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, NULL, 0), VFX_OK);
         if (f == 0)
             e0 = energy(&r) + 1e-12;
         check_state(s);
@@ -332,10 +332,10 @@ static void test_two_coincident(void **state)
     d.flags = RT_SPH_NO_GRAVITY;
     rt_sph *s = make(d);
     float x[2] = {0.05f, 0.05f}, y[2] = {0.1f, 0.1f}, z[2] = {0.03f, 0.03f};
-    assert_int_equal(rt_sph_add_particles(s, 2, x, y, z, NULL, NULL, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_particles(s, 2, x, y, z, NULL, NULL, NULL, NULL, 0), VFX_OK);
     rt_sph_report r;
     for (int f = 0; f < 10; ++f) {
-        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, NULL, 0), VFX_OK);
         check_state(s);
         assert_true(r.kinetic_energy == 0.0);
         assert_true(r.max_density_error <= 0.f);
@@ -348,18 +348,18 @@ static void test_two_coincident(void **state)
     d.domain_max[2] = 0.1f;
     s = make(d);
     float lo[3] = {0.02f, 0.05f, 0.02f}, hi[3] = {0.08f, 0.11f, 0.08f};
-    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
     float px = 0.055f, py = 0.085f, pz = 0.055f; /* exactly a lattice site */
-    assert_int_equal(rt_sph_add_particles(s, 1, &px, &py, &pz, NULL, NULL, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_particles(s, 1, &px, &py, &pz, NULL, NULL, NULL, NULL, 0), VFX_OK);
     uint32_t dup = rt_sph_get_columns(s).count - 1;
-    assert_int_equal(rt_sph_step(s, 0.f, &r), VFX_OK);
+    assert_int_equal(rt_sph_step(s, 0.f, &r, NULL, 0), VFX_OK);
     double e0 = energy(&r);
     float err0 = r.max_density_error;
     print_message("duplicate particle: initial compression %.3f, energy %.4g J\n", err0, e0);
     assert_true(err0 > 0.1f); /* the pair sits at ~2x the lattice density of one particle */
     double e_prev = 0.0;
     for (int f = 0; f < 3; ++f) {
-        assert_int_equal(rt_sph_step(s, 1.f / 240.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 240.f, &r, NULL, 0), VFX_OK);
         check_state(s);
         /* No gravity. The separation is not energy-conserving: the spiky gradient that pushes
          * the pair apart is not the derivative of the poly6 density (whose gradient vanishes
@@ -421,14 +421,14 @@ static void test_all_at_one_point(void **state)
     float x[N], y[N], z[N];
     for (int i = 0; i < N; ++i)
         x[i] = 0.05f, y[i] = 0.1f, z[i] = 0.03f;
-    assert_int_equal(rt_sph_add_particles(s, N, x, y, z, NULL, NULL, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_particles(s, N, x, y, z, NULL, NULL, NULL, NULL, 0), VFX_OK);
     rt_sph_report r;
-    assert_int_equal(rt_sph_step(s, 0.f, &r), VFX_OK);
+    assert_int_equal(rt_sph_step(s, 0.f, &r, NULL, 0), VFX_OK);
     float err0 = r.max_density_error;
     assert_true(err0 > 10.f); /* 300 particles on one point: a huge compression */
     double bound = release_bound(s, N);
     for (int f = 0; f < 20; ++f) {
-        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, NULL, 0), VFX_OK);
         check_state(s);
         assert_true(r.kinetic_energy < bound);
     }
@@ -442,14 +442,14 @@ static void run_block(rt_sph *s, int frames, float frame_dt, bool expect_cap, fl
 {
     float lo[3] = {0, 0, 0}, hi[3] = {0.1f, 0.08f, 0.06f};
     uint32_t n;
-    assert_int_equal(rt_sph_add_block(s, lo, hi, &n), VFX_OK);
+    assert_int_equal(rt_sph_add_block(s, lo, hi, &n, NULL, 0), VFX_OK);
     assert_int_equal(n, 10 * 8 * 6);
     rt_sph_report r;
-    assert_int_equal(rt_sph_step(s, 0.f, &r), VFX_OK);
+    assert_int_equal(rt_sph_step(s, 0.f, &r, NULL, 0), VFX_OK);
     double e0 = energy(&r);
     print_message("block at rest: initial max density error %.5f\n", r.max_density_error);
     for (int f = 0; f < frames; ++f) {
-        assert_int_equal(rt_sph_step(s, frame_dt, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, frame_dt, &r, NULL, 0), VFX_OK);
         check_state(s);
         if (expect_cap) {
             assert_true(r.cap_hit);
@@ -519,12 +519,12 @@ static void test_outside_domain(void **state)
         z[i] = 5.f;
         vx[i] = x[i] > 0 ? 3.f : -3.f; /* and moving further out */
     }
-    assert_int_equal(rt_sph_add_particles(s, N, x, y, z, vx, NULL, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_particles(s, N, x, y, z, vx, NULL, NULL, NULL, 0), VFX_OK);
     assert_int_equal(rt_sph_clamped_on_add(s), N);
     check_state(s);
     rt_sph_report r;
     for (int f = 0; f < 20; ++f) {
-        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, NULL, 0), VFX_OK);
         check_state(s);
         /* clamped onto two edges 1 mm apart: the pile expands; bounded by the initial
          * 0.5 N m 3^2 plus what the clamped EOS can release */
@@ -543,11 +543,12 @@ static void test_blowup_reported(void **state)
     rt_sph *s = make(d);
     float x[3] = {0.02f, 0.05f, 0.08f}, y[3] = {0.1f, 0.1f, 0.1f}, z[3] = {0.03f, 0.03f, 0.03f};
     float vy[3] = {0.f, 0.f, -5.f}; /* particle 2 is already beyond the limit: no dt helps */
-    assert_int_equal(rt_sph_add_particles(s, 3, x, y, z, NULL, vy, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_particles(s, 3, x, y, z, NULL, vy, NULL, NULL, 0), VFX_OK);
+    char err[256];
     rt_sph_report r;
-    assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_ERR_NUMERIC);
-    assert_non_null(strstr(rt_sph_last_error(s), "particle 2"));
-    assert_non_null(strstr(rt_sph_last_error(s), "speed"));
+    assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, err, sizeof err), VFX_ERR_NUMERIC);
+    assert_non_null(strstr(err, "particle 2"));
+    assert_non_null(strstr(err, "speed"));
     assert_int_equal(r.redo_count, rt_sph_params(s)->max_redo);
     /* the last good state stays: unchanged, finite */
     check_state(s);
@@ -580,12 +581,12 @@ static void test_thread_count_determinism(void **state)
         d.threads = (uint32_t)(t + 1);
         s[t] = make(d);
         float lo[3] = {0, 0, 0}, hi[3] = {0.05f, 0.15f, 0.06f};
-        assert_int_equal(rt_sph_add_block(s[t], lo, hi, NULL), VFX_OK); /* 450 particles: 1 chunk */
+        assert_int_equal(rt_sph_add_block(s[t], lo, hi, NULL, NULL, 0), VFX_OK); /* 450 particles: 1 chunk */
         float lo2[3] = {0.06f, 0.1f, 0}, hi2[3] = {0.1f, 0.2f, 0.06f};
-        assert_int_equal(rt_sph_add_block(s[t], lo2, hi2, NULL), VFX_OK);
+        assert_int_equal(rt_sph_add_block(s[t], lo2, hi2, NULL, NULL, 0), VFX_OK);
         rt_sph_report r;
         for (int f = 0; f < 5; ++f)
-            assert_int_equal(rt_sph_step(s[t], 1.f / 60.f, &r), VFX_OK);
+            assert_int_equal(rt_sph_step(s[t], 1.f / 60.f, &r, NULL, 0), VFX_OK);
     }
     /* each particle sums its neighbours in the same order whatever thread runs it */
     assert_bitwise_equal_and_destroy(s);
@@ -603,19 +604,19 @@ static void test_colliders_emitter_paddle(void **state)
                                .motion_axis = {1, 0, 0}, .motion_amplitude = 0.01f, .motion_frequency = 2.f};
     rt_sph_collider slope = {.kind = RT_SPH_PLANE, .center = {0.28f, 0.0f, 0.f}, .normal = {-1, 1, 0},
                               .no_slip = 1};
-    assert_int_equal(rt_sph_add_collider(s, &ball, NULL), VFX_OK);
-    assert_int_equal(rt_sph_add_collider(s, &box, NULL), VFX_OK);
-    assert_int_equal(rt_sph_add_collider(s, &paddle, NULL), VFX_OK);
-    assert_int_equal(rt_sph_add_collider(s, &slope, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_collider(s, &ball, NULL, NULL, 0), VFX_OK);
+    assert_int_equal(rt_sph_add_collider(s, &box, NULL, NULL, 0), VFX_OK);
+    assert_int_equal(rt_sph_add_collider(s, &paddle, NULL, NULL, 0), VFX_OK);
+    assert_int_equal(rt_sph_add_collider(s, &slope, NULL, NULL, 0), VFX_OK);
     rt_sph_emitter e = {.center = {0.15f, 0.17f, 0.03f}, .direction = {0, -1, 0}, .speed = 1.f,
                          .radius = 0.015f, .max_emit = 400};
-    assert_int_equal(rt_sph_add_emitter(s, &e), VFX_OK);
+    assert_int_equal(rt_sph_add_emitter(s, &e, NULL, 0), VFX_OK);
     float lo[3] = {0.04f, 0, 0}, hi[3] = {0.1f, 0.06f, 0.06f};
-    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
     rt_sph_report r;
     uint32_t emitted = 0;
     for (int f = 0; f < 30; ++f) {
-        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, NULL, 0), VFX_OK);
         emitted += r.emitted;
         check_state(s);
         assert_true(r.max_density_error < 0.1f); /* 10%: impacts of the jet on the ball */
@@ -655,11 +656,11 @@ static void test_mesh_collider(void **state)
     rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.3f, 0.2f, 0.06f}, .threads = 2};
     rt_sph *s = make(d);
     uint32_t bad[3] = {0, 1, 99};
-    assert_int_equal(rt_sph_add_mesh_collider(s, m.positions, m.vertex_count, bad, 3, NULL, NULL),
+    assert_int_equal(rt_sph_add_mesh_collider(s, m.positions, m.vertex_count, bad, 3, NULL, NULL, err, sizeof err),
                      VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(rt_sph_last_error(s), "triangle 0 uses vertex 99"));
+    assert_non_null(strstr(err, "triangle 0 uses vertex 99"));
     uint32_t idx;
-    assert_int_equal(rt_sph_add_mesh_collider(s, m.positions, m.vertex_count, m.indices, m.index_count, NULL, &idx),
+    assert_int_equal(rt_sph_add_mesh_collider(s, m.positions, m.vertex_count, m.indices, m.index_count, NULL, &idx, NULL, 0),
                      VFX_OK);
     rt_mesh_data_free(&m);
     /* sampled distance against the exact box distance (float64) on a 9^3 probe lattice around
@@ -685,10 +686,10 @@ static void test_mesh_collider(void **state)
     assert_true(worst < 5e-3);
     /* fluid dropped on it: nothing inside the cube (shrunk by the 5 mm tolerance) */
     float lo[3] = {0.11f, 0.1f, 0.0f}, hi[3] = {0.19f, 0.16f, 0.06f};
-    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
     rt_sph_report r;
     for (int f = 0; f < 20; ++f) {
-        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, NULL, 0), VFX_OK);
         check_state(s);
         assert_true(r.max_density_error < 0.1f);
         rt_sph_columns col = rt_sph_get_columns(s);
@@ -725,14 +726,14 @@ static void test_hydrostatic(void **state)
                       .threads = 2, .viscosity = 0.1f};
     rt_sph *s = make(d);
     float lo[3] = {0, 0, 0}, hi[3] = {0.06f, 0.15f, 0.06f};
-    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
     rt_sph_report r;
     enum { BINS = 8 };
     double psum[3][BINS] = {{0}}, dsum[3][BINS] = {{0}}; /* all, wall layer, inner */
     int cnt[3][BINS] = {{0}};
     float max_err = 0.f, mean_err = 0.f;
     for (int f = 0; f < 60; ++f) {
-        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, NULL, 0), VFX_OK);
         check_state(s);
         if (f < 30)
             continue;
@@ -831,14 +832,14 @@ static void dam_break_run(int res)
                       .no_slip_faces = RT_SPH_FACE_Y_MIN | RT_SPH_FACE_X_MIN};
     rt_sph *s = make(d);
     float lo[3] = {0, 0, 0}, hi[3] = {(float)a, (float)(2 * a), 4 * dx};
-    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
     double Ts = sqrt(2 * g / a);
     rt_sph_report r;
-    assert_int_equal(rt_sph_step(s, 0.f, &r), VFX_OK);
+    assert_int_equal(rt_sph_step(s, 0.f, &r, NULL, 0), VFX_OK);
     double e0 = energy(&r), e_prev = e0;
     for (int k = 0; k < 9; ++k) {
         double target = T_mm[k] / Ts;
-        assert_int_equal(rt_sph_step(s, (float)(target - rt_sph_time(s)), &r), VFX_OK);
+        assert_int_equal(rt_sph_step(s, (float)(target - rt_sph_time(s)), &r, NULL, 0), VFX_OK);
         assert_false(r.cap_hit);
         check_state(s);
         /* friction and viscosity only take energy out (1% for the explicit integration) */
@@ -923,7 +924,7 @@ static rt_sph *splash(uint32_t flags, uint32_t threads)
                 x[n] = 0.005f + 0.01f * (float)i, y[n] = 0.005f + 0.01f * (float)j;
                 z[n] = 0.005f + 0.01f * (float)k, vx[n] = 1.f;
             }
-    assert_int_equal(rt_sph_add_particles(s, n, x, y, z, vx, NULL, NULL), VFX_OK);
+    assert_int_equal(rt_sph_add_particles(s, n, x, y, z, vx, NULL, NULL, NULL, 0), VFX_OK);
     return s;
 }
 
@@ -937,8 +938,8 @@ static void test_verlet_matches_rebuild(void **state)
         uint64_t lo, hi;
         brute_pairs(v, &lo, &hi);
         rt_sph_report rv, rb;
-        assert_int_equal(rt_sph_step(v, 5e-5f, &rv), VFX_OK);
-        assert_int_equal(rt_sph_step(b, 5e-5f, &rb), VFX_OK);
+        assert_int_equal(rt_sph_step(v, 5e-5f, &rv, NULL, 0), VFX_OK);
+        assert_int_equal(rt_sph_step(b, 5e-5f, &rb, NULL, 0), VFX_OK);
         assert_int_equal(rv.substeps, 1);
         assert_int_equal(rb.neighbor_rebuilds, 2); /* the substep and the closing pass */
         rebuilds += rv.neighbor_rebuilds;
@@ -995,9 +996,9 @@ static void test_verlet_rebuild_trigger(void **state)
         rt_sph *s = make(d);
         float lo[3] = {0.1f, 0.02f, 0.02f}, hi[3] = {0.2f, 0.1f, 0.1f};
         uint32_t nb;
-        assert_int_equal(rt_sph_add_block(s, lo, hi, &nb), VFX_OK);
+        assert_int_equal(rt_sph_add_block(s, lo, hi, &nb, NULL, 0), VFX_OK);
         float px = 0.08f, py = 0.06f, pz = 0.06f, pv = fast ? 4.f : 0.05f;
-        assert_int_equal(rt_sph_add_particles(s, 1, &px, &py, &pz, &pv, NULL, NULL), VFX_OK);
+        assert_int_equal(rt_sph_add_particles(s, 1, &px, &py, &pz, &pv, NULL, NULL, NULL, 0), VFX_OK);
         const uint32_t n = nb + 1;
         const float skin = rt_sph_params(s)->neighbor_skin * rt_sph_support(s);
         float *ref = malloc(3 * n * sizeof(float)), *ref0 = malloc(3 * n * sizeof(float));
@@ -1013,7 +1014,7 @@ static void test_verlet_rebuild_trigger(void **state)
             uint64_t plo, phi;
             brute_pairs(s, &plo, &phi);
             rt_sph_report r;
-            assert_int_equal(rt_sph_step(s, 1e-4f, &r), VFX_OK);
+            assert_int_equal(rt_sph_step(s, 1e-4f, &r, NULL, 0), VFX_OK);
             assert_true(r.neighbor_pairs >= plo && r.neighbor_pairs <= phi);
             rt_sph_columns c = rt_sph_get_columns(s);
             assert_int_equal(c.count, n);
@@ -1071,12 +1072,12 @@ static void test_verlet_threads_bitwise(void **state)
         s[t] = make(d);
         float lo[3] = {0, 0, 0}, hi[3] = {0.1f, 0.24f, 0.1f};
         uint32_t n;
-        assert_int_equal(rt_sph_add_block(s[t], lo, hi, &n), VFX_OK);
+        assert_int_equal(rt_sph_add_block(s[t], lo, hi, &n, NULL, 0), VFX_OK);
         assert_int_equal(n, 2400);
         rt_sph_report r;
         uint32_t rebuilds = 0;
         for (int f = 0; f < 4; ++f) {
-            assert_int_equal(rt_sph_step(s[t], 1.f / 60.f, &r), VFX_OK);
+            assert_int_equal(rt_sph_step(s[t], 1.f / 60.f, &r, NULL, 0), VFX_OK);
             rebuilds += r.neighbor_rebuilds;
         }
         assert_true(rebuilds >= 2);
@@ -1092,10 +1093,10 @@ static void test_million_particles(void **state)
     rt_sph *s = make(d);
     float lo[3] = {0, 0, 0}, hi[3] = {2.0f, 2.0f, 2.0f};
     uint32_t n;
-    assert_int_equal(rt_sph_add_block(s, lo, hi, &n), VFX_OK);
+    assert_int_equal(rt_sph_add_block(s, lo, hi, &n, NULL, 0), VFX_OK);
     assert_int_equal(n, 1000000);
     rt_sph_report r;
-    assert_int_equal(rt_sph_step(s, 1e-5f, &r), VFX_OK);
+    assert_int_equal(rt_sph_step(s, 1e-5f, &r, NULL, 0), VFX_OK);
     assert_int_equal(r.substeps, 1);
     print_message("1,000,000 particles: %.1f MiB in the solver, %llu neighbour pairs\n",
                   rt_sph_memory_bytes(s) / 1048576.0, (unsigned long long)r.neighbor_pairs);
