@@ -172,7 +172,7 @@ static int run_cfg(const tet_mesh *m, const tet_camera *cam, const tet_tf *tf,
         /* CPU time of the whole process (every worker thread): the figure that survives other
          * load */
         double t0 = tet_now_ms(), c0 = tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID);
-        if (tet_render_workers(m, cam, tf, o, img, &rr->c, rr->pw, err) != 0) {
+        if (tet_render_workers(m, cam, tf, o, img, &rr->c, rr->pw, err, sizeof err) != 0) {
             fprintf(stderr, "bench tetvol: %s\n", err);
             return -1;
         }
@@ -242,18 +242,18 @@ static int bench_tf(const tet_mesh *m, const tet_camera *cam, const tet_tf *base
     o.ert = 0;
     tet_pool *pool;
     char err[256];
-    if (tet_pool_create(1, &pool, err) != VFX_OK) return -1;
+    if (tet_pool_create(1, &pool, err, sizeof err) != TET_OK) return -1;
     double rmse[9] = {0}, mx[9] = {0};
     uint64_t pieces[9] = {0}, segs = 0;
     for (int r = 0; r <= reps; r++)
         for (int t = 0; t < 3; t++) {
             tet_tf tf = {.points = tabs[t], .count = counts[t], .method = TET_TF_EXACT};
-            if (r == 0 && tet_render_pool(pool, m, cam, &tf, &o, ref, NULL, NULL, err) != VFX_OK) goto fail;
+            if (r == 0 && tet_render_pool(pool, m, cam, &tf, &o, ref, NULL, NULL, err, sizeof err) != TET_OK) goto fail;
             for (int k = 0; k < 3; k++) {
                 tf.method = k;
                 tet_counters c;
                 double c0 = tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID);
-                if (tet_render_pool(pool, m, cam, &tf, &o, img, &c, NULL, err) != VFX_OK) goto fail;
+                if (tet_render_pool(pool, m, cam, &tf, &o, img, &c, NULL, err, sizeof err) != TET_OK) goto fail;
                 if (r > 0) cpu[(size_t)(r - 1) * 9 + t * 3 + k] = tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID) - c0;
                 if (r == 0) {
                     diff(ref, img, n, &rmse[t * 3 + k], &mx[t * 3 + k]);
@@ -294,7 +294,7 @@ static int bench_threads(const tet_mesh *m, const tet_camera *cam, const tet_tf 
     float *img = malloc(n * sizeof *img);
     tet_pool *pools[2];
     char err[256];
-    if (!img || tet_pool_create(1, &pools[0], err) != VFX_OK || tet_pool_create(2, &pools[1], err) != VFX_OK)
+    if (!img || tet_pool_create(1, &pools[0], err, sizeof err) != TET_OK || tet_pool_create(2, &pools[1], err, sizeof err) != TET_OK)
         return -1;
     for (int cfg = 0; cfg < 2; cfg++) {
         tet_options o;
@@ -306,7 +306,7 @@ static int bench_threads(const tet_mesh *m, const tet_camera *cam, const tet_tf 
             for (int p = 0; p < 2; p++) {
                 tet_counters c, w[2];
                 double t0 = tet_now_ms(), c0 = tet_clock_ms(CLOCK_PROCESS_CPUTIME_ID);
-                if (tet_render_pool(pools[p], m, cam, tf, &o, img, &c, w, err) != VFX_OK) {
+                if (tet_render_pool(pools[p], m, cam, tf, &o, img, &c, w, err, sizeof err) != TET_OK) {
                     fprintf(stderr, "bench tetvol threads: %s\n", err);
                     return -1;
                 }

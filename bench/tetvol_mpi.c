@@ -247,7 +247,7 @@ int main(int argc, char **argv)
         MPI_Abort(MPI_COMM_WORLD, 1);
     }
     tet_mpi *ctx;
-    if (tet_mpi_create(MPI_COMM_WORLD, &ctx, err) != 0) {
+    if (tet_mpi_create(MPI_COMM_WORLD, &ctx, err, sizeof err) != 0) {
         fprintf(stderr, "volfx-tetvol-mpi: %s\n", err);
         MPI_Abort(MPI_COMM_WORLD, 1);
     }
@@ -262,7 +262,7 @@ int main(int argc, char **argv)
         o.ert = 0;
         o.ert_threshold = 1.0f; /* the partial-compositing stop of the no-ERT runs below */
         double t0 = MPI_Wtime();
-        if (tet_render(&m, &cam, &tf, &o, ref, &c, err) != 0) {
+        if (tet_render(&m, &cam, &tf, &o, ref, &c, err, sizeof err) != 0) {
             fprintf(stderr, "volfx-tetvol-mpi: %s\n", err);
             MPI_Abort(MPI_COMM_WORLD, 1);
         }
@@ -302,7 +302,7 @@ int main(int argc, char **argv)
         for (int r = 0; r < repeat; r++) {
             barrier_polite();
             double t0 = MPI_Wtime();
-            rc = tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err);
+            rc = tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err, sizeof err);
             double t = (MPI_Wtime() - t0) * 1e3, tmax = t;
             MPI_Reduce(&t, &tmax, 1, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
             if (rc != 0) {

@@ -103,10 +103,10 @@ typedef struct shared {
  * report the same first fault: image size, worker count (at most 64), a scalar field, a
  * perspective projection, a valid transfer function. Sets *near_d to the near-plane distance
  * the projection implies (1e-4 when it implies none). */
-int tet_check_view(const tet_mesh *mesh, const tet_camera *cam, const tet_tf *tf, int nw,
-                   double *near_d, char err[256]);
-/* First tet referencing a point out of range: VFX_ERR_INVALID_ARGUMENT naming it, or VFX_OK. */
-int tet_check_indices(const tet_mesh *mesh, char err[256]);
+tet_result tet_check_view(const tet_mesh *mesh, const tet_camera *cam, const tet_tf *tf, int nw,
+                   double *near_d, char *err, size_t errlen);
+/* First tet referencing a point out of range: TET_ERR_INVALID_ARGUMENT naming it, or TET_OK. */
+tet_result tet_check_indices(const tet_mesh *mesh, char *err, size_t errlen);
 /* Transforms points [i0, i1) to view space with their scalar and pixel coordinates (pixel k's
  * centre at k); every engine uses it so all see bit-identical vertices. */
 void tet_view_vertices(const tet_mesh *mesh, const float *V, const float *P, int W, int H,
@@ -119,8 +119,8 @@ uint32_t tet_build_keys(const tet_mesh *mesh, const pvert *vp, uint32_t c0, uint
 /* ---- tet_tf.c: transfer function ---- */
 
 /* Prepares tf for the scan (the pre-integrated tables allocated when its method asks for
- * them). Returns VFX_OK, or an error code with a message. */
-int tet_tf_prepare(const tet_tf *tf, tf_prep *out, char err[256]);
+ * them). Returns TET_OK, or an error code with a message. */
+tet_result tet_tf_prepare(const tet_tf *tf, tf_prep *out, char *err, size_t errlen);
 /* Frees what tet_tf_prepare allocated. */
 void tet_tf_release(tf_prep *tf);
 /* The premultiplied colour and opacity of the ray segment between view depths tin and tout

@@ -37,30 +37,30 @@ static void local_build(tet_local *L, int p, int count)
     L->built[p] = 1;
 }
 
-int tet_local_create(const tet_mesh *mesh, const tet_camera *cam,
+tet_result tet_local_create(const tet_mesh *mesh, const tet_camera *cam,
                          const tet_tf *tf, const tet_options *opts, int parts,
-                         int own, tet_local **out, char err[256])
+                         int own, tet_local **out, char *err, size_t errlen)
 {
     *out = NULL;
     if (!mesh || !cam || !tf || !opts || parts <= 0 || own < 0 || own >= parts) {
-        snprintf(err, 256, "tet_render: NULL argument or partition %d of %d", own, parts);
-        return VFX_ERR_INVALID_ARGUMENT;
+        tet_errf(err, errlen, "tet_render: NULL argument or partition %d of %d", own, parts);
+        return TET_ERR_INVALID_ARGUMENT;
     }
     const int W = cam->width, H = cam->height;
     double near_d;
-    int rc = tet_check_view(mesh, cam, tf, 1, &near_d, err);
-    if (rc != VFX_OK)
+    tet_result rc = tet_check_view(mesh, cam, tf, 1, &near_d, err, errlen);
+    if (rc != TET_OK)
         return rc;
     /* every index is checked on every process (cheap), so all report the same bad tet */
-    if ((rc = tet_check_indices(mesh, err)) != VFX_OK)
+    if ((rc = tet_check_indices(mesh, err, errlen)) != TET_OK)
         return rc;
     const float *P = cam->proj, *V = cam->view;
     const uint32_t np = mesh->point_count, nt = mesh->tet_count;
     const int D = opts->tiles_d > 0 ? opts->tiles_d : 1;
     tet_local *L = calloc(1, sizeof *L);
     if (!L) {
-        snprintf(err, 256, "tet_render: out of memory");
-        return VFX_ERR_OUT_OF_MEMORY;
+        tet_errf(err, errlen, "tet_render: out of memory");
+        return TET_ERR_OUT_OF_MEMORY;
     }
     L->parts = parts;
     L->vp = malloc((size_t)np * sizeof *L->vp + 1);
@@ -73,11 +73,11 @@ int tet_local_create(const tet_mesh *mesh, const tet_camera *cam,
     pthread_mutex_init(&L->sh.lock, NULL);
     if (!L->vp || !L->keys || !L->ktmp || !L->bounds || !L->valid || !L->built ||
         tet_worker_reset(&L->w, W, H, D) != 0) {
-        snprintf(err, 256, "tet_render: out of memory (%u points, %u tets, %dx%d)", np, nt, W, H);
+        tet_errf(err, errlen, "tet_render: out of memory (%u points, %u tets, %dx%d)", np, nt, W, H);
         tet_local_destroy(L);
-        return VFX_ERR_OUT_OF_MEMORY;
+        return TET_ERR_OUT_OF_MEMORY;
     }
-    if ((rc = tet_tf_prepare(tf, &L->tf, err)) != VFX_OK) {
+    if ((rc = tet_tf_prepare(tf, &L->tf, err, errlen)) != TET_OK) {
         tet_local_destroy(L);
         return rc;
     }
@@ -93,7 +93,7 @@ int tet_local_create(const tet_mesh *mesh, const tet_camera *cam,
     L->w.sh = &L->sh;
     local_build(L, own, 1);
     *out = L;
-    return VFX_OK;
+    return TET_OK;
 }
 
 void tet_local_destroy(tet_local *L)

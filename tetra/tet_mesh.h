@@ -5,7 +5,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
-#include <volfx/volfx.h>
+#include "tet_result.h"
 
 typedef struct tet_mesh {
     uint32_t point_count;
@@ -22,9 +22,9 @@ typedef struct tet_mesh {
 /* Frees the arrays of a mesh and zeroes it; NULL allowed. */
 void tet_mesh_free(tet_mesh *mesh);
 
-/* Checks a filled mesh: indices in range, finite points (VFX_ERR_NUMERIC naming the point),
- * NaN scalars (VFX_ERR_NUMERIC naming the point), flips inverted tets, counts degenerate ones,
+/* Checks a filled mesh: indices in range, finite points (TET_ERR_NUMERIC naming the point),
+ * NaN scalars (TET_ERR_NUMERIC naming the point), flips inverted tets, counts degenerate ones,
  * sets scalar_min/max. */
-vfx_result tet_validate(tet_mesh *mesh, char *err, size_t errlen);
+tet_result tet_validate(tet_mesh *mesh, char *err, size_t errlen);
 
 #endif

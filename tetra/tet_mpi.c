@@ -59,7 +59,7 @@ static void over(tet_rseg *f, const tet_rseg *b)
 }
 
 int tet_seglists_merge(const tet_seglists *a, const tet_seglists *b, int partial,
-                           tet_seglists *out)
+                       tet_seglists *out)
 {
     size_t np = a->p1 - a->p0;
     size_t na = a->off[np], nb = b->off[np];
@@ -123,26 +123,26 @@ static int slice_lists(const tet_seglists *l, size_t q0, size_t q1, tet_seglists
 }
 
 /* All ranks agree on failure: the worst code wins, and its message is the local one if any. */
-static int agree(MPI_Comm comm, int rc, char err[256], const char *what)
+static tet_result agree(MPI_Comm comm, tet_result rc, char *err, size_t errlen, const char *what)
 {
-    int worst = rc;
+    int mine = (int)rc, worst = mine; /* an enum's size is the compiler's: MPI sees ints */
     MPI_Request rq;
-    MPI_Iallreduce(&rc, &worst, 1, MPI_INT, MPI_MAX, comm, &rq);
+    MPI_Iallreduce(&mine, &worst, 1, MPI_INT, MPI_MAX, comm, &rq);
     wait_polite(1, &rq);
-    if (worst != VFX_OK && rc == VFX_OK)
-        snprintf(err, 256, "tet_mpi: another rank failed during %s (code %d)", what, worst);
-    return worst;
+    if (worst != TET_OK && rc == TET_OK)
+        tet_errf(err, errlen, "tet_mpi: another rank failed during %s (code %d)", what, worst);
+    return (tet_result)worst;
 }
 
 /* One exchange step, called by every rank of comm: sends the lists of [s0, s1) of cur to dst
  * (dst < 0: none) and receives those of [k0, k1) from src (src < 0: none) into in. The segment
  * counts travel first and every rank agrees that the receive buffers exist before any payload
  * moves, so a failed allocation returns an error everywhere instead of leaving a send hanging. */
-static int exchange(MPI_Comm comm, MPI_Datatype segt, const tet_seglists *cur, int dst,
+static tet_result exchange(MPI_Comm comm, MPI_Datatype segt, const tet_seglists *cur, int dst,
                     size_t s0, size_t s1, int src, size_t k0, size_t k1, uint32_t *counts,
-                    tet_seglists *in, uint64_t *bytes, char err[256])
+                    tet_seglists *in, uint64_t *bytes, char *err, size_t errlen)
 {
-    int rc = VFX_OK;
+    tet_result rc = TET_OK;
     uint64_t ns = 0, nr = 0;
     MPI_Request rq[3];
     int nrq = 0;
@@ -163,19 +163,19 @@ static int exchange(MPI_Comm comm, MPI_Datatype segt, const tet_seglists *cur, i
         in->off = malloc((k1 - k0 + 1) * sizeof *in->off);
         in->segs = nr <= INT_MAX ? malloc((size_t)(nr + 1) * sizeof *in->segs) : NULL;
         if (!in->off || !in->segs) {
-            snprintf(err, 256, "tet_mpi: out of memory receiving %llu segments from rank %d",
+            tet_errf(err, errlen, "tet_mpi: out of memory receiving %llu segments from rank %d",
                      (unsigned long long)nr, src);
-            rc = VFX_ERR_OUT_OF_MEMORY;
+            rc = TET_ERR_OUT_OF_MEMORY;
         }
     }
-    rc = agree(comm, rc, err, "list exchange");
-    if (rc == VFX_OK && dst >= 0) {
+    rc = agree(comm, rc, err, errlen, "list exchange");
+    if (rc == TET_OK && dst >= 0) {
         size_t a = s0 - cur->p0;
         MPI_Isend(counts, (int)(s1 - s0), MPI_UINT32_T, dst, TAG_SWAP_N, comm, &rq[nrq++]);
         MPI_Isend(cur->segs + cur->off[a], (int)ns, segt, dst, TAG_SWAP_S, comm, &rq[nrq++]);
         *bytes += sizeof ns + (uint64_t)(s1 - s0) * sizeof(uint32_t) + ns * sizeof(tet_rseg);
     }
-    if (rc == VFX_OK && src >= 0) {
+    if (rc == TET_OK && src >= 0) {
         size_t np = k1 - k0;
         MPI_Request r2[2];
         MPI_Irecv(in->off, (int)np, MPI_UINT32_T, src, TAG_SWAP_N, comm, &r2[0]);
@@ -190,15 +190,15 @@ static int exchange(MPI_Comm comm, MPI_Datatype segt, const tet_seglists *cur, i
         in->off[np] = acc;
     }
     wait_polite(nrq, rq);
-    if (rc != VFX_OK)
+    if (rc != TET_OK)
         tet_seglists_free(in);
     return rc;
 }
 
-int tet_mpi_composite(MPI_Comm comm, int W, int H, tet_seglists *lists, int partial,
-                          float *rgba, tet_mpi_stats *st, char err[256])
+tet_result tet_mpi_composite(MPI_Comm comm, int W, int H, tet_seglists *lists, int partial,
+                          float *rgba, tet_mpi_stats *st, char *err, size_t errlen)
 {
-    int rank, P, rc = VFX_OK;
+    int rank, P, rc = TET_OK;
     MPI_Comm_rank(comm, &rank);
     MPI_Comm_size(comm, &P);
     double t0 = tet_now_ms();
@@ -209,14 +209,14 @@ int tet_mpi_composite(MPI_Comm comm, int W, int H, tet_seglists *lists, int part
     uint64_t bytes = 0;
     uint32_t *counts = malloc((npix + 1) * sizeof *counts);
     if (!counts) {
-        snprintf(err, 256, "tet_mpi: out of memory for %zu pixel counts", npix);
-        rc = VFX_ERR_OUT_OF_MEMORY;
+        tet_errf(err, errlen, "tet_mpi: out of memory for %zu pixel counts", npix);
+        rc = TET_ERR_OUT_OF_MEMORY;
     } else if (lists->p0 != 0 || lists->p1 != npix || !lists->off) {
-        snprintf(err, 256, "tet_mpi: composite needs full-screen lists (got pixels %zu..%zu of %zu)",
+        tet_errf(err, errlen, "tet_mpi: composite needs full-screen lists (got pixels %zu..%zu of %zu)",
                  lists->p0, lists->p1, npix);
-        rc = VFX_ERR_INVALID_ARGUMENT;
+        rc = TET_ERR_INVALID_ARGUMENT;
     }
-    rc = agree(comm, rc, err, "composite set-up");
+    rc = agree(comm, rc, err, errlen, "composite set-up");
     int G = 1;
     while (G * 2 <= P)
         G *= 2;
@@ -224,45 +224,45 @@ int tet_mpi_composite(MPI_Comm comm, int W, int H, tet_seglists *lists, int part
     memset(lists, 0, sizeof *lists);
     memset(&merged, 0, sizeof merged);
     /* Fold: ranks G..P-1 hand their whole screen to rank - G, so the swap runs on 2^k ranks. */
-    if (rc == VFX_OK && P > G) {
+    if (rc == TET_OK && P > G) {
         int dst = rank >= G ? rank - G : -1, src = rank + G < P ? rank + G : -1;
-        rc = exchange(comm, segt, &cur, dst, 0, npix, src, 0, npix, counts, &in, &bytes, err);
-        int r2 = VFX_OK;
-        if (rc == VFX_OK && src >= 0) {
+        rc = exchange(comm, segt, &cur, dst, 0, npix, src, 0, npix, counts, &in, &bytes, err, errlen);
+        tet_result r2 = TET_OK;
+        if (rc == TET_OK && src >= 0) {
             if (tet_seglists_merge(&cur, &in, partial, &merged) != 0) {
-                snprintf(err, 256, "tet_mpi: out of memory folding rank %d's lists", src);
-                r2 = VFX_ERR_OUT_OF_MEMORY;
+                tet_errf(err, errlen, "tet_mpi: out of memory folding rank %d's lists", src);
+                r2 = TET_ERR_OUT_OF_MEMORY;
             } else {
                 tet_seglists_free(&cur);
                 cur = merged;
             }
         }
-        if (rc == VFX_OK && dst >= 0)
+        if (rc == TET_OK && dst >= 0)
             tet_seglists_free(&cur);
         tet_seglists_free(&in);
-        if (rc == VFX_OK)
-            rc = agree(comm, r2, err, "fold");
+        if (rc == TET_OK)
+            rc = agree(comm, r2, err, errlen, "fold");
     }
     /* Binary swap: at stage s the pair (rank, rank ^ 2^s) splits its common range in halves;
      * the lower rank keeps the first. Lists are merged by depth, so the result is exact
      * however the two ranks' cells interleave along the rays. Ranks >= G only take part in
      * the agreements. */
     size_t p0 = 0, p1 = npix;
-    for (int bit = 1; rc == VFX_OK && bit < G; bit <<= 1) {
+    for (int bit = 1; rc == TET_OK && bit < G; bit <<= 1) {
         int partner = rank < G ? rank ^ bit : -1;
         size_t mid = p0 + (p1 - p0) / 2;
         size_t k0 = (rank & bit) ? mid : p0, k1 = (rank & bit) ? p1 : mid;
         size_t s0 = (rank & bit) ? p0 : mid, s1 = (rank & bit) ? mid : p1;
         rc = exchange(comm, segt, &cur, partner, s0, s1, partner, k0, k1, counts, &in, &bytes,
-                      err);
-        if (rc != VFX_OK)
+                      err, errlen);
+        if (rc != TET_OK)
             break;
-        int r2 = VFX_OK;
+        tet_result r2 = TET_OK;
         if (partner >= 0) {
             if (slice_lists(&cur, k0, k1, &keep) != 0 ||
                 tet_seglists_merge(&keep, &in, partial, &merged) != 0) {
-                snprintf(err, 256, "tet_mpi: out of memory in binary swap stage %d", bit);
-                r2 = VFX_ERR_OUT_OF_MEMORY;
+                tet_errf(err, errlen, "tet_mpi: out of memory in binary swap stage %d", bit);
+                r2 = TET_ERR_OUT_OF_MEMORY;
             }
             tet_seglists_free(&keep);
             tet_seglists_free(&in);
@@ -272,7 +272,7 @@ int tet_mpi_composite(MPI_Comm comm, int W, int H, tet_seglists *lists, int part
             p0 = k0;
             p1 = k1;
         }
-        rc = agree(comm, r2, err, "binary swap");
+        rc = agree(comm, r2, err, errlen, "binary swap");
     }
     double t1 = tet_now_ms();
     /* Final composition of this rank's part, then gather to rank 0. */
@@ -280,16 +280,16 @@ int tet_mpi_composite(MPI_Comm comm, int W, int H, tet_seglists *lists, int part
     float *part = malloc((mine + 1) * 4 * sizeof *part);
     long long *ranges = rank == 0 ? malloc((size_t)P * 2 * sizeof *ranges) : NULL;
     int *cnts = rank == 0 ? malloc((size_t)P * 2 * sizeof *cnts) : NULL;
-    if (rc == VFX_OK && (!part || (rank == 0 && (!ranges || !cnts)))) {
-        snprintf(err, 256, "tet_mpi: out of memory for %zu final pixels", mine);
-        rc = VFX_ERR_OUT_OF_MEMORY;
+    if (rc == TET_OK && (!part || (rank == 0 && (!ranges || !cnts)))) {
+        tet_errf(err, errlen, "tet_mpi: out of memory for %zu final pixels", mine);
+        rc = TET_ERR_OUT_OF_MEMORY;
     }
-    if (rc == VFX_OK && rank == 0 && !rgba) {
-        snprintf(err, 256, "tet_mpi: rank 0 needs an output image");
-        rc = VFX_ERR_INVALID_ARGUMENT;
+    if (rc == TET_OK && rank == 0 && !rgba) {
+        tet_errf(err, errlen, "tet_mpi: rank 0 needs an output image");
+        rc = TET_ERR_INVALID_ARGUMENT;
     }
-    rc = agree(comm, rc, err, "final composition");
-    if (rc == VFX_OK) {
+    rc = agree(comm, rc, err, errlen, "final composition");
+    if (rc == TET_OK) {
         for (size_t p = 0; p < mine; p++) {
             tet_rseg acc = {0, 0, 0, 0, 0, 0};
             for (uint32_t i = cur.off[p]; i < cur.off[p + 1]; i++)
@@ -337,21 +337,21 @@ struct tet_mpi {
     int win_dd;    /* its entries; 0 = no window yet */
 };
 
-int tet_mpi_create(MPI_Comm comm, tet_mpi **out, char err[256])
+tet_result tet_mpi_create(MPI_Comm comm, tet_mpi **out, char *err, size_t errlen)
 {
     tet_mpi *m = calloc(1, sizeof *m);
-    int rc = m ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
+    tet_result rc = m ? TET_OK : TET_ERR_OUT_OF_MEMORY;
     if (!m)
-        snprintf(err, 256, "tet_mpi: out of memory for the context");
-    rc = agree(comm, rc, err, "context creation");
-    if (rc != VFX_OK) {
+        tet_errf(err, errlen, "tet_mpi: out of memory for the context");
+    rc = agree(comm, rc, err, errlen, "context creation");
+    if (rc != TET_OK) {
         free(m);
         *out = NULL;
         return rc;
     }
     m->comm = comm;
     *out = m;
-    return VFX_OK;
+    return TET_OK;
 }
 
 void tet_mpi_destroy(tet_mpi *m)
@@ -515,12 +515,12 @@ static void fingerprint(const tet_mesh *mesh, const tet_camera *cam, const tet_o
         fp[FP_D] = (uint64_t)(int64_t)opts->tiles_d;
 }
 
-/* Collective: VFX_OK when every rank holds the same mesh, image size and table size as rank 0,
- * else VFX_ERR_INVALID_ARGUMENT on every rank with the differing ranks named in err. Ranks
+/* Collective: TET_OK when every rank holds the same mesh, image size and table size as rank 0,
+ * else TET_ERR_INVALID_ARGUMENT on every rank with the differing ranks named in err. Ranks
  * with a stale copy of a mesh would otherwise scan cells the others never sorted (a crash in
  * the scan) or composite different data into one image. */
-static int check_same_input(MPI_Comm comm, int P, const tet_mesh *mesh, const tet_camera *cam,
-                            const tet_options *opts, char err[256])
+static tet_result check_same_input(MPI_Comm comm, int P, const tet_mesh *mesh, const tet_camera *cam,
+                            const tet_options *opts, char *err, size_t errlen)
 {
     uint64_t mine[FP_N];
     fingerprint(mesh, cam, opts, mine);
@@ -531,8 +531,8 @@ static int check_same_input(MPI_Comm comm, int P, const tet_mesh *mesh, const te
     wait_polite(1, &rq);
     if (!every) {
         free(all);
-        snprintf(err, 256, "tet_mpi: out of memory for %d ranks' mesh checksums", P);
-        return VFX_ERR_OUT_OF_MEMORY;
+        tet_errf(err, errlen, "tet_mpi: out of memory for %d ranks' mesh checksums", P);
+        return TET_ERR_OUT_OF_MEMORY;
     }
     MPI_Iallgather(mine, FP_N, MPI_UINT64_T, all, FP_N, MPI_UINT64_T, comm, &rq);
     wait_polite(1, &rq);
@@ -554,19 +554,19 @@ static int check_same_input(MPI_Comm comm, int P, const tet_mesh *mesh, const te
                            : f[FP_H_TETS] != all[FP_H_TETS] ? "tets"
                            : f[FP_H_SCALAR] != all[FP_H_SCALAR] || f[FP_SCALAR] != all[FP_SCALAR] ? "scalars"
                            : "image or table size";
-        snprintf(err, 256, "tet_mpi: rank%s %s%s hold%s a different mesh from rank 0 (%s differ; "
+        tet_errf(err, errlen, "tet_mpi: rank%s %s%s hold%s a different mesh from rank 0 (%s differ; "
                  "rank %d: %llu points, %llu tets; rank 0: %llu points, %llu tets)",
                  bad > 1 ? "s" : "", list, bad > 8 ? ", ..." : "", bad > 1 ? "" : "s", what, first,
                  (unsigned long long)f[FP_POINTS], (unsigned long long)f[FP_TETS],
                  (unsigned long long)all[FP_POINTS], (unsigned long long)all[FP_TETS]);
     }
     free(all);
-    return bad ? VFX_ERR_INVALID_ARGUMENT : VFX_OK;
+    return bad ? TET_ERR_INVALID_ARGUMENT : TET_OK;
 }
 
-int tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
+tet_result tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
                        const tet_tf *tf, const tet_options *opts, float *rgba,
-                       tet_mpi_stats *mine, tet_mpi_stats *all, char err[256])
+                       tet_mpi_stats *mine, tet_mpi_stats *all, char *err, size_t errlen)
 {
     double t_start = tet_now_ms();
     MPI_Comm comm = ctx->comm;
@@ -585,15 +585,15 @@ int tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
     R.st = &st;
     /* rank 0 gathers the statistics even when the caller wants none */
     tet_mpi_stats *gather_tmp = rank == 0 && !all ? malloc((size_t)P * sizeof *gather_tmp) : NULL;
-    int rc = check_same_input(comm, P, mesh, cam, opts, err);
-    if (rc != VFX_OK)
+    tet_result rc = check_same_input(comm, P, mesh, cam, opts, err, errlen);
+    if (rc != TET_OK)
         goto done;
-    rc = tet_local_create(mesh, cam, tf, opts, P, rank, &R.L, err);
-    if (rc == VFX_OK && rank == 0 && !all && !gather_tmp) {
-        snprintf(err, 256, "tet_mpi: out of memory for %d ranks' statistics", P);
-        rc = VFX_ERR_OUT_OF_MEMORY;
+    rc = tet_local_create(mesh, cam, tf, opts, P, rank, &R.L, err, errlen);
+    if (rc == TET_OK && rank == 0 && !all && !gather_tmp) {
+        tet_errf(err, errlen, "tet_mpi: out of memory for %d ranks' statistics", P);
+        rc = TET_ERR_OUT_OF_MEMORY;
     }
-    if (rc == VFX_OK) {
+    if (rc == TET_OK) {
         R.DD = tet_local_tiles_d(R.L) * tet_local_tiles_d(R.L);
         size_t n = (size_t)R.DD + 1 + (size_t)P; /* the reduction, then a table's scratch */
         R.sendbuf = malloc(n * sizeof(float));
@@ -602,12 +602,12 @@ int tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
         R.enc = malloc((size_t)R.DD * sizeof(float));
         R.remaining = malloc((size_t)P * sizeof(float));
         if (!R.sendbuf || !R.recvbuf || !R.known || !R.enc || !R.remaining) {
-            snprintf(err, 256, "tet_mpi: out of memory for the ERT exchange (D*D = %d)", R.DD);
-            rc = VFX_ERR_OUT_OF_MEMORY;
+            tet_errf(err, errlen, "tet_mpi: out of memory for the ERT exchange (D*D = %d)", R.DD);
+            rc = TET_ERR_OUT_OF_MEMORY;
         }
     }
-    rc = agree(comm, rc, err, "set-up");
-    if (rc != VFX_OK)
+    rc = agree(comm, rc, err, errlen, "set-up");
+    if (rc != TET_OK)
         goto done;
     R.share = opts->share && opts->ert && P > 1;
     if (R.share) {
@@ -631,7 +631,7 @@ int tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
         }
         /* nobody reads it before it is reset; the agreement after the scan keeps the next
          * frame's reset after every access of this one */
-        agree(comm, VFX_OK, err, "window set-up");
+        agree(comm, TET_OK, err, errlen, "window set-up");
     }
     tet_local_part(R.L, rank, &R.next, &R.end);
     st.cells_assigned = R.end - R.next;
@@ -683,7 +683,7 @@ int tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
             if (tet_local_scan(R.L, R.next++) != 0) {
                 failed = 1;
                 R.end = R.next; /* nothing to hand out either */
-                snprintf(err, 256, "tet_mpi: rank %d out of memory at %llu segments", rank,
+                tet_errf(err, errlen, "tet_mpi: rank %d out of memory at %llu segments", rank,
                          (unsigned long long)cnt->segments_made);
             }
         }
@@ -738,8 +738,8 @@ int tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
     st.t_phase1_ms = tet_now_ms() - t1;
     st.t_phase1_cpu_ms = tet_thread_cpu_ms() - c1;
 
-    rc = agree(comm, failed ? VFX_ERR_OUT_OF_MEMORY : VFX_OK, err, "the scan");
-    if (rc != VFX_OK)
+    rc = agree(comm, failed ? TET_ERR_OUT_OF_MEMORY : TET_OK, err, errlen, "the scan");
+    if (rc != TET_OK)
         goto done;
     /* Phase 2: this rank's full-screen lists, exported and composited by binary swap. */
     double te = tet_now_ms();
@@ -751,10 +751,10 @@ int tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
     lists.off = malloc((npix + 1) * sizeof *lists.off);
     size_t nseg = lists.off ? tet_local_export(R.L, 0, npix, lists.off, NULL) : 0;
     lists.segs = lists.off && nseg <= INT_MAX ? malloc((nseg + 1) * sizeof *lists.segs) : NULL;
-    int r2 = VFX_OK;
+    tet_result r2 = TET_OK;
     if (!lists.segs) {
-        snprintf(err, 256, "tet_mpi: rank %d out of memory exporting %zu segments", rank, nseg);
-        r2 = VFX_ERR_OUT_OF_MEMORY;
+        tet_errf(err, errlen, "tet_mpi: rank %d out of memory exporting %zu segments", rank, nseg);
+        r2 = TET_ERR_OUT_OF_MEMORY;
         tet_seglists_free(&lists);
     } else {
         tet_local_export(R.L, 0, npix, lists.off, lists.segs);
@@ -763,11 +763,11 @@ int tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
     st.cnt = *cnt;
     tet_local_destroy(R.L); /* the lists are all phase 2 needs */
     R.L = NULL;
-    rc = agree(comm, r2, err, "export");
+    rc = agree(comm, r2, err, errlen, "export");
     st.t_export_ms = tet_now_ms() - te;
-    if (rc == VFX_OK)
+    if (rc == TET_OK)
         rc = tet_mpi_composite(comm, cam->width, cam->height, &lists, opts->partial_composite,
-                                   rgba, &st, err);
+                                   rgba, &st, err, errlen);
     tet_seglists_free(&lists);
 done:
     if (R.L)
@@ -775,7 +775,7 @@ done:
     st.t_total_ms = tet_now_ms() - t_start;
     if (mine)
         *mine = st;
-    if (rc == VFX_OK) {
+    if (rc == TET_OK) {
         MPI_Request rq;
         MPI_Igather(&st, (int)sizeof st, MPI_BYTE, all ? all : gather_tmp, (int)sizeof st,
                     MPI_BYTE, 0, comm, &rq);

@@ -46,29 +46,29 @@ typedef struct tet_mpi_stats {
 /* A communicator and what is kept between renders on it (the shared ERT table's window). */
 typedef struct tet_mpi tet_mpi;
 
-/* Creates a context on comm (which must outlive it). Collective; VFX_OK or an error code on
+/* Creates a context on comm (which must outlive it). Collective; TET_OK or an error code on
  * every rank with a message in err. */
-int tet_mpi_create(MPI_Comm comm, tet_mpi **out, char err[256]);
+tet_result tet_mpi_create(MPI_Comm comm, tet_mpi **out, char *err, size_t errlen);
 /* Frees a context; NULL allowed. Collective when not NULL. */
 void tet_mpi_destroy(tet_mpi *ctx);
 
 /* Renders mesh on all ranks of ctx's comm (every rank passes the same mesh, camera, tf and opts;
  * opts->workers is ignored: one scan per rank). rgba (width*height*4, premultiplied) is filled
  * on rank 0 and may be NULL elsewhere; mine (may be NULL) gets this rank's statistics, all
- * (rank 0, NULL or comm-size entries) every rank's. Collective; returns VFX_OK or the same
+ * (rank 0, NULL or comm-size entries) every rank's. Collective; returns TET_OK or the same
  * error code on every rank, with a message in err. */
-int tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
+tet_result tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
                        const tet_tf *tf, const tet_options *opts, float *rgba,
-                       tet_mpi_stats *mine, tet_mpi_stats *all, char err[256]);
+                       tet_mpi_stats *mine, tet_mpi_stats *all, char *err, size_t errlen);
 
 /* Binary-swap composition of every rank's full-screen lists (range [0, width*height)): ranks
  * beyond the largest power of two first fold theirs into a partner, then log2 stages swap
  * half the current range with a partner and merge the received lists by depth (touching
  * segments partially composited when partial is set); each rank composites its 1/P front to
  * back and rank 0 gathers rgba. lists is consumed (its arrays freed). st may be NULL.
- * Collective; returns VFX_OK or an error code on every rank with a message in err. */
-int tet_mpi_composite(MPI_Comm comm, int width, int height, tet_seglists *lists,
-                          int partial, float *rgba, tet_mpi_stats *st, char err[256]);
+ * Collective; returns TET_OK or an error code on every rank with a message in err. */
+tet_result tet_mpi_composite(MPI_Comm comm, int width, int height, tet_seglists *lists,
+                          int partial, float *rgba, tet_mpi_stats *st, char *err, size_t errlen);
 
 /* Merges two depth-ordered lists over the same pixel range into out (allocated here);
  * touching segments are partially composited when partial is set. Returns 0 or -1 (memory). */

@@ -86,25 +86,25 @@ typedef struct tet_counters {
 void tet_options_default(tet_options *opts);
 
 /* Renders mesh (with its scalar) into rgba (width*height*4 floats, premultiplied, row 0 = bottom).
- * Returns VFX_OK or an error code with a message in err; counters may be NULL. */
-int tet_render(const tet_mesh *mesh, const tet_camera *cam, const tet_tf *tf,
+ * Returns TET_OK or an error code with a message in err; counters may be NULL. */
+tet_result tet_render(const tet_mesh *mesh, const tet_camera *cam, const tet_tf *tf,
                    const tet_options *opts, float *rgba, tet_counters *counters,
-                   char err[256]);
+                   char *err, size_t errlen);
 
 /* As tet_render with opts->workers threads; per_worker (NULL or opts->workers entries)
  * receives each worker's counters. counters totals the cells and keeps the maximum times. */
-int tet_render_workers(const tet_mesh *mesh, const tet_camera *cam,
+tet_result tet_render_workers(const tet_mesh *mesh, const tet_camera *cam,
                            const tet_tf *tf, const tet_options *opts, float *rgba,
                            tet_counters *counters, tet_counters *per_worker,
-                           char err[256]);
+                           char *err, size_t errlen);
 
 /* A persistent pool of render workers: workers - 1 threads created once that wait for frames,
  * plus the calling thread, with their segment lists and tables kept between frames. */
 typedef struct tet_pool tet_pool;
 
-/* Creates a pool of workers (<= 0 means 1, at most 64). Returns VFX_OK or an error code with a
+/* Creates a pool of workers (<= 0 means 1, at most 64). Returns TET_OK or an error code with a
  * message in err. A thread that cannot be started is not fatal: its share runs on the caller. */
-int tet_pool_create(int workers, tet_pool **out, char err[256]);
+tet_result tet_pool_create(int workers, tet_pool **out, char *err, size_t errlen);
 /* Stops the threads and frees the pool; NULL allowed. */
 void tet_pool_destroy(tet_pool *pool);
 /* Workers of the pool (threads started + the caller). */
@@ -113,8 +113,8 @@ int tet_pool_workers(const tet_pool *pool);
 int tet_pool_threads(const tet_pool *pool);
 
 /* As tet_render_workers on the pool's workers (opts->workers is ignored). */
-int tet_render_pool(tet_pool *pool, const tet_mesh *mesh, const tet_camera *cam,
+tet_result tet_render_pool(tet_pool *pool, const tet_mesh *mesh, const tet_camera *cam,
                     const tet_tf *tf, const tet_options *opts, float *rgba,
-                    tet_counters *counters, tet_counters *per_worker, char err[256]);
+                    tet_counters *counters, tet_counters *per_worker, char *err, size_t errlen);
 
 #endif

@@ -21,10 +21,10 @@ typedef struct tet_local tet_local;
 /* Validates the inputs as tet_render_workers does and prepares a scan split into parts
  * partitions (contiguous ranges of the mesh's cell order, each sorted front to back), building
  * the keys of partition own (its NaN cells counted). The arguments must outlive the result.
- * Returns VFX_OK or an error code with a message in err. */
-int tet_local_create(const tet_mesh *mesh, const tet_camera *cam,
+ * Returns TET_OK or an error code with a message in err. */
+tet_result tet_local_create(const tet_mesh *mesh, const tet_camera *cam,
                          const tet_tf *tf, const tet_options *opts, int parts, int own,
-                         tet_local **out, char err[256]);
+                         tet_local **out, char *err, size_t errlen);
 /* Frees a scan state; NULL allowed. */
 void tet_local_destroy(tet_local *L);
 /* The key range [k0, k1) of partition part (its keys are built first if they were not). */

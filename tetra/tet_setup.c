@@ -19,57 +19,57 @@ void tet_options_default(tet_options *o)
     o->dlb = 1;
 }
 
-int tet_check_view(const tet_mesh *mesh, const tet_camera *cam, const tet_tf *tf, int nw,
-                   double *near_d, char err[256])
+tet_result tet_check_view(const tet_mesh *mesh, const tet_camera *cam, const tet_tf *tf, int nw,
+                   double *near_d, char *err, size_t errlen)
 {
     const int W = cam->width, H = cam->height;
     if (W <= 0 || H <= 0 || W > 16384 || H > 16384) {
-        snprintf(err, 256, "tet_render: image size %dx%d out of range", W, H);
-        return VFX_ERR_INVALID_ARGUMENT;
+        tet_errf(err, errlen, "tet_render: image size %dx%d out of range", W, H);
+        return TET_ERR_INVALID_ARGUMENT;
     }
     if (nw > 64) {
-        snprintf(err, 256, "tet_render: %d workers requested, at most 64", nw);
-        return VFX_ERR_INVALID_ARGUMENT;
+        tet_errf(err, errlen, "tet_render: %d workers requested, at most 64", nw);
+        return TET_ERR_INVALID_ARGUMENT;
     }
     if (!mesh->scalar) {
-        snprintf(err, 256, "tet_render: mesh has no scalar field");
-        return VFX_ERR_INVALID_ARGUMENT;
+        tet_errf(err, errlen, "tet_render: mesh has no scalar field");
+        return TET_ERR_INVALID_ARGUMENT;
     }
     const float *P = cam->proj;
     if (P[11] > -0.5f || !(fabsf(P[0]) > 0) || !(fabsf(P[5]) > 0)) {
-        snprintf(err, 256, "tet_render: projection is not a perspective matrix (P[11]=%g)",
+        tet_errf(err, errlen, "tet_render: projection is not a perspective matrix (P[11]=%g)",
                  (double)P[11]);
-        return VFX_ERR_INVALID_ARGUMENT;
+        return TET_ERR_INVALID_ARGUMENT;
     }
     if (tf->count != 0 && (tf->count < 2 || tf->count > TET_TF_MAX_POINTS || !tf->points)) {
-        snprintf(err, 256, "tet_render: transfer function of %d points (need 0 or 2..%d with a table)",
+        tet_errf(err, errlen, "tet_render: transfer function of %d points (need 0 or 2..%d with a table)",
                  tf->count, TET_TF_MAX_POINTS);
-        return VFX_ERR_INVALID_ARGUMENT;
+        return TET_ERR_INVALID_ARGUMENT;
     }
     if (tf->method < TET_TF_EXACT || tf->method > TET_TF_MIDPOINT) {
-        snprintf(err, 256, "tet_render: unknown transfer-function method %d", tf->method);
-        return VFX_ERR_INVALID_ARGUMENT;
+        tet_errf(err, errlen, "tet_render: unknown transfer-function method %d", tf->method);
+        return TET_ERR_INVALID_ARGUMENT;
     }
     if (tf->pre_size < 0 || tf->pre_size > (1 << 20)) {
-        snprintf(err, 256, "tet_render: pre-integrated table of %d cells (0..%d)", tf->pre_size, 1 << 20);
-        return VFX_ERR_INVALID_ARGUMENT;
+        tet_errf(err, errlen, "tet_render: pre-integrated table of %d cells (0..%d)", tf->pre_size, 1 << 20);
+        return TET_ERR_INVALID_ARGUMENT;
     }
     *near_d = (double)P[14] / ((double)P[10] - 1.0);
     if (!(*near_d > 0)) *near_d = 1e-4;
-    return VFX_OK;
+    return TET_OK;
 }
 
-int tet_check_indices(const tet_mesh *mesh, char err[256])
+tet_result tet_check_indices(const tet_mesh *mesh, char *err, size_t errlen)
 {
     const uint32_t np = mesh->point_count;
     for (uint32_t c = 0; c < mesh->tet_count; c++)
         for (int k = 0; k < 4; k++)
             if (mesh->tets[4 * c + k] >= np) {
-                snprintf(err, 256, "tet_render: tet %u references point %u of %u", c,
+                tet_errf(err, errlen, "tet_render: tet %u references point %u of %u", c,
                          mesh->tets[4 * c + k], np);
-                return VFX_ERR_INVALID_ARGUMENT;
+                return TET_ERR_INVALID_ARGUMENT;
             }
-    return VFX_OK;
+    return TET_OK;
 }
 
 void tet_view_vertices(const tet_mesh *mesh, const float *V, const float *P, int W, int H,

@@ -216,15 +216,15 @@ static void integrate(const tf_prep *tf, double a, double b, double *T, double K
         K[c] += h * (ta * ca[c] + 4 * tm * cm[c] + tb * cb[c]);
 }
 
-static int build_preintegrated(tf_prep *tf, int cells, char err[256])
+static tet_result build_preintegrated(tf_prep *tf, int cells, char *err, size_t errlen)
 {
     tf->pre_n = cells;
     tf->pre_ds = tf->span / cells;
     tf->pre_T = malloc((size_t)(cells + 1) * sizeof *tf->pre_T);
     tf->pre_K = malloc((size_t)(cells + 1) * 3 * sizeof *tf->pre_K);
     if (!tf->pre_T || !tf->pre_K) {
-        snprintf(err, 256, "tet_render: out of memory for a %d-cell pre-integrated table", cells);
-        return VFX_ERR_OUT_OF_MEMORY;
+        tet_errf(err, errlen, "tet_render: out of memory for a %d-cell pre-integrated table", cells);
+        return TET_ERR_OUT_OF_MEMORY;
     }
     double T = 0, K[3] = {0, 0, 0};
     tf->pre_T[0] = 0;
@@ -243,7 +243,7 @@ static int build_preintegrated(tf_prep *tf, int cells, char err[256])
         for (int c = 0; c < 3; c++)
             tf->pre_K[3 * (i + 1) + c] = K[c];
     }
-    return VFX_OK;
+    return TET_OK;
 }
 
 #define TET_TF_MAX_RGB 1e6
@@ -255,7 +255,7 @@ static int rgb_ok(const float *c)
     return 1;
 }
 
-int tet_tf_prepare(const tet_tf *in, tf_prep *tf, char err[256])
+tet_result tet_tf_prepare(const tet_tf *in, tf_prep *tf, char *err, size_t errlen)
 {
     tf->method = in->method;
     tf->pre_T = tf->pre_K = NULL;
@@ -264,14 +264,14 @@ int tet_tf_prepare(const tet_tf *in, tf_prep *tf, char err[256])
         /* found by fuzz_tet_render: a NaN domain or extinction rendered NaN pixels as success */
         if (!isfinite(in->smin) || !isfinite(in->smax) || !isfinite(in->tau_lo) || !isfinite(in->tau_hi) ||
             !(in->tau_lo >= 0) || !(in->tau_hi >= 0)) {
-            snprintf(err, 256, "tet_render: linear transfer function smin %g smax %g tau_lo %g tau_hi %g "
+            tet_errf(err, errlen, "tet_render: linear transfer function smin %g smax %g tau_lo %g tau_hi %g "
                      "(finite, tau >= 0)", (double)in->smin, (double)in->smax, (double)in->tau_lo,
                      (double)in->tau_hi);
-            return VFX_ERR_INVALID_ARGUMENT;
+            return TET_ERR_INVALID_ARGUMENT;
         }
         if (!rgb_ok(in->color_lo) || !rgb_ok(in->color_hi)) {
-            snprintf(err, 256, "tet_render: linear transfer function colour outside [0, %g]", TET_TF_MAX_RGB);
-            return VFX_ERR_INVALID_ARGUMENT;
+            tet_errf(err, errlen, "tet_render: linear transfer function colour outside [0, %g]", TET_TF_MAX_RGB);
+            return TET_ERR_INVALID_ARGUMENT;
         }
         tf->n = 2;
         tf->s[0] = in->smin, tf->s[1] = in->smax;
@@ -285,14 +285,14 @@ int tet_tf_prepare(const tet_tf *in, tf_prep *tf, char err[256])
             /* colours in [0, TET_TF_MAX_RGB]: a finite 2e37 still summed to Inf pixels
              * (fuzz_tet_render) */
             if (!isfinite(p->s) || !isfinite(p->tau) || !(p->tau >= 0) || !rgb_ok(p->rgb)) {
-                snprintf(err, 256, "tet_render: transfer function point %d is not finite, has tau < 0 or a "
+                tet_errf(err, errlen, "tet_render: transfer function point %d is not finite, has tau < 0 or a "
                          "colour outside [0, %g]", i, TET_TF_MAX_RGB);
-                return VFX_ERR_INVALID_ARGUMENT;
+                return TET_ERR_INVALID_ARGUMENT;
             }
             if (i > 0 && !(p->s > in->points[i - 1].s)) {
-                snprintf(err, 256, "tet_render: transfer function point %d (scalar %g) does not follow %g",
+                tet_errf(err, errlen, "tet_render: transfer function point %d (scalar %g) does not follow %g",
                          i, (double)p->s, (double)in->points[i - 1].s);
-                return VFX_ERR_INVALID_ARGUMENT;
+                return TET_ERR_INVALID_ARGUMENT;
             }
             tf->s[i] = p->s;
             tf->tau[i] = p->tau;
@@ -304,8 +304,8 @@ int tet_tf_prepare(const tet_tf *in, tf_prep *tf, char err[256])
      * breakpoint that close to a segment's end would only perturb the rounding */
     tf->eps = 1e-6 * (tf->span > 0 ? tf->span : 0);
     if (tf->method == TET_TF_PREINTEGRATED && tf->span > 0)
-        return build_preintegrated(tf, in->pre_size > 0 ? in->pre_size : 1024, err);
-    return VFX_OK;
+        return build_preintegrated(tf, in->pre_size > 0 ? in->pre_size : 1024, err, errlen);
+    return TET_OK;
 }
 
 void tet_tf_release(tf_prep *tf)

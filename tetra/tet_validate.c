@@ -19,24 +19,24 @@ static double signed_volume6(const float *p, const uint32_t *t)
            u[2] * (v[0] * w[1] - v[1] * w[0]);
 }
 
-vfx_result tet_validate(tet_mesh *m, char *err, size_t errlen)
+tet_result tet_validate(tet_mesh *m, char *err, size_t errlen)
 {
     if (!m || m->point_count == 0 || m->tet_count == 0 || !m->points || !m->tets) {
-        snprintf(err, errlen, "mesh has no points or no tetrahedra");
-        return VFX_ERR_FORMAT;
+        tet_errf(err, errlen, "mesh has no points or no tetrahedra");
+        return TET_ERR_FORMAT;
     }
     for (uint32_t i = 0; i < m->point_count; i++)
         for (int k = 0; k < 3; k++)
             if (!isfinite(m->points[3 * (size_t)i + k])) {
-                snprintf(err, errlen, "point %u has a non-finite coordinate", i);
-                return VFX_ERR_NUMERIC;
+                tet_errf(err, errlen, "point %u has a non-finite coordinate", i);
+                return TET_ERR_NUMERIC;
             }
     for (uint32_t t = 0; t < m->tet_count; t++)
         for (int k = 0; k < 4; k++)
             if (m->tets[4 * (size_t)t + k] >= m->point_count) {
-                snprintf(err, errlen, "tetrahedron %u vertex %d index %u out of range (%u points)",
+                tet_errf(err, errlen, "tetrahedron %u vertex %d index %u out of range (%u points)",
                          t, k, m->tets[4 * (size_t)t + k], m->point_count);
-                return VFX_ERR_FORMAT;
+                return TET_ERR_FORMAT;
             }
     /* Degenerate: |6V| below a relative epsilon of the bounding box scale cubed. */
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -67,8 +67,8 @@ vfx_result tet_validate(tet_mesh *m, char *err, size_t errlen)
         for (uint32_t i = 0; i < m->point_count; i++) {
             float s = m->scalar[i];
             if (!isfinite(s)) {
-                snprintf(err, errlen, "scalar '%s' is not finite at point %u", m->scalar_name, i);
-                return VFX_ERR_NUMERIC;
+                tet_errf(err, errlen, "scalar '%s' is not finite at point %u", m->scalar_name, i);
+                return TET_ERR_NUMERIC;
             }
             mn = s < mn ? s : mn;
             mx = s > mx ? s : mx;
@@ -76,5 +76,5 @@ vfx_result tet_validate(tet_mesh *m, char *err, size_t errlen)
         m->scalar_min = mn;
         m->scalar_max = mx;
     }
-    return VFX_OK;
+    return TET_OK;
 }

@@ -91,21 +91,21 @@ static void pool_run(tet_pool *p, pool_fn fn, void *arg)
     }
 }
 
-int tet_pool_create(int workers, tet_pool **out, char err[256])
+tet_result tet_pool_create(int workers, tet_pool **out, char *err, size_t errlen)
 {
     *out = NULL;
     const int n = workers <= 0 ? 1 : workers;
     if (n > 64) {
-        snprintf(err, 256, "tet_render: %d workers requested, at most 64", n);
-        return VFX_ERR_INVALID_ARGUMENT;
+        tet_errf(err, errlen, "tet_render: %d workers requested, at most 64", n);
+        return TET_ERR_INVALID_ARGUMENT;
     }
     tet_pool *p = calloc(1, sizeof *p);
     worker *ws = aligned_alloc(64, (size_t)n * sizeof *ws);
     if (!p || !ws) {
         free(p);
         free(ws);
-        snprintf(err, 256, "tet_render: out of memory for a pool of %d workers", n);
-        return VFX_ERR_OUT_OF_MEMORY;
+        tet_errf(err, errlen, "tet_render: out of memory for a pool of %d workers", n);
+        return TET_ERR_OUT_OF_MEMORY;
     }
     memset(ws, 0, (size_t)n * sizeof *ws);
     for (int i = 0; i < n; i++)
@@ -128,7 +128,7 @@ int tet_pool_create(int workers, tet_pool **out, char err[256])
         p->nthreads++;
     }
     *out = p;
-    return VFX_OK;
+    return TET_OK;
 }
 
 void tet_pool_destroy(tet_pool *p)
@@ -383,25 +383,25 @@ static void sum_counters(tet_counters *cnt, const tet_counters *c)
     if (c->t_wait_ms > cnt->t_wait_ms) cnt->t_wait_ms = c->t_wait_ms;
 }
 
-int tet_render_pool(tet_pool *pool, const tet_mesh *mesh, const tet_camera *cam,
+tet_result tet_render_pool(tet_pool *pool, const tet_mesh *mesh, const tet_camera *cam,
                     const tet_tf *tf, const tet_options *opts, float *rgba,
-                    tet_counters *counters, tet_counters *per_worker, char err[256])
+                    tet_counters *counters, tet_counters *per_worker, char *err, size_t errlen)
 {
     tet_counters cnt;
     memset(&cnt, 0, sizeof cnt);
     if (counters) *counters = cnt;
     if (!pool || !mesh || !cam || !tf || !opts || !rgba) {
-        snprintf(err, 256, "tet_render: NULL argument");
-        return VFX_ERR_INVALID_ARGUMENT;
+        tet_errf(err, errlen, "tet_render: NULL argument");
+        return TET_ERR_INVALID_ARGUMENT;
     }
     const int W = cam->width, H = cam->height, nw = pool->n;
     double near_d;
-    int rc = tet_check_view(mesh, cam, tf, nw, &near_d, err);
-    if (rc == VFX_OK)
-        rc = tet_check_indices(mesh, err);
-    if (rc == VFX_OK)
-        rc = tet_tf_prepare(tf, &pool->tf, err);
-    if (rc != VFX_OK) {
+    tet_result rc = tet_check_view(mesh, cam, tf, nw, &near_d, err, errlen);
+    if (rc == TET_OK)
+        rc = tet_check_indices(mesh, err, errlen);
+    if (rc == TET_OK)
+        rc = tet_tf_prepare(tf, &pool->tf, err, errlen);
+    if (rc != TET_OK) {
         tet_tf_release(&pool->tf);
         return rc;
     }
@@ -412,14 +412,14 @@ int tet_render_pool(tet_pool *pool, const tet_mesh *mesh, const tet_camera *cam,
     memset(&sh, 0, sizeof sh);
     pthread_mutex_init(&sh.lock, NULL);
     if (pool_frame_buffers(pool, np, nt, D) != 0) {
-        snprintf(err, 256, "tet_render: out of memory (%u points, %u tets)", np, nt);
-        rc = VFX_ERR_OUT_OF_MEMORY;
+        tet_errf(err, errlen, "tet_render: out of memory (%u points, %u tets)", np, nt);
+        rc = TET_ERR_OUT_OF_MEMORY;
         goto done;
     }
     for (int i = 0; i < nw; i++)
         if (tet_worker_reset(&ws[i], W, H, D) != 0) {
-            snprintf(err, 256, "tet_render: out of memory for worker %d (%dx%d)", i, W, H);
-            rc = VFX_ERR_OUT_OF_MEMORY;
+            tet_errf(err, errlen, "tet_render: out of memory for worker %d (%dx%d)", i, W, H);
+            rc = TET_ERR_OUT_OF_MEMORY;
             goto done;
         }
     scan_ctx X = {mesh, &pool->tf, opts, pool->vp, cam->proj, near_d, W, H, D};
@@ -446,9 +446,9 @@ int tet_render_pool(tet_pool *pool, const tet_mesh *mesh, const tet_camera *cam,
         ws[i].cnt.t_wait_ms = t_all - job.t_scan_end[i];
     for (int i = 0; i < nw; i++)
         if (ws[i].failed) {
-            snprintf(err, 256, "tet_render: worker %d out of memory at %zu segments", i,
+            tet_errf(err, errlen, "tet_render: worker %d out of memory at %zu segments", i,
                      ws[i].pool.n);
-            rc = VFX_ERR_OUT_OF_MEMORY;
+            rc = TET_ERR_OUT_OF_MEMORY;
             goto done;
         }
     double tc = tet_now_ms();
@@ -466,31 +466,31 @@ done:
     return rc;
 }
 
-int tet_render_workers(const tet_mesh *mesh, const tet_camera *cam,
+tet_result tet_render_workers(const tet_mesh *mesh, const tet_camera *cam,
                        const tet_tf *tf, const tet_options *opts, float *rgba,
                        tet_counters *counters, tet_counters *per_worker,
-                       char err[256])
+                       char *err, size_t errlen)
 {
     if (counters) memset(counters, 0, sizeof *counters);
     if (!mesh || !cam || !tf || !opts || !rgba) {
-        snprintf(err, 256, "tet_render: NULL argument");
-        return VFX_ERR_INVALID_ARGUMENT;
+        tet_errf(err, errlen, "tet_render: NULL argument");
+        return TET_ERR_INVALID_ARGUMENT;
     }
     double near_d; /* the view's faults first, as the pool would report them */
-    int rc = tet_check_view(mesh, cam, tf, opts->workers <= 0 ? 1 : opts->workers, &near_d, err);
-    if (rc != VFX_OK)
+    tet_result rc = tet_check_view(mesh, cam, tf, opts->workers <= 0 ? 1 : opts->workers, &near_d, err, errlen);
+    if (rc != TET_OK)
         return rc;
     tet_pool *pool;
-    rc = tet_pool_create(opts->workers, &pool, err);
-    if (rc != VFX_OK)
+    rc = tet_pool_create(opts->workers, &pool, err, errlen);
+    if (rc != TET_OK)
         return rc;
-    rc = tet_render_pool(pool, mesh, cam, tf, opts, rgba, counters, per_worker, err);
+    rc = tet_render_pool(pool, mesh, cam, tf, opts, rgba, counters, per_worker, err, errlen);
     tet_pool_destroy(pool);
     return rc;
 }
 
-int tet_render(const tet_mesh *mesh, const tet_camera *cam, const tet_tf *tf,
-               const tet_options *opts, float *rgba, tet_counters *counters, char err[256])
+tet_result tet_render(const tet_mesh *mesh, const tet_camera *cam, const tet_tf *tf,
+               const tet_options *opts, float *rgba, tet_counters *counters, char *err, size_t errlen)
 {
-    return tet_render_workers(mesh, cam, tf, opts, rgba, counters, NULL, err);
+    return tet_render_workers(mesh, cam, tf, opts, rgba, counters, NULL, err, errlen);
 }

@@ -51,6 +51,13 @@ typedef struct volume_state {
     bool warned_many;
 } volume_state;
 
+/* tet_result's values are vfx_result's (tetra/tet_result.h), checked here where both are seen. */
+_Static_assert(TET_OK == (int)VFX_OK && TET_ERR_INVALID_ARGUMENT == (int)VFX_ERR_INVALID_ARGUMENT &&
+                   TET_ERR_OUT_OF_MEMORY == (int)VFX_ERR_OUT_OF_MEMORY &&
+                   TET_ERR_FORMAT == (int)VFX_ERR_FORMAT && TET_ERR_NUMERIC == (int)VFX_ERR_NUMERIC,
+               "tet_result and vfx_result codes differ");
+static vfx_result from_tet(tet_result r) { return (vfx_result)r; }
+
 static bool volume_present(vfx_context *ctx)
 {
     return ctx->host.volume_count && ctx->host.volume && ctx->host.volume_count(ctx->host.user) > 0;
@@ -410,7 +417,7 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
         tet_pool_destroy(s->pool);
         s->pool = NULL;
     }
-    if (!s->pool && (r = (vfx_result)tet_pool_create(o.workers, &s->pool, err)) != VFX_OK)
+    if (!s->pool && (r = from_tet(tet_pool_create(o.workers, &s->pool, err, sizeof err))) != VFX_OK)
         return volfx_fail(ctx, r, "volume[0]: %s", err);
 
     const uint64_t key = render_key(s, &cam, &tf, &o);
@@ -431,9 +438,9 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
             }
             dst = s->up_map[up];
         }
-        int rr = tet_render_pool(s->pool, &s->mesh, &cam, &tf, &o, dst, &c, NULL, err);
-        if (rr != VFX_OK)
-            return volfx_fail(ctx, (vfx_result)rr, "volume[0]: %s", err);
+        tet_result rr = tet_render_pool(s->pool, &s->mesh, &cam, &tf, &o, dst, &c, NULL, err, sizeof err);
+        if (rr != TET_OK)
+            return volfx_fail(ctx, from_tet(rr), "volume[0]: %s", err);
         s->last_key = key;
         volfx_stat_set(ctx, "volume.render_skipped", 0);
         volfx_stat_set(ctx, "volume.cells_scanned", (double)c.cells_scanned);

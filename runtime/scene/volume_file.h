@@ -4,6 +4,7 @@
 #define RT_VOLUME_FILE_H
 
 #include <stddef.h>
+#include <volfx/volfx.h>
 #include "tet_mesh.h" /* tetra/: the mesh type and tet_validate */
 
 /* Documented caps (docs/tetvol-input.md); each refusal names the cap it hit. Claimed counts are
@@ -13,6 +14,10 @@
 #define RT_VOLUME_MAX_TETS (1u << 24)       /* 16,777,216 tetrahedra */
 #define RT_VTU_MAX_DECODED_BYTES (1u << 30) /* base64-decoded plus inflated array bytes, per file */
 #define RT_ZLIB_MAX_RATIO 1032u             /* deflate cannot expand a byte beyond this */
+
+/* The tet library's result as the runtime's: tet_result's values are vfx_result's
+ * (tetra/tet_result.h), checked in volume_file_vtu.c where both are seen. */
+static inline vfx_result rt_result_from_tet(tet_result r) { return (vfx_result)r; }
 
 /* Loads a VTK XML UnstructuredGrid file (tetrahedra only); scalar_name NULL -> no scalar.
  * A vector point field gives its magnitude. On error *out is left zeroed. */

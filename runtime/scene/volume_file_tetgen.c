@@ -281,7 +281,7 @@ vfx_result rt_volume_load_tetgen(const char *path_base, const char *scalar_name,
         }
     }
     char inner[256] = "";
-    res = tet_validate(out, inner, sizeof inner);
+    res = rt_result_from_tet(tet_validate(out, inner, sizeof inner));
     if (res)
         snprintf(err, errlen, "%s.node/.ele: %s", path_base, inner);
 done:

@@ -14,6 +14,11 @@
 #include <string.h>
 #include <zlib.h>
 
+_Static_assert(TET_OK == (int)VFX_OK && TET_ERR_INVALID_ARGUMENT == (int)VFX_ERR_INVALID_ARGUMENT &&
+                   TET_ERR_OUT_OF_MEMORY == (int)VFX_ERR_OUT_OF_MEMORY &&
+                   TET_ERR_FORMAT == (int)VFX_ERR_FORMAT && TET_ERR_NUMERIC == (int)VFX_ERR_NUMERIC,
+               "tet_result and vfx_result codes differ (rt_result_from_tet)");
+
 enum { SEC_NONE, SEC_POINTS, SEC_CELLS, SEC_POINTDATA };
 enum { T_BAD, T_I8, T_U8, T_I16, T_U16, T_I32, T_U32, T_I64, T_U64, T_F32, T_F64 };
 enum { F_ASCII, F_BINARY, F_APPENDED };
@@ -696,7 +701,7 @@ vfx_result rt_volume_load_vtu_mem(const void *data, size_t size, const char *sca
             out->scalar[i] = (float)(as->ncomp == 1 ? m : sqrt(m));
         }
     }
-    r = tet_validate(out, err, errlen);
+    r = rt_result_from_tet(tet_validate(out, err, errlen));
 done:
     if (r != VFX_OK) tet_mesh_free(out);
     if (s->parser) XML_ParserFree(s->parser);

@@ -2,7 +2,7 @@
  * effect (points, tets, scalars, a transfer-function table, the options) from raw bytes, so
  * NaN, Inf, huge, coincident and out-of-range values all occur. The camera is a fixed valid
  * perspective one (the ABI checks the frame view before the renderer sees it). The renderer
- * must return VFX_OK or an error with its text, never crash, and leave the image finite. */
+ * must return TET_OK or an error with its text, never crash, and leave the image finite. */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -72,10 +72,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     static float rgba[W * H * 4];
     char err[256] = "";
     tet_counters c;
-    int rc = tet_render(&m, &cam, &tf, &o, rgba, &c, err);
-    if (rc != VFX_OK && !err[0])
+    int rc = tet_render(&m, &cam, &tf, &o, rgba, &c, err, sizeof err);
+    if (rc != TET_OK && !err[0])
         abort(); /* an error without its text */
-    if (rc == VFX_OK)
+    if (rc == TET_OK)
         for (int i = 0; i < W * H * 4; ++i)
             if (!isfinite(rgba[i]))
                 abort(); /* a non-finite pixel returned as success */

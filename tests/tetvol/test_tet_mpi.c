@@ -79,8 +79,8 @@ static int test_swap(int P)
         float *img = g_rank == 0 ? calloc(npix * 4, sizeof *img) : NULL;
         tet_mpi_stats st;
         memset(&st, 0, sizeof st);
-        int rc = tet_mpi_composite(MPI_COMM_WORLD, W, H, &l, partial, img, &st, err);
-        CHECK(rc == VFX_OK, "composite failed: %s", err);
+        int rc = tet_mpi_composite(MPI_COMM_WORLD, W, H, &l, partial, img, &st, err, sizeof err);
+        CHECK(rc == TET_OK, "composite failed: %s", err);
         if (g_rank == 0) {
             /* Reference: all segments in depth order, float64 front to back. Naive: each
              * rank's own segments composited to a flat image, the images composited in rank
@@ -176,7 +176,7 @@ static int test_render(int P)
     tet_tf tf = test_tf();
     char err[256];
     tet_mpi *ctx;
-    CHECK(tet_mpi_create(MPI_COMM_WORLD, &ctx, err) == VFX_OK, "%s", err);
+    CHECK(tet_mpi_create(MPI_COMM_WORLD, &ctx, err, sizeof err) == TET_OK, "%s", err);
     tet_mpi_stats *all = calloc((size_t)P, sizeof *all);
     float *ref = calloc(n4, sizeof *ref), *img = calloc(n4, sizeof *img);
     CHECK(all && ref && img, "memory");
@@ -191,7 +191,7 @@ static int test_render(int P)
         tet_counters c0;
         o.ert = 0;
         o.ert_threshold = 1.0f; /* the same partial-compositing stop as an ERT-1.0 run */
-        CHECK(tet_render(&m, &cam, &tf, &o, ref, &c0, err) == VFX_OK, "%s", err);
+        CHECK(tet_render(&m, &cam, &tf, &o, ref, &c0, err, sizeof err) == TET_OK, "%s", err);
         for (int mode = 0; mode < 4; mode++) {
             o.share = mode & 1;
             o.dlb = (mode >> 1) & 1;
@@ -200,8 +200,8 @@ static int test_render(int P)
              * rank and in each swap stage): 1e-5 is ~100 ulps of values <= 1 */
             o.ert = 0;
             o.ert_threshold = 1.0f;
-            CHECK(tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err) ==
-                      VFX_OK, "%s", err);
+            CHECK(tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err, sizeof err) ==
+                      TET_OK, "%s", err);
             if (g_rank == 0) {
                 double d = max_diff(ref, img, n4);
                 uint64_t keys = 0, scanned = 0, taken = 0, given = 0;
@@ -229,8 +229,8 @@ static int test_render(int P)
              * attenuated by >= 0.9: each variant stays within 1 - 0.9 = 0.1 of no-ERT */
             o.ert = 1;
             o.ert_threshold = 0.9f;
-            CHECK(tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err) ==
-                      VFX_OK, "%s", err);
+            CHECK(tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err, sizeof err) ==
+                      TET_OK, "%s", err);
             if (g_rank == 0) {
                 double d = max_diff(ref, img, n4);
                 uint64_t skipped = 0, rounds = 0;
@@ -251,8 +251,8 @@ static int test_render(int P)
         /* bad input: every rank reports the same error naming the tet, no rank hangs */
         uint32_t keep = m.tets[4 * 5 + 2];
         m.tets[4 * 5 + 2] = m.point_count + 3;
-        int rc = tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err);
-        CHECK(rc == VFX_ERR_INVALID_ARGUMENT && strstr(err, "tet 5"), "rc %d: %s", rc, err);
+        int rc = tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err, sizeof err);
+        CHECK(rc == TET_ERR_INVALID_ARGUMENT && strstr(err, "tet 5"), "rc %d: %s", rc, err);
         m.tets[4 * 5 + 2] = keep;
         free(m.points);
         free(m.scalar);
@@ -291,11 +291,11 @@ static int test_render(int P)
         o.update_c = 50;
         o.ert = 0;
         o.ert_threshold = 1.0f;
-        CHECK(tet_render(&g, &cam, &tf, &o, ref, NULL, err) == VFX_OK, "%s", err);
+        CHECK(tet_render(&g, &cam, &tf, &o, ref, NULL, err, sizeof err) == TET_OK, "%s", err);
         int moved = 0;
         for (int attempt = 0; attempt < 8 && !moved; attempt++) {
-            CHECK(tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err) ==
-                      VFX_OK, "%s", err);
+            CHECK(tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err, sizeof err) ==
+                      TET_OK, "%s", err);
             if (g_rank == 0) {
                 double d = max_diff(ref, img, n4);
                 uint64_t taken = 0, given = 0, keys = 0;
@@ -337,7 +337,7 @@ static int test_mismatch(int P)
     tet_tf tf = test_tf();
     char err[256];
     tet_mpi *ctx;
-    CHECK(tet_mpi_create(MPI_COMM_WORLD, &ctx, err) == VFX_OK, "%s", err);
+    CHECK(tet_mpi_create(MPI_COMM_WORLD, &ctx, err, sizeof err) == TET_OK, "%s", err);
     float *img = calloc((size_t)W * H * 4, sizeof *img);
     CHECK(img, "memory");
     tet_options o;
@@ -348,8 +348,8 @@ static int test_mismatch(int P)
         /* rank 0 has a 4^3 grid, the others a 7^3 one */
         tet_mesh m;
         make_grid(g_rank == 0 ? 4 : 7, 0, &m);
-        int rc = tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, NULL, err);
-        CHECK(rc == VFX_ERR_INVALID_ARGUMENT, "rank %d: counts differ, rc %d: %s", g_rank, rc, err);
+        int rc = tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, NULL, err, sizeof err);
+        CHECK(rc == TET_ERR_INVALID_ARGUMENT, "rank %d: counts differ, rc %d: %s", g_rank, rc, err);
         CHECK(strstr(err, P > 2 ? "ranks 1, 2" : "rank 1") && strstr(err, "counts"),
               "rank %d: message does not name the ranks: %s", g_rank, err);
         free(m.points); free(m.scalar); free(m.tets);
@@ -357,16 +357,16 @@ static int test_mismatch(int P)
         make_grid(7, 0, &m);
         if (g_rank == P - 1)
             m.scalar[m.point_count / 2] += 0.25f;
-        rc = tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, NULL, err);
+        rc = tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, NULL, err, sizeof err);
         char want[32];
         snprintf(want, sizeof want, "rank %d ", P - 1);
-        CHECK(rc == VFX_ERR_INVALID_ARGUMENT && strstr(err, want) && strstr(err, "scalars"),
+        CHECK(rc == TET_ERR_INVALID_ARGUMENT && strstr(err, want) && strstr(err, "scalars"),
               "rank %d: scalars differ, rc %d: %s", g_rank, rc, err);
         /* and the same mesh everywhere renders */
         if (g_rank == P - 1)
             m.scalar[m.point_count / 2] -= 0.25f;
-        rc = tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, NULL, err);
-        CHECK(rc == VFX_OK, "rank %d: same mesh, rc %d: %s", g_rank, rc, err);
+        rc = tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, NULL, err, sizeof err);
+        CHECK(rc == TET_OK, "rank %d: same mesh, rc %d: %s", g_rank, rc, err);
         free(m.points); free(m.scalar); free(m.tets);
     }
     if (g_rank == 0)

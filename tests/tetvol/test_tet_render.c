@@ -172,7 +172,7 @@ static void test_cube_vs_reference(void **state)
     double *ref = calloc(24 * 24 * 4, sizeof *ref);
     char err[256];
     tet_counters cnt;
-    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err, sizeof err), 0);
     /* reference in the rotated frame: rotate the points instead of the camera */
     float rp[24];
     for (int i = 0; i < 8; i++)
@@ -216,12 +216,12 @@ static void test_ert_threshold(void **state)
     char err[256];
     tet_counters c0, c1, c2;
     o.ert = 0; o.ert_threshold = 1.0f; /* same merge stop as the ERT 1.0 run */
-    assert_int_equal(tet_render(&m, &cam, &tf, &o, a, &c0, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, a, &c0, err, sizeof err), 0);
     o.ert = 1; o.ert_threshold = 1.0f;
-    assert_int_equal(tet_render(&m, &cam, &tf, &o, b, &c1, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, b, &c1, err, sizeof err), 0);
     assert_memory_equal(a, b, 40 * 40 * 4 * sizeof *a);
     o.ert_threshold = 0.9f;
-    assert_int_equal(tet_render(&m, &cam, &tf, &o, b, &c2, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, b, &c2, err, sizeof err), 0);
     double mx = 0;
     for (int i = 0; i < 40 * 40 * 4; i++)
         mx = fmax(mx, fabs(a[i] - b[i]));
@@ -238,7 +238,7 @@ static void test_ert_threshold(void **state)
     tet_counters pw[4];
     for (int mode = 0; mode < 4; mode++) {
         o.ert = 0; o.ert_threshold = 1.0f; o.workers = 4; o.share = mode & 1; o.dlb = (mode >> 1) & 1;
-        assert_int_equal(tet_render_workers(&m, &cam, &tf, &o, c, &c1, pw, err), 0);
+        assert_int_equal(tet_render_workers(&m, &cam, &tf, &o, c, &c1, pw, err, sizeof err), 0);
         double dmax = 0;
         for (int i = 0; i < 40 * 40 * 4; i++)
             dmax = fmax(dmax, fabs(a[i] - c[i]));
@@ -248,7 +248,7 @@ static void test_ert_threshold(void **state)
             sum += pw[i].cells_scanned;
         assert_int_equal(sum, c0.cells_scanned);
         o.ert = 1; o.ert_threshold = 0.9f;
-        assert_int_equal(tet_render_workers(&m, &cam, &tf, &o, c, &c1, pw, err), 0);
+        assert_int_equal(tet_render_workers(&m, &cam, &tf, &o, c, &c1, pw, err, sizeof err), 0);
         dmax = 0;
         for (int i = 0; i < 40 * 40 * 4; i++)
             dmax = fmax(dmax, fabs(a[i] - c[i]));
@@ -278,7 +278,7 @@ static void test_camera_inside_and_nan(void **state)
     double ref[16 * 16 * 4];
     char err[256];
     tet_counters cnt;
-    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err, sizeof err), 0);
     assert_true(cnt.cells_near_crossing > 0);
     reference(&m, &cam, &tf, 0.5, 0.05, 2000, ref);
     double mx = 0;
@@ -291,14 +291,14 @@ static void test_camera_inside_and_nan(void **state)
     assert_true(mx < 0.05); /* same midpoint-rule bound as the cube test */
     /* everything behind the camera: nothing drawn, all counted */
     make_cam(&cam, 16, 16, -3.0f, 0.05f);
-    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err, sizeof err), 0);
     assert_int_equal(cnt.cells_behind, 5);
     for (int i = 0; i < 16 * 16 * 4; i++)
         assert_true(img[i] == 0.0f);
     /* NaN scalar at one vertex: its cells are skipped and counted, the rest renders */
     sc[6] = NAN;
     make_cam(&cam, 16, 16, 4.0f, 0.1f);
-    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err, sizeof err), 0);
     assert_true(cnt.cells_nan >= 1);
     for (int i = 0; i < 16 * 16 * 4; i++)
         assert_false(isnan(img[i]));
@@ -315,7 +315,7 @@ static double vs_reference(const tet_mesh *m, const tet_camera *cam, const tet_t
     double *ref = calloc((size_t)n, sizeof *ref);
     tet_options o; tet_options_default(&o); o.ert = 0;
     char err[256];
-    assert_int_equal(tet_render(m, cam, tf, &o, img, cnt, err), 0);
+    assert_int_equal(tet_render(m, cam, tf, &o, img, cnt, err, sizeof err), 0);
     reference_range(m, cam, tf, dist, near, tmax, steps, ref);
     double se = 0, mx = 0;
     for (int i = 0; i < n; i++) {
@@ -371,7 +371,7 @@ static void test_visibility_cycle(void **state)
     float img[48 * 48 * 4];
     tet_options o; tet_options_default(&o); o.ert = 0;
     char err[256];
-    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err, sizeof err), 0);
     double *ref = calloc(48 * 48 * 4, sizeof *ref);
     reference_range(&m, &cam, &tf, 3.0, 2.4, 3.6, 1500, ref);
     double se = 0, mx = 0;
@@ -399,7 +399,7 @@ static void test_visibility_cycle(void **state)
         tet_mesh mi = m;
         mi.tets = &tets[4 * i];
         mi.tet_count = 1;
-        assert_int_equal(tet_render(&mi, &cam, &tf, &o, one[i], &cnt, err), 0);
+        assert_int_equal(tet_render(&mi, &cam, &tf, &o, one[i], &cnt, err, sizeof err), 0);
         nearest[i] = INFINITY;
         for (int j = 0; j < 4; j++)
             nearest[i] = fmin(nearest[i], 3.0 - pts[3 * (4 * i + j) + 2]);
@@ -445,7 +445,7 @@ static void test_coincident_vertices(void **state)
     float img[24 * 24 * 4];
     char err[256];
     tet_counters cnt;
-    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err, sizeof err), 0);
     assert_int_equal(cnt.cells_degenerate, 1);
     assert_int_equal(cnt.cells_scanned, 0);
     for (int i = 0; i < 24 * 24 * 4; i++)
@@ -455,9 +455,9 @@ static void test_coincident_vertices(void **state)
     float alone[24 * 24 * 4];
     m.tets = two;
     m.tet_count = 1;
-    assert_int_equal(tet_render(&m, &cam, &tf, &o, alone, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, alone, &cnt, err, sizeof err), 0);
     m.tet_count = 2;
-    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err, sizeof err), 0);
     assert_int_equal(cnt.cells_degenerate, 1);
     assert_memory_equal(img, alone, sizeof img);
     /* shared face (1,2,3) between (0,1,2,3) and (4,1,3,2) (both positively oriented), the
@@ -511,13 +511,13 @@ static void test_opacity_extremes(void **state)
     float img[24 * 24 * 4];
     char err[256];
     tet_counters cnt;
-    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err, sizeof err), 0);
     assert_true(cnt.segments_made > 0);
     assert_int_equal(cnt.cells_skipped_ert, 0);
     for (int i = 0; i < 24 * 24 * 4; i++)
         assert_true(img[i] == 0.0f);
     tf.tau_lo = tf.tau_hi = 1e30f;
-    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err), 0);
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, img, &cnt, err, sizeof err), 0);
     int covered = 0;
     for (int p = 0; p < 24 * 24; p++) {
         for (int c = 0; c < 4; c++)

@@ -46,7 +46,7 @@ static err2 render_vs(const tet_tf *tf, const double *ref, float *img, tet_count
     tet_options_default(&o);
     o.ert = 0;
     char err[256];
-    assert_int_equal(tet_render(&g_mesh, &g_cam, tf, &o, img, cnt, err), VFX_OK);
+    assert_int_equal(tet_render(&g_mesh, &g_cam, tf, &o, img, cnt, err, sizeof err), TET_OK);
     err2 e = {0, 0};
     for (int i = 0; i < W * H * 4; i++) {
         assert_false(isnan(img[i]));
@@ -106,8 +106,8 @@ static void test_two_point_table_is_linear(void **state)
     tet_options_default(&o);
     char err[256];
     tet_counters ca, cb;
-    assert_int_equal(tet_render(&g_mesh, &g_cam, &lin, &o, a, &ca, err), VFX_OK);
-    assert_int_equal(tet_render(&g_mesh, &g_cam, &tab, &o, b, &cb, err), VFX_OK);
+    assert_int_equal(tet_render(&g_mesh, &g_cam, &lin, &o, a, &ca, err, sizeof err), TET_OK);
+    assert_int_equal(tet_render(&g_mesh, &g_cam, &tab, &o, b, &cb, err, sizeof err), TET_OK);
     assert_memory_equal(a, b, W * H * 4 * sizeof *a);
     /* the scalar stays inside [0, 1]: no segment crosses a breakpoint */
     assert_int_equal(cb.tf_pieces, cb.segments_made);
@@ -220,18 +220,18 @@ static void test_bad_tables(void **state)
     char err[256];
     tet_tf_point pts[3] = {{0, {1, 1, 1}, 1}, {0.5f, {1, 1, 1}, 1}, {0.4f, {1, 1, 1}, 1}};
     tet_tf tf = {.points = pts, .count = 3};
-    assert_int_equal(tet_render(&g_mesh, &g_cam, &tf, &o, img, NULL, err), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(tet_render(&g_mesh, &g_cam, &tf, &o, img, NULL, err, sizeof err), TET_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "point 2"));
     pts[2].s = 1, pts[1].tau = NAN;
-    assert_int_equal(tet_render(&g_mesh, &g_cam, &tf, &o, img, NULL, err), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(tet_render(&g_mesh, &g_cam, &tf, &o, img, NULL, err, sizeof err), TET_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "point 1"));
     pts[1].tau = 1;
     tf.count = 1;
-    assert_int_equal(tet_render(&g_mesh, &g_cam, &tf, &o, img, NULL, err), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(tet_render(&g_mesh, &g_cam, &tf, &o, img, NULL, err, sizeof err), TET_ERR_INVALID_ARGUMENT);
     tf.count = 3, tf.method = 7;
-    assert_int_equal(tet_render(&g_mesh, &g_cam, &tf, &o, img, NULL, err), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(tet_render(&g_mesh, &g_cam, &tf, &o, img, NULL, err, sizeof err), TET_ERR_INVALID_ARGUMENT);
     tf.method = TET_TF_PREINTEGRATED, tf.pre_size = 1 << 30;
-    assert_int_equal(tet_render(&g_mesh, &g_cam, &tf, &o, img, NULL, err), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(tet_render(&g_mesh, &g_cam, &tf, &o, img, NULL, err, sizeof err), TET_ERR_INVALID_ARGUMENT);
     free(img);
 }
 

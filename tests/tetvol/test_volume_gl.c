@@ -94,7 +94,7 @@ static float *direct_alpha(void)
     o.workers = 1;
     float *rgba = malloc(W * H * 4 * sizeof(float)), *a = malloc(W * H * sizeof(float));
     char err[256];
-    assert_int_equal(tet_render_workers(&m, &cam, &tf, &o, rgba, NULL, NULL, err), VFX_OK);
+    assert_int_equal(tet_render_workers(&m, &cam, &tf, &o, rgba, NULL, NULL, err, sizeof err), TET_OK);
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x)
             a[y * W + x] = rgba[4 * ((H - 1 - y) * W + x) + 3];
@@ -250,7 +250,7 @@ static void test_view2_breakpoints(void **state)
     o.workers = 1;
     float *img = malloc(W * H * 4 * sizeof(float));
     char err[256];
-    assert_int_equal(tet_render_workers(&m, &cam, &tf, &o, img, NULL, NULL, err), VFX_OK);
+    assert_int_equal(tet_render_workers(&m, &cam, &tf, &o, img, NULL, NULL, err, sizeof err), TET_OK);
     double d = 0, amax = 0;
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
