@@ -53,6 +53,126 @@ static float water_h_from_spacing(const rt_scene_water *w)
     return vol > 0 ? (float)(2.0 * cbrt(vol / w->count)) : 0.0f;
 }
 
+/* water.generator: the kind (layers, box, sphere) and its count and shape. */
+static vfx_result parse_water_generator(pctx *c, const cJSON *v, rt_scene_water *w)
+{
+    static const char *const gkeys[] = {"kind", "count", "origin", "spacing", "layer_side", "min", "max",
+                                        "center", "radius", NULL};
+    static const char *const kinds[] = {"layers", "box", "sphere", NULL};
+    vfx_result r;
+    const char *PG = "water.generator";
+    const cJSON *g = cJSON_GetObjectItemCaseSensitive(v, "generator");
+    if (!g)
+        return rt_scene_failf(c, VFX_ERR_FORMAT, PG, "required for source \"generator\"");
+    if ((r = rt_scene_expect_object(c, g, PG)))
+        return r;
+    rt_scene_check_keys(c, g, PG, gkeys);
+    uint32_t kind = 0;
+    r = rt_scene_get_enum(c, g, PG, "kind", true, kinds, &kind);
+    if (!r) r = rt_scene_get_uint(c, g, PG, "count", true, 0, RT_SCENE_MAX_PARTICLES, &w->count);
+    if (r)
+        return r;
+    w->generator = (rt_scene_generator)kind;
+    if (kind == RT_SCENE_GEN_LAYERS) {
+        r = rt_scene_get_point(c, g, PG, "origin", false, w->origin);
+        if (!r) r = rt_scene_get_float(c, g, PG, "spacing", false, POSITIVE, &w->spacing);
+        if (!r) r = rt_scene_get_uint(c, g, PG, "layer_side", false, 1, 4096, &w->layer_side);
+    } else if (kind == RT_SCENE_GEN_BOX) {
+        r = rt_scene_get_point(c, g, PG, "min", true, w->box_min);
+        if (!r) r = rt_scene_get_point(c, g, PG, "max", true, w->box_max);
+        for (int k = 0; k < 3 && !r; ++k)
+            if (!(w->box_max[k] > w->box_min[k]))
+                r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.generator.max",
+                          "must exceed min on every axis (axis %d: %g <= %g)", k, w->box_max[k], w->box_min[k]);
+    } else {
+        r = rt_scene_get_point(c, g, PG, "center", false, w->center);
+        if (!r) r = rt_scene_get_float(c, g, PG, "radius", true, POSITIVE, &w->radius);
+    }
+    return r;
+}
+
+/* water.simulation: the tank, the initial fluid box, the particle count, gravity, dt, no-slip
+ * walls and the optional paddle. */
+static vfx_result parse_water_simulation(pctx *c, const cJSON *v, rt_scene_water *w)
+{
+    static const char *const skeys[] = {"tank", "fluid", "particle_count", "gravity", "dt", "paddle", "no_slip", NULL};
+    vfx_result r;
+    const char *PS = "water.simulation";
+    const cJSON *s = cJSON_GetObjectItemCaseSensitive(v, "simulation");
+    if (!s)
+        return rt_scene_failf(c, VFX_ERR_FORMAT, PS, "required for source \"simulation\"");
+    if ((r = rt_scene_expect_object(c, s, PS)))
+        return r;
+    rt_scene_check_keys(c, s, PS, skeys);
+    r = rt_scene_parse_box(c, s, PS, "tank", w->tank_min, w->tank_max);
+    if (!r) r = rt_scene_parse_box(c, s, PS, "fluid", w->box_min, w->box_max);
+    for (int k = 0; k < 3 && !r; ++k)
+        if (w->box_min[k] < w->tank_min[k] || w->box_max[k] > w->tank_max[k])
+            r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.simulation.fluid", "must lie inside the tank (axis %d)", k);
+    if (!r) r = rt_scene_get_uint(c, s, PS, "particle_count", true, 0, RT_SCENE_MAX_PARTICLES, &w->count);
+    if (!r) r = rt_scene_get_vec(c, s, PS, "gravity", 3, false, (range){-1000, 1000, false}, w->gravity);
+    if (!r) r = rt_scene_get_float(c, s, PS, "dt", false, (range){0, 0.1, true}, &w->dt);
+    if (!r) r = rt_scene_get_bool(c, s, PS, "no_slip", &w->no_slip);
+    if (r)
+        return r;
+    const cJSON *pd = cJSON_GetObjectItemCaseSensitive(s, "paddle");
+    if (pd) {
+        static const char *const pkeys[] = {"axis", "amplitude", "period_s", NULL};
+        static const char *const axes[] = {"x", "y", "z", NULL};
+        const char *PP = "water.simulation.paddle";
+        if ((r = rt_scene_expect_object(c, pd, PP)))
+            return r;
+        rt_scene_check_keys(c, pd, PP, pkeys);
+        w->paddle = true;
+        r = rt_scene_get_enum(c, pd, PP, "axis", false, axes, &w->paddle_axis);
+        if (!r) r = rt_scene_get_float(c, pd, PP, "amplitude", false, NONNEG, &w->paddle_amplitude);
+        if (!r) r = rt_scene_get_float(c, pd, PP, "period_s", false, (range){0, 1e4, true}, &w->paddle_period_s);
+        if (r)
+            return r;
+    }
+    return VFX_OK;
+}
+
+/* water.quality (present): the method, its sample and step limits, the disabled stages and the
+ * kernel; writes w->params and w->kernel. */
+static vfx_result parse_water_quality(pctx *c, const cJSON *q, rt_scene_water *w)
+{
+    vfx_water_params *wp = &w->params;
+    static const char *const qkeys[] = {"max_samples", "step", "refine_iters", "pyramid_level", "method",
+                                        "disable", "kernel", NULL};
+    static const char *const methods[] = {"paper", "brute", "grid", "tile", NULL};
+    static const char *const flags[] = {"billboard_init", "skip", "blend", "pack4", "pyramid", "refine",
+                                        "shading", "finish", "local_list", "subdivide", "tiles", "refract_trace",
+                                        "temporal", "half_res", "spray", NULL};
+    static const uint32_t bits[] = {VFX_WATER_NO_BILLBOARD_INIT, VFX_WATER_NO_SKIP, VFX_WATER_NO_BLEND,
+                                    VFX_WATER_NO_PACK4, VFX_WATER_NO_PYRAMID, VFX_WATER_NO_REFINE,
+                                    VFX_WATER_NO_SHADING, VFX_WATER_NO_FINISH, VFX_WATER_NO_LOCAL_LIST,
+                                    VFX_WATER_NO_SUBDIVIDE, VFX_WATER_NO_TILES, VFX_WATER_NO_REFRACT_TRACE,
+                                    VFX_WATER_NO_TEMPORAL, VFX_WATER_NO_HALF_RES, VFX_WATER_NO_SPRAY};
+    vfx_result r;
+    const char *PQ = "water.quality";
+    if ((r = rt_scene_expect_object(c, q, PQ)))
+        return r;
+    rt_scene_check_keys(c, q, PQ, qkeys);
+    r = rt_scene_get_uint(c, q, PQ, "max_samples", false, 1, 4096, &wp->max_samples);
+    if (!r) r = rt_scene_get_float(c, q, PQ, "step", false, (range){0, 1e3, true}, &wp->step);
+    if (!r) r = rt_scene_get_uint(c, q, PQ, "refine_iters", false, 1, 64, &wp->refine_iters);
+    if (!r) r = rt_scene_get_uint(c, q, PQ, "pyramid_level", false, 1, 12, &wp->pyramid_level);
+    if (!r) r = rt_scene_get_enum(c, q, PQ, "method", false, methods, &wp->method);
+    if (!r) r = rt_scene_get_flags(c, q, PQ, "disable", flags, bits, &wp->disable);
+    if (!r && cJSON_GetObjectItemCaseSensitive(q, "kernel")) {
+        static const char *const kernels[] = {"isotropic", "anisotropic", NULL};
+        uint32_t k = 0;
+        r = rt_scene_get_enum(c, q, PQ, "kernel", false, kernels, &k);
+        w->kernel = k == 1 ? VFX_WATER_KERNEL_ANISOTROPIC : VFX_WATER_KERNEL_ISOTROPIC;
+        if (!r && w->kernel == VFX_WATER_KERNEL_ANISOTROPIC && wp->method != VFX_WATER_METHOD_TILE)
+            r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.quality.kernel",
+                            "\"anisotropic\" is drawn by method \"tile\" only (method \"%s\" draws the seed's isotropic kernel)",
+                            methods[wp->method]);
+    }
+    return r;
+}
+
 vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
 {
     static const char *const keys[] = {"source", "path", "generator", "simulation", "h", "threshold",
@@ -77,74 +197,10 @@ vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
         if ((r = rt_scene_get_path(c, v, P, "path", true, w->path)))
             return r;
     } else if (w->source == RT_SCENE_WATER_GENERATOR) {
-        static const char *const gkeys[] = {"kind", "count", "origin", "spacing", "layer_side", "min", "max",
-                                            "center", "radius", NULL};
-        static const char *const kinds[] = {"layers", "box", "sphere", NULL};
-        const char *PG = "water.generator";
-        const cJSON *g = cJSON_GetObjectItemCaseSensitive(v, "generator");
-        if (!g)
-            return rt_scene_failf(c, VFX_ERR_FORMAT, PG, "required for source \"generator\"");
-        if ((r = rt_scene_expect_object(c, g, PG)))
+        if ((r = parse_water_generator(c, v, w)))
             return r;
-        rt_scene_check_keys(c, g, PG, gkeys);
-        uint32_t kind = 0;
-        r = rt_scene_get_enum(c, g, PG, "kind", true, kinds, &kind);
-        if (!r) r = rt_scene_get_uint(c, g, PG, "count", true, 0, RT_SCENE_MAX_PARTICLES, &w->count);
-        if (r)
-            return r;
-        w->generator = (rt_scene_generator)kind;
-        if (kind == RT_SCENE_GEN_LAYERS) {
-            r = rt_scene_get_point(c, g, PG, "origin", false, w->origin);
-            if (!r) r = rt_scene_get_float(c, g, PG, "spacing", false, POSITIVE, &w->spacing);
-            if (!r) r = rt_scene_get_uint(c, g, PG, "layer_side", false, 1, 4096, &w->layer_side);
-        } else if (kind == RT_SCENE_GEN_BOX) {
-            r = rt_scene_get_point(c, g, PG, "min", true, w->box_min);
-            if (!r) r = rt_scene_get_point(c, g, PG, "max", true, w->box_max);
-            for (int k = 0; k < 3 && !r; ++k)
-                if (!(w->box_max[k] > w->box_min[k]))
-                    r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.generator.max",
-                              "must exceed min on every axis (axis %d: %g <= %g)", k, w->box_max[k], w->box_min[k]);
-        } else {
-            r = rt_scene_get_point(c, g, PG, "center", false, w->center);
-            if (!r) r = rt_scene_get_float(c, g, PG, "radius", true, POSITIVE, &w->radius);
-        }
-        if (r)
-            return r;
-    } else {
-        static const char *const skeys[] = {"tank", "fluid", "particle_count", "gravity", "dt", "paddle", "no_slip", NULL};
-        const char *PS = "water.simulation";
-        const cJSON *s = cJSON_GetObjectItemCaseSensitive(v, "simulation");
-        if (!s)
-            return rt_scene_failf(c, VFX_ERR_FORMAT, PS, "required for source \"simulation\"");
-        if ((r = rt_scene_expect_object(c, s, PS)))
-            return r;
-        rt_scene_check_keys(c, s, PS, skeys);
-        r = rt_scene_parse_box(c, s, PS, "tank", w->tank_min, w->tank_max);
-        if (!r) r = rt_scene_parse_box(c, s, PS, "fluid", w->box_min, w->box_max);
-        for (int k = 0; k < 3 && !r; ++k)
-            if (w->box_min[k] < w->tank_min[k] || w->box_max[k] > w->tank_max[k])
-                r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.simulation.fluid", "must lie inside the tank (axis %d)", k);
-        if (!r) r = rt_scene_get_uint(c, s, PS, "particle_count", true, 0, RT_SCENE_MAX_PARTICLES, &w->count);
-        if (!r) r = rt_scene_get_vec(c, s, PS, "gravity", 3, false, (range){-1000, 1000, false}, w->gravity);
-        if (!r) r = rt_scene_get_float(c, s, PS, "dt", false, (range){0, 0.1, true}, &w->dt);
-        if (!r) r = rt_scene_get_bool(c, s, PS, "no_slip", &w->no_slip);
-        if (r)
-            return r;
-        const cJSON *pd = cJSON_GetObjectItemCaseSensitive(s, "paddle");
-        if (pd) {
-            static const char *const pkeys[] = {"axis", "amplitude", "period_s", NULL};
-            static const char *const axes[] = {"x", "y", "z", NULL};
-            const char *PP = "water.simulation.paddle";
-            if ((r = rt_scene_expect_object(c, pd, PP)))
-                return r;
-            rt_scene_check_keys(c, pd, PP, pkeys);
-            w->paddle = true;
-            r = rt_scene_get_enum(c, pd, PP, "axis", false, axes, &w->paddle_axis);
-            if (!r) r = rt_scene_get_float(c, pd, PP, "amplitude", false, NONNEG, &w->paddle_amplitude);
-            if (!r) r = rt_scene_get_float(c, pd, PP, "period_s", false, (range){0, 1e4, true}, &w->paddle_period_s);
-            if (r)
-                return r;
-        }
+    } else if ((r = parse_water_simulation(c, v, w))) {
+        return r;
     }
     vfx_water_params *wp = &w->params;
     /* ours (TILE) unless water.quality.method names another */
@@ -159,39 +215,8 @@ vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
     if (wp->h == 0)
         wp->h = water_h_from_spacing(w);
     const cJSON *q = cJSON_GetObjectItemCaseSensitive(v, "quality");
-    if (q) {
-        static const char *const qkeys[] = {"max_samples", "step", "refine_iters", "pyramid_level", "method",
-                                            "disable", "kernel", NULL};
-        static const char *const methods[] = {"paper", "brute", "grid", "tile", NULL};
-        static const char *const flags[] = {"billboard_init", "skip", "blend", "pack4", "pyramid", "refine",
-                                            "shading", "finish", "local_list", "subdivide", "tiles", "refract_trace",
-                                            "temporal", "half_res", "spray", NULL};
-        static const uint32_t bits[] = {VFX_WATER_NO_BILLBOARD_INIT, VFX_WATER_NO_SKIP, VFX_WATER_NO_BLEND,
-                                        VFX_WATER_NO_PACK4, VFX_WATER_NO_PYRAMID, VFX_WATER_NO_REFINE,
-                                        VFX_WATER_NO_SHADING, VFX_WATER_NO_FINISH, VFX_WATER_NO_LOCAL_LIST,
-                                        VFX_WATER_NO_SUBDIVIDE, VFX_WATER_NO_TILES, VFX_WATER_NO_REFRACT_TRACE,
-                                        VFX_WATER_NO_TEMPORAL, VFX_WATER_NO_HALF_RES, VFX_WATER_NO_SPRAY};
-        const char *PQ = "water.quality";
-        if ((r = rt_scene_expect_object(c, q, PQ)))
-            return r;
-        rt_scene_check_keys(c, q, PQ, qkeys);
-        r = rt_scene_get_uint(c, q, PQ, "max_samples", false, 1, 4096, &wp->max_samples);
-        if (!r) r = rt_scene_get_float(c, q, PQ, "step", false, (range){0, 1e3, true}, &wp->step);
-        if (!r) r = rt_scene_get_uint(c, q, PQ, "refine_iters", false, 1, 64, &wp->refine_iters);
-        if (!r) r = rt_scene_get_uint(c, q, PQ, "pyramid_level", false, 1, 12, &wp->pyramid_level);
-        if (!r) r = rt_scene_get_enum(c, q, PQ, "method", false, methods, &wp->method);
-        if (!r) r = rt_scene_get_flags(c, q, PQ, "disable", flags, bits, &wp->disable);
-        if (!r && cJSON_GetObjectItemCaseSensitive(q, "kernel")) {
-            static const char *const kernels[] = {"isotropic", "anisotropic", NULL};
-            uint32_t k = 0;
-            r = rt_scene_get_enum(c, q, PQ, "kernel", false, kernels, &k);
-            w->kernel = k == 1 ? VFX_WATER_KERNEL_ANISOTROPIC : VFX_WATER_KERNEL_ISOTROPIC;
-            if (!r && w->kernel == VFX_WATER_KERNEL_ANISOTROPIC && wp->method != VFX_WATER_METHOD_TILE)
-                r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.quality.kernel",
-                                "\"anisotropic\" is drawn by method \"tile\" only (method \"%s\" draws the seed's isotropic kernel)",
-                                methods[wp->method]);
-        }
-    }
+    if (q)
+        r = parse_water_quality(c, q, w);
     /* the default: anisotropic for TILE (flat water flat, sheets stay sheets, for 1.4x the
      * plugin's CPU in the default scene; docs/water.md "Anisotropic kernels"), the seed's
      * isotropic kernel for the other methods */
