@@ -8,7 +8,9 @@
  * (distance image, PFM) --points FILE (positions as raw float32 xyz) --wave A (the particles move:
  * every frame, warm-up included, y += A sin(2 x + 0.5 f) - A sin(2 x + 0.5 (f - 1)), a wave
  * travelling along x, so temporal reuse meets a moving surface as in a game) --kernel isotropic|anisotropic
- * (vfx_water_params2.kernel; TILE only). cpu_ms_per_frame is the
+ * (vfx_water_params2.kernel; TILE only) --preset default|low|medium|high|ultra (vfx_water_params3.preset: the
+ * method, kernel, step and refinement left to the preset; without it the method defaults to paper
+ * and the kernel to isotropic, as before presets). cpu_ms_per_frame is the
  * process's CPU time over the timed frames (all llvmpipe threads) divided by the frames. Per-pass GPU ms (counters *.gpu_ms) need at least 4 frames. */
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
@@ -38,7 +40,8 @@ typedef struct bench_scene {
     const char *points;  /* raw float32 x y z per particle, for scripts/compare-vtk-fluid.py */
     const char *dist;    /* the distance image (PFM) */
     float wave;          /* amplitude of the travelling wave the particles follow (0: still) */
-    uint32_t kernel;     /* vfx_water_kernel (0: the plugin's default, isotropic) */
+    uint32_t kernel;     /* vfx_water_kernel (set from --kernel, or from --preset as the plugin resolves it) */
+    uint32_t preset;     /* vfx_water_preset (--preset; 0: none sent, a version-2 host) */
 } bench_scene;
 
 static void *bench_gl_proc(void *user, const char *name) { (void)user; return (void *)eglGetProcAddress(name); }
@@ -59,7 +62,12 @@ static vfx_result bench_chunk(void *user, uint32_t index, vfx_particle_view *out
 static vfx_result bench_params(void *user, vfx_water_params *out)
 {
     bench_scene *s = user;
-    if (out->version == VFX_WATER_PARAMS2_VERSION && out->size >= sizeof(vfx_water_params2)) {
+    if (s->preset && out->version >= VFX_WATER_PARAMS3_VERSION && out->size >= sizeof(vfx_water_params3)) {
+        memset(out, 0, sizeof(vfx_water_params3));
+        ((vfx_water_params3 *)out)->preset = s->preset;
+        out->size = sizeof(vfx_water_params3);
+        out->version = VFX_WATER_PARAMS3_VERSION;
+    } else if (out->version >= VFX_WATER_PARAMS2_VERSION && out->size >= sizeof(vfx_water_params2)) {
         memset(out, 0, sizeof(vfx_water_params2));
         ((vfx_water_params2 *)out)->kernel = s->kernel;
         out->size = sizeof(vfx_water_params2);
@@ -75,6 +83,7 @@ static vfx_result bench_params(void *user, vfx_water_params *out)
     out->refine_iters = s->refine;
     out->pyramid_level = s->pyramid;
     out->step = s->step_h > 0 ? s->step_h * 0.61f : 0.0f;
+    out->h = 0.61f; /* the layouts' spacing 0.3 at the seed's ratio; the reference's h */
     return VFX_OK;
 }
 
@@ -94,7 +103,8 @@ static double cpu_ms(void)
     return (u.ru_utime.tv_sec + u.ru_stime.tv_sec) * 1e3 + (u.ru_utime.tv_usec + u.ru_stime.tv_usec) * 1e-3;
 }
 
-static const char *method_name(uint32_t m) { return m == 0 ? "paper" : m == 1 ? "brute" : m == 2 ? "grid" : "tile"; }
+static const char *method_name(uint32_t m) { return m == VFX_WATER_METHOD_PAPER ? "paper" : m == 1 ? "brute" : m == 2 ? "grid" : "tile"; }
+static const char *const PRESET_NAMES[] = {"default", "low", "medium", "high", "ultra", NULL};
 
 /* A pool: side x side columns at spacing 0.3, 4 layers deep (the last layer partly filled),
  * centred on x and z, its floor at y = 0. */
@@ -190,10 +200,10 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
     double p50 = fp.p50;
     printf("{\"effect\":\"metaballs\",\"method\":\"%s\",\"disable\":%u,\"max_samples\":%u,\"step_h\":%.4g,"
            "\"refine\":%u,\"pyramid\":%u,\"particles\":%u,\"width\":%u,\"height\":%u,"
-           "\"frames\":%u,\"warmup\":%d,\"wave\":%.4g,\"kernel\":\"%s\",\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"cpu_ms_per_frame\":%.2f,\"fps\":%.3g,\"gl_renderer\":\"%s\"",
+           "\"frames\":%u,\"warmup\":%d,\"wave\":%.4g,\"preset\":\"%s\",\"kernel\":\"%s\",\"frame_ms\":{\"p50\":%.2f,\"p95\":%.2f,\"p99\":%.2f},\"cpu_ms_per_frame\":%.2f,\"fps\":%.3g,\"gl_renderer\":\"%s\"",
            method_name(s.method), s.disable, s.max_samples ? s.max_samples : 64, s.step_h > 0 ? s.step_h : 0.125,
            s.refine ? s.refine : 3, s.pyramid ? s.pyramid : 3, n, width, height, frames, !s.no_warmup, s.wave,
-           s.kernel == VFX_WATER_KERNEL_ANISOTROPIC ? "anisotropic" : "isotropic", p50, fp.p95, fp.p99, cpu_per_frame, 1000.0 / p50,
+           s.preset ? PRESET_NAMES[s.preset] : "none", s.kernel == VFX_WATER_KERNEL_ANISOTROPIC ? "anisotropic" : "isotropic", p50, fp.p95, fp.p99, cpu_per_frame, 1000.0 / p50,
            (const char *)glGetString(GL_RENDERER));
     printf(",\"camera\":{\"eye\":[%.9g,%.9g,%.9g],\"center\":[%.9g,%.9g,%.9g],\"up\":[0,1,0],\"fovy_deg\":%.9g,"
            "\"near\":%.9g,\"far\":%.9g},\"h\":0.61",
@@ -270,7 +280,8 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
 
 int bench_metaballs(int argc, char **argv)
 {
-    uint32_t parts[8], sizes[8], np = 0, ns = 0, frames = 3, method = 0;
+    uint32_t parts[8], sizes[8], np = 0, ns = 0, frames = 3, method = VFX_WATER_METHOD_PAPER;
+    int method_given = 0, kernel_given = 0;
     bench_scene opt;
     memset(&opt, 0, sizeof opt);
     int reference = 0;
@@ -281,8 +292,9 @@ int bench_metaballs(int argc, char **argv)
         else if (!strcmp(argv[i], "--reference")) reference = 1;
         else if (!strcmp(argv[i], "--method") && i + 1 < argc) {
             ++i;
-            method = !strcmp(argv[i], "brute") ? 1 : !strcmp(argv[i], "grid") ? 2 : !strcmp(argv[i], "paper") ? 0
+            method = !strcmp(argv[i], "brute") ? 1 : !strcmp(argv[i], "grid") ? 2 : !strcmp(argv[i], "paper") ? VFX_WATER_METHOD_PAPER
                    : !strcmp(argv[i], "tile") ? 3 : 99;
+            method_given = 1;
             if (method == 99) { fprintf(stderr, "metaballs: --method paper|brute|grid|tile, not %s\n", argv[i]); return 2; }
         }
         else if (!strcmp(argv[i], "--disable") && i + 1 < argc) opt.disable = (uint32_t)strtoul(argv[++i], NULL, 0);
@@ -305,9 +317,27 @@ int bench_metaballs(int argc, char **argv)
             ++i;
             if (strcmp(argv[i], "isotropic") && strcmp(argv[i], "anisotropic")) { fprintf(stderr, "metaballs: --kernel isotropic|anisotropic, not %s\n", argv[i]); return 2; }
             opt.kernel = !strcmp(argv[i], "anisotropic") ? VFX_WATER_KERNEL_ANISOTROPIC : VFX_WATER_KERNEL_ISOTROPIC;
+            kernel_given = 1;
+        }
+        else if (!strcmp(argv[i], "--preset") && i + 1 < argc) {
+            ++i;
+            opt.preset = 99;
+            for (uint32_t k = 0; PRESET_NAMES[k]; ++k)
+                if (!strcmp(argv[i], PRESET_NAMES[k])) opt.preset = k ? k : VFX_WATER_PRESET_MEDIUM;
+            if (opt.preset == 99) { fprintf(stderr, "metaballs: --preset default|low|medium|high|ultra, not %s\n", argv[i]); return 2; }
         }
         else if (!strcmp(argv[i], "--json")) continue;
         else { fprintf(stderr, "metaballs: unknown option %s\n", argv[i]); return 2; }
+    }
+    /* a preset: the zero method (TILE) and kernel (the preset's) unless given; the kernel the
+     * plugin resolves is recorded for the JSON and the reference */
+    if (opt.preset) {
+        if (!method_given) method = VFX_WATER_METHOD_DEFAULT;
+        if (kernel_given) { fprintf(stderr, "metaballs: --preset sets the kernel; --kernel is not taken with it\n"); return 2; }
+        opt.kernel = opt.preset == VFX_WATER_PRESET_LOW || (method != VFX_WATER_METHOD_DEFAULT && method != VFX_WATER_METHOD_TILE)
+                     ? VFX_WATER_KERNEL_ISOTROPIC : VFX_WATER_KERNEL_ANISOTROPIC;
+    } else if (!kernel_given) {
+        opt.kernel = VFX_WATER_KERNEL_ISOTROPIC;
     }
     if (!np) parts[np++] = 4096;
     if (!ns) sizes[ns++] = 128;

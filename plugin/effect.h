@@ -22,6 +22,8 @@ typedef struct volfx_frame_targets {
     double origin[3];        /* positions are relative to this */
     bool color_hdr;          /* framebuffer colour is float: write linear radiance */
     unsigned environment_cubemap; /* 0 -> procedural sky */
+    /* Version 3: the view's id (0 for versions 1 and 2); effects key per-view state on it. */
+    uint32_t view_id;
 } volfx_frame_targets;
 
 struct volfx_effect_ops {

@@ -200,9 +200,22 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
     gl_bind(ctx);
     if (!frame)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view is NULL");
+    /* version 3 is version 2 plus the view's id: read on as version 2 */
+    uint32_t view_id = 0;
+    vfx_frame_view2 as_v2;
+    if (frame->version == VFX_FRAME_VIEW3_VERSION) {
+        if (frame->size < sizeof(vfx_frame_view3))
+            return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view of version 3 has size %u (need %zu)",
+                              frame->size, sizeof(vfx_frame_view3));
+        view_id = ((const vfx_frame_view3 *)frame)->view_id;
+        memcpy(&as_v2, frame, sizeof as_v2);
+        as_v2.v1.size = sizeof as_v2;
+        as_v2.v1.version = VFX_FRAME_VIEW2_VERSION;
+        frame = &as_v2.v1;
+    }
     if (frame->version != VFX_FRAME_VIEW_VERSION && frame->version != VFX_FRAME_VIEW2_VERSION)
-        return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view of version %u (this plugin reads %u and %u)",
-                          frame->version, VFX_FRAME_VIEW_VERSION, VFX_FRAME_VIEW2_VERSION);
+        return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view of version %u (this plugin reads %u, %u and %u)",
+                          frame->version, VFX_FRAME_VIEW_VERSION, VFX_FRAME_VIEW2_VERSION, VFX_FRAME_VIEW3_VERSION);
     size_t need = frame->version == VFX_FRAME_VIEW2_VERSION ? sizeof(vfx_frame_view2) : sizeof(vfx_frame_view);
     if (frame->size < need)
         return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view of version %u has size %u (need %zu)",
@@ -220,6 +233,7 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
     }
     volfx_frame_targets targets;
     memset(&targets, 0, sizeof targets);
+    targets.view_id = view_id;
     targets.scene_depth = frame->depth_texture;
     targets.scene_color = frame->color_texture;
     volfx_mat4_mul(frame->proj, frame->view, targets.view_proj);

@@ -93,7 +93,17 @@ static vfx_result host_water_params(void *user, vfx_water_params *out)
     game_app *app = user;
     if (!out || out->size < sizeof *out)
         return VFX_ERR_ABI;
-    if (out->version == VFX_WATER_PARAMS2_VERSION && out->size >= sizeof(vfx_water_params2)) {
+    if (out->version >= VFX_WATER_PARAMS3_VERSION && out->size >= sizeof(vfx_water_params3)) {
+        vfx_water_params3 *p3 = (vfx_water_params3 *)out;
+        memset(p3, 0, sizeof *p3);
+        p3->v2.v1 = app->water;
+        p3->v2.v1.size = sizeof *p3;
+        p3->v2.v1.version = VFX_WATER_PARAMS3_VERSION;
+        p3->v2.kernel = app->water.method == VFX_WATER_METHOD_TILE ? app->water_kernel : VFX_WATER_KERNEL_ISOTROPIC;
+        p3->preset = app->water_preset;
+        return VFX_OK;
+    }
+    if (out->version >= VFX_WATER_PARAMS2_VERSION && out->size >= sizeof(vfx_water_params2)) {
         vfx_water_params2 *p2 = (vfx_water_params2 *)out;
         memset(p2, 0, sizeof *p2);
         p2->v1 = app->water;

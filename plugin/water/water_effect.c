@@ -12,6 +12,7 @@
 #include "context.h"
 
 #include "water_internal.h"
+#include "water_params.h"
 
 
 static void paper_free(water_state *s)
@@ -37,19 +38,13 @@ static void groups_free(vfx_context *ctx, water_state *s)
 }
 
 
-static void water_defaults(vfx_water_params *p)
+/* This frame's parameters: the resolved ones, h from the spacing when the host gave none. */
+static vfx_result water_set_params(vfx_context *ctx, water_state *s, volfx_water_resolved *res)
 {
-    if (!(p->h > 0) || !isfinite(p->h)) p->h = 0.61f;
-    if (!(p->threshold > 0) || !isfinite(p->threshold)) p->threshold = 0.765625f;
-    if (p->max_samples == 0) p->max_samples = 64;
-    if (!(p->step > 0) || !isfinite(p->step)) p->step = p->h / 8.0f;
-    if (p->refine_iters == 0) p->refine_iters = 3;
-    if (p->pyramid_level == 0) p->pyramid_level = 3;
-    if (p->color[0] == 0 && p->color[1] == 0 && p->color[2] == 0) {
-        p->color[0] = 0.15f; p->color[1] = 0.55f; p->color[2] = 0.6f;
-    }
-    if (!(p->absorption > 0)) p->absorption = 0.6f;
-    if (!(p->ior > 1)) p->ior = 1.333f;
+    vfx_result r = res->p.h == 0 ? volfx_water_params_set_h(ctx, res, s->auto_h > 0 ? s->auto_h : 0.61f) : VFX_OK;
+    if (r == VFX_OK)
+        s->params = res->p;
+    return r;
 }
 
 static bool water_present(vfx_context *ctx)
@@ -216,25 +211,28 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
     (void)time;
     (void)dt;
     water_state *s = state;
-    /* version 2 offered; a version-1 host writes only v1 (the rest stays 0: defaults) */
-    vfx_water_params2 p2;
-    memset(&p2, 0, sizeof p2);
-    p2.v1.size = sizeof p2;
-    p2.v1.version = VFX_WATER_PARAMS2_VERSION;
+    /* version 3 offered; an older host writes only its part (the rest stays 0: defaults) */
+    vfx_water_params3 p3;
+    memset(&p3, 0, sizeof p3);
+    p3.v2.v1.size = sizeof p3;
+    p3.v2.v1.version = VFX_WATER_PARAMS3_VERSION;
     if (ctx->host.water_params) {
-        vfx_result r = ctx->host.water_params(ctx->host.user, &p2.v1);
+        vfx_result r = ctx->host.water_params(ctx->host.user, &p3.v2.v1);
         if (r != VFX_OK && r != VFX_ERR_NOT_FOUND)
             return volfx_fail(ctx, r, "water: host water_params failed (%d)", (int)r);
         if (r == VFX_ERR_NOT_FOUND)
-            memset(&p2, 0, sizeof p2);
+            memset(&p3, 0, sizeof p3);
     }
-    s->params = p2.v1;
-    water_defaults(&s->params);
-    uint32_t pver = p2.v1.version == VFX_WATER_PARAMS2_VERSION && p2.v1.size >= sizeof p2 ? VFX_WATER_PARAMS2_VERSION
-                                                                                         : VFX_WATER_PARAMS_VERSION;
-    vfx_result kr = volfx_water_kernel_params_check(ctx, &p2, pver, &s->kp);
+    uint32_t pver = p3.v2.v1.version, psz = p3.v2.v1.size;
+    pver = pver == VFX_WATER_PARAMS3_VERSION && psz >= sizeof p3                      ? VFX_WATER_PARAMS3_VERSION
+           : pver == VFX_WATER_PARAMS2_VERSION && psz >= sizeof(vfx_water_params2) ? VFX_WATER_PARAMS2_VERSION
+                                                                                    : VFX_WATER_PARAMS_VERSION;
+    volfx_water_resolved res;
+    vfx_result kr = volfx_water_params_resolve(ctx, &p3, pver, &res);
     if (kr)
         return kr;
+    s->kp = res.kp;
+    s->preset = res.preset;
     uint32_t chunks = ctx->host.particle_chunk_count(ctx->host.user);
     uint64_t total = 0;
     /* every chunk with the nonzero revision of the last upload (0: the host tracks none) */
@@ -267,9 +265,20 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
      * positions (the box and the NaN count are still right), so nothing is read or uploaded. */
     int same = revs_same && total == s->count && s->groups[0].cols[0] == before &&
                s->group_count == before_groups;
+    /* h from the spacing: measured on the first upload, and again when the count has changed by
+     * more than 2x since (an h that moves every frame would make the surface breathe and drop
+     * the temporal history each frame) */
+    bool spacing = res.p.h == 0 && (!(s->auto_h > 0) || total > 2ull * s->auto_h_count ||
+                                    2ull * total < s->auto_h_count);
+    same = same && !spacing;
     s->upload_skipped = same;
     if (same)
-        return VFX_OK;
+        return water_set_params(ctx, s, &res);
+    /* every stride-th finite particle, at most 2^20, for the spacing */
+    uint32_t stride = (uint32_t)(total >> 20) + 1u, cand = 0;
+    float *cxyz = spacing ? volfx_alloc(ctx, (((size_t)total + stride - 1) / stride + 1) * 3 * sizeof(float)) : NULL;
+    if (spacing && !cxyz)
+        return VFX_ERR_OUT_OF_MEMORY;
     if (chunks != s->chunk_rev_count) {
         volfx_free(ctx, s->chunk_rev);
         s->chunk_rev_count = 0;
@@ -325,16 +334,36 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
                 if (!seen || q[k] > s->hi[k]) s->hi[k] = q[k];
             }
             seen = 1;
+            if (cxyz && (off + i) % stride == 0) {
+                memcpy(cxyz + 3 * (size_t)cand, q, sizeof q);
+                ++cand;
+            }
         }
-        if (s->aniso && (r = volfx_water_aniso_columns_chunk(ctx, s->aniso, c, off, v.count, v.radius, v2.kernel)))
+        if (s->aniso && (r = volfx_water_aniso_columns_chunk(ctx, s->aniso, c, off, v.count, v.radius, v2.kernel))) {
+            volfx_free(ctx, cxyz);
             return r;
-        if ((r = volfx_water_spray_chunk(ctx, s->spray, off, &v)))
+        }
+        if ((r = volfx_water_spray_chunk(ctx, s->spray, off, &v))) {
+            volfx_free(ctx, cxyz);
             return r;
+        }
         off += v.count;
         s->chunk_rev[c] = v.revision;
     }
     s->count = off;
     s->nan_count = nan_count;
+    if (spacing) {
+        double d = volfx_water_spacing(ctx, cxyz, cand, stride);
+        volfx_free(ctx, cxyz);
+        if (d < 0)
+            return VFX_ERR_OUT_OF_MEMORY;
+        /* the seed's ratio h = 2 x spacing (0.61 at its 0.3); no spacing (one particle, all on
+         * one point): the seed's 0.61 */
+        s->auto_h = d > 0 && isfinite(d) ? (float)(2.0 * d) : 0.61f;
+        s->auto_h_count = (uint32_t)total;
+    }
+    if ((kr = water_set_params(ctx, s, &res)))
+        return kr;
     const char *e = volfx_gpu_error_string();
     if (e)
         return volfx_fail(ctx, VFX_ERR_GL, "water upload of %u particles: %s", off, e);
@@ -512,6 +541,8 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->counters);
     glClearNamedBufferData(s->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     volfx_stat_set(ctx, "water.particles", s->count);
+    volfx_stat_set(ctx, "water.h", p->h);
+    volfx_stat_set(ctx, "water.preset", s->preset);
     volfx_stat_set(ctx, "water.nan_skipped", s->nan_count);
     volfx_stat_set(ctx, "water.upload_skipped", s->upload_skipped);
     s->last_method_drawn = UINT32_MAX; /* until this frame completes: nothing for debug_pixel_class */

@@ -56,6 +56,9 @@ typedef struct water_state {
     uint32_t width, height;
     vfx_water_params params;
     volfx_water_kernel_params kp; /* the kernel (vfx_water_params2), checked */
+    uint32_t preset;       /* vfx_water_params3.preset resolved (LOW..ULTRA) */
+    float auto_h;          /* h from the particles' spacing (0: not measured yet) */
+    uint32_t auto_h_count; /* the particle count it was measured at */
     volfx_water_aniso *aniso; /* per-particle kernels (TILE), made when asked for or given */
     volfx_water_grid *grid;  /* GRID baseline state, made the first time GRID is asked for */
     volfx_water_tile *tile;  /* TILE lists (TILE, and PAPER's finishing pass), made when needed */

@@ -248,6 +248,11 @@ static void march_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_tile
     glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_refine_iters"), (p->disable & VFX_WATER_NO_REFINE) ? 0u : p->refine_iters);
     glUniform1i(volfx_gpu_uniform(ctx, prog, "u_has_depth"), frame->depth_texture != 0);
     glUniform1i(volfx_gpu_uniform(ctx, prog, "u_subdivide"), !(p->disable & VFX_WATER_NO_SUBDIVIDE));
+    /* nodes down to h/128 whatever the step (the step is at most h: water_params.c) */
+    int depth = 4;
+    while (depth < 7 && p->step > p->h / 8.0f * (float)(1 << (depth - 4)) * 1.0001f)
+        ++depth;
+    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_sub_depth"), depth);
     glUniform1i(volfx_gpu_uniform(ctx, prog, "u_local"), !(p->disable & VFX_WATER_NO_LOCAL_LIST));
     if (in->kernels)
         glUniform1f(volfx_gpu_uniform(ctx, prog, "u_rbound"), in->rbound);

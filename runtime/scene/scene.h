@@ -111,6 +111,8 @@ typedef struct rt_scene_water {
     /* water.quality.kernel (vfx_water_params2.kernel): anisotropic for method TILE unless the
      * scene says "isotropic"; isotropic for the other methods (they draw no other) */
     uint32_t kernel;
+    /* water.quality.preset (vfx_water_params3.preset; 0: the plugin's default, medium) */
+    uint32_t preset;
 } rt_scene_water;
 
 typedef struct rt_scene_transfer_point {

@@ -37,7 +37,7 @@ vfx_result rt_scene_parse_box(pctx *c, const cJSON *obj, const char *path, const
  * where h/spacing sets how many neighbours a point's field sums (~33 at 2: a surface without the
  * single spheres showing, a sheet one particle thick still closed). The spacing is the layers'
  * own or the cube root of the volume per particle of the generated box or sphere or of the
- * simulation's initial fluid box; a file gives none (0: the plugin's default, 0.61). */
+ * simulation's initial fluid box; a file gives none (0: the plugin measures the spacing). */
 static float water_h_from_spacing(const rt_scene_water *w)
 {
     double vol = 0;
@@ -139,8 +139,11 @@ static vfx_result parse_water_quality(pctx *c, const cJSON *q, rt_scene_water *w
 {
     vfx_water_params *wp = &w->params;
     static const char *const qkeys[] = {"max_samples", "step", "refine_iters", "pyramid_level", "method",
-                                        "disable", "kernel", NULL};
+                                        "disable", "kernel", "preset", NULL};
     static const char *const methods[] = {"paper", "brute", "grid", "tile", NULL};
+    static const uint32_t method_ids[] = {VFX_WATER_METHOD_PAPER, VFX_WATER_METHOD_BRUTE, VFX_WATER_METHOD_GRID,
+                                          VFX_WATER_METHOD_TILE};
+    static const char *const presets[] = {"low", "medium", "high", "ultra", NULL};
     static const char *const flags[] = {"billboard_init", "skip", "blend", "pack4", "pyramid", "refine",
                                         "shading", "finish", "local_list", "subdivide", "tiles", "refract_trace",
                                         "temporal", "half_res", "spray", NULL};
@@ -158,7 +161,14 @@ static vfx_result parse_water_quality(pctx *c, const cJSON *q, rt_scene_water *w
     if (!r) r = rt_scene_get_float(c, q, PQ, "step", false, (range){0, 1e3, true}, &wp->step);
     if (!r) r = rt_scene_get_uint(c, q, PQ, "refine_iters", false, 1, 64, &wp->refine_iters);
     if (!r) r = rt_scene_get_uint(c, q, PQ, "pyramid_level", false, 1, 12, &wp->pyramid_level);
-    if (!r) r = rt_scene_get_enum(c, q, PQ, "method", false, methods, &wp->method);
+    uint32_t mi = 3;
+    if (!r) r = rt_scene_get_enum(c, q, PQ, "method", false, methods, &mi);
+    wp->method = method_ids[mi];
+    if (!r && cJSON_GetObjectItemCaseSensitive(q, "preset")) {
+        uint32_t pi = 0;
+        r = rt_scene_get_enum(c, q, PQ, "preset", false, presets, &pi);
+        w->preset = VFX_WATER_PRESET_LOW + pi;
+    }
     if (!r) r = rt_scene_get_flags(c, q, PQ, "disable", flags, bits, &wp->disable);
     if (!r && cJSON_GetObjectItemCaseSensitive(q, "kernel")) {
         static const char *const kernels[] = {"isotropic", "anisotropic", NULL};
@@ -168,7 +178,7 @@ static vfx_result parse_water_quality(pctx *c, const cJSON *q, rt_scene_water *w
         if (!r && w->kernel == VFX_WATER_KERNEL_ANISOTROPIC && wp->method != VFX_WATER_METHOD_TILE)
             r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.quality.kernel",
                             "\"anisotropic\" is drawn by method \"tile\" only (method \"%s\" draws the seed's isotropic kernel)",
-                            methods[wp->method]);
+                            methods[mi]);
     }
     return r;
 }
@@ -217,11 +227,12 @@ vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
     const cJSON *q = cJSON_GetObjectItemCaseSensitive(v, "quality");
     if (q)
         r = parse_water_quality(c, q, w);
-    /* the default: anisotropic for TILE (flat water flat, sheets stay sheets, for 1.4x the
-     * plugin's CPU in the default scene; docs/water.md "Anisotropic kernels"), the seed's
-     * isotropic kernel for the other methods */
+    /* the default: the preset's, as the plugin resolves it (anisotropic for TILE but at preset
+     * "low": flat water flat, sheets stay sheets; docs/water.md "Presets"), the seed's isotropic
+     * kernel for the other methods */
     if (!r && w->kernel == VFX_WATER_KERNEL_DEFAULT)
-        w->kernel = wp->method == VFX_WATER_METHOD_TILE ? VFX_WATER_KERNEL_ANISOTROPIC : VFX_WATER_KERNEL_ISOTROPIC;
+        w->kernel = wp->method == VFX_WATER_METHOD_TILE && w->preset != VFX_WATER_PRESET_LOW ? VFX_WATER_KERNEL_ANISOTROPIC
+                                                                                             : VFX_WATER_KERNEL_ISOTROPIC;
     return r;
 }
 

@@ -141,7 +141,10 @@ uniform bool u_has_depth, u_subdivide, u_local;
 #ifndef LOCAL_K
 #define LOCAL_K 16
 #endif
-#define SUB_DEPTH 4
+// the bound-driven subdivision's depth: 4 at steps of h/8 (nodes of h/128), one more per doubling
+// of the step (u_sub_depth, at most 7 at steps of h), so the finest node stays h/128 or less
+uniform int u_sub_depth;
+#define SUB_DEPTH_MAX 7
 // temporal reuse: the proof's dyadic depth at most (nodes of 2 steps or more)
 #define PROOF_DEPTH 4
 
@@ -647,7 +650,14 @@ void main()
             }
         }
 #endif
-        while (t < b_end && t <= t_lim && steps < MAX_STEPS) {
+        while (t < b_end && steps < MAX_STEPS) {
+            // the last sample sits on t_lim (the host depth, or the list's last exit in the dense
+            // march): a surface between the previous sample and it is bracketed even when the
+            // step reaches past it (steps near h drew nothing before, issue 28)
+            if (t > t_lim) {
+                if (!have_prev || tp >= t_lim) break;
+                t = t_lim;
+            }
             ++steps;
             vec2 su = field(t, have_prev ? tp : t);
             ++nsamp;
@@ -664,12 +674,12 @@ void main()
                 // end is always known (tp's, or the right end of the node visited before it)
                 float w = t - tp, lf = fp;
                 int d = 1, k = 0;
-                for (int it = 0; it < 2 << SUB_DEPTH; ++it) {
+                for (int it = 0; it < 2 << SUB_DEPTH_MAX; ++it) {
                     float n0 = tp + w * float(k) / float(1 << d), n1 = tp + w * float(k + 1) / float(1 << d);
                     vec2 v = field(n1, n0);
                     ++nsub;
                     float fv = sqrt(v.x) - u_T;
-                    if (v.y >= u_T * u_T && d < SUB_DEPTH) { ++d; k *= 2; continue; } // open it
+                    if (v.y >= u_T * u_T && d < u_sub_depth) { ++d; k *= 2; continue; } // open it
                     if (fv >= 0.0) {
                         state = 1; ta = n0; fa = lf; tb = n1; fb = fv;
                         break;

@@ -157,25 +157,29 @@ enum {
     VFX_WATER_NO_SPRAY = 1u << 14,
 };
 
+/* Zero means the recommended method (TILE). The paper method is selected by name (its value was
+ * 0 before version 3 of the parameters: zero-filled parameters now mean the recommended look). */
 typedef enum vfx_water_method {
-    VFX_WATER_METHOD_PAPER = 0,     /* billboards + blended potentials, the published method (docs/water.md) */
+    VFX_WATER_METHOD_DEFAULT = 0,   /* the recommended method: TILE */
     VFX_WATER_METHOD_BRUTE = 1,     /* baseline: per-pixel march over all particles (compute) */
     VFX_WATER_METHOD_GRID = 2,      /* baseline: per-pixel march over a uniform grid (compute) */
     VFX_WATER_METHOD_TILE = 3,      /* ours (recommended; scenes default to it): per-pixel march
                                        over screen-tile particle lists, no sample cap */
+    VFX_WATER_METHOD_PAPER = 4,     /* billboards + blended potentials, the published method (docs/water.md) */
 } vfx_water_method;
 
 #define VFX_WATER_PARAMS_VERSION 1u
 typedef struct vfx_water_params {
     uint32_t size, version;
-    float h;               /* kernel radius; 0 -> 0.61 */
+    float h;               /* kernel radius; 0 -> 2 x the particles' spacing (the median nearest-
+                              neighbour distance, estimated by the plugin; docs/water.md) */
     float threshold;       /* T in I = sqrt(sum P) - T; 0 -> 0.765625 */
-    uint32_t max_samples;  /* cap per pixel; 0 -> 64 */
-    float step;            /* sample spacing; 0 -> h/8 */
-    uint32_t refine_iters; /* regula falsi iterations; 0 -> 3 */
+    uint32_t max_samples;  /* cap per pixel, <= 4096 (paper, brute, grid); 0 -> 64 */
+    float step;            /* sample spacing; 0 -> the preset's (h/8) */
+    uint32_t refine_iters; /* regula falsi iterations, <= 64; 0 -> the preset's (3) */
     uint32_t pyramid_level;/* min/max pyramid level used for culling; 0 -> 3 */
     uint32_t disable;      /* VFX_WATER_NO_* bits; 0 = every technique on */
-    uint32_t method;       /* vfx_water_method */
+    uint32_t method;       /* vfx_water_method; 0 -> TILE */
     float color[3];        /* absorption tint; all 0 -> sea water */
     float absorption;      /* per unit length; 0 -> 0.6 */
     float ior;             /* 0 -> 1.333 */
@@ -184,7 +188,8 @@ typedef struct vfx_water_params {
 
 /* The kernel each particle adds to the field (vfx_water_params2.kernel). */
 typedef enum vfx_water_kernel {
-    VFX_WATER_KERNEL_DEFAULT = 0,     /* isotropic (the seed's) */
+    VFX_WATER_KERNEL_DEFAULT = 0,     /* the preset's: anisotropic for TILE (isotropic at preset
+                                         low), isotropic for the other methods */
     VFX_WATER_KERNEL_ISOTROPIC = 1,   /* P(|x - p|), every method */
     /* Yu & Turk 2013: an ellipsoid per particle from the weighted covariance of its
      * neighbours, computed on the GPU each frame (docs/water.md "Anisotropic kernels"); flat
@@ -195,7 +200,7 @@ typedef enum vfx_water_kernel {
 /* Version 2 of the water parameters: version 1 as its first member (never edited), then the
  * kernel. The plugin offers one with v1.size = sizeof(vfx_water_params2) and v1.version =
  * VFX_WATER_PARAMS2_VERSION; a host that knows version 2 fills all of it and keeps version 2,
- * a version-1 host writes a vfx_water_params (version 1: the isotropic kernel). Zero means
+ * a version-1 host writes a vfx_water_params (version 1: the default kernel). Zero means
  * default in every field; out-of-range values are refused with the field's name. */
 #define VFX_WATER_PARAMS2_VERSION 2u
 typedef struct vfx_water_params2 {
@@ -211,6 +216,27 @@ typedef struct vfx_water_params2 {
     float aniso_smoothing;
     uint32_t _reserved[6];
 } vfx_water_params2;
+
+/* Quality presets (vfx_water_params3.preset): what each sets and measures is in docs/water.md
+ * ("Presets"); a field the host sets explicitly wins over its preset's value. */
+typedef enum vfx_water_preset {
+    VFX_WATER_PRESET_DEFAULT = 0, /* the recommended one: MEDIUM */
+    VFX_WATER_PRESET_LOW = 1,     /* TILE, isotropic kernel, reduced resolution, steps of h/6 */
+    VFX_WATER_PRESET_MEDIUM = 2,  /* TILE, anisotropic kernel, reduced resolution, temporal reuse, h/8 */
+    VFX_WATER_PRESET_HIGH = 3,    /* MEDIUM at full resolution */
+    VFX_WATER_PRESET_ULTRA = 4,   /* HIGH with steps of h/16 and 5 regula falsi steps */
+} vfx_water_preset;
+
+/* Version 3 of the water parameters: version 2 as its first member (never edited), then the
+ * quality preset. The plugin offers one with v1.size = sizeof(vfx_water_params3) and v1.version =
+ * VFX_WATER_PARAMS3_VERSION; a version-1 or version-2 host gets the default preset. Zero means
+ * default in every field. */
+#define VFX_WATER_PARAMS3_VERSION 3u
+typedef struct vfx_water_params3 {
+    vfx_water_params2 v2;
+    uint32_t preset;               /* vfx_water_preset */
+    uint32_t _reserved[7];
+} vfx_water_params3;
 
 /* One beam; the field is defined exactly in docs/beams.md:
  * head rho_h = a / sqrt(|P-M|^2 + eps^2) inside radius R, trail rho_t = b / sqrt(r^2 + eps^2)
@@ -414,6 +440,20 @@ typedef struct vfx_frame_view2 {
     uint32_t environment_cubemap; /* GL cubemap the water reflects; 0 -> a procedural sky */
     uint32_t _reserved[4];
 } vfx_frame_view2;
+
+/* Version 3 of the frame view: version 2 as its first member (never edited), then the view's id.
+ * The host sets v1.size = sizeof(vfx_frame_view3) and v1.version = VFX_FRAME_VIEW3_VERSION. Each
+ * view keeps its own state under its id (the water's temporal history and its size-dependent
+ * targets; docs/water.md "Views"), so split screen or a second camera rendered alternately with
+ * the first keeps each one's history and sizes; versions 1 and 2 are view 0. The plugin keeps
+ * the VFX_MAX_VIEWS most recently rendered ids; an older one starts afresh. */
+#define VFX_FRAME_VIEW3_VERSION 3u
+#define VFX_MAX_VIEWS 4u
+typedef struct vfx_frame_view3 {
+    vfx_frame_view2 v2;
+    uint32_t view_id;             /* any value */
+    uint32_t _reserved[7];
+} vfx_frame_view3;
 
 #define VFX_STATS_MAX 64
 typedef struct vfx_stat {

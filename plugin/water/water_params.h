@@ -1,0 +1,36 @@
+/* water_params.h — the water's parameters as the effect draws them: the host's (any version of
+ * vfx_water_params), checked, with the preset's values in every field the host left 0
+ * (docs/water.md "Presets"), and h from the particles' spacing when the host gives none. */
+#ifndef VOLFX_WATER_PARAMS_H
+#define VOLFX_WATER_PARAMS_H
+
+#include "effect.h"
+#include "water_aniso.h"
+
+/* The resolved parameters of one frame. */
+typedef struct volfx_water_resolved {
+    vfx_water_params p;          /* every default applied, method never 0; h and step 0 while
+                                    h waits for the particles' spacing (volfx_water_params_set_h) */
+    volfx_water_kernel_params kp;
+    uint32_t preset;             /* VFX_WATER_PRESET_LOW .. _ULTRA (never DEFAULT) */
+    float step_div;              /* step = h / step_div when the host gave no step */
+} volfx_water_resolved;
+
+/* Reads the host's parameters (`in` holds `version`'s fields; the rest are 0), checks them and
+ * applies the preset; an unknown method, kernel or preset, or a value outside its documented
+ * range that would hang or silently draw nothing, fails with VFX_ERR_INVALID_ARGUMENT naming
+ * the field. */
+vfx_result volfx_water_params_resolve(vfx_context *ctx, const vfx_water_params3 *in, uint32_t version,
+                                      volfx_water_resolved *out);
+/* Sets h and the preset's step that depends on it; an explicit step outside [h/1024, h] fails
+ * with VFX_ERR_INVALID_ARGUMENT naming it. */
+vfx_result volfx_water_params_set_h(vfx_context *ctx, volfx_water_resolved *r, float h);
+
+/* The particles' spacing: the median distance from a sample of up to 512 particles to their
+ * nearest other particle (a hashed grid over `m` candidate positions, xyz interleaved, every
+ * `stride`-th of the finite particles: the result is scaled by cbrt(stride)); 0 when no
+ * particle has a neighbour at a nonzero distance. Allocates m + 2^k words, freed again;
+ * -1 on allocation failure. */
+double volfx_water_spacing(vfx_context *ctx, const float *xyz, uint32_t m, uint32_t stride);
+
+#endif

@@ -1,0 +1,305 @@
+/* The water's parameters as a host gives them (issues 24 and 28): zero-filled parameters mean the
+ * recommended look (TILE, the anisotropic kernel, h from the particles' spacing), the presets,
+ * the paper method by name, and the values that hung or drew nothing (step, max_samples,
+ * refine_iters) drawn against the float64 reference or refused by name. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <epoxy/gl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "debug.h"
+#include "camera_ref.h"
+#include "test_util.h"
+#include "water_ref.h"
+#include "water_test_host.h"
+
+typedef struct host {
+    test_log log;
+    float *x, *y, *z;
+    uint32_t n;
+    uint32_t pver;         /* the parameters' version the host answers with: 1 or 3 */
+    vfx_water_params3 p;   /* its fields (size and version are written by water_params) */
+} host;
+
+static uint32_t chunk_count(void *user)
+{
+    host *s = user;
+    return water_test_chunk_count(s->n, 97);
+}
+
+static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
+{
+    host *s = user;
+    water_test_chunk(s->x, s->y, s->z, s->n, 97, index, out);
+    return VFX_OK;
+}
+
+static vfx_result water_params(void *user, vfx_water_params *out)
+{
+    const host *s = user;
+    if (s->pver == 3 && out->version >= VFX_WATER_PARAMS3_VERSION && out->size >= sizeof(vfx_water_params3)) {
+        *(vfx_water_params3 *)out = s->p;
+        out->size = sizeof(vfx_water_params3);
+        out->version = VFX_WATER_PARAMS3_VERSION;
+        return VFX_OK;
+    }
+    *out = s->p.v2.v1;
+    out->size = sizeof *out;
+    out->version = VFX_WATER_PARAMS_VERSION;
+    return VFX_OK;
+}
+
+/* A pool: nx x nz columns, ny layers, at `spacing`, its floor at y = 0, centred on x and z. */
+static host pool_host(uint32_t nx, uint32_t nz, uint32_t ny, float spacing)
+{
+    host s;
+    memset(&s, 0, sizeof s);
+    s.n = nx * ny * nz;
+    s.x = malloc(s.n * sizeof(float));
+    s.y = malloc(s.n * sizeof(float));
+    s.z = malloc(s.n * sizeof(float));
+    uint32_t i = 0;
+    for (uint32_t y = 0; y < ny; ++y)
+        for (uint32_t z = 0; z < nz; ++z)
+            for (uint32_t x = 0; x < nx; ++x, ++i) {
+                s.x[i] = ((float)x - 0.5f * (float)(nx - 1)) * spacing;
+                s.y[i] = (float)y * spacing;
+                s.z[i] = ((float)z - 0.5f * (float)(nz - 1)) * spacing;
+            }
+    s.pver = 1;
+    return s;
+}
+
+static void free_host(host *s) { free(s->x); free(s->y); free(s->z); }
+
+typedef struct session {
+    vfx_plugin_api api;
+    vfx_context *ctx;
+    vfx_host_api host;
+    GLuint fbo, col;
+    uint32_t w, h;
+} session;
+
+static void session_open(session *ss, host *s, uint32_t w, uint32_t h)
+{
+    memset(ss, 0, sizeof *ss);
+    ss->host = (vfx_host_api){.size = sizeof ss->host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
+                              .user = s, .log = test_log_fn, .particle_chunk_count = chunk_count,
+                              .particle_chunk = chunk_view, .water_params = water_params};
+    ss->api.size = sizeof ss->api;
+    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
+    assert_int_equal(ss->api.create(&ss->host, &ss->ctx), VFX_OK);
+    ss->ctx->debug.sync_counters = true;
+    ss->w = w;
+    ss->h = h;
+    glCreateTextures(GL_TEXTURE_2D, 1, &ss->col);
+    glTextureStorage2D(ss->col, 1, GL_RGBA8, (GLsizei)w, (GLsizei)h);
+    glCreateFramebuffers(1, &ss->fbo);
+    glNamedFramebufferTexture(ss->fbo, GL_COLOR_ATTACHMENT0, ss->col, 0);
+}
+
+static void session_close(session *ss)
+{
+    ss->api.destroy(ss->ctx);
+    glDeleteFramebuffers(1, &ss->fbo);
+    glDeleteTextures(1, &ss->col);
+}
+
+/* One update and render of `cam` (a frame view of version 1). */
+static vfx_result session_frame(session *ss, const ref_camera *cam)
+{
+    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = ss->fbo, .width = ss->w,
+                         .height = ss->h, .fov_y = (float)cam->fov_y, .near_plane = (float)cam->near_plane,
+                         .far_plane = (float)cam->far_plane};
+    for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam->eye[k];
+    ref_camera_matrices(cam, fv.view, fv.proj);
+    vfx_result r = ss->api.update(ss->ctx, 0.0, 0.0f);
+    return r ? r : ss->api.render(ss->ctx, &fv);
+}
+
+static double stat(session *ss, const char *name)
+{
+    vfx_stats2 st = {.size = sizeof st, .version = VFX_STATS2_VERSION};
+    assert_int_equal(ss->api.get_stats(ss->ctx, (vfx_stats *)&st), VFX_OK);
+    for (uint32_t k = 0; k < st.count; ++k)
+        if (!strcmp(st.entries[k].name, name)) return st.entries[k].value;
+    return -1;
+}
+
+/* The isotropic float64 reference of host s with kernel radius h against the GPU's distances. */
+static ref_water_error against_reference(session *ss, const host *s, const ref_camera *cam, double h)
+{
+    size_t n = (size_t)ss->w * ss->h;
+    float *gpu = malloc(n * 4), *ref = malloc(n * 4);
+    assert_int_equal(ss->api.read_raw(ss->ctx, VFX_EFFECT_WATER, gpu, n), VFX_OK);
+    double fwd[3], right[3], up[3];
+    ref_camera_basis(cam, fwd, right, up);
+    ref_water_camera rc = {{cam->eye[0], cam->eye[1], cam->eye[2]}, {fwd[0], fwd[1], fwd[2]}, {up[0], up[1], up[2]},
+                           cam->fov_y, ss->w, ss->h};
+    ref_water_params rp = ref_water_default_params();
+    rp.h = h;
+    rp.step = h / 32;
+    char err[256];
+    ref_water_error e;
+    assert_int_equal(ref_water_render(&rc, s->x, s->y, s->z, s->n, &rp, ref, NULL, NULL, err), 0);
+    assert_int_equal(ref_water_compare(gpu, NULL, ref, NULL, n, h, &e), 0);
+    free(gpu);
+    free(ref);
+    return e;
+}
+
+static const ref_camera POOL_CAM = {{0.2, 0.9, 1.3}, {0, 0.1, 0}, {0, 1, 0}, 0.9, 48, 32, 0.05, 50};
+
+/* Zero-filled version-1 parameters (as docs/integration.md's first image fills them) draw the
+ * recommended look: TILE (tile stats), the anisotropic kernel (kernels stretched), preset medium,
+ * h = 2 x the spacing (0.1 here: h 0.2, within the median's rounding). Before: the paper method
+ * with h 0.61, whatever the spacing. */
+static void test_zero_params_recommended(void **state)
+{
+    (void)state;
+    host s = pool_host(12, 12, 3, 0.1f);
+    session ss;
+    session_open(&ss, &s, POOL_CAM.width, POOL_CAM.height);
+    assert_int_equal(session_frame(&ss, &POOL_CAM), VFX_OK);
+    print_message("zero params: h %.4f preset %.0f entries %.0f stretched %.0f found %.0f\n", stat(&ss, "water.h"),
+                  stat(&ss, "water.preset"), stat(&ss, "water.tile_entries"), stat(&ss, "water.aniso_stretched"),
+                  stat(&ss, "water.pixels_found"));
+    assert_true(fabs(stat(&ss, "water.h") - 0.2) < 1e-4);
+    assert_true(stat(&ss, "water.preset") == VFX_WATER_PRESET_MEDIUM);
+    assert_true(stat(&ss, "water.tile_entries") > 0);
+    assert_true(stat(&ss, "water.aniso_stretched") > 0);
+    assert_true(stat(&ss, "water.pixels_found") > 200);
+    /* h stays what it was measured at while the count holds (a breathing h would drop the
+     * temporal history every frame): a second frame reuses the history */
+    assert_int_equal(session_frame(&ss, &POOL_CAM), VFX_OK);
+    assert_true(stat(&ss, "water.tile_temporal_valid") == 1);
+    session_close(&ss);
+    free_host(&s);
+}
+
+/* Each preset resolves to what docs/water.md says it sets; the paper method is chosen by name;
+ * an unknown preset is refused by name. The isotropic preset "low" against the float64
+ * reference: hole rate 0 (its march is exact up to the reduced resolution's interpolation). */
+static void test_presets(void **state)
+{
+    (void)state;
+    host s = pool_host(12, 12, 3, 0.1f);
+    s.pver = 3;
+    s.p.v2.v1.h = 0.2f;
+    for (uint32_t pr = VFX_WATER_PRESET_LOW; pr <= VFX_WATER_PRESET_ULTRA; ++pr) {
+        s.p.preset = pr;
+        session ss;
+        session_open(&ss, &s, POOL_CAM.width, POOL_CAM.height);
+        assert_int_equal(session_frame(&ss, &POOL_CAM), VFX_OK);
+        double stretched = stat(&ss, "water.aniso_stretched"), up = stat(&ss, "water.tile_half_upsampled");
+        print_message("preset %u: stretched %.0f upsampled %.0f samples %.0f found %.0f\n", pr, stretched, up,
+                      stat(&ss, "water.samples"), stat(&ss, "water.pixels_found"));
+        assert_true(stat(&ss, "water.preset") == pr);
+        assert_true((pr == VFX_WATER_PRESET_LOW) == (stretched < 0));   /* low: isotropic */
+        assert_true((pr >= VFX_WATER_PRESET_HIGH) == (up <= 0));         /* high, ultra: full resolution */
+        if (pr == VFX_WATER_PRESET_LOW) {
+            ref_water_error e = against_reference(&ss, &s, &POOL_CAM, 0.2);
+            print_message("preset low against the reference: hits %u holes %.4f false %.4f p99 %.2e h\n", e.ref_hits,
+                          e.hole_rate, e.false_hit_rate, e.dist_p99_rel_h);
+            assert_true(e.ref_hits > 200);
+            assert_true(e.hole_rate == 0 && e.false_hit_rate == 0);
+        }
+        session_close(&ss);
+    }
+    /* the paper method by name: no tile lists, its sample counters */
+    s.p.preset = 0;
+    s.p.v2.v1.method = VFX_WATER_METHOD_PAPER;
+    session ss;
+    session_open(&ss, &s, POOL_CAM.width, POOL_CAM.height);
+    assert_int_equal(session_frame(&ss, &POOL_CAM), VFX_OK);
+    assert_true(stat(&ss, "water.pixels_sample_cap") >= 0);
+    assert_true(stat(&ss, "water.aniso_stretched") < 0);
+    session_close(&ss);
+    s.p.v2.v1.method = 0;
+    s.p.preset = 9;
+    session_open(&ss, &s, POOL_CAM.width, POOL_CAM.height);
+    assert_int_equal(session_frame(&ss, &POOL_CAM), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(s.log.last, "preset 9"));
+    session_close(&ss);
+    free_host(&s);
+}
+
+/* The step (issue 28): a step of h drew holes (the last sample before the list's last exit was
+ * skipped; 2 of 2,109 reference pixels in the 1,000-particle layers); a step of h/1024 draws the
+ * reference; beyond [h/1024, h] the step is refused by name (5 drew nothing at all, 1e-4 ran
+ * out of llvmpipe's loop budget and drew nothing with 0 undecided pixels). max_samples and
+ * refine_iters of 4e9 hung a paper-method frame: refused by name. */
+static void test_step_and_loop_bounds(void **state)
+{
+    (void)state;
+    /* the paper's layers (1,000 particles at its spacing 0.3, h 0.61) from volfx-bench's camera */
+    host s = pool_host(1, 1, 1, 0.3f);
+    free_host(&s);
+    s.n = 1000;
+    s.x = malloc(s.n * 4); s.y = malloc(s.n * 4); s.z = malloc(s.n * 4);
+    ref_water_layers(s.n, 0.3, s.x, s.y, s.z);
+    s.p.v2.v1.h = 0.61f;
+    s.p.v2.v1.method = VFX_WATER_METHOD_TILE;
+    s.p.v2.v1.disable = VFX_WATER_NO_HALF_RES;
+    s.pver = 3;
+    s.p.v2.kernel = VFX_WATER_KERNEL_ISOTROPIC; /* the reference's */
+    const ref_camera cam = {{0, 4.3, 8}, {0, 0.15, 0}, {0, 1, 0}, 0.9, 96, 64, 0.1, 100};
+    const float steps[] = {0.61f, 0.61f / 1000.0f};
+    for (int k = 0; k < 2; ++k) {
+        s.p.v2.v1.step = steps[k];
+        session ss;
+        session_open(&ss, &s, cam.width, cam.height);
+        assert_int_equal(session_frame(&ss, &cam), VFX_OK);
+        ref_water_error e = against_reference(&ss, &s, &cam, 0.61);
+        print_message("step %g: hits %u holes %.4f false %.4f p99 %.2e h, undecided %.0f\n", (double)steps[k], e.ref_hits,
+                      e.hole_rate, e.false_hit_rate, e.dist_p99_rel_h, stat(&ss, "water.pixels_undecided"));
+        assert_true(e.ref_hits > 2000);
+        assert_true(e.hole_rate == 0 && e.false_hit_rate == 0);
+        assert_true(stat(&ss, "water.pixels_undecided") == 0);
+        /* regula falsi's 3 steps from a bracket one step long: 1.4e-4 h at h/1000 (the h/32
+         * reference's own error is ~1e-4 h), 1e-2 h at a step of h (measured 7.7e-3) */
+        assert_true(e.dist_p99_rel_h < (k == 0 ? 2e-2 : 5e-4));
+        session_close(&ss);
+    }
+    struct { const char *field; float step; uint32_t samples, refine, method; } bad[] = {
+        {"step", 5.0f, 0, 0, VFX_WATER_METHOD_TILE},
+        {"step", 1e-4f, 0, 0, VFX_WATER_METHOD_TILE},
+        {"step", -0.1f, 0, 0, VFX_WATER_METHOD_TILE},
+        {"step", NAN, 0, 0, VFX_WATER_METHOD_TILE},
+        {"max_samples", 0, 4000000000u, 0, VFX_WATER_METHOD_PAPER},
+        {"refine_iters", 0, 0, 4000000000u, VFX_WATER_METHOD_PAPER},
+        {"refine_iters", 0, 0, 65, VFX_WATER_METHOD_TILE},
+    };
+    for (size_t b = 0; b < sizeof bad / sizeof bad[0]; ++b) {
+        s.p.v2.v1.step = bad[b].step;
+        s.p.v2.v1.max_samples = bad[b].samples;
+        s.p.v2.v1.refine_iters = bad[b].refine;
+        s.p.v2.v1.method = bad[b].method;
+        session ss;
+        session_open(&ss, &s, 16, 16);
+        assert_int_equal(session_frame(&ss, &cam), VFX_ERR_INVALID_ARGUMENT);
+        print_message("refused: %s\n", s.log.last);
+        assert_non_null(strstr(s.log.last, bad[b].field));
+        session_close(&ss);
+    }
+    free_host(&s);
+}
+
+int main(void)
+{
+    rt_gl_context *gl = test_gl_or_skip();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_zero_params_recommended),
+        cmocka_unit_test(test_presets),
+        cmocka_unit_test(test_step_and_loop_bounds),
+    };
+    int rc = cmocka_run_group_tests(tests, NULL, NULL);
+    rt_gl_context_destroy(gl);
+    return rc;
+}
