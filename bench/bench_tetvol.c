@@ -11,6 +11,7 @@
 #endif
 #include <math.h>
 #include "core/args.h"
+#include "core/file.h"
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -115,8 +116,12 @@ static void diff(const float *a, const float *b, size_t n, double *rmse, double 
  * RGBA image, or the three premultiplied colour channels when ch < 0. */
 static int write_pfm(const char *path, const float *rgba, int w, int h, int ch)
 {
-    FILE *f = fopen(path, "wb");
-    if (!f) return -1;
+    char err[1200];
+    FILE *f = rt_open_output(path, "wb", err, sizeof err); /* never blocks on a FIFO */
+    if (!f) {
+        fprintf(stderr, "tetvol: %s\n", err);
+        return -1;
+    }
     int ok = fprintf(f, "%s\n%d %d\n-1.0\n", ch < 0 ? "PF" : "Pf", w, h) > 0;
     for (size_t i = 0; i < (size_t)w * h && ok; i++)
         ok = ch < 0 ? fwrite(&rgba[4 * i], sizeof(float), 3, f) == 3

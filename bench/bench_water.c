@@ -21,6 +21,7 @@
 #include <time.h>
 #include <sys/resource.h>
 
+#include "core/file.h"
 #include "gfx/gl_context.h"
 #include "gfx/image.h"
 #include "debug.h"
@@ -146,13 +147,14 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
         cam = (ref_camera){{0, top + 4.0, 8.0}, {0, top * 0.5, 0}, {0, 1, 0}, 0.9, width, height, 0.1, 100};
     }
     if (s.points) {
-        FILE *f = fopen(s.points, "wb");
+        char perr[1200];
+        FILE *f = rt_open_output(s.points, "wb", perr, sizeof perr); /* never blocks on a FIFO */
         for (uint32_t i = 0; f && i < n; ++i) {
             float q[3] = {s.x[i], s.y[i], s.z[i]};
             fwrite(q, 4, 3, f);
         }
         if (f) fclose(f);
-        else fprintf(stderr, "metaballs: cannot write %s\n", s.points);
+        else fprintf(stderr, "metaballs: --points: %s\n", perr);
     }
     vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = bench_gl_proc, .user = &s,
                          .particle_chunk_count = bench_chunks, .particle_chunk = bench_chunk,

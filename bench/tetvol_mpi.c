@@ -18,6 +18,7 @@
 #include <mpi.h>
 
 #include "core/args.h"
+#include "core/file.h"
 #include "scene/volume_file.h"
 #include "tet_mpi.h"
 #include "tet_render.h"
@@ -367,9 +368,10 @@ int main(int argc, char **argv)
     }
     if (rank == 0 && ppm) {
         /* premultiplied colour over black, rows flipped (row 0 is the bottom) */
-        FILE *f = fopen(ppm, "wb");
+        char perr[1200];
+        FILE *f = rt_open_output(ppm, "wb", perr, sizeof perr); /* never blocks on a FIFO */
         if (!f) {
-            fprintf(stderr, "volfx-tetvol-mpi: cannot write %s\n", ppm);
+            fprintf(stderr, "volfx-tetvol-mpi: --ppm: %s\n", perr);
         } else {
             fprintf(f, "P6\n%d %d\n255\n", size, size);
             for (int y = size - 1; y >= 0; y--)

@@ -266,12 +266,13 @@ int main(int argc, char **argv)
             printf("raw %s: %s\n", o.raw_effect, o.raw_path);
         }
     }
-    if (o.csv && rt_profiler_write_csv(app->profiler, o.csv)) {
-        fprintf(stderr, "volfx-game: cannot write %s\n", o.csv);
+    char werr[1200];
+    if (o.csv && rt_profiler_write_csv(app->profiler, o.csv, werr, sizeof werr)) {
+        fprintf(stderr, "volfx-game: --csv: %s\n", werr);
         rc = 1;
     }
-    if (o.trace && rt_profiler_write_trace(app->profiler, o.trace)) {
-        fprintf(stderr, "volfx-game: cannot write %s\n", o.trace);
+    if (o.trace && rt_profiler_write_trace(app->profiler, o.trace, werr, sizeof werr)) {
+        fprintf(stderr, "volfx-game: --trace: %s\n", werr);
         rc = 1;
     }
     game_demo_free(app, &demo);

@@ -1,14 +1,13 @@
 /* args.c — see args.h. */
 #define _POSIX_C_SOURCE 200809L
 #include "core/args.h"
+#include "core/file.h"
 
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 bool rt_arg_u32(const char *opt, const char *v, uint32_t lo, uint32_t hi, uint32_t *out, char *err,
                 size_t errlen)
@@ -57,24 +56,13 @@ bool rt_arg_size(const char *opt, const char *v, uint32_t max, uint32_t *w, uint
 
 bool rt_arg_writable(const char *opt, const char *path, char *err, size_t errlen)
 {
-    struct stat st;
     if (!path || !*path) {
         snprintf(err, errlen, "%s wants a file name", opt);
         return false;
     }
-    if (stat(path, &st) == 0) {
-        if (S_ISDIR(st.st_mode) || access(path, W_OK) != 0) {
-            snprintf(err, errlen, "%s: %s %s", opt, path, S_ISDIR(st.st_mode) ? "is a directory" : "is not writable");
-            return false;
-        }
-        return true;
-    }
-    char dir[1024];
-    const char *slash = strrchr(path, '/');
-    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) + (slash == path) : 1, slash ? path : ".");
-    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode) || access(dir, W_OK | X_OK) != 0) {
-        snprintf(err, errlen, "%s: cannot create %s (directory '%s' %s)", opt, path, dir,
-                 stat(dir, &st) != 0 ? "does not exist" : "is not writable");
+    char msg[1200];
+    if (rt_check_output_path(path, msg, sizeof msg) != VFX_OK) {
+        snprintf(err, errlen, "%s: %s", opt, msg);
         return false;
     }
     return true;

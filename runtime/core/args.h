@@ -17,8 +17,10 @@ bool rt_arg_double(const char *opt, const char *v, double lo, double hi, double 
 /* "WxH", each in [1, max]; false with "OPT: ..." in err. */
 bool rt_arg_size(const char *opt, const char *v, uint32_t max, uint32_t *w, uint32_t *h, char *err,
                  size_t errlen);
-/* True when `path` can be written: an existing regular file we may write, or a new name in an
- * existing writable directory (checked before a long run, so it cannot fail at the end). */
+/* True when `path` can be written (rt_check_output_path: an existing regular file we may write
+ * or /dev/null, or a new name in an existing writable directory; never a FIFO, directory or
+ * other device), checked before a long run so it cannot fail or block at the end;
+ * "OPT: PATH ..." in err. */
 bool rt_arg_writable(const char *opt, const char *path, char *err, size_t errlen);
 
 #endif

@@ -34,6 +34,72 @@ vfx_result rt_check_regular_file(const char *path, char *err, size_t errlen)
     return VFX_OK;
 }
 
+/* /dev/null (by device number, so a link to it counts): the one device an output may be */
+static int is_dev_null(const struct stat *st)
+{
+    struct stat n;
+    return S_ISCHR(st->st_mode) && stat("/dev/null", &n) == 0 && S_ISCHR(n.st_mode) && n.st_rdev == st->st_rdev;
+}
+
+vfx_result rt_check_output_path(const char *path, char *err, size_t errlen)
+{
+    struct stat st;
+    if (!path || !*path) {
+        snprintf(err, errlen, "an empty output path");
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    if (stat(path, &st) == 0) {
+        if (!S_ISREG(st.st_mode) && !is_dev_null(&st)) {
+            snprintf(err, errlen, "%s %s; an output must be a regular file or /dev/null", path, kind_of(st.st_mode));
+            return VFX_ERR_IO;
+        }
+        if (access(path, W_OK) != 0) {
+            snprintf(err, errlen, "%s is not writable", path);
+            return VFX_ERR_IO;
+        }
+        return VFX_OK;
+    }
+    char dir[1024];
+    const char *slash = strrchr(path, '/');
+    snprintf(dir, sizeof dir, "%.*s", slash ? (int)(slash - path) + (slash == path) : 1, slash ? path : ".");
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode) || access(dir, W_OK | X_OK) != 0) {
+        snprintf(err, errlen, "cannot create %s (directory '%s' %s)", path, dir,
+                 stat(dir, &st) != 0 ? "does not exist" : !S_ISDIR(st.st_mode) ? "is not a directory" : "is not writable");
+        return VFX_ERR_IO;
+    }
+    return VFX_OK;
+}
+
+FILE *rt_open_output(const char *path, const char *mode, char *err, size_t errlen)
+{
+    /* O_NONBLOCK: a FIFO without a reader fails at once (ENXIO) instead of blocking the open
+     * forever; it is cleared again for the writes to a regular file */
+    int fd = path && *path ? open(path, O_WRONLY | O_CREAT | O_TRUNC | O_NONBLOCK | O_NOCTTY | O_CLOEXEC, 0666) : -1;
+    if (fd < 0) {
+        int e = path && *path ? errno : EINVAL;
+        struct stat st;
+        if (e == ENXIO && stat(path, &st) == 0 && S_ISFIFO(st.st_mode))
+            snprintf(err, errlen, "%s is a FIFO (named pipe) with no reader; an output must be a regular file or /dev/null",
+                     path ? path : "");
+        else
+            snprintf(err, errlen, "cannot write %s: %s", path ? path : "(null)", strerror(e));
+        return NULL;
+    }
+    struct stat st;
+    if (fstat(fd, &st) != 0 || (!S_ISREG(st.st_mode) && !is_dev_null(&st))) {
+        close(fd);
+        snprintf(err, errlen, "%s %s; an output must be a regular file or /dev/null", path, kind_of(st.st_mode));
+        return NULL;
+    }
+    int fl = fcntl(fd, F_GETFL);
+    FILE *f = fl < 0 || fcntl(fd, F_SETFL, fl & ~O_NONBLOCK) < 0 ? NULL : fdopen(fd, mode);
+    if (!f) {
+        snprintf(err, errlen, "cannot write %s: %s", path, strerror(errno));
+        close(fd);
+    }
+    return f;
+}
+
 static vfx_result over_cap(const char *path, unsigned long long n, int at_least, const char *cap_text,
                            char *err, size_t errlen)
 {

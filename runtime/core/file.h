@@ -3,6 +3,7 @@
 #define RT_FILE_H
 
 #include <stddef.h>
+#include <stdio.h>
 #include <volfx/volfx.h>
 
 /* Fails (VFX_ERR_IO) unless `path` names a regular file, without opening it: "PATH: is a
@@ -17,5 +18,15 @@ vfx_result rt_check_regular_file(const char *path, char *err, size_t errlen);
  * more than max_bytes + 1 are held. Other errors name the path: short read, out of memory. */
 vfx_result rt_read_file(const char *path, size_t max_bytes, const char *cap_text, char **out,
                          size_t *size, char *err, size_t errlen);
+
+/* Checks an output path before a run: an existing path must be a regular file we may write or
+ * /dev/null (a FIFO, directory, socket or other device is refused, naming what it is); a new
+ * name needs an existing writable directory. Messages start with the path. */
+vfx_result rt_check_output_path(const char *path, char *err, size_t errlen);
+
+/* Opens an output for writing (`mode` "w" or "wb", truncating) without ever blocking: a FIFO
+ * with no reader, or anything but a regular file or /dev/null, gives NULL and a message naming
+ * the path, as does any open error. */
+FILE *rt_open_output(const char *path, const char *mode, char *err, size_t errlen);
 
 #endif

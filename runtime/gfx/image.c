@@ -1,5 +1,6 @@
 /* image.c — PNG via zlib's compress2 and crc32; PFM by hand. */
 #include "gfx/image.h"
+#include "core/file.h"
 
 #include <stdbool.h>
 #include <stdio.h>
@@ -54,10 +55,11 @@ vfx_result rt_write_png(const char *path, uint32_t w, uint32_t h, const uint8_t 
         snprintf(err, errlen, "png: zlib error %d", zr);
         return VFX_ERR_IO;
     }
-    FILE *f = fopen(path, "wb");
+    char why[1200];
+    FILE *f = rt_open_output(path, "wb", why, sizeof why);
     if (!f) {
         free(z);
-        snprintf(err, errlen, "png: cannot write '%s'", path);
+        snprintf(err, errlen, "png: %s", why);
         return VFX_ERR_IO;
     }
     static const uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
@@ -83,9 +85,10 @@ vfx_result rt_write_pfm(const char *path, uint32_t w, uint32_t h, const float *d
         snprintf(err, errlen, "pfm: bad arguments");
         return VFX_ERR_INVALID_ARGUMENT;
     }
-    FILE *f = fopen(path, "wb");
+    char why[1200];
+    FILE *f = rt_open_output(path, "wb", why, sizeof why);
     if (!f) {
-        snprintf(err, errlen, "pfm: cannot write '%s'", path);
+        snprintf(err, errlen, "pfm: %s", why);
         return VFX_ERR_IO;
     }
     bool ok = fprintf(f, "Pf\n%u %u\n-1.0\n", w, h) > 0;

@@ -1,20 +1,33 @@
 /* mesh_import.c — Assimp scene flattening; node transforms applied on the CPU so one draw
- * per file is enough. */
+ * per file is enough. Assimp never sees a file the checks of mesh_check.c have not passed, and
+ * every file it opens goes through import_io below, so an .mtl or .bin it follows is held to
+ * the same rules (regular file, size cap) as the mesh. */
+#define _POSIX_C_SOURCE 200809L
 #include "gfx/mesh_import.h"
 #include "core/file.h"
+#include "gfx/mesh_check.h"
 
+#include <assimp/cfileio.h>
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <epoxy/gl.h>
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
-#define IMPORT_FLAGS (aiProcess_Triangulate | aiProcess_GenSmoothNormals | aiProcess_JoinIdenticalVertices \
-                      | aiProcess_SortByPType | aiProcess_FindInvalidData)
-#define MAX_VERTICES (64u * 1024u * 1024u)
+/* ValidateDataStructure first: Assimp's later steps index vertices with the file's face
+ * indices unchecked (a truncated binary PLY crashed in JoinIdenticalVertices). */
+#define IMPORT_FLAGS (aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_GenSmoothNormals \
+                      | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType | aiProcess_FindInvalidData)
+/* flattened output (a mesh instanced by many nodes is copied per node): 4 M vertices hold
+ * 96 MB of positions and normals */
+#define MAX_VERTICES (4u * RT_MESH_MAX_IMPORT_VERTICES)
+#define MAX_NODE_DEPTH 64
+#define MAX_EXTERNAL 8
 
 void rt_mesh_data_free(rt_mesh_data *m)
 {
@@ -26,8 +39,153 @@ void rt_mesh_data_free(rt_mesh_data *m)
     memset(m, 0, sizeof *m);
 }
 
-static void count_node(const struct aiScene *s, const struct aiNode *n, uint64_t *v, uint64_t *i)
+/* ---- the files Assimp may open --------------------------------------------------------------- */
+
+typedef struct import_io {
+    struct aiFileIO io;
+    const char *main_name; /* served from `main`, read and checked before Assimp started */
+    const unsigned char *main;
+    size_t main_size;
+    int allow_external; /* file imports: files beside it (an .mtl, a .bin); memory imports: none */
+    char *ext_name[MAX_EXTERNAL];
+    char *ext_data[MAX_EXTERNAL];
+    size_t ext_size[MAX_EXTERNAL];
+    unsigned ext_count;
+    size_t total; /* bytes of every file this import holds */
+    vfx_result refused;
+    char refusal[512];
+} import_io;
+
+typedef struct open_file {
+    struct aiFile f;
+    const unsigned char *data;
+    size_t size, pos;
+} open_file;
+
+static size_t of_read(struct aiFile *f, char *buf, size_t size, size_t count)
 {
+    open_file *o = (open_file *)f->UserData;
+    if (size == 0 || count == 0)
+        return 0;
+    size_t items = (o->size - o->pos) / size;
+    if (items > count)
+        items = count;
+    memcpy(buf, o->data + o->pos, items * size);
+    o->pos += items * size;
+    return items;
+}
+
+static size_t of_write(struct aiFile *f, const char *buf, size_t size, size_t count)
+{
+    (void)f, (void)buf, (void)size, (void)count;
+    return 0; /* importing writes nothing */
+}
+
+static size_t of_tell(struct aiFile *f) { return ((open_file *)f->UserData)->pos; }
+static size_t of_size(struct aiFile *f) { return ((open_file *)f->UserData)->size; }
+static void of_flush(struct aiFile *f) { (void)f; }
+
+static enum aiReturn of_seek(struct aiFile *f, size_t off, enum aiOrigin origin)
+{
+    open_file *o = (open_file *)f->UserData;
+    /* Assimp passes a negative offset as its size_t: the unsigned sum wraps to the target */
+    size_t to = origin == aiOrigin_SET ? off : origin == aiOrigin_CUR ? o->pos + off : o->size + off;
+    if (to > o->size)
+        return aiReturn_FAILURE;
+    o->pos = to;
+    return aiReturn_SUCCESS;
+}
+
+static void io_refuse(import_io *x, vfx_result r, const char *name, const char *why)
+{
+    if (x->refused)
+        return;
+    x->refused = r;
+    snprintf(x->refusal, sizeof x->refusal, "%s: references %s, refused: %s", x->main_name, name, why);
+}
+
+/* An external file: read whole through rt_read_file (regular files only, within what is left
+ * of the import's byte cap), kept until the import ends. A missing file is NULL as Assimp
+ * expects (an OBJ without its .mtl still imports); one refused fails the import. */
+static int io_external(import_io *x, const char *name, const unsigned char **data, size_t *size)
+{
+    for (unsigned i = 0; i < x->ext_count; ++i)
+        if (strcmp(x->ext_name[i], name) == 0) {
+            *data = (const unsigned char *)x->ext_data[i], *size = x->ext_size[i];
+            return 1;
+        }
+    if (!x->allow_external)
+        return 0;
+    struct stat st;
+    if (stat(name, &st) != 0 && errno == ENOENT)
+        return 0;
+    if (x->ext_count == MAX_EXTERNAL) {
+        io_refuse(x, VFX_ERR_FORMAT, name, "more than 8 other files for one mesh");
+        return 0;
+    }
+    char msg[400], cap[64], *buf = NULL;
+    size_t n = 0, left = RT_MESH_MAX_BYTES - x->total;
+    snprintf(cap, sizeof cap, "%zu bytes (what is left of %s for the mesh and its files)", left,
+             RT_MESH_MAX_BYTES_TEXT);
+    vfx_result r = rt_read_file(name, left, cap, &buf, &n, msg, sizeof msg);
+    if (r) {
+        io_refuse(x, r, name, msg);
+        return 0;
+    }
+    x->ext_name[x->ext_count] = strdup(name);
+    if (!x->ext_name[x->ext_count]) {
+        free(buf);
+        io_refuse(x, VFX_ERR_OUT_OF_MEMORY, name, "out of memory");
+        return 0;
+    }
+    x->ext_data[x->ext_count] = buf;
+    x->ext_size[x->ext_count++] = n;
+    x->total += n;
+    *data = (const unsigned char *)buf, *size = n;
+    return 1;
+}
+
+static struct aiFile *io_open(struct aiFileIO *io, const char *name, const char *mode)
+{
+    import_io *x = (import_io *)io->UserData;
+    if (!name || strpbrk(mode ? mode : "", "wa+"))
+        return NULL;
+    const unsigned char *data;
+    size_t size;
+    if (strcmp(name, x->main_name) == 0)
+        data = x->main, size = x->main_size;
+    else if (!io_external(x, name, &data, &size))
+        return NULL;
+    open_file *o = calloc(1, sizeof *o);
+    if (!o)
+        return NULL;
+    o->f = (struct aiFile){.ReadProc = of_read, .WriteProc = of_write, .TellProc = of_tell,
+                           .FileSizeProc = of_size, .SeekProc = of_seek, .FlushProc = of_flush,
+                           .UserData = (aiUserData)o};
+    o->data = data, o->size = size;
+    return &o->f;
+}
+
+static void io_close(struct aiFileIO *io, struct aiFile *f)
+{
+    (void)io;
+    free(f ? f->UserData : NULL);
+}
+
+static void io_release(import_io *x)
+{
+    for (unsigned i = 0; i < x->ext_count; ++i)
+        free(x->ext_name[i]), free(x->ext_data[i]);
+    x->ext_count = 0;
+}
+
+/* ---- flattening ------------------------------------------------------------------------------ */
+
+static int count_node(const struct aiScene *s, const struct aiNode *n, unsigned depth, uint64_t *v,
+                      uint64_t *i)
+{
+    if (depth > MAX_NODE_DEPTH)
+        return 0;
     for (unsigned k = 0; k < n->mNumMeshes; ++k) {
         const struct aiMesh *m = s->mMeshes[n->mMeshes[k]];
         if (!(m->mPrimitiveTypes & aiPrimitiveType_TRIANGLE))
@@ -38,7 +196,9 @@ static void count_node(const struct aiScene *s, const struct aiNode *n, uint64_t
                 *i += 3;
     }
     for (unsigned c = 0; c < n->mNumChildren; ++c)
-        count_node(s, n->mChildren[c], v, i);
+        if (!count_node(s, n->mChildren[c], depth + 1, v, i))
+            return 0;
+    return 1;
 }
 
 static void add_node(const struct aiScene *s, const struct aiNode *n, struct aiMatrix4x4 parent,
@@ -77,7 +237,7 @@ static void add_node(const struct aiScene *s, const struct aiNode *n, struct aiM
             const struct aiFace *face = &m->mFaces[f];
             if (face->mNumIndices != 3)
                 continue;
-            for (int a = 0; a < 3; ++a)
+            for (int a = 0; a < 3; ++a) /* ValidateDataStructure proved each < mNumVertices */
                 out->indices[out->index_count++] = base + face->mIndices[a];
         }
     }
@@ -88,27 +248,22 @@ static void add_node(const struct aiScene *s, const struct aiNode *n, struct aiM
 static vfx_result from_scene(const struct aiScene *s, const char *what, rt_mesh_data *out,
                              char *err, size_t errlen)
 {
-    memset(out, 0, sizeof *out);
-    if (!s) {
-        snprintf(err, errlen, "%s: assimp: %s", what, aiGetErrorString());
-        return VFX_ERR_FORMAT;
-    }
     if (!s->mRootNode || (s->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
         snprintf(err, errlen, "%s: assimp: incomplete scene", what);
-        aiReleaseImport(s);
         return VFX_ERR_FORMAT;
     }
     uint64_t nv = 0, ni = 0;
-    count_node(s, s->mRootNode, &nv, &ni);
+    if (!count_node(s, s->mRootNode, 0, &nv, &ni)) {
+        snprintf(err, errlen, "%s: node hierarchy deeper than %u", what, MAX_NODE_DEPTH);
+        return VFX_ERR_FORMAT;
+    }
     if (nv == 0 || ni == 0) {
         snprintf(err, errlen, "%s: no triangles in the file", what);
-        aiReleaseImport(s);
         return VFX_ERR_FORMAT;
     }
     if (nv > MAX_VERTICES || ni > 3ull * MAX_VERTICES) {
-        snprintf(err, errlen, "%s: %llu vertices exceed the limit of %u", what,
-                 (unsigned long long)nv, MAX_VERTICES);
-        aiReleaseImport(s);
+        snprintf(err, errlen, "%s: %llu vertices once every node's meshes are placed, above the cap of %u",
+                 what, (unsigned long long)nv, MAX_VERTICES);
         return VFX_ERR_FORMAT;
     }
     out->positions = malloc(nv * 3 * sizeof(float));
@@ -116,7 +271,6 @@ static vfx_result from_scene(const struct aiScene *s, const char *what, rt_mesh_
     out->indices = malloc(ni * sizeof(uint32_t));
     if (!out->positions || !out->normals || !out->indices) {
         rt_mesh_data_free(out);
-        aiReleaseImport(s);
         snprintf(err, errlen, "%s: out of memory", what);
         return VFX_ERR_OUT_OF_MEMORY;
     }
@@ -125,7 +279,6 @@ static vfx_result from_scene(const struct aiScene *s, const char *what, rt_mesh_
     struct aiMatrix4x4 id;
     aiIdentityMatrix4(&id);
     add_node(s, s->mRootNode, id, out);
-    aiReleaseImport(s);
     for (uint32_t i = 0; i < out->vertex_count * 3; ++i)
         if (!isfinite(out->positions[i])) {
             snprintf(err, errlen, "%s: vertex %u has a non-finite coordinate", what, i / 3);
@@ -135,26 +288,114 @@ static vfx_result from_scene(const struct aiScene *s, const char *what, rt_mesh_
     return VFX_OK;
 }
 
+/* 1 + the first mesh whose primitive-type flags are not exactly the kinds of its faces, or 0.
+ * Assimp 5.2's Triangulate step asserts (abort(), asserts are on in Debian's build) when a
+ * mesh says POLYGON but holds none; ValidateDataStructure checks only that no kind is missing,
+ * and lets a face of no index through. A fuzzed PLY (a face list of count 0) reached it. */
+static unsigned primitive_types_disagree(const struct aiScene *s)
+{
+    for (unsigned m = 0; m < s->mNumMeshes; ++m) {
+        const struct aiMesh *mesh = s->mMeshes[m];
+        unsigned kinds = 0;
+        for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+            unsigned n = mesh->mFaces[f].mNumIndices;
+            if (n == 0) /* counted as a polygon by Triangulate, so it asserts too */
+                return m + 1;
+            kinds |= n == 1 ? aiPrimitiveType_POINT : n == 2 ? aiPrimitiveType_LINE
+                     : n == 3 ? aiPrimitiveType_TRIANGLE : aiPrimitiveType_POLYGON;
+        }
+        if ((mesh->mPrimitiveTypes & (aiPrimitiveType_POINT | aiPrimitiveType_LINE | aiPrimitiveType_TRIANGLE
+                                      | aiPrimitiveType_POLYGON)) != kinds)
+            return m + 1;
+    }
+    return 0;
+}
+
+/* Checks the bytes, has Assimp read them (validated, nothing else) and counts the vertices;
+ * only a scene under the cap is read again with the post-processing, the costly part (~700
+ * bytes a vertex). Two reads, because Assimp 5.2's aiApplyPostProcessing frees the scene when
+ * a step fails and then releases it again (SIGSEGV on BoxWithInfinites.glb): the one-call
+ * import handles that failure correctly. The raw read costs about a sixth of the full one. */
+static vfx_result import_checked(import_io *x, rt_mesh_format fmt, rt_mesh_data *out, char *err,
+                                 size_t errlen)
+{
+    const char *name = x->main_name;
+    vfx_result r = rt_mesh_check_bytes(fmt, x->main, x->main_size, name, err, errlen);
+    if (r)
+        return r;
+    x->io = (struct aiFileIO){.OpenProc = io_open, .CloseProc = io_close, .UserData = (aiUserData)x};
+    const struct aiScene *s = NULL;
+    for (int pass = 0; pass < 2 && !r; ++pass) {
+        s = aiImportFileEx(name, pass ? IMPORT_FLAGS : aiProcess_ValidateDataStructure, &x->io);
+        if (x->refused) {
+            snprintf(err, errlen, "%s", x->refusal);
+            r = x->refused;
+        } else if (!s) {
+            snprintf(err, errlen, "%s: assimp: %s", name, aiGetErrorString());
+            r = VFX_ERR_FORMAT;
+        } else if (pass == 0) {
+            uint64_t nv = 0;
+            for (unsigned m = 0; m < s->mNumMeshes; ++m)
+                nv += s->mMeshes[m]->mNumVertices;
+            unsigned bad = primitive_types_disagree(s);
+            if (bad) {
+                snprintf(err, errlen, "%s: mesh %u: a face of no index, or faces that disagree with the "
+                         "primitive types the reader gave them (Assimp's triangulation would abort)", name, bad - 1);
+                r = VFX_ERR_FORMAT;
+            } else if (nv > RT_MESH_MAX_IMPORT_VERTICES) {
+                snprintf(err, errlen, "%s: %llu vertices, above the cap of %u", name, (unsigned long long)nv,
+                         RT_MESH_MAX_IMPORT_VERTICES);
+                r = VFX_ERR_FORMAT;
+            }
+            aiReleaseImport(s);
+            s = NULL;
+        }
+    }
+    if (!r)
+        r = from_scene(s, name, out, err, errlen);
+    if (s)
+        aiReleaseImport(s);
+    io_release(x);
+    return r;
+}
+
 vfx_result rt_mesh_import(const char *path, rt_mesh_data *out, char *err, size_t errlen)
 {
     if (!path || !out)
         return VFX_ERR_INVALID_ARGUMENT;
-    /* checked before Assimp opens it: a FIFO would block, a directory or device is no mesh */
-    vfx_result r = rt_check_regular_file(path, err, errlen);
-    if (r) {
-        memset(out, 0, sizeof *out);
+    memset(out, 0, sizeof *out);
+    rt_mesh_format fmt = rt_mesh_format_of_name(path);
+    char *buf = NULL;
+    size_t size = 0;
+    /* read here, not by Assimp: a FIFO would block it, a directory or device is no mesh, and
+     * the bytes checked are the bytes it parses */
+    vfx_result r = rt_read_file(path, RT_MESH_MAX_BYTES, RT_MESH_MAX_BYTES_TEXT, &buf, &size, err, errlen);
+    if (r)
         return r;
+    if (!fmt) {
+        free(buf);
+        return rt_mesh_check_bytes(fmt, NULL, 0, path, err, errlen);
     }
-    return from_scene(aiImportFile(path, IMPORT_FLAGS), path, out, err, errlen);
+    import_io x = {.main_name = path, .main = (const unsigned char *)buf, .main_size = size,
+                   .allow_external = 1, .total = size};
+    r = import_checked(&x, fmt, out, err, errlen);
+    free(buf);
+    return r;
 }
 
 vfx_result rt_mesh_import_memory(const void *data, size_t size, const char *hint,
                                   rt_mesh_data *out, char *err, size_t errlen)
 {
-    if (!data || !out || size == 0 || size > UINT32_MAX)
+    if (!data || !out || !hint || size == 0 || size > RT_MESH_MAX_BYTES)
         return VFX_ERR_INVALID_ARGUMENT;
-    return from_scene(aiImportFileFromMemory(data, (unsigned)size, IMPORT_FLAGS, hint), "(memory)",
-                      out, err, errlen);
+    memset(out, 0, sizeof *out);
+    char name[48];
+    snprintf(name, sizeof name, "(memory).%.16s", hint);
+    rt_mesh_format fmt = rt_mesh_format_of_name(name);
+    if (!fmt)
+        return rt_mesh_check_bytes(fmt, data, size, name, err, errlen);
+    import_io x = {.main_name = name, .main = data, .main_size = size, .total = size};
+    return import_checked(&x, fmt, out, err, errlen);
 }
 
 vfx_result rt_mesh_make_box(const float mn[3], const float mx[3], rt_mesh_data *out)

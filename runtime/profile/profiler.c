@@ -1,6 +1,7 @@
 /* profiler.c — fixed table of named series x frames; no allocation per frame. */
 #define _GNU_SOURCE /* program_invocation_short_name: the trace's process name */
 #include "profile/profiler.h"
+#include "core/file.h"
 
 #include <errno.h>
 #include <math.h>
@@ -391,9 +392,9 @@ rt_frame_pcts rt_frame_percentiles(double *v, uint32_t n)
     return r;
 }
 
-vfx_result rt_profiler_write_csv(const rt_profiler *p, const char *path)
+vfx_result rt_profiler_write_csv(const rt_profiler *p, const char *path, char *err, size_t errlen)
 {
-    FILE *f = fopen(path, "w");
+    FILE *f = rt_open_output(path, "w", err, errlen);
     if (!f)
         return VFX_ERR_IO;
     fprintf(f, "frame,frame_ms");
@@ -414,7 +415,11 @@ vfx_result rt_profiler_write_csv(const rt_profiler *p, const char *path)
         }
         fprintf(f, "\n");
     }
-    return fclose(f) == 0 ? VFX_OK : VFX_ERR_IO;
+    if (fclose(f) != 0) {
+        snprintf(err, errlen, "write to %s failed", path);
+        return VFX_ERR_IO;
+    }
+    return VFX_OK;
 }
 
 /* One slice of a track as the trace will show it. */
@@ -488,9 +493,9 @@ static int trace_name_len(const series *s)
     return (int)(s->kind == SERIES_GPU && len > 7 ? len - 7 : len);
 }
 
-vfx_result rt_profiler_write_trace(const rt_profiler *p, const char *path)
+vfx_result rt_profiler_write_trace(const rt_profiler *p, const char *path, char *err, size_t errlen)
 {
-    FILE *f = fopen(path, "w");
+    FILE *f = rt_open_output(path, "w", err, errlen);
     if (!f)
         return VFX_ERR_IO;
     fprintf(f, "{\"displayTimeUnit\":\"ms\",\"traceEvents\":[\n");
@@ -564,5 +569,9 @@ vfx_result rt_profiler_write_trace(const rt_profiler *p, const char *path)
         }
     }
     fprintf(f, "\n]}\n");
-    return fclose(f) == 0 ? VFX_OK : VFX_ERR_IO;
+    if (fclose(f) != 0) {
+        snprintf(err, errlen, "write to %s failed", path);
+        return VFX_ERR_IO;
+    }
+    return VFX_OK;
 }

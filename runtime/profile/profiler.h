@@ -49,15 +49,16 @@ double rt_profiler_series_median(const rt_profiler *p, const char *name);
 /* Writes frame,frame_ms,<series...> one row per kept frame (CPU and GPU series in ms, the
  * counter series as counts). Each row holds its own frame's GPU times (recorded
  * gpu.timer_lag_frames frames later); the last lag rows' GPU cells are empty. */
-vfx_result rt_profiler_write_csv(const rt_profiler *p, const char *path);
+vfx_result rt_profiler_write_csv(const rt_profiler *p, const char *path, char *err, size_t errlen);
 /* Writes Chrome trace-event JSON for Perfetto/chrome://tracing: process and thread names, a
  * "frame N" slice per frame on the CPU thread (tid 1) with the CPU spans nested inside it at
  * their measured starts, a "gpu frame N" slice per frame on the GPU thread (tid 2) starting when
  * that frame's plugin.render issued it (or when the GPU finished the frame before) with the
  * passes laid end to end inside their parent by the plugin's order and depth (names without
  * ".gpu_ms"; a repeated pass as one slice of its total), categories frame/cpu/gpu/counter, and
- * counter tracks fps, particles, water holes, volume cells skipped. */
-vfx_result rt_profiler_write_trace(const rt_profiler *p, const char *path);
+ * counter tracks fps, particles, water holes, volume cells skipped. Both writers open the path
+ * with rt_open_output (never blocking on a FIFO) and name it in err on failure. */
+vfx_result rt_profiler_write_trace(const rt_profiler *p, const char *path, char *err, size_t errlen);
 /* Median of v[0..n) (sorts v in place); NAN when n is 0. */
 double rt_median(double *v, uint32_t n);
 /* Frame-time percentiles for benchmark JSON ("frame_ms":{"p50","p95","p99"}). */

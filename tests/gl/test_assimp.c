@@ -36,8 +36,11 @@ static void test_box_obj(void **state)
 static void test_other_formats(void **state)
 {
     (void)state;
-    static const char *files[] = {MODELS "/PLY/cube.ply", MODELS "/STL/Spider_ascii.stl",
-                                  MODELS "/OBJ/spider.obj", MODELS "/3DS/fels.3ds"};
+    static const char *files[] = {MODELS "/PLY/cube.ply", MODELS "/PLY/cube_binary.ply", MODELS "/PLY/Wuson.ply",
+                                  MODELS "/STL/Spider_ascii.stl", MODELS "/OBJ/spider.obj",
+                                  MODELS "/glTF2/BoxTextured-glTF/BoxTextured.gltf",
+                                  MODELS "/glTF2/BoxTextured-glTF-Binary/BoxTextured.glb",
+                                  MODELS "/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb"};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; ++i) {
         FILE *f = fopen(files[i], "rb");
         if (!f)
@@ -52,6 +55,15 @@ static void test_other_formats(void **state)
         for (uint32_t k = 0; k < m.index_count; ++k)
             assert_true(m.indices[k] < m.vertex_count);
         rt_mesh_data_free(&m);
+    }
+    /* issue 28: the formats the game does not use are refused before Assimp reads them */
+    rt_mesh_data m;
+    char err[512];
+    FILE *f3 = fopen(MODELS "/3DS/fels.3ds", "rb");
+    if (f3) {
+        fclose(f3);
+        assert_int_equal(rt_mesh_import(MODELS "/3DS/fels.3ds", &m, err, sizeof err), VFX_ERR_FORMAT);
+        assert_non_null(strstr(err, ".3ds is not a mesh format the game imports"));
     }
 }
 

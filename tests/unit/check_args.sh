@@ -33,6 +33,15 @@ expect 2 "cannot create /nonexistent-dir/x.pfm" "$bench" frame --dump-raw beams 
 expect 2 "--grid wants a whole number in 1..200, got '-3'" "$bench" tetvol --grid -3
 expect 2 "--tau wants a number" "$bench" tetvol --tau inf
 dir=$(mktemp -d)
+# issue 28: an output naming a FIFO with no reader blocked forever at start, saying nothing
+mkfifo "$dir/out.fifo"
+for opt in --csv --trace --png; do
+  expect 2 "$opt: $dir/out.fifo is a FIFO (named pipe); an output must be a regular file or /dev/null" \
+    "$game" --headless --frames 1 --size 16x16 $opt "$dir/out.fifo"
+done
+expect 2 "--dump-raw: $dir/out.fifo is a FIFO" "$game" --headless --frames 1 --dump-raw beams "$dir/out.fifo"
+expect 2 "--dump-raw: $dir/out.fifo is a FIFO" "$bench" frame --frames 1 --dump-raw beams "$dir/out.fifo"
+expect 2 "--png: /dev/zero is a character device" "$game" --headless --frames 1 --png /dev/zero
 printf '4 3 1 0\n0 0 0 0 1\n1 1 0 0 2\n2 0 1 0 3\n3 1 1 0 4\n' > "$dir/flat.node"
 printf '1 4 0\n0 0 1 2 3\n' > "$dir/flat.ele"
 expect 1 "is flat (extent 0 along z)" "$bench" tetvol --mesh "$dir/flat.node" --size 8 --reps 1

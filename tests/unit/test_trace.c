@@ -101,7 +101,7 @@ static void test_trace_nested(void **state)
     }
     char path[64];
     snprintf(path, sizeof path, "/tmp/volfx-trace-%d.json", (int)getpid());
-    assert_int_equal(rt_profiler_write_trace(p, path), VFX_OK);
+    assert_int_equal(rt_profiler_write_trace(p, path, NULL, 0), VFX_OK);
     rt_profiler_destroy(p);
     size_t len;
     char *text = NULL, err[256];

@@ -1,0 +1,274 @@
+/* Mesh import bounded before Assimp reads a byte (issue 28): truncated and lying files of every
+ * enabled format, generated here, are refused with an error naming the file, fast and in
+ * bounded memory; files beside a mesh (an .mtl, a glTF buffer) cannot be FIFOs or devices; the
+ * formats the game does not use are refused by name; small valid files of each format import.
+ * Before the fix the 189-byte PLY was SIGSEGV, the 22-byte .glb took 4.2 GB and 27 s, the PLY
+ * claiming 2e9 vertices all the machine's memory, an .mtl FIFO hung the import. */
+#define _POSIX_C_SOURCE 200809L
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "gfx/mesh_check.h"
+#include "gfx/mesh_import.h"
+
+static void write_file(const char *path, const void *data, size_t n)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(data, 1, n, f), n);
+    fclose(f);
+}
+
+static double cpu_s(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return ru.ru_utime.tv_sec + ru.ru_stime.tv_sec + 1e-6 * (ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
+/* Imports `path`, expects `want` with an error naming the file and holding `needle`, in under
+ * half a second of CPU (each case below takes a few ms; the failures took 27 s to minutes). */
+static void expect_refused(const char *path, vfx_result want, const char *needle)
+{
+    rt_mesh_data m;
+    char err[600] = "";
+    double t0 = cpu_s();
+    vfx_result r = rt_mesh_import(path, &m, err, sizeof err);
+    double dt = cpu_s() - t0;
+    if (r != want || !strstr(err, path) || !strstr(err, needle))
+        fail_msg("%s: result %d (want %d), \"%s\" (want \"%s\")", path, r, want, err, needle);
+    assert_null(m.positions);
+    assert_true(dt < 0.5);
+}
+
+static const char ply_head[] = "ply\nformat binary_little_endian 1.0\nelement vertex %s\n"
+                               "property float x\nproperty float y\nproperty float z\nelement face %s\n"
+                               "property list uchar int vertex_indices\nend_header\n";
+
+static void test_truncated_binary_ply(void **state)
+{
+    (void)state;
+    /* 8 vertices and 12 faces claimed, cut at 189 bytes: Assimp's post-processing indexed
+     * vertices that were never read (SIGSEGV in volfx-game) */
+    unsigned char buf[512] = {0};
+    int n = snprintf((char *)buf, sizeof buf, ply_head, "8", "12");
+    assert_true(n > 0 && n < 189);
+    write_file("trunc189.ply", buf, 189);
+    expect_refused("trunc189.ply", VFX_ERR_FORMAT, "element vertex claims 8");
+}
+
+static void test_ply_claiming_2e9_vertices(void **state)
+{
+    (void)state;
+    unsigned char buf[227] = {0};
+    int n = snprintf((char *)buf, sizeof buf, ply_head, "2000000000", "1");
+    assert_true(n > 0 && n < 227);
+    write_file("huge_count.ply", buf, sizeof buf);
+    expect_refused("huge_count.ply", VFX_ERR_FORMAT, "claims 2000000000");
+    /* under the cap but more than the body holds, binary and ASCII */
+    n = snprintf((char *)buf, sizeof buf, ply_head, "1000", "0");
+    write_file("short.ply", buf, sizeof buf);
+    expect_refused("short.ply", VFX_ERR_FORMAT, "needs at least 12000 bytes");
+    static const char ascii[] = "ply\nformat ascii 1.0\nelement vertex 100\nproperty float x\n"
+                                "property float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n";
+    write_file("short_ascii.ply", ascii, sizeof ascii - 1);
+    expect_refused("short_ascii.ply", VFX_ERR_FORMAT, "of ASCII data");
+    /* an element with no property takes no byte: its count alone is capped */
+    static const char empty_el[] = "ply\nformat ascii 1.0\nelement junk 4000000\nend_header\n";
+    write_file("noprop.ply", empty_el, sizeof empty_el - 1);
+    expect_refused("noprop.ply", VFX_ERR_FORMAT, "has no property");
+}
+
+static void le32(unsigned char *p, uint32_t v)
+{
+    for (int i = 0; i < 4; ++i)
+        p[i] = (unsigned char)(v >> (8 * i));
+}
+
+static void test_glb_claiming_4gb(void **state)
+{
+    (void)state;
+    /* 22 bytes: header and JSON chunk both claim ~4 GB (Assimp: 4.2 GB peak, 27 s) */
+    unsigned char g[22] = {'g', 'l', 'T', 'F'};
+    le32(g + 4, 2), le32(g + 8, 0xFFFFFFF0u), le32(g + 12, 0xFFFFFFF0u);
+    memcpy(g + 16, "JSON{}", 6);
+    write_file("huge.glb", g, sizeof g);
+    expect_refused("huge.glb", VFX_ERR_FORMAT, "claims 4294967280 bytes");
+    le32(g + 8, sizeof g); /* an honest total, the chunk still lying */
+    write_file("huge_chunk.glb", g, sizeof g);
+    expect_refused("huge_chunk.glb", VFX_ERR_FORMAT, "chunk 0 at byte 12 claims 4294967280 bytes");
+    le32(g + 4, 1);
+    write_file("v1.glb", g, sizeof g);
+    expect_refused("v1.glb", VFX_ERR_FORMAT, "only glTF 2.0");
+}
+
+static void test_stl_counts(void **state)
+{
+    (void)state;
+    /* 2^31 + 1 triangles: 84 + 50 N wraps in 32 bits to the 134 bytes the file has */
+    unsigned char s[134] = {0};
+    le32(s + 80, 0x80000001u);
+    write_file("wrap.stl", s, sizeof s);
+    expect_refused("wrap.stl", VFX_ERR_FORMAT, "claims 2147483649 triangles");
+    le32(s + 80, 1000);
+    write_file("short.stl", s, 84);
+    expect_refused("short.stl", VFX_ERR_FORMAT, "not an STL file");
+}
+
+static void test_obj_corner_cap(void **state)
+{
+    (void)state;
+    /* "f 1 1 1" is 8 bytes and 3 Assimp vertices: 400,000 lines are 1.2 M, over the cap */
+    size_t lines = 400000, n = 8 + 8 * lines;
+    char *buf = malloc(n);
+    assert_non_null(buf);
+    memcpy(buf, "v 0 0 0\n", 8);
+    for (size_t i = 0; i < lines; ++i)
+        memcpy(buf + 8 + 8 * i, "f 1 1 1\n", 8);
+    write_file("corners.obj", buf, n);
+    free(buf);
+    expect_refused("corners.obj", VFX_ERR_FORMAT, "1200000 face corners");
+}
+
+static void test_files_beside_the_mesh(void **state)
+{
+    (void)state;
+    unlink("pipe.mtl");
+    assert_int_equal(mkfifo("pipe.mtl", 0600), 0);
+    static const char obj[] = "mtllib pipe.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    write_file("with_fifo_mtl.obj", obj, sizeof obj - 1);
+    expect_refused("with_fifo_mtl.obj", VFX_ERR_IO, "pipe.mtl: is a FIFO");
+    static const char gltf[] =
+        "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+        "\"buffers\":[{\"byteLength\":36,\"uri\":\"/dev/zero\"}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}]}";
+    write_file("devzero.gltf", gltf, sizeof gltf - 1);
+    expect_refused("devzero.gltf", VFX_ERR_IO, "/dev/zero: is a character device");
+    /* a missing .mtl stays what it was: the mesh imports without it */
+    static const char obj2[] = "mtllib not_there.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    write_file("missing_mtl.obj", obj2, sizeof obj2 - 1);
+    rt_mesh_data m;
+    char err[600];
+    assert_int_equal(rt_mesh_import("missing_mtl.obj", &m, err, sizeof err), VFX_OK);
+    assert_int_equal(m.index_count, 3);
+    rt_mesh_data_free(&m);
+    unlink("pipe.mtl");
+}
+
+static void test_disabled_formats(void **state)
+{
+    (void)state;
+    static const char off[] = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    write_file("tri.off", off, sizeof off - 1);
+    expect_refused("tri.off", VFX_ERR_FORMAT, ".off is not a mesh format the game imports");
+    write_file("noext", off, sizeof off - 1);
+    expect_refused("noext", VFX_ERR_FORMAT, "no file extension");
+    static const char gltf1[] = "{\"asset\":{\"version\":\"1.0\"},\"scene\":\"s\",\"scenes\":{\"s\":{\"nodes\":[]}}}";
+    write_file("v1.gltf", gltf1, sizeof gltf1 - 1);
+    expect_refused("v1.gltf", VFX_ERR_FORMAT, "only glTF 2.0");
+    /* a PLY named .obj is parsed as OBJ, never handed to another importer: no triangle */
+    unsigned char buf[512] = {0};
+    int n = snprintf((char *)buf, sizeof buf, ply_head, "3", "1");
+    write_file("ply_named.obj", buf, (size_t)n);
+    expect_refused("ply_named.obj", VFX_ERR_FORMAT, "ply_named.obj");
+}
+
+/* One triangle (0,0,0) (1,0,0) (0,1,0) in each enabled format. */
+static void expect_triangle(const char *path)
+{
+    rt_mesh_data m;
+    char err[600] = "";
+    if (rt_mesh_import(path, &m, err, sizeof err) != VFX_OK)
+        fail_msg("%s: %s", path, err);
+    assert_int_equal(m.index_count, 3);
+    assert_true(m.bounds_max[0] == 1.f && m.bounds_max[1] == 1.f && m.bounds_min[0] == 0.f);
+    rt_mesh_data_free(&m);
+}
+
+static void test_valid_files_of_each_format(void **state)
+{
+    (void)state;
+    static const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    unsigned char buf[1024] = {0};
+    /* binary PLY */
+    int n = snprintf((char *)buf, sizeof buf, ply_head, "3", "1");
+    memcpy(buf + n, tri, sizeof tri);
+    n += (int)sizeof tri;
+    buf[n++] = 3;
+    for (int32_t i = 0; i < 3; ++i, n += 4)
+        memcpy(buf + n, &i, 4);
+    write_file("tri_bin.ply", buf, (size_t)n);
+    expect_triangle("tri_bin.ply");
+    static const char ascii[] = "ply\r\nformat ascii 1.0\r\ncomment made by a test\r\nelement vertex 3\r\n"
+                                "property float x\r\nproperty float y\r\nproperty float z\r\nelement face 1\r\n"
+                                "property list uchar int vertex_indices\r\nend_header\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2";
+    write_file("tri_ascii.ply", ascii, sizeof ascii - 1);
+    expect_triangle("tri_ascii.ply");
+    /* binary STL: 80-byte header, count, then normal, 3 vertices, attribute */
+    memset(buf, 0, sizeof buf);
+    le32(buf + 80, 1);
+    memcpy(buf + 84 + 12, tri, sizeof tri);
+    write_file("tri_bin.stl", buf, 134);
+    expect_triangle("tri_bin.stl");
+    static const char stl[] = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+                              "vertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
+    write_file("tri_ascii.stl", stl, sizeof stl - 1);
+    expect_triangle("tri_ascii.stl");
+    static const char obj[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    write_file("tri.obj", obj, sizeof obj - 1);
+    expect_triangle("tri.obj");
+    /* glb: JSON chunk (padded with spaces to 4 bytes) then the BIN chunk of the positions */
+    static const char json[] =
+        "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],\"buffers\":[{\"byteLength\":36}],"
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],\"accessors\":[{\"bufferView\":0,"
+        "\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]}]}";
+    size_t jl = (sizeof json - 1 + 3) & ~(size_t)3, total = 12 + 8 + jl + 8 + sizeof tri;
+    memset(buf, ' ', sizeof buf);
+    memcpy(buf, "glTF", 4), le32(buf + 4, 2), le32(buf + 8, (uint32_t)total);
+    le32(buf + 12, (uint32_t)jl), memcpy(buf + 16, "JSON", 4), memcpy(buf + 20, json, sizeof json - 1);
+    le32(buf + 20 + jl, sizeof tri), memcpy(buf + 24 + jl, "BIN\0", 4), memcpy(buf + 28 + jl, tri, sizeof tri);
+    write_file("tri.glb", buf, total);
+    expect_triangle("tri.glb");
+    /* .gltf with its buffer in a .bin beside it (read through the same checks) */
+    write_file("tri.bin", tri, sizeof tri);
+    char gltf[1024];
+    snprintf(gltf, sizeof gltf, "%.*s", (int)(strstr(json, "\"buffers\"") - json), json);
+    strcat(gltf, "\"buffers\":[{\"byteLength\":36,\"uri\":\"tri.bin\"}]");
+    strcat(gltf, strstr(json, ",\"bufferViews\""));
+    write_file("tri.gltf", gltf, strlen(gltf));
+    expect_triangle("tri.gltf");
+}
+
+static void test_memory_stayed_bounded(void **state)
+{
+    (void)state;
+    /* every case above in one process: the peak RSS stays that of a small program (a 4 GB
+     * claim that got through would show here even if it failed later) */
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    assert_true(ru.ru_maxrss < 256 * 1024);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_truncated_binary_ply), cmocka_unit_test(test_ply_claiming_2e9_vertices),
+        cmocka_unit_test(test_glb_claiming_4gb),     cmocka_unit_test(test_stl_counts),
+        cmocka_unit_test(test_obj_corner_cap),       cmocka_unit_test(test_files_beside_the_mesh),
+        cmocka_unit_test(test_disabled_formats),     cmocka_unit_test(test_valid_files_of_each_format),
+        cmocka_unit_test(test_memory_stayed_bounded),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
