@@ -124,7 +124,7 @@ static void test_csv_gpu_rows(void **s)
     int fd = mkstemp(path);
     assert_true(fd >= 0);
     close(fd);
-    assert_int_equal(rt_profiler_write_csv(p, path), VFX_OK);
+    assert_int_equal(rt_profiler_write_csv(p, path, NULL, 0), VFX_OK);
     FILE *f = fopen(path, "r");
     char line[512];
     assert_non_null(fgets(line, sizeof line, f));
