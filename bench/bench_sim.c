@@ -20,6 +20,7 @@
 #include "sim/sph.h"
 
 int bench_sim(int argc, char **argv);
+int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads);
 
 static double now_s(void)
 {
@@ -387,6 +388,22 @@ int bench_sim(int argc, char **argv)
                 fprintf(stderr, "volfx-bench sim: --methods wants rebuild, verlet or rebuild,verlet\n");
                 return 2;
             }
+        } else if (!strcmp(argv[i], "--pool") && i + 1 < argc) {
+            /* the default scene's pool in WCSPH and PBF (bench_sim_pool.c) */
+            uint32_t pn = (uint32_t)atoi(argv[++i]);
+            int pf = 60;
+            bool pp = true;
+            for (int k = i + 1; k < argc; ++k) {
+                if (!strcmp(argv[k], "--frames") && k + 1 < argc)
+                    pf = atoi(argv[++k]);
+                else if (!strcmp(argv[k], "--no-paddle"))
+                    pp = false;
+            }
+            if (pn < 1 || pf < 1) {
+                fprintf(stderr, "volfx-bench sim --pool N [--frames F] [--no-paddle]\n");
+                return 2;
+            }
+            return bench_sim_pool(pn, pf, pp, 2);
         } else if (!strcmp(argv[i], "--dam-break")) {
             dam = true;
         } else if (!strcmp(argv[i], "--res") && i + 1 < argc) {

@@ -76,7 +76,7 @@ static vfx_result load_water(game_app *app, game_demo *demo, const rt_scene *sc)
         rt_sph_desc sd = {.spacing = spacing, .max_substeps = 64,
                            /* ~0.6 m of water moves at ~3.4 m/s: c0 = 25 m/s keeps the compression
                             * near (3.4/25)^2 = 2% with half the substeps of the default */
-                           .sound_speed = 25.0f};
+                           .sound_speed = 25.0f, .solver = w->solver};
         memcpy(sd.domain_min, w->tank_min, sizeof sd.domain_min);
         memcpy(sd.domain_max, w->tank_max, sizeof sd.domain_max);
         memcpy(sd.gravity, w->gravity, sizeof sd.gravity);
@@ -88,6 +88,11 @@ static vfx_result load_water(game_app *app, game_demo *demo, const rt_scene *sc)
             rt_logf(&app->log, VFX_LOG_ERROR, "scene water simulation: %s", err);
             goto done;
         }
+        /* the scene's dt is the clock's step: whole steps follow the frame clock (up to 4 a
+         * frame); the profiler records the sim.* figures every frame */
+        rt_sim_system_set_stats_sink(demo->sim, rt_profiler_counter, app->profiler);
+        if ((r = rt_sim_system_set_clock(demo->sim, w->dt, 4)))
+            goto done;
         if (w->paddle) {
             uint32_t ax = w->paddle_axis < 3 ? w->paddle_axis : 0;
             rt_sph_collider paddle = {.kind = RT_SPH_BOX, .motion_amplitude = w->paddle_amplitude,
@@ -411,6 +416,8 @@ void game_demo_toggle(game_app *app, game_demo *demo, vfx_effect_kind kind)
 void game_demo_print_profile(game_app *app, FILE *out)
 {
     static const char *series[] = {"vfx.sim.sph", "plugin.update", "host.scene", "plugin.render"};
+    static const char *sim[] = {"sim.steps", "sim.iterations", "sim.realtime_factor", "sim.max_speed",
+                                "sim.density_error"};
     fprintf(out, "cpu ms (median):");
     for (size_t i = 0; i < sizeof series / sizeof series[0]; ++i) {
         double m = rt_profiler_series_median(app->profiler, series[i]);
@@ -418,6 +425,12 @@ void game_demo_print_profile(game_app *app, FILE *out)
             fprintf(out, " %s %.3f", series[i], m);
     }
     fprintf(out, "\n");
+    if (!isnan(rt_profiler_series_median(app->profiler, sim[0]))) {
+        fprintf(out, "sim (median):");
+        for (size_t i = 0; i < sizeof sim / sizeof sim[0]; ++i)
+            fprintf(out, " %s %.4g", sim[i], rt_profiler_series_median(app->profiler, sim[i]));
+        fprintf(out, "\n");
+    }
     vfx_stats2 st = {.size = sizeof st, .version = VFX_STATS2_VERSION};
     if (app->api->get_stats(app->ctx, (vfx_stats *)&st) == VFX_OK && st.count) {
         fprintf(out, "plugin stats (last frame):");

@@ -205,7 +205,7 @@ int main(int argc, char **argv)
            app->camera.height, headless ? "headless" : "window", demo.description);
     const float dt = 1.0f / 60.0f; /* fixed simulation step: runs are repeatable */
     bool paused = false, step = false;
-    double start = rt_now_ms();
+    double start = rt_now_ms(), last_ms = start;
     double next_progress = start + o.progress_s * 1000.0;
     int rc = 0;
     for (uint32_t f = 0; f < frames; ++f) {
@@ -213,8 +213,14 @@ int main(int argc, char **argv)
             break;
         if (rt_gl_context_should_close(app->gl))
             break;
-        handle_input(app, &demo, &paused, &step, dt);
-        float frame_dt = (paused && !step) ? 0.f : dt;
+        /* headless: a fixed dt per frame (repeatable runs); a window: the frame clock (the
+         * simulation's accumulator steps by the scene's dt to follow it), at most 0.1 s */
+        double now = rt_now_ms();
+        float wall_dt = f ? (float)fmin(0.1, (now - last_ms) * 1e-3) : dt;
+        last_ms = now;
+        float clock_dt = headless ? dt : wall_dt;
+        handle_input(app, &demo, &paused, &step, clock_dt);
+        float frame_dt = (paused && !step) ? 0.f : clock_dt;
         step = false;
         game_demo_animate(app, &demo, frame_dt);
         if (game_app_frame(app, frame_dt)) {

@@ -219,6 +219,12 @@ void rt_profiler_cpu(rt_profiler *p, const char *name, double cpu_ms)
         record(p, name, cpu_ms, SERIES_CPU);
 }
 
+void rt_profiler_counter(void *p, const char *name, double value)
+{
+    if (p && name)
+        record(p, name, value, SERIES_COUNTER);
+}
+
 void rt_profiler_gpu_stats(rt_profiler *p, const vfx_stats *stats)
 {
     if (!p || !stats)

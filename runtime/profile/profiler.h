@@ -35,6 +35,9 @@ void rt_profiler_frame_add(rt_profiler *p, double ms);
 void rt_profiler_on_system(void *profiler, const char *name, rt_phase phase, double cpu_ms);
 /* Records a CPU span by name with its own timing (for host work outside systems). */
 void rt_profiler_cpu(rt_profiler *p, const char *name, double cpu_ms);
+/* Records a counter series of the current frame by name (host figures such as sim.*; in the CSV
+ * and the series medians, not a trace track). p is an rt_profiler (void: a stats sink). */
+void rt_profiler_counter(void *p, const char *name, double value);
 /* Records the plugin's stats for the current frame: every "<pass>.gpu_ms" (a GPU series, in the
  * stats' order) with its "<pass>.gpu_depth", gpu.timer_lag_frames, and the counters drawn as
  * counter tracks (water.particles, water.pixels_sample_cap, volume.cells_skipped_ert). Version 1

@@ -95,7 +95,9 @@ static vfx_result parse_water_generator(pctx *c, const cJSON *v, rt_scene_water 
  * walls and the optional paddle. */
 static vfx_result parse_water_simulation(pctx *c, const cJSON *v, rt_scene_water *w)
 {
-    static const char *const skeys[] = {"tank", "fluid", "particle_count", "gravity", "dt", "paddle", "no_slip", NULL};
+    static const char *const skeys[] = {"tank", "fluid", "particle_count", "gravity", "dt", "paddle", "no_slip",
+                                        "solver", NULL};
+    static const char *const solvers[] = {"wcsph", "pbf", NULL}; /* rt_sph_solver order */
     vfx_result r;
     const char *PS = "water.simulation";
     const cJSON *s = cJSON_GetObjectItemCaseSensitive(v, "simulation");
@@ -113,6 +115,7 @@ static vfx_result parse_water_simulation(pctx *c, const cJSON *v, rt_scene_water
     if (!r) r = rt_scene_get_vec(c, s, PS, "gravity", 3, false, (range){-1000, 1000, false}, w->gravity);
     if (!r) r = rt_scene_get_float(c, s, PS, "dt", false, (range){0, 0.1, true}, &w->dt);
     if (!r) r = rt_scene_get_bool(c, s, PS, "no_slip", &w->no_slip);
+    if (!r) r = rt_scene_get_enum(c, s, PS, "solver", false, solvers, &w->solver);
     if (r)
         return r;
     const cJSON *pd = cJSON_GetObjectItemCaseSensitive(s, "paddle");
@@ -199,7 +202,7 @@ vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
     w->source = (rt_scene_water_source)src;
     w->layer_side = 24;
     w->spacing = 0.1f;
-    w->dt = 0.004f;
+    w->dt = 1.0f / 60.0f; /* the clock step: one solver call per 60 Hz frame */
     w->gravity[1] = -9.81f;
     w->paddle_amplitude = 0.2f;
     w->paddle_period_s = 2.0f;

@@ -5,6 +5,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <math.h>
+#include <time.h>
 
 #define SIM_NO_TABLE UINT32_MAX
 /* The world bumps a table's revision once per component a system declared as written when
@@ -21,7 +23,70 @@ struct rt_sim_system {
     uint32_t table;
     uint64_t revision;
     bool bound;
+    /* the clock (rt_sim_system_set_clock) and the last frame's figures */
+    float step_dt;
+    uint32_t max_steps;
+    double accum;
+    rt_sim_stats stats;
+    void (*sink)(void *user, const char *name, double value);
+    void *sink_user;
 };
+
+static double wall_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Steps the bound solver over the frame's dt: once, or by the clock's whole steps. */
+static vfx_result sim_advance(rt_sim_system *s, float frame_dt, char *err, size_t errlen)
+{
+    rt_sim_stats st = {.dropped_s = s->stats.dropped_s};
+    rt_sph_report sum = {0};
+    vfx_result r = VFX_OK;
+    double t0 = wall_s();
+    uint32_t n = 1;
+    float dt = frame_dt;
+    if (s->step_dt > 0.f) {
+        s->accum += frame_dt;
+        /* 1e-3 of a step: a frame of step_dt (rounded to float) is one step; the remainder may
+         * then be a little negative, which the next frame makes up */
+        double k = floor(s->accum / s->step_dt + 1e-3);
+        n = k > s->max_steps ? s->max_steps : (uint32_t)k;
+        if (k > s->max_steps) {
+            st.dropped_s += s->accum - s->max_steps * (double)s->step_dt;
+            s->accum = s->max_steps * (double)s->step_dt;
+        }
+        s->accum -= n * (double)s->step_dt;
+        dt = s->step_dt;
+    }
+    for (uint32_t i = 0; i < n && !r; ++i) {
+        rt_sph_report rep;
+        r = rt_sph_step(s->sph, dt, &rep, err, errlen);
+        st.steps += rep.substeps;
+        st.iterations += rep.iterations;
+        st.simulated_s += rep.simulated_time;
+        sum = rep;
+        sum.substeps = st.steps;
+    }
+    if (n == 0) /* no whole step this frame: the state's figures as they are */
+        r = rt_sph_step(s->sph, 0.f, &sum, err, errlen);
+    double wall = wall_s() - t0;
+    st.realtime_factor = wall > 0 ? st.simulated_s / wall : 0;
+    st.max_speed = sum.max_speed;
+    st.density_error = sum.mean_density_error;
+    s->report = sum;
+    s->stats = st;
+    if (s->sink) {
+        s->sink(s->sink_user, "sim.steps", st.steps);
+        s->sink(s->sink_user, "sim.iterations", st.iterations);
+        s->sink(s->sink_user, "sim.realtime_factor", st.realtime_factor);
+        s->sink(s->sink_user, "sim.max_speed", st.max_speed);
+        s->sink(s->sink_user, "sim.density_error", st.density_error);
+    }
+    return r;
+}
 
 /* The columns of `table` (count 0 when it is empty or unknown). */
 static void table_columns(rt_sim_system *s, uint32_t table, rt_sph_columns *c)
@@ -132,7 +197,7 @@ static vfx_result sim_run(rt_world *w, const rt_system_ctx *ctx)
         s->bound = true;
     }
     /* A failed step leaves the last good (finite) state in the columns. */
-    r = rt_sph_step(s->sph, ctx->dt, &s->report, err, sizeof err);
+    r = sim_advance(s, ctx->dt, err, sizeof err);
     if (s->table != SIM_NO_TABLE)
         s->revision = rt_world_table_revision(w, s->table) + SIM_OWN_BUMPS;
     return r ? rt_world_fail(w, r, "vfx.sim.sph: %s", err) : VFX_OK;
@@ -192,3 +257,22 @@ void rt_sim_system_destroy(rt_sim_system *s)
 rt_sph *rt_sim_system_solver(rt_sim_system *s) { return s ? s->sph : NULL; }
 const rt_sph_report *rt_sim_system_report(const rt_sim_system *s) { return s ? &s->report : NULL; }
 
+
+vfx_result rt_sim_system_set_clock(rt_sim_system *s, float step_dt, uint32_t max_steps)
+{
+    if (!s || !(step_dt >= 0.f) || !isfinite(step_dt) || (step_dt > 0.f && max_steps == 0))
+        return VFX_ERR_INVALID_ARGUMENT;
+    s->step_dt = step_dt;
+    s->max_steps = max_steps;
+    s->accum = 0.0;
+    return VFX_OK;
+}
+
+const rt_sim_stats *rt_sim_system_stats(const rt_sim_system *s) { return s ? &s->stats : NULL; }
+
+void rt_sim_system_set_stats_sink(rt_sim_system *s, void (*sink)(void *user, const char *name, double value),
+                                  void *user)
+{
+    if (s)
+        s->sink = sink, s->sink_user = user;
+}

@@ -30,6 +30,26 @@ void rt_sim_system_destroy(rt_sim_system *sys);
 rt_sph *rt_sim_system_solver(rt_sim_system *sys);
 /* Report of the last step (zeroed before the first). */
 const rt_sph_report *rt_sim_system_report(const rt_sim_system *sys);
+/* The simulation clock: from now on each run adds the frame's dt to an accumulator and steps
+ * the solver by whole steps of step_dt (at most max_steps a frame; time beyond that is dropped
+ * and counted, so a slow frame never makes the next slower), so simulated time follows the
+ * frame clock. step_dt 0 (the default) steps once by the frame's dt. */
+vfx_result rt_sim_system_set_clock(rt_sim_system *sys, float step_dt, uint32_t max_steps);
+/* Per-frame figures of the last run (the stats docs/stats.md lists as sim.*). */
+typedef struct rt_sim_stats {
+    uint32_t steps;          /* solver steps (PBF steps, WCSPH substeps) this frame */
+    uint32_t iterations;     /* PBF Jacobi iterations this frame (0 for WCSPH) */
+    double realtime_factor;  /* simulated seconds this frame / wall seconds the solver took */
+    double simulated_s;      /* simulated seconds this frame */
+    double dropped_s;        /* frame time the clock dropped (max_steps reached), total */
+    float max_speed;         /* [m/s], end of the frame */
+    float density_error;     /* mean max(0, rho/rho0 - 1), end of the frame */
+} rt_sim_stats;
+/* The last run's figures (zero before the first). */
+const rt_sim_stats *rt_sim_system_stats(const rt_sim_system *sys);
+/* Called at the end of every run with each sim.* figure (e.g. rt_profiler_counter); NULL: none. */
+void rt_sim_system_set_stats_sink(rt_sim_system *sys, void (*sink)(void *user, const char *name, double value),
+                                  void *user);
 
 
 #endif

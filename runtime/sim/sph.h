@@ -38,7 +38,17 @@ enum {
     /* the grid sort and 5x5x5 cell scan on every substep instead of Verlet lists (the
      * baseline the benchmark compares against) */
     RT_SPH_REBUILD_EVERY_SUBSTEP = 1u << 2,
+    /* PBF: turn off a part of the solver (each measured in docs/simulation.md) */
+    RT_SPH_PBF_WARM_START = 1u << 3,    /* experiment: pressures carried between steps (unstable) */
+    RT_SPH_PBF_NO_SCORR = 1u << 4,      /* no artificial pressure s_corr */
+    RT_SPH_PBF_NO_XSPH = 1u << 5,       /* no XSPH viscosity */
 };
+
+/* The solver (rt_sph_desc.solver). */
+typedef enum rt_sph_solver {
+    RT_SPH_SOLVER_WCSPH = 0, /* weakly compressible, explicit, adaptive substeps (the default) */
+    RT_SPH_SOLVER_PBF = 1,   /* Position Based Fluids (Macklin & Mueller 2013), sph_pbf.c */
+} rt_sph_solver;
 
 /* Faces of the domain box, for rt_sph_desc.no_slip_faces. */
 enum {
@@ -73,6 +83,19 @@ typedef struct rt_sph_desc {
      * kinematic viscosity that sets their shear stress [m^2/s]; 1.0e-6 (water at 20 C). */
     uint32_t no_slip_faces;
     float kinematic_viscosity;
+    /* Position Based Fluids (solver = RT_SPH_SOLVER_PBF; docs/simulation.md "PBF"): a call of
+     * rt_sph_step takes ceil(frame_dt / pbf_max_step) steps, more when a particle would move
+     * more than pbf_cfl * H in one (up to max_substeps; the frame is always covered). */
+    uint32_t solver;            /* rt_sph_solver; WCSPH */
+    uint32_t pbf_iterations;    /* Jacobi iterations per step; 4 */
+    float pbf_max_step;         /* longest step [s]; 1/60 */
+    float pbf_cfl;              /* largest move per step as a fraction of H; 0.5 */
+    float pbf_relaxation;       /* constraint-force mixing eps, a fraction of the lattice's
+                                 * sum |grad C|^2; 1 */
+    float pbf_scorr_k;          /* artificial pressure k of s_corr = -k (W(r)/W(dq))^4; 0.001 */
+    float pbf_scorr_dq;         /* its dq as a fraction of H; 0.2 */
+    float pbf_xsph;             /* XSPH viscosity c; 0.01 */
+    float pbf_vorticity;        /* vorticity confinement epsilon [m/s]; 0 (off) */
 } rt_sph_desc;
 
 typedef enum rt_sph_dt_limit {
@@ -101,6 +124,8 @@ typedef struct rt_sph_report {
                                  * (substeps + 1 with RT_SPH_REBUILD_EVERY_SUBSTEP) */
     uint64_t skin_pairs;        /* entries of the Verlet lists walked, summed over substeps */
     uint32_t emitted;           /* particles emitted during this step */
+    uint32_t iterations;        /* PBF: Jacobi iterations over all steps (0 for WCSPH) */
+    uint32_t speed_clamped;     /* PBF: particles whose speed was held at velocity_limit */
 } rt_sph_report;
 
 typedef struct rt_sph_columns {

@@ -31,6 +31,7 @@ typedef struct sph_chunk_out {
     uint32_t bad;      /* first failing row in the chunk, UINT32_MAX when none */
     int bad_kind;      /* 1 non-finite, 2 speed, 3 density change */
     float bad_value;
+    uint32_t clamped;  /* PBF: speeds held at the limit */
 } sph_chunk_out;
 
 typedef struct sph_collider_state {
@@ -110,6 +111,14 @@ struct rt_sph {
     sph_chunk_fn job;
     atomic_uint next_chunk;
     uint32_t nchunks;
+    /* Position Based Fluids (sph_pbf.c): pr holds each particle's pressure [Pa] (the multiplier
+     * lambda = -p dt^2 / rho0) and follows the rows through sorts */
+    uint32_t pbf_valid;          /* rows [0, pbf_valid) have a pressure; later rows are new */
+    float pbf_D0;                /* sum_j |grad_j C_i|^2 of a lattice particle [1/m^2] (0: not yet) */
+    float pbf_eps, pbf_wdq;      /* constraint-force mixing; (H^2 - dq^2)^3 of s_corr */
+    float pbf_vmax;              /* largest speed after the last step */
+    float pbf_dt;                /* the step being taken */
+    float *pc[3], *pn[3];        /* positions of the current and the next Jacobi iterate */
 };
 
 /* Rows [*b, *e) of a work item. */
@@ -247,6 +256,13 @@ void rt_sph_density_chunk(rt_sph *s, uint32_t chunk);
 void rt_sph_force_chunk(rt_sph *s, uint32_t chunk);
 void rt_sph_integrate_chunk(rt_sph *s, uint32_t chunk);
 void rt_sph_disp_chunk(rt_sph *s, uint32_t chunk);
+
+/* sph_kernels.c: deterministic, antisymmetric unit direction for two exactly coincident
+ * particles (ids a, b) */
+void rt_sph_coincident_dir(uint32_t a, uint32_t b, float out[3]);
+
+/* sph_pbf.c: a frame of Position Based Fluids (the WCSPH frame is in sph_step.c) */
+vfx_result rt_sph_pbf_step(rt_sph *s, float frame_dt, rt_sph_report *rep, char *err, size_t errlen);
 
 /* sph_emit.c: runs the emitters for dt (0 on the first substep); count added to *emitted */
 vfx_result rt_sph_emit(rt_sph *s, double dt, uint32_t *emitted, char *err, size_t errlen);

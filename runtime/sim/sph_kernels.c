@@ -238,8 +238,7 @@ void rt_sph_disp_chunk(rt_sph *s, uint32_t chunk)
     s->out[chunk].disp2_max = d2;
 }
 
-/* Deterministic, antisymmetric unit direction for exactly coincident particles. */
-static void coincident_dir(uint32_t a, uint32_t b, float out[3])
+void rt_sph_coincident_dir(uint32_t a, uint32_t b, float out[3])
 {
     uint32_t lo = a < b ? a : b, hi = a < b ? b : a;
     uint64_t h = ((uint64_t)lo * 0x9E3779B97F4A7C15ull) ^ ((uint64_t)hi * 0xC2B2AE3D27D4EB4Full);
@@ -349,7 +348,7 @@ void rt_sph_force_chunk(rt_sph *s, uint32_t chunk)
                 if (!(dx * dx + dy * dy + dz * dz <= eps2))
                     continue;
                 float u[3];
-                coincident_dir(s->id[i], s->id[j], u);
+                rt_sph_coincident_dir(s->id[i], s->id[j], u);
                 float coef = (pri + P[j]) * H * H;
                 sx += coef * u[0], sy += coef * u[1], sz += coef * u[2];
                 sd += ((vxi - VX[j]) * u[0] + (vyi - VY[j]) * u[1] + (vzi - VZ[j]) * u[2]) * H * H;

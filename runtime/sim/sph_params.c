@@ -45,6 +45,18 @@ static vfx_result fill_params(rt_sph_desc *p, char *err, size_t err_len)
         return VFX_ERR_INVALID_ARGUMENT;
     }
     p->neighbor_skin = def(p->neighbor_skin, 0.3f); /* measured: docs/simulation.md */
+    if (p->solver > RT_SPH_SOLVER_PBF) {
+        snprintf(err, err_len, "rt_sph_create: desc.solver %u is not a solver (0 WCSPH, 1 PBF)", p->solver);
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    /* PBF defaults: measured in docs/simulation.md ("PBF") */
+    if (!p->pbf_iterations) p->pbf_iterations = 4;
+    p->pbf_max_step = def(p->pbf_max_step, 1.f / 60.f);
+    p->pbf_cfl = def(p->pbf_cfl, 0.5f);
+    p->pbf_relaxation = def(p->pbf_relaxation, 1.f);
+    p->pbf_scorr_k = def(p->pbf_scorr_k, 0.001f);
+    p->pbf_scorr_dq = def(p->pbf_scorr_dq, 0.2f);
+    p->pbf_xsph = def(p->pbf_xsph, 0.01f);
 
     const float *fields[] = {&p->spacing, &p->support_ratio, &p->rest_density, &p->sound_speed,
                              &p->stiffness, &p->gamma, &p->viscosity, &p->cfl, &p->velocity_limit,
@@ -52,13 +64,15 @@ static vfx_result fill_params(rt_sph_desc *p, char *err, size_t err_len)
                              &p->gravity[0], &p->gravity[1], &p->gravity[2],
                              &p->domain_min[0], &p->domain_min[1], &p->domain_min[2],
                              &p->domain_max[0], &p->domain_max[1], &p->domain_max[2],
-                             &p->neighbor_skin};
+                             &p->neighbor_skin, &p->pbf_max_step, &p->pbf_cfl, &p->pbf_relaxation,
+                             &p->pbf_scorr_k, &p->pbf_scorr_dq, &p->pbf_xsph, &p->pbf_vorticity};
     static const char *names[] = {"spacing", "support_ratio", "rest_density", "sound_speed",
                                   "stiffness", "gamma", "viscosity", "cfl", "velocity_limit",
                                   "density_change_limit", "kinematic_viscosity", "gravity[0]", "gravity[1]", "gravity[2]",
                                   "domain_min[0]", "domain_min[1]", "domain_min[2]",
                                   "domain_max[0]", "domain_max[1]", "domain_max[2]",
-                                  "neighbor_skin"};
+                                  "neighbor_skin", "pbf_max_step", "pbf_cfl", "pbf_relaxation",
+                                  "pbf_scorr_k", "pbf_scorr_dq", "pbf_xsph", "pbf_vorticity"};
     for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
         if (!isfinite(*fields[i])) {
             snprintf(err, err_len, "rt_sph_create: desc.%s is not finite", names[i]);
@@ -71,6 +85,14 @@ static vfx_result fill_params(rt_sph_desc *p, char *err, size_t err_len)
         p->kinematic_viscosity < 0.f) {
         snprintf(err, err_len, "rt_sph_create: a parameter is out of range (spacing>0, "
                  "support_ratio>=1, rest_density>0, gamma>=1, 0<cfl<=1, others >= 0)");
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
+    if (!(p->pbf_max_step > 0.f) || !(p->pbf_cfl > 0.f) || !(p->pbf_relaxation > 0.f) ||
+        p->pbf_scorr_k < 0.f || !(p->pbf_scorr_dq > 0.f && p->pbf_scorr_dq < 1.f) || p->pbf_xsph < 0.f ||
+        p->pbf_xsph > 1.f || p->pbf_vorticity < 0.f || p->pbf_iterations > 1000) {
+        snprintf(err, err_len, "rt_sph_create: a PBF parameter is out of range (pbf_max_step, pbf_cfl, "
+                 "pbf_relaxation > 0; 0 < pbf_scorr_dq < 1; 0 <= pbf_xsph <= 1; pbf_scorr_k, "
+                 "pbf_vorticity >= 0; pbf_iterations <= 1000)");
         return VFX_ERR_INVALID_ARGUMENT;
     }
     if (!(p->neighbor_skin > 0.f && p->neighbor_skin <= 1.f)) {

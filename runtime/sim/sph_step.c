@@ -196,6 +196,12 @@ vfx_result rt_sph_step(rt_sph *s, float frame_dt, rt_sph_report *report, char *e
     if (!isfinite(frame_dt) || frame_dt < 0.f) {
         return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_step: frame_dt %g must be finite and >= 0", (double)frame_dt);
     }
+    if (s->p.solver == RT_SPH_SOLVER_PBF) {
+        vfx_result pr = rt_sph_pbf_step(s, frame_dt, &rep, err, errlen);
+        if (report)
+            *report = rep;
+        return pr;
+    }
     double t = 0.0;
     rep.dt_min = INFINITY;
     vfx_result res = VFX_OK;

@@ -62,6 +62,8 @@ float rt_sph_pressure(const rt_sph *s, uint32_t i)
 {
     if (!s || i >= s->n)
         return 0.f;
+    if (s->p.solver == RT_SPH_SOLVER_PBF)
+        return s->pr[i]; /* PBF keeps the pressure itself */
     return s->pr[i] * s->rho[i] * s->rho[i];
 }
 
@@ -253,6 +255,7 @@ void rt_sph_clear(rt_sph *s)
     s->n = 0;
     s->next_id = 0;
     s->lists_valid = false;
+    s->pbf_valid = 0;
 }
 
 vfx_result rt_sph_add_block(rt_sph *s, const float lo[3], const float hi[3], uint32_t *added,
@@ -338,6 +341,7 @@ vfx_result rt_sph_bind(rt_sph *s, const rt_sph_host *host, const rt_sph_columns 
     s->host = *host;
     s->n = 0;
     s->next_id = 0;
+    s->pbf_valid = 0; /* PBF: hydrostatic pressures again for the bound rows */
     if ((r = rt_sph_reserve(s, c->count, err, errlen))) {
         rt_sph_clear(s);
         return r;

@@ -244,6 +244,9 @@ static const bad_case bad_cases[] = {
     {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
      "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"no_slip\":3}}}",
      VFX_ERR_FORMAT, "water.simulation.no_slip: expected true or false, got a number"},
+    {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
+     "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"solver\":\"sph\"}}}",
+     VFX_ERR_INVALID_ARGUMENT, "water.simulation.solver: unknown value \"sph\"; expected one of \"wcsph\", \"pbf\""},
     {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"h\":0}}", VFX_ERR_INVALID_ARGUMENT, "water.h: must be > 0, got 0"},
     {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"disable\":[\"pyramid\",\"magic\"]}}}",
      VFX_ERR_INVALID_ARGUMENT, "water.quality.disable[1]: unknown flag \"magic\""},

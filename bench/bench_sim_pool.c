@@ -1,0 +1,90 @@
+/* bench_sim_pool.c — `volfx-bench sim --pool N`: the default scene's pool (tank 3.3 x 1.4 x 2.5 m,
+ * fluid 3.2 x 0.32 x 2.4 m at N particles, the paddle of sample_game/scenes/default.json) in
+ * WCSPH and PBF, stepped in turn every 60 Hz frame of one run (the load of a shared machine falls
+ * on both), CPU time of the process per frame (both worker threads), max speed over frames 2..F,
+ * mean compression. The block is on the solvers' calibrated lattice (rt_sph_add_block: layers
+ * dx/2 from the walls) in front of the paddle. One JSON object per solver. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "profile/profiler.h"
+#include "sim/sph.h"
+
+int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads);
+
+static double cpu_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec * 1e3 + 1e-6 * (double)t.tv_nsec;
+}
+
+int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads)
+{
+    const float tmin[3] = {-1.65f, 0.f, -1.25f}, tmax[3] = {1.65f, 1.4f, 1.25f};
+    const float fmin[3] = {-1.6f, 0.02f, -1.2f}, fmax[3] = {1.6f, 0.34f, 1.2f};
+    double vol = 1.0;
+    for (int k = 0; k < 3; ++k)
+        vol *= fmax[k] - fmin[k];
+    float dx = (float)cbrt(vol / n); /* as demo_scene.c: the count fills the scene's block */
+    const float amp = 0.25f, period = 2.5f;
+    rt_sph *s[2] = {NULL, NULL};
+    uint32_t added[2] = {0, 0};
+    for (int m = 0; m < 2; ++m) {
+        rt_sph_desc d = {.spacing = dx, .max_substeps = 64, .sound_speed = 25.f, .threads = threads,
+                          .solver = m ? RT_SPH_SOLVER_PBF : RT_SPH_SOLVER_WCSPH};
+        memcpy(d.domain_min, tmin, sizeof tmin);
+        memcpy(d.domain_max, tmax, sizeof tmax);
+        char err[256];
+        if (rt_sph_create(&d, &s[m], err, sizeof err)) {
+            fprintf(stderr, "volfx-bench sim --pool: %s\n", err);
+            rt_sph_destroy(s[0]);
+            return 1;
+        }
+        float lo[3] = {tmin[0], tmin[1], tmin[2]}, hi[3] = {tmax[0], fmax[1], tmax[2]};
+        if (paddle) {
+            rt_sph_collider c = {.kind = RT_SPH_BOX, .center = {tmin[0] + amp + dx, 0.5f * (tmin[1] + tmax[1]), 0},
+                                  .half = {0.5f * dx, 0.5f * (tmax[1] - tmin[1]), 0.5f * (tmax[2] - tmin[2])},
+                                  .motion_axis = {1, 0, 0}, .motion_amplitude = amp, .motion_frequency = 1.f / period};
+            rt_sph_add_collider(s[m], &c, NULL, NULL, 0);
+            lo[0] = c.center[0] + 0.5f * dx + 0.25f * dx; /* in front of the plate at t = 0 */
+        }
+        if (rt_sph_add_block(s[m], lo, hi, &added[m], NULL, 0))
+            return 1;
+    }
+    double *ms[2] = {calloc((size_t)frames, sizeof(double)), calloc((size_t)frames, sizeof(double))};
+    float vmax[2] = {0, 0};
+    double err_sum[2] = {0, 0};
+    uint32_t steps[2] = {0, 0}, iters[2] = {0, 0};
+    for (int f = 0; f < frames && ms[0] && ms[1]; ++f)
+        for (int m = 0; m < 2; ++m) {
+            rt_sph_report r;
+            char err[256];
+            double t0 = cpu_ms();
+            if (rt_sph_step(s[m], 1.f / 60.f, &r, err, sizeof err)) {
+                fprintf(stderr, "volfx-bench sim --pool: %s\n", err);
+                return 1;
+            }
+            ms[m][f] = cpu_ms() - t0;
+            if (f >= 1 && r.max_speed > vmax[m])
+                vmax[m] = r.max_speed;
+            err_sum[m] += r.mean_density_error;
+            steps[m] += r.substeps, iters[m] += r.iterations;
+        }
+    double med[2];
+    for (int m = 0; m < 2; ++m) {
+        med[m] = rt_median(ms[m], (uint32_t)frames);
+        printf("{\"bench\":\"sim_pool\",\"solver\":\"%s\",\"particles\":%u,\"spacing\":%.5f,\"paddle\":%s,"
+               "\"frames\":%d,\"threads\":%u,\"cpu_ms_per_frame_median\":%.3f,\"steps_per_frame\":%.2f,"
+               "\"iterations_per_frame\":%.2f,\"max_speed_frames_2_on\":%.4f,\"mean_compression\":%.5f}\n",
+               m ? "pbf" : "wcsph", added[m], dx, paddle ? "true" : "false", frames, rt_sph_thread_count(s[m]),
+               med[m], (double)steps[m] / frames, (double)iters[m] / frames, vmax[m], err_sum[m] / frames);
+    }
+    printf("{\"bench\":\"sim_pool\",\"wcsph_over_pbf_cpu\":%.2f}\n", med[0] / med[1]);
+    free(ms[0]), free(ms[1]);
+    rt_sph_destroy(s[0]), rt_sph_destroy(s[1]);
+    return 0;
+}

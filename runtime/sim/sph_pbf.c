@@ -1,0 +1,789 @@
+/* sph_pbf.c — Position Based Fluids (Macklin & Mueller 2013) on the WCSPH solver's columns,
+ * neighbour lists, walls and worker pool: a step predicts positions under gravity, finds the
+ * neighbours once (Verlet walk or rebuild), then projects the density constraints
+ * C_i = rho_i/rho0 - 1 >= 0 by a fixed number of Jacobi iterations, and derives the
+ * velocities from the moved positions; XSPH viscosity and (optional) vorticity confinement
+ * act on the velocities after. Every pass is a gather over fixed lists, so with a fixed
+ * iteration count the result does not depend on the thread count.
+ *
+ * The multipliers start from zero in every iteration (the paper's scheme) and are projected
+ * (lambda <= 0: the constraint only pushes, so the deficient density at a free surface does not
+ * pull particles together). The Jacobi update is damped by the constraint-force mixing eps
+ * (pbf_relaxation, a fraction of the lattice's sum |grad C|^2): at 0.05 of it the iteration
+ * amplified the highest-frequency modes (measured, docs/simulation.md "PBF").
+ *
+ * RT_SPH_PBF_WARM_START (an experiment, off by default): each particle keeps its pressure p_i
+ * between steps in pr (Pa; lambda_i = -p_i dt^2 / rho0), a step first applies the correction of
+ * last step's pressures, and a fresh fluid starts from the hydrostatic rho0 |g| depth. Measured
+ * unstable with 3 iterations (the carried pressure acts as an integral of the compression). */
+#include "sim/sph_internal.h"
+#include "core/error.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#if defined(__SSE2__) && (defined(__GNUC__) || defined(__clang__))
+#include <emmintrin.h>
+#define PBF_SSE 1
+static inline float pbf_hsum(__m128 v)
+{
+    float l[4];
+    _mm_storeu_ps(l, v);
+    return (l[0] + l[1]) + (l[2] + l[3]);
+}
+#else
+#define PBF_SSE 0
+#endif
+
+/* ---- parameters ---------------------------------------------------------------------------- */
+
+static void pbf_calibrate(rt_sph *s)
+{
+    /* sum_j |grad_j C_i|^2 = sum_j (V ks (H - r)^2)^2 on the lattice the solver fills blocks
+     * with (the gradient sum itself vanishes there): the scale of the constraint's stiffness,
+     * which the mixing eps and the s_corr amplitude are given relative to */
+    const double dx = s->p.spacing, V = s->mass / s->p.rest_density, H = s->H;
+    int R = (int)ceil(s->p.support_ratio) + 1;
+    double D = 0.0;
+    for (int i = -R; i <= R; ++i)
+        for (int j = -R; j <= R; ++j)
+            for (int k = -R; k <= R; ++k) {
+                double r = sqrt((double)(i * i + j * j + k * k)) * dx;
+                if (r <= 0.0 || r >= H)
+                    continue;
+                double g = V * s->k_spiky * (H - r) * (H - r);
+                D += g * g;
+            }
+    s->pbf_D0 = (float)D;
+    s->pbf_eps = s->p.pbf_relaxation * (float)D;
+    double dq = s->p.pbf_scorr_dq * H, t = H * H - dq * dq;
+    s->pbf_wdq = (float)(t * t * t);
+}
+
+/* ---- wall terms ------------------------------------------------------------------------------ */
+
+/* The walls' share of the density constraint at p: rho0 * (missing fraction) in *wall_rho, the
+ * gradient of the missing fraction (grad C_i from the walls) in g, and 1 / (the kernel's
+ * fraction inside the fluid, held at 0.2) in *inv_gam. */
+static void pbf_walls(const rt_sph *s, float px, float py, float pz, float *wall_rho, float g[3],
+                      float *inv_gam)
+{
+    sph_wall_hit w[SPH_MAX_WALLS];
+    float fr[SPH_MAX_WALLS], inside, extra;
+    int nw = rt_sph_gather_walls(s, px, py, pz, w, SPH_MAX_WALLS);
+    g[0] = g[1] = g[2] = 0.f;
+    *inv_gam = 1.f;
+    if (!nw) {
+        *wall_rho = 0.f;
+        return;
+    }
+    sph_wall_share(s, w, nw, fr, &inside, &extra);
+    *wall_rho = s->p.rest_density * (1.f - inside + extra);
+    float gam = inside - extra;
+    *inv_gam = gam > 0.2f ? 1.f / gam : 5.f;
+    int nb = sph_walls_box(w, nw);
+    for (int k = 0; k < nw; ++k) {
+        /* box walls through 1 - prod(1 - f): d/dx = sum_k prod_{l != k} (1 - f_l) df_k/dx */
+        float others = 1.f;
+        if (k < nb)
+            for (int l = 0; l < nb; ++l)
+                if (l != k)
+                    others *= 1.f - fr[l];
+        /* f falls with the distance d, which grows along the normal n into the fluid */
+        float gr = others * s->wall_scale * (float)rt_sph_wall_density_gradient(w[k].d, s->H);
+        g[0] -= gr * w[k].n[0], g[1] -= gr * w[k].n[1], g[2] -= gr * w[k].n[2];
+    }
+}
+
+/* Moves p out of every collider and the domain box to the clamp margin (positions only). */
+static void pbf_clamp(const rt_sph *s, float p[3])
+{
+    const float margin = 0.25f * s->p.spacing;
+    for (uint32_t c = 0; c < s->ncol; ++c) {
+        float n[3];
+        float d = rt_sph_surface_distance(&s->col[c], p[0], p[1], p[2], n);
+        if (d < margin)
+            for (int a = 0; a < 3; ++a)
+                p[a] += (margin - d) * n[a];
+    }
+    const float *lo = s->p.domain_min, *hi = s->p.domain_max;
+    for (int a = 0; a < 3; ++a)
+        p[a] = sph_clampf(p[a], lo[a] + margin, hi[a] - margin);
+}
+
+/* ---- passes ---------------------------------------------------------------------------------- */
+
+/* v += dt g (speed held at the limit), x += dt v, clamped to the walls with v following the
+ * clamp; displacement since the last rebuild. */
+static void pbf_predict_chunk(rt_sph *s, uint32_t chunk)
+{
+    uint32_t b, e;
+    sph_chunk_rows(s, chunk, &b, &e);
+    const float dt = s->pbf_dt, inv_dt = 1.f / dt, *g = s->p.gravity;
+    const float vlim = s->p.velocity_limit, vlim2 = vlim * vlim;
+    sph_chunk_out acc = s->out[chunk];
+    float disp2 = 0.f;
+    for (uint32_t i = b; i < e; ++i) {
+        float v[3] = {s->vx[i] + dt * g[0], s->vy[i] + dt * g[1], s->vz[i] + dt * g[2]};
+        float v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        if (!isfinite(v2)) {
+            v[0] = v[1] = v[2] = 0.f;
+            if (acc.bad == UINT32_MAX)
+                acc.bad = i, acc.bad_kind = 1, acc.bad_value = v2;
+        } else if (v2 > vlim2) {
+            float k = vlim / sqrtf(v2);
+            v[0] *= k, v[1] *= k, v[2] *= k;
+            acc.clamped++;
+        }
+        float p[3] = {s->x[i] + dt * v[0], s->y[i] + dt * v[1], s->z[i] + dt * v[2]}, q[3] = {p[0], p[1], p[2]};
+        pbf_clamp(s, q);
+        for (int a = 0; a < 3; ++a)
+            v[a] += (q[a] - p[a]) * inv_dt;
+        s->x[i] = q[0], s->y[i] = q[1], s->z[i] = q[2];
+        s->vx[i] = v[0], s->vy[i] = v[1], s->vz[i] = v[2];
+        float ex = q[0] - s->x0[i], ey = q[1] - s->y0[i], ez = q[2] - s->z0[i];
+        float d2 = ex * ex + ey * ey + ez * ez;
+        disp2 = d2 > disp2 ? d2 : disp2;
+    }
+    acc.disp2_max = disp2;
+    s->out[chunk] = acc;
+}
+
+/* The constraint of each particle at the current iterate: density (particles and walls), its
+ * gradients, and the multiplier's change; the pressure follows (projected: p >= 0). */
+static void pbf_lambda_chunk(rt_sph *s, uint32_t chunk)
+{
+    uint32_t b, e;
+    sph_chunk_rows(s, chunk, &b, &e);
+    const float H = s->H, H2 = s->H2, eps2 = 1e-12f * H2, rho0 = s->p.rest_density;
+    const float Vks = s->mass / rho0 * s->k_spiky, mk = s->mass * s->k_poly6;
+    const float dt2 = s->pbf_dt * s->pbf_dt, to_l = dt2 / rho0, eps = s->pbf_eps;
+    const bool warm = (s->p.flags & RT_SPH_PBF_WARM_START) != 0;
+    const float *X = s->pc[0], *Y = s->pc[1], *Z = s->pc[2];
+    sph_chunk_out acc = s->out[chunk];
+    for (uint32_t i = b; i < e; ++i) {
+        const float px = X[i], py = Y[i], pz = Z[i];
+        const uint32_t *L = s->cnb[chunk] + s->nb_start[i];
+        const uint32_t nn = s->nb_count[i];
+        float sw = H2 * H2 * H2, gx = 0.f, gy = 0.f, gz = 0.f, g2 = 0.f;
+        uint32_t k = 0, coincident = 0;
+#if PBF_SSE
+        {
+            const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), vpz = _mm_set1_ps(pz);
+            const __m128 vH = _mm_set1_ps(H), vH2 = _mm_set1_ps(H2), veps = _mm_set1_ps(eps2);
+            const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.f);
+            __m128 w4 = zero, gx4 = zero, gy4 = zero, gz4 = zero, g24 = zero;
+            for (; k + 4 <= nn; k += 4) {
+                uint32_t j0 = L[k], j1 = L[k + 1], j2 = L[k + 2], j3 = L[k + 3];
+                __m128 dx = vpx - _mm_setr_ps(X[j0], X[j1], X[j2], X[j3]);
+                __m128 dy = vpy - _mm_setr_ps(Y[j0], Y[j1], Y[j2], Y[j3]);
+                __m128 dz = vpz - _mm_setr_ps(Z[j0], Z[j1], Z[j2], Z[j3]);
+                __m128 r2 = dx * dx + dy * dy + dz * dz;
+                __m128 t = _mm_max_ps(vH2 - r2, zero);
+                w4 += t * t * t;
+                __m128 valid = _mm_cmpgt_ps(r2, veps);
+                coincident += (0x4332322132212110ull >> (4 * (~_mm_movemask_ps(valid) & 15))) & 15u;
+                __m128 rl = _mm_sqrt_ps(r2), hr = _mm_max_ps(vH - rl, zero);
+                __m128 hr2 = hr * hr;
+                __m128 q = _mm_and_ps(valid, hr2 * (one / rl)); /* G_ij / Vks */
+                gx4 += q * dx, gy4 += q * dy, gz4 += q * dz;
+                g24 += _mm_and_ps(valid, hr2 * hr2);
+            }
+            sw += pbf_hsum(w4);
+            gx = -pbf_hsum(gx4), gy = -pbf_hsum(gy4), gz = -pbf_hsum(gz4), g2 = pbf_hsum(g24);
+        }
+#endif
+        for (; k < nn; ++k) {
+            uint32_t j = L[k];
+            float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
+            float r2 = dx * dx + dy * dy + dz * dz;
+            float t = H2 - r2 > 0.f ? H2 - r2 : 0.f;
+            sw += t * t * t;
+            if (r2 > eps2) {
+                float rl = sqrtf(r2), hr = H - rl > 0.f ? H - rl : 0.f, q = hr * hr / rl;
+                gx -= q * dx, gy -= q * dy, gz -= q * dz;
+                g2 += hr * hr * hr * hr;
+            } else {
+                coincident++;
+            }
+        }
+        for (uint32_t k2 = 0; coincident && k2 < nn; ++k2) {
+            uint32_t j = L[k2];
+            float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
+            if (!(dx * dx + dy * dy + dz * dz <= eps2))
+                continue;
+            float u[3];
+            rt_sph_coincident_dir(s->id[i], s->id[j], u); /* (H - 0)^2 along a fixed axis */
+            gx -= H * H * u[0], gy -= H * H * u[1], gz -= H * H * u[2];
+            g2 += H * H * H * H;
+            coincident--;
+        }
+        float wall_rho, gw[3], ig;
+        pbf_walls(s, px, py, pz, &wall_rho, gw, &ig);
+        float rho = mk * sw + wall_rho;
+        (void)ig;
+        float Gx = Vks * gx + gw[0], Gy = Vks * gy + gw[1], Gz = Vks * gz + gw[2];
+        /* the paper's denominator |grad_i C_i|^2 + sum_j |grad_j C_i|^2 + eps: grad_i C_i . A_i
+         * (i's own move per unit multiplier) can be near zero or negative at a wall */
+        float D = Gx * Gx + Gy * Gy + Gz * Gz + Vks * Vks * g2 + eps;
+        float C = rho / rho0 - 1.f;
+        float l_old = warm ? -s->pr[i] * to_l : 0.f;
+        float l_new = l_old - C / D;
+        l_new = l_new < 0.f ? l_new : 0.f; /* pressure >= 0: the constraint only pushes */
+        s->drho[i] = l_new - l_old;        /* this iteration's multiplier */
+        s->pr[i] = -l_new / to_l;
+        s->rho[i] = rho;
+        float err = C;
+        if (err > acc.rho_err_max)
+            acc.rho_err_max = err;
+        if (!isfinite(rho) && acc.bad == UINT32_MAX)
+            acc.bad = i, acc.bad_kind = 1, acc.bad_value = rho;
+    }
+    s->out[chunk] = acc;
+}
+
+typedef struct pbf_delta_args {
+    const float *lam; /* multipliers (scaled by lam_scale) */
+    float lam_scale;
+    bool scorr;
+} pbf_delta_args;
+
+/* Position correction of each particle from the multipliers (this iteration's, or the warm
+ * start's pressures): dp_i = -sum_j (l_i + l_j + s_corr) G_ij d_ij + l_i grad C_wall, written
+ * to the next iterate, clamped to the walls. */
+static void pbf_delta(rt_sph *s, uint32_t chunk, const pbf_delta_args *a)
+{
+    uint32_t b, e;
+    sph_chunk_rows(s, chunk, &b, &e);
+    const float H = s->H, H2 = s->H2, eps2 = 1e-12f * H2, rho0 = s->p.rest_density;
+    const float Vks = s->mass / rho0 * s->k_spiky, ls = a->lam_scale;
+    const float maxd = 0.5f * s->H;
+    /* s_corr = -k (W(r)/W(dq))^4, as a multiplier: k in units of the lattice's 1/D0 */
+    const float sk = a->scorr ? s->p.pbf_scorr_k / s->pbf_D0 : 0.f, iwdq = 1.f / s->pbf_wdq;
+    const float *X = s->pc[0], *Y = s->pc[1], *Z = s->pc[2], *Lm = a->lam;
+    float *NX = s->pn[0], *NY = s->pn[1], *NZ = s->pn[2];
+    for (uint32_t i = b; i < e; ++i) {
+        const float px = X[i], py = Y[i], pz = Z[i], li = ls * Lm[i];
+        const uint32_t *L = s->cnb[chunk] + s->nb_start[i];
+        const uint32_t nn = s->nb_count[i];
+        float sx = 0.f, sy = 0.f, sz = 0.f;
+        uint32_t k = 0, coincident = 0;
+#if PBF_SSE
+        {
+            const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), vpz = _mm_set1_ps(pz);
+            const __m128 vH = _mm_set1_ps(H), vH2 = _mm_set1_ps(H2), veps = _mm_set1_ps(eps2);
+            const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.f), vli = _mm_set1_ps(li);
+            const __m128 vls = _mm_set1_ps(ls), vsk = _mm_set1_ps(sk), viw = _mm_set1_ps(iwdq);
+            __m128 sx4 = zero, sy4 = zero, sz4 = zero;
+            for (; k + 4 <= nn; k += 4) {
+                uint32_t j0 = L[k], j1 = L[k + 1], j2 = L[k + 2], j3 = L[k + 3];
+                __m128 dx = vpx - _mm_setr_ps(X[j0], X[j1], X[j2], X[j3]);
+                __m128 dy = vpy - _mm_setr_ps(Y[j0], Y[j1], Y[j2], Y[j3]);
+                __m128 dz = vpz - _mm_setr_ps(Z[j0], Z[j1], Z[j2], Z[j3]);
+                __m128 lj = vls * _mm_setr_ps(Lm[j0], Lm[j1], Lm[j2], Lm[j3]);
+                __m128 r2 = dx * dx + dy * dy + dz * dz;
+                __m128 valid = _mm_cmpgt_ps(r2, veps);
+                coincident += (0x4332322132212110ull >> (4 * (~_mm_movemask_ps(valid) & 15))) & 15u;
+                __m128 t = _mm_max_ps(vH2 - r2, zero);
+                __m128 w = t * t * t * viw, w2 = w * w;
+                __m128 rl = _mm_sqrt_ps(r2), hr = _mm_max_ps(vH - rl, zero);
+                __m128 q = _mm_and_ps(valid, hr * hr * (one / rl));
+                __m128 coef = (vli + lj - vsk * w2 * w2) * q;
+                sx4 += coef * dx, sy4 += coef * dy, sz4 += coef * dz;
+            }
+            sx = pbf_hsum(sx4), sy = pbf_hsum(sy4), sz = pbf_hsum(sz4);
+        }
+#endif
+        for (; k < nn; ++k) {
+            uint32_t j = L[k];
+            float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
+            float r2 = dx * dx + dy * dy + dz * dz;
+            if (!(r2 > eps2)) {
+                coincident++;
+                continue;
+            }
+            float t = H2 - r2 > 0.f ? H2 - r2 : 0.f;
+            float w = t * t * t * iwdq, w2 = w * w;
+            float rl = sqrtf(r2), hr = H - rl > 0.f ? H - rl : 0.f;
+            float coef = (li + ls * Lm[j] - sk * w2 * w2) * hr * hr / rl;
+            sx += coef * dx, sy += coef * dy, sz += coef * dz;
+        }
+        for (uint32_t k2 = 0; coincident && k2 < nn; ++k2) {
+            uint32_t j = L[k2];
+            float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
+            if (!(dx * dx + dy * dy + dz * dz <= eps2))
+                continue;
+            float u[3];
+            rt_sph_coincident_dir(s->id[i], s->id[j], u);
+            float coef = (li + ls * Lm[j] - sk) * H * H;
+            sx += coef * u[0], sy += coef * u[1], sz += coef * u[2];
+            coincident--;
+        }
+        /* the wall's missing fluid as a mirror image of i (multiplier l_i, so 2 l_i with i's
+         * own, as a neighbour pair has), and the sum over the kernel's fluid share (Ferrand et
+         * al. 2013, as sph_wall_accel): a hydrostatic pressure is then balanced at a wall */
+        float wall_rho, gw[3], ig;
+        pbf_walls(s, px, py, pz, &wall_rho, gw, &ig);
+        float d[3] = {(-Vks * sx + 2.f * li * gw[0]) * ig, (-Vks * sy + 2.f * li * gw[1]) * ig,
+                      (-Vks * sz + 2.f * li * gw[2]) * ig};
+        float dl = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (dl > maxd) /* only in collapsed inputs (many particles on one point) */
+            for (int q = 0; q < 3; ++q)
+                d[q] *= maxd / dl;
+        float p[3] = {px + d[0], py + d[1], pz + d[2]};
+        pbf_clamp(s, p);
+        NX[i] = p[0], NY[i] = p[1], NZ[i] = p[2];
+    }
+}
+
+static void pbf_delta_chunk(rt_sph *s, uint32_t chunk)
+{
+    pbf_delta_args a = {s->drho, 1.f, !(s->p.flags & RT_SPH_PBF_NO_SCORR) && s->p.pbf_scorr_k > 0.f};
+    pbf_delta(s, chunk, &a);
+}
+
+static void pbf_warm_chunk(rt_sph *s, uint32_t chunk)
+{
+    /* lambda = -p dt^2 / rho0 */
+    pbf_delta_args a = {s->pr, -s->pbf_dt * s->pbf_dt / s->p.rest_density, false};
+    pbf_delta(s, chunk, &a);
+}
+
+/* v += (x_final - x_predicted) / dt, x = x_final (speed held at the limit). */
+static void pbf_finish_chunk(rt_sph *s, uint32_t chunk)
+{
+    uint32_t b, e;
+    sph_chunk_rows(s, chunk, &b, &e);
+    const float inv_dt = 1.f / s->pbf_dt, vlim = s->p.velocity_limit, vlim2 = vlim * vlim;
+    const float *PX = s->pc[0], *PY = s->pc[1], *PZ = s->pc[2];
+    sph_chunk_out acc = s->out[chunk];
+    for (uint32_t i = b; i < e; ++i) {
+        float v[3] = {s->vx[i] + (PX[i] - s->x[i]) * inv_dt, s->vy[i] + (PY[i] - s->y[i]) * inv_dt,
+                      s->vz[i] + (PZ[i] - s->z[i]) * inv_dt};
+        float v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        if (!isfinite(v2) || !isfinite(PX[i] + PY[i] + PZ[i])) {
+            /* keep the predicted (finite) position at rest */
+            s->vx[i] = s->vy[i] = s->vz[i] = 0.f;
+            if (acc.bad == UINT32_MAX)
+                acc.bad = i, acc.bad_kind = 1, acc.bad_value = v2;
+            continue;
+        }
+        if (v2 > vlim2) {
+            float k = vlim / sqrtf(v2);
+            v[0] *= k, v[1] *= k, v[2] *= k;
+            acc.clamped++;
+        }
+        s->x[i] = PX[i], s->y[i] = PY[i], s->z[i] = PZ[i];
+        s->vx[i] = v[0], s->vy[i] = v[1], s->vz[i] = v[2];
+    }
+    s->out[chunk] = acc;
+}
+
+/* Wall-law friction of the no-slip walls (the shear of sph_wall_accel) as a velocity change
+ * over dt, never beyond stopping the particle relative to the wall. */
+static void pbf_friction(const rt_sph *s, float px, float py, float pz, float v[3])
+{
+    sph_wall_hit w[SPH_MAX_WALLS];
+    float fr[SPH_MAX_WALLS], inside, extra;
+    int nw = rt_sph_gather_walls(s, px, py, pz, w, SPH_MAX_WALLS);
+    if (!nw)
+        return;
+    sph_wall_share(s, w, nw, fr, &inside, &extra);
+    for (int k = 0; k < nw; ++k) {
+        if (!w[k].no_slip)
+            continue;
+        const float *wv = w[k].vel, *wn = w[k].n;
+        float rx = v[0] - wv[0], ry = v[1] - wv[1], rz = v[2] - wv[2];
+        float vn = rx * wn[0] + ry * wn[1] + rz * wn[2];
+        float tx = rx - vn * wn[0], ty = ry - vn * wn[1], tz = rz - vn * wn[2];
+        float ut = sqrtf(tx * tx + ty * ty + tz * tz);
+        if (!(ut > 0.f))
+            continue;
+        float y = w[k].d > 0.25f * s->p.spacing ? w[k].d : 0.25f * s->p.spacing;
+        float us = (float)rt_sph_wall_friction_velocity(ut, y, s->p.kinematic_viscosity);
+        float gr = (float)rt_sph_wall_density_gradient(w[k].d, s->H);
+        float dv = s->pbf_dt * us * us * s->fric_scale * gr;
+        float f = dv < ut ? dv / ut : 1.f;
+        v[0] -= f * tx, v[1] -= f * ty, v[2] -= f * tz;
+    }
+}
+
+/* At the final positions: density (for the report and the columns), XSPH viscosity
+ * v_i += c sum_j V (v_j - v_i) W_ij, the vorticity omega_i = sum_j V v_ij x grad_j W_ij (for the
+ * confinement pass) and the no-slip walls' friction; the new velocities go to pn. */
+static void pbf_visc_chunk(rt_sph *s, uint32_t chunk)
+{
+    uint32_t b, e;
+    sph_chunk_rows(s, chunk, &b, &e);
+    const float H = s->H, H2 = s->H2, eps2 = 1e-12f * H2, rho0 = s->p.rest_density;
+    const float V = s->mass / rho0, mk = s->mass * s->k_poly6, ks = s->k_spiky;
+    const float c = (s->p.flags & RT_SPH_PBF_NO_XSPH) ? 0.f : s->p.pbf_xsph;
+    const bool vort = s->p.pbf_vorticity > 0.f;
+    const float *X = s->x, *Y = s->y, *Z = s->z, *VX = s->vx, *VY = s->vy, *VZ = s->vz;
+    sph_chunk_out acc = s->out[chunk];
+    for (uint32_t i = b; i < e; ++i) {
+        const float px = X[i], py = Y[i], pz = Z[i], vxi = VX[i], vyi = VY[i], vzi = VZ[i];
+        const uint32_t *L = s->cnb[chunk] + s->nb_start[i];
+        const uint32_t nn = s->nb_count[i];
+        float sw = H2 * H2 * H2, ux = 0.f, uy = 0.f, uz = 0.f, wx = 0.f, wy = 0.f, wz = 0.f;
+        uint32_t k = 0;
+#if PBF_SSE
+        if (!vort) {
+            const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), vpz = _mm_set1_ps(pz);
+            const __m128 vvx = _mm_set1_ps(vxi), vvy = _mm_set1_ps(vyi), vvz = _mm_set1_ps(vzi);
+            const __m128 vH2 = _mm_set1_ps(H2), zero = _mm_setzero_ps();
+            __m128 w4 = zero, ux4 = zero, uy4 = zero, uz4 = zero;
+            for (; k + 4 <= nn; k += 4) {
+                uint32_t j0 = L[k], j1 = L[k + 1], j2 = L[k + 2], j3 = L[k + 3];
+                __m128 dx = vpx - _mm_setr_ps(X[j0], X[j1], X[j2], X[j3]);
+                __m128 dy = vpy - _mm_setr_ps(Y[j0], Y[j1], Y[j2], Y[j3]);
+                __m128 dz = vpz - _mm_setr_ps(Z[j0], Z[j1], Z[j2], Z[j3]);
+                __m128 r2 = dx * dx + dy * dy + dz * dz;
+                __m128 t = _mm_max_ps(vH2 - r2, zero), w = t * t * t;
+                w4 += w;
+                ux4 += (_mm_setr_ps(VX[j0], VX[j1], VX[j2], VX[j3]) - vvx) * w;
+                uy4 += (_mm_setr_ps(VY[j0], VY[j1], VY[j2], VY[j3]) - vvy) * w;
+                uz4 += (_mm_setr_ps(VZ[j0], VZ[j1], VZ[j2], VZ[j3]) - vvz) * w;
+            }
+            sw += pbf_hsum(w4), ux = pbf_hsum(ux4), uy = pbf_hsum(uy4), uz = pbf_hsum(uz4);
+        }
+#endif
+        for (; k < nn; ++k) {
+            uint32_t j = L[k];
+            float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
+            float r2 = dx * dx + dy * dy + dz * dz;
+            float t = H2 - r2 > 0.f ? H2 - r2 : 0.f, w = t * t * t;
+            float dvx = VX[j] - vxi, dvy = VY[j] - vyi, dvz = VZ[j] - vzi;
+            sw += w;
+            ux += dvx * w, uy += dvy * w, uz += dvz * w;
+            if (vort && r2 > eps2) {
+                /* grad_j W_ij = +ks (H - r)^2 d / r, d = x_i - x_j */
+                float rl = sqrtf(r2), hr = H - rl > 0.f ? H - rl : 0.f, q = hr * hr / rl;
+                float gx = q * dx, gy = q * dy, gz = q * dz;
+                wx += dvy * gz - dvz * gy, wy += dvz * gx - dvx * gz, wz += dvx * gy - dvy * gx;
+            }
+        }
+        float wall_rho, gw[3], ig;
+        pbf_walls(s, px, py, pz, &wall_rho, gw, &ig);
+        float rho = mk * sw + wall_rho;
+        s->rho[i] = rho;
+        const float cw = c * V * s->k_poly6;
+        float v[3] = {vxi + cw * ux, vyi + cw * uy, vzi + cw * uz};
+        if (s->friction)
+            pbf_friction(s, px, py, pz, v);
+        s->pn[0][i] = v[0], s->pn[1][i] = v[1], s->pn[2][i] = v[2];
+        if (vort) {
+            s->ax[i] = V * ks * wx, s->ay[i] = V * ks * wy, s->az[i] = V * ks * wz;
+            s->tmp[i] = sqrtf(s->ax[i] * s->ax[i] + s->ay[i] * s->ay[i] + s->az[i] * s->az[i]);
+        }
+        float err = (rho - rho0) / rho0;
+        if (err > acc.rho_err_max)
+            acc.rho_err_max = err;
+        if (err > 0.f)
+            acc.rho_err_sum += err;
+        acc.pairs += nn;
+    }
+    s->out[chunk] = acc;
+}
+
+/* v = the new velocities (+ dt eps N x omega with vorticity confinement, N = eta/|eta|,
+ * eta = sum_j V |omega_j| grad_i W_ij); energies and the largest speed. */
+static void pbf_commit_chunk(rt_sph *s, uint32_t chunk)
+{
+    uint32_t b, e;
+    sph_chunk_rows(s, chunk, &b, &e);
+    const float H = s->H, H2 = s->H2, eps2 = 1e-12f * H2, m = s->mass;
+    const float V = m / s->p.rest_density, ks = s->k_spiky, ve = s->p.pbf_vorticity * s->pbf_dt;
+    const bool vort = s->p.pbf_vorticity > 0.f;
+    const float *g = s->p.gravity, *lo = s->p.domain_min;
+    sph_chunk_out acc = s->out[chunk];
+    double ke = 0.0, pe = 0.0;
+    for (uint32_t i = b; i < e; ++i) {
+        float v[3] = {s->pn[0][i], s->pn[1][i], s->pn[2][i]};
+        if (vort) {
+            const uint32_t *L = s->cnb[chunk] + s->nb_start[i];
+            float ex = 0.f, ey = 0.f, ez = 0.f;
+            for (uint32_t k = 0; k < s->nb_count[i]; ++k) {
+                uint32_t j = L[k];
+                float dx = s->x[i] - s->x[j], dy = s->y[i] - s->y[j], dz = s->z[i] - s->z[j];
+                float r2 = dx * dx + dy * dy + dz * dz;
+                if (!(r2 > eps2))
+                    continue;
+                float rl = sqrtf(r2), hr = H - rl > 0.f ? H - rl : 0.f, q = -s->tmp[j] * hr * hr / rl;
+                ex += q * dx, ey += q * dy, ez += q * dz;
+            }
+            float el = sqrtf(ex * ex + ey * ey + ez * ez);
+            if (el > 0.f) {
+                (void)V, (void)ks; /* |eta| normalises: V ks drop out */
+                float nx = ex / el, ny = ey / el, nz = ez / el;
+                const float ox = s->ax[i], oy = s->ay[i], oz = s->az[i];
+                v[0] += ve * (ny * oz - nz * oy), v[1] += ve * (nz * ox - nx * oz), v[2] += ve * (nx * oy - ny * ox);
+            }
+        }
+        s->vx[i] = v[0], s->vy[i] = v[1], s->vz[i] = v[2];
+        float v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        if (v2 > acc.v2_max)
+            acc.v2_max = v2;
+        ke += 0.5 * (double)m * v2;
+        pe -= (double)m * (g[0] * (s->x[i] - lo[0]) + g[1] * (s->y[i] - lo[1]) + g[2] * (s->z[i] - lo[2]));
+    }
+    acc.ke = ke, acc.pe = pe;
+    s->out[chunk] = acc;
+}
+
+/* pr gathered in the sorted order of the last rebuild (tmp as the target). */
+static void pbf_permute_pr_chunk(rt_sph *s, uint32_t chunk)
+{
+    uint32_t b, e;
+    sph_chunk_rows(s, chunk, &b, &e);
+    for (uint32_t i = b; i < e; ++i)
+        s->tmp[i] = s->pr[s->perm[i]];
+}
+
+/* ---- a step ----------------------------------------------------------------------------------- */
+
+/* Pressures of rows without one: the hydrostatic rho0 |g| depth below the highest particle of
+ * the same column (a fresh fluid: every row) or 0 (rows added to a running fluid). */
+static void pbf_init_pressure(rt_sph *s)
+{
+    uint32_t from = s->pbf_valid <= s->n ? s->pbf_valid : 0;
+    if (from >= s->n) {
+        s->pbf_valid = s->n;
+        return;
+    }
+    const float *g = s->p.gravity;
+    float gl = sqrtf(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    for (uint32_t i = from; i < s->n; ++i)
+        s->pr[i] = 0.f;
+    if (from == 0 && gl > 0.f) {
+        int a = fabsf(g[0]) >= fabsf(g[1]) && fabsf(g[0]) >= fabsf(g[2]) ? 0 : (fabsf(g[1]) >= fabsf(g[2]) ? 1 : 2);
+        int u = (a + 1) % 3, w = (a + 2) % 3;
+        float up = g[a] < 0.f ? 1.f : -1.f, c = s->p.spacing;
+        const float *lo = s->p.domain_min, *hi = s->p.domain_max;
+        float *P[3] = {s->x, s->y, s->z};
+        double nu = ceil((hi[u] - lo[u]) / c), nw = ceil((hi[w] - lo[w]) / c);
+        while (nu * nw > (double)(1u << 22))
+            c *= 2.f, nu = ceil((hi[u] - lo[u]) / c), nw = ceil((hi[w] - lo[w]) / c);
+        int NU = (int)nu, NW = (int)nw;
+        float *top = malloc((size_t)NU * (size_t)NW * sizeof *top);
+        if (top) { /* out of memory: zero pressures, the iterations build them up */
+            for (size_t q = 0; q < (size_t)NU * (size_t)NW; ++q)
+                top[q] = -INFINITY;
+            for (uint32_t i = 0; i < s->n; ++i) {
+                size_t q = (size_t)sph_cell_coord(P[u][i], lo[u], 1.f / c, NU) * (size_t)NW +
+                           (size_t)sph_cell_coord(P[w][i], lo[w], 1.f / c, NW);
+                float h = up * P[a][i];
+                top[q] = h > top[q] ? h : top[q];
+            }
+            for (uint32_t i = 0; i < s->n; ++i) {
+                size_t q = (size_t)sph_cell_coord(P[u][i], lo[u], 1.f / c, NU) * (size_t)NW +
+                           (size_t)sph_cell_coord(P[w][i], lo[w], 1.f / c, NW);
+                s->pr[i] = s->p.rest_density * gl * (top[q] - up * P[a][i]);
+            }
+            free(top);
+        }
+    }
+    s->pbf_valid = s->n;
+}
+
+/* Neighbours at the current (predicted) positions: a rebuild (sort, cell scan recording the
+ * Verlet lists; pressures follow the sort) when a particle has moved half the skin since the
+ * last one, else a Verlet walk; both write the exact lists (r < H) the iterations walk and the
+ * density there. */
+static vfx_result pbf_neighbours(rt_sph *s, rt_sph_report *rep, char *err, size_t errlen)
+{
+    bool rebuild = !s->verlet || !s->lists_valid || !(4.f * s->disp2_max < s->skin * s->skin);
+    if (rebuild) {
+        vfx_result r = rt_sph_build_grid(s, err, errlen);
+        if (r)
+            return r;
+        rt_sph_parallel(s, pbf_permute_pr_chunk, false);
+        float *t = s->pr;
+        s->pr = s->tmp, s->tmp = t;
+        rep->neighbor_rebuilds++;
+        s->dens_mode = s->verlet ? 1 : 0;
+    } else {
+        s->dens_mode = 2;
+    }
+    /* the WCSPH density pass writes its EOS term into pr: give it tmp instead */
+    float *t = s->pr;
+    s->pr = s->tmp, s->tmp = t;
+    rt_sph_parallel(s, rt_sph_density_chunk, true);
+    t = s->pr, s->pr = s->tmp, s->tmp = t;
+    if (s->verlet && rebuild) {
+        s->lists_valid = !atomic_load(&s->nb_oom);
+        s->disp2_max = 0.f;
+    }
+    if (atomic_exchange(&s->nb_oom, false)) {
+        s->lists_valid = false;
+        return rt_errf(err, errlen, VFX_ERR_OUT_OF_MEMORY,
+                       "rt_sph_step: out of memory for the neighbour lists of %u particles", s->n);
+    }
+    for (uint32_t c = 0; c < sph_chunk_count(s); ++c)
+        rep->skin_pairs += s->out[c].skin_pairs;
+    return VFX_OK;
+}
+
+static uint32_t pbf_first_bad(const rt_sph *s)
+{
+    for (uint32_t c = 0; c < sph_chunk_count(s); ++c)
+        if (s->out[c].bad != UINT32_MAX)
+            return s->out[c].bad;
+    return UINT32_MAX;
+}
+
+static vfx_result pbf_substep(rt_sph *s, float dt, rt_sph_report *rep, char *err, size_t errlen)
+{
+    s->pbf_dt = dt;
+    rt_sph_update_colliders(s, s->time + dt); /* the constraints hold at the end of the step */
+    rt_sph_parallel(s, pbf_predict_chunk, true);
+    uint32_t nch = sph_chunk_count(s);
+    float d2 = 0.f;
+    for (uint32_t c = 0; c < nch; ++c) {
+        d2 = s->out[c].disp2_max > d2 ? s->out[c].disp2_max : d2;
+        rep->speed_clamped += s->out[c].clamped;
+    }
+    s->disp2_max = d2;
+    vfx_result r = pbf_neighbours(s, rep, err, errlen);
+    if (r)
+        return r;
+    /* iterates: the predicted positions, then xn.. and vxn.. in turn */
+    float *bufA[3] = {s->xn, s->yn, s->zn}, *bufB[3] = {s->vxn, s->vyn, s->vzn};
+    float *cur[3] = {s->x, s->y, s->z};
+    int next_is_a = 1;
+    memcpy(s->pc, cur, sizeof cur);
+    if (s->p.flags & RT_SPH_PBF_WARM_START) {
+        memcpy(s->pn, bufA, sizeof bufA);
+        rt_sph_parallel(s, pbf_warm_chunk, false);
+        memcpy(s->pc, bufA, sizeof bufA);
+        next_is_a = 0;
+    }
+    for (uint32_t it = 0; it < s->p.pbf_iterations; ++it) {
+        rt_sph_parallel(s, pbf_lambda_chunk, true);
+        memcpy(s->pn, next_is_a ? bufA : bufB, sizeof bufA);
+        rt_sph_parallel(s, pbf_delta_chunk, false);
+        memcpy(s->pc, s->pn, sizeof s->pc);
+        next_is_a = !next_is_a;
+        rep->iterations++;
+    }
+    rt_sph_parallel(s, pbf_finish_chunk, false);
+    uint32_t bad = pbf_first_bad(s);
+    for (uint32_t c = 0; c < nch; ++c)
+        rep->speed_clamped += s->out[c].clamped;
+    /* the velocities after viscosity into the free iterate buffer */
+    memcpy(s->pn, next_is_a ? bufA : bufB, sizeof bufA);
+    rt_sph_parallel(s, pbf_visc_chunk, true);
+    rt_sph_parallel(s, pbf_commit_chunk, false);
+    if (bad == UINT32_MAX)
+        bad = pbf_first_bad(s);
+    if (bad != UINT32_MAX) {
+        return rt_errf(err, errlen, VFX_ERR_NUMERIC, "rt_sph_step: particle %u (row %u) got a non-finite "
+                       "position or velocity at t=%.6g s (PBF); it was left at its predicted position, at rest",
+                       s->id[bad], bad, s->time);
+    }
+    return VFX_OK;
+}
+
+/* End-state figures from the chunk reductions of the last step's closing passes. */
+static void pbf_reduce_report(rt_sph *s, rt_sph_report *rep)
+{
+    float emax = 0.f, v2 = 0.f;
+    double esum = 0.0, ke = 0.0, pe = 0.0;
+    uint64_t pairs = 0;
+    for (uint32_t c = 0; c < sph_chunk_count(s); ++c) {
+        const sph_chunk_out *o = &s->out[c];
+        emax = o->rho_err_max > emax ? o->rho_err_max : emax;
+        v2 = o->v2_max > v2 ? o->v2_max : v2;
+        esum += o->rho_err_sum, ke += o->ke, pe += o->pe, pairs += o->pairs;
+    }
+    rep->max_density_error = emax;
+    rep->mean_density_error = s->n ? (float)(esum / s->n) : 0.f;
+    rep->max_speed = sqrtf(v2);
+    rep->kinetic_energy = ke;
+    rep->potential_energy = pe;
+    rep->internal_energy = 0.0;
+    rep->neighbor_pairs += pairs;
+    s->pbf_vmax = rep->max_speed;
+}
+
+/* A call without steps: the densities and energies of the state as it is. */
+static vfx_result pbf_state_report(rt_sph *s, rt_sph_report *rep, char *err, size_t errlen)
+{
+    vfx_result r = pbf_neighbours(s, rep, err, errlen);
+    if (r)
+        return r;
+    float *A[3] = {s->xn, s->yn, s->zn};
+    memcpy(s->pn, A, sizeof A);
+    s->pbf_dt = 1.f; /* no friction applies: the velocities are not kept */
+    bool fr = s->friction;
+    s->friction = false;
+    rt_sph_parallel(s, pbf_visc_chunk, true);
+    s->friction = fr;
+    /* energies without touching the velocities */
+    double ke = 0.0, pe = 0.0;
+    float v2m = 0.f;
+    const float m = s->mass, *g = s->p.gravity, *lo = s->p.domain_min;
+    for (uint32_t i = 0; i < s->n; ++i) {
+        float v2 = s->vx[i] * s->vx[i] + s->vy[i] * s->vy[i] + s->vz[i] * s->vz[i];
+        v2m = v2 > v2m ? v2 : v2m;
+        ke += 0.5 * (double)m * v2;
+        pe -= (double)m * (g[0] * (s->x[i] - lo[0]) + g[1] * (s->y[i] - lo[1]) + g[2] * (s->z[i] - lo[2]));
+    }
+    for (uint32_t c = 0; c < sph_chunk_count(s); ++c)
+        s->out[c].ke = s->out[c].pe = 0.0, s->out[c].v2_max = 0.f;
+    if (s->n)
+        s->out[0].ke = ke, s->out[0].pe = pe, s->out[0].v2_max = v2m;
+    pbf_reduce_report(s, rep);
+    return VFX_OK;
+}
+
+vfx_result rt_sph_pbf_step(rt_sph *s, float frame_dt, rt_sph_report *rep, char *err, size_t errlen)
+{
+    if (s->pbf_D0 == 0.f)
+        pbf_calibrate(s);
+    /* steps: no longer than pbf_max_step, and no particle moving more than pbf_cfl H in one
+     * (the speed at the start plus what gravity adds over the frame) */
+    const float *g = s->p.gravity;
+    float gl = sqrtf(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]), vmax = 0.f;
+    for (uint32_t i = 0; i < s->n; ++i) {
+        float v2 = s->vx[i] * s->vx[i] + s->vy[i] * s->vy[i] + s->vz[i] * s->vz[i];
+        vmax = v2 > vmax ? v2 : vmax;
+    }
+    vmax = sqrtf(vmax);
+    double steps = ceil((double)frame_dt / s->p.pbf_max_step - 1e-6);
+    double cfl = ceil((double)frame_dt * (vmax + gl * frame_dt) / (s->p.pbf_cfl * s->H) - 1e-6);
+    if (cfl > steps)
+        steps = cfl;
+    if (steps > s->p.max_substeps)
+        steps = s->p.max_substeps, rep->cap_hit = true;
+    uint32_t n = frame_dt > 0.f ? (uint32_t)(steps > 1 ? steps : 1) : 0;
+    float dt = n ? frame_dt / (float)n : 0.f;
+    rep->dt_min = n ? dt : 0.0;
+    rep->dt_max = rep->dt_last = n ? dt : 0.0;
+    rep->dt_limit = cfl > ceil((double)frame_dt / s->p.pbf_max_step - 1e-6) ? RT_SPH_DT_CFL : RT_SPH_DT_FRAME;
+    vfx_result r = VFX_OK;
+    if (s->verlet && s->lists_valid && s->n) {
+        rt_sph_parallel(s, rt_sph_disp_chunk, false); /* columns may have been moved by hand */
+        float d2 = 0.f;
+        for (uint32_t c = 0; c < sph_chunk_count(s); ++c)
+            d2 = s->out[c].disp2_max > d2 ? s->out[c].disp2_max : d2;
+        s->disp2_max = d2;
+    }
+    for (uint32_t k = 0; k < n; ++k) {
+        if (s->nem && (r = rt_sph_emit(s, k ? dt : 0.0, &rep->emitted, err, errlen)))
+            break;
+        pbf_init_pressure(s);
+        if (s->n && (r = pbf_substep(s, dt, rep, err, errlen)))
+            break;
+        s->time += dt;
+        rep->substeps++;
+        rep->simulated_time += dt;
+    }
+    if (!r && s->n && rep->substeps)
+        pbf_reduce_report(s, rep);
+    else if (!r && s->n) {
+        pbf_init_pressure(s);
+        r = pbf_state_report(s, rep, err, errlen);
+    }
+    return r;
+}

@@ -1,0 +1,198 @@
+/* Position Based Fluids (runtime/sim/sph_pbf.c): the stiff cases the WCSPH suite runs (particles
+ * on one point, a column dropped onto a thin wall, speeds at the cap), bitwise determinism over
+ * thread counts, and a closed tank at rest whose energy must not grow. Every case checks the
+ * invariants of test_sph: finite columns, every particle inside the domain. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "sim/sph.h"
+
+static rt_sph *make(rt_sph_desc d)
+{
+    rt_sph *s = NULL;
+    char err[256];
+    d.solver = RT_SPH_SOLVER_PBF;
+    vfx_result r = rt_sph_create(&d, &s, err, sizeof err);
+    if (r)
+        fprintf(stderr, "create: %s\n", err);
+    assert_int_equal(r, VFX_OK);
+    return s;
+}
+
+static void check_state(rt_sph *s)
+{
+    const rt_sph_desc *p = rt_sph_params(s);
+    rt_sph_columns c = rt_sph_get_columns(s);
+    for (uint32_t i = 0; i < c.count; ++i) {
+        float v[7] = {c.x[i], c.y[i], c.z[i], c.vx[i], c.vy[i], c.vz[i], c.density[i]};
+        for (int k = 0; k < 7; ++k)
+            assert_true(isfinite(v[k]));
+        for (int a = 0; a < 3; ++a) {
+            float q = a == 0 ? c.x[i] : a == 1 ? c.y[i] : c.z[i];
+            assert_true(q >= p->domain_min[a] && q <= p->domain_max[a]);
+        }
+    }
+}
+
+static rt_sph_desc small_box(void)
+{
+    rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.1f, 0.2f, 0.06f}, .threads = 2};
+    return d;
+}
+
+static void test_pbf_params(void **state)
+{
+    (void)state;
+    rt_sph *s = make(small_box());
+    const rt_sph_desc *p = rt_sph_params(s);
+    assert_int_equal(p->solver, RT_SPH_SOLVER_PBF);
+    assert_int_equal(p->pbf_iterations, 4);
+    assert_true(fabsf(p->pbf_max_step - 1.f / 60.f) < 1e-9f);
+    rt_sph_destroy(s);
+    rt_sph_desc bad = small_box();
+    bad.solver = 7;
+    rt_sph *t = NULL;
+    char err[256];
+    assert_int_equal(rt_sph_create(&bad, &t, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "desc.solver"));
+    bad.solver = RT_SPH_SOLVER_PBF;
+    bad.pbf_scorr_dq = 1.5f;
+    assert_int_equal(rt_sph_create(&bad, &t, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+}
+
+/* 300 particles on one point: the coincident pairs are pushed apart along fixed directions, each
+ * iteration moves a particle at most H/2, so the cloud spreads without a blow-up. */
+static void test_pbf_all_at_one_point(void **state)
+{
+    (void)state;
+    rt_sph *s = make(small_box());
+    enum { N = 300 };
+    float x[N], y[N], z[N];
+    for (int i = 0; i < N; ++i)
+        x[i] = 0.05f, y[i] = 0.1f, z[i] = 0.03f;
+    assert_int_equal(rt_sph_add_particles(s, N, x, y, z, NULL, NULL, NULL, NULL, 0), VFX_OK);
+    rt_sph_report r;
+    assert_int_equal(rt_sph_step(s, 0.f, &r, NULL, 0), VFX_OK);
+    assert_true(r.max_density_error > 10.f);
+    const rt_sph_desc *p = rt_sph_params(s);
+    for (int f = 0; f < 30; ++f) {
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, NULL, 0), VFX_OK);
+        check_state(s);
+        /* per step a particle moves at most iterations * H/2 by the corrections plus what it
+         * had: the speed after a step is bounded by the velocity limit (the solver's cap) */
+        assert_true(r.max_speed <= p->velocity_limit * 1.0001f);
+    }
+    print_message("PBF one point: max density error after 0.5 s %.3f, max speed %.3f\n", r.max_density_error,
+                  r.max_speed);
+    assert_true(r.max_density_error < 1.0f); /* spread: from > 1000% to below 100% */
+    rt_sph_destroy(s);
+}
+
+/* Speeds beyond the limit are held at it (PBF has no dt to halve: the state stays valid). */
+static void test_pbf_speed_cap(void **state)
+{
+    (void)state;
+    rt_sph_desc d = small_box();
+    d.velocity_limit = 1.f;
+    rt_sph *s = make(d);
+    float x[3] = {0.02f, 0.05f, 0.08f}, y[3] = {0.1f, 0.1f, 0.1f}, z[3] = {0.03f, 0.03f, 0.03f};
+    float vy[3] = {0.f, 0.f, -50.f};
+    assert_int_equal(rt_sph_add_particles(s, 3, x, y, z, NULL, vy, NULL, NULL, 0), VFX_OK);
+    rt_sph_report r;
+    assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, NULL, 0), VFX_OK);
+    check_state(s);
+    assert_true(r.speed_clamped >= 1);
+    assert_true(r.max_speed <= 1.0001f);
+    rt_sph_destroy(s);
+}
+
+/* A column dropped onto a wall one spacing thick (a box collider): nothing passes into it. */
+static void test_pbf_thin_wall(void **state)
+{
+    (void)state;
+    rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.2f, 0.3f, 0.04f}, .threads = 2};
+    rt_sph *s = make(d);
+    rt_sph_collider wall = {.kind = RT_SPH_BOX, .center = {0.1f, 0.08f, 0.02f}, .half = {0.1f, 0.005f, 0.1f}};
+    assert_int_equal(rt_sph_add_collider(s, &wall, NULL, NULL, 0), VFX_OK);
+    float lo[3] = {0.06f, 0.15f, 0}, hi[3] = {0.14f, 0.28f, 0.04f};
+    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
+    rt_sph_report r;
+    for (int f = 0; f < 60; ++f) {
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, NULL, 0), VFX_OK);
+        check_state(s);
+        rt_sph_columns c = rt_sph_get_columns(s);
+        for (uint32_t i = 0; i < c.count; ++i)
+            assert_false(fabsf(c.y[i] - 0.08f) < 0.005f); /* not inside the plate */
+        assert_true(r.max_density_error < 0.5f);
+    }
+    rt_sph_destroy(s);
+}
+
+/* One and two threads over 3 chunks: the columns bitwise equal (fixed iteration counts and
+ * chunk-ordered reductions). */
+static void test_pbf_threads_bitwise(void **state)
+{
+    (void)state;
+    rt_sph *s[2];
+    for (int t = 0; t < 2; ++t) {
+        rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.3f, 0.2f, 0.1f},
+                          .threads = (uint32_t)(t + 1)};
+        s[t] = make(d);
+        float lo[3] = {0, 0, 0}, hi[3] = {0.12f, 0.2f, 0.1f};
+        assert_int_equal(rt_sph_add_block(s[t], lo, hi, NULL, NULL, 0), VFX_OK); /* 2,400: 3 chunks */
+        rt_sph_report r;
+        for (int f = 0; f < 10; ++f)
+            assert_int_equal(rt_sph_step(s[t], 1.f / 60.f, &r, NULL, 0), VFX_OK);
+    }
+    rt_sph_columns c[2] = {rt_sph_get_columns(s[0]), rt_sph_get_columns(s[1])};
+    assert_int_equal(rt_sph_thread_count(s[1]), 2);
+    assert_int_equal(c[0].count, c[1].count);
+    assert_memory_equal(c[0].x, c[1].x, c[0].count * sizeof(float));
+    assert_memory_equal(c[0].vy, c[1].vy, c[0].count * sizeof(float));
+    assert_memory_equal(c[0].density, c[1].density, c[0].count * sizeof(float));
+    rt_sph_destroy(s[0]);
+    rt_sph_destroy(s[1]);
+}
+
+/* A closed tank at rest (no paddle): total energy (kinetic + gravity; PBF has no internal energy)
+ * must not grow by more than 1% of the initial energy between sampled points. */
+static void test_pbf_closed_tank_energy(void **state)
+{
+    (void)state;
+    rt_sph_desc d = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {0.6f, 0.4f, 0.3f}, .threads = 2};
+    rt_sph *s = make(d);
+    float lo[3] = {0, 0, 0}, hi[3] = {0.6f, 0.12f, 0.3f};
+    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
+    rt_sph_report r;
+    assert_int_equal(rt_sph_step(s, 0.f, &r, NULL, 0), VFX_OK);
+    double e0 = r.kinetic_energy + r.potential_energy, prev = e0, vmax = 0;
+    for (int f = 0; f < 120; ++f) {
+        assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, NULL, 0), VFX_OK);
+        check_state(s);
+        vmax = r.max_speed > vmax ? r.max_speed : vmax;
+        if (f % 10 == 9) {
+            double e = r.kinetic_energy + r.potential_energy;
+            assert_true(e <= prev + 0.01 * fabs(e0));
+            prev = e;
+        }
+    }
+    print_message("PBF closed tank: energy %.4g -> %.4g J, max speed %.3f m/s, mean compression %.4f\n", e0, prev,
+                  vmax, r.mean_density_error);
+    rt_sph_destroy(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_pbf_params),       cmocka_unit_test(test_pbf_all_at_one_point),
+        cmocka_unit_test(test_pbf_speed_cap),    cmocka_unit_test(test_pbf_thin_wall),
+        cmocka_unit_test(test_pbf_threads_bitwise), cmocka_unit_test(test_pbf_closed_tank_energy),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
