@@ -15,17 +15,6 @@
 #include "water_params.h"
 
 
-static void paper_free(water_state *s)
-{
-    GLuint tex[] = {s->cur, s->next1, s->pot, s->st, s->br, s->reft, s->depth, s->pyr, s->grad, s->back};
-    glDeleteTextures(10, tex);
-    GLuint fb[] = {s->fbo_dist, s->fbo_pot, s->fbo_grad, s->fbo_back};
-    glDeleteFramebuffers(4, fb);
-    s->cur = s->next1 = s->pot = s->st = s->br = s->reft = s->depth = s->pyr = 0;
-    s->grad = s->back = 0;
-    s->fbo_dist = s->fbo_pot = s->fbo_grad = s->fbo_back = 0;
-}
-
 static void groups_free(vfx_context *ctx, water_state *s)
 {
     for (uint32_t g = 0; g < s->group_count; ++g)
@@ -59,6 +48,7 @@ static vfx_result water_create(vfx_context *ctx, void **out)
     water_state *s = volfx_alloc(ctx, sizeof *s);
     if (!s)
         return VFX_ERR_OUT_OF_MEMORY;
+    s->active = -1;
     glCreateVertexArrays(1, &s->vao);
     /* one SSBO binding must hold a whole column */
     GLint64 block = 0;
@@ -81,9 +71,8 @@ static void water_destroy(vfx_context *ctx, void *state)
 {
     water_state *s = state;
     groups_free(ctx, s);
-    paper_free(s);
+    volfx_water_views_destroy(ctx, s);
     volfx_water_grid_destroy(ctx, s->grid);
-    volfx_water_tile_destroy(ctx, s->tile);
     volfx_water_aniso_destroy(ctx, s->aniso);
     volfx_water_spray_destroy(ctx, s->spray);
     volfx_free(ctx, s->chunk_rev);
@@ -95,61 +84,14 @@ static void water_destroy(vfx_context *ctx, void *state)
     glDeleteBuffers(WATER_COUNTER_RING, s->ring);
     if (s->counters)
         glDeleteBuffers(1, &s->counters);
-    if (ctx->water_dist_tex) {
-        glDeleteTextures(1, &ctx->water_dist_tex);
-        ctx->water_dist_tex = 0;
-    }
     volfx_free(ctx, s);
 }
 
+/* Targets are per view and made at the size the view is drawn at (water_view.c): a resize of
+ * the context allocates nothing here, so a second view at another size costs no reallocation. */
 static vfx_result water_resize(vfx_context *ctx, void *state, uint32_t width, uint32_t height)
 {
-    water_state *s = state;
-    if (ctx->water_dist_tex)
-        glDeleteTextures(1, &ctx->water_dist_tex);
-    glCreateTextures(GL_TEXTURE_2D, 1, &ctx->water_dist_tex);
-    glTextureStorage2D(ctx->water_dist_tex, 1, GL_R32F, (GLsizei)width, (GLsizei)height);
-    glTextureParameteri(ctx->water_dist_tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTextureParameteri(ctx->water_dist_tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    volfx_gpu_label(GL_TEXTURE, ctx->water_dist_tex, "water.dist");
-    s->width = width;
-    s->height = height;
-    paper_free(s);
-    s->cur = volfx_water_make_tex(GL_R32F, width, height, 1, "water.dist_cur");
-    s->next1 = volfx_water_make_tex(GL_R32F, width, height, 1, "water.dist_next");
-    s->pot = volfx_water_make_tex(GL_RGBA16F, width, height, 1, "water.potential");
-    s->st = volfx_water_make_tex(GL_RGBA32F, width, height, 1, "water.state");
-    s->br = volfx_water_make_tex(GL_RGBA32F, width, height, 1, "water.bracket");
-    s->reft = volfx_water_make_tex(GL_R32F, width, height, 1, "water.refine_t");
-    s->depth = volfx_water_make_tex(GL_DEPTH_COMPONENT32F, width, height, 1, "water.depth");
-    int levels = 1;
-    while (levels < 8 && ((width >> levels) > 0 || (height >> levels) > 0))
-        ++levels;
-    s->pyr_levels = levels;
-    s->pyr = volfx_water_make_tex(GL_RG32F, width, height, levels, "water.minmax_pyramid");
-    s->grad = volfx_water_make_tex(WATER_GRAD_FORMAT, width, height, 1, "water.surface_gradient");
-    s->back = volfx_water_make_tex(GL_R32F, width, height, 1, "water.back_distance");
-    glCreateFramebuffers(1, &s->fbo_grad);
-    glNamedFramebufferTexture(s->fbo_grad, GL_COLOR_ATTACHMENT0, s->grad, 0);
-    glCreateFramebuffers(1, &s->fbo_back);
-    glNamedFramebufferTexture(s->fbo_back, GL_COLOR_ATTACHMENT0, s->back, 0);
-    glCreateFramebuffers(1, &s->fbo_dist);
-    glNamedFramebufferTexture(s->fbo_dist, GL_COLOR_ATTACHMENT0, s->cur, 0);
-    glNamedFramebufferTexture(s->fbo_dist, GL_DEPTH_ATTACHMENT, s->depth, 0);
-    glCreateFramebuffers(1, &s->fbo_pot);
-    glNamedFramebufferTexture(s->fbo_pot, GL_COLOR_ATTACHMENT0, s->pot, 0);
-    if (glCheckNamedFramebufferStatus(s->fbo_dist, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE ||
-        glCheckNamedFramebufferStatus(s->fbo_pot, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE ||
-        glCheckNamedFramebufferStatus(s->fbo_grad, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE ||
-        glCheckNamedFramebufferStatus(s->fbo_back, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-        return volfx_fail(ctx, VFX_ERR_GL, "water resize %ux%u: incomplete framebuffer", width, height);
-    if (!s->counters) {
-        glCreateBuffers(1, &s->counters);
-        glNamedBufferStorage(s->counters, WATER_COUNTERS * sizeof(uint32_t), NULL, GL_DYNAMIC_STORAGE_BIT);
-    }
-    const char *e = volfx_gpu_error_string();
-    if (e)
-        return volfx_fail(ctx, VFX_ERR_GL, "water resize %ux%u: %s", width, height, e);
+    (void)ctx, (void)state, (void)width, (void)height;
     return VFX_OK;
 }
 
@@ -489,7 +431,7 @@ static vfx_result tile_lists(vfx_context *ctx, water_state *s, volfx_water_tile_
         return VFX_ERR_OUT_OF_MEMORY;
     *in = (volfx_water_tile_input){s->cols, s->count, &s->params, s->width, s->height, ctx->water_dist_tex,
                                    s->counters, s->have_last ? s->last[10] : 0, s->view_proj, s->lo, s->hi,
-                                   frame->eye, fabsf(frame->proj[5]) * 0.5f * (float)s->height, s->frame_no, 0, 0.0f};
+                                   frame->eye, fabsf(frame->proj[5]) * 0.5f * (float)s->height, volfx_water_view_frames(s), 0, 0.0f};
     /* per-particle kernels: the anisotropic ones, or the host's radius / kernel columns */
     if (s->params.method == VFX_WATER_METHOD_TILE &&
         (s->kp.kernel == VFX_WATER_KERNEL_ANISOTROPIC || volfx_water_aniso_has_columns(s->aniso))) {
@@ -522,10 +464,9 @@ static vfx_result paper_finish(vfx_context *ctx, water_state *s, const vfx_frame
     return r ? r : volfx_water_tile_finish(ctx, s->tile, &in, frame, targets, s->st, s->cur);
 }
 
-static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
+static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
                                volfx_frame_targets *targets)
 {
-    water_state *s = state;
     const vfx_water_params *p = &s->params;
     targets->water_dist = ctx->water_dist_tex;
     volfx_stat_set(ctx, "water.position_buffers", s->group_count);
@@ -618,6 +559,22 @@ static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_vi
     return VFX_OK;
 }
 
+static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
+                               volfx_frame_targets *targets)
+{
+    water_state *s = state;
+    if (s->counters == 0) {
+        glCreateBuffers(1, &s->counters);
+        glNamedBufferStorage(s->counters, WATER_COUNTERS * sizeof(uint32_t), NULL, GL_DYNAMIC_STORAGE_BIT);
+    }
+    vfx_result r = volfx_water_view_begin(ctx, s, targets->view_id, frame->width, frame->height,
+                                          s->params.method != VFX_WATER_METHOD_TILE);
+    if (r == VFX_OK)
+        r = render_view(ctx, s, frame, targets);
+    volfx_water_view_end(s, r == VFX_OK);
+    return r;
+}
+
 vfx_result volfx_water_debug_gradient(vfx_context *ctx, float *out, size_t count)
 {
     water_state *s = ctx->effect_state[VFX_EFFECT_WATER];
@@ -668,7 +625,9 @@ static vfx_result water_read_raw(vfx_context *ctx, void *state, float *out, size
 {
     water_state *s = state;
     size_t n = (size_t)s->width * s->height;
-    if (count < n || !ctx->water_dist_tex)
+    if (!ctx->water_dist_tex || s->last_method_drawn == UINT32_MAX || s->frame_no == 0)
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "water read_raw: no water frame drawn yet");
+    if (count < n)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water read_raw: %zu floats, need %zu", count, n);
     return volfx_gpu_read_top_first(ctx, ctx->water_dist_tex, GL_RED, 1, -1, s->width, s->height, out);
 }

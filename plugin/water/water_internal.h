@@ -44,6 +44,24 @@ typedef struct water_group {
     uint32_t first, count;
 } water_group;
 
+/* The most GPU memory one view's water targets may take: 8192x8192 with TILE (1.5 GiB) fits,
+ * 16384x16384 (6 GiB) is refused before anything is allocated (docs/water.md "Views"). */
+#define WATER_VIEW_BYTES_MAX (2ull << 30)
+
+/* One view's state (water_view.c): its targets at its size (the paper method's only once one of
+ * the other methods drew in it) and its TILE state with the temporal history. */
+typedef struct water_view {
+    uint32_t id;
+    bool live;
+    uint64_t used;         /* view_clock when last drawn (the least recent is replaced) */
+    uint64_t frames;       /* frames drawn in this view: temporal reuse needs consecutive ones */
+    uint32_t width, height;
+    GLuint dist, cur, next1, pot, st, br, reft, depth, pyr, grad, back;
+    GLuint fbo_dist, fbo_pot, fbo_grad, fbo_back;
+    int pyr_levels;
+    volfx_water_tile *tile;
+} water_view;
+
 typedef struct water_state {
     GLuint cols[3];        /* group 0's columns: the compute paths (brute, NO_BLEND) read only it */
     water_group *groups;   /* position buffers of at most buffer_cap particles each */
@@ -89,8 +107,23 @@ typedef struct water_state {
     float view_proj[16];
     GLuint vao; /* empty: billboards are built from gl_VertexID / gl_InstanceID */
     volfx_ubo frame_ubo; /* water_frame_block */
+    water_view views[VFX_MAX_VIEWS];
+    int active;            /* the view being drawn (its targets are in the fields above), -1 none */
+    uint64_t view_clock;
 } water_state;
 
+/* Makes `id`'s view the active one (a free or the least recent slot for a new id), its targets at
+ * width x height (with the paper method's when `paper`), reallocated only when its own size
+ * changed; copies them into s. A size whose targets pass WATER_VIEW_BYTES_MAX fails before
+ * allocating (VFX_ERR_UNSUPPORTED, the bytes in the message). */
+vfx_result volfx_water_view_begin(vfx_context *ctx, water_state *s, uint32_t id, uint32_t width, uint32_t height,
+                                  bool paper);
+/* Keeps what the frame made (the TILE state) in the active view; counts the frame when drawn. */
+void volfx_water_view_end(water_state *s, bool drawn);
+/* Frames the active view has drawn (the temporal history's clock). */
+uint64_t volfx_water_view_frames(const water_state *s);
+/* Frees every view's targets and TILE state. */
+void volfx_water_views_destroy(vfx_context *ctx, water_state *s);
 /* An R/RG/RGBA texture of one or more levels with nearest filtering, labelled. */
 GLuint volfx_water_make_tex(GLenum fmt, uint32_t w, uint32_t h, int levels, const char *label);
 /* Fills and binds the WaterFrame block (binding 4) from this frame's camera, parameters and
