@@ -11,16 +11,6 @@
 #include "context.h"
 #include "frame_check.h"
 
-#ifndef VFX_HAS_WATER_OPS
-#define VFX_HAS_WATER_OPS 0
-#endif
-#ifndef VFX_HAS_BEAMS_OPS
-#define VFX_HAS_BEAMS_OPS 0
-#endif
-#ifndef VFX_HAS_VOLUME_OPS
-#define VFX_HAS_VOLUME_OPS 0
-#endif
-
 /* --------------------------------------------------------------------- lifecycle */
 
 /* Binds this context's GL table to the calling thread for the call (gpu/gl.h says why). */
@@ -58,13 +48,13 @@ static vfx_result gl_load(vfx_context *ctx)
 
 static void register_effects(vfx_context *ctx)
 {
-#if VFX_WITH_WATER && VFX_HAS_WATER_OPS
+#if VFX_WITH_WATER
     ctx->effect_ops[VFX_EFFECT_WATER] = &volfx_water_ops;
 #endif
-#if VFX_WITH_BEAMS && VFX_HAS_BEAMS_OPS
+#if VFX_WITH_BEAMS
     ctx->effect_ops[VFX_EFFECT_BEAMS] = &volfx_beams_ops;
 #endif
-#if VFX_WITH_TETVOL && VFX_HAS_VOLUME_OPS
+#if VFX_WITH_TETVOL
     ctx->effect_ops[VFX_EFFECT_VOLUME] = &volfx_volume_ops;
 #endif
     (void)ctx;
@@ -344,9 +334,9 @@ VFX_EXPORT vfx_result vfx_plugin_entry(uint32_t abi_version, const vfx_host_api 
     out->size = sizeof *out;
     out->version = VFX_PLUGIN_API_VERSION;
     out->name = "volfx";
-    out->effects_built = (VFX_WITH_WATER && VFX_HAS_WATER_OPS ? VFX_EFFECT_BIT(VFX_EFFECT_WATER) : 0)
-                         | (VFX_WITH_BEAMS && VFX_HAS_BEAMS_OPS ? VFX_EFFECT_BIT(VFX_EFFECT_BEAMS) : 0)
-                         | (VFX_WITH_TETVOL && VFX_HAS_VOLUME_OPS ? VFX_EFFECT_BIT(VFX_EFFECT_VOLUME) : 0);
+    out->effects_built = (VFX_WITH_WATER ? VFX_EFFECT_BIT(VFX_EFFECT_WATER) : 0)
+                         | (VFX_WITH_BEAMS ? VFX_EFFECT_BIT(VFX_EFFECT_BEAMS) : 0)
+                         | (VFX_WITH_TETVOL ? VFX_EFFECT_BIT(VFX_EFFECT_VOLUME) : 0);
     out->create = plugin_create;
     out->destroy = plugin_destroy;
     out->resize = plugin_resize;

@@ -1,22 +1,10 @@
-/* test_util.c — see test_util.h. */
+/* test_util.c — see test_util.h: the GL-free helpers (shared data, log capture); the GL ones are
+ * in test_gl.c, so GL-free tests link no GL. */
 #include "test_util.h"
-
-#include <epoxy/egl.h>
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-rt_gl_context *test_gl_or_skip(void)
-{
-    rt_gl_context *gl = NULL;
-    rt_gl_context_desc d = {.mode = RT_GL_HEADLESS, .width = 64, .height = 64};
-    if (rt_gl_context_create(&d, &gl) != VFX_OK) {
-        fprintf(stderr, "no headless GL 4.5 context: skipping\n");
-        exit(VFX_TEST_SKIP);
-    }
-    return gl;
-}
 
 const char *test_shared_data_or_skip(const char *rel, char *buf, unsigned buflen)
 {
@@ -41,10 +29,4 @@ void test_log_fn(void *user, vfx_log_level level, const char *message)
         l->errors++;
     else if (level == VFX_LOG_WARN)
         l->warnings++;
-}
-
-void *test_gl_proc(void *user, const char *name)
-{
-    (void)user;
-    return (void *)eglGetProcAddress(name);
 }

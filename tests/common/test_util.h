@@ -1,4 +1,5 @@
-/* test_util.h — shared helpers for tests: a headless GL context or a clean skip (exit 77). */
+/* test_util.h — shared helpers for tests: a headless GL context or a clean skip (exit 77).
+ * test_util.c (GL-free, test_util_dep) and test_gl.c (test_gl_dep, links the GL runtime). */
 #ifndef TEST_UTIL_H
 #define TEST_UTIL_H
 
