@@ -357,6 +357,7 @@ vfx_result game_app_frame(game_app *app, float dt)
             app->environment.eye[k] = (float)app->camera.eye[k];
         rt_renderer_set_environment(app->renderer, &app->environment);
     }
+    rt_renderer_set_origin(app->renderer, app->origin);
     rt_renderer_begin_scene(app->renderer, view, proj, app->clear_color);
     rt_component draw_terms[2] = {app->mesh_comp, app->transform_comp};
     rt_query_iter it = rt_query_begin(app->world, draw_terms, 2);

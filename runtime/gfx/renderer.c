@@ -14,8 +14,9 @@
 struct rt_renderer {
     rt_logger log;
     GLuint mesh_prog;
-    GLint u_model, u_view_proj, u_color, u_light, u_environment, u_eye, u_fog;
+    GLint u_model, u_view_proj, u_color, u_light, u_environment, u_eye, u_fog, u_origin;
     rt_renderer_environment env;
+    float origin[3]; /* the scene's origin (rt_renderer_set_origin), for the meshes' patterns */
     GLuint sky_prog, sky_vao;
     GLint u_sky_inv_view_proj, u_sky_sun;
     GLuint scene_fbo, scene_color, scene_depth;
@@ -101,6 +102,7 @@ vfx_result rt_renderer_create(const rt_logger *logger, rt_renderer **out)
     r->u_environment = glGetUniformLocation(r->mesh_prog, "u_environment");
     r->u_eye = glGetUniformLocation(r->mesh_prog, "u_eye");
     r->u_fog = glGetUniformLocation(r->mesh_prog, "u_fog");
+    r->u_origin = glGetUniformLocation(r->mesh_prog, "u_origin");
     *out = r;
     return VFX_OK;
 }
@@ -230,6 +232,12 @@ vfx_result rt_renderer_resize(rt_renderer *r, uint32_t w, uint32_t h)
     return VFX_OK;
 }
 
+void rt_renderer_set_origin(rt_renderer *r, const double origin[3])
+{
+    for (int k = 0; k < 3; ++k)
+        r->origin[k] = (float)origin[k];
+}
+
 vfx_result rt_renderer_set_environment(rt_renderer *r, const rt_renderer_environment *env)
 {
     if (!r || !env)
@@ -300,6 +308,7 @@ void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float 
     glUniformMatrix4fv(r->u_model, 1, GL_FALSE, model);
     glUniformMatrix4fv(r->u_view_proj, 1, GL_FALSE, (const float *)vp);
     glUniform3fv(r->u_color, 1, rgb);
+    glUniform3fv(r->u_origin, 1, r->origin);
     if (r->env.sky) {
         glUniform3fv(r->u_light, 1, r->env.sun_dir);
         glUniform1i(r->u_environment, 1);

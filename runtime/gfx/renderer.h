@@ -35,6 +35,9 @@ typedef struct rt_renderer_environment {
 /* Sets the environment for the frames that follow (the eye moves with the camera: call it when
  * the camera moves). VFX_ERR_GL when the sky's shader cannot be made. */
 vfx_result rt_renderer_set_environment(rt_renderer *r, const rt_renderer_environment *env);
+/* The world position the meshes' model matrices are relative to (a scene's origin): their
+ * stone and checker patterns are laid out in world space, so they stay put whatever the origin. */
+void rt_renderer_set_origin(rt_renderer *r, const double origin[3]);
 /* Draws a mesh with a model matrix and a colour into the scene target. */
 void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float model[16],
                             const float rgb[3]);

@@ -16,15 +16,35 @@
 
 /* ------------------------------------------------------------------ sections */
 
+/* The camera's eye when the scene has no "origin" key: camera.eye read in double (its checks
+ * come with the camera's), or the default eye. */
+static void implicit_origin(pctx *c, const cJSON *cam, rt_scene *s)
+{
+    double eye[3] = {RT_SCENE_DEFAULT_EYE};
+    const cJSON *e = cJSON_IsObject(cam) ? cJSON_GetObjectItemCaseSensitive(cam, "eye") : NULL;
+    const cJSON *x = cJSON_IsArray(e) && cJSON_GetArraySize(e) == 3 ? e->child : NULL;
+    for (int i = 0; x && i < 3; ++i, x = x->next)
+        if (cJSON_IsNumber(x) && isfinite(x->valuedouble) && fabs(x->valuedouble) <= COORD_MAX)
+            eye[i] = x->valuedouble;
+    memcpy(c->origin, eye, sizeof eye);
+    memcpy(s->origin, eye, sizeof eye);
+    c->defaults_world = true;
+}
+
 /* "origin": [x, y, z] or "camera" (the camera's eye), in double: every position the scene holds
  * is stored as its difference to it, so a scene 1e5 units out keeps float32 digits near the
- * camera; the game hands the origin to the plugin in frame view 2. Absent: the world origin. */
+ * camera; the game hands the origin to the plugin in frame view 2. Absent: the camera's eye, as
+ * with "camera" (camera-relative by default, as large-world engines render), but the defaults
+ * of positions the scene leaves out stay world positions, so the scene means what it meant with
+ * the world origin. [0, 0, 0] is the opt-out: float32 world coordinates. */
 static vfx_result parse_origin(pctx *c, const cJSON *root, rt_scene *s)
 {
     const cJSON *o = cJSON_GetObjectItemCaseSensitive(root, "origin");
-    if (!o)
-        return VFX_OK;
     const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
+    if (!o) {
+        implicit_origin(c, cam, s);
+        return VFX_OK;
+    }
     const cJSON *src = o;
     const char *P = "origin";
     if (cJSON_IsString(o)) {
@@ -200,8 +220,13 @@ static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
         return r;
     if ((r = parse_origin(c, root, s)))
         return r;
-    s->camera = (rt_scene_camera){.eye = {0, 2, 6}, .target = {0, 0.5f, 0}, .up = {0, 1, 0}, .fov_y_deg = 60,
+    s->camera = (rt_scene_camera){.eye = {RT_SCENE_DEFAULT_EYE}, .target = {0, 0.5f, 0}, .up = {0, 1, 0}, .fov_y_deg = 60,
                                    .width = 640, .height = 360, .near_plane = 0.05f, .far_plane = 200};
+    if (c->defaults_world && !cJSON_GetObjectItemCaseSensitive(root, "camera"))
+        for (int i = 0; i < 3; ++i) { /* no camera object to read: its world defaults made relative here */
+            s->camera.eye[i] = (float)((double)s->camera.eye[i] - c->origin[i]);
+            s->camera.target[i] = (float)((double)s->camera.target[i] - c->origin[i]);
+        }
     s->beams_view = (vfx_beams_view){.size = sizeof s->beams_view, .version = VFX_BEAMS_VIEW_VERSION,
                                      .saturation = VFX_SATURATE_SMOOTH, .saturate_c = 1};
     const cJSON *v;

@@ -15,6 +15,8 @@
 #include "core/log.h"
 
 #define RT_SCENE_FORMAT_VERSION 1
+/* camera.eye when the scene gives none (also the origin of a scene without "origin") */
+#define RT_SCENE_DEFAULT_EYE 0, 2, 6
 #define RT_SCENE_MAX_BYTES (16u << 20)        /* scene files above 16 MiB are refused */
 #define RT_SCENE_MAX_MESHES 64
 #define RT_SCENE_MAX_BEAMS 256

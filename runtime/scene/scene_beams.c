@@ -60,7 +60,7 @@ static vfx_result joints_value(pctx *c, const cJSON *v, const char *P, uint32_t 
     for (const cJSON *e = v->child; e; e = e->next, ++i) {
         char PI[JPATH];
         rt_scene_join_index(PI, P, i);
-        vfx_result r = rt_scene_vec_value(c, e, PI, 3, COORD, dst + 3 * i);
+        vfx_result r = rt_scene_point_value(c, e, PI, 3, dst + 3 * i); /* positions: relative to the origin */
         if (r)
             return r;
     }

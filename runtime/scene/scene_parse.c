@@ -207,9 +207,12 @@ vfx_result rt_scene_get_point(pctx *c, const cJSON *obj, const char *path, const
     char p[JPATH];
     rt_scene_join(p, path, key);
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (!v)
-        return required ? rt_scene_failf(c, VFX_ERR_FORMAT, p, "required array of 3 numbers missing") : VFX_OK;
-    return rt_scene_point_value(c, v, p, 3, out);
+    if (!v && required)
+        return rt_scene_failf(c, VFX_ERR_FORMAT, p, "required array of 3 numbers missing");
+    if (!v && c->defaults_world) /* the default is a world position: relative to the origin too */
+        for (int i = 0; i < 3; ++i)
+            out[i] = (float)((double)out[i] - c->origin[i]);
+    return v ? rt_scene_point_value(c, v, p, 3, out) : VFX_OK;
 }
 
 vfx_result rt_scene_get_vec(pctx *c, const cJSON *obj, const char *path, const char *key, int n,
@@ -364,8 +367,12 @@ vfx_result rt_scene_parse_transform(pctx *c, const cJSON *obj, const char *path,
             return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "give either matrix or translate/rotate_deg/scale, not both");
         return rt_scene_point_value(c, mv, p, 16, model);
     }
-    /* no translate: at the world origin, which is -origin from the scene's origin */
-    float t[3] = {(float)-c->origin[0], (float)-c->origin[1], (float)-c->origin[2]};
+    /* no translate: at the world origin, which is -origin from the scene's origin (with
+     * defaults_world rt_scene_get_point makes the world default 0 that) */
+    float t[3] = {0, 0, 0};
+    if (!c->defaults_world)
+        for (int i = 0; i < 3; ++i)
+            t[i] = (float)-c->origin[i];
     float rdeg[3] = {0, 0, 0}, s[3] = {1, 1, 1};
     vfx_result r = rt_scene_get_point(c, obj, path, "translate", false, t);
     if (!r) r = rt_scene_get_vec(c, obj, path, "rotate_deg", 3, false, (range){-36000, 36000, false}, rdeg);

@@ -18,6 +18,8 @@ typedef struct pctx {
     size_t errlen;
     const char *base_dir;
     double origin[3]; /* the scene's origin: positions are stored relative to it (scene.h) */
+    bool defaults_world; /* no "origin" key: the origin is the camera's eye, and a position the
+                            scene leaves out keeps its world-space default (stored relative too) */
 } pctx;
 typedef struct range {
     double lo, hi;

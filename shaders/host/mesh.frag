@@ -10,6 +10,7 @@ uniform vec3 u_light_dir;
 uniform int u_environment;
 uniform vec3 u_eye;
 uniform float u_fog;
+uniform vec3 u_origin; // the scene's origin: v_world is relative to it, the patterns are the world's
 out vec4 o_color;
 
 float hash2(vec2 p)
@@ -41,13 +42,14 @@ void main()
         n = -n;
     vec3 l = normalize(u_light_dir);
     float diffuse = max(dot(n, l), 0.0);
+    vec3 p = v_world + u_origin; // the patterns stay put in the world whatever the origin
     if (u_environment == 0) {
-        vec3 c = floor(v_world * 2.0);
+        vec3 c = floor(p * 2.0);
         float checker = mod(c.x + c.y + c.z, 2.0) * 0.15 + 0.85;
         o_color = vec4(u_color * checker * (0.25 + 0.75 * diffuse), 1.0);
         return;
     }
-    vec3 albedo = u_color * stone(v_world, n);
+    vec3 albedo = u_color * stone(p, n);
     vec3 sky_up = volfx_sky(vec3(0.0, 1.0, 0.0), l), sky_side = volfx_sky(vec3(n.x, 0.05, n.z), l);
     vec3 ambient = mix(sky_side, sky_up, clamp(n.y * 0.5 + 0.5, 0.0, 1.0)) * 1.5 + vec3(0.07, 0.07, 0.09);
     vec3 sun = vec3(1.0, 0.72, 0.48) * 1.7 * diffuse;

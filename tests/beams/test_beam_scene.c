@@ -44,7 +44,7 @@ static void test_defaults_and_values(void **state)
     assert_true(fabsf(b[1].intensity - 2.f) < 1e-6f); /* keyframed: halfway from 1 to 3 */
     assert_true(fabsf(b[1].exposure - 1.f) < 1e-6f);
     assert_true(b[1].flow_amount == 0.3f && b[1].flow_speed == 4.f && b[1].flow_scale == 0.7f);
-    assert_true(b[1].v1.head[1] == 1.f);
+    assert_true(b[1].v1.head[1] + s->origin[1] == 1.0); /* stored relative to the default origin (the eye) */
     assert_int_equal(s->beams_view2.bloom, VFX_BEAMS_BLOOM_OFF);
     assert_true(s->beams_view2.bloom_strength == 0.3f);
     assert_int_equal(s->beams_view2.bloom_levels, 3);
@@ -108,8 +108,10 @@ static void test_joints(void **state)
     assert_int_equal(b[0].joint_count, 3);
     assert_int_equal(b[1].joint_first, 3);
     assert_int_equal(b[1].joint_count, 2);
-    assert_true(j[2][1] == 1.f);
-    assert_true(j[3][1] == 1.f && j[4][0] == 2.f && j[4][1] == 2.f); /* halfway */
+    /* joints are positions: stored relative to the scene's origin (here the default eye) */
+    const double *o = s->origin;
+    assert_true(j[2][1] + o[1] == 1.0);
+    assert_true(j[3][1] + o[1] == 1.0 && j[4][0] + o[0] == 2.0 && j[4][1] + o[1] == 2.0); /* halfway */
     /* room for 4 joints: the second beam does not fit and stays straight */
     assert_int_equal(rt_scene_beams2_at(s, 1.0, b, 2, &j[0][0], 4, &nj), 2);
     assert_int_equal(nj, 3);

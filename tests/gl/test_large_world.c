@@ -3,8 +3,10 @@
  * The scene is read in double and stored relative to its origin, the game hands the origin to the
  * plugin in frame view 2, and the shifted renders must match the one at the origin: beams H to
  * 1e-5 relative, water with no hole and a p99 distance difference <= 1% of h, volume opacity RMSE
- * <= 1e-4. The same 1e5 scene with "origin": [0, 0, 0] (float32 world coordinates, what a host
- * without an origin does) is measured too: its beams miss 1e-5, which is what the origin buys. */
+ * <= 1e-4. The 1e4 scene without an "origin" key (camera-relative by default) must meet the same
+ * bounds. The same 1e5 scene with "origin": [0, 0, 0] (the opt-out: float32 world coordinates, what
+ * a host without an origin does) is measured too: its beams miss 1e-5, which is what the origin
+ * buys. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -28,13 +30,13 @@ typedef struct raw3 {
     float water[W * H], beams[W * H], volume[W * H];
 } raw3;
 
-/* The scene with every position plus d; origin "camera" or "zero". */
+/* The scene with every position plus d; origin: the "origin" key's JSON value, NULL for none. */
 static void write_scene(const char *path, double d, const char *origin)
 {
     FILE *f = fopen(path, "w");
     assert_non_null(f);
     fprintf(f,
-            "{\"origin\": %s,\n"
+            "{%s%s%s\n"
             " \"camera\": {\"eye\": [%.17g, %.17g, %.17g], \"target\": [%.17g, %.17g, %.17g], \"fov_y_deg\": 55,"
             " \"near\": 0.05, \"far\": 60},\n"
             " \"water\": {\"source\": \"generator\", \"generator\": {\"kind\": \"box\", \"count\": 2744,"
@@ -47,7 +49,7 @@ static void write_scene(const char *path, double d, const char *origin)
             " \"volume\": {\"generator\": {\"cells\": 4, \"min\": [-0.5, -0.5, -0.5], \"max\": [0.5, 0.5, 0.5]},"
             " \"translate\": [%.17g, %.17g, %.17g], \"workers\": 1,"
             " \"transfer\": [{\"scalar\": 0, \"rgba\": [0.2, 0.4, 1, 0.5]}, {\"scalar\": 1, \"rgba\": [1, 0.8, 0.2, 3]}]}}\n",
-            origin, d + 0.2, d + 1.2, d + 4.5, d, d + 0.1, d, d - 0.7, d - 0.6, d - 0.7, d + 0.1, d + 0.2, d + 0.1,
+            origin ? "\"origin\": " : "", origin ? origin : "", origin ? "," : "", d + 0.2, d + 1.2, d + 4.5, d, d + 0.1, d, d - 0.7, d - 0.6, d - 0.7, d + 0.1, d + 0.2, d + 0.1,
             d - 2.0, d + 1.0, d - 0.5, d + 2.0, d + 0.6, d - 0.3, d + 1.3, d - 0.2, d - 0.4);
     fclose(f);
 }
@@ -136,7 +138,16 @@ static void test_shifted_worlds(void **state)
         assert_true(d.water_p99_h <= 0.01);
         assert_true(d.volume_rmse <= 1e-4);
     }
-    /* float32 world coordinates, as without an origin: the beams lose the 1e-5 */
+    /* no "origin" key: camera-relative by default, the held-out 1e4 case within the same bounds */
+    render_scene(1e4, NULL, &r);
+    diff n = compare(&ref, &r);
+    printf("shifted by 1e4, no origin key (camera-relative by default): beams max rel %.3g, water holes %u false %u "
+           "p99 %.3g h, volume rmse %.3g\n", n.beams_rel, n.holes, n.false_hits, n.water_p99_h, n.volume_rmse);
+    assert_true(n.beams_rel <= 1e-5);
+    assert_int_equal(n.holes, 0);
+    assert_true(n.water_p99_h <= 0.01);
+    assert_true(n.volume_rmse <= 1e-4);
+    /* the opt-out, float32 world coordinates: the beams lose the 1e-5 */
     render_scene(1e5, "[0, 0, 0]", &r);
     diff z = compare(&ref, &r);
     printf("shifted by 1e5, origin [0,0,0] (float32 world coordinates): beams max rel %.3g, water holes %u "

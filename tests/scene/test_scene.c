@@ -33,7 +33,7 @@ static void test_every_field(void **state)
 {
     (void)state;
     const char *json =
-        "{\"version\":1,\"name\":\"full\",\"description\":\"d\","
+        "{\"version\":1,\"origin\":[0,0,0],\"name\":\"full\",\"description\":\"d\"," /* world values */
         "\"camera\":{\"eye\":[1,2,3],\"target\":[0,1,0],\"up\":[0,0,1],\"fov_y_deg\":45,\"width\":320,"
         "\"height\":200,\"near\":0.1,\"far\":50},"
         "\"meshes\":[{\"path\":\"m/arena.obj\",\"translate\":[1,2,3],\"rotate_deg\":[0,90,0],\"scale\":2,"
@@ -461,11 +461,58 @@ static void test_unknown_keys_warn(void **state)
     rt_scene_free(s);
 }
 
+/* Camera-relative by default: without "origin" the origin is camera.eye (in double), every
+ * position is stored relative to it, and a position the scene leaves out keeps its world
+ * default; stored + origin must give back the world values (the reference: the same scene with
+ * the opt-out "origin": [0, 0, 0], stored as world values). */
+static void test_origin_default(void **state)
+{
+    (void)state;
+    const char *body =
+        "\"camera\":{\"eye\":[10000.25,2,6.5]},"          /* target left out: world default */
+        "\"meshes\":[{\"box\":{\"min\":[0,0,0],\"max\":[1,1,1]}},"  /* no translate: world 0 */
+        "{\"box\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"translate\":[10001,0,0]}],"
+        "\"beams\":[{\"head\":[10000,1,0],\"dir\":[1,0,0]}],"
+        "\"water\":{\"source\":\"generator\",\"generator\":{\"kind\":\"layers\",\"count\":8}}}";
+    char rel[1024], abs_[1024];
+    snprintf(rel, sizeof rel, "{%s", body);
+    snprintf(abs_, sizeof abs_, "{\"origin\":[0,0,0],%s", body);
+    test_log log = {0};
+    rt_scene *r = NULL, *w = NULL;
+    char err[256];
+    assert_int_equal(load(rel, &log, &r, err, sizeof err), VFX_OK);
+    assert_int_equal(load(abs_, &log, &w, err, sizeof err), VFX_OK);
+    assert_true(r->origin[0] == 10000.25 && r->origin[1] == 2 && r->origin[2] == 6.5);
+    assert_true(w->origin[0] == 0 && w->origin[1] == 0 && w->origin[2] == 0);
+    for (int k = 0; k < 3; ++k) {
+        /* stored relative: eye 0; the world values agree within the world values' float32 ulp
+         * (1e-3 at 1e4: the relative ones are the more exact) */
+        assert_true(r->camera.eye[k] == 0);
+        double tol = 1e-3;
+        assert_true(fabs(r->camera.target[k] + r->origin[k] - w->camera.target[k]) <= tol);
+        assert_true(fabs(r->meshes[0].model[12 + k] + r->origin[k] - w->meshes[0].model[12 + k]) <= tol);
+        assert_true(fabs(r->meshes[1].model[12 + k] + r->origin[k] - w->meshes[1].model[12 + k]) <= tol);
+        assert_true(fabs(r->beams[0].base.head[k] + r->origin[k] - w->beams[0].base.head[k]) <= tol);
+        assert_true(fabs(r->water.origin[k] + r->origin[k] - w->water.origin[k]) <= tol);
+    }
+    assert_close(r->camera.target[0], -10000.25); /* the default target (0, 0.5, 0), relative */
+    assert_close(r->beams[0].base.head[0], -0.25);
+    rt_scene_free(r);
+    rt_scene_free(w);
+    /* no camera object at all: the default eye is the origin */
+    assert_int_equal(load("{}", &log, &r, err, sizeof err), VFX_OK);
+    assert_true(r->origin[0] == 0 && r->origin[1] == 2 && r->origin[2] == 6);
+    assert_close(r->camera.eye[1], 0);
+    assert_close(r->camera.target[1], -1.5);
+    assert_close(r->camera.target[2], -6);
+    rt_scene_free(r);
+}
+
 static void test_keyframes(void **state)
 {
     (void)state;
     const char *json =
-        "{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"keyframes\":{"
+        "{\"origin\":[0,0,0],\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"keyframes\":{"
         "\"length\":[{\"t\":1,\"value\":2},{\"t\":3,\"value\":6},{\"t\":4,\"value\":4}],"
         "\"head\":[{\"t\":0,\"value\":[0,0,0]},{\"t\":2,\"value\":[2,-4,8]}],"
         "\"dir\":[{\"t\":0,\"value\":[1,0,0]},{\"t\":2,\"value\":[-1,0,0]}],"
@@ -510,7 +557,7 @@ static void test_keyframes(void **state)
     assert_int_equal(load("{\"beams\":[{\"dir\":[1,0,0],\"keyframes\":{\"head\":[{\"t\":0,\"value\":[7,8,9]}]}}]}",
                           &log, &s, err, sizeof err),
                      VFX_OK);
-    assert_close(s->beams[0].base.head[1], 8);
+    assert_close(s->beams[0].base.head[1] + s->origin[1], 8); /* stored relative to the default origin */
     rt_scene_free(s);
 }
 
@@ -579,7 +626,7 @@ static void test_relative_paths_and_io(void **state)
     snprintf(scene_path, sizeof scene_path, "%s/s.json", dir);
     snprintf(part_path, sizeof part_path, "%s/p.bin", dir);
     FILE *f = fopen(scene_path, "w");
-    fputs("{\"water\":{\"source\":\"file\",\"path\":\"p.bin\"}}", f);
+    fputs("{\"origin\":[0,0,0],\"water\":{\"source\":\"file\",\"path\":\"p.bin\"}}", f);
     fclose(f);
     const float xyz[6] = {1, 2, 3, 4, 5, 6};
     assert_int_equal(rt_particle_file_save(part_path, xyz, 2, err, sizeof err), VFX_OK);
@@ -720,6 +767,7 @@ int main(void)
         cmocka_unit_test(test_environment),
         cmocka_unit_test(test_syntax_errors),
         cmocka_unit_test(test_unknown_keys_warn),
+        cmocka_unit_test(test_origin_default),
         cmocka_unit_test(test_keyframes),
         cmocka_unit_test(test_sample_scenes),
         cmocka_unit_test(test_relative_paths_and_io),

@@ -310,7 +310,7 @@ static void test_file_volume_in_scene(void **state)
     tet_tf_point pts[64];
     FILE *f = fopen(scene, "w");
     assert_non_null(f);
-    fprintf(f, "{\"version\": 1, \"name\": \"vtu64\", \"camera\": {\"eye\": [0.9, 1.3, 3.4], \"target\": [0, 0, 0],"
+    fprintf(f, "{\"version\": 1, \"origin\": [0, 0, 0], \"name\": \"vtu64\", \"camera\": {\"eye\": [0.9, 1.3, 3.4], \"target\": [0, 0, 0],"
                " \"up\": [0, 1, 0], \"fov_y_deg\": 55, \"width\": %d, \"height\": %d, \"near\": 0.1, \"far\": 50},"
                " \"volume\": {\"path\": \"grid.vtu\", \"scalar\": \"f\", \"workers\": 1, \"disable\": [\"ert\"], \"transfer\": [", W, H);
     for (int i = 0; i < 64; ++i) {
