@@ -94,11 +94,14 @@ static vfx_result host_water_params(void *user, vfx_water_params *out)
     if (!out || out->size < sizeof *out)
         return VFX_ERR_ABI;
     if (out->version >= VFX_WATER_PARAMS3_VERSION && out->size >= sizeof(vfx_water_params3)) {
+        bool v4 = out->version >= VFX_WATER_PARAMS4_VERSION && out->size >= sizeof(vfx_water_params4);
         vfx_water_params3 *p3 = (vfx_water_params3 *)out;
+        if (v4) /* the diffuse particles' fields; version 3's below */
+            *(vfx_water_params4 *)out = app->water_diffuse;
         memset(p3, 0, sizeof *p3);
         p3->v2.v1 = app->water;
-        p3->v2.v1.size = sizeof *p3;
-        p3->v2.v1.version = VFX_WATER_PARAMS3_VERSION;
+        p3->v2.v1.size = v4 ? sizeof(vfx_water_params4) : sizeof *p3;
+        p3->v2.v1.version = v4 ? VFX_WATER_PARAMS4_VERSION : VFX_WATER_PARAMS3_VERSION;
         p3->v2.kernel = app->water.method == VFX_WATER_METHOD_TILE ? app->water_kernel : VFX_WATER_KERNEL_ISOTROPIC;
         p3->preset = app->water_preset;
         return VFX_OK;

@@ -60,6 +60,7 @@ typedef struct game_app {
     vfx_water_params water;
     uint32_t water_kernel;     /* vfx_water_kernel for method TILE (the others get isotropic) */
     uint32_t water_preset;     /* vfx_water_preset (0: the plugin's default) */
+    vfx_water_params4 water_diffuse; /* the diffuse particles' fields (its v3 member unused) */
     vfx_beam beams[GAME_APP_MAX_BEAMS];
     uint32_t beam_count;
     vfx_beams_view beams_view; /* parameters; beams/count filled per call */

@@ -117,6 +117,7 @@ static vfx_result load_water(game_app *app, game_demo *demo, const rt_scene *sc)
     app->water = w->params;
     app->water_kernel = w->kernel;
     app->water_preset = w->preset;
+    app->water_diffuse = w->diffuse;
     app->water_enabled = n > 0;
 done:
     free(px), free(py), free(pz);

@@ -26,6 +26,10 @@ struct volfx_water_aniso {
     volfx_water_kernel_params done_kp;
     bool done_radius, done_kernel, done;
     bool searched;         /* the last pass counted neighbours (the anisotropic kernel, computed) */
+    /* the hashed grid in sorted/start: built from data_rev grid_rev (0: none), these cells */
+    uint64_t grid_rev;
+    uint32_t grid_count, grid_buckets;
+    float grid_cs, grid_lo[3];
 };
 
 vfx_result volfx_water_kernel_params_check(vfx_context *ctx, const vfx_water_params2 *in, uint32_t version,
@@ -260,6 +264,105 @@ static void aniso_step(vfx_context *ctx, GLuint prog, const volfx_water_aniso_in
     glMemoryBarrier(barrier);
 }
 
+/* The buckets of a grid over n particles (a power of two, about 2 n) and the scan's length. */
+static uint32_t grid_buckets(uint32_t count, uint32_t *need)
+{
+    uint32_t n = count ? count : 1;
+    uint32_t buckets = 1024;
+    while (buckets < 2u * n && buckets < ANISO_MAX_BUCKETS)
+        buckets *= 2;
+    *need = (buckets + 1 + 1023u) & ~1023u;
+    return buckets;
+}
+
+/* The grid build's buffers for in->count particles; an error when GL could not make them. */
+static vfx_result ensure_buffers(vfx_context *ctx, volfx_water_aniso *a, const volfx_water_aniso_input *in)
+{
+    uint32_t n = in->count ? in->count : 1, need;
+    grid_buckets(in->count, &need);
+    if (need > a->bucket_cap) {
+        a->count = regrow(a->count, (GLsizeiptr)need * 4, "water.aniso_count");
+        a->start = regrow(a->start, (GLsizeiptr)need * 4, "water.aniso_start");
+        a->bucket_cap = need;
+        a->grid_rev = 0;
+    }
+    if (n > a->particle_cap || !a->kern) {
+        a->sorted = regrow(a->sorted, (GLsizeiptr)n * 16, "water.aniso_sorted");
+        a->kern = regrow(a->kern, (GLsizeiptr)n * VOLFX_WATER_KERNEL_STRIDE, "water.aniso_kernels");
+        a->nbr = regrow(a->nbr, (GLsizeiptr)n * 4, "water.aniso_neighbours");
+        a->particle_cap = n;
+        a->grid_rev = 0;
+    }
+    if (!a->radius) /* bound even when unused */
+        a->radius = regrow(a->radius, 4, "water.aniso_radius");
+    if (!a->hostg)
+        a->hostg = regrow(a->hostg, 24, "water.aniso_host_kernel");
+    const char *e = volfx_gpu_error_string();
+    if (e)
+        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water aniso: buffers for %u particles: %s", in->count, e);
+    return VFX_OK;
+}
+
+static void bind_all(const volfx_water_aniso *a, const volfx_water_aniso_input *in)
+{
+    GLuint bind[] = {in->cols[0], in->cols[1], in->cols[2], a->count, in->counters, a->start, a->blocks, a->sorted,
+                     a->kern, a->nbr, a->radius, a->hostg};
+    for (GLuint k = 0; k < sizeof bind / sizeof bind[0]; ++k)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, k, bind[k]);
+}
+
+/* The hashed grid of cell kp->radius h over the positions: counts, prefix sum, scatter into
+ * `sorted` (the buffers bound by bind_all). */
+static vfx_result grid_steps(vfx_context *ctx, volfx_water_aniso *a, const volfx_water_aniso_input *in)
+{
+    GLuint count = volfx_gpu_compute(ctx, "water/aniso.comp", "#define MODE_COUNT\n");
+    GLuint scatter = volfx_gpu_compute(ctx, "water/aniso.comp", "#define MODE_SCATTER\n");
+    GLuint scan = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n");
+    GLuint top = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n#define SCAN_TOP\n");
+    GLuint add = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN_ADD\n");
+    if (!count || !scatter || !scan || !top || !add)
+        return VFX_ERR_GL;
+    uint32_t need, buckets = grid_buckets(in->count, &need), nscan = buckets + 1;
+    float cs = in->kp->radius * in->h;
+    GLuint groups = (in->count + 63u) / 64u, blocks = need / 1024u;
+    GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
+    glClearNamedBufferSubData(a->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
+    aniso_step(ctx, count, in, buckets, cs, nscan, gx, gy, GL_SHADER_STORAGE_BARRIER_BIT);
+    aniso_step(ctx, scan, in, buckets, cs, nscan, blocks, 1, GL_SHADER_STORAGE_BARRIER_BIT);
+    aniso_step(ctx, top, in, buckets, cs, blocks, 1, 1, GL_SHADER_STORAGE_BARRIER_BIT);
+    aniso_step(ctx, add, in, buckets, cs, nscan, (nscan + 255u) / 256u, 1,
+               GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    glClearNamedBufferSubData(a->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
+    aniso_step(ctx, scatter, in, buckets, cs, nscan, gx, gy, GL_SHADER_STORAGE_BARRIER_BIT);
+    a->grid_rev = in->data_rev;
+    a->grid_count = in->count;
+    a->grid_buckets = buckets;
+    a->grid_cs = cs;
+    memcpy(a->grid_lo, in->lo, sizeof a->grid_lo);
+    return VFX_OK;
+}
+
+vfx_result volfx_water_aniso_grid_build(vfx_context *ctx, volfx_water_aniso *a, const volfx_water_aniso_input *in,
+                                        volfx_water_aniso_grid *out)
+{
+    float cs = in->kp->radius * in->h;
+    if (!(a->grid_rev && a->grid_rev == in->data_rev && a->grid_count == in->count && a->grid_cs == cs &&
+          !memcmp(a->grid_lo, in->lo, sizeof a->grid_lo))) {
+        vfx_result r = ensure_buffers(ctx, a, in);
+        if (r)
+            return r;
+        bind_all(a, in);
+        volfx_gpu_pass_begin(ctx, "water.aniso_grid");
+        r = grid_steps(ctx, a, in);
+        volfx_gpu_pass_end(ctx);
+        if (r)
+            return r;
+    }
+    *out = (volfx_water_aniso_grid){a->sorted, a->start, a->grid_buckets, a->grid_cs,
+                                    {a->grid_lo[0], a->grid_lo[1], a->grid_lo[2]}};
+    return VFX_OK;
+}
+
 vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, const volfx_water_aniso_input *in)
 {
     const volfx_water_kernel_params *kp = in->kp;
@@ -270,54 +373,21 @@ vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, con
         return VFX_OK;
     }
     volfx_stat_set(ctx, "water.aniso_skipped", 0);
-    uint32_t n = in->count ? in->count : 1;
-    uint32_t buckets = 1024;
-    while (buckets < 2u * n && buckets < ANISO_MAX_BUCKETS)
-        buckets *= 2;
-    uint32_t nscan = buckets + 1, need = (nscan + 1023u) & ~1023u;
-    if (need > a->bucket_cap) {
-        a->count = regrow(a->count, (GLsizeiptr)need * 4, "water.aniso_count");
-        a->start = regrow(a->start, (GLsizeiptr)need * 4, "water.aniso_start");
-        a->bucket_cap = need;
-    }
-    if (n > a->particle_cap || !a->kern) {
-        a->sorted = regrow(a->sorted, (GLsizeiptr)n * 16, "water.aniso_sorted");
-        a->kern = regrow(a->kern, (GLsizeiptr)n * VOLFX_WATER_KERNEL_STRIDE, "water.aniso_kernels");
-        a->nbr = regrow(a->nbr, (GLsizeiptr)n * 4, "water.aniso_neighbours");
-        a->particle_cap = n;
-    }
-    if (!a->radius) /* bound even when unused */
-        a->radius = regrow(a->radius, 4, "water.aniso_radius");
-    if (!a->hostg)
-        a->hostg = regrow(a->hostg, 24, "water.aniso_host_kernel");
-    const char *e = volfx_gpu_error_string();
-    if (e)
-        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water aniso: buffers for %u particles: %s", in->count, e);
+    vfx_result r = ensure_buffers(ctx, a, in);
+    if (r)
+        return r;
+    uint32_t need, buckets = grid_buckets(in->count, &need), nscan = buckets + 1;
     GLuint kern = volfx_gpu_compute(ctx, "water/aniso.comp", "#define MODE_KERNEL\n");
-    GLuint count = volfx_gpu_compute(ctx, "water/aniso.comp", "#define MODE_COUNT\n");
-    GLuint scatter = volfx_gpu_compute(ctx, "water/aniso.comp", "#define MODE_SCATTER\n");
-    GLuint scan = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n");
-    GLuint top = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n#define SCAN_TOP\n");
-    GLuint add = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN_ADD\n");
-    if (!kern || !count || !scatter || !scan || !top || !add)
+    if (!kern)
         return VFX_ERR_GL;
-    GLuint bind[] = {in->cols[0], in->cols[1], in->cols[2], a->count, in->counters, a->start, a->blocks, a->sorted,
-                     a->kern, a->nbr, a->radius, a->hostg};
-    for (GLuint k = 0; k < sizeof bind / sizeof bind[0]; ++k)
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, k, bind[k]);
+    bind_all(a, in);
     float cs = kp->radius * in->h;
-    GLuint groups = (in->count + 63u) / 64u, blocks = need / 1024u;
+    GLuint groups = (in->count + 63u) / 64u;
     GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
     volfx_gpu_pass_begin(ctx, "water.aniso");
-    if (aniso) {
-        glClearNamedBufferSubData(a->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
-        aniso_step(ctx, count, in, buckets, cs, nscan, gx, gy, GL_SHADER_STORAGE_BARRIER_BIT);
-        aniso_step(ctx, scan, in, buckets, cs, nscan, blocks, 1, GL_SHADER_STORAGE_BARRIER_BIT);
-        aniso_step(ctx, top, in, buckets, cs, blocks, 1, 1, GL_SHADER_STORAGE_BARRIER_BIT);
-        aniso_step(ctx, add, in, buckets, cs, nscan, (nscan + 255u) / 256u, 1,
-                   GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-        glClearNamedBufferSubData(a->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
-        aniso_step(ctx, scatter, in, buckets, cs, nscan, gx, gy, GL_SHADER_STORAGE_BARRIER_BIT);
+    if (aniso && (r = grid_steps(ctx, a, in))) {
+        volfx_gpu_pass_end(ctx);
+        return r;
     }
     glUseProgram(kern);
     aniso_uniforms(ctx, kern, in, buckets, cs, nscan);
@@ -328,7 +398,7 @@ vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, con
         glDispatchCompute(gx, gy, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     volfx_gpu_pass_end(ctx);
-    e = volfx_gpu_error_string();
+    const char *e = volfx_gpu_error_string();
     if (e)
         return volfx_fail(ctx, VFX_ERR_GL, "water aniso pass over %u particles: %s", in->count, e);
     a->done = true;

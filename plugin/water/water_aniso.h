@@ -67,6 +67,19 @@ GLuint volfx_water_aniso_kernels(const volfx_water_aniso *a);
  * than Ne means isolated (spray). 0 (no buffer) before a pass and when the last one searched no
  * neighbours (the isotropic kernel with a radius column, host kernels). */
 GLuint volfx_water_aniso_neighbours(const volfx_water_aniso *a);
+/* The hashed neighbour grid of the positions (for the diffuse particles): cell `cell`
+ * (neighbourhood radius x h) from `origin`, `buckets` (a power of two) hashed as aniso.comp's
+ * bucket_of; start[b] .. start[b + 1] index `sorted` (vec4: position, the particle's index as
+ * float bits). */
+typedef struct volfx_water_aniso_grid {
+    GLuint sorted, start;
+    uint32_t buckets;
+    float cell, origin[3];
+} volfx_water_aniso_grid;
+/* Describes the grid of in's positions, building it first unless the last build (the kernel
+ * pass's or this one's, pass water.aniso_grid) was of the same upload, count, cell and box. */
+vfx_result volfx_water_aniso_grid_build(vfx_context *ctx, volfx_water_aniso *a, const volfx_water_aniso_input *in,
+                                        volfx_water_aniso_grid *out);
 /* A bound of every particle's bounding radius over h (kr^(2/3) ks times the largest radius
  * column value, or the host kernels' largest 1 / eigenvalue): the binning's depth slabs. */
 float volfx_water_aniso_sigma_bound(const volfx_water_aniso *a);

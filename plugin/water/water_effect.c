@@ -1,7 +1,7 @@
 /* water_effect.c — metaball water (seed 000, Mishima et al.): the effect's create, resize,
  * upload, per-frame method choice, shading and counter readback. The methods: PAPER and BRUTE
  * (water_paper.c), GRID (water_grid.c), TILE, ours (water_tile.c, with water_aniso.c's kernels);
- * spray and foam in water_spray.c. */
+ * spray, foam and bubbles in water_diffuse.c. */
 #include <math.h>
 #include <string.h>
 
@@ -74,7 +74,7 @@ static void water_destroy(vfx_context *ctx, void *state)
     volfx_water_views_destroy(ctx, s);
     volfx_water_grid_destroy(ctx, s->grid);
     volfx_water_aniso_destroy(ctx, s->aniso);
-    volfx_water_spray_destroy(ctx, s->spray);
+    volfx_water_diffuse_destroy(ctx, s->diffuse);
     volfx_free(ctx, s->chunk_rev);
     glDeleteVertexArrays(1, &s->vao);
     volfx_ubo_destroy(&s->frame_ubo);
@@ -148,29 +148,55 @@ static vfx_result query_chunk(vfx_context *ctx, uint32_t c, vfx_particle_view2 *
     return r;
 }
 
+/* The version of the parameters the host wrote into the offered struct (1 to 4). */
+static uint32_t params_version(const vfx_water_params4 *p4)
+{
+    const vfx_water_params *v1 = &p4->v3.v2.v1;
+    if (v1->version == VFX_WATER_PARAMS4_VERSION && v1->size >= sizeof *p4)
+        return VFX_WATER_PARAMS4_VERSION;
+    if (v1->version == VFX_WATER_PARAMS3_VERSION && v1->size >= sizeof p4->v3)
+        return VFX_WATER_PARAMS3_VERSION;
+    if (v1->version == VFX_WATER_PARAMS2_VERSION && v1->size >= sizeof p4->v3.v2)
+        return VFX_WATER_PARAMS2_VERSION;
+    return VFX_WATER_PARAMS_VERSION;
+}
+
 static vfx_result water_update(vfx_context *ctx, void *state, double time, float dt)
 {
     (void)time;
-    (void)dt;
     water_state *s = state;
-    /* version 3 offered; an older host writes only its part (the rest stays 0: defaults) */
-    vfx_water_params3 p3;
-    memset(&p3, 0, sizeof p3);
-    p3.v2.v1.size = sizeof p3;
-    p3.v2.v1.version = VFX_WATER_PARAMS3_VERSION;
-    if (ctx->host.water_params) {
-        vfx_result r = ctx->host.water_params(ctx->host.user, &p3.v2.v1);
+    /* a hitch or a bad clock must not throw the diffuse particles across the scene */
+    s->dt = isfinite(dt) && dt > 0 ? (dt < 0.1f ? dt : 0.1f) : 0.0f;
+    s->diffuse_due = true; /* stepped once, by the first view drawn after this update */
+    /* version 4 offered; a host that answers an older version is offered the older ones in
+     * turn (a host written for version 2 may test for exactly 2), then keeps what it wrote
+     * (the rest stays 0: defaults) */
+    vfx_water_params4 p4;
+    static const struct { uint32_t version, size; } offers[] = {
+        {VFX_WATER_PARAMS4_VERSION, sizeof(vfx_water_params4)}, {VFX_WATER_PARAMS3_VERSION, sizeof(vfx_water_params3)},
+        {VFX_WATER_PARAMS2_VERSION, sizeof(vfx_water_params2)}};
+    for (size_t o = 0; o < sizeof offers / sizeof offers[0]; ++o) {
+        memset(&p4, 0, sizeof p4);
+        p4.v3.v2.v1.size = offers[o].size;
+        p4.v3.v2.v1.version = offers[o].version;
+        if (!ctx->host.water_params)
+            break;
+        vfx_result r = ctx->host.water_params(ctx->host.user, &p4.v3.v2.v1);
         if (r != VFX_OK && r != VFX_ERR_NOT_FOUND)
             return volfx_fail(ctx, r, "water: host water_params failed (%d)", (int)r);
-        if (r == VFX_ERR_NOT_FOUND)
-            memset(&p3, 0, sizeof p3);
+        if (r == VFX_ERR_NOT_FOUND) {
+            memset(&p4, 0, sizeof p4);
+            break;
+        }
+        if (params_version(&p4) >= offers[o].version)
+            break;
     }
-    uint32_t pver = p3.v2.v1.version, psz = p3.v2.v1.size;
-    pver = pver == VFX_WATER_PARAMS3_VERSION && psz >= sizeof p3                      ? VFX_WATER_PARAMS3_VERSION
-           : pver == VFX_WATER_PARAMS2_VERSION && psz >= sizeof(vfx_water_params2) ? VFX_WATER_PARAMS2_VERSION
-                                                                                    : VFX_WATER_PARAMS_VERSION;
+    uint32_t pver = params_version(&p4);
     volfx_water_resolved res;
-    vfx_result kr = volfx_water_params_resolve(ctx, &p3, pver, &res);
+    vfx_result kr = volfx_water_params_resolve(ctx, &p4.v3, pver < VFX_WATER_PARAMS3_VERSION ? pver : VFX_WATER_PARAMS3_VERSION,
+                                               &res);
+    if (!kr)
+        kr = volfx_water_diffuse_params_check(ctx, &p4, pver, &s->dp);
     if (kr)
         return kr;
     s->kp = res.kp;
@@ -240,9 +266,9 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
         if (r)
             return r;
     }
-    if (!s->spray && !(s->spray = volfx_water_spray_create(ctx)))
+    if (!s->diffuse && !(s->diffuse = volfx_water_diffuse_create(ctx)))
         return VFX_ERR_OUT_OF_MEMORY;
-    if ((gr = volfx_water_spray_begin(ctx, s->spray, (uint32_t)total)))
+    if ((gr = volfx_water_diffuse_begin(ctx, s->diffuse, (uint32_t)total)))
         return gr;
     uint32_t off = 0, nan_count = 0;
     int seen = 0;
@@ -285,7 +311,7 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
             volfx_free(ctx, cxyz);
             return r;
         }
-        if ((r = volfx_water_spray_chunk(ctx, s->spray, off, &v))) {
+        if ((r = volfx_water_diffuse_chunk(ctx, s->diffuse, off, &v))) {
             volfx_free(ctx, cxyz);
             return r;
         }
@@ -344,7 +370,11 @@ static void publish_counters(vfx_context *ctx, water_state *s)
         volfx_stat_set(ctx, "water.tile_half_upsampled", c[22]);
         volfx_stat_set(ctx, "water.tile_half_remarched", c[23]);
     }
-    volfx_stat_set(ctx, "water.spray_isolated", c[26]);
+    volfx_stat_set(ctx, "water.ssr_hits", c[26]);
+    volfx_stat_set(ctx, "water.diffuse_spray", c[27]);
+    volfx_stat_set(ctx, "water.diffuse_foam", c[28]);
+    volfx_stat_set(ctx, "water.diffuse_bubbles", c[29]);
+    volfx_stat_set(ctx, "water.diffuse_generated", c[30]);
     if (paper) {
         /* the cap pixels the finishing pass took (0 with VFX_WATER_NO_FINISH), and what is left
          * undecided: cap pixels not finished plus those the finishing march could not decide */
@@ -464,6 +494,44 @@ static vfx_result paper_finish(vfx_context *ctx, water_state *s, const vfx_frame
     return r ? r : volfx_water_tile_finish(ctx, s->tile, &in, frame, targets, s->st, s->cur);
 }
 
+/* Whether this frame has diffuse particles: the host's velocities, not switched off, one
+ * position buffer (the grid reads one) and the shading on. */
+static bool diffuse_on(const water_state *s)
+{
+    return !(s->params.disable & (VFX_WATER_NO_DIFFUSE | VFX_WATER_NO_SHADING)) && s->group_count == 1 &&
+           volfx_water_diffuse_ready(s->diffuse);
+}
+
+/* The diffuse particles' step over this update's fluid (once per update: the first view drawn
+ * steps them, the others draw the same pool) and their foam and bubble layer in this view
+ * (*layer, 0: none). */
+static vfx_result diffuse_frame(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
+                                const volfx_frame_targets *targets, GLuint *layer)
+{
+    *layer = 0;
+    if (!diffuse_on(s)) {
+        if (s->diffuse)
+            volfx_water_diffuse_clear(s->diffuse);
+        return VFX_OK;
+    }
+    vfx_result r;
+    if (s->diffuse_due) {
+        if (!s->aniso && !(s->aniso = volfx_water_aniso_create(ctx)))
+            return VFX_ERR_OUT_OF_MEMORY;
+        volfx_water_aniso_input ai = {s->cols, s->count, s->lo, s->hi, s->params.h, &s->kp, s->counters, s->data_rev};
+        volfx_water_aniso_grid grid;
+        if ((r = volfx_water_aniso_grid_build(ctx, s->aniso, &ai, &grid)))
+            return r;
+        volfx_water_diffuse_input in = {s->cols, s->count, s->lo, s->hi, s->params.h, s->dt, &s->dp, &grid,
+                                        s->counters, s->frame_no};
+        if ((r = volfx_water_diffuse_step(ctx, s->diffuse, &in)))
+            return r;
+        s->diffuse_due = false;
+    }
+    volfx_water_diffuse_draw dd = {s->params.h, s->params.absorption, ctx->water_dist_tex, s->vao, WATER_SHUTTER_S};
+    return volfx_water_diffuse_splat(ctx, s->diffuse, &dd, frame, targets, layer);
+}
+
 static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
                                volfx_frame_targets *targets)
 {
@@ -518,6 +586,9 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
         (r = volfx_water_surface_passes(ctx, s, frame)) != VFX_OK)
         return r;
 
+    GLuint layer = 0;
+    if ((r = diffuse_frame(ctx, s, frame, targets, &layer)))
+        return r;
     GLuint shade = volfx_gpu_program(ctx, "common/fullscreen.vert", "water/shade.frag", NULL);
     if (!shade)
         return VFX_ERR_GL;
@@ -544,13 +615,20 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
         glBindTextureUnit(5, targets->environment_cubemap);
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_env"), targets->environment_cubemap != 0);
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_hdr"), targets->color_hdr);
+    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_ssr"), !(p->disable & VFX_WATER_NO_SSR));
+    if (layer)
+        glBindTextureUnit(6, layer);
+    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_diffuse"), layer != 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->counters);
     volfx_gpu_fullscreen(ctx);
+    /* the SSR hits counted by the fragments reach the counter copy */
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     volfx_pass_end(ctx);
-    if (!(p->disable & (VFX_WATER_NO_SPRAY | VFX_WATER_NO_SHADING)) && s->spray && s->group_count == 1 &&
-        (r = volfx_water_spray_draw(ctx, s->spray, s->cols, s->count, p, frame, targets, ctx->water_dist_tex, s->vao,
-                                     s->kp.kernel == VFX_WATER_KERNEL_ANISOTROPIC ? volfx_water_aniso_neighbours(s->aniso) : 0,
-                                     s->kp.min_neighbours)))
-        return r;
+    if (layer) {
+        volfx_water_diffuse_draw dd = {p->h, p->absorption, ctx->water_dist_tex, s->vao, WATER_SHUTTER_S};
+        if ((r = volfx_water_diffuse_spray(ctx, s->diffuse, &dd, frame, targets)))
+            return r;
+    }
     counters_frame_end(ctx, s, p->method);
     s->last_method_drawn = p->method;
     const char *e = volfx_gpu_error_string();
@@ -619,6 +697,15 @@ vfx_result volfx_water_debug_kernels(vfx_context *ctx, float *out, uint32_t *nbr
         memset(nbrs, 0, (size_t)s->count * 4); /* no neighbour search ran */
     const char *e = volfx_gpu_error_string();
     return e ? volfx_fail(ctx, VFX_ERR_GL, "water debug kernels: %s", e) : VFX_OK;
+}
+
+vfx_result volfx_water_debug_diffuse(vfx_context *ctx, float *pot, size_t fluid, float *pool, size_t pool_cap,
+                                     uint32_t *alive)
+{
+    water_state *s = ctx->effect_state[VFX_EFFECT_WATER];
+    if (!s || !s->diffuse)
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "water debug diffuse: no water effect or no upload yet");
+    return volfx_water_diffuse_debug(ctx, s->diffuse, pot, fluid, pool, pool_cap, alive);
 }
 
 static vfx_result water_read_raw(vfx_context *ctx, void *state, float *out, size_t count)

@@ -20,4 +20,10 @@ vfx_result volfx_water_debug_pixel_class(vfx_context *ctx, uint8_t *out, size_t 
  * VFX_ERR_NOT_FOUND when none. */
 vfx_result volfx_water_debug_kernels(vfx_context *ctx, float *out, uint32_t *nbrs, size_t particles);
 
+/* Copies the diffuse particles of the last step (water_diffuse.h volfx_water_diffuse_debug: 4
+ * potentials a fluid particle, 8 floats a pool entry, the pool's size). VFX_ERR_NOT_FOUND when
+ * no step ran. */
+vfx_result volfx_water_debug_diffuse(vfx_context *ctx, float *pot, size_t fluid, float *pool, size_t pool_cap,
+                                     uint32_t *alive);
+
 #endif

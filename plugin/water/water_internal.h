@@ -10,13 +10,16 @@
 #include "water_grid.h"
 #include "water_tile.h"
 #include "water_aniso.h"
-#include "water_spray.h"
+#include "water_diffuse.h"
 
 /* Counter readback ring: frames the GPU may run behind before a result is dropped. */
 #define WATER_COUNTER_RING 3
 /* march.comp's 8 (PAPER and the gradient pass), GRID's cells visited and sphere tests,
- * tile.comp's 14 (TILE and the paper method's finishing pass) and aniso.comp's 2 */
-#define WATER_COUNTERS 27
+ * tile.comp's 14 (TILE and the paper method's finishing pass), aniso.comp's 2, shade.frag's
+ * SSR hits (26) and diffuse.comp's 4 (27-30: spray, foam, bubbles, generated) */
+#define WATER_COUNTERS 31
+/* seconds a spray streak spans (its motion blur): two frames at 60 Hz */
+#define WATER_SHUTTER_S (1.0f / 30.0f)
 /* Particles the effect takes at most: positions are 12 bytes each (12 GiB at the limit) and a
  * particle index must fit the int of gl_InstanceID and of the draw's instance count. */
 #define WATER_MAX_PARTICLES (1u << 30)
@@ -80,7 +83,10 @@ typedef struct water_state {
     volfx_water_aniso *aniso; /* per-particle kernels (TILE), made when asked for or given */
     volfx_water_grid *grid;  /* GRID baseline state, made the first time GRID is asked for */
     volfx_water_tile *tile;  /* TILE lists (TILE, and PAPER's finishing pass), made when needed */
-    volfx_water_spray *spray; /* spray and foam from the host's velocities */
+    volfx_water_diffuse *diffuse; /* spray, foam and bubbles from the host's velocities */
+    volfx_water_diffuse_params dp; /* their parameters (vfx_water_params4), checked */
+    float dt;              /* the last update's step, seconds (the diffuse particles') */
+    bool diffuse_due;      /* an update since the last diffuse step */
     float lo[3], hi[3];    /* box of the finite particles */
     /* upload skipping: the host's per-chunk revisions of the last upload (0 = untracked: the
      * host gives none, so every frame uploads); data_rev counts uploads, which GRID keys on */

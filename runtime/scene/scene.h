@@ -116,6 +116,8 @@ typedef struct rt_scene_water {
     uint32_t kernel;
     /* water.quality.preset (vfx_water_params3.preset; 0: the plugin's default, medium) */
     uint32_t preset;
+    /* water.diffuse: the diffuse particles' fields of version 4 (its v3 member unused) */
+    vfx_water_params4 diffuse;
 } rt_scene_water;
 
 typedef struct rt_scene_transfer_point {

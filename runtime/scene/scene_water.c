@@ -149,12 +149,12 @@ static vfx_result parse_water_quality(pctx *c, const cJSON *q, rt_scene_water *w
     static const char *const presets[] = {"low", "medium", "high", "ultra", NULL};
     static const char *const flags[] = {"billboard_init", "skip", "blend", "pack4", "pyramid", "refine",
                                         "shading", "finish", "local_list", "subdivide", "tiles", "refract_trace",
-                                        "temporal", "half_res", "spray", NULL};
+                                        "temporal", "half_res", "spray", "ssr", NULL};
     static const uint32_t bits[] = {VFX_WATER_NO_BILLBOARD_INIT, VFX_WATER_NO_SKIP, VFX_WATER_NO_BLEND,
                                     VFX_WATER_NO_PACK4, VFX_WATER_NO_PYRAMID, VFX_WATER_NO_REFINE,
                                     VFX_WATER_NO_SHADING, VFX_WATER_NO_FINISH, VFX_WATER_NO_LOCAL_LIST,
                                     VFX_WATER_NO_SUBDIVIDE, VFX_WATER_NO_TILES, VFX_WATER_NO_REFRACT_TRACE,
-                                    VFX_WATER_NO_TEMPORAL, VFX_WATER_NO_HALF_RES, VFX_WATER_NO_SPRAY};
+                                    VFX_WATER_NO_TEMPORAL, VFX_WATER_NO_HALF_RES, VFX_WATER_NO_SPRAY, VFX_WATER_NO_SSR};
     vfx_result r;
     const char *PQ = "water.quality";
     if ((r = rt_scene_expect_object(c, q, PQ)))
@@ -186,10 +186,58 @@ static vfx_result parse_water_quality(pctx *c, const cJSON *q, rt_scene_water *w
     return r;
 }
 
+/* water.diffuse (vfx_water_params4's fields; the plugin checks the ranges' relations). */
+static vfx_result parse_diffuse(pctx *c, const cJSON *v, rt_scene_water *w)
+{
+    static const char *const keys[] = {"max", "gravity", "trapped_air", "wave_crest", "energy", "rate_trapped_air",
+                                       "rate_wave_crest", "lifetime", "buoyancy", "drag", "spray_below",
+                                       "bubble_above", NULL};
+    vfx_water_params4 *d = &w->diffuse;
+    memset(d, 0, sizeof *d);
+    const cJSON *o = cJSON_GetObjectItemCaseSensitive(v, "diffuse");
+    const char *P = "water.diffuse";
+    vfx_result r = VFX_OK;
+    if (o) {
+        if ((r = rt_scene_expect_object(c, o, P)))
+            return r;
+        rt_scene_check_keys(c, o, P, keys);
+        const range POS4 = {0, 1e4, true};
+        r = rt_scene_get_uint(c, o, P, "max", false, 1, 4194304, &d->diffuse_max);
+        if (!r) r = rt_scene_get_vec(c, o, P, "gravity", 3, false, (range){-1e4, 1e4, false}, d->gravity);
+        if (!r) r = rt_scene_get_vec(c, o, P, "trapped_air", 2, false, POS4, d->trapped_air);
+        if (!r) r = rt_scene_get_vec(c, o, P, "wave_crest", 2, false, POS4, d->wave_crest);
+        if (!r) r = rt_scene_get_vec(c, o, P, "energy", 2, false, POS4, d->energy);
+        if (!r) r = rt_scene_get_float(c, o, P, "rate_trapped_air", false, (range){0, 1e4, false}, &d->rate_trapped_air);
+        if (!r) r = rt_scene_get_float(c, o, P, "rate_wave_crest", false, (range){0, 1e4, false}, &d->rate_wave_crest);
+        if (!r) r = rt_scene_get_float(c, o, P, "lifetime", false, (range){0, 60, true}, &d->lifetime);
+        if (!r) r = rt_scene_get_float(c, o, P, "buoyancy", false, (range){0, 20, true}, &d->buoyancy);
+        if (!r) r = rt_scene_get_float(c, o, P, "drag", false, (range){0, 60, true}, &d->drag);
+        if (!r) r = rt_scene_get_uint(c, o, P, "spray_below", false, 1, 10000, &d->spray_below);
+        if (!r) r = rt_scene_get_uint(c, o, P, "bubble_above", false, 1, 10000, &d->bubble_above);
+        for (int k = 0; !r && k < 3; ++k) {
+            const float *pr = k == 0 ? d->trapped_air : k == 1 ? d->wave_crest : d->energy;
+            static const char *const names[] = {"trapped_air", "wave_crest", "energy"};
+            char PK[JPATH];
+            rt_scene_join(PK, P, names[k]);
+            if ((pr[0] != 0 || pr[1] != 0) && !(pr[0] < pr[1]))
+                r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PK, "[min, max] needs min < max (got [%g, %g])", pr[0], pr[1]);
+        }
+        if (!r && d->spray_below && d->bubble_above && d->spray_below > d->bubble_above) {
+            char PK[JPATH];
+            rt_scene_join(PK, P, "spray_below");
+            r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, PK, "%u is above bubble_above %u", d->spray_below, d->bubble_above);
+        }
+    }
+    /* the spray falls with the simulation's gravity unless the scene says otherwise */
+    if (!r && rt_scene_is_zero3(d->gravity) && w->source == RT_SCENE_WATER_SIMULATION)
+        memcpy(d->gravity, w->gravity, sizeof d->gravity);
+    return r;
+}
+
 vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
 {
     static const char *const keys[] = {"source", "path", "generator", "simulation", "h", "threshold",
-                                       "quality", "color", "absorption", "ior", NULL};
+                                       "quality", "color", "absorption", "ior", "diffuse", NULL};
     static const char *const sources[] = {"file", "generator", "simulation", NULL};
     const char *P = "water";
     vfx_result r = rt_scene_expect_object(c, v, P);
@@ -230,6 +278,8 @@ vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
     const cJSON *q = cJSON_GetObjectItemCaseSensitive(v, "quality");
     if (q)
         r = parse_water_quality(c, q, w);
+    if (!r)
+        r = parse_diffuse(c, v, w);
     /* the default: the preset's, as the plugin resolves it (anisotropic for TILE but at preset
      * "low": flat water flat, sheets stay sheets; docs/water.md "Presets"), the seed's isotropic
      * kernel for the other methods */

@@ -7,27 +7,43 @@
 // host depth) until it leaves it, so the thickness is the one along the refracted ray and the
 // host colour is looked up where that ray leaves (REFRACT_*); Beer-Lambert over that thickness
 // with the absorbed part partly scattered back as the tint (WATER_SCATTER), plus the sun's
-// highlight. Misses are discarded so the host image shows through unchanged. An HDR host gets
-// the highlight unclamped (it blooms); a display-colour host gets everything clamped to 1.
+// highlight. The reflected ray first looks for the host's scene in screen space (SSR: marched
+// against the host depth, the host colour where it meets it, fading to the sky at the screen's
+// edges); off screen or past the march it sees the cubemap or the sky. The diffuse particles'
+// layer adds foam (white, opacity 1 - exp(-FOAM_K x thickness)) on the surface and the bubbles
+// seen through the water. Misses are discarded so the host image shows through unchanged. An
+// HDR host gets the highlight unclamped (it blooms); a display-colour host gets everything
+// clamped to 1.
 #include "common/depth.glsl"
 #include "common/sky.glsl"
+#include "water/white.glsl"
 layout(binding = 0) uniform sampler2D u_dist;
 layout(binding = 1) uniform sampler2D u_scene_color;
 layout(binding = 2) uniform sampler2D u_grad;   // xyz = grad sum P, w = sum P
 layout(binding = 3) uniform sampler2D u_back;   // farthest ball exit along the ray
 layout(binding = 4) uniform sampler2D u_scene_depth;
 layout(binding = 5) uniform samplerCube u_env;  // the host's environment (frame view 2)
+layout(binding = 6) uniform sampler2D u_diffuse; // R foam thickness, G bubbles (u_has_diffuse)
+// the effect's counter buffer: slot 26 counts the reflected rays that met the host's scene
+layout(std430, binding = 4) buffer Counters { uint c_slots_[26]; uint c_ssr_hits; };
 uniform mat4 u_inv_view_proj, u_view_proj;
 uniform vec3 u_eye;
 uniform float u_h;                  // kernel radius: the smallest thickness the trace resolves
 uniform bool u_refract_view;        // ablation: the view ray's thickness and a fixed offset
 uniform float u_absorption, u_ior;
 uniform vec3 u_tint;
-uniform bool u_flat, u_has_color, u_has_depth, u_has_env, u_hdr;
+uniform bool u_flat, u_has_color, u_has_depth, u_has_env, u_hdr, u_ssr, u_has_diffuse;
 out vec4 o_color;
 #define WATER_SCATTER 0.35
-// the sample host's default sun (scene environment.sun_dir), normalised
-const vec3 WATER_SUN = vec3(-0.4653, 0.3619, -0.8079);
+// SSR: SSR_STEPS steps growing as k^2 over SSR_REACH x the eye's distance (at least 40 h), a
+// hit where the ray passes behind the host depth by less than the step (or h), refined by
+// SSR_BISECT halvings; both bounds hold for any input
+#define SSR_STEPS 24
+#define SSR_BISECT 5
+#define SSR_REACH 2.0
+// foam opacity per unit of splatted thickness, bubbles' brightness per unit
+#define FOAM_K 0.9
+#define BUBBLE_K 0.5
 // The refracted ray's trace: REFRACT_STEPS even steps over twice the view ray's thickness (plus
 // h), then REFRACT_BISECT halvings of the step where it left; both bounds hold for any input.
 #define REFRACT_STEPS 16
@@ -74,6 +90,44 @@ float refracted_thickness(vec3 x, vec3 rd, float s_max, out ivec2 exit_pix)
     return s_max;
 }
 
+// Where the ray from x along r passes behind the host depth: *col the host colour there and
+// *fade its weight (0 at the screen's edges and at the march's end); false when it leaves the
+// screen, goes behind the eye or meets nothing.
+bool ssr(vec3 x, vec3 r, float t, out vec3 col, out float fade)
+{
+    col = vec3(0.0);
+    fade = 0.0;
+    float reach = max(SSR_REACH * t, 40.0 * u_h), s0 = 0.0;
+    for (int k = 1; k <= SSR_STEPS; ++k) {
+        float f = float(k) / float(SSR_STEPS), s1 = reach * f * f;
+        vec4 q = u_view_proj * vec4(x + s1 * r, 1.0);
+        if (!(q.w > 0.0)) return false;
+        vec3 ndc = q.xyz / q.w;
+        if (any(greaterThan(abs(ndc.xy), vec2(1.0)))) return false;
+        ivec2 pix = clamp(ivec2((ndc.xy * 0.5 + 0.5) * g_size), ivec2(0), ivec2(g_size) - 1);
+        float z = texelFetch(u_scene_depth, pix, 0).r;
+        if (ndc.z * 0.5 + 0.5 <= z || z >= 1.0) { s0 = s1; continue; }
+        float scene = volfx_depth_distance(u_inv_view_proj, u_eye, ndc.xy, z);
+        float behind = length(x + s1 * r - u_eye) - scene;
+        // passed far behind a surface (the ray went under an object's edge): not this one
+        if (behind > max(s1 - s0, u_h)) { s0 = s1; continue; }
+        float a = s0, b = s1;
+        for (int i = 0; i < SSR_BISECT; ++i) {
+            float m = 0.5 * (a + b);
+            vec4 qm = u_view_proj * vec4(x + m * r, 1.0);
+            vec3 nm = qm.xyz / qm.w;
+            ivec2 pm = clamp(ivec2((nm.xy * 0.5 + 0.5) * g_size), ivec2(0), ivec2(g_size) - 1);
+            if (nm.z * 0.5 + 0.5 > texelFetch(u_scene_depth, pm, 0).r) { b = m; pix = pm; ndc = nm; }
+            else a = m;
+        }
+        col = texelFetch(u_scene_color, pix, 0).rgb;
+        vec2 edge = smoothstep(vec2(1.0), vec2(0.85), abs(ndc.xy));
+        fade = edge.x * edge.y * (1.0 - f * f);
+        return true;
+    }
+    return false;
+}
+
 void main()
 {
     ivec2 pix = ivec2(gl_FragCoord.xy);
@@ -91,6 +145,15 @@ void main()
     float fresnel = r0 + (1.0 - r0) * pow(1.0 - c, 5.0);
     vec3 r = reflect(dir, n);
     vec3 sky = u_has_env ? texture(u_env, r).rgb : volfx_sky(r, WATER_SUN);
+    g_size = size;
+    if (u_ssr && u_has_color && u_has_depth) {
+        vec3 hit;
+        float fade;
+        if (ssr(u_eye + t * dir, r, t, hit, fade)) {
+            sky = mix(sky, hit, fade);
+            atomicAdd(c_ssr_hits, 1u);
+        }
+    }
     vec3 behind = vec3(0.1, 0.15, 0.2);
     float back = texelFetch(u_back, pix, 0).r;
     if (u_has_depth)
@@ -100,7 +163,6 @@ void main()
     if (u_refract_view || dot(rd, rd) == 0.0) {
         if (u_has_color) behind = texture(u_scene_color, (vec2(pix) + 0.5) / size + rd.xy * 0.03).rgb;
     } else {
-        g_size = size;
         ivec2 ep;
         // a step past the front so the first sample is inside (the front's refine tolerance)
         vec3 x = u_eye + (t + 1.0e-3 * u_h) * dir;
@@ -111,8 +173,14 @@ void main()
     // colour (light scattered in the body): a deep pool reads as tinted water, not black
     vec3 trans = exp(-u_absorption * thickness * (vec3(1.0) - u_tint));
     vec3 body = behind * trans + WATER_SCATTER * u_tint * (vec3(1.0) - trans);
+    vec2 foam_bub = u_has_diffuse ? texelFetch(u_diffuse, pix, 0).rg : vec2(0.0);
+    vec3 white = water_white_light();
+    // bubbles: white specks behind the surface (already attenuated by the water in front)
+    body += white * (1.0 - exp(-BUBBLE_K * foam_bub.g)) * u_tint * 1.5;
     // the sun's highlight on the reflected ray: a warm glint on every wave facing it
     float sun = pow(max(dot(r, WATER_SUN), 0.0), 400.0);
     vec3 col = mix(body, sky, fresnel) + vec3(2.0, 1.5, 1.1) * sun;
+    // foam on the surface hides what is under it, the glint too
+    col = mix(col, white, 1.0 - exp(-FOAM_K * foam_bub.r));
     o_color = vec4(u_hdr ? col : min(col, vec3(1.0)), 1.0);
 }

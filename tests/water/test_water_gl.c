@@ -786,98 +786,39 @@ static void test_shading_pixels(void **state)
     }
 }
 
-/* Spray: one particle, over a dark host image, seen from 1 away. With a velocity of 3 (above the
- * white speed) it counts as spray and its billboard shows around the water sphere, each pixel the
- * premultiplied blend of spray.frag computed here in double (disc (1 - r^2)^2 x 0.85 on the
- * camera-facing plane through the particle, lit by the sky above and towards the sun and the
- * sun); standing still, with NaN velocity, or with NO_SPRAY the image is the one without
- * velocities, bit for bit. */
-static void test_spray(void **state)
+/* Diffuse particles off: with velocity columns at rest, NaN velocities, fast ones under
+ * VFX_WATER_NO_DIFFUSE, or fast ones in a paused frame (dt 0: nothing is generated) the image is
+ * the one without velocity columns, bit for bit, and no diffuse particle is counted (the
+ * generation itself is tested in test_water_diffuse against a float64 reference). */
+static void test_diffuse_off(void **state)
 {
     (void)state;
     static const float host[4] = {0.05f, 0.05f, 0.05f, 1.0f};
     const ref_camera cam = {{0, 0, 1.0}, {0, 0, 0}, {0, 1, 0}, 0.9, 48, 48, 0.1, 100};
     const size_t n = (size_t)cam.width * cam.height;
     float v[3][1];
-    float *img[5];
-    double counted[5];
-    for (int c = 0; c < 5; ++c) {
-        /* 0 no velocity columns, 1 fast, 2 still, 3 NaN velocity, 4 fast with NO_SPRAY */
+    float *img[4];
+    for (int c = 0; c < 4; ++c) {
+        /* 0 no velocity columns, 1 still, 2 NaN velocity, 3 fast with NO_DIFFUSE */
         scene s = make_scene(1);
         s.params.method = VFX_WATER_METHOD_TILE;
         s.x[0] = s.y[0] = s.z[0] = 0;
-        v[0][0] = c == 3 ? NAN : (c == 1 || c == 4) ? 3.0f : 0.0f;
+        v[0][0] = c == 2 ? NAN : c == 3 ? 3.0f : 0.0f;
         v[1][0] = v[2][0] = 0;
         if (c > 0)
             for (int k = 0; k < 3; ++k) s.vel[k] = v[k];
-        if (c == 4) s.params.disable = VFX_WATER_NO_SPRAY;
+        if (c == 3) s.params.disable = VFX_WATER_NO_DIFFUSE;
         session ss;
         session_open(&ss, &s, &cam, host, 0, true);
         assert_int_equal(session_frame(&ss), VFX_OK);
         img[c] = session_pixels(&ss);
-        counted[c] = stat_of_ctx(&ss, "water.spray_particles");
+        assert_true(stat_of_ctx(&ss, "water.diffuse_spray") <= 0);
+        assert_true(stat_of_ctx(&ss, "water.diffuse_generated") <= 0);
         session_close(&ss);
         free_scene(&s);
     }
-    assert_true(counted[0] == 0 && counted[1] == 1 && counted[2] == 0 && counted[3] == 0);
-    for (int c = 2; c < 5; ++c) assert_memory_equal(img[c], img[0], n * 16);
-    /* the expected blend where the billboard lies outside the water sphere (the water pixels
-     * also fade by the depth under the surface; they are left out) */
-    const double h = 0.61, rho = h * (1 - 0.765625), rad = 0.45 * h;
-    const double sun[3] = {-0.4653, 0.3619, -0.8079};
-    double sh[3] = {sun[0], 0.15, sun[2]}, up[3] = {0, 1, 0}, s_up[3], s_h[3], light[3];
-    sky_d(up, sun, s_up);
-    sky_d(sh, sun, s_h);
-    const double sunc[3] = {1.0, 0.62, 0.32};
-    double l3[3];
-    for (int k = 0; k < 3; ++k) l3[k] = 0.5 * (s_up[k] + s_h[k]) + 0.35 * sunc[k];
-    double lum = 0.2126 * l3[0] + 0.7152 * l3[1] + 0.0722 * l3[2];
-    for (int k = 0; k < 3; ++k) light[k] = fmin(1.2 * (lum + 0.25 * (l3[k] - lum)), 1.0);
-    uint32_t checked = 0;
-    double worst = 0;
-    for (uint32_t j = 0; j < cam.height; ++j)
-        for (uint32_t i = 0; i < cam.width; ++i) {
-            double dir[3];
-            ref_pixel_ray(&cam, i, j, dir);
-            /* the quad's plane through the origin faces the eye (normal z): q = eye + t dir */
-            double t = -cam.eye[2] / dir[2], qx = t * dir[0], qy = t * dir[1];
-            double r2 = (qx * qx + qy * qy) / (rad * rad);
-            double perp2 = 1 - dir[2] * dir[2]; /* squared distance of the ray from the origin */
-            if (perp2 < 1.3 * 1.3 * rho * rho) continue; /* on or near the water sphere */
-            const float *got = img[1] + 4 * ((size_t)j * cam.width + i);
-            double a = r2 < 1 ? (1 - r2) * (1 - r2) * 0.85 : 0;
-            for (int k = 0; k < 3; ++k) {
-                double want = host[k] * (1 - a) + light[k] * a;
-                worst = fmax(worst, fabs(got[k] - want));
-            }
-            checked += a > 0.05;
-        }
-    print_message("spray: %u halo pixels checked, worst |rgb - expected| %.2e\n", checked, worst);
-    assert_true(checked > 100);
-    /* measured 5e-8: the disc is interpolated across the quad (perspective-correct, float32,
-     * ~1e-6 in r^2 at a pixel) and the blend rounds in the RGBA32F target only */
-    assert_true(worst < 1e-5);
-    for (int c = 0; c < 5; ++c) free(img[c]);
-
-    /* drops in flight: two lone particles at 0.5 (below the spray speed, above the isolated
-     * drops') count as isolated spray with the anisotropic kernel (its neighbour counts), not
-     * with the isotropic one (no counts) */
-    for (int k = 0; k < 2; ++k) {
-        scene s = make_scene(2);
-        s.params.method = VFX_WATER_METHOD_TILE;
-        s.kernel = k ? VFX_WATER_KERNEL_ANISOTROPIC : VFX_WATER_KERNEL_ISOTROPIC;
-        s.x[0] = -0.3f, s.x[1] = 0.3f;
-        s.y[0] = s.y[1] = s.z[0] = s.z[1] = 0;
-        float vx[2] = {0.5f, 0.5f}, zero[2] = {0, 0};
-        s.vel[0] = vx, s.vel[1] = s.vel[2] = zero;
-        session ss;
-        session_open(&ss, &s, &cam, host, 0, true);
-        assert_int_equal(session_frame(&ss), VFX_OK);
-        assert_true(stat_of_ctx(&ss, "water.spray_particles") == 0);
-        assert_true(stat_of_ctx(&ss, "water.spray_isolated") == (k ? 2 : 0));
-        session_close(&ss);
-        free_scene(&s);
-    }
+    for (int c = 1; c < 4; ++c) assert_memory_equal(img[c], img[0], n * 16);
+    for (int c = 0; c < 4; ++c) free(img[c]);
 }
 
 /* Multi-buffer chunking: 3000 particles (in host chunks of 97, so chunks straddle buffers)
@@ -1461,7 +1402,7 @@ int main(void)
         cmocka_unit_test(test_blobs_vs_reference),
         cmocka_unit_test(test_normals_vs_reference),
         cmocka_unit_test(test_shading_pixels),
-        cmocka_unit_test(test_spray),
+        cmocka_unit_test(test_diffuse_off),
         cmocka_unit_test(test_chunked_buffers),
         cmocka_unit_test(test_count_overflow_refused),
         cmocka_unit_test(test_async_counters),

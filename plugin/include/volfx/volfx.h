@@ -153,8 +153,13 @@ enum {
     /* TILE: no reduced-resolution march (one ray per 2x2 block, the rest upsampled where the
      * block agrees and marched where it does not) */
     VFX_WATER_NO_HALF_RES = 1u << 13,
-    /* shading: no spray and foam (the fast particles drawn white; needs the velocity columns) */
+    /* shading: no diffuse particles (spray, foam and bubbles, vfx_water_params4; they need the
+     * velocity columns): none generated, advected or drawn */
     VFX_WATER_NO_SPRAY = 1u << 14,
+    VFX_WATER_NO_DIFFUSE = VFX_WATER_NO_SPRAY,
+    /* shading (ablation): no screen-space reflection of the host's colour; the reflected ray
+     * sees only the cubemap or the sky */
+    VFX_WATER_NO_SSR = 1u << 15,
 };
 
 /* Zero means the recommended method (TILE). The paper method is selected by name (its value was
@@ -237,6 +242,39 @@ typedef struct vfx_water_params3 {
     uint32_t preset;               /* vfx_water_preset */
     uint32_t _reserved[7];
 } vfx_water_params3;
+
+/* Version 4 of the water parameters: version 3 as its first member (never edited), then the
+ * diffuse particles (spray, foam and bubbles) after Ihmsen, Akinci, Akinci & Teschner 2012,
+ * "Unified spray, foam and bubbles for particle-based fluids". The plugin generates them on the
+ * GPU from the host's positions and velocities (no velocity columns: none), advects them and
+ * draws them (docs/water.md "Diffuse particles"). Lengths are in units of h and speeds in units
+ * of v_ref = sqrt(|gravity| h), the speed of a gravity wave over h, so a scene in other units
+ * sees the same spray; zero means default in every field; out-of-range values are refused with
+ * the field's name. The plugin offers one with v1.size = sizeof(vfx_water_params4) and
+ * v1.version = VFX_WATER_PARAMS4_VERSION; a host that answers an older version is then offered
+ * the older ones in turn (so a host that tests for exactly its version keeps working) and gets
+ * these defaults. */
+#define VFX_WATER_PARAMS4_VERSION 4u
+typedef struct vfx_water_params4 {
+    vfx_water_params3 v3;
+    uint32_t diffuse_max;          /* the pool's cap, 1..4194304; 0 -> 32768 */
+    float gravity[3];              /* scene units / s^2 (spray, bubbles, v_ref); 0 -> (0, -9.81, 0) */
+    /* potentials' clamp ranges [min, max] (each 0 -> default; min < max):
+     * trapped air sum_j |v_ij| (1 - v_ij.x_ij) W_ij in units of v_ref, 0 -> [1.5, 6];
+     * wave crest sum_j (1 - n_i.n_j) W_ij over the convex neighbours of a particle moving along
+     * its normal, no unit, 0 -> [0.3, 1.5]; kinetic energy |v|^2 / v_ref^2, 0 -> [0.5, 4] */
+    float trapped_air[2], wave_crest[2], energy[2];
+    /* particles generated per fluid particle per second at full potential, <= 10000;
+     * 0 -> 40 (trapped air) and 60 (wave crest) */
+    float rate_trapped_air, rate_wave_crest;
+    float lifetime;                /* seconds a foam particle lives (spray and bubbles do not age), <= 60; 0 -> 2.5 */
+    float buoyancy;                /* k_b: a bubble's upward acceleration over |gravity|, <= 20; 0 -> 2 */
+    float drag;                    /* k_d: a bubble's velocity pulled to the fluid's per second x dt, <= 60; 0 -> 8 */
+    /* classification by fluid neighbours within h: fewer than spray_below -> spray, more than
+     * bubble_above -> bubble, else foam; 0 -> 6 and 20 (Ihmsen's); spray_below <= bubble_above */
+    uint32_t spray_below, bubble_above;
+    uint32_t _reserved[8];
+} vfx_water_params4;
 
 /* One beam; the field is defined exactly in docs/beams.md:
  * head rho_h = a / sqrt(|P-M|^2 + eps^2) inside radius R, trail rho_t = b / sqrt(r^2 + eps^2)
