@@ -118,7 +118,8 @@ static void test_pbf_thin_wall(void **state)
     (void)state;
     rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.2f, 0.3f, 0.04f}, .threads = 2};
     rt_sph *s = make(d);
-    rt_sph_collider wall = {.kind = RT_SPH_BOX, .center = {0.1f, 0.08f, 0.02f}, .half = {0.1f, 0.005f, 0.1f}};
+    rt_sph_collider wall = {.kind = RT_SPH_BOX, .center = {0.1f, 0.08f, 0.02f}, .half = {0.3f, 0.005f, 0.3f}};
+    /* wider than the domain: its nearest face is always the top or the bottom */
     assert_int_equal(rt_sph_add_collider(s, &wall, NULL, NULL, 0), VFX_OK);
     float lo[3] = {0.06f, 0.15f, 0}, hi[3] = {0.14f, 0.28f, 0.04f};
     assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
