@@ -60,12 +60,17 @@ static unsigned ply_type_size(const char *t)
     return 0;
 }
 
+#define PLY_MAX_PROPS 32
+
 typedef struct ply_element {
     char name[32];
     unsigned long long count;
     unsigned props;          /* properties (a list counts once) */
     unsigned long long bytes; /* binary: the least bytes one instance takes */
     unsigned line;
+    unsigned char size[PLY_MAX_PROPS];     /* a scalar's bytes, or a list item's */
+    unsigned char list[PLY_MAX_PROPS];     /* a list's count bytes; 0 for a scalar */
+    unsigned char signed_count[PLY_MAX_PROPS];
 } ply_element;
 
 /* Next header line [*pos, end) into `line` (NUL-terminated, CR dropped); 0 at the end of data. */
@@ -108,6 +113,89 @@ static vfx_result ply_fail(const char *name, char *err, size_t errlen, const cha
     return VFX_ERR_FORMAT;
 }
 
+/* Walks the body, instance by instance: every list's count (in the body, where no header check
+ * sees it) must fit in what follows. Assimp sizes a list by its count before reading it (an
+ * ASCII face claiming 4e9 indices asked for 32 GB). Binary: bytes; ASCII: one line an instance,
+ * as Assimp reads it, holding every value and every list item. */
+static vfx_result ply_walk_body(const unsigned char *d, size_t size, size_t pos, int binary,
+                                const ply_element *el, unsigned nel, const char *name, char *err,
+                                size_t errlen)
+{
+    for (unsigned i = 0; i < nel; ++i) {
+        const ply_element *e = &el[i];
+        for (unsigned long long k = 0; k < e->count; ++k) {
+            size_t eol = pos;
+            if (!binary) {
+                while (pos < size && isspace(d[pos])) /* blank lines between instances */
+                    ++pos;
+                eol = pos;
+                while (eol < size && d[eol] != '\n')
+                    ++eol;
+            }
+            for (unsigned p = 0; p < e->props; ++p) {
+                unsigned long long n = 1; /* items this property holds */
+                size_t item = e->size[p];
+                if (binary && e->list[p]) {
+                    unsigned cs = e->list[p];
+                    if (size - pos < cs)
+                        goto truncated;
+                    unsigned long long v = 0;
+                    for (unsigned b = 0; b < cs; ++b)
+                        v |= (unsigned long long)d[pos + (binary == 2 ? cs - 1 - b : b)] << (8 * b);
+                    if (e->signed_count[p] && (v >> (8 * cs - 1)) & 1)
+                        goto negative;
+                    pos += cs;
+                    n = v;
+                } else if (!binary && e->list[p]) {
+                    while (pos < eol && (d[pos] == ' ' || d[pos] == '\t' || d[pos] == '\r'))
+                        ++pos;
+                    if (pos == eol)
+                        goto truncated;
+                    if (d[pos] == '-')
+                        goto negative;
+                    unsigned long long v = 0;
+                    for (; pos < eol && isdigit(d[pos]); ++pos)
+                        v = v > 1ull << 40 ? v : v * 10 + (d[pos] - '0');
+                    n = v;
+                }
+                if (binary) {
+                    if (n > (size - pos) / item)
+                        goto too_many;
+                    pos += n * item;
+                    continue;
+                }
+                for (unsigned long long t = 0; t < n; ++t) { /* n tokens on this line */
+                    while (pos < eol && (d[pos] == ' ' || d[pos] == '\t' || d[pos] == '\r'))
+                        ++pos;
+                    if (pos == eol) {
+                        if (e->list[p])
+                            goto too_many;
+                        goto truncated;
+                    }
+                    while (pos < eol && !(d[pos] == ' ' || d[pos] == '\t' || d[pos] == '\r'))
+                        ++pos;
+                }
+                continue;
+            too_many:
+                snprintf(err, errlen, "%s: PLY body: element %s %llu, property %u: a list of %llu items, more "
+                         "than the %s holds (truncated or lying)", name, e->name, k, p, n, binary ? "file" : "line");
+                return VFX_ERR_FORMAT;
+            negative:
+                snprintf(err, errlen, "%s: PLY body: element %s %llu, property %u: a negative list count", name,
+                         e->name, k, p);
+                return VFX_ERR_FORMAT;
+            truncated:
+                snprintf(err, errlen, "%s: PLY body: element %s %llu of %llu, property %u: the %s ends (truncated)",
+                         name, e->name, k, e->count, p, binary ? "file" : "line");
+                return VFX_ERR_FORMAT;
+            }
+            if (!binary)
+                pos = eol;
+        }
+    }
+    return VFX_OK;
+}
+
 static vfx_result check_ply(const unsigned char *d, size_t size, const char *name, char *err,
                             size_t errlen)
 {
@@ -125,8 +213,8 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
             return ply_fail(name, err, errlen, "longer than %s characters", ln, "255");
         if (bad_byte)
             return ply_fail(name, err, errlen, "%s", ln, "a byte that is not ASCII text (or a CR not ending the line)");
-        char w[4][64] = {{0}};
-        int nw = sscanf(line, "%63s %63s %63s %63s", w[0], w[1], w[2], w[3]);
+        char w[5][64] = {{0}};
+        int nw = sscanf(line, "%63s %63s %63s %63s %63s", w[0], w[1], w[2], w[3], w[4]);
         if (ln == 1) {
             if (strcmp(line, "ply") != 0)
                 return ply_fail(name, err, errlen, "%s", ln, "not a PLY file (no \"ply\" on the first line)");
@@ -139,8 +227,10 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
                 return ply_fail(name, err, errlen, "%s", ln, "a second or empty format line");
             if (strcmp(w[1], "ascii") == 0)
                 binary = 0;
-            else if (strcmp(w[1], "binary_little_endian") == 0 || strcmp(w[1], "binary_big_endian") == 0)
+            else if (strcmp(w[1], "binary_little_endian") == 0)
                 binary = 1;
+            else if (strcmp(w[1], "binary_big_endian") == 0)
+                binary = 2;
             else
                 return ply_fail(name, err, errlen, "unknown format \"%s\"", ln, w[1]);
         } else if (strcmp(w[0], "element") == 0) {
@@ -150,6 +240,9 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
                 return ply_fail(name, err, errlen, "%s", ln, "an element line needs a name and a count");
             if (nel == PLY_MAX_ELEMENTS)
                 return ply_fail(name, err, errlen, "more than %s elements", ln, "16");
+            for (unsigned k = 0; k < nel; ++k)
+                if (strcmp(el[k].name, w[1]) == 0) /* Assimp 5.2 corrupts its heap on a repeat */
+                    return ply_fail(name, err, errlen, "element %s declared twice", ln, w[1]);
             ply_element *e = &el[nel++];
             memset(e, 0, sizeof *e);
             snprintf(e->name, sizeof e->name, "%.31s", w[1]);
@@ -160,12 +253,22 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
                 return ply_fail(name, err, errlen, "%s", ln, "a property before any element");
             ply_element *e = &el[nel - 1];
             unsigned sz;
+            if (e->props == PLY_MAX_PROPS)
+                return ply_fail(name, err, errlen, "more than %s properties in one element", ln, "32");
             if (strcmp(w[1], "list") == 0) {
                 /* a list takes at least its count: it may hold no item */
-                if (nw != 4 || !(sz = ply_type_size(w[2])) || !ply_type_size(w[3]))
+                unsigned isz = ply_type_size(w[3]);
+                if (nw != 5 || !(sz = ply_type_size(w[2])) || !isz)
                     return ply_fail(name, err, errlen, "%s", ln, "a list property needs two types and a name");
+                if (strstr(w[2], "float") || strcmp(w[2], "double") == 0)
+                    return ply_fail(name, err, errlen, "a list count of type %s", ln, w[2]);
+                e->list[e->props] = (unsigned char)sz;
+                e->signed_count[e->props] = w[2][0] != 'u';
+                e->size[e->props] = (unsigned char)isz;
             } else if (nw != 3 || !(sz = ply_type_size(w[1]))) {
                 return ply_fail(name, err, errlen, "unknown property type \"%s\"", ln, w[1]);
+            } else {
+                e->size[e->props] = (unsigned char)sz;
             }
             e->props++;
             e->bytes += sz;
@@ -208,7 +311,7 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
             return VFX_ERR_FORMAT;
         }
     }
-    return VFX_OK;
+    return ply_walk_body(d, size, pos, binary, el, nel, name, err, errlen);
 }
 
 /* ---- STL ---------------------------------------------------------------------------------- */

@@ -87,6 +87,23 @@ static void test_ply_claiming_2e9_vertices(void **state)
     static const char empty_el[] = "ply\nformat ascii 1.0\nelement junk 4000000\nend_header\n";
     write_file("noprop.ply", empty_el, sizeof empty_el - 1);
     expect_refused("noprop.ply", VFX_ERR_FORMAT, "has no property");
+    /* list counts live in the body: Assimp sized a face by its count before reading it (an
+     * ASCII face of 4e9 indices asked for 32 GB) */
+    static const char list_ascii[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                     "property float y\nproperty float z\nelement face 1\n"
+                                     "property list uint int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
+                                     "4000000000 0 1 2\n";
+    write_file("list_ascii.ply", list_ascii, sizeof list_ascii - 1);
+    expect_refused("list_ascii.ply", VFX_ERR_FORMAT, "a list of 4000000000 items, more than the line holds");
+    n = snprintf((char *)buf, sizeof buf, ply_head, "0", "1");
+    memset(buf + n, 0xff, 1); /* uchar count 255, no index after it */
+    write_file("list_bin.ply", buf, (size_t)n + 1);
+    expect_refused("list_bin.ply", VFX_ERR_FORMAT, "a list of 255 items, more than the file holds");
+    /* an element declared twice corrupted Assimp's heap (found by fuzz_mesh_ply) */
+    static const char twice[] = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nelement vertex 1\n"
+                                "property float x\nend_header\n0\n0\n";
+    write_file("twice.ply", twice, sizeof twice - 1);
+    expect_refused("twice.ply", VFX_ERR_FORMAT, "element vertex declared twice");
 }
 
 static void le32(unsigned char *p, uint32_t v)
