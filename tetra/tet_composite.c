@@ -149,7 +149,7 @@ void tet_update_table(shared *sh, worker *w)
 void tet_composite_rows(const shared *sh, float *rgba, int y0, int y1)
 {
     const int W = sh->X->W, nw = sh->nw;
-    int32_t cur[64];
+    int32_t cur[TET_MAX_WORKERS];
     for (int y = y0; y < y1; y++)
         for (int x = 0; x < W; x++) {
             size_t pix = (size_t)y * W + x;

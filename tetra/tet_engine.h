@@ -100,7 +100,7 @@ typedef struct shared {
 /* ---- tet_setup.c: checks, projection, keys ---- */
 
 /* The checks every entry point makes once its pointers are known non-NULL, in one order so all
- * report the same first fault: image size, worker count (at most 64), a scalar field, a
+ * report the same first fault: image size, worker count (at most TET_MAX_WORKERS), a scalar field, a
  * perspective projection, a valid transfer function. Sets *near_d to the near-plane distance
  * the projection implies (1e-4 when it implies none). */
 tet_result tet_check_view(const tet_mesh *mesh, const tet_camera *cam, const tet_tf *tf, int nw,

@@ -14,6 +14,9 @@ typedef struct tet_camera {
     int width, height;
 } tet_camera;
 
+/* Most render workers (threads) of one frame: the plugin's volume.workers goes to 256. */
+#define TET_MAX_WORKERS 256
+
 /* Most breakpoints a transfer function table may have. */
 #define TET_TF_MAX_POINTS 1024
 
@@ -57,7 +60,7 @@ typedef struct tet_options {
     int update_c;          /* C: table updated every (remaining cells)/C cells */
     int partial_composite; /* 1: merge adjacent segments on insert */
     const float *max_dist; /* optional width*height host depth as ray distance; NULL = none */
-    int workers;           /* threads, each owning a partition of cells (<= 0 means 1, max 64) */
+    int workers;           /* threads, each owning a partition of cells (<= 0 means 1, max TET_MAX_WORKERS) */
     int share;             /* 1: weak sharing of the ERT tables at each table update */
     int dlb;               /* 1: dynamic load balancing (idle worker takes 1/3 of the most loaded) */
 } tet_options;
@@ -102,8 +105,9 @@ tet_result tet_render_workers(const tet_mesh *mesh, const tet_camera *cam,
  * plus the calling thread, with their segment lists and tables kept between frames. */
 typedef struct tet_pool tet_pool;
 
-/* Creates a pool of workers (<= 0 means 1, at most 64). Returns TET_OK or an error code with a
- * message in err. A thread that cannot be started is not fatal: its share runs on the caller. */
+/* Creates a pool of workers (<= 0 means 1, at most TET_MAX_WORKERS). Returns TET_OK or an error
+ * code with a message in err. A thread that cannot be started is not fatal: its share runs on
+ * the caller. */
 tet_result tet_pool_create(int workers, tet_pool **out, char *err, size_t errlen);
 /* Stops the threads and frees the pool; NULL allowed. */
 void tet_pool_destroy(tet_pool *pool);

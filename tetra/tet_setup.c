@@ -27,8 +27,8 @@ tet_result tet_check_view(const tet_mesh *mesh, const tet_camera *cam, const tet
         tet_errf(err, errlen, "tet_render: image size %dx%d out of range", W, H);
         return TET_ERR_INVALID_ARGUMENT;
     }
-    if (nw > 64) {
-        tet_errf(err, errlen, "tet_render: %d workers requested, at most 64", nw);
+    if (nw > TET_MAX_WORKERS) {
+        tet_errf(err, errlen, "tet_render: %d workers requested, at most %d", nw, TET_MAX_WORKERS);
         return TET_ERR_INVALID_ARGUMENT;
     }
     if (!mesh->scalar) {

@@ -20,7 +20,7 @@ typedef void (*pool_fn)(void *arg, int index);
 struct tet_pool {
     int n;                    /* workers: the caller (index 0) and threads 1..nthreads */
     int nthreads;
-    pthread_t th[63];
+    pthread_t th[TET_MAX_WORKERS - 1];
     pthread_mutex_t m;
     pthread_cond_t go, done;
     uint64_t gen;             /* job generation: a thread runs each one once */
@@ -95,8 +95,8 @@ tet_result tet_pool_create(int workers, tet_pool **out, char *err, size_t errlen
 {
     *out = NULL;
     const int n = workers <= 0 ? 1 : workers;
-    if (n > 64) {
-        tet_errf(err, errlen, "tet_render: %d workers requested, at most 64", n);
+    if (n > TET_MAX_WORKERS) {
+        tet_errf(err, errlen, "tet_render: %d workers requested, at most %d", n, TET_MAX_WORKERS);
         return TET_ERR_INVALID_ARGUMENT;
     }
     tet_pool *p = calloc(1, sizeof *p);
@@ -291,7 +291,7 @@ typedef struct frame_job {
     pvert *vp;
     cellkey *keys, *ktmp;
     float *rgba;
-    double t_scan_end[64];   /* wall clock when each worker finished scanning */
+    double t_scan_end[TET_MAX_WORKERS]; /* wall clock when each worker finished scanning */
 } frame_job;
 
 /* Phase 1: worker i projects its share of the points. */

@@ -413,7 +413,7 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
     o.workers = v->workers ? (int)v->workers : (int)(cores > 0 ? (cores < 64 ? cores : 64) : 1);
     o.max_dist = s->max_dist;
     char err[256];
-    if (s->pool && tet_pool_workers(s->pool) != (o.workers > 64 ? 64 : o.workers)) {
+    if (s->pool && tet_pool_workers(s->pool) != o.workers) {
         tet_pool_destroy(s->pool);
         s->pool = NULL;
     }

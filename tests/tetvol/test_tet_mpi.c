@@ -192,6 +192,19 @@ static int test_render(int P)
         o.ert = 0;
         o.ert_threshold = 1.0f; /* the same partial-compositing stop as an ERT-1.0 run */
         CHECK(tet_render(&m, &cam, &tf, &o, ref, &c0, err, sizeof err) == TET_OK, "%s", err);
+        o.ert = 1;
+        o.ert_threshold = 0.9f;
+        CHECK(tet_render(&m, &cam, &tf, &o, img, NULL, err, sizeof err) == TET_OK, "%s", err);
+        /* One process with ERT 0.9 on this scene: measured 0.00603 (either cell order; one
+         * thread, so the same every run: the skip set depends on the cell order and the
+         * update schedule only). 0.0075 leaves 25% for another compiler's float contraction
+         * and still fails when ERT skips wrongly (checking one tile row of a cell's box
+         * measured 0.0123 on the one-process test's scene, 1.6x). The 1 - 0.9 = 0.1 bound of
+         * the theory allowed any of that. */
+        const double d_one = max_diff(ref, img, n4);
+        if (g_rank == 0)
+            printf("one process shuffle=%d ERT 0.9: max diff %.3g\n", shuffle, d_one);
+        CHECK(d_one <= 0.0075, "one-process ERT 0.9 differs from no-ERT by %g (measured 0.00603)", d_one);
         for (int mode = 0; mode < 4; mode++) {
             o.share = mode & 1;
             o.dlb = (mode >> 1) & 1;
@@ -225,8 +238,13 @@ static int test_render(int P)
                       (unsigned long long)given);
                 CHECK(o.dlb || taken == 0, "work moved without DLB");
             }
-            /* ERT 0.9: a skipped cell lies behind pixels of opacity >= 0.9, so its light is
-             * attenuated by >= 0.9: each variant stays within 1 - 0.9 = 0.1 of no-ERT */
+            /* ERT 0.9: a rank skips a cell only behind tiles its own lists or the shared table
+             * proved terminated, which the one process proves at least as early (it holds
+             * every segment), so the ranks skip less and err less: measured at most 0.000174
+             * (2 and 4 ranks, every mode, several runs) against the one process's 0.00603.
+             * The skip set depends on the timing of the table exchanges, so the bound is the
+             * one process's own error (deterministic, checked above) with 25% margin, not the
+             * theory's 0.1 that a table never updated or a wrong skip passed. */
             o.ert = 1;
             o.ert_threshold = 0.9f;
             CHECK(tet_mpi_render(ctx, &m, &cam, &tf, &o, img, NULL, all, err, sizeof err) ==
@@ -241,7 +259,7 @@ static int test_render(int P)
                 printf("P=%d shuffle=%d share=%d dlb=%d ERT 0.9: max diff %.3g, skipped %llu, "
                        "table exchanges %llu\n", P, shuffle, o.share, o.dlb, d,
                        (unsigned long long)skipped, (unsigned long long)rounds);
-                CHECK(d <= 0.1 + 1e-5, "ERT 0.9 differs from no-ERT by %g", d);
+                CHECK(d <= 1.25 * d_one + 1e-5, "ERT 0.9 differs from no-ERT by %g (one process: %g)", d, d_one);
                 /* Without DLB each rank's partition is fixed, so its local table alone skips
                  * the same cells every run (sharing only adds); with DLB the cells a rank ends
                  * up with depend on timing and a run may skip none (seen under ASan). */

@@ -228,12 +228,20 @@ static void test_ert_threshold(void **state)
     print_message("ERT 0.9: skipped %llu of %u cells (scanned %llu, updates %llu, alpha0 %.3f), max diff %.4g\n",
                   (unsigned long long)c2.cells_skipped_ert, NT, (unsigned long long)c2.cells_scanned, (unsigned long long)c2.table_updates, a[4 * (20 * 40 + 20) + 3], mx);
     assert_true(c2.cells_skipped_ert > 0);
-    assert_true(mx <= 0.1 + 1e-5); /* skipped light is attenuated by at least 1 - 0.9 */
+    /* The theory bounds a skipped cell's light by 1 - 0.9 = 0.1, a bound under which a wrong
+     * skip (one tile row of the cell's box checked: 0.0123 measured) or a stale table passed.
+     * One thread renders the same every run (the skip set depends on the cell order and the
+     * update schedule only): measured 0.007629; 0.0095 leaves 25% for another compiler's float
+     * contraction and fails that mutation. */
+    assert_true(mx <= 0.0095);
 
     /* Workers: without ERT, 1 vs 4 workers (with and without DLB) differ only by the float
      * association of partial compositing (different segments merge on each worker): 1e-5 is
      * ~100 float32 ulps of values <= 1. With ERT 0.9, SHARE/DLB on/off only change which
-     * hidden cells are skipped, so each stays within 0.1 of the no-ERT image. */
+     * hidden cells are skipped: a worker knows at most the terminations one thread knows
+     * (its own lists and the shared table), so it skips no more; measured 0 to 0.007629 over
+     * 200 runs (the most when sharing makes every table complete, as one thread's), so the
+     * one-thread bound above holds them too. */
     float *c = calloc(40 * 40 * 4, sizeof *c);
     tet_counters pw[4];
     for (int mode = 0; mode < 4; mode++) {
@@ -256,10 +264,44 @@ static void test_ert_threshold(void **state)
                       o.share, o.dlb, (unsigned long long)c1.cells_skipped_ert, dmax,
                       (unsigned long long)pw[0].cells_scanned, (unsigned long long)pw[1].cells_scanned,
                       (unsigned long long)pw[2].cells_scanned, (unsigned long long)pw[3].cells_scanned);
-        assert_true(dmax <= 0.1 + 1e-5);
+        assert_true(dmax <= 0.0095);
     }
     o.workers = 1;
     free(c);
+    free(a); free(b); free(pts); free(sc); free(tets);
+}
+
+/* volume.workers is documented up to 256 (the scene and the plugin allow it); the pool was
+ * capped at 64 and failed the first frame of 65..256 (issue 28). 256 workers render the image of
+ * one within the partial-compositing association bound (1e-5, as above); 257 are refused. */
+static void test_many_workers(void **state)
+{
+    (void)state;
+    enum { N = 3 };
+    tet_mesh m;
+    float *pts, *sc;
+    uint32_t *tets;
+    make_grid(N, &m, &pts, &sc, &tets);
+    tet_camera cam; make_cam(&cam, 24, 24, 4.0f, 0.1f);
+    tet_tf tf; make_tf(&tf, 4.0f);
+    tet_options o; tet_options_default(&o); o.ert = 0;
+    float *a = calloc(24 * 24 * 4, sizeof *a), *b = calloc(24 * 24 * 4, sizeof *b);
+    char err[256];
+    tet_counters c;
+    o.workers = 1;
+    assert_int_equal(tet_render(&m, &cam, &tf, &o, a, &c, err, sizeof err), 0);
+    tet_pool *pool = NULL;
+    assert_int_equal(tet_pool_create(TET_MAX_WORKERS, &pool, err, sizeof err), 0);
+    assert_int_equal(tet_pool_workers(pool), 256);
+    o.workers = 256;
+    assert_int_equal(tet_render_pool(pool, &m, &cam, &tf, &o, b, &c, NULL, err, sizeof err), 0);
+    double mx = 0;
+    for (int i = 0; i < 24 * 24 * 4; i++)
+        mx = fmax(mx, fabs(a[i] - b[i]));
+    assert_true(mx < 1e-5);
+    tet_pool_destroy(pool);
+    assert_int_not_equal(tet_pool_create(TET_MAX_WORKERS + 1, &pool, err, sizeof err), 0);
+    assert_non_null(strstr(err, "at most 256"));
     free(a); free(b); free(pts); free(sc); free(tets);
 }
 
@@ -540,6 +582,7 @@ int main(void)
         cmocka_unit_test(test_cube_vs_reference),
         cmocka_unit_test(test_ert_threshold),
         cmocka_unit_test(test_camera_inside_and_nan),
+        cmocka_unit_test(test_many_workers),
         cmocka_unit_test(test_visibility_cycle),
         cmocka_unit_test(test_coincident_vertices),
         cmocka_unit_test(test_opacity_extremes),
