@@ -1,5 +1,6 @@
 /* demo_scene.c — turns a scene (runtime/scene) into app content and animates it. */
 #include "demo_scene.h"
+#include "scene_dir.h"
 #include "core/file.h"
 
 #include <math.h>
@@ -10,17 +11,6 @@
 
 extern const char game_default_scene_json[];
 extern const unsigned long game_default_scene_json_len;
-
-/* The built-in default scene's relative paths (its dome mesh) resolve against
- * VFX_SCENE_DIR when set, else the scenes folder of the tree the game was built from. */
-static const char *default_scene_dir(void)
-{
-    const char *env = getenv("VFX_SCENE_DIR");
-#ifndef GAME_SCENE_DIR
-#define GAME_SCENE_DIR "."
-#endif
-    return env && *env ? env : GAME_SCENE_DIR;
-}
 
 static vfx_result load_meshes(game_app *app, const rt_scene *sc)
 {
@@ -382,11 +372,14 @@ vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path
 {
     memset(demo, 0, sizeof *demo);
     demo->effects_off = effects_off | ~app->api->effects_built; /* what the plugin lacks is off too */
-    char err[512];
+    char err[512], dir[4096], found[4096];
+    /* a bare name is one of the scenes the game ships; the built-in default's relative paths
+     * (its dome mesh) resolve against the same folder */
+    scene_path = game_scene_resolve(scene_path, found, sizeof found);
     vfx_result r = scene_path
                        ? rt_scene_load_file(scene_path, &app->log, &demo->scene, err, sizeof err)
-                       : rt_scene_load_mem(game_default_scene_json, game_default_scene_json_len, default_scene_dir(),
-                                            &app->log, &demo->scene, err, sizeof err);
+                       : rt_scene_load_mem(game_default_scene_json, game_default_scene_json_len,
+                                            game_scene_dir(dir, sizeof dir), &app->log, &demo->scene, err, sizeof err);
     if (r) {
         rt_logf(&app->log, VFX_LOG_ERROR, "scene %s: %s", scene_path ? scene_path : "(built-in default)", err);
         return r;

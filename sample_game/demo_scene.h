@@ -30,7 +30,8 @@ typedef struct game_demo {
 } game_demo;
 
 /* Loads the scene file `scene_path` (NULL -> the built-in default, sample_game/scenes/
- * default.json embedded at build time) into the app: meshes as entities, water particles (an
+ * default.json embedded at build time; a bare name -> one of the shipped scenes, scene_dir.h)
+ * into the app: meshes as entities, water particles (an
  * SPH system when the scene sets up a simulation), beams with their keyframes, the volume.
  * Effects in `effects_off`, or not built into the plugin, are left out entirely. */
 vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path, uint32_t effects_off);

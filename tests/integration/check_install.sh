@@ -50,4 +50,27 @@ out=$("$dest$prefix/bin/volfx-game" --headless --frames 2 --size 64x36 --no-volu
       --plugin "$soname" 2>&1) || { echo "$out"; fail "installed volfx-game --plugin $soname failed"; }
 echo "$out" | grep "loaded from" || { echo "$out"; fail "the game did not report the plugin's path"; }
 echo "$out" | grep -q "loaded from $lib/libvolfx.so.1" || fail "plugin not loaded from the DESTDIR"
+# The installed game with the source tree gone: the default scene (its dome mesh is a relative
+# path in the scene) must come from the installed share/volfx/scenes. The source tree is hidden
+# under an empty tmpfs in a private mount namespace where unshare can make one (root); elsewhere
+# the log must still name the installed file.
+scenes=$dest$prefix/share/volfx/scenes
+[ -f "$scenes/data/dome.vtu" ] && [ -f "$scenes/default.json" ] || fail "scenes not installed under share/volfx/scenes"
+game="$dest$prefix/bin/volfx-game --headless --frames 1 --size 64x36 --progress 0 --png $dest/d.png"
+if unshare -m true 2>/dev/null; then
+  hidden="with $src hidden"
+  # shellcheck disable=SC2086
+  out=$(unshare -m sh -c "mount -t tmpfs none '$src' && exec $game" 2>&1) || { echo "$out"; fail "installed volfx-game failed $hidden"; }
+else
+  hidden="(unshare -m refused: source tree present)"
+  # shellcheck disable=SC2086
+  out=$($game 2>&1) || { echo "$out"; fail "installed volfx-game failed"; }
+fi
+echo "$out" | grep "scene volume" || { echo "$out"; fail "no volume loaded by the default scene"; }
+echo "$out" | grep -q "scene volume $scenes/data/dome.vtu:" || fail "the default scene's dome did not come from $scenes"
+[ -s "$dest/d.png" ] || fail "no image written"
+echo "installed game rendered the default scene $hidden"
+# A shipped scene by bare name, found in the installed scenes folder.
+# shellcheck disable=SC2086
+$game --scene beams-only.json >/dev/null 2>&1 || fail "installed volfx-game --scene beams-only.json failed"
 echo "install ok"
