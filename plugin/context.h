@@ -17,6 +17,8 @@ typedef struct volfx_debug_knobs {
     bool sync_counters;        /* GPU counters of this frame, waited for (a stall); otherwise
                                   effects report those of the last frame the GPU finished */
     uint32_t water_buffer_cap; /* particles per water position buffer; 0 -> the GL limit */
+    uint32_t water_max_tiles;  /* TILE's tile count limit; 0 -> the scan's 2^20 - 1 */
+    uint64_t water_storage_cap; /* bytes per TILE storage block; 0 -> GL_MAX_SHADER_STORAGE_BLOCK_SIZE */
 } volfx_debug_knobs;
 
 struct vfx_context {

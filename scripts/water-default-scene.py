@@ -10,7 +10,7 @@ and shader compilation cancel, and the simulation is the same in every run (same
 fixed steps). plugin.render is the game's own median wall time of the render call (F2 run).
 
 Usage: scripts/water-default-scene.py [--build build] [--rounds 3] [--frames 6] [--size 640x360]
-       [--configs paper,tile,no_temporal,no_half,no_both]
+       [--configs paper,tile,no_temporal,no_half,no_both,low,medium,high,ultra]
 The PNG of every configuration's last frame goes to /tmp/water-default-NAME.png.
 --callgrind: instead, each configuration once under valgrind --tool=callgrind with llvmpipe in the
 calling thread (LP_NUM_THREADS=0), instructions collected inside the plugin's render call only
@@ -34,6 +34,11 @@ CONFIGS = {
     "no_temporal": ("tile, NO_TEMPORAL", "tile", ["temporal"]),
     "no_half": ("tile, NO_HALF_RES", "tile", ["half_res"]),
     "no_both": ("tile, NO_TEMPORAL + NO_HALF_RES", "tile", ["temporal", "half_res"]),
+    # the quality presets (water.quality.preset; medium is the default)
+    "low": ("preset low", "tile", [], "low"),
+    "medium": ("**preset medium (the default)**", "tile", [], "medium"),
+    "high": ("preset high", "tile", [], "high"),
+    "ultra": ("preset ultra", "tile", [], "ultra"),
 }
 
 
@@ -80,6 +85,8 @@ def main():
         q["method"] = CONFIGS[n][1]
         if CONFIGS[n][2]:
             q["disable"] = CONFIGS[n][2]
+        if len(CONFIGS[n]) > 3:
+            q["preset"] = CONFIGS[n][3]
         # next to default.json: its relative paths resolve the same
         f = os.path.join(ROOT, "sample_game", "scenes", ".water-default-%d-%s.json" % (os.getpid(), n))
         json.dump(s, open(f, "w"))

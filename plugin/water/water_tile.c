@@ -11,7 +11,10 @@
 #include "gpu/gpu.h"
 #include "water_tile.h"
 
-#define TILE_PX 8
+/* tiles of 8x8 pixels, or 16, 32 or 64 a side when 8x8 tiles would pass TILE_MAX_TILES
+ * (8192x8192 makes 2^20 tiles of 8: one too many for the scan) */
+#define TILE_SHIFT_MIN 3
+#define TILE_SHIFT_MAX 6
 /* the two-level scan of grid.comp: 1024 blocks of 1024 */
 #define TILE_MAX_TILES ((1u << 20) - 1u)
 /* 256 MiB of entries at most */
@@ -30,6 +33,8 @@ struct volfx_water_tile {
     uint32_t entry_cap;  /* entries `entries` holds */
     uint32_t global_cap; /* particles `globals` holds */
     uint32_t tiles_x, tiles_y, slabs;
+    int shift;           /* tiles of 2^shift pixels a side */
+    uint64_t ssbo_max;   /* bytes one storage block may hold (GL_MAX_SHADER_STORAGE_BLOCK_SIZE) */
     float d0, ds;        /* slab k starts at distance d0 + k ds from the eye */
     /* temporal reuse: each pixel's hit point of the frame `hits_frame` (world space), and this
      * frame's reprojected guesses; valid for the next frame only, at the same size and field */
@@ -51,6 +56,11 @@ volfx_water_tile *volfx_water_tile_create(vfx_context *ctx)
     if (!t)
         return NULL;
     t->blocks = volfx_gpu_storage(1024 * sizeof(uint32_t), "water.tile_blocks");
+    GLint64 block = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
+    t->ssbo_max = block > 0 ? (uint64_t)block : (1u << 27); /* GL 4.5's minimum is 2^27 */
+    if (ctx->debug.water_storage_cap && ctx->debug.water_storage_cap < t->ssbo_max)
+        t->ssbo_max = ctx->debug.water_storage_cap;
     return t;
 }
 
@@ -73,6 +83,7 @@ static void tile_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_tile 
     glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_cap"), (in->params->disable & VFX_WATER_NO_TILES) ? 0u : t->entry_cap);
     glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_global_tiles"), TILE_GLOBAL_TILES);
     glUniform2i(volfx_gpu_uniform(ctx, prog, "u_tiles"), (GLint)t->tiles_x, (GLint)t->tiles_y);
+    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_tile_shift"), t->shift);
     glUniform2i(volfx_gpu_uniform(ctx, prog, "u_size"), (GLint)in->width, (GLint)in->height);
     glUniform1f(volfx_gpu_uniform(ctx, prog, "u_h"), in->params->h);
     glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_slabs"), t->slabs);
@@ -104,14 +115,27 @@ static void bind_buffers(const volfx_water_tile *t, const volfx_water_tile_input
 
 vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in)
 {
-    t->tiles_x = (in->width + TILE_PX - 1) / TILE_PX;
-    t->tiles_y = (in->height + TILE_PX - 1) / TILE_PX;
-    uint64_t tiles = (uint64_t)t->tiles_x * t->tiles_y;
-    if (tiles > TILE_MAX_TILES)
-        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, "water tile: %ux%u pixels make %llu tiles of %dx%d, more than %u",
-                          in->width, in->height, (unsigned long long)tiles, TILE_PX, TILE_PX, TILE_MAX_TILES);
+    uint32_t max_tiles = TILE_MAX_TILES;
+    if (ctx->debug.water_max_tiles && ctx->debug.water_max_tiles < max_tiles)
+        max_tiles = ctx->debug.water_max_tiles;
+    uint64_t tiles = 0;
+    for (t->shift = TILE_SHIFT_MIN; t->shift <= TILE_SHIFT_MAX; ++t->shift) {
+        uint32_t px = 1u << t->shift;
+        t->tiles_x = (in->width + px - 1) / px;
+        t->tiles_y = (in->height + px - 1) / px;
+        tiles = (uint64_t)t->tiles_x * t->tiles_y;
+        if (tiles <= max_tiles)
+            break;
+    }
+    if (tiles > max_tiles) /* 16384^2 at 64x64 tiles is 65,536 of them: only a debug cap gets here */
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, "water tile: %ux%u pixels make %llu tiles of %ux%u, more than %u",
+                          in->width, in->height, (unsigned long long)tiles, 1u << TILE_SHIFT_MAX, 1u << TILE_SHIFT_MAX,
+                          max_tiles);
+    volfx_stat_set(ctx, "water.tile_pixels", 1u << t->shift);
+    /* entries of 16 bytes in one storage block */
+    uint64_t max_entries = t->ssbo_max / 16u < TILE_MAX_ENTRIES ? t->ssbo_max / 16u : TILE_MAX_ENTRIES;
     t->slabs = TILE_SLABS;
-    while (t->slabs > 1 && tiles * t->slabs > TILE_MAX_TILES)
+    while (t->slabs > 1 && tiles * t->slabs > max_tiles)
         t->slabs /= 2;
     /* the particles' distances from the eye: from the box (0 when the eye is inside) to its
      * farthest corner */
@@ -146,16 +170,16 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
      * that does not fit reads every particle (right, but slow). */
     double fpx = (double)in->focal_px;
     double span_px = dmin > 2.0 * hx ? 2.0 * sqrt(3.0) * hx * fpx / (dmin - hx) : 1e9;
-    double per = span_px / TILE_PX + 2.0;
+    double per = span_px / (double)(1u << t->shift) + 2.0;
     per = per * per;
     if (per > (double)tiles) per = (double)tiles;
     if (per > TILE_GLOBAL_TILES) per = TILE_GLOBAL_TILES;
-    uint64_t want = (uint64_t)fmin((double)in->count * per + 65536.0, (double)TILE_MAX_ENTRIES);
+    uint64_t want = (uint64_t)fmin((double)in->count * per + 65536.0, (double)max_entries);
     if (in->last_entries) {
         uint64_t w2 = (uint64_t)in->last_entries + in->last_entries / 4u + 1024u;
         if (w2 > want) want = w2;
     }
-    if (want > TILE_MAX_ENTRIES) want = TILE_MAX_ENTRIES;
+    if (want > max_entries) want = max_entries;
     if (!t->entries || want > t->entry_cap) {
         if (t->entries) glDeleteBuffers(1, &t->entries);
         t->entries = volfx_gpu_storage((GLsizeiptr)want * 16, "water.tile_entries");
@@ -271,9 +295,10 @@ static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const vol
     else if (in->kernels) /* stretched kernels overlap more: at a flat pool's surface ~16 supports
                              against ~9 (docs/water.md); 16 slots sent 9,359 pixels of the 3,000-
                              particle pool to the dense fallback and cost 1.8x the CPU of 32 */
-        prog = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_MARCH\n#define ANISO\n#define LOCAL_K 32\n");
+        prog = volfx_gpu_compute(ctx, "water/tile.comp", half == 2 ? "#define MODE_MARCH\n#define ANISO\n#define LOCAL_K 32\n#define UPSAMPLE_PASS\n"
+                                                                   : "#define MODE_MARCH\n#define ANISO\n#define LOCAL_K 32\n");
     else
-        prog = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_MARCH\n");
+        prog = volfx_gpu_compute(ctx, "water/tile.comp", half == 2 ? "#define MODE_MARCH\n#define UPSAMPLE_PASS\n" : "#define MODE_MARCH\n");
     if (!prog)
         return VFX_ERR_GL;
     GLenum access = finish ? GL_READ_ONLY : GL_READ_WRITE;
@@ -341,6 +366,13 @@ vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const v
     bool temporal = !(p->disable & VFX_WATER_NO_TEMPORAL);
     bool half = !(p->disable & VFX_WATER_NO_HALF_RES);
     uint32_t px = in->width * in->height;
+    /* the hit list (16 bytes a pixel) and the re-march list (4) must each fit one storage block
+     * (128 MiB on llvmpipe: 2896^2 and 5792^2 pixels); past that the frame is drawn without
+     * temporal reuse or without the reduced resolution (the same surface, more rays) */
+    bool limited = false;
+    if (temporal && 16u + (uint64_t)px * 16u > t->ssbo_max) temporal = false, limited = true;
+    if (half && 16u + (uint64_t)px * 4u > t->ssbo_max) half = false, limited = true;
+    volfx_stat_set(ctx, "water.tile_storage_limited", limited);
     if (temporal && (!t->hits || px > t->hits_px)) {
         if (t->hits) glDeleteBuffers(1, &t->hits);
         if (t->guess) glDeleteBuffers(1, &t->guess);

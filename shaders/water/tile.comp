@@ -53,6 +53,7 @@ uniform uint u_count;        // particles in the columns (non-finite included)
 uniform uint u_cap;          // entries the Entries buffer holds
 uniform uint u_global_tiles; // a particle covering more tiles goes to the global list
 uniform ivec2 u_tiles;       // tiles across, down
+uniform int u_tile_shift;    // tiles of 2^shift pixels a side: 8, or more when 8x8 tiles would pass the scan's 2^20
 uniform ivec2 u_size;        // pixels
 uniform float u_h;
 // Depth slabs: within a tile the entries are in slab order of the distance from the eye (key
@@ -104,7 +105,7 @@ bool tile_rect(vec3 p, vec3 ext, out ivec4 r)
     vec2 plo = clamp(floor((lo * 0.5 + 0.5) * sz - 0.5), vec2(-1.0), sz);
     vec2 phi = clamp(ceil((hi * 0.5 + 0.5) * sz - 0.5), vec2(-1.0), sz);
     if (phi.x < 0.0 || phi.y < 0.0 || plo.x > sz.x - 1.0 || plo.y > sz.y - 1.0) return false;
-    ivec2 a = ivec2(max(plo, vec2(0.0))) >> 3, b = ivec2(min(phi, sz - 1.0)) >> 3;
+    ivec2 a = ivec2(max(plo, vec2(0.0))) >> u_tile_shift, b = ivec2(min(phi, sz - 1.0)) >> u_tile_shift;
     r = ivec4(a, min(b, u_tiles - 1));
     return true;
 }
@@ -524,7 +525,7 @@ void main()
     vec4 st = imageLoad(u_st, pix);
     if (st.x != 3.0) return;     // only the paper's sample-cap pixels
 #endif
-    uint ti = uint((pix.y >> 3) * u_tiles.x + (pix.x >> 3)) * u_slabs;
+    uint ti = uint((pix.y >> u_tile_shift) * u_tiles.x + (pix.x >> u_tile_shift)) * u_slabs;
     g_start = tstart[ti];
     g_n = tstart[ti + u_slabs] - g_start;
     g_over = g_start + g_n > u_cap;
@@ -540,15 +541,17 @@ void main()
     bool g_empty = false;  // the ray meets no sphere of influence at all
 #if defined(MODE_MARCH)
     uint pidx = uint(pix.y * u_size.x + pix.x);
-    if (u_half == 2) {
-        if (((pix.x | pix.y) & 1) == 0) return;   // a coarse pixel: done by the u_half 1 pass
-        if (upsample(pix, t_lim, pidx)) return;
-        uint k = atomicAdd(rm_count, 1u);
-        rm_pix[k] = pidx;
-        if ((k & 63u) == 0u) atomicAdd(rm_groups, 1u);   // a new group of 64 begins
-        atomicAdd(c_remarched, 1u);
-        return;
-    }
+#if defined(UPSAMPLE_PASS)
+    // u_half 2, compiled on its own: without the march below (dead after the return) the pass
+    // costs llvmpipe a fraction of the whole program's per-invocation set-up
+    if (((pix.x | pix.y) & 1) == 0) return;   // a coarse pixel: done by the u_half 1 pass
+    if (upsample(pix, t_lim, pidx)) return;
+    uint k = atomicAdd(rm_count, 1u);
+    rm_pix[k] = pidx;
+    if ((k & 63u) == 0u) atomicAdd(rm_groups, 1u);   // a new group of 64 begins
+    atomicAdd(c_remarched, 1u);
+    return;
+#endif
 #endif
 
     bool have_prev = false;
