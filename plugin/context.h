@@ -34,6 +34,7 @@ struct vfx_context {
     unsigned water_dist_tex;    /* shared target owned by the context */
     unsigned no_depth_tex;      /* far depth for a frame view without depth_texture (frame_check.c) */
     uint32_t no_depth_w, no_depth_h;
+    unsigned frame_block;       /* GL uniform buffer of the frame gate's VolfxFrame block */
     volfx_debug_knobs debug;
 };
 

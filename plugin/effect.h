@@ -7,24 +7,51 @@
 
 #include "context.h"
 
-/* Targets shared between effects during one render. Effects run in a fixed order:
- * water (writes water_dist), volume (over, clipped by scene depth and water), beams (additive,
- * integrated up to the nearer of scene and water). */
+/* The frame gate (plugin/frame_check.c): what effects read of the camera, computed once a frame
+ * from the checked frame view, and the targets effects share during one render. Effects run in
+ * a fixed order: water (writes water_dist), volume (over, clipped by scene depth and water),
+ * beams (additive, integrated up to the nearer of scene and water). No effect multiplies or
+ * inverts these matrices, and none reads the camera from the frame view: the `frame` argument of
+ * render() stays only until every effect reads this (docs/architecture.md "Frame gate"). */
 typedef struct volfx_frame_targets {
-    unsigned scene_depth;  /* host depth texture (window depth [0,1]) */
+    unsigned scene_depth;  /* host depth texture (window depth [0,1]); a far-depth one for 0 */
     unsigned scene_color;  /* host colour texture */
     unsigned water_dist;   /* R32F distance along the view ray to water, -1 miss; 0 = no water */
-    /* Made once per frame in entry.c from the frame view, so no effect multiplies or inverts. */
     float view_proj[16];     /* proj * view */
-    float inv_view_proj[16]; /* window/NDC -> world */
-    float inv_view[16];      /* eye space -> world */
+    float inv_view_proj[16]; /* window/NDC -> position */
+    float inv_view[16];      /* eye space -> position */
     /* Version 2 fields (defaults when the host passed version 1). */
     double origin[3];        /* positions are relative to this */
     bool color_hdr;          /* framebuffer colour is float: write linear radiance */
     unsigned environment_cubemap; /* 0 -> procedural sky */
     /* Version 3: the view's id (0 for versions 1 and 2); effects key per-view state on it. */
     uint32_t view_id;
+    /* The rest of the camera (frame gate, issue 23). */
+    unsigned framebuffer;    /* where effects draw their result */
+    uint32_t width, height;
+    uint32_t effects;        /* VFX_EFFECT_BIT mask drawn this frame (the host's 0 -> all) */
+    float view[16], proj[16];        /* the host's, checked finite */
+    float eye[3];                    /* the host's eye (relative to origin) */
+    double view_eye[3];              /* -R^T t of the view matrix, in double */
+    float near_plane, far_plane;     /* checked against proj; filled from it when the host gave 0, 0
+                                      * (far FLT_MAX for an infinite projection) */
+    float fov_y;                     /* radians, [0, pi) */
+    float cam_view_proj[16];         /* camera-relative: proj * view without its translation */
+    float inv_cam_view_proj[16];     /* window/NDC -> direction from the eye */
 } volfx_frame_targets;
+
+/* The shared std140 block of the frame gate (shaders/common/frame.glsl, `VolfxFrame`): uploaded
+ * once a frame and bound at this uniform block binding before any effect renders; effects keep
+ * it bound (they bind their own blocks at other indices: beams 3, water 4, volume 0). */
+#define VOLFX_FRAME_BINDING 6u
+typedef struct volfx_frame_block {
+    float view_proj[16], inv_view_proj[16], cam_view_proj[16], inv_cam_view_proj[16];
+    float view[16], proj[16], inv_view[16];
+    float eye_fov[4];        /* eye xyz, fov_y */
+    float planes_size[4];    /* near, far, width, height */
+    float origin_hdr[4];     /* origin xyz (float), 1 when HDR */
+    uint32_t flags[4];       /* cubemap given, view id, effects mask, 0 */
+} volfx_frame_block;
 
 struct volfx_effect_ops {
     const char *name;

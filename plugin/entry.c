@@ -182,73 +182,28 @@ static vfx_result plugin_update(vfx_context *ctx, double time, float dt)
     return VFX_OK;
 }
 
-/* Cofactors in double, so near-singular projections keep their digits. */
+/* The frame gate (frame_check.c) checks the view and derives the camera once; the effects then
+ * read it from targets (and the VolfxFrame block it binds). */
 static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
 {
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
     gl_bind(ctx);
-    if (!frame)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view is NULL");
-    /* version 3 is version 2 plus the view's id: read on as version 2 */
-    uint32_t view_id = 0;
-    vfx_frame_view2 as_v2;
-    if (frame->version == VFX_FRAME_VIEW3_VERSION) {
-        if (frame->size < sizeof(vfx_frame_view3))
-            return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view of version 3 has size %u (need %zu)",
-                              frame->size, sizeof(vfx_frame_view3));
-        view_id = ((const vfx_frame_view3 *)frame)->view_id;
-        memcpy(&as_v2, frame, sizeof as_v2);
-        as_v2.v1.size = sizeof as_v2;
-        as_v2.v1.version = VFX_FRAME_VIEW2_VERSION;
-        frame = &as_v2.v1;
-    }
-    if (frame->version != VFX_FRAME_VIEW_VERSION && frame->version != VFX_FRAME_VIEW2_VERSION)
-        return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view of version %u (this plugin reads %u, %u and %u)",
-                          frame->version, VFX_FRAME_VIEW_VERSION, VFX_FRAME_VIEW2_VERSION, VFX_FRAME_VIEW3_VERSION);
-    size_t need = frame->version == VFX_FRAME_VIEW2_VERSION ? sizeof(vfx_frame_view2) : sizeof(vfx_frame_view);
-    if (frame->size < need)
-        return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view of version %u has size %u (need %zu)",
-                          frame->version, frame->size, need);
-    if (frame->width == 0 || frame->height == 0)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame is %ux%u", frame->width,
-                        frame->height);
-    for (int i = 0; i < 16; ++i)
-        if (!isfinite(frame->view[i]) || !isfinite(frame->proj[i]))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: camera matrix element %d is not finite", i);
-    if (frame->width != ctx->width || frame->height != ctx->height) {
-        vfx_result r = plugin_resize(ctx, frame->width, frame->height);
+    volfx_frame_targets targets;
+    vfx_frame_view2 checked; /* what the effects still receive: validated, near/far filled */
+    vfx_result cr = volfx_frame_gate(ctx, frame, &targets, &checked);
+    if (cr)
+        return cr;
+    if (targets.width != ctx->width || targets.height != ctx->height) {
+        vfx_result r = plugin_resize(ctx, targets.width, targets.height);
         if (r)
             return r;
     }
-    volfx_frame_targets targets;
-    memset(&targets, 0, sizeof targets);
-    targets.view_id = view_id;
-    targets.scene_depth = frame->depth_texture;
-    targets.scene_color = frame->color_texture;
-    volfx_mat4_mul(frame->proj, frame->view, targets.view_proj);
-    if (!volfx_mat4_invert(targets.view_proj, targets.inv_view_proj))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: view*projection is singular");
-    if (!volfx_mat4_invert(frame->view, targets.inv_view))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: view matrix is singular");
-    if (frame->version == VFX_FRAME_VIEW2_VERSION) {
-        const vfx_frame_view2 *f2 = (const vfx_frame_view2 *)frame;
-        for (int i = 0; i < 3; ++i) {
-            if (!isfinite(f2->origin[i]))
-                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view origin[%d] is not finite", i);
-            targets.origin[i] = f2->origin[i];
-        }
-        targets.color_hdr = f2->color_hdr != 0;
-        targets.environment_cubemap = f2->environment_cubemap;
-    }
-
-    uint32_t mask = frame->effects ? frame->effects : 0xffffffffu;
+    uint32_t mask = targets.effects;
     bool drawing = false;
     for (int k = 0; k < VFX_EFFECT_COUNT; ++k)
         drawing |= ctx->effect_state[k] && (mask & VFX_EFFECT_BIT(k));
-    vfx_frame_view2 checked; /* what the effects read: validated, near/far filled */
-    vfx_result cr = volfx_check_frame(ctx, frame, drawing, &checked, &targets);
-    if (cr)
+    if ((cr = volfx_frame_gate_gl(ctx, drawing, &targets)))
         return cr;
     frame = &checked.v1;
 

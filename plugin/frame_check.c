@@ -3,6 +3,7 @@
 #include "frame_check.h"
 
 #include "gpu/gpu.h"
+#include "gpu/pass.h"
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -155,10 +156,20 @@ static vfx_result check_planes(vfx_context *ctx, vfx_frame_view *v)
     return VFX_OK;
 }
 
+static void drop_far_depth(vfx_context *ctx)
+{
+    if (ctx->no_depth_tex) {
+        GLuint t = ctx->no_depth_tex;
+        glDeleteTextures(1, &t);
+    }
+    ctx->no_depth_tex = 0;
+    ctx->no_depth_w = ctx->no_depth_h = 0;
+}
+
 static vfx_result far_depth(vfx_context *ctx, uint32_t w, uint32_t h, unsigned *out)
 {
     if (!ctx->no_depth_tex || ctx->no_depth_w != w || ctx->no_depth_h != h) {
-        volfx_frame_check_destroy(ctx);
+        drop_far_depth(ctx);
         GLuint t = 0;
         glCreateTextures(GL_TEXTURE_2D, 1, &t);
         glTextureStorage2D(t, 1, GL_DEPTH_COMPONENT32F, (GLsizei)w, (GLsizei)h);
@@ -175,13 +186,91 @@ static vfx_result far_depth(vfx_context *ctx, uint32_t w, uint32_t h, unsigned *
     return VFX_OK;
 }
 
-vfx_result volfx_check_frame(vfx_context *ctx, const vfx_frame_view *frame, bool drawing,
-                             vfx_frame_view2 *out, volfx_frame_targets *targets)
+/* Version 3 is version 2 plus the view's id: read on as version 2. Then the version 1/2 sizes,
+ * the frame size and the matrices' finiteness; *checked gets the view as version 1 or 2. */
+static vfx_result read_view(vfx_context *ctx, const vfx_frame_view *frame, uint32_t *view_id,
+                            vfx_frame_view2 *checked)
 {
-    memset(out, 0, sizeof *out);
-    memcpy(out, frame, frame->version == VFX_FRAME_VIEW2_VERSION ? sizeof(vfx_frame_view2) : sizeof(vfx_frame_view));
-    vfx_frame_view *v = &out->v1;
-    v->size = frame->version == VFX_FRAME_VIEW2_VERSION ? sizeof(vfx_frame_view2) : sizeof(vfx_frame_view);
+    *view_id = 0;
+    if (frame->version == VFX_FRAME_VIEW3_VERSION) {
+        if (frame->size < sizeof(vfx_frame_view3))
+            return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view of version 3 has size %u (need %zu)",
+                              frame->size, sizeof(vfx_frame_view3));
+        *view_id = ((const vfx_frame_view3 *)frame)->view_id;
+        memcpy(checked, frame, sizeof *checked);
+        checked->v1.size = sizeof *checked;
+        checked->v1.version = VFX_FRAME_VIEW2_VERSION;
+        frame = &checked->v1;
+    }
+    if (frame->version != VFX_FRAME_VIEW_VERSION && frame->version != VFX_FRAME_VIEW2_VERSION)
+        return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view of version %u (this plugin reads %u, %u and %u)",
+                          frame->version, VFX_FRAME_VIEW_VERSION, VFX_FRAME_VIEW2_VERSION, VFX_FRAME_VIEW3_VERSION);
+    size_t need = frame->version == VFX_FRAME_VIEW2_VERSION ? sizeof(vfx_frame_view2) : sizeof(vfx_frame_view);
+    if (frame->size < need)
+        return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view of version %u has size %u (need %zu)",
+                          frame->version, frame->size, need);
+    if (frame->width == 0 || frame->height == 0)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame is %ux%u", frame->width,
+                          frame->height);
+    for (int i = 0; i < 16; ++i)
+        if (!isfinite(frame->view[i]) || !isfinite(frame->proj[i]))
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: camera matrix element %d is not finite", i);
+    if (frame != &checked->v1) {
+        vfx_frame_view2 copy;
+        memset(&copy, 0, sizeof copy);
+        memcpy(&copy, frame, need);
+        *checked = copy;
+    }
+    checked->v1.size = (uint32_t)need;
+    return VFX_OK;
+}
+
+/* Cofactors in double (volfx_mat4_invert), so near-singular projections keep their digits. */
+static vfx_result derive_camera(vfx_context *ctx, const vfx_frame_view2 *checked, volfx_frame_targets *t)
+{
+    const vfx_frame_view *v = &checked->v1;
+    volfx_mat4_mul(v->proj, v->view, t->view_proj);
+    if (!volfx_mat4_invert(t->view_proj, t->inv_view_proj))
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: view*projection is singular");
+    if (!volfx_mat4_invert(v->view, t->inv_view))
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: view matrix is singular");
+    if (v->version == VFX_FRAME_VIEW2_VERSION) {
+        for (int i = 0; i < 3; ++i) {
+            if (!isfinite(checked->origin[i]))
+                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view origin[%d] is not finite", i);
+            t->origin[i] = checked->origin[i];
+        }
+        t->color_hdr = checked->color_hdr != 0;
+        t->environment_cubemap = checked->environment_cubemap;
+    }
+    /* Camera-relative: the eye is the origin, so far-away geometry keeps float32 digits when
+     * effects subtract the eye in double first. */
+    float view_rot[16];
+    memcpy(view_rot, v->view, sizeof view_rot);
+    view_rot[12] = view_rot[13] = view_rot[14] = 0.f;
+    volfx_mat4_mul(v->proj, view_rot, t->cam_view_proj);
+    if (!volfx_mat4_invert(t->cam_view_proj, t->inv_cam_view_proj))
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: camera rotation*projection is singular");
+    /* eye = -R^T t from the view matrix (exact for the matrices used, whatever eye says) */
+    for (int k = 0; k < 3; ++k)
+        t->view_eye[k] = -((double)v->view[k * 4 + 0] * v->view[12] + (double)v->view[k * 4 + 1] * v->view[13]
+                           + (double)v->view[k * 4 + 2] * v->view[14]);
+    return VFX_OK;
+}
+
+vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx_frame_targets *t,
+                            vfx_frame_view2 *checked)
+{
+    memset(t, 0, sizeof *t);
+    memset(checked, 0, sizeof *checked);
+    if (!frame)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view is NULL");
+    vfx_result r = read_view(ctx, frame, &t->view_id, checked);
+    if (r)
+        return r;
+    if ((r = derive_camera(ctx, checked, t)))
+        return r;
+    vfx_frame_view *v = &checked->v1;
     for (int k = 0; k < 3; ++k)
         if (!isfinite(v->eye[k]))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view eye[%d] is not finite", k);
@@ -191,29 +280,76 @@ vfx_result volfx_check_frame(vfx_context *ctx, const vfx_frame_view *frame, bool
     if (v->effects & ~((1u << VFX_EFFECT_COUNT) - 1))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view effects 0x%x has bits of no effect "
                           "(known: 0x%x)", v->effects, (1u << VFX_EFFECT_COUNT) - 1);
-    vfx_result r = check_planes(ctx, v);
-    if (r || !drawing)
+    if ((r = check_planes(ctx, v)))
         return r;
-    if (v->framebuffer && (r = check_framebuffer(ctx, v->framebuffer, v->width, v->height)))
-        return r;
-    if (v->color_texture && (r = check_texture(ctx, "color_texture", v->color_texture, WANT_COLOR, v->width, v->height)))
-        return r;
-    if (v->depth_texture && (r = check_texture(ctx, "depth_texture", v->depth_texture, WANT_DEPTH, v->width, v->height)))
-        return r;
-    if (frame->version == VFX_FRAME_VIEW2_VERSION && out->environment_cubemap &&
-        (r = check_texture(ctx, "environment_cubemap", out->environment_cubemap, WANT_CUBE, 0, 0)))
-        return r;
-    if (!v->depth_texture)
-        return far_depth(ctx, v->width, v->height, &targets->scene_depth);
+    t->scene_depth = v->depth_texture;
+    t->scene_color = v->color_texture;
+    t->framebuffer = v->framebuffer;
+    t->width = v->width, t->height = v->height;
+    t->effects = v->effects ? v->effects : 0xffffffffu;
+    memcpy(t->view, v->view, sizeof t->view);
+    memcpy(t->proj, v->proj, sizeof t->proj);
+    memcpy(t->eye, v->eye, sizeof t->eye);
+    t->near_plane = v->near_plane, t->far_plane = v->far_plane;
+    t->fov_y = v->fov_y;
     return VFX_OK;
+}
+
+/* Fills and uploads the VolfxFrame block (made on first use) and binds it for the frame. */
+static vfx_result upload_block(vfx_context *ctx, const volfx_frame_targets *t)
+{
+    if (!ctx->frame_block) {
+        volfx_ubo u = {0};
+        if (!volfx_ubo_create(ctx, &u, sizeof(volfx_frame_block), "volfx.frame_block"))
+            return VFX_ERR_GL;
+        ctx->frame_block = u.buffer;
+    }
+    volfx_frame_block b;
+    memcpy(b.view_proj, t->view_proj, sizeof b.view_proj);
+    memcpy(b.inv_view_proj, t->inv_view_proj, sizeof b.inv_view_proj);
+    memcpy(b.cam_view_proj, t->cam_view_proj, sizeof b.cam_view_proj);
+    memcpy(b.inv_cam_view_proj, t->inv_cam_view_proj, sizeof b.inv_cam_view_proj);
+    memcpy(b.view, t->view, sizeof b.view);
+    memcpy(b.proj, t->proj, sizeof b.proj);
+    memcpy(b.inv_view, t->inv_view, sizeof b.inv_view);
+    b.eye_fov[0] = t->eye[0], b.eye_fov[1] = t->eye[1], b.eye_fov[2] = t->eye[2], b.eye_fov[3] = t->fov_y;
+    b.planes_size[0] = t->near_plane, b.planes_size[1] = t->far_plane;
+    b.planes_size[2] = (float)t->width, b.planes_size[3] = (float)t->height;
+    for (int k = 0; k < 3; ++k)
+        b.origin_hdr[k] = (float)t->origin[k];
+    b.origin_hdr[3] = t->color_hdr ? 1.f : 0.f;
+    b.flags[0] = t->environment_cubemap != 0, b.flags[1] = t->view_id, b.flags[2] = t->effects, b.flags[3] = 0;
+    volfx_ubo u = {ctx->frame_block, sizeof(volfx_frame_block)};
+    volfx_ubo_update(&u, &b, sizeof b);
+    volfx_ubo_bind(&u, VOLFX_FRAME_BINDING);
+    return VFX_OK;
+}
+
+vfx_result volfx_frame_gate_gl(vfx_context *ctx, bool drawing, volfx_frame_targets *t)
+{
+    if (!drawing)
+        return VFX_OK;
+    vfx_result r;
+    if (t->framebuffer && (r = check_framebuffer(ctx, t->framebuffer, t->width, t->height)))
+        return r;
+    if (t->scene_color && (r = check_texture(ctx, "color_texture", t->scene_color, WANT_COLOR, t->width, t->height)))
+        return r;
+    if (t->scene_depth && (r = check_texture(ctx, "depth_texture", t->scene_depth, WANT_DEPTH, t->width, t->height)))
+        return r;
+    if (t->environment_cubemap &&
+        (r = check_texture(ctx, "environment_cubemap", t->environment_cubemap, WANT_CUBE, 0, 0)))
+        return r;
+    if (!t->scene_depth && (r = far_depth(ctx, t->width, t->height, &t->scene_depth)))
+        return r;
+    return upload_block(ctx, t);
 }
 
 void volfx_frame_check_destroy(vfx_context *ctx)
 {
-    if (ctx->no_depth_tex) {
-        GLuint t = ctx->no_depth_tex;
-        glDeleteTextures(1, &t);
+    if (ctx->frame_block) {
+        GLuint b = ctx->frame_block;
+        glDeleteBuffers(1, &b);
+        ctx->frame_block = 0;
     }
-    ctx->no_depth_tex = 0;
-    ctx->no_depth_w = ctx->no_depth_h = 0;
+    drop_far_depth(ctx);
 }

@@ -1,7 +1,8 @@
-/* frame_check.h — what the plugin checks of the host's input at the ABI before any effect sees
- * it: the host api's callback pairs, and a frame view's fields (texture and framebuffer names,
- * their targets, formats and sizes by GL queries, near/far against the projection). Every error
- * names the field. */
+/* frame_check.h — the frame gate: what the plugin checks of the host's input at the ABI before
+ * any effect sees it (the host api's callback pairs; every field of a frame view: version,
+ * size, finiteness, near/far against the projection, texture and framebuffer names, their
+ * targets, formats and sizes by GL queries), and the one place the camera is derived for the
+ * effects (volfx_frame_targets, and its GL block). Every error names the field. */
 #ifndef VOLFX_FRAME_CHECK_H
 #define VOLFX_FRAME_CHECK_H
 
@@ -14,15 +15,23 @@
  * complete or absent. */
 vfx_result volfx_check_host(const vfx_host_api *host, char *msg, size_t msglen);
 
-/* Checks `frame` (version 1 or 2; size and version already checked) and writes the view the
- * effects get into *out (version kept; near_plane/far_plane filled from the projection when the
- * host gave both 0). `drawing` true: some effect will draw, so its GL names are queried too.
- * A depth_texture of 0 (no host depth: nothing occludes) becomes a far-depth texture of the
- * frame's size in targets->scene_depth, owned by the context. Errors go through volfx_fail. */
-vfx_result volfx_check_frame(vfx_context *ctx, const vfx_frame_view *frame, bool drawing,
-                             vfx_frame_view2 *out, volfx_frame_targets *targets);
+/* The frame gate, step 1 (no GL): the frame view's version (1, 2 or 3) and size, its frame
+ * size, finite view, proj, origin and eye, fov_y in [0, pi), effect bits, near/far against the
+ * projection (filled from it when the host gave both 0); then everything effects read of the
+ * camera into *t, the matrices multiplied and inverted here once (a singular view or
+ * view*projection is refused), and the view effects still receive into *checked (version 1 or
+ * 2, near/far filled). Every error names the field, through volfx_fail. */
+vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx_frame_targets *t,
+                            vfx_frame_view2 *checked);
 
-/* Deletes the context's far-depth texture (if any). */
+/* The frame gate, step 2, once the context has the frame's size and `drawing` says some effect
+ * will draw (else nothing is done): the frame view's GL names (framebuffer, colour and depth
+ * textures, cubemap: names, targets, formats, sizes by GL queries); a depth_texture of 0 becomes
+ * a far-depth texture of the frame's size in t->scene_depth, owned by the context; then the
+ * VolfxFrame block (volfx_frame_block) is uploaded and bound at VOLFX_FRAME_BINDING. */
+vfx_result volfx_frame_gate_gl(vfx_context *ctx, bool drawing, volfx_frame_targets *t);
+
+/* Deletes the context's far-depth texture and frame block buffer (if any). */
 void volfx_frame_check_destroy(vfx_context *ctx);
 
 #endif

@@ -68,5 +68,10 @@ void volfx_program_uniforms(GLuint prog, const char *const *names, GLint *locs, 
  * `blend`, timed as `name`, textures bound by the caller: the final pass of every effect. */
 void volfx_composite(vfx_context *ctx, const vfx_frame_view *frame, const char *name, GLuint prog,
                      volfx_blend blend);
+/* The same into the frame gate's framebuffer and size (effect.h): what effects call once they
+ * read only volfx_frame_targets. */
+struct volfx_frame_targets;
+void volfx_composite_targets(vfx_context *ctx, const struct volfx_frame_targets *t, const char *name,
+                             GLuint prog, volfx_blend blend);
 
 #endif

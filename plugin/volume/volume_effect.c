@@ -18,11 +18,10 @@
 #include "effect.h"
 #include "tet_render.h"
 
-/* std140 mirror of shaders/volume/distance.frag's block */
+/* std140 mirror of shaders/volume/distance.frag's own block (the camera comes from the frame
+ * gate's VolfxFrame block) */
 typedef struct volume_dist_ubo {
-    float proj[4];   /* P[0], P[5], P[8], P[9]: pixel -> view ray */
-    float depth[4];  /* P[10], P[14], has_water, 0: window depth -> view depth */
-    float size[4];   /* width, height */
+    float water[4];  /* 1 when the water's distance is bound */
 } volume_dist_ubo;
 
 typedef struct volume_state {
@@ -268,12 +267,9 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
 /* GPU: the ray distance to the host's depth (the renderer's own ray model: view depth from the
  * projection, times |(dx, dy, -1)|), min with the water's distance, into dist_tex, copied into
  * this frame's pack buffer and fenced. */
-static void distance_pass(vfx_context *ctx, volume_state *s, const vfx_frame_view *frame,
-                          const volfx_frame_targets *targets, int slot)
+static void distance_pass(vfx_context *ctx, volume_state *s, const volfx_frame_targets *targets, int slot)
 {
-    const float *P = frame->proj;
-    volume_dist_ubo u = {{P[0], P[5], P[8], P[9]}, {P[10], P[14], targets->water_dist ? 1.f : 0.f, 0},
-                         {(float)s->width, (float)s->height, 0, 0}};
+    volume_dist_ubo u = {{targets->water_dist ? 1.f : 0.f, 0, 0, 0}};
     volfx_ubo_update(&s->ubo, &u, sizeof u);
     volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "volume.distance", .framebuffer = s->dist_fbo,
                                              .width = s->width, .height = s->height});
@@ -383,7 +379,8 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
     const vfx_volume_view *v = &s->view.v1;
     /* this frame's distances go to one pack buffer; the render uses the previous frame's */
     const int slot = (int)(s->frame & 1u), prev = slot ^ 1;
-    distance_pass(ctx, s, frame, targets, slot);
+    (void)frame; /* everything comes from the frame gate's targets */
+    distance_pass(ctx, s, targets, slot);
     const bool late = s->frame > 0 && s->fence[prev];
     vfx_result r = read_distances(ctx, s, late ? prev : slot);
     if (r != VFX_OK)
@@ -396,8 +393,8 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
     bool has_model = false;
     for (int i = 0; i < 16; ++i)
         has_model |= v->model[i] != 0;
-    volfx_mat4_mul(frame->view, has_model ? v->model : identity, cam.view);
-    memcpy(cam.proj, frame->proj, sizeof cam.proj);
+    volfx_mat4_mul(targets->view, has_model ? v->model : identity, cam.view); /* model-view */
+    memcpy(cam.proj, targets->proj, sizeof cam.proj);
     cam.width = (int)s->width, cam.height = (int)s->height;
     tet_tf tf;
     make_tf(s, &tf);
@@ -463,7 +460,7 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
     }
     volfx_stat_set(ctx, "volume.renders_skipped_total", (double)s->skipped);
     glBindTextureUnit(0, s->tex);
-    volfx_composite(ctx, frame, "volume.composite", s->prog, VOLFX_BLEND_OVER_PREMUL);
+    volfx_composite_targets(ctx, targets, "volume.composite", s->prog, VOLFX_BLEND_OVER_PREMUL);
     const char *e = volfx_gpu_error_string();
     return e ? volfx_fail(ctx, VFX_ERR_GL, "volume render: %s", e) : VFX_OK;
 }

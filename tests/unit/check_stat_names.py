@@ -21,7 +21,7 @@ for args in re.findall(r"volfx_gpu_pass_begin\(\s*ctx\s*,([^;]*)\)\s*;", code):
     passes |= set(re.findall(r'"(%s)"' % NS, args))
 for expr in re.findall(r"\.name\s*=\s*([^,}]*)", code):  # a pass desc's name, maybe a ?: of two
     passes |= set(re.findall(r'"(%s)"' % NS, expr))
-passes |= set(re.findall(r'volfx_composite\(\s*ctx\s*,[^,]+,\s*"(%s)"' % NS, code))
+passes |= set(re.findall(r'volfx_composite(?:_targets)?\(\s*ctx\s*,[^,]+,\s*"(%s)"' % NS, code))
 
 doc = open(os.path.join(root, "docs", "stats.md")).read()
 counters_part, _, passes_part = doc.partition("## GPU passes")
