@@ -295,6 +295,9 @@ vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx
     return VFX_OK;
 }
 
+/* std140 of shaders/common/frame.glsl: seven mat4 then four vec4/uvec4, no padding */
+_Static_assert(sizeof(volfx_frame_block) == 7 * 64 + 4 * 16, "volfx_frame_block mirrors VolfxFrame (std140)");
+
 /* Fills and uploads the VolfxFrame block (made on first use) and binds it for the frame. */
 static vfx_result upload_block(vfx_context *ctx, const volfx_frame_targets *t)
 {

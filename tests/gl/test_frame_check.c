@@ -2,7 +2,8 @@
  * callback pairs at create and update; every frame-view field: texture names, targets, formats
  * and sizes (GL queries), the framebuffer, near/far against the projection, the effects mask;
  * depth_texture 0 drawing as "nothing occludes" (the beams vanished before); read_raw and
- * get_stats with NULL writing their own error instead of leaving a stale one. */
+ * get_stats with NULL writing their own error instead of leaving a stale one; the frame gate's
+ * VolfxFrame block against float64 references (issue 23). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -442,6 +443,94 @@ static void test_v2_views(void **state)
     free_fixture(&f);
 }
 
+/* The frame gate's VolfxFrame block (issue 23): after a render, the buffer bound at
+ * VOLFX_FRAME_BINDING holds the checked camera and what is derived from it. References in
+ * float64 from the float matrices the host gave: proj*view summed in double (the gate
+ * multiplies in float, error <= 4 ulp of the largest product, bounded by 1e-5 relative to the
+ * matrix's largest entry here); the inverses checked by M * M^-1 = I in double within 1e-4
+ * (the near/far ratio of 1000 makes the projection's condition number ~1e3, and float32
+ * inverses lose about that many ulps); the camera-relative matrix is proj * (view without its
+ * translation), and its inverse maps clip points back onto directions from the eye. */
+static void mul_d(const float *a, const float *b, double *out)
+{
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) {
+            double s = 0;
+            for (int k = 0; k < 4; ++k)
+                s += (double)a[k * 4 + r] * b[c * 4 + k];
+            out[c * 4 + r] = s;
+        }
+}
+
+static void expect_identity(const float *a, const float *b, double tol)
+{
+    double p[16];
+    mul_d(a, b, p);
+    for (int i = 0; i < 16; ++i)
+        assert_true(fabs(p[i] - (i % 5 == 0 ? 1.0 : 0.0)) <= tol);
+}
+
+static void test_frame_block(void **state)
+{
+    (void)state;
+    test_log log = {0};
+    vfx_host_api host = beams_host(&log);
+    const vfx_plugin_api *api = plugin_api();
+    vfx_context *ctx;
+    assert_int_equal(api->create(&host, &ctx), VFX_OK);
+    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_OK);
+    fixture f;
+    make_fixture(&f);
+    vfx_frame_view3 v3 = {0};
+    memcpy(&v3.v2.v1, &f.fv, sizeof f.fv);
+    v3.v2.v1.size = sizeof v3, v3.v2.v1.version = VFX_FRAME_VIEW3_VERSION;
+    v3.v2.v1.near_plane = 0, v3.v2.v1.far_plane = 0; /* filled from proj by the gate */
+    v3.v2.origin[0] = 1e6, v3.v2.origin[1] = -2.5, v3.v2.origin[2] = 3.0;
+    v3.v2.color_hdr = 1;
+    v3.v2.environment_cubemap = f.cube;
+    v3.view_id = 7;
+    expect(api, ctx, &v3.v2.v1, VFX_OK, NULL);
+    GLint buf = 0;
+    glGetIntegeri_v(GL_UNIFORM_BUFFER_BINDING, VOLFX_FRAME_BINDING, &buf);
+    assert_true(buf != 0);
+    GLint64 bytes = 0;
+    glGetNamedBufferParameteri64v((GLuint)buf, GL_BUFFER_SIZE, &bytes);
+    assert_true(bytes >= (GLint64)sizeof(volfx_frame_block));
+    volfx_frame_block b;
+    glGetNamedBufferSubData((GLuint)buf, 0, sizeof b, &b);
+    const float *V = f.fv.view, *P = f.fv.proj;
+    for (int i = 0; i < 16; ++i)
+        assert_true(b.view[i] == V[i] && b.proj[i] == P[i]);
+    double vp[16], big = 0;
+    mul_d(P, V, vp);
+    for (int i = 0; i < 16; ++i)
+        big = fmax(big, fabs(vp[i]));
+    for (int i = 0; i < 16; ++i)
+        assert_true(fabs(b.view_proj[i] - vp[i]) <= 1e-5 * big);
+    expect_identity(b.view_proj, b.inv_view_proj, 1e-4);
+    expect_identity(V, b.inv_view, 1e-4);
+    float rot[16];
+    memcpy(rot, V, sizeof rot);
+    rot[12] = rot[13] = rot[14] = 0;
+    mul_d(P, rot, vp);
+    for (int i = 0; i < 16; ++i)
+        assert_true(fabs(b.cam_view_proj[i] - vp[i]) <= 1e-5 * big);
+    expect_identity(b.cam_view_proj, b.inv_cam_view_proj, 1e-4);
+    for (int k = 0; k < 3; ++k)
+        assert_true(b.eye_fov[k] == f.fv.eye[k]);
+    assert_true(b.eye_fov[3] == f.fv.fov_y);
+    /* near/far of the perspective matrix, 0.1 and 100 (ref_camera_matrices), to float rounding */
+    assert_true(fabs(b.planes_size[0] - 0.1) <= 1e-5 && fabs(b.planes_size[1] - 100.0) <= 1e-2);
+    assert_true(b.planes_size[2] == W && b.planes_size[3] == H);
+    assert_true(b.origin_hdr[0] == 1e6f && b.origin_hdr[1] == -2.5f && b.origin_hdr[2] == 3.0f);
+    assert_true(b.origin_hdr[3] == 1.0f);
+    assert_int_equal(b.flags[0], 1);
+    assert_int_equal(b.flags[1], 7);
+    assert_int_equal(b.flags[2], 0xffffffffu); /* effects 0: all */
+    api->destroy(ctx);
+    free_fixture(&f);
+}
+
 int main(void)
 {
     g_gl = test_gl_or_skip();
@@ -450,6 +539,7 @@ int main(void)
         cmocka_unit_test(test_nothing_drawn),
         cmocka_unit_test(test_callback_pairs),
         cmocka_unit_test(test_v2_views),
+        cmocka_unit_test(test_frame_block),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     rt_gl_context_destroy(g_gl);
