@@ -16,7 +16,7 @@
 #define HEADER_UINTS 16
 /* a spray streak's half-width and a foam / bubble splat's radius, in units of h */
 #define SPRAY_RADIUS_H 0.12f
-#define FOAM_RADIUS_H 0.5f
+#define FOAM_RADIUS_H 0.8f
 
 struct volfx_water_diffuse {
     GLuint vel;           /* vec4 a fluid particle */
@@ -57,9 +57,9 @@ vfx_result volfx_water_diffuse_params_check(vfx_context *ctx, const vfx_water_pa
         memcpy(out->gravity, in->gravity, sizeof out->gravity);
     }
     struct { const char *name; const float *v; float def[2]; float *dst; } pairs[] = {
-        {"trapped_air", in->trapped_air, {1.5f, 6.0f}, out->ta},
-        {"wave_crest", in->wave_crest, {0.3f, 1.5f}, out->wc},
-        {"energy", in->energy, {0.5f, 4.0f}, out->ek},
+        {"trapped_air", in->trapped_air, {6.0f, 18.0f}, out->ta},
+        {"wave_crest", in->wave_crest, {0.5f, 2.0f}, out->wc},
+        {"energy", in->energy, {1.0f, 6.0f}, out->ek},
     };
     for (size_t k = 0; k < sizeof pairs / sizeof pairs[0]; ++k) {
         for (int e = 0; e < 2; ++e) {
@@ -74,9 +74,9 @@ vfx_result volfx_water_diffuse_params_check(vfx_context *ctx, const vfx_water_pa
                               pairs[k].name, pairs[k].dst[0], pairs[k].dst[1]);
     }
     struct { const char *name; float v, hi, def; float *dst; } f[] = {
-        {"rate_trapped_air", in->rate_trapped_air, 1e4f, 40.0f, &out->rate_ta},
-        {"rate_wave_crest", in->rate_wave_crest, 1e4f, 60.0f, &out->rate_wc},
-        {"lifetime", in->lifetime, 60.0f, 2.5f, &out->lifetime},
+        {"rate_trapped_air", in->rate_trapped_air, 1e4f, 10.0f, &out->rate_ta},
+        {"rate_wave_crest", in->rate_wave_crest, 1e4f, 25.0f, &out->rate_wc},
+        {"lifetime", in->lifetime, 60.0f, 1.5f, &out->lifetime},
         {"buoyancy", in->buoyancy, 20.0f, 2.0f, &out->buoyancy},
         {"drag", in->drag, 60.0f, 8.0f, &out->drag},
     };

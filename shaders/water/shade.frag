@@ -42,7 +42,7 @@ out vec4 o_color;
 #define SSR_BISECT 5
 #define SSR_REACH 2.0
 // foam opacity per unit of splatted thickness, bubbles' brightness per unit
-#define FOAM_K 0.9
+#define FOAM_K 0.35
 #define BUBBLE_K 0.5
 // The refracted ray's trace: REFRACT_STEPS even steps over twice the view ray's thickness (plus
 // h), then REFRACT_BISECT halvings of the step where it left; both bounds hold for any input.

@@ -260,14 +260,14 @@ typedef struct vfx_water_params4 {
     uint32_t diffuse_max;          /* the pool's cap, 1..4194304; 0 -> 32768 */
     float gravity[3];              /* scene units / s^2 (spray, bubbles, v_ref); 0 -> (0, -9.81, 0) */
     /* potentials' clamp ranges [min, max] (each 0 -> default; min < max):
-     * trapped air sum_j |v_ij| (1 - v_ij.x_ij) W_ij in units of v_ref, 0 -> [1.5, 6];
+     * trapped air sum_j |v_ij| (1 - v_ij.x_ij) W_ij in units of v_ref, 0 -> [6, 18];
      * wave crest sum_j (1 - n_i.n_j) W_ij over the convex neighbours of a particle moving along
-     * its normal, no unit, 0 -> [0.3, 1.5]; kinetic energy |v|^2 / v_ref^2, 0 -> [0.5, 4] */
+     * its normal, no unit, 0 -> [0.5, 2]; kinetic energy |v|^2 / v_ref^2, 0 -> [1, 6] */
     float trapped_air[2], wave_crest[2], energy[2];
     /* particles generated per fluid particle per second at full potential, <= 10000;
-     * 0 -> 40 (trapped air) and 60 (wave crest) */
+     * 0 -> 10 (trapped air) and 25 (wave crest) */
     float rate_trapped_air, rate_wave_crest;
-    float lifetime;                /* seconds a foam particle lives (spray and bubbles do not age), <= 60; 0 -> 2.5 */
+    float lifetime;                /* seconds a foam particle lives (spray and bubbles do not age), <= 60; 0 -> 1.5 */
     float buoyancy;                /* k_b: a bubble's upward acceleration over |gravity|, <= 20; 0 -> 2 */
     float drag;                    /* k_d: a bubble's velocity pulled to the fluid's per second x dt, <= 60; 0 -> 8 */
     /* classification by fluid neighbours within h: fewer than spray_below -> spray, more than
