@@ -55,6 +55,7 @@ typedef struct tf_prep {
     float s[TET_TF_MAX_POINTS];
     float tau[TET_TF_MAX_POINTS];
     float rgb[TET_TF_MAX_POINTS][3];
+    double inv_range[TET_TF_MAX_POINTS]; /* 1 / (s[k+1] - s[k]), 0 for an empty piece */
     int pre_n;                 /* grid cells of the pre-integrated tables */
     double pre_ds;             /* grid spacing in scalar units */
     double *pre_T;             /* pre_n + 1: integral of tau ds from s[0] */
