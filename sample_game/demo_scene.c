@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "scene/volume_file.h"
+#include "volume_shield.h"
 
 extern const char game_default_scene_json[];
 extern const unsigned long game_default_scene_json_len;
@@ -222,7 +223,8 @@ static void volume_transfer(game_demo *demo, const rt_scene_volume *v, vfx_volum
 static vfx_result volume_prepare_animation(game_demo *demo, const rt_scene_volume *v)
 {
     const rt_scene_volume_animation *an = &v->anim;
-    demo->vol_animated = an->ripple_amplitude > 0 || an->glow_gain > 0 || an->pulse_period_s > 0;
+    const bool shield = an->rim_gain > 0 || an->hit_gain > 0;
+    demo->vol_animated = an->ripple_amplitude > 0 || an->glow_gain > 0 || an->pulse_period_s > 0 || shield;
     if (!demo->vol_animated)
         return VFX_OK;
     size_t np = demo->vol_point_count;
@@ -239,6 +241,17 @@ static vfx_result volume_prepare_animation(game_demo *demo, const rt_scene_volum
     for (int k = 0; k < 3; ++k)
         demo->vol_center[k] = 0.5f * (lo[k] + hi[k]);
     demo->vol_center[1] = lo[1]; /* a dome ripples out from its floor */
+    float r2 = 0;
+    for (size_t i = 0; i < np; ++i) {
+        float d2 = 0;
+        for (int k = 0; k < 3; ++k)
+            d2 += (demo->vol_points[3 * i + k] - demo->vol_center[k]) * (demo->vol_points[3 * i + k] - demo->vol_center[k]);
+        r2 = fmaxf(r2, d2);
+    }
+    demo->vol_radius = sqrtf(r2);
+    if (shield)
+        return game_shield_create(demo->vol_points, demo->vol_point_count, demo->vol_tets, demo->vol_tet_count,
+                                  lo[1], &demo->vol_shield);
     return VFX_OK;
 }
 
@@ -305,7 +318,7 @@ static void animate_volume(game_app *app, game_demo *demo)
     const rt_scene_volume_animation *an = &v->anim;
     vfx_volume_view2 *vv = &app->volumes[0];
     const double t = app->time;
-    if (an->ripple_amplitude > 0 || an->glow_gain > 0) {
+    if (an->ripple_amplitude > 0 || an->glow_gain > 0 || demo->vol_shield) {
         const float *M = v->model, *c = demo->vol_center;
         const double w = 2 * M_PI / an->ripple_period_s, k = 2 * M_PI / an->ripple_wavelength;
         bool identity = true;
@@ -327,6 +340,10 @@ static void animate_volume(game_app *app, game_demo *demo)
             }
             demo->vol_scalar[i] = s;
         }
+        game_shield_frame sf = {demo->vol_points, M, {app->camera.eye[0], app->camera.eye[1], app->camera.eye[2]},
+                                app->beams2, app->beam_count, t,
+                                {c[0], c[1], c[2]}, demo->vol_radius};
+        game_shield_apply(demo->vol_shield, an, &sf, demo->vol_scalar);
         vv->v1.revision++;
     }
     if (an->pulse_period_s > 0 && demo->vol_transfer_count >= 2) {
@@ -480,5 +497,6 @@ void game_demo_free(game_app *app, game_demo *demo)
     free(demo->vol_scalar);
     free(demo->vol_base_points);
     free(demo->vol_base_scalar);
+    game_shield_destroy(demo->vol_shield);
     memset(demo, 0, sizeof *demo);
 }

@@ -24,7 +24,8 @@ typedef struct game_demo {
     float vol_transfer[RT_SCENE_MAX_TRANSFER * 4], vol_transfer_pos[RT_SCENE_MAX_TRANSFER];
     uint32_t vol_transfer_count;
     float vol_anim_transfer[(RT_SCENE_MAX_TRANSFER + 3) * 4], vol_anim_pos[RT_SCENE_MAX_TRANSFER + 3];
-    float *vol_base_points, *vol_base_scalar, vol_center[3];
+    float *vol_base_points, *vol_base_scalar, vol_center[3], vol_radius;
+    struct game_shield *vol_shield; /* rim and hit ripples (volume_shield.h); NULL when off */
     bool vol_animated;
     uint32_t *vol_tets, vol_point_count, vol_tet_count;
 } game_demo;

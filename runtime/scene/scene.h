@@ -136,6 +136,12 @@ typedef struct rt_scene_volume_animation {
     float pulse_rgba[4];             /* the band's colour and extinction */
     float pulse_width;               /* half width in [0,1] of the transfer domain */
     float pulse_period_s;            /* one sweep from the domain's low to high end */
+    float rim_gain;                  /* scalar added at boundary vertices seen edge-on */
+    float rim_power;                 /* sharpness of the rim: gain (1 - |n.v|)^power */
+    float hit_gain;                  /* scalar of the rings around a beam's strike point */
+    float hit_wavelength;            /* ring spacing, world units */
+    float hit_speed;                 /* ring speed outwards, world units per second */
+    float hit_reach;                 /* rings fade as exp(-r / reach), world units */
 } rt_scene_volume_animation;
 
 typedef struct rt_scene_volume {

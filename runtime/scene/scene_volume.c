@@ -14,13 +14,48 @@ bool rt_scene_ends_with(const char *s, const char *suffix)
     return a >= b && strcmp(s + a - b, suffix) == 0;
 }
 
+/* volume.animate.rim {gain, power} and .hit_ripple {gain, wavelength, speed, reach}: the
+ * energy-shield terms the game adds to the scalar (sample_game/volume_shield.c). */
+static vfx_result parse_shield(pctx *c, const cJSON *a, rt_scene_volume_animation *an)
+{
+    vfx_result r = VFX_OK;
+    const cJSON *rim = cJSON_GetObjectItemCaseSensitive(a, "rim");
+    if (rim) {
+        static const char *const k[] = {"gain", "power", NULL};
+        const char *PR = "volume.animate.rim";
+        if ((r = rt_scene_expect_object(c, rim, PR)))
+            return r;
+        rt_scene_check_keys(c, rim, PR, k);
+        an->rim_power = 3.0f;
+        r = rt_scene_get_float(c, rim, PR, "gain", true, (range){0, 1e3, false}, &an->rim_gain);
+        if (!r) r = rt_scene_get_float(c, rim, PR, "power", false, (range){0.1, 64, false}, &an->rim_power);
+        if (r)
+            return r;
+    }
+    const cJSON *hit = cJSON_GetObjectItemCaseSensitive(a, "hit_ripple");
+    if (hit) {
+        static const char *const k[] = {"gain", "wavelength", "speed", "reach", NULL};
+        const char *PH = "volume.animate.hit_ripple";
+        if ((r = rt_scene_expect_object(c, hit, PH)))
+            return r;
+        rt_scene_check_keys(c, hit, PH, k);
+        an->hit_wavelength = 0.5f, an->hit_speed = 1.0f, an->hit_reach = 1.0f;
+        r = rt_scene_get_float(c, hit, PH, "gain", true, (range){0, 1e3, false}, &an->hit_gain);
+        if (!r) r = rt_scene_get_float(c, hit, PH, "wavelength", false, POSITIVE, &an->hit_wavelength);
+        if (!r) r = rt_scene_get_float(c, hit, PH, "speed", false, (range){0, 1e3, false}, &an->hit_speed);
+        if (!r) r = rt_scene_get_float(c, hit, PH, "reach", false, POSITIVE, &an->hit_reach);
+    }
+    return r;
+}
+
 /* volume.animate: {"ripple": {amplitude, wavelength, period_s}, "beam_glow": {gain, reach},
- * "transfer_pulse": {rgba, width, period_s}}; absent parts stay 0 (off). */
+ * "transfer_pulse": {rgba, width, period_s}, "rim": {gain, power}, "hit_ripple": {gain,
+ * wavelength, speed, reach}}; absent parts stay 0 (off). */
 static vfx_result parse_animation(pctx *c, const cJSON *a, rt_scene_volume_animation *an)
 {
     if (!a)
         return VFX_OK;
-    static const char *const keys[] = {"ripple", "beam_glow", "transfer_pulse", NULL};
+    static const char *const keys[] = {"ripple", "beam_glow", "transfer_pulse", "rim", "hit_ripple", NULL};
     const char *P = "volume.animate";
     vfx_result r = rt_scene_expect_object(c, a, P);
     if (r)
@@ -67,7 +102,7 @@ static vfx_result parse_animation(pctx *c, const cJSON *a, rt_scene_volume_anima
         if (r)
             return r;
     }
-    return VFX_OK;
+    return parse_shield(c, a, an);
 }
 
 vfx_result rt_scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol)
