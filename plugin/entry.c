@@ -268,6 +268,28 @@ static vfx_result plugin_read_raw(vfx_context *ctx, vfx_effect_kind effect, floa
     return ctx->effect_ops[effect]->read_raw(ctx, ctx->effect_state[effect], out, count);
 }
 
+/* Program binaries kept in a host folder (gpu/program_cache.c). */
+static vfx_result plugin_set_program_cache(vfx_context *ctx, const char *dir)
+{
+    if (!ctx)
+        return VFX_ERR_INVALID_ARGUMENT;
+    gl_bind(ctx);
+    return volfx_gpu_set_program_cache(ctx, dir);
+}
+
+/* Warm-up: one render of the frame (it compiles exactly the variants the frame uses, and
+ * llvmpipe-like drivers JIT their draw-time variants only when drawing), then a wait, so the
+ * first real frame finds everything built. */
+static vfx_result plugin_warm_up(vfx_context *ctx, const vfx_frame_view *frame)
+{
+    if (!ctx)
+        return VFX_ERR_INVALID_ARGUMENT;
+    vfx_result r = plugin_render(ctx, frame);
+    if (r == VFX_OK)
+        glFinish();
+    return r;
+}
+
 VFX_EXPORT vfx_result vfx_plugin_entry(uint32_t abi_version, const vfx_host_api *host,
                                        vfx_plugin_api *out)
 {
@@ -285,9 +307,15 @@ VFX_EXPORT vfx_result vfx_plugin_entry(uint32_t abi_version, const vfx_host_api 
             host->log(host->user, VFX_LOG_ERROR, "volfx: plugin api struct too small or NULL");
         return VFX_ERR_ABI;
     }
-    memset(out, 0, sizeof *out);
-    out->size = sizeof *out;
-    out->version = VFX_PLUGIN_API_VERSION;
+    const bool v2 = out->size >= sizeof(vfx_plugin_api2);
+    memset(out, 0, v2 ? sizeof(vfx_plugin_api2) : sizeof *out);
+    out->size = v2 ? sizeof(vfx_plugin_api2) : sizeof *out;
+    out->version = v2 ? VFX_PLUGIN_API2_VERSION : VFX_PLUGIN_API_VERSION;
+    if (v2) {
+        vfx_plugin_api2 *a2 = (vfx_plugin_api2 *)out;
+        a2->set_program_cache = plugin_set_program_cache;
+        a2->warm_up = plugin_warm_up;
+    }
     out->name = "volfx";
     out->effects_built = (VFX_WITH_WATER ? VFX_EFFECT_BIT(VFX_EFFECT_WATER) : 0)
                          | (VFX_WITH_BEAMS ? VFX_EFFECT_BIT(VFX_EFFECT_BEAMS) : 0)

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gpu/program_cache.h"
 #include "volfx_shaders.h"
 #include "shader_text.h"
 
@@ -39,6 +40,7 @@ struct volfx_gpu {
     uint32_t open[GPU_PASS_DEPTH];      /* open pass slots */
     uint32_t open_count;
     bool has_debug;
+    volfx_program_cache *cache; /* program binaries in the host's folder; NULL: off */
 };
 
 unsigned volfx_gl_command_count(void) { return VOLFX_GL_COMMAND_COUNT; }
@@ -98,6 +100,7 @@ void volfx_gpu_destroy(vfx_context *ctx, volfx_gpu *g)
     for (int f = 0; f < GPU_RING; ++f)
         glDeleteQueries(GPU_MAX_PASSES * 2, g->ring[f].queries);
     glDeleteVertexArrays(1, &g->empty_vao);
+    volfx_program_cache_close(ctx, g->cache);
     volfx_free(ctx, g);
 }
 
@@ -130,6 +133,8 @@ GLuint volfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *s
         }
     }
     if (ok) {
+        /* the program cache reads the binary back (a hint: drivers may keep it anyway) */
+        glProgramParameteri(prog, GL_PROGRAM_BINARY_RETRIEVABLE_HINT, GL_TRUE);
         glLinkProgram(prog);
         GLint status = 0;
         glGetProgramiv(prog, GL_LINK_STATUS, &status);
@@ -204,8 +209,13 @@ static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const c
             volfx_fail(ctx, VFX_ERR_GL, "%s", err);
             ok = false;
         }
-    if (ok)
+    if (ok && g->cache)
+        prog = volfx_program_cache_load(ctx, g->cache, n, stages, (const char *const *)bufs);
+    if (ok && !prog) {
         prog = volfx_gpu_link_sources(ctx, n, stages, (const char *const *)bufs, paths);
+        if (prog && g->cache)
+            volfx_program_cache_store(ctx, g->cache, n, stages, (const char *const *)bufs, prog);
+    }
     for (int i = 0; i < n; ++i)
         free(bufs[i]);
     if (!prog) {
@@ -220,6 +230,16 @@ static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const c
     snprintf(label, sizeof label, "volfx.%s", n > 1 ? paths[1] : paths[0]);
     volfx_gpu_label(GL_PROGRAM, prog, label);
     return prog;
+}
+
+vfx_result volfx_gpu_set_program_cache(vfx_context *ctx, const char *dir)
+{
+    volfx_gpu *g = ctx->gpu;
+    volfx_program_cache_close(ctx, g->cache);
+    g->cache = NULL;
+    if (!dir || !*dir)
+        return VFX_OK;
+    return volfx_program_cache_open(ctx, dir, &g->cache);
 }
 
 GLint volfx_gpu_uniform(vfx_context *ctx, GLuint prog, const char *name)
@@ -312,6 +332,12 @@ void volfx_gpu_frame_end(vfx_context *ctx)
     }
     if (f->count)
         volfx_stat_set(ctx, "gpu.timer_lag_frames", GPU_RING - 1);
+    if (g->cache) {
+        volfx_program_cache_counts c = volfx_program_cache_counts_of(g->cache);
+        volfx_stat_set(ctx, "gpu.program_cache_loaded", c.loaded);
+        volfx_stat_set(ctx, "gpu.program_cache_stored", c.stored);
+        volfx_stat_set(ctx, "gpu.program_cache_rejected", c.rejected);
+    }
     f->count = 0;
     g->frame = oldest;
 }

@@ -16,6 +16,9 @@ void volfx_gpu_destroy(vfx_context *ctx, volfx_gpu *gpu);
  * cached by (paths, defines). 0 on failure, with an error naming file:line. A source may
  * `#include "common/x.glsl"` (one level, expanded with #line so errors keep file:line). */
 GLuint volfx_gpu_program(vfx_context *ctx, const char *vert, const char *frag, const char *defines);
+/* Keeps program binaries in `dir` from now on (gpu/program_cache.h); NULL or "" switches it
+ * off. Programs already linked stay as they are. */
+vfx_result volfx_gpu_set_program_cache(vfx_context *ctx, const char *dir);
 /* Same for a compute shader. */
 GLuint volfx_gpu_compute(vfx_context *ctx, const char *comp, const char *defines);
 /* Location of a uniform of a program made by volfx_gpu_program/compute, from the table read

@@ -549,8 +549,30 @@ typedef struct vfx_plugin_api {
     vfx_result (*read_raw)(vfx_context *ctx, vfx_effect_kind effect, float *out, size_t count);
 } vfx_plugin_api;
 
+/* Version 2 of the plugin api: version 1 as its first member (never edited), then the calls
+ * that take the first-use shader hitch away. A host that knows it sets v1.size =
+ * sizeof(vfx_plugin_api2) and passes &api.v1 to vfx_plugin_entry; a plugin that knows it fills
+ * all of it and answers v1.version = VFX_PLUGIN_API2_VERSION (an older plugin answers version 1
+ * and leaves the rest untouched: check v1.version). */
+#define VFX_PLUGIN_API2_VERSION 2u
+typedef struct vfx_plugin_api2 {
+    vfx_plugin_api v1;
+    /* Keeps linked program binaries (GL_ARB_get_program_binary) in the folder `dir`, made if
+     * absent: a program found there with this driver (GL_VENDOR, GL_RENDERER, GL_VERSION) and
+     * the same source is loaded instead of compiled; a stale, foreign or corrupt file is rebuilt
+     * from source and rewritten, never trusted. NULL or "" switches it off (the default). Call it
+     * before the frame that first needs a program. */
+    vfx_result (*set_program_cache)(vfx_context *ctx, const char *dir);
+    /* Compiles every program the given frame needs, and the driver's variants of them, before
+     * the first real frame: after update, it renders `frame` as render() would (into
+     * frame->framebuffer, which the host then draws its real first frame over) and waits for the
+     * GPU. The effects' state is then that of one rendered frame. */
+    vfx_result (*warm_up)(vfx_context *ctx, const vfx_frame_view *frame);
+    void *_reserved[6];
+} vfx_plugin_api2;
+
 /* The one exported symbol. The host passes its ABI version; out->size must be set by the host
- * to sizeof(vfx_plugin_api) it knows. A different ABI version is refused (VFX_ERR_ABI) with a
+ * to sizeof(vfx_plugin_api) it knows (or sizeof(vfx_plugin_api2): see there). A different ABI version is refused (VFX_ERR_ABI) with a
  * message naming both versions through host->log. */
 typedef vfx_result (*vfx_plugin_entry_fn)(uint32_t abi_version, const vfx_host_api *host,
                                           vfx_plugin_api *out);
