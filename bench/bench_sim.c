@@ -250,14 +250,22 @@ static double surge_front(rt_sph *s, float dx)
     return 0.0;
 }
 
+static double cpu_now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
 static int dam_break(int res, uint32_t threads, double t_max, double settle_s, uint32_t no_slip,
-                     const char *cpu)
+                     uint32_t solver, const char *cpu)
 {
     const double a = 0.05715, g = 9.81;
     float dx = (float)(a / res);
     rt_sph_desc d = {.spacing = dx, .domain_min = {0, 0, 0},
                       .domain_max = {(float)(10 * a), (float)(2.5 * a), 4 * dx},
-                      .threads = threads, .max_substeps = 1000000, .no_slip_faces = no_slip};
+                      .threads = threads, .max_substeps = 1000000, .no_slip_faces = no_slip,
+                      .solver = solver};
     rt_sph *s;
     char err[256];
     if (rt_sph_create(&d, &s, err, sizeof err)) {
@@ -299,7 +307,7 @@ static int dam_break(int res, uint32_t threads, double t_max, double settle_s, u
     } else {
         rt_sph_add_block(s, lo, hi, &n, NULL, 0);
     }
-    double Ts = sqrt(2 * g / a), worst = 0.0;
+    double Ts = sqrt(2 * g / a), worst = 0.0, c0 = cpu_now_s(), err_sum = 0.0;
     uint64_t substeps = 0;
     int rc = 0, used = 0;
     for (size_t k = 0; k < sizeof mm_T / sizeof mm_T[0]; ++k) {
@@ -312,17 +320,22 @@ static int dam_break(int res, uint32_t threads, double t_max, double settle_s, u
             break;
         }
         substeps += r.substeps;
+        err_sum += r.mean_density_error;
         double front = surge_front(s, dx);
         double Z = front / a, e = (Z - mm_Z[k]) / mm_Z[k];
         worst = fabs(e) > worst ? fabs(e) : worst;
         used++;
-        printf("{\"effect\":\"sim\",\"case\":\"dam_break\",\"a_over_dx\":%d,\"settle_s\":%.2f,\"no_slip\":%u,\"particles\":%u,\"T\":%.3f,"
-               "\"Z\":%.4f,\"Z_martin_moyce\":%.3f,\"error_pct\":%.2f,\"max_density_error\":%.4f}\n",
-               res, settle_s, no_slip, n, mm_T[k], Z, mm_Z[k], 100.0 * e, r.max_density_error);
+        printf("{\"effect\":\"sim\",\"case\":\"dam_break\",\"solver\":\"%s\",\"a_over_dx\":%d,\"settle_s\":%.2f,\"no_slip\":%u,\"particles\":%u,\"T\":%.3f,"
+               "\"Z\":%.4f,\"Z_martin_moyce\":%.3f,\"error_pct\":%.2f,\"max_density_error\":%.4f,\"mean_density_error\":%.5f}\n",
+               solver ? "pbf" : "wcsph", res, settle_s, no_slip, n, mm_T[k], Z, mm_Z[k], 100.0 * e,
+               r.max_density_error, r.mean_density_error);
     }
-    printf("{\"effect\":\"sim\",\"case\":\"dam_break_summary\",\"a_over_dx\":%d,\"settle_s\":%.2f,\"no_slip\":%u,\"particles\":%u,"
-           "\"points\":%d,\"max_abs_error_pct\":%.2f,\"substeps\":%llu,\"wall_s\":%.2f,\"cpu\":\"%s\"}\n",
-           res, settle_s, no_slip, n, used, 100.0 * worst, (unsigned long long)substeps, now_s() - t0, cpu);
+    double sim_s = rt_sph_time(s) > 0 ? rt_sph_time(s) : 1.0;
+    printf("{\"effect\":\"sim\",\"case\":\"dam_break_summary\",\"solver\":\"%s\",\"a_over_dx\":%d,\"settle_s\":%.2f,\"no_slip\":%u,\"particles\":%u,"
+           "\"points\":%d,\"max_abs_error_pct\":%.2f,\"substeps\":%llu,\"wall_s\":%.2f,"
+           "\"cpu_s_per_simulated_s\":%.3f,\"mean_density_error_at_points\":%.5f,\"cpu\":\"%s\"}\n",
+           solver ? "pbf" : "wcsph", res, settle_s, no_slip, n, used, 100.0 * worst, (unsigned long long)substeps,
+           now_s() - t0, (cpu_now_s() - c0) / sim_s, used ? err_sum / used : 0.0, cpu);
     rt_sph_destroy(s);
     return rc;
 }
@@ -350,7 +363,7 @@ int bench_sim(int argc, char **argv)
     bool dam = false;
     bench_opts bo = {.warmup_s = 0.2, .nskin = 1, .rebuild = true, .verlet = true};
     double t_max = 6.0, settle_s = 0.0;
-    uint32_t no_slip = 0;
+    uint32_t no_slip = 0, solver = RT_SPH_SOLVER_WCSPH;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--sizes") && i + 1 < argc) {
             if ((nsizes = parse_list(argv[++i], sizes, 8)) <= 0) {
@@ -412,6 +425,13 @@ int bench_sim(int argc, char **argv)
             t_max = atof(argv[++i]);
         } else if (!strcmp(argv[i], "--settle") && i + 1 < argc) {
             settle_s = atof(argv[++i]);
+        } else if (!strcmp(argv[i], "--solver") && i + 1 < argc) {
+            const char *v = argv[++i];
+            if (strcmp(v, "wcsph") && strcmp(v, "pbf")) {
+                fprintf(stderr, "volfx-bench sim: --solver is wcsph or pbf, not '%s'\n", v);
+                return 2;
+            }
+            solver = strcmp(v, "pbf") ? RT_SPH_SOLVER_WCSPH : RT_SPH_SOLVER_PBF;
         } else if (!strcmp(argv[i], "--no-slip")) {
             /* the experiment's solid walls: the floor and the back wall behind the column */
             no_slip = RT_SPH_FACE_Y_MIN | RT_SPH_FACE_X_MIN;
@@ -440,7 +460,7 @@ int bench_sim(int argc, char **argv)
     char cpu[256];
     cpu_model(cpu, sizeof cpu);
     if (dam)
-        return dam_break(res, threads[nthreads - 1], t_max, settle_s, no_slip, cpu);
+        return dam_break(res, threads[nthreads - 1], t_max, settle_s, no_slip, solver, cpu);
     bo.substeps = substeps;
     bo.reps = reps;
     for (int k = 0; k < nsizes; ++k)
