@@ -158,19 +158,23 @@ static void test_cache(void **state)
 
 int main(void)
 {
-    test_gl_or_skip();
+    rt_gl_context *gl = test_gl_or_skip();
     GLint formats = 0;
     glGetIntegerv(GL_NUM_PROGRAM_BINARY_FORMATS, &formats);
     if (formats <= 0) {
         printf("the driver offers no program binary format: skipping\n");
+        rt_gl_context_destroy(gl);
         return VFX_TEST_SKIP;
     }
-    if (!mkdtemp(g_dir))
+    if (!mkdtemp(g_dir)) {
+        rt_gl_context_destroy(gl);
         return 1;
+    }
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_cache)};
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     if (g_entry[0])
         remove(g_entry);
     rmdir(g_dir);
+    rt_gl_context_destroy(gl);
     return rc;
 }
