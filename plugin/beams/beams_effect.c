@@ -10,6 +10,7 @@
 #include "gpu/gpu.h"
 #include "gpu/pass.h"
 #include "effect.h"
+#include "param_ranges.h"
 
 #define TILE_PX 16
 #define MAX_BEAMS (1u << 20)
@@ -236,6 +237,8 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
     if (v.v1.count > MAX_BEAMS || (!v.v1.beams && !b2))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: %u beams (at most %u, non-NULL array)",
                           v.v1.count, MAX_BEAMS);
+    if ((r = volfx_beams_view_check_ranges(ctx, &v, ver)))
+        return r;
     if (!(v.v1.saturate_c >= 0) || !isfinite(v.v1.saturate_c) || !(v.v1.far_distance >= 0)
         || !isfinite(v.v1.far_distance))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: saturate_c and far_distance must be finite and >= 0");
@@ -267,6 +270,8 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
             straight.head[0] = straight.head[1] = straight.head[2] = straight.length = 0.f;
             b = &straight;
         }
+        if ((r = volfx_beam_check_ranges(ctx, i, b, b2 ? &b2[i] : NULL)))
+            return r;
         if (volfx_beam_validate(b, &s->beams[i], err, sizeof err))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: %s", i, err);
         if ((r = beam_look_of(ctx, i, b2 ? &b2[i] : NULL, &s->looks[i])))

@@ -16,6 +16,7 @@
 
 #include "gpu/pass.h"
 #include "effect.h"
+#include "param_ranges.h"
 #include "tet_render.h"
 
 /* std140 mirror of shaders/volume/distance.frag's own block (the camera comes from the frame
@@ -223,14 +224,10 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
                           v1->point_count, v1->tet_count);
     if ((r = check_transfer(ctx, &v)) != VFX_OK)
         return r;
-    if (!(v1->ert_threshold >= 0 && v1->ert_threshold <= 1))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: ert_threshold %g outside [0, 1]",
-                          (double)v1->ert_threshold);
-    /* the scene file's caps (scene_volume.c): tiles sizes a DxD table per worker, so 65,535
-     * asked for 4.3e9 entries each (issue 18) */
-    if (v1->tiles > 1024 || v1->update_c > (1u << 20) || v1->workers > 256)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: tiles %u (0..1024), update_c %u (0..%u), "
-                          "workers %u (0..256)", v1->tiles, v1->update_c, 1u << 20, v1->workers);
+    /* ert_threshold, tiles (a DxD table per worker: 65,535 asked for 4.3e9 entries each, issue
+     * 18), update_c, workers: their documented ranges (plugin/param_ranges.c) */
+    if ((r = volfx_volume_view_check_ranges(ctx, v1)) != VFX_OK)
+        return r;
     for (int i = 0; i < 16; ++i)
         if (!isfinite(v1->model[i]))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: model[%d] is not finite", i);

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "context.h"
+#include "param_ranges.h"
 #include "water_params.h"
 
 /* What each preset sets in the fields the host left 0. The measured cost and error of each are in
@@ -36,6 +37,12 @@ vfx_result volfx_water_params_resolve(vfx_context *ctx, const vfx_water_params3 
                                       volfx_water_resolved *out)
 {
     memset(out, 0, sizeof *out);
+    /* every number against its documented range first (plugin/param_ranges.c): a negative or
+     * NaN h, threshold, step, absorption or ior, a colour of NaN or 1e30, an ior of Inf were
+     * silently replaced by defaults or gave NaN pixels */
+    vfx_result rr = volfx_water_params_check_ranges(ctx, in, version);
+    if (rr)
+        return rr;
     vfx_water_params p = in->v2.v1;
     uint32_t preset = version >= VFX_WATER_PARAMS3_VERSION ? in->preset : 0;
     if (preset > VFX_WATER_PRESET_ULTRA)
@@ -50,12 +57,6 @@ vfx_result volfx_water_params_resolve(vfx_context *ctx, const vfx_water_params3 
                           p.method);
     if (p.method == VFX_WATER_METHOD_DEFAULT)
         p.method = VFX_WATER_METHOD_TILE;
-    /* a loop bound per pixel: 4096 samples is the scene format's documented cap (a paper-method
-     * frame of 4e9 samples never ends), 64 regula falsi steps more than float32 can use */
-    if (p.max_samples > 4096)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.max_samples %u above 4096", p.max_samples);
-    if (p.refine_iters > 64)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.refine_iters %u above 64", p.refine_iters);
     vfx_water_params2 k2 = version >= VFX_WATER_PARAMS2_VERSION ? in->v2 : (vfx_water_params2){0};
     if (k2.kernel == VFX_WATER_KERNEL_DEFAULT)
         k2.kernel = p.method == VFX_WATER_METHOD_TILE ? d->kernel : VFX_WATER_KERNEL_ISOTROPIC;
@@ -64,24 +65,20 @@ vfx_result volfx_water_params_resolve(vfx_context *ctx, const vfx_water_params3 
         return r;
     if (p.method == VFX_WATER_METHOD_TILE)
         p.disable |= d->disable;
-    if (!(p.h > 0) || !isfinite(p.h))
-        p.h = 0; /* from the spacing, once the particles are read */
-    if (!(p.threshold > 0) || !isfinite(p.threshold)) p.threshold = 0.765625f;
+    /* only 0 means the default here: the range check refused every other value outside */
+    if (p.threshold == 0) p.threshold = 0.765625f;
     if (p.max_samples == 0) p.max_samples = 64;
     if (p.refine_iters == 0) p.refine_iters = d->refine_iters;
     if (p.pyramid_level == 0) p.pyramid_level = 3;
     if (p.color[0] == 0 && p.color[1] == 0 && p.color[2] == 0) {
         p.color[0] = 0.15f; p.color[1] = 0.55f; p.color[2] = 0.6f;
     }
-    if (!(p.absorption > 0)) p.absorption = 0.6f;
-    if (!(p.ior > 1)) p.ior = 1.333f;
+    if (p.absorption == 0) p.absorption = 0.6f;
+    if (p.ior == 0) p.ior = 1.333f;
     out->step_div = d->step_div;
     out->preset = preset;
     float step = p.step;
     p.step = 0;
-    if (step != 0 && !(step > 0 && isfinite(step)))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.step %g is not a positive number (0: the preset's)",
-                          (double)step);
     if (step > 0) {
         p.step = step;
         out->step_div = -1.0f; /* explicit: set_h checks it against h */

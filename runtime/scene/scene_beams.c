@@ -16,13 +16,17 @@ static const char *const beam_keyframe_names[] = {
 
 static range beam_param_range(int k)
 {
-    switch (k) {
+    switch (k) { /* the plugin's ranges (volfx_ranges.h) */
     case RT_BEAM_PARAM_HEAD:
     case RT_BEAM_PARAM_DIR: return COORD;
-    case RT_BEAM_PARAM_RADIUS: return POSITIVE;
-    case RT_BEAM_PARAM_COLOR: return (range){0, 1000, false};
-    case RT_BEAM_PARAM_INTENSITY: return (range){0, 1e6, true};
-    case RT_BEAM_PARAM_EXPOSURE: return (range){-64, 64, false};
+    case RT_BEAM_PARAM_LENGTH: return rt_scene_range(VFX_RANGE_BEAM_LENGTH);
+    case RT_BEAM_PARAM_RADIUS: return rt_scene_range(VFX_RANGE_BEAM_RADIUS);
+    case RT_BEAM_PARAM_A: return rt_scene_range(VFX_RANGE_BEAM_A);
+    case RT_BEAM_PARAM_B: return rt_scene_range(VFX_RANGE_BEAM_B);
+    case RT_BEAM_PARAM_EPS: return rt_scene_range(VFX_RANGE_BEAM_EPS);
+    case RT_BEAM_PARAM_COLOR: return rt_scene_range(VFX_RANGE_BEAM_COLOR);
+    case RT_BEAM_PARAM_INTENSITY: return rt_scene_range(VFX_RANGE_BEAM_INTENSITY);
+    case RT_BEAM_PARAM_EXPOSURE: return rt_scene_range(VFX_RANGE_BEAM_EXPOSURE);
     default: return NONNEG;
     }
 }
@@ -176,9 +180,9 @@ static vfx_result parse_look(pctx *c, const cJSON *e, const char *P, vfx_beam2 *
         return r;
     rt_scene_check_keys(c, flow, PF, flow_keys);
     look->flow_amount = 0.5f;
-    if (!r) r = rt_scene_get_float(c, flow, PF, "amount", false, (range){0, 1, false}, &look->flow_amount);
-    if (!r) r = rt_scene_get_float(c, flow, PF, "speed", false, COORD, &look->flow_speed);
-    if (!r) r = rt_scene_get_float(c, flow, PF, "scale", false, NONNEG, &look->flow_scale);
+    if (!r) r = rt_scene_get_float_row(c, flow, PF, "amount", VFX_RANGE_BEAM_FLOW_AMOUNT, &look->flow_amount);
+    if (!r) r = rt_scene_get_float_row(c, flow, PF, "speed", VFX_RANGE_BEAM_FLOW_SPEED, &look->flow_speed);
+    if (!r) r = rt_scene_get_float_row(c, flow, PF, "scale", VFX_RANGE_BEAM_FLOW_SCALE, &look->flow_scale);
     return r;
 }
 
@@ -271,17 +275,17 @@ vfx_result rt_scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view 
         return r;
     rt_scene_check_keys(c, v, P, keys);
     r = rt_scene_get_enum(c, v, P, "saturation", false, sat, &bv->saturation);
-    if (!r) r = rt_scene_get_float(c, v, P, "c", false, POSITIVE, &bv->saturate_c);
-    if (!r) r = rt_scene_get_float(c, v, P, "far_distance", false, NONNEG, &bv->far_distance);
+    if (!r) r = rt_scene_get_float_row(c, v, P, "c", VFX_RANGE_BEAMS_C, &bv->saturate_c);
+    if (!r) r = rt_scene_get_float_row(c, v, P, "far_distance", VFX_RANGE_BEAMS_FAR, &bv->far_distance);
     if (!r) r = rt_scene_get_enum(c, v, P, "method", false, meth, &bv->method);
-    if (!r) r = rt_scene_get_uint(c, v, P, "march_samples", false, 1, 4096, &bv->march_samples);
+    if (!r) r = rt_scene_get_uint_row(c, v, P, "march_samples", VFX_RANGE_BEAMS_MARCH_SAMPLES, &bv->march_samples);
     bool bloom = true;
     if (!r && cJSON_GetObjectItemCaseSensitive(v, "bloom")) {
         r = rt_scene_get_bool(c, v, P, "bloom", &bloom);
         bv2->bloom = bloom ? VFX_BEAMS_BLOOM_ON : VFX_BEAMS_BLOOM_OFF;
     }
-    if (!r) r = rt_scene_get_float(c, v, P, "bloom_strength", false, NONNEG, &bv2->bloom_strength);
-    if (!r) r = rt_scene_get_uint(c, v, P, "bloom_levels", false, 1, 8, &bv2->bloom_levels);
+    if (!r) r = rt_scene_get_float_row(c, v, P, "bloom_strength", VFX_RANGE_BEAMS_BLOOM_STRENGTH, &bv2->bloom_strength);
+    if (!r) r = rt_scene_get_uint_row(c, v, P, "bloom_levels", VFX_RANGE_BEAMS_BLOOM_LEVELS, &bv2->bloom_levels);
     return r;
 }
 

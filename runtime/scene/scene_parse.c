@@ -395,3 +395,29 @@ vfx_result rt_scene_parse_transform(pctx *c, const cJSON *obj, const char *path,
     rt_scene_mat_trs(t, rdeg, s, model);
     return VFX_OK;
 }
+
+static const struct {
+    double lo, hi;
+    uint32_t flags;
+} range_rows[VFX_RANGE_COUNT] = {
+#define ROW_(id, field, key, lo, hi, flags, note) [VFX_RANGE_##id] = {lo, hi, flags},
+    VFX_RANGE_TABLE(ROW_)
+#undef ROW_
+};
+
+range rt_scene_range(vfx_range_id id)
+{
+    return (range){range_rows[id].lo, range_rows[id].hi, (range_rows[id].flags & VFX_RANGE_LO_OPEN) != 0};
+}
+
+vfx_result rt_scene_get_float_row(pctx *c, const cJSON *obj, const char *path, const char *key, vfx_range_id id,
+                                  float *out)
+{
+    return rt_scene_get_float(c, obj, path, key, false, rt_scene_range(id), out);
+}
+
+vfx_result rt_scene_get_uint_row(pctx *c, const cJSON *obj, const char *path, const char *key, vfx_range_id id,
+                                 uint32_t *out)
+{
+    return rt_scene_get_uint(c, obj, path, key, false, range_rows[id].lo, range_rows[id].hi, out);
+}

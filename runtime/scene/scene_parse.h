@@ -9,6 +9,7 @@
 #include <stddef.h>
 
 #include "scene/scene.h"
+#include <volfx/volfx_ranges.h>
 
 #define JPATH 256
 #define COORD_MAX 1e6 /* metres: beyond this float precision is gone anyway */
@@ -36,6 +37,16 @@ static const range COORD = {-COORD_MAX, COORD_MAX, false};
 static const range POSITIVE = {0, COORD_MAX, true};
 static const range NONNEG = {0, COORD_MAX, false};
 static const range UNIT = {0, 1, false};
+
+/* A VFX_RANGE_TABLE row (plugin/include/volfx/volfx_ranges.h) as the scene checks it: the
+ * plugin's own range, so a key and the ABI field it fills cannot drift apart (a scene leaves a
+ * key out for the default instead of writing the ABI's 0). */
+range rt_scene_range(vfx_range_id id);
+/* rt_scene_get_float / rt_scene_get_uint with the range of row `id`. */
+vfx_result rt_scene_get_float_row(pctx *c, const cJSON *obj, const char *path, const char *key, vfx_range_id id,
+                                  float *out);
+vfx_result rt_scene_get_uint_row(pctx *c, const cJSON *obj, const char *path, const char *key, vfx_range_id id,
+                                 uint32_t *out);
 
 vfx_result rt_scene_failf(pctx *c, vfx_result r, const char *path, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));

@@ -146,10 +146,11 @@ vfx_result rt_scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol)
     }
     r = rt_scene_get_string(c, v, P, "scalar", false, vol->scalar, sizeof vol->scalar);
     if (!r) r = rt_scene_get_bool(c, v, P, "transfer_normalized", &vol->transfer_normalized);
-    if (!r) r = rt_scene_get_float(c, v, P, "ert_threshold", false, (range){0, 1, true}, &vol->ert_threshold);
-    if (!r) r = rt_scene_get_uint(c, v, P, "tiles", false, 1, 1024, &vol->tiles);
-    if (!r) r = rt_scene_get_uint(c, v, P, "update_c", false, 1, 1u << 20, &vol->update_c);
-    if (!r) r = rt_scene_get_uint(c, v, P, "workers", false, 0, 256, &vol->workers);
+    /* the plugin's ranges (volfx_ranges.h) */
+    if (!r) r = rt_scene_get_float_row(c, v, P, "ert_threshold", VFX_RANGE_VOLUME_ERT_THRESHOLD, &vol->ert_threshold);
+    if (!r) r = rt_scene_get_uint_row(c, v, P, "tiles", VFX_RANGE_VOLUME_TILES, &vol->tiles);
+    if (!r) r = rt_scene_get_uint_row(c, v, P, "update_c", VFX_RANGE_VOLUME_UPDATE_C, &vol->update_c);
+    if (!r) r = rt_scene_get_uint_row(c, v, P, "workers", VFX_RANGE_VOLUME_WORKERS, &vol->workers);
     if (!r) {
         static const char *const flags[] = {"ert", "share", "dlb", NULL};
         static const uint32_t bits[] = {VFX_VOLUME_NO_ERT, VFX_VOLUME_NO_SHARE, VFX_VOLUME_NO_DLB};

@@ -160,10 +160,10 @@ static vfx_result parse_water_quality(pctx *c, const cJSON *q, rt_scene_water *w
     if ((r = rt_scene_expect_object(c, q, PQ)))
         return r;
     rt_scene_check_keys(c, q, PQ, qkeys);
-    r = rt_scene_get_uint(c, q, PQ, "max_samples", false, 1, 4096, &wp->max_samples);
-    if (!r) r = rt_scene_get_float(c, q, PQ, "step", false, (range){0, 1e3, true}, &wp->step);
-    if (!r) r = rt_scene_get_uint(c, q, PQ, "refine_iters", false, 1, 64, &wp->refine_iters);
-    if (!r) r = rt_scene_get_uint(c, q, PQ, "pyramid_level", false, 1, 12, &wp->pyramid_level);
+    r = rt_scene_get_uint_row(c, q, PQ, "max_samples", VFX_RANGE_WATER_MAX_SAMPLES, &wp->max_samples);
+    if (!r) r = rt_scene_get_float_row(c, q, PQ, "step", VFX_RANGE_WATER_STEP, &wp->step);
+    if (!r) r = rt_scene_get_uint_row(c, q, PQ, "refine_iters", VFX_RANGE_WATER_REFINE_ITERS, &wp->refine_iters);
+    if (!r) r = rt_scene_get_uint_row(c, q, PQ, "pyramid_level", VFX_RANGE_WATER_PYRAMID_LEVEL, &wp->pyramid_level);
     uint32_t mi = 3;
     if (!r) r = rt_scene_get_enum(c, q, PQ, "method", false, methods, &mi);
     wp->method = method_ids[mi];
@@ -266,11 +266,12 @@ vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
     vfx_water_params *wp = &w->params;
     /* ours (TILE) unless water.quality.method names another */
     *wp = (vfx_water_params){.size = sizeof *wp, .version = VFX_WATER_PARAMS_VERSION, .method = VFX_WATER_METHOD_TILE};
-    r = rt_scene_get_float(c, v, P, "h", false, (range){0, 1e3, true}, &wp->h);
-    if (!r) r = rt_scene_get_float(c, v, P, "threshold", false, (range){0, 1e3, true}, &wp->threshold);
-    if (!r) r = rt_scene_get_vec(c, v, P, "color", 3, false, UNIT, wp->color);
-    if (!r) r = rt_scene_get_float(c, v, P, "absorption", false, (range){0, 1e3, false}, &wp->absorption);
-    if (!r) r = rt_scene_get_float(c, v, P, "ior", false, (range){1, 3, false}, &wp->ior);
+    /* the plugin's ranges (volfx_ranges.h) */
+    r = rt_scene_get_float_row(c, v, P, "h", VFX_RANGE_WATER_H, &wp->h);
+    if (!r) r = rt_scene_get_float_row(c, v, P, "threshold", VFX_RANGE_WATER_THRESHOLD, &wp->threshold);
+    if (!r) r = rt_scene_get_vec(c, v, P, "color", 3, false, rt_scene_range(VFX_RANGE_WATER_COLOR), wp->color);
+    if (!r) r = rt_scene_get_float_row(c, v, P, "absorption", VFX_RANGE_WATER_ABSORPTION, &wp->absorption);
+    if (!r) r = rt_scene_get_float_row(c, v, P, "ior", VFX_RANGE_WATER_IOR, &wp->ior);
     if (r)
         return r;
     if (wp->h == 0)

@@ -1,0 +1,144 @@
+/* param_ranges.c — see param_ranges.h. */
+#include "param_ranges.h"
+
+#include <math.h>
+#include <stdio.h>
+
+static const volfx_range ROWS[VFX_RANGE_COUNT] = {
+#define ROW_(id, field, key, lo, hi, flags, note) [VFX_RANGE_##id] = {field, key, lo, hi, flags, note},
+    VFX_RANGE_TABLE(ROW_)
+#undef ROW_
+};
+
+const volfx_range *volfx_range_row(vfx_range_id id)
+{
+    return &ROWS[id];
+}
+
+char *volfx_range_text(const volfx_range *r, char *out, size_t n)
+{
+    if (r->flags & VFX_RANGE_INT)
+        snprintf(out, n, "%.17g..%.17g%s", r->lo, r->hi, r->flags & VFX_RANGE_ZERO ? " or 0" : "");
+    else
+        snprintf(out, n, "%c%.17g, %.17g]%s", r->flags & VFX_RANGE_LO_OPEN ? '(' : '[', r->lo, r->hi,
+                 r->flags & VFX_RANGE_ZERO ? " or 0" : "");
+    return out;
+}
+
+static int fits(const volfx_range *r, double v)
+{
+    if (v == 0 && (r->flags & VFX_RANGE_ZERO))
+        return 1;
+    return (r->flags & VFX_RANGE_LO_OPEN ? v > r->lo : v >= r->lo) && v <= r->hi; /* NaN fails */
+}
+
+static vfx_result refuse(vfx_context *ctx, const char *what, const volfx_range *r, const char *index, double v)
+{
+    char t[96], val[40];
+    snprintf(val, sizeof val, r->flags & VFX_RANGE_INT ? "%.0f" : "%g", v); /* integers in full */
+    return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "%s: %s%s %s outside %s%s%s%s", what, r->field, index, val,
+                      volfx_range_text(r, t, sizeof t), r->note[0] ? " (" : "", r->note, r->note[0] ? ")" : "");
+}
+
+vfx_result volfx_range_check(vfx_context *ctx, const char *what, vfx_range_id id, double v)
+{
+    const volfx_range *r = &ROWS[id];
+    return fits(r, v) ? VFX_OK : refuse(ctx, what, r, "", v);
+}
+
+vfx_result volfx_range_check_vec(vfx_context *ctx, const char *what, vfx_range_id id, const float *v, int n)
+{
+    const volfx_range *r = &ROWS[id];
+    int zero = 1;
+    for (int k = 0; k < n; ++k)
+        zero = zero && v[k] == 0;
+    if (zero && (r->flags & VFX_RANGE_ZERO))
+        return VFX_OK;
+    /* a single 0 component is a colour, not the default: checked against the bounds alone */
+    volfx_range strict = *r;
+    strict.flags &= ~VFX_RANGE_ZERO;
+    for (int k = 0; k < n; ++k)
+        if (!fits(&strict, v[k])) {
+            char idx[16];
+            snprintf(idx, sizeof idx, "[%d]", k);
+            return refuse(ctx, what, r, idx, v[k]);
+        }
+    return VFX_OK;
+}
+
+vfx_result volfx_water_params_check_ranges(vfx_context *ctx, const vfx_water_params3 *in, uint32_t version)
+{
+    const vfx_water_params *p = &in->v2.v1;
+    const char *w = "water";
+    vfx_result r;
+    if ((r = volfx_range_check(ctx, w, VFX_RANGE_WATER_H, p->h))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_THRESHOLD, p->threshold))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_MAX_SAMPLES, p->max_samples))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_STEP, p->step))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_REFINE_ITERS, p->refine_iters))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_PYRAMID_LEVEL, p->pyramid_level))
+        || (r = volfx_range_check_vec(ctx, w, VFX_RANGE_WATER_COLOR, p->color, 3))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_ABSORPTION, p->absorption))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_IOR, p->ior)))
+        return r;
+    if (version < VFX_WATER_PARAMS2_VERSION)
+        return VFX_OK;
+    const vfx_water_params2 *k = &in->v2;
+    if ((r = volfx_range_check(ctx, w, VFX_RANGE_WATER_ANISO_RADIUS, k->aniso_radius))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_ANISO_MAX_STRETCH, k->aniso_max_stretch))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_ANISO_MIN_NEIGHBOURS, k->aniso_min_neighbours))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_ANISO_SCALE, k->aniso_scale))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_ANISO_SMOOTHING, k->aniso_smoothing)))
+        return r;
+    return VFX_OK;
+}
+
+vfx_result volfx_beam_check_ranges(vfx_context *ctx, uint32_t i, const vfx_beam *b, const vfx_beam2 *b2)
+{
+    char w[32];
+    snprintf(w, sizeof w, "beams[%u]", i);
+    vfx_result r;
+    if ((r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_LENGTH, b->length))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_RADIUS, b->radius))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_A, b->a))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_B, b->b))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_EPS, b->eps))
+        || (r = volfx_range_check_vec(ctx, w, VFX_RANGE_BEAM_COLOR, b->color, 4)))
+        return r;
+    if (!b2)
+        return VFX_OK;
+    if ((r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_INTENSITY, b2->intensity))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_EXPOSURE, b2->exposure))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_FLOW_AMOUNT, b2->flow_amount))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_FLOW_SPEED, b2->flow_speed))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_FLOW_SCALE, b2->flow_scale)))
+        return r;
+    return VFX_OK;
+}
+
+vfx_result volfx_beams_view_check_ranges(vfx_context *ctx, const vfx_beams_view2 *v, uint32_t version)
+{
+    vfx_result r;
+    if ((r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_C, v->v1.saturate_c))
+        || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_FAR, v->v1.far_distance))
+        || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_MARCH_SAMPLES, v->v1.march_samples)))
+        return r;
+    if (version < VFX_BEAMS_VIEW2_VERSION)
+        return VFX_OK;
+    if ((r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_BLOOM_STRENGTH, v->bloom_strength))
+        || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_BLOOM_LEVELS, v->bloom_levels)))
+        return r;
+    return VFX_OK;
+}
+
+vfx_result volfx_volume_view_check_ranges(vfx_context *ctx, const vfx_volume_view *v)
+{
+    const char *w = "volume[0]";
+    vfx_result r;
+    if ((r = volfx_range_check(ctx, w, VFX_RANGE_VOLUME_ERT_THRESHOLD, v->ert_threshold))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_VOLUME_TILES, v->tiles))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_VOLUME_UPDATE_C, v->update_c))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_VOLUME_WORKERS, v->workers)))
+        return r;
+    return VFX_OK;
+}
