@@ -20,7 +20,8 @@
 #include "sim/sph.h"
 
 int bench_sim(int argc, char **argv);
-int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads);
+int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsigned solvers, uint32_t pbf_steps,
+                   uint32_t pbf_iters);
 
 static double now_s(void)
 {
@@ -406,17 +407,27 @@ int bench_sim(int argc, char **argv)
             uint32_t pn = (uint32_t)atoi(argv[++i]);
             int pf = 60;
             bool pp = true;
+            unsigned ps = 3u, pt = 2u, psteps = 0u, piters = 0u; /* 0: the solver's defaults */
             for (int k = i + 1; k < argc; ++k) {
                 if (!strcmp(argv[k], "--frames") && k + 1 < argc)
                     pf = atoi(argv[++k]);
                 else if (!strcmp(argv[k], "--no-paddle"))
                     pp = false;
+                else if (!strcmp(argv[k], "--solver") && k + 1 < argc)
+                    ++k, ps = !strcmp(argv[k], "wcsph") ? 1u : !strcmp(argv[k], "pbf") ? 2u : 0u;
+                else if (!strcmp(argv[k], "--threads") && k + 1 < argc)
+                    pt = (unsigned)atoi(argv[++k]);
+                else if (!strcmp(argv[k], "--pbf-steps") && k + 1 < argc)
+                    psteps = (unsigned)atoi(argv[++k]);
+                else if (!strcmp(argv[k], "--pbf-iterations") && k + 1 < argc)
+                    piters = (unsigned)atoi(argv[++k]);
             }
-            if (pn < 1 || pf < 1) {
-                fprintf(stderr, "volfx-bench sim --pool N [--frames F] [--no-paddle]\n");
+            if (pn < 1 || pf < 1 || !ps || pt < 1 || pt > 64) {
+                fprintf(stderr, "volfx-bench sim --pool N [--frames F] [--no-paddle] [--solver wcsph|pbf (default "
+                        "both)] [--threads 1..64 (2)] [--pbf-steps S (per 1/60 s)] [--pbf-iterations I]\n");
                 return 2;
             }
-            return bench_sim_pool(pn, pf, pp, 2);
+            return bench_sim_pool(pn, pf, pp, pt, ps, psteps, piters);
         } else if (!strcmp(argv[i], "--dam-break")) {
             dam = true;
         } else if (!strcmp(argv[i], "--res") && i + 1 < argc) {

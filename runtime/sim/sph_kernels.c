@@ -398,6 +398,8 @@ void rt_sph_integrate_chunk(rt_sph *s, uint32_t chunk)
         float p[3] = {s->x[i] + dt * v[0], s->y[i] + dt * v[1], s->z[i] + dt * v[2]};
         /* colliders: push back to the margin, remove the velocity into the solid (relative) */
         for (uint32_t c = 0; c < s->ncol; ++c) {
+            if (sph_collider_beyond(&s->col[c], p[0], p[1], p[2], margin))
+                continue;
             float n[3];
             float d = rt_sph_surface_distance(&s->col[c], p[0], p[1], p[2], n);
             if (d < margin) {

@@ -100,6 +100,8 @@ static void pbf_clamp(const rt_sph *s, float p[3])
 {
     const float margin = 0.25f * s->p.spacing;
     for (uint32_t c = 0; c < s->ncol; ++c) {
+        if (sph_collider_beyond(&s->col[c], p[0], p[1], p[2], margin))
+            continue;
         float n[3];
         float d = rt_sph_surface_distance(&s->col[c], p[0], p[1], p[2], n);
         if (d < margin)

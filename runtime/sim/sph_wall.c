@@ -78,6 +78,8 @@ int rt_sph_gather_walls(const rt_sph *s, float px, float py, float pz, sph_wall_
         }
     }
     for (uint32_t c = 0; c < s->ncol && k < max; ++c) {
+        if (sph_collider_beyond(&s->col[c], px, py, pz, s->H))
+            continue;
         float n[3];
         float d = rt_sph_surface_distance(&s->col[c], px, py, pz, n);
         if (d < s->H) {
