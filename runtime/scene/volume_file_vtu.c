@@ -554,6 +554,161 @@ static const vtu_array *find(const vtu_state *s, int section, const char *name)
     return NULL;
 }
 
+/* What the assembly needs from the file: its arrays, then their values decoded as doubles. */
+typedef struct {
+    const vtu_array *points, *conn, *offsets, *types, *scalar;
+    size_t app_start; /* first byte after the AppendedData '_' marker (0: none) */
+    double *pts, *cells, *sc;
+} vtu_decoded;
+
+/* Splits off the appended section (expat only sees the XML before it) and parses the XML. */
+static vfx_result vtu_parse(vtu_state *s, vtu_decoded *d)
+{
+    const char *data = s->data;
+    size_t size = s->size, xml_len = size;
+    const char *ad = NULL;
+    for (size_t i = 0; i + 13 <= size; i++)
+        if (data[i] == '<' && !memcmp(data + i, "<AppendedData", 13)) {
+            ad = data + i;
+            break;
+        }
+    if (ad) {
+        const char *gt = memchr(ad, '>', size - (size_t)(ad - data));
+        const char *us = gt ? memchr(gt, '_', size - (size_t)(gt - data)) : NULL;
+        if (!us)
+            return errf(s, VFX_ERR_FORMAT, "AppendedData without its '_' marker");
+        d->app_start = (size_t)(us - data) + 1;
+        xml_len = (size_t)(gt + 1 - data);
+    }
+    s->parser = XML_ParserCreate(NULL);
+    if (!s->parser)
+        return errf(s, VFX_ERR_OUT_OF_MEMORY, "out of memory for the XML parser");
+    XML_SetUserData(s->parser, s);
+    XML_SetElementHandler(s->parser, on_start, on_end);
+    XML_SetCharacterDataHandler(s->parser, on_text);
+    if (xml_len > (size_t)0x7fffffff)
+        return errf(s, VFX_ERR_FORMAT, "file too large");
+    if (XML_Parse(s->parser, data, (int)xml_len, ad ? XML_FALSE : XML_TRUE) == XML_STATUS_ERROR) {
+        if (!s->failed)
+            errf(s, VFX_ERR_FORMAT, "not valid XML: line %lu: %s",
+                 (unsigned long)XML_GetCurrentLineNumber(s->parser),
+                 XML_ErrorString(XML_GetErrorCode(s->parser)));
+        return VFX_ERR_FORMAT;
+    }
+    if (!s->has_grid || s->pieces != 1)
+        return errf(s, VFX_ERR_FORMAT, "no UnstructuredGrid Piece found");
+    return VFX_OK;
+}
+
+/* Finds the Points, the three Cells arrays and the named point field. */
+static vfx_result vtu_find_arrays(vtu_state *s, const char *scalar_name, vtu_decoded *d)
+{
+    d->points = find(s, SEC_POINTS, NULL);
+    d->conn = find(s, SEC_CELLS, "connectivity");
+    d->offsets = find(s, SEC_CELLS, "offsets");
+    d->types = find(s, SEC_CELLS, "types");
+    if (!d->points || !d->conn || !d->offsets || !d->types)
+        return errf(s, VFX_ERR_FORMAT, "missing %s", !d->points ? "Points DataArray"
+                    : !d->conn ? "Cells connectivity" : !d->offsets ? "Cells offsets" : "Cells types");
+    if (d->points->ncomp != 3 || (d->points->type != T_F32 && d->points->type != T_F64))
+        return errf(s, VFX_ERR_FORMAT, "Points must be 3-component Float32/Float64");
+    if (!scalar_name)
+        return VFX_OK;
+    d->scalar = find(s, SEC_POINTDATA, scalar_name);
+    if (d->scalar)
+        return VFX_OK;
+    int n = snprintf(s->err, s->errlen, "point field '%s' not found; present:", scalar_name);
+    for (int i = 0; i < s->narr && n >= 0 && (size_t)n < s->errlen; i++)
+        if (s->arr[i].section == SEC_POINTDATA)
+            n += snprintf(s->err + n, s->errlen - (size_t)n, " %s", s->arr[i].name);
+    return VFX_ERR_NOT_FOUND;
+}
+
+static const char *vtk_cell_name(double t)
+{
+    static const struct { int type; const char *name; } names[] = {
+        {1, "VTK_VERTEX"}, {2, "VTK_POLY_VERTEX"}, {3, "VTK_LINE"}, {4, "VTK_POLY_LINE"},
+        {5, "VTK_TRIANGLE"}, {6, "VTK_TRIANGLE_STRIP"}, {7, "VTK_POLYGON"}, {8, "VTK_PIXEL"},
+        {9, "VTK_QUAD"}, {11, "VTK_VOXEL"}, {12, "VTK_HEXAHEDRON"}, {13, "VTK_WEDGE"},
+        {14, "VTK_PYRAMID"}, {21, "VTK_QUADRATIC_EDGE"}, {22, "VTK_QUADRATIC_TRIANGLE"},
+        {23, "VTK_QUADRATIC_QUAD"}, {24, "VTK_QUADRATIC_TETRA"}, {25, "VTK_QUADRATIC_HEXAHEDRON"},
+        {42, "VTK_POLYHEDRON"}};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (t == names[i].type)
+            return names[i].name;
+    return "not a VTK linear or quadratic cell type this reader knows";
+}
+
+/* Types first, then offsets, then 4 vertices a cell: a hexahedron's 8 or a triangle's 3 would
+ * otherwise surface as "surplus values" in the connectivity, not as the cell it is. */
+static vfx_result vtu_read_cells(vtu_state *s, vtu_decoded *d)
+{
+    size_t nc = (size_t)s->ncells;
+    double *types = NULL, *offs = NULL;
+    vfx_result r = read_array(s, d->types, nc, &types, d->app_start);
+    if (r)
+        return r;
+    size_t other = 0, first = nc;
+    for (size_t c = 0; c < nc; c++)
+        if (types[c] != 10 && other++ == 0)
+            first = c;
+    if (other) {
+        r = errf(s, VFX_ERR_UNSUPPORTED, "cell %zu has VTK type %g (%s); only tetrahedra (VTK_TETRA = "
+                 "10) are supported (%zu of the %zu cells are not tetrahedra)", first, types[first],
+                 vtk_cell_name(types[first]), other, nc);
+        free(types);
+        return r;
+    }
+    free(types);
+    if ((r = read_array(s, d->offsets, nc, &offs, d->app_start)))
+        return r;
+    for (size_t c = 0; c < nc && !r; c++)
+        if (offs[c] != 4.0 * (double)(c + 1))
+            r = errf(s, VFX_ERR_FORMAT, "cell %zu: offset %g, expected %zu for 4-vertex cells", c,
+                     offs[c], 4 * (c + 1));
+    free(offs);
+    return r ? r : read_array(s, d->conn, 4 * nc, &d->cells, d->app_start);
+}
+
+/* Builds the mesh from the decoded arrays: float32 points, checked indices, the scalar (a
+ * vector field's magnitude), then tet_validate. */
+static vfx_result vtu_assemble(vtu_state *s, const vtu_decoded *d, tet_mesh *out)
+{
+    size_t np = (size_t)s->npoints, nc = (size_t)s->ncells;
+    const vtu_array *as = d->scalar;
+    out->point_count = (uint32_t)np;
+    out->tet_count = (uint32_t)nc;
+    out->points = malloc(sizeof(float) * 3 * np);
+    out->tets = malloc(sizeof(uint32_t) * 4 * nc);
+    if (as) out->scalar = malloc(sizeof(float) * np);
+    if (!out->points || !out->tets || (as && !out->scalar))
+        return errf(s, VFX_ERR_OUT_OF_MEMORY, "out of memory for %zu points and %zu tetrahedra", np, nc);
+    for (size_t i = 0; i < 3 * np; i++)
+        out->points[i] = (float)d->pts[i];
+    for (size_t i = 0; i < 4 * nc; i++) {
+        double v = d->cells[i];
+        if (!(v >= 0 && v < (double)np))
+            return errf(s, VFX_ERR_FORMAT, "cell %zu vertex %zu: index %g out of range (%zu points)",
+                        i / 4, i % 4, v, np);
+        if (v != floor(v)) /* a Float connectivity array */
+            return errf(s, VFX_ERR_FORMAT, "DataArray 'connectivity': value %zu (cell %zu vertex %zu) "
+                        "index %.17g is not an integer", i, i / 4, i % 4, v);
+        out->tets[i] = (uint32_t)v;
+    }
+    if (as) {
+        snprintf(out->scalar_name, sizeof out->scalar_name, "%s%.60s%s", as->ncomp > 1 ? "|" : "",
+                 as->name, as->ncomp > 1 ? "|" : "");
+        size_t k = (size_t)as->ncomp;
+        for (size_t i = 0; i < np; i++) {
+            double m = 0;
+            for (size_t j = 0; j < k; j++)
+                m += d->sc[i * k + j] * d->sc[i * k + j];
+            out->scalar[i] = (float)(k == 1 ? d->sc[i] : sqrt(m));
+        }
+    }
+    return rt_result_from_tet(tet_validate(out, s->err, s->errlen));
+}
+
 vfx_result rt_volume_load_vtu_mem(const void *data, size_t size, const char *scalar_name,
                                 tet_mesh *out, char *err, size_t errlen)
 {
@@ -576,137 +731,17 @@ vfx_result rt_volume_load_vtu_mem(const void *data, size_t size, const char *sca
     s->cur = -1;
     s->err = err;
     s->errlen = errlen;
-    vfx_result r = VFX_OK;
-    double *pts = NULL, *conn = NULL, *offs = NULL, *types = NULL, *sc = NULL;
-    size_t app_start = 0, xml_len = size;
-    /* Appended section: expat only sees the XML before it. */
-    const char *ad = NULL;
-    for (size_t i = 0; i + 13 <= size; i++)
-        if (((const char *)data)[i] == '<' && !memcmp((const char *)data + i, "<AppendedData", 13)) {
-            ad = (const char *)data + i;
-            break;
-        }
-    if (ad) {
-        const char *gt = memchr(ad, '>', size - (size_t)(ad - (const char *)data));
-        const char *us = gt ? memchr(gt, '_', size - (size_t)(gt - (const char *)data)) : NULL;
-        if (!us) {
-            snprintf(err, errlen, "AppendedData without its '_' marker");
-            r = VFX_ERR_FORMAT;
-            goto done;
-        }
-        app_start = (size_t)(us - (const char *)data) + 1;
-        xml_len = (size_t)(gt + 1 - (const char *)data);
-    }
-    s->parser = XML_ParserCreate(NULL);
-    if (!s->parser) { r = errf(s, VFX_ERR_OUT_OF_MEMORY, "out of memory for the XML parser"); goto done; }
-    XML_SetUserData(s->parser, s);
-    XML_SetElementHandler(s->parser, on_start, on_end);
-    XML_SetCharacterDataHandler(s->parser, on_text);
-    if (xml_len > (size_t)0x7fffffff) { snprintf(err, errlen, "file too large"); r = VFX_ERR_FORMAT; goto done; }
-    if (XML_Parse(s->parser, data, (int)xml_len, ad ? XML_FALSE : XML_TRUE) == XML_STATUS_ERROR) {
-        if (!s->failed)
-            snprintf(err, errlen, "not valid XML: line %lu: %s",
-                     (unsigned long)XML_GetCurrentLineNumber(s->parser),
-                     XML_ErrorString(XML_GetErrorCode(s->parser)));
-        r = VFX_ERR_FORMAT;
-        goto done;
-    }
-    if (!s->has_grid || s->pieces != 1) {
-        snprintf(err, errlen, "no UnstructuredGrid Piece found");
-        r = VFX_ERR_FORMAT;
-        goto done;
-    }
-    const vtu_array *ap = find(s, SEC_POINTS, NULL), *ac = find(s, SEC_CELLS, "connectivity");
-    const vtu_array *ao = find(s, SEC_CELLS, "offsets"), *at = find(s, SEC_CELLS, "types");
-    if (!ap || !ac || !ao || !at) {
-        snprintf(err, errlen, "missing %s", !ap ? "Points DataArray" : !ac ? "Cells connectivity"
-                 : !ao ? "Cells offsets" : "Cells types");
-        r = VFX_ERR_FORMAT;
-        goto done;
-    }
-    if (ap->ncomp != 3 || (ap->type != T_F32 && ap->type != T_F64)) {
-        snprintf(err, errlen, "Points must be 3-component Float32/Float64");
-        r = VFX_ERR_FORMAT;
-        goto done;
-    }
-    const vtu_array *as = NULL;
-    if (scalar_name) {
-        as = find(s, SEC_POINTDATA, scalar_name);
-        if (!as) {
-            int n = snprintf(err, errlen, "point field '%s' not found; present:", scalar_name);
-            for (int i = 0; i < s->narr && n >= 0 && (size_t)n < errlen; i++)
-                if (s->arr[i].section == SEC_POINTDATA)
-                    n += snprintf(err + n, errlen - (size_t)n, " %s", s->arr[i].name);
-            r = VFX_ERR_NOT_FOUND;
-            goto done;
-        }
-    }
-    size_t np = (size_t)s->npoints, nc = (size_t)s->ncells;
-    if ((r = read_array(s, ap, np, &pts, app_start)) ||
-        (r = read_array(s, at, nc, &types, app_start)) ||
-        (r = read_array(s, ao, nc, &offs, app_start)) ||
-        (r = read_array(s, ac, 4 * nc, &conn, app_start)))
-        goto done;
-    for (size_t c = 0; c < nc; c++) {
-        if (types[c] != 10) {
-            snprintf(err, errlen, "cell %zu has VTK type %g; only tetrahedra (VTK_TETRA = 10) "
-                     "are supported", c, types[c]);
-            r = VFX_ERR_UNSUPPORTED;
-            goto done;
-        }
-        if (offs[c] != 4.0 * (double)(c + 1)) {
-            snprintf(err, errlen, "cell %zu: offset %g, expected %zu for 4-vertex cells", c,
-                     offs[c], 4 * (c + 1));
-            r = VFX_ERR_FORMAT;
-            goto done;
-        }
-    }
-    if (as && (r = read_array(s, as, np, &sc, app_start)))
-        goto done;
-    out->point_count = (uint32_t)np;
-    out->tet_count = (uint32_t)nc;
-    out->points = malloc(sizeof(float) * 3 * np);
-    out->tets = malloc(sizeof(uint32_t) * 4 * nc);
-    if (as) out->scalar = malloc(sizeof(float) * np);
-    if (!out->points || !out->tets || (as && !out->scalar)) {
-        r = errf(s, VFX_ERR_OUT_OF_MEMORY, "out of memory for %zu points and %zu tetrahedra", np, nc);
-        goto done;
-    }
-    for (size_t i = 0; i < 3 * np; i++)
-        out->points[i] = (float)pts[i];
-    for (size_t i = 0; i < 4 * nc; i++) {
-        if (!(conn[i] >= 0 && conn[i] < (double)np)) {
-            snprintf(err, errlen, "cell %zu vertex %zu: index %g out of range (%zu points)",
-                     i / 4, i % 4, conn[i], np);
-            r = VFX_ERR_FORMAT;
-            goto done;
-        }
-        if (conn[i] != floor(conn[i])) { /* a Float connectivity array */
-            r = errf(s, VFX_ERR_FORMAT, "DataArray 'connectivity': value %zu (cell %zu vertex %zu) "
-                     "index %.17g is not an integer", i, i / 4, i % 4, conn[i]);
-            goto done;
-        }
-        out->tets[i] = (uint32_t)conn[i];
-    }
-    if (as) {
-        snprintf(out->scalar_name, sizeof out->scalar_name, "%s%.60s%s", as->ncomp > 1 ? "|" : "",
-                 as->name, as->ncomp > 1 ? "|" : "");
-        for (size_t i = 0; i < np; i++) {
-            double m = 0;
-            if (as->ncomp == 1)
-                m = sc[i];
-            else
-                for (int k = 0; k < as->ncomp; k++)
-                    m += sc[i * (size_t)as->ncomp + k] * sc[i * (size_t)as->ncomp + k];
-            out->scalar[i] = (float)(as->ncomp == 1 ? m : sqrt(m));
-        }
-    }
-    r = rt_result_from_tet(tet_validate(out, err, errlen));
-done:
+    vtu_decoded d = {0};
+    vfx_result r = vtu_parse(s, &d);
+    if (!r) r = vtu_find_arrays(s, scalar_name, &d);
+    if (!r) r = read_array(s, d.points, (size_t)s->npoints, &d.pts, d.app_start);
+    if (!r) r = vtu_read_cells(s, &d);
+    if (!r && d.scalar) r = read_array(s, d.scalar, (size_t)s->npoints, &d.sc, d.app_start);
+    if (!r) r = vtu_assemble(s, &d, out);
     if (r != VFX_OK) tet_mesh_free(out);
     if (s->parser) XML_ParserFree(s->parser);
     free(s);
-    free(pts); free(conn); free(offs); free(types); free(sc);
+    free(d.pts); free(d.cells); free(d.sc);
     return r;
 }
 

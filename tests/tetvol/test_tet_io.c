@@ -515,6 +515,86 @@ static void test_claimed_counts(void **st)
 #endif
 }
 
+/* Issue 28 item 6: real hexahedra (8 vertices a cell), triangles (3) and mixed cells name the
+ * first cell that is not a tetrahedron and its VTK type; before, the connectivity was read as 4
+ * a cell first and the error was "connectivity: surplus values" (or a missing-values one). */
+static char *cells_vtu(int npts, const char *conn, const char *offs, const char *types, int ncells)
+{
+    static char buf[4096];
+    int n = snprintf(buf, sizeof buf, "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" "
+                     "version=\"1.0\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n<Piece "
+                     "NumberOfPoints=\"%d\" NumberOfCells=\"%d\">\n<Points><DataArray type=\"Float32\" "
+                     "NumberOfComponents=\"3\" format=\"ascii\">", npts, ncells);
+    for (int i = 0; i < npts; i++)
+        n += snprintf(buf + n, sizeof buf - (size_t)n, " %d %d %d", i & 1, (i >> 1) & 1, (i >> 2) & 1);
+    snprintf(buf + n, sizeof buf - (size_t)n, "</DataArray></Points>\n<Cells><DataArray type=\"Int64\" "
+             "Name=\"connectivity\" format=\"ascii\">%s</DataArray>\n<DataArray type=\"Int64\" "
+             "Name=\"offsets\" format=\"ascii\">%s</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" "
+             "format=\"ascii\">%s</DataArray></Cells>\n</Piece></UnstructuredGrid></VTKFile>\n",
+             conn, offs, types);
+    return buf;
+}
+
+static void test_cell_kinds(void **st)
+{
+    (void)st;
+    struct { const char *what, *conn, *offs, *types; int ncells; const char *part; } c[] = {
+        {"two hexahedra", "0 1 3 2 4 5 7 6  0 1 3 2 4 5 7 6", "8 16", "12 12", 2,
+         "cell 0 has VTK type 12 (VTK_HEXAHEDRON); only tetrahedra (VTK_TETRA = 10) are supported "
+         "(2 of the 2 cells"},
+        {"triangles", "0 1 2 1 2 3 2 3 4", "3 6 9", "5 5 5", 3, "cell 0 has VTK type 5 (VTK_TRIANGLE)"},
+        {"tet then hexahedron", "0 1 2 4  0 1 3 2 4 5 7 6", "4 12", "10 12", 2,
+         "cell 1 has VTK type 12 (VTK_HEXAHEDRON)"},
+        {"tet, wedge, tet", "0 1 2 4  0 1 2 4 5 6  1 2 3 7", "4 10 14", "10 13 10", 3,
+         "cell 1 has VTK type 13 (VTK_WEDGE); only tetrahedra (VTK_TETRA = 10) are supported (1 of the 3"},
+    };
+    for (size_t i = 0; i < sizeof c / sizeof c[0]; i++) {
+        tet_mesh m;
+        char err[256];
+        preset(err, sizeof err);
+        const char *f = cells_vtu(8, c[i].conn, c[i].offs, c[i].types, c[i].ncells);
+        vfx_result r = rt_volume_load_vtu_mem(f, strlen(f), NULL, &m, err, sizeof err);
+        if (r != VFX_ERR_UNSUPPORTED || !strstr(err, c[i].part))
+            fail_msg("%s: code %d, \"%s\"", c[i].what, r, err);
+        assert_null(m.points);
+    }
+    /* and the same file with tetrahedra loads: the failure above is the cell type */
+    tet_mesh m;
+    char err[256];
+    const char *f = cells_vtu(8, "0 1 2 4  1 2 3 7", "4 8", "10 10", 2);
+    assert_int_equal(rt_volume_load_vtu_mem(f, strlen(f), NULL, &m, err, sizeof err), VFX_OK);
+    assert_int_equal(m.tet_count, 2);
+    tet_mesh_free(&m);
+}
+
+/* Issue 28 item 6: the NumberOfCells cap (RT_VOLUME_MAX_TETS) is named before any array is
+ * read (without the cap, the byte check would answer "hold at most": a different message). */
+static void test_cell_count_cap(void **st)
+{
+    (void)st;
+    char cap[32], under[32];
+    snprintf(cap, sizeof cap, "%u", RT_VOLUME_MAX_TETS + 1u);
+    snprintf(under, sizeof under, "%u", RT_VOLUME_MAX_TETS);
+    tet_mesh m;
+    char err[256];
+    preset(err, sizeof err);
+    const char *f = cells_vtu(8, "0 1 2 4", "4", "10", 1);
+    char buf[4096];
+    snprintf(buf, sizeof buf, "%s", f);
+    char *at = strstr(buf, "NumberOfCells=\"1\"");
+    assert_non_null(at);
+    char out[4200];
+    snprintf(out, sizeof out, "%.*sNumberOfCells=\"%s\"%s", (int)(at - buf), buf, cap, at + 17);
+    assert_int_equal(rt_volume_load_vtu_mem(out, strlen(out), NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
+    assert_msg(err, "NumberOfCells 16777217 above the cap of 16777216 (RT_VOLUME_MAX_TETS)");
+    /* at the cap: past the cap check, refused by the text's size instead */
+    snprintf(out, sizeof out, "%.*sNumberOfCells=\"%s\"%s", (int)(at - buf), buf, under, at + 17);
+    preset(err, sizeof err);
+    assert_int_not_equal(rt_volume_load_vtu_mem(out, strlen(out), NULL, &m, err, sizeof err), VFX_OK);
+    assert_null(strstr(err, "RT_VOLUME_MAX_TETS"));
+    assert_false(strstr(err, SENTINEL));
+}
+
 /* Defects 3 and 4: non-regular files refused before opening, without blocking; the file cap
  * named; /proc files read for what they hold. alarm() turns a hang into a failure. */
 static void test_special_files(void **st)
@@ -767,6 +847,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_more_malformed),    cmocka_unit_test(test_claimed_counts),
         cmocka_unit_test(test_special_files),     cmocka_unit_test(test_ascii_strict),
         cmocka_unit_test(test_tetgen_strict),
+        cmocka_unit_test(test_cell_kinds),        cmocka_unit_test(test_cell_count_cap),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
