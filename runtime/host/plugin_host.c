@@ -47,6 +47,12 @@ vfx_result rt_plugin_host_load_as(const char *path, uint32_t abi, const vfx_host
     *out = NULL;
     /* A path (not a soname the loader searches) is checked first: dlopen of a FIFO blocks
      * forever in open(), a directory gives only "cannot read file data". */
+    /* dlopen("") is the main program, whose missing entry symbol would be blamed instead */
+    if (!path[0]) {
+        rt_logf(log, VFX_LOG_ERROR, "plugin path is empty: name the plugin's file (a path with '/') "
+                "or a soname the loader searches");
+        return VFX_ERR_INVALID_ARGUMENT;
+    }
     char why[512];
     if (strchr(path, '/') && rt_check_regular_file(path, why, sizeof why)) {
         rt_logf(log, VFX_LOG_ERROR, "plugin %s", why);

@@ -11,7 +11,8 @@ typedef struct rt_plugin_host rt_plugin_host;
 /* Loads the shared plugin at `path` (a bare soname such as VFX_SONAME goes through the loader's
  * search path; the file found is logged) and calls its entry with VFX_ABI_VERSION. Fails with
  * VFX_ERR_IO (cannot open: dlerror text), VFX_ERR_NOT_FOUND (no vfx_plugin_entry symbol),
- * VFX_ERR_ABI (versions differ: the message names both). */
+ * VFX_ERR_ABI (versions differ: the message names both), VFX_ERR_INVALID_ARGUMENT (an empty
+ * path: dlopen("") would open the program itself). */
 vfx_result rt_plugin_host_load(const char *path, const vfx_host_api *host, const rt_logger *log,
                                 rt_plugin_host **out);
 /* Same, with an entry function linked into the executable (static plugin). */

@@ -122,6 +122,13 @@ static void test_special_file_plugin(void **state)
     assert_non_null(strstr(log.last, "is a directory"));
     unlink(fifo);
     rmdir(dir);
+    /* issue 28: "" is named as an empty path (dlopen("") opened the game itself, and the error
+     * was its missing vfx_plugin_entry symbol) */
+    log.last[0] = 0;
+    assert_int_equal(rt_plugin_host_load("", &host, &lg, &h), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(log.last, "plugin path is empty"));
+    assert_null(strstr(log.last, "symbol"));
+    assert_null(h);
 }
 
 static void test_create_refuses_bad_host(void **state)
