@@ -60,7 +60,7 @@ int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsign
             return 1;
     }
     double *ms[2] = {calloc((size_t)frames, sizeof(double)), calloc((size_t)frames, sizeof(double))};
-    float vmax[2] = {0, 0};
+    float vmax[2] = {0, 0}, vlast[2] = {0, 0};
     double err_sum[2] = {0, 0};
     uint32_t steps[2] = {0, 0}, iters[2] = {0, 0};
     for (int f = 0; f < frames && ms[0] && ms[1]; ++f)
@@ -75,6 +75,7 @@ int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsign
                 return 1;
             }
             ms[m][f] = cpu_ms() - t0;
+            vlast[m] = r.max_speed;
             if (f >= 1 && r.max_speed > vmax[m])
                 vmax[m] = r.max_speed;
             err_sum[m] += r.mean_density_error;
@@ -87,9 +88,9 @@ int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsign
         med[m] = rt_median(ms[m], (uint32_t)frames);
         printf("{\"bench\":\"sim_pool\",\"solver\":\"%s\",\"particles\":%u,\"spacing\":%.5f,\"paddle\":%s,"
                "\"frames\":%d,\"threads\":%u,\"cpu_ms_per_frame_median\":%.3f,\"steps_per_frame\":%.2f,"
-               "\"iterations_per_frame\":%.2f,\"max_speed_frames_2_on\":%.4f,\"mean_compression\":%.5f}\n",
+               "\"iterations_per_frame\":%.2f,\"max_speed_frames_2_on\":%.4f,\"max_speed_last\":%.4f,\"mean_compression\":%.5f}\n",
                m ? "pbf" : "wcsph", added[m], dx, paddle ? "true" : "false", frames, rt_sph_thread_count(s[m]),
-               med[m], (double)steps[m] / frames, (double)iters[m] / frames, vmax[m], err_sum[m] / frames);
+               med[m], (double)steps[m] / frames, (double)iters[m] / frames, vmax[m], vlast[m], err_sum[m] / frames);
     }
     if (solvers == 3u)
         printf("{\"bench\":\"sim_pool\",\"wcsph_over_pbf_cpu\":%.2f}\n", med[0] / med[1]);

@@ -92,7 +92,7 @@ typedef struct rt_sph_desc {
     float pbf_cfl;              /* largest move per step as a fraction of H; 0.5 */
     float pbf_relaxation;       /* constraint-force mixing eps, a fraction of the lattice's
                                  * sum |grad C|^2; 1 */
-    float pbf_scorr_k;          /* artificial pressure k of s_corr = -k (W(r)/W(dq))^4; 0.001 */
+    float pbf_scorr_k;          /* artificial pressure k of s_corr = -k (W(r)/W(dq))^4; 0 (off) */
     float pbf_scorr_dq;         /* its dq as a fraction of H; 0.2 */
     float pbf_xsph;             /* XSPH viscosity c; 0.01 */
     float pbf_vorticity;        /* vorticity confinement epsilon [m/s]; 0 (off) */
