@@ -21,7 +21,7 @@
 
 int bench_sim(int argc, char **argv);
 int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsigned solvers, uint32_t pbf_steps,
-                   uint32_t pbf_iters);
+                   uint32_t pbf_iters, float pbf_relax);
 
 static double now_s(void)
 {
@@ -408,6 +408,7 @@ int bench_sim(int argc, char **argv)
             int pf = 60;
             bool pp = true;
             unsigned ps = 3u, pt = 2u, psteps = 0u, piters = 0u; /* 0: the solver's defaults */
+            float prelax = 0.f;
             for (int k = i + 1; k < argc; ++k) {
                 if (!strcmp(argv[k], "--frames") && k + 1 < argc)
                     pf = atoi(argv[++k]);
@@ -421,13 +422,16 @@ int bench_sim(int argc, char **argv)
                     psteps = (unsigned)atoi(argv[++k]);
                 else if (!strcmp(argv[k], "--pbf-iterations") && k + 1 < argc)
                     piters = (unsigned)atoi(argv[++k]);
+                else if (!strcmp(argv[k], "--pbf-relaxation") && k + 1 < argc)
+                    prelax = (float)atof(argv[++k]);
             }
             if (pn < 1 || pf < 1 || !ps || pt < 1 || pt > 64) {
                 fprintf(stderr, "volfx-bench sim --pool N [--frames F] [--no-paddle] [--solver wcsph|pbf (default "
-                        "both)] [--threads 1..64 (2)] [--pbf-steps S (per 1/60 s)] [--pbf-iterations I]\n");
+                        "both)] [--threads 1..64 (2)] [--pbf-steps S (per 1/60 s)] [--pbf-iterations I]\n"
+                        "                      [--pbf-relaxation R]\n");
                 return 2;
             }
-            return bench_sim_pool(pn, pf, pp, pt, ps, psteps, piters);
+            return bench_sim_pool(pn, pf, pp, pt, ps, psteps, piters, prelax);
         } else if (!strcmp(argv[i], "--dam-break")) {
             dam = true;
         } else if (!strcmp(argv[i], "--res") && i + 1 < argc) {

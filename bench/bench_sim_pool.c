@@ -14,7 +14,7 @@
 #include "sim/sph.h"
 
 int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsigned solvers, uint32_t pbf_steps,
-                   uint32_t pbf_iters);
+                   uint32_t pbf_iters, float pbf_relax);
 
 static double cpu_ms(void)
 {
@@ -25,7 +25,7 @@ static double cpu_ms(void)
 
 /* solvers: bit 0 WCSPH, bit 1 PBF (callgrind of one solver alone) */
 int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsigned solvers, uint32_t pbf_steps,
-                   uint32_t pbf_iters)
+                   uint32_t pbf_iters, float pbf_relax)
 {
     const float tmin[3] = {-1.65f, 0.f, -1.25f}, tmax[3] = {1.65f, 1.4f, 1.25f};
     const float fmin[3] = {-1.6f, 0.02f, -1.2f}, fmax[3] = {1.6f, 0.34f, 1.2f};
@@ -39,7 +39,8 @@ int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsign
     for (int m = 0; m < 2; ++m) {
         rt_sph_desc d = {.spacing = dx, .max_substeps = 64, .sound_speed = 25.f, .threads = threads,
                           .solver = m ? RT_SPH_SOLVER_PBF : RT_SPH_SOLVER_WCSPH,
-                          .pbf_iterations = pbf_iters, .pbf_max_step = pbf_steps ? 1.f / (60.f * pbf_steps) : 0.f};
+                          .pbf_iterations = pbf_iters, .pbf_max_step = pbf_steps ? 1.f / (60.f * pbf_steps) : 0.f,
+                          .pbf_relaxation = pbf_relax};
         memcpy(d.domain_min, tmin, sizeof tmin);
         memcpy(d.domain_max, tmax, sizeof tmax);
         char err[256];

@@ -108,7 +108,7 @@ typedef struct rt_scene_water {
     float paddle_amplitude;          /* metres */
     float paddle_period_s;
     bool no_slip;                    /* tank walls (all six faces) with wall-law friction */
-    uint32_t solver;                 /* water.simulation.solver: 0 "wcsph", 1 "pbf" (rt_sph_solver) */
+    uint32_t solver;                 /* water.simulation.solver: 0 "wcsph", 1 "pbf" (rt_sph_solver); "pbf" */
     /* rendering (seed 000), a full vfx_water_params with size/version filled */
     vfx_water_params params;
     /* water.quality.kernel (vfx_water_params2.kernel): anisotropic for method TILE unless the

@@ -115,6 +115,7 @@ static vfx_result parse_water_simulation(pctx *c, const cJSON *v, rt_scene_water
     if (!r) r = rt_scene_get_vec(c, s, PS, "gravity", 3, false, (range){-1000, 1000, false}, w->gravity);
     if (!r) r = rt_scene_get_float(c, s, PS, "dt", false, (range){0, 0.1, true}, &w->dt);
     if (!r) r = rt_scene_get_bool(c, s, PS, "no_slip", &w->no_slip);
+    w->solver = 1; /* "pbf" when the key is absent (issue 22: 5-7x cheaper per frame, calmer at rest) */
     if (!r) r = rt_scene_get_enum(c, s, PS, "solver", false, solvers, &w->solver);
     if (r)
         return r;

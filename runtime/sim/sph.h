@@ -87,11 +87,11 @@ typedef struct rt_sph_desc {
      * rt_sph_step takes ceil(frame_dt / pbf_max_step) steps, more when a particle would move
      * more than pbf_cfl * H in one (up to max_substeps; the frame is always covered). */
     uint32_t solver;            /* rt_sph_solver; WCSPH */
-    uint32_t pbf_iterations;    /* Jacobi iterations per step; 4 */
+    uint32_t pbf_iterations;    /* Jacobi iterations per step; 6 */
     float pbf_max_step;         /* longest step [s]; 1/60 */
     float pbf_cfl;              /* largest move per step as a fraction of H; 0.5 */
     float pbf_relaxation;       /* constraint-force mixing eps, a fraction of the lattice's
-                                 * sum |grad C|^2; 1 */
+                                 * sum |grad C|^2; 0.2 */
     float pbf_scorr_k;          /* artificial pressure k of s_corr = -k (W(r)/W(dq))^4; 0 (off) */
     float pbf_scorr_dq;         /* its dq as a fraction of H; 0.2 */
     float pbf_xsph;             /* XSPH viscosity c; 0.01 */

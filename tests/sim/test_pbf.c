@@ -52,7 +52,8 @@ static void test_pbf_params(void **state)
     rt_sph *s = make(small_box());
     const rt_sph_desc *p = rt_sph_params(s);
     assert_int_equal(p->solver, RT_SPH_SOLVER_PBF);
-    assert_int_equal(p->pbf_iterations, 4);
+    assert_int_equal(p->pbf_iterations, 6);
+    assert_true(fabsf(p->pbf_relaxation - 0.2f) < 1e-9f);
     assert_true(fabsf(p->pbf_max_step - 1.f / 60.f) < 1e-9f);
     rt_sph_destroy(s);
     rt_sph_desc bad = small_box();
