@@ -118,6 +118,7 @@ struct rt_sph {
     float pbf_eps, pbf_wdq;      /* constraint-force mixing; (H^2 - dq^2)^3 of s_corr */
     float pbf_vmax;              /* largest speed after the last step */
     float pbf_dt;                /* the step being taken */
+    uint32_t pbf_iter;           /* the Jacobi iteration being run (0: the walls are evaluated) */
     float *pc[3], *pn[3];        /* positions of the current and the next Jacobi iterate */
 };
 
