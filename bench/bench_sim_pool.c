@@ -16,6 +16,13 @@
 int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsigned solvers, uint32_t pbf_steps,
                    uint32_t pbf_iters, float pbf_relax);
 
+static double wall_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec * 1e3 + 1e-6 * (double)t.tv_nsec;
+}
+
 static double cpu_ms(void)
 {
     struct timespec t;
@@ -61,21 +68,25 @@ int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsign
             return 1;
     }
     double *ms[2] = {calloc((size_t)frames, sizeof(double)), calloc((size_t)frames, sizeof(double))};
+    /* wall time too: the profiler's `cpu ms: vfx.sim.sph`, which the issue's goals quote, is the
+     * system's wall time on the frame thread (both workers busy inside it) */
+    double *wms[2] = {calloc((size_t)frames, sizeof(double)), calloc((size_t)frames, sizeof(double))};
     float vmax[2] = {0, 0}, vlast[2] = {0, 0};
     double err_sum[2] = {0, 0};
     uint32_t steps[2] = {0, 0}, iters[2] = {0, 0};
-    for (int f = 0; f < frames && ms[0] && ms[1]; ++f)
+    for (int f = 0; f < frames && ms[0] && ms[1] && wms[0] && wms[1]; ++f)
         for (int m = 0; m < 2; ++m) {
             if (!(solvers >> m & 1u))
                 continue;
             rt_sph_report r;
             char err[256];
-            double t0 = cpu_ms();
+            double t0 = cpu_ms(), w0 = wall_ms();
             if (rt_sph_step(s[m], 1.f / 60.f, &r, err, sizeof err)) {
                 fprintf(stderr, "volfx-bench sim --pool: %s\n", err);
                 return 1;
             }
             ms[m][f] = cpu_ms() - t0;
+            wms[m][f] = wall_ms() - w0;
             vlast[m] = r.max_speed;
             if (f >= 1 && r.max_speed > vmax[m])
                 vmax[m] = r.max_speed;
@@ -88,14 +99,14 @@ int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsign
             continue;
         med[m] = rt_median(ms[m], (uint32_t)frames);
         printf("{\"bench\":\"sim_pool\",\"solver\":\"%s\",\"particles\":%u,\"spacing\":%.5f,\"paddle\":%s,"
-               "\"frames\":%d,\"threads\":%u,\"cpu_ms_per_frame_median\":%.3f,\"steps_per_frame\":%.2f,"
+               "\"frames\":%d,\"threads\":%u,\"cpu_ms_per_frame_median\":%.3f,\"wall_ms_per_frame_median\":%.3f,\"steps_per_frame\":%.2f,"
                "\"iterations_per_frame\":%.2f,\"max_speed_frames_2_on\":%.4f,\"max_speed_last\":%.4f,\"mean_compression\":%.5f}\n",
                m ? "pbf" : "wcsph", added[m], dx, paddle ? "true" : "false", frames, rt_sph_thread_count(s[m]),
-               med[m], (double)steps[m] / frames, (double)iters[m] / frames, vmax[m], vlast[m], err_sum[m] / frames);
+               med[m], rt_median(wms[m], (uint32_t)frames), (double)steps[m] / frames, (double)iters[m] / frames, vmax[m], vlast[m], err_sum[m] / frames);
     }
     if (solvers == 3u)
         printf("{\"bench\":\"sim_pool\",\"wcsph_over_pbf_cpu\":%.2f}\n", med[0] / med[1]);
-    free(ms[0]), free(ms[1]);
+    free(ms[0]), free(ms[1]), free(wms[0]), free(wms[1]);
     rt_sph_destroy(s[0]), rt_sph_destroy(s[1]);
     return 0;
 }
