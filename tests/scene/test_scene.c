@@ -156,6 +156,17 @@ static void test_defaults(void **state)
         assert_int_equal(s->water.kernel, kcases[k].kernel);
         rt_scene_free(s);
     }
+    /* water.simulation.solver: "pbf" when absent (issue 22), "wcsph" when asked for */
+    static const char *const solver_cases[] = {"", ",\"solver\":\"wcsph\"", ",\"solver\":\"pbf\""};
+    for (int k = 0; k < 3; ++k) {
+        char json[512];
+        snprintf(json, sizeof json, "{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],"
+                 "\"max\":[1,1,1]},\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10%s}}}",
+                 solver_cases[k]);
+        assert_int_equal(load(json, &log, &s, err, sizeof err), VFX_OK);
+        assert_int_equal(s->water.solver, k == 1 ? 0u : 1u); /* rt_sph_solver: 0 WCSPH, 1 PBF */
+        rt_scene_free(s);
+    }
     /* beam defaults: only head and dir given */
     assert_int_equal(load("{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0]}]}", &log, &s, err, sizeof err), VFX_OK);
     assert_close(s->beams[0].base.radius, 0.5);
