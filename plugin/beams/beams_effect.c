@@ -7,12 +7,12 @@
 #include <string.h>
 
 #include "beams/beam_field.h"
+#include "beams/beams_bin.h"
 #include "gpu/gpu.h"
 #include "gpu/pass.h"
 #include "effect.h"
 #include "param_ranges.h"
 
-#define TILE_PX 16
 #define MAX_BEAMS (1u << 20)
 #define MAX_BLOOM_LEVELS 8
 
@@ -24,7 +24,6 @@ typedef struct beam_gpu {
 
 /* std140, mirrors BeamsFrame in shaders/beams/frame.glsl */
 typedef struct beams_block {
-    float inv_rot_view_proj[16];
     float far, c;
     int32_t tile_px, tiles_x, samples, has_water, smooth_saturation, bloom;
     float bloom_gain, _pad[3];
@@ -49,7 +48,7 @@ typedef struct beams_state {
     uint32_t bloom_w[MAX_BLOOM_LEVELS + 1], bloom_h[MAX_BLOOM_LEVELS + 1];
     uint32_t bloom_levels;                /* allocated levels */
     volfx_ubo ubo;
-    uint32_t width, height, tiles_x, tiles_y;
+    volfx_beams_grid grid;                /* the target in pixels and tiles */
     vfx_beams_view2 view;                 /* the host's answer; v1 answers padded with defaults */
     double time;
     volfx_beam_d *beams;        /* validated, normalised */
@@ -59,7 +58,7 @@ typedef struct beams_state {
     bool *visible;            /* per beam: on screen this frame */
     uint32_t count, capacity;
     uint32_t *ranges, *list;  /* 2 per tile; tile lists */
-    uint32_t list_capacity;
+    uint32_t list_capacity, pairs;  /* list entries allocated, used this frame */
 } beams_state;
 
 /* Asks the host for its view, offering version 2; a version 1 answer leaves the rest zero. */
@@ -161,7 +160,7 @@ static vfx_result make_bloom(vfx_context *ctx, beams_state *s, uint32_t levels)
 {
     free_bloom(s);
     for (uint32_t i = 1; i <= levels; ++i) {
-        uint32_t w = s->width >> i, h = s->height >> i;
+        uint32_t w = s->grid.width >> i, h = s->grid.height >> i;
         s->bloom_w[i] = w ? w : 1, s->bloom_h[i] = h ? h : 1;
         s->bloom_tex[i] = make_target(GL_RGBA16F, s->bloom_w[i], s->bloom_h[i], true, "beams.bloom");
         glCreateFramebuffers(1, &s->bloom_fbo[i]);
@@ -189,11 +188,9 @@ static vfx_result beams_resize(vfx_context *ctx, void *state, uint32_t w, uint32
     glNamedFramebufferDrawBuffers(s->acc_fbo, 2, bufs);
     if (glCheckNamedFramebufferStatus(s->acc_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
         return volfx_fail(ctx, VFX_ERR_GL, "beams: H target %ux%u incomplete", w, h);
-    s->width = w, s->height = h;
-    s->tiles_x = (w + TILE_PX - 1) / TILE_PX;
-    s->tiles_y = (h + TILE_PX - 1) / TILE_PX;
+    s->grid = volfx_beams_grid_of(w, h);
     volfx_free(ctx, s->ranges);
-    s->ranges = volfx_alloc(ctx, (size_t)s->tiles_x * s->tiles_y * 2 * sizeof(uint32_t));
+    s->ranges = volfx_alloc(ctx, (size_t)s->grid.tiles_x * s->grid.tiles_y * 2 * sizeof(uint32_t));
     return s->ranges ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
 }
 
@@ -294,36 +291,6 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
     return VFX_OK;
 }
 
-/* Screen rectangle (in tiles) a beam can touch: its bounding sphere's box projected; the whole
- * screen when the sphere reaches the near side of the eye. Conservative, never misses a pixel. */
-static bool beam_tiles(const beams_state *s, const float vp_rot[16], const double rel_c[3],
-                       double rad, uint32_t rect[4])
-{
-    double minx = 1e30, miny = 1e30, maxx = -1e30, maxy = -1e30;
-    for (int k = 0; k < 8; ++k) {
-        double p[3] = {rel_c[0] + (k & 1 ? rad : -rad), rel_c[1] + (k & 2 ? rad : -rad),
-                       rel_c[2] + (k & 4 ? rad : -rad)};
-        double cl[4];
-        for (int r = 0; r < 4; ++r)
-            cl[r] = vp_rot[r] * p[0] + vp_rot[4 + r] * p[1] + vp_rot[8 + r] * p[2] + vp_rot[12 + r];
-        if (!(cl[3] > 1e-6)) { /* behind or at the eye: cover everything */
-            rect[0] = 0, rect[1] = 0, rect[2] = s->tiles_x - 1, rect[3] = s->tiles_y - 1;
-            return true;
-        }
-        double x = cl[0] / cl[3], y = cl[1] / cl[3];
-        minx = fmin(minx, x), maxx = fmax(maxx, x), miny = fmin(miny, y), maxy = fmax(maxy, y);
-    }
-    if (maxx < -1 || minx > 1 || maxy < -1 || miny > 1)
-        return false;
-    double px0 = (fmax(minx, -1) * 0.5 + 0.5) * s->width, px1 = (fmin(maxx, 1) * 0.5 + 0.5) * s->width;
-    double py0 = (fmax(miny, -1) * 0.5 + 0.5) * s->height, py1 = (fmin(maxy, 1) * 0.5 + 0.5) * s->height;
-    rect[0] = (uint32_t)fmin(floor(px0 / TILE_PX), s->tiles_x - 1);
-    rect[2] = (uint32_t)fmin(floor(px1 / TILE_PX), s->tiles_x - 1);
-    rect[1] = (uint32_t)fmin(floor(py0 / TILE_PX), s->tiles_y - 1);
-    rect[3] = (uint32_t)fmin(floor(py1 / TILE_PX), s->tiles_y - 1);
-    return true;
-}
-
 static vfx_result upload(vfx_context *ctx, GLuint buf, size_t *cap, const void *data, size_t bytes)
 {
     if (bytes == 0)
@@ -338,96 +305,74 @@ static vfx_result upload(vfx_context *ctx, GLuint buf, size_t *cap, const void *
     return e ? volfx_fail(ctx, VFX_ERR_GL, "beams: buffer upload of %zu bytes: %s", bytes, e) : VFX_OK;
 }
 
-static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
-                               volfx_frame_targets *targets)
+/* Beam i as the integrate pass reads it (camera-relative: heads are M - eye in double, so a
+ * beam a million units away keeps float32 digits), and the sphere bounding it (centre relative
+ * to the eye, radius). A polyline's joints go into joint_xyz. */
+static void pack_beam(beams_state *s, uint32_t i, const double eye[3], float c, double centre[3], double *bound)
 {
-    beams_state *s = state;
-    /* Camera-relative frame: the eye is the origin and heads are M - eye in double, so a beam
-     * a million units away keeps float32 digits. */
-    float view_rot[16], vp_rot[16], inv[16];
-    memcpy(view_rot, frame->view, sizeof view_rot);
-    view_rot[12] = view_rot[13] = view_rot[14] = 0.f;
-    volfx_mat4_mul(frame->proj, view_rot, vp_rot);
-    if (!volfx_mat4_invert(vp_rot, inv))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: camera rotation*projection is singular");
-    /* eye = -R^T t from the view matrix (robust even when frame->eye is not filled) */
-    double eye[3];
-    for (int k = 0; k < 3; ++k)
-        eye[k] = -((double)frame->view[k * 4 + 0] * frame->view[12] + (double)frame->view[k * 4 + 1] * frame->view[13]
-                   + (double)frame->view[k * 4 + 2] * frame->view[14]);
-    float c = s->view.v1.saturate_c > 0 ? s->view.v1.saturate_c : 1.f;
-    uint32_t ntiles = s->tiles_x * s->tiles_y;
-    uint32_t (*rects)[4] = s->rects; /* sized with the beams in update: no per-frame allocation */
-    bool *visible = s->visible;
-    memset(s->ranges, 0, (size_t)ntiles * 2 * sizeof(uint32_t));
-    uint64_t pairs = 0;
+    const volfx_beam_d *b = &s->beams[i];
+    beam_gpu *g = &s->gpu[i];
+    double rel[3], half = 0.5 * b->length;
+    for (int k = 0; k < 3; ++k) {
+        rel[k] = b->head[k] - eye[k];
+        centre[k] = rel[k] + 0.5 * b->length * b->dir[k];
+        g->m_l[k] = (float)rel[k];
+        g->d_r[k] = (float)b->dir[k];
+    }
+    uint32_t jfirst = s->joint_used;
+    if (b->joint_count >= 2) {
+        /* joints camera-relative like the head; the bounding sphere of their box stands in
+         * for (M, D, L) where only bounds are used (culling, the marching chord) */
+        double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+        for (int j = 0; j < b->joint_count; ++j) {
+            float *out = s->joint_xyz[s->joint_used++];
+            for (int k = 0; k < 3; ++k) {
+                double x = b->joints[j][k] - eye[k];
+                out[k] = (float)x;
+                lo[k] = fmin(lo[k], x), hi[k] = fmax(hi[k], x);
+            }
+            out[3] = 0.f;
+        }
+        half = 0;
+        for (int k = 0; k < 3; ++k) {
+            centre[k] = 0.5 * (lo[k] + hi[k]);
+            half += 0.25 * (hi[k] - lo[k]) * (hi[k] - lo[k]);
+        }
+        half = sqrt(half);
+        for (int k = 0; k < 3; ++k)
+            g->m_l[k] = (float)(centre[k] - (k == 0 ? half : 0.0)), g->d_r[k] = k == 0 ? 1.f : 0.f;
+    }
+    g->m_l[3] = (float)(2.0 * half), g->d_r[3] = (float)b->radius;
+    const beam_look *lk = &s->looks[i];
+    float gain = exp2f(lk->exposure), wavelength = lk->flow_scale > 0 ? lk->flow_scale : 2.f * (float)b->radius;
+    g->ab_eps[0] = (float)b->a, g->ab_eps[1] = (float)b->b, g->ab_eps[2] = (float)b->eps;
+    g->ab_eps[3] = 1.f / wavelength;
+    g->look[0] = lk->intensity;
+    g->look[1] = gain / c;
+    g->look[2] = lk->flow_amount;
+    /* the phase wraps at 2^12 wavelengths so float32 keeps its fraction after hours */
+    g->look[3] = (float)fmod(s->time * lk->flow_speed / wavelength, 4096.0);
+    g->mode[0] = (uint32_t)b->smooth, g->mode[1] = lk->thesis;
+    g->mode[2] = jfirst, g->mode[3] = (uint32_t)b->joint_count;
+    /* the thesis ramp tints with colour x intensity x 2^exposure (the v1 colour for v1 beams) */
+    for (int k = 0; k < 4; ++k)
+        g->color[k] = lk->color[k] * (lk->thesis && k < 3 ? lk->intensity * gain : 1.f);
+    *bound = half + b->radius;
+}
+
+/* The CPU half of a frame: every beam packed for the GPU and binned to the screen tiles it can
+ * touch (beams_bin.h), with the frame gate's eye and camera-relative view-projection; stats. */
+static vfx_result bin_beams(vfx_context *ctx, beams_state *s, const volfx_frame_targets *t, float c)
+{
     s->joint_used = 0;
     for (uint32_t i = 0; i < s->count; ++i) {
-        const volfx_beam_d *b = &s->beams[i];
-        beam_gpu *g = &s->gpu[i];
-        double rel[3], centre[3], half = 0.5 * b->length;
-        for (int k = 0; k < 3; ++k) {
-            rel[k] = b->head[k] - eye[k];
-            centre[k] = rel[k] + 0.5 * b->length * b->dir[k];
-            g->m_l[k] = (float)rel[k];
-            g->d_r[k] = (float)b->dir[k];
-        }
-        uint32_t jfirst = s->joint_used;
-        if (b->joint_count >= 2) {
-            /* joints camera-relative like the head; the bounding sphere of their box stands in
-             * for (M, D, L) where only bounds are used (culling, the marching chord) */
-            double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-            for (int j = 0; j < b->joint_count; ++j) {
-                float *out = s->joint_xyz[s->joint_used++];
-                for (int k = 0; k < 3; ++k) {
-                    double x = b->joints[j][k] - eye[k];
-                    out[k] = (float)x;
-                    lo[k] = fmin(lo[k], x), hi[k] = fmax(hi[k], x);
-                }
-                out[3] = 0.f;
-            }
-            half = 0;
-            for (int k = 0; k < 3; ++k) {
-                centre[k] = 0.5 * (lo[k] + hi[k]);
-                half += 0.25 * (hi[k] - lo[k]) * (hi[k] - lo[k]);
-            }
-            half = sqrt(half);
-            for (int k = 0; k < 3; ++k)
-                g->m_l[k] = (float)(centre[k] - (k == 0 ? half : 0.0)), g->d_r[k] = k == 0 ? 1.f : 0.f;
-        }
-        g->m_l[3] = (float)(2.0 * half), g->d_r[3] = (float)b->radius;
-        const beam_look *lk = &s->looks[i];
-        float gain = exp2f(lk->exposure), wavelength = lk->flow_scale > 0 ? lk->flow_scale : 2.f * (float)b->radius;
-        g->ab_eps[0] = (float)b->a, g->ab_eps[1] = (float)b->b, g->ab_eps[2] = (float)b->eps;
-        g->ab_eps[3] = 1.f / wavelength;
-        g->look[0] = lk->intensity;
-        g->look[1] = gain / c;
-        g->look[2] = lk->flow_amount;
-        /* the phase wraps at 2^12 wavelengths so float32 keeps its fraction after hours */
-        g->look[3] = (float)fmod(s->time * lk->flow_speed / wavelength, 4096.0);
-        g->mode[0] = (uint32_t)b->smooth, g->mode[1] = lk->thesis;
-        g->mode[2] = jfirst, g->mode[3] = (uint32_t)b->joint_count;
-        /* the thesis ramp tints with colour x intensity x 2^exposure (the v1 colour for v1 beams) */
-        for (int k = 0; k < 4; ++k)
-            g->color[k] = lk->color[k] * (lk->thesis && k < 3 ? lk->intensity * gain : 1.f);
-        visible[i] = beam_tiles(s, vp_rot, centre, half + b->radius, rects[i]);
-        if (!visible[i])
-            continue;
-        for (uint32_t ty = rects[i][1]; ty <= rects[i][3]; ++ty)
-            for (uint32_t tx = rects[i][0]; tx <= rects[i][2]; ++tx)
-                s->ranges[2 * (ty * s->tiles_x + tx) + 1]++;
-        pairs += (uint64_t)(rects[i][2] - rects[i][0] + 1) * (rects[i][3] - rects[i][1] + 1);
+        double centre[3], bound;
+        pack_beam(s, i, t->view_eye, c, centre, &bound);
+        s->visible[i] = volfx_beams_bin_rect(&s->grid, t->cam_view_proj, centre, bound, s->rects[i]);
     }
-    if (pairs > UINT32_MAX / 2) {
+    uint64_t pairs = volfx_beams_bin_pairs((const uint32_t(*)[4])s->rects, s->visible, s->count);
+    if (pairs > UINT32_MAX / 2)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: %llu beam-tile pairs", (unsigned long long)pairs);
-    }
-    uint32_t offset = 0, empty = 0;
-    for (uint32_t t = 0; t < ntiles; ++t) {
-        s->ranges[2 * t] = offset;
-        offset += s->ranges[2 * t + 1];
-        empty += s->ranges[2 * t + 1] == 0;
-        s->ranges[2 * t + 1] = 0; /* refilled below as a cursor */
-    }
     if (pairs > s->list_capacity) {
         volfx_free(ctx, s->list);
         s->list = volfx_alloc(ctx, pairs * sizeof(uint32_t));
@@ -435,113 +380,137 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
     }
     if (pairs && !s->list)
         return VFX_ERR_OUT_OF_MEMORY;
-    for (uint32_t i = 0; i < s->count; ++i) {
-        if (!visible[i])
-            continue;
-        for (uint32_t ty = rects[i][1]; ty <= rects[i][3]; ++ty)
-            for (uint32_t tx = rects[i][0]; tx <= rects[i][2]; ++tx) {
-                uint32_t t = ty * s->tiles_x + tx;
-                s->list[s->ranges[2 * t] + s->ranges[2 * t + 1]++] = i;
-            }
-    }
+    uint32_t ntiles = s->grid.tiles_x * s->grid.tiles_y;
+    uint32_t empty = volfx_beams_bin_fill(&s->grid, (const uint32_t(*)[4])s->rects, s->visible, s->count,
+                                          s->ranges, s->list);
     volfx_stat_set(ctx, "beams.count", s->count);
     volfx_stat_set(ctx, "beams.tiles", ntiles);
     volfx_stat_set(ctx, "beams.tiles_empty", empty);
     volfx_stat_set(ctx, "beams.pairs", (double)pairs);
     volfx_stat_set(ctx, "beams.pairs_culled", (double)s->count * ntiles - (double)pairs);
-    vfx_result r;
-    if ((r = upload(ctx, s->beam_buf, &s->beam_cap, s->gpu, s->count * sizeof(beam_gpu)))
-        || (r = upload(ctx, s->range_buf, &s->range_cap, s->ranges, (size_t)ntiles * 2 * sizeof(uint32_t)))
-        || (r = upload(ctx, s->list_buf, &s->list_cap, s->list, pairs * sizeof(uint32_t)))
-        || (r = upload(ctx, s->joint_buf, &s->joint_cap, s->joint_xyz, s->joint_used * sizeof s->joint_xyz[0])))
-        return r;
+    s->pairs = (uint32_t)pairs;
+    return VFX_OK;
+}
 
-    bool march = s->view.v1.method == 1, any_smooth = false, any_poly = false;
+/* The integrate program for this frame's beams: code only for what some beam needs. */
+static GLuint integrate_program(vfx_context *ctx, beams_state *s, bool march)
+{
+    bool any_smooth = false, any_poly = false;
     for (uint32_t i = 0; i < s->count; ++i)
         any_smooth |= s->beams[i].smooth != 0, any_poly |= s->beams[i].joint_count >= 2;
     unsigned variant = (unsigned)march | (unsigned)any_smooth << 1 | (unsigned)any_poly << 2;
-    GLuint prog = s->prog_integrate[variant];
-    if (!prog) {
+    if (!s->prog_integrate[variant]) {
         static const char *const defs[8] = {
             NULL, "#define VOLFX_BEAMS_MARCH 1", "#define VOLFX_BEAMS_SMOOTH 1",
             "#define VOLFX_BEAMS_MARCH 1\n#define VOLFX_BEAMS_SMOOTH 1", "#define VOLFX_BEAMS_POLYLINE 1",
             "#define VOLFX_BEAMS_MARCH 1\n#define VOLFX_BEAMS_POLYLINE 1",
             "#define VOLFX_BEAMS_SMOOTH 1\n#define VOLFX_BEAMS_POLYLINE 1",
             "#define VOLFX_BEAMS_MARCH 1\n#define VOLFX_BEAMS_SMOOTH 1\n#define VOLFX_BEAMS_POLYLINE 1"};
-        prog = s->prog_integrate[variant] = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
-                                                              defs[variant]);
-        if (!prog)
-            return VFX_ERR_GL;
+        s->prog_integrate[variant] = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
+                                                       defs[variant]);
     }
+    return s->prog_integrate[variant];
+}
+
+/* down: light -> 1/2 -> ... -> 1/2^levels; up: each level's tent added onto the next larger,
+ * so level 1 ends holding the sum of all levels */
+static void bloom_passes(vfx_context *ctx, beams_state *s, uint32_t levels)
+{
+    for (uint32_t i = 1; i <= levels; ++i) {
+        volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "beams.bloom_down", .framebuffer = s->bloom_fbo[i],
+                                                 .width = s->bloom_w[i], .height = s->bloom_h[i]});
+        glUseProgram(s->prog_down);
+        glBindTextureUnit(0, i == 1 ? s->light_tex : s->bloom_tex[i - 1]);
+        volfx_gpu_fullscreen(ctx);
+        volfx_pass_end(ctx);
+    }
+    for (uint32_t i = levels; i > 1; --i) {
+        volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "beams.bloom_up", .framebuffer = s->bloom_fbo[i - 1],
+                                                 .width = s->bloom_w[i - 1], .height = s->bloom_h[i - 1],
+                                                 .blend = VOLFX_BLEND_ADD});
+        glUseProgram(s->prog_up);
+        glBindTextureUnit(0, s->bloom_tex[i]);
+        volfx_gpu_fullscreen(ctx);
+        volfx_pass_end(ctx);
+    }
+}
+
+/* The GL half of a frame: uploads, the integrate (or march) pass into H and light, the bloom
+ * chain, the composite into the frame gate's framebuffer. The camera comes from the VolfxFrame
+ * block (shaders/common/frame.glsl), bound by the frame gate. */
+static vfx_result gl_passes(vfx_context *ctx, beams_state *s, volfx_frame_targets *t, float c)
+{
+    uint32_t ntiles = s->grid.tiles_x * s->grid.tiles_y;
+    vfx_result r;
+    if ((r = upload(ctx, s->beam_buf, &s->beam_cap, s->gpu, s->count * sizeof(beam_gpu)))
+        || (r = upload(ctx, s->range_buf, &s->range_cap, s->ranges, (size_t)ntiles * 2 * sizeof(uint32_t)))
+        || (r = upload(ctx, s->list_buf, &s->list_cap, s->list, (size_t)s->pairs * sizeof(uint32_t)))
+        || (r = upload(ctx, s->joint_buf, &s->joint_cap, s->joint_xyz, s->joint_used * sizeof s->joint_xyz[0])))
+        return r;
+    bool march = s->view.v1.method == 1;
+    GLuint prog = integrate_program(ctx, s, march);
+    if (!prog)
+        return VFX_ERR_GL;
     /* bloom: on by default for version 2 hosts, off for version 1 ones (their image as it was) */
     bool v2 = s->view.v1.version == VFX_BEAMS_VIEW2_VERSION;
     bool bloom = v2 && s->view.bloom != VFX_BEAMS_BLOOM_OFF;
     uint32_t levels = s->view.bloom_levels ? s->view.bloom_levels : 5;
-    while (levels > 1 && ((s->width >> levels) == 0 || (s->height >> levels) == 0))
+    while (levels > 1 && ((s->grid.width >> levels) == 0 || (s->grid.height >> levels) == 0))
         levels--; /* a tiny target: no level below 1x1 */
     if (bloom && levels != s->bloom_levels && (r = make_bloom(ctx, s, levels)))
         return r;
     float strength = s->view.bloom_strength > 0 ? s->view.bloom_strength : 0.6f;
-    float far = s->view.v1.far_distance > 0 ? s->view.v1.far_distance : frame->far_plane;
+    float far = s->view.v1.far_distance > 0 ? s->view.v1.far_distance : t->far_plane;
     if (!(far > 0))
         far = 1e30f;
-    beams_block blk = {.far = far, .c = c, .tile_px = TILE_PX, .tiles_x = (int32_t)s->tiles_x,
+    beams_block blk = {.far = far, .c = c, .tile_px = VOLFX_BEAMS_TILE_PX, .tiles_x = (int32_t)s->grid.tiles_x,
                        .samples = (int32_t)(s->view.v1.march_samples ? s->view.v1.march_samples : 32),
-                       .has_water = targets->water_dist != 0,
+                       .has_water = t->water_dist != 0,
                        .smooth_saturation = s->view.v1.saturation == VFX_SATURATE_SMOOTH,
                        .bloom = bloom, .bloom_gain = strength / (float)levels};
-    memcpy(blk.inv_rot_view_proj, inv, sizeof inv);
     volfx_ubo_update(&s->ubo, &blk, sizeof blk);
     volfx_ubo_bind(&s->ubo, 3);
 
     volfx_pass_begin(ctx, &(volfx_pass_desc){.name = march ? "beams.march" : "beams.integrate",
-                                             .framebuffer = s->acc_fbo, .width = s->width, .height = s->height});
+                                             .framebuffer = s->acc_fbo, .width = s->grid.width,
+                                             .height = s->grid.height});
     glUseProgram(prog);
-    glBindTextureUnit(0, targets->scene_depth);
-    glBindTextureUnit(1, targets->water_dist);
+    glBindTextureUnit(0, t->scene_depth);
+    glBindTextureUnit(1, t->water_dist);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s->beam_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s->range_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s->list_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->joint_buf);
     volfx_gpu_fullscreen(ctx);
     volfx_pass_end(ctx);
-
-    if (bloom) {
-        /* down: light -> 1/2 -> ... -> 1/2^levels; up: each level's tent added onto the next
-         * larger, so level 1 ends holding the sum of all levels */
-        for (uint32_t i = 1; i <= levels; ++i) {
-            volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "beams.bloom_down", .framebuffer = s->bloom_fbo[i],
-                                                     .width = s->bloom_w[i], .height = s->bloom_h[i]});
-            glUseProgram(s->prog_down);
-            glBindTextureUnit(0, i == 1 ? s->light_tex : s->bloom_tex[i - 1]);
-            volfx_gpu_fullscreen(ctx);
-            volfx_pass_end(ctx);
-        }
-        for (uint32_t i = levels; i > 1; --i) {
-            volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "beams.bloom_up", .framebuffer = s->bloom_fbo[i - 1],
-                                                     .width = s->bloom_w[i - 1], .height = s->bloom_h[i - 1],
-                                                     .blend = VOLFX_BLEND_ADD});
-            glUseProgram(s->prog_up);
-            glBindTextureUnit(0, s->bloom_tex[i]);
-            volfx_gpu_fullscreen(ctx);
-            volfx_pass_end(ctx);
-        }
-    }
+    if (bloom)
+        bloom_passes(ctx, s, levels);
     volfx_stat_set(ctx, "beams.bloom_levels", bloom ? levels : 0);
     glBindTextureUnit(0, s->light_tex);
     glBindTextureUnit(1, bloom ? s->bloom_tex[1] : s->light_tex);
-    volfx_composite(ctx, frame, "beams.composite", s->prog_composite, VOLFX_BLEND_ADD);
+    volfx_composite_targets(ctx, t, "beams.composite", s->prog_composite, VOLFX_BLEND_ADD);
     const char *e = volfx_gpu_error_string();
     return e ? volfx_fail(ctx, VFX_ERR_GL, "beams render: %s", e) : VFX_OK;
+}
+
+/* Reads only the frame gate (targets): CPU binning, then the GL passes. */
+static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
+                               volfx_frame_targets *targets)
+{
+    (void)frame;
+    beams_state *s = state;
+    float c = s->view.v1.saturate_c > 0 ? s->view.v1.saturate_c : 1.f;
+    vfx_result r = bin_beams(ctx, s, targets, c);
+    return r ? r : gl_passes(ctx, s, targets, c);
 }
 
 static vfx_result beams_read_raw(vfx_context *ctx, void *state, float *out, size_t count)
 {
     beams_state *s = state;
-    size_t n = (size_t)s->width * s->height;
+    size_t n = (size_t)s->grid.width * s->grid.height;
     if (count < n)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams read_raw: %zu floats < %zu", count, n);
-    return volfx_gpu_read_top_first(ctx, s->acc_tex, GL_RED, 1, 0, s->width, s->height, out);
+    return volfx_gpu_read_top_first(ctx, s->acc_tex, GL_RED, 1, 0, s->grid.width, s->grid.height, out);
 }
 
 const volfx_effect_ops volfx_beams_ops = {

@@ -1,7 +1,7 @@
-// frame.glsl — the beams' one uniform block, uploaded once per frame (beams_block in
-// plugin/beams/beams_effect.c mirrors it, std140).
+// frame.glsl — the beams' own uniform block, uploaded once per frame (beams_block in
+// plugin/beams/beams_effect.c mirrors it, std140). The camera is not here: it is the frame
+// gate's VolfxFrame block (shaders/common/frame.glsl).
 layout(std140, binding = 3) uniform BeamsFrame {
-    mat4 u_inv_rot_view_proj; // inverse(proj * view without translation): eye at 0
     float u_far;              // integrate to here where no surface
     float u_c;                // saturate_c
     int u_tile_px;

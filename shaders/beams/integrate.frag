@@ -6,6 +6,7 @@
 layout(std430, binding = 4) readonly buffer Joints { vec4 joints[]; }; // xyz relative to the eye
 vec3 volfx_joint(uint i) { return joints[i].xyz; }
 #include "beams/beam_field.glsl"
+#include "common/frame.glsl"
 #include "beams/frame.glsl"
 
 in vec2 v_ndc;
@@ -75,12 +76,12 @@ float volfx_poly_nearest_u(uint first, int nj, vec3 V)
 void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    vec4 p = u_inv_rot_view_proj * vec4(v_ndc, 0.0, 1.0);
+    vec4 p = vfx_inv_cam_view_proj * vec4(v_ndc, 0.0, 1.0);
     vec3 V = normalize(p.xyz / p.w);
     float tmax = u_far;
     float depth = texelFetch(u_scene_depth, px, 0).r;
     if (depth < 1.0) {
-        vec4 s = u_inv_rot_view_proj * vec4(v_ndc, depth * 2.0 - 1.0, 1.0);
+        vec4 s = vfx_inv_cam_view_proj * vec4(v_ndc, depth * 2.0 - 1.0, 1.0);
         tmax = min(tmax, length(s.xyz / s.w));
     }
     if (u_has_water != 0) {
