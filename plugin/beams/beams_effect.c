@@ -15,6 +15,7 @@
 
 #define MAX_BEAMS (1u << 20)
 #define MAX_BLOOM_LEVELS 8
+_Static_assert(VOLFX_BEAMS_BIN_MAX_POINTS >= VOLFX_BEAM_MAX_JOINTS, "a polyline fits a capsule");
 
 /* std430, mirrors struct Beam in shaders/beams/integrate.frag */
 typedef struct beam_gpu {
@@ -55,6 +56,8 @@ typedef struct beams_state {
     beam_look *looks;
     beam_gpu *gpu;
     uint32_t (*rects)[4];     /* per beam: its tile rectangle this frame */
+    volfx_beams_capsule *caps; /* per beam: its support for the per-tile test */
+    float (*cones)[4];        /* per tile: its cone of pixel rays this frame */
     bool *visible;            /* per beam: on screen this frame */
     uint32_t count, capacity;
     uint32_t *ranges, *list;  /* 2 per tile; tile lists */
@@ -97,6 +100,7 @@ static void free_per_beam(vfx_context *ctx, beams_state *s)
     volfx_free(ctx, s->joint_xyz);
     volfx_free(ctx, s->gpu);
     volfx_free(ctx, s->rects);
+    volfx_free(ctx, s->caps);
     volfx_free(ctx, s->visible);
 }
 
@@ -114,6 +118,7 @@ static void beams_destroy(vfx_context *ctx, void *state)
     volfx_ubo_destroy(&s->ubo);
     free_per_beam(ctx, s);
     volfx_free(ctx, s->ranges);
+    volfx_free(ctx, s->cones);
     volfx_free(ctx, s->list);
     volfx_free(ctx, s); /* programs belong to the shared cache */
 }
@@ -191,7 +196,9 @@ static vfx_result beams_resize(vfx_context *ctx, void *state, uint32_t w, uint32
     s->grid = volfx_beams_grid_of(w, h);
     volfx_free(ctx, s->ranges);
     s->ranges = volfx_alloc(ctx, (size_t)s->grid.tiles_x * s->grid.tiles_y * 2 * sizeof(uint32_t));
-    return s->ranges ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
+    volfx_free(ctx, s->cones);
+    s->cones = volfx_alloc(ctx, (size_t)s->grid.tiles_x * s->grid.tiles_y * sizeof *s->cones);
+    return s->ranges && s->cones ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
 }
 
 /* The look of a version 2 beam, checked; a version 1 beam gets version 1's look. */
@@ -252,8 +259,9 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
         s->joint_xyz = volfx_alloc(ctx, (size_t)n * VOLFX_BEAM_MAX_JOINTS * sizeof *s->joint_xyz);
         s->gpu = volfx_alloc(ctx, n * sizeof *s->gpu);
         s->rects = volfx_alloc(ctx, n * sizeof *s->rects);
+        s->caps = volfx_alloc(ctx, n * sizeof *s->caps);
         s->visible = volfx_alloc(ctx, n * sizeof *s->visible);
-        s->capacity = (s->beams && s->looks && s->joint_xyz && s->gpu && s->rects && s->visible) ? n : 0;
+        s->capacity = (s->beams && s->looks && s->joint_xyz && s->gpu && s->rects && s->caps && s->visible) ? n : 0;
         if (!s->capacity)
             return VFX_ERR_OUT_OF_MEMORY;
     }
@@ -343,6 +351,13 @@ static void pack_beam(beams_state *s, uint32_t i, const double eye[3], float c, 
             g->m_l[k] = (float)(centre[k] - (k == 0 ? half : 0.0)), g->d_r[k] = k == 0 ? 1.f : 0.f;
     }
     g->m_l[3] = (float)(2.0 * half), g->d_r[3] = (float)b->radius;
+    volfx_beams_capsule *cap = &s->caps[i]; /* the support: within R of the axis or polyline */
+    cap->r = b->radius;
+    cap->n = b->joint_count >= 2 ? (uint32_t)b->joint_count : 2;
+    for (uint32_t j = 0; j < cap->n; ++j)
+        for (int k = 0; k < 3; ++k)
+            cap->p[j][k] = b->joint_count >= 2 ? b->joints[j][k] - eye[k]
+                                               : rel[k] + (j ? b->length * b->dir[k] : 0.0);
     const beam_look *lk = &s->looks[i];
     float gain = exp2f(lk->exposure), wavelength = lk->flow_scale > 0 ? lk->flow_scale : 2.f * (float)b->radius;
     g->ab_eps[0] = (float)b->a, g->ab_eps[1] = (float)b->b, g->ab_eps[2] = (float)b->eps;
@@ -370,24 +385,36 @@ static vfx_result bin_beams(vfx_context *ctx, beams_state *s, const volfx_frame_
         pack_beam(s, i, t->view_eye, c, centre, &bound);
         s->visible[i] = volfx_beams_bin_rect(&s->grid, t->cam_view_proj, centre, bound, s->rects[i]);
     }
-    uint64_t pairs = volfx_beams_bin_pairs((const uint32_t(*)[4])s->rects, s->visible, s->count);
-    if (pairs > UINT32_MAX / 2)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: %llu beam-tile pairs", (unsigned long long)pairs);
-    if (pairs > s->list_capacity) {
+    uint64_t bound = volfx_beams_bin_pairs((const uint32_t(*)[4])s->rects, s->visible, s->count);
+    if (bound > UINT32_MAX / 2)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: %llu beam-tile pairs", (unsigned long long)bound);
+    if (bound > s->list_capacity) {
         volfx_free(ctx, s->list);
-        s->list = volfx_alloc(ctx, pairs * sizeof(uint32_t));
-        s->list_capacity = s->list ? (uint32_t)pairs : 0;
+        s->list = volfx_alloc(ctx, bound * sizeof(uint32_t));
+        s->list_capacity = s->list ? (uint32_t)bound : 0;
     }
-    if (pairs && !s->list)
+    if (bound && !s->list)
         return VFX_ERR_OUT_OF_MEMORY;
     uint32_t ntiles = s->grid.tiles_x * s->grid.tiles_y;
-    uint32_t empty = volfx_beams_bin_fill(&s->grid, (const uint32_t(*)[4])s->rects, s->visible, s->count,
-                                          s->ranges, s->list);
+    volfx_beams_grid_cones(&s->grid, t->inv_cam_view_proj, s->cones);
+    uint64_t pairs = 0;
+    uint32_t empty = volfx_beams_bin_fill(&s->grid, (const uint32_t(*)[4])s->rects, s->visible, s->count, s->caps,
+                                          (const float(*)[4])s->cones, s->ranges, s->list, &pairs);
+    /* pixels x beams the integrate pass evaluates (edge tiles hold fewer pixels) */
+    double pixel_pairs = 0;
+    for (uint32_t k = 0; k < ntiles; ++k) {
+        uint32_t tx = k % s->grid.tiles_x, ty = k / s->grid.tiles_x;
+        uint32_t w = s->grid.width - tx * VOLFX_BEAMS_TILE_PX, h = s->grid.height - ty * VOLFX_BEAMS_TILE_PX;
+        pixel_pairs += (double)s->ranges[2 * k + 1] * (w < VOLFX_BEAMS_TILE_PX ? w : VOLFX_BEAMS_TILE_PX)
+                       * (h < VOLFX_BEAMS_TILE_PX ? h : VOLFX_BEAMS_TILE_PX);
+    }
     volfx_stat_set(ctx, "beams.count", s->count);
     volfx_stat_set(ctx, "beams.tiles", ntiles);
     volfx_stat_set(ctx, "beams.tiles_empty", empty);
     volfx_stat_set(ctx, "beams.pairs", (double)pairs);
     volfx_stat_set(ctx, "beams.pairs_culled", (double)s->count * ntiles - (double)pairs);
+    volfx_stat_set(ctx, "beams.pairs_rect", (double)bound);
+    volfx_stat_set(ctx, "beams.pixel_pairs", pixel_pairs);
     s->pairs = (uint32_t)pairs;
     return VFX_OK;
 }

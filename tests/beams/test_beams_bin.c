@@ -2,6 +2,11 @@
  *  - conservative: for seeded random spheres before a perspective camera, every one of 64
  *    points on and in the sphere that projects on screen lands in a tile of the rectangle
  *    (projected in double here, independently of the binning's box-corner bound);
+ *  - the per-tile capsule test: for seeded random beams (segments, radii) and every tile of a
+ *    640x360 camera, 16 random pixel rays of the tile (the shader's: NDC of the pixel centre
+ *    unprojected) against 400 points along the segment (distance in double); any ray within
+ *    the radius of a point needs the test to say "touches"; and the test must cull (a test that
+ *    always says yes would pass the first check);
  *  - the lists: for every tile, exactly the beams whose rectangle holds it, in increasing order,
  *    and the empty-tile count, against a per-tile scan of all rectangles.
  * Exact integer checks: no tolerance. */
@@ -14,6 +19,7 @@
 #include <cmocka.h>
 
 #include "beams/beams_bin.h"
+#include "context.h"
 
 static double rnd(uint64_t *st)
 {
@@ -75,6 +81,59 @@ static void test_rect_conservative(void **st)
     assert_true(visible > 500 && checked > 10000); /* the test saw enough on-screen spheres */
 }
 
+static void test_capsule_conservative(void **st)
+{
+    (void)st;
+    volfx_beams_grid g = volfx_beams_grid_of(640, 360);
+    float m[16], inv[16], (*cones)[4] = calloc((size_t)g.tiles_x * g.tiles_y, sizeof *cones);
+    camera(m, 640.0 / 360.0, -0.2);
+    assert_true(volfx_mat4_invert(m, inv)); /* the test camera's inverse (plugin/context.c) */
+    volfx_beams_grid_cones(&g, inv, cones);
+    uint64_t seed = 5;
+    long touching = 0, culled = 0;
+    for (int it = 0; it < 12; ++it) {
+        /* straight beams (2 points) and polylines of 3 and 4 joints */
+        volfx_beams_capsule c = {.r = 0.05 + 1.5 * rnd(&seed), .n = 2 + (uint32_t)(it % 3)};
+        for (uint32_t j = 0; j < c.n; ++j) {
+            for (int k = 0; k < 3; ++k)
+                c.p[j][k] = 24 * rnd(&seed) - 12;
+            c.p[j][2] -= 14; /* mostly in front (the camera looks down -z, yawed) */
+        }
+        for (uint32_t t = 0; t < g.tiles_x * g.tiles_y; ++t) {
+            bool says = volfx_beams_capsule_touches(&c, cones[t]);
+            culled += !says;
+            bool near = false;
+            for (int r = 0; r < 16 && !near; ++r) {
+                double px = (t % g.tiles_x) * VOLFX_BEAMS_TILE_PX + floor(16 * rnd(&seed)) + 0.5;
+                double py = (t / g.tiles_x) * VOLFX_BEAMS_TILE_PX + floor(16 * rnd(&seed)) + 0.5;
+                double nx = 2 * px / g.width - 1, ny = 2 * py / g.height - 1, h[4], v[3], n = 0;
+                for (int k = 0; k < 4; ++k)
+                    h[k] = inv[k] * nx + inv[4 + k] * ny + inv[12 + k];
+                for (int k = 0; k < 3; ++k)
+                    v[k] = h[k] / h[3], n += v[k] * v[k];
+                for (int k = 0; k < 3; ++k)
+                    v[k] /= sqrt(n);
+                for (int j = 0; j <= 400 * (int)(c.n - 1) && !near; ++j) {
+                    double p[3], d2 = 0, tp = 0, u = j / 400.0;
+                    int sgi = (int)u < (int)c.n - 1 ? (int)u : (int)c.n - 2;
+                    for (int k = 0; k < 3; ++k)
+                        p[k] = c.p[sgi][k] + (c.p[sgi + 1][k] - c.p[sgi][k]) * (u - sgi), tp += p[k] * v[k];
+                    tp = fmax(tp, 0.0);
+                    for (int k = 0; k < 3; ++k)
+                        d2 += (p[k] - tp * v[k]) * (p[k] - tp * v[k]);
+                    near = d2 < c.r * c.r;
+                }
+            }
+            touching += near;
+            if (near && !says)
+                fail_msg("capsule %d tile %u: a pixel ray passes within r, the test culled it", it, t);
+        }
+    }
+    assert_true(touching > 100);
+    assert_true(culled > 2000); /* it culls: 12 beams x 920 tiles, most tiles far from a beam */
+    free(cones);
+}
+
 static void test_lists_brute_force(void **st)
 {
     (void)st;
@@ -92,7 +151,9 @@ static void test_lists_brute_force(void **st)
     }
     uint64_t pairs = volfx_beams_bin_pairs((const uint32_t(*)[4])rects, vis, N);
     uint32_t ntiles = g.tiles_x * g.tiles_y, *ranges = calloc(2 * (size_t)ntiles, 4), *list = calloc(pairs + 1, 4);
-    uint32_t empty = volfx_beams_bin_fill(&g, (const uint32_t(*)[4])rects, vis, N, ranges, list);
+    uint64_t written = 0;
+    uint32_t empty = volfx_beams_bin_fill(&g, (const uint32_t(*)[4])rects, vis, N, NULL, NULL, ranges, list, &written);
+    assert_int_equal(written, pairs);
     uint32_t want_empty = 0;
     uint64_t total = 0;
     for (uint32_t ty = 0; ty < g.tiles_y; ++ty)
@@ -118,6 +179,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_rect_conservative),
+        cmocka_unit_test(test_capsule_conservative),
         cmocka_unit_test(test_lists_brute_force),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
