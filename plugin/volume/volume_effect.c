@@ -248,6 +248,11 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
                 s->data_min = fminf(s->data_min, v1->scalar[i]);
                 s->data_max = fmaxf(s->data_max, v1->scalar[i]);
             }
+        /* nothing finite: the renderer would skip every cell, and the empty range reached the
+         * transfer function as a bad one (issue 28) */
+        if (!(s->data_min <= s->data_max))
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: all %u scalars are NaN or infinite "
+                              "(nothing to draw)", v1->point_count);
         s->revision = v1->revision;
         s->last_key = 0; /* new data: never reuse the old image, whatever the key says */
     }

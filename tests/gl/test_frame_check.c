@@ -423,6 +423,14 @@ static void test_v2_views(void **state)
         attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "volume[0]: model[0] is not finite");
         good_views(&a); a.vv.v1.scalar_min = NAN;
         attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "volume[0]: scalar_min nan");
+        /* every scalar NaN or Inf (issue 28): named as that, with or without a given range (it
+         * was reported as a bad transfer function) */
+        static const float nan4[4] = {NAN, NAN, INFINITY, -NAN};
+        for (int ranged = 0; ranged < 2; ++ranged) {
+            good_views(&a); a.vv.v1.scalar = nan4;
+            a.vv.v1.scalar_min = 0, a.vv.v1.scalar_max = ranged ? 3.f : 0.f;
+            attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "volume[0]: all 4 scalars are NaN or infinite");
+        }
         /* a NaN or Inf coordinate: that cell is skipped, the good one drawn, the image finite */
         good_views(&a);
         check_counted(api, &a, &f, "volume.cells_scanned", 1);
