@@ -71,6 +71,11 @@ vfx_result volfx_water_params_check_ranges(vfx_context *ctx, const vfx_water_par
     const vfx_water_params *p = &in->v2.v1;
     const char *w = "water";
     vfx_result r;
+    /* the version the host wrote (0: it answered VFX_ERR_NOT_FOUND, the defaults); one this
+     * plugin does not know was read as version 1 before (issue 28) */
+    if (p->version > VFX_WATER_PARAMS4_VERSION)
+        return volfx_fail(ctx, VFX_ERR_ABI, "water: host water_params of version %u (this plugin reads 1 to %u)",
+                          p->version, VFX_WATER_PARAMS4_VERSION);
     if ((r = volfx_range_check(ctx, w, VFX_RANGE_WATER_H, p->h))
         || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_THRESHOLD, p->threshold))
         || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_MAX_SAMPLES, p->max_samples))

@@ -34,6 +34,20 @@ static vfx_result one_beam(void *user, vfx_beams_view *out)
     return VFX_OK;
 }
 static uint32_t one_chunk(void *user) { (void)user; return 1; }
+static const float k_px[4] = {0, 0.1f, 0.2f, 0.3f}, k_py[4] = {0}, k_pz[4] = {0};
+static vfx_result four_particles(void *user, uint32_t c, vfx_particle_view *out)
+{
+    (void)user, (void)c;
+    *out = (vfx_particle_view){.size = sizeof *out, .version = VFX_PARTICLE_VIEW_VERSION, .count = 4,
+                               .pos = {k_px, k_py, k_pz}};
+    return VFX_OK;
+}
+static vfx_result params_v99(void *user, vfx_water_params *out)
+{
+    (void)user;
+    out->version = 99; /* a struct version this plugin cannot know */
+    return VFX_OK;
+}
 static uint32_t one_volume(void *user) { (void)user; return 1; }
 static void host_free(void *user, void *p) { (void)user; free(p); }
 
@@ -231,6 +245,27 @@ static void test_nothing_drawn(void **state)
     expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "far_plane");
     api->destroy(ctx);
     free_fixture(&f);
+}
+
+/* Issue 28: water parameters of an unknown version (99) refused at update, naming it (they
+ * were read as version 1). */
+static void test_unknown_water_params_version(void **state)
+{
+    (void)state;
+    test_log log = {0};
+    const vfx_plugin_api *api = plugin_api();
+    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
+                         .user = &log, .log = test_log_fn, .particle_chunk_count = one_chunk,
+                         .particle_chunk = four_particles, .water_params = params_v99};
+    vfx_context *ctx;
+    assert_int_equal(api->create(&host, &ctx), VFX_OK);
+    if (!(api->effects_built & VFX_EFFECT_BIT(VFX_EFFECT_WATER))) {
+        api->destroy(ctx);
+        return;
+    }
+    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_ERR_ABI);
+    assert_non_null(strstr(api->last_error(ctx), "water: host water_params of version 99"));
+    api->destroy(ctx);
 }
 
 /* Defect 7: a callback without its partner called through NULL (particle_chunk_count set,
@@ -546,6 +581,7 @@ int main(void)
         cmocka_unit_test(test_frame_fields),
         cmocka_unit_test(test_nothing_drawn),
         cmocka_unit_test(test_callback_pairs),
+        cmocka_unit_test(test_unknown_water_params_version),
         cmocka_unit_test(test_v2_views),
         cmocka_unit_test(test_frame_block),
     };
