@@ -274,6 +274,27 @@ vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx
     for (int k = 0; k < 3; ++k)
         if (!isfinite(v->eye[k]))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view eye[%d] is not finite", k);
+    /* eye against the view matrix's own (inverse translation, double cofactors rounded once to
+     * float): a host's float32 lookAt rounds R and t (~1 ulp each), leaves R^T R - I at a few
+     * ulps and t's dot products at ~3, so the two differ by <~ 20 FLT_EPSILON max(|eye|, |t|, 1);
+     * 256 FLT_EPSILON (3.1e-5 relative, at least 3.1e-5 units) keeps >10x margin and refuses a
+     * wrong eye (the water's rays then missed everywhere). Large worlds: with view 2 positions are
+     * relative to origin, so |eye| stays small; without it, at 1e6 units float32 itself resolves
+     * only 0.06 and the bound is 31 units. An eye of exactly (0, 0, 0) is taken from the view. */
+    double scale = 1, off = 0;
+    for (int k = 0; k < 3; ++k) {
+        scale = fmax(scale, fmax(fabs((double)v->eye[k]), fabs((double)v->view[12 + k])));
+        off = fmax(off, fabs((double)v->eye[k] - t->inv_view[12 + k]));
+    }
+    bool unset = v->eye[0] == 0 && v->eye[1] == 0 && v->eye[2] == 0; /* zero means default */
+    if (unset)
+        for (int k = 0; k < 3; ++k)
+            v->eye[k] = t->inv_view[12 + k];
+    if (!unset && off > 256 * FLT_EPSILON * scale)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view eye (%g, %g, %g) is not the view "
+                          "matrix's eye (%g, %g, %g): off by %g, more than %g", (double)v->eye[0], (double)v->eye[1],
+                          (double)v->eye[2], (double)t->inv_view[12], (double)t->inv_view[13],
+                          (double)t->inv_view[14], off, 256 * FLT_EPSILON * scale);
     if (!isfinite(v->fov_y) || v->fov_y < 0 || v->fov_y >= 3.14159265f)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view fov_y %g outside [0, pi) radians",
                           (double)v->fov_y);

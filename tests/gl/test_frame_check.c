@@ -197,6 +197,39 @@ static void test_frame_fields(void **state)
     v = f.fv;
     v.eye[1] = INFINITY;
     expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "eye[1] is not finite");
+    /* an eye the view matrix does not have (issue 28: accepted, the water then missed
+     * everywhere); within float32 rounding it passes, also far from the origin */
+    v = f.fv;
+    v.eye[2] = 4;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "frame view eye (0, 0, 4) is not the view matrix's eye (0, 0, 5)");
+    v = f.fv;
+    v.eye[0] = 1e-3f; /* tolerance here 256 FLT_EPSILON x 5 = 1.5e-4 */
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "is not the view matrix's eye");
+    v = f.fv;
+    v.eye[2] = 0; /* (0, 0, 0): unset, taken from the view (zero means default) */
+    expect(api, ctx, &v, VFX_OK, NULL);
+    v = f.fv;
+    v.eye[2] = nextafterf(5.f, 6.f);
+    expect(api, ctx, &v, VFX_OK, NULL);
+    v = f.fv;
+    ref_camera far_cam = {{3e5, 1e3, 2e5}, {3e5 - 4, 1e3, 2e5 - 3}, {0, 1, 0}, 0.8, W, H, 0.1, 100};
+    ref_camera_matrices(&far_cam, v.view, v.proj);
+    for (int k = 0; k < 3; ++k) v.eye[k] = (float)far_cam.eye[k];
+    expect(api, ctx, &v, VFX_OK, NULL);
+    /* an orthographic projection: planes derived from it (both 0) and checked against it;
+     * swapping its near/far formulas in projection_planes fails here */
+    v = f.fv;
+    memset(v.proj, 0, sizeof v.proj);
+    v.proj[0] = 2.f / 4, v.proj[5] = 2.f / 4, v.proj[10] = -2.f / (100 - 0.1f);
+    v.proj[14] = -(100 + 0.1f) / (100 - 0.1f), v.proj[15] = 1;
+    v.fov_y = 0;
+    expect(api, ctx, &v, VFX_OK, NULL);
+    v.near_plane = v.far_plane = 0;
+    expect(api, ctx, &v, VFX_OK, NULL);
+    v.near_plane = 0.1f, v.far_plane = 50;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "far_plane 50, but proj has far 100");
+    v.near_plane = 1, v.far_plane = 100;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "near_plane 1, but proj has near 0.");
     v = f.fv;
     v.effects = 1u << 9;
     expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "effects 0x200 has bits of no effect");

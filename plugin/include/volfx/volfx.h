@@ -456,7 +456,7 @@ typedef struct vfx_frame_view {
     uint32_t depth_texture; /* opaque scene depth, NOT attached to `framebuffer` */
     uint32_t width, height;
     float view[16], proj[16];
-    float eye[3];
+    float eye[3];           /* the view matrix's eye (checked against it); (0, 0, 0) -> taken from view */
     float near_plane, far_plane;
     float fov_y;            /* radians */
     uint32_t effects;       /* VFX_EFFECT_BIT mask to draw; 0 -> all present */
