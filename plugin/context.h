@@ -27,6 +27,7 @@ struct vfx_context {
     struct volfx_gl_table *gl;    /* every GL command, through host.gl_get_proc_address */
     uint32_t width, height;
     void *effect_state[VFX_EFFECT_COUNT];
+    uint32_t rendered;          /* VFX_EFFECT_BIT of effects rendered since their creation (read_raw) */
     const volfx_effect_ops *effect_ops[VFX_EFFECT_COUNT];
     vfx_stats2 stats;           /* counters of the frame being made */
     vfx_stats2 last_stats;      /* counters of the last finished frame */

@@ -160,6 +160,8 @@ static vfx_result plugin_update(vfx_context *ctx, double time, float dt)
         if (!ops)
             continue;
         bool present = ops->present(ctx);
+        if (present != (ctx->effect_state[k] != NULL))
+            ctx->rendered &= ~VFX_EFFECT_BIT(k); /* created or destroyed: nothing to read yet */
         if (present && !ctx->effect_state[k]) {
             vfx_result r = ops->create(ctx, &ctx->effect_state[k]);
             if (r)
@@ -217,6 +219,8 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
         if (!ctx->effect_state[k] || !(mask & VFX_EFFECT_BIT(k)))
             continue;
         result = ctx->effect_ops[k]->render(ctx, ctx->effect_state[k], frame, &targets);
+        if (result == VFX_OK)
+            ctx->rendered |= VFX_EFFECT_BIT(k);
     }
     volfx_gpu_frame_end(ctx);
     ctx->last_stats = ctx->stats;
@@ -262,6 +266,9 @@ static vfx_result plugin_read_raw(vfx_context *ctx, vfx_effect_kind effect, floa
     if (!ctx->effect_state[effect])
         return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "read_raw: effect %s is absent from the world",
                         ctx->effect_ops[effect]->name);
+    if (!(ctx->rendered & VFX_EFFECT_BIT(effect)))
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "read_raw: effect %s has not been rendered since it was "
+                          "created (nothing to read)", ctx->effect_ops[effect]->name);
     if (count < (size_t)ctx->width * ctx->height)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "read_raw: buffer of %zu floats, need %ux%u",
                         count, ctx->width, ctx->height);

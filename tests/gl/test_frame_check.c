@@ -133,6 +133,10 @@ static void test_frame_fields(void **state)
     assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_OK);
     fixture f;
     make_fixture(&f);
+    /* read_raw before any render (issue 28: VFX_OK with nothing rendered) */
+    static float early[W * H];
+    assert_int_equal(api->read_raw(ctx, VFX_EFFECT_BEAMS, early, W * H), VFX_ERR_NOT_FOUND);
+    assert_non_null(strstr(api->last_error(ctx), "read_raw: effect beams has not been rendered"));
     expect(api, ctx, &f.fv, VFX_OK, NULL);
     double h_ref = max_h(api, ctx);
     assert_true(h_ref > 0.1); /* the beam is in view */
