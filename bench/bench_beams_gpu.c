@@ -10,6 +10,7 @@
 #include "app.h"
 #include "beams/beam_field.h"
 #include "beams_ref.h"
+#include "camera_ref.h"
 
 int bench_beams_gpu(int argc, char **argv);
 
@@ -115,8 +116,10 @@ int bench_beams_gpu(int argc, char **argv)
         game_app *app;
         if (game_app_create(&d, &app))
             return 1;
+        /* the host's camera and the float64 reference's: the same numbers */
+        rt_camera hc = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, M_PI / 3, w, h, 0.05, 50};
         ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, M_PI / 3, w, h, 0.05, 50};
-        game_app_set_camera(app, &cam);
+        game_app_set_camera(app, &hc);
         app->beams_view = (vfx_beams_view){.size = sizeof(vfx_beams_view), .version = VFX_BEAMS_VIEW_VERSION};
         size_t np = (size_t)w * h;
         double *ref = malloc(np * sizeof(double)), *cond = malloc(np * sizeof(double));

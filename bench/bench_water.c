@@ -27,6 +27,7 @@
 #include "debug.h"
 #include "profile/profiler.h"
 #include "camera_ref.h"
+#include "gfx/camera.h"
 #include "water_ref.h"
 
 typedef struct bench_scene {
@@ -136,15 +137,15 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
     s.z = malloc(n * 4);
     s.n = n;
     uint32_t width = size, height = opt->height ? opt->height : size;
-    ref_camera cam;
+    rt_camera cam; /* the host camera (runtime); the reference gets the same numbers */
     if (s.pool) {
         pool_layout(n, s.x, s.y, s.z);
         double side = 0.3 * ceil(sqrt(n / 4.0));
-        cam = (ref_camera){{0, 0.55 * side, 0.95 * side}, {0, 0, -0.1 * side}, {0, 1, 0}, 0.9, width, height, 0.1, 100};
+        cam = (rt_camera){{0, 0.55 * side, 0.95 * side}, {0, 0, -0.1 * side}, {0, 1, 0}, 0.9, width, height, 0.1, 100};
     } else {
         ref_water_layers(n, 0.3, s.x, s.y, s.z);
         double top = (double)((n - 1) / 576) * 0.3;
-        cam = (ref_camera){{0, top + 4.0, 8.0}, {0, top * 0.5, 0}, {0, 1, 0}, 0.9, width, height, 0.1, 100};
+        cam = (rt_camera){{0, top + 4.0, 8.0}, {0, top * 0.5, 0}, {0, 1, 0}, 0.9, width, height, 0.1, 100};
     }
     if (s.points) {
         char perr[1200];
@@ -174,7 +175,8 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
                          .width = width, .height = height, .fov_y = 0.9f, .near_plane = 0.1f, .far_plane = 100.f};
     static const float black[4] = {0.35f, 0.4f, 0.5f, 1}; /* the host image the water refracts (compare-vtk-fluid.py gives VTK the same background) */
     for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam.eye[k];
-    ref_camera_matrices(&cam, fv.view, fv.proj);
+    rt_camera_view(&cam, fv.view);
+    rt_camera_proj(&cam, fv.proj);
     double *ms = malloc(frames * sizeof *ms);
     float *y0 = malloc(n * 4);
     memcpy(y0, s.y, n * 4);
@@ -222,7 +224,9 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
         float *gpu = malloc((size_t)width * height * 4), *ref = malloc((size_t)width * height * 4);
         api.read_raw(ctx, VFX_EFFECT_WATER, gpu, (size_t)width * height);
         double fwd[3], right[3], up[3];
-        ref_camera_basis(&cam, fwd, right, up);
+        const ref_camera rcam = {{cam.eye[0], cam.eye[1], cam.eye[2]}, {cam.target[0], cam.target[1], cam.target[2]},
+                                 {cam.up[0], cam.up[1], cam.up[2]}, cam.fov_y, width, height, cam.near_plane, cam.far_plane};
+        ref_camera_basis(&rcam, fwd, right, up);
         ref_water_camera rc2 = {{cam.eye[0], cam.eye[1], cam.eye[2]}, {fwd[0], fwd[1], fwd[2]},
                                     {up[0], up[1], up[2]}, cam.fov_y, width, height};
         ref_water_params rp = ref_water_default_params();

@@ -178,12 +178,13 @@ static vfx_result host_volume(void *user, uint32_t index, vfx_volume_view *out)
 
 /* -------------------------------------------------------------------- lifecycle */
 
-vfx_result game_app_set_camera(game_app *app, const ref_camera *cam)
+vfx_result game_app_set_camera(game_app *app, const rt_camera *cam)
 {
-    if (!cam || cam->width == 0 || cam->height == 0 || !(cam->fov_y > 0 && cam->fov_y < M_PI)
-        || !(cam->near_plane > 0) || !(cam->far_plane > cam->near_plane)) {
-        rt_logf(&app->log, VFX_LOG_ERROR, "camera: need size > 0, 0 < fov_y < pi, 0 < near < far");
-        return VFX_ERR_INVALID_ARGUMENT;
+    char err[256];
+    vfx_result r = rt_camera_check(cam, err, sizeof err);
+    if (r) {
+        rt_logf(&app->log, VFX_LOG_ERROR, "%s", err);
+        return r;
     }
     app->camera = *cam;
     return rt_renderer_resize(app->renderer, cam->width, cam->height);
@@ -235,7 +236,7 @@ vfx_result game_app_create(const game_app_desc *desc, game_app **out)
         goto fail;
     if ((r = rt_renderer_create(&app->log, &app->renderer)))
         goto fail;
-    app->camera = (ref_camera){{0, 2, 6}, {0, 0.5, 0}, {0, 1, 0}, 60.0 * M_PI / 180.0, w, h, 0.05, 200.0};
+    app->camera = (rt_camera){{0, 2, 6}, {0, 0.5, 0}, {0, 1, 0}, 60.0 * M_PI / 180.0, w, h, 0.05, 200.0};
     if ((r = rt_renderer_set_hdr(app->renderer, !app->desc.ldr, app->desc.exposure))
         || (r = rt_renderer_resize(app->renderer, w, h)))
         goto fail;
@@ -352,16 +353,25 @@ vfx_result game_app_frame(game_app *app, float dt)
         return r;
     }
     rt_profiler_cpu(app->profiler, "plugin.update", rt_now_ms() - t0);
-    float view[16], proj[16];
-    ref_camera_matrices(&app->camera, view, proj);
+    /* the frame view is filled in place: camera first (the host scene draws with the same
+     * matrices), then the targets the scene pass reports; version 2 says whether the output
+     * is an HDR target */
+    vfx_frame_view2 frame = {.v1 = {.size = sizeof frame, .version = VFX_FRAME_VIEW2_VERSION,
+                                    .near_plane = (float)app->camera.near_plane,
+                                    .far_plane = (float)app->camera.far_plane,
+                                    .fov_y = (float)app->camera.fov_y},
+                             .origin = {app->origin[0], app->origin[1], app->origin[2]}};
+    rt_camera_view(&app->camera, frame.v1.view);
+    rt_camera_proj(&app->camera, frame.v1.proj);
+    for (int k = 0; k < 3; ++k)
+        frame.v1.eye[k] = (float)app->camera.eye[k];
     t0 = rt_now_ms();
     if (app->environment.sky) { /* the fog is seen from the camera */
-        for (int k = 0; k < 3; ++k)
-            app->environment.eye[k] = (float)app->camera.eye[k];
+        memcpy(app->environment.eye, frame.v1.eye, sizeof app->environment.eye);
         rt_renderer_set_environment(app->renderer, &app->environment);
     }
     rt_renderer_set_origin(app->renderer, app->origin);
-    rt_renderer_begin_scene(app->renderer, view, proj, app->clear_color);
+    rt_renderer_begin_scene(app->renderer, frame.v1.view, frame.v1.proj, app->clear_color);
     rt_component draw_terms[2] = {app->mesh_comp, app->transform_comp};
     rt_query_iter it = rt_query_begin(app->world, draw_terms, 2);
     while (rt_query_next(&it)) {
@@ -372,26 +382,17 @@ vfx_result game_app_frame(game_app *app, float dt)
     }
     rt_renderer_targets tg;
     rt_renderer_end_scene(app->renderer, &tg);
-    /* version 2: says whether the output is an HDR target */
-    vfx_frame_view2 frame2 = {.v1 = {.size = sizeof frame2, .version = VFX_FRAME_VIEW2_VERSION,
-                                     .framebuffer = tg.output_framebuffer, .color_texture = tg.scene_color,
-                                     .depth_texture = tg.scene_depth, .width = tg.width, .height = tg.height},
-                              .origin = {app->origin[0], app->origin[1], app->origin[2]},
-                              .color_hdr = tg.color_hdr};
-    vfx_frame_view frame = frame2.v1;
-    memcpy(frame.view, view, sizeof frame.view);
-    memcpy(frame.proj, proj, sizeof frame.proj);
-    for (int k = 0; k < 3; ++k)
-        frame.eye[k] = (float)app->camera.eye[k];
-    frame.near_plane = (float)app->camera.near_plane;
-    frame.far_plane = (float)app->camera.far_plane;
-    frame.fov_y = (float)app->camera.fov_y;
+    frame.v1.framebuffer = tg.output_framebuffer;
+    frame.v1.color_texture = tg.scene_color;
+    frame.v1.depth_texture = tg.scene_depth;
+    frame.v1.width = tg.width;
+    frame.v1.height = tg.height;
+    frame.color_hdr = tg.color_hdr;
     rt_profiler_cpu(app->profiler, "host.scene", rt_now_ms() - t0);
     t0 = rt_now_ms();
     if ((r = rt_world_run_phase(app->world, RT_PHASE_RENDER, app->time, dt)))
         return r;
-    frame2.v1 = frame;
-    if ((r = app->api->render(app->ctx, &frame2.v1))) {
+    if ((r = app->api->render(app->ctx, &frame.v1))) {
         rt_logf(&app->log, VFX_LOG_ERROR, "plugin render: %s", app->api->last_error(app->ctx));
         return r;
     }

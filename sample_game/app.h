@@ -9,12 +9,12 @@
 
 #include "ecs/particles.h"
 #include "ecs/world.h"
+#include "gfx/camera.h"
 #include "gfx/gl_context.h"
 #include "gfx/mesh_import.h"
 #include "gfx/renderer.h"
 #include "host/plugin_host.h"
 #include "profile/profiler.h"
-#include "camera_ref.h"
 
 #define GAME_APP_MAX_BEAMS 1024
 #define GAME_APP_MAX_JOINTS 4096
@@ -51,7 +51,7 @@ typedef struct game_app {
     vfx_context *ctx;
     rt_profiler *profiler;
     vfx_host_api host;
-    ref_camera camera;
+    rt_camera camera;
     float clear_color[3];
     rt_renderer_environment environment; /* sky, sun and fog (zero: clear colour) */
     rt_component mesh_comp, transform_comp; /* scene meshes are entities of the world */
@@ -101,7 +101,8 @@ vfx_result game_app_frame(game_app *app, float dt);
 vfx_result game_app_screenshot(game_app *app, const char *path);
 /* Writes an effect's raw quantity of the last frame as a PFM. */
 vfx_result game_app_dump_raw(game_app *app, vfx_effect_kind effect, const char *path);
-/* Sets the camera (and resizes the targets when the size changed). */
-vfx_result game_app_set_camera(game_app *app, const ref_camera *cam);
+/* Sets the camera (and resizes the targets when the size changed); VFX_ERR_INVALID_ARGUMENT,
+ * logged naming the field, for a camera rt_camera_check refuses. */
+vfx_result game_app_set_camera(game_app *app, const rt_camera *cam);
 
 #endif

@@ -404,7 +404,7 @@ vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path
     const rt_scene *sc = demo->scene;
     memcpy(app->origin, sc->origin, sizeof app->origin);
     const rt_scene_camera *c = &sc->camera;
-    ref_camera cam = {{c->eye[0], c->eye[1], c->eye[2]}, {c->target[0], c->target[1], c->target[2]},
+    rt_camera cam = {{c->eye[0], c->eye[1], c->eye[2]}, {c->target[0], c->target[1], c->target[2]},
                           {c->up[0], c->up[1], c->up[2]}, c->fov_y_deg * M_PI / 180.0,
                           app->desc.width ? app->desc.width : c->width, app->desc.height ? app->desc.height : c->height,
                           c->near_plane, c->far_plane};

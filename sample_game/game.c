@@ -151,7 +151,7 @@ static void handle_input(game_app *app, game_demo *demo, bool *paused, bool *ste
     if (n && !demo->key_latch[4]) *step = true;
     demo->key_latch[3] = p, demo->key_latch[4] = n;
     double f[3], r[3], u[3];
-    ref_camera_basis(&app->camera, f, r, u);
+    rt_camera_basis(&app->camera, f, r, u);
     double speed = 3.0 * dt, move[3] = {0, 0, 0};
     if (glfwGetKey(w, GLFW_KEY_W) == GLFW_PRESS) for (int k = 0; k < 3; ++k) move[k] += f[k] * speed;
     if (glfwGetKey(w, GLFW_KEY_S) == GLFW_PRESS) for (int k = 0; k < 3; ++k) move[k] -= f[k] * speed;
@@ -159,21 +159,11 @@ static void handle_input(game_app *app, game_demo *demo, bool *paused, bool *ste
     if (glfwGetKey(w, GLFW_KEY_A) == GLFW_PRESS) for (int k = 0; k < 3; ++k) move[k] -= r[k] * speed;
     if (glfwGetKey(w, GLFW_KEY_E) == GLFW_PRESS) move[1] += speed;
     if (glfwGetKey(w, GLFW_KEY_Q) == GLFW_PRESS) move[1] -= speed;
-    for (int k = 0; k < 3; ++k) {
-        app->camera.eye[k] += move[k];
-        app->camera.target[k] += move[k];
-    }
+    rt_camera_translate(&app->camera, move);
     double mx, my;
     glfwGetCursorPos(w, &mx, &my);
     if (glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS && demo->mouse_down) {
-        double yaw = -(mx - demo->mouse_x) * 0.005;
-        double off[3];
-        for (int k = 0; k < 3; ++k) off[k] = app->camera.eye[k] - app->camera.target[k];
-        double c = cos(yaw), s = sin(yaw);
-        double x = off[0] * c - off[2] * s, z = off[0] * s + off[2] * c;
-        off[0] = x, off[2] = z;
-        off[1] += (my - demo->mouse_y) * 0.01;
-        for (int k = 0; k < 3; ++k) app->camera.eye[k] = app->camera.target[k] + off[k];
+        rt_camera_orbit(&app->camera, -(mx - demo->mouse_x) * 0.005, (my - demo->mouse_y) * 0.01);
     }
     demo->mouse_down = glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
     demo->mouse_x = mx, demo->mouse_y = my;

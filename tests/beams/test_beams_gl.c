@@ -15,12 +15,15 @@
 #include "app.h"
 #include "beams_ref.h"
 #include "debug.h"
+#include "test_camera.h"
 #include "test_util.h"
 
 #define W 64
 #define H 48
 
 static game_app *g_app;
+/* the camera the host renders with; the references trace its rays in float64 */
+static const ref_camera g_cam = {{0.2, 0.3, 4}, {0, 0, 0}, {0, 1, 0}, 0.9, W, H, 0.05, 50};
 static test_log g_log;
 static int g_smooth; /* the falloff the references integrate (set with use_v2) */
 static uint32_t g_nj;  /* joints of the bending beam the references integrate (0: straight) */
@@ -35,7 +38,7 @@ static int setup(void **state)
     game_app_desc d = {.mode = RT_GL_HEADLESS, .width = W, .height = H, .logger = {test_log_fn, &g_log}};
     if (game_app_create(&d, &g_app) != VFX_OK)
         exit(VFX_TEST_SKIP);
-    ref_camera cam = {{0.2, 0.3, 4}, {0, 0, 0}, {0, 1, 0}, 0.9, W, H, 0.05, 50};
+    rt_camera cam = test_rt_camera(&g_cam);
     assert_int_equal(game_app_set_camera(g_app, &cam), VFX_OK);
     g_app->beams[0] = k_beam;
     g_app->beam_count = 1;
@@ -67,8 +70,8 @@ static double ref_pixel(uint32_t i, uint32_t j, double t1)
     b.smooth = g_smooth;
     assert_int_equal(volfx_beam_set_joints(&b, &g_app->joints[0][0], g_nj, err, sizeof err), VFX_OK);
     double dir[3];
-    ref_pixel_ray(&g_app->camera, i, j, dir);
-    return ref_beams_integral(&b, 1, g_app->camera.eye, dir, 0.0, t1, 1e-10, NULL);
+    ref_pixel_ray(&g_cam, i, j, dir);
+    return ref_beams_integral(&b, 1, g_cam.eye, dir, 0.0, t1, 1e-10, NULL);
 }
 
 /* The float32 inputs the GPU works from: the pixel direction, unprojected in float32 from the
@@ -116,11 +119,11 @@ static int compare_image(const float *gpu, double (*t1_of)(uint32_t, uint32_t), 
         double e = fabs(gpu[k] - ref[k]);
         uint32_t i = k % W, j = k / W;
         double t1 = t1_of(i, j), dir[3], end[3];
-        ref_pixel_ray(&g_app->camera, i, j, dir);
+        ref_pixel_ray(&g_cam, i, j, dir);
         for (int c = 0; c < 3; ++c)
-            end[c] = g_app->camera.eye[c] + t1 * dir[c];
+            end[c] = g_cam.eye[c] + t1 * dir[c];
         double cut = t1 < 50.0 ? volfx_beam_density_d(&b, end) * 2e-5 * t1 : 0.0;
-        double cond = ref_beams_cond_abs(&b, 1, g_app->camera.eye, dir, 0.0, t1, 2.0);
+        double cond = ref_beams_cond_abs(&b, 1, g_cam.eye, dir, 0.0, t1, 2.0);
         int bright = ref[k] > 1e-6 * hmax;
         double tol = (bright ? 1e-5 * ref[k] : 1e-6 * hmax) + cond + cut;
         ie->max_ratio = fmax(ie->max_ratio, e / tol);
@@ -190,8 +193,8 @@ static double g_wall_z;
 static double t_wall(uint32_t i, uint32_t j)
 {
     double d[3];
-    ref_pixel_ray(&g_app->camera, i, j, d);
-    double t = (g_wall_z - g_app->camera.eye[2]) / d[2];
+    ref_pixel_ray(&g_cam, i, j, d);
+    double t = (g_wall_z - g_cam.eye[2]) / d[2];
     return t > 0 && t < 50 ? t : 50.0;
 }
 
@@ -222,9 +225,9 @@ static double g_box_min[3], g_box_max[3];
 static double t_box(uint32_t i, uint32_t j)
 {
     double d[3], t0 = 0, t1 = 50;
-    ref_pixel_ray(&g_app->camera, i, j, d);
+    ref_pixel_ray(&g_cam, i, j, d);
     for (int k = 0; k < 3; ++k) { /* slab test, float64 */
-        double a = (g_box_min[k] - g_app->camera.eye[k]) / d[k], b = (g_box_max[k] - g_app->camera.eye[k]) / d[k];
+        double a = (g_box_min[k] - g_cam.eye[k]) / d[k], b = (g_box_max[k] - g_cam.eye[k]) / d[k];
         if (a > b) { double t = a; a = b; b = t; }
         t0 = fmax(t0, a), t1 = fmin(t1, b);
     }
@@ -284,11 +287,11 @@ static void test_mz_sweep(void **state)
         volfx_beam_d b;
         char err[128];
         assert_int_equal(volfx_beam_validate(&g_app->beams[0], &b, err, sizeof err), VFX_OK);
-        ref_pixel_ray(&g_app->camera, cx, cy, dir);
+        ref_pixel_ray(&g_cam, cx, cy, dir);
         for (int c = 0; c < 3; ++c)
-            end[c] = g_app->camera.eye[c] + t1 * dir[c];
+            end[c] = g_cam.eye[c] + t1 * dir[c];
         /* the bound of compare_image: 1e-5, the inputs' conditioning, the depth-derived end */
-        double tol = 1e-5 * ref + ref_beams_cond_abs(&b, 1, g_app->camera.eye, dir, 0.0, t1, 2.0) +
+        double tol = 1e-5 * ref + ref_beams_cond_abs(&b, 1, g_cam.eye, dir, 0.0, t1, 2.0) +
                      (t1 < 50.0 ? volfx_beam_density_d(&b, end) * 2e-5 * t1 : 0.0);
         printf("m_z %.2f: H %.6g (reference %.6g, error %.3g, bound %.3g)\n", zs[k], h, ref, fabs(h - ref), tol);
         assert_true(fabs(h - ref) <= tol);

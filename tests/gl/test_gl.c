@@ -15,6 +15,7 @@
 #include "app.h"
 #include "gpu/gpu.h"
 #include "debug.h"
+#include "camera_ref.h"
 #include "test_util.h"
 
 static rt_gl_context *g_gl;

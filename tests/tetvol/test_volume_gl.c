@@ -18,6 +18,7 @@
 #include "tet_testmesh.h"
 #include "debug.h"
 #include "scene/scene.h"
+#include "test_camera.h"
 #include "test_util.h"
 #include "tet_render.h"
 
@@ -25,6 +26,8 @@
 #define H 36
 
 static game_app *g_app;
+/* the camera the host renders with; the references trace its rays in float64 */
+static const ref_camera g_cam = {{0.3, 0.4, 3.5}, {0, 0, 0}, {0, 1, 0}, 0.9, W, H, 0.05, 50};
 static const char *g_showcase; /* sample_game/scenes/volume-showcase.json (argv[1]) */
 static float *g_points, *g_scalar;
 static uint32_t *g_tets, g_np, g_nt;
@@ -35,7 +38,7 @@ static int setup(void **state)
     game_app_desc d = {.mode = RT_GL_HEADLESS, .width = W, .height = H};
     if (game_app_create(&d, &g_app) != VFX_OK)
         exit(VFX_TEST_SKIP);
-    ref_camera cam = {{0.3, 0.4, 3.5}, {0, 0, 0}, {0, 1, 0}, 0.9, W, H, 0.05, 50};
+    rt_camera cam = test_rt_camera(&g_cam);
     assert_int_equal(game_app_set_camera(g_app, &cam), VFX_OK);
     rt_scene_volume sv;
     memset(&sv, 0, sizeof sv);
@@ -85,7 +88,7 @@ static float *direct_alpha(void)
 {
     tet_mesh m = {.point_count = g_np, .tet_count = g_nt, .points = g_points, .tets = g_tets, .scalar = g_scalar};
     tet_camera cam = {.width = W, .height = H};
-    ref_camera_matrices(&g_app->camera, cam.view, cam.proj);
+    ref_camera_matrices(&g_cam, cam.view, cam.proj);
     tet_tf tf = {.smin = 0, .smax = 1, .tau_lo = 0.2f, .tau_hi = 3.0f, .color_lo = {0.1f, 0.3f, 0.9f},
                      .color_hi = {1.0f, 0.85f, 0.3f}};
     tet_options o;
@@ -135,7 +138,7 @@ static void test_hidden_by_depth(void **state)
     assert_int_equal(rt_world_despawn(g_app->world, e), VFX_OK);
     /* the wall's edge (x = 0.1, z = 1.2) projected to a pixel column */
     float view[16], proj[16];
-    ref_camera_matrices(&g_app->camera, view, proj);
+    ref_camera_matrices(&g_cam, view, proj);
     double p[4] = {0.1, 0.0, 1.2, 1.0}, v[4] = {0}, c[4] = {0};
     for (int r = 0; r < 4; ++r)
         for (int k = 0; k < 4; ++k)
@@ -240,7 +243,7 @@ static void test_view2_breakpoints(void **state)
     float *gpu = render_alpha();
     tet_mesh m = {.point_count = g_np, .tet_count = g_nt, .points = g_points, .tets = g_tets, .scalar = g_scalar};
     tet_camera cam = {.width = W, .height = H};
-    ref_camera_matrices(&g_app->camera, cam.view, cam.proj);
+    ref_camera_matrices(&g_cam, cam.view, cam.proj);
     tet_tf_point pts[3];
     for (int i = 0; i < 3; ++i) /* the view's domain is [0, 1] */
         pts[i] = (tet_tf_point){pos[i], {rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2]}, rgba[4 * i + 3]};
@@ -333,7 +336,8 @@ static void test_file_volume_in_scene(void **state)
     free(a);
     a = render_alpha(); /* the second frame clips with this scene's distances */
     tet_camera cam = {.width = W, .height = H};
-    ref_camera_matrices(&g_app->camera, cam.view, cam.proj);
+    const ref_camera scene_cam = {{0.9, 1.3, 3.4}, {0, 0, 0}, {0, 1, 0}, 55 * M_PI / 180.0, W, H, 0.1, 50}; /* the file's */
+    ref_camera_matrices(&scene_cam, cam.view, cam.proj);
     tet_tf tf = {.points = pts, .count = 64};
     double *ref = malloc(W * H * 4 * sizeof *ref);
     ref_testmesh_raymarch(6, &grid, &cam, &tf, 3000, ref);
