@@ -387,6 +387,10 @@ typedef struct rank_scan {
     int ask_msg;
     int asked;            /* rank asked, -1 when none */
     tet_mpi_stats *st;
+    /* the scan: coop when reductions run (sharing or load balancing with P > 1), the ERT
+     * table updated C times per stretch, failed once a scan ran out of memory */
+    int coop, ert, failed;
+    uint32_t C;
 } rank_scan;
 
 static void start_round(rank_scan *R)
@@ -564,6 +568,191 @@ static tet_result check_same_input(MPI_Comm comm, int P, const tet_mesh *mesh, c
     return bad ? TET_ERR_INVALID_ARGUMENT : TET_OK;
 }
 
+/* Set-up after the local engine: the reduction buffers and the tables' scratch. */
+static tet_result alloc_exchange(rank_scan *R, char *err, size_t errlen)
+{
+    R->DD = tet_local_tiles_d(R->L) * tet_local_tiles_d(R->L);
+    size_t n = (size_t)R->DD + 1 + (size_t)R->P; /* the reduction, then a table's scratch */
+    R->sendbuf = malloc(n * sizeof(float));
+    R->recvbuf = malloc(n * sizeof(float));
+    R->known = malloc((size_t)R->DD * sizeof(float));
+    R->enc = malloc((size_t)R->DD * sizeof(float));
+    R->remaining = malloc((size_t)R->P * sizeof(float));
+    if (!R->sendbuf || !R->recvbuf || !R->known || !R->enc || !R->remaining) {
+        tet_errf(err, errlen, "tet_mpi: out of memory for the ERT exchange (D*D = %d)", R->DD);
+        return TET_ERR_OUT_OF_MEMORY;
+    }
+    return TET_OK;
+}
+
+/* The shared ERT table's window on rank 0, reset to +inf (collective; only when sharing).
+ * Same decision and D on every rank (same opts), so the collectives match. The window is
+ * kept in the context: creating one is a collective that spins inside Open MPI, which with
+ * more ranks than cores cost seconds per frame. */
+static void share_window(tet_mpi *ctx, rank_scan *R, char *err, size_t errlen)
+{
+    if (ctx->win_dd != R->DD) {
+        if (ctx->win_dd)
+            MPI_Win_free(&ctx->win);
+        MPI_Aint bytes = R->rank == 0 ? (MPI_Aint)R->DD * (MPI_Aint)sizeof(float) : 0;
+        MPI_Win_allocate(bytes, sizeof(float), MPI_INFO_NULL, R->comm, &ctx->win_mem, &ctx->win);
+        ctx->win_dd = R->DD;
+    }
+    R->win = ctx->win;
+    if (R->rank == 0) {
+        MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, R->win);
+        for (int i = 0; i < R->DD; i++)
+            ctx->win_mem[i] = INFINITY;
+        MPI_Win_unlock(0, R->win);
+    }
+    /* nobody reads it before it is reset; the agreement after the scan keeps the next
+     * frame's reset after every access of this one */
+    agree(R->comm, TET_OK, err, errlen, "window set-up");
+}
+
+/* Scan: the keys [next, end) in order, the ERT table updated C times per stretch and, when
+ * cooperating, shared and the reductions and requests moved along (cheap MPI_Test /
+ * MPI_Iprobe every POLL keys, so a rank scanning a long stretch still answers). Sets failed
+ * when a scan runs out of memory. */
+static void scan_keys(rank_scan *R, char *err, size_t errlen)
+{
+    const uint32_t POLL = 256;
+    tet_mpi_stats *st = R->st;
+    tet_counters *cnt = tet_local_counters(R->L);
+    uint32_t rem = R->end - R->next;
+    uint32_t interval = rem / R->C > 0 ? rem / R->C : 1, since = 0;
+    double ts = tet_now_ms(), tin = 0, tu0 = cnt->t_update_ms;
+    while (R->next < R->end && !R->failed) {
+        if (since >= interval) {
+            if (R->ert)
+                tet_local_update_table(R->L);
+            if (R->coop) {
+                double tp = tet_now_ms();
+                if (R->share)
+                    share_table(R);
+                poll_rank(R, 1);
+                st->polls++;
+                tin += tet_now_ms() - tp;
+            }
+            interval = (R->end - R->next) / R->C > 0 ? (R->end - R->next) / R->C : 1;
+            since = 0;
+        } else if (R->coop && since % POLL == POLL - 1) {
+            double tp = tet_now_ms();
+            poll_rank(R, 0);
+            st->polls++;
+            tin += tet_now_ms() - tp;
+        }
+        if (R->next >= R->end)
+            break; /* everything left was handed away */
+        since++;
+        st->keys_done++;
+        if (tet_local_scan(R->L, R->next++) != 0) {
+            R->failed = 1;
+            R->end = R->next; /* nothing to hand out either */
+            tet_errf(err, errlen, "tet_mpi: rank %d out of memory at %llu segments", R->rank,
+                     (unsigned long long)cnt->segments_made);
+        }
+    }
+    cnt->t_sc_ms += tet_now_ms() - ts - tin - (cnt->t_update_ms - tu0);
+    st->t_comm_ms += tin;
+}
+
+/* Steal: out of keys, ask for more until a request is answered with some (returns 1, the
+ * keys in [next, end)) or nobody has any to give (0). The rank keeps answering other
+ * requests meanwhile (with nothing). */
+static int steal_keys(rank_scan *R)
+{
+    while (ask_for_work(R)) {
+        double tw = tet_now_ms();
+        for (;;) {
+            int flag = 0;
+            MPI_Test(&R->give_rq, &flag, MPI_STATUS_IGNORE);
+            if (flag)
+                break;
+            poll_rank(R, 1);
+            idle_pause();
+        }
+        wait_polite(1, &R->ask_rq); /* it was answered, so it was received */
+        R->st->t_idle_ms += tet_now_ms() - tw;
+        uint32_t n = R->give[1] - R->give[0];
+        int asked = R->asked;
+        R->asked = -1;
+        if (n > 0) {
+            tet_local_need(R->L, R->give[0], R->give[1]); /* sorts the victim's keys */
+            R->next = R->give[0];
+            R->end = R->give[1];
+            R->st->cells_taken += n;
+            return 1;
+        }
+        R->remaining[asked] = 0; /* stale: do not ask it again before new counts */
+    }
+    return 0;
+}
+
+/* Termination: keep taking part in reductions (answering requests with nothing) until one
+ * shows every rank done. Every rank sees the same result of the same reduction, so all
+ * leave after the same one and no message is left in flight (a rank waiting for an answer
+ * is not done, so that reduction cannot say all done). */
+static void wait_all_done(rank_scan *R)
+{
+    double tw = tet_now_ms();
+    R->done = 1;
+    while (!R->all_done) {
+        poll_rank(R, 1);
+        if (!R->all_done)
+            idle_pause();
+    }
+    R->st->t_idle_ms += tet_now_ms() - tw;
+}
+
+/* Phase 1 on this rank: scan, steal when out of keys (load balancing), then termination. */
+static void scan_phase(rank_scan *R, char *err, size_t errlen)
+{
+    for (;;) {
+        scan_keys(R, err, errlen);
+        if (!R->coop || R->failed || !R->dlb || !steal_keys(R))
+            break;
+    }
+    if (R->coop)
+        wait_all_done(R);
+}
+
+/* Phase 2: this rank's full-screen segment lists exported (the local engine is destroyed
+ * after: the lists are all phase 2 needs), then composited by binary swap. */
+static tet_result binary_swap_phase(rank_scan *R, const tet_camera *cam, const tet_options *opts,
+                                    float *rgba, char *err, size_t errlen)
+{
+    tet_mpi_stats *st = R->st;
+    double te = tet_now_ms();
+    tet_seglists lists;
+    memset(&lists, 0, sizeof lists);
+    size_t npix = (size_t)cam->width * cam->height;
+    lists.p0 = 0;
+    lists.p1 = npix;
+    lists.off = malloc((npix + 1) * sizeof *lists.off);
+    size_t nseg = lists.off ? tet_local_export(R->L, 0, npix, lists.off, NULL) : 0;
+    lists.segs = lists.off && nseg <= INT_MAX ? malloc((nseg + 1) * sizeof *lists.segs) : NULL;
+    tet_result r2 = TET_OK;
+    if (!lists.segs) {
+        tet_errf(err, errlen, "tet_mpi: rank %d out of memory exporting %zu segments", R->rank, nseg);
+        r2 = TET_ERR_OUT_OF_MEMORY;
+        tet_seglists_free(&lists);
+    } else {
+        tet_local_export(R->L, 0, npix, lists.off, lists.segs);
+    }
+    st->segments_local = nseg;
+    st->cnt = *tet_local_counters(R->L);
+    tet_local_destroy(R->L);
+    R->L = NULL;
+    tet_result rc = agree(R->comm, r2, err, errlen, "export");
+    st->t_export_ms = tet_now_ms() - te;
+    if (rc == TET_OK)
+        rc = tet_mpi_composite(R->comm, cam->width, cam->height, &lists, opts->partial_composite,
+                               rgba, st, err, errlen);
+    tet_seglists_free(&lists);
+    return rc;
+}
+
 tet_result tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *cam,
                        const tet_tf *tf, const tet_options *opts, float *rgba,
                        tet_mpi_stats *mine, tet_mpi_stats *all, char *err, size_t errlen)
@@ -593,46 +782,14 @@ tet_result tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *
         tet_errf(err, errlen, "tet_mpi: out of memory for %d ranks' statistics", P);
         rc = TET_ERR_OUT_OF_MEMORY;
     }
-    if (rc == TET_OK) {
-        R.DD = tet_local_tiles_d(R.L) * tet_local_tiles_d(R.L);
-        size_t n = (size_t)R.DD + 1 + (size_t)P; /* the reduction, then a table's scratch */
-        R.sendbuf = malloc(n * sizeof(float));
-        R.recvbuf = malloc(n * sizeof(float));
-        R.known = malloc((size_t)R.DD * sizeof(float));
-        R.enc = malloc((size_t)R.DD * sizeof(float));
-        R.remaining = malloc((size_t)P * sizeof(float));
-        if (!R.sendbuf || !R.recvbuf || !R.known || !R.enc || !R.remaining) {
-            tet_errf(err, errlen, "tet_mpi: out of memory for the ERT exchange (D*D = %d)", R.DD);
-            rc = TET_ERR_OUT_OF_MEMORY;
-        }
-    }
+    if (rc == TET_OK)
+        rc = alloc_exchange(&R, err, errlen);
     rc = agree(comm, rc, err, errlen, "set-up");
     if (rc != TET_OK)
         goto done;
     R.share = opts->share && opts->ert && P > 1;
-    if (R.share) {
-        /* Same decision and D on every rank (same opts), so the collectives match. The window
-         * is kept in the context: creating one is a collective that spins inside Open MPI,
-         * which with more ranks than cores cost seconds per frame. */
-        if (ctx->win_dd != R.DD) {
-            if (ctx->win_dd)
-                MPI_Win_free(&ctx->win);
-            MPI_Aint bytes = rank == 0 ? (MPI_Aint)R.DD * (MPI_Aint)sizeof(float) : 0;
-            MPI_Win_allocate(bytes, sizeof(float), MPI_INFO_NULL, comm, &ctx->win_mem,
-                             &ctx->win);
-            ctx->win_dd = R.DD;
-        }
-        R.win = ctx->win;
-        if (rank == 0) {
-            MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, R.win);
-            for (int i = 0; i < R.DD; i++)
-                ctx->win_mem[i] = INFINITY;
-            MPI_Win_unlock(0, R.win);
-        }
-        /* nobody reads it before it is reset; the agreement after the scan keeps the next
-         * frame's reset after every access of this one */
-        agree(comm, TET_OK, err, errlen, "window set-up");
-    }
+    if (R.share)
+        share_window(ctx, &R, err, errlen);
     tet_local_part(R.L, rank, &R.next, &R.end);
     st.cells_assigned = R.end - R.next;
     for (int i = 0; i < R.DD; i++)
@@ -642,133 +799,17 @@ tet_result tet_mpi_render(tet_mpi *ctx, const tet_mesh *mesh, const tet_camera *
     R.dlb = opts->dlb;
     /* reductions are needed for sharing, and for the remaining counts and the termination
      * agreement of load balancing; without either the ranks scan independently */
-    const int coop = P > 1 && (R.share || R.dlb);
-    const int ert = opts->ert;
-    const uint32_t C = opts->update_c > 0 ? (uint32_t)opts->update_c : 1;
-    /* progress between table updates: cheap MPI_Test / MPI_Iprobe so that reductions and
-     * requests move while a rank scans a long stretch */
-    const uint32_t POLL = 256;
-    int failed = 0;
+    R.coop = P > 1 && (R.share || R.dlb);
+    R.ert = opts->ert;
+    R.C = opts->update_c > 0 ? (uint32_t)opts->update_c : 1;
     double t1 = tet_now_ms(), c1 = tet_thread_cpu_ms();
     st.t_setup_ms = t1 - t_start;
-    tet_counters *cnt = tet_local_counters(R.L);
-    for (;;) {
-        uint32_t rem = R.end - R.next;
-        uint32_t interval = rem / C > 0 ? rem / C : 1, since = 0;
-        double ts = tet_now_ms(), tin = 0, tu0 = cnt->t_update_ms;
-        while (R.next < R.end && !failed) {
-            if (since >= interval) {
-                if (ert)
-                    tet_local_update_table(R.L);
-                if (coop) {
-                    double tp = tet_now_ms();
-                    if (R.share)
-                        share_table(&R);
-                    poll_rank(&R, 1);
-                    st.polls++;
-                    tin += tet_now_ms() - tp;
-                }
-                interval = (R.end - R.next) / C > 0 ? (R.end - R.next) / C : 1;
-                since = 0;
-            } else if (coop && since % POLL == POLL - 1) {
-                double tp = tet_now_ms();
-                poll_rank(&R, 0);
-                st.polls++;
-                tin += tet_now_ms() - tp;
-            }
-            if (R.next >= R.end)
-                break; /* everything left was handed away */
-            since++;
-            st.keys_done++;
-            if (tet_local_scan(R.L, R.next++) != 0) {
-                failed = 1;
-                R.end = R.next; /* nothing to hand out either */
-                tet_errf(err, errlen, "tet_mpi: rank %d out of memory at %llu segments", rank,
-                         (unsigned long long)cnt->segments_made);
-            }
-        }
-        cnt->t_sc_ms += tet_now_ms() - ts - tin - (cnt->t_update_ms - tu0);
-        st.t_comm_ms += tin;
-        if (!coop || failed || !R.dlb)
-            break;
-        /* Out of keys: ask for more until a request is answered with some, or nobody has
-         * any to give. The rank keeps answering other requests meanwhile (with nothing). */
-        int got = 0;
-        while (!got && ask_for_work(&R)) {
-            double tw = tet_now_ms();
-            for (;;) {
-                int flag = 0;
-                MPI_Test(&R.give_rq, &flag, MPI_STATUS_IGNORE);
-                if (flag)
-                    break;
-                poll_rank(&R, 1);
-                idle_pause();
-            }
-            wait_polite(1, &R.ask_rq); /* it was answered, so it was received */
-            st.t_idle_ms += tet_now_ms() - tw;
-            uint32_t n = R.give[1] - R.give[0];
-            if (n > 0) {
-                tet_local_need(R.L, R.give[0], R.give[1]); /* sorts the victim's keys */
-                R.next = R.give[0];
-                R.end = R.give[1];
-                st.cells_taken += n;
-                got = 1;
-            } else {
-                R.remaining[R.asked] = 0; /* stale: do not ask it again before new counts */
-            }
-            R.asked = -1;
-        }
-        if (!got)
-            break;
-    }
-    /* Done: keep taking part in reductions (answering requests with nothing) until one shows
-     * every rank done. Every rank sees the same result of the same reduction, so all leave
-     * after the same one and no message is left in flight (a rank waiting for an answer is
-     * not done, so that reduction cannot say all done). */
-    if (coop) {
-        double tw = tet_now_ms();
-        R.done = 1;
-        while (!R.all_done) {
-            poll_rank(&R, 1);
-            if (!R.all_done)
-                idle_pause();
-        }
-        st.t_idle_ms += tet_now_ms() - tw;
-    }
+    scan_phase(&R, err, errlen);
     st.t_phase1_ms = tet_now_ms() - t1;
     st.t_phase1_cpu_ms = tet_thread_cpu_ms() - c1;
-
-    rc = agree(comm, failed ? TET_ERR_OUT_OF_MEMORY : TET_OK, err, errlen, "the scan");
-    if (rc != TET_OK)
-        goto done;
-    /* Phase 2: this rank's full-screen lists, exported and composited by binary swap. */
-    double te = tet_now_ms();
-    tet_seglists lists;
-    memset(&lists, 0, sizeof lists);
-    size_t npix = (size_t)cam->width * cam->height;
-    lists.p0 = 0;
-    lists.p1 = npix;
-    lists.off = malloc((npix + 1) * sizeof *lists.off);
-    size_t nseg = lists.off ? tet_local_export(R.L, 0, npix, lists.off, NULL) : 0;
-    lists.segs = lists.off && nseg <= INT_MAX ? malloc((nseg + 1) * sizeof *lists.segs) : NULL;
-    tet_result r2 = TET_OK;
-    if (!lists.segs) {
-        tet_errf(err, errlen, "tet_mpi: rank %d out of memory exporting %zu segments", rank, nseg);
-        r2 = TET_ERR_OUT_OF_MEMORY;
-        tet_seglists_free(&lists);
-    } else {
-        tet_local_export(R.L, 0, npix, lists.off, lists.segs);
-    }
-    st.segments_local = nseg;
-    st.cnt = *cnt;
-    tet_local_destroy(R.L); /* the lists are all phase 2 needs */
-    R.L = NULL;
-    rc = agree(comm, r2, err, errlen, "export");
-    st.t_export_ms = tet_now_ms() - te;
+    rc = agree(comm, R.failed ? TET_ERR_OUT_OF_MEMORY : TET_OK, err, errlen, "the scan");
     if (rc == TET_OK)
-        rc = tet_mpi_composite(comm, cam->width, cam->height, &lists, opts->partial_composite,
-                                   rgba, &st, err, errlen);
-    tet_seglists_free(&lists);
+        rc = binary_swap_phase(&R, cam, opts, rgba, err, errlen);
 done:
     if (R.L)
         st.cnt = *tet_local_counters(R.L);

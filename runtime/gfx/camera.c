@@ -12,7 +12,8 @@ vfx_result rt_camera_check(const rt_camera *c, char *err, size_t errlen)
         return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "camera: NULL");
     for (int k = 0; k < 3; ++k)
         if (!isfinite(c->eye[k]) || !isfinite(c->target[k]) || !isfinite(c->up[k]))
-            return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "camera: eye, target and up must be finite");
+            return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT,
+                           "camera: eye, target and up must be finite");
     if (c->width == 0 || c->height == 0)
         return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT,
                        "camera: size %ux%u, need both > 0", c->width, c->height);

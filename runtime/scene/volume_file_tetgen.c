@@ -1,6 +1,7 @@
 /* volume_file_tetgen.c — TetGen .node/.ele reader. The first node's index decides 0- or 1-based
  * numbering, as TetGen itself does. */
 #include "scene/volume_file.h"
+#include "core/error.h"
 #include "core/file.h"
 
 #include <errno.h>
@@ -79,6 +80,214 @@ static int parse_numbers(char *s, double *v, int maxn)
 
 #define TG_MAXCOL 64
 
+/* .node header: "points [dimension 3] [attributes] [markers 0|1]", checked against the caps
+ * and against the file's size. */
+static vfx_result node_header(tg_reader *r, size_t sz, double *np, int *nattr, int *nmark,
+                              char *err, size_t errlen)
+{
+    double v[TG_MAXCOL];
+    char *line;
+    int n;
+    if (!next_line(r, &line) || (n = parse_numbers(line, v, TG_MAXCOL)) < 1)
+        return rt_errf(err, errlen, VFX_ERR_FORMAT, "%s: missing or bad header line", r->name);
+    double p = v[0], dim = n > 1 ? v[1] : 3, na = n > 2 ? v[2] : 0, nm = n > 3 ? v[3] : 0;
+    if (p < 4 || p > 1e9 || dim != 3 || na < 0 || na > TG_MAXCOL - 5 || nm < 0 || nm > 1 ||
+        !whole(p) || !whole(na) || !whole(nm))
+        return rt_errf(err, errlen, VFX_ERR_FORMAT,
+                       "%s:%d: bad header (points %g, dimension %g, attributes %g, markers %g)", r->name,
+                       r->line, p, dim, na, nm);
+    if (p > RT_VOLUME_MAX_POINTS)
+        return rt_errf(err, errlen, VFX_ERR_FORMAT, "%s: header claims %.0f points, above the cap of %u "
+                       "(RT_VOLUME_MAX_POINTS)", r->name, p, RT_VOLUME_MAX_POINTS);
+    /* Every point takes a line of at least 2 bytes: a header claiming more points than that is
+     * truncated, refused before allocating for the claimed count (found by fuzz_tetgen: a
+     * 9-byte file asked for 12 GB). Loose on purpose: near misses get the exact "i of n". */
+    if (p > (double)sz / 2)
+        return rt_errf(err, errlen, VFX_ERR_FORMAT,
+                       "%s: truncated: header claims %g points, file has %zu bytes",
+                       r->name, p, sz);
+    *np = p, *nattr = (int)na, *nmark = (int)nm;
+    return VFX_OK;
+}
+
+/* The attribute the scalar comes from: "attrK" with K < nattr ("" is attr0); -1 without a
+ * scalar_name. VFX_ERR_NOT_FOUND naming what the file has otherwise. */
+static vfx_result node_scalar(const char *path, const char *scalar_name, int nattr, int *attr_index,
+                              char *err, size_t errlen)
+{
+    *attr_index = -1;
+    if (!scalar_name)
+        return VFX_OK;
+    int k = 0;
+    int named = !*scalar_name || (sscanf(scalar_name, "attr%d", &k) == 1 && k >= 0);
+    if (named && k < nattr) {
+        *attr_index = k;
+        return VFX_OK;
+    }
+    if (!named || nattr > 0)
+        return rt_errf(err, errlen, VFX_ERR_NOT_FOUND,
+                       "%s: scalar field '%s' not found; present: attr0..attr%d",
+                       path, scalar_name, nattr - 1);
+    return rt_errf(err, errlen, VFX_ERR_NOT_FOUND,
+                   "%s: scalar field '%s' not found; the file has no node attributes", path, scalar_name);
+}
+
+/* One .node point line: "index x y z attributes... [marker]"; the first index sets *base. */
+static vfx_result node_point(tg_reader *r, uint32_t i, int cols, int attr_index, int *base, tet_mesh *out,
+                             char *err, size_t errlen)
+{
+    double v[TG_MAXCOL];
+    char *line;
+    if (!next_line(r, &line))
+        return rt_errf(err, errlen, VFX_ERR_FORMAT,
+                       "%s: truncated: %u of %u points", r->name, i, out->point_count);
+    int n = parse_numbers(line, v, TG_MAXCOL);
+    if (n != cols)
+        return rt_errf(err, errlen, VFX_ERR_FORMAT, "%s:%d: point %u has %d numbers, expected %d", r->name,
+                       r->line, i, n, cols);
+    if (i == 0) {
+        if (v[0] != 0 && v[0] != 1)
+            return rt_errf(err, errlen, VFX_ERR_FORMAT, "%s:%d: first point index %g is neither 0 nor 1",
+                           r->name, r->line, v[0]);
+        *base = (int)v[0];
+    }
+    if (v[0] != (double)i + *base)
+        return rt_errf(err, errlen, VFX_ERR_FORMAT, "%s:%d: point index %g, expected %u", r->name, r->line,
+                       v[0], i + *base);
+    /* Checked here, as float32, so the message has the file and line (1e39 is finite as a
+     * double and Inf as the float the renderer uses). */
+    for (int k = 0; k < 3; k++) {
+        out->points[3 * (size_t)i + k] = (float)v[1 + k];
+        if (!isfinite(out->points[3 * (size_t)i + k]))
+            return rt_errf(err, errlen, VFX_ERR_NUMERIC,
+                           "%s:%d: point %u coordinate %c = %g is not finite as float32",
+                           r->name, r->line, i, "xyz"[k], v[1 + k]);
+    }
+    if (attr_index >= 0) {
+        out->scalar[i] = (float)v[4 + attr_index];
+        if (!isfinite(out->scalar[i]))
+            return rt_errf(err, errlen, VFX_ERR_NUMERIC,
+                           "%s:%d: point %u attribute %d = %g is not finite as float32",
+                           r->name, r->line, i, attr_index, v[4 + attr_index]);
+    }
+    return VFX_OK;
+}
+
+/* The .node file: points (and the chosen attribute as the scalar) into out; *base is the
+ * numbering (0 or 1) the .ele file's indices use. */
+static vfx_result read_node(const char *path, const char *scalar_name, tet_mesh *out, int *base,
+                            char *err, size_t errlen)
+{
+    char *buf = NULL;
+    size_t sz;
+    vfx_result res = read_whole(path, &buf, &sz, err, errlen);
+    if (res)
+        return res;
+    tg_reader r = {buf, buf, 0, path};
+    double np = 0;
+    int nattr = 0, nmark = 0, attr_index = -1;
+    if ((res = node_header(&r, sz, &np, &nattr, &nmark, err, errlen))
+        || (res = node_scalar(path, scalar_name, nattr, &attr_index, err, errlen)))
+        goto done;
+    out->point_count = (uint32_t)np;
+    out->points = malloc(sizeof(float) * 3 * (size_t)np);
+    if (attr_index >= 0) {
+        out->scalar = malloc(sizeof(float) * (size_t)np);
+        snprintf(out->scalar_name, sizeof out->scalar_name, "attr%d", attr_index);
+    }
+    if (!out->points || (attr_index >= 0 && !out->scalar)) {
+        res = rt_errf(err, errlen, VFX_ERR_OUT_OF_MEMORY,
+                      "%s: out of memory for %u points", path, out->point_count);
+        goto done;
+    }
+    *base = 0;
+    for (uint32_t i = 0; i < out->point_count && !res; i++)
+        res = node_point(&r, i, 4 + nattr + nmark, attr_index, base, out, err, errlen);
+done:
+    free(buf);
+    return res;
+}
+
+/* .ele header: "tetrahedra [nodes per tet 4|10] [attributes]"; *cols the numbers per line. */
+static vfx_result ele_header(tg_reader *r, size_t sz, double *nt, int *cols, char *err, size_t errlen)
+{
+    double v[TG_MAXCOL];
+    char *line;
+    int n;
+    if (!next_line(r, &line) || (n = parse_numbers(line, v, TG_MAXCOL)) < 1)
+        return rt_errf(err, errlen, VFX_ERR_FORMAT, "%s: missing or bad header line", r->name);
+    double t = v[0], npt = n > 1 ? v[1] : 4, neattr = n > 2 ? v[2] : 0;
+    if (t < 1 || t > 1e9 || (npt != 4 && npt != 10) || neattr < 0 || neattr > TG_MAXCOL - 12 ||
+        !whole(t) || !whole(neattr))
+        return rt_errf(err, errlen, VFX_ERR_FORMAT,
+                       "%s:%d: bad header (tetrahedra %g, nodes per tet %g, attributes %g)",
+                       r->name, r->line, t, npt, neattr);
+    if (t > RT_VOLUME_MAX_TETS)
+        return rt_errf(err, errlen, VFX_ERR_FORMAT, "%s: header claims %.0f tetrahedra, above the cap of %u "
+                       "(RT_VOLUME_MAX_TETS)", r->name, t, RT_VOLUME_MAX_TETS);
+    /* Same bound as for points. */
+    if (t > (double)sz / 2)
+        return rt_errf(err, errlen, VFX_ERR_FORMAT,
+                       "%s: truncated: header claims %g tetrahedra, file has %zu bytes",
+                       r->name, t, sz);
+    *nt = t;
+    *cols = 1 + (int)npt + (int)neattr;
+    return VFX_OK;
+}
+
+/* One .ele line: "index v0 v1 v2 v3 [6 more nodes] [attributes]"; the corners, in range of
+ * the points in the given numbering, into out->tets. */
+static vfx_result ele_tet(tg_reader *r, uint32_t t, int cols, int base, tet_mesh *out,
+                          char *err, size_t errlen)
+{
+    double v[TG_MAXCOL];
+    char *line;
+    if (!next_line(r, &line))
+        return rt_errf(err, errlen, VFX_ERR_FORMAT,
+                       "%s: truncated: %u of %u tetrahedra", r->name, t, out->tet_count);
+    int n = parse_numbers(line, v, TG_MAXCOL);
+    if (n != cols)
+        return rt_errf(err, errlen, VFX_ERR_FORMAT,
+                       "%s:%d: tetrahedron %u has %d numbers, expected %d", r->name,
+                       r->line, t, n, cols);
+    for (int k = 0; k < 4; k++) {
+        double idx = v[1 + k] - base;
+        if (!(idx >= 0 && idx < (double)out->point_count) || idx != (double)(uint32_t)idx)
+            return rt_errf(err, errlen, VFX_ERR_FORMAT,
+                           "%s:%d: tetrahedron %u vertex %d index %g out of range "
+                           "(%u points, %d-based)", r->name, r->line, t, k, v[1 + k], out->point_count, base);
+        out->tets[4 * (size_t)t + k] = (uint32_t)idx;
+    }
+    return VFX_OK;
+}
+
+/* The .ele file: the tetrahedra over out's points, numbered from base. */
+static vfx_result read_ele(const char *path, int base, tet_mesh *out, char *err, size_t errlen)
+{
+    char *buf = NULL;
+    size_t sz;
+    vfx_result res = read_whole(path, &buf, &sz, err, errlen);
+    if (res)
+        return res;
+    tg_reader r = {buf, buf, 0, path};
+    double nt = 0;
+    int cols = 0;
+    if ((res = ele_header(&r, sz, &nt, &cols, err, errlen)))
+        goto done;
+    out->tet_count = (uint32_t)nt;
+    out->tets = malloc(sizeof(uint32_t) * 4 * (size_t)nt);
+    if (!out->tets) {
+        res = rt_errf(err, errlen, VFX_ERR_OUT_OF_MEMORY,
+                      "%s: out of memory for %u tetrahedra", path, out->tet_count);
+        goto done;
+    }
+    for (uint32_t t = 0; t < out->tet_count && !res; t++)
+        res = ele_tet(&r, t, cols, base, out, err, errlen);
+done:
+    free(buf);
+    return res;
+}
+
 vfx_result rt_volume_load_tetgen(const char *path_base, const char *scalar_name,
                                tet_mesh *out, char *err, size_t errlen)
 {
@@ -93,202 +302,21 @@ vfx_result rt_volume_load_tetgen(const char *path_base, const char *scalar_name,
         snprintf(err, errlen, "%s: out of memory for the path", path_base);
         return VFX_ERR_OUT_OF_MEMORY;
     }
-    vfx_result res = VFX_OK;
-    char *nodebuf = NULL, *elebuf = NULL;
-    double v[TG_MAXCOL];
-    size_t sz;
-    char *line;
-
-    snprintf(path, plen + 8, "%s.node", path_base);
-    if ((res = read_whole(path, &nodebuf, &sz, err, errlen)))
-        goto done;
-    tg_reader r = {nodebuf, nodebuf, 0, path};
-    int n;
-    if (!next_line(&r, &line) || (n = parse_numbers(line, v, TG_MAXCOL)) < 1) {
-        snprintf(err, errlen, "%s: missing or bad header line", path);
-        res = VFX_ERR_FORMAT;
-        goto done;
-    }
-    double np = v[0], dim = n > 1 ? v[1] : 3, nattr = n > 2 ? v[2] : 0, nmark = n > 3 ? v[3] : 0;
-    if (np < 4 || np > 1e9 || dim != 3 || nattr < 0 || nattr > TG_MAXCOL - 5 || nmark < 0 ||
-        nmark > 1 || !whole(np) || !whole(nattr) || !whole(nmark)) {
-        snprintf(err, errlen,
-                 "%s:%d: bad header (points %g, dimension %g, attributes %g, markers %g)", path,
-                 r.line, np, dim, nattr, nmark);
-        res = VFX_ERR_FORMAT;
-        goto done;
-    }
-    if (np > RT_VOLUME_MAX_POINTS) {
-        snprintf(err, errlen, "%s: header claims %.0f points, above the cap of %u "
-                 "(RT_VOLUME_MAX_POINTS)", path, np, RT_VOLUME_MAX_POINTS);
-        res = VFX_ERR_FORMAT;
-        goto done;
-    }
-    /* Every point takes a line of at least 2 bytes: a header claiming more points than that is
-     * truncated, refused before allocating for the claimed count (found by fuzz_tetgen: a
-     * 9-byte file asked for 12 GB). Loose on purpose: near misses get the exact "i of n". */
-    if (np > (double)sz / 2) {
-        snprintf(err, errlen, "%s: truncated: header claims %g points, file has %zu bytes", path,
-                 np, sz);
-        res = VFX_ERR_FORMAT;
-        goto done;
-    }
-    int attr_index = -1;
-    if (scalar_name) {
-        int k = 0;
-        if (*scalar_name && (sscanf(scalar_name, "attr%d", &k) != 1 || k < 0)) {
-            snprintf(err, errlen, "%s: scalar field '%s' not found; present: attr0..attr%d",
-                     path, scalar_name, (int)nattr - 1);
-            res = VFX_ERR_NOT_FOUND;
-            goto done;
-        }
-        if (k >= (int)nattr) {
-            if (nattr > 0)
-                snprintf(err, errlen, "%s: scalar field '%s' not found; present: attr0..attr%d",
-                         path, scalar_name, (int)nattr - 1);
-            else
-                snprintf(err, errlen, "%s: scalar field '%s' not found; the file has no node "
-                         "attributes", path, scalar_name);
-            res = VFX_ERR_NOT_FOUND;
-            goto done;
-        }
-        attr_index = k;
-    }
-    out->point_count = (uint32_t)np;
-    out->points = malloc(sizeof(float) * 3 * (size_t)np);
-    if (attr_index >= 0) {
-        out->scalar = malloc(sizeof(float) * (size_t)np);
-        snprintf(out->scalar_name, sizeof out->scalar_name, "attr%d", attr_index);
-    }
-    if (!out->points || (attr_index >= 0 && !out->scalar)) {
-        snprintf(err, errlen, "%s: out of memory for %u points", path, out->point_count);
-        res = VFX_ERR_OUT_OF_MEMORY;
-        goto done;
-    }
     int base = 0;
-    int cols = 4 + (int)nattr + (int)nmark;
-    for (uint32_t i = 0; i < out->point_count; i++) {
-        if (!next_line(&r, &line)) {
-            snprintf(err, errlen, "%s: truncated: %u of %u points", path, i, out->point_count);
-            res = VFX_ERR_FORMAT;
-            goto done;
-        }
-        n = parse_numbers(line, v, TG_MAXCOL);
-        if (n != cols) {
-            snprintf(err, errlen, "%s:%d: point %u has %d numbers, expected %d", path, r.line, i,
-                     n, cols);
-            res = VFX_ERR_FORMAT;
-            goto done;
-        }
-        if (i == 0) {
-            if (v[0] != 0 && v[0] != 1) {
-                snprintf(err, errlen, "%s:%d: first point index %g is neither 0 nor 1", path,
-                         r.line, v[0]);
-                res = VFX_ERR_FORMAT;
-                goto done;
-            }
-            base = (int)v[0];
-        }
-        if (v[0] != (double)i + base) {
-            snprintf(err, errlen, "%s:%d: point index %g, expected %u", path, r.line, v[0],
-                     i + base);
-            res = VFX_ERR_FORMAT;
-            goto done;
-        }
-        /* Checked here, as float32, so the message has the file and line (1e39 is finite as a
-         * double and Inf as the float the renderer uses). */
-        for (int k = 0; k < 3; k++) {
-            out->points[3 * (size_t)i + k] = (float)v[1 + k];
-            if (!isfinite(out->points[3 * (size_t)i + k])) {
-                snprintf(err, errlen, "%s:%d: point %u coordinate %c = %g is not finite as float32",
-                         path, r.line, i, "xyz"[k], v[1 + k]);
-                res = VFX_ERR_NUMERIC;
-                goto done;
-            }
-        }
-        if (attr_index >= 0) {
-            out->scalar[i] = (float)v[4 + attr_index];
-            if (!isfinite(out->scalar[i])) {
-                snprintf(err, errlen, "%s:%d: point %u attribute %d = %g is not finite as float32",
-                         path, r.line, i, attr_index, v[4 + attr_index]);
-                res = VFX_ERR_NUMERIC;
-                goto done;
-            }
-        }
+    snprintf(path, plen + 8, "%s.node", path_base);
+    vfx_result res = read_node(path, scalar_name, out, &base, err, errlen);
+    if (!res) {
+        snprintf(path, plen + 8, "%s.ele", path_base);
+        res = read_ele(path, base, out, err, errlen);
     }
-
-    snprintf(path, plen + 8, "%s.ele", path_base);
-    if ((res = read_whole(path, &elebuf, &sz, err, errlen)))
-        goto done;
-    r = (tg_reader){elebuf, elebuf, 0, path};
-    if (!next_line(&r, &line) || (n = parse_numbers(line, v, TG_MAXCOL)) < 1) {
-        snprintf(err, errlen, "%s: missing or bad header line", path);
-        res = VFX_ERR_FORMAT;
-        goto done;
+    if (!res) {
+        char inner[256] = "";
+        res = rt_result_from_tet(tet_validate(out, inner, sizeof inner));
+        if (res)
+            snprintf(err, errlen, "%s.node/.ele: %s", path_base, inner);
     }
-    double nt = v[0], npt = n > 1 ? v[1] : 4, neattr = n > 2 ? v[2] : 0;
-    if (nt < 1 || nt > 1e9 || (npt != 4 && npt != 10) || neattr < 0 || neattr > TG_MAXCOL - 12 ||
-        !whole(nt) || !whole(neattr)) {
-        snprintf(err, errlen, "%s:%d: bad header (tetrahedra %g, nodes per tet %g, attributes %g)",
-                 path, r.line, nt, npt, neattr);
-        res = VFX_ERR_FORMAT;
-        goto done;
-    }
-    if (nt > RT_VOLUME_MAX_TETS) {
-        snprintf(err, errlen, "%s: header claims %.0f tetrahedra, above the cap of %u "
-                 "(RT_VOLUME_MAX_TETS)", path, nt, RT_VOLUME_MAX_TETS);
-        res = VFX_ERR_FORMAT;
-        goto done;
-    }
-    /* Same bound for tetrahedra. */
-    if (nt > (double)sz / 2) {
-        snprintf(err, errlen, "%s: truncated: header claims %g tetrahedra, file has %zu bytes",
-                 path, nt, sz);
-        res = VFX_ERR_FORMAT;
-        goto done;
-    }
-    out->tet_count = (uint32_t)nt;
-    out->tets = malloc(sizeof(uint32_t) * 4 * (size_t)nt);
-    if (!out->tets) {
-        snprintf(err, errlen, "%s: out of memory for %u tetrahedra", path, out->tet_count);
-        res = VFX_ERR_OUT_OF_MEMORY;
-        goto done;
-    }
-    cols = 1 + (int)npt + (int)neattr;
-    for (uint32_t t = 0; t < out->tet_count; t++) {
-        if (!next_line(&r, &line)) {
-            snprintf(err, errlen, "%s: truncated: %u of %u tetrahedra", path, t, out->tet_count);
-            res = VFX_ERR_FORMAT;
-            goto done;
-        }
-        n = parse_numbers(line, v, TG_MAXCOL);
-        if (n != cols) {
-            snprintf(err, errlen, "%s:%d: tetrahedron %u has %d numbers, expected %d", path,
-                     r.line, t, n, cols);
-            res = VFX_ERR_FORMAT;
-            goto done;
-        }
-        for (int k = 0; k < 4; k++) {
-            double idx = v[1 + k] - base;
-            if (!(idx >= 0 && idx < np) || idx != (double)(uint32_t)idx) {
-                snprintf(err, errlen, "%s:%d: tetrahedron %u vertex %d index %g out of range "
-                         "(%u points, %d-based)", path, r.line, t, k, v[1 + k], out->point_count,
-                         base);
-                res = VFX_ERR_FORMAT;
-                goto done;
-            }
-            out->tets[4 * (size_t)t + k] = (uint32_t)idx;
-        }
-    }
-    char inner[256] = "";
-    res = rt_result_from_tet(tet_validate(out, inner, sizeof inner));
-    if (res)
-        snprintf(err, errlen, "%s.node/.ele: %s", path_base, inner);
-done:
     if (res != VFX_OK)
         tet_mesh_free(out);
-    free(nodebuf);
-    free(elebuf);
     free(path);
     return res;
 }
