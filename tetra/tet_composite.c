@@ -10,20 +10,6 @@
 #include <math.h>
 #include <stdlib.h>
 
-static int pool_push(seg_pool *p, seg v)
-{
-    if (p->n == p->cap) {
-        size_t nc = p->cap ? p->cap * 2 : 4096;
-        seg *ns = realloc(p->s, nc * sizeof *ns);
-        if (!ns)
-            return -1;
-        p->s = ns;
-        p->cap = nc;
-    }
-    p->s[p->n] = v;
-    return (int)p->n++;
-}
-
 void tet_over(seg *f, const seg *b)
 {
     float t = 1.0f - f->a;
@@ -33,60 +19,94 @@ void tet_over(seg *f, const seg *b)
     f->a += t * b->a;
 }
 
-/* The paper's partial compositing: a merged segment is again a segment. */
-int tet_insert_seg(seg_pool *p, int32_t *head, int32_t *hint, seg v, int partial, float stop,
-                   uint64_t *merged)
+/* Reserves a pool slot (its contents written later, when it stops being a pixel's hint). */
+static int32_t pool_reserve(seg_pool *p)
 {
+    if (p->n == p->cap) {
+        size_t nc = p->cap ? p->cap * 2 : 4096;
+        seg *ns = realloc(p->s, nc * sizeof *ns);
+        if (!ns)
+            return -1;
+        p->s = ns;
+        p->cap = nc;
+    }
+    return (int32_t)p->n++;
+}
+
+/* Makes idx the pixel's hint: the old hint's live copy goes back to its pool slot and idx's is
+ * loaded into open (seg *src: where idx's current contents are, NULL for the pool slot). */
+static void set_hint(seg_pool *p, int32_t *hint, seg *open, int32_t idx, const seg *src)
+{
+    if (idx == *hint)
+        return;
+    seg cur = src ? *src : p->s[idx];
+    if (*hint >= 0)
+        p->s[*hint] = *open;
+    *open = cur;
+    *hint = idx;
+}
+
+/* The paper's partial compositing: a merged segment is again a segment. */
+int tet_insert_seg(seg_pool *p, int32_t *head, int32_t *hint, seg *open, seg v, int partial,
+                   float stop, uint64_t *merged)
+{
+    const int32_t h = *hint;
     int32_t prev = -1, cur = *head;
+#define SEG(i) ((i) == h ? open : &p->s[i])
     /* cells arrive roughly front to back, so the pixel's last inserted segment is usually just
      * in front of the new one: start the walk there. It is always linked: the only unlink (the
-     * chain merge below) happens in an insertion, which then points the hint at the survivor. */
-    if (*hint >= 0 && p->s[*hint].zf < v.zf) {
-        prev = *hint;
-        cur = p->s[prev].next;
+     * chain merge below) happens in an insertion, which then makes the survivor the hint. */
+    if (h >= 0 && open->zf < v.zf) {
+        prev = h;
+        cur = open->next;
     }
-    while (cur >= 0 && p->s[cur].zf < v.zf) {
+    while (cur >= 0 && SEG(cur)->zf < v.zf) {
         prev = cur;
-        cur = p->s[cur].next;
+        cur = SEG(cur)->next;
     }
     if (partial) {
         float eps = TET_TOUCH_EPS * (1.0f + fabsf(v.zf));
         /* never grow a segment that is already opaque past the ERT threshold: its z_back is
          * where the pixel terminated, and growing it would push the termination depth back */
-        if (prev >= 0 && p->s[prev].a < stop && fabsf(p->s[prev].zb - v.zf) <= eps) {
-            seg *ps = &p->s[prev];
+        if (prev >= 0 && SEG(prev)->a < stop && fabsf(SEG(prev)->zb - v.zf) <= eps) {
+            seg *ps = SEG(prev);
             tet_over(ps, &v);
             ps->zb = v.zb;
             (*merged)++;
             /* the grown segment may now touch its successor */
-            if (cur >= 0 && ps->a < stop && fabsf(ps->zb - p->s[cur].zf) <= eps) {
-                tet_over(ps, &p->s[cur]);
-                ps->zb = p->s[cur].zb;
-                ps->next = p->s[cur].next;
+            if (cur >= 0 && ps->a < stop && fabsf(ps->zb - SEG(cur)->zf) <= eps) {
+                const seg *cs = SEG(cur);
+                tet_over(ps, cs);
+                ps->zb = cs->zb;
+                ps->next = cs->next;
             }
-            *hint = prev;
+            set_hint(p, hint, open, prev, ps);
             return 0;
         }
-        if (cur >= 0 && v.a < stop && fabsf(v.zb - p->s[cur].zf) <= eps) {
-            seg *cs = &p->s[cur];
+        if (cur >= 0 && v.a < stop && fabsf(v.zb - SEG(cur)->zf) <= eps) {
+            seg *cs = SEG(cur);
             seg m = v;
             tet_over(&m, cs);
             m.zb = cs->zb;
             m.next = cs->next;
             *cs = m;
             (*merged)++;
-            *hint = cur;
+            set_hint(p, hint, open, cur, cs);
             return 0;
         }
     }
     v.next = cur;
-    int idx = pool_push(p, v);
+    int32_t idx = pool_reserve(p);
     if (idx < 0)
         return -1;
     if (prev >= 0)
-        p->s[prev].next = idx;
+        SEG(prev)->next = idx;
     else
         *head = idx;
+#undef SEG
+    if (h >= 0)
+        p->s[h] = *open;
+    *open = v;
     *hint = idx;
     return 0;
 }
@@ -94,13 +114,16 @@ int tet_insert_seg(seg_pool *p, int32_t *head, int32_t *hint, seg v, int partial
 /* Paper 3.1.1: a pixel is terminated when the opacity of its known segments, composited as if
  * they were contiguous, reaches the threshold; gaps only add opacity, so this is conservative.
  * Returns the ray distance where it terminated, or -1. */
-static float pixel_termination(const seg_pool *p, int32_t head, float thr)
+static float pixel_termination(const worker *w, size_t pix, float thr)
 {
     float a = 0.0f;
-    for (int32_t c = head; c >= 0; c = p->s[c].next) {
-        a += (1.0f - a) * p->s[c].a;
+    const int32_t h = w->hints[pix];
+    for (int32_t c = w->heads[pix]; c >= 0;) {
+        const seg *s = tet_seg_at(&w->pool, &w->open[pix], h, c);
+        a += (1.0f - a) * s->a;
         if (a >= thr)
-            return p->s[c].zb;
+            return s->zb;
+        c = s->next;
     }
     return -1.0f;
 }
@@ -121,7 +144,7 @@ void tet_update_table(shared *sh, worker *w)
             float deep = 0;
             for (int y = y0; y < y1 && term; y++)
                 for (int x = x0; x < x1; x++) {
-                    float z = pixel_termination(&w->pool, w->heads[(size_t)y * W + x],
+                    float z = pixel_termination(w, (size_t)y * W + x,
                                                 X->opts->ert_threshold);
                     if (z < 0) { term = 0; break; }
                     if (z > deep) deep = z;
@@ -153,20 +176,25 @@ void tet_composite_rows(const shared *sh, float *rgba, int y0, int y1)
     for (int y = y0; y < y1; y++)
         for (int x = 0; x < W; x++) {
             size_t pix = (size_t)y * W + x;
-            for (int i = 0; i < nw; i++)
+            const seg *cs[TET_MAX_WORKERS];
+            for (int i = 0; i < nw; i++) {
                 cur[i] = sh->w[i].heads[pix];
+                cs[i] = cur[i] >= 0 ? tet_seg_at(&sh->w[i].pool, &sh->w[i].open[pix], sh->w[i].hints[pix], cur[i]) : NULL;
+            }
             seg acc = {0, 0, 0, 0, 0, 0, -1};
             for (;;) {
                 int bi = -1;
                 float bz = INFINITY;
                 for (int i = 0; i < nw; i++)
-                    if (cur[i] >= 0 && sh->w[i].pool.s[cur[i]].zf < bz) {
-                        bz = sh->w[i].pool.s[cur[i]].zf;
+                    if (cs[i] && cs[i]->zf < bz) {
+                        bz = cs[i]->zf;
                         bi = i;
                     }
                 if (bi < 0) break;
-                tet_over(&acc, &sh->w[bi].pool.s[cur[bi]]);
-                cur[bi] = sh->w[bi].pool.s[cur[bi]].next;
+                tet_over(&acc, cs[bi]);
+                cur[bi] = cs[bi]->next;
+                const worker *wb = &sh->w[bi];
+                cs[bi] = cur[bi] >= 0 ? tet_seg_at(&wb->pool, &wb->open[pix], wb->hints[pix], cur[bi]) : NULL;
             }
             rgba[4 * pix + 0] = acc.r;
             rgba[4 * pix + 1] = acc.g;

@@ -25,6 +25,15 @@ typedef struct seg_pool {
     size_t n, cap;
 } seg_pool;
 
+/* Segment idx of a pixel whose hint (last inserted segment) is hint. The hint's live copy is
+ * the pixel's entry of the worker's dense open array, not its pool slot: the pool is written in
+ * insertion order, so a cell's neighbouring pixels have their hints on scattered cache lines,
+ * while their open entries are neighbours (the insert was the scan's largest cache-miss cost). */
+static inline const seg *tet_seg_at(const seg_pool *p, const seg *open, int32_t hint, int32_t idx)
+{
+    return idx == hint ? open : &p->s[idx];
+}
+
 typedef struct tile {
     int terminated;
     float deepest;
@@ -56,6 +65,13 @@ typedef struct tf_prep {
     float tau[TET_TF_MAX_POINTS];
     float rgb[TET_TF_MAX_POINTS][3];
     double inv_range[TET_TF_MAX_POINTS]; /* 1 / (s[k+1] - s[k]), 0 for an empty piece */
+    /* per breakpoint pair k (n - 1 of them), in doubles on one or two cache lines, what the
+     * exact integrator's piece reads: no float conversions or differences per piece */
+    struct tf_piece {
+        double s0, ir;         /* s[k], inv_range[k] */
+        double tau0, dtau;     /* tau[k], tau[k+1] - tau[k] */
+        double c0[3], dc[3];   /* rgb[k], rgb[k+1] - rgb[k] */
+    } pc[TET_TF_MAX_POINTS];
     int pre_n;                 /* grid cells of the pre-integrated tables */
     double pre_ds;             /* grid spacing in scalar units */
     double *pre_T;             /* pre_n + 1: integral of tau ds from s[0] */
@@ -79,6 +95,7 @@ typedef struct worker {
     _Alignas(64) seg_pool pool;
     int32_t *heads;
     int32_t *hints;         /* per pixel: the segment last inserted (a walk start), or -1 */
+    seg *open;              /* per pixel: the live copy of the hint segment (tet_seg_at) */
     tile *tiles;            /* local ERT table */
     size_t pixels;          /* heads/hints capacity */
     int tiles_cap;          /* tiles capacity */
@@ -133,9 +150,10 @@ int tet_tf_segment(const tf_prep *tf, double S0, double Sb, double tin, double t
 /* ---- tet_composite.c: segment lists, ERT tables, final composite ---- */
 
 /* Inserts v into the pixel list at *head in order of zf, merging touching neighbours when
- * partial is set (never growing a segment past stop). Returns 0, or -1 when out of memory. */
-int tet_insert_seg(seg_pool *p, int32_t *head, int32_t *hint, seg v, int partial, float stop,
-                   uint64_t *merged);
+ * partial is set (never growing a segment past stop); *hint and *open are the pixel's hint and
+ * its live copy (tet_seg_at). Returns 0, or -1 when out of memory. */
+int tet_insert_seg(seg_pool *p, int32_t *head, int32_t *hint, seg *open, seg v, int partial,
+                   float stop, uint64_t *merged);
 /* front-over-back of two premultiplied segments */
 void tet_over(seg *f, const seg *b);
 /* Rebuilds w's ERT table from its lists; with sharing on, merges it with the shared one. */

@@ -144,10 +144,11 @@ static void piece_aw(double ta, double tb, double l, double *alpha, double *w)
     double a, f0, f1, f2, f3; /* alpha, F0 - exp(-x), F1, F2, F3 */
     if (x < 0.1) {
         a = x * (1 - x * (1.0 / 2 - x * (1.0 / 6 - x * (1.0 / 24 - x * (1.0 / 120 - x * (1.0 / 720))))));
-        f0 = x * (1.0 / 2 + x * (-1.0 / 3 + x * (1.0 / 8 + x * (-1.0 / 30 + x * (1.0 / 144 - x / 840)))));
-        f1 = 1.0 / 6 + x * (-1.0 / 12 + x * (1.0 / 40 + x * (-1.0 / 180 + x / 1008)));
-        f2 = 1.0 / 30 + x * (-1.0 / 60 + x * (1.0 / 210 - x / 1008));
-        f3 = 1.0 / 140 - x / 280;
+        /* constants as products: x / 840 would be a division (no -ffast-math) in the chain */
+        f0 = x * (1.0 / 2 + x * (-1.0 / 3 + x * (1.0 / 8 + x * (-1.0 / 30 + x * (1.0 / 144 - x * (1.0 / 840))))));
+        f1 = 1.0 / 6 + x * (-1.0 / 12 + x * (1.0 / 40 + x * (-1.0 / 180 + x * (1.0 / 1008))));
+        f2 = 1.0 / 30 + x * (-1.0 / 60 + x * (1.0 / 210 - x * (1.0 / 1008)));
+        f3 = 1.0 / 140 - x * (1.0 / 280);
     } else {
         const double E = exp(-x), ix = 1.0 / x;
         const double g0 = (1 - E) * ix, g1 = (g0 - E) * ix, g2 = (2 * g1 - E) * ix;
@@ -191,14 +192,14 @@ static int upper_index(const tf_prep *tf, double v)
 static void walk_piece(const tf_prep *tf, int kr, double sf, double sk, double l, double acc[4])
 {
     const int k = kr < 0 ? 0 : kr > tf->n - 2 ? tf->n - 2 : kr;
-    const double ua = clamp01((sf - tf->s[k]) * tf->inv_range[k]);
-    const double ub = clamp01((sk - tf->s[k]) * tf->inv_range[k]);
-    const double dtau = (double)tf->tau[k + 1] - tf->tau[k];
+    const struct tf_piece *pc = &tf->pc[k];
+    const double ua = clamp01((sf - pc->s0) * pc->ir);
+    const double ub = clamp01((sk - pc->s0) * pc->ir);
     double alpha, w;
-    piece_aw(tf->tau[k] + dtau * ua, tf->tau[k] + dtau * ub, l, &alpha, &w);
+    piece_aw(pc->tau0 + pc->dtau * ua, pc->tau0 + pc->dtau * ub, l, &alpha, &w);
     const double beta = ua * alpha + (ub - ua) * w, T = 1.0 - acc[3];
     for (int c = 0; c < 3; c++) {
-        const double v = tf->rgb[k][c] * alpha + ((double)tf->rgb[k + 1][c] - tf->rgb[k][c]) * beta;
+        const double v = pc->c0[c] * alpha + pc->dc[c] * beta;
         acc[c] += T * (v > 0 ? v : 0);
     }
     acc[3] += T * alpha;
@@ -443,6 +444,15 @@ tet_result tet_tf_prepare(const tet_tf *in, tf_prep *tf, char *err, size_t errle
     for (int k = 0; k + 1 < tf->n; k++) {
         double range = (double)tf->s[k + 1] - tf->s[k];
         tf->inv_range[k] = range > 0 ? 1.0 / range : 0.0;
+        struct tf_piece *pc = &tf->pc[k];
+        pc->s0 = tf->s[k];
+        pc->ir = tf->inv_range[k];
+        pc->tau0 = tf->tau[k];
+        pc->dtau = (double)tf->tau[k + 1] - tf->tau[k];
+        for (int c = 0; c < 3; c++) {
+            pc->c0[c] = tf->rgb[k][c];
+            pc->dc[c] = (double)tf->rgb[k + 1][c] - tf->rgb[k][c];
+        }
     }
     /* a piece shorter than a millionth of the domain carries nothing visible; splitting at a
      * breakpoint that close to a segment's end would only perturb the rounding */

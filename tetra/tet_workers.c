@@ -175,9 +175,11 @@ int tet_worker_reset(worker *w, int W, int H, int D)
     if (w->pixels < np) {
         free(w->heads);
         free(w->hints);
+        free(w->open);
         w->heads = malloc(np * sizeof *w->heads);
         w->hints = malloc(np * sizeof *w->hints);
-        w->pixels = w->heads && w->hints ? np : 0;
+        w->open = malloc(np * sizeof *w->open);
+        w->pixels = w->heads && w->hints && w->open ? np : 0;
         if (!w->pixels)
             return -1;
     }
@@ -202,9 +204,11 @@ void tet_worker_free(worker *w)
 {
     free(w->heads);
     free(w->hints);
+    free(w->open);
     free(w->tiles);
     free(w->pool.s);
     w->heads = w->hints = NULL;
+    w->open = NULL;
     w->tiles = NULL;
     w->pool.s = NULL;
     w->pool.n = w->pool.cap = 0;
