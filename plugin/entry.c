@@ -10,6 +10,9 @@
 #include "effect.h"
 #include "context.h"
 #include "frame_check.h"
+#if VFX_WITH_BEAMS
+#include "beams/beams_impact.h"
+#endif
 
 /* --------------------------------------------------------------------- lifecycle */
 
@@ -297,6 +300,25 @@ static vfx_result plugin_warm_up(vfx_context *ctx, const vfx_frame_view *frame)
     return r;
 }
 
+/* The lights of the effects as of the last update (only the beams cast any). */
+static vfx_result plugin_get_lights(vfx_context *ctx, vfx_lights *out)
+{
+    if (!ctx)
+        return VFX_ERR_INVALID_ARGUMENT;
+    if (!out || out->version != VFX_LIGHTS_VERSION || out->size < sizeof *out || (out->capacity && !out->lights))
+        return volfx_fail(ctx, VFX_ERR_ABI, "get_lights: lights of version %u, size %u, capacity %u, array %s "
+                          "(this plugin reads version %u of size %zu with a non-NULL array when capacity > 0)",
+                          out ? out->version : 0, out ? out->size : 0, out ? out->capacity : 0,
+                          out && out->lights ? "set" : "NULL", VFX_LIGHTS_VERSION, sizeof *out);
+    out->count = out->total = 0;
+#if VFX_WITH_BEAMS
+    volfx_beams_impact *im = volfx_beams_impact_of(ctx);
+    if (im)
+        volfx_beams_impact_lights(im, out);
+#endif
+    return VFX_OK;
+}
+
 VFX_EXPORT vfx_result vfx_plugin_entry(uint32_t abi_version, const vfx_host_api *host,
                                        vfx_plugin_api *out)
 {
@@ -314,10 +336,13 @@ VFX_EXPORT vfx_result vfx_plugin_entry(uint32_t abi_version, const vfx_host_api 
             host->log(host->user, VFX_LOG_ERROR, "volfx: plugin api struct too small or NULL");
         return VFX_ERR_ABI;
     }
-    const bool v2 = out->size >= sizeof(vfx_plugin_api2);
-    memset(out, 0, v2 ? sizeof(vfx_plugin_api2) : sizeof *out);
-    out->size = v2 ? sizeof(vfx_plugin_api2) : sizeof *out;
-    out->version = v2 ? VFX_PLUGIN_API2_VERSION : VFX_PLUGIN_API_VERSION;
+    const bool v2 = out->size >= sizeof(vfx_plugin_api2), v3 = out->size >= sizeof(vfx_plugin_api3);
+    const size_t size = v3 ? sizeof(vfx_plugin_api3) : v2 ? sizeof(vfx_plugin_api2) : sizeof *out;
+    memset(out, 0, size);
+    out->size = (uint32_t)size;
+    out->version = v3 ? VFX_PLUGIN_API3_VERSION : v2 ? VFX_PLUGIN_API2_VERSION : VFX_PLUGIN_API_VERSION;
+    if (v3)
+        ((vfx_plugin_api3 *)out)->get_lights = plugin_get_lights;
     if (v2) {
         vfx_plugin_api2 *a2 = (vfx_plugin_api2 *)out;
         a2->set_program_cache = plugin_set_program_cache;

@@ -8,6 +8,7 @@
 
 #include "beams/beam_field.h"
 #include "beams/beams_bin.h"
+#include "beams/beams_impact.h"
 #include "gpu/gpu.h"
 #include "gpu/pass.h"
 #include "effect.h"
@@ -52,6 +53,8 @@ typedef struct beams_state {
     volfx_beams_grid grid;                /* the target in pixels and tiles */
     vfx_beams_view2 view;                 /* the host's answer; v1 answers padded with defaults */
     double time;
+    float dt;
+    volfx_beams_impact *impact;           /* flares, sparks, glow, lights (beams_impact.h) */
     volfx_beam_d *beams;        /* validated, normalised */
     beam_look *looks;
     beam_gpu *gpu;
@@ -116,6 +119,7 @@ static void beams_destroy(vfx_context *ctx, void *state)
     glDeleteFramebuffers(1, &s->acc_fbo);
     free_bloom(s);
     volfx_ubo_destroy(&s->ubo);
+    volfx_beams_impact_destroy(ctx, s->impact);
     free_per_beam(ctx, s);
     volfx_free(ctx, s->ranges);
     volfx_free(ctx, s->cones);
@@ -135,6 +139,11 @@ static vfx_result beams_create(vfx_context *ctx, void **out)
         || !volfx_ubo_create(ctx, &s->ubo, sizeof(beams_block), "beams.frame")) {
         beams_destroy(ctx, s);
         return VFX_ERR_GL;
+    }
+    vfx_result ir = volfx_beams_impact_create(ctx, &s->impact);
+    if (ir) {
+        beams_destroy(ctx, s);
+        return ir;
     }
     GLuint bufs[4];
     glCreateBuffers(4, bufs);
@@ -229,7 +238,6 @@ static vfx_result beam_look_of(vfx_context *ctx, uint32_t i, const vfx_beam2 *b2
 
 static vfx_result beams_update(vfx_context *ctx, void *state, double time, float dt)
 {
-    (void)dt;
     beams_state *s = state;
     vfx_beams_view2 v;
     vfx_result r = query_view(ctx, &v);
@@ -265,6 +273,8 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
         if (!s->capacity)
             return VFX_ERR_OUT_OF_MEMORY;
     }
+    if (!volfx_beams_impact_set_count(ctx, s->impact, n))
+        return VFX_ERR_OUT_OF_MEMORY;
     char err[200];
     for (uint32_t i = 0; i < n; ++i) {
         const vfx_beam *b = b2 ? &b2[i].v1 : &v.v1.beams[i];
@@ -292,10 +302,13 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
         bool none = c[0] == 0 && c[1] == 0 && c[2] == 0;
         for (int k = 0; k < 4; ++k)
             s->looks[i].color[k] = none ? 1.f : c[k];
+        volfx_beams_impact_set_beam(s->impact, i, &s->beams[i], s->looks[i].color,
+                                    s->looks[i].intensity * exp2f(s->looks[i].exposure));
     }
     s->count = n;
     s->view = v;
     s->time = time;
+    s->dt = dt;
     return VFX_OK;
 }
 
@@ -510,6 +523,8 @@ static vfx_result gl_passes(vfx_context *ctx, beams_state *s, volfx_frame_target
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->joint_buf);
     volfx_gpu_fullscreen(ctx);
     volfx_pass_end(ctx);
+    if ((r = volfx_beams_impact_render(ctx, s->impact, t, s->light_tex, s->time, s->dt)))
+        return r;
     if (bloom)
         bloom_passes(ctx, s, levels);
     volfx_stat_set(ctx, "beams.bloom_levels", bloom ? levels : 0);
@@ -538,6 +553,12 @@ static vfx_result beams_read_raw(vfx_context *ctx, void *state, float *out, size
     if (count < n)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams read_raw: %zu floats < %zu", count, n);
     return volfx_gpu_read_top_first(ctx, s->acc_tex, GL_RED, 1, 0, s->grid.width, s->grid.height, out);
+}
+
+volfx_beams_impact *volfx_beams_impact_of(vfx_context *ctx)
+{
+    beams_state *s = ctx->effect_state[VFX_EFFECT_BEAMS];
+    return s ? s->impact : NULL;
 }
 
 const volfx_effect_ops volfx_beams_ops = {

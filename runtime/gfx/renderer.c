@@ -323,6 +323,13 @@ void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float 
     glBindVertexArray(0);
 }
 
+void rt_renderer_get_targets(const rt_renderer *r, rt_renderer_targets *out)
+{
+    *out = (rt_renderer_targets){.output_framebuffer = r->out_fbo, .scene_color = r->scene_color,
+                                 .scene_depth = r->scene_depth, .width = r->width, .height = r->height,
+                                 .color_hdr = r->hdr};
+}
+
 void rt_renderer_end_scene(rt_renderer *r, rt_renderer_targets *out)
 {
     glPopDebugGroup();
@@ -332,9 +339,7 @@ void rt_renderer_end_scene(rt_renderer *r, rt_renderer_targets *out)
     glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
     glDisable(GL_DEPTH_TEST);
     glUseProgram(0);
-    *out = (rt_renderer_targets){.output_framebuffer = r->out_fbo, .scene_color = r->scene_color,
-                                 .scene_depth = r->scene_depth, .width = r->width, .height = r->height,
-                                 .color_hdr = r->hdr};
+    rt_renderer_get_targets(r, out);
 }
 
 vfx_result rt_renderer_read_rgba(rt_renderer *r, uint8_t *rgba)

@@ -49,6 +49,8 @@ typedef struct rt_renderer_targets {
     bool color_hdr; /* colour targets are RGBA16F linear radiance (rt_renderer_set_hdr) */
 } rt_renderer_targets;
 
+/* The targets as rt_renderer_end_scene reports them, without drawing (tests read them back). */
+void rt_renderer_get_targets(const rt_renderer *r, rt_renderer_targets *out);
 /* Copies scene colour and depth into the output target and says where they are. */
 void rt_renderer_end_scene(rt_renderer *r, rt_renderer_targets *out);
 /* HDR mode on or off (off at creation): colour targets RGBA16F holding linear radiance,

@@ -571,8 +571,64 @@ typedef struct vfx_plugin_api2 {
     void *_reserved[6];
 } vfx_plugin_api2;
 
+/* ---------------------------------------------------------------------- lights */
+
+/* A light an effect casts on the host's scene (issue 25: each beam's body, head and impact), for
+ * hosts that light their own meshes with it (docs/integration.md "Lights"). Positions are
+ * relative to the frame's origin, like every position the host gives. */
+typedef enum vfx_light_kind {
+    VFX_LIGHT_POINT = 0, /* at p0 (p1 = p0): irradiance I cos(theta) / d^2 */
+    VFX_LIGHT_LINE = 1,  /* the segment p0..p1, isotropic, I per unit length: the integral of
+                            I cos(theta) / d^2 over the segment */
+} vfx_light_kind;
+
+typedef enum vfx_light_source {
+    VFX_LIGHT_BEAM_BODY = 0,   /* a beam's trail (one segment of a bending beam) */
+    VFX_LIGHT_BEAM_HEAD = 1,   /* a beam's head (its orb) */
+    VFX_LIGHT_BEAM_IMPACT = 2, /* where a beam meets the host's depth (read back 1-3 frames late) */
+} vfx_light_source;
+
+#define VFX_LIGHT_VERSION 1u
+typedef struct vfx_light {
+    uint32_t kind;       /* vfx_light_kind */
+    uint32_t source;     /* vfx_light_source */
+    uint32_t index;      /* the beam's index in the host's beams view */
+    float radius;        /* past this distance from the light its irradiance is below 1/256 of
+                            its irradiance at 1 unit: a host may leave it out there */
+    float p0[3], p1[3];  /* endpoints (relative to the frame's origin); p1 = p0 for a point */
+    float color[3];      /* linear RGB, largest component 1 */
+    float intensity;     /* I: radiant intensity (point) or intensity per unit length (line) */
+    uint32_t _reserved[4];
+} vfx_light;
+
+/* The host's array for get_lights: size = sizeof(vfx_lights), version = VFX_LIGHTS_VERSION,
+ * capacity entries of vfx_light (version VFX_LIGHT_VERSION) at lights. */
+#define VFX_LIGHTS_VERSION 1u
+typedef struct vfx_lights {
+    uint32_t size, version;
+    uint32_t capacity;   /* entries at lights */
+    uint32_t count;      /* out: entries written (<= capacity) */
+    uint32_t total;      /* out: lights the plugin had (more than count when capacity fell short) */
+    uint32_t _reserved0;
+    vfx_light *lights;
+    uint32_t _reserved[4];
+} vfx_lights;
+
+/* Version 3 of the plugin api: version 2 as its first member (never edited), then the lights.
+ * A host that knows it sets v2.v1.size = sizeof(vfx_plugin_api3) and passes &api.v2.v1; a plugin
+ * that knows it fills all of it and answers version 3 (an older one answers 1 or 2). */
+#define VFX_PLUGIN_API3_VERSION 3u
+typedef struct vfx_plugin_api3 {
+    vfx_plugin_api2 v2;
+    /* The lights of the effects as of the last update (beams: body and head of this update,
+     * impacts as last read back from the GPU), for the host to light its meshes with before it
+     * draws them. Call after update. */
+    vfx_result (*get_lights)(vfx_context *ctx, vfx_lights *out);
+    void *_reserved[7];
+} vfx_plugin_api3;
+
 /* The one exported symbol. The host passes its ABI version; out->size must be set by the host
- * to sizeof(vfx_plugin_api) it knows (or sizeof(vfx_plugin_api2): see there). A different ABI version is refused (VFX_ERR_ABI) with a
+ * to sizeof(vfx_plugin_api) it knows (or sizeof(vfx_plugin_api2) or sizeof(vfx_plugin_api3): see there). A different ABI version is refused (VFX_ERR_ABI) with a
  * message naming both versions through host->log. */
 typedef vfx_result (*vfx_plugin_entry_fn)(uint32_t abi_version, const vfx_host_api *host,
                                           vfx_plugin_api *out);

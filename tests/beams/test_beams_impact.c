@@ -1,0 +1,373 @@
+/* Beam impacts (issue 25) through the real host on llvmpipe: the hit of a beam with the host's
+ * depth found on the GPU against a float64 march of the same depth buffer read back (and the
+ * floor's plane, analytically), a beam that only passes behind a pillar makes no impact, sparks
+ * never go below a flat floor's depth, the counts stay bounded and agree with the pools, and the
+ * lights of api3. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <epoxy/gl.h>
+
+#include "app.h"
+#include "beams/beams_impact.h"
+#include "debug.h"
+#include "test_camera.h"
+#include "test_util.h"
+
+#define W 96
+#define H 64
+#define DT (1.f / 30.f)
+
+static game_app *g_app;
+static test_log g_log;
+/* the camera the host renders with; the reference marches its rays in float64 */
+static const ref_camera g_cam = {{0.3, 2.2, 3.0}, {0, 0, 0}, {0, 1, 0}, 1.0, W, H, 0.05, 50};
+
+/* A beam from src (its source) whose head is at head (its front, which strikes). */
+static vfx_beam beam_from_to(const double src[3], const double head[3], float radius)
+{
+    vfx_beam b = {.radius = radius, .a = 0.6f, .b = 0.4f, .eps = 0.05f, .color = {1.f, 0.5f, 0.2f, 1.f}};
+    double d[3], l = 0;
+    for (int k = 0; k < 3; ++k)
+        d[k] = src[k] - head[k], l += d[k] * d[k];
+    l = sqrt(l);
+    for (int k = 0; k < 3; ++k)
+        b.head[k] = (float)head[k], b.dir[k] = (float)(d[k] / l);
+    b.length = (float)l;
+    return b;
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    memset(&g_log, 0, sizeof g_log);
+    game_app_desc d = {.mode = RT_GL_HEADLESS, .width = W, .height = H, .logger = {test_log_fn, &g_log}};
+    if (game_app_create(&d, &g_app) != VFX_OK)
+        exit(VFX_TEST_SKIP);
+    rt_camera cam = test_rt_camera(&g_cam);
+    assert_int_equal(game_app_set_camera(g_app, &cam), VFX_OK);
+    const float grey[3] = {0.5f, 0.5f, 0.5f};
+    /* the floor, top at y = 0; a pillar at x = 1.2 in front of z = 0 */
+    assert_int_equal(game_app_add_box(g_app, (float[3]){-6, -0.2f, -6}, (float[3]){6, 0, 6}, grey, NULL), VFX_OK);
+    assert_int_equal(game_app_add_box(g_app, (float[3]){1.1f, 0, 0.9f}, (float[3]){1.3f, 1.6f, 1.1f}, grey, NULL),
+                     VFX_OK);
+    g_app->beams_view = (vfx_beams_view){.size = sizeof(vfx_beams_view), .version = VFX_BEAMS_VIEW_VERSION};
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    game_app_destroy(g_app);
+    return 0;
+}
+
+/* ------------------------------------------------ the float64 reference: a march of the depth */
+
+typedef struct depth_ref {
+    const ref_camera *cam;
+    const float *depth; /* W x H, GL rows (bottom first) */
+} depth_ref;
+
+/* The surface seen at pixel (i, jb) (jb from the bottom), from its depth: false for the far plane. */
+static bool ref_surface(const depth_ref *r, int i, int jb, double S[3])
+{
+    float d = r->depth[(size_t)jb * W + i];
+    if (d >= 1.f)
+        return false;
+    double f[3], rt[3], up[3], dir[3];
+    ref_camera_basis(r->cam, f, rt, up);
+    ref_pixel_ray(r->cam, (uint32_t)i, (uint32_t)(H - 1 - jb), dir);
+    double n = r->cam->near_plane, fa = r->cam->far_plane, z = 2.0 * d - 1.0;
+    double ze = 2.0 * fa * n / ((fa + n) - z * (fa - n)); /* view depth of a GL perspective */
+    double t = ze / (dir[0] * f[0] + dir[1] * f[1] + dir[2] * f[2]);
+    for (int k = 0; k < 3; ++k)
+        S[k] = r->cam->eye[k] + t * dir[k];
+    return true;
+}
+
+/* 0 unknown, 1 in front, 2 behind the tangent plane of the surface at P's pixel (the shader's
+ * rule, impact_depth.glsl, in float64). */
+static int ref_classify(const depth_ref *r, const double P[3], double S[3], double nrm[3])
+{
+    double f[3], rt[3], up[3], q[3];
+    ref_camera_basis(r->cam, f, rt, up);
+    for (int k = 0; k < 3; ++k)
+        q[k] = P[k] - r->cam->eye[k];
+    double zc = q[0] * f[0] + q[1] * f[1] + q[2] * f[2];
+    if (!(zc > 0))
+        return 0;
+    double t = tan(r->cam->fov_y * 0.5);
+    double nx = (q[0] * rt[0] + q[1] * rt[1] + q[2] * rt[2]) / (zc * t * W / H);
+    double ny = (q[0] * up[0] + q[1] * up[1] + q[2] * up[2]) / (zc * t);
+    if (fabs(nx) > 1 || fabs(ny) > 1)
+        return 0;
+    int i = (int)fmin(floor((nx * 0.5 + 0.5) * W), W - 1), jb = (int)fmin(floor((ny * 0.5 + 0.5) * H), H - 1);
+    if (!ref_surface(r, i, jb, S))
+        return 0;
+    double d[2][3];
+    for (int a = 0; a < 2; ++a) {
+        int di = a == 0, dj = a == 1;
+        double A[3], B[3];
+        bool ha = (a == 0 ? i < W - 1 : jb < H - 1) && ref_surface(r, i + di, jb + dj, A);
+        bool hb = (a == 0 ? i > 0 : jb > 0) && ref_surface(r, i - di, jb - dj, B);
+        double da2 = 0, db2 = 0;
+        for (int k = 0; k < 3; ++k)
+            da2 += (A[k] - S[k]) * (A[k] - S[k]) * ha, db2 += (S[k] - B[k]) * (S[k] - B[k]) * hb;
+        for (int k = 0; k < 3; ++k)
+            d[a][k] = ha && (!hb || da2 <= db2) ? A[k] - S[k] : (hb ? S[k] - B[k] : 0.0);
+    }
+    nrm[0] = d[0][1] * d[1][2] - d[0][2] * d[1][1];
+    nrm[1] = d[0][2] * d[1][0] - d[0][0] * d[1][2];
+    nrm[2] = d[0][0] * d[1][1] - d[0][1] * d[1][0];
+    double l = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]), side = 0, behind = 0;
+    for (int k = 0; k < 3; ++k)
+        nrm[k] /= l, side += nrm[k] * (S[k] - r->cam->eye[k]);
+    for (int k = 0; k < 3; ++k)
+        nrm[k] *= side > 0 ? -1 : 1, behind += (P[k] - S[k]) * nrm[k];
+    return behind < 0 ? 2 : 1;
+}
+
+/* The first front-to-behind crossing along src -> head -> R past it, bisected in float64. */
+static bool ref_hit(const depth_ref *r, const double src[3], const double head[3], double R, double hit[3])
+{
+    double axis[3], len = 0;
+    for (int k = 0; k < 3; ++k)
+        axis[k] = head[k] - src[k], len += axis[k] * axis[k];
+    len = sqrt(len);
+    double total = len + R, S[3], n[3], prev[3] = {src[0], src[1], src[2]};
+    int pc = ref_classify(r, prev, S, n);
+    for (int j = 1; j <= 4096; ++j) { /* finer than the GPU's 128: the first crossing all the same */
+        double s = total * j / 4096.0, Q[3];
+        for (int k = 0; k < 3; ++k)
+            Q[k] = src[k] + axis[k] / len * s;
+        int c = ref_classify(r, Q, S, n);
+        if (pc == 1 && c == 2) {
+            double a[3], b[3];
+            memcpy(a, prev, sizeof a), memcpy(b, Q, sizeof b);
+            for (int it = 0; it < 60; ++it) {
+                double m[3];
+                for (int k = 0; k < 3; ++k)
+                    m[k] = 0.5 * (a[k] + b[k]);
+                int cm = ref_classify(r, m, S, n);
+                if (cm == 0)
+                    return false;
+                memcpy(cm == 2 ? b : a, m, sizeof m);
+            }
+            for (int k = 0; k < 3; ++k)
+                hit[k] = 0.5 * (a[k] + b[k]);
+            return true;
+        }
+        memcpy(prev, Q, sizeof prev);
+        pc = c;
+    }
+    return false;
+}
+
+static float *read_depth(void)
+{
+    rt_renderer_targets tg;
+    rt_renderer_get_targets(g_app->renderer, &tg);
+    float *d = malloc(sizeof(float) * W * H);
+    assert_non_null(d);
+    glGetTextureImage(tg.scene_depth, 0, GL_DEPTH_COMPONENT, GL_FLOAT, (GLsizei)(sizeof(float) * W * H), d);
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    return d;
+}
+
+static double stat(const char *name)
+{
+    vfx_stats2 st = {.size = sizeof st, .version = VFX_STATS2_VERSION};
+    assert_int_equal(g_app->api->get_stats(g_app->ctx, (vfx_stats *)&st), VFX_OK);
+    for (uint32_t i = 0; i < st.count; ++i)
+        if (!strcmp(st.entries[i].name, name))
+            return st.entries[i].value;
+    fail_msg("stat %s not set", name);
+    return 0;
+}
+
+/* ------------------------------------------------------------------------------ tests */
+
+/* A beam struck into the floor at an angle: the GPU's hit against the float64 march of the same
+ * depth buffer, and against the floor's plane y = 0. Tolerances: both converge to the plane the
+ * depth-reconstructed points span (the crossing is judged against the tangent plane, not the
+ * pixel), so they differ by the float32 reconstruction of that plane: DEPTH32F near 1 keeps 2^-24
+ * in window depth, dz = z^2/near x 2^-24 = 1e-5 m at 3.3 m, and the float32 unprojection adds a
+ * few ulps of 3 m; 1e-3 m along a 45-degree beam covers 30x that. Against the analytic plane the
+ * tangent plane of a pixel's neighbours is the floor's up to the same depth error: 2e-3 m. */
+static void test_hit_matches_reference(void **state)
+{
+    (void)state;
+    const double src[3] = {-1.5, 1.5, 0.2}, head[3] = {0.1, -0.1, 0.2}, R = 0.25;
+    g_app->beams[0] = beam_from_to(src, head, (float)R);
+    g_app->beam_count = 1;
+    assert_int_equal(game_app_frame(g_app, DT), VFX_OK);
+    volfx_beams_impact *im = volfx_beams_impact_of(g_app->ctx);
+    assert_non_null(im);
+    float gpu[1][8];
+    assert_int_equal(volfx_beams_impact_debug_hits(im, gpu, 1), 1);
+    assert_true(gpu[0][3] == 1.f);
+    float *depth = read_depth();
+    depth_ref r = {&g_cam, depth};
+    double ref[3];
+    assert_true(ref_hit(&r, src, head, R, ref));
+    free(depth);
+    double e_ref = 0, e_plane = 0;
+    /* the analytic hit: src + s (head - src) at y = 0 */
+    double s = src[1] / (src[1] - head[1]), plane[3];
+    for (int k = 0; k < 3; ++k) {
+        plane[k] = src[k] + s * (head[k] - src[k]);
+        e_ref = fmax(e_ref, fabs(gpu[0][k] - ref[k]));
+        e_plane = fmax(e_plane, fabs(gpu[0][k] - plane[k]));
+    }
+    printf("hit gpu (%.6f %.6f %.6f) ref (%.6f %.6f %.6f) |gpu-ref| %.2e |gpu-plane| %.2e normal (%.4f %.4f %.4f)\n",
+           gpu[0][0], gpu[0][1], gpu[0][2], ref[0], ref[1], ref[2], e_ref, e_plane, gpu[0][4], gpu[0][5], gpu[0][6]);
+    assert_true(e_ref < 1e-3);
+    assert_true(e_plane < 2e-3);
+    /* the floor's normal: float32 differences of neighbouring reconstructed points */
+    assert_true(fabs(gpu[0][5] - 1.0) < 1e-3);
+}
+
+/* A beam whose head stops in the air, and one that passes behind the pillar and ends in the air
+ * beyond it: no impact (the second crosses the pillar's depth, but not its surface). */
+static void test_no_false_hit(void **state)
+{
+    (void)state;
+    const double src[3] = {-1.5, 1.2, 0.0}, head[3] = {0.0, 1.0, 0.0};
+    g_app->beams[0] = beam_from_to(src, head, 0.2f);
+    /* behind the pillar (x 1.1..1.3, z 0.9..1.1) as the camera at z = 3 sees it: z = -0.5 */
+    const double s2[3] = {0.6, 0.8, -0.5}, h2[3] = {2.2, 0.8, -0.5};
+    g_app->beams[1] = beam_from_to(s2, h2, 0.1f);
+    g_app->beam_count = 2;
+    assert_int_equal(game_app_frame(g_app, DT), VFX_OK);
+    float gpu[2][8];
+    assert_int_equal(volfx_beams_impact_debug_hits(volfx_beams_impact_of(g_app->ctx), gpu, 2), 2);
+    assert_true(gpu[0][3] == 0.f);
+    assert_true(gpu[1][3] == 0.f);
+}
+
+/* Sparks from a beam struck into the floor, 45 frames at 30 Hz: none ever below the floor's
+ * top (y = 0). A spark is put back on the tangent plane the depth gives, 3 mm above it; the
+ * plane's error is the depth's (1e-5 m, above), so -1e-3 m has 100x room. Some sparks must
+ * reach the floor (they fall), so the test is not passed by sparks that never come down. */
+static void test_sparks_stay_above_floor(void **state)
+{
+    (void)state;
+    const double src[3] = {-1.5, 1.5, 0.2}, head[3] = {0.1, -0.1, 0.2};
+    g_app->beams[0] = beam_from_to(src, head, 0.25f);
+    g_app->beam_count = 1;
+    static float sp[VOLFX_IMPACT_MAX_SPARKS][12];
+    uint32_t near_floor = 0, live_max = 0;
+    double lowest = 1e9;
+    for (int f = 0; f < 45; ++f) {
+        assert_int_equal(game_app_frame(g_app, DT), VFX_OK);
+        uint32_t n = volfx_beams_impact_debug_sparks(volfx_beams_impact_of(g_app->ctx), sp, VOLFX_IMPACT_MAX_SPARKS);
+        uint32_t live = 0;
+        for (uint32_t i = 0; i < n; ++i) {
+            if (!(sp[i][7] > 0) || sp[i][3] >= sp[i][7])
+                continue;
+            live++;
+            lowest = fmin(lowest, sp[i][1]);
+            near_floor += sp[i][1] < 0.02f && sp[i][3] > 0.2f;
+            if (sp[i][1] < -1e-3f)
+                fail_msg("frame %d: spark %u at (%g %g %g), below the floor", f, i, (double)sp[i][0], (double)sp[i][1], (double)sp[i][2]);
+        }
+        live_max = live > live_max ? live : live_max;
+    }
+    printf("sparks: at most %u alive, lowest y %.5f, %u spark-frames on the floor\n", live_max, lowest, near_floor);
+    assert_true(live_max > 20);
+    assert_true(near_floor > 0);
+}
+
+/* 200 beams struck into the floor: every one an impact, the sparks bounded by the pool, and the
+ * stats (read back without a stall, so a few frames late: settled with dt = 0 frames, which
+ * neither emit nor move) equal to what the pools hold. */
+static void test_counts_bounded(void **state)
+{
+    (void)state;
+    uint32_t n = 200;
+    for (uint32_t i = 0; i < n; ++i) {
+        double x = -1.5 + 3.0 * (i % 20) / 19.0, z = -1.0 + 1.5 * (i / 20) / 9.0;
+        const double src[3] = {x - 0.5, 1.5, z}, head[3] = {x + 0.1, -0.1, z};
+        g_app->beams[i] = beam_from_to(src, head, 0.05f);
+    }
+    g_app->beam_count = n;
+    for (int f = 0; f < 6; ++f)
+        assert_int_equal(game_app_frame(g_app, DT), VFX_OK);
+    for (int f = 0; f < 4; ++f)
+        assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
+    static float sp[VOLFX_IMPACT_MAX_SPARKS][12];
+    uint32_t pool = volfx_beams_impact_debug_sparks(volfx_beams_impact_of(g_app->ctx), sp, VOLFX_IMPACT_MAX_SPARKS);
+    uint32_t live = 0;
+    for (uint32_t i = 0; i < pool; ++i)
+        live += sp[i][7] > 0 && sp[i][3] < sp[i][7];
+    double impacts = stat("beams.impacts"), sparks = stat("beams.sparks");
+    printf("impacts %.0f, sparks %.0f (pool %u, %u alive)\n", impacts, sparks, pool, live);
+    assert_int_equal(pool, VOLFX_IMPACT_MAX_SPARKS);
+    assert_true(impacts >= n - 10); /* beams hidden behind the pillar make none */
+    assert_true(sparks <= VOLFX_IMPACT_MAX_SPARKS);
+    assert_true(sparks == live);
+    assert_true(live > VOLFX_IMPACT_MAX_SPARKS / 2); /* 200 impacts x 6 a frame fill the pool */
+}
+
+/* Plugin api 3's lights for one beam struck into the floor: its trail as a line light from head
+ * to source, its head as a point, and (once read back) the impact as a point half a radius above
+ * the hit; a short array gets the first ones and the total; a wrong version is refused. */
+static void test_lights(void **state)
+{
+    (void)state;
+    vfx_plugin_api3 api = {.v2.v1.size = sizeof api};
+    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, &g_app->host, &api.v2.v1), VFX_OK);
+    assert_int_equal(api.v2.v1.version, VFX_PLUGIN_API3_VERSION);
+    assert_non_null(api.get_lights);
+    const double src[3] = {-1.5, 1.5, 0.2}, head[3] = {0.1, -0.1, 0.2}, R = 0.25;
+    g_app->beams[0] = beam_from_to(src, head, (float)R);
+    g_app->beam_count = 1;
+    for (int f = 0; f < 5; ++f)
+        assert_int_equal(game_app_frame(g_app, DT), VFX_OK);
+    vfx_light l[8];
+    vfx_lights out = {.size = sizeof out, .version = VFX_LIGHTS_VERSION, .capacity = 8, .lights = l};
+    assert_int_equal(api.get_lights(g_app->ctx, &out), VFX_OK);
+    assert_int_equal(out.total, 3);
+    assert_int_equal(out.count, 3);
+    assert_true(stat("beams.lights") == 3);
+    assert_int_equal(l[0].kind, VFX_LIGHT_LINE);
+    assert_int_equal(l[0].source, VFX_LIGHT_BEAM_BODY);
+    assert_int_equal(l[1].kind, VFX_LIGHT_POINT);
+    assert_int_equal(l[1].source, VFX_LIGHT_BEAM_HEAD);
+    assert_int_equal(l[2].source, VFX_LIGHT_BEAM_IMPACT);
+    for (int k = 0; k < 3; ++k) {
+        /* the beam as the host gave it, in float (the plugin normalised D in double) */
+        assert_true(fabs(l[0].p0[k] - head[k]) < 1e-5 && fabs(l[0].p1[k] - src[k]) < 1e-5);
+        double hit = src[k] + src[1] / (src[1] - head[1]) * (head[k] - src[k]) + (k == 1 ? 0.5 * R : 0.0);
+        assert_true(fabs(l[2].p0[k] - hit) < 2e-3); /* the hit's tolerance (test above) */
+    }
+    assert_true(fabs(fmaxf(l[0].color[0], fmaxf(l[0].color[1], l[0].color[2])) - 1.f) < 1e-6);
+    assert_true(l[0].intensity > 0 && l[2].radius > 0);
+    out.capacity = 1;
+    assert_int_equal(api.get_lights(g_app->ctx, &out), VFX_OK);
+    assert_int_equal(out.count, 1);
+    assert_int_equal(out.total, 3);
+    out.version = 7;
+    assert_int_equal(api.get_lights(g_app->ctx, &out), VFX_ERR_ABI);
+    assert_non_null(strstr(api.v2.v1.last_error(g_app->ctx), "version 7"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_hit_matches_reference),
+        cmocka_unit_test(test_no_false_hit),
+        cmocka_unit_test(test_sparks_stay_above_floor),
+        cmocka_unit_test(test_counts_bounded),
+        cmocka_unit_test(test_lights),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
