@@ -27,27 +27,38 @@ static double stat_of(game_app *app, const char *name)
 /* A beam set as in the thesis: beams fired across the view at different depths and angles. Sets
  * above 10 (the 100 / 1,000-beam runs) are spread over the view on a grid of short, thin beams,
  * as a game's many projectiles would be, so a tile sees a few tens of beams rather than all. */
+/* The app's beam entities, n of them (respawned when the count changes). */
+static vfx_beam2 *beam_entities(game_app *app, uint32_t n)
+{
+    uint32_t have;
+    game_app_beams(app, &have);
+    if (have != n) {
+        game_app_clear_beams(app);
+        game_app_add_beams(app, NULL, n);
+    }
+    return game_app_beams(app, &have);
+}
+
 static void make_beams(game_app *app, uint32_t n)
 {
+    vfx_beam2 *beams = beam_entities(app, n);
     if (n > 10) {
         uint32_t cols = (uint32_t)ceil(sqrt(n * 16.0 / 9.0)), rows = (n + cols - 1) / cols;
         for (uint32_t i = 0; i < n; ++i) {
             double fx = ((i % cols) + 0.5) / cols, fy = ((i / cols) + 0.5) / rows, a = 2.4 * i;
             float L = (float)(4.0 / cols), R = (float)(1.2 / cols);
-            app->beams[i] = (vfx_beam){.head = {(float)(-2.6 + 5.2 * fx), (float)(-1.45 + 2.9 * fy), (float)(-0.5 * sin(a))},
+            beams[i] = (vfx_beam2){.v1 = {.head = {(float)(-2.6 + 5.2 * fx), (float)(-1.45 + 2.9 * fy), (float)(-0.5 * sin(a))},
                                        .dir = {(float)cos(a), (float)sin(a), 0.2f}, .length = L,
-                                       .radius = R, .a = 0.3f, .b = 0.3f, .eps = 0.0f};
+                                       .radius = R, .a = 0.3f, .b = 0.3f, .eps = 0.0f}};
         }
-        app->beam_count = n;
         return;
     }
     for (uint32_t i = 0; i < n; ++i) {
         double a = 2.0 * M_PI * i / (n > 1 ? n : 1);
-        app->beams[i] = (vfx_beam){.head = {(float)(-2.0 + 0.3 * cos(a)), (float)(0.8 * sin(a)), (float)(-0.5 * cos(a))},
+        beams[i] = (vfx_beam2){.v1 = {.head = {(float)(-2.0 + 0.3 * cos(a)), (float)(0.8 * sin(a)), (float)(-0.5 * cos(a))},
                                    .dir = {1, (float)(0.2 * sin(a)), (float)(0.1 * cos(a))}, .length = 3.0f,
-                                   .radius = 0.5f, .a = 0.3f, .b = 0.3f, .eps = 0.0f};
+                                   .radius = 0.5f, .a = 0.3f, .b = 0.3f, .eps = 0.0f}};
     }
-    app->beam_count = n;
 }
 
 /* Issue 15's options: the beams go to the plugin as version 2 beams (the v1 fields as set, this
@@ -58,8 +69,10 @@ static void sync_v2(game_app *app)
     app->beams_v2 = g_falloff != 0;
     if (!app->beams_v2)
         return;
-    for (uint32_t i = 0; i < app->beam_count; ++i)
-        app->beams2[i] = (vfx_beam2){.v1 = app->beams[i], .falloff = (uint32_t)g_falloff, .ramp = VFX_BEAM_RAMP_HOT};
+    uint32_t n;
+    vfx_beam2 *beams = game_app_beams(app, &n);
+    for (uint32_t i = 0; i < n; ++i)
+        beams[i] = (vfx_beam2){.v1 = beams[i].v1, .falloff = (uint32_t)g_falloff, .ramp = VFX_BEAM_RAMP_HOT};
     app->beams_view2 = (vfx_beams_view2){.bloom = g_bloom ? VFX_BEAMS_BLOOM_ON : VFX_BEAMS_BLOOM_OFF};
 }
 
@@ -130,7 +143,7 @@ int bench_beams_gpu(int argc, char **argv)
             volfx_beam_d bd[GAME_APP_MAX_BEAMS];
             char err[128];
             for (uint32_t i = 0; i < sets[si]; ++i) {
-                volfx_beam_validate(&app->beams[i], &bd[i], err, sizeof err);
+                volfx_beam_validate(&beam_entities(app, sets[si])[i].v1, &bd[i], err, sizeof err);
                 bd[i].smooth = g_falloff == VFX_BEAM_FALLOFF_SMOOTH;
             }
             if (timing_only) {
@@ -181,7 +194,7 @@ int bench_beams_gpu(int argc, char **argv)
                     make_beams(app, sets[si]);
                     for (uint32_t b = 0; b < sets[si]; ++b) {
                         float ph = 0.4f * (float)f + (float)b;
-                        vfx_beam *bm = &app->beams[b];
+                        vfx_beam *bm = &beam_entities(app, sets[si])[b].v1;
                         bm->a *= 0.5f + 0.5f * sinf(ph), bm->b *= 0.5f + 0.5f * cosf(ph);
                         bm->head[0] += 0.5f * sinf(ph), bm->length *= 0.6f + 0.4f * sinf(ph);
                         bm->dir[1] += 0.3f * cosf(ph), bm->radius *= 0.8f + 0.2f * sinf(ph);

@@ -63,10 +63,12 @@ static void measure(game_app *app, uint32_t frames, double ms[NPASS])
     }
 }
 
-static void print_json(const char *variant, const char *png, const game_app *app, const double ms[NPASS], FILE *out)
+static void print_json(const char *variant, const char *png, game_app *app, const double ms[NPASS], FILE *out)
 {
+    uint32_t beam_count;
+    game_app_beams(app, &beam_count);
     fprintf(out, "{\"variant\": \"%s\", \"png\": \"%s\", \"width\": %u, \"height\": %u, \"beams\": %u", variant, png,
-            app->camera.width, app->camera.height, app->beam_count);
+            app->camera.width, app->camera.height, beam_count);
     for (size_t p = 0; p < NPASS; ++p)
         if (!isnan(ms[p]))
             fprintf(out, ", \"%s_ms\": %.4f", k_passes[p] + 6, ms[p]);
@@ -87,9 +89,11 @@ static void run_variant(game_app *app, game_demo *demo, double t, const variant 
 {
     app->time = t;
     game_demo_animate(app, demo, 0.f);
-    for (uint32_t i = 0; i < app->beam_count; ++i)
+    uint32_t n;
+    vfx_beam2 *beams = game_app_beams(app, &n);
+    for (uint32_t i = 0; i < n; ++i)
         if (v->falloff)
-            app->beams2[i].falloff = (uint32_t)v->falloff;
+            beams[i].falloff = (uint32_t)v->falloff;
     app->beams_view2 = demo->scene->beams_view2;
     if (v->bloom)
         app->beams_view2.bloom = (uint32_t)v->bloom;
@@ -160,8 +164,10 @@ int bench_beams_panel(int argc, char **argv)
         variant m = {"march-probe", VFX_BEAM_FALLOFF_SMOOTH, VFX_BEAMS_BLOOM_OFF, n};
         app->time = t;
         game_demo_animate(app, &demo, 0.f);
-        for (uint32_t i = 0; i < app->beam_count; ++i)
-            app->beams2[i].falloff = VFX_BEAM_FALLOFF_SMOOTH;
+        uint32_t nb;
+        vfx_beam2 *beams = game_app_beams(app, &nb);
+        for (uint32_t i = 0; i < nb; ++i)
+            beams[i].falloff = VFX_BEAM_FALLOFF_SMOOTH;
         app->beams_view2 = demo.scene->beams_view2;
         app->beams_view2.bloom = VFX_BEAMS_BLOOM_OFF;
         app->beams_view.method = 1;

@@ -122,12 +122,16 @@ static vfx_result host_water_params(void *user, vfx_water_params *out)
     return VFX_OK;
 }
 
+/* The beam entities' column is the view's array (version 2, no copy); a version-1 view gets a
+ * copy of each beam's v1 part. */
 static vfx_result host_beams(void *user, vfx_beams_view *out)
 {
     game_app *app = user;
     if (!out || out->size < sizeof *out)
         return VFX_ERR_ABI;
-    if (app->beam_count == 0)
+    uint32_t n;
+    vfx_beam2 *beams = game_app_beams(app, &n);
+    if (n == 0)
         return VFX_ERR_NOT_FOUND;
     if (app->beams_v2 && out->version >= VFX_BEAMS_VIEW2_VERSION && out->size >= sizeof(vfx_beams_view2)) {
         vfx_beams_view2 *v2 = (vfx_beams_view2 *)out;
@@ -135,42 +139,61 @@ static vfx_result host_beams(void *user, vfx_beams_view *out)
         v2->v1 = app->beams_view;
         v2->v1.size = sizeof *v2;
         v2->v1.version = VFX_BEAMS_VIEW2_VERSION;
-        v2->v1.count = app->beam_count;
+        v2->v1.count = n;
         v2->v1.beams = NULL;
-        v2->beams = app->beams2;
+        v2->beams = beams;
         v2->joints = &app->joints[0][0];
         v2->joint_count = app->joint_count;
         return VFX_OK;
     }
-    if (app->beams_v2) /* a version 1 plugin: the v1 part of each beam */
-        for (uint32_t i = 0; i < app->beam_count; ++i)
-            app->beams[i] = app->beams2[i].v1;
+    if (n > app->beams_v1_cap) {
+        vfx_beam *p = realloc(app->beams_v1, n * sizeof *p);
+        if (!p)
+            return VFX_ERR_OUT_OF_MEMORY;
+        app->beams_v1 = p;
+        app->beams_v1_cap = n;
+    }
+    for (uint32_t i = 0; i < n; ++i)
+        app->beams_v1[i] = beams[i].v1;
     *out = app->beams_view;
     out->size = sizeof *out;
     out->version = VFX_BEAMS_VIEW_VERSION;
-    out->count = app->beam_count;
-    out->beams = app->beams;
+    out->count = n;
+    out->beams = app->beams_v1;
     return VFX_OK;
 }
 
-static uint32_t host_volume_count(void *user) { return ((game_app *)user)->volume_count; }
+static uint32_t host_volume_count(void *user) { return game_app_volume_count(user); }
+
+/* The index-th volume entity's view, in query order. */
+static const vfx_volume_view2 *volume_at(game_app *app, uint32_t index)
+{
+    rt_query_iter it = rt_query_begin(app->world, &app->effects.volume, 1);
+    while (rt_query_next(&it)) {
+        if (index < it.rows)
+            return (const vfx_volume_view2 *)rt_query_column(&it, app->effects.volume, 0) + index;
+        index -= it.rows;
+    }
+    return NULL;
+}
 
 static vfx_result host_volume(void *user, uint32_t index, vfx_volume_view *out)
 {
     game_app *app = user;
     if (!out || out->size < sizeof *out)
         return VFX_ERR_ABI;
-    if (index >= app->volume_count)
+    const vfx_volume_view2 *v = volume_at(app, index);
+    if (!v)
         return VFX_ERR_NOT_FOUND;
     /* a plugin that offers version 2 gets it (the version-1 part first), an older one version 1 */
     if (out->size >= sizeof(vfx_volume_view2) && out->version == VFX_VOLUME_VIEW2_VERSION) {
         vfx_volume_view2 *o2 = (vfx_volume_view2 *)out;
-        *o2 = app->volumes[index];
+        *o2 = *v;
         o2->v1.size = sizeof *o2;
         o2->v1.version = VFX_VOLUME_VIEW2_VERSION;
         return VFX_OK;
     }
-    *out = app->volumes[index].v1;
+    *out = v->v1;
     out->size = sizeof *out;
     out->version = VFX_VOLUME_VIEW_VERSION;
     return VFX_OK;
@@ -229,7 +252,7 @@ vfx_result game_app_create(const game_app_desc *desc, game_app **out)
         r = VFX_ERR_OUT_OF_MEMORY;
         goto fail;
     }
-    if ((r = rt_particles_register(app->world, &app->particles)))
+    if ((r = rt_particles_register(app->world, &app->particles)) || (r = rt_effects_register(app->world, &app->effects)))
         goto fail;
     if ((r = rt_world_register(app->world, &(rt_component_desc){"vfx.mesh", sizeof(game_app_mesh), 8, 1}, &app->mesh_comp))
         || (r = rt_world_register(app->world, &(rt_component_desc){"vfx.transform", 64, 16, 1}, &app->transform_comp)))
@@ -272,6 +295,7 @@ void game_app_destroy(game_app *app)
         app->api->destroy(app->ctx);
     rt_plugin_host_unload(app->plugin);
     free(app->chunks);
+    free(app->beams_v1);
     if (app->world) {
         rt_query_iter it = rt_query_begin(app->world, &app->mesh_comp, 1);
         while (rt_query_next(&it)) {
@@ -333,6 +357,68 @@ vfx_result game_app_add_box(game_app *app, const float mn[3], const float mx[3],
     rt_mesh_data data;
     vfx_result r = rt_mesh_make_box(mn, mx, &data);
     return r ? r : add_mesh(app, &data, NULL, rgb, out);
+}
+
+vfx_result game_app_add_beams(game_app *app, const vfx_beam2 *beams, uint32_t n)
+{
+    return rt_beams_spawn(app->world, &app->effects, n, beams, NULL);
+}
+
+vfx_beam2 *game_app_beams(game_app *app, uint32_t *count)
+{
+    return rt_beams_column(app->world, &app->effects, count);
+}
+
+void game_app_clear_beams(game_app *app)
+{
+    /* ids first: despawning reorders the table under a walk */
+    rt_query_iter it = rt_query_begin(app->world, &app->effects.beam, 1);
+    uint32_t n = 0;
+    while (rt_query_next(&it))
+        n += it.rows;
+    rt_entity *ids = malloc((n ? n : 1) * sizeof *ids);
+    if (!ids)
+        return;
+    uint32_t k = 0;
+    it = rt_query_begin(app->world, &app->effects.beam, 1);
+    while (rt_query_next(&it))
+        for (uint32_t i = 0; i < it.rows; ++i)
+            ids[k++] = it.entities[i];
+    for (uint32_t i = 0; i < k; ++i)
+        rt_world_despawn(app->world, ids[i]);
+    free(ids);
+}
+
+vfx_result game_app_add_volume(game_app *app, const vfx_volume_view2 *view, rt_entity *out)
+{
+    rt_entity e;
+    vfx_result r = rt_world_spawn(app->world, 1, &app->effects.volume, 1, &e);
+    if (r)
+        return r;
+    *(vfx_volume_view2 *)rt_world_get(app->world, e, app->effects.volume, 0) = *view;
+    if (out)
+        *out = e;
+    return VFX_OK;
+}
+
+vfx_volume_view2 *game_app_volume(game_app *app, rt_entity e)
+{
+    return rt_world_get(app->world, e, app->effects.volume, 0);
+}
+
+uint32_t game_app_volume_count(game_app *app)
+{
+    return rt_query_count(app->world, &app->effects.volume, 1);
+}
+
+vfx_result game_app_remove(game_app *app, rt_entity e)
+{
+    game_app_mesh *m = rt_world_get(app->world, e, app->mesh_comp, 0);
+    if (m) {
+        rt_mesh_gpu_destroy(&m->gpu);
+        app->mesh_count--;
+    }
+    return rt_world_despawn(app->world, e);
 }
 
 vfx_result game_app_frame(game_app *app, float dt)

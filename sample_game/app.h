@@ -7,6 +7,7 @@
 #include <stdint.h>
 #include <volfx/volfx.h>
 
+#include "ecs/effects.h"
 #include "ecs/particles.h"
 #include "ecs/world.h"
 #include "gfx/camera.h"
@@ -16,9 +17,8 @@
 #include "host/plugin_host.h"
 #include "profile/profiler.h"
 
-#define GAME_APP_MAX_BEAMS 1024
+#define GAME_APP_MAX_BEAMS 1024  /* beams a scene may spawn */
 #define GAME_APP_MAX_JOINTS 4096
-#define GAME_APP_MAX_VOLUMES 4
 
 typedef struct game_app_desc {
     rt_gl_mode mode;
@@ -46,6 +46,7 @@ typedef struct game_app {
     rt_renderer *renderer;
     rt_world *world;
     rt_particle_components particles;
+    rt_effect_components effects; /* beams and volumes are entities ("vfx.beam", "vfx.volume") */
     rt_plugin_host *plugin;
     const vfx_plugin_api *api;
     vfx_context *ctx;
@@ -61,16 +62,13 @@ typedef struct game_app {
     uint32_t water_kernel;     /* vfx_water_kernel for method TILE (the others get isotropic) */
     uint32_t water_preset;     /* vfx_water_preset (0: the plugin's default) */
     vfx_water_params4 water_diffuse; /* the diffuse particles' fields (its v3 member unused) */
-    vfx_beam beams[GAME_APP_MAX_BEAMS];
-    uint32_t beam_count;
-    vfx_beams_view beams_view; /* parameters; beams/count filled per call */
-    bool beams_v2;             /* answer version 2 views from beams2 and beams_view2 */
-    vfx_beam2 beams2[GAME_APP_MAX_BEAMS];
+    vfx_beams_view beams_view; /* parameters; beams/count filled per call from the beam entities */
+    bool beams_v2;             /* answer version 2 views (vfx_beam2 and beams_view2) */
     vfx_beams_view2 beams_view2; /* bloom settings; its v1 member is beams_view */
-    float joints[GAME_APP_MAX_JOINTS][3]; /* bending beams' joints (beams2[i].joint_first) */
+    float joints[GAME_APP_MAX_JOINTS][3]; /* bending beams' joints (vfx_beam2.joint_first) */
     uint32_t joint_count;
-    vfx_volume_view2 volumes[GAME_APP_MAX_VOLUMES]; /* the plugin gets version 2 or 1 */
-    uint32_t volume_count;
+    vfx_beam *beams_v1;        /* a version-1 view's copy of each beam's v1 part */
+    uint32_t beams_v1_cap;
     double time;
     double origin[3];          /* large worlds: what every position the game holds is relative to
                                   (the scene's "origin"), handed to the plugin in frame view 2 */
@@ -95,6 +93,24 @@ vfx_result game_app_add_mesh_file(game_app *app, const char *path, const float m
 /* Adds an axis-aligned box entity to the scene; `out` may be NULL. */
 vfx_result game_app_add_box(game_app *app, const float min[3], const float max[3], const float rgb[3],
                            rt_entity *out);
+/* Spawns n beam entities (component "vfx.beam"), copies of beams (NULL: zeroed, to be filled
+ * through game_app_beams); they reach the plugin with beams_view's parameters. */
+vfx_result game_app_add_beams(game_app *app, const vfx_beam2 *beams, uint32_t n);
+/* The beams as one array to read or edit in place, their number in *count (NULL, 0: none).
+ * Valid until the next structural change of the world. */
+vfx_beam2 *game_app_beams(game_app *app, uint32_t *count);
+/* Despawns every beam entity. */
+void game_app_clear_beams(game_app *app);
+/* Spawns a volume entity (component "vfx.volume") with a copy of the view; its arrays stay the
+ * caller's and must outlive the entity. `out` may be NULL. */
+vfx_result game_app_add_volume(game_app *app, const vfx_volume_view2 *view, rt_entity *out);
+/* The volume entity's view, to edit in place (bump v1.revision when its data changed); NULL for
+ * a stale id. Valid until the next structural change of the world. */
+vfx_volume_view2 *game_app_volume(game_app *app, rt_entity e);
+/* Number of volume entities. */
+uint32_t game_app_volume_count(game_app *app);
+/* Despawns an entity (mesh, beam or volume); VFX_ERR_NOT_FOUND for a stale id. */
+vfx_result game_app_remove(game_app *app, rt_entity e);
 /* One frame: world systems (dt), plugin update, host scene, plugin render, present. */
 vfx_result game_app_frame(game_app *app, float dt);
 /* Writes the last frame's colour as a PNG. */

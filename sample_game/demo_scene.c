@@ -262,7 +262,7 @@ static vfx_result load_volume(game_app *app, game_demo *demo, const rt_scene *sc
     vfx_result r = volume_mesh(app, demo, v);
     if (r)
         return r;
-    vfx_volume_view2 *vv = &app->volumes[0];
+    vfx_volume_view2 view, *vv = &view;
     memset(vv, 0, sizeof *vv);
     vv->v1.size = sizeof *vv;
     vv->v1.version = VFX_VOLUME_VIEW2_VERSION;
@@ -282,17 +282,17 @@ static vfx_result load_volume(game_app *app, game_demo *demo, const rt_scene *sc
     vv->v1.revision = 1;
     if ((r = volume_prepare_animation(demo, v)))
         return r;
-    app->volume_count = 1;
-    return VFX_OK;
+    return game_app_add_volume(app, vv, &demo->vol_entity);
 }
 
 /* The beams' light on the volume: per point, a Gaussian of its distance to each beam's axis
  * segment [M, M + L D] (in beam radii), scaled by gain. */
-static float beam_glow(const game_app *app, const rt_scene_volume_animation *an, const float w[3])
+static float beam_glow(const vfx_beam2 *beams, uint32_t beam_count, const rt_scene_volume_animation *an,
+                       const float w[3])
 {
     float g = 0;
-    for (uint32_t b = 0; b < app->beam_count; ++b) {
-        const vfx_beam *bm = &app->beams2[b].v1;
+    for (uint32_t b = 0; b < beam_count; ++b) {
+        const vfx_beam *bm = &beams[b].v1;
         float d[3] = {w[0] - bm->head[0], w[1] - bm->head[1], w[2] - bm->head[2]};
         float dl = sqrtf(bm->dir[0] * bm->dir[0] + bm->dir[1] * bm->dir[1] + bm->dir[2] * bm->dir[2]);
         if (!(dl > 0))
@@ -316,7 +316,9 @@ static void animate_volume(game_app *app, game_demo *demo)
 {
     const rt_scene_volume *v = &demo->scene->volume;
     const rt_scene_volume_animation *an = &v->anim;
-    vfx_volume_view2 *vv = &app->volumes[0];
+    vfx_volume_view2 *vv = game_app_volume(app, demo->vol_entity);
+    uint32_t beam_count;
+    const vfx_beam2 *beams = game_app_beams(app, &beam_count);
     const double t = app->time;
     if (an->ripple_amplitude > 0 || an->glow_gain > 0 || demo->vol_shield) {
         const float *M = v->model, *c = demo->vol_center;
@@ -332,16 +334,16 @@ static void animate_volume(game_app *app, game_demo *demo)
             for (int j = 0; j < 3; ++j)
                 q[j] = c[j] + (p[j] - c[j]) * f;
             float s = demo->vol_base_scalar[i];
-            if (an->glow_gain > 0 && app->beam_count) {
+            if (an->glow_gain > 0 && beam_count) {
                 float wp[3];
                 for (int r = 0; r < 3; ++r)
                     wp[r] = identity ? q[r] : M[r] * q[0] + M[4 + r] * q[1] + M[8 + r] * q[2] + M[12 + r];
-                s += beam_glow(app, an, wp);
+                s += beam_glow(beams, beam_count, an, wp);
             }
             demo->vol_scalar[i] = s;
         }
         game_shield_frame sf = {demo->vol_points, M, {app->camera.eye[0], app->camera.eye[1], app->camera.eye[2]},
-                                app->beams2, app->beam_count, t,
+                                beams, beam_count, t,
                                 {c[0], c[1], c[2]}, demo->vol_radius};
         game_shield_apply(demo->vol_shield, an, &sf, demo->vol_scalar);
         vv->v1.revision++;
@@ -385,6 +387,23 @@ static void animate_volume(game_app *app, game_demo *demo)
     }
 }
 
+static uint32_t beam_count_of(game_app *app)
+{
+    uint32_t n;
+    game_app_beams(app, &n);
+    return n;
+}
+
+/* The scene's beams at time t into the beam entities (their count is the scene's, capped). */
+static void beams_at(game_app *app, game_demo *demo, double t)
+{
+    uint32_t n;
+    vfx_beam2 *beams = game_app_beams(app, &n);
+    if (n)
+        rt_scene_beams2_at(demo->scene, t, beams, n < demo->beam_base_count ? n : demo->beam_base_count,
+                           &app->joints[0][0], GAME_APP_MAX_JOINTS, &app->joint_count);
+}
+
 vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path, uint32_t effects_off)
 {
     memset(demo, 0, sizeof *demo);
@@ -420,8 +439,9 @@ vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path
         app->beams_view = sc->beams_view;
         app->beams_view2 = sc->beams_view2;
         app->beams_v2 = true;
-        app->beam_count = rt_scene_beams2_at(sc, 0.0, app->beams2, demo->beam_base_count, &app->joints[0][0],
-                                             GAME_APP_MAX_JOINTS, &app->joint_count);
+        if ((r = game_app_add_beams(app, NULL, demo->beam_base_count)))
+            return r;
+        beams_at(app, demo, 0.0); /* the keyframes at t = 0 into the beam entities */
     }
     if (sc->has_volume && !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_VOLUME)) && (r = load_volume(app, demo, sc)))
         return r;
@@ -429,17 +449,16 @@ vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path
         rt_logf(&app->log, VFX_LOG_INFO, "scene volume left out (effect switched off or not built)");
     snprintf(demo->description, sizeof demo->description,
              "scene '%.60s': %u meshes, %u particles%s, %u beams, %u volumes", sc->name, app->mesh_count,
-             demo->particle_count, demo->sim ? " (SPH)" : "", app->beam_count, app->volume_count);
+             demo->particle_count, demo->sim ? " (SPH)" : "", beam_count_of(app), game_app_volume_count(app));
     return VFX_OK;
 }
 
 void game_demo_animate(game_app *app, game_demo *demo, float dt)
 {
     (void)dt;
-    if (demo->scene && app->beam_count) /* keyframed: grow, thicken, move, turn */
-        app->beam_count = rt_scene_beams2_at(demo->scene, app->time, app->beams2, demo->beam_base_count,
-                                             &app->joints[0][0], GAME_APP_MAX_JOINTS, &app->joint_count);
-    if (demo->scene && demo->vol_animated && app->volume_count) /* after the beams: they light it */
+    if (demo->scene) /* keyframed: grow, thicken, move, turn */
+        beams_at(app, demo, app->time);
+    if (demo->scene && demo->vol_animated && game_app_volume(app, demo->vol_entity)) /* after the beams: they light it */
         animate_volume(app, demo);
 }
 
@@ -449,10 +468,15 @@ void game_demo_toggle(game_app *app, game_demo *demo, vfx_effect_kind kind)
     bool off = demo->effects_off & VFX_EFFECT_BIT(kind);
     if (kind == VFX_EFFECT_WATER)
         app->water_enabled = !off && demo->particle_count > 0;
-    else if (kind == VFX_EFFECT_BEAMS)
-        app->beam_count = off ? 0 : demo->beam_base_count;
-    else if (kind == VFX_EFFECT_VOLUME)
-        app->volume_count = off || !demo->vol_tets ? 0 : 1;
+    else if (kind == VFX_EFFECT_BEAMS && off)
+        game_app_clear_beams(app);
+    else if (kind == VFX_EFFECT_BEAMS && !beam_count_of(app)) /* back: the next animate fills them */
+        game_app_add_beams(app, NULL, demo->beam_base_count);
+    else if (kind == VFX_EFFECT_VOLUME && off && game_app_volume(app, demo->vol_entity)) {
+        demo->vol_view = *game_app_volume(app, demo->vol_entity); /* as it was, for switching back */
+        game_app_remove(app, demo->vol_entity);
+    } else if (kind == VFX_EFFECT_VOLUME && !off && demo->vol_tets && !game_app_volume(app, demo->vol_entity))
+        game_app_add_volume(app, &demo->vol_view, &demo->vol_entity);
 }
 
 void game_demo_print_profile(game_app *app, FILE *out)
@@ -489,7 +513,8 @@ void game_demo_free(game_app *app, game_demo *demo)
         if (rep->cap_hit)
             rt_logf(&app->log, VFX_LOG_WARN, "water simulation: substep cap hit in the last frame");
     }
-    app->volume_count = 0; /* the views point into the arrays freed here */
+    if (game_app_volume(app, demo->vol_entity)) /* its view points into the arrays freed here */
+        game_app_remove(app, demo->vol_entity);
     rt_sim_system_destroy(demo->sim); /* the world must not run again after this */
     rt_scene_free(demo->scene);
     free(demo->vol_points);

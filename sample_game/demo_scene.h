@@ -27,6 +27,8 @@ typedef struct game_demo {
     float *vol_base_points, *vol_base_scalar, vol_center[3], vol_radius;
     struct game_shield *vol_shield; /* rim and hit ripples (volume_shield.h); NULL when off */
     bool vol_animated;
+    rt_entity vol_entity;     /* the volume's entity (stale while the volume is switched off) */
+    vfx_volume_view2 vol_view; /* its view while switched off */
     uint32_t *vol_tets, vol_point_count, vol_tet_count;
 } game_demo;
 

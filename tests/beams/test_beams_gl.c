@@ -31,6 +31,15 @@ static uint32_t g_nj;  /* joints of the bending beam the references integrate (0
 static const vfx_beam k_beam = {.head = {-1.5f, 0.1f, 0.0f}, .dir = {1, 0.2f, 0}, .length = 2.5f,
                                 .radius = 0.5f, .a = 0.4f, .b = 0.25f, .eps = 0.05f};
 
+/* The one beam entity the tests draw. */
+static vfx_beam2 *beam0(void)
+{
+    uint32_t n;
+    vfx_beam2 *b = game_app_beams(g_app, &n);
+    assert_int_equal(n, 1);
+    return b;
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -40,8 +49,7 @@ static int setup(void **state)
         exit(VFX_TEST_SKIP);
     rt_camera cam = test_rt_camera(&g_cam);
     assert_int_equal(game_app_set_camera(g_app, &cam), VFX_OK);
-    g_app->beams[0] = k_beam;
-    g_app->beam_count = 1;
+    assert_int_equal(game_app_add_beams(g_app, &(vfx_beam2){.v1 = k_beam}, 1), VFX_OK);
     g_app->beams_view = (vfx_beams_view){.size = sizeof(vfx_beams_view), .version = VFX_BEAMS_VIEW_VERSION};
     return 0;
 }
@@ -66,7 +74,7 @@ static double ref_pixel(uint32_t i, uint32_t j, double t1)
 {
     volfx_beam_d b;
     char err[128];
-    assert_int_equal(volfx_beam_validate(&g_app->beams[0], &b, err, sizeof err), VFX_OK);
+    assert_int_equal(volfx_beam_validate(&beam0()->v1, &b, err, sizeof err), VFX_OK);
     b.smooth = g_smooth;
     assert_int_equal(volfx_beam_set_joints(&b, &g_app->joints[0][0], g_nj, err, sizeof err), VFX_OK);
     double dir[3];
@@ -103,7 +111,7 @@ static int compare_image(const float *gpu, double (*t1_of)(uint32_t, uint32_t), 
 {
     volfx_beam_d b;
     char err[128];
-    assert_int_equal(volfx_beam_validate(&g_app->beams[0], &b, err, sizeof err), VFX_OK);
+    assert_int_equal(volfx_beam_validate(&beam0()->v1, &b, err, sizeof err), VFX_OK);
     b.smooth = g_smooth;
     assert_int_equal(volfx_beam_set_joints(&b, &g_app->joints[0][0], g_nj, err, sizeof err), VFX_OK);
     int bad = 0;
@@ -174,7 +182,7 @@ static void test_matches_reference(void **state)
     assert_true(pairs >= 1 && culled >= 0 && pairs + culled == 12); /* 4x3 tiles of 16 px */
     free(raw);
     /* a small beam in the top-right corner: most tiles culled, their pixels exactly 0 */
-    g_app->beams[0] = (vfx_beam){.head = {1.6f, 1.1f, 0}, .dir = {1, 0, 0}, .length = 0.1f, .radius = 0.1f,
+    beam0()->v1 = (vfx_beam){.head = {1.6f, 1.1f, 0}, .dir = {1, 0, 0}, .length = 0.1f, .radius = 0.1f,
                                  .a = 0.4f, .b = 0.25f, .eps = 0.05f};
     raw = render_raw();
     assert_int_equal(g_app->api->get_stats(g_app->ctx, &st), VFX_OK);
@@ -185,7 +193,7 @@ static void test_matches_reference(void **state)
     assert_true(culled >= 9);
     assert_true(raw[(H - 1) * W + 0] == 0.f && raw[(H / 2) * W + W / 2] == 0.f);
     free(raw);
-    g_app->beams[0] = k_beam;
+    beam0()->v1 = k_beam;
 }
 
 static double g_wall_z;
@@ -286,7 +294,7 @@ static void test_mz_sweep(void **state)
         double t1 = t_wall(cx, cy), ref = ref_pixel(cx, cy, t1), dir[3], end[3];
         volfx_beam_d b;
         char err[128];
-        assert_int_equal(volfx_beam_validate(&g_app->beams[0], &b, err, sizeof err), VFX_OK);
+        assert_int_equal(volfx_beam_validate(&beam0()->v1, &b, err, sizeof err), VFX_OK);
         ref_pixel_ray(&g_cam, cx, cy, dir);
         for (int c = 0; c < 3; ++c)
             end[c] = g_cam.eye[c] + t1 * dir[c];
@@ -333,19 +341,19 @@ static void test_marching_baseline(void **state)
 static void test_bad_input_and_absence(void **state)
 {
     (void)state;
-    g_app->beams[0].radius = -1.f;
+    beam0()->v1.radius = -1.f;
     assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "beams[0]"));
-    g_app->beams[0] = k_beam;
-    g_app->beams[0].head[1] = NAN;
+    beam0()->v1 = k_beam;
+    beam0()->v1.head[1] = NAN;
     assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "not finite"));
-    g_app->beams[0] = k_beam;
+    beam0()->v1 = k_beam;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_non_null(g_app->ctx->effect_state[VFX_EFFECT_BEAMS]);
     /* no beams: the effect's state is freed, no pass runs, and once the timer results of the
      * last frames with beams have drained (a ring of 4 frames), no beams stat is reported */
-    g_app->beam_count = 0;
+    game_app_clear_beams(g_app);
     for (int f = 0; f < 5; ++f)
         assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_null(g_app->ctx->effect_state[VFX_EFFECT_BEAMS]);
@@ -353,20 +361,20 @@ static void test_bad_input_and_absence(void **state)
     g_app->api->get_stats(g_app->ctx, &st);
     for (uint32_t k = 0; k < st.count; ++k)
         assert_null(strstr(st.entries[k].name, "beams."));
-    g_app->beam_count = 1;
+    assert_int_equal(game_app_add_beams(g_app, &(vfx_beam2){.v1 = k_beam}, 1), VFX_OK);
 }
 
-/* The game answers version 2 views from beams2 (k_beam with this falloff, the hot ramp, bloom
- * as given), or version 1 ones again (v2 = false). */
+/* The game answers version 2 views from the beam entity (k_beam with this falloff, the hot ramp,
+ * bloom as given), or version 1 ones again (v2 = false). */
 static void use_v2(bool v2, bool smooth, bool bloom)
 {
     g_app->beams_v2 = v2;
     g_smooth = v2 && smooth;
-    g_app->beams[0] = k_beam;
-    g_app->beams2[0] = (vfx_beam2){.v1 = k_beam, .falloff = smooth ? VFX_BEAM_FALLOFF_SMOOTH : VFX_BEAM_FALLOFF_HARD,
-                                   .ramp = VFX_BEAM_RAMP_HOT, .intensity = 1.f};
-    g_app->beams2[0].v1.color[0] = 0.2f, g_app->beams2[0].v1.color[1] = 0.5f, g_app->beams2[0].v1.color[2] = 1.f;
-    g_app->beams2[0].v1.color[3] = 1.f;
+    vfx_beam2 *b = beam0();
+    *b = (vfx_beam2){.v1 = k_beam, .falloff = smooth ? VFX_BEAM_FALLOFF_SMOOTH : VFX_BEAM_FALLOFF_HARD,
+                     .ramp = VFX_BEAM_RAMP_HOT, .intensity = 1.f};
+    if (v2) /* coloured; a version 1 view carries k_beam as it is */
+        b->v1.color[0] = 0.2f, b->v1.color[1] = 0.5f, b->v1.color[2] = 1.f, b->v1.color[3] = 1.f;
     g_app->beams_view2 = (vfx_beams_view2){.bloom = bloom ? VFX_BEAMS_BLOOM_ON : VFX_BEAMS_BLOOM_OFF};
 }
 
@@ -407,8 +415,8 @@ static void test_polyline_matches_reference(void **state)
         use_v2(true, smooth, false);
         memcpy(g_app->joints, J, sizeof J);
         g_app->joint_count = 4;
-        g_app->beams2[0].joint_first = 0;
-        g_app->beams2[0].joint_count = 4;
+        beam0()->joint_first = 0;
+        beam0()->joint_count = 4;
         g_nj = 4;
         float *raw = render_raw();
         image_errors ie;
@@ -438,15 +446,15 @@ static uint8_t *render_rgba(void)
 static void test_emission_and_bloom(void **state)
 {
     (void)state;
-    g_app->beam_count = 0;
+    game_app_clear_beams(g_app);
     uint8_t *bg = render_rgba();
-    g_app->beam_count = 1;
+    assert_int_equal(game_app_add_beams(g_app, &(vfx_beam2){.v1 = k_beam}, 1), VFX_OK);
     use_v2(true, true, false);
-    g_app->beams2[0].exposure = 3.f; /* x = 8 H: the core (H ~ 0.6) is well past the white point */
+    beam0()->exposure = 3.f; /* x = 8 H: the core (H ~ 0.6) is well past the white point */
     float *raw = render_raw();
     uint8_t *plain = render_rgba();
     use_v2(true, true, true);
-    g_app->beams2[0].exposure = 3.f;
+    beam0()->exposure = 3.f;
     uint8_t *glow = render_rgba();
     int outside = 0, spilled = 0, kmax = 0;
     /* raw (read_raw) and the RGBA read-back are both top row first: index k is one pixel */
@@ -491,11 +499,11 @@ static void test_bad_v2_input(void **state)
 {
     (void)state;
     use_v2(true, true, true);
-    g_app->beams2[0].falloff = 7;
+    beam0()->falloff = 7;
     assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "beams[0]: falloff"));
     use_v2(true, true, true);
-    g_app->beams2[0].flow_amount = 2.f;
+    beam0()->flow_amount = 2.f;
     assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "flow_amount"));
     use_v2(true, true, true);

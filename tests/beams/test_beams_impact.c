@@ -195,6 +195,17 @@ static double stat(const char *name)
 
 /* ------------------------------------------------------------------------------ tests */
 
+/* The app's beam entities, n of them, zeroed (respawned: the beams of the last test go). */
+static vfx_beam2 *beam_entities(uint32_t n)
+{
+    game_app_clear_beams(g_app);
+    assert_int_equal(game_app_add_beams(g_app, NULL, n), VFX_OK);
+    uint32_t have;
+    vfx_beam2 *b = game_app_beams(g_app, &have);
+    assert_int_equal(have, n);
+    return b;
+}
+
 /* A beam struck into the floor at an angle: the GPU's hit against the float64 march of the same
  * depth buffer, and against the floor's plane y = 0. Tolerances: both converge to the plane the
  * depth-reconstructed points span (the crossing is judged against the tangent plane, not the
@@ -206,8 +217,7 @@ static void test_hit_matches_reference(void **state)
 {
     (void)state;
     const double src[3] = {-1.5, 1.5, 0.2}, head[3] = {0.1, -0.1, 0.2}, R = 0.25;
-    g_app->beams[0] = beam_from_to(src, head, (float)R);
-    g_app->beam_count = 1;
+    beam_entities(1)[0].v1 = beam_from_to(src, head, (float)R);
     assert_int_equal(game_app_frame(g_app, DT), VFX_OK);
     volfx_beams_impact *im = volfx_beams_impact_of(g_app->ctx);
     assert_non_null(im);
@@ -241,11 +251,11 @@ static void test_no_false_hit(void **state)
 {
     (void)state;
     const double src[3] = {-1.5, 1.2, 0.0}, head[3] = {0.0, 1.0, 0.0};
-    g_app->beams[0] = beam_from_to(src, head, 0.2f);
+    vfx_beam2 *b = beam_entities(2);
+    b[0].v1 = beam_from_to(src, head, 0.2f);
     /* behind the pillar (x 1.1..1.3, z 0.9..1.1) as the camera at z = 3 sees it: z = -0.5 */
     const double s2[3] = {0.6, 0.8, -0.5}, h2[3] = {2.2, 0.8, -0.5};
-    g_app->beams[1] = beam_from_to(s2, h2, 0.1f);
-    g_app->beam_count = 2;
+    b[1].v1 = beam_from_to(s2, h2, 0.1f);
     assert_int_equal(game_app_frame(g_app, DT), VFX_OK);
     float gpu[2][8];
     assert_int_equal(volfx_beams_impact_debug_hits(volfx_beams_impact_of(g_app->ctx), gpu, 2), 2);
@@ -261,8 +271,7 @@ static void test_sparks_stay_above_floor(void **state)
 {
     (void)state;
     const double src[3] = {-1.5, 1.5, 0.2}, head[3] = {0.1, -0.1, 0.2};
-    g_app->beams[0] = beam_from_to(src, head, 0.25f);
-    g_app->beam_count = 1;
+    beam_entities(1)[0].v1 = beam_from_to(src, head, 0.25f);
     static float sp[VOLFX_IMPACT_MAX_SPARKS][12];
     uint32_t near_floor = 0, live_max = 0;
     double lowest = 1e9;
@@ -293,12 +302,12 @@ static void test_counts_bounded(void **state)
 {
     (void)state;
     uint32_t n = 200;
+    vfx_beam2 *b = beam_entities(n);
     for (uint32_t i = 0; i < n; ++i) {
         double x = -1.5 + 3.0 * (i % 20) / 19.0, z = -1.0 + 1.5 * (i / 20) / 9.0;
         const double src[3] = {x - 0.5, 1.5, z}, head[3] = {x + 0.1, -0.1, z};
-        g_app->beams[i] = beam_from_to(src, head, 0.05f);
+        b[i].v1 = beam_from_to(src, head, 0.05f);
     }
-    g_app->beam_count = n;
     for (int f = 0; f < 6; ++f)
         assert_int_equal(game_app_frame(g_app, DT), VFX_OK);
     for (int f = 0; f < 4; ++f)
@@ -328,8 +337,7 @@ static void test_lights(void **state)
     assert_int_equal(api.v2.v1.version, VFX_PLUGIN_API3_VERSION);
     assert_non_null(api.get_lights);
     const double src[3] = {-1.5, 1.5, 0.2}, head[3] = {0.1, -0.1, 0.2}, R = 0.25;
-    g_app->beams[0] = beam_from_to(src, head, (float)R);
-    g_app->beam_count = 1;
+    beam_entities(1)[0].v1 = beam_from_to(src, head, (float)R);
     for (int f = 0; f < 5; ++f)
         assert_int_equal(game_app_frame(g_app, DT), VFX_OK);
     vfx_light l[8];

@@ -26,6 +26,7 @@
 #define H 36
 
 static game_app *g_app;
+static rt_entity g_vol; /* the generated grid's volume entity */
 /* the camera the host renders with; the references trace its rays in float64 */
 static const ref_camera g_cam = {{0.3, 0.4, 3.5}, {0, 0, 0}, {0, 1, 0}, 0.9, W, H, 0.05, 50};
 static const char *g_showcase; /* sample_game/scenes/volume-showcase.json (argv[1]) */
@@ -48,11 +49,11 @@ static int setup(void **state)
         sv.gen_min[k] = -0.7f, sv.gen_max[k] = 0.7f;
     char err[256];
     assert_int_equal(rt_scene_volume_generate(&sv, &g_points, &g_np, &g_tets, &g_nt, &g_scalar, err, sizeof err), VFX_OK);
-    vfx_volume_view *v = &g_app->volumes[0].v1;
-    *v = (vfx_volume_view){.size = sizeof *v, .version = VFX_VOLUME_VIEW_VERSION, .point_count = g_np,
-                           .tet_count = g_nt, .points = g_points, .tets = g_tets, .scalar = g_scalar,
-                           .scalar_min = 0, .scalar_max = 1, .workers = 1, .revision = 1};
-    g_app->volume_count = 1;
+    vfx_volume_view2 view = {.v1 = {.size = sizeof(vfx_volume_view), .version = VFX_VOLUME_VIEW_VERSION,
+                                    .point_count = g_np, .tet_count = g_nt, .points = g_points, .tets = g_tets,
+                                    .scalar = g_scalar, .scalar_min = 0, .scalar_max = 1, .workers = 1,
+                                    .revision = 1}};
+    assert_int_equal(game_app_add_volume(g_app, &view, &g_vol), VFX_OK);
     return 0;
 }
 
@@ -176,16 +177,17 @@ static void test_bad_view_and_absence(void **state)
     (void)state;
     uint32_t saved = g_tets[5];
     g_tets[5] = g_np + 7;
-    g_app->volumes[0].v1.revision = 2;
+    game_app_volume(g_app, g_vol)->v1.revision = 2;
     assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "volume[0]: tet 1 uses point"));
     g_tets[5] = saved;
-    g_app->volumes[0].v1.revision = 3;
+    game_app_volume(g_app, g_vol)->v1.revision = 3;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
-    g_app->volume_count = 0;
+    vfx_volume_view2 keep = *game_app_volume(g_app, g_vol);
+    assert_int_equal(game_app_remove(g_app, g_vol), VFX_OK);
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_null(g_app->ctx->effect_state[VFX_EFFECT_VOLUME]);
-    g_app->volume_count = 1;
+    assert_int_equal(game_app_add_volume(g_app, &keep, &g_vol), VFX_OK);
 }
 
 /* Nothing changed: the render is skipped (counted) and the image kept; a new transfer function,
@@ -193,7 +195,7 @@ static void test_bad_view_and_absence(void **state)
 static void test_skip_when_unchanged(void **state)
 {
     (void)state;
-    vfx_volume_view *v = &g_app->volumes[0].v1;
+    vfx_volume_view *v = &game_app_volume(g_app, g_vol)->v1;
     float *a = render_alpha();
     float *b = render_alpha();
     assert_true(stat("volume.render_skipped") == 1);
@@ -234,7 +236,7 @@ static void test_skip_when_unchanged(void **state)
 static void test_view2_breakpoints(void **state)
 {
     (void)state;
-    vfx_volume_view2 *v2 = &g_app->volumes[0];
+    vfx_volume_view2 *v2 = game_app_volume(g_app, g_vol);
     float rgba[3 * 4] = {0.2f, 0.4f, 1.0f, 0.5f, 1, 1, 1, 9.0f, 1.0f, 0.5f, 0.1f, 2.0f};
     float pos[3] = {0.2f, 0.5f, 0.9f};
     v2->v1.transfer_rgba = rgba;
@@ -329,7 +331,7 @@ static void test_file_volume_in_scene(void **state)
     }
     fprintf(f, "]}}\n");
     fclose(f);
-    g_app->volume_count = 0;
+    game_app_remove(g_app, g_vol); /* the scene's volume replaces it (stale after the first) */
     game_demo demo;
     assert_int_equal(game_demo_load(g_app, &demo, scene, 0), VFX_OK);
     float *a = render_alpha();
@@ -378,17 +380,17 @@ static void test_showcase_animates(void **state)
     (void)state;
     if (!g_showcase)
         skip();
-    g_app->volume_count = 0;
+    game_app_remove(g_app, g_vol); /* the scene's volume replaces it (stale after the first) */
     game_demo demo;
     assert_int_equal(game_demo_load(g_app, &demo, g_showcase, VFX_EFFECT_BIT(VFX_EFFECT_WATER)), VFX_OK);
     assert_true(demo.vol_animated);
-    uint64_t rev = g_app->volumes[0].v1.revision;
+    uint64_t rev = game_app_volume(g_app, demo.vol_entity)->v1.revision;
     float *prev = NULL;
     for (int f = 0; f < 3; ++f) {
         g_app->time = 2.6 + 0.1 * f; /* the beam crosses the dome */
         game_demo_animate(g_app, &demo, 0.1f);
         float *a = render_alpha();
-        assert_true(g_app->volumes[0].v1.revision == rev + 1 + (uint64_t)f);
+        assert_true(game_app_volume(g_app, demo.vol_entity)->v1.revision == rev + 1 + (uint64_t)f);
         if (prev) {
             assert_true(stat("volume.render_skipped") == 0);
             double d = 0;
@@ -400,6 +402,27 @@ static void test_showcase_animates(void **state)
         prev = a;
     }
     free(prev);
+    /* switched off, an effect's entities leave the world; switched back, they return (the
+     * volume as it was, the beams refilled from the keyframes by the next animate) */
+    uint32_t nb;
+    game_app_beams(g_app, &nb);
+    assert_true(nb == demo.beam_base_count && nb > 0);
+    uint64_t rev_off = game_app_volume(g_app, demo.vol_entity)->v1.revision;
+    game_demo_toggle(g_app, &demo, VFX_EFFECT_VOLUME);
+    game_demo_toggle(g_app, &demo, VFX_EFFECT_BEAMS);
+    assert_int_equal(game_app_volume_count(g_app), 0);
+    assert_null(game_app_beams(g_app, &nb));
+    game_demo_animate(g_app, &demo, 0.1f);
+    assert_int_equal(game_app_frame(g_app, 0.1f), VFX_OK);
+    assert_null(g_app->ctx->effect_state[VFX_EFFECT_VOLUME]);
+    game_demo_toggle(g_app, &demo, VFX_EFFECT_VOLUME);
+    game_demo_toggle(g_app, &demo, VFX_EFFECT_BEAMS);
+    game_demo_animate(g_app, &demo, 0.1f);
+    assert_int_equal(game_app_volume_count(g_app), 1);
+    assert_true(game_app_volume(g_app, demo.vol_entity)->v1.revision == rev_off + 1);
+    const vfx_beam2 *beams = game_app_beams(g_app, &nb);
+    assert_true(nb == demo.beam_base_count && beams[0].v1.length > 0);
+    assert_int_equal(game_app_frame(g_app, 0.1f), VFX_OK);
     game_demo_free(g_app, &demo);
 }
 

@@ -7,6 +7,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "ecs/effects.h"
 #include "ecs/particles.h"
 #include "ecs/world.h"
 #include "test_util.h"
@@ -213,6 +214,42 @@ static void test_system_order(void **state)
     rt_world_destroy(w);
 }
 
+/* Beams are entities of one table: the column is the view's array, spawns append in order,
+ * registering twice finds the same components, a volume is its own entity. */
+static void test_effect_components(void **state)
+{
+    (void)state;
+    rt_world *w = rt_world_create(NULL);
+    rt_effect_components ec, again;
+    assert_int_equal(rt_effects_register(w, &ec), VFX_OK);
+    assert_int_equal(rt_effects_register(w, &again), VFX_OK);
+    assert_true(ec.beam == again.beam && ec.volume == again.volume && ec.beam != ec.volume);
+    uint32_t n = 7;
+    assert_null(rt_beams_column(w, &ec, &n));
+    assert_int_equal(n, 0);
+    vfx_beam2 b[5];
+    memset(b, 0, sizeof b);
+    for (int i = 0; i < 5; ++i)
+        b[i].v1.length = (float)(i + 1);
+    rt_entity ids[5];
+    assert_int_equal(rt_beams_spawn(w, &ec, 3, b, ids), VFX_OK);
+    assert_int_equal(rt_beams_spawn(w, &ec, 2, b + 3, ids + 3), VFX_OK);
+    vfx_beam2 *col = rt_beams_column(w, &ec, &n);
+    assert_int_equal(n, 5);
+    for (int i = 0; i < 5; ++i) {
+        assert_true(col[i].v1.length == (float)(i + 1));
+        assert_ptr_equal(rt_world_get(w, ids[i], ec.beam, 0), &col[i]);
+    }
+    assert_int_equal(rt_beams_spawn(w, &ec, 2, NULL, NULL), VFX_OK); /* zeroed */
+    col = rt_beams_column(w, &ec, &n);
+    assert_true(n == 7 && col[5].v1.length == 0.f && col[6].v1.length == 0.f);
+    rt_entity v;
+    assert_int_equal(rt_world_spawn(w, 1, &ec.volume, 1, &v), VFX_OK);
+    assert_int_equal(rt_query_count(w, &ec.volume, 1), 1);
+    assert_int_equal(rt_query_count(w, &ec.beam, 1), 7);
+    rt_world_destroy(w);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -222,6 +259,7 @@ int main(void)
         cmocka_unit_test(test_column_stability_and_moves),
         cmocka_unit_test(test_permute),
         cmocka_unit_test(test_system_order),
+        cmocka_unit_test(test_effect_components),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
