@@ -455,13 +455,14 @@ static vfx_result grid_march(vfx_context *ctx, water_state *s, const vfx_frame_v
 }
 
 static vfx_result tile_lists(vfx_context *ctx, water_state *s, volfx_water_tile_input *in,
-                             const vfx_frame_view *frame)
+                             const vfx_frame_view *frame, const volfx_frame_targets *targets)
 {
     if (!s->tile && !(s->tile = volfx_water_tile_create(ctx)))
         return VFX_ERR_OUT_OF_MEMORY;
     *in = (volfx_water_tile_input){s->cols, s->count, &s->params, s->width, s->height, ctx->water_dist_tex,
                                    s->counters, s->have_last ? s->last[10] : 0, s->view_proj, s->lo, s->hi,
-                                   frame->eye, fabsf(frame->proj[5]) * 0.5f * (float)s->height, volfx_water_view_frames(s), 0, 0.0f};
+                                   frame->eye, fabsf(frame->proj[5]) * 0.5f * (float)s->height, volfx_water_view_frames(s), 0, 0.0f,
+                                   targets->inv_view_proj, frame->depth_texture != 0};
     /* per-particle kernels: the anisotropic ones, or the host's radius / kernel columns */
     if (s->params.method == VFX_WATER_METHOD_TILE &&
         (s->kp.kernel == VFX_WATER_KERNEL_ANISOTROPIC || volfx_water_aniso_has_columns(s->aniso))) {
@@ -481,8 +482,8 @@ static vfx_result tile_march(vfx_context *ctx, water_state *s, const vfx_frame_v
                              const volfx_frame_targets *targets)
 {
     volfx_water_tile_input in;
-    vfx_result r = tile_lists(ctx, s, &in, frame);
-    return r ? r : volfx_water_tile_march(ctx, s->tile, &in, frame, targets, s->grad, s->back);
+    vfx_result r = tile_lists(ctx, s, &in, frame, targets);
+    return r ? r : volfx_water_tile_march(ctx, s->tile, &in, frame, s->grad, s->back);
 }
 
 /* The paper method's sample-cap pixels, finished by TILE's march from where they stopped. */
@@ -490,8 +491,8 @@ static vfx_result paper_finish(vfx_context *ctx, water_state *s, const vfx_frame
                                const volfx_frame_targets *targets)
 {
     volfx_water_tile_input in;
-    vfx_result r = tile_lists(ctx, s, &in, frame);
-    return r ? r : volfx_water_tile_finish(ctx, s->tile, &in, frame, targets, s->st, s->cur);
+    vfx_result r = tile_lists(ctx, s, &in, frame, targets);
+    return r ? r : volfx_water_tile_finish(ctx, s->tile, &in, frame, s->st, s->cur);
 }
 
 /* Whether this frame has diffuse particles: the host's velocities, not switched off, one

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "gpu/gpu.h"
+#include "gpu/pass.h"
 #include "water_tile.h"
 
 /* tiles of 8x8 pixels, or 16, 32 or 64 a side when 8x8 tiles would pass TILE_MAX_TILES
@@ -24,6 +25,35 @@
 #define TILE_GLOBAL_TILES 4096u
 /* depth slabs per tile (fewer when tiles * slabs would pass the scan's limit) */
 #define TILE_SLABS 32u
+/* tile.comp's WaterTile block (std140) */
+#define TILE_UBO_BINDING 5u
+
+/* Mirrors tile.comp's WaterTile block (std140): every constant of a TILE frame, uploaded once a
+ * frame when the bins are made and read by every tile.comp dispatch of the frame. */
+typedef struct tile_block {
+    float view_proj[16], inv_view_proj[16];
+    float eye[3], h;
+    int32_t tiles[2], size[2];
+    uint32_t count, cap, global_tiles;
+    int32_t tile_shift;
+    uint32_t slabs;
+    float d0, ds, rbound;
+    float threshold, step, window, rho;
+    uint32_t refine_iters, has_depth, subdivide, local;
+    int32_t sub_depth;
+    float half_tol, half_cos;
+    uint32_t pad0;
+} tile_block;
+_Static_assert(sizeof(tile_block) == 240, "tile_block mirrors tile.comp's std140 WaterTile");
+
+/* The loose uniforms that differ between the dispatches of one frame, resolved once per
+ * program: grid.comp's scan length, tile.comp's march switches. */
+enum { LOC_N, LOC_HALF, LOC_TEMPORAL, LOC_REUSE, LOC_COUNT };
+#define TILE_PROG_CACHE 8
+typedef struct tile_prog_locs {
+    GLuint prog;
+    GLint loc[LOC_COUNT];
+} tile_prog_locs;
 
 struct volfx_water_tile {
     GLuint count, start, blocks, entries, globals;
@@ -48,6 +78,9 @@ struct volfx_water_tile {
     uint64_t hits_frame;
     float hits_field[3]; /* h, T, step of those hits */
     float hits_eye[3], hits_fwd[3];
+    volfx_ubo ubo;       /* tile_block */
+    tile_prog_locs progs[TILE_PROG_CACHE];
+    uint32_t nprogs;     /* slots filled; later programs replace them in turn */
 };
 
 volfx_water_tile *volfx_water_tile_create(vfx_context *ctx)
@@ -61,6 +94,10 @@ volfx_water_tile *volfx_water_tile_create(vfx_context *ctx)
     t->ssbo_max = block > 0 ? (uint64_t)block : (1u << 27); /* GL 4.5's minimum is 2^27 */
     if (ctx->debug.water_storage_cap && ctx->debug.water_storage_cap < t->ssbo_max)
         t->ssbo_max = ctx->debug.water_storage_cap;
+    if (!volfx_ubo_create(ctx, &t->ubo, sizeof(tile_block), "water.tile")) {
+        volfx_water_tile_destroy(ctx, t);
+        return NULL;
+    }
     return t;
 }
 
@@ -72,23 +109,68 @@ void volfx_water_tile_destroy(vfx_context *ctx, volfx_water_tile *t)
     for (int k = 0; k < 9; ++k)
         if (b[k])
             glDeleteBuffers(1, &b[k]);
+    volfx_ubo_destroy(&t->ubo);
     volfx_free(ctx, t);
 }
 
 
-static void tile_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_tile *t, const volfx_water_tile_input *in, uint32_t n)
+/* The loose uniforms' locations of prog, resolved the first time it is seen (a frame uses at
+ * most 5 such programs: the cache holds the isotropic and anisotropic sets in turn). */
+static const GLint *prog_locs(volfx_water_tile *t, GLuint prog)
 {
-    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_count"), in->count);
-    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_n"), n);
-    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_cap"), (in->params->disable & VFX_WATER_NO_TILES) ? 0u : t->entry_cap);
-    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_global_tiles"), TILE_GLOBAL_TILES);
-    glUniform2i(volfx_gpu_uniform(ctx, prog, "u_tiles"), (GLint)t->tiles_x, (GLint)t->tiles_y);
-    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_tile_shift"), t->shift);
-    glUniform2i(volfx_gpu_uniform(ctx, prog, "u_size"), (GLint)in->width, (GLint)in->height);
-    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_h"), in->params->h);
-    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_slabs"), t->slabs);
-    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_d0"), t->d0);
-    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_ds"), t->ds);
+    for (uint32_t k = 0; k < t->nprogs && k < TILE_PROG_CACHE; ++k)
+        if (t->progs[k].prog == prog)
+            return t->progs[k].loc;
+    static const char *const names[LOC_COUNT] = {"u_n", "u_half", "u_temporal", "u_reuse"};
+    tile_prog_locs *e = &t->progs[t->nprogs++ % TILE_PROG_CACHE];
+    e->prog = prog;
+    volfx_program_uniforms(prog, names, e->loc, LOC_COUNT);
+    return e->loc;
+}
+
+/* Fills tile.comp's block for this frame (once, after the bins' sizes are known). */
+static void tile_block_upload(const volfx_water_tile *t, const volfx_water_tile_input *in)
+{
+    const vfx_water_params *p = in->params;
+    tile_block b;
+    memset(&b, 0, sizeof b);
+    memcpy(b.view_proj, in->view_proj, sizeof b.view_proj);
+    memcpy(b.inv_view_proj, in->inv_view_proj, sizeof b.inv_view_proj);
+    memcpy(b.eye, in->eye, sizeof b.eye);
+    b.h = p->h;
+    b.tiles[0] = (int32_t)t->tiles_x;
+    b.tiles[1] = (int32_t)t->tiles_y;
+    b.size[0] = (int32_t)in->width;
+    b.size[1] = (int32_t)in->height;
+    b.count = in->count;
+    b.cap = (p->disable & VFX_WATER_NO_TILES) ? 0u : t->entry_cap;
+    b.global_tiles = TILE_GLOBAL_TILES;
+    b.tile_shift = t->shift;
+    b.slabs = t->slabs;
+    b.d0 = t->d0;
+    b.ds = t->ds;
+    b.rbound = in->kernels ? in->rbound : 0.0f;
+    b.threshold = p->threshold;
+    b.step = p->step;
+    /* a window of 2h holds the spheres one ray meets near its first entry (16 to 30 in dense
+     * water at a spacing of h/2); the local list takes 32 */
+    b.window = 2.0f * p->h;
+    float rho = p->h * (1.0f - p->threshold);
+    b.rho = rho > 0 ? rho : 0.0f;
+    b.refine_iters = (p->disable & VFX_WATER_NO_REFINE) ? 0u : p->refine_iters;
+    b.has_depth = in->has_depth;
+    b.subdivide = !(p->disable & VFX_WATER_NO_SUBDIVIDE);
+    b.local = !(p->disable & VFX_WATER_NO_LOCAL_LIST);
+    /* nodes down to h/128 whatever the step (the step is at most h: water_params.c) */
+    int depth = 4;
+    while (depth < 7 && p->step > p->h / 8.0f * (float)(1 << (depth - 4)) * 1.0001f)
+        ++depth;
+    b.sub_depth = depth;
+    /* the neighbours' tangent planes agree within a quarter step (the march's own bracket is
+     * one step wide before regula falsi) and their normals within 18 degrees */
+    b.half_tol = 0.25f * p->step;
+    b.half_cos = 0.95f;
+    volfx_ubo_update(&t->ubo, &b, sizeof b);
 }
 
 static void bind_buffers(const volfx_water_tile *t, const volfx_water_tile_input *in)
@@ -111,6 +193,7 @@ static void bind_buffers(const volfx_water_tile *t, const volfx_water_tile_input
     }
     if (t->remarch)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 14, t->remarch);
+    volfx_ubo_bind(&t->ubo, TILE_UBO_BINDING);
 }
 
 vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in)
@@ -213,6 +296,7 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
     GLuint add = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN_ADD\n");
     if (!count || !scatter || !scan || !top || !add)
         return VFX_ERR_GL;
+    tile_block_upload(t, in);
     bind_buffers(t, in);
     GLuint groups = (in->count + 63u) / 64u, blocks = need / 1024u;
     GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
@@ -220,31 +304,25 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
     glClearNamedBufferSubData(t->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     glClearNamedBufferSubData(t->globals, GL_R32UI, 0, 16, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     glUseProgram(count);
-    tile_uniforms(ctx, count, t, in, nscan);
-    glUniformMatrix4fv(volfx_gpu_uniform(ctx, count, "u_view_proj"), 1, GL_FALSE, in->view_proj);
-    glUniform3fv(volfx_gpu_uniform(ctx, count, "u_eye_bin"), 1, in->eye);
     if (groups)
         glDispatchCompute(gx, gy, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     glUseProgram(scan);
-    tile_uniforms(ctx, scan, t, in, nscan);
+    glUniform1ui(prog_locs(t, scan)[LOC_N], nscan);
     glDispatchCompute(blocks, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     glUseProgram(top);
-    tile_uniforms(ctx, top, t, in, blocks);
+    glUniform1ui(prog_locs(t, top)[LOC_N], blocks);
     glDispatchCompute(1, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     glUseProgram(add);
-    tile_uniforms(ctx, add, t, in, nscan);
+    glUniform1ui(prog_locs(t, add)[LOC_N], nscan);
     glDispatchCompute((nscan + 255u) / 256u, 1, 1);
     /* the counts are spent: the same buffer becomes the per-tile fill cursor of the scatter,
      * and ends holding each tile's count again */
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     glClearNamedBufferSubData(t->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     glUseProgram(scatter);
-    tile_uniforms(ctx, scatter, t, in, nscan);
-    glUniformMatrix4fv(volfx_gpu_uniform(ctx, scatter, "u_view_proj"), 1, GL_FALSE, in->view_proj);
-    glUniform3fv(volfx_gpu_uniform(ctx, scatter, "u_eye_bin"), 1, in->eye);
     if (groups)
         glDispatchCompute(gx, gy, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -253,41 +331,11 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
     return VFX_OK;
 }
 
-static void march_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_tile *t, const volfx_water_tile_input *in,
-                           const vfx_frame_view *frame, const volfx_frame_targets *targets)
-{
-    const vfx_water_params *p = in->params;
-    tile_uniforms(ctx, prog, t, in, 0);
-    glBindImageTexture(0, in->dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-    glBindTextureUnit(1, frame->depth_texture);
-    glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
-    glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_eye"), 1, frame->eye);
-    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_T"), p->threshold);
-    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_step"), p->step);
-    /* a window of 2h holds the spheres one ray meets near its first entry (16 to 30 in dense
-     * water at a spacing of h/2); the local list takes 32 */
-    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_window"), 2.0f * p->h);
-    float rho = p->h * (1.0f - p->threshold);
-    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_rho"), rho > 0 ? rho : 0.0f);
-    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_refine_iters"), (p->disable & VFX_WATER_NO_REFINE) ? 0u : p->refine_iters);
-    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_has_depth"), frame->depth_texture != 0);
-    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_subdivide"), !(p->disable & VFX_WATER_NO_SUBDIVIDE));
-    /* nodes down to h/128 whatever the step (the step is at most h: water_params.c) */
-    int depth = 4;
-    while (depth < 7 && p->step > p->h / 8.0f * (float)(1 << (depth - 4)) * 1.0001f)
-        ++depth;
-    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_sub_depth"), depth);
-    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_local"), !(p->disable & VFX_WATER_NO_LOCAL_LIST));
-    if (in->kernels)
-        glUniform1f(volfx_gpu_uniform(ctx, prog, "u_rbound"), in->rbound);
-}
-
 /* The march over the tile lists: MODE_MARCH writes gradient and back distance for every pixel,
  * MODE_FINISH reads the paper method's state and next step and finishes its sample-cap pixels.
  * The two differ only in the define, the pass name and how images 1 and 2 are bound. */
 static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
-                                const vfx_frame_view *frame, const volfx_frame_targets *targets,
-                                bool finish, GLuint img1, GLuint img2, int half, bool temporal, bool reuse)
+                                const vfx_frame_view *frame, bool finish, GLuint img1, GLuint img2, int half, bool temporal, bool reuse)
 {
     GLuint prog;
     if (finish) /* the paper method's kernel: isotropic */
@@ -307,19 +355,17 @@ static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const vol
                               : half == 3 ? "water.tile_remarch" : "water.tile_march");
     glUseProgram(prog);
     bind_buffers(t, in);
-    march_uniforms(ctx, prog, t, in, frame, targets);
+    glBindImageTexture(0, in->dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    glBindTextureUnit(1, frame->depth_texture);
     glBindImageTexture(1, img1, 0, GL_FALSE, 0, access, GL_RGBA32F);
     glBindImageTexture(2, img2, 0, GL_FALSE, 0, access, GL_R32F);
     uint32_t w = in->width, h = in->height;
     if (!finish) {
         glBindImageTexture(0, in->dist_tex, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
-        glUniform1i(volfx_gpu_uniform(ctx, prog, "u_half"), half);
-        glUniform1i(volfx_gpu_uniform(ctx, prog, "u_temporal"), temporal);
-        glUniform1i(volfx_gpu_uniform(ctx, prog, "u_reuse"), reuse);
-        /* the neighbours' tangent planes agree within a quarter step (the march's own bracket
-         * is one step wide before regula falsi) and their normals within 18 degrees */
-        glUniform1f(volfx_gpu_uniform(ctx, prog, "u_half_tol"), 0.25f * in->params->step);
-        glUniform1f(volfx_gpu_uniform(ctx, prog, "u_half_cos"), 0.95f);
+        const GLint *loc = prog_locs(t, prog);
+        glUniform1i(loc[LOC_HALF], half);
+        glUniform1i(loc[LOC_TEMPORAL], temporal);
+        glUniform1i(loc[LOC_REUSE], reuse);
         if (half == 1) {
             w = (w + 1) / 2;
             h = (h + 1) / 2;
@@ -359,8 +405,7 @@ static bool camera_cut(const volfx_water_tile *t, const volfx_water_tile_input *
 }
 
 vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
-                                  const vfx_frame_view *frame, const volfx_frame_targets *targets,
-                                  GLuint grad_tex, GLuint back_tex)
+                                  const vfx_frame_view *frame, GLuint grad_tex, GLuint back_tex)
 {
     const vfx_water_params *p = in->params;
     bool temporal = !(p->disable & VFX_WATER_NO_TEMPORAL);
@@ -407,9 +452,6 @@ vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const v
         glClearNamedBufferSubData(t->guess, GL_R32UI, 0, (GLsizeiptr)px * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &none);
         glUseProgram(prog);
         bind_buffers(t, in);
-        glUniform2i(volfx_gpu_uniform(ctx, prog, "u_size"), (GLint)in->width, (GLint)in->height);
-        glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_view_proj"), 1, GL_FALSE, in->view_proj);
-        glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_eye"), 1, in->eye);
         /* one invocation per kept hit point (the march counted the groups) */
         glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, t->hits);
         glDispatchComputeIndirect(0);
@@ -431,14 +473,14 @@ vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const v
             return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water tile: remarch list for %ux%u pixels: %s",
                               in->width, in->height, e);
     }
-    vfx_result r = tile_dispatch(ctx, t, in, frame, targets, false, grad_tex, back_tex, half ? 1 : 0, temporal, reuse);
+    vfx_result r = tile_dispatch(ctx, t, in, frame, false, grad_tex, back_tex, half ? 1 : 0, temporal, reuse);
     if (r == VFX_OK && half) {
         /* no group, one row, one layer, no pixel */
         const uint32_t args[4] = {0, 1, 1, 0};
         glNamedBufferSubData(t->remarch, 0, sizeof args, args);
-        r = tile_dispatch(ctx, t, in, frame, targets, false, grad_tex, back_tex, 2, temporal, reuse);
+        r = tile_dispatch(ctx, t, in, frame, false, grad_tex, back_tex, 2, temporal, reuse);
         if (r == VFX_OK)
-            r = tile_dispatch(ctx, t, in, frame, targets, false, grad_tex, back_tex, 3, temporal, reuse);
+            r = tile_dispatch(ctx, t, in, frame, false, grad_tex, back_tex, 3, temporal, reuse);
     }
     t->hits_valid = temporal && r == VFX_OK;
     t->hits_frame = in->frame_no;
@@ -453,8 +495,7 @@ vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const v
 }
 
 vfx_result volfx_water_tile_finish(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
-                                   const vfx_frame_view *frame, const volfx_frame_targets *targets,
-                                   GLuint st_tex, GLuint next_tex)
+                                   const vfx_frame_view *frame, GLuint st_tex, GLuint next_tex)
 {
-    return tile_dispatch(ctx, t, in, frame, targets, true, st_tex, next_tex, 0, false, false);
+    return tile_dispatch(ctx, t, in, frame, true, st_tex, next_tex, 0, false, false);
 }

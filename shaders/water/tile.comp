@@ -46,21 +46,38 @@ layout(std430, binding = 8) buffer Globals { uint gcount, gpad0, gpad1, gpad2; v
 // per particle: centre (w bounding radius), G (xx xy xz yy), G (yz zz), half-extents
 layout(std430, binding = 9) readonly buffer Kern { vec4 kern[]; };
 layout(std430, binding = 10) buffer EntryId { uint eid[]; };   // the particle of each entry
-// a bound of every particle's bounding radius: last_exit's early stop
-uniform float u_rbound;
 #endif
-uniform uint u_count;        // particles in the columns (non-finite included)
-uniform uint u_cap;          // entries the Entries buffer holds
-uniform uint u_global_tiles; // a particle covering more tiles goes to the global list
-uniform ivec2 u_tiles;       // tiles across, down
-uniform int u_tile_shift;    // tiles of 2^shift pixels a side: 8, or more when 8x8 tiles would pass the scan's 2^20
-uniform ivec2 u_size;        // pixels
-uniform float u_h;
-// Depth slabs: within a tile the entries are in slab order of the distance from the eye (key
-// tile * u_slabs + slab), each entry's w the near bound of its slab, so a scan that only needs
-// spheres entering before some distance stops at the first entry whose slab starts past it.
-uniform uint u_slabs;
-uniform float u_d0, u_ds;
+// Every constant of a TILE frame, one std140 block uploaded once a frame by water_tile.c
+// (tile_block mirrors it; binding TILE_UBO_BINDING there). Only the three switches that differ
+// between the dispatches of one frame (u_half, u_temporal, u_reuse) are loose uniforms.
+layout(std140, binding = 5) uniform WaterTile {
+    mat4 u_view_proj;       // proj * view: binning and reprojection
+    mat4 u_inv_view_proj;   // clip -> world: the march's rays
+    vec3 u_eye;
+    float u_h;
+    ivec2 u_tiles;          // tiles across, down
+    ivec2 u_size;           // pixels
+    uint u_count;           // particles in the columns (non-finite included)
+    uint u_cap;             // entries the Entries buffer holds
+    uint u_global_tiles;    // a particle covering more tiles goes to the global list
+    int u_tile_shift;       // tiles of 2^shift pixels a side: 8, or more when 8x8 tiles would pass the scan's 2^20
+    // Depth slabs: within a tile the entries are in slab order of the distance from the eye (key
+    // tile * u_slabs + slab), each entry's w the near bound of its slab, so a scan that only
+    // needs spheres entering before some distance stops at the first entry whose slab starts
+    // past it.
+    uint u_slabs;
+    float u_d0, u_ds;
+    float u_rbound;         // ANISO: a bound of every particle's bounding radius (last_exit's early stop)
+    float u_T, u_step, u_window, u_rho;
+    uint u_refine_iters;
+    bool u_has_depth, u_subdivide, u_local;
+    // the bound-driven subdivision's depth: 4 at steps of h/8 (nodes of h/128), one more per
+    // doubling of the step (at most 7 at steps of h), so the finest node stays h/128 or less
+    int u_sub_depth;
+    float u_half_tol;       // upsample: the neighbours' plane predictions agree within this
+    float u_half_cos;       // upsample: the neighbours' normals agree within this cosine
+    uint u_tile_pad0;
+};
 #if defined(MODE_MARCH) || defined(MODE_REPROJECT)
 // temporal reuse: last frame's hit points (world space; x groups of 64 for the indirect dispatch,
 // the count, then the points: only found pixels append, so a frame where the water covers a
@@ -76,9 +93,6 @@ layout(std430, binding = 14) buffer Remarch { uint rm_groups, rm_gy, rm_gz, rm_c
 #endif
 
 #if defined(MODE_COUNT) || defined(MODE_SCATTER)
-uniform mat4 u_view_proj;
-uniform vec3 u_eye_bin;
-
 // Tiles whose pixel centres the box p +- ext can cover (the cube of half-size h bounds the
 // sphere of influence, the ellipsoid's axis-aligned box its ellipsoid, so a ray through a
 // centre outside the rectangle misses it). false: off screen or behind.
@@ -111,12 +125,6 @@ bool tile_rect(vec3 p, vec3 ext, out ivec4 r)
 }
 #endif
 
-#if defined(MODE_REPROJECT)
-uniform mat4 u_view_proj;
-uniform vec3 u_eye;
-uniform ivec2 u_prev_size;
-#endif
-
 #if defined(MODE_MARCH) || defined(MODE_FINISH)
 layout(binding = 1) uniform sampler2D u_scene_depth;
 #if defined(MODE_MARCH)
@@ -127,24 +135,14 @@ layout(r32f, binding = 2) uniform image2D u_back;
 uniform bool u_temporal;     // write this frame's hit points
 uniform bool u_reuse;        // the guesses are this frame's (reprojected from the last)
 uniform int u_half;
-uniform float u_half_tol;    // upsample: the neighbours' plane predictions agree within this
-uniform float u_half_cos;    // upsample: the neighbours' normals agree within this cosine
 #else
 layout(r32f, binding = 0) uniform writeonly image2D u_dist;
 layout(rgba32f, binding = 1) uniform readonly image2D u_st;    // the paper's pixel state
 layout(r32f, binding = 2) uniform readonly image2D u_next;     // the paper's next sample
 #endif
-uniform mat4 u_inv_view_proj;
-uniform vec3 u_eye;
-uniform float u_T, u_step, u_window, u_rho;
-uniform uint u_refine_iters;
-uniform bool u_has_depth, u_subdivide, u_local;
 #ifndef LOCAL_K
 #define LOCAL_K 16
 #endif
-// the bound-driven subdivision's depth: 4 at steps of h/8 (nodes of h/128), one more per doubling
-// of the step (u_sub_depth, at most 7 at steps of h), so the finest node stays h/128 or less
-uniform int u_sub_depth;
 #define SUB_DEPTH_MAX 7
 // temporal reuse: the proof's dyadic depth at most (nodes of 2 steps or more)
 #define PROOF_DEPTH 4
@@ -457,10 +455,10 @@ void main()
     if (!tile_rect(p, kern[4u * i + 3u].xyz, r)) return;
     // filed by key = dist - R_i + h <= (its nearest entry) + h: the march's "w - h >= b" stops
     // stay exact; the CPU's d0 is lowered by the largest R_i - h so that key >= d0
-    float dist = length(p - u_eye_bin) - kc.w + u_h;
+    float dist = length(p - u_eye) - kc.w + u_h;
 #else
     if (!tile_rect(p, vec3(u_h), r)) return;
-    float dist = length(p - u_eye_bin);
+    float dist = length(p - u_eye);
 #endif
     uint area = uint(r.z - r.x + 1) * uint(r.w - r.y + 1);
     uint slab = uint(clamp(floor((dist - u_d0) / u_ds), 0.0, float(u_slabs - 1u)));
