@@ -13,10 +13,12 @@
 #include "scene/scene.h"
 #include "test_util.h"
 
+static vfx_result g_code; /* the last load's result */
+
 static rt_scene *load(const char *json, char *err, size_t errlen)
 {
     rt_scene *s = NULL;
-    rt_scene_load_mem(json, strlen(json), NULL, NULL, &s, err, errlen);
+    g_code = rt_scene_load_mem(json, strlen(json), NULL, NULL, &s, err, errlen);
     return s;
 }
 
@@ -58,15 +60,18 @@ static void test_defaults_and_values(void **state)
 static void test_bad_values(void **state)
 {
     (void)state;
+    /* a value out of range or unknown is VFX_ERR_INVALID_ARGUMENT, a value of the wrong JSON
+     * type VFX_ERR_FORMAT; the message names the key's path */
     static const struct {
         const char *beam, *msg;
+        vfx_result code;
     } cases[] = {
-        {"\"falloff\": \"soft\"", "beams[0].falloff: unknown value \"soft\""},
-        {"\"ramp\": 3", "beams[0].ramp"},
-        {"\"intensity\": 0", "beams[0].intensity"},
-        {"\"exposure\": 100", "beams[0].exposure"},
-        {"\"flow\": {\"amount\": 2}", "beams[0].flow.amount"},
-        {"\"flow\": 1", "beams[0].flow"},
+        {"\"falloff\": \"soft\"", "beams[0].falloff: unknown value \"soft\"", VFX_ERR_INVALID_ARGUMENT},
+        {"\"ramp\": 3", "beams[0].ramp", VFX_ERR_FORMAT},
+        {"\"intensity\": 0", "beams[0].intensity", VFX_ERR_INVALID_ARGUMENT},
+        {"\"exposure\": 100", "beams[0].exposure", VFX_ERR_INVALID_ARGUMENT},
+        {"\"flow\": {\"amount\": 2}", "beams[0].flow.amount", VFX_ERR_INVALID_ARGUMENT},
+        {"\"flow\": 1", "beams[0].flow", VFX_ERR_FORMAT},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         char json[512], err[256] = "";
@@ -76,12 +81,15 @@ static void test_bad_values(void **state)
         if (s || !strstr(err, cases[i].msg))
             printf("case %s: got \"%s\"\n", cases[i].beam, err);
         assert_null(s);
+        assert_int_equal(g_code, cases[i].code);
         assert_non_null(strstr(err, cases[i].msg));
     }
     char err[256] = "";
     assert_null(load("{\"version\": 1, \"beam_settings\": {\"bloom_levels\": 9}}", err, sizeof err));
+    assert_int_equal(g_code, VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(err, "beam_settings.bloom_levels"));
     assert_null(load("{\"version\": 1, \"beam_settings\": {\"bloom\": \"yes\"}}", err, sizeof err));
+    assert_int_equal(g_code, VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "beam_settings.bloom"));
 }
 
@@ -119,12 +127,14 @@ static void test_joints(void **state)
     rt_scene_free(s);
     static const struct {
         const char *beam, *msg;
+        vfx_result code;
     } bad[] = {
-        {"\"joints\": [[0, 0, 0]]", "beams[0].joints: expected an array of 2 to 6"},
-        {"\"joints\": [[0, 0, 0], [1, 0]]", "beams[0].joints[1]"},
-        {"\"joints\": [[0,0,0],[1,0,0],[2,0,0],[3,0,0],[4,0,0],[5,0,0],[6,0,0]]", "beams[0].joints"},
+        {"\"joints\": [[0, 0, 0]]", "beams[0].joints: expected an array of 2 to 6", VFX_ERR_INVALID_ARGUMENT},
+        {"\"joints\": [[0, 0, 0], [1, 0]]", "beams[0].joints[1]", VFX_ERR_FORMAT},
+        {"\"joints\": [[0,0,0],[1,0,0],[2,0,0],[3,0,0],[4,0,0],[5,0,0],[6,0,0]]", "beams[0].joints",
+         VFX_ERR_INVALID_ARGUMENT},
         {"\"joints\": [[0, 0, 0], [1, 0, 0]], \"keyframes\": {\"joints\": [{\"t\": 0, \"value\": [[0, 0, 0], [1, 0, 0], [2, 0, 0]]}]}",
-         "beams[0].keyframes.joints[0].value: 3 joints; every key"},
+         "beams[0].keyframes.joints[0].value: 3 joints; every key", VFX_ERR_INVALID_ARGUMENT},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
         char json[512];
@@ -134,6 +144,7 @@ static void test_joints(void **state)
         if (t || !strstr(err, bad[i].msg))
             printf("case %s: got \"%s\"\n", bad[i].beam, err);
         assert_null(t);
+        assert_int_equal(g_code, bad[i].code);
         assert_non_null(strstr(err, bad[i].msg));
     }
 }

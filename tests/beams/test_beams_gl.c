@@ -342,12 +342,12 @@ static void test_bad_input_and_absence(void **state)
 {
     (void)state;
     beam0()->v1.radius = -1.f;
-    assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "beams[0]"));
     beam0()->v1 = k_beam;
     beam0()->v1.head[1] = NAN;
-    assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
-    assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "not finite"));
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "beams[0]: beam head.y"));
     beam0()->v1 = k_beam;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_non_null(g_app->ctx->effect_state[VFX_EFFECT_BEAMS]);
@@ -500,15 +500,15 @@ static void test_bad_v2_input(void **state)
     (void)state;
     use_v2(true, true, true);
     beam0()->falloff = 7;
-    assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "beams[0]: falloff"));
     use_v2(true, true, true);
     beam0()->flow_amount = 2.f;
-    assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "flow_amount"));
     use_v2(true, true, true);
     g_app->beams_view2.bloom_levels = 99;
-    assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "bloom_levels"));
     use_v2(false, false, false);
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);

@@ -72,7 +72,7 @@ static void test_corrupt_files(void **state)
     (void)state;
     rt_mesh_data m;
     char err[512];
-    assert_int_not_equal(rt_mesh_import(MODELS "/invalid/malformed.obj", &m, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_mesh_import(MODELS "/invalid/malformed.obj", &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "malformed.obj"));
     assert_null(m.positions);
     assert_int_equal(rt_mesh_import(MODELS "/invalid/empty.obj", &m, err, sizeof err), VFX_ERR_FORMAT);
@@ -85,7 +85,7 @@ static void test_corrupt_files(void **state)
     FILE *f = fopen("truncated.stl", "wb");
     fwrite(stl, 1, sizeof stl, f);
     fclose(f);
-    assert_int_not_equal(rt_mesh_import("truncated.stl", &m, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_mesh_import("truncated.stl", &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "truncated.stl"));
     static const char garbage[] = "v 1 2\nf 1 2 3 4 5\nv nan nan nan\n";
     vfx_result r = rt_mesh_import_memory(garbage, sizeof garbage - 1, "obj", &m, err, sizeof err);

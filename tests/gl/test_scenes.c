@@ -54,7 +54,7 @@ static void test_bad_scene_refused(void **state)
     if (game_app_create(&d, &app) != VFX_OK)
         exit(VFX_TEST_SKIP);
     game_demo demo;
-    assert_int_not_equal(game_demo_load(app, &demo, "/no/such/scene.json", 0), VFX_OK);
+    assert_int_equal(game_demo_load(app, &demo, "/no/such/scene.json", 0), VFX_ERR_IO);
     assert_non_null(strstr(log.last, "/no/such/scene.json"));
     game_demo_free(app, &demo);
     game_app_destroy(app);

@@ -349,17 +349,18 @@ static void test_environment(void **state)
     assert_false(s->environment.sky);
     assert_true(s->environment.sun_dir[1] == 1 && s->environment.fog == 0.5f);
     rt_scene_free(s);
-    static const struct { const char *json, *needle; } bad[] = {
-        {"{\"environment\": {\"sky\": \"noon\"}}", "environment.sky"},
-        {"{\"environment\": {\"sun_dir\": [0, 0, 0]}}", "environment.sun_dir"},
-        {"{\"environment\": {\"fog\": -1}}", "environment.fog"},
-        {"{\"environment\": {\"fog\": 11}}", "environment.fog"},
-        {"{\"environment\": 3}", "environment"},
+    /* out of range: VFX_ERR_INVALID_ARGUMENT; the wrong JSON type: VFX_ERR_FORMAT */
+    static const struct { const char *json, *needle; vfx_result code; } bad[] = {
+        {"{\"environment\": {\"sky\": \"noon\"}}", "environment.sky", VFX_ERR_INVALID_ARGUMENT},
+        {"{\"environment\": {\"sun_dir\": [0, 0, 0]}}", "environment.sun_dir", VFX_ERR_INVALID_ARGUMENT},
+        {"{\"environment\": {\"fog\": -1}}", "environment.fog", VFX_ERR_INVALID_ARGUMENT},
+        {"{\"environment\": {\"fog\": 11}}", "environment.fog", VFX_ERR_INVALID_ARGUMENT},
+        {"{\"environment\": 3}", "environment", VFX_ERR_FORMAT},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
         s = NULL;
         err[0] = 0;
-        assert_int_not_equal(load(bad[i].json, &log, &s, err, sizeof err), VFX_OK);
+        assert_int_equal(load(bad[i].json, &log, &s, err, sizeof err), bad[i].code);
         if (!strstr(err, bad[i].needle))
             fail_msg("%s: error \"%s\" does not name %s", bad[i].json, err, bad[i].needle);
         assert_null(s);
@@ -432,7 +433,6 @@ static void test_syntax_errors(void **state)
     assert_non_null(strstr(err, "line 1"));
     /* empty input */
     assert_int_equal(load("", &log, &s, err, sizeof err), VFX_ERR_FORMAT);
-    assert_non_null(strstr(err, "syntax error"));
     /* two objects: text after the scene */
     assert_int_equal(load("{}\n{}", &log, &s, err, sizeof err), VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "line 2, column 1 (byte 3): text after the scene object"));

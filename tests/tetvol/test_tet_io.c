@@ -126,7 +126,7 @@ static void test_wrong_counts(void **st)
     /* 6 points declared, 5 given */
     assert_int_equal(load_str(make_ascii("6", "5", "2 2 2", "4", "10"), NULL, &m, err),
                      VFX_ERR_FORMAT);
-    assert_non_null(strstr(err, "too few values"));
+    assert_non_null(strstr(err, "18 values expected"));
     assert_int_equal(load_str(make_ascii("0", "5", "2 2 2", "4", "10"), NULL, &m, err),
                      VFX_ERR_FORMAT);
     assert_non_null(strstr(err, "NumberOfPoints"));
@@ -138,13 +138,11 @@ static void test_empty_and_not_xml(void **st)
     tet_mesh m;
     char err[256];
     assert_int_equal(rt_volume_load_vtu_mem("", 0, NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
-    assert_non_null(strstr(err, "empty"));
     assert_int_equal(load_str("solid cube\nfacet normal 0 0 1\n", NULL, &m, err), VFX_ERR_FORMAT);
-    assert_non_null(strstr(err, "not valid XML"));
+    assert_non_null(strstr(err, "line 1"));
     const char *s = make_ascii("5", "5", "2 2 2", "4", "10");
     assert_int_equal(rt_volume_load_vtu_mem(s, strlen(s) / 2, NULL, &m, err, sizeof err),
                      VFX_ERR_FORMAT); /* truncated */
-    assert_non_null(strstr(err, "not valid XML"));
     assert_int_equal(rt_volume_load_vtu("/nonexistent/x.vtu", NULL, &m, err, sizeof err),
                      VFX_ERR_IO);
 }
@@ -590,7 +588,7 @@ static void test_cell_count_cap(void **st)
     /* at the cap: past the cap check, refused by the text's size instead */
     snprintf(out, sizeof out, "%.*sNumberOfCells=\"%s\"%s", (int)(at - buf), buf, under, at + 17);
     preset(err, sizeof err);
-    assert_int_not_equal(rt_volume_load_vtu_mem(out, strlen(out), NULL, &m, err, sizeof err), VFX_OK);
+    assert_int_equal(rt_volume_load_vtu_mem(out, strlen(out), NULL, &m, err, sizeof err), VFX_ERR_FORMAT);
     assert_null(strstr(err, "RT_VOLUME_MAX_TETS"));
     assert_false(strstr(err, SENTINEL));
 }
