@@ -369,6 +369,14 @@ static void publish_counters(vfx_context *ctx, water_state *s)
         volfx_stat_set(ctx, "water.tile_temporal_samples_saved", (double)c[20] - c[21]);
         volfx_stat_set(ctx, "water.tile_half_upsampled", c[22]);
         volfx_stat_set(ctx, "water.tile_half_remarched", c[23]);
+        if (c[12] && !s->undecided_warned) {
+            /* not drawn: said once, never a silent miss (issue 28) */
+            s->undecided_warned = 1;
+            volfx_log(ctx, VFX_LOG_WARN, "water: %u pixels undecided (not drawn) in frame %llu: the march ran past "
+                      "MAX_STEPS or the driver ended its loops (llvmpipe: 65,535 loop iterations a shader invocation; "
+                      "%u tile entries this frame); a higher resolution, a larger h or method grid draws them",
+                      c[12], (unsigned long long)s->last_frame, c[10]);
+        }
     }
     volfx_stat_set(ctx, "water.ssr_hits", c[26]);
     volfx_stat_set(ctx, "water.diffuse_spray", c[27]);

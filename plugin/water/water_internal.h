@@ -110,6 +110,7 @@ typedef struct water_state {
     uint32_t last_method;
     int have_last;
     uint32_t dropped;      /* counter results overwritten before the GPU finished them */
+    uint32_t undecided_warned; /* TILE pixels left undecided were logged (once a context) */
     float view_proj[16];
     GLuint vao; /* empty: billboards are built from gl_VertexID / gl_InstanceID */
     volfx_ubo frame_ubo; /* water_frame_block */

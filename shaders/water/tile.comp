@@ -357,6 +357,20 @@ float next_local_entry(float t)
         if (Le[j] >= t) e = min(e, Le[j]);
     return e;
 }
+
+// true when the driver may have cut this invocation's loops short. llvmpipe (Mesa gallivm)
+// gives an invocation 65,535 loop iterations in all, every loop together (LP_MAX_TGSI_LOOP_
+// ITERATIONS, one counter per shader); past that each loop ends after its current iteration,
+// silently: a tile list of ~90,000 entries (262,144 particles in a 0.8 box seen 12 pixels
+// wide) drew no water while every pixel was counted as left (issue 28). A spent counter lets
+// a loop of two iterations run once, so this probe, run last, says whether it was spent.
+// The bound is not a constant (u_slabs >= 1 < 2^31), so the compiler cannot unroll the loop.
+bool loop_budget_spent()
+{
+    uint n = 0u;
+    for (uint k = 0u; k < 2u + (u_slabs >> 31); ++k) ++n;
+    return n < 2u;
+}
 #endif
 
 #if defined(MODE_MARCH)
@@ -719,6 +733,7 @@ void main()
         result = tt;
         if (!(result <= t_lim)) { result = -1.0; state = 2; }
     }
+    if (loop_budget_spent()) { state = 4; result = -1.0; }   // undecided, counted: not a miss
     imageStore(u_dist, pix, vec4(result));
 #if defined(MODE_MARCH)
     if (state == 1) {
