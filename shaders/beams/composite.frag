@@ -14,5 +14,7 @@ void main()
         L += u_bloom_gain * texture(u_bloom_tex, v_uv).rgb;
     if (!(L.r + L.g + L.b > 0.0))
         discard;
-    o_color = vec4(L, 0.0);
+    // at most half the largest half float: added to a host colour below that, an RGBA16F frame
+    // stays finite whatever bloom_strength (up to 1e6) does to the capped light (issue 28)
+    o_color = vec4(min(L, vec3(32768.0)), 0.0);
 }

@@ -12,6 +12,9 @@ vec3 volfx_joint(uint i) { return joints[i].xyz; }
 in vec2 v_ndc;
 layout(location = 0) out float o_acc;
 layout(location = 1) out vec4 o_light;
+// the light's cap: 12 stops above white (tone-mapped white long before), so the light and the
+// bloom chain's sum of up to 9 levels stay finite in their RGBA16F targets (largest 65504)
+const float LIGHT_MAX = 4096.0;
 
 struct Beam {
     vec4 m_l;    // head relative to the eye, length
@@ -136,7 +139,9 @@ void main()
             Hth += h;
             tint += h * bm.color.rgb;
         } else if (h > 0.0) {
-            float x = h * bm.look.y;
+            // capped where the pixel is white anyway: beam_settings.c 1e-30 or exposure 64 made
+            // x * x Inf, the ramp Inf / Inf NaN, and the beam vanished (issue 28)
+            float x = min(h * bm.look.y, LIGHT_MAX);
             if (bm.look.z > 0.0) {
 #ifdef VOLFX_BEAMS_POLYLINE
                 float u = poly ? volfx_poly_nearest_u(bm.mode.z, int(bm.mode.w), V)
@@ -155,5 +160,5 @@ void main()
         light += tint / Hth * I;
     }
     o_acc = H;
-    o_light = vec4(light, 0.0);
+    o_light = vec4(min(light, vec3(LIGHT_MAX)), 0.0);   // finite whatever the gain
 }
