@@ -1,0 +1,264 @@
+/* test_hardening.c — issue 28's outside attack, the classes that need an effect drawing through
+ * the real plugin: TILE on a tile list longer than llvmpipe's loop budget (drew nothing and
+ * counted every pixel as left), beams at the documented extremes of exposure and saturate_c (NaN:
+ * the beam vanished), an out-of-memory target reported as what it is, and a frame view of
+ * framebuffer 0 (the default framebuffer, which a surfaceless context does not have). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <epoxy/gl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+
+#include "camera_ref.h"
+#include "context.h"
+#include "test_util.h"
+#include "water_ref.h"
+
+typedef struct host {
+    test_log log;
+    float *x, *y, *z;
+    uint32_t n;
+    uint32_t method;
+    vfx_beam2 beam;
+    float saturate_c;
+} host;
+
+static uint32_t one_chunk(void *user) { return ((host *)user)->n ? 1u : 0u; }
+
+static vfx_result chunk(void *user, uint32_t c, vfx_particle_view *out)
+{
+    (void)c;
+    host *s = user;
+    *out = (vfx_particle_view){.size = sizeof *out, .version = VFX_PARTICLE_VIEW_VERSION, .count = s->n,
+                               .pos = {s->x, s->y, s->z}};
+    return VFX_OK;
+}
+
+static vfx_result water_params(void *user, vfx_water_params *out)
+{
+    host *s = user;
+    *out = (vfx_water_params){.size = sizeof *out, .version = VFX_WATER_PARAMS_VERSION, .method = s->method,
+                              .h = 0.02f};
+    return VFX_OK;
+}
+
+static vfx_result beams_view(void *user, vfx_beams_view *out)
+{
+    host *s = user;
+    if (out->size < sizeof(vfx_beams_view2) || out->version < VFX_BEAMS_VIEW2_VERSION)
+        return VFX_ERR_ABI;
+    vfx_beams_view2 *v = (vfx_beams_view2 *)out;
+    memset(v, 0, sizeof *v);
+    v->v1 = (vfx_beams_view){.size = sizeof *v, .version = VFX_BEAMS_VIEW2_VERSION, .count = 1,
+                             .saturate_c = s->saturate_c};
+    v->beams = &s->beam;
+    return VFX_OK;
+}
+
+typedef struct session {
+    vfx_plugin_api api;
+    vfx_context *ctx;
+    vfx_host_api hapi;
+    GLuint fbo, col, scene;
+    uint32_t w, h;
+} session;
+
+static void session_open(session *ss, host *s, uint32_t w, uint32_t h, GLenum fmt)
+{
+    memset(ss, 0, sizeof *ss);
+    ss->hapi = (vfx_host_api){.size = sizeof ss->hapi, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
+                              .user = s, .log = test_log_fn};
+    if (s->n) {
+        ss->hapi.particle_chunk_count = one_chunk;
+        ss->hapi.particle_chunk = chunk;
+        ss->hapi.water_params = water_params;
+    } else {
+        ss->hapi.beams = beams_view;
+    }
+    ss->api.size = sizeof ss->api;
+    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
+    assert_int_equal(ss->api.create(&ss->hapi, &ss->ctx), VFX_OK);
+    ss->ctx->debug.sync_counters = true;
+    ss->w = w, ss->h = h;
+    glCreateTextures(GL_TEXTURE_2D, 1, &ss->col);
+    glTextureStorage2D(ss->col, 1, fmt, (GLsizei)w, (GLsizei)h);
+    glCreateTextures(GL_TEXTURE_2D, 1, &ss->scene);
+    glTextureStorage2D(ss->scene, 1, fmt, (GLsizei)w, (GLsizei)h);
+    glCreateFramebuffers(1, &ss->fbo);
+    glNamedFramebufferTexture(ss->fbo, GL_COLOR_ATTACHMENT0, ss->col, 0);
+    const float black[4] = {0, 0, 0, 1};
+    glClearTexImage(ss->col, 0, GL_RGBA, GL_FLOAT, black);
+    glClearTexImage(ss->scene, 0, GL_RGBA, GL_FLOAT, black);
+}
+
+static void session_close(session *ss)
+{
+    ss->api.destroy(ss->ctx);
+    glDeleteFramebuffers(1, &ss->fbo);
+    GLuint t[] = {ss->col, ss->scene};
+    glDeleteTextures(2, t);
+}
+
+static vfx_frame_view frame_of(const session *ss, const ref_camera *cam)
+{
+    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = ss->fbo,
+                         .color_texture = ss->scene, .width = (uint32_t)cam->width, .height = (uint32_t)cam->height,
+                         .fov_y = (float)cam->fov_y, .near_plane = (float)cam->near_plane,
+                         .far_plane = (float)cam->far_plane};
+    for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam->eye[k];
+    ref_camera_matrices(cam, fv.view, fv.proj);
+    return fv;
+}
+
+static vfx_result session_frame(session *ss, const ref_camera *cam)
+{
+    vfx_frame_view fv = frame_of(ss, cam);
+    vfx_result r = ss->api.update(ss->ctx, 0.0, 0.0f);
+    return r ? r : ss->api.render(ss->ctx, &fv);
+}
+
+static double stat(session *ss, const char *name)
+{
+    vfx_stats2 st = {.size = sizeof st, .version = VFX_STATS2_VERSION};
+    assert_int_equal(ss->api.get_stats(ss->ctx, (vfx_stats *)&st), VFX_OK);
+    for (uint32_t k = 0; k < st.count; ++k)
+        if (!strcmp(st.entries[k].name, name)) return st.entries[k].value;
+    return -1;
+}
+
+/* 42^3 = 74,088 particles at a spacing of h/2 in a cube 0.41 wide, seen whole by one 8x8 tile:
+ * every pixel's list holds all of them, more than the 65,535 loop iterations llvmpipe gives one
+ * shader invocation (all loops together; Mesa gallivm's loop limiter), after which every loop
+ * ends early without a word. The attack's case (262,144 particles in a 0.8 box at 96x64: TILE
+ * 46-54 water pixels, GRID 144, TILE 0 with temporal reuse and the reduced resolution off) is
+ * the same limit at a size that takes 20 s here. Before: 0 found, every pixel counted as left,
+ * 0 undecided, nothing logged. Now each pixel whose loops the driver may have cut is counted
+ * undecided and a warning says why; no pixel is drawn that the float64 reference does not
+ * have; GRID (short cell lists) draws the reference's pixels. On a driver without the limit
+ * (any GPU) TILE draws them: then the first branch below holds trivially with 0 undecided. */
+static void test_tile_loop_budget(void **state)
+{
+    (void)state;
+    host s = {0};
+    const uint32_t side = 42;
+    s.n = side * side * side;
+    s.x = malloc(s.n * 4), s.y = malloc(s.n * 4), s.z = malloc(s.n * 4);
+    for (uint32_t i = 0; i < s.n; ++i) {
+        s.x[i] = 0.01f * (float)(i % side) - 0.205f;
+        s.y[i] = 0.01f * (float)(i / side % side) - 0.205f;
+        s.z[i] = 0.01f * (float)(i / side / side) - 0.205f;
+    }
+    const ref_camera cam = {{0.3, 0.4, 1.5}, {0, 0, 0}, {0, 1, 0}, 0.6, 8, 8, 0.1, 50};
+    /* the float64 reference (h/32 samples and bisection) */
+    float ref[64], tile[64], grid[64];
+    double fwd[3], right[3], up[3];
+    ref_camera_basis(&cam, fwd, right, up);
+    ref_water_camera rc = {{cam.eye[0], cam.eye[1], cam.eye[2]}, {fwd[0], fwd[1], fwd[2]}, {up[0], up[1], up[2]},
+                           cam.fov_y, 8, 8};
+    ref_water_params rp = ref_water_default_params();
+    rp.h = 0.02;
+    rp.step = rp.h / 32;
+    char err[256];
+    assert_int_equal(ref_water_render(&rc, s.x, s.y, s.z, s.n, &rp, ref, NULL, NULL, err), 0);
+    int ref_hits = 0;
+    for (int i = 0; i < 64; ++i) ref_hits += ref[i] >= 0;
+    assert_true(ref_hits >= 8); /* the cube covers about a fifth of the 64 pixels */
+    session ss;
+    s.method = VFX_WATER_METHOD_TILE;
+    session_open(&ss, &s, 8, 8, GL_RGBA8);
+    assert_int_equal(session_frame(&ss, &cam), VFX_OK);
+    assert_int_equal(ss.api.read_raw(ss.ctx, VFX_EFFECT_WATER, tile, 64), VFX_OK);
+    double found = stat(&ss, "water.pixels_found"), undecided = stat(&ss, "water.pixels_undecided");
+    print_message("TILE: found %.0f, undecided %.0f, left %.0f, reference %d; log: %s\n", found, undecided,
+                  stat(&ss, "water.pixels_left"), ref_hits, s.log.last);
+    int false_hits = 0, missed = 0;
+    for (int i = 0; i < 64; ++i) false_hits += tile[i] >= 0 && ref[i] < 0, missed += tile[i] < 0 && ref[i] >= 0;
+    assert_int_equal(false_hits, 0);
+    /* every reference pixel TILE did not draw is counted undecided (none silently "left") */
+    assert_true(undecided >= missed);
+    if (missed) {
+        assert_non_null(strstr(s.log.last, "undecided (not drawn)"));
+        assert_non_null(strstr(s.log.last, "65,535 loop iterations"));
+    }
+    session_close(&ss);
+    s.method = VFX_WATER_METHOD_GRID;
+    s.log = (test_log){0};
+    session_open(&ss, &s, 8, 8, GL_RGBA8);
+    assert_int_equal(session_frame(&ss, &cam), VFX_OK);
+    assert_int_equal(ss.api.read_raw(ss.ctx, VFX_EFFECT_WATER, grid, 64), VFX_OK);
+    int agree = 0;
+    for (int i = 0; i < 64; ++i) agree += (grid[i] >= 0) == (ref[i] >= 0);
+    print_message("GRID: %d of 64 pixels agree with the reference\n", agree);
+    /* one grazing silhouette pixel may differ (the reference's h/32 samples against GRID's step) */
+    assert_true(agree >= 63);
+    session_close(&ss);
+    free(s.x), free(s.y), free(s.z);
+}
+
+/* Reads the RGBA16F output; returns the largest red value and counts non-finite components. */
+static float read_out(const session *ss, int *nonfinite)
+{
+    size_t n = (size_t)ss->w * ss->h * 4;
+    float *px = malloc(n * 4);
+    glGetTextureImage(ss->col, 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * 4), px);
+    float m = 0;
+    *nonfinite = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (!isfinite(px[i])) ++*nonfinite;
+        else if (i % 4 == 0 && px[i] > m) m = px[i];
+    }
+    free(px);
+    return m;
+}
+
+/* The documented extremes: exposure -64..64 stops, saturate_c (0, 1e6]. exposure 63/64 and c
+ * 1e-30 made the ramp's x * x Inf and x^2 / (x^2 + 9) NaN: the beam vanished; 62 was white. Now
+ * every gain gives a finite frame (RGBA16F, where an Inf or NaN would show) and a beam at least
+ * as bright as at exposure 0; -64 and c 1e6 give a finite, dim one. */
+static void test_beams_extreme_gain(void **state)
+{
+    (void)state;
+    const ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8, 32, 24, 0.1, 100};
+    const struct { float exposure, c; int bright; } cases[] = {
+        {0, 1, 0}, {62, 1, 1}, {63, 1, 1}, {64, 1, 1}, {0, 1e-30f, 1}, {64, 1e-30f, 1}, {-64, 1, -1}, {0, 1e6f, -1},
+    };
+    float base = 0;
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        host s = {0};
+        s.beam = (vfx_beam2){.v1 = {.head = {-1, 0, 0}, .dir = {1, 0, 0}, .length = 2, .radius = 0.5f, .a = 0.05f,
+                                    .b = 0.03f, .eps = 0.02f, .color = {1, 0.5f, 0.2f, 1}},
+                             .exposure = cases[k].exposure};
+        s.saturate_c = cases[k].c;
+        session ss;
+        session_open(&ss, &s, 32, 24, GL_RGBA16F);
+        assert_int_equal(session_frame(&ss, &cam), VFX_OK);
+        int bad;
+        float m = read_out(&ss, &bad);
+        print_message("exposure %g, c %g: brightest red %g, %d non-finite\n", (double)cases[k].exposure,
+                      (double)cases[k].c, (double)m, bad);
+        assert_int_equal(bad, 0);
+        if (k == 0) base = m;
+        assert_true(base > 0.05f);
+        if (cases[k].bright > 0) assert_true(m >= base);
+        if (cases[k].bright < 0) assert_true(m < base);
+        session_close(&ss);
+    }
+}
+
+int main(void)
+{
+    rt_gl_context *gl = test_gl_or_skip();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_tile_loop_budget),
+        cmocka_unit_test(test_beams_extreme_gain),
+    };
+    int rc = cmocka_run_group_tests(tests, NULL, NULL);
+    rt_gl_context_destroy(gl);
+    return rc;
+}
