@@ -17,18 +17,20 @@ typedef struct {
     const char *name;
 } tg_reader;
 
-/* The text is parsed as a C string: a NUL inside would silently end it early. */
-static vfx_result read_whole(const char *path, char **buf, size_t *size, char *err, size_t errlen)
+/* The whole file as a reader at its first line (r->buf is the caller's to free). The text is
+ * parsed as a C string: a NUL inside would silently end it early. */
+static vfx_result reader_open(const char *path, tg_reader *rd, size_t *size, char *err, size_t errlen)
 {
+    char *buf = NULL;
     vfx_result r = rt_read_file(path, RT_VOLUME_MAX_FILE_BYTES,
-                                "1 GiB for a volume file (RT_VOLUME_MAX_FILE_BYTES)", buf, size, err, errlen);
-    const char *z = r ? NULL : memchr(*buf, 0, *size);
+                                "1 GiB for a volume file (RT_VOLUME_MAX_FILE_BYTES)", &buf, size, err, errlen);
+    const char *z = r ? NULL : memchr(buf, 0, *size);
     if (z) {
-        snprintf(err, errlen, "%s: byte %zu is a NUL byte (not a text file?)", path, (size_t)(z - *buf));
-        free(*buf);
-        *buf = NULL;
+        snprintf(err, errlen, "%s: byte %zu is a NUL byte (not a text file?)", path, (size_t)(z - buf));
+        free(buf);
         return VFX_ERR_FORMAT;
     }
+    *rd = (tg_reader){buf, buf, 0, path};
     return r;
 }
 
@@ -80,6 +82,22 @@ static int parse_numbers(char *s, double *v, int maxn)
 
 #define TG_MAXCOL 64
 
+/* A header's count against its cap and the file's size. Every item takes a line of at least 2
+ * bytes: a header claiming more than that is truncated, refused before allocating for the
+ * claimed count (found by fuzz_tetgen: a 9-byte file asked for 12 GB). Loose on purpose: near
+ * misses get the exact "i of n". */
+static vfx_result header_count(const tg_reader *r, size_t sz, double n, const char *what, uint32_t cap,
+                               const char *cap_name, char *err, size_t errlen)
+{
+    if (n > cap)
+        return rt_errf(err, errlen, VFX_ERR_FORMAT, "%s: header claims %.0f %s, above the cap of %u (%s)",
+                       r->name, n, what, cap, cap_name);
+    if (n > (double)sz / 2)
+        return rt_errf(err, errlen, VFX_ERR_FORMAT, "%s: truncated: header claims %g %s, file has %zu bytes",
+                       r->name, n, what, sz);
+    return VFX_OK;
+}
+
 /* .node header: "points [dimension 3] [attributes] [markers 0|1]", checked against the caps
  * and against the file's size. */
 static vfx_result node_header(tg_reader *r, size_t sz, double *np, int *nattr, int *nmark,
@@ -96,16 +114,10 @@ static vfx_result node_header(tg_reader *r, size_t sz, double *np, int *nattr, i
         return rt_errf(err, errlen, VFX_ERR_FORMAT,
                        "%s:%d: bad header (points %g, dimension %g, attributes %g, markers %g)", r->name,
                        r->line, p, dim, na, nm);
-    if (p > RT_VOLUME_MAX_POINTS)
-        return rt_errf(err, errlen, VFX_ERR_FORMAT, "%s: header claims %.0f points, above the cap of %u "
-                       "(RT_VOLUME_MAX_POINTS)", r->name, p, RT_VOLUME_MAX_POINTS);
-    /* Every point takes a line of at least 2 bytes: a header claiming more points than that is
-     * truncated, refused before allocating for the claimed count (found by fuzz_tetgen: a
-     * 9-byte file asked for 12 GB). Loose on purpose: near misses get the exact "i of n". */
-    if (p > (double)sz / 2)
-        return rt_errf(err, errlen, VFX_ERR_FORMAT,
-                       "%s: truncated: header claims %g points, file has %zu bytes",
-                       r->name, p, sz);
+    vfx_result res = header_count(r, sz, p, "points", RT_VOLUME_MAX_POINTS, "RT_VOLUME_MAX_POINTS",
+                                  err, errlen);
+    if (res)
+        return res;
     *np = p, *nattr = (int)na, *nmark = (int)nm;
     return VFX_OK;
 }
@@ -132,19 +144,28 @@ static vfx_result node_scalar(const char *path, const char *scalar_name, int nat
                    "%s: scalar field '%s' not found; the file has no node attributes", path, scalar_name);
 }
 
+/* Item i of count (a point or a tetrahedron): the next line, exactly cols numbers into v. */
+static vfx_result item_line(tg_reader *r, const char *one, const char *many, uint32_t i, uint32_t count,
+                            int cols, double *v, char *err, size_t errlen)
+{
+    char *line;
+    if (!next_line(r, &line))
+        return rt_errf(err, errlen, VFX_ERR_FORMAT, "%s: truncated: %u of %u %s", r->name, i, count, many);
+    int n = parse_numbers(line, v, TG_MAXCOL);
+    if (n != cols)
+        return rt_errf(err, errlen, VFX_ERR_FORMAT, "%s:%d: %s %u has %d numbers, expected %d", r->name,
+                       r->line, one, i, n, cols);
+    return VFX_OK;
+}
+
 /* One .node point line: "index x y z attributes... [marker]"; the first index sets *base. */
 static vfx_result node_point(tg_reader *r, uint32_t i, int cols, int attr_index, int *base, tet_mesh *out,
                              char *err, size_t errlen)
 {
     double v[TG_MAXCOL];
-    char *line;
-    if (!next_line(r, &line))
-        return rt_errf(err, errlen, VFX_ERR_FORMAT,
-                       "%s: truncated: %u of %u points", r->name, i, out->point_count);
-    int n = parse_numbers(line, v, TG_MAXCOL);
-    if (n != cols)
-        return rt_errf(err, errlen, VFX_ERR_FORMAT, "%s:%d: point %u has %d numbers, expected %d", r->name,
-                       r->line, i, n, cols);
+    vfx_result res = item_line(r, "point", "points", i, out->point_count, cols, v, err, errlen);
+    if (res)
+        return res;
     if (i == 0) {
         if (v[0] != 0 && v[0] != 1)
             return rt_errf(err, errlen, VFX_ERR_FORMAT, "%s:%d: first point index %g is neither 0 nor 1",
@@ -178,12 +199,11 @@ static vfx_result node_point(tg_reader *r, uint32_t i, int cols, int attr_index,
 static vfx_result read_node(const char *path, const char *scalar_name, tet_mesh *out, int *base,
                             char *err, size_t errlen)
 {
-    char *buf = NULL;
+    tg_reader r;
     size_t sz;
-    vfx_result res = read_whole(path, &buf, &sz, err, errlen);
+    vfx_result res = reader_open(path, &r, &sz, err, errlen);
     if (res)
         return res;
-    tg_reader r = {buf, buf, 0, path};
     double np = 0;
     int nattr = 0, nmark = 0, attr_index = -1;
     if ((res = node_header(&r, sz, &np, &nattr, &nmark, err, errlen))
@@ -204,7 +224,7 @@ static vfx_result read_node(const char *path, const char *scalar_name, tet_mesh 
     for (uint32_t i = 0; i < out->point_count && !res; i++)
         res = node_point(&r, i, 4 + nattr + nmark, attr_index, base, out, err, errlen);
 done:
-    free(buf);
+    free(r.buf);
     return res;
 }
 
@@ -222,14 +242,10 @@ static vfx_result ele_header(tg_reader *r, size_t sz, double *nt, int *cols, cha
         return rt_errf(err, errlen, VFX_ERR_FORMAT,
                        "%s:%d: bad header (tetrahedra %g, nodes per tet %g, attributes %g)",
                        r->name, r->line, t, npt, neattr);
-    if (t > RT_VOLUME_MAX_TETS)
-        return rt_errf(err, errlen, VFX_ERR_FORMAT, "%s: header claims %.0f tetrahedra, above the cap of %u "
-                       "(RT_VOLUME_MAX_TETS)", r->name, t, RT_VOLUME_MAX_TETS);
-    /* Same bound as for points. */
-    if (t > (double)sz / 2)
-        return rt_errf(err, errlen, VFX_ERR_FORMAT,
-                       "%s: truncated: header claims %g tetrahedra, file has %zu bytes",
-                       r->name, t, sz);
+    vfx_result res = header_count(r, sz, t, "tetrahedra", RT_VOLUME_MAX_TETS, "RT_VOLUME_MAX_TETS",
+                                  err, errlen);
+    if (res)
+        return res;
     *nt = t;
     *cols = 1 + (int)npt + (int)neattr;
     return VFX_OK;
@@ -241,15 +257,9 @@ static vfx_result ele_tet(tg_reader *r, uint32_t t, int cols, int base, tet_mesh
                           char *err, size_t errlen)
 {
     double v[TG_MAXCOL];
-    char *line;
-    if (!next_line(r, &line))
-        return rt_errf(err, errlen, VFX_ERR_FORMAT,
-                       "%s: truncated: %u of %u tetrahedra", r->name, t, out->tet_count);
-    int n = parse_numbers(line, v, TG_MAXCOL);
-    if (n != cols)
-        return rt_errf(err, errlen, VFX_ERR_FORMAT,
-                       "%s:%d: tetrahedron %u has %d numbers, expected %d", r->name,
-                       r->line, t, n, cols);
+    vfx_result res = item_line(r, "tetrahedron", "tetrahedra", t, out->tet_count, cols, v, err, errlen);
+    if (res)
+        return res;
     for (int k = 0; k < 4; k++) {
         double idx = v[1 + k] - base;
         if (!(idx >= 0 && idx < (double)out->point_count) || idx != (double)(uint32_t)idx)
@@ -264,12 +274,11 @@ static vfx_result ele_tet(tg_reader *r, uint32_t t, int cols, int base, tet_mesh
 /* The .ele file: the tetrahedra over out's points, numbered from base. */
 static vfx_result read_ele(const char *path, int base, tet_mesh *out, char *err, size_t errlen)
 {
-    char *buf = NULL;
+    tg_reader r;
     size_t sz;
-    vfx_result res = read_whole(path, &buf, &sz, err, errlen);
+    vfx_result res = reader_open(path, &r, &sz, err, errlen);
     if (res)
         return res;
-    tg_reader r = {buf, buf, 0, path};
     double nt = 0;
     int cols = 0;
     if ((res = ele_header(&r, sz, &nt, &cols, err, errlen)))
@@ -284,7 +293,7 @@ static vfx_result read_ele(const char *path, int base, tet_mesh *out, char *err,
     for (uint32_t t = 0; t < out->tet_count && !res; t++)
         res = ele_tet(&r, t, cols, base, out, err, errlen);
 done:
-    free(buf);
+    free(r.buf);
     return res;
 }
 

@@ -43,12 +43,7 @@ static vfx_beam2 *beam0(void)
 static int setup(void **state)
 {
     (void)state;
-    memset(&g_log, 0, sizeof g_log);
-    game_app_desc d = {.mode = RT_GL_HEADLESS, .width = W, .height = H, .logger = {test_log_fn, &g_log}};
-    if (game_app_create(&d, &g_app) != VFX_OK)
-        exit(VFX_TEST_SKIP);
-    rt_camera cam = test_rt_camera(&g_cam);
-    assert_int_equal(game_app_set_camera(g_app, &cam), VFX_OK);
+    g_app = test_app_with_camera(&g_cam, &g_log);
     assert_int_equal(game_app_add_beams(g_app, &(vfx_beam2){.v1 = k_beam}, 1), VFX_OK);
     g_app->beams_view = (vfx_beams_view){.size = sizeof(vfx_beams_view), .version = VFX_BEAMS_VIEW_VERSION};
     return 0;

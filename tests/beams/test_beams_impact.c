@@ -47,12 +47,7 @@ static vfx_beam beam_from_to(const double src[3], const double head[3], float ra
 static int setup(void **state)
 {
     (void)state;
-    memset(&g_log, 0, sizeof g_log);
-    game_app_desc d = {.mode = RT_GL_HEADLESS, .width = W, .height = H, .logger = {test_log_fn, &g_log}};
-    if (game_app_create(&d, &g_app) != VFX_OK)
-        exit(VFX_TEST_SKIP);
-    rt_camera cam = test_rt_camera(&g_cam);
-    assert_int_equal(game_app_set_camera(g_app, &cam), VFX_OK);
+    g_app = test_app_with_camera(&g_cam, &g_log);
     const float grey[3] = {0.5f, 0.5f, 0.5f};
     /* the floor, top at y = 0; a pillar at x = 1.2 in front of z = 0 */
     assert_int_equal(game_app_add_box(g_app, (float[3]){-6, -0.2f, -6}, (float[3]){6, 0, 6}, grey, NULL), VFX_OK);

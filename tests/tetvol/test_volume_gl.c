@@ -36,11 +36,7 @@ static uint32_t *g_tets, g_np, g_nt;
 static int setup(void **state)
 {
     (void)state;
-    game_app_desc d = {.mode = RT_GL_HEADLESS, .width = W, .height = H};
-    if (game_app_create(&d, &g_app) != VFX_OK)
-        exit(VFX_TEST_SKIP);
-    rt_camera cam = test_rt_camera(&g_cam);
-    assert_int_equal(game_app_set_camera(g_app, &cam), VFX_OK);
+    g_app = test_app_with_camera(&g_cam, NULL);
     rt_scene_volume sv;
     memset(&sv, 0, sizeof sv);
     sv.generated = true;
