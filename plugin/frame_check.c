@@ -363,6 +363,11 @@ vfx_result volfx_frame_gate_gl(vfx_context *ctx, bool drawing, volfx_frame_targe
     if (t->environment_cubemap &&
         (r = check_texture(ctx, "environment_cubemap", t->environment_cubemap, WANT_CUBE, 0, 0)))
         return r;
+    /* framebuffer 0 is the default framebuffer, which a surfaceless context lacks: the first draw
+     * into it failed with a GL error that named nothing (issue 28) */
+    if (!t->framebuffer && glCheckNamedFramebufferStatus(0, GL_DRAW_FRAMEBUFFER) == GL_FRAMEBUFFER_UNDEFINED)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view framebuffer 0 is the default "
+                          "framebuffer, and the current context has none (surfaceless): name a framebuffer object");
     if (!t->scene_depth && (r = far_depth(ctx, t->width, t->height, &t->scene_depth)))
         return r;
     return upload_block(ctx, t);

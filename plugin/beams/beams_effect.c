@@ -180,8 +180,9 @@ static vfx_result make_bloom(vfx_context *ctx, beams_state *s, uint32_t levels)
         glCreateFramebuffers(1, &s->bloom_fbo[i]);
         glNamedFramebufferTexture(s->bloom_fbo[i], GL_COLOR_ATTACHMENT0, s->bloom_tex[i], 0);
         s->bloom_levels = i;
-        if (glCheckNamedFramebufferStatus(s->bloom_fbo[i], GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-            return volfx_fail(ctx, VFX_ERR_GL, "beams: bloom level %u incomplete", i);
+        vfx_result r = volfx_gpu_check_target(ctx, s->bloom_fbo[i], "beams: bloom level", s->bloom_w[i], s->bloom_h[i]);
+        if (r)
+            return r;
     }
     return VFX_OK;
 }
@@ -200,8 +201,9 @@ static vfx_result beams_resize(vfx_context *ctx, void *state, uint32_t w, uint32
     glNamedFramebufferTexture(s->acc_fbo, GL_COLOR_ATTACHMENT1, s->light_tex, 0);
     static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     glNamedFramebufferDrawBuffers(s->acc_fbo, 2, bufs);
-    if (glCheckNamedFramebufferStatus(s->acc_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-        return volfx_fail(ctx, VFX_ERR_GL, "beams: H target %ux%u incomplete", w, h);
+    vfx_result r = volfx_gpu_check_target(ctx, s->acc_fbo, "beams: H and light targets", w, h);
+    if (r)
+        return r;
     s->grid = volfx_beams_grid_of(w, h);
     volfx_free(ctx, s->ranges);
     s->ranges = volfx_alloc(ctx, (size_t)s->grid.tiles_x * s->grid.tiles_y * 2 * sizeof(uint32_t));

@@ -58,6 +58,19 @@ const char *volfx_gpu_error_string(void)
     }
 }
 
+vfx_result volfx_gpu_check_target(vfx_context *ctx, GLuint fb, const char *what, uint32_t w, uint32_t h)
+{
+    const char *e = volfx_gpu_error_string();
+    if (e && !strcmp(e, "GL_OUT_OF_MEMORY")) /* reported as "incomplete framebuffer" before (issue 28) */
+        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "%s %ux%u: out of memory making its textures (GL_OUT_OF_MEMORY)",
+                          what, w, h);
+    GLenum st = glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER);
+    if (st != GL_FRAMEBUFFER_COMPLETE || e)
+        return volfx_fail(ctx, VFX_ERR_GL, "%s %ux%u: framebuffer status 0x%x%s%s", what, w, h, st, e ? ", " : "",
+                          e ? e : "");
+    return VFX_OK;
+}
+
 vfx_result volfx_gpu_create(vfx_context *ctx, volfx_gpu **out)
 {
     *out = NULL;

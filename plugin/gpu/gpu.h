@@ -52,6 +52,10 @@ GLuint volfx_gpu_storage(GLsizeiptr bytes, const char *label);
 void volfx_gpu_label(GLenum kind, GLuint object, const char *label);
 /* Returns a GL error as a string, or NULL when glGetError() is GL_NO_ERROR. */
 const char *volfx_gpu_error_string(void);
+/* VFX_OK when the render target framebuffer fb (what, w x h, just made) is complete. Reads the GL
+ * error first: GL_OUT_OF_MEMORY fails with VFX_ERR_OUT_OF_MEMORY naming it (the framebuffer's
+ * incompleteness is its symptom), any other incompleteness or error with VFX_ERR_GL. */
+vfx_result volfx_gpu_check_target(vfx_context *ctx, GLuint fb, const char *what, uint32_t w, uint32_t h);
 
 /* Compiles and links from source strings (used by volfx_gpu_program; tests call it directly).
  * `names` give the file name of each stage for error messages. */

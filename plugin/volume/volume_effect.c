@@ -154,8 +154,9 @@ static vfx_result volume_resize(vfx_context *ctx, void *state, uint32_t w, uint3
     s->width = w, s->height = h;
     s->frame = 0;
     s->last_key = 0;
-    if (glCheckNamedFramebufferStatus(s->dist_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-        return volfx_fail(ctx, VFX_ERR_GL, "volume: distance target %ux%u incomplete", w, h);
+    vfx_result r = volfx_gpu_check_target(ctx, s->dist_fbo, "volume: distance target", w, h);
+    if (r)
+        return r;
     return s->max_dist ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
 }
 

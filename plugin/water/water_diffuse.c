@@ -337,8 +337,9 @@ vfx_result volfx_water_diffuse_splat(vfx_context *ctx, volfx_water_diffuse *d, c
         glNamedFramebufferTexture(d->fbo, GL_COLOR_ATTACHMENT0, d->layer, 0);
         d->layer_w = frame->width;
         d->layer_h = frame->height;
-        if (glCheckNamedFramebufferStatus(d->fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-            return volfx_fail(ctx, VFX_ERR_GL, "water diffuse: incomplete layer framebuffer %ux%u", frame->width, frame->height);
+        vfx_result r = volfx_gpu_check_target(ctx, d->fbo, "water diffuse: layer", frame->width, frame->height);
+        if (r)
+            return r;
     }
     GLuint prog = volfx_gpu_program(ctx, "water/diffuse.vert", "water/diffuse.frag", "#define SPLAT\n");
     if (!prog)

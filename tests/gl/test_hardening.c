@@ -251,12 +251,101 @@ static void test_beams_extreme_gain(void **state)
     }
 }
 
+static host beam_host(void)
+{
+    host s = {0};
+    s.beam = (vfx_beam2){.v1 = {.head = {-1, 0, 0}, .dir = {1, 0, 0}, .length = 2, .radius = 0.5f, .a = 0.05f,
+                                .b = 0.03f, .eps = 0.02f}};
+    return s;
+}
+
+/* Framebuffer 0 names the default framebuffer, which the surfaceless context here does not have:
+ * refused naming the field (before: "beams render: GL_INVALID_FRAMEBUFFER_OPERATION", no field),
+ * no GL error left behind, and the next frame into a framebuffer object draws. */
+static void test_framebuffer_zero(void **state)
+{
+    (void)state;
+    const ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8, 16, 16, 0.1, 100};
+    host s = beam_host();
+    session ss;
+    session_open(&ss, &s, 16, 16, GL_RGBA8);
+    vfx_frame_view fv = frame_of(&ss, &cam);
+    fv.framebuffer = 0;
+    assert_int_equal(ss.api.update(ss.ctx, 0.0, 0.0f), VFX_OK);
+    vfx_result r = ss.api.render(ss.ctx, &fv);
+    print_message("framebuffer 0: %d %s\n", r, ss.api.last_error(ss.ctx));
+    assert_int_equal(r, VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(ss.api.last_error(ss.ctx), "framebuffer 0 is the default framebuffer"));
+    assert_int_equal(glGetError(), GL_NO_ERROR);
+    assert_int_equal(session_frame(&ss, &cam), VFX_OK);
+    session_close(&ss);
+}
+
+static size_t vm_size_bytes(void)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    size_t kb = 0;
+    while (f && fgets(line, sizeof line, f))
+        if (sscanf(line, "VmSize: %zu kB", &kb) == 1)
+            break;
+    if (f)
+        fclose(f);
+    return kb * 1024;
+}
+
+/* The attack's 16,384^2 frame ran out of memory in the effects' targets and was told "incomplete
+ * framebuffer". Here the same failure at 4096x3072 (the beams' H, light and bloom targets, about
+ * 170 MiB) under an address-space limit 64 MiB above what the process holds: the GL reports
+ * GL_OUT_OF_MEMORY and the plugin says out of memory, naming the target and the size; after the
+ * limit is lifted the context draws again. Skipped where the limit cannot be set. */
+static void test_target_out_of_memory(void **state)
+{
+    (void)state;
+    const ref_camera small = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8, 16, 16, 0.1, 100};
+    ref_camera big = small;
+    big.width = 4096, big.height = 3072;
+    host s = beam_host();
+    session ss;
+    session_open(&ss, &s, 16, 16, GL_RGBA8);
+    assert_int_equal(session_frame(&ss, &small), VFX_OK); /* programs built */
+    GLuint tex, fbo; /* the host's own target of the big frame, made before the limit */
+    glCreateTextures(GL_TEXTURE_2D, 1, &tex);
+    glTextureStorage2D(tex, 1, GL_RGBA8, 4096, 3072);
+    glCreateFramebuffers(1, &fbo);
+    glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, tex, 0);
+    vfx_frame_view fv = frame_of(&ss, &big);
+    fv.framebuffer = fbo, fv.color_texture = 0;
+    struct rlimit old;
+    assert_int_equal(getrlimit(RLIMIT_AS, &old), 0);
+    size_t vm = vm_size_bytes();
+    struct rlimit lim = {vm + (64u << 20), old.rlim_max};
+    if (!vm || (old.rlim_max != RLIM_INFINITY && lim.rlim_cur > old.rlim_max) || setrlimit(RLIMIT_AS, &lim) != 0) {
+        session_close(&ss);
+        skip();
+    }
+    vfx_result r = ss.api.update(ss.ctx, 0.0, 0.0f);
+    if (!r) r = ss.api.render(ss.ctx, &fv);
+    setrlimit(RLIMIT_AS, &old);
+    print_message("4096x3072 under a limit of VmSize + 64 MiB: %d %s\n", r, ss.api.last_error(ss.ctx));
+    assert_int_equal(r, VFX_ERR_OUT_OF_MEMORY);
+    assert_non_null(strstr(ss.api.last_error(ss.ctx), "out of memory"));
+    assert_non_null(strstr(ss.api.last_error(ss.ctx), "4096x3072"));
+    while (glGetError() != GL_NO_ERROR) {}
+    assert_int_equal(session_frame(&ss, &small), VFX_OK);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteTextures(1, &tex);
+    session_close(&ss);
+}
+
 int main(void)
 {
     rt_gl_context *gl = test_gl_or_skip();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_tile_loop_budget),
         cmocka_unit_test(test_beams_extreme_gain),
+        cmocka_unit_test(test_framebuffer_zero),
+        cmocka_unit_test(test_target_out_of_memory),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     rt_gl_context_destroy(gl);
