@@ -25,13 +25,29 @@ typedef struct seg_pool {
     size_t n, cap;
 } seg_pool;
 
-/* Segment idx of a pixel whose hint (last inserted segment) is hint. The hint's live copy is
- * the pixel's entry of the worker's dense open array, not its pool slot: the pool is written in
+/* A pixel's list: its first segment, its hint (the segment last inserted, a walk start; -1 for
+ * none) and the hint's live copy, which is here and not in its pool slot: the pool is written in
  * insertion order, so a cell's neighbouring pixels have their hints on scattered cache lines,
- * while their open entries are neighbours (the insert was the scan's largest cache-miss cost). */
-static inline const seg *tet_seg_at(const seg_pool *p, const seg *open, int32_t hint, int32_t idx)
+ * while their list entries are neighbours (the insert was the scan's largest cache-miss cost). */
+typedef struct pixel_list {
+    seg open;
+    int32_t head, hint;
+} pixel_list;
+
+/* Segment idx of pixel list L (the hint's live copy when idx is the hint). */
+static inline const seg *tet_seg_at(const seg_pool *p, const pixel_list *L, int32_t idx)
 {
-    return idx == hint ? open : &p->s[idx];
+    return idx == L->hint ? &L->open : &p->s[idx];
+}
+
+/* front-over-back of two premultiplied segments */
+static inline void tet_over(seg *f, const seg *b)
+{
+    float t = 1.0f - f->a;
+    f->r += t * b->r;
+    f->g += t * b->g;
+    f->b += t * b->b;
+    f->a += t * b->a;
 }
 
 typedef struct tile {
@@ -93,11 +109,9 @@ typedef struct scan_ctx {
  * (false sharing). */
 typedef struct worker {
     _Alignas(64) seg_pool pool;
-    int32_t *heads;
-    int32_t *hints;         /* per pixel: the segment last inserted (a walk start), or -1 */
-    seg *open;              /* per pixel: the live copy of the hint segment (tet_seg_at) */
+    pixel_list *px;         /* per pixel */
     tile *tiles;            /* local ERT table */
-    size_t pixels;          /* heads/hints capacity */
+    size_t pixels;          /* px capacity */
     int tiles_cap;          /* tiles capacity */
     tet_counters cnt;
     uint32_t next, end;     /* remaining cells: keys[next..end), guarded by lock */
@@ -147,15 +161,8 @@ void tet_tf_release(tf_prep *tf);
 int tet_tf_segment(const tf_prep *tf, double S0, double Sb, double tin, double tout, double L,
                    float out[4]);
 
-/* ---- tet_composite.c: segment lists, ERT tables, final composite ---- */
+/* ---- tet_composite.c: ERT tables, final composite (insertion: tet_scan.c) ---- */
 
-/* Inserts v into the pixel list at *head in order of zf, merging touching neighbours when
- * partial is set (never growing a segment past stop); *hint and *open are the pixel's hint and
- * its live copy (tet_seg_at). Returns 0, or -1 when out of memory. */
-int tet_insert_seg(seg_pool *p, int32_t *head, int32_t *hint, seg *open, seg v, int partial,
-                   float stop, uint64_t *merged);
-/* front-over-back of two premultiplied segments */
-void tet_over(seg *f, const seg *b);
 /* Rebuilds w's ERT table from its lists; with sharing on, merges it with the shared one. */
 void tet_update_table(shared *sh, worker *w);
 /* Final composite of rows [y0, y1): the workers' lists merged in depth order per pixel. */

@@ -171,8 +171,8 @@ size_t tet_local_export(const tet_local *L, size_t p0, size_t p1, uint32_t *offs
     size_t n = 0;
     for (size_t p = p0; p < p1; p++) {
         offsets[p - p0] = (uint32_t)n;
-        for (int32_t c = L->w.heads[p]; c >= 0; n++) {
-            const seg *s = tet_seg_at(&L->w.pool, &L->w.open[p], L->w.hints[p], c);
+        for (int32_t c = L->w.px[p].head; c >= 0; n++) {
+            const seg *s = tet_seg_at(&L->w.pool, &L->w.px[p], c);
             if (segs) {
                 tet_rseg o = {s->zf, s->zb, s->r, s->g, s->b, s->a};
                 segs[n] = o;

@@ -5,6 +5,7 @@
 #include "tet_engine.h"
 
 #include <math.h>
+#include <stdlib.h>
 
 /* floor/ceil without the libm call (no SSE4.1 rounding by default); |v| < 2^31 here */
 static inline int ifloor(double v)
@@ -257,6 +258,103 @@ static int ray_interval(const cell *C, const double b[4], double dx, double dy, 
     return t1 > t0;
 }
 
+/* Reserves a pool slot (written when it stops being its pixel's hint). */
+static int32_t pool_reserve(seg_pool *p)
+{
+    if (p->n == p->cap) {
+        size_t nc = p->cap ? p->cap * 2 : 4096;
+        seg *ns = realloc(p->s, nc * sizeof *ns);
+        if (!ns)
+            return -1;
+        p->s = ns;
+        p->cap = nc;
+    }
+    return (int32_t)p->n++;
+}
+
+/* Makes idx the hint of L: the old hint's live copy goes back to its pool slot and idx's
+ * current contents (at src) become the live copy. */
+static inline void set_hint(seg_pool *p, pixel_list *L, int32_t idx, const seg *src)
+{
+    if (idx == L->hint)
+        return;
+    seg cur = *src;
+    if (L->hint >= 0)
+        p->s[L->hint] = L->open;
+    L->open = cur;
+    L->hint = idx;
+}
+
+/* Inserts v into pixel list L in order of zf; with partial set, merges it with a touching
+ * neighbour (the paper's partial compositing, 2.1: a merged segment is again a segment), never
+ * growing a segment past stop. Here, not in tet_composite.c, so that v stays in registers (passed
+ * through the stack it was stored as floats and reloaded as vectors, a forwarding stall).
+ * Returns 0, or -1 when out of memory. */
+static inline int insert_seg(seg_pool *p, pixel_list *L, seg v, int partial, float stop,
+                             uint64_t *merged)
+{
+    const int32_t h = L->hint;
+    seg *const open = &L->open;
+    int32_t prev = -1, cur = L->head;
+#define SEG(i) ((i) == h ? open : &p->s[i])
+    /* cells arrive roughly front to back, so the pixel's last inserted segment is usually just
+     * in front of the new one: start the walk there. It is always linked: the only unlink (the
+     * chain merge below) happens in an insertion, which then makes the survivor the hint. */
+    if (h >= 0 && open->zf < v.zf) {
+        prev = h;
+        cur = open->next;
+    }
+    while (cur >= 0 && SEG(cur)->zf < v.zf) {
+        prev = cur;
+        cur = SEG(cur)->next;
+    }
+    if (partial) {
+        float eps = TET_TOUCH_EPS * (1.0f + fabsf(v.zf));
+        /* never grow a segment that is already opaque past the ERT threshold: its z_back is
+         * where the pixel terminated, and growing it would push the termination depth back */
+        if (prev >= 0 && SEG(prev)->a < stop && fabsf(SEG(prev)->zb - v.zf) <= eps) {
+            seg *ps = SEG(prev);
+            tet_over(ps, &v);
+            ps->zb = v.zb;
+            (*merged)++;
+            /* the grown segment may now touch its successor */
+            if (cur >= 0 && ps->a < stop && fabsf(ps->zb - SEG(cur)->zf) <= eps) {
+                const seg *cs = SEG(cur);
+                tet_over(ps, cs);
+                ps->zb = cs->zb;
+                ps->next = cs->next;
+            }
+            set_hint(p, L, prev, ps);
+            return 0;
+        }
+        if (cur >= 0 && v.a < stop && fabsf(v.zb - SEG(cur)->zf) <= eps) {
+            seg *cs = SEG(cur);
+            seg m = v;
+            tet_over(&m, cs);
+            m.zb = cs->zb;
+            m.next = cs->next;
+            *cs = m;
+            (*merged)++;
+            set_hint(p, L, cur, cs);
+            return 0;
+        }
+    }
+    v.next = cur;
+    int32_t idx = pool_reserve(p);
+    if (idx < 0)
+        return -1;
+    if (prev >= 0)
+        SEG(prev)->next = idx;
+    else
+        L->head = idx;
+#undef SEG
+    if (h >= 0)
+        p->s[h] = *open;
+    *open = v;
+    L->hint = idx;
+    return 0;
+}
+
 /* Step 7: the segment [tin, tout] of pixel pix (ray length per unit depth L, scalar S0 + Sb t
  * along it), clipped by the host's depth, integrated through the transfer function and
  * inserted into the pixel's list. Returns 0, or -1 when out of memory. */
@@ -273,7 +371,7 @@ static int emit_segment(const scan_ctx *X, worker *w, size_t pix, double tin, do
     w->cnt.tf_pieces += (uint64_t)tet_tf_segment(X->tf, S0, Sb, tin, tout, L, c);
     seg sg = {(float)(tin * L), (float)(tout * L), c[0], c[1], c[2], c[3], -1};
     w->cnt.segments_made++;
-    return tet_insert_seg(&w->pool, &w->heads[pix], &w->hints[pix], &w->open[pix], sg, opts->partial_composite,
+    return insert_seg(&w->pool, &w->px[pix], sg, opts->partial_composite,
                           opts->ert_threshold, &w->cnt.segments_merged);
 }
 

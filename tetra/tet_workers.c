@@ -173,13 +173,9 @@ int tet_worker_reset(worker *w, int W, int H, int D)
 {
     const size_t np = (size_t)W * H;
     if (w->pixels < np) {
-        free(w->heads);
-        free(w->hints);
-        free(w->open);
-        w->heads = malloc(np * sizeof *w->heads);
-        w->hints = malloc(np * sizeof *w->hints);
-        w->open = malloc(np * sizeof *w->open);
-        w->pixels = w->heads && w->hints && w->open ? np : 0;
+        free(w->px);
+        w->px = malloc(np * sizeof *w->px);
+        w->pixels = w->px ? np : 0;
         if (!w->pixels)
             return -1;
     }
@@ -191,7 +187,7 @@ int tet_worker_reset(worker *w, int W, int H, int D)
             return -1;
     }
     for (size_t p = 0; p < np; p++)
-        w->heads[p] = w->hints[p] = -1;
+        w->px[p].head = w->px[p].hint = -1;
     memset(w->tiles, 0, (size_t)D * D * sizeof *w->tiles);
     memset(&w->cnt, 0, sizeof w->cnt);
     w->pool.n = 0;
@@ -202,13 +198,10 @@ int tet_worker_reset(worker *w, int W, int H, int D)
 
 void tet_worker_free(worker *w)
 {
-    free(w->heads);
-    free(w->hints);
-    free(w->open);
+    free(w->px);
     free(w->tiles);
     free(w->pool.s);
-    w->heads = w->hints = NULL;
-    w->open = NULL;
+    w->px = NULL;
     w->tiles = NULL;
     w->pool.s = NULL;
     w->pool.n = w->pool.cap = 0;
