@@ -160,6 +160,7 @@ double ref_beams_integral(const volfx_beam_d *beams, uint32_t n, const double o[
     for (uint32_t i = 0; i < n; ++i) {
         int nj = beams[i].joint_count >= 2 ? beams[i].joint_count : 2;
         cap += (size_t)nj * SPHERE_BREAKS + (size_t)(nj - 1) * SEGMENT_BREAKS;
+        cap += 2 * SPHERE_BREAKS + SEGMENT_BREAKS; /* the anatomy's head, orb and widest body */
     }
     int m = 0;
     double *br = malloc(cap * sizeof(double));
@@ -172,6 +173,17 @@ double ref_beams_integral(const volfx_beam_d *beams, uint32_t n, const double o[
     for (uint32_t i = 0; i < n; ++i) {
         const volfx_beam_d *b = &beams[i];
         double eps = b->eps > VOLFX_BEAM_EPS_FLOOR * b->radius ? b->eps : VOLFX_BEAM_EPS_FLOOR * b->radius;
+        const double *j0 = b->joint_count >= 2 ? b->joints[0] : b->head;
+        double src[3];
+        for (int c = 0; c < 3; ++c)
+            src[c] = b->joint_count >= 2 ? b->joints[b->joint_count - 1][c] : b->head[c] + b->length * b->dir[c];
+        /* the anatomy's own supports; the body's varying edge is left to the bisection */
+        if (b->head_radius > 0)
+            sphere_breaks(o, v, j0, b->head_radius, eps, t0, t1, br, &m);
+        if (b->orb_radius > 0)
+            sphere_breaks(o, v, src, b->orb_radius, eps, t0, t1, br, &m);
+        if (b->joint_count < 2 && b->surge > 0)
+            segment_breaks(o, v, b->head, b->dir, b->length, b->radius * (1 + b->surge), eps, t0, t1, br, &m);
         if (b->joint_count >= 2) {
             for (int k = 0; k < b->joint_count; ++k)
                 sphere_breaks(o, v, b->joints[k], b->radius, eps, t0, t1, br, &m);

@@ -133,6 +133,25 @@ static vfx_result host_beams(void *user, vfx_beams_view *out)
     vfx_beam2 *beams = game_app_beams(app, &n);
     if (n == 0)
         return VFX_ERR_NOT_FOUND;
+    if (app->beams_v3 && app->beams3_count == n && out->version >= VFX_BEAMS_VIEW3_VERSION
+        && out->size >= sizeof(vfx_beams_view3)) {
+        /* the anatomy beside the entities' column: each beam's version 2 part is the column's */
+        for (uint32_t i = 0; i < n; ++i)
+            app->beams3[i].v2 = beams[i];
+        vfx_beams_view3 *v3 = (vfx_beams_view3 *)out;
+        memset(v3, 0, sizeof *v3);
+        v3->v2 = app->beams_view2;
+        v3->v2.v1 = app->beams_view;
+        v3->v2.v1.size = sizeof *v3;
+        v3->v2.v1.version = VFX_BEAMS_VIEW3_VERSION;
+        v3->v2.v1.count = n;
+        v3->v2.v1.beams = NULL;
+        v3->v2.beams = beams;
+        v3->v2.joints = &app->joints[0][0];
+        v3->v2.joint_count = app->joint_count;
+        v3->beams3 = app->beams3;
+        return VFX_OK;
+    }
     if (app->beams_v2 && out->version >= VFX_BEAMS_VIEW2_VERSION && out->size >= sizeof(vfx_beams_view2)) {
         vfx_beams_view2 *v2 = (vfx_beams_view2 *)out;
         *v2 = app->beams_view2;
@@ -296,6 +315,7 @@ void game_app_destroy(game_app *app)
     rt_plugin_host_unload(app->plugin);
     free(app->chunks);
     free(app->beams_v1);
+    free(app->beams3);
     if (app->world) {
         rt_query_iter it = rt_query_begin(app->world, &app->mesh_comp, 1);
         while (rt_query_next(&it)) {
@@ -362,6 +382,24 @@ vfx_result game_app_add_box(game_app *app, const float mn[3], const float mx[3],
 vfx_result game_app_add_beams(game_app *app, const vfx_beam2 *beams, uint32_t n)
 {
     return rt_beams_spawn(app->world, &app->effects, n, beams, NULL);
+}
+
+vfx_result game_app_set_anatomy(game_app *app, const vfx_beam3 *beams, uint32_t n)
+{
+    if (n > app->beams3_cap) {
+        vfx_beam3 *p = realloc(app->beams3, n * sizeof *p);
+        if (!p)
+            return VFX_ERR_OUT_OF_MEMORY;
+        app->beams3 = p;
+        app->beams3_cap = n;
+    }
+    if (n && beams)
+        memcpy(app->beams3, beams, n * sizeof *beams);
+    else if (n)
+        memset(app->beams3, 0, n * sizeof *app->beams3);
+    app->beams3_count = n;
+    app->beams_v3 = n > 0;
+    return VFX_OK;
 }
 
 vfx_beam2 *game_app_beams(game_app *app, uint32_t *count)

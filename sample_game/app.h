@@ -69,6 +69,9 @@ typedef struct game_app {
     uint32_t joint_count;
     vfx_beam *beams_v1;        /* a version-1 view's copy of each beam's v1 part */
     uint32_t beams_v1_cap;
+    bool beams_v3;             /* answer version 3 views: beams3 holds each beam entity's anatomy */
+    vfx_beam3 *beams3;         /* beams3_count of them, in the column's order (game_app_set_anatomy) */
+    uint32_t beams3_count, beams3_cap;
     double time;
     double origin[3];          /* large worlds: what every position the game holds is relative to
                                   (the scene's "origin"), handed to the plugin in frame view 2 */
@@ -99,6 +102,11 @@ vfx_result game_app_add_beams(game_app *app, const vfx_beam2 *beams, uint32_t n)
 /* The beams as one array to read or edit in place, their number in *count (NULL, 0: none).
  * Valid until the next structural change of the world. */
 vfx_beam2 *game_app_beams(game_app *app, uint32_t *count);
+/* The beams' anatomy (version 3), in the order of game_app_beams' column: while their count is
+ * the column's, a plugin that offers version 3 gets them, each with the column's version 2 part
+ * (whatever the v2 members of `beams` held); beams NULL: n zeroed ones (version 2's look, to be
+ * written through app->beams3); n = 0 goes back to version 2 views. */
+vfx_result game_app_set_anatomy(game_app *app, const vfx_beam3 *beams, uint32_t n);
 /* Despawns every beam entity. */
 void game_app_clear_beams(game_app *app);
 /* Spawns a volume entity (component "vfx.volume") with a copy of the view; its arrays stay the

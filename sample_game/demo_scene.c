@@ -394,14 +394,23 @@ static uint32_t beam_count_of(game_app *app)
     return n;
 }
 
-/* The scene's beams at time t into the beam entities (their count is the scene's, capped). */
+/* The scene's beams at time t into the beam entities (their count is the scene's, capped), and
+ * their anatomy (version 3) beside them. */
 static void beams_at(game_app *app, game_demo *demo, double t)
 {
     uint32_t n;
     vfx_beam2 *beams = game_app_beams(app, &n);
-    if (n)
-        rt_scene_beams2_at(demo->scene, t, beams, n < demo->beam_base_count ? n : demo->beam_base_count,
-                           &app->joints[0][0], GAME_APP_MAX_JOINTS, &app->joint_count);
+    if (!n)
+        return;
+    uint32_t m = n < demo->beam_base_count ? n : demo->beam_base_count;
+    if (app->beams3_count != n && game_app_set_anatomy(app, NULL, n)) { /* no memory: version 2 only */
+        game_app_set_anatomy(app, NULL, 0);
+        rt_scene_beams2_at(demo->scene, t, beams, m, &app->joints[0][0], GAME_APP_MAX_JOINTS, &app->joint_count);
+        return;
+    }
+    rt_scene_beams3_at(demo->scene, t, app->beams3, m, &app->joints[0][0], GAME_APP_MAX_JOINTS, &app->joint_count);
+    for (uint32_t i = 0; i < m; ++i)
+        beams[i] = app->beams3[i].v2;
 }
 
 vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path, uint32_t effects_off)

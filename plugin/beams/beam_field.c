@@ -2,6 +2,7 @@
 #include "beams/beam_field.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 
 /* log1p(z)/z for z >= 0. The float version mirrors the GLSL, where log() near 1 is only good
@@ -22,6 +23,8 @@ static double log1p_over_d(double z) { return z > 0 ? log1p(z) / z : 1.0; }
 #define REAL float
 #define SFX(n) n##_f
 #define R_SQRT sqrtf
+#define R_COS cosf
+#define R_FLOOR floorf
 #define R_FMA fmaf
 #define R_FABS fabsf
 #define R_LOG1P_OVER log1p_over_f
@@ -32,6 +35,8 @@ static double log1p_over_d(double z) { return z > 0 ? log1p(z) / z : 1.0; }
 #undef REAL
 #undef SFX
 #undef R_SQRT
+#undef R_COS
+#undef R_FLOOR
 #undef R_FMA
 #undef R_FABS
 #undef R_LOG1P_OVER
@@ -42,6 +47,8 @@ static double log1p_over_d(double z) { return z > 0 ? log1p(z) / z : 1.0; }
 #define REAL double
 #define SFX(n) n##_d
 #define R_SQRT sqrt
+#define R_COS cos
+#define R_FLOOR floor
 #define R_FMA fma
 #define R_FABS fabs
 #define R_LOG1P_OVER log1p_over_d
@@ -52,6 +59,8 @@ static double log1p_over_d(double z) { return z > 0 ? log1p(z) / z : 1.0; }
 #undef REAL
 #undef SFX
 #undef R_SQRT
+#undef R_COS
+#undef R_FLOOR
 #undef R_FMA
 #undef R_FABS
 #undef R_LOG1P_OVER
@@ -91,11 +100,64 @@ vfx_result volfx_beam_validate(const vfx_beam *in, volfx_beam_d *out, char *err,
     out->eps = in->eps;
     out->smooth = 0;      /* a v1 beam has the hard support; the effect sets the falloff */
     out->joint_count = 0; /* straight; volfx_beam_set_joints makes it a polyline */
+    out->head_radius = out->orb_radius = out->orb_a = 0; /* no anatomy: the effect sets it */
+    out->taper = out->surge = out->surge_inv_wl = out->surge_phase = 0;
     return VFX_OK;
 }
 
+#define SFXF(n) n##_f
+#define SFXD(n) n##_d
+
+/* The anatomy as beam_integral_anat reads it; false when there is none (version 2's field). */
+static bool anatomy_d(const volfx_beam_d *bm, double an[8])
+{
+    double v[8] = {bm->head_radius, bm->orb_radius, bm->orb_a, 0, bm->taper, bm->surge, bm->surge_inv_wl,
+                   bm->surge_phase};
+    if (bm->joint_count >= 2)
+        v[4] = v[5] = 0; /* a polyline has no body profile */
+    bool any = false;
+    for (int k = 0; k < 8; ++k)
+        an[k] = v[k], any |= v[k] != 0;
+    return any;
+}
+
+/* A polyline's head at its own radius and its orb at the last joint (sphere pieces); the head
+ * is left out of the polyline's own integral when it has its own radius. */
+#define POLY_ANATOMY(REAL, SFX, J, nj)                                                                   \
+    do {                                                                                                 \
+        REAL zero[3] = {0, 0, 0}, eps = (REAL)bm->eps, Rr = (REAL)bm->radius;                           \
+        eps = eps > (REAL)VOLFX_BEAM_EPS_FLOOR * Rr ? eps : (REAL)VOLFX_BEAM_EPS_FLOOR * Rr;             \
+        if (an[0] > 0 && bm->a > 0)                                                                      \
+            H += (REAL)bm->a * SFX(prim_piece)(O, V, J[0], zero, 0, 0, (REAL)an[0], eps, t0, t1, bm->smooth); \
+        if (an[1] > 0 && an[2] > 0)                                                                      \
+            H += (REAL)an[2] * SFX(prim_piece)(O, V, J[nj - 1], zero, 0, 0, (REAL)an[1], eps, t0, t1, bm->smooth); \
+    } while (0)
+
 float volfx_beam_integral_f(const volfx_beam_d *bm, const float O[3], const float V[3], float t0, float t1)
 {
+    double and[8];
+    bool anat = anatomy_d(bm, and);
+    float an[8];
+    for (int k = 0; k < 8; ++k)
+        an[k] = (float)and[k];
+    if (bm->joint_count >= 2 && anat) {
+        float J[VOLFX_BEAM_MAX_JOINTS][3];
+        for (int k = 0; k < bm->joint_count; ++k)
+            for (int i = 0; i < 3; ++i)
+                J[k][i] = (float)bm->joints[k][i];
+        float H = polyline_integral_f((const float(*)[3])J, bm->joint_count, (float)bm->radius,
+                                      an[0] > 0 ? 0.f : (float)bm->a, (float)bm->b, (float)bm->eps, bm->smooth, O,
+                                      V, t0, t1);
+        if (t1 > t0)
+            POLY_ANATOMY(float, SFXF, J, bm->joint_count);
+        return H;
+    }
+    if (anat) {
+        float M[3] = {(float)bm->head[0], (float)bm->head[1], (float)bm->head[2]};
+        float D[3] = {(float)bm->dir[0], (float)bm->dir[1], (float)bm->dir[2]};
+        return beam_integral_anat_f(M, D, (float)bm->length, (float)bm->radius, (float)bm->a, (float)bm->b,
+                                    (float)bm->eps, bm->smooth, an, O, V, t0, t1);
+    }
     if (bm->joint_count >= 2) {
         float J[VOLFX_BEAM_MAX_JOINTS][3];
         for (int k = 0; k < bm->joint_count; ++k)
@@ -112,19 +174,42 @@ float volfx_beam_integral_f(const volfx_beam_d *bm, const float O[3], const floa
 
 double volfx_beam_integral_d(const volfx_beam_d *bm, const double O[3], const double V[3], double t0, double t1)
 {
+    double an[8];
+    bool anat = anatomy_d(bm, an);
+    if (bm->joint_count >= 2 && anat) {
+        const double(*J)[3] = (const double(*)[3])bm->joints;
+        double H = polyline_integral_d(J, bm->joint_count, bm->radius, an[0] > 0 ? 0.0 : bm->a, bm->b, bm->eps,
+                                       bm->smooth, O, V, t0, t1);
+        if (t1 > t0)
+            POLY_ANATOMY(double, SFXD, J, bm->joint_count);
+        return H;
+    }
+    if (anat)
+        return beam_integral_anat_d(bm->head, bm->dir, bm->length, bm->radius, bm->a, bm->b, bm->eps, bm->smooth,
+                                    an, O, V, t0, t1);
     if (bm->joint_count >= 2)
         return polyline_integral_d((const double(*)[3])bm->joints, bm->joint_count, bm->radius, bm->a, bm->b,
                                    bm->eps, bm->smooth, O, V, t0, t1);
     return beam_integral_d(bm->head, bm->dir, bm->length, bm->radius, bm->a, bm->b, bm->eps, bm->smooth, O, V, t0, t1);
 }
 
-/* w(r) = (1 - r^2/R^2)^2 for the smooth support, 1 for the hard one (r^2 <= R^2 here). */
-static double falloff_d(const volfx_beam_d *bm, double r2)
+/* One piece's density k w(r) / sqrt(r^2 + e^2) inside radius R, w = (1 - r^2/R^2)^2 for the
+ * smooth support, 1 for the hard one. */
+static double piece_density(const volfx_beam_d *bm, double k, double r2, double R, double e)
 {
-    if (!bm->smooth)
-        return 1.0;
-    double q = 1.0 - r2 / (bm->radius * bm->radius);
-    return q * q;
+    if (!(k > 0) || !(r2 <= R * R))
+        return 0;
+    double w = 1.0;
+    if (bm->smooth) {
+        double q = 1.0 - r2 / (R * R);
+        w = q * q;
+    }
+    return k * w / sqrt(r2 + e * e);
+}
+
+static double dist2_d(const double a[3], const double p[3])
+{
+    return (p[0] - a[0]) * (p[0] - a[0]) + (p[1] - a[1]) * (p[1] - a[1]) + (p[2] - a[2]) * (p[2] - a[2]);
 }
 
 /* Squared distance from p to the segment a..b (its end points included). */
@@ -141,50 +226,45 @@ static double seg_dist2(const double a[3], const double b[3], const double p[3])
     return r2;
 }
 
+double volfx_beam_profile_d(const volfx_beam_d *bm, double u)
+{
+    double an[8] = {0, 0, 0, 0, bm->taper, bm->surge, bm->surge_inv_wl, bm->surge_phase};
+    return bm->joint_count >= 2 ? 1.0 : profile_d(an, bm->length, u);
+}
+
+double volfx_beam_max_radius(const volfx_beam_d *bm)
+{
+    double r = bm->radius * (bm->joint_count >= 2 ? 1.0 : 1.0 + bm->surge);
+    r = fmax(r, bm->head_radius);
+    return bm->orb_a > 0 ? fmax(r, bm->orb_radius) : r;
+}
+
+/* Straight from the definition (beam_field.h): nothing of the closed form's pieces. */
 double volfx_beam_density_d(const volfx_beam_d *bm, const double p[3])
 {
-    if (bm->joint_count >= 2) { /* straight from the definition: r = distance to the polyline */
-        double e = bm->eps > VOLFX_BEAM_EPS_FLOOR * bm->radius ? bm->eps : VOLFX_BEAM_EPS_FLOOR * bm->radius;
-        double R2 = bm->radius * bm->radius, rho = 0, d2 = 0, r2 = INFINITY;
-        for (int k = 0; k < 3; ++k)
-            d2 += (p[k] - bm->joints[0][k]) * (p[k] - bm->joints[0][k]);
+    double e = bm->eps > VOLFX_BEAM_EPS_FLOOR * bm->radius ? bm->eps : VOLFX_BEAM_EPS_FLOOR * bm->radius;
+    double Rh = bm->head_radius > 0 ? bm->head_radius : bm->radius, rho = 0;
+    const double *head = bm->joint_count >= 2 ? bm->joints[0] : bm->head;
+    double src[3];
+    for (int k = 0; k < 3; ++k)
+        src[k] = bm->joint_count >= 2 ? bm->joints[bm->joint_count - 1][k] : bm->head[k] + bm->length * bm->dir[k];
+    rho += piece_density(bm, bm->a, dist2_d(head, p), Rh, e);
+    if (bm->orb_radius > 0)
+        rho += piece_density(bm, bm->orb_a, dist2_d(src, p), bm->orb_radius, e);
+    if (bm->joint_count >= 2) { /* r = distance to the polyline */
+        double r2 = INFINITY;
         for (int k = 0; k + 1 < bm->joint_count; ++k)
             r2 = fmin(r2, seg_dist2(bm->joints[k], bm->joints[k + 1], p));
-        if (d2 <= R2)
-            rho += bm->a * falloff_d(bm, d2) / sqrt(d2 + e * e);
-        if (r2 <= R2)
-            rho += bm->b * falloff_d(bm, r2) / sqrt(r2 + e * e);
-        return rho;
+        return rho + piece_density(bm, bm->b, r2, bm->radius, e);
     }
-    double e = bm->eps > VOLFX_BEAM_EPS_FLOOR * bm->radius ? bm->eps : VOLFX_BEAM_EPS_FLOOR * bm->radius;
-    double d[3], d2 = 0, u = 0;
-    for (int k = 0; k < 3; ++k) {
-        d[k] = p[k] - bm->head[k];
-        d2 += d[k] * d[k];
-        u += d[k] * bm->dir[k];
-    }
-    double R2 = bm->radius * bm->radius, rho = 0;
-    if (d2 <= R2)
-        rho += bm->a * falloff_d(bm, d2) / sqrt(d2 + e * e);
-    double r2;
-    if (u < 0) {
-        r2 = d2;
-    } else if (u > bm->length) {
-        r2 = 0;
-        for (int k = 0; k < 3; ++k) {
-            double q = d[k] - bm->length * bm->dir[k];
-            r2 += q * q;
-        }
-    } else {
-        r2 = 0;
-        for (int k = 0; k < 3; ++k) {
-            double q = d[k] - u * bm->dir[k];
-            r2 += q * q;
-        }
-    }
-    if (r2 <= R2)
-        rho += bm->b * falloff_d(bm, r2) / sqrt(r2 + e * e);
-    return rho;
+    double u = 0;
+    for (int k = 0; k < 3; ++k)
+        u += (p[k] - bm->head[k]) * bm->dir[k];
+    double uc = fmin(fmax(u, 0.0), bm->length), foot[3];
+    for (int k = 0; k < 3; ++k)
+        foot[k] = bm->head[k] + uc * bm->dir[k];
+    double R = bm->radius * volfx_beam_profile_d(bm, uc);
+    return rho + piece_density(bm, bm->b, dist2_d(foot, p), R, e);
 }
 
 vfx_result volfx_beam_set_joints(volfx_beam_d *bm, const float *xyz, uint32_t count, char *err, size_t errlen)

@@ -27,6 +27,13 @@ typedef struct volfx_beam_d {
     int smooth; /* 1: densities times w(r) = (1 - (r/R)^2)^2 (the smooth support), 0: hard */
     int joint_count;                           /* 0: straight; 2..MAX: a polyline, head at J0 */
     double joints[VOLFX_BEAM_MAX_JOINTS][3];
+    /* the attack's anatomy (vfx_beam3; all 0: none, the field above exactly): the head sphere's
+     * radius (0 -> radius), the orb at the source (the end M + L D, or the last joint) with its
+     * radius (0: none) and strength, the body's radius profile (straight beams only):
+     * R(u) = radius (1 - taper clamp(u / L, 0, 1)) (1 + surge bump(u surge_inv_wl + surge_phase)),
+     * bump(x) = ((1 + cos 2 pi x) / 2)^3; the caps use R(0) and R(L). Each piece's softening
+     * floor is VOLFX_BEAM_EPS_FLOOR times its own radius. */
+    double head_radius, orb_radius, orb_a, taper, surge, surge_inv_wl, surge_phase;
 } volfx_beam_d;
 
 /* Checks a beam (finite, L >= 0, R > 0, a, b, eps >= 0, D not zero) and normalises D into out;
@@ -54,6 +61,12 @@ float volfx_beam_integral_f(const volfx_beam_d *beam, const float origin[3], con
                           float t0, float t1);
 double volfx_beam_integral_d(const volfx_beam_d *beam, const double origin[3], const double dir[3],
                            double t0, double t1);
+
+/* The body's radius multiplier R(u) / radius at u (1 without a profile), float64. */
+double volfx_beam_profile_d(const volfx_beam_d *beam, double u);
+
+/* The largest support radius of any piece (head, orb, body at its widest): bounds for culling. */
+double volfx_beam_max_radius(const volfx_beam_d *beam);
 
 /* The density at a point (float64), for references and tests. */
 double volfx_beam_density_d(const volfx_beam_d *beam, const double p[3]);

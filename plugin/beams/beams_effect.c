@@ -22,6 +22,7 @@ _Static_assert(VOLFX_BEAMS_BIN_MAX_POINTS >= VOLFX_BEAM_MAX_JOINTS, "a polyline 
 typedef struct beam_gpu {
     float m_l[4], d_r[4], ab_eps[4], color[4], look[4];
     uint32_t mode[4];
+    float an0[4], an1[4], look2[4]; /* the anatomy (beam_field.glsl), core / flow kind / twist */
 } beam_gpu;
 
 /* std140, mirrors BeamsFrame in shaders/beams/frame.glsl */
@@ -36,10 +37,13 @@ typedef struct beam_look {
     float intensity, exposure, flow_amount, flow_speed, flow_scale;
     float color[4];  /* the beam's colour; all 0 -> white */
     bool thesis;
+    float core, twist;    /* vfx_beam3: hue-keeping ramp's core (0: version 2's ramp), spiral */
+    uint32_t flow_kind;
+    bool anatomy;         /* needs the ANATOMY program (head radius, orb, profile, core, spiral) */
 } beam_look;
 
 typedef struct beams_state {
-    GLuint prog_integrate[8]; /* [march | smooth << 1 | polyline << 2]: code only where a beam needs it */
+    GLuint prog_integrate[16]; /* [march | smooth << 1 | polyline << 2 | anatomy << 3]: code only where needed */
     GLuint prog_composite, prog_down, prog_up;
     GLuint beam_buf, range_buf, list_buf, joint_buf;
     size_t beam_cap, range_cap, list_cap, joint_cap; /* bytes */
@@ -67,22 +71,25 @@ typedef struct beams_state {
     uint32_t list_capacity, pairs;  /* list entries allocated, used this frame */
 } beams_state;
 
-/* Asks the host for its view, offering version 2; a version 1 answer leaves the rest zero. */
-static vfx_result query_view(vfx_context *ctx, vfx_beams_view2 *v)
+/* Asks the host for its view, offering version 3; an older answer leaves the rest zero. */
+static vfx_result query_view(vfx_context *ctx, vfx_beams_view3 *v3)
 {
-    memset(v, 0, sizeof *v);
-    v->v1.size = sizeof *v;
-    v->v1.version = VFX_BEAMS_VIEW2_VERSION;
+    memset(v3, 0, sizeof *v3);
+    vfx_beams_view2 *v = &v3->v2;
+    v->v1.size = sizeof *v3;
+    v->v1.version = VFX_BEAMS_VIEW3_VERSION;
     vfx_result r = ctx->host.beams(ctx->host.user, &v->v1);
     if (r == VFX_OK && v->v1.version == VFX_BEAMS_VIEW_VERSION)
-        memset((char *)v + sizeof v->v1, 0, sizeof *v - sizeof v->v1); /* nothing a v1 host wrote */
+        memset((char *)v3 + sizeof v->v1, 0, sizeof *v3 - sizeof v->v1); /* nothing a v1 host wrote */
+    else if (r == VFX_OK && v->v1.version == VFX_BEAMS_VIEW2_VERSION)
+        memset((char *)v3 + sizeof *v, 0, sizeof *v3 - sizeof *v);
     return r;
 }
 
 static bool beams_present(vfx_context *ctx)
 {
-    vfx_beams_view2 v;
-    return ctx->host.beams && query_view(ctx, &v) == VFX_OK && v.v1.count > 0;
+    vfx_beams_view3 v;
+    return ctx->host.beams && query_view(ctx, &v) == VFX_OK && v.v2.v1.count > 0;
 }
 
 static void free_bloom(beams_state *s)
@@ -238,17 +245,71 @@ static vfx_result beam_look_of(vfx_context *ctx, uint32_t i, const vfx_beam2 *b2
     return VFX_OK;
 }
 
+/* A version 3 beam's anatomy, checked, into the field (bd) and the look; `time` drives the orb's
+ * pulse and the surges. Version 2 beams keep none. */
+static vfx_result beam_anatomy_of(vfx_context *ctx, uint32_t i, const vfx_beam3 *b3, double time, volfx_beam_d *bd,
+                                  beam_look *lk)
+{
+    if (!b3)
+        return VFX_OK;
+    const float f[] = {b3->head_radius, b3->orb_radius, b3->orb_strength, b3->orb_pulse, b3->orb_pulse_hz, b3->taper,
+                       b3->surge_amount, b3->surge_wavelength, b3->surge_speed, b3->flow_twist, b3->core};
+    bool finite = true;
+    for (size_t k = 0; k < sizeof f / sizeof f[0]; ++k)
+        finite &= isfinite(f[k]) != 0;
+    if (!finite || !(b3->head_radius >= 0 && b3->orb_radius >= 0 && b3->orb_strength >= 0) || !(b3->orb_pulse <= 1)
+        || !(b3->orb_pulse >= 0 && b3->orb_pulse_hz >= 0) || !(b3->taper >= 0 && b3->taper <= 0.95f)
+        || !(b3->surge_amount >= 0 && b3->surge_amount <= 4) || !(b3->surge_wavelength >= 0)
+        || !(b3->core >= 0 && b3->core <= 1) || b3->flow_kind > VFX_BEAM_FLOW_SPIRAL
+        || !(fabsf(b3->flow_twist) <= 64))
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                          "beams[%u]: vfx_beam3 needs finite head_radius, orb_radius, orb_strength >= 0, orb_pulse "
+                          "in [0, 1], orb_pulse_hz >= 0, taper in [0, 0.95], surge_amount in [0, 4], "
+                          "surge_wavelength >= 0, core in [0, 1], flow_kind 0..1, |flow_twist| <= 64 (got %g, %g, "
+                          "%g, %g, %g, %g, %g, %g, %g, %u, %g)", i, (double)b3->head_radius, (double)b3->orb_radius,
+                          (double)b3->orb_strength, (double)b3->orb_pulse, (double)b3->orb_pulse_hz,
+                          (double)b3->taper, (double)b3->surge_amount, (double)b3->surge_wavelength,
+                          (double)b3->core, b3->flow_kind, (double)b3->flow_twist);
+    bd->head_radius = b3->head_radius;
+    if (b3->orb_radius > 0) {
+        double pulse = 1.0 + b3->orb_pulse * sin(6.283185307179586 * fmod(time * b3->orb_pulse_hz, 1.0));
+        bd->orb_radius = b3->orb_radius * pulse;
+        bd->orb_a = b3->orb_strength > 0 ? b3->orb_strength : bd->a;
+    }
+    if (!bd->joint_count) {
+        bd->taper = b3->taper;
+        bd->surge = b3->surge_amount;
+        double wl = b3->surge_wavelength > 0 ? b3->surge_wavelength : 8.0 * bd->radius;
+        bd->surge_inv_wl = bd->surge > 0 ? 1.0 / wl : 0.0;
+        bd->surge_phase = bd->surge > 0 ? fmod(fmod(time * b3->surge_speed / wl, 1.0) + 1.0, 1.0) : 0.0;
+    }
+    lk->core = b3->core;
+    lk->flow_kind = b3->flow_kind;
+    lk->twist = b3->flow_twist != 0 ? b3->flow_twist : 1.f;
+    lk->anatomy = bd->head_radius > 0 || bd->orb_radius > 0 || bd->taper > 0 || bd->surge > 0 || lk->core > 0
+                  || (lk->flow_kind == VFX_BEAM_FLOW_SPIRAL && lk->flow_amount > 0);
+    return VFX_OK;
+}
+
 static vfx_result beams_update(vfx_context *ctx, void *state, double time, float dt)
 {
     beams_state *s = state;
-    vfx_beams_view2 v;
-    vfx_result r = query_view(ctx, &v);
+    vfx_beams_view3 v3;
+    vfx_result r = query_view(ctx, &v3);
+    vfx_beams_view2 v = v3.v2;
     uint32_t ver = v.v1.version;
-    if (r || (ver != VFX_BEAMS_VIEW_VERSION && ver != VFX_BEAMS_VIEW2_VERSION))
-        return volfx_fail(ctx, VFX_ERR_ABI, "beams: host view of version %u (need %u or %u)", ver,
-                          VFX_BEAMS_VIEW_VERSION, VFX_BEAMS_VIEW2_VERSION);
+    if (r || (ver != VFX_BEAMS_VIEW_VERSION && ver != VFX_BEAMS_VIEW2_VERSION && ver != VFX_BEAMS_VIEW3_VERSION))
+        return volfx_fail(ctx, VFX_ERR_ABI, "beams: host view of version %u (need %u, %u or %u)", ver,
+                          VFX_BEAMS_VIEW_VERSION, VFX_BEAMS_VIEW2_VERSION, VFX_BEAMS_VIEW3_VERSION);
+    const vfx_beam3 *b3 = ver == VFX_BEAMS_VIEW3_VERSION ? v3.beams3 : NULL;
+    if (ver == VFX_BEAMS_VIEW3_VERSION && !b3)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: a version 3 view with beams3 NULL");
+    if (b3) { /* a version 3 view: the version 2 parts are read from beams3 */
+        v.v1.version = VFX_BEAMS_VIEW2_VERSION;
+        v.beams = NULL;
+    }
     const vfx_beam2 *b2 = ver == VFX_BEAMS_VIEW2_VERSION ? v.beams : NULL;
-    if (v.v1.count > MAX_BEAMS || (!v.v1.beams && !b2))
+    if (v.v1.count > MAX_BEAMS || (!v.v1.beams && !b2 && !b3))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: %u beams (at most %u, non-NULL array)",
                           v.v1.count, MAX_BEAMS);
     if ((r = volfx_beams_view_check_ranges(ctx, &v, ver)))
@@ -279,27 +340,30 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
         return VFX_ERR_OUT_OF_MEMORY;
     char err[200];
     for (uint32_t i = 0; i < n; ++i) {
-        const vfx_beam *b = b2 ? &b2[i].v1 : &v.v1.beams[i];
+        const vfx_beam2 *b2i = b3 ? &b3[i].v2 : b2 ? &b2[i] : NULL;
+        const vfx_beam *b = b2i ? &b2i->v1 : &v.v1.beams[i];
         vfx_beam straight;
-        if (b2 && b2[i].joint_count) { /* a bending beam's head, dir and length are ignored */
+        if (b2i && b2i->joint_count) { /* a bending beam's head, dir and length are ignored */
             straight = *b;
             straight.dir[0] = 1.f, straight.dir[1] = straight.dir[2] = 0.f;
             straight.head[0] = straight.head[1] = straight.head[2] = straight.length = 0.f;
             b = &straight;
         }
-        if ((r = volfx_beam_check_ranges(ctx, i, b, b2 ? &b2[i] : NULL)))
+        if ((r = volfx_beam_check_ranges(ctx, i, b, b2i)))
             return r;
         if (volfx_beam_validate(b, &s->beams[i], err, sizeof err))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: %s", i, err);
-        if ((r = beam_look_of(ctx, i, b2 ? &b2[i] : NULL, &s->looks[i])))
+        if ((r = beam_look_of(ctx, i, b2i, &s->looks[i])))
             return r;
-        s->beams[i].smooth = b2 && b2[i].falloff != VFX_BEAM_FALLOFF_HARD;
-        uint32_t jc = b2 ? b2[i].joint_count : 0, jf = b2 ? b2[i].joint_first : 0;
+        s->beams[i].smooth = b2i && b2i->falloff != VFX_BEAM_FALLOFF_HARD;
+        uint32_t jc = b2i ? b2i->joint_count : 0, jf = b2i ? b2i->joint_first : 0;
         if (jc && (!v.joints || jf > v.joint_count || jc > v.joint_count - jf))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: joints %u..%u outside the view's %u joints",
                               i, jf, jf + jc, v.joints ? v.joint_count : 0);
         if (jc && volfx_beam_set_joints(&s->beams[i], v.joints + 3 * (size_t)jf, jc, err, sizeof err))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: %s", i, err);
+        if ((r = beam_anatomy_of(ctx, i, b3 ? &b3[i] : NULL, time, &s->beams[i], &s->looks[i])))
+            return r;
         const float *c = b->color;
         bool none = c[0] == 0 && c[1] == 0 && c[2] == 0;
         for (int k = 0; k < 4; ++k)
@@ -366,8 +430,9 @@ static void pack_beam(beams_state *s, uint32_t i, const double eye[3], float c, 
             g->m_l[k] = (float)(centre[k] - (k == 0 ? half : 0.0)), g->d_r[k] = k == 0 ? 1.f : 0.f;
     }
     g->m_l[3] = (float)(2.0 * half), g->d_r[3] = (float)b->radius;
-    volfx_beams_capsule *cap = &s->caps[i]; /* the support: within R of the axis or polyline */
-    cap->r = b->radius;
+    double rmax = volfx_beam_max_radius(b); /* head, orb and body at its widest */
+    volfx_beams_capsule *cap = &s->caps[i]; /* the support: within rmax of the axis or polyline */
+    cap->r = rmax;
     cap->n = b->joint_count >= 2 ? (uint32_t)b->joint_count : 2;
     for (uint32_t j = 0; j < cap->n; ++j)
         for (int k = 0; k < 3; ++k)
@@ -384,10 +449,16 @@ static void pack_beam(beams_state *s, uint32_t i, const double eye[3], float c, 
     g->look[3] = (float)fmod(s->time * lk->flow_speed / wavelength, 4096.0);
     g->mode[0] = (uint32_t)b->smooth, g->mode[1] = lk->thesis;
     g->mode[2] = jfirst, g->mode[3] = (uint32_t)b->joint_count;
+    float an0[4] = {(float)b->head_radius, (float)b->orb_radius, (float)b->orb_a, 0.f};
+    float an1[4] = {(float)b->taper, (float)b->surge, (float)b->surge_inv_wl, (float)b->surge_phase};
+    float look2[4] = {lk->core, (float)lk->flow_kind, lk->twist, 0.f};
+    memcpy(g->an0, an0, sizeof an0);
+    memcpy(g->an1, an1, sizeof an1);
+    memcpy(g->look2, look2, sizeof look2);
     /* the thesis ramp tints with colour x intensity x 2^exposure (the v1 colour for v1 beams) */
     for (int k = 0; k < 4; ++k)
         g->color[k] = lk->color[k] * (lk->thesis && k < 3 ? lk->intensity * gain : 1.f);
-    *bound = half + b->radius;
+    *bound = half + rmax;
 }
 
 /* The CPU half of a frame: every beam packed for the GPU and binned to the screen tiles it can
@@ -437,19 +508,20 @@ static vfx_result bin_beams(vfx_context *ctx, beams_state *s, const volfx_frame_
 /* The integrate program for this frame's beams: code only for what some beam needs. */
 static GLuint integrate_program(vfx_context *ctx, beams_state *s, bool march)
 {
-    bool any_smooth = false, any_poly = false;
+    bool any_smooth = false, any_poly = false, any_anat = false;
     for (uint32_t i = 0; i < s->count; ++i)
-        any_smooth |= s->beams[i].smooth != 0, any_poly |= s->beams[i].joint_count >= 2;
-    unsigned variant = (unsigned)march | (unsigned)any_smooth << 1 | (unsigned)any_poly << 2;
+        any_smooth |= s->beams[i].smooth != 0, any_poly |= s->beams[i].joint_count >= 2,
+            any_anat |= s->looks[i].anatomy;
+    unsigned variant = (unsigned)march | (unsigned)any_smooth << 1 | (unsigned)any_poly << 2 | (unsigned)any_anat << 3;
     if (!s->prog_integrate[variant]) {
-        static const char *const defs[8] = {
-            NULL, "#define VOLFX_BEAMS_MARCH 1", "#define VOLFX_BEAMS_SMOOTH 1",
-            "#define VOLFX_BEAMS_MARCH 1\n#define VOLFX_BEAMS_SMOOTH 1", "#define VOLFX_BEAMS_POLYLINE 1",
-            "#define VOLFX_BEAMS_MARCH 1\n#define VOLFX_BEAMS_POLYLINE 1",
-            "#define VOLFX_BEAMS_SMOOTH 1\n#define VOLFX_BEAMS_POLYLINE 1",
-            "#define VOLFX_BEAMS_MARCH 1\n#define VOLFX_BEAMS_SMOOTH 1\n#define VOLFX_BEAMS_POLYLINE 1"};
+        static const char *const names[4] = {"#define VOLFX_BEAMS_MARCH 1\n", "#define VOLFX_BEAMS_SMOOTH 1\n",
+                                             "#define VOLFX_BEAMS_POLYLINE 1\n", "#define VOLFX_BEAMS_ANATOMY 1\n"};
+        char defs[160] = "";
+        for (unsigned k = 0; k < 4; ++k)
+            if (variant >> k & 1u)
+                strncat(defs, names[k], sizeof defs - strlen(defs) - 1);
         s->prog_integrate[variant] = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
-                                                       defs[variant]);
+                                                       variant ? defs : NULL);
     }
     return s->prog_integrate[variant];
 }

@@ -54,6 +54,11 @@ typedef enum rt_scene_beam_param {
     RT_BEAM_PARAM_COLOR,      /* 4 */
     RT_BEAM_PARAM_INTENSITY,  /* 1 (vfx_beam2) */
     RT_BEAM_PARAM_EXPOSURE,   /* 1 (vfx_beam2) */
+    RT_BEAM_PARAM_HEAD_RADIUS,  /* 1 (vfx_beam3, the attack's anatomy) */
+    RT_BEAM_PARAM_ORB_RADIUS,   /* 1 */
+    RT_BEAM_PARAM_ORB_STRENGTH, /* 1 */
+    RT_BEAM_PARAM_TAPER,        /* 1 */
+    RT_BEAM_PARAM_SURGE,        /* 1: surge amount */
     RT_BEAM_PARAM_COUNT
 } rt_scene_beam_param;
 
@@ -68,7 +73,7 @@ typedef struct rt_scene_beam {
     vfx_beam base;                                  /* values when not animated */
     rt_scene_track tracks[RT_BEAM_PARAM_COUNT];   /* count 0 = not animated */
     float loop_s;                                   /* >0: time wraps modulo loop_s */
-    vfx_beam2 look;     /* falloff, ramp, intensity, exposure, flow; its v1 member is unused */
+    vfx_beam3 look;     /* falloff, ramp, intensity, exposure, flow, anatomy; v2.v1 is unused */
     uint32_t joint_count;                  /* 0 straight, 2..RT_SCENE_MAX_JOINTS: bending beam */
     float joints[RT_SCENE_MAX_JOINTS][3];  /* values when not animated */
     rt_scene_track joint_track;            /* dim 3 * joint_count; count 0 = not animated */
@@ -204,6 +209,9 @@ uint32_t rt_scene_beams_at(const rt_scene *scene, double time, vfx_beam *out, ui
  * not fit are left straight), each beam's joint_first indexing into it; *joint_count (may be
  * NULL) gets how many were written. */
 uint32_t rt_scene_beams2_at(const rt_scene *scene, double time, vfx_beam2 *out, uint32_t n, float *joints,
+                            uint32_t joint_cap, uint32_t *joint_count);
+/* The same as version 3 beams (the attack's anatomy, docs/scene-format.md), joints as above. */
+uint32_t rt_scene_beams3_at(const rt_scene *scene, double time, vfx_beam3 *out, uint32_t n, float *joints,
                             uint32_t joint_cap, uint32_t *joint_count);
 /* Linear interpolation of one track at time t into out[0..dim); clamped at the ends. */
 void rt_scene_track_eval(const rt_scene_track *track, double t, float *out);

@@ -9,10 +9,15 @@
 #include <string.h>
 
 static const char *const beam_param_names[RT_BEAM_PARAM_COUNT + 1] = {
-    "head", "dir", "length", "radius", "a", "b", "eps", "color", "intensity", "exposure", NULL};
-static const int beam_param_dim[RT_BEAM_PARAM_COUNT] = {3, 3, 1, 1, 1, 1, 1, 4, 1, 1};
+    "head", "dir", "length", "radius", "a", "b", "eps", "color", "intensity", "exposure",
+    "head_radius", "orb_radius", "orb_strength", "taper", "surge", NULL};
+static const int beam_param_dim[RT_BEAM_PARAM_COUNT] = {3, 3, 1, 1, 1, 1, 1, 4, 1, 1, 1, 1, 1, 1, 1};
 static const char *const beam_keyframe_names[] = {
-    "head", "dir", "length", "radius", "a", "b", "eps", "color", "intensity", "exposure", "joints", NULL};
+    "head", "dir", "length", "radius", "a", "b", "eps", "color", "intensity", "exposure",
+    "head_radius", "orb_radius", "orb_strength", "taper", "surge", "joints", NULL};
+/* The anatomy's ranges (vfx_beam3; the plugin checks the same in beams_effect.c). */
+static const range TAPER_RANGE = {0, 0.95, false};
+static const range SURGE_RANGE = {0, 4, false};
 
 static range beam_param_range(int k)
 {
@@ -27,15 +32,22 @@ static range beam_param_range(int k)
     case RT_BEAM_PARAM_COLOR: return rt_scene_range(VFX_RANGE_BEAM_COLOR);
     case RT_BEAM_PARAM_INTENSITY: return rt_scene_range(VFX_RANGE_BEAM_INTENSITY);
     case RT_BEAM_PARAM_EXPOSURE: return rt_scene_range(VFX_RANGE_BEAM_EXPOSURE);
+    case RT_BEAM_PARAM_TAPER: return TAPER_RANGE;
+    case RT_BEAM_PARAM_SURGE: return SURGE_RANGE;
     default: return NONNEG;
     }
 }
 
-static float *beam_param_ptr(vfx_beam *b, vfx_beam2 *look, int k)
+static float *beam_param_ptr(vfx_beam *b, vfx_beam3 *look, int k)
 {
     switch (k) {
-    case RT_BEAM_PARAM_INTENSITY: return &look->intensity;
-    case RT_BEAM_PARAM_EXPOSURE: return &look->exposure;
+    case RT_BEAM_PARAM_INTENSITY: return &look->v2.intensity;
+    case RT_BEAM_PARAM_EXPOSURE: return &look->v2.exposure;
+    case RT_BEAM_PARAM_HEAD_RADIUS: return &look->head_radius;
+    case RT_BEAM_PARAM_ORB_RADIUS: return &look->orb_radius;
+    case RT_BEAM_PARAM_ORB_STRENGTH: return &look->orb_strength;
+    case RT_BEAM_PARAM_TAPER: return &look->taper;
+    case RT_BEAM_PARAM_SURGE: return &look->surge_amount;
     case RT_BEAM_PARAM_HEAD: return b->head;
     case RT_BEAM_PARAM_DIR: return b->dir;
     case RT_BEAM_PARAM_LENGTH: return &b->length;
@@ -157,20 +169,61 @@ static vfx_result parse_joints(pctx *c, const cJSON *e, const cJSON *kf, const c
     return r;
 }
 
-/* falloff, ramp and flow of one beam (intensity and exposure are parameters, keyframable). */
-static vfx_result parse_look(pctx *c, const cJSON *e, const char *P, vfx_beam2 *look)
+static const range TWIST_RANGE = {-64, 64, false};
+static const range CORE_RANGE = {0, 1, false};
+
+/* orb {pulse, pulse_hz}, surge {wavelength, speed} and core (the keyframable sizes are
+ * parameters). Scenes default the core to 0.2: the hue-keeping ramp (0 keeps version 2's). */
+static vfx_result parse_anatomy(pctx *c, const cJSON *e, const char *P, vfx_beam3 *look)
+{
+    static const char *const orb_keys[] = {"pulse", "pulse_hz", NULL};
+    static const char *const surge_keys[] = {"wavelength", "speed", NULL};
+    look->core = 0.2f;
+    vfx_result r = rt_scene_get_float(c, e, P, "core", false, CORE_RANGE, &look->core);
+    const cJSON *orb = cJSON_GetObjectItemCaseSensitive(e, "orb");
+    if (!r && orb) {
+        char PO[JPATH];
+        rt_scene_join(PO, P, "orb");
+        if ((r = rt_scene_expect_object(c, orb, PO)))
+            return r;
+        rt_scene_check_keys(c, orb, PO, orb_keys);
+        r = rt_scene_get_float(c, orb, PO, "pulse", false, UNIT, &look->orb_pulse);
+        if (!r) r = rt_scene_get_float(c, orb, PO, "pulse_hz", false, NONNEG, &look->orb_pulse_hz);
+    }
+    const cJSON *surge = cJSON_GetObjectItemCaseSensitive(e, "surges");
+    if (!r && surge) {
+        char PS[JPATH];
+        rt_scene_join(PS, P, "surges");
+        if ((r = rt_scene_expect_object(c, surge, PS)))
+            return r;
+        rt_scene_check_keys(c, surge, PS, surge_keys);
+        r = rt_scene_get_float(c, surge, PS, "wavelength", false, NONNEG, &look->surge_wavelength);
+        if (!r) r = rt_scene_get_float(c, surge, PS, "speed", false, COORD, &look->surge_speed);
+    }
+    return r;
+}
+
+/* falloff, ramp, flow and the anatomy's settings of one beam (intensity, exposure and the
+ * anatomy's sizes are parameters, keyframable). */
+static vfx_result parse_look(pctx *c, const cJSON *e, const char *P, vfx_beam3 *look3)
 {
     static const char *const falloffs[] = {"smooth", "hard", NULL};
     static const char *const ramps[] = {"hot", "thesis", NULL};
-    static const char *const flow_keys[] = {"amount", "speed", "scale", NULL};
+    static const char *const flow_keys[] = {"amount", "speed", "scale", "kind", "twist", NULL};
+    static const char *const kinds[] = {"noise", "spiral", NULL};
+    vfx_beam2 *look = &look3->v2;
     uint32_t f = 0, rp = 0;
     vfx_result r = rt_scene_get_enum(c, e, P, "falloff", false, falloffs, &f);
     if (!r)
         r = rt_scene_get_enum(c, e, P, "ramp", false, ramps, &rp);
+    if (!r)
+        r = parse_anatomy(c, e, P, look3);
     if (r)
         return r;
     look->falloff = f == 1 ? VFX_BEAM_FALLOFF_HARD : VFX_BEAM_FALLOFF_SMOOTH;
     look->ramp = rp == 1 ? VFX_BEAM_RAMP_THESIS : VFX_BEAM_RAMP_HOT;
+    if (rp == 1)
+        look3->core = 0; /* the thesis ramp has no core */
     const cJSON *flow = cJSON_GetObjectItemCaseSensitive(e, "flow");
     if (!flow)
         return VFX_OK;
@@ -183,6 +236,8 @@ static vfx_result parse_look(pctx *c, const cJSON *e, const char *P, vfx_beam2 *
     if (!r) r = rt_scene_get_float_row(c, flow, PF, "amount", VFX_RANGE_BEAM_FLOW_AMOUNT, &look->flow_amount);
     if (!r) r = rt_scene_get_float_row(c, flow, PF, "speed", VFX_RANGE_BEAM_FLOW_SPEED, &look->flow_speed);
     if (!r) r = rt_scene_get_float_row(c, flow, PF, "scale", VFX_RANGE_BEAM_FLOW_SCALE, &look->flow_scale);
+    if (!r) r = rt_scene_get_enum(c, flow, PF, "kind", false, kinds, &look3->flow_kind);
+    if (!r) r = rt_scene_get_float(c, flow, PF, "twist", false, TWIST_RANGE, &look3->flow_twist);
     return r;
 }
 
@@ -190,7 +245,8 @@ vfx_result rt_scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
 {
     static const char *const keys[] = {"head", "dir", "length", "radius", "a", "b", "eps", "color",
                                        "intensity", "exposure", "falloff", "ramp", "flow", "joints",
-                                       "keyframes", "loop_s", NULL};
+                                       "keyframes", "loop_s", "head_radius", "orb_radius", "orb_strength",
+                                       "taper", "surge", "orb", "surges", "core", NULL};
     int n;
     vfx_result ra = rt_scene_alloc_array(c, v, "beams", RT_SCENE_MAX_BEAMS, sizeof *s->beams, (void **)&s->beams, &n);
     if (ra || n == 0)
@@ -203,7 +259,7 @@ vfx_result rt_scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
         s->beam_count = (uint32_t)i + 1; /* so that free() sees tracks of a half-parsed beam */
         vfx_beam *b = &o->base;
         *b = (vfx_beam){.length = 1.0f, .radius = 0.5f, .a = 0.05f, .b = 0.03f, .eps = 0.02f, .color = {1, 1, 1, 1}};
-        o->look = (vfx_beam2){.falloff = VFX_BEAM_FALLOFF_SMOOTH, .ramp = VFX_BEAM_RAMP_HOT, .intensity = 1.0f};
+        o->look = (vfx_beam3){.v2 = {.falloff = VFX_BEAM_FALLOFF_SMOOTH, .ramp = VFX_BEAM_RAMP_HOT, .intensity = 1.0f}};
         vfx_result r = rt_scene_expect_object(c, e, P);
         if (r)
             return r;
@@ -338,16 +394,16 @@ static double beam_time(const rt_scene_beam *b, double time)
 }
 
 /* One beam at `time`: keyframes interpolated, wrapped by loop_s. */
-static void beam_at(const rt_scene_beam *b, double time, vfx_beam2 *out)
+static void beam_at(const rt_scene_beam *b, double time, vfx_beam3 *out)
 {
     double t = beam_time(b, time);
     *out = b->look;
-    out->v1 = b->base;
+    out->v2.v1 = b->base;
     for (int k = 0; k < RT_BEAM_PARAM_COUNT; ++k) {
         const rt_scene_track *tr = &b->tracks[k];
         if (!tr->count)
             continue;
-        float *dst = beam_param_ptr(&out->v1, out, k);
+        float *dst = beam_param_ptr(&out->v2.v1, out, k);
         rt_scene_track_eval(tr, t, dst);
         /* opposite direction keys pass through zero: hold the earlier key's direction */
         if (k == RT_BEAM_PARAM_DIR && rt_scene_is_zero3(dst))
@@ -355,31 +411,49 @@ static void beam_at(const rt_scene_beam *b, double time, vfx_beam2 *out)
     }
 }
 
-uint32_t rt_scene_beams2_at(const rt_scene *scene, double time, vfx_beam2 *out, uint32_t n, float *joints,
-                            uint32_t joint_cap, uint32_t *joint_count)
+/* Evaluates beam i into out3 (or out2, its version 2 part) with its joints, as both entry points. */
+static uint32_t beams_at(const rt_scene *scene, double time, vfx_beam3 *out3, vfx_beam2 *out2, uint32_t n,
+                         float *joints, uint32_t joint_cap, uint32_t *joint_count)
 {
     uint32_t used = 0;
     if (joint_count)
         *joint_count = 0;
-    if (!scene || !out)
+    if (!scene || (!out3 && !out2))
         return 0;
     uint32_t count = scene->beam_count < n ? scene->beam_count : n;
     for (uint32_t i = 0; i < count; ++i) {
         const rt_scene_beam *b = &scene->beams[i];
-        beam_at(b, time, &out[i]);
-        if (!b->joint_count || !joints || joint_cap - used < b->joint_count)
-            continue;
-        float *dst = joints + 3 * (size_t)used;
-        memcpy(dst, b->joints, 3 * b->joint_count * sizeof(float));
-        if (b->joint_track.count)
-            rt_scene_track_eval(&b->joint_track, beam_time(b, time), dst);
-        out[i].joint_first = used;
-        out[i].joint_count = b->joint_count;
-        used += b->joint_count;
+        vfx_beam3 b3;
+        beam_at(b, time, &b3);
+        if (b->joint_count && joints && joint_cap - used >= b->joint_count) {
+            float *dst = joints + 3 * (size_t)used;
+            memcpy(dst, b->joints, 3 * b->joint_count * sizeof(float));
+            if (b->joint_track.count)
+                rt_scene_track_eval(&b->joint_track, beam_time(b, time), dst);
+            b3.v2.joint_first = used;
+            b3.v2.joint_count = b->joint_count;
+            used += b->joint_count;
+        }
+        if (out3)
+            out3[i] = b3;
+        else
+            out2[i] = b3.v2;
     }
     if (joint_count)
         *joint_count = used;
     return count;
+}
+
+uint32_t rt_scene_beams3_at(const rt_scene *scene, double time, vfx_beam3 *out, uint32_t n, float *joints,
+                            uint32_t joint_cap, uint32_t *joint_count)
+{
+    return beams_at(scene, time, out, NULL, n, joints, joint_cap, joint_count);
+}
+
+uint32_t rt_scene_beams2_at(const rt_scene *scene, double time, vfx_beam2 *out, uint32_t n, float *joints,
+                            uint32_t joint_cap, uint32_t *joint_count)
+{
+    return beams_at(scene, time, NULL, out, n, joints, joint_cap, joint_count);
 }
 
 uint32_t rt_scene_beams_at(const rt_scene *scene, double time, vfx_beam *out, uint32_t n)
@@ -388,9 +462,9 @@ uint32_t rt_scene_beams_at(const rt_scene *scene, double time, vfx_beam *out, ui
         return 0;
     uint32_t count = scene->beam_count < n ? scene->beam_count : n;
     for (uint32_t i = 0; i < count; ++i) {
-        vfx_beam2 b2;
-        beam_at(&scene->beams[i], time, &b2);
-        out[i] = b2.v1;
+        vfx_beam3 b3;
+        beam_at(&scene->beams[i], time, &b3);
+        out[i] = b3.v2.v1;
     }
     return count;
 }

@@ -228,6 +228,104 @@ float volfx_beam_integral(vec3 M, vec3 D, float L, float R, float a, float b, fl
     return H;
 }
 
+#ifdef VOLFX_BEAMS_ANATOMY
+// beam_field_impl.inc's anatomy, line for line: an0 = (head radius (0 -> R), orb radius, orb
+// strength, 0), an1 = (taper, surge, 1 / surge wavelength, surge phase).
+float volfx_profile(vec4 an1, float L, float u)
+{
+    float f = 1.0;
+    if (an1.x > 0.0 && L > 0.0)
+        f *= 1.0 - an1.x * clamp(u / L, 0.0, 1.0);
+    if (an1.y > 0.0) {
+        float x = u * an1.z + an1.w;
+        float cb = 0.5 + 0.5 * cos(6.283185307179586 * (x - floor(x)));
+        f *= 1.0 + an1.y * cb * cb * cb;
+    }
+    return f;
+}
+
+float volfx_trail_profiled(vec3 wp, vec3 V, vec3 D, float L, float R, vec4 an1, float eps, float ta, float tb,
+                           float u0, float c, bool soft)
+{
+    const float inf = 1e30;
+    float H = volfx_sphere_piece(wp, V, R * volfx_profile(an1, L, 0.0), eps, ta, tb, u0, c, -inf, 0.0, soft)
+              + volfx_sphere_piece(wp - L * D, V, R * volfx_profile(an1, L, L), eps, ta, tb, u0, c, L, inf, soft);
+    float Rm = R * (1.0 + an1.y);
+    float wd = dot(wp, D);
+    vec3 a = wp - wd * D;
+    vec3 b = volfx_cross_acc(volfx_cross_acc(D, V), D);
+    float s = sqrt(dot(b, b)), lo = ta, hi = tb;
+    if (s > 0.0) {
+        vec3 bh = b / s;
+        float beta = dot(a, bh);
+        vec3 q = a - beta * bh;
+        float rr = dot(q, q);
+        if (rr >= Rm * Rm)
+            return H;
+        float hc = sqrt(Rm * Rm - rr);
+        volfx_clip_linear(beta, s, -hc, hc, lo, hi);
+    } else if (dot(a, a) > Rm * Rm) {
+        return H;
+    }
+    volfx_clip_linear(u0, c, 0.0, L, lo, hi);
+    if (!(hi >= lo))
+        return H;
+    float ua = u0 + c * lo, ub = u0 + c * hi;
+    if (ua > ub) {
+        float t = ua;
+        ua = ub, ub = t;
+    }
+    ua = max(ua, 0.0), ub = min(ub, L);
+    float step = inf;
+    if (an1.y > 0.0)
+        step = 1.0 / (16.0 * an1.z);
+    if (an1.x > 0.0 && L / 8.0 < step)
+        step = L / 8.0;
+    float span = ub - ua;
+    int n = span > step ? int(span / step) + 1 : 1;
+    n = min(n, 16);
+    if (n == 1)
+        return H + volfx_cylinder_piece(wp, V, D, L, R * volfx_profile(an1, L, 0.5 * (ua + ub)), eps, ta, tb, u0, c,
+                                        soft);
+    float du = span / float(n);
+    for (int k = 0; k < n; ++k) {
+        float ulo = k == 0 ? 0.0 : ua + float(k) * du, uhi = k == n - 1 ? L : ua + float(k + 1) * du;
+        float um = ua + (float(k) + 0.5) * du;
+        H += volfx_cylinder_piece(wp - ulo * D, V, D, uhi - ulo, R * volfx_profile(an1, L, um), eps, ta, tb, u0 - ulo,
+                                  c, soft);
+    }
+    return H;
+}
+
+float volfx_beam_integral_anat(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, bool soft,
+                               vec4 an0, vec4 an1, vec3 V, float t0, float t1)
+{
+    if (!(t1 > t0))
+        return 0.0;
+    float eps = max(eps_in, VOLFX_BEAM_EPS_FLOOR * R);
+    vec3 w = -M;
+    vec3 wp = volfx_cross_acc(V, volfx_cross_acc(w, V));
+    float wv = dot(w, V);
+    float ta = t0 + wv, tb = t1 + wv;
+    float c = dot(V, D), u0 = dot(wp, D);
+    vec3 ge = wp - L * D;
+    float H = 0.0;
+    const float inf = 1e30;
+    if (a > 0.0)
+        H += a * volfx_sphere_piece(wp, V, an0.x > 0.0 ? an0.x : R, eps, ta, tb, 0.0, 0.0, -1.0, 1.0, soft);
+    if (an0.y > 0.0 && an0.z > 0.0)
+        H += an0.z * volfx_sphere_piece(ge, V, an0.y, eps, ta, tb, 0.0, 0.0, -1.0, 1.0, soft);
+    if (!(b > 0.0))
+        return H;
+    if (an1.x > 0.0 || an1.y > 0.0)
+        return H + b * volfx_trail_profiled(wp, V, D, L, R, an1, eps, ta, tb, u0, c, soft);
+    H += b * volfx_sphere_piece(wp, V, R, eps, ta, tb, u0, c, -inf, 0.0, soft);
+    H += b * volfx_cylinder_piece(wp, V, D, L, R, eps, ta, tb, u0, c, soft);
+    H += b * volfx_sphere_piece(ge, V, R, eps, ta, tb, u0, c, L, inf, soft);
+    return H;
+}
+#endif
+
 // the raw density (for the ray-marching baseline), P relative to the eye
 float volfx_beam_density(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, bool soft,
                          vec3 P)

@@ -9,7 +9,8 @@ out vec4 o_color;
 
 void main()
 {
-    vec3 L = texelFetch(u_light, ivec2(gl_FragCoord.xy), 0).rgb;
+    vec4 l4 = texelFetch(u_light, ivec2(gl_FragCoord.xy), 0);
+    vec3 L = l4.rgb + vec3(l4.a); // a: the white cores (integrate.frag), kept out of the bloom
     if (u_bloom != 0)
         L += u_bloom_gain * texture(u_bloom_tex, v_uv).rgb;
     if (!(L.r + L.g + L.b > 0.0))

@@ -23,6 +23,9 @@ struct Beam {
     vec4 color;  // rgb (thesis ramp: times intensity and 2^exposure)
     vec4 look;   // intensity, 2^exposure / c, flow amount, flow phase
     uvec4 mode;  // smooth falloff, thesis ramp, first joint, joint count (>= 2: a polyline)
+    vec4 an0;    // anatomy: head radius (0 -> R), orb radius (0: none), orb strength, 0
+    vec4 an1;    // anatomy: taper, surge, 1 / surge wavelength, surge phase
+    vec4 look2;  // core (0: version 2's ramp), flow kind (1: spiral), spiral twist, 0
 };
 layout(std430, binding = 0) readonly buffer Beams { Beam beams[]; };
 layout(std430, binding = 1) readonly buffer Ranges { uvec2 ranges[]; };
@@ -51,6 +54,50 @@ float volfx_nearest_u(vec3 M, vec3 D, float L, vec3 V)
     return clamp(u, 0.0, L);
 }
 
+#ifdef VOLFX_BEAMS_ANATOMY
+// where the ray t V passes the point P: (distance, signed offset along side)
+vec2 volfx_pass_point(vec3 P, vec3 V, vec3 side)
+{
+    vec3 off = max(dot(P, V), 0.0) * V - P;
+    return vec2(length(off), dot(off, side));
+}
+
+// the ray's nearest approach to the straight axis: (u, distance, signed offset across)
+vec3 volfx_nearest(vec3 M, vec3 D, float L, vec3 V)
+{
+    float u = volfx_nearest_u(M, D, L, V);
+    vec3 n = cross(D, V);
+    float nn = length(n);
+    vec2 dp = volfx_pass_point(M + u * D, V, nn > 1e-6 ? n / nn : vec3(0.0));
+    return vec3(u, dp);
+}
+
+// light of a hue-keeping beam (docs/beams.md "Colour"): rgb, the colour C (brightest channel
+// normalised to 1) x (1 - exp(-x)), so it never passes the intensity and the tone map keeps it
+// saturated, plus the core W x C; a, the core's white W (bounded by 3 x intensity, weighted by
+// exp(-(d / (core R))^2) where the ray passes at distance d of the axis, the head or the orb),
+// which the composite adds as white and the bloom never sees: the bloom is of hued light only
+vec4 volfx_core_ramp(Beam bm, float x, float d_axis, vec3 V)
+{
+    vec3 C = bm.color.rgb / max(max(bm.color.r, bm.color.g), max(bm.color.b, 1e-6));
+    float core = bm.look2.x;
+    float R = bm.d_r.w, Rh = bm.an0.x > 0.0 ? bm.an0.x : R;
+    float q = d_axis / (core * R);
+    float w = exp(-q * q);
+    if (bm.ab_eps.x > 0.0) {
+        float qh = volfx_pass_point(bm.m_l.xyz, V, vec3(0.0)).x / (core * Rh);
+        w = max(w, exp(-qh * qh));
+    }
+    if (bm.an0.y > 0.0 && bm.an0.z > 0.0) {
+        vec3 S = bm.mode.w >= 2u ? volfx_joint(bm.mode.z + bm.mode.w - 1u) : bm.m_l.xyz + bm.m_l.w * bm.d_r.xyz;
+        float qo = volfx_pass_point(S, V, vec3(0.0)).x / (core * bm.an0.y);
+        w = max(w, exp(-qo * qo));
+    }
+    float W = 3.0 * w * (1.0 - exp(-x * x / 9.0));
+    return bm.look.x * vec4(C * (1.0 - exp(-x) + W), W);
+}
+#endif
+
 #ifdef VOLFX_BEAMS_POLYLINE
 // the same for a polyline: arc length from J0 at the nearest approach to the nearest segment
 float volfx_poly_nearest_u(uint first, int nj, vec3 V)
@@ -74,6 +121,28 @@ float volfx_poly_nearest_u(uint first, int nj, vec3 V)
     }
     return u;
 }
+
+#ifdef VOLFX_BEAMS_ANATOMY
+// the same as volfx_nearest for a polyline: (arc length, distance, signed offset across)
+vec3 volfx_poly_nearest(uint first, int nj, vec3 V)
+{
+    float best = 1e30, s = 0.0;
+    vec3 res = vec3(0.0, 1e30, 0.0);
+    for (int k = 0; k + 1 < nj; ++k) {
+        vec3 A = volfx_joint(first + uint(k)), e = volfx_joint(first + uint(k + 1)) - A;
+        float len = length(e);
+        if (!(len > 0.0))
+            continue;
+        vec3 r = volfx_nearest(A, e / len, len, V);
+        if (r.y < best) {
+            best = r.y;
+            res = vec3(s + r.x, r.y, r.z);
+        }
+        s += len;
+    }
+    return res;
+}
+#endif
 #endif
 
 void main()
@@ -95,6 +164,7 @@ void main()
     uvec2 range = ranges[(px.y / u_tile_px) * u_tiles_x + px.x / u_tile_px];
     float H = 0.0, Hth = 0.0;
     vec3 tint = vec3(0.0), light = vec3(0.0);
+    float white = 0.0; // the hue-keeping beams' white cores: added by the composite, not bloomed
     for (uint k = 0u; k < range.y; ++k) {
         Beam bm = beams[list[range.x + k]];
         bool soft = bm.mode.x != 0u;
@@ -126,13 +196,31 @@ void main()
         }
 #else
 #ifdef VOLFX_BEAMS_POLYLINE
-        if (poly)
+        if (poly) {
+#ifdef VOLFX_BEAMS_ANATOMY
+            // the head at its own radius and the orb at the last joint: sphere pieces
+            float eps = max(bm.ab_eps.z, VOLFX_BEAM_EPS_FLOOR * bm.d_r.w);
+            h = volfx_polyline_integral(bm.mode.z, int(bm.mode.w), bm.d_r.w, bm.an0.x > 0.0 ? 0.0 : bm.ab_eps.x,
+                                        bm.ab_eps.y, bm.ab_eps.z, soft, V, 0.0, tmax);
+            if (bm.an0.x > 0.0 && bm.ab_eps.x > 0.0)
+                h += bm.ab_eps.x * volfx_prim_piece(V, volfx_joint(bm.mode.z), vec3(0.0), 0.0, false, bm.an0.x, eps,
+                                                    0.0, tmax, soft);
+            if (bm.an0.y > 0.0 && bm.an0.z > 0.0 && tmax > 0.0)
+                h += bm.an0.z * volfx_prim_piece(V, volfx_joint(bm.mode.z + bm.mode.w - 1u), vec3(0.0), 0.0, false,
+                                                 bm.an0.y, eps, 0.0, tmax, soft);
+#else
             h = volfx_polyline_integral(bm.mode.z, int(bm.mode.w), bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
                                         bm.ab_eps.z, soft, V, 0.0, tmax);
-        else
 #endif
+        } else
+#endif
+#ifdef VOLFX_BEAMS_ANATOMY
+            h = volfx_beam_integral_anat(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
+                                         bm.ab_eps.z, soft, bm.an0, bm.an1, V, 0.0, tmax);
+#else
             h = volfx_beam_integral(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
                                     bm.ab_eps.z, soft, V, 0.0, tmax);
+#endif
 #endif
         H += h;
         if (bm.mode.y != 0u) {
@@ -142,6 +230,33 @@ void main()
             // capped where the pixel is white anyway: beam_settings.c 1e-30 or exposure 64 made
             // x * x Inf, the ramp Inf / Inf NaN, and the beam vanished (issue 28)
             float x = min(h * bm.look.y, LIGHT_MAX);
+#ifdef VOLFX_BEAMS_ANATOMY
+            if (bm.look2.x > 0.0 || bm.look2.y > 0.0) {
+#ifdef VOLFX_BEAMS_POLYLINE
+                vec3 nr = poly ? volfx_poly_nearest(bm.mode.z, int(bm.mode.w), V)
+                               : volfx_nearest(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, V);
+#else
+                vec3 nr = volfx_nearest(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, V);
+#endif
+                if (bm.look.z > 0.0) {
+                    float ph = nr.x * bm.ab_eps.w - bm.look.w, n;
+                    if (bm.look2.y > 0.0) { // a helix: stripes slanted by twist wavelengths across the tube
+                        float phi = asin(clamp(nr.z / bm.d_r.w, -1.0, 1.0));
+                        float c = 0.5 + 0.5 * cos(6.2831853 * (ph + bm.look2.z * phi / 3.14159265));
+                        n = c * c;
+                    } else {
+                        n = volfx_flow_noise(ph);
+                    }
+                    x *= 1.0 + bm.look.z * (2.0 * n - 1.0);
+                }
+                if (bm.look2.x > 0.0) {
+                    vec4 lw = volfx_core_ramp(bm, x, nr.y, V);
+                    light += lw.rgb;
+                    white += lw.a;
+                    continue;
+                }
+            } else
+#endif
             if (bm.look.z > 0.0) {
 #ifdef VOLFX_BEAMS_POLYLINE
                 float u = poly ? volfx_poly_nearest_u(bm.mode.z, int(bm.mode.w), V)
@@ -160,5 +275,5 @@ void main()
         light += tint / Hth * I;
     }
     o_acc = H;
-    o_light = vec4(min(light, vec3(LIGHT_MAX)), 0.0);   // finite whatever the gain
+    o_light = vec4(min(light, vec3(LIGHT_MAX)), min(white, LIGHT_MAX)); // finite whatever the gain
 }

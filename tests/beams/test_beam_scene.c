@@ -149,12 +149,60 @@ static void test_joints(void **state)
     }
 }
 
+/* The anatomy's keys (vfx_beam3): values, keyframes, defaults (core 0.2 in scenes, 0 with the
+ * thesis ramp) and bad values refused with their path. */
+static void test_anatomy_keys(void **state)
+{
+    (void)state;
+    char err[256] = "";
+    rt_scene *s = load("{\"version\": 1, \"beams\": ["
+                       "{\"head\": [0, 0, 0], \"dir\": [1, 0, 0]},"
+                       "{\"head\": [0, 1, 0], \"dir\": [1, 0, 0], \"head_radius\": 0.9, \"orb_radius\": 0.4,"
+                       " \"orb\": {\"pulse\": 0.3, \"pulse_hz\": 2}, \"taper\": 0.5, \"surges\": {\"wavelength\": 1.5,"
+                       " \"speed\": 3}, \"flow\": {\"amount\": 0.6, \"kind\": \"spiral\", \"twist\": 2}, \"core\": 0.3,"
+                       " \"loop_s\": 2, \"keyframes\": {\"surge\": [{\"t\": 0, \"value\": 0}, {\"t\": 2, \"value\": 1}],"
+                       " \"orb_strength\": [{\"t\": 0, \"value\": 1}, {\"t\": 2, \"value\": 3}]}},"
+                       "{\"head\": [0, 0, 0], \"dir\": [1, 0, 0], \"ramp\": \"thesis\"}]}",
+                       err, sizeof err);
+    assert_non_null(s);
+    vfx_beam3 b[3];
+    assert_int_equal(rt_scene_beams3_at(s, 1.0, b, 3, NULL, 0, NULL), 3);
+    assert_true(b[0].core == 0.2f && b[0].head_radius == 0.f && b[0].orb_radius == 0.f && b[0].taper == 0.f);
+    assert_true(b[2].core == 0.f);
+    assert_true(b[1].head_radius == 0.9f && b[1].orb_radius == 0.4f && b[1].orb_pulse == 0.3f);
+    assert_true(b[1].orb_pulse_hz == 2.f && b[1].taper == 0.5f && b[1].surge_wavelength == 1.5f);
+    assert_true(b[1].surge_speed == 3.f && b[1].flow_kind == VFX_BEAM_FLOW_SPIRAL && b[1].flow_twist == 2.f);
+    assert_true(b[1].core == 0.3f && b[1].v2.flow_amount == 0.6f);
+    assert_true(fabsf(b[1].surge_amount - 0.5f) < 1e-6f && fabsf(b[1].orb_strength - 2.f) < 1e-6f); /* halfway */
+    vfx_beam2 b2[3];
+    assert_int_equal(rt_scene_beams2_at(s, 1.0, b2, 3, NULL, 0, NULL), 3);
+    assert_memory_equal(&b2[1], &b[1].v2, sizeof b2[1]);
+    rt_scene_free(s);
+    static const char *const bad[][2] = {
+        {"\"taper\": 0.99", "beams[0].taper"},
+        {"\"surge\": -1", "beams[0].surge"},
+        {"\"core\": 2", "beams[0].core"},
+        {"\"orb\": {\"pulse\": 1.5}", "beams[0].orb.pulse"},
+        {"\"flow\": {\"kind\": \"swirl\"}", "beams[0].flow.kind"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        char json[256];
+        snprintf(json, sizeof json, "{\"version\": 1, \"beams\": [{\"head\": [0, 0, 0], \"dir\": [1, 0, 0], %s}]}",
+                 bad[i][0]);
+        err[0] = 0;
+        assert_null(load(json, err, sizeof err));
+        if (!strstr(err, bad[i][1]))
+            fail_msg("%s: error '%s' does not name %s", bad[i][0], err, bad[i][1]);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_defaults_and_values),
         cmocka_unit_test(test_bad_values),
         cmocka_unit_test(test_joints),
+        cmocka_unit_test(test_anatomy_keys),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

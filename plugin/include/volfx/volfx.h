@@ -365,6 +365,50 @@ typedef struct vfx_beams_view2 {
     uint32_t _reserved[4];
 } vfx_beams_view2;
 
+/* Version 3 of a beam (issue 25, docs/beams.md "Anatomy of an attack"): version 2 as its first
+ * member (never edited), then the attack's anatomy. Every field 0 -> version 2's look. The orb
+ * and the head are sphere pieces of the same closed form; the body's radius R(u) varies along
+ * u = (P - M).D as R (1 - taper u / L) (1 + surge_amount bump(u / surge_wavelength + phase)),
+ * bump(x) = ((1 + cos 2 pi x) / 2)^3, phase = surge_speed time / surge_wavelength (surges travel
+ * from the source M + L D towards the head M); straight beams only (a polyline ignores taper and
+ * surges). */
+typedef struct vfx_beam3 {
+    vfx_beam2 v2;
+    float head_radius;       /* the head sphere's support radius (>= 0); 0 -> R */
+    float orb_radius;        /* the charging orb at the source M + L D (>= 0); 0 -> no orb */
+    float orb_strength;      /* the orb's density strength (like a, >= 0); 0 -> a */
+    float orb_pulse;         /* 0..1: the orb's radius times 1 + orb_pulse sin(2 pi orb_pulse_hz time) */
+    float orb_pulse_hz;      /* >= 0 */
+    float taper;             /* 0..0.95: the body's radius falls linearly to (1 - taper) R at the source */
+    float surge_amount;      /* 0..4: a surge widens the body by up to this fraction of R */
+    float surge_wavelength;  /* distance between surges (> 0 when surge_amount > 0); 0 -> 8 R */
+    float surge_speed;       /* units per second, source to head (finite) */
+    uint32_t flow_kind;      /* vfx_beam_flow_kind */
+    float flow_twist;        /* spiral: turns per flow wavelength (finite); 0 -> 1 */
+    /* > 0: the hue-keeping ramp (docs/beams.md "Colour"): the beam's colour C (brightest channel
+     * 1) x intensity x (1 - exp(-x)) in the halo, and white (at most 3 x intensity) only where
+     * the ray passes within about core x R of the axis, the head or the orb; 0 -> the version 2
+     * ramp; at most 1 */
+    float core;
+    uint32_t _reserved[8];
+} vfx_beam3;
+
+/* The flow's pattern (vfx_beam3.flow_kind). */
+typedef enum vfx_beam_flow_kind {
+    VFX_BEAM_FLOW_NOISE = 0,  /* version 2's: value noise along the beam */
+    VFX_BEAM_FLOW_SPIRAL = 1, /* a helix wound round the axis, moving at flow_speed */
+} vfx_beam_flow_kind;
+
+/* Version 3 of the beams view: version 2 as its first member; the plugin offers it with
+ * v1.size = sizeof(vfx_beams_view3), v1.version = VFX_BEAMS_VIEW3_VERSION; a version 3 host
+ * sets beams3 (v2.beams and v1.beams are then ignored), an older one answers its version. */
+#define VFX_BEAMS_VIEW3_VERSION 3u
+typedef struct vfx_beams_view3 {
+    vfx_beams_view2 v2;
+    const vfx_beam3 *beams3; /* v2.v1.count beams */
+    uint32_t _reserved[4];
+} vfx_beams_view3;
+
 /* Bits of vfx_volume_view.disable. */
 enum {
     VFX_VOLUME_NO_ERT = 1u << 0,   /* no early ray termination at all */
