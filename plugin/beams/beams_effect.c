@@ -71,7 +71,8 @@ typedef struct beams_state {
     uint32_t list_capacity, pairs;  /* list entries allocated, used this frame */
 } beams_state;
 
-/* Asks the host for its view, offering version 3; an older answer leaves the rest zero. */
+/* Asks the host for its view, offering version 3, then version 2 as before issue 25 (a host
+ * that answers only the exact version it knows); an older answer leaves the rest zero. */
 static vfx_result query_view(vfx_context *ctx, vfx_beams_view3 *v3)
 {
     memset(v3, 0, sizeof *v3);
@@ -79,6 +80,12 @@ static vfx_result query_view(vfx_context *ctx, vfx_beams_view3 *v3)
     v->v1.size = sizeof *v3;
     v->v1.version = VFX_BEAMS_VIEW3_VERSION;
     vfx_result r = ctx->host.beams(ctx->host.user, &v->v1);
+    if (r != VFX_OK) {
+        memset(v3, 0, sizeof *v3);
+        v->v1.size = sizeof *v;
+        v->v1.version = VFX_BEAMS_VIEW2_VERSION;
+        r = ctx->host.beams(ctx->host.user, &v->v1);
+    }
     if (r == VFX_OK && v->v1.version == VFX_BEAMS_VIEW_VERSION)
         memset((char *)v3 + sizeof v->v1, 0, sizeof *v3 - sizeof v->v1); /* nothing a v1 host wrote */
     else if (r == VFX_OK && v->v1.version == VFX_BEAMS_VIEW2_VERSION)
@@ -301,12 +308,13 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
     if (r || (ver != VFX_BEAMS_VIEW_VERSION && ver != VFX_BEAMS_VIEW2_VERSION && ver != VFX_BEAMS_VIEW3_VERSION))
         return volfx_fail(ctx, VFX_ERR_ABI, "beams: host view of version %u (need %u, %u or %u)", ver,
                           VFX_BEAMS_VIEW_VERSION, VFX_BEAMS_VIEW2_VERSION, VFX_BEAMS_VIEW3_VERSION);
+    /* a version 3 answer without beams3 is a version 2 host that kept the offered version (the
+     * integration hosts do): read as version 2 */
     const vfx_beam3 *b3 = ver == VFX_BEAMS_VIEW3_VERSION ? v3.beams3 : NULL;
-    if (ver == VFX_BEAMS_VIEW3_VERSION && !b3)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: a version 3 view with beams3 NULL");
-    if (b3) { /* a version 3 view: the version 2 parts are read from beams3 */
-        v.v1.version = VFX_BEAMS_VIEW2_VERSION;
-        v.beams = NULL;
+    if (ver == VFX_BEAMS_VIEW3_VERSION) {
+        v.v1.version = ver = VFX_BEAMS_VIEW2_VERSION;
+        if (b3) /* the version 2 parts are read from beams3 */
+            v.beams = NULL;
     }
     const vfx_beam2 *b2 = ver == VFX_BEAMS_VIEW2_VERSION ? v.beams : NULL;
     if (v.v1.count > MAX_BEAMS || (!v.v1.beams && !b2 && !b3))

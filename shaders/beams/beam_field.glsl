@@ -471,8 +471,14 @@ float volfx_polyline_integral(uint first, int nj, float R, float a, float b, flo
         }
         br[j + 1] = x;
     }
-    int cur = -1;
+    // The runs of one nearest primitive are found first and integrated after, in the same order
+    // (so H is the same to the bit): llvmpipe executes the body of every `if` for all lanes, so a
+    // piece evaluated inside this loop cost one sphere and one cylinder piece per interval, where
+    // the loop below costs one per run (docs/benchmarks-beams.md, issue 25 cost).
+    int cur = -1, runs = 0;
     float run0 = t0;
+    int rprim[VOLFX_POLY_MAX_BREAKS];
+    float rlo[VOLFX_POLY_MAX_BREAKS], rhi[VOLFX_POLY_MAX_BREAKS];
     for (int k = 0; k + 1 < nb; ++k) {
         if (!(br[k + 1] > br[k]))
             continue;
@@ -486,14 +492,26 @@ float volfx_polyline_integral(uint first, int nj, float R, float a, float b, flo
             }
         }
         if (arg != cur) {
-            if (cur >= 0)
-                H += b * volfx_prim_piece(V, C[cur], D[cur], L[cur], seg[cur], R, eps, run0, br[k], soft);
+            if (cur >= 0) {
+                rprim[runs] = cur;
+                rlo[runs] = run0;
+                rhi[runs] = br[k];
+                runs++;
+            }
             cur = arg;
             run0 = br[k];
         }
     }
-    if (cur >= 0)
-        H += b * volfx_prim_piece(V, C[cur], D[cur], L[cur], seg[cur], R, eps, run0, t1, soft);
+    if (cur >= 0) {
+        rprim[runs] = cur;
+        rlo[runs] = run0;
+        rhi[runs] = t1;
+        runs++;
+    }
+    for (int r = 0; r < runs; ++r) {
+        int i = rprim[r];
+        H += b * volfx_prim_piece(V, C[i], D[i], L[i], seg[i], R, eps, rlo[r], rhi[r], soft);
+    }
     return H;
 }
 
