@@ -134,6 +134,20 @@ static double stat(session *ss, const char *name)
     return -1;
 }
 
+/* The float64 reference's distances of host s (isotropic, h/32 samples and bisection). */
+static void reference(const host *s, const ref_camera *cam, float *out)
+{
+    double fwd[3], right[3], up[3];
+    ref_camera_basis(cam, fwd, right, up);
+    ref_water_camera rc = {{cam->eye[0], cam->eye[1], cam->eye[2]}, {fwd[0], fwd[1], fwd[2]}, {up[0], up[1], up[2]},
+                           cam->fov_y, (uint32_t)cam->width, (uint32_t)cam->height};
+    ref_water_params rp = ref_water_default_params();
+    rp.h = s->h ? s->h : 0.02;
+    rp.step = rp.h / 32;
+    char err[256];
+    assert_int_equal(ref_water_render(&rc, s->x, s->y, s->z, s->n, &rp, out, NULL, NULL, err), 0);
+}
+
 /* 42^3 = 74,088 particles at a spacing of h/2 in a cube 0.41 wide, seen whole by one 8x8 tile:
  * every pixel's list holds all of them, more than the 65,535 loop iterations llvmpipe gives one
  * shader invocation (all loops together; Mesa gallivm's loop limiter), after which every loop
@@ -157,17 +171,8 @@ static void test_tile_loop_budget(void **state)
         s.z[i] = 0.01f * (float)(i / side / side) - 0.205f;
     }
     const ref_camera cam = {{0.3, 0.4, 1.5}, {0, 0, 0}, {0, 1, 0}, 0.6, 8, 8, 0.1, 50};
-    /* the float64 reference (h/32 samples and bisection) */
     float ref[64], tile[64], grid[64];
-    double fwd[3], right[3], up[3];
-    ref_camera_basis(&cam, fwd, right, up);
-    ref_water_camera rc = {{cam.eye[0], cam.eye[1], cam.eye[2]}, {fwd[0], fwd[1], fwd[2]}, {up[0], up[1], up[2]},
-                           cam.fov_y, 8, 8};
-    ref_water_params rp = ref_water_default_params();
-    rp.h = 0.02;
-    rp.step = rp.h / 32;
-    char err[256];
-    assert_int_equal(ref_water_render(&rc, s.x, s.y, s.z, s.n, &rp, ref, NULL, NULL, err), 0);
+    reference(&s, &cam, ref);
     int ref_hits = 0;
     for (int i = 0; i < 64; ++i) ref_hits += ref[i] >= 0;
     assert_true(ref_hits >= 8); /* the cube covers about a fifth of the 64 pixels */
@@ -358,15 +363,7 @@ static void test_refine_iters_high(void **state)
     const ref_camera cam = {{0, 4.3, 8}, {0, 0.15, 0}, {0, 1, 0}, 0.9, 48, 32, 0.1, 100};
     enum { N = 48 * 32 };
     static float ref[N], d3[N], a[N], b[N];
-    double fwd[3], right[3], up[3];
-    ref_camera_basis(&cam, fwd, right, up);
-    ref_water_camera rc = {{cam.eye[0], cam.eye[1], cam.eye[2]}, {fwd[0], fwd[1], fwd[2]}, {up[0], up[1], up[2]},
-                           cam.fov_y, 48, 32};
-    ref_water_params rp = ref_water_default_params();
-    rp.h = 0.61;
-    rp.step = rp.h / 32;
-    char err[256];
-    assert_int_equal(ref_water_render(&rc, s.x, s.y, s.z, s.n, &rp, ref, NULL, NULL, err), 0);
+    reference(&s, &cam, ref);
     const uint32_t methods[] = {VFX_WATER_METHOD_TILE, VFX_WATER_METHOD_GRID, VFX_WATER_METHOD_BRUTE,
                                 VFX_WATER_METHOD_PAPER};
     for (int m = 0; m < 4; ++m) {
