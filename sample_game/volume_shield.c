@@ -253,15 +253,27 @@ void game_shield_apply(game_shield *s, const rt_scene_volume_animation *an, cons
         double S[3], strength;
         if (!strike_point(&f->beams[b], C, R, S, &strength))
             continue;
-        /* rings r = speed t + n wavelength, each a raised cosine, fading with distance */
+        /* rings r = speed t + n wavelength, each a raised cosine, fading with distance, in the
+         * shell only: the boundary vertices and, fading out over 15% of the radius, those near
+         * the sphere. Added to every vertex, each ring was a spherical shell through the whole
+         * dome, and seen through the volume the shells blurred into a haze over the statue
+         * (frames 30, 90, 400: no ring could be told apart) */
         for (uint32_t i = 0; i < s->point_count; ++i) {
-            const float *p = &s->world[3 * i];
+            const float *n = &s->normal[3 * i], *p = &s->world[3 * i];
+            double shell = 1;
+            if (n[0] == 0 && n[1] == 0 && n[2] == 0) { /* inside the mesh */
+                double c[3] = {p[0] - C[0], p[1] - C[1], p[2] - C[2]};
+                double g = fabs(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) - R) / (0.15 * R);
+                if (!(g < 1))
+                    continue;
+                shell = 1 - g;
+            }
             double d[3] = {p[0] - S[0], p[1] - S[1], p[2] - S[2]};
             double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
             if (r > 4 * an->hit_reach)
                 continue;
             double ring = 0.5 + 0.5 * cos(k * (r - an->hit_speed * f->time));
-            scalar[i] += (float)(strength * an->hit_gain * ring * ring * exp(-r / an->hit_reach));
+            scalar[i] += (float)(shell * strength * an->hit_gain * ring * ring * exp(-r / an->hit_reach));
         }
     }
 }

@@ -90,7 +90,7 @@ static void test_rim(void **state)
 /* Hit rings: a beam from a source at z = 5.5 to a head at z = 0.5 enters the sphere of radius
  * 0.7 round the origin at (0, 0, 0.7), a grid point: there the ring term at time t is
  * gain (1/2 + cos(-k speed t) / 2)^2 (r = 0), and at (0.7, 0, 0.7) (r = 0.7) it fades by
- * exp(-0.7 / reach). A beam pointing away from the sphere, far off, adds nothing. */
+ * exp(-0.7 / reach); interior points far from the sphere get no ring. A beam pointing away from the sphere, far off, adds nothing. */
 static void test_hit_ripple(void **state)
 {
     (void)state;
@@ -109,6 +109,10 @@ static void test_hit_ripple(void **state)
     double ring0 = 0.5 + 0.5 * cos(-k * t), ring1 = 0.5 + 0.5 * cos(k * (0.7 - t));
     assert_true(fabs(sc[point_at(0, 0, 0.7f)] - 1.5 * ring0 * ring0) < 1e-5);
     assert_true(fabs(sc[point_at(0.7f, 0, 0.7f)] - 1.5 * ring1 * ring1 * exp(-0.7 / 0.8)) < 1e-5);
+    /* the rings run in the shell: the centre, 0.7 from the strike like the point above (ring
+     * 0.65 there) but a radius from the sphere, gets nothing (each ring was a spherical shell
+     * through the volume, a haze) */
+    assert_true(sc[point_at(0, 0, 0)] == 0);
     /* the far beam alone adds nothing */
     memset(sc, 0, g_np * sizeof *sc);
     f.beams = &b[1], f.beam_count = 1;
