@@ -9,7 +9,7 @@
 //                  wave crest I_wc = sum_j (1 - n_i . n_j) W_ij over the neighbours behind the
 //                  normal (x^_ji . n_i < 0), counted when v^_i . n_i >= 0.6, energy E = |v|^2;
 //                  n = Phi(E) (k_ta Phi(I_ta) + k_wc Phi(I_wc)) dt new particles (Phi the clamp
-//                  of eq. 1), placed in a cylinder of radius h/2 around the particle along its
+//                  of eq. 1; where Phi(E) = 0 the neighbours are not visited), placed in a cylinder of radius h/2 around the particle along its
 //                  velocity, appended to the pool while it has room
 //   MODE_PREP      one invocation: the pool's count clamped to the cap, the advection's
 //                  indirect dispatch
@@ -184,6 +184,14 @@ void main()
     nrm[i] = vec4(dot(g, g) > 0.0 ? normalize(g) : vec3(0.0), off);
 #else
     vec3 v = vel[i].xyz;
+    float sp = length(v);
+    float ek = sp * sp / (u_vref * u_vref);
+    // Phi(E) is 0 at or below the energy clamp's minimum: no particle can come of this one, so
+    // its neighbours are not visited (most of a calm pool; the potentials there read 0)
+    if (!(ek > u_ek.x)) {
+        pot[i] = vec4(0.0, 0.0, ek, 0.0);
+        return;
+    }
     vec4 ni = nrm[i];
     bool surf = ni.w >= SURFACE;
     float ta = 0.0, wc = 0.0;
@@ -197,10 +205,8 @@ void main()
             if (surf && nj.w >= SURFACE && dot(d, ni.xyz) > 0.0) wc += (1.0 - dot(ni.xyz, nj.xyz)) * W;
         }
     })
-    float sp = length(v);
     if (!(sp > 0.0) || dot(v / sp, ni.xyz) < CREST_VN) wc = 0.0;
     ta /= u_vref;
-    float ek = sp * sp / (u_vref * u_vref);
     float want = phi(ek, u_ek) * (u_rate_ta * phi(ta, u_ta) + u_rate_wc * phi(wc, u_wc)) * u_dt;
     pot[i] = vec4(ta, wc, ek, want);
     if (!(want > 0.0)) return;

@@ -206,6 +206,7 @@ static void reference_potentials(const host *s, double h, double dt, double *pot
         if (!(sp > 0) || vn < CREST_VN) wc = 0;
         ta /= vref;
         double ek = sp * sp / (vref * vref);
+        if (fabs(ek - 0.5) < eps) ambiguous[i] = true; /* the energy clamp's minimum: skipped or not */
         double *o = pot + 4 * i;
         o[0] = ta, o[1] = wc, o[2] = ek;
         o[3] = phi(ek, 0.5, 4.0) * (40.0 * phi(ta, 1.5, 6.0) + 60.0 * phi(wc, 0.3, 1.5)) * dt;
@@ -236,7 +237,11 @@ static void test_potentials_vs_reference(void **state)
     const double lo[3] = {1.5, 0.3, 0.5}, hi[3] = {6.0, 1.5, 4.0};
     for (uint32_t i = 0; i < s.n; ++i) {
         if (amb[i]) { ++skipped; continue; }
-        for (int k = 0; k < 4; ++k) {
+        /* at or below the energy clamp's minimum nothing can be generated and the GPU does not
+         * visit the neighbours: trapped air and wave crest read 0 there */
+        bool slow = ref[4 * i + 2] <= 0.5;
+        if (slow) assert_true(pot[4 * i] == 0 && pot[4 * i + 1] == 0 && pot[4 * i + 3] == 0);
+        for (int k = slow ? 2 : 0; k < 4; ++k) {
             double e = fabs(pot[4 * i + k] - ref[4 * i + k]) / fmax(1.0, fabs(ref[4 * i + k]));
             worst[k] = fmax(worst[k], e);
         }

@@ -260,9 +260,9 @@ typedef struct vfx_water_params4 {
     uint32_t diffuse_max;          /* the pool's cap, 1..4194304; 0 -> 32768 */
     float gravity[3];              /* scene units / s^2 (spray, bubbles, v_ref); 0 -> (0, -9.81, 0) */
     /* potentials' clamp ranges [min, max] (each 0 -> default; min < max):
-     * trapped air sum_j |v_ij| (1 - v_ij.x_ij) W_ij in units of v_ref, 0 -> [6, 18];
+     * trapped air sum_j |v_ij| (1 - v_ij.x_ij) W_ij in units of v_ref, 0 -> [1.5, 6];
      * wave crest sum_j (1 - n_i.n_j) W_ij over the convex neighbours of a particle moving along
-     * its normal, no unit, 0 -> [0.5, 2]; kinetic energy |v|^2 / v_ref^2, 0 -> [1, 6] */
+     * its normal, no unit, 0 -> [0.2, 1]; kinetic energy |v|^2 / v_ref^2, 0 -> [0.3, 2] */
     float trapped_air[2], wave_crest[2], energy[2];
     /* particles generated per fluid particle per second at full potential, <= 10000;
      * 0 -> 10 (trapped air) and 25 (wave crest) */
