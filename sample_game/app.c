@@ -296,6 +296,7 @@ vfx_result game_app_create(const game_app_desc *desc, game_app **out)
     if (r)
         goto fail;
     app->api = rt_plugin_host_api(app->plugin);
+    app->api3 = rt_plugin_host_api3(app->plugin); /* NULL for a plugin without lights */
     if ((r = app->api->create(&app->host, &app->ctx)))
         goto fail;
     *out = app;
@@ -495,6 +496,13 @@ vfx_result game_app_frame(game_app *app, float dt)
         rt_renderer_set_environment(app->renderer, &app->environment);
     }
     rt_renderer_set_origin(app->renderer, app->origin);
+    if (app->api3) { /* the effects' lights on the meshes: beams' trails, heads and impacts */
+        vfx_light lights[RT_RENDERER_MAX_LIGHTS];
+        vfx_lights l = {.size = sizeof l, .version = VFX_LIGHTS_VERSION, .capacity = RT_RENDERER_MAX_LIGHTS,
+                        .lights = lights};
+        if (app->api3->get_lights(app->ctx, &l) == VFX_OK)
+            rt_renderer_set_lights(app->renderer, lights, l.count);
+    }
     rt_renderer_begin_scene(app->renderer, frame.v1.view, frame.v1.proj, app->clear_color);
     rt_component draw_terms[2] = {app->mesh_comp, app->transform_comp};
     rt_query_iter it = rt_query_begin(app->world, draw_terms, 2);

@@ -49,6 +49,7 @@ typedef struct game_app {
     rt_effect_components effects; /* beams and volumes are entities ("vfx.beam", "vfx.volume") */
     rt_plugin_host *plugin;
     const vfx_plugin_api *api;
+    const vfx_plugin_api3 *api3; /* get_lights (NULL: a plugin of api 1 or 2) */
     vfx_context *ctx;
     rt_profiler *profiler;
     vfx_host_api host;

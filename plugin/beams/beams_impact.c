@@ -338,9 +338,9 @@ static void put_light(vfx_lights *out, vfx_light_kind kind, vfx_light_source src
 
 /* Light levels of the beams' parts, chosen so a beam 1 m above a floor lights it to about the
  * level of the dusk scene's sun (docs/beams.md "Lights"). */
-#define BODY_INTENSITY 1.2f  /* per unit length, x the trail strength b / 0.5 */
-#define HEAD_INTENSITY 1.5f  /* x the head strength a */
-#define IMPACT_INTENSITY 3.0f
+#define BODY_INTENSITY 3.0f  /* per unit length, x the trail strength b / 0.5 */
+#define HEAD_INTENSITY 4.0f  /* x the head strength a */
+#define IMPACT_INTENSITY 8.0f
 
 void volfx_beams_impact_lights(const volfx_beams_impact *im, vfx_lights *out)
 {

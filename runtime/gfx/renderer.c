@@ -15,6 +15,9 @@ struct rt_renderer {
     rt_logger log;
     GLuint mesh_prog;
     GLint u_model, u_view_proj, u_color, u_light, u_environment, u_eye, u_fog, u_origin;
+    GLint u_light_count, u_lights;
+    float lights[RT_RENDERER_MAX_LIGHTS * 12]; /* mesh.frag's u_lights: p0 kind, p1 I, rgb radius */
+    uint32_t light_count;
     rt_renderer_environment env;
     float origin[3]; /* the scene's origin (rt_renderer_set_origin), for the meshes' patterns */
     GLuint sky_prog, sky_vao;
@@ -103,6 +106,8 @@ vfx_result rt_renderer_create(const rt_logger *logger, rt_renderer **out)
     r->u_eye = glGetUniformLocation(r->mesh_prog, "u_eye");
     r->u_fog = glGetUniformLocation(r->mesh_prog, "u_fog");
     r->u_origin = glGetUniformLocation(r->mesh_prog, "u_origin");
+    r->u_light_count = glGetUniformLocation(r->mesh_prog, "u_light_count");
+    r->u_lights = glGetUniformLocation(r->mesh_prog, "u_lights");
     *out = r;
     return VFX_OK;
 }
@@ -296,6 +301,31 @@ void rt_renderer_begin_scene(rt_renderer *r, const float view[16], const float p
         draw_sky(r);
 }
 
+vfx_result rt_renderer_set_lights(rt_renderer *r, const vfx_light *lights, uint32_t n)
+{
+    if (!r || (n && !lights))
+        return VFX_ERR_INVALID_ARGUMENT;
+    r->light_count = 0;
+    if (n > RT_RENDERER_MAX_LIGHTS)
+        n = RT_RENDERER_MAX_LIGHTS;
+    for (uint32_t i = 0; i < n; ++i) {
+        const vfx_light *l = &lights[i];
+        if (l->kind != VFX_LIGHT_POINT && l->kind != VFX_LIGHT_LINE) {
+            rt_logf(&r->log, VFX_LOG_ERROR, "lights[%u]: kind %u unknown (0 point, 1 line)", i, l->kind);
+            return VFX_ERR_ABI;
+        }
+        float *o = r->lights + 12 * i;
+        memcpy(o, l->p0, 12);
+        o[3] = (float)l->kind;
+        memcpy(o + 4, l->p1, 12);
+        o[7] = l->intensity;
+        memcpy(o + 8, l->color, 12);
+        o[11] = l->radius > 0 ? l->radius : 3e38f;
+    }
+    r->light_count = n;
+    return VFX_OK;
+}
+
 void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float model[16],
                             const float rgb[3])
 {
@@ -309,6 +339,9 @@ void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float 
     glUniformMatrix4fv(r->u_view_proj, 1, GL_FALSE, (const float *)vp);
     glUniform3fv(r->u_color, 1, rgb);
     glUniform3fv(r->u_origin, 1, r->origin);
+    glUniform1i(r->u_light_count, (GLint)r->light_count);
+    if (r->light_count)
+        glUniform4fv(r->u_lights, (GLsizei)(3 * r->light_count), r->lights);
     if (r->env.sky) {
         glUniform3fv(r->u_light, 1, r->env.sun_dir);
         glUniform1i(r->u_environment, 1);

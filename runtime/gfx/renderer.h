@@ -38,6 +38,12 @@ vfx_result rt_renderer_set_environment(rt_renderer *r, const rt_renderer_environ
 /* The world position the meshes' model matrices are relative to (a scene's origin): their
  * stone and checker patterns are laid out in world space, so they stay put whatever the origin. */
 void rt_renderer_set_origin(rt_renderer *r, const double origin[3]);
+/* Lights the meshes drawn from now on with the plugin's lights (get_lights of plugin api 3:
+ * points and isotropic line segments on Lambertian meshes, closed-form irradiance), on top of
+ * the sun and sky. At most RT_RENDERER_MAX_LIGHTS are kept (the first ones); n = 0 clears them.
+ * VFX_ERR_ABI for a light of a kind this renderer does not know (none is kept then). */
+#define RT_RENDERER_MAX_LIGHTS 32
+vfx_result rt_renderer_set_lights(rt_renderer *r, const vfx_light *lights, uint32_t n);
 /* Draws a mesh with a model matrix and a colour into the scene target. */
 void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float model[16],
                             const float rgb[3]);

@@ -9,30 +9,35 @@
 
 struct rt_plugin_host {
     void *handle; /* NULL for a static plugin */
-    vfx_plugin_api api;
+    vfx_plugin_api3 api3; /* offered as version 3; an older plugin fills its version's part */
 };
 
 /* Calls the entry and checks what came back, so a broken plugin never reaches the game. */
 static vfx_result handshake(vfx_plugin_entry_fn entry, uint32_t abi, const vfx_host_api *host,
                             const rt_logger *log, rt_plugin_host *h, const char *where)
 {
-    memset(&h->api, 0, sizeof h->api);
-    h->api.size = sizeof h->api;
-    h->api.version = VFX_PLUGIN_API_VERSION;
-    vfx_result r = entry(abi, host, &h->api);
+    memset(&h->api3, 0, sizeof h->api3);
+    vfx_plugin_api *api = &h->api3.v2.v1;
+    api->size = sizeof h->api3;
+    api->version = VFX_PLUGIN_API_VERSION;
+    vfx_result r = entry(abi, host, api);
     if (r != VFX_OK) {
         rt_logf(log, VFX_LOG_ERROR, "plugin %s refused the host (host ABI %u): %s", where, abi,
                  vfx_result_name(r));
         return r;
     }
-    if (h->api.version != VFX_PLUGIN_API_VERSION || h->api.size != sizeof h->api) {
+    static const size_t sizes[4] = {0, sizeof(vfx_plugin_api), sizeof(vfx_plugin_api2), sizeof(vfx_plugin_api3)};
+    if (api->version < VFX_PLUGIN_API_VERSION || api->version > VFX_PLUGIN_API3_VERSION
+        || api->size != sizes[api->version]) {
         rt_logf(log, VFX_LOG_ERROR,
-                 "plugin %s: plugin API version %u (size %u), this host needs version %u (size %zu)",
-                 where, h->api.version, h->api.size, VFX_PLUGIN_API_VERSION, sizeof h->api);
+                 "plugin %s: plugin API version %u (size %u), this host needs version %u (size %zu), "
+                 "2 (size %zu) or 3 (size %zu)", where, api->version, api->size, VFX_PLUGIN_API_VERSION,
+                 sizes[1], sizes[2], sizes[3]);
         return VFX_ERR_ABI;
     }
-    if (!h->api.create || !h->api.destroy || !h->api.resize || !h->api.update || !h->api.render
-        || !h->api.get_stats || !h->api.last_error || !h->api.read_raw) {
+    if (!api->create || !api->destroy || !api->resize || !api->update || !api->render
+        || !api->get_stats || !api->last_error || !api->read_raw
+        || (api->version == VFX_PLUGIN_API3_VERSION && !h->api3.get_lights)) {
         rt_logf(log, VFX_LOG_ERROR, "plugin %s: function table has NULL entries", where);
         return VFX_ERR_ABI;
     }
@@ -113,7 +118,12 @@ vfx_result rt_plugin_host_load_static(vfx_plugin_entry_fn entry, const vfx_host_
     return VFX_OK;
 }
 
-const vfx_plugin_api *rt_plugin_host_api(const rt_plugin_host *h) { return h ? &h->api : NULL; }
+const vfx_plugin_api *rt_plugin_host_api(const rt_plugin_host *h) { return h ? &h->api3.v2.v1 : NULL; }
+
+const vfx_plugin_api3 *rt_plugin_host_api3(const rt_plugin_host *h)
+{
+    return h && h->api3.v2.v1.version >= VFX_PLUGIN_API3_VERSION ? &h->api3 : NULL;
+}
 
 void rt_plugin_host_unload(rt_plugin_host *h)
 {

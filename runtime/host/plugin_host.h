@@ -23,6 +23,8 @@ vfx_result rt_plugin_host_load_as(const char *path, uint32_t abi_version, const 
                                    const rt_logger *log, rt_plugin_host **out);
 /* The plugin's function table (valid until unload). */
 const vfx_plugin_api *rt_plugin_host_api(const rt_plugin_host *h);
+/* Its version 3 table (get_lights), or NULL for a plugin of version 1 or 2. */
+const vfx_plugin_api3 *rt_plugin_host_api3(const rt_plugin_host *h);
 /* Unloads (dlclose) the plugin. Destroy every context first. NULL allowed. */
 void rt_plugin_host_unload(rt_plugin_host *h);
 
