@@ -32,8 +32,11 @@ static void test_good_plugin(void **state)
     rt_plugin_host *h = NULL;
     assert_int_equal(rt_plugin_host_load(g_plugin, &host, &lg, &h), VFX_OK);
     const vfx_plugin_api *api = rt_plugin_host_api(h);
-    assert_int_equal(api->version, VFX_PLUGIN_API_VERSION);
-    assert_int_equal(api->size, sizeof(vfx_plugin_api));
+    /* the host offers version 3 (get_lights) and this plugin answers it */
+    assert_int_equal(api->version, VFX_PLUGIN_API3_VERSION);
+    assert_int_equal(api->size, sizeof(vfx_plugin_api3));
+    assert_non_null(rt_plugin_host_api3(h));
+    assert_non_null(rt_plugin_host_api3(h)->get_lights);
     assert_string_equal(api->name, "volfx");
     assert_non_null(api->create);
     assert_non_null(api->render);
