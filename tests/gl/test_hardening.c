@@ -354,7 +354,7 @@ static void test_target_out_of_memory(void **state)
  * water-only scenes at 96x64); kept as a regression test: the paper's 1,000-particle layers at
  * 48x32 with 64 iterations (the documented maximum; 60 measured the same) in every method have
  * at most the holes and false hits of 3 iterations against the float64 reference, and two runs
- * give the same distances bit for bit. */
+ * find the same pixels at the same distances (to the atomics' summation order). */
 static void test_refine_iters_high(void **state)
 {
     (void)state;
@@ -394,7 +394,18 @@ static void test_refine_iters_high(void **state)
             /* the same coverage as 3 iterations: the refinement moves a hit along its ray, it
              * never turns a found pixel into a miss (the attack's transparent patches) */
             assert_true(e.hole_rate <= e3.hole_rate && e.false_hit_rate <= e3.false_hit_rate);
-            assert_memory_equal(a, b, sizeof a);
+            /* Two runs agree pixel for pixel on hit or miss; a hit's distance may differ in its
+             * last bits, because TILE's and GRID's scatter order a slab's entries by atomics,
+             * which changes the field's summation order (measured: 0 to 7.8e-7 h in three runs
+             * under load; bit-for-bit equality failed once in CI-like conditions). 1e-4 h is
+             * over 100x that and still far below a step of the march (h/8). */
+            float worst = 0.f;
+            for (int p = 0; p < N; ++p) {
+                assert_int_equal(a[p] < 0.f, b[p] < 0.f);
+                worst = fmaxf(worst, fabsf(a[p] - b[p]));
+            }
+            print_message("method %u: two runs differ by at most %.3g h\n", methods[m], worst / s.h);
+            assert_true(worst <= 1e-4f * s.h);
         }
     }
     free(s.x), free(s.y), free(s.z);
