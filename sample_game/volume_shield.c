@@ -13,7 +13,13 @@ struct game_shield {
     uint32_t point_count;
     float *world;           /* 3 per point: this frame's world positions */
     float *normal;          /* 3 per point: area-weighted boundary normal (0 off the boundary) */
+    uint32_t *source;       /* per point: the boundary vertex whose normal its rim uses (itself on the
+                             * boundary, the nearest in tet edges within SOURCE_HOPS inside, else ~0u) */
 };
+
+/* How many tet edges inward the rim reaches (it fades by the distance to the sphere anyway). */
+enum { SOURCE_HOPS = 4 };
+#define NO_SOURCE 0xffffffffu
 
 typedef struct face_key {
     uint32_t v[3];          /* sorted */
@@ -56,6 +62,56 @@ static void oriented_face(const float *P, const uint32_t *t, uint32_t slot, uint
     out[0] = f[0];
     out[1] = d > 0 ? f[2] : f[1]; /* the left-out vertex is behind the face */
     out[2] = d > 0 ? f[1] : f[2];
+}
+
+/* Gives every point within SOURCE_HOPS tet edges of the shell the nearest boundary vertex in
+ * edges (a breadth-first search from all boundary vertices at once), so the rim is not a layer
+ * one tet thick: with the interior vertices at 0, each tet under the silhouette interpolated the
+ * rim down to nothing over its own depth, and the uneven tets beaded the rim. False when out of
+ * memory. */
+static bool rim_sources(game_shield *s, const uint32_t *tets, uint32_t tet_count)
+{
+    const uint32_t np = s->point_count;
+    uint32_t *start = calloc((size_t)np + 1, sizeof *start), *adj = malloc((size_t)tet_count * 12 * sizeof *adj);
+    uint32_t *queue = malloc((size_t)np * sizeof *queue), *hops = malloc((size_t)np * sizeof *hops);
+    s->source = malloc((size_t)np * sizeof *s->source);
+    bool ok = start && adj && queue && hops && s->source;
+    if (ok) {
+        /* every tet edge both ways (shared edges repeat: harmless for the search) */
+        for (size_t i = 0; i < (size_t)tet_count * 4; ++i)
+            start[tets[i] + 1] += 3;
+        for (uint32_t i = 0; i < np; ++i)
+            start[i + 1] += start[i];
+        memcpy(hops, start, (size_t)np * sizeof *hops); /* hops: the fill cursor for now */
+        for (uint32_t t = 0; t < tet_count; ++t)
+            for (int a = 0; a < 4; ++a)
+                for (int b = 0; b < 4; ++b)
+                    if (a != b)
+                        adj[hops[tets[4 * t + a]]++] = tets[4 * t + b];
+        uint32_t head = 0, tail = 0;
+        for (uint32_t i = 0; i < np; ++i)
+            s->source[i] = NO_SOURCE, hops[i] = 0;
+        for (uint32_t k = 0; k < s->face_count * 3; ++k) {
+            uint32_t v = s->faces[k];
+            if (s->source[v] == NO_SOURCE)
+                s->source[v] = v, queue[tail++] = v;
+        }
+        while (head < tail) {
+            uint32_t v = queue[head++];
+            if (hops[v] >= SOURCE_HOPS)
+                continue;
+            for (uint32_t e = start[v]; e < start[v + 1]; ++e)
+                if (s->source[adj[e]] == NO_SOURCE) {
+                    s->source[adj[e]] = s->source[v], hops[adj[e]] = hops[v] + 1;
+                    queue[tail++] = adj[e];
+                }
+        }
+    }
+    free(start);
+    free(adj);
+    free(queue);
+    free(hops);
+    return ok;
 }
 
 vfx_result game_shield_create(const float *points, uint32_t point_count, const uint32_t *tets,
@@ -113,6 +169,10 @@ vfx_result game_shield_create(const float *points, uint32_t point_count, const u
         i = j;
     }
     free(keys);
+    if (!rim_sources(s, tets, tet_count)) {
+        game_shield_destroy(s);
+        return VFX_ERR_OUT_OF_MEMORY;
+    }
     *out = s;
     return VFX_OK;
 }
@@ -124,6 +184,7 @@ void game_shield_destroy(game_shield *s)
     free(s->faces);
     free(s->world);
     free(s->normal);
+    free(s->source);
     free(s);
 }
 
@@ -212,27 +273,23 @@ static void frame_geometry(game_shield *s, const game_shield_frame *f)
     }
 }
 
+/* How much of the shell a vertex is: 1 on the boundary, else fading out over 15% of the radius
+ * of the sphere (C, R), 0 beyond. */
+static double shell_weight(const float *n, const float *p, const double C[3], double R)
+{
+    if (n[0] != 0 || n[1] != 0 || n[2] != 0)
+        return 1;
+    double c[3] = {p[0] - C[0], p[1] - C[1], p[2] - C[2]};
+    double g = fabs(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) - R) / (0.15 * R);
+    return g < 1 ? 1 - g : 0;
+}
+
 void game_shield_apply(game_shield *s, const rt_scene_volume_animation *an, const game_shield_frame *f,
                        float *scalar)
 {
     if (!s || (an->rim_gain <= 0 && an->hit_gain <= 0))
         return;
     frame_geometry(s, f);
-    if (an->rim_gain > 0)
-        for (uint32_t i = 0; i < s->point_count; ++i) {
-            const float *n = &s->normal[3 * i], *p = &s->world[3 * i];
-            float nl = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-            if (!(nl > 0))
-                continue; /* inside the mesh */
-            double v[3] = {f->eye[0] - p[0], f->eye[1] - p[1], f->eye[2] - p[2]};
-            double vl = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-            if (!(vl > 0))
-                continue;
-            double c = fabs((n[0] * v[0] + n[1] * v[1] + n[2] * v[2]) / (nl * vl));
-            scalar[i] += (float)(an->rim_gain * pow(1 - (c < 1 ? c : 1), an->rim_power));
-        }
-    if (an->hit_gain <= 0 || !f->beams)
-        return;
     /* the dome's sphere in world space: centre and radius through the model matrix */
     float cw[3], ew[3], e[3] = {f->center[0] + f->radius, f->center[1], f->center[2]};
     bool identity = true;
@@ -248,6 +305,26 @@ void game_shield_apply(game_shield *s, const rt_scene_volume_animation *an, cons
     const double C[3] = {cw[0], cw[1], cw[2]};
     const double R = sqrt(((double)ew[0] - cw[0]) * (ew[0] - cw[0]) + ((double)ew[1] - cw[1]) * (ew[1] - cw[1]) +
                           ((double)ew[2] - cw[2]) * (ew[2] - cw[2]));
+    if (an->rim_gain > 0)
+        for (uint32_t i = 0; i < s->point_count; ++i) {
+            if (s->source[i] == NO_SOURCE)
+                continue; /* deep inside the mesh */
+            /* the normal of the nearest boundary vertex, seen from this vertex, weighted by how
+             * much of the shell it is: the rim reaches into the shell evenly */
+            const float *n = &s->normal[3 * s->source[i]], *p = &s->world[3 * i];
+            const double w = shell_weight(&s->normal[3 * i], p, C, R);
+            float nl = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            if (!(nl > 0) || !(w > 0))
+                continue;
+            double v[3] = {f->eye[0] - p[0], f->eye[1] - p[1], f->eye[2] - p[2]};
+            double vl = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+            if (!(vl > 0))
+                continue;
+            double c = fabs((n[0] * v[0] + n[1] * v[1] + n[2] * v[2]) / (nl * vl));
+            scalar[i] += (float)(w * an->rim_gain * pow(1 - (c < 1 ? c : 1), an->rim_power));
+        }
+    if (an->hit_gain <= 0 || !f->beams)
+        return;
     const double k = 2 * M_PI / an->hit_wavelength;
     for (uint32_t b = 0; b < f->beam_count; ++b) {
         double S[3], strength;
@@ -259,15 +336,10 @@ void game_shield_apply(game_shield *s, const rt_scene_volume_animation *an, cons
          * dome, and seen through the volume the shells blurred into a haze over the statue
          * (frames 30, 90, 400: no ring could be told apart) */
         for (uint32_t i = 0; i < s->point_count; ++i) {
-            const float *n = &s->normal[3 * i], *p = &s->world[3 * i];
-            double shell = 1;
-            if (n[0] == 0 && n[1] == 0 && n[2] == 0) { /* inside the mesh */
-                double c[3] = {p[0] - C[0], p[1] - C[1], p[2] - C[2]};
-                double g = fabs(sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) - R) / (0.15 * R);
-                if (!(g < 1))
-                    continue;
-                shell = 1 - g;
-            }
+            const float *p = &s->world[3 * i];
+            const double shell = shell_weight(&s->normal[3 * i], p, C, R);
+            if (!(shell > 0))
+                continue;
             double d[3] = {p[0] - S[0], p[1] - S[1], p[2] - S[2]};
             double r = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
             if (r > 4 * an->hit_reach)

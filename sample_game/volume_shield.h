@@ -35,9 +35,11 @@ typedef struct game_shield_frame {
     float center[3], radius;
 } game_shield_frame;
 
-/* Adds to scalar[i] the rim term gain (1 - |n.v|)^power at boundary vertices (n the vertex
- * normal from this frame's boundary faces in world space, v the unit vector to the eye) and
- * the hit ripples of every beam whose axis enters the dome's bounding sphere. */
+/* Adds to scalar[i] the rim term w gain (1 - |n.v|)^power at the shell's vertices (n the
+ * normal from this frame's boundary faces in world space of the vertex, or inside of its
+ * nearest boundary vertex in tet edges; v the unit vector to the eye; w 1 on the boundary,
+ * inside fading out over 15% of the radius from the sphere) and the hit ripples of every beam
+ * whose axis enters the dome's bounding sphere. */
 void game_shield_apply(game_shield *s, const rt_scene_volume_animation *an, const game_shield_frame *f,
                        float *scalar);
 

@@ -5,6 +5,7 @@
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -87,6 +88,58 @@ static void test_rim(void **state)
     game_shield_destroy(s);
 }
 
+/* Rim inside the shell: on a 4 x 4 x 4 grid (points at -0.7, -0.35, 0, 0.35, 0.7) with the
+ * sphere of radius 0.4 round the origin, the interior point (0, 0, 0.35) is 0.05 inside the
+ * sphere: shell weight 1 - 0.05 / (0.15 * 0.4) = 1/6. Its nearest boundary vertices in tet
+ * edges all lie on the flat +z face (a neighbour differs by at most 0.35 per axis, and only
+ * z can reach 0.7), whose vertex normals are exactly +z. With the eye at (100, 0, 0.35) the
+ * view from the point is along +x: cos = 0, rim = gain / 6. The boundary vertex (0, 0, 0.7)
+ * keeps its full term (cos = 0.35 / |(100, 0, -0.35)|); the centre, 2 edges in but 0.4 from
+ * the sphere, gets nothing. Before the rim reached inside, the interior point got 0 and the
+ * rim was a layer one tet thick (beaded along the silhouette). Float accumulation: 1e-5. */
+static void test_rim_shell(void **state)
+{
+    (void)state;
+    rt_scene_volume sv;
+    memset(&sv, 0, sizeof sv);
+    sv.generated = true;
+    sv.gen_cells = 4;
+    for (int k = 0; k < 3; ++k)
+        sv.gen_min[k] = -0.7f, sv.gen_max[k] = 0.7f;
+    float *P, *sc0;
+    uint32_t *T, np, nt;
+    char err[256];
+    assert_int_equal(rt_scene_volume_generate(&sv, &P, &np, &T, &nt, &sc0, err, sizeof err), VFX_OK);
+    game_shield *s;
+    assert_int_equal(game_shield_create(P, np, T, nt, -100.f, &s), VFX_OK);
+    rt_scene_volume_animation an = {.rim_gain = 2.0f, .rim_power = 3.0f};
+    float *sc = calloc(np, sizeof *sc);
+    game_shield_frame f = {.points = P, .eye = {100, 0, 0.35}, .center = {0, 0, 0}, .radius = 0.4f};
+    game_shield_apply(s, &an, &f, sc);
+    uint32_t inner = UINT32_MAX, outer = UINT32_MAX, centre = UINT32_MAX;
+    for (uint32_t i = 0; i < np; ++i) {
+        const float *p = &P[3 * i];
+        if (fabsf(p[0]) < 1e-6f && fabsf(p[1]) < 1e-6f) {
+            if (fabsf(p[2] - 0.35f) < 1e-6f)
+                inner = i;
+            else if (fabsf(p[2] - 0.7f) < 1e-6f)
+                outer = i;
+            else if (fabsf(p[2]) < 1e-6f)
+                centre = i;
+        }
+    }
+    assert_true(inner != UINT32_MAX && outer != UINT32_MAX && centre != UINT32_MAX);
+    assert_true(fabs(sc[inner] - 2.0 / 6.0) < 1e-5);
+    double c = 0.35 / sqrt(100.0 * 100.0 + 0.35 * 0.35);
+    assert_true(fabs(sc[outer] - 2.0 * pow(1 - c, 3)) < 1e-5);
+    assert_true(sc[centre] == 0);
+    free(sc);
+    game_shield_destroy(s);
+    free(P);
+    free(T);
+    free(sc0);
+}
+
 /* Hit rings: a beam from a source at z = 5.5 to a head at z = 0.5 enters the sphere of radius
  * 0.7 round the origin at (0, 0, 0.7), a grid point: there the ring term at time t is
  * gain (1/2 + cos(-k speed t) / 2)^2 (r = 0), and at (0.7, 0, 0.7) (r = 0.7) it fades by
@@ -128,6 +181,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_boundary_faces),
         cmocka_unit_test(test_rim),
+        cmocka_unit_test(test_rim_shell),
         cmocka_unit_test(test_hit_ripple),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
