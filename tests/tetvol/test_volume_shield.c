@@ -19,17 +19,23 @@ enum { N = 2 }; /* cubes per side: points at -0.7, 0, 0.7 */
 static float *g_points, *g_scalar;
 static uint32_t *g_tets, g_np, g_nt;
 
-static int setup(void **state)
+/* A box [-0.7, 0.7]^3 of cells^3 cubes split into tets (the scene's generated volume). */
+static int box_mesh(int cells, float **P, uint32_t *np, uint32_t **T, uint32_t *nt, float **scalar)
 {
-    (void)state;
     rt_scene_volume sv;
     memset(&sv, 0, sizeof sv);
     sv.generated = true;
-    sv.gen_cells = N;
+    sv.gen_cells = cells;
     for (int k = 0; k < 3; ++k)
         sv.gen_min[k] = -0.7f, sv.gen_max[k] = 0.7f;
     char err[256];
-    return rt_scene_volume_generate(&sv, &g_points, &g_np, &g_tets, &g_nt, &g_scalar, err, sizeof err) == VFX_OK ? 0 : -1;
+    return rt_scene_volume_generate(&sv, P, np, T, nt, scalar, err, sizeof err) == VFX_OK ? 0 : -1;
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    return box_mesh(N, &g_points, &g_np, &g_tets, &g_nt, &g_scalar);
 }
 
 static int teardown(void **state)
@@ -100,16 +106,9 @@ static void test_rim(void **state)
 static void test_rim_shell(void **state)
 {
     (void)state;
-    rt_scene_volume sv;
-    memset(&sv, 0, sizeof sv);
-    sv.generated = true;
-    sv.gen_cells = 4;
-    for (int k = 0; k < 3; ++k)
-        sv.gen_min[k] = -0.7f, sv.gen_max[k] = 0.7f;
     float *P, *sc0;
     uint32_t *T, np, nt;
-    char err[256];
-    assert_int_equal(rt_scene_volume_generate(&sv, &P, &np, &T, &nt, &sc0, err, sizeof err), VFX_OK);
+    assert_int_equal(box_mesh(4, &P, &np, &T, &nt, &sc0), 0);
     game_shield *s;
     assert_int_equal(game_shield_create(P, np, T, nt, -100.f, &s), VFX_OK);
     rt_scene_volume_animation an = {.rim_gain = 2.0f, .rim_power = 3.0f};
