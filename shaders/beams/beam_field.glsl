@@ -39,20 +39,32 @@ float volfx_same_sign(float lo, float hi, float dx, float s, float Q)
     return dx * k / den * volfx_log1p_over(z);
 }
 
+// The same-sign pieces of [y0, y1] (beam_field_impl.inc's branches as selects): split at 0 when
+// the signs differ, mirrored when both are negative; the second piece is empty (lo = hi = dx = 0,
+// which the piece functions turn into exactly 0) unless split. llvmpipe executes every branch
+// of an `if` for all lanes, so one call site per piece instead of four halves the piece code a
+// pixel runs; the values and their sum are the same to the bit.
+void volfx_same_sign_parts(float dx, float y0, float y1, out vec3 p0, out vec3 p1)
+{
+    if (y0 < 0.0 && y1 > 0.0) {
+        float xa = dx * (-y0) / (y1 - y0);
+        p0 = vec3(0.0, -y0, xa);
+        p1 = vec3(0.0, y1, dx - xa);
+    } else {
+        p0 = y1 <= 0.0 ? vec3(-y1, -y0, dx) : vec3(y0, y1, dx);
+        p1 = vec3(0.0);
+    }
+}
+
 // integral over x in [x0, x1] of 1/sqrt((s x + beta)^2 + Q^2)
 float volfx_segment_integral(float x0, float x1, float s, float beta, float Q)
 {
     float dx = x1 - x0;
     if (!(dx > 0.0) || !(Q > 0.0))
         return 0.0;
-    float y0 = s * x0 + beta, y1 = s * x1 + beta;
-    if (y0 < 0.0 && y1 > 0.0) {
-        float xa = dx * (-y0) / (y1 - y0);
-        return volfx_same_sign(0.0, -y0, xa, s, Q) + volfx_same_sign(0.0, y1, dx - xa, s, Q);
-    }
-    if (y1 <= 0.0)
-        return volfx_same_sign(-y1, -y0, dx, s, Q);
-    return volfx_same_sign(y0, y1, dx, s, Q);
+    vec3 p0, p1;
+    volfx_same_sign_parts(dx, s * x0 + beta, s * x1 + beta, p0, p1);
+    return volfx_same_sign(p0.x, p0.y, p0.z, s, Q) + volfx_same_sign(p1.x, p1.y, p1.z, s, Q);
 }
 
 #ifdef VOLFX_BEAMS_SMOOTH
@@ -119,14 +131,9 @@ float volfx_segment_integral_smooth(float x0, float x1, float s, float beta, flo
     float dx = x1 - x0;
     if (!(dx > 0.0) || !(Q > 0.0) || !(h > 0.0))
         return 0.0;
-    float y0 = s * x0 + beta, y1 = s * x1 + beta;
-    if (y0 < 0.0 && y1 > 0.0) {
-        float xa = dx * (-y0) / (y1 - y0);
-        return volfx_smooth_same_sign(0.0, -y0, xa, s, Q, h) + volfx_smooth_same_sign(0.0, y1, dx - xa, s, Q, h);
-    }
-    if (y1 <= 0.0)
-        return volfx_smooth_same_sign(-y1, -y0, dx, s, Q, h);
-    return volfx_smooth_same_sign(y0, y1, dx, s, Q, h);
+    vec3 p0, p1;
+    volfx_same_sign_parts(dx, s * x0 + beta, s * x1 + beta, p0, p1);
+    return volfx_smooth_same_sign(p0.x, p0.y, p0.z, s, Q, h) + volfx_smooth_same_sign(p1.x, p1.y, p1.z, s, Q, h);
 }
 
 #endif
