@@ -211,18 +211,27 @@ float volfx_cylinder_piece(vec3 wp, vec3 V, vec3 D, float L, float R, float eps,
     return volfx_piece(lo, hi, s, beta, sqrt(rr + eps * eps), hc, R, soft);
 }
 
+// The ray seen from M: P(tau) - M = wp + tau V with tau measured from the closest approach to M
+// ([ta, tb] the ray's [t0, t1]), and u(tau) = u0 + c tau along D.
+vec3 volfx_ray_frame(vec3 M, vec3 D, vec3 V, float t0, float t1, out float ta, out float tb, out float c,
+                     out float u0)
+{
+    vec3 w = -M;
+    vec3 wp = volfx_cross_acc(V, volfx_cross_acc(w, V));
+    float wv = dot(w, V);
+    ta = t0 + wv, tb = t1 + wv;
+    c = dot(V, D), u0 = dot(wp, D);
+    return wp;
+}
+
 // H of one beam along t*V (origin = eye = 0), t in [t0, t1]; M is relative to the eye.
 float volfx_beam_integral(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, bool soft,
                         vec3 V, float t0, float t1)
 {
     if (!(t1 > t0))
         return 0.0;
-    float eps = max(eps_in, VOLFX_BEAM_EPS_FLOOR * R);
-    vec3 w = -M;
-    vec3 wp = volfx_cross_acc(V, volfx_cross_acc(w, V));
-    float wv = dot(w, V);
-    float ta = t0 + wv, tb = t1 + wv;
-    float c = dot(V, D), u0 = dot(wp, D);
+    float eps = max(eps_in, VOLFX_BEAM_EPS_FLOOR * R), ta, tb, c, u0;
+    vec3 wp = volfx_ray_frame(M, D, V, t0, t1, ta, tb, c, u0);
     float H = 0.0;
     if (a > 0.0)
         H += a * volfx_sphere_piece(wp, V, R, eps, ta, tb, 0.0, 0.0, -1.0, 1.0, soft);
@@ -309,12 +318,8 @@ float volfx_beam_integral_anat(vec3 M, vec3 D, float L, float R, float a, float 
 {
     if (!(t1 > t0))
         return 0.0;
-    float eps = max(eps_in, VOLFX_BEAM_EPS_FLOOR * R);
-    vec3 w = -M;
-    vec3 wp = volfx_cross_acc(V, volfx_cross_acc(w, V));
-    float wv = dot(w, V);
-    float ta = t0 + wv, tb = t1 + wv;
-    float c = dot(V, D), u0 = dot(wp, D);
+    float eps = max(eps_in, VOLFX_BEAM_EPS_FLOOR * R), ta, tb, c, u0;
+    vec3 wp = volfx_ray_frame(M, D, V, t0, t1, ta, tb, c, u0);
     vec3 ge = wp - L * D;
     float H = 0.0;
     const float inf = 1e30;
