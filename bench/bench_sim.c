@@ -266,7 +266,7 @@ static int dam_break(int res, uint32_t threads, double t_max, double settle_s, u
     rt_sph_desc d = {.spacing = dx, .domain_min = {0, 0, 0},
                       .domain_max = {(float)(10 * a), (float)(2.5 * a), 4 * dx},
                       .threads = threads, .max_substeps = 1000000, .no_slip_faces = no_slip,
-                      .solver = solver};
+                      .solver = solver & 255u, .flags = (solver & 256u) ? RT_SPH_PBF_RECOMPUTE : 0u};
     rt_sph *s;
     char err[256];
     if (rt_sph_create(&d, &s, err, sizeof err)) {
@@ -328,14 +328,14 @@ static int dam_break(int res, uint32_t threads, double t_max, double settle_s, u
         used++;
         printf("{\"effect\":\"sim\",\"case\":\"dam_break\",\"solver\":\"%s\",\"a_over_dx\":%d,\"settle_s\":%.2f,\"no_slip\":%u,\"particles\":%u,\"T\":%.3f,"
                "\"Z\":%.4f,\"Z_martin_moyce\":%.3f,\"error_pct\":%.2f,\"max_density_error\":%.4f,\"mean_density_error\":%.5f}\n",
-               solver ? "pbf" : "wcsph", res, settle_s, no_slip, n, mm_T[k], Z, mm_Z[k], 100.0 * e,
+               (solver & 256u) ? "pbf-recompute" : solver ? "pbf" : "wcsph", res, settle_s, no_slip, n, mm_T[k], Z, mm_Z[k], 100.0 * e,
                r.max_density_error, r.mean_density_error);
     }
     double sim_s = rt_sph_time(s) > 0 ? rt_sph_time(s) : 1.0;
     printf("{\"effect\":\"sim\",\"case\":\"dam_break_summary\",\"solver\":\"%s\",\"a_over_dx\":%d,\"settle_s\":%.2f,\"no_slip\":%u,\"particles\":%u,"
            "\"points\":%d,\"max_abs_error_pct\":%.2f,\"substeps\":%llu,\"wall_s\":%.2f,"
            "\"cpu_s_per_simulated_s\":%.3f,\"mean_density_error_at_points\":%.5f,\"cpu\":\"%s\"}\n",
-           solver ? "pbf" : "wcsph", res, settle_s, no_slip, n, used, 100.0 * worst, (unsigned long long)substeps,
+           (solver & 256u) ? "pbf-recompute" : solver ? "pbf" : "wcsph", res, settle_s, no_slip, n, used, 100.0 * worst, (unsigned long long)substeps,
            now_s() - t0, (cpu_now_s() - c0) / sim_s, used ? err_sum / used : 0.0, cpu);
     rt_sph_destroy(s);
     return rc;
@@ -414,8 +414,16 @@ int bench_sim(int argc, char **argv)
                     pf = atoi(argv[++k]);
                 else if (!strcmp(argv[k], "--no-paddle"))
                     pp = false;
-                else if (!strcmp(argv[k], "--solver") && k + 1 < argc)
-                    ++k, ps = !strcmp(argv[k], "wcsph") ? 1u : !strcmp(argv[k], "pbf") ? 2u : 0u;
+                else if (!strcmp(argv[k], "--solver") && k + 1 < argc) {
+                    /* a comma list, all stepped in turn every frame */
+                    char list[128];
+                    snprintf(list, sizeof list, "%s", argv[++k]);
+                    ps = 0u;
+                    for (char *t = strtok(list, ","); t; t = strtok(NULL, ","))
+                        ps |= !strcmp(t, "wcsph") ? 1u : !strcmp(t, "pbf") ? 2u : !strcmp(t, "pbf-recompute") ? 4u : 1u << 8;
+                    if (ps >> 8)
+                        ps = 0u;
+                }
                 else if (!strcmp(argv[k], "--threads") && k + 1 < argc)
                     pt = (unsigned)atoi(argv[++k]);
                 else if (!strcmp(argv[k], "--pbf-steps") && k + 1 < argc)
@@ -426,9 +434,10 @@ int bench_sim(int argc, char **argv)
                     prelax = (float)atof(argv[++k]);
             }
             if (pn < 1 || pf < 1 || !ps || pt < 1 || pt > 64) {
-                fprintf(stderr, "volfx-bench sim --pool N [--frames F] [--no-paddle] [--solver wcsph|pbf (default "
-                        "both)] [--threads 1..64 (2)] [--pbf-steps S (per 1/60 s)] [--pbf-iterations I]\n"
-                        "                      [--pbf-relaxation R]\n");
+                fprintf(stderr, "volfx-bench sim --pool N [--frames F] [--no-paddle] [--solver a comma list of wcsph, "
+                        "pbf, pbf-recompute (default wcsph,pbf)]\n"
+                        "                      [--threads 1..64 (2)] [--pbf-steps S (per 1/60 s)] [--pbf-iterations I] "
+                        "[--pbf-relaxation R]\n");
                 return 2;
             }
             return bench_sim_pool(pn, pf, pp, pt, ps, psteps, piters, prelax);
@@ -442,11 +451,12 @@ int bench_sim(int argc, char **argv)
             settle_s = atof(argv[++i]);
         } else if (!strcmp(argv[i], "--solver") && i + 1 < argc) {
             const char *v = argv[++i];
-            if (strcmp(v, "wcsph") && strcmp(v, "pbf")) {
-                fprintf(stderr, "volfx-bench sim: --solver is wcsph or pbf, not '%s'\n", v);
+            if (strcmp(v, "wcsph") && strcmp(v, "pbf") && strcmp(v, "pbf-recompute")) {
+                fprintf(stderr, "volfx-bench sim: --solver is wcsph, pbf or pbf-recompute, not '%s'\n", v);
                 return 2;
             }
-            solver = strcmp(v, "pbf") ? RT_SPH_SOLVER_WCSPH : RT_SPH_SOLVER_PBF;
+            /* pbf-recompute: PBF with RT_SPH_PBF_RECOMPUTE (bit 8 here, the flag in dam_break) */
+            solver = !strcmp(v, "wcsph") ? RT_SPH_SOLVER_WCSPH : !strcmp(v, "pbf") ? RT_SPH_SOLVER_PBF : RT_SPH_SOLVER_PBF | 256u;
         } else if (!strcmp(argv[i], "--no-slip")) {
             /* the experiment's solid walls: the floor and the back wall behind the column */
             no_slip = RT_SPH_FACE_Y_MIN | RT_SPH_FACE_X_MIN;

@@ -42,6 +42,9 @@ enum {
     RT_SPH_PBF_WARM_START = 1u << 3,    /* experiment: pressures carried between steps (unstable) */
     RT_SPH_PBF_NO_SCORR = 1u << 4,      /* no artificial pressure s_corr */
     RT_SPH_PBF_NO_XSPH = 1u << 5,       /* no XSPH viscosity */
+    /* the original passes, each pair's kernel gradient computed in both passes of an iteration
+     * (the default computes it once, sph_pbf_lin.c; bitwise the same result: for benchmarks) */
+    RT_SPH_PBF_RECOMPUTE = 1u << 6,
 };
 
 /* The solver (rt_sph_desc.solver). */

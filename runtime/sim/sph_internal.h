@@ -3,7 +3,8 @@
  * lattice calibration, create/destroy), sph_storage.c (columns, adding particles),
  * sph_collide.c (colliders, mesh distance fields), sph_grid.c (cell sort, volume fraction),
  * sph_wall.c (wall integrals, wall law, wall terms of the passes), sph_kernels.c (the
- * per-chunk passes and their SSE2 pair loops), sph_emit.c (emitters), sph_step.c (substeps). */
+ * per-chunk passes and their SSE2 pair loops), sph_emit.c (emitters), sph_step.c (substeps),
+ * sph_pbf.c (Position Based Fluids), sph_pbf_lin.c (its pair terms, computed once per iteration). */
 #ifndef RT_SIM_SPH_INTERNAL_H
 #define RT_SIM_SPH_INTERNAL_H
 
@@ -120,6 +121,13 @@ struct rt_sph {
     float pbf_dt;                /* the step being taken */
     uint32_t pbf_iter;           /* the Jacobi iteration being run (0: the walls are evaluated) */
     float *pc[3], *pn[3];        /* positions of the current and the next Jacobi iterate */
+    bool pbf_store;              /* this step's lambda passes store the pair terms (sph_pbf_lin.c) */
+    /* sph_pbf_lin.c: the iteration's pair terms, four arrays per work item parallel to cnb
+     * (pbf_pe_cap[c] entries each), and per-particle terms (columns of pbf_lin_cap) */
+    float **pbf_pe;
+    uint32_t *pbf_pe_cap, pbf_pe_chunks;
+    float *pbf_lin;
+    uint32_t pbf_lin_cap;
 };
 
 /* Rows [*b, *e) of a work item. */
@@ -273,6 +281,9 @@ void rt_sph_wall_accel(const rt_sph *s, const float p[3], const float vel[3], fl
 
 /* sph_kernels.c: the passes run by rt_sph_parallel */
 void rt_sph_density_chunk(rt_sph *s, uint32_t chunk);
+/* The density pass's neighbour lists alone (exact and, by dens_mode, Verlet), no density,
+ * pressure or wall terms: what PBF's linearised iterations need of it */
+void rt_sph_lists_chunk(rt_sph *s, uint32_t chunk);
 void rt_sph_force_chunk(rt_sph *s, uint32_t chunk);
 void rt_sph_integrate_chunk(rt_sph *s, uint32_t chunk);
 void rt_sph_disp_chunk(rt_sph *s, uint32_t chunk);
@@ -283,6 +294,24 @@ void rt_sph_coincident_dir(uint32_t a, uint32_t b, float out[3]);
 
 /* sph_pbf.c: a frame of Position Based Fluids (the WCSPH frame is in sph_step.c) */
 vfx_result rt_sph_pbf_step(rt_sph *s, float frame_dt, rt_sph_report *rep, char *err, size_t errlen);
+/* sph_pbf.c: the walls' density rho0 * (missing fraction) at p and its gradient / rho0 */
+void rt_sph_pbf_walls(const rt_sph *s, float px, float py, float pz, float *wall_rho, float g[3]);
+/* sph_pbf.c: moves p out of every collider and the domain box to the clamp margin (dx/4) */
+void rt_sph_pbf_clamp(const rt_sph *s, float p[3]);
+
+/* sph_pbf_lin.c: the pair terms PBF's lambda pass stores for its position pass.
+ * Grows the storage for the current lists (after the neighbour pass); an error when out of memory. */
+vfx_result rt_sph_pbf_lin_reserve(rt_sph *s, char *err, size_t errlen);
+void rt_sph_pbf_lin_free(rt_sph *s);
+size_t rt_sph_pbf_lin_bytes(const rt_sph *s);
+/* The work item's arrays of d_ij (x, y, z) and (H - r)^2 / r, indexed as cnb[chunk]. */
+void rt_sph_pbf_pair_arrays(const rt_sph *s, uint32_t chunk, float *pe[4]);
+/* Row i's count of coincident stored pairs; in the first iteration also its wall room. */
+void rt_sph_pbf_store_particle(rt_sph *s, uint32_t i, uint32_t coincident);
+uint32_t rt_sph_pbf_stored_coincident(const rt_sph *s, uint32_t i);
+/* False when row i at p is surely farther than the clamp margin from every wall (the clamp is
+ * then the identity). */
+bool rt_sph_pbf_may_reach_wall(const rt_sph *s, uint32_t i, const float p[3]);
 
 /* sph_emit.c: runs the emitters for dt (0 on the first substep); count added to *emitted */
 vfx_result rt_sph_emit(rt_sph *s, double dt, uint32_t *emitted, char *err, size_t errlen);

@@ -88,7 +88,8 @@ density_tail(rt_sph *s, uint32_t i, float sum, uint32_t nn, float px, float py, 
 
 /* Density by a scan of the 5x5x5 cells, recording the exact list (r < H) for the force pass
  * and, when `record`, the Verlet list (r < H + skin) and the positions it was built at. */
-static inline __attribute__((always_inline)) void density_scan(rt_sph *s, uint32_t chunk, const bool record)
+static inline __attribute__((always_inline)) void density_scan(rt_sph *s, uint32_t chunk, const bool record,
+                                                               const bool lists_only)
 {
     uint32_t b, e;
     sph_chunk_rows(s, chunk, &b, &e);
@@ -140,7 +141,10 @@ static inline __attribute__((always_inline)) void density_scan(rt_sph *s, uint32
             o->skin_pairs += ns;
             s->x0[i] = px, s->y0[i] = py, s->z0[i] = pz;
         }
-        density_tail(s, i, sum, nn, px, py, pz, o, walls);
+        if (lists_only)
+            o->pairs += nn;
+        else
+            density_tail(s, i, sum, nn, px, py, pz, o, walls);
     }
     if (record)
         s->snb_used[chunk] = sused;
@@ -150,7 +154,7 @@ static inline __attribute__((always_inline)) void density_scan(rt_sph *s, uint32
 /* Density by a walk of the Verlet lists (r < H test), writing the exact list for the force
  * pass. Branch-free: ~40% of a list is within H at the default skin of 0.3 H, a coin flip for
  * the predictor (the cell scan's 27% hit rate is why its branch measured cheaper there). */
-static void density_walk(rt_sph *s, uint32_t chunk)
+static inline __attribute__((always_inline)) void density_walk(rt_sph *s, uint32_t chunk, const bool lists_only)
 {
     uint32_t b, e;
     sph_chunk_rows(s, chunk, &b, &e);
@@ -208,7 +212,10 @@ static void density_walk(rt_sph *s, uint32_t chunk)
         s->nb_count[i] = nn;
         used += nn;
         o->skin_pairs += ns;
-        density_tail(s, i, sum, nn, px, py, pz, o, walls);
+        if (lists_only)
+            o->pairs += nn;
+        else
+            density_tail(s, i, sum, nn, px, py, pz, o, walls);
     }
     s->out[chunk] = acc;
 }
@@ -216,11 +223,21 @@ static void density_walk(rt_sph *s, uint32_t chunk)
 void rt_sph_density_chunk(rt_sph *s, uint32_t chunk)
 {
     if (s->dens_mode == 2)
-        density_walk(s, chunk);
+        density_walk(s, chunk, false);
     else if (s->dens_mode == 1)
-        density_scan(s, chunk, true);
+        density_scan(s, chunk, true, false);
     else
-        density_scan(s, chunk, false);
+        density_scan(s, chunk, false, false);
+}
+
+void rt_sph_lists_chunk(rt_sph *s, uint32_t chunk)
+{
+    if (s->dens_mode == 2)
+        density_walk(s, chunk, true);
+    else if (s->dens_mode == 1)
+        density_scan(s, chunk, true, true);
+    else
+        density_scan(s, chunk, false, true);
 }
 
 /* Squared displacement of every particle since the last rebuild (columns edited by hand). */

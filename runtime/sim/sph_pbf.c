@@ -95,8 +95,14 @@ static void pbf_walls(const rt_sph *s, float px, float py, float pz, float *wall
     }
 }
 
+void rt_sph_pbf_walls(const rt_sph *s, float px, float py, float pz, float *wall_rho, float g[3])
+{
+    float ig;
+    pbf_walls(s, px, py, pz, wall_rho, g, &ig);
+}
+
 /* Moves p out of every collider and the domain box to the clamp margin (positions only). */
-static void pbf_clamp(const rt_sph *s, float p[3])
+void rt_sph_pbf_clamp(const rt_sph *s, float p[3])
 {
     const float margin = 0.25f * s->p.spacing;
     for (uint32_t c = 0; c < s->ncol; ++c) {
@@ -167,7 +173,7 @@ static void pbf_predict_chunk(rt_sph *s, uint32_t chunk)
             acc.clamped++;
         }
         float p[3] = {s->x[i] + dt * v[0], s->y[i] + dt * v[1], s->z[i] + dt * v[2]}, q[3] = {p[0], p[1], p[2]};
-        pbf_clamp(s, q);
+        rt_sph_pbf_clamp(s, q);
         for (int a = 0; a < 3; ++a)
             v[a] += (q[a] - p[a]) * inv_dt;
         s->x[i] = q[0], s->y[i] = q[1], s->z[i] = q[2];
@@ -191,10 +197,16 @@ static void pbf_lambda_chunk(rt_sph *s, uint32_t chunk)
     const float dt2 = s->pbf_dt * s->pbf_dt, to_l = dt2 / rho0, eps = s->pbf_eps;
     const bool warm = (s->p.flags & RT_SPH_PBF_WARM_START) != 0;
     const float *X = s->pc[0], *Y = s->pc[1], *Z = s->pc[2];
+    /* the position pass's pair terms, when it reads them (sph_pbf_lin.c) */
+    const bool store = s->pbf_store;
+    float *PE[4] = {NULL, NULL, NULL, NULL};
+    if (store)
+        rt_sph_pbf_pair_arrays(s, chunk, PE);
     sph_chunk_out acc = s->out[chunk];
     for (uint32_t i = b; i < e; ++i) {
         const float px = X[i], py = Y[i], pz = Z[i];
-        const uint32_t *L = s->cnb[chunk] + s->nb_start[i];
+        const uint32_t off = s->nb_start[i];
+        const uint32_t *L = s->cnb[chunk] + off;
         const uint32_t nn = s->nb_count[i];
         float sw = H2 * H2 * H2, gx = 0.f, gy = 0.f, gz = 0.f, g2 = 0.f;
         uint32_t k = 0, coincident = 0;
@@ -219,11 +231,16 @@ static void pbf_lambda_chunk(rt_sph *s, uint32_t chunk)
                 __m128 q = _mm_and_ps(valid, hr2 * (one / rl)); /* G_ij / Vks */
                 gx4 += q * dx, gy4 += q * dy, gz4 += q * dz;
                 g24 += _mm_and_ps(valid, hr2 * hr2);
+                if (store) {
+                    _mm_storeu_ps(PE[0] + off + k, dx), _mm_storeu_ps(PE[1] + off + k, dy);
+                    _mm_storeu_ps(PE[2] + off + k, dz), _mm_storeu_ps(PE[3] + off + k, q);
+                }
             }
             sw += pbf_hsum(w4);
             gx = -pbf_hsum(gx4), gy = -pbf_hsum(gy4), gz = -pbf_hsum(gz4), g2 = pbf_hsum(g24);
         }
 #endif
+        const uint32_t coincident4 = coincident; /* of the stored pairs */
         for (; k < nn; ++k) {
             uint32_t j = L[k];
             float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
@@ -251,6 +268,8 @@ static void pbf_lambda_chunk(rt_sph *s, uint32_t chunk)
         }
         float wall_rho, gw[3];
         pbf_walls_iter(s, i, px, py, pz, true, &wall_rho, gw);
+        if (store)
+            rt_sph_pbf_store_particle(s, i, coincident4);
         float rho = mk * sw + wall_rho;
         float Gx = Vks * gx + gw[0], Gy = Vks * gy + gw[1], Gz = Vks * gz + gw[2];
         /* the paper's denominator |grad_i C_i|^2 + sum_j |grad_j C_i|^2 + eps: grad_i C_i . A_i
@@ -276,6 +295,7 @@ typedef struct pbf_delta_args {
     const float *lam; /* multipliers (scaled by lam_scale) */
     float lam_scale;
     bool scorr;
+    bool stored;      /* the lambda pass's pair terms (no s_corr, lam_scale 1): sph_pbf_lin.c */
 } pbf_delta_args;
 
 /* Position correction of each particle from the multipliers (this iteration's, or the warm
@@ -292,14 +312,32 @@ static void pbf_delta(rt_sph *s, uint32_t chunk, const pbf_delta_args *a)
     const float sk = a->scorr ? s->p.pbf_scorr_k / s->pbf_D0 : 0.f, iwdq = 1.f / s->pbf_wdq;
     const float *X = s->pc[0], *Y = s->pc[1], *Z = s->pc[2], *Lm = a->lam;
     float *NX = s->pn[0], *NY = s->pn[1], *NZ = s->pn[2];
+    float *PE[4] = {NULL, NULL, NULL, NULL};
+    if (a->stored)
+        rt_sph_pbf_pair_arrays(s, chunk, PE);
     for (uint32_t i = b; i < e; ++i) {
         const float px = X[i], py = Y[i], pz = Z[i], li = ls * Lm[i];
-        const uint32_t *L = s->cnb[chunk] + s->nb_start[i];
+        const uint32_t off = s->nb_start[i];
+        const uint32_t *L = s->cnb[chunk] + off;
         const uint32_t nn = s->nb_count[i];
         float sx = 0.f, sy = 0.f, sz = 0.f;
         uint32_t k = 0, coincident = 0;
 #if PBF_SSE
-        {
+        if (a->stored) {
+            /* the same operations on the lambda pass's d_ij and (H - r)^2 / r (masked to 0 for
+             * coincident pairs, counted there): bitwise the sums below, without the position
+             * gathers, the square root and the division; s_corr is off here (sk = 0) */
+            const float *DX = PE[0] + off, *DY = PE[1] + off, *DZ = PE[2] + off, *Q = PE[3] + off;
+            const __m128 vli = _mm_set1_ps(li), zero = _mm_setzero_ps();
+            __m128 sx4 = zero, sy4 = zero, sz4 = zero;
+            for (; k + 4 <= nn; k += 4) {
+                __m128 lj = _mm_setr_ps(Lm[L[k]], Lm[L[k + 1]], Lm[L[k + 2]], Lm[L[k + 3]]);
+                __m128 coef = (vli + lj) * _mm_loadu_ps(Q + k);
+                sx4 += coef * _mm_loadu_ps(DX + k), sy4 += coef * _mm_loadu_ps(DY + k), sz4 += coef * _mm_loadu_ps(DZ + k);
+            }
+            sx = pbf_hsum(sx4), sy = pbf_hsum(sy4), sz = pbf_hsum(sz4);
+            coincident = rt_sph_pbf_stored_coincident(s, i);
+        } else {
             const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), vpz = _mm_set1_ps(pz);
             const __m128 vH = _mm_set1_ps(H), vH2 = _mm_set1_ps(H2), veps = _mm_set1_ps(eps2);
             const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.f), vli = _mm_set1_ps(li);
@@ -363,21 +401,29 @@ static void pbf_delta(rt_sph *s, uint32_t chunk, const pbf_delta_args *a)
             for (int q = 0; q < 3; ++q)
                 d[q] *= maxd / dl;
         float p[3] = {px + d[0], py + d[1], pz + d[2]};
-        pbf_clamp(s, p);
+        if (!a->stored || rt_sph_pbf_may_reach_wall(s, i, p))
+            rt_sph_pbf_clamp(s, p);
         NX[i] = p[0], NY[i] = p[1], NZ[i] = p[2];
     }
 }
 
 static void pbf_delta_chunk(rt_sph *s, uint32_t chunk)
 {
-    pbf_delta_args a = {s->drho, 1.f, !(s->p.flags & RT_SPH_PBF_NO_SCORR) && s->p.pbf_scorr_k > 0.f};
+    pbf_delta_args a = {s->drho, 1.f, !(s->p.flags & RT_SPH_PBF_NO_SCORR) && s->p.pbf_scorr_k > 0.f, false};
+    pbf_delta(s, chunk, &a);
+}
+
+/* The same from the pair terms the lambda pass stored (s->pbf_store). */
+static void pbf_delta_store_chunk(rt_sph *s, uint32_t chunk)
+{
+    pbf_delta_args a = {s->drho, 1.f, false, true};
     pbf_delta(s, chunk, &a);
 }
 
 static void pbf_warm_chunk(rt_sph *s, uint32_t chunk)
 {
     /* lambda = -p dt^2 / rho0 */
-    pbf_delta_args a = {s->pr, -s->pbf_dt * s->pbf_dt / s->p.rest_density, false};
+    pbf_delta_args a = {s->pr, -s->pbf_dt * s->pbf_dt / s->p.rest_density, false, false};
     pbf_delta(s, chunk, &a);
 }
 
@@ -620,8 +666,7 @@ static void pbf_init_pressure(rt_sph *s)
 
 /* Neighbours at the current (predicted) positions: a rebuild (sort, cell scan recording the
  * Verlet lists; pressures follow the sort) when a particle has moved half the skin since the
- * last one, else a Verlet walk; both write the exact lists (r < H) the iterations walk and the
- * density there. */
+ * last one, else a Verlet walk; both write the exact lists (r < H) the iterations walk. */
 static vfx_result pbf_neighbours(rt_sph *s, rt_sph_report *rep, char *err, size_t errlen)
 {
     bool rebuild = !s->verlet || !s->lists_valid || !(4.f * s->disp2_max < s->skin * s->skin);
@@ -637,11 +682,9 @@ static vfx_result pbf_neighbours(rt_sph *s, rt_sph_report *rep, char *err, size_
     } else {
         s->dens_mode = 2;
     }
-    /* the WCSPH density pass writes its EOS term into pr: give it tmp instead */
-    float *t = s->pr;
-    s->pr = s->tmp, s->tmp = t;
-    rt_sph_parallel(s, rt_sph_density_chunk, true);
-    t = s->pr, s->pr = s->tmp, s->tmp = t;
+    /* the lists alone: every pass after this evaluates its own density (the WCSPH density
+     * pass's sum, wall terms and EOS were 2% of PBF's instructions, callgrind) */
+    rt_sph_parallel(s, rt_sph_lists_chunk, true);
     if (s->verlet && rebuild) {
         s->lists_valid = !atomic_load(&s->nb_oom);
         s->disp2_max = 0.f;
@@ -667,6 +710,11 @@ static uint32_t pbf_first_bad(const rt_sph *s)
 static vfx_result pbf_substep(rt_sph *s, float dt, rt_sph_report *rep, char *err, size_t errlen)
 {
     s->pbf_dt = dt;
+    /* the position pass reads the lambda pass's pair terms (sph_pbf_lin.c) unless asked not to,
+     * or for the warm-start experiment (its first correction has no lambda pass before it) or
+     * the artificial pressure (its per-pair W is not stored) */
+    s->pbf_store = !(s->p.flags & (RT_SPH_PBF_RECOMPUTE | RT_SPH_PBF_WARM_START)) &&
+                   !(!(s->p.flags & RT_SPH_PBF_NO_SCORR) && s->p.pbf_scorr_k > 0.f);
     rt_sph_update_colliders(s, s->time + dt); /* the constraints hold at the end of the step */
     rt_sph_parallel(s, pbf_predict_chunk, true);
     uint32_t nch = sph_chunk_count(s);
@@ -690,11 +738,13 @@ static vfx_result pbf_substep(rt_sph *s, float dt, rt_sph_report *rep, char *err
         memcpy(s->pc, bufA, sizeof bufA);
         next_is_a = 0;
     }
+    if (s->pbf_store && (r = rt_sph_pbf_lin_reserve(s, err, errlen)))
+        return r;
     for (uint32_t it = 0; it < s->p.pbf_iterations; ++it) {
         s->pbf_iter = it;
         rt_sph_parallel(s, pbf_lambda_chunk, true);
         memcpy(s->pn, next_is_a ? bufA : bufB, sizeof bufA);
-        rt_sph_parallel(s, pbf_delta_chunk, false);
+        rt_sph_parallel(s, s->pbf_store ? pbf_delta_store_chunk : pbf_delta_chunk, false);
         memcpy(s->pc, s->pn, sizeof s->pc);
         next_is_a = !next_is_a;
         rep->iterations++;

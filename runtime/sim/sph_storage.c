@@ -43,6 +43,7 @@ void rt_sph_free_columns(rt_sph *s)
     s->cnb = NULL, s->cnb_cap = NULL, s->cnb_chunks = 0;
     s->snb = NULL, s->snb_cap = NULL, s->snb_used = NULL;
     s->lists_valid = false;
+    rt_sph_pbf_lin_free(s);
 }
 
 size_t rt_sph_memory_bytes(const rt_sph *s)
@@ -54,7 +55,7 @@ size_t rt_sph_memory_bytes(const rt_sph *s)
         lists += ((size_t)s->cnb_cap[c] + s->snb_cap[c]) * sizeof(uint32_t) + 3 * sizeof(uint32_t) +
                  2 * sizeof(uint32_t *);
     size_t scratch = (size_t)s->cap * (15 * sizeof(float) + 8 * sizeof(uint32_t));
-    return sizeof *s + lists + scratch + (size_t)s->state_cap * 7 * sizeof(float) +
+    return sizeof *s + lists + scratch + rt_sph_pbf_lin_bytes(s) + (size_t)s->state_cap * 7 * sizeof(float) +
            ((size_t)s->ncells + 1) * sizeof(uint32_t) + (size_t)s->out_cap * sizeof(sph_chunk_out);
 }
 

@@ -162,6 +162,52 @@ static void test_pbf_threads_bitwise(void **state)
     rt_sph_destroy(s[1]);
 }
 
+/* The default passes (sph_pbf_lin.c: the lambda pass stores each pair's terms, the position pass
+ * reads them and skips the clamp far from the walls) against the original ones
+ * (RT_SPH_PBF_RECOMPUTE): the same operations in the same order, so bitwise the same state after
+ * 20 frames of a column falling past a moving box paddle (colliders, walls, clamps, Verlet walks
+ * and rebuilds), and for 12 frames of particles started on one point (the coincident pairs).
+ * Checked by mutation: the neighbours' multipliers left out of the stored sum, the clamp never
+ * run, or the stored coincident count zeroed each fail it. */
+static void test_pbf_stored_pairs_bitwise(void **state)
+{
+    (void)state;
+    for (int c = 0; c < 2; ++c) {
+        rt_sph *s[2];
+        for (int m = 0; m < 2; ++m) {
+            rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.2f, 0.25f, 0.06f},
+                              .threads = 2, .flags = m ? RT_SPH_PBF_RECOMPUTE : 0u};
+            s[m] = make(d);
+            if (c == 0) {
+                rt_sph_collider p = {.kind = RT_SPH_BOX, .center = {0.14f, 0.05f, 0.03f}, .half = {0.005f, 0.05f, 0.03f},
+                                      .motion_axis = {1, 0, 0}, .motion_amplitude = 0.03f, .motion_frequency = 2.f};
+                assert_int_equal(rt_sph_add_collider(s[m], &p, NULL, NULL, 0), VFX_OK);
+                float lo[3] = {0, 0, 0}, hi[3] = {0.08f, 0.2f, 0.06f};
+                assert_int_equal(rt_sph_add_block(s[m], lo, hi, NULL, NULL, 0), VFX_OK);
+            } else {
+                float x[64], y[64], z[64];
+                for (int k = 0; k < 64; ++k)
+                    x[k] = 0.1f, y[k] = 0.05f, z[k] = 0.03f;
+                assert_int_equal(rt_sph_add_particles(s[m], 64, x, y, z, NULL, NULL, NULL, NULL, 0), VFX_OK);
+            }
+            rt_sph_report r;
+            for (int f = 0; f < (c ? 12 : 20); ++f)
+                assert_int_equal(rt_sph_step(s[m], 1.f / 60.f, &r, NULL, 0), VFX_OK);
+            check_state(s[m]);
+        }
+        rt_sph_columns k[2] = {rt_sph_get_columns(s[0]), rt_sph_get_columns(s[1])};
+        assert_int_equal(k[0].count, k[1].count);
+        assert_memory_equal(k[0].id, k[1].id, k[0].count * sizeof(uint32_t));
+        assert_memory_equal(k[0].x, k[1].x, k[0].count * sizeof(float));
+        assert_memory_equal(k[0].y, k[1].y, k[0].count * sizeof(float));
+        assert_memory_equal(k[0].z, k[1].z, k[0].count * sizeof(float));
+        assert_memory_equal(k[0].vx, k[1].vx, k[0].count * sizeof(float));
+        assert_memory_equal(k[0].density, k[1].density, k[0].count * sizeof(float));
+        rt_sph_destroy(s[0]);
+        rt_sph_destroy(s[1]);
+    }
+}
+
 /* A closed tank at rest (no paddle): total energy (kinetic + gravity; PBF has no internal energy)
  * must not grow by more than 1% of the initial energy between sampled points. */
 static void test_pbf_closed_tank_energy(void **state)
@@ -235,7 +281,7 @@ int main(void)
         cmocka_unit_test(test_pbf_params),       cmocka_unit_test(test_pbf_all_at_one_point),
         cmocka_unit_test(test_pbf_speed_cap),    cmocka_unit_test(test_pbf_thin_wall),
         cmocka_unit_test(test_pbf_threads_bitwise), cmocka_unit_test(test_pbf_closed_tank_energy),
-        cmocka_unit_test(test_pbf_free_block_energy),
+        cmocka_unit_test(test_pbf_free_block_energy), cmocka_unit_test(test_pbf_stored_pairs_bitwise),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
