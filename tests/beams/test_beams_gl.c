@@ -517,9 +517,10 @@ static void test_anatomy_matches_closed_form(void **state)
     b.head_radius = 0.8, b.orb_radius = 0.45, b.orb_a = 0.6, b.taper = 0.5, b.surge = 0.6;
     b.surge_inv_wl = 1.0 / 0.9, b.surge_phase = 0;
     double *ref = malloc(W * H * sizeof(double)), hmax = 0, worst = 0;
+    const ref_camera cam = test_ref_camera(&g_app->camera);
     for (uint32_t k = 0; k < W * H; ++k) {
         double dir[3];
-        ref_pixel_ray(&g_app->camera, k % W, k / W, dir);
+        ref_pixel_ray(&cam, k % W, k / W, dir);
         ref[k] = volfx_beam_integral_d(&b, g_app->camera.eye, dir, 0.0, t_far(k % W, k / W));
         hmax = fmax(hmax, ref[k]);
     }
@@ -551,7 +552,8 @@ static void test_anatomy_matches_closed_form(void **state)
 static double ray_axis_distance(int k)
 {
     double V[3], M[3], D[3], n = 0;
-    ref_pixel_ray(&g_app->camera, (uint32_t)(k % W), (uint32_t)(k / W), V);
+    const ref_camera cam = test_ref_camera(&g_app->camera);
+    ref_pixel_ray(&cam, (uint32_t)(k % W), (uint32_t)(k / W), V);
     for (int c = 0; c < 3; ++c)
         M[c] = k_beam.head[c] - g_app->camera.eye[c], D[c] = k_beam.dir[c], n += D[c] * D[c];
     double b = 0, d = 0, e = 0;

@@ -21,6 +21,14 @@ static inline rt_camera test_rt_camera(const ref_camera *c)
                        c->near_plane, c->far_plane};
 }
 
+/* The reference camera with a runtime camera's numbers (the oracle's rays for what a host drew). */
+static inline ref_camera test_ref_camera(const rt_camera *c)
+{
+    return (ref_camera){{c->eye[0], c->eye[1], c->eye[2]}, {c->target[0], c->target[1], c->target[2]},
+                        {c->up[0], c->up[1], c->up[2]}, c->fov_y, c->width, c->height,
+                        c->near_plane, c->far_plane};
+}
+
 /* The sample host, headless, at the camera's size and rendering with its numbers; its log
  * recorded into *log (cleared first) when log is not NULL. Exits 77 (skip) without a GL
  * context. */
