@@ -21,7 +21,7 @@
 
 int bench_sim(int argc, char **argv);
 int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsigned solvers, uint32_t pbf_steps,
-                   uint32_t pbf_iters, float pbf_relax);
+                   uint32_t pbf_iters, float pbf_relax, float ramp_s);
 
 static double now_s(void)
 {
@@ -408,7 +408,7 @@ int bench_sim(int argc, char **argv)
             int pf = 60;
             bool pp = true;
             unsigned ps = 3u, pt = 2u, psteps = 0u, piters = 0u; /* 0: the solver's defaults */
-            float prelax = 0.f;
+            float prelax = 0.f, pramp = -1.f; /* -1: one paddle period, as the scene's default */
             for (int k = i + 1; k < argc; ++k) {
                 if (!strcmp(argv[k], "--frames") && k + 1 < argc)
                     pf = atoi(argv[++k]);
@@ -432,15 +432,17 @@ int bench_sim(int argc, char **argv)
                     piters = (unsigned)atoi(argv[++k]);
                 else if (!strcmp(argv[k], "--pbf-relaxation") && k + 1 < argc)
                     prelax = (float)atof(argv[++k]);
+                else if (!strcmp(argv[k], "--paddle-ramp") && k + 1 < argc)
+                    pramp = (float)atof(argv[++k]);
             }
-            if (pn < 1 || pf < 1 || !ps || pt < 1 || pt > 64) {
+            if (pn < 1 || pf < 1 || !ps || pt < 1 || pt > 64 || !(pramp >= 0.f || pramp == -1.f)) {
                 fprintf(stderr, "volfx-bench sim --pool N [--frames F] [--no-paddle] [--solver a comma list of wcsph, "
                         "pbf, pbf-recompute (default wcsph,pbf)]\n"
                         "                      [--threads 1..64 (2)] [--pbf-steps S (per 1/60 s)] [--pbf-iterations I] "
-                        "[--pbf-relaxation R]\n");
+                        "[--pbf-relaxation R] [--paddle-ramp S (0: none; default one period)]\n");
                 return 2;
             }
-            return bench_sim_pool(pn, pf, pp, pt, ps, psteps, piters, prelax);
+            return bench_sim_pool(pn, pf, pp, pt, ps, psteps, piters, prelax, pramp);
         } else if (!strcmp(argv[i], "--dam-break")) {
             dam = true;
         } else if (!strcmp(argv[i], "--res") && i + 1 < argc) {

@@ -14,7 +14,7 @@
 #include "sim/sph.h"
 
 int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsigned solvers, uint32_t pbf_steps,
-                   uint32_t pbf_iters, float pbf_relax);
+                   uint32_t pbf_iters, float pbf_relax, float ramp_s);
 
 static double wall_ms(void)
 {
@@ -32,7 +32,7 @@ static double cpu_ms(void)
 
 /* solvers: bit 0 WCSPH, bit 1 PBF, bit 2 PBF with RT_SPH_PBF_RECOMPUTE (callgrind of one alone) */
 int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsigned solvers, uint32_t pbf_steps,
-                   uint32_t pbf_iters, float pbf_relax)
+                   uint32_t pbf_iters, float pbf_relax, float ramp_s)
 {
     const float tmin[3] = {-1.65f, 0.f, -1.25f}, tmax[3] = {1.65f, 1.4f, 1.25f};
     const float fmin[3] = {-1.6f, 0.02f, -1.2f}, fmax[3] = {1.6f, 0.34f, 1.2f};
@@ -66,7 +66,8 @@ int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsign
         if (paddle) {
             rt_sph_collider c = {.kind = RT_SPH_BOX, .center = {tmin[0] + amp + dx, 0.5f * (tmin[1] + tmax[1]), 0},
                                   .half = {0.5f * dx, 0.5f * (tmax[1] - tmin[1]), 0.5f * (tmax[2] - tmin[2])},
-                                  .motion_axis = {1, 0, 0}, .motion_amplitude = amp, .motion_frequency = 1.f / period};
+                                  .motion_axis = {1, 0, 0}, .motion_amplitude = amp, .motion_frequency = 1.f / period,
+                                  .motion_ramp_s = ramp_s < 0.f ? period : ramp_s}; /* as the scene's default */
             rt_sph_add_collider(s[m], &c, NULL, NULL, 0);
             lo[0] = c.center[0] + 0.5f * dx + 0.25f * dx; /* in front of the plate at t = 0 */
         }
@@ -110,10 +111,11 @@ int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsign
         med[m] = rt_median(ms[m], (uint32_t)frames);
         printf("{\"bench\":\"sim_pool\",\"solver\":\"%s\",\"particles\":%u,\"spacing\":%.5f,\"paddle\":%s,"
                "\"frames\":%d,\"threads\":%u,\"cpu_ms_per_frame_median\":%.3f,\"wall_ms_per_frame_median\":%.3f,\"steps_per_frame\":%.2f,"
-               "\"iterations_per_frame\":%.2f,\"rebuilds_per_frame\":%.2f,\"max_speed_frames_2_on\":%.4f,\"max_speed_last\":%.4f,\"mean_compression\":%.5f}\n",
+               "\"iterations_per_frame\":%.2f,\"rebuilds_per_frame\":%.2f,\"max_speed_frames_2_on\":%.4f,\"max_speed_last\":%.4f,\"mean_compression\":%.5f,\"paddle_ramp_s\":%.3f}\n",
                name[m], added[m], dx, paddle ? "true" : "false", frames, rt_sph_thread_count(s[m]),
                med[m], rt_median(wms[m], (uint32_t)frames), (double)steps[m] / frames, (double)iters[m] / frames,
-               (double)rebuilds[m] / frames, vmax[m], vlast[m], err_sum[m] / frames);
+               (double)rebuilds[m] / frames, vmax[m], vlast[m], err_sum[m] / frames,
+               paddle ? (double)(ramp_s < 0.f ? period : ramp_s) : 0.0);
     }
     for (int m = 1; m < NS; ++m)
         if ((solvers & 1u) && (solvers >> m & 1u))

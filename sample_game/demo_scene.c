@@ -118,7 +118,8 @@ static vfx_result load_water(game_app *app, game_demo *demo, const rt_scene *sc)
         if (w->paddle) {
             uint32_t ax = w->paddle_axis < 3 ? w->paddle_axis : 0;
             rt_sph_collider paddle = {.kind = RT_SPH_BOX, .motion_amplitude = w->paddle_amplitude,
-                                       .motion_frequency = w->paddle_period_s > 0 ? 1.0f / w->paddle_period_s : 0};
+                                       .motion_frequency = w->paddle_period_s > 0 ? 1.0f / w->paddle_period_s : 0,
+                                       .motion_ramp_s = w->paddle_ramp_s};
             for (int k = 0; k < 3; ++k) {
                 paddle.center[k] = 0.5f * (w->tank_min[k] + w->tank_max[k]);
                 paddle.half[k] = 0.5f * (w->tank_max[k] - w->tank_min[k]);

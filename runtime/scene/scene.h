@@ -112,6 +112,7 @@ typedef struct rt_scene_water {
     uint32_t paddle_axis;            /* 0 x, 1 y, 2 z: the axis the paddle moves along */
     float paddle_amplitude;          /* metres */
     float paddle_period_s;
+    float paddle_ramp_s;             /* amplitude ramped in over this time (default one period) */
     bool no_slip;                    /* tank walls (all six faces) with wall-law friction */
     uint32_t solver;                 /* water.simulation.solver: 0 "wcsph", 1 "pbf" (rt_sph_solver); "pbf" */
     /* rendering (seed 000), a full vfx_water_params with size/version filled */

@@ -121,7 +121,7 @@ static vfx_result parse_water_simulation(pctx *c, const cJSON *v, rt_scene_water
         return r;
     const cJSON *pd = cJSON_GetObjectItemCaseSensitive(s, "paddle");
     if (pd) {
-        static const char *const pkeys[] = {"axis", "amplitude", "period_s", NULL};
+        static const char *const pkeys[] = {"axis", "amplitude", "period_s", "ramp_s", NULL};
         static const char *const axes[] = {"x", "y", "z", NULL};
         const char *PP = "water.simulation.paddle";
         if ((r = rt_scene_expect_object(c, pd, PP)))
@@ -131,8 +131,12 @@ static vfx_result parse_water_simulation(pctx *c, const cJSON *v, rt_scene_water
         r = rt_scene_get_enum(c, pd, PP, "axis", false, axes, &w->paddle_axis);
         if (!r) r = rt_scene_get_float(c, pd, PP, "amplitude", false, NONNEG, &w->paddle_amplitude);
         if (!r) r = rt_scene_get_float(c, pd, PP, "period_s", false, (range){0, 1e4, true}, &w->paddle_period_s);
+        w->paddle_ramp_s = -1.f; /* absent: one period (issue 22: it started at its peak speed) */
+        if (!r) r = rt_scene_get_float(c, pd, PP, "ramp_s", false, (range){0, 1e4, true}, &w->paddle_ramp_s);
         if (r)
             return r;
+        if (w->paddle_ramp_s < 0.f)
+            w->paddle_ramp_s = w->paddle_period_s;
     }
     return VFX_OK;
 }

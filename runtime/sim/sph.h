@@ -149,11 +149,15 @@ typedef struct rt_sph_collider {
     float normal[3];          /* plane only, normalised on add */
     float radius;             /* sphere */
     float half[3];            /* box half extents */
-    /* Paddle motion: centre(t) = centre + axis*amplitude*sin(2*pi*frequency*t); 0 = static. */
+    /* Paddle motion: centre(t) = centre + axis*amplitude*r(t)*sin(2*pi*frequency*t) (r = 1, or
+     * the ramp below); 0 = static. */
     float motion_axis[3];
     float motion_amplitude;   /* [m] */
     float motion_frequency;   /* [Hz] */
     uint32_t no_slip;         /* nonzero: wall-law friction on its surface (default free-slip) */
+    /* The amplitude ramps in over this many seconds from t = 0 (a smoothstep: the paddle
+     * starts at rest and without a jerk); 0 = full amplitude from the start. */
+    float motion_ramp_s;
 } rt_sph_collider;
 
 typedef struct rt_sph_emitter {

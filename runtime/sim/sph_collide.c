@@ -18,6 +18,10 @@ vfx_result rt_sph_add_collider(rt_sph *s, const rt_sph_collider *c, uint32_t *in
         !isfinite(k.radius) || !isfinite(k.motion_amplitude) || !isfinite(k.motion_frequency)) {
         return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_collider: collider %u has a non-finite field", s->ncol);
     }
+    if (!(k.motion_ramp_s >= 0.f && k.motion_ramp_s <= 1e6f)) {
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_collider: collider %u has motion_ramp_s %g "
+                       "(0 to 1e6 s)", s->ncol, (double)k.motion_ramp_s);
+    }
     if (k.kind == RT_SPH_PLANE) {
         float l = sqrtf(k.normal[0] * k.normal[0] + k.normal[1] * k.normal[1] + k.normal[2] * k.normal[2]);
         if (!(l > 1e-6f)) {
@@ -158,8 +162,9 @@ vfx_result rt_sph_add_mesh_collider(rt_sph *s, const float *positions, uint32_t 
     if (motion) {
         st.c = *motion;
         if (!sph_finite3(st.c.center) || !sph_finite3(st.c.motion_axis) || !isfinite(st.c.motion_amplitude) ||
-            !isfinite(st.c.motion_frequency)) {
-            return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_mesh_collider: motion has a non-finite field");
+            !isfinite(st.c.motion_frequency) || !(st.c.motion_ramp_s >= 0.f && st.c.motion_ramp_s <= 1e6f)) {
+            return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_add_mesh_collider: motion has a non-finite "
+                           "field or a motion_ramp_s outside 0 to 1e6 s");
         }
     }
     st.c.kind = RT_SPH_BOX; /* unused for meshes: the sdf decides */
@@ -317,8 +322,14 @@ void rt_sph_update_colliders(rt_sph *s, double t)
     for (uint32_t i = 0; i < s->ncol; ++i) {
         sph_collider_state *st = &s->col[i];
         const rt_sph_collider *c = &st->c;
-        double w = 2.0 * SPH_PI * c->motion_frequency;
-        double off = c->motion_amplitude * sin(w * t), vel = c->motion_amplitude * w * cos(w * t);
+        double w = 2.0 * SPH_PI * c->motion_frequency, amp = c->motion_amplitude, damp = 0.0;
+        if (c->motion_ramp_s > 0.f && t < c->motion_ramp_s) {
+            /* r = u^2 (3 - 2u), u = t / ramp: zero speed at t = 0, r' = 0 where the ramp ends */
+            double u = t > 0.0 ? t / c->motion_ramp_s : 0.0;
+            damp = amp * 6.0 * u * (1.0 - u) / c->motion_ramp_s;
+            amp *= u * u * (3.0 - 2.0 * u);
+        }
+        double off = amp * sin(w * t), vel = amp * w * cos(w * t) + damp * sin(w * t);
         for (int a = 0; a < 3; ++a) {
             st->pos[a] = c->center[a] + (float)(off * c->motion_axis[a]);
             st->vel[a] = (float)(vel * c->motion_axis[a]);

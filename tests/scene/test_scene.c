@@ -253,6 +253,9 @@ static const bad_case bad_cases[] = {
      "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"paddle\":{\"axis\":\"w\"}}}}",
      VFX_ERR_INVALID_ARGUMENT, "water.simulation.paddle.axis: unknown value \"w\""},
     {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
+     "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"paddle\":{\"ramp_s\":-1}}}}",
+     VFX_ERR_INVALID_ARGUMENT, "water.simulation.paddle.ramp_s"},
+    {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
      "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"no_slip\":3}}}",
      VFX_ERR_FORMAT, "water.simulation.no_slip: expected true or false, got a number"},
     {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
@@ -604,6 +607,8 @@ static void test_sample_scenes(void **state)
             assert_true(s->beam_count >= 3 && s->beam_count <= 4);
             assert_true(s->beams[0].joint_count >= 2 && s->beams[0].joint_track.count >= 2); /* it bends, animated */
             assert_true(s->has_water && s->water.source == RT_SCENE_WATER_SIMULATION && s->water.paddle);
+            /* ramp_s absent: the paddle's amplitude ramps in over one period */
+            assert_true(s->water.paddle_ramp_s == s->water.paddle_period_s && s->water.paddle_period_s > 0.f);
             assert_true(s->has_volume);
             assert_true(s->mesh_count >= 1);
         }

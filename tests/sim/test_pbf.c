@@ -208,6 +208,48 @@ static void test_pbf_stored_pairs_bitwise(void **state)
     }
 }
 
+/* A paddle whose amplitude ramps in (rt_sph_collider.motion_ramp_s): its face is where the
+ * float64 formula puts it, A u^2 (3 - 2u) sin(2 pi f t) with u = t / ramp, at t = 1/60 s (where
+ * the unramped paddle has already moved 1 cm: it started at its peak speed), mid-ramp and
+ * after the ramp (where both agree). Tolerance 2e-6 m: float32 positions of a box ~0.5 m from
+ * the origin (6e-8 m per ulp) through a distance evaluation. */
+static void test_pbf_paddle_ramp(void **state)
+{
+    (void)state;
+    const double A = 0.1, f = 1.0, ramp = 1.0, pi = 3.14159265358979323846;
+    const double times[3] = {1.0 / 60.0, 0.25, 1.5};
+    for (int m = 0; m < 2; ++m) {
+        rt_sph_desc d = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {1.f, 0.5f, 0.2f}, .threads = 1};
+        rt_sph *s = make(d);
+        rt_sph_collider c = {.kind = RT_SPH_BOX, .center = {0.3f, 0.25f, 0.1f}, .half = {0.01f, 0.25f, 0.1f},
+                              .motion_axis = {1, 0, 0}, .motion_amplitude = (float)A, .motion_frequency = (float)f,
+                              .motion_ramp_s = m ? 0.f : (float)ramp};
+        assert_int_equal(rt_sph_add_collider(s, &c, NULL, NULL, 0), VFX_OK);
+        float x[1] = {0.9f}, y[1] = {0.01f}, z[1] = {0.1f}; /* one particle, far from the paddle */
+        assert_int_equal(rt_sph_add_particles(s, 1, x, y, z, NULL, NULL, NULL, NULL, 0), VFX_OK);
+        double t = 0.0;
+        for (int k = 0; k < 3; ++k) {
+            rt_sph_report r;
+            assert_int_equal(rt_sph_step(s, (float)(times[k] - t), &r, NULL, 0), VFX_OK);
+            t = rt_sph_time(s);
+            double u = t < ramp ? t / ramp : 1.0, rr = m ? 1.0 : u * u * (3.0 - 2.0 * u);
+            double face = 0.3 + A * rr * sin(2.0 * pi * f * t) + 0.01; /* the +x face */
+            const float p[3] = {0.8f, 0.25f, 0.1f};
+            double dist = rt_sph_collider_distance(s, 0, p);
+            assert_true(fabs(dist - (0.8 - face)) <= 2e-6);
+            if (k == 0 && !m)
+                assert_true(fabs(face - 0.31) < 1e-4); /* ramped: still at rest to 0.1 mm */
+            if (k == 0 && m)
+                assert_true(face - 0.31 > 0.01);      /* unramped: 1 cm in the first frame */
+        }
+        rt_sph_destroy(s);
+    }
+    rt_sph_collider bad = {.kind = RT_SPH_BOX, .half = {1, 1, 1}, .motion_ramp_s = -1.f};
+    rt_sph *s = make(small_box());
+    assert_int_equal(rt_sph_add_collider(s, &bad, NULL, NULL, 0), VFX_ERR_INVALID_ARGUMENT);
+    rt_sph_destroy(s);
+}
+
 /* A closed tank at rest (no paddle): total energy (kinetic + gravity; PBF has no internal energy)
  * must not grow by more than 1% of the initial energy between sampled points. */
 static void test_pbf_closed_tank_energy(void **state)
@@ -282,6 +324,7 @@ int main(void)
         cmocka_unit_test(test_pbf_speed_cap),    cmocka_unit_test(test_pbf_thin_wall),
         cmocka_unit_test(test_pbf_threads_bitwise), cmocka_unit_test(test_pbf_closed_tank_energy),
         cmocka_unit_test(test_pbf_free_block_energy), cmocka_unit_test(test_pbf_stored_pairs_bitwise),
+        cmocka_unit_test(test_pbf_paddle_ramp),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
