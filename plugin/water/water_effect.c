@@ -553,7 +553,8 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
                         "buffer (only the paper method's billboard passes draw several)",
                         s->count, s->group_count, s->buffer_cap, p->method,
                         (p->disable & VFX_WATER_NO_BLEND) ? " with NO_BLEND" : "");
-    volfx_mat4_mul(frame->proj, frame->view, s->view_proj);
+    /* the frame gate's product (the same proj * view, made once a frame), kept for next frame's reprojection */
+    memcpy(s->view_proj, targets->view_proj, sizeof s->view_proj);
     if (p->method != VFX_WATER_METHOD_TILE) /* TILE's passes set their own uniforms */
         volfx_water_frame_upload(s, frame, targets);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->counters);
