@@ -387,14 +387,50 @@ float volfx_prim_dist2(vec3 V, vec3 C, vec3 D, float L, bool seg, float t)
     return dot(q, q);
 }
 
+// A joint's sphere or a segment's cylinder: volfx_sphere_piece's and volfx_cylinder_piece's
+// arguments to volfx_piece computed side by side and chosen by selects, then one volfx_piece.
+// llvmpipe runs both sides of an `if` for all lanes, so the branch form paid two piece
+// evaluations per run; the values are the same to the bit (beam_field_impl.inc keeps the branch,
+// which a CPU takes).
 float volfx_prim_piece(vec3 V, vec3 C, vec3 D, float L, bool seg, float R, float eps, float ta, float tb, bool soft)
 {
     vec3 w = -C;
     vec3 wp = volfx_cross_acc(V, volfx_cross_acc(w, V));
     float wv = dot(w, V);
-    if (!seg)
-        return volfx_sphere_piece(wp, V, R, eps, ta + wv, tb + wv, 0.0, 0.0, -1.0, 1.0, soft);
-    return volfx_cylinder_piece(wp, V, D, L, R, eps, ta + wv, tb + wv, dot(wp, D), dot(V, D), soft);
+    ta += wv;
+    tb += wv;
+    // the joint's sphere (volfx_sphere_piece with u0 = c = 0, [umin, umax) = [-1, 1): no clip)
+    float gv = dot(wp, V);
+    vec3 gp = wp - gv * V;
+    float dd = dot(gp, gp);
+    bool sph_in = dd < R * R;
+    float hs = sqrt(max(R * R - dd, 0.0));
+    float slo = max(ta + gv, -hs), shi = min(tb + gv, hs);
+    // the segment's cylinder (volfx_cylinder_piece)
+    float u0 = dot(wp, D), c = dot(V, D);
+    vec3 a = wp - u0 * D;
+    vec3 b = volfx_cross_acc(volfx_cross_acc(D, V), D);
+    float s = sqrt(dot(b, b));
+    float beta = 0.0, rr, lo = ta, hi = tb;
+    bool cin;
+    if (s > 0.0) {
+        vec3 bh = b / s;
+        beta = dot(a, bh);
+        vec3 q = a - beta * bh;
+        rr = dot(q, q);
+        cin = rr < R * R;
+    } else {
+        rr = dot(a, a);
+        cin = rr <= R * R;
+    }
+    float hc = sqrt(max(R * R - rr, 0.0));
+    if (s > 0.0)
+        volfx_clip_linear(beta, s, -hc, hc, lo, hi);
+    volfx_clip_linear(u0, c, 0.0, L, lo, hi);
+    bool inside = seg ? cin : sph_in;
+    float x0 = seg ? lo : slo, x1 = seg ? hi : shi;
+    return volfx_piece(x0, inside ? x1 : x0, seg ? s : 1.0, seg ? beta : 0.0, sqrt((seg ? rr : dd) + eps * eps),
+                       seg ? hc : hs, R, soft);
 }
 
 float volfx_polyline_integral(uint first, int nj, float R, float a, float b, float eps_in, bool soft, vec3 V,
