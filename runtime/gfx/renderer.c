@@ -6,6 +6,7 @@
 
 #include <cglm/cglm.h>
 #include <epoxy/gl.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -15,8 +16,10 @@ struct rt_renderer {
     rt_logger log;
     GLuint mesh_prog;
     GLint u_model, u_view_proj, u_color, u_light, u_environment, u_eye, u_fog, u_origin;
-    GLint u_light_count, u_lights;
+    GLint u_light_count, u_lights, u_light_reach;
     float lights[RT_RENDERER_MAX_LIGHTS * 12]; /* mesh.frag's u_lights: p0 kind, p1 I, rgb radius */
+    float reach2[RT_RENDERER_MAX_LIGHTS];      /* mesh.frag's u_light_reach (window's end, squared) */
+    vfx_light src[RT_RENDERER_MAX_LIGHTS];     /* as given, for the per-mesh culling */
     uint32_t light_count;
     rt_renderer_environment env;
     float origin[3]; /* the scene's origin (rt_renderer_set_origin), for the meshes' patterns */
@@ -108,6 +111,7 @@ vfx_result rt_renderer_create(const rt_logger *logger, rt_renderer **out)
     r->u_origin = glGetUniformLocation(r->mesh_prog, "u_origin");
     r->u_light_count = glGetUniformLocation(r->mesh_prog, "u_light_count");
     r->u_lights = glGetUniformLocation(r->mesh_prog, "u_lights");
+    r->u_light_reach = glGetUniformLocation(r->mesh_prog, "u_light_reach");
     *out = r;
     return VFX_OK;
 }
@@ -301,6 +305,53 @@ void rt_renderer_begin_scene(rt_renderer *r, const float view[16], const float p
         draw_sky(r);
 }
 
+/* The window's end for the shader (no radius): a light's irradiance at a point at distance d
+ * from it (from the nearest point of its segment) is at most I L cmax / d^2, L its length (1 for
+ * a point): every point p of the segment is at least d away, and cos(theta) / |p - x|^2 <=
+ * 1 / d^2. So past d0^2 = I L cmax / cutoff it is below the cutoff, and mesh.frag fades it
+ * out between d0^2 and 2 d0^2 (smoothstep in d^2, no pop): the windowed sum differs from the
+ * exact one by less than the cutoff, under 1/512 of display white on albedo <= 1. */
+static float window_end2(const vfx_light *l)
+{
+    float len = 1.f;
+    if (l->kind == VFX_LIGHT_LINE) {
+        float e[3] = {l->p1[0] - l->p0[0], l->p1[1] - l->p0[1], l->p1[2] - l->p0[2]};
+        len = sqrtf(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    }
+    float cmax = fmaxf(fmaxf(l->color[0], l->color[1]), l->color[2]);
+    float d0sq = fmaxf(l->intensity, 0.f) * len * fmaxf(cmax, 0.f) / RT_RENDERER_LIGHT_CUTOFF;
+    return isfinite(d0sq) ? fminf(2.f * d0sq, 3e38f) : 3e38f; /* a NaN or inf light: never cut */
+}
+
+float rt_renderer_light_reach2(const vfx_light *l)
+{
+    float w = window_end2(l);
+    if (l->kind == VFX_LIGHT_POINT && l->radius > 0)
+        w = fminf(w, l->radius * l->radius); /* mesh.frag drops a point past its radius */
+    return w;
+}
+
+uint32_t rt_renderer_lights_near_box(const vfx_light *lights, uint32_t n, const float lo[3],
+                                     const float hi[3], uint32_t *keep)
+{
+    uint32_t kept = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        const vfx_light *l = &lights[i];
+        /* the gap between the box and the segment's own box: no more than the distance from
+         * any point of the mesh to any point of the segment, so the test never drops a light
+         * that could reach the mesh */
+        float d2 = 0;
+        for (int k = 0; k < 3; ++k) {
+            float a = fminf(l->p0[k], l->p1[k]), b = fmaxf(l->p0[k], l->p1[k]);
+            float gap = fmaxf(fmaxf(lo[k] - b, a - hi[k]), 0.f);
+            d2 += gap * gap;
+        }
+        if (!(d2 >= rt_renderer_light_reach2(l))) /* NaN positions: kept */
+            keep[kept++] = i;
+    }
+    return kept;
+}
+
 vfx_result rt_renderer_set_lights(rt_renderer *r, const vfx_light *lights, uint32_t n)
 {
     if (!r || (n && !lights))
@@ -321,13 +372,16 @@ vfx_result rt_renderer_set_lights(rt_renderer *r, const vfx_light *lights, uint3
         o[7] = l->intensity;
         memcpy(o + 8, l->color, 12);
         o[11] = l->radius > 0 ? l->radius : 3e38f;
+        r->reach2[i] = window_end2(l);
+        r->src[i] = *l;
     }
     r->light_count = n;
     return VFX_OK;
 }
 
-void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float model[16],
-                            const float rgb[3])
+/* The draw with the lights listed in keep (n of them; keep NULL: all). */
+static void draw(rt_renderer *r, const rt_mesh_gpu *mesh, const float model[16], const float rgb[3],
+                 const uint32_t *keep, uint32_t n)
 {
     mat4 vp;
     view_proj(r, vp);
@@ -339,9 +393,21 @@ void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float 
     glUniformMatrix4fv(r->u_view_proj, 1, GL_FALSE, (const float *)vp);
     glUniform3fv(r->u_color, 1, rgb);
     glUniform3fv(r->u_origin, 1, r->origin);
-    glUniform1i(r->u_light_count, (GLint)r->light_count);
-    if (r->light_count)
-        glUniform4fv(r->u_lights, (GLsizei)(3 * r->light_count), r->lights);
+    float packed[RT_RENDERER_MAX_LIGHTS * 12], reach[RT_RENDERER_MAX_LIGHTS];
+    const float *lights = r->lights, *reach2 = r->reach2;
+    if (keep) {
+        for (uint32_t i = 0; i < n; ++i) {
+            memcpy(packed + 12 * i, r->lights + 12 * keep[i], 12 * sizeof(float));
+            reach[i] = r->reach2[keep[i]];
+        }
+        lights = packed;
+        reach2 = reach;
+    }
+    glUniform1i(r->u_light_count, (GLint)n);
+    if (n) {
+        glUniform4fv(r->u_lights, (GLsizei)(3 * n), lights);
+        glUniform1fv(r->u_light_reach, (GLsizei)n, reach2);
+    }
     if (r->env.sky) {
         glUniform3fv(r->u_light, 1, r->env.sun_dir);
         glUniform1i(r->u_environment, 1);
@@ -354,6 +420,30 @@ void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float 
     glBindVertexArray(mesh->vao);
     glDrawElements(GL_TRIANGLES, (GLsizei)mesh->index_count, GL_UNSIGNED_INT, NULL);
     glBindVertexArray(0);
+}
+
+void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float model[16],
+                            const float rgb[3])
+{
+    draw(r, mesh, model, rgb, NULL, r->light_count);
+}
+
+void rt_renderer_draw_mesh_bounded(rt_renderer *r, const rt_mesh_gpu *mesh, const float model[16],
+                                   const float rgb[3], const float lo[3], const float hi[3])
+{
+    /* the world box of the model box's 8 corners (model maps to origin-relative world) */
+    float wlo[3] = {3e38f, 3e38f, 3e38f}, whi[3] = {-3e38f, -3e38f, -3e38f};
+    for (int c = 0; c < 8; ++c) {
+        float p[3] = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]};
+        for (int k = 0; k < 3; ++k) {
+            float w = model[12 + k] + model[k] * p[0] + model[4 + k] * p[1] + model[8 + k] * p[2];
+            wlo[k] = fminf(wlo[k], w);
+            whi[k] = fmaxf(whi[k], w);
+        }
+    }
+    uint32_t keep[RT_RENDERER_MAX_LIGHTS];
+    uint32_t n = rt_renderer_lights_near_box(r->src, r->light_count, wlo, whi, keep);
+    draw(r, mesh, model, rgb, keep, n);
 }
 
 void rt_renderer_get_targets(const rt_renderer *r, rt_renderer_targets *out)

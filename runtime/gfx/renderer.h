@@ -44,9 +44,25 @@ void rt_renderer_set_origin(rt_renderer *r, const double origin[3]);
  * VFX_ERR_ABI for a light of a kind this renderer does not know (none is kept then). */
 #define RT_RENDERER_MAX_LIGHTS 32
 vfx_result rt_renderer_set_lights(rt_renderer *r, const vfx_light *lights, uint32_t n);
-/* Draws a mesh with a model matrix and a colour into the scene target. */
+/* The irradiance a light's windowed contribution (shaders/host/mesh.frag) is cut at: below it a
+ * Lambertian surface of albedo <= 1 gets under 1/512 of display white (half an 8-bit step). */
+#define RT_RENDERER_LIGHT_CUTOFF (3.14159265f / 512.f)
+/* Squared distance from a light (its point or segment) past which the meshes' shader adds
+ * nothing of it: the window's outer end, 2x the squared distance where its irradiance bound
+ * drops to RT_RENDERER_LIGHT_CUTOFF, and no further than its radius for a point. */
+float rt_renderer_light_reach2(const vfx_light *l);
+/* Writes to keep[] the indices (ascending) of the lights that can light some point of the world
+ * box lo..hi (relative to the origin, like the lights), i.e. whose reach meets the box; returns
+ * how many. Conservative: a light left out adds exactly nothing anywhere in the box. */
+uint32_t rt_renderer_lights_near_box(const vfx_light *lights, uint32_t n, const float lo[3],
+                                     const float hi[3], uint32_t *keep);
+/* Draws a mesh with a model matrix and a colour into the scene target, lit by every light. */
 void rt_renderer_draw_mesh(rt_renderer *r, const rt_mesh_gpu *mesh, const float model[16],
                             const float rgb[3]);
+/* Same, for a mesh whose model-space bounding box is lo..hi: only the lights that reach its
+ * world box (rt_renderer_lights_near_box) go to the draw, so a far mesh pays for none. */
+void rt_renderer_draw_mesh_bounded(rt_renderer *r, const rt_mesh_gpu *mesh, const float model[16],
+                                   const float rgb[3], const float lo[3], const float hi[3]);
 /* The targets of a finished scene: the output framebuffer effects draw into, and the scene's
  * colour and depth textures they sample (never attached to the output: no feedback loop). */
 typedef struct rt_renderer_targets {
