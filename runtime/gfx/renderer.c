@@ -16,9 +16,8 @@ struct rt_renderer {
     rt_logger log;
     GLuint mesh_prog;
     GLint u_model, u_view_proj, u_color, u_light, u_environment, u_eye, u_fog, u_origin;
-    GLint u_light_count, u_lights, u_light_reach;
+    GLint u_light_count, u_lights;
     float lights[RT_RENDERER_MAX_LIGHTS * 12]; /* mesh.frag's u_lights: p0 kind, p1 I, rgb radius */
-    float reach2[RT_RENDERER_MAX_LIGHTS];      /* mesh.frag's u_light_reach (window's end, squared) */
     vfx_light src[RT_RENDERER_MAX_LIGHTS];     /* as given, for the per-mesh culling */
     uint32_t light_count;
     rt_renderer_environment env;
@@ -111,7 +110,6 @@ vfx_result rt_renderer_create(const rt_logger *logger, rt_renderer **out)
     r->u_origin = glGetUniformLocation(r->mesh_prog, "u_origin");
     r->u_light_count = glGetUniformLocation(r->mesh_prog, "u_light_count");
     r->u_lights = glGetUniformLocation(r->mesh_prog, "u_lights");
-    r->u_light_reach = glGetUniformLocation(r->mesh_prog, "u_light_reach");
     *out = r;
     return VFX_OK;
 }
@@ -305,13 +303,13 @@ void rt_renderer_begin_scene(rt_renderer *r, const float view[16], const float p
         draw_sky(r);
 }
 
-/* The window's end for the shader (no radius): a light's irradiance at a point at distance d
- * from it (from the nearest point of its segment) is at most I L cmax / d^2, L its length (1 for
- * a point): every point p of the segment is at least d away, and cos(theta) / |p - x|^2 <=
- * 1 / d^2. So past d0^2 = I L cmax / cutoff it is below the cutoff, and mesh.frag fades it
- * out between d0^2 and 2 d0^2 (smoothstep in d^2, no pop): the windowed sum differs from the
- * exact one by less than the cutoff, under 1/512 of display white on albedo <= 1. */
-static float window_end2(const vfx_light *l)
+/* The distance past which a light adds less than RT_RENDERER_LIGHT_CUTOFF anywhere, squared.
+ * At distance d from a light (from the nearest point of its segment) its irradiance is at most
+ * I L cmax / d^2, L its length (1 for a point): every point p of the segment is at least d away
+ * and cos(theta) / |p - x|^2 <= 1 / d^2. So past d0^2 = I L cmax / cutoff it adds under the
+ * cutoff: dropping it there changes a pixel of albedo <= 1 by under 1/512 of white, and a light
+ * crossing that distance as it moves changes it by no more (no visible pop, so no window). */
+float rt_renderer_light_reach2(const vfx_light *l)
 {
     float len = 1.f;
     if (l->kind == VFX_LIGHT_LINE) {
@@ -319,18 +317,12 @@ static float window_end2(const vfx_light *l)
         len = sqrtf(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
     }
     float cmax = fmaxf(fmaxf(l->color[0], l->color[1]), l->color[2]);
-    float d0sq = fmaxf(l->intensity, 0.f) * len * fmaxf(cmax, 0.f) / RT_RENDERER_LIGHT_CUTOFF;
-    return isfinite(d0sq) ? fminf(2.f * d0sq, 3e38f) : 3e38f; /* a NaN or inf light: never cut */
-}
-
-float rt_renderer_light_reach2(const vfx_light *l)
-{
-    float w = window_end2(l);
+    float w = fmaxf(l->intensity, 0.f) * len * fmaxf(cmax, 0.f) / RT_RENDERER_LIGHT_CUTOFF;
+    w = isfinite(w) ? w : 3e38f; /* a NaN or inf light: never cut */
     if (l->kind == VFX_LIGHT_POINT && l->radius > 0)
         w = fminf(w, l->radius * l->radius); /* mesh.frag drops a point past its radius */
     return w;
 }
-
 uint32_t rt_renderer_lights_near_box(const vfx_light *lights, uint32_t n, const float lo[3],
                                      const float hi[3], uint32_t *keep)
 {
@@ -372,7 +364,6 @@ vfx_result rt_renderer_set_lights(rt_renderer *r, const vfx_light *lights, uint3
         o[7] = l->intensity;
         memcpy(o + 8, l->color, 12);
         o[11] = l->radius > 0 ? l->radius : 3e38f;
-        r->reach2[i] = window_end2(l);
         r->src[i] = *l;
     }
     r->light_count = n;
@@ -393,21 +384,16 @@ static void draw(rt_renderer *r, const rt_mesh_gpu *mesh, const float model[16],
     glUniformMatrix4fv(r->u_view_proj, 1, GL_FALSE, (const float *)vp);
     glUniform3fv(r->u_color, 1, rgb);
     glUniform3fv(r->u_origin, 1, r->origin);
-    float packed[RT_RENDERER_MAX_LIGHTS * 12], reach[RT_RENDERER_MAX_LIGHTS];
-    const float *lights = r->lights, *reach2 = r->reach2;
+    float packed[RT_RENDERER_MAX_LIGHTS * 12];
+    const float *lights = r->lights;
     if (keep) {
-        for (uint32_t i = 0; i < n; ++i) {
+        for (uint32_t i = 0; i < n; ++i)
             memcpy(packed + 12 * i, r->lights + 12 * keep[i], 12 * sizeof(float));
-            reach[i] = r->reach2[keep[i]];
-        }
         lights = packed;
-        reach2 = reach;
     }
     glUniform1i(r->u_light_count, (GLint)n);
-    if (n) {
+    if (n)
         glUniform4fv(r->u_lights, (GLsizei)(3 * n), lights);
-        glUniform1fv(r->u_light_reach, (GLsizei)n, reach2);
-    }
     if (r->env.sky) {
         glUniform3fv(r->u_light, 1, r->env.sun_dir);
         glUniform1i(r->u_environment, 1);

@@ -44,16 +44,15 @@ void rt_renderer_set_origin(rt_renderer *r, const double origin[3]);
  * VFX_ERR_ABI for a light of a kind this renderer does not know (none is kept then). */
 #define RT_RENDERER_MAX_LIGHTS 32
 vfx_result rt_renderer_set_lights(rt_renderer *r, const vfx_light *lights, uint32_t n);
-/* The irradiance a light's windowed contribution (shaders/host/mesh.frag) is cut at: below it a
- * Lambertian surface of albedo <= 1 gets under 1/512 of display white (half an 8-bit step). */
+/* The irradiance below which a light is left out of a mesh's draw: a Lambertian surface of
+ * albedo <= 1 gets under 1/512 of display white from it (half an 8-bit step). */
 #define RT_RENDERER_LIGHT_CUTOFF (3.14159265f / 512.f)
-/* Squared distance from a light (its point or segment) past which the meshes' shader adds
- * nothing of it: the window's outer end, 2x the squared distance where its irradiance bound
- * drops to RT_RENDERER_LIGHT_CUTOFF, and no further than its radius for a point. */
+/* Squared distance from a light (its point or segment) past which its irradiance bound is below
+ * RT_RENDERER_LIGHT_CUTOFF (no further than its radius for a point, which mesh.frag cuts at). */
 float rt_renderer_light_reach2(const vfx_light *l);
 /* Writes to keep[] the indices (ascending) of the lights that can light some point of the world
  * box lo..hi (relative to the origin, like the lights), i.e. whose reach meets the box; returns
- * how many. Conservative: a light left out adds exactly nothing anywhere in the box. */
+ * how many. Conservative: a light left out adds under the cutoff anywhere in the box. */
 uint32_t rt_renderer_lights_near_box(const vfx_light *lights, uint32_t n, const float lo[3],
                                      const float hi[3], uint32_t *keep);
 /* Draws a mesh with a model matrix and a colour into the scene target, lit by every light. */

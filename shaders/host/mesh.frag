@@ -16,11 +16,6 @@ uniform vec3 u_origin; // the scene's origin: v_world is relative to it, the pat
 #define RT_MAX_LIGHTS 32
 uniform int u_light_count;
 uniform vec4 u_lights[3 * RT_MAX_LIGHTS];
-// Per light the squared distance where its window ends (renderer.c window_end2): full weight
-// to half of it, fading (smoothstep in d^2) to nothing at it. Past half, the light's irradiance
-// bound is below RT_RENDERER_LIGHT_CUTOFF, so the fade changes a pixel by less than that, and
-// a fragment past the end skips the light's closed form for one distance to its segment.
-uniform float u_light_reach[RT_MAX_LIGHTS];
 out vec4 o_color;
 
 float hash2(vec2 p)
@@ -80,13 +75,6 @@ vec3 plugin_lights(vec3 x, vec3 n)
     vec3 E = vec3(0.0);
     for (int i = 0; i < u_light_count && i < RT_MAX_LIGHTS; ++i) {
         vec4 a = u_lights[3 * i], b = u_lights[3 * i + 1], c = u_lights[3 * i + 2];
-        vec3 e = b.xyz - a.xyz, q = x - a.xyz;
-        float ee = dot(e, e);
-        vec3 r = q - e * (ee > 0.0 ? clamp(dot(q, e) / ee, 0.0, 1.0) : 0.0);
-        float reach = u_light_reach[i], d2 = dot(r, r);
-        if (d2 >= reach) // NaN positions are not cut (renderer.c keeps them too)
-            continue;
-        c.rgb *= 1.0 - smoothstep(0.5 * reach, reach, d2);
         if (a.w == 0.0) {
             vec3 v = a.xyz - x;
             float d2 = max(dot(v, v), 1e-6);

@@ -51,8 +51,9 @@ static int teardown(void **state)
     return 0;
 }
 
-/* The floor's linear radiance (RGBA, GL rows) lit by these lights. */
-static void render(const vfx_light *l, uint32_t n, float *rgba)
+/* The floor's linear radiance (RGBA, GL rows) lit by these lights; drawn with its box
+ * (rt_renderer_draw_mesh_bounded) when `bounded`. */
+static void render_mesh(const vfx_light *l, uint32_t n, float *rgba, bool bounded)
 {
     assert_int_equal(rt_renderer_set_lights(g_r, l, n), VFX_OK);
     rt_camera cam = test_rt_camera(&g_cam);
@@ -61,11 +62,20 @@ static void render(const vfx_light *l, uint32_t n, float *rgba)
     rt_camera_proj(&cam, proj);
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     rt_renderer_begin_scene(g_r, view, proj, (float[3]){0, 0, 0});
-    rt_renderer_draw_mesh(g_r, &g_floor, identity, (float[3]){1, 1, 1});
+    if (bounded)
+        rt_renderer_draw_mesh_bounded(g_r, &g_floor, identity, (float[3]){1, 1, 1}, (float[3]){-6, -0.2f, -6},
+                                      (float[3]){6, 0, 6});
+    else
+        rt_renderer_draw_mesh(g_r, &g_floor, identity, (float[3]){1, 1, 1});
     rt_renderer_targets tg;
     rt_renderer_end_scene(g_r, &tg);
     glGetTextureImage(tg.scene_color, 0, GL_RGBA, GL_FLOAT, (GLsizei)(sizeof(float) * 4 * W * H), rgba);
     assert_int_equal(glGetError(), GL_NO_ERROR);
+}
+
+static void render(const vfx_light *l, uint32_t n, float *rgba)
+{
+    render_mesh(l, n, rgba, false);
 }
 
 /* float64 Gauss-Legendre (5 points on each of 4000 pieces) of I max(n.(p - x), 0) / |p - x|^3
@@ -194,7 +204,7 @@ static void test_unknown_kind(void **state)
 
 /* The per-mesh culling (rt_renderer_lights_near_box): a box far from every light gets none of
  * them, a box next to them keeps every one, and the reach it uses matches its bound: at the
- * reach's inner half (where mesh.frag's fade starts) the float64 quadrature of the strongest
+ * reach the float64 quadrature of the strongest
  * light, straight below its middle, is under the cutoff, so a culled light adds nothing seen. */
 static void test_cull_far_mesh(void **state)
 {
@@ -212,12 +222,27 @@ static void test_cull_far_mesh(void **state)
     assert_true(r0 < 200.f && r0 > 10.f);
     assert_int_equal(rt_renderer_lights_near_box(l, 3, (float[3]){-1, 0.8f - r0 - 1.f, -1}, (float[3]){1, 0.8f - r0 - 0.5f, 1}, keep), 0);
     assert_int_equal(rt_renderer_lights_near_box(l, 3, (float[3]){-1, 0.8f - r0 + 0.5f, -1}, (float[3]){1, 0.8f - r0 + 1.f, 1}, keep), 1);
-    /* the bound behind the reach: at d = r0 / sqrt(2) below the segment's middle, facing it */
-    double x[3] = {0, 0.8 - r0 / sqrt(2.0), 0};
+    /* the bound behind the reach: at d = r0 below the segment's middle, facing it */
+    double x[3] = {0, 0.8 - r0, 0};
     l[0].p0[1] = l[0].p1[1] = 0.8f;
     double E = quad_irradiance(&l[0], x);
     assert_true(E > 0);
     assert_true(E < RT_RENDERER_LIGHT_CUTOFF);
+    /* drawn with its box, the floor keeps both near lights (the same image, bit for bit) and
+     * loses a far one: the image with it equals the unlit one */
+    static float all[W * H * 4], culled[W * H * 4], unlit[W * H * 4];
+    render_mesh(l, 2, all, false);
+    render_mesh(l, 2, culled, true);
+    assert_memory_equal(all, culled, sizeof all);
+    vfx_light far = line(36, 1, 0, 37, 1, 0, 4.f); /* 30 m from the box, past its 25.5 m reach */
+    render_mesh(&far, 1, culled, true);
+    render_mesh(NULL, 0, unlit, false);
+    assert_memory_equal(unlit, culled, sizeof unlit);
+    /* what the cut light would have added: under the cutoff's radiance (albedo 1, checker and
+     * sun term <= 1), plus one half-float ulp of the unlit value */
+    render_mesh(&far, 1, all, false);
+    for (size_t i = 0; i < (size_t)W * H * 4; ++i)
+        assert_true(fabsf(all[i] - unlit[i]) <= RT_RENDERER_LIGHT_CUTOFF / 3.14159265f + unlit[i] * 0x1p-10f);
     /* a light through NaN is never cut (it is the plugin's bug to see, not to hide) */
     l[1].p0[0] = NAN;
     assert_int_equal(rt_renderer_lights_near_box(l + 1, 1, (float[3]){500, 0, 500}, (float[3]){510, 5, 510}, keep), 1);
