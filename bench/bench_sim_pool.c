@@ -84,6 +84,9 @@ int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsign
      * system's wall time on the frame thread (both workers busy inside it) */
     float vmax[NS] = {0}, vlast[NS] = {0};
     double err_sum[NS] = {0};
+    /* issue 22's closed-tank goal: total energy (kinetic + gravity + WCSPH's internal; PBF has
+     * none) sampled every 10 frames; the largest rise between any two samples, over the first */
+    double e0[NS] = {0}, emin[NS] = {0}, grow[NS] = {0}, ke_last[NS] = {0};
     uint32_t steps[NS] = {0}, iters[NS] = {0}, rebuilds[NS] = {0};
     for (int f = 0; f < frames && ok; ++f)
         for (int m = 0; m < NS; ++m) {
@@ -102,6 +105,15 @@ int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsign
             if (f >= 1 && r.max_speed > vmax[m])
                 vmax[m] = r.max_speed;
             err_sum[m] += r.mean_density_error;
+            ke_last[m] = r.kinetic_energy;
+            if (f % 10 == 0) {
+                const double e = r.kinetic_energy + r.potential_energy + r.internal_energy;
+                if (f == 0)
+                    e0[m] = emin[m] = e;
+                const double rise = (e - emin[m]) / fabs(e0[m]); /* fmax names the fluid box here */
+                grow[m] = rise > grow[m] ? rise : grow[m];
+                emin[m] = e < emin[m] ? e : emin[m];
+            }
             steps[m] += r.substeps, iters[m] += r.iterations, rebuilds[m] += r.neighbor_rebuilds;
         }
     double med[NS];
@@ -111,11 +123,12 @@ int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsign
         med[m] = rt_median(ms[m], (uint32_t)frames);
         printf("{\"bench\":\"sim_pool\",\"solver\":\"%s\",\"particles\":%u,\"spacing\":%.5f,\"paddle\":%s,"
                "\"frames\":%d,\"threads\":%u,\"cpu_ms_per_frame_median\":%.3f,\"wall_ms_per_frame_median\":%.3f,\"steps_per_frame\":%.2f,"
-               "\"iterations_per_frame\":%.2f,\"rebuilds_per_frame\":%.2f,\"max_speed_frames_2_on\":%.4f,\"max_speed_last\":%.4f,\"mean_compression\":%.5f,\"paddle_ramp_s\":%.3f}\n",
+               "\"iterations_per_frame\":%.2f,\"rebuilds_per_frame\":%.2f,\"max_speed_frames_2_on\":%.4f,\"max_speed_last\":%.4f,\"mean_compression\":%.5f,\"paddle_ramp_s\":%.3f,"
+               "\"energy_first_J\":%.6g,\"energy_growth_max\":%.3g,\"kinetic_energy_last_J\":%.4g}\n",
                name[m], added[m], dx, paddle ? "true" : "false", frames, rt_sph_thread_count(s[m]),
                med[m], rt_median(wms[m], (uint32_t)frames), (double)steps[m] / frames, (double)iters[m] / frames,
                (double)rebuilds[m] / frames, vmax[m], vlast[m], err_sum[m] / frames,
-               paddle ? (double)(ramp_s < 0.f ? period : ramp_s) : 0.0);
+               paddle ? (double)(ramp_s < 0.f ? period : ramp_s) : 0.0, e0[m], grow[m], ke_last[m]);
     }
     for (int m = 1; m < NS; ++m)
         if ((solvers & 1u) && (solvers >> m & 1u))
