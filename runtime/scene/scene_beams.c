@@ -172,6 +172,21 @@ static vfx_result parse_joints(pctx *c, const cJSON *e, const cJSON *kf, const c
 static const range TWIST_RANGE = {-64, 64, false};
 static const range CORE_RANGE = {0, 1, false};
 
+/* The optional object e.name: *obj NULL when absent; else checked to be an object with only
+ * the given keys, and its JSON path written to path (the key checks report through c). */
+static vfx_result optional_object(pctx *c, const cJSON *e, const char *P, const char *name,
+                                  const char *const *keys, const cJSON **obj, char path[JPATH])
+{
+    *obj = cJSON_GetObjectItemCaseSensitive(e, name);
+    if (!*obj)
+        return VFX_OK;
+    rt_scene_join(path, P, name);
+    vfx_result r = rt_scene_expect_object(c, *obj, path);
+    if (!r)
+        rt_scene_check_keys(c, *obj, path, keys);
+    return r;
+}
+
 /* orb {pulse, pulse_hz}, surge {wavelength, speed} and core (the keyframable sizes are
  * parameters). Scenes default the core to 0.2: the hue-keeping ramp (0 keeps version 2's). */
 static vfx_result parse_anatomy(pctx *c, const cJSON *e, const char *P, vfx_beam3 *look)
@@ -180,23 +195,15 @@ static vfx_result parse_anatomy(pctx *c, const cJSON *e, const char *P, vfx_beam
     static const char *const surge_keys[] = {"wavelength", "speed", NULL};
     look->core = 0.2f;
     vfx_result r = rt_scene_get_float(c, e, P, "core", false, CORE_RANGE, &look->core);
-    const cJSON *orb = cJSON_GetObjectItemCaseSensitive(e, "orb");
+    const cJSON *orb = NULL, *surge = NULL;
+    char PO[JPATH], PS[JPATH];
+    if (!r) r = optional_object(c, e, P, "orb", orb_keys, &orb, PO);
     if (!r && orb) {
-        char PO[JPATH];
-        rt_scene_join(PO, P, "orb");
-        if ((r = rt_scene_expect_object(c, orb, PO)))
-            return r;
-        rt_scene_check_keys(c, orb, PO, orb_keys);
         r = rt_scene_get_float(c, orb, PO, "pulse", false, UNIT, &look->orb_pulse);
         if (!r) r = rt_scene_get_float(c, orb, PO, "pulse_hz", false, NONNEG, &look->orb_pulse_hz);
     }
-    const cJSON *surge = cJSON_GetObjectItemCaseSensitive(e, "surges");
+    if (!r) r = optional_object(c, e, P, "surges", surge_keys, &surge, PS);
     if (!r && surge) {
-        char PS[JPATH];
-        rt_scene_join(PS, P, "surges");
-        if ((r = rt_scene_expect_object(c, surge, PS)))
-            return r;
-        rt_scene_check_keys(c, surge, PS, surge_keys);
         r = rt_scene_get_float(c, surge, PS, "wavelength", false, NONNEG, &look->surge_wavelength);
         if (!r) r = rt_scene_get_float(c, surge, PS, "speed", false, COORD, &look->surge_speed);
     }
@@ -224,14 +231,10 @@ static vfx_result parse_look(pctx *c, const cJSON *e, const char *P, vfx_beam3 *
     look->ramp = rp == 1 ? VFX_BEAM_RAMP_THESIS : VFX_BEAM_RAMP_HOT;
     if (rp == 1)
         look3->core = 0; /* the thesis ramp has no core */
-    const cJSON *flow = cJSON_GetObjectItemCaseSensitive(e, "flow");
-    if (!flow)
-        return VFX_OK;
+    const cJSON *flow;
     char PF[JPATH];
-    rt_scene_join(PF, P, "flow");
-    if ((r = rt_scene_expect_object(c, flow, PF)))
+    if ((r = optional_object(c, e, P, "flow", flow_keys, &flow, PF)) || !flow)
         return r;
-    rt_scene_check_keys(c, flow, PF, flow_keys);
     look->flow_amount = 0.5f;
     if (!r) r = rt_scene_get_float_row(c, flow, PF, "amount", VFX_RANGE_BEAM_FLOW_AMOUNT, &look->flow_amount);
     if (!r) r = rt_scene_get_float_row(c, flow, PF, "speed", VFX_RANGE_BEAM_FLOW_SPEED, &look->flow_speed);
