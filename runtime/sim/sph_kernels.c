@@ -88,8 +88,7 @@ density_tail(rt_sph *s, uint32_t i, float sum, uint32_t nn, float px, float py, 
 
 /* Density by a scan of the 5x5x5 cells, recording the exact list (r < H) for the force pass
  * and, when `record`, the Verlet list (r < H + skin) and the positions it was built at. */
-static inline __attribute__((always_inline)) void density_scan(rt_sph *s, uint32_t chunk, const bool record,
-                                                               const bool lists_only)
+static inline __attribute__((always_inline)) void density_scan(rt_sph *s, uint32_t chunk, const bool record)
 {
     uint32_t b, e;
     sph_chunk_rows(s, chunk, &b, &e);
@@ -141,10 +140,125 @@ static inline __attribute__((always_inline)) void density_scan(rt_sph *s, uint32
             o->skin_pairs += ns;
             s->x0[i] = px, s->y0[i] = py, s->z0[i] = pz;
         }
-        if (lists_only)
-            o->pairs += nn;
-        else
-            density_tail(s, i, sum, nn, px, py, pz, o, walls);
+        density_tail(s, i, sum, nn, px, py, pz, o, walls);
+    }
+    if (record)
+        s->snb_used[chunk] = sused;
+    s->out[chunk] = acc;
+}
+
+#if SPH_SSE
+/* The lanes of each 4-bit mask, packed to the front, and the mask's bit count. */
+static const uint32_t sph_pack_lanes[16][4] __attribute__((aligned(16))) = {
+    {0, 0, 0, 0}, {0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0}, {2, 0, 0, 0}, {0, 2, 0, 0}, {1, 2, 0, 0}, {0, 1, 2, 0},
+    {3, 0, 0, 0}, {0, 3, 0, 0}, {1, 3, 0, 0}, {0, 1, 3, 0}, {2, 3, 0, 0}, {0, 2, 3, 0}, {1, 2, 3, 0}, {0, 1, 2, 3}};
+static const uint8_t sph_pack_count[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
+
+/* Appends base + the set lanes of `mask` to list[*n..] in lane order: one 16-byte store of which
+ * the entries past the new end are scratch (the list needs 3 entries of room beyond it), so the
+ * next group's store address waits on one add, not on four dependent ones. */
+static inline __attribute__((always_inline)) void sph_append4(uint32_t *list, uint32_t *n, __m128i base, int mask)
+{
+    __m128i v = _mm_add_epi32(base, _mm_load_si128((const __m128i *)sph_pack_lanes[mask]));
+    _mm_storeu_si128((__m128i *)(list + *n), v);
+    *n += sph_pack_count[mask];
+}
+
+/* Appends the candidates j in [lo, hi) within H (to L, count *nn) and, when `record`, within
+ * H + skin (to SL, *ns), self excluded, in increasing j: the lists the scalar scan writes, entry
+ * for entry. A row of cells is contiguous, so four candidates are one unaligned load per column;
+ * a row's last partial group is the four entries ending at hi with the lanes before `k` masked
+ * (reads stay inside [0, n): the caller guarantees n >= 4). Branch-free appends: ~27% of the
+ * candidates are within H, an unpredictable branch for the scalar scan. */
+static inline __attribute__((always_inline)) void
+lists_row_sse(const float *X, const float *Y, const float *Z, uint32_t lo, uint32_t hi, uint32_t i, __m128 vpx,
+              __m128 vpy, __m128 vpz, __m128 vH2, __m128 vS2, const bool record, uint32_t *L, uint32_t *nn,
+              uint32_t *SL, uint32_t *ns)
+{
+    const __m128i lane = _mm_setr_epi32(0, 1, 2, 3), vi = _mm_set1_epi32((int)i);
+    uint32_t a = *nn, b = *ns;
+    for (uint32_t k = lo; k < hi; k += 4) {
+        /* the last group overlaps the one before (or starts at 0 for a row ending below 4) */
+        uint32_t g = k + 4 <= hi ? k : (hi >= 4 ? hi - 4 : 0);
+        __m128 dx = vpx - _mm_loadu_ps(X + g), dy = vpy - _mm_loadu_ps(Y + g), dz = vpz - _mm_loadu_ps(Z + g);
+        __m128 r2 = dx * dx + dy * dy + dz * dz;
+        const __m128i vg = _mm_set1_epi32((int)g), idx = _mm_add_epi32(vg, lane);
+        /* lanes below k were appended by the previous group, lanes from hi are another row's;
+         * the self pair is left out (indices < 2^31: the capacity bound is 2^27) */
+        __m128i keep = _mm_andnot_si128(_mm_cmpeq_epi32(idx, vi),
+                                        _mm_and_si128(_mm_cmpgt_epi32(idx, _mm_set1_epi32((int)k - 1)),
+                                                      _mm_cmplt_epi32(idx, _mm_set1_epi32((int)hi))));
+        int in = _mm_movemask_ps(_mm_and_ps(_mm_cmplt_ps(r2, vH2), _mm_castsi128_ps(keep)));
+        sph_append4(L, &a, vg, in);
+        if (record) {
+            int sk = _mm_movemask_ps(_mm_and_ps(_mm_cmplt_ps(r2, vS2), _mm_castsi128_ps(keep)));
+            sph_append4(SL, &b, vg, sk);
+        }
+    }
+    *nn = a, *ns = b;
+}
+#endif
+
+/* The lists alone (PBF: every pass after this evaluates its own density) by the 5x5x5 cell scan:
+ * the exact list (r < H) and, when `record`, the Verlet list and the positions it was built at.
+ * The same lists as density_scan's, four candidates at a time. */
+static inline __attribute__((always_inline)) void lists_scan(rt_sph *s, uint32_t chunk, const bool record)
+{
+    uint32_t b, e;
+    sph_chunk_rows(s, chunk, &b, &e);
+    const float H2 = s->H2, S2 = s->S2;
+    sph_chunk_out acc = s->out[chunk];
+    const float *X = s->x, *Y = s->y, *Z = s->z;
+    uint32_t used = 0, sused = 0;
+    for (uint32_t i = b; i < e; ++i) {
+        float px = X[i], py = Y[i], pz = Z[i];
+        sph_ranges r;
+        sph_neighbor_ranges(s, px, py, pz, 2, &r);
+        uint32_t cand = 0;
+        for (int q = 0; q < r.count; ++q)
+            cand += r.hi[q] - r.lo[q];
+        /* +3: a group's appends write up to three entries past the last one kept */
+        if (!grow_list(s, &s->cnb[chunk], &s->cnb_cap[chunk], used + cand + 3) ||
+            (record && !grow_list(s, &s->snb[chunk], &s->snb_cap[chunk], sused + cand + 3))) {
+            s->out[chunk] = acc;
+            return;
+        }
+        uint32_t *L = s->cnb[chunk] + used, *SL = record ? s->snb[chunk] + sused : NULL;
+        uint32_t nn = 0, ns = 0;
+#if SPH_SSE
+        if (s->n >= 4) {
+            const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), vpz = _mm_set1_ps(pz);
+            const __m128 vH2 = _mm_set1_ps(H2), vS2 = _mm_set1_ps(S2);
+            for (int q = 0; q < r.count; ++q)
+                lists_row_sse(X, Y, Z, r.lo[q], r.hi[q], i, vpx, vpy, vpz, vH2, vS2, record, L, &nn, SL, &ns);
+        } else
+#endif
+        {
+            for (int q = 0; q < r.count; ++q)
+                for (uint32_t j = r.lo[q]; j < r.hi[q]; ++j) {
+                    float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
+                    float r2 = dx * dx + dy * dy + dz * dz;
+                    if (record && r2 < S2) {
+                        SL[ns] = j;
+                        ns += j != i;
+                    }
+                    if (r2 < H2) {
+                        L[nn] = j;
+                        nn += j != i;
+                    }
+                }
+        }
+        s->nb_start[i] = used;
+        s->nb_count[i] = nn;
+        used += nn;
+        if (record) {
+            s->sk_start[i] = sused;
+            s->sk_count[i] = ns;
+            sused += ns;
+            acc.skin_pairs += ns;
+            s->x0[i] = px, s->y0[i] = py, s->z0[i] = pz;
+        }
+        acc.pairs += nn;
     }
     if (record)
         s->snb_used[chunk] = sused;
@@ -225,9 +339,9 @@ void rt_sph_density_chunk(rt_sph *s, uint32_t chunk)
     if (s->dens_mode == 2)
         density_walk(s, chunk, false);
     else if (s->dens_mode == 1)
-        density_scan(s, chunk, true, false);
+        density_scan(s, chunk, true);
     else
-        density_scan(s, chunk, false, false);
+        density_scan(s, chunk, false);
 }
 
 void rt_sph_lists_chunk(rt_sph *s, uint32_t chunk)
@@ -235,9 +349,9 @@ void rt_sph_lists_chunk(rt_sph *s, uint32_t chunk)
     if (s->dens_mode == 2)
         density_walk(s, chunk, true);
     else if (s->dens_mode == 1)
-        density_scan(s, chunk, true, true);
+        lists_scan(s, chunk, true);
     else
-        density_scan(s, chunk, false, true);
+        lists_scan(s, chunk, false);
 }
 
 /* Squared displacement of every particle since the last rebuild (columns edited by hand). */
