@@ -420,7 +420,8 @@ int bench_sim(int argc, char **argv)
                     snprintf(list, sizeof list, "%s", argv[++k]);
                     ps = 0u;
                     for (char *t = strtok(list, ","); t; t = strtok(NULL, ","))
-                        ps |= !strcmp(t, "wcsph") ? 1u : !strcmp(t, "pbf") ? 2u : !strcmp(t, "pbf-recompute") ? 4u : 1u << 8;
+                        ps |= !strcmp(t, "wcsph") ? 1u : !strcmp(t, "pbf") ? 2u : !strcmp(t, "pbf-recompute") ? 4u
+                              : !strcmp(t, "pbf-jacobi") ? 8u : 1u << 8;
                     if (ps >> 8)
                         ps = 0u;
                 }
@@ -437,7 +438,7 @@ int bench_sim(int argc, char **argv)
             }
             if (pn < 1 || pf < 1 || !ps || pt < 1 || pt > 64 || !(pramp >= 0.f || pramp == -1.f)) {
                 fprintf(stderr, "volfx-bench sim --pool N [--frames F] [--no-paddle] [--solver a comma list of wcsph, "
-                        "pbf, pbf-recompute (default wcsph,pbf)]\n"
+                        "pbf, pbf-recompute, pbf-jacobi (6 plain Jacobi iterations, the old default) (default wcsph,pbf)]\n"
                         "                      [--threads 1..64 (2)] [--pbf-steps S (per 1/60 s)] [--pbf-iterations I] "
                         "[--pbf-relaxation R] [--paddle-ramp S (0: none; default one period)]\n");
                 return 2;

@@ -30,7 +30,8 @@ static double cpu_ms(void)
     return (double)t.tv_sec * 1e3 + 1e-6 * (double)t.tv_nsec;
 }
 
-/* solvers: bit 0 WCSPH, bit 1 PBF, bit 2 PBF with RT_SPH_PBF_RECOMPUTE (callgrind of one alone) */
+/* solvers: bit 0 WCSPH, bit 1 PBF, bit 2 PBF with RT_SPH_PBF_RECOMPUTE (callgrind of one alone),
+ * bit 3 PBF with plain Jacobi iterations (RT_SPH_PBF_NO_CHEBYSHEV, 6 unless --pbf-iterations) */
 int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsigned solvers, uint32_t pbf_steps,
                    uint32_t pbf_iters, float pbf_relax, float ramp_s)
 {
@@ -41,17 +42,17 @@ int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsign
         vol *= fmax[k] - fmin[k];
     float dx = (float)cbrt(vol / n); /* as demo_scene.c: the count fills the scene's block */
     const float amp = 0.25f, period = 2.5f;
-    enum { NS = 3 };
-    static const char *const name[NS] = {"wcsph", "pbf", "pbf-recompute"};
-    rt_sph *s[NS] = {NULL, NULL, NULL};
-    uint32_t added[NS] = {0, 0, 0};
+    enum { NS = 4 };
+    static const char *const name[NS] = {"wcsph", "pbf", "pbf-recompute", "pbf-jacobi"};
+    rt_sph *s[NS] = {NULL, NULL, NULL, NULL};
+    uint32_t added[NS] = {0, 0, 0, 0};
     for (int m = 0; m < NS; ++m) {
         if (!(solvers >> m & 1u))
             continue;
         rt_sph_desc d = {.spacing = dx, .max_substeps = 64, .sound_speed = 25.f, .threads = threads,
                           .solver = m ? RT_SPH_SOLVER_PBF : RT_SPH_SOLVER_WCSPH,
-                          .flags = m == 2 ? RT_SPH_PBF_RECOMPUTE : 0u,
-                          .pbf_iterations = pbf_iters, .pbf_max_step = pbf_steps ? 1.f / (60.f * pbf_steps) : 0.f,
+                          .flags = m == 2 ? RT_SPH_PBF_RECOMPUTE : m == 3 ? RT_SPH_PBF_NO_CHEBYSHEV : 0u,
+                          .pbf_iterations = pbf_iters ? pbf_iters : m == 3 ? 6u : 0u, .pbf_max_step = pbf_steps ? 1.f / (60.f * pbf_steps) : 0.f,
                           .pbf_relaxation = pbf_relax};
         memcpy(d.domain_min, tmin, sizeof tmin);
         memcpy(d.domain_max, tmax, sizeof tmax);

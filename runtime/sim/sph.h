@@ -45,6 +45,9 @@ enum {
     /* the original passes, each pair's kernel gradient computed in both passes of an iteration
      * (the default computes it once, sph_pbf_lin.c; bitwise the same result: for benchmarks) */
     RT_SPH_PBF_RECOMPUTE = 1u << 6,
+    /* PBF: plain Jacobi iterations, without the Chebyshev acceleration (the pre-round-3 method;
+     * give it 6 iterations for the old default) */
+    RT_SPH_PBF_NO_CHEBYSHEV = 1u << 7,
 };
 
 /* The solver (rt_sph_desc.solver). */
@@ -90,7 +93,7 @@ typedef struct rt_sph_desc {
      * rt_sph_step takes ceil(frame_dt / pbf_max_step) steps, more when a particle would move
      * more than pbf_cfl * H in one (up to max_substeps; the frame is always covered). */
     uint32_t solver;            /* rt_sph_solver; WCSPH */
-    uint32_t pbf_iterations;    /* Jacobi iterations per step; 6 */
+    uint32_t pbf_iterations;    /* Jacobi iterations per step; 5 */
     float pbf_max_step;         /* longest step [s]; 1/60 */
     float pbf_cfl;              /* largest move per step as a fraction of H; 0.5 */
     float pbf_relaxation;       /* constraint-force mixing eps, a fraction of the lattice's
@@ -99,6 +102,9 @@ typedef struct rt_sph_desc {
     float pbf_scorr_dq;         /* its dq as a fraction of H; 0.2 */
     float pbf_xsph;             /* XSPH viscosity c; 0.01 */
     float pbf_vorticity;        /* vorticity confinement epsilon [m/s]; 0 (off) */
+    /* Chebyshev semi-iterative acceleration of the Jacobi iterations (Wang 2015): the estimate
+     * of the iteration's spectral radius rho, 0 <= rho < 1; 0.7. Off with RT_SPH_PBF_NO_CHEBYSHEV */
+    float pbf_chebyshev_rho;
 } rt_sph_desc;
 
 typedef enum rt_sph_dt_limit {

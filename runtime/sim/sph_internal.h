@@ -120,6 +120,8 @@ struct rt_sph {
     float pbf_vmax;              /* largest speed after the last step */
     float pbf_dt;                /* the step being taken */
     uint32_t pbf_iter;           /* the Jacobi iteration being run (0: the walls are evaluated) */
+    float cheb_omega;            /* this iteration's Chebyshev weight (1: a plain Jacobi update) */
+    float *cheb_prev[3];         /* the iterate before the current one (its extrapolation base) */
     float *pc[3], *pn[3];        /* positions of the current and the next Jacobi iterate */
     bool pbf_store;              /* this step's lambda passes store the pair terms (sph_pbf_lin.c) */
     /* sph_pbf_lin.c: the iteration's pair terms, four arrays per work item parallel to cnb
