@@ -30,6 +30,10 @@ struct rt_sim_system {
     rt_sim_stats stats;
     void (*sink)(void *user, const char *name, double value);
     void *sink_user;
+    /* rt_sim_system_settle_next: pending until the next run */
+    bool settle;
+    rt_sph_settle_desc settle_desc;
+    rt_logger log;
 };
 
 static double wall_s(void)
@@ -40,9 +44,10 @@ static double wall_s(void)
 }
 
 /* Steps the bound solver over the frame's dt: once, or by the clock's whole steps. */
-static vfx_result sim_advance(rt_sim_system *s, float frame_dt, char *err, size_t errlen)
+static vfx_result sim_advance(rt_sim_system *s, float frame_dt, const rt_sph_settle_report *settled, char *err,
+                              size_t errlen)
 {
-    rt_sim_stats st = {.dropped_s = s->stats.dropped_s};
+    rt_sim_stats st = {.dropped_s = s->stats.dropped_s, .settle_steps = settled->steps, .settle_cpu_s = settled->cpu_s};
     rt_sph_report sum = {0};
     vfx_result r = VFX_OK;
     double t0 = wall_s();
@@ -84,6 +89,7 @@ static vfx_result sim_advance(rt_sim_system *s, float frame_dt, char *err, size_
         s->sink(s->sink_user, "sim.realtime_factor", st.realtime_factor);
         s->sink(s->sink_user, "sim.max_speed", st.max_speed);
         s->sink(s->sink_user, "sim.density_error", st.density_error);
+        s->sink(s->sink_user, "sim.settle_steps", st.settle_steps);
     }
     return r;
 }
@@ -196,8 +202,17 @@ static vfx_result sim_run(rt_world *w, const rt_system_ctx *ctx)
         }
         s->bound = true;
     }
+    rt_sph_settle_report settled = {0};
+    if (s->settle) {
+        s->settle = false;
+        if ((r = rt_sph_settle(s->sph, &s->settle_desc, &settled, err, sizeof err)))
+            return rt_world_fail(w, r, "vfx.sim.sph: settling: %s", err);
+        rt_logf(&s->log, VFX_LOG_INFO, "fluid settled before frame 0: %u steps, max speed %.3f m/s at the last, "
+                "mean compression %.2f%%, %.2f CPU s; velocities zeroed", settled.steps,
+                (double)settled.max_speed_last, 100.0 * settled.compression, settled.cpu_s);
+    }
     /* A failed step leaves the last good (finite) state in the columns. */
-    r = sim_advance(s, ctx->dt, err, sizeof err);
+    r = sim_advance(s, ctx->dt, &settled, err, sizeof err);
     if (s->table != SIM_NO_TABLE)
         s->revision = rt_world_table_revision(w, s->table) + SIM_OWN_BUMPS;
     return r ? rt_world_fail(w, r, "vfx.sim.sph: %s", err) : VFX_OK;
@@ -265,6 +280,26 @@ vfx_result rt_sim_system_set_clock(rt_sim_system *s, float step_dt, uint32_t max
     s->step_dt = step_dt;
     s->max_steps = max_steps;
     s->accum = 0.0;
+    return VFX_OK;
+}
+
+/* rt_sph_settle's progress, as a log line */
+static void settle_progress(void *user, uint32_t step, uint32_t max_steps, float max_speed, float compression)
+{
+    const rt_sim_system *s = user;
+    rt_logf(&s->log, VFX_LOG_INFO, "settling the fluid: step %u of at most %u, max speed %.3f m/s, mean "
+            "compression %.2f%%", step, max_steps, (double)max_speed, 100.0 * compression);
+}
+
+vfx_result rt_sim_system_settle_next(rt_sim_system *s, const rt_sph_settle_desc *desc, const rt_logger *log)
+{
+    if (!s)
+        return VFX_ERR_INVALID_ARGUMENT;
+    s->settle_desc = desc ? *desc : (rt_sph_settle_desc){0};
+    s->settle_desc.progress = settle_progress;
+    s->settle_desc.user = s;
+    s->log = log ? *log : (rt_logger){0};
+    s->settle = true;
     return VFX_OK;
 }
 

@@ -13,6 +13,7 @@
 #ifndef RT_SIM_SYSTEM_H
 #define RT_SIM_SYSTEM_H
 
+#include "core/log.h"
 #include "ecs/particles.h"
 #include "ecs/world.h"
 #include "sim/sph.h"
@@ -44,7 +45,14 @@ typedef struct rt_sim_stats {
     double dropped_s;        /* frame time the clock dropped (max_steps reached), total */
     float max_speed;         /* [m/s], end of the frame */
     float density_error;     /* mean max(0, rho/rho0 - 1), end of the frame */
+    uint32_t settle_steps;   /* rt_sph_settle steps run before this frame's steps (0 but once) */
+    double settle_cpu_s;     /* their process CPU seconds */
 } rt_sim_stats;
+/* The next run settles the particles before its first step (rt_sph_settle, desc NULL: its
+ * defaults), once: a fluid block placed in a scene then starts in the solver's equilibrium at
+ * rest. A progress line every desc->progress_every steps and a summary go to log (NULL: stderr);
+ * desc's own progress callback is not used. The steps are counted in the stats (settle_steps). */
+vfx_result rt_sim_system_settle_next(rt_sim_system *sys, const rt_sph_settle_desc *desc, const rt_logger *log);
 /* The last run's figures (zero before the first). */
 const rt_sim_stats *rt_sim_system_stats(const rt_sim_system *sys);
 /* Called at the end of every run with each sim.* figure (e.g. rt_profiler_counter); NULL: none. */

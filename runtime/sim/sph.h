@@ -247,6 +247,30 @@ vfx_result rt_sph_add_emitter(rt_sph *sim, const rt_sph_emitter *e, char *err, s
  * one. frame_dt must be finite and >= 0. */
 vfx_result rt_sph_step(rt_sph *sim, float frame_dt, rt_sph_report *report, char *err,
                        size_t errlen);
+/* rt_sph_settle: damped steps before a scene's frame 0, so a fresh block (the calibrated lattice)
+ * starts in the solver's own hydrostatic equilibrium instead of sinking into it. Zero means the
+ * default. */
+typedef struct rt_sph_settle_desc {
+    uint32_t max_steps;   /* at most this many steps (default 120) */
+    float step_dt;        /* each a rt_sph_step of this dt [s] (default 1/60) */
+    float damping;        /* velocities multiplied by this after each step (default 0.9; 0..1) */
+    float speed_tol;      /* stop once a step ends below this max speed [m/s] (default 0.03) */
+    uint32_t progress_every; /* progress(...) every this many steps and at the end (default 20) */
+    void (*progress)(void *user, uint32_t step, uint32_t max_steps, float max_speed, float compression);
+    void *user;
+} rt_sph_settle_desc;
+typedef struct rt_sph_settle_report {
+    uint32_t steps;        /* steps taken */
+    float max_speed_first; /* max speed after the first step [m/s] */
+    float max_speed_last;  /* after the last step, before its damping (the velocities are then zeroed) */
+    float compression;     /* mean compression after the last step */
+    double cpu_s;          /* process CPU seconds the settle took (all threads) */
+} rt_sph_settle_report;
+/* Steps with the velocities damped until the max speed falls below speed_tol or max_steps are
+ * taken, then zeroes the velocities and sets the clock (and the colliders' motion) back to where
+ * it was: the state is the settled positions at rest. NULL desc: defaults. */
+vfx_result rt_sph_settle(rt_sph *sim, const rt_sph_settle_desc *desc, rt_sph_settle_report *report, char *err,
+                         size_t errlen);
 /* The SoA columns (see the validity note above). */
 rt_sph_columns rt_sph_get_columns(rt_sph *sim);
 /* Pressure [Pa] of row i from the last density pass (0 when i is out of range). */

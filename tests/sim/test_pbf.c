@@ -340,6 +340,62 @@ static void test_pbf_closed_tank_energy(void **state)
     rt_sph_destroy(s);
 }
 
+/* Issue 22's start at rest: the closed tank of the test above (6 layers, as the default pool)
+ * started from the calibrated lattice sinks into PBF's own hydrostatic state (~1.9% mean
+ * compression here) at up to 0.45 m/s over frames 2-60; rt_sph_settle does that sinking before
+ * frame 0. Measured (AMD EPYC, 2026-12-03): 0.45 m/s without, 0.064 m/s over frames 2-30 and
+ * 0.081 over 2-120 after 120 settle steps. The issue's 0.05 m/s is not met: what is left is the
+ * wall layers pressed into the walls (docs/simulation.md "Start at rest"). The bounds sit between
+ * the two with a 2x margin each way (the settled run is chaotic at the 0.01 m/s level): the
+ * unsettled start must exceed 0.3 m/s (the problem is reproduced), the settled one stay below
+ * 0.15 m/s. The settle also leaves the clock and the velocities at zero. */
+static void test_pbf_settled_tank_at_rest(void **state)
+{
+    (void)state;
+    float vmax[2] = {0.f, 0.f};
+    for (int k = 0; k < 2; ++k) {
+        rt_sph_desc d = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {0.6f, 0.4f, 0.3f}, .threads = 2};
+        rt_sph *s = make(d);
+        float lo[3] = {0, 0, 0}, hi[3] = {0.6f, 0.12f, 0.3f};
+        assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
+        if (k) {
+            rt_sph_settle_desc sd = {.max_steps = 120};
+            rt_sph_settle_report sr;
+            char err[256];
+            assert_int_equal(rt_sph_settle(s, &sd, &sr, err, sizeof err), VFX_OK);
+            assert_true(sr.steps >= 1 && sr.steps <= 120);
+            assert_true(sr.max_speed_first > sr.max_speed_last);
+            assert_true(rt_sph_time(s) == 0.0);
+            rt_sph_columns c = rt_sph_get_columns(s);
+            for (uint32_t i = 0; i < c.count; ++i)
+                assert_true(c.vx[i] == 0.f && c.vy[i] == 0.f && c.vz[i] == 0.f);
+            print_message("settle: %u steps, max speed %.3f -> %.3f m/s, compression %.4f, %.2f CPU s\n", sr.steps,
+                          sr.max_speed_first, sr.max_speed_last, sr.compression, sr.cpu_s);
+        }
+        rt_sph_report r;
+        for (int f = 0; f < 60; ++f) {
+            assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, NULL, 0), VFX_OK);
+            if (f >= 1)
+                vmax[k] = r.max_speed > vmax[k] ? r.max_speed : vmax[k];
+        }
+        check_state(s);
+        rt_sph_destroy(s);
+    }
+    print_message("resting tank, max speed over frames 2-60: %.3f m/s from the lattice, %.3f settled\n", vmax[0],
+                  vmax[1]);
+    assert_true(vmax[0] > 0.3f);
+    assert_true(vmax[1] < 0.15f);
+    /* bad arguments are refused by name */
+    rt_sph *s = make(small_box());
+    char err[256];
+    rt_sph_settle_desc bad = {.damping = 1.5f};
+    assert_int_equal(rt_sph_settle(s, &bad, NULL, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "damping"));
+    assert_int_equal(rt_sph_settle(NULL, NULL, NULL, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(rt_sph_settle(s, NULL, NULL, err, sizeof err), VFX_OK); /* no particles: nothing to do */
+    rt_sph_destroy(s);
+}
+
 /* A free block in zero gravity with 5 mm/s of noise (far from every wall): PBF's projection and
  * XSPH can only take kinetic energy away, so it must not grow over 60 frames; the reference is
  * the initial kinetic energy itself (float64 sum here). With the artificial pressure s_corr on
@@ -388,6 +444,7 @@ int main(void)
         cmocka_unit_test(test_pbf_threads_bitwise), cmocka_unit_test(test_pbf_closed_tank_energy),
         cmocka_unit_test(test_pbf_free_block_energy), cmocka_unit_test(test_pbf_stored_pairs_bitwise),
         cmocka_unit_test(test_pbf_paddle_ramp),  cmocka_unit_test(test_pbf_chebyshev_converges),
+        cmocka_unit_test(test_pbf_settled_tank_at_rest),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -113,6 +113,56 @@ static void test_system_writes_columns(void **state)
     rt_sim_system_destroy(sys);
 }
 
+/* rt_sim_system_settle_next: the first run settles the block (counted in the stats and logged
+ * through the logger, a progress line and a summary), later runs do not. */
+static void count_log(void *user, vfx_log_level level, const char *message)
+{
+    (void)level;
+    if (strstr(message, "settl"))
+        ++*(int *)user;
+}
+
+static void test_system_settles_once(void **state)
+{
+    (void)state;
+    rt_world *w = rt_world_create(NULL);
+    assert_non_null(w);
+    rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.1f, 0.2f, 0.06f}, .threads = 2,
+                      .solver = RT_SPH_SOLVER_PBF};
+    rt_sim_system *sys;
+    char err[256];
+    assert_int_equal(rt_sim_system_create(w, &d, &sys, err, sizeof err), VFX_OK);
+    rt_particle_components pc;
+    assert_int_equal(rt_particles_register(w, &pc), VFX_OK);
+    enum { N = 300 }; /* a 10 x 5 x 6 block on the floor, on the solver's lattice */
+    float x[N], y[N], z[N];
+    for (int i = 0; i < N; ++i) {
+        x[i] = 0.005f + 0.01f * (float)(i % 10);
+        y[i] = 0.005f + 0.01f * (float)((i / 10) % 5);
+        z[i] = 0.005f + 0.01f * (float)(i / 50);
+    }
+    assert_int_equal(rt_particles_spawn(w, &pc, N, x, y, z, false), VFX_OK);
+    int lines = 0;
+    rt_logger log = {count_log, &lines};
+    rt_sph_settle_desc sd = {.max_steps = 30, .progress_every = 10};
+    assert_int_equal(rt_sim_system_settle_next(sys, &sd, &log), VFX_OK);
+    assert_int_equal(rt_world_run_phase(w, RT_PHASE_SIMULATE, 0.0, 1.f / 60.f), VFX_OK);
+    const rt_sim_stats *st = rt_sim_system_stats(sys);
+    assert_true(st->settle_steps >= 1 && st->settle_steps <= 30);
+    assert_true(st->settle_cpu_s >= 0.0);
+    assert_int_equal(st->steps, 1);
+    /* a progress line per 10 steps, one at the end (may coincide), and the summary */
+    assert_true(lines >= 2 && lines <= 5);
+    print_message("settled in %u steps, %d log lines\n", st->settle_steps, lines);
+    /* frame 0 ran one step of 1/60 s after the settle: the clock did not run during it */
+    assert_true(fabs(rt_sph_time(rt_sim_system_solver(sys)) - 1.0 / 60.0) < 1e-6);
+    assert_int_equal(rt_world_run_phase(w, RT_PHASE_SIMULATE, 1 / 60.0, 1.f / 60.f), VFX_OK);
+    assert_int_equal(rt_sim_system_stats(sys)->settle_steps, 0);
+    assert_int_equal(rt_sim_system_settle_next(NULL, NULL, NULL), VFX_ERR_INVALID_ARGUMENT);
+    rt_world_destroy(w);
+    rt_sim_system_destroy(sys);
+}
+
 static void test_system_reports_bad_column(void **state)
 {
     (void)state;
@@ -139,6 +189,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_system_writes_columns),
         cmocka_unit_test(test_system_reports_bad_column),
+        cmocka_unit_test(test_system_settles_once),
     };
     return cmocka_run_group_tests_name("sim_system", tests, NULL, NULL);
 }
