@@ -341,10 +341,10 @@ static void test_pbf_closed_tank_energy(void **state)
 }
 
 /* Issue 22's start at rest: the closed tank of the test above (6 layers, as the default pool)
- * started from the calibrated lattice sinks into PBF's own hydrostatic state (~1.9% mean
- * compression here) at up to 0.45 m/s over frames 2-60; rt_sph_settle does that sinking before
- * frame 0. Measured (AMD EPYC, 2026-12-03): 0.45 m/s without, 0.064 m/s over frames 2-30 and
- * 0.081 over 2-120 after 120 settle steps. The issue's 0.05 m/s is not met: what is left is the
+ * started from the calibrated lattice sinks into PBF's own hydrostatic state (~1.3% mean
+ * compression here) at up to 0.44 m/s over frames 2-60; rt_sph_settle does that sinking before
+ * frame 0. Measured (AMD EPYC, 2026-12-03, 5 Chebyshev iterations): 0.44 m/s without, 0.080 m/s
+ * after 120 settle steps. The issue's 0.05 m/s is not met: what is left is the
  * wall layers pressed into the walls (docs/simulation.md "Start at rest"). The bounds sit between
  * the two with a 2x margin each way (the settled run is chaotic at the 0.01 m/s level): the
  * unsettled start must exceed 0.3 m/s (the problem is reproduced), the settled one stay below
