@@ -132,16 +132,29 @@ int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsign
         if (!(solvers >> m & 1u))
             continue;
         med[m] = rt_median(ms[m], (uint32_t)frames);
+        /* the last frame's rms speed, and the particles pressed against the tank's faces (within
+         * 0.3 dx: the lattice's wall layers start at dx/2, PBF's clamp holds them at dx/4) */
+        rt_sph_columns c = rt_sph_get_columns(s[m]);
+        uint32_t floor_pressed = 0, side_pressed = 0;
+        double v2 = 0.0;
+        for (uint32_t i = 0; i < c.count; ++i) {
+            v2 += (double)c.vx[i] * c.vx[i] + (double)c.vy[i] * c.vy[i] + (double)c.vz[i] * c.vz[i];
+            floor_pressed += c.y[i] - tmin[1] < 0.3f * dx;
+            float side = fminf(fminf(c.x[i] - tmin[0], tmax[0] - c.x[i]), fminf(c.z[i] - tmin[2], tmax[2] - c.z[i]));
+            side_pressed += side < 0.3f * dx;
+        }
         printf("{\"bench\":\"sim_pool\",\"solver\":\"%s\",\"particles\":%u,\"spacing\":%.5f,\"paddle\":%s,"
                "\"frames\":%d,\"threads\":%u,\"cpu_ms_per_frame_median\":%.3f,\"wall_ms_per_frame_median\":%.3f,\"steps_per_frame\":%.2f,"
                "\"iterations_per_frame\":%.2f,\"rebuilds_per_frame\":%.2f,\"max_speed_frames_2_on\":%.4f,\"max_speed_frames_2_30\":%.4f,\"max_speed_last\":%.4f,\"mean_compression\":%.5f,\"paddle_ramp_s\":%.3f,"
                "\"energy_first_J\":%.6g,\"energy_growth_max\":%.3g,\"kinetic_energy_last_J\":%.4g,"
-               "\"settle_steps\":%u,\"settle_cpu_s\":%.3f,\"settle_max_speed_last\":%.4f}\n",
+               "\"settle_steps\":%u,\"settle_cpu_s\":%.3f,\"settle_max_speed_last\":%.4f,"
+               "\"rms_speed_last\":%.4f,\"floor_pressed_last\":%u,\"side_pressed_last\":%u}\n",
                name[m], added[m], dx, paddle ? "true" : "false", frames, rt_sph_thread_count(s[m]),
                med[m], rt_median(wms[m], (uint32_t)frames), (double)steps[m] / frames, (double)iters[m] / frames,
                (double)rebuilds[m] / frames, vmax[m], frames >= 2 ? vmax30[m] : 0.f, vlast[m], err_sum[m] / frames,
                paddle ? (double)(ramp_s < 0.f ? period : ramp_s) : 0.0, e0[m], grow[m], ke_last[m],
-               settled[m].steps, settled[m].cpu_s, settled[m].max_speed_last);
+               settled[m].steps, settled[m].cpu_s, settled[m].max_speed_last,
+               c.count ? sqrt(v2 / c.count) : 0.0, floor_pressed, side_pressed);
     }
     for (int m = 1; m < NS; ++m)
         if ((solvers & 1u) && (solvers >> m & 1u))

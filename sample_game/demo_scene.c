@@ -117,8 +117,9 @@ static vfx_result load_water(game_app *app, game_demo *demo, const rt_scene *sc)
             goto done;
         /* the block starts on the calibrated lattice at rho0, which neither solver holds at rest:
          * settled into the solver's hydrostatic state before frame 0, it does not sink into it
-         * during the first second (docs/simulation.md "Start at rest") */
-        if ((r = rt_sim_system_settle_next(demo->sim, NULL, &app->log)))
+         * during the first second (docs/simulation.md "Start at rest"; water.simulation.settle_steps) */
+        rt_sph_settle_desc settle = {.max_steps = w->settle_steps};
+        if (w->settle_steps && (r = rt_sim_system_settle_next(demo->sim, &settle, &app->log)))
             goto done;
         if (w->paddle) {
             uint32_t ax = w->paddle_axis < 3 ? w->paddle_axis : 0;

@@ -115,6 +115,7 @@ typedef struct rt_scene_water {
     float paddle_ramp_s;             /* amplitude ramped in over this time (default one period) */
     bool no_slip;                    /* tank walls (all six faces) with wall-law friction */
     uint32_t solver;                 /* water.simulation.solver: 0 "wcsph", 1 "pbf" (rt_sph_solver); "pbf" */
+    uint32_t settle_steps;           /* rt_sph_settle's steps at most before frame 0 (default 120; 0: none) */
     /* rendering (seed 000), a full vfx_water_params with size/version filled */
     vfx_water_params params;
     /* water.quality.kernel (vfx_water_params2.kernel): anisotropic for method TILE unless the

@@ -96,7 +96,7 @@ static vfx_result parse_water_generator(pctx *c, const cJSON *v, rt_scene_water 
 static vfx_result parse_water_simulation(pctx *c, const cJSON *v, rt_scene_water *w)
 {
     static const char *const skeys[] = {"tank", "fluid", "particle_count", "gravity", "dt", "paddle", "no_slip",
-                                        "solver", NULL};
+                                        "solver", "settle_steps", NULL};
     static const char *const solvers[] = {"wcsph", "pbf", NULL}; /* rt_sph_solver order */
     vfx_result r;
     const char *PS = "water.simulation";
@@ -117,6 +117,8 @@ static vfx_result parse_water_simulation(pctx *c, const cJSON *v, rt_scene_water
     if (!r) r = rt_scene_get_bool(c, s, PS, "no_slip", &w->no_slip);
     w->solver = 1; /* "pbf" when the key is absent (issue 22: 5-7x cheaper per frame, calmer at rest) */
     if (!r) r = rt_scene_get_enum(c, s, PS, "solver", false, solvers, &w->solver);
+    w->settle_steps = 120; /* absent: the block settles before frame 0 (issue 22: it sank at ~1 m/s) */
+    if (!r) r = rt_scene_get_uint(c, s, PS, "settle_steps", false, 0, 10000, &w->settle_steps);
     if (r)
         return r;
     const cJSON *pd = cJSON_GetObjectItemCaseSensitive(s, "paddle");

@@ -256,6 +256,9 @@ static const bad_case bad_cases[] = {
      "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"paddle\":{\"ramp_s\":-1}}}}",
      VFX_ERR_INVALID_ARGUMENT, "water.simulation.paddle.ramp_s"},
     {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
+     "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"settle_steps\":-3}}}",
+     VFX_ERR_INVALID_ARGUMENT, "water.simulation.settle_steps"},
+    {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
      "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"no_slip\":3}}}",
      VFX_ERR_FORMAT, "water.simulation.no_slip: expected true or false, got a number"},
     {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
@@ -609,6 +612,7 @@ static void test_sample_scenes(void **state)
             assert_true(s->has_water && s->water.source == RT_SCENE_WATER_SIMULATION && s->water.paddle);
             /* ramp_s absent: the paddle's amplitude ramps in over one period */
             assert_true(s->water.paddle_ramp_s == s->water.paddle_period_s && s->water.paddle_period_s > 0.f);
+            assert_int_equal(s->water.settle_steps, 120); /* absent: the block settles before frame 0 */
             assert_true(s->has_volume);
             assert_true(s->mesh_count >= 1);
         }
