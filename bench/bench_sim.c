@@ -258,15 +258,18 @@ static double cpu_now_s(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
+/* pbf_iters, pbf_rho: PBF's iterations and Chebyshev rho (0: the defaults; rho < 0: plain Jacobi) */
 static int dam_break(int res, uint32_t threads, double t_max, double settle_s, uint32_t no_slip,
-                     uint32_t solver, const char *cpu)
+                     uint32_t solver, uint32_t pbf_iters, float pbf_rho, const char *cpu)
 {
     const double a = 0.05715, g = 9.81;
     float dx = (float)(a / res);
     rt_sph_desc d = {.spacing = dx, .domain_min = {0, 0, 0},
                       .domain_max = {(float)(10 * a), (float)(2.5 * a), 4 * dx},
                       .threads = threads, .max_substeps = 1000000, .no_slip_faces = no_slip,
-                      .solver = solver & 255u, .flags = (solver & 256u) ? RT_SPH_PBF_RECOMPUTE : 0u};
+                      .solver = solver & 255u,
+                      .flags = ((solver & 256u) ? RT_SPH_PBF_RECOMPUTE : 0u) | (pbf_rho < 0.f ? RT_SPH_PBF_NO_CHEBYSHEV : 0u),
+                      .pbf_iterations = pbf_iters, .pbf_chebyshev_rho = pbf_rho > 0.f ? pbf_rho : 0.f};
     rt_sph *s;
     char err[256];
     if (rt_sph_create(&d, &s, err, sizeof err)) {
@@ -364,7 +367,8 @@ int bench_sim(int argc, char **argv)
     bool dam = false;
     bench_opts bo = {.warmup_s = 0.2, .nskin = 1, .rebuild = true, .verlet = true};
     double t_max = 6.0, settle_s = 0.0;
-    uint32_t no_slip = 0, solver = RT_SPH_SOLVER_WCSPH;
+    uint32_t no_slip = 0, solver = RT_SPH_SOLVER_WCSPH, dam_iters = 0;
+    float dam_rho = 0.f;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--sizes") && i + 1 < argc) {
             if ((nsizes = parse_list(argv[++i], sizes, 8)) <= 0) {
@@ -468,6 +472,10 @@ int bench_sim(int argc, char **argv)
             }
             /* pbf-recompute: PBF with RT_SPH_PBF_RECOMPUTE (bit 8 here, the flag in dam_break) */
             solver = !strcmp(v, "wcsph") ? RT_SPH_SOLVER_WCSPH : !strcmp(v, "pbf") ? RT_SPH_SOLVER_PBF : RT_SPH_SOLVER_PBF | 256u;
+        } else if (!strcmp(argv[i], "--pbf-iterations") && i + 1 < argc) {
+            dam_iters = (uint32_t)atoi(argv[++i]);
+        } else if (!strcmp(argv[i], "--pbf-chebyshev") && i + 1 < argc) {
+            dam_rho = (float)atof(argv[++i]); /* < 0: plain Jacobi */
         } else if (!strcmp(argv[i], "--no-slip")) {
             /* the experiment's solid walls: the floor and the back wall behind the column */
             no_slip = RT_SPH_FACE_Y_MIN | RT_SPH_FACE_X_MIN;
@@ -478,7 +486,9 @@ int bench_sim(int argc, char **argv)
                  "                list, one set of Verlet solvers each; 0 = default)]\n"
                  "volfx-bench sim --dam-break [--res 20 (a/dx)] [--t-max 6 (last T)] [--threads 2]\n"
                  "                            [--settle 0 (s at rest behind a gate first; 0 = release a fresh lattice)]\n"
-                 "                            [--no-slip (wall-law friction on the floor and back wall)]");
+                 "                            [--no-slip (wall-law friction on the floor and back wall)]\n"
+                 "                            [--solver wcsph|pbf|pbf-recompute] [--pbf-iterations I (PBF; 0 = 5)]\n"
+                 "                            [--pbf-chebyshev R (PBF's rho; 0 = 0.7, < 0 = plain Jacobi)]");
             return 0;
         } else if (strcmp(argv[i], "--json") != 0) {
             fprintf(stderr, "volfx-bench sim: unknown option '%s'\n", argv[i]);
@@ -496,7 +506,7 @@ int bench_sim(int argc, char **argv)
     char cpu[256];
     cpu_model(cpu, sizeof cpu);
     if (dam)
-        return dam_break(res, threads[nthreads - 1], t_max, settle_s, no_slip, solver, cpu);
+        return dam_break(res, threads[nthreads - 1], t_max, settle_s, no_slip, solver, dam_iters, dam_rho, cpu);
     bo.substeps = substeps;
     bo.reps = reps;
     for (int k = 0; k < nsizes; ++k)
