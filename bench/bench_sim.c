@@ -21,7 +21,7 @@
 
 int bench_sim(int argc, char **argv);
 int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsigned solvers, uint32_t pbf_steps,
-                   uint32_t pbf_iters, float pbf_relax, float ramp_s, uint32_t settle, float pbf_xsph);
+                   uint32_t pbf_iters, float pbf_relax, float ramp_s, uint32_t settle, bool settle_qs, float pbf_xsph);
 
 static double now_s(void)
 {
@@ -415,6 +415,7 @@ int bench_sim(int argc, char **argv)
             float prelax = 0.f, pramp = -1.f; /* -1: one paddle period, as the scene's default */
             int psettle = 0;                  /* rt_sph_settle's steps at most before frame 0 */
             float pxsph = 0.f;                /* 0: the solver's default */
+            bool pqs = false;                 /* --settle-quasi-static */
             for (int k = i + 1; k < argc; ++k) {
                 if (!strcmp(argv[k], "--frames") && k + 1 < argc)
                     pf = atoi(argv[++k]);
@@ -443,6 +444,8 @@ int bench_sim(int argc, char **argv)
                     pramp = (float)atof(argv[++k]);
                 else if (!strcmp(argv[k], "--settle") && k + 1 < argc)
                     psettle = atoi(argv[++k]);
+                else if (!strcmp(argv[k], "--settle-quasi-static"))
+                    pqs = true;
                 else if (!strcmp(argv[k], "--pbf-xsph") && k + 1 < argc)
                     pxsph = (float)atof(argv[++k]);
             }
@@ -452,10 +455,11 @@ int bench_sim(int argc, char **argv)
                         "pbf, pbf-recompute, pbf-jacobi (6 plain Jacobi iterations, the old default) (default wcsph,pbf)]\n"
                         "                      [--threads 1..64 (2)] [--pbf-steps S (per 1/60 s)] [--pbf-iterations I] "
                         "[--pbf-relaxation R] [--paddle-ramp S (0: none; default one period)]\n"
-                        "                      [--settle N (rt_sph_settle before frame 0, at most N steps; 0: none)] [--pbf-xsph C]\n");
+                        "                      [--settle N (rt_sph_settle before frame 0, at most N steps; 0: none)] [--settle-quasi-static]\n"
+                        "                      [--pbf-xsph C]\n");
                 return 2;
             }
-            return bench_sim_pool(pn, pf, pp, pt, ps, psteps, piters, prelax, pramp, (uint32_t)psettle, pxsph);
+            return bench_sim_pool(pn, pf, pp, pt, ps, psteps, piters, prelax, pramp, (uint32_t)psettle, pqs, pxsph);
         } else if (!strcmp(argv[i], "--dam-break")) {
             dam = true;
         } else if (!strcmp(argv[i], "--res") && i + 1 < argc) {

@@ -14,7 +14,7 @@
 #include "sim/sph.h"
 
 int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsigned solvers, uint32_t pbf_steps,
-                   uint32_t pbf_iters, float pbf_relax, float ramp_s, uint32_t settle, float pbf_xsph);
+                   uint32_t pbf_iters, float pbf_relax, float ramp_s, uint32_t settle, bool settle_qs, float pbf_xsph);
 
 static double wall_ms(void)
 {
@@ -33,7 +33,7 @@ static double cpu_ms(void)
 /* solvers: bit 0 WCSPH, bit 1 PBF, bit 2 PBF with RT_SPH_PBF_RECOMPUTE (callgrind of one alone),
  * bit 3 PBF with plain Jacobi iterations (RT_SPH_PBF_NO_CHEBYSHEV, 6 unless --pbf-iterations) */
 int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsigned solvers, uint32_t pbf_steps,
-                   uint32_t pbf_iters, float pbf_relax, float ramp_s, uint32_t settle, float pbf_xsph)
+                   uint32_t pbf_iters, float pbf_relax, float ramp_s, uint32_t settle, bool settle_qs, float pbf_xsph)
 {
     const float tmin[3] = {-1.65f, 0.f, -1.25f}, tmax[3] = {1.65f, 1.4f, 1.25f};
     const float fmin[3] = {-1.6f, 0.02f, -1.2f}, fmax[3] = {1.6f, 0.34f, 1.2f};
@@ -76,7 +76,7 @@ int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsign
         if (rt_sph_add_block(s[m], lo, hi, &added[m], NULL, 0))
             return 1;
         if (settle) { /* as the sample game before frame 0 (rt_sph_settle's defaults) */
-            rt_sph_settle_desc sd = {.max_steps = settle};
+            rt_sph_settle_desc sd = {.max_steps = settle, .quasi_static = settle_qs};
             if (rt_sph_settle(s[m], &sd, &settled[m], err, sizeof err)) {
                 fprintf(stderr, "volfx-bench sim --pool: %s\n", err);
                 return 1;

@@ -255,6 +255,8 @@ typedef struct rt_sph_settle_desc {
     float step_dt;        /* each a rt_sph_step of this dt [s] (default 1/60) */
     float damping;        /* velocities multiplied by this after each step (default 0.9; 0..1) */
     float speed_tol;      /* stop once a step ends below this max speed [m/s] (default 0.03) */
+    bool quasi_static;    /* velocities zeroed after every step instead of damped: each step's max
+                           * speed is then how far the solver's step moves a fluid at rest */
     uint32_t progress_every; /* progress(...) every this many steps and at the end (default 20) */
     void (*progress)(void *user, uint32_t step, uint32_t max_steps, float max_speed, float compression);
     void *user;

@@ -55,7 +55,7 @@ vfx_result rt_sph_settle(rt_sph *s, const rt_sph_settle_desc *desc, rt_sph_settl
         if (k == 0)
             out.max_speed_first = sr.max_speed;
         const bool done = sr.max_speed < d.speed_tol || k + 1 == d.max_steps;
-        const float damp = done ? 0.f : d.damping;
+        const float damp = done || d.quasi_static ? 0.f : d.damping;
         for (uint32_t i = 0; i < s->n; ++i)
             s->vx[i] *= damp, s->vy[i] *= damp, s->vz[i] *= damp;
         if (d.progress && ((k + 1) % d.progress_every == 0 || done))

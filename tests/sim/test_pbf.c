@@ -393,6 +393,17 @@ static void test_pbf_settled_tank_at_rest(void **state)
     assert_non_null(strstr(err, "damping"));
     assert_int_equal(rt_sph_settle(NULL, NULL, NULL, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
     assert_int_equal(rt_sph_settle(s, NULL, NULL, err, sizeof err), VFX_OK); /* no particles: nothing to do */
+    /* quasi-static: the velocities are zero after every step, so the report's speeds are each
+     * step's own; 3 particles resting on the floor */
+    float x[3] = {0.02f, 0.05f, 0.08f}, y[3] = {0.005f, 0.005f, 0.005f}, z[3] = {0.03f, 0.03f, 0.03f};
+    assert_int_equal(rt_sph_add_particles(s, 3, x, y, z, NULL, NULL, NULL, NULL, 0), VFX_OK);
+    rt_sph_settle_desc qs = {.max_steps = 5, .quasi_static = true};
+    rt_sph_settle_report qr;
+    assert_int_equal(rt_sph_settle(s, &qs, &qr, err, sizeof err), VFX_OK);
+    assert_true(qr.steps >= 1 && qr.steps <= 5);
+    rt_sph_columns c = rt_sph_get_columns(s);
+    for (uint32_t i = 0; i < c.count; ++i)
+        assert_true(c.vx[i] == 0.f && c.vy[i] == 0.f && c.vz[i] == 0.f && c.y[i] < 0.01f);
     rt_sph_destroy(s);
 }
 
