@@ -18,10 +18,9 @@
 
 #include "profile/profiler.h"
 #include "sim/sph.h"
+#include "bench_sim_pool.h"
 
 int bench_sim(int argc, char **argv);
-int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsigned solvers, uint32_t pbf_steps,
-                   uint32_t pbf_iters, float pbf_relax, float ramp_s, uint32_t settle, bool settle_qs, float pbf_xsph);
 
 static double now_s(void)
 {
@@ -258,9 +257,10 @@ static double cpu_now_s(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-/* pbf_iters, pbf_rho: PBF's iterations and Chebyshev rho (0: the defaults; rho < 0: plain Jacobi) */
+/* pbf_iters, pbf_rho, pbf_relax: PBF's iterations, Chebyshev rho and relaxation (0: the defaults;
+ * rho < 0: plain Jacobi) */
 static int dam_break(int res, uint32_t threads, double t_max, double settle_s, uint32_t no_slip,
-                     uint32_t solver, uint32_t pbf_iters, float pbf_rho, const char *cpu)
+                     uint32_t solver, uint32_t pbf_iters, float pbf_rho, float pbf_relax, const char *cpu)
 {
     const double a = 0.05715, g = 9.81;
     float dx = (float)(a / res);
@@ -269,7 +269,8 @@ static int dam_break(int res, uint32_t threads, double t_max, double settle_s, u
                       .threads = threads, .max_substeps = 1000000, .no_slip_faces = no_slip,
                       .solver = solver & 255u,
                       .flags = ((solver & 256u) ? RT_SPH_PBF_RECOMPUTE : 0u) | (pbf_rho < 0.f ? RT_SPH_PBF_NO_CHEBYSHEV : 0u),
-                      .pbf_iterations = pbf_iters, .pbf_chebyshev_rho = pbf_rho > 0.f ? pbf_rho : 0.f};
+                      .pbf_iterations = pbf_iters, .pbf_chebyshev_rho = pbf_rho > 0.f ? pbf_rho : 0.f,
+                      .pbf_relaxation = pbf_relax};
     rt_sph *s;
     char err[256];
     if (rt_sph_create(&d, &s, err, sizeof err)) {
@@ -368,7 +369,7 @@ int bench_sim(int argc, char **argv)
     bench_opts bo = {.warmup_s = 0.2, .nskin = 1, .rebuild = true, .verlet = true};
     double t_max = 6.0, settle_s = 0.0;
     uint32_t no_slip = 0, solver = RT_SPH_SOLVER_WCSPH, dam_iters = 0;
-    float dam_rho = 0.f;
+    float dam_rho = 0.f, dam_relax = 0.f;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--sizes") && i + 1 < argc) {
             if ((nsizes = parse_list(argv[++i], sizes, 8)) <= 0) {
@@ -408,58 +409,63 @@ int bench_sim(int argc, char **argv)
             }
         } else if (!strcmp(argv[i], "--pool") && i + 1 < argc) {
             /* the default scene's pool in WCSPH and PBF (bench_sim_pool.c) */
-            uint32_t pn = (uint32_t)atoi(argv[++i]);
-            int pf = 60;
-            bool pp = true;
-            unsigned ps = 3u, pt = 2u, psteps = 0u, piters = 0u; /* 0: the solver's defaults */
-            float prelax = 0.f, pramp = -1.f; /* -1: one paddle period, as the scene's default */
-            int psettle = 0;                  /* rt_sph_settle's steps at most before frame 0 */
-            float pxsph = 0.f;                /* 0: the solver's default */
-            bool pqs = false;                 /* --settle-quasi-static */
-            for (int k = i + 1; k < argc; ++k) {
-                if (!strcmp(argv[k], "--frames") && k + 1 < argc)
-                    pf = atoi(argv[++k]);
+            bench_pool_opts po = {.n = (uint32_t)atoi(argv[++i]), .frames = 60, .threads = 2u, .solvers = 3u,
+                                  .ramp_s = -1.f};
+            bool bad = false;
+            for (int k = i + 1; k < argc && !bad; ++k) {
+                const bool more = k + 1 < argc;
+                if (!strcmp(argv[k], "--frames") && more)
+                    po.frames = atoi(argv[++k]);
                 else if (!strcmp(argv[k], "--no-paddle"))
-                    pp = false;
-                else if (!strcmp(argv[k], "--solver") && k + 1 < argc) {
+                    po.no_paddle = true;
+                else if (!strcmp(argv[k], "--solver") && more) {
                     /* a comma list, all stepped in turn every frame */
                     char list[128];
                     snprintf(list, sizeof list, "%s", argv[++k]);
-                    ps = 0u;
+                    po.solvers = 0u;
                     for (char *t = strtok(list, ","); t; t = strtok(NULL, ","))
-                        ps |= !strcmp(t, "wcsph") ? 1u : !strcmp(t, "pbf") ? 2u : !strcmp(t, "pbf-recompute") ? 4u
-                              : !strcmp(t, "pbf-jacobi") ? 8u : 1u << 8;
-                    if (ps >> 8)
-                        ps = 0u;
+                        po.solvers |= !strcmp(t, "wcsph") ? 1u : !strcmp(t, "pbf") ? 2u : !strcmp(t, "pbf-recompute") ? 4u
+                                      : !strcmp(t, "pbf-jacobi") ? 8u : 1u << 8;
+                    if (po.solvers >> 8)
+                        po.solvers = 0u;
+                } else if (!strcmp(argv[k], "--threads") && more)
+                    po.threads = (unsigned)atoi(argv[++k]);
+                else if (!strcmp(argv[k], "--pbf-steps") && more)
+                    po.pbf_steps = (unsigned)atoi(argv[++k]);
+                else if (!strcmp(argv[k], "--pbf-iterations") && more)
+                    po.pbf_iters = (unsigned)atoi(argv[++k]);
+                else if (!strcmp(argv[k], "--pbf-relaxation") && more)
+                    po.pbf_relax = (float)atof(argv[++k]);
+                else if (!strcmp(argv[k], "--pbf-chebyshev") && more)
+                    po.pbf_rho = (float)atof(argv[++k]);
+                else if (!strcmp(argv[k], "--paddle-ramp") && more)
+                    po.ramp_s = (float)atof(argv[++k]);
+                else if (!strcmp(argv[k], "--settle") && more) {
+                    int v = atoi(argv[++k]);
+                    bad = v < 0 || v > 100000;
+                    po.settle = (uint32_t)(v > 0 ? v : 0);
+                } else if (!strcmp(argv[k], "--settle-quasi-static"))
+                    po.settle_qs = true;
+                else if (!strcmp(argv[k], "--pbf-xsph") && more)
+                    po.pbf_xsph = (float)atof(argv[++k]);
+                else if (strcmp(argv[k], "--json") != 0) {
+                    fprintf(stderr, "volfx-bench sim --pool: unknown option '%s'\n", argv[k]);
+                    bad = true;
                 }
-                else if (!strcmp(argv[k], "--threads") && k + 1 < argc)
-                    pt = (unsigned)atoi(argv[++k]);
-                else if (!strcmp(argv[k], "--pbf-steps") && k + 1 < argc)
-                    psteps = (unsigned)atoi(argv[++k]);
-                else if (!strcmp(argv[k], "--pbf-iterations") && k + 1 < argc)
-                    piters = (unsigned)atoi(argv[++k]);
-                else if (!strcmp(argv[k], "--pbf-relaxation") && k + 1 < argc)
-                    prelax = (float)atof(argv[++k]);
-                else if (!strcmp(argv[k], "--paddle-ramp") && k + 1 < argc)
-                    pramp = (float)atof(argv[++k]);
-                else if (!strcmp(argv[k], "--settle") && k + 1 < argc)
-                    psettle = atoi(argv[++k]);
-                else if (!strcmp(argv[k], "--settle-quasi-static"))
-                    pqs = true;
-                else if (!strcmp(argv[k], "--pbf-xsph") && k + 1 < argc)
-                    pxsph = (float)atof(argv[++k]);
             }
-            if (pn < 1 || pf < 1 || !ps || pt < 1 || pt > 64 || !(pramp >= 0.f || pramp == -1.f) || psettle < 0 ||
-                psettle > 100000 || !(pxsph >= 0.f && pxsph <= 1.f)) {
+            if (bad || po.n < 1 || po.frames < 1 || !po.solvers || po.threads < 1 || po.threads > 64 ||
+                !(po.ramp_s >= 0.f || po.ramp_s == -1.f) || !(po.pbf_xsph >= 0.f && po.pbf_xsph <= 1.f) ||
+                !(po.pbf_rho < 1.f) || !(po.pbf_relax >= 0.f)) {
                 fprintf(stderr, "volfx-bench sim --pool N [--frames F] [--no-paddle] [--solver a comma list of wcsph, "
                         "pbf, pbf-recompute, pbf-jacobi (6 plain Jacobi iterations, the old default) (default wcsph,pbf)]\n"
                         "                      [--threads 1..64 (2)] [--pbf-steps S (per 1/60 s)] [--pbf-iterations I] "
-                        "[--pbf-relaxation R] [--paddle-ramp S (0: none; default one period)]\n"
+                        "[--pbf-relaxation R] [--pbf-chebyshev RHO (< 0: plain Jacobi)]\n"
+                        "                      [--paddle-ramp S (0: none; default one period)]\n"
                         "                      [--settle N (rt_sph_settle before frame 0, at most N steps; 0: none)] [--settle-quasi-static]\n"
                         "                      [--pbf-xsph C]\n");
                 return 2;
             }
-            return bench_sim_pool(pn, pf, pp, pt, ps, psteps, piters, prelax, pramp, (uint32_t)psettle, pqs, pxsph);
+            return bench_sim_pool(&po);
         } else if (!strcmp(argv[i], "--dam-break")) {
             dam = true;
         } else if (!strcmp(argv[i], "--res") && i + 1 < argc) {
@@ -478,6 +484,8 @@ int bench_sim(int argc, char **argv)
             solver = !strcmp(v, "wcsph") ? RT_SPH_SOLVER_WCSPH : !strcmp(v, "pbf") ? RT_SPH_SOLVER_PBF : RT_SPH_SOLVER_PBF | 256u;
         } else if (!strcmp(argv[i], "--pbf-iterations") && i + 1 < argc) {
             dam_iters = (uint32_t)atoi(argv[++i]);
+        } else if (!strcmp(argv[i], "--pbf-relaxation") && i + 1 < argc) {
+            dam_relax = (float)atof(argv[++i]);
         } else if (!strcmp(argv[i], "--pbf-chebyshev") && i + 1 < argc) {
             dam_rho = (float)atof(argv[++i]); /* < 0: plain Jacobi */
         } else if (!strcmp(argv[i], "--no-slip")) {
@@ -492,7 +500,7 @@ int bench_sim(int argc, char **argv)
                  "                            [--settle 0 (s at rest behind a gate first; 0 = release a fresh lattice)]\n"
                  "                            [--no-slip (wall-law friction on the floor and back wall)]\n"
                  "                            [--solver wcsph|pbf|pbf-recompute] [--pbf-iterations I (PBF; 0 = 5)]\n"
-                 "                            [--pbf-chebyshev R (PBF's rho; 0 = 0.7, < 0 = plain Jacobi)]");
+                 "                            [--pbf-chebyshev R (PBF's rho; 0 = 0.7, < 0 = plain Jacobi)] [--pbf-relaxation E]");
             return 0;
         } else if (strcmp(argv[i], "--json") != 0) {
             fprintf(stderr, "volfx-bench sim: unknown option '%s'\n", argv[i]);
@@ -510,7 +518,7 @@ int bench_sim(int argc, char **argv)
     char cpu[256];
     cpu_model(cpu, sizeof cpu);
     if (dam)
-        return dam_break(res, threads[nthreads - 1], t_max, settle_s, no_slip, solver, dam_iters, dam_rho, cpu);
+        return dam_break(res, threads[nthreads - 1], t_max, settle_s, no_slip, solver, dam_iters, dam_rho, dam_relax, cpu);
     bo.substeps = substeps;
     bo.reps = reps;
     for (int k = 0; k < nsizes; ++k)

@@ -12,9 +12,7 @@
 
 #include "profile/profiler.h"
 #include "sim/sph.h"
-
-int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsigned solvers, uint32_t pbf_steps,
-                   uint32_t pbf_iters, float pbf_relax, float ramp_s, uint32_t settle, bool settle_qs, float pbf_xsph);
+#include "bench_sim_pool.h"
 
 static double wall_ms(void)
 {
@@ -32,9 +30,14 @@ static double cpu_ms(void)
 
 /* solvers: bit 0 WCSPH, bit 1 PBF, bit 2 PBF with RT_SPH_PBF_RECOMPUTE (callgrind of one alone),
  * bit 3 PBF with plain Jacobi iterations (RT_SPH_PBF_NO_CHEBYSHEV, 6 unless --pbf-iterations) */
-int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsigned solvers, uint32_t pbf_steps,
-                   uint32_t pbf_iters, float pbf_relax, float ramp_s, uint32_t settle, bool settle_qs, float pbf_xsph)
+int bench_sim_pool(const bench_pool_opts *o)
 {
+    const uint32_t n = o->n, threads = o->threads, pbf_steps = o->pbf_steps, pbf_iters = o->pbf_iters;
+    const uint32_t settle = o->settle;
+    const unsigned solvers = o->solvers;
+    const int frames = o->frames;
+    const bool paddle = !o->no_paddle, settle_qs = o->settle_qs;
+    const float pbf_relax = o->pbf_relax, ramp_s = o->ramp_s, pbf_xsph = o->pbf_xsph;
     const float tmin[3] = {-1.65f, 0.f, -1.25f}, tmax[3] = {1.65f, 1.4f, 1.25f};
     const float fmin[3] = {-1.6f, 0.02f, -1.2f}, fmax[3] = {1.6f, 0.34f, 1.2f};
     double vol = 1.0;
@@ -52,7 +55,9 @@ int bench_sim_pool(uint32_t n, int frames, bool paddle, uint32_t threads, unsign
             continue;
         rt_sph_desc d = {.spacing = dx, .max_substeps = 64, .sound_speed = 25.f, .threads = threads,
                           .solver = m ? RT_SPH_SOLVER_PBF : RT_SPH_SOLVER_WCSPH,
-                          .flags = m == 2 ? RT_SPH_PBF_RECOMPUTE : m == 3 ? RT_SPH_PBF_NO_CHEBYSHEV : 0u,
+                          .flags = (m == 2 ? RT_SPH_PBF_RECOMPUTE : 0u) |
+                                   (m == 3 || o->pbf_rho < 0.f ? RT_SPH_PBF_NO_CHEBYSHEV : 0u),
+                          .pbf_chebyshev_rho = o->pbf_rho > 0.f ? o->pbf_rho : 0.f,
                           .pbf_iterations = pbf_iters ? pbf_iters : m == 3 ? 6u : 0u, .pbf_max_step = pbf_steps ? 1.f / (60.f * pbf_steps) : 0.f,
                           .pbf_relaxation = pbf_relax, .pbf_xsph = pbf_xsph};
         memcpy(d.domain_min, tmin, sizeof tmin);
