@@ -97,13 +97,13 @@ typedef struct rt_sph_desc {
     float pbf_max_step;         /* longest step [s]; 1/60 */
     float pbf_cfl;              /* largest move per step as a fraction of H; 0.5 */
     float pbf_relaxation;       /* constraint-force mixing eps, a fraction of the lattice's
-                                 * sum |grad C|^2; 0.2 */
+                                 * sum |grad C|^2; 0.5 */
     float pbf_scorr_k;          /* artificial pressure k of s_corr = -k (W(r)/W(dq))^4; 0 (off) */
     float pbf_scorr_dq;         /* its dq as a fraction of H; 0.2 */
     float pbf_xsph;             /* XSPH viscosity c; 0.01 */
     float pbf_vorticity;        /* vorticity confinement epsilon [m/s]; 0 (off) */
     /* Chebyshev semi-iterative acceleration of the Jacobi iterations (Wang 2015): the estimate
-     * of the iteration's spectral radius rho, 0 <= rho < 1; 0.7. Off with RT_SPH_PBF_NO_CHEBYSHEV */
+     * of the iteration's spectral radius rho, 0 <= rho < 1; 0.8. Off with RT_SPH_PBF_NO_CHEBYSHEV */
     float pbf_chebyshev_rho;
 } rt_sph_desc;
 
