@@ -2,12 +2,12 @@
 """sim-goals.py — issue 22's goals for the fluid simulation, measured in one run.
 
 Runs, in this order (each a command a reader can run alone):
-  volfx-bench sim --pool 16384 --frames 60 --solver wcsph,pbf,pbf-jacobi [--settle N]
+  volfx-bench sim --pool 16384 --frames 60 --solver wcsph,pbf,pbf-jacobi --settle 120
       the default scene's pool (tank, spacing and paddle of default.json), the three solvers
       stepped in turn every frame: CPU per 1/60 s frame (process CPU of both worker threads,
       median over the frames), the WCSPH / PBF ratio, mean compression, max speed over frames 2-30
-  volfx-bench sim --pool 65536 --frames 20 --solver wcsph,pbf,pbf-jacobi [--settle N]
-  volfx-bench sim --pool 16384 --frames 300 --no-paddle --solver pbf [--settle N]
+  volfx-bench sim --pool 65536 --frames 20 --solver wcsph,pbf,pbf-jacobi --settle 120
+  volfx-bench sim --pool 16384 --frames 300 --no-paddle --solver pbf --settle 120
       the closed pool: max speed over frames 2-300 and at 300, energy growth between samples
   volfx-bench sim --dam-break --res 20 --no-slip --solver wcsph|pbf --threads 2
       Martin & Moyce (1952): the worst front error over the 9 tabulated times
@@ -15,7 +15,7 @@ Runs, in this order (each a command a reader can run alone):
       sim.max_speed over frames 2-30, sim.density_error, vfx.sim.sph; the frame-30 image
 
 Usage: /usr/bin/python3 scripts/sim-goals.py [--build build-release] [--game-build build]
-       [--settle N] [--skip-game] [--png FILE]
+       [--settle 120] [--skip-game] [--png FILE]
 Prints one markdown table (docs/simulation.md, "Measured against WCSPH") and the machine line.
 """
 import argparse
@@ -42,11 +42,12 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--build", default="build-release")
     ap.add_argument("--game-build", default="build")
-    ap.add_argument("--settle", type=int, default=-1, help="--settle N for the pool runs (-1: the bench's default)")
+    ap.add_argument("--settle", type=int, default=120,
+                    help="--settle N for the pool runs: the game's default water.simulation.settle_steps (0: none)")
     ap.add_argument("--skip-game", action="store_true")
     ap.add_argument("--png", default="sim-goals-frame30.png")
     a = ap.parse_args()
-    settle = ["--settle", str(a.settle)] if a.settle >= 0 else []
+    settle = ["--settle", str(a.settle)] if a.settle > 0 else []
     load0 = open("/proc/loadavg").read().split()[0]
 
     p16 = by_solver(bench(a.build, ["--pool", "16384", "--frames", "60", "--solver", "wcsph,pbf,pbf-jacobi"] + settle))
