@@ -457,7 +457,7 @@ int bench_sim(int argc, char **argv)
                 !(po.ramp_s >= 0.f || po.ramp_s == -1.f) || !(po.pbf_xsph >= 0.f && po.pbf_xsph <= 1.f) ||
                 !(po.pbf_rho < 1.f) || !(po.pbf_relax >= 0.f)) {
                 fprintf(stderr, "volfx-bench sim --pool N [--frames F] [--no-paddle] [--solver a comma list of wcsph, "
-                        "pbf, pbf-recompute, pbf-jacobi (6 plain Jacobi iterations, the old default) (default wcsph,pbf)]\n"
+                        "pbf, pbf-recompute, pbf-jacobi (6 plain Jacobi iterations at eps 0.2 D0, the old default) (default wcsph,pbf)]\n"
                         "                      [--threads 1..64 (2)] [--pbf-steps S (per 1/60 s)] [--pbf-iterations I] "
                         "[--pbf-relaxation R] [--pbf-chebyshev RHO (< 0: plain Jacobi)]\n"
                         "                      [--paddle-ramp S (0: none; default one period)]\n"

@@ -59,7 +59,8 @@ int bench_sim_pool(const bench_pool_opts *o)
                                    (m == 3 || o->pbf_rho < 0.f ? RT_SPH_PBF_NO_CHEBYSHEV : 0u),
                           .pbf_chebyshev_rho = o->pbf_rho > 0.f ? o->pbf_rho : 0.f,
                           .pbf_iterations = pbf_iters ? pbf_iters : m == 3 ? 6u : 0u, .pbf_max_step = pbf_steps ? 1.f / (60.f * pbf_steps) : 0.f,
-                          .pbf_relaxation = pbf_relax, .pbf_xsph = pbf_xsph};
+                          /* pbf-jacobi: the old default, eps 0.2 D0 unless asked */
+                          .pbf_relaxation = pbf_relax > 0.f ? pbf_relax : m == 3 ? 0.2f : 0.f, .pbf_xsph = pbf_xsph};
         memcpy(d.domain_min, tmin, sizeof tmin);
         memcpy(d.domain_max, tmax, sizeof tmax);
         char err[256];
