@@ -86,6 +86,24 @@ density_tail(rt_sph *s, uint32_t i, float sum, uint32_t nn, float px, float py, 
         o->bad = i, o->bad_kind = 1, o->bad_value = rho;
 }
 
+/* Closes particle i's lists: offsets and counts, and at a rebuild the Verlet list and the
+ * positions it was built at. */
+static inline __attribute__((always_inline)) void
+lists_close(rt_sph *s, uint32_t i, uint32_t nn, uint32_t ns, const bool record, uint32_t *used, uint32_t *sused,
+            sph_chunk_out *o, float px, float py, float pz)
+{
+    s->nb_start[i] = *used;
+    s->nb_count[i] = nn;
+    *used += nn;
+    if (record) {
+        s->sk_start[i] = *sused;
+        s->sk_count[i] = ns;
+        *sused += ns;
+        o->skin_pairs += ns;
+        s->x0[i] = px, s->y0[i] = py, s->z0[i] = pz;
+    }
+}
+
 /* Density by a scan of the 5x5x5 cells, recording the exact list (r < H) for the force pass
  * and, when `record`, the Verlet list (r < H + skin) and the positions it was built at. */
 static inline __attribute__((always_inline)) void density_scan(rt_sph *s, uint32_t chunk, const bool record)
@@ -130,16 +148,7 @@ static inline __attribute__((always_inline)) void density_scan(rt_sph *s, uint32
                 }
             }
         }
-        s->nb_start[i] = used;
-        s->nb_count[i] = nn;
-        used += nn;
-        if (record) {
-            s->sk_start[i] = sused;
-            s->sk_count[i] = ns;
-            sused += ns;
-            o->skin_pairs += ns;
-            s->x0[i] = px, s->y0[i] = py, s->z0[i] = pz;
-        }
+        lists_close(s, i, nn, ns, record, &used, &sused, o, px, py, pz);
         density_tail(s, i, sum, nn, px, py, pz, o, walls);
     }
     if (record)
@@ -248,16 +257,7 @@ static inline __attribute__((always_inline)) void lists_scan(rt_sph *s, uint32_t
                     }
                 }
         }
-        s->nb_start[i] = used;
-        s->nb_count[i] = nn;
-        used += nn;
-        if (record) {
-            s->sk_start[i] = sused;
-            s->sk_count[i] = ns;
-            sused += ns;
-            acc.skin_pairs += ns;
-            s->x0[i] = px, s->y0[i] = py, s->z0[i] = pz;
-        }
+        lists_close(s, i, nn, ns, record, &used, &sused, &acc, px, py, pz);
         acc.pairs += nn;
     }
     if (record)
