@@ -54,6 +54,12 @@ typedef struct sph_emitter_state {
 
 typedef void (*sph_chunk_fn)(rt_sph *s, uint32_t chunk);
 
+/* A worker thread's share: participant `index` (the caller is 0) of every pass. */
+typedef struct sph_worker {
+    rt_sph *s;
+    uint32_t index;
+} sph_worker;
+
 struct rt_sph {
     rt_sph_desc p;
     float mass, H, H2, h, inv_cell;
@@ -103,6 +109,7 @@ struct rt_sph {
     uint32_t **snb, *snb_cap, *snb_used, *sk_start, *sk_count;
     /* thread pool */
     pthread_t *threads;
+    sph_worker *workers;
     uint32_t nthreads; /* workers besides the caller */
     pthread_mutex_t mu;
     pthread_cond_t cv_start, cv_done;
@@ -110,7 +117,6 @@ struct rt_sph {
     uint32_t busy;
     bool quit;
     sph_chunk_fn job;
-    atomic_uint next_chunk;
     uint32_t nchunks;
     /* Position Based Fluids (sph_pbf.c): pr holds each particle's pressure [Pa] (the multiplier
      * lambda = -p dt^2 / rho0) and follows the rows through sorts */
