@@ -130,7 +130,7 @@ struct rt_sph {
     float *cheb_prev[3];         /* the iterate before the current one (its extrapolation base) */
     float *pc[3], *pn[3];        /* positions of the current and the next Jacobi iterate */
     bool pbf_store;              /* this step's lambda passes store the pair terms (sph_pbf_lin.c) */
-    /* sph_pbf_lin.c: the iteration's pair terms, four arrays per work item parallel to cnb
+    /* sph_pbf_lin.c: the iteration's pair terms, three arrays per work item parallel to cnb
      * (pbf_pe_cap[c] entries each), and per-particle terms (columns of pbf_lin_cap) */
     float **pbf_pe;
     uint32_t *pbf_pe_cap, pbf_pe_chunks;

@@ -235,12 +235,13 @@ static void pbf_lambda_chunk(rt_sph *s, uint32_t chunk)
                 coincident += (0x4332322132212110ull >> (4 * (~_mm_movemask_ps(valid) & 15))) & 15u;
                 __m128 rl = _mm_sqrt_ps(r2), hr = _mm_max_ps(vH - rl, zero);
                 __m128 hr2 = hr * hr;
-                __m128 q = _mm_and_ps(valid, hr2 * (one / rl)); /* G_ij / Vks */
-                gx4 += q * dx, gy4 += q * dy, gz4 += q * dz;
+                __m128 q = _mm_and_ps(valid, hr2 * (one / rl)); /* |G_ij| / (Vks r) */
+                __m128 qx = q * dx, qy = q * dy, qz = q * dz;    /* G_ij / Vks */
+                gx4 += qx, gy4 += qy, gz4 += qz;
                 g24 += _mm_and_ps(valid, hr2 * hr2);
                 if (store) {
-                    _mm_storeu_ps(PE[0] + off + k, dx), _mm_storeu_ps(PE[1] + off + k, dy);
-                    _mm_storeu_ps(PE[2] + off + k, dz), _mm_storeu_ps(PE[3] + off + k, q);
+                    _mm_storeu_ps(PE[0] + off + k, qx), _mm_storeu_ps(PE[1] + off + k, qy);
+                    _mm_storeu_ps(PE[2] + off + k, qz);
                 }
             }
             sw += pbf_hsum(w4);
@@ -335,13 +336,13 @@ static void pbf_delta(rt_sph *s, uint32_t chunk, const pbf_delta_args *a)
             /* the same operations on the lambda pass's d_ij and (H - r)^2 / r (masked to 0 for
              * coincident pairs, counted there): bitwise the sums below, without the position
              * gathers, the square root and the division; s_corr is off here (sk = 0) */
-            const float *DX = PE[0] + off, *DY = PE[1] + off, *DZ = PE[2] + off, *Q = PE[3] + off;
+            const float *GX = PE[0] + off, *GY = PE[1] + off, *GZ = PE[2] + off;
             const __m128 vli = _mm_set1_ps(li), zero = _mm_setzero_ps();
             __m128 sx4 = zero, sy4 = zero, sz4 = zero;
             for (; k + 4 <= nn; k += 4) {
                 __m128 lj = _mm_setr_ps(Lm[L[k]], Lm[L[k + 1]], Lm[L[k + 2]], Lm[L[k + 3]]);
-                __m128 coef = (vli + lj) * _mm_loadu_ps(Q + k);
-                sx4 += coef * _mm_loadu_ps(DX + k), sy4 += coef * _mm_loadu_ps(DY + k), sz4 += coef * _mm_loadu_ps(DZ + k);
+                __m128 coef = vli + lj;
+                sx4 += coef * _mm_loadu_ps(GX + k), sy4 += coef * _mm_loadu_ps(GY + k), sz4 += coef * _mm_loadu_ps(GZ + k);
             }
             sx = pbf_hsum(sx4), sy = pbf_hsum(sy4), sz = pbf_hsum(sz4);
             coincident = rt_sph_pbf_stored_coincident(s, i);
@@ -364,8 +365,8 @@ static void pbf_delta(rt_sph *s, uint32_t chunk, const pbf_delta_args *a)
                 __m128 w = t * t * t * viw, w2 = w * w;
                 __m128 rl = _mm_sqrt_ps(r2), hr = _mm_max_ps(vH - rl, zero);
                 __m128 q = _mm_and_ps(valid, hr * hr * (one / rl));
-                __m128 coef = (vli + lj - vsk * w2 * w2) * q;
-                sx4 += coef * dx, sy4 += coef * dy, sz4 += coef * dz;
+                __m128 coef = vli + lj - vsk * w2 * w2; /* times G_ij / Vks, as the stored path */
+                sx4 += coef * (q * dx), sy4 += coef * (q * dy), sz4 += coef * (q * dz);
             }
             sx = pbf_hsum(sx4), sy = pbf_hsum(sy4), sz = pbf_hsum(sz4);
         }

@@ -2,9 +2,10 @@
  * runs the original passes, which compute them in both).
  *
  * Both passes of a Jacobi iteration evaluate the pairs at the same iterate. The lambda pass
- * (sph_pbf.c) now also stores, for the pairs its four-wide loop takes, d_ij = x_i - x_j and
- * q_ij = (H - r)^2 / r (0 for coincident pairs, which it counts), and the position pass
- * computes sum_j (l_i + l_j) q_ij d_ij from them with the same operations in the same order:
+ * (sph_pbf.c) now also stores, for the pairs its four-wide loop takes, q_ij d_ij (the kernel
+ * gradient over Vks, d_ij = x_i - x_j, q_ij = (H - r)^2 / r, 0 for coincident pairs, which it
+ * counts), and the position pass computes sum_j (l_i + l_j) (q_ij d_ij) from them with the same
+ * operations in the same order:
  * a gather of the neighbours' multipliers over stored floats, no position gather, square root
  * or division, and bitwise the original result (the scalar remainder of each list, < 4 pairs,
  * is recomputed as before). The clamp to the walls is skipped when a particle is nearer to its
@@ -19,7 +20,7 @@
  * difference of the neighbours' and the wall's gradients, and its direction turns with moves of
  * 1e-4 m).
  *
- * Storage: four float arrays per work item parallel to the exact neighbour list cnb[chunk]
+ * Storage: three float arrays per work item parallel to the exact neighbour list cnb[chunk]
  * (same offsets nb_start[i]), and per particle the count of coincident stored pairs and the
  * room; grown as needed, valid within a step. */
 #include "sim/sph_internal.h"
@@ -29,8 +30,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* per-pair arrays of pbf_pe[chunk], each pbf_pe_cap[chunk] floats: d (3), q */
-enum { PE_N = 4 };
+/* per-pair arrays of pbf_pe[chunk], each pbf_pe_cap[chunk] floats: G_ij / Vks = q_ij d_ij (3) */
+enum { PE_N = 3 };
 /* per-particle columns of pbf_lin, each pbf_lin_cap floats */
 enum { LIN_ROOM, LIN_COINCIDENT, LIN_NCOLS };
 
@@ -99,8 +100,8 @@ size_t rt_sph_pbf_lin_bytes(const rt_sph *s)
 void rt_sph_pbf_pair_arrays(const rt_sph *s, uint32_t chunk, float *pe[4])
 {
     size_t cap = s->pbf_pe_cap[chunk];
-    for (int k = 0; k < PE_N; ++k)
-        pe[k] = s->pbf_pe[chunk] + (size_t)k * cap;
+    for (int k = 0; k < 4; ++k)
+        pe[k] = k < PE_N ? s->pbf_pe[chunk] + (size_t)k * cap : NULL;
 }
 
 /* A lower bound of the distance from p to every collider's surface and every face of the
