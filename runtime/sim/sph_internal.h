@@ -312,8 +312,8 @@ void rt_sph_pbf_clamp(const rt_sph *s, float p[3]);
 vfx_result rt_sph_pbf_lin_reserve(rt_sph *s, char *err, size_t errlen);
 void rt_sph_pbf_lin_free(rt_sph *s);
 size_t rt_sph_pbf_lin_bytes(const rt_sph *s);
-/* The work item's arrays of d_ij (x, y, z) and (H - r)^2 / r, indexed as cnb[chunk]. */
-void rt_sph_pbf_pair_arrays(const rt_sph *s, uint32_t chunk, float *pe[4]);
+/* The work item's arrays of the stored gradients q_ij d_ij (x, y, z), indexed as cnb[chunk]. */
+void rt_sph_pbf_pair_arrays(const rt_sph *s, uint32_t chunk, float *pe[3]);
 /* Row i's count of coincident stored pairs; in the first iteration also its wall room. */
 void rt_sph_pbf_store_particle(rt_sph *s, uint32_t i, uint32_t coincident);
 uint32_t rt_sph_pbf_stored_coincident(const rt_sph *s, uint32_t i);

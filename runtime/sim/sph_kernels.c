@@ -86,6 +86,49 @@ density_tail(rt_sph *s, uint32_t i, float sum, uint32_t nn, float px, float py, 
         o->bad = i, o->bad_kind = 1, o->bad_value = rho;
 }
 
+/* The rows of cells around p (*r) and room in the chunk's lists for all their candidates plus
+ * `slack` entries (the Verlet list too when `record`); false when the lists cannot grow. */
+static inline __attribute__((always_inline)) bool scan_room(rt_sph *s, uint32_t chunk, float px, float py,
+                                                            float pz, const bool record, uint32_t used,
+                                                            uint32_t sused, uint32_t slack, sph_ranges *r)
+{
+    sph_neighbor_ranges(s, px, py, pz, 2, r);
+    uint32_t cand = slack;
+    for (int q = 0; q < r->count; ++q)
+        cand += r->hi[q] - r->lo[q];
+    return grow_list(s, &s->cnb[chunk], &s->cnb_cap[chunk], used + cand) &&
+           (!record || grow_list(s, &s->snb[chunk], &s->snb_cap[chunk], sused + cand));
+}
+
+/* One candidate at a time over the rows of cells in r: appends those within H to L (count *nn)
+ * and, when `record`, within H + skin to SL (*ns), self excluded; returns the poly6 sum
+ * (H^2 - r^2)^3 of those within H (dropped by a caller that wants the lists only). */
+static inline __attribute__((always_inline)) float
+scan_ranges(const float *X, const float *Y, const float *Z, const sph_ranges *r, uint32_t i, float px, float py,
+            float pz, float H2, float S2, const bool record, uint32_t *L, uint32_t *nn, uint32_t *SL, uint32_t *ns)
+{
+    float sum = 0.f;
+    uint32_t a = *nn, b = *ns;
+    for (int q = 0; q < r->count; ++q) {
+        for (uint32_t j = r->lo[q]; j < r->hi[q]; ++j) {
+            float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
+            float r2 = dx * dx + dy * dy + dz * dz;
+            if (record && r2 < S2) {
+                SL[b] = j;
+                b += j != i;
+            }
+            if (r2 < H2) {
+                float t = H2 - r2;
+                sum += t * t * t;
+                L[a] = j;
+                a += j != i;
+            }
+        }
+    }
+    *nn = a, *ns = b;
+    return sum;
+}
+
 /* Closes particle i's lists: offsets and counts, and at a rebuild the Verlet list and the
  * positions it was built at. */
 static inline __attribute__((always_inline)) void
@@ -120,34 +163,13 @@ static inline __attribute__((always_inline)) void density_scan(rt_sph *s, uint32
     for (uint32_t i = b; i < e; ++i) {
         float px = X[i], py = Y[i], pz = Z[i];
         sph_ranges r;
-        sph_neighbor_ranges(s, px, py, pz, 2, &r);
-        uint32_t cand = 0;
-        for (int q = 0; q < r.count; ++q)
-            cand += r.hi[q] - r.lo[q];
-        if (!grow_list(s, &s->cnb[chunk], &s->cnb_cap[chunk], used + cand) ||
-            (record && !grow_list(s, &s->snb[chunk], &s->snb_cap[chunk], sused + cand))) {
+        if (!scan_room(s, chunk, px, py, pz, record, used, sused, 0, &r)) {
             s->out[chunk] = acc;
             return;
         }
         uint32_t *L = s->cnb[chunk] + used, *SL = record ? s->snb[chunk] + sused : NULL;
-        float sum = 0.f;
         uint32_t nn = 0, ns = 0;
-        for (int q = 0; q < r.count; ++q) {
-            for (uint32_t j = r.lo[q]; j < r.hi[q]; ++j) {
-                float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
-                float r2 = dx * dx + dy * dy + dz * dz;
-                if (record && r2 < S2) {
-                    SL[ns] = j;
-                    ns += j != i;
-                }
-                if (r2 < H2) {
-                    float t = H2 - r2;
-                    sum += t * t * t;
-                    L[nn] = j;
-                    nn += j != i;
-                }
-            }
-        }
+        float sum = scan_ranges(X, Y, Z, &r, i, px, py, pz, H2, S2, record, L, &nn, SL, &ns);
         lists_close(s, i, nn, ns, record, &used, &sused, o, px, py, pz);
         density_tail(s, i, sum, nn, px, py, pz, o, walls);
     }
@@ -222,13 +244,8 @@ static inline __attribute__((always_inline)) void lists_scan(rt_sph *s, uint32_t
     for (uint32_t i = b; i < e; ++i) {
         float px = X[i], py = Y[i], pz = Z[i];
         sph_ranges r;
-        sph_neighbor_ranges(s, px, py, pz, 2, &r);
-        uint32_t cand = 0;
-        for (int q = 0; q < r.count; ++q)
-            cand += r.hi[q] - r.lo[q];
         /* +3: a group's appends write up to three entries past the last one kept */
-        if (!grow_list(s, &s->cnb[chunk], &s->cnb_cap[chunk], used + cand + 3) ||
-            (record && !grow_list(s, &s->snb[chunk], &s->snb_cap[chunk], sused + cand + 3))) {
+        if (!scan_room(s, chunk, px, py, pz, record, used, sused, 3, &r)) {
             s->out[chunk] = acc;
             return;
         }
@@ -242,21 +259,7 @@ static inline __attribute__((always_inline)) void lists_scan(rt_sph *s, uint32_t
                 lists_row_sse(X, Y, Z, r.lo[q], r.hi[q], i, vpx, vpy, vpz, vH2, vS2, record, L, &nn, SL, &ns);
         } else
 #endif
-        {
-            for (int q = 0; q < r.count; ++q)
-                for (uint32_t j = r.lo[q]; j < r.hi[q]; ++j) {
-                    float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
-                    float r2 = dx * dx + dy * dy + dz * dz;
-                    if (record && r2 < S2) {
-                        SL[ns] = j;
-                        ns += j != i;
-                    }
-                    if (r2 < H2) {
-                        L[nn] = j;
-                        nn += j != i;
-                    }
-                }
-        }
+            (void)scan_ranges(X, Y, Z, &r, i, px, py, pz, H2, S2, record, L, &nn, SL, &ns);
         lists_close(s, i, nn, ns, record, &used, &sused, &acc, px, py, pz);
         acc.pairs += nn;
     }

@@ -206,7 +206,7 @@ static void pbf_lambda_chunk(rt_sph *s, uint32_t chunk)
     const float *X = s->pc[0], *Y = s->pc[1], *Z = s->pc[2];
     /* the position pass's pair terms, when it reads them (sph_pbf_lin.c) */
     const bool store = s->pbf_store;
-    float *PE[4] = {NULL, NULL, NULL, NULL};
+    float *PE[3] = {NULL, NULL, NULL};
     if (store)
         rt_sph_pbf_pair_arrays(s, chunk, PE);
     sph_chunk_out acc = s->out[chunk];
@@ -306,7 +306,6 @@ typedef struct pbf_delta_args {
     bool stored;      /* the lambda pass's pair terms (no s_corr, lam_scale 1): sph_pbf_lin.c */
 } pbf_delta_args;
 
-
 /* Position correction of each particle from the multipliers (this iteration's, or the warm
  * start's pressures): dp_i = -sum_j (l_i + l_j + s_corr) G_ij d_ij + l_i grad C_wall, written
  * to the next iterate, clamped to the walls. */
@@ -321,7 +320,7 @@ static void pbf_delta(rt_sph *s, uint32_t chunk, const pbf_delta_args *a)
     const float sk = a->scorr ? s->p.pbf_scorr_k / s->pbf_D0 : 0.f, iwdq = 1.f / s->pbf_wdq;
     const float *X = s->pc[0], *Y = s->pc[1], *Z = s->pc[2], *Lm = a->lam;
     float *NX = s->pn[0], *NY = s->pn[1], *NZ = s->pn[2];
-    float *PE[4] = {NULL, NULL, NULL, NULL};
+    float *PE[3] = {NULL, NULL, NULL};
     if (a->stored)
         rt_sph_pbf_pair_arrays(s, chunk, PE);
     for (uint32_t i = b; i < e; ++i) {
@@ -333,8 +332,8 @@ static void pbf_delta(rt_sph *s, uint32_t chunk, const pbf_delta_args *a)
         uint32_t k = 0, coincident = 0;
 #if PBF_SSE
         if (a->stored) {
-            /* the same operations on the lambda pass's d_ij and (H - r)^2 / r (masked to 0 for
-             * coincident pairs, counted there): bitwise the sums below, without the position
+            /* the same operations on the lambda pass's stored gradients q_ij d_ij (q masked to 0
+             * for coincident pairs, counted there): bitwise the sums below, without the position
              * gathers, the square root and the division; s_corr is off here (sk = 0) */
             const float *GX = PE[0] + off, *GY = PE[1] + off, *GZ = PE[2] + off;
             const __m128 vli = _mm_set1_ps(li), zero = _mm_setzero_ps();

@@ -97,11 +97,11 @@ size_t rt_sph_pbf_lin_bytes(const rt_sph *s)
     return b;
 }
 
-void rt_sph_pbf_pair_arrays(const rt_sph *s, uint32_t chunk, float *pe[4])
+void rt_sph_pbf_pair_arrays(const rt_sph *s, uint32_t chunk, float *pe[3])
 {
     size_t cap = s->pbf_pe_cap[chunk];
-    for (int k = 0; k < 4; ++k)
-        pe[k] = k < PE_N ? s->pbf_pe[chunk] + (size_t)k * cap : NULL;
+    for (int k = 0; k < PE_N; ++k)
+        pe[k] = s->pbf_pe[chunk] + (size_t)k * cap;
 }
 
 /* A lower bound of the distance from p to every collider's surface and every face of the
