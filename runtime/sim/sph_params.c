@@ -55,8 +55,8 @@ static vfx_result fill_params(rt_sph_desc *p, char *err, size_t err_len)
     p->pbf_max_step = def(p->pbf_max_step, 1.f / 60.f);
     p->pbf_cfl = def(p->pbf_cfl, 0.5f);
     /* 0.5 with the Chebyshev acceleration (rho 0.8): the default pool as compressed as with 0.2 and
-     * rho 0.7 (0.50% against 0.48%), but a third of the kinetic energy left at rest after 300
-     * frames (0.24 J against 0.73 J): the larger mixing damps the iteration's highest-frequency
+     * rho 0.7 (0.53% against 0.48%), but a third of the kinetic energy left at rest after 300
+     * frames (0.26 J against 0.72 J): the larger mixing damps the iteration's highest-frequency
      * mode, which the extrapolation otherwise amplifies (docs/simulation.md, "Chebyshev") */
     p->pbf_relaxation = def(p->pbf_relaxation, 0.5f);
     /* s_corr off by default: in zero gravity a free block with 0.5 cm/s of noise gained 9x its
@@ -65,10 +65,10 @@ static vfx_result fill_params(rt_sph_desc *p, char *err, size_t err_len)
     p->pbf_scorr_k = def(p->pbf_scorr_k, 0.f);
     p->pbf_scorr_dq = def(p->pbf_scorr_dq, 0.2f);
     p->pbf_xsph = def(p->pbf_xsph, 0.01f);
-    /* 0.8 with 5 iterations (and eps 0.5 D0): the default pool at 0.50% mean compression against
-     * 0.76% with the old 6 plain ones, and the dam break within 10% at all 9 points (worst 9.3%);
-     * 0.9 made the pool boil at eps 0.2, and 2 iterations at 0.8 blew up (docs/simulation.md,
-     * "Chebyshev acceleration") */
+    /* 0.8 with 5 iterations (and eps 0.5 D0): the default pool at 0.53% mean compression against
+     * 0.76% with the old 6 plain ones, and the dam break within 10% at all 9 points (worst 9.6%);
+     * 0.9 stirred the pool up (66 J of kinetic energy against 53.5 J at frame 120), and 2
+     * iterations at 0.8 more (240 J) (docs/simulation.md, "Chebyshev acceleration") */
     p->pbf_chebyshev_rho = def(p->pbf_chebyshev_rho, 0.8f);
 
     const float *fields[] = {&p->spacing, &p->support_ratio, &p->rest_density, &p->sound_speed,
