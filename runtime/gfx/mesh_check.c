@@ -238,6 +238,10 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
             unsigned long long c = nw == 3 && isdigit((unsigned char)w[2][0]) ? strtoull(w[2], &end, 10) : 0;
             if (nw != 3 || !end || *end)
                 return ply_fail(name, err, errlen, "%s", ln, "an element line needs a name and a count");
+            /* Assimp 5.2 reads an element's count from the start of a name it does not know, so a
+             * name of digits became a count of billions (fuzz_mesh_ply: 2.9 GB in one vector) */
+            if (!isalpha((unsigned char)w[1][0]) && w[1][0] != '_')
+                return ply_fail(name, err, errlen, "element name \"%s\" does not start with a letter", ln, w[1]);
             if (nel == PLY_MAX_ELEMENTS)
                 return ply_fail(name, err, errlen, "more than %s elements", ln, "16");
             for (unsigned k = 0; k < nel; ++k)
