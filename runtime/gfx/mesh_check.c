@@ -71,7 +71,18 @@ typedef struct ply_element {
     unsigned char size[PLY_MAX_PROPS];     /* a scalar's bytes, or a list item's */
     unsigned char list[PLY_MAX_PROPS];     /* a list's count bytes; 0 for a scalar */
     unsigned char signed_count[PLY_MAX_PROPS];
+    unsigned char kind[PLY_MAX_PROPS];     /* a scalar's or list item's type: PLY_UINT, PLY_SINT, PLY_REAL */
 } ply_element;
+
+enum { PLY_UINT, PLY_SINT, PLY_REAL };
+
+/* The kind of a type name that ply_type_size knows. */
+static unsigned char ply_type_kind(const char *t)
+{
+    if (strncmp(t, "float", 5) == 0 || strcmp(t, "double") == 0)
+        return PLY_REAL;
+    return t[0] == 'u' ? PLY_UINT : PLY_SINT;
+}
 
 /* Next header line [*pos, end) into `line` (NUL-terminated, CR dropped); 0 at the end of data. */
 static int ply_line(const unsigned char *d, size_t size, size_t *pos, char *line, size_t cap,
@@ -196,6 +207,257 @@ static vfx_result ply_walk_body(const unsigned char *d, size_t size, size_t pos,
     return VFX_OK;
 }
 
+/* ---- ASCII PLY as Assimp 5.2 reads it ----------------------------------------------------
+ * ply_walk_body's lines end at '\n' and its values are whitespace-separated tokens. Assimp's
+ * (IOStreamBuffer::getNextLine and PLY::PropertyInstance::ParseInstance, in its installed
+ * headers and 5.2's PlyParser.cpp) differ:
+ * - a line also ends at '\r', '\0' or '\f', and a line that starts at a line end skips to past
+ *   the next '\n' (with no '\n' left, it reads past the end of its block);
+ * - lines are copied into one buffer, never cleared: a last line with no line end, or a value
+ *   parse that runs past a line's end, reads what earlier, longer lines left there;
+ * - a number it cannot read leaves the parse where it was, so the next value is read from the
+ *   middle of a token;
+ * - a list is sized by its count (8 bytes an item) before its items are read.
+ * A face line that Assimp saw where ply_walk_body saw a vertex asked for 2.9 GB
+ * (fuzz_mesh_ply). So the body is walked a second time, the way Assimp walks it, over a copy of
+ * its buffer, and every list count it would read must fit in the values left on its line.
+ * Files above Assimp's 16 MB read-ahead block may split a line at a block edge; not mirrored. */
+
+static int ply_is_line_end(int c)
+{
+    return c == '\r' || c == '\n' || c == '\0' || c == '\f';
+}
+
+typedef struct ply_cursor {
+    const unsigned char *b; /* Assimp's line buffer: ab_len bytes, then zeros */
+    size_t len, c;
+} ply_cursor;
+
+static int ply_at(const ply_cursor *k, size_t i)
+{
+    return i < k->len ? k->b[i] : 0;
+}
+
+/* getNextLine from *pos into ab: 1 with a line, 0 without one (ab may hold part of it, as
+ * Assimp's buffer does), -1 where Assimp would read past its block. */
+static int ply_assimp_line(const unsigned char *d, size_t size, size_t *pos, unsigned char *ab)
+{
+    size_t p = *pos;
+    if (p >= size)
+        return 0;
+    if (ply_is_line_end(d[p])) {
+        while (p < size && d[p] != '\n')
+            ++p;
+        if (p == size)
+            return -1;
+        if (++p >= size) {
+            *pos = p;
+            return 0;
+        }
+    }
+    size_t i = 0;
+    while (!ply_is_line_end(d[p])) {
+        ab[i++] = d[p++];
+        if (p >= size) {
+            *pos = p;
+            return 0;
+        }
+    }
+    ab[i] = '\n';
+    *pos = p + 1;
+    return 1;
+}
+
+/* strtoul10: digits, wrapping at 32 bits; none read where none are. */
+static uint32_t ply_strtoul10(ply_cursor *k)
+{
+    uint32_t v = 0;
+    while (isdigit(ply_at(k, k->c)))
+        v = v * 10u + (uint32_t)(ply_at(k, k->c++) - '0');
+    return v;
+}
+
+/* strtoul10_64 as fast_atoreal_move calls it: 0 where no digit starts it (Assimp throws); on
+ * overflow Assimp returns without moving; max > 0 stops after max digits and skips the rest. */
+static int ply_strtoul10_64(ply_cursor *k, unsigned max)
+{
+    if (!isdigit(ply_at(k, k->c)))
+        return 0;
+    size_t start = k->c;
+    unsigned long long v = 0;
+    for (unsigned n = 0; isdigit(ply_at(k, k->c));) {
+        unsigned long long nv = v * 10ull + (unsigned long long)(ply_at(k, k->c) - '0');
+        if (nv < v) {
+            k->c = start;
+            return 1;
+        }
+        v = nv, ++k->c;
+        if (max && ++n == max) {
+            while (isdigit(ply_at(k, k->c)))
+                ++k->c;
+            return 1;
+        }
+    }
+    return 1;
+}
+
+/* fast_atoreal_move: 0 where Assimp throws (no number there). */
+static int ply_atoreal(ply_cursor *k)
+{
+    if (ply_at(k, k->c) == '-' || ply_at(k, k->c) == '+')
+        ++k->c;
+    const char *p = (const char *)k->b + k->c;
+    size_t left = k->c < k->len ? k->len - k->c : 0;
+    if (left >= 3 && strncasecmp(p, "nan", 3) == 0) {
+        k->c += 3;
+        return 1;
+    }
+    if (left >= 3 && strncasecmp(p, "inf", 3) == 0) {
+        k->c += left >= 8 && strncasecmp(p + 3, "inity", 5) == 0 ? 8 : 3;
+        return 1;
+    }
+    int c0 = ply_at(k, k->c), c1 = ply_at(k, k->c + 1);
+    if (!isdigit(c0) && !((c0 == '.' || c0 == ',') && isdigit(c1)))
+        return 0;
+    if (c0 != '.' && c0 != ',')
+        ply_strtoul10_64(k, 0);
+    c0 = ply_at(k, k->c), c1 = ply_at(k, k->c + 1);
+    if ((c0 == '.' || c0 == ',') && isdigit(c1)) {
+        ++k->c;
+        ply_strtoul10_64(k, 15);
+    } else if (c0 == '.') {
+        ++k->c;
+    }
+    if (ply_at(k, k->c) == 'e' || ply_at(k, k->c) == 'E') {
+        ++k->c;
+        if (ply_at(k, k->c) == '-' || ply_at(k, k->c) == '+')
+            ++k->c;
+        return ply_strtoul10_64(k, 0);
+    }
+    return 1;
+}
+
+/* ParseValue of one value of kind `kind`, with the value ConvertTo<unsigned int> makes a list
+ * count of in *as_count; 0 where Assimp throws. */
+static int ply_value(ply_cursor *k, unsigned char kind, uint32_t *as_count)
+{
+    if (kind == PLY_REAL)
+        return ply_atoreal(k);
+    int neg = 0;
+    if (kind == PLY_SINT && (ply_at(k, k->c) == '-' || ply_at(k, k->c) == '+'))
+        neg = ply_at(k, k->c++) == '-';
+    uint32_t v = ply_strtoul10(k);
+    if (as_count)
+        *as_count = neg ? 0u - v : v;
+    return 1;
+}
+
+/* SkipSpaces: blanks and tabs; 0 at a line end. */
+static int ply_skip_spaces(ply_cursor *k)
+{
+    while (ply_at(k, k->c) == ' ' || ply_at(k, k->c) == '\t')
+        ++k->c;
+    return !ply_is_line_end(ply_at(k, k->c));
+}
+
+/* Values left before the next line end: the items a list's loop can read. */
+static unsigned long long ply_values_left(const ply_cursor *k)
+{
+    unsigned long long n = 0;
+    int in = 0;
+    for (size_t i = k->c; !ply_is_line_end(ply_at(k, i)); ++i) {
+        int blank = ply_at(k, i) == ' ' || ply_at(k, i) == '\t';
+        n += !blank && !in;
+        in = !blank;
+    }
+    return n;
+}
+
+/* Element names whose instances Assimp 5.2 parses (PLY::Element::ParseSemantic); it skips one
+ * line an instance of any other. */
+static int ply_assimp_parses(const char *name)
+{
+    static const char *const known[] = {"vertex", "face", "tristrips", "edge", "material", "TextureFile"};
+    for (size_t i = 0; i < sizeof known / sizeof known[0]; ++i)
+        if (strcmp(name, known[i]) == 0)
+            return 1;
+    return 0;
+}
+
+/* One instance line in ab: every list count must fit in the values left on its line. */
+static vfx_result ply_assimp_instance(ply_cursor *k, const ply_element *e, unsigned long long n,
+                                      unsigned long long line, const char *name, char *err, size_t errlen)
+{
+    for (unsigned p = 0; p < e->props; ++p) {
+        if (!ply_skip_spaces(k))
+            continue; /* Assimp leaves the property at its default, the parse where it is */
+        uint32_t cnt = 1;
+        if (e->list[p]) {
+            ply_value(k, e->signed_count[p] ? PLY_SINT : PLY_UINT, &cnt);
+            unsigned long long room = ply_values_left(k);
+            if (cnt > room) {
+                snprintf(err, errlen, "%s: PLY body line %llu (as Assimp splits lines: at CR, LF, NUL and FF): "
+                         "element %s %llu, property %u: a list of %u items, more than the %llu values left on "
+                         "its line", name, line, e->name, n, p, cnt, room);
+                return VFX_ERR_FORMAT;
+            }
+        }
+        for (uint32_t t = 0; t < cnt; ++t) {
+            if (e->list[p] && !ply_skip_spaces(k))
+                break;
+            if (!ply_value(k, e->kind[p], NULL)) {
+                snprintf(err, errlen, "%s: PLY body line %llu: element %s %llu, property %u: not a number",
+                         name, line, e->name, n, p);
+                return VFX_ERR_FORMAT;
+            }
+        }
+        while (ply_at(k, k->c) == ' ' || ply_at(k, k->c) == '\t' || ply_at(k, k->c) == '\r' ||
+               ply_at(k, k->c) == '\n') /* SkipSpacesAndLineEnd: on past the line's end */
+            ++k->c;
+    }
+    return VFX_OK;
+}
+
+static vfx_result ply_walk_ascii_as_assimp(const unsigned char *d, size_t size, const ply_element *el,
+                                           unsigned nel, const char *name, char *err, size_t errlen)
+{
+    unsigned char *ab = calloc(size + 2, 1); /* no line is longer than the file */
+    if (!ab) {
+        snprintf(err, errlen, "%s: out of memory (%zu bytes) checking the PLY body", name, size + 2);
+        return VFX_ERR_OUT_OF_MEMORY;
+    }
+    /* the header's lines, through end_header, go through the same buffer */
+    size_t pos = 0;
+    int got;
+    while ((got = ply_assimp_line(d, size, &pos, ab)) == 1 && strncmp((const char *)ab, "end_header", 10) != 0) {
+    }
+    vfx_result r = VFX_OK;
+    unsigned long long line = 0; /* of the body, as Assimp splits it */
+    if (got == 1) {
+        got = ply_assimp_line(d, size, &pos, ab);
+        line = 1;
+    }
+    for (unsigned i = 0; i < nel && r == VFX_OK && got >= 0; ++i) {
+        const int parsed = ply_assimp_parses(el[i].name);
+        for (unsigned long long n = 0; n < el[i].count && r == VFX_OK && got >= 0; ++n) {
+            ply_cursor k = {ab, size + 2, 0};
+            if (parsed)
+                r = ply_assimp_instance(&k, &el[i], n, line, name, err, errlen);
+            if (got != 1)
+                break; /* no line left: Assimp parses its buffer again, as just checked */
+            if ((got = ply_assimp_line(d, size, &pos, ab)) == 1)
+                ++line;
+        }
+    }
+    if (r == VFX_OK && got < 0) {
+        snprintf(err, errlen, "%s: PLY body after line %llu: a CR, NUL or FF with no LF after it (Assimp reads "
+                 "past its buffer looking for one)", name, line);
+        r = VFX_ERR_FORMAT;
+    }
+    free(ab);
+    return r;
+}
+
 static vfx_result check_ply(const unsigned char *d, size_t size, const char *name, char *err,
                             size_t errlen)
 {
@@ -269,10 +531,12 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
                 e->list[e->props] = (unsigned char)sz;
                 e->signed_count[e->props] = w[2][0] != 'u';
                 e->size[e->props] = (unsigned char)isz;
+                e->kind[e->props] = ply_type_kind(w[3]);
             } else if (nw != 3 || !(sz = ply_type_size(w[1]))) {
                 return ply_fail(name, err, errlen, "unknown property type \"%s\"", ln, w[1]);
             } else {
                 e->size[e->props] = (unsigned char)sz;
+                e->kind[e->props] = ply_type_kind(w[1]);
             }
             e->props++;
             e->bytes += sz;
@@ -315,7 +579,10 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
             return VFX_ERR_FORMAT;
         }
     }
-    return ply_walk_body(d, size, pos, binary, el, nel, name, err, errlen);
+    vfx_result r = ply_walk_body(d, size, pos, binary, el, nel, name, err, errlen);
+    if (r == VFX_OK && !binary)
+        r = ply_walk_ascii_as_assimp(d, size, el, nel, name, err, errlen);
+    return r;
 }
 
 /* ---- STL ---------------------------------------------------------------------------------- */

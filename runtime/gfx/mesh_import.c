@@ -386,8 +386,13 @@ vfx_result rt_mesh_import(const char *path, rt_mesh_data *out, char *err, size_t
 vfx_result rt_mesh_import_memory(const void *data, size_t size, const char *hint,
                                   rt_mesh_data *out, char *err, size_t errlen)
 {
-    if (!data || !out || !hint || size == 0 || size > RT_MESH_MAX_BYTES)
+    if (!data || !out || !hint || size == 0 || size > RT_MESH_MAX_BYTES) {
+        if (err && errlen)
+            snprintf(err, errlen, "rt_mesh_import_memory: %s (%zu bytes; NULL data, out or hint, or a size of 0 "
+                     "or above %llu)", !data || !out || !hint ? "a NULL argument" : "no mesh in the bytes", size,
+                     (unsigned long long)RT_MESH_MAX_BYTES);
         return VFX_ERR_INVALID_ARGUMENT;
+    }
     memset(out, 0, sizeof *out);
     char name[48];
     snprintf(name, sizeof name, "(memory).%.16s", hint);

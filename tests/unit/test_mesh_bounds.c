@@ -110,6 +110,23 @@ static void test_ply_claiming_2e9_vertices(void **state)
                                  "property float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
     write_file("digits.ply", digits, sizeof digits - 1);
     expect_refused("digits.ply", VFX_ERR_FORMAT, "line 3: element name \"8888888888888888vertex\" does not start with a letter");
+    /* Assimp ends a line at a lone CR too: its fourth line, the face, claims 4e9 items (32 GB),
+     * where a reader splitting at LF sees a vertex x of 4e9 (found by fuzz_mesh_ply) */
+    static const char cr[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nelement face 1\n"
+                             "property list uchar int vertex_indices\nend_header\n0\r1\n2\n4000000000 0 1 2\n3 0 1 2\n";
+    write_file("cr.ply", cr, sizeof cr - 1);
+    expect_refused("cr.ply", VFX_ERR_FORMAT, "PLY body line 4 (as Assimp splits lines: at CR, LF, NUL and FF): element "
+                   "face 0, property 0: a list of 4000000000 items, more than the 3 values left on its line");
+    /* a line that starts at a CR makes Assimp look for the next LF, past its buffer if none */
+    static const char nolf[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nelement face 1\n"
+                               "property list uchar int vertex_indices\nend_header\n0\n1\n2\n\r\r3 0 1 2";
+    write_file("nolf.ply", nolf, sizeof nolf - 1);
+    expect_refused("nolf.ply", VFX_ERR_FORMAT, "a CR, NUL or FF with no LF after it");
+    /* with no mesh in them, the bytes are refused by name */
+    char err[256] = "";
+    rt_mesh_data m;
+    assert_int_equal(rt_mesh_import_memory(cr, 0, "ply", &m, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(err, "rt_mesh_import_memory: no mesh in the bytes (0 bytes"));
 }
 
 static void le32(unsigned char *p, uint32_t v)
