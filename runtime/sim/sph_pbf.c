@@ -132,12 +132,15 @@ void rt_sph_pbf_clamp(const rt_sph *s, float p[3])
  * order, wall_rho(x) = wall_rho(x0) + rho0 grad . (x - x0). The iterations move a particle by a
  * fraction of a spacing, where the wall integrals are smooth; evaluating them in every pass of
  * every iteration was 19% of PBF's instructions (callgrind, default pool). The warm-start
- * experiment, whose first correction runs before any lambda pass, evaluates them every time. */
-static void pbf_walls_iter(rt_sph *s, uint32_t i, float px, float py, float pz, bool lambda_pass, float *wall_rho,
-                           float g[3])
+ * experiment, whose first correction runs before any lambda pass, evaluates them every time.
+ * Inlined into both pair passes: as a call it took 10% of PBF's cycles for 4% of its
+ * instructions (perf, default pool, 1 thread); inlined, the frame's median CPU fell ~5%. */
+static inline __attribute__((always_inline)) void pbf_walls_iter(rt_sph *s, uint32_t i, float px, float py,
+                                                                 float pz, bool lambda_pass, float *wall_rho,
+                                                                 float g[3])
 {
     float ig;
-    if (s->p.flags & RT_SPH_PBF_WARM_START) {
+    if (__builtin_expect((s->p.flags & RT_SPH_PBF_WARM_START) != 0, 0)) {
         pbf_walls(s, px, py, pz, wall_rho, g, &ig);
         return;
     }
