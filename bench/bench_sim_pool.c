@@ -28,6 +28,32 @@ static double cpu_ms(void)
     return (double)t.tv_sec * 1e3 + 1e-6 * (double)t.tv_nsec;
 }
 
+/* Where the fastest particle is (the closed pool's rest goal: which layer keeps moving): at a
+ * side wall of the tank (within 1.5 dx) and in the top layer (within 1 dx of the highest
+ * particle), at a side wall below it, on the floor (within 1.5 dx), in the top layer away from
+ * the walls, or inside. */
+enum { WHERE_SIDE_TOP, WHERE_SIDE, WHERE_FLOOR, WHERE_TOP, WHERE_INSIDE, WHERE_N };
+static const char *const where_name[WHERE_N] = {"side_top", "side", "floor", "top", "inside"};
+
+static int fastest_where(rt_sph *s, const float tmin[3], const float tmax[3], float dx)
+{
+    rt_sph_columns c = rt_sph_get_columns(s);
+    uint32_t best = 0;
+    float v2max = -1.f, ytop = -INFINITY;
+    for (uint32_t i = 0; i < c.count; ++i) {
+        float v2 = c.vx[i] * c.vx[i] + c.vy[i] * c.vy[i] + c.vz[i] * c.vz[i];
+        if (v2 > v2max)
+            v2max = v2, best = i;
+        ytop = fmaxf(ytop, c.y[i]);
+    }
+    if (!c.count)
+        return WHERE_INSIDE;
+    const uint32_t i = best;
+    float side = fminf(fminf(c.x[i] - tmin[0], tmax[0] - c.x[i]), fminf(c.z[i] - tmin[2], tmax[2] - c.z[i]));
+    bool at_side = side < 1.5f * dx, top = c.y[i] > ytop - dx, floor = c.y[i] - tmin[1] < 1.5f * dx;
+    return at_side ? (top ? WHERE_SIDE_TOP : WHERE_SIDE) : floor ? WHERE_FLOOR : top ? WHERE_TOP : WHERE_INSIDE;
+}
+
 /* solvers: bit 0 WCSPH, bit 1 PBF, bit 2 PBF with RT_SPH_PBF_RECOMPUTE (callgrind of one alone),
  * bit 3 PBF with plain Jacobi iterations (RT_SPH_PBF_NO_CHEBYSHEV, 6 unless --pbf-iterations) */
 int bench_sim_pool(const bench_pool_opts *o)
@@ -103,6 +129,7 @@ int bench_sim_pool(const bench_pool_opts *o)
      * none) sampled every 10 frames; the largest rise between any two samples, over the first */
     double e0[NS] = {0}, emin[NS] = {0}, grow[NS] = {0}, ke_last[NS] = {0};
     uint32_t steps[NS] = {0}, iters[NS] = {0}, rebuilds[NS] = {0};
+    uint32_t where[NS][WHERE_N] = {{0}}; /* frames 2..F by where the fastest particle was */
     for (int f = 0; f < frames && ok; ++f)
         for (int m = 0; m < NS; ++m) {
             if (!(solvers >> m & 1u))
@@ -132,6 +159,8 @@ int bench_sim_pool(const bench_pool_opts *o)
                 emin[m] = e < emin[m] ? e : emin[m];
             }
             steps[m] += r.substeps, iters[m] += r.iterations, rebuilds[m] += r.neighbor_rebuilds;
+            if (f >= 1)
+                where[m][fastest_where(s[m], tmin, tmax, dx)]++;
         }
     double med[NS];
     for (int m = 0; m < NS; ++m) {
@@ -154,13 +183,16 @@ int bench_sim_pool(const bench_pool_opts *o)
                "\"iterations_per_frame\":%.2f,\"rebuilds_per_frame\":%.2f,\"max_speed_frames_2_on\":%.4f,\"max_speed_frames_2_30\":%.4f,\"max_speed_last\":%.4f,\"mean_compression\":%.5f,\"paddle_ramp_s\":%.3f,"
                "\"energy_first_J\":%.6g,\"energy_growth_max\":%.3g,\"kinetic_energy_last_J\":%.4g,"
                "\"settle_steps\":%u,\"settle_cpu_s\":%.3f,\"settle_max_speed_last\":%.4f,"
-               "\"rms_speed_last\":%.4f,\"floor_pressed_last\":%u,\"side_pressed_last\":%u}\n",
+               "\"rms_speed_last\":%.4f,\"floor_pressed_last\":%u,\"side_pressed_last\":%u,"
+               "\"fastest_frames_2_on\":{\"%s\":%u,\"%s\":%u,\"%s\":%u,\"%s\":%u,\"%s\":%u}}\n",
                name[m], added[m], dx, paddle ? "true" : "false", frames, rt_sph_thread_count(s[m]),
                med[m], rt_median(wms[m], (uint32_t)frames), (double)steps[m] / frames, (double)iters[m] / frames,
                (double)rebuilds[m] / frames, vmax[m], frames >= 2 ? vmax30[m] : 0.f, vlast[m], err_sum[m] / frames,
                paddle ? (double)(ramp_s < 0.f ? period : ramp_s) : 0.0, e0[m], grow[m], ke_last[m],
                settled[m].steps, settled[m].cpu_s, settled[m].max_speed_last,
-               c.count ? sqrt(v2 / c.count) : 0.0, floor_pressed, side_pressed);
+               c.count ? sqrt(v2 / c.count) : 0.0, floor_pressed, side_pressed, where_name[0], where[m][0],
+               where_name[1], where[m][1], where_name[2], where[m][2], where_name[3], where[m][3], where_name[4],
+               where[m][4]);
     }
     for (int m = 1; m < NS; ++m)
         if ((solvers & 1u) && (solvers >> m & 1u))
