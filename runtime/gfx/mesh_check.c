@@ -429,7 +429,8 @@ static vfx_result ply_walk_ascii_as_assimp(const unsigned char *d, size_t size, 
     /* the header's lines, through end_header, go through the same buffer */
     size_t pos = 0;
     int got;
-    while ((got = ply_assimp_line(d, size, &pos, ab)) == 1 && strncmp((const char *)ab, "end_header", 10) != 0) {
+    while ((got = ply_assimp_line(d, size, &pos, ab)) == 1 &&
+           strncmp((const char *)ab + strspn((const char *)ab, " \t"), "end_header", 10) != 0) {
     }
     vfx_result r = VFX_OK;
     unsigned long long line = 0; /* of the body, as Assimp splits it */
