@@ -373,11 +373,12 @@ static unsigned long long ply_values_left(const ply_cursor *k)
     return n;
 }
 
-/* Element names whose instances Assimp 5.2 parses (PLY::Element::ParseSemantic); it skips one
- * line an instance of any other. */
+/* Element names Assimp 5.2 knows (PLY::Element::ParseSemantic). It reads the count of any other
+ * from the start of its name (the name is not skipped first): 0 for a name that starts with a
+ * letter, so it reads none of its instances (TextureFile takes no count at all). */
 static int ply_assimp_parses(const char *name)
 {
-    static const char *const known[] = {"vertex", "face", "tristrips", "edge", "material", "TextureFile"};
+    static const char *const known[] = {"vertex", "face", "tristrips", "edge", "material"};
     for (size_t i = 0; i < sizeof known / sizeof known[0]; ++i)
         if (strcmp(name, known[i]) == 0)
             return 1;
@@ -439,11 +440,11 @@ static vfx_result ply_walk_ascii_as_assimp(const unsigned char *d, size_t size, 
         line = 1;
     }
     for (unsigned i = 0; i < nel && r == VFX_OK && got >= 0; ++i) {
-        const int parsed = ply_assimp_parses(el[i].name);
+        if (!ply_assimp_parses(el[i].name))
+            continue; /* no instance, as Assimp reads it (check_ply keeps these last) */
         for (unsigned long long n = 0; n < el[i].count && r == VFX_OK && got >= 0; ++n) {
             ply_cursor k = {ab, size + 2, 0};
-            if (parsed)
-                r = ply_assimp_instance(&k, &el[i], n, line, name, err, errlen);
+            r = ply_assimp_instance(&k, &el[i], n, line, name, err, errlen);
             if (got != 1)
                 break; /* no line left: Assimp parses its buffer again, as just checked */
             if ((got = ply_assimp_line(d, size, &pos, ab)) == 1)
@@ -571,6 +572,17 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
                      name, e->line, e->name, e->count);
             return VFX_ERR_FORMAT;
         }
+        /* an element Assimp does not know is empty to it, so the data of the next one it knows
+         * would be read from this one's bytes (a uint list count of 4e9 from a float: 32 GB asked,
+         * found by fuzz_mesh_ply in CI) */
+        for (unsigned j = i + 1; e->count > 0 && !ply_assimp_parses(e->name) && j < nel; ++j)
+            if (ply_assimp_parses(el[j].name)) {
+                snprintf(err, errlen, "%s: PLY header line %u: element %s (%llu) comes before element %s, and "
+                         "Assimp 5.2 reads an element it does not know as empty: it would read %s from %s's "
+                         "data; put %s after the mesh's elements or leave it out", name, e->line, e->name,
+                         e->count, el[j].name, el[j].name, e->name, e->name);
+                return VFX_ERR_FORMAT;
+            }
         need += e->count * (binary ? e->bytes : 2ull * e->props); /* <= 2^24 * 16 * 8 * ...: no overflow */
         if (need > body + (binary ? 0 : 1)) {
             snprintf(err, errlen,

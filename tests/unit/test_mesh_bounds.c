@@ -122,6 +122,26 @@ static void test_ply_claiming_2e9_vertices(void **state)
                                "property list uchar int vertex_indices\nend_header\n0\n1\n2\n\r\r3 0 1 2";
     write_file("nolf.ply", nolf, sizeof nolf - 1);
     expect_refused("nolf.ply", VFX_ERR_FORMAT, "a CR, NUL or FF with no LF after it");
+    /* Assimp reads an element it does not know as empty: the face's uint count came from the
+     * unknown element's float (0xffffffff items, 32 GB asked; found by fuzz_mesh_ply in CI) */
+    static const char unknown_first[] = "ply\nformat binary_little_endian 1.0\nelement camera 1\nproperty float x\n"
+                                        "element face 1\nproperty list uint int vertex_indices\nend_header\n"
+                                        "\xff\xff\xff\xff\0\0\0\0";
+    write_file("unknown_first.ply", unknown_first, sizeof unknown_first - 1);
+    expect_refused("unknown_first.ply", VFX_ERR_FORMAT, "PLY header line 3: element camera (1) comes before element "
+                   "face, and Assimp 5.2 reads an element it does not know as empty");
+    /* after the mesh's elements it is harmless, and the file imports */
+    static const char unknown_last[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                       "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                                       "element camera 1\nproperty float x\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n7\n";
+    write_file("unknown_last.ply", unknown_last, sizeof unknown_last - 1);
+    {
+        rt_mesh_data ok;
+        char e2[512] = "";
+        assert_int_equal(rt_mesh_import("unknown_last.ply", &ok, e2, sizeof e2), VFX_OK);
+        assert_int_equal(ok.index_count, 3);
+        rt_mesh_data_free(&ok);
+    }
     /* with no mesh in them, the bytes are refused by name */
     char err[256] = "";
     rt_mesh_data m;
