@@ -471,6 +471,7 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
     ply_element el[PLY_MAX_ELEMENTS];
     unsigned nel = 0;
     int ended = 0;
+    unsigned props_end = 0; /* the line that ended the current element's properties for Assimp */
     while (!ended && ply_line(d, size, &pos, line, sizeof line, &too_long, &bad_byte)) {
         ++ln;
         if (too_long)
@@ -484,6 +485,11 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
                 return ply_fail(name, err, errlen, "%s", ln, "not a PLY file (no \"ply\" on the first line)");
             continue;
         }
+        /* Assimp 5.2 ends an element's properties at the first line that is not one (a comment,
+         * a blank line, anything): it drops the properties after it and reads the body with fewer
+         * (an ASCII vertex lost y and z; a binary body shifts) */
+        if (nel > 0 && !props_end && (nw <= 0 || strcmp(w[0], "property") != 0))
+            props_end = ln;
         if (nw <= 0 || strcmp(w[0], "comment") == 0 || strcmp(w[0], "obj_info") == 0)
             continue;
         if (strcmp(w[0], "format") == 0) {
@@ -516,9 +522,16 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
             snprintf(e->name, sizeof e->name, "%.31s", w[1]);
             e->count = c;
             e->line = ln;
+            props_end = 0;
         } else if (strcmp(w[0], "property") == 0) {
             if (nel == 0)
                 return ply_fail(name, err, errlen, "%s", ln, "a property before any element");
+            if (props_end) {
+                char why[96];
+                snprintf(why, sizeof why, "a property after line %u, which is not one (Assimp 5.2 ends the", props_end);
+                return ply_fail(name, err, errlen, "%s element's properties there and would drop this one; move "
+                                "that line above the element)", ln, why);
+            }
             ply_element *e = &el[nel - 1];
             unsigned sz;
             if (e->props == PLY_MAX_PROPS)

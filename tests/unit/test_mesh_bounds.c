@@ -142,6 +142,13 @@ static void test_ply_claiming_2e9_vertices(void **state)
         assert_int_equal(ok.index_count, 3);
         rt_mesh_data_free(&ok);
     }
+    /* Assimp ends an element's properties at a comment: y and z were dropped and every vertex
+     * read (x, 0, 0), silently (a binary body would shift under it) */
+    static const char comment_mid[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\ncomment hi\n"
+                                      "property float y\nproperty float z\nelement face 1\n"
+                                      "property list uchar int vertex_indices\nend_header\n1 2 3\n4 5 6\n7 8 9\n3 0 1 2\n";
+    write_file("comment_mid.ply", comment_mid, sizeof comment_mid - 1);
+    expect_refused("comment_mid.ply", VFX_ERR_FORMAT, "PLY header line 6: a property after line 5, which is not one");
     /* with no mesh in them, the bytes are refused by name */
     char err[256] = "";
     rt_mesh_data m;
