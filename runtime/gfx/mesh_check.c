@@ -559,6 +559,13 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
             ended = 1;
         } /* other lines are skipped, as Assimp does (Blender wrote "Created by ..." there) */
     }
+    if (ended && d[pos - 1] != '\n') {
+        /* Assimp 5.2's header loop never ends when end_header is the file's last bytes: its
+         * line reader fails there, keeps the line unterminated, and is asked again forever
+         * (fuzz_mesh_ply timeout) */
+        snprintf(err, errlen, "%s: PLY header line %u: end_header ends the file with no line end after it", name, ln);
+        return VFX_ERR_FORMAT;
+    }
     if (ended && nel == 0) {
         snprintf(err, errlen, "%s: PLY header declares no element", name);
         return VFX_ERR_FORMAT;

@@ -149,6 +149,10 @@ static void test_ply_claiming_2e9_vertices(void **state)
                                       "property list uchar int vertex_indices\nend_header\n1 2 3\n4 5 6\n7 8 9\n3 0 1 2\n";
     write_file("comment_mid.ply", comment_mid, sizeof comment_mid - 1);
     expect_refused("comment_mid.ply", VFX_ERR_FORMAT, "PLY header line 6: a property after line 5, which is not one");
+    /* end_header as the file's last bytes: Assimp's header loop never ended (fuzz_mesh_ply) */
+    static const char no_eol[] = "ply\nformat binary_little_endian 1.0\nelement vertex 0\nprtex_indices\nend_header";
+    write_file("no_eol.ply", no_eol, sizeof no_eol - 1);
+    expect_refused("no_eol.ply", VFX_ERR_FORMAT, "PLY header line 5: end_header ends the file with no line end after it");
     /* with no mesh in them, the bytes are refused by name */
     char err[256] = "";
     rt_mesh_data m;
