@@ -55,6 +55,17 @@ static const char ply_head[] = "ply\nformat binary_little_endian 1.0\nelement ve
                                "property float x\nproperty float y\nproperty float z\nelement face %s\n"
                                "property list uchar int vertex_indices\nend_header\n";
 
+/* path imports, with index_count indices */
+static void expect_imported(const char *path, uint32_t index_count)
+{
+    rt_mesh_data m;
+    char err[600] = "";
+    if (rt_mesh_import(path, &m, err, sizeof err) != VFX_OK)
+        fail_msg("%s: %s", path, err);
+    assert_int_equal(m.index_count, index_count);
+    rt_mesh_data_free(&m);
+}
+
 static void test_truncated_binary_ply(void **state)
 {
     (void)state;
@@ -135,13 +146,7 @@ static void test_ply_claiming_2e9_vertices(void **state)
                                        "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
                                        "element camera 1\nproperty float x\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n7\n";
     write_file("unknown_last.ply", unknown_last, sizeof unknown_last - 1);
-    {
-        rt_mesh_data ok;
-        char e2[512] = "";
-        assert_int_equal(rt_mesh_import("unknown_last.ply", &ok, e2, sizeof e2), VFX_OK);
-        assert_int_equal(ok.index_count, 3);
-        rt_mesh_data_free(&ok);
-    }
+    expect_imported("unknown_last.ply", 3);
     /* Assimp ends an element's properties at a comment: y and z were dropped and every vertex
      * read (x, 0, 0), silently (a binary body would shift under it) */
     static const char comment_mid[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\ncomment hi\n"
@@ -229,11 +234,7 @@ static void test_files_beside_the_mesh(void **state)
     /* a missing .mtl stays what it was: the mesh imports without it */
     static const char obj2[] = "mtllib not_there.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
     write_file("missing_mtl.obj", obj2, sizeof obj2 - 1);
-    rt_mesh_data m;
-    char err[600];
-    assert_int_equal(rt_mesh_import("missing_mtl.obj", &m, err, sizeof err), VFX_OK);
-    assert_int_equal(m.index_count, 3);
-    rt_mesh_data_free(&m);
+    expect_imported("missing_mtl.obj", 3);
     unlink("pipe.mtl");
 }
 
