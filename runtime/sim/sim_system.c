@@ -34,6 +34,10 @@ struct rt_sim_system {
     bool settle;
     rt_sph_settle_desc settle_desc;
     rt_logger log;
+    /* rt_sim_system_warn_slow: the bound, whether it was said, the settle's start */
+    double slow_s;
+    bool slow_said;
+    double settle_t0;
 };
 
 static double wall_s(void)
@@ -41,6 +45,21 @@ static double wall_s(void)
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Says once, through the logger, that one solver step took `took` wall seconds, above the bound. */
+static void warn_slow(rt_sim_system *s, double took, const char *when)
+{
+    if (s->slow_said || !(s->slow_s > 0.0) || !(took > s->slow_s))
+        return;
+    s->slow_said = true;
+    const rt_sph_desc *p = rt_sph_params(s->sph);
+    const float *lo = p->domain_min, *hi = p->domain_max;
+    rt_logf(&s->log, VFX_LOG_WARN, "fluid simulation: one solver step of %u particles (spacing %g m) in the tank "
+            "[%g, %g, %g]..[%g, %g, %g] took %.3g s %s, above %.3g s: each frame takes up to %u such steps; fewer "
+            "particles (a larger spacing) make it faster", rt_sph_get_columns(s->sph).count, (double)p->spacing,
+            (double)lo[0], (double)lo[1], (double)lo[2], (double)hi[0], (double)hi[1], (double)hi[2], took, when,
+            s->slow_s, s->step_dt > 0.f ? s->max_steps : 1u);
 }
 
 /* Steps the bound solver over the frame's dt: once, or by the clock's whole steps. */
@@ -68,7 +87,9 @@ static vfx_result sim_advance(rt_sim_system *s, float frame_dt, const rt_sph_set
     }
     for (uint32_t i = 0; i < n && !r; ++i) {
         rt_sph_report rep;
+        double ts = wall_s();
         r = rt_sph_step(s->sph, dt, &rep, err, errlen);
+        warn_slow(s, wall_s() - ts, "(wall clock)");
         st.steps += rep.substeps;
         st.iterations += rep.iterations;
         st.simulated_s += rep.simulated_time;
@@ -205,6 +226,7 @@ static vfx_result sim_run(rt_world *w, const rt_system_ctx *ctx)
     rt_sph_settle_report settled = {0};
     if (s->settle) {
         s->settle = false;
+        s->settle_t0 = wall_s();
         if ((r = rt_sph_settle(s->sph, &s->settle_desc, &settled, err, sizeof err)))
             return rt_world_fail(w, r, "vfx.sim.sph: settling: %s", err);
         rt_logf(&s->log, VFX_LOG_INFO, "fluid settled before frame 0: %u steps, max speed %.3f m/s at the last, "
@@ -286,7 +308,11 @@ vfx_result rt_sim_system_set_clock(rt_sim_system *s, float step_dt, uint32_t max
 /* rt_sph_settle's progress, as a log line */
 static void settle_progress(void *user, uint32_t step, uint32_t max_steps, float max_speed, float compression)
 {
-    const rt_sim_system *s = user;
+    rt_sim_system *s = user;
+    if (step == 1) /* rt_sph_settle reports its first step for this: the bound is said before the rest */
+        warn_slow(s, wall_s() - s->settle_t0, "(wall clock, settling before frame 0)");
+    if (step == 1 && step != max_steps && s->settle_desc.progress_every != 1)
+        return;
     rt_logf(&s->log, VFX_LOG_INFO, "settling the fluid: step %u of at most %u, max speed %.3f m/s, mean "
             "compression %.2f%%", step, max_steps, (double)max_speed, 100.0 * compression);
 }
@@ -298,8 +324,20 @@ vfx_result rt_sim_system_settle_next(rt_sim_system *s, const rt_sph_settle_desc 
     s->settle_desc = desc ? *desc : (rt_sph_settle_desc){0};
     s->settle_desc.progress = settle_progress;
     s->settle_desc.user = s;
-    s->log = log ? *log : (rt_logger){0};
+    if (log)
+        s->log = *log;
     s->settle = true;
+    return VFX_OK;
+}
+
+vfx_result rt_sim_system_warn_slow(rt_sim_system *s, double seconds, const rt_logger *log)
+{
+    if (!s || !(seconds >= 0.0) || !isfinite(seconds))
+        return VFX_ERR_INVALID_ARGUMENT;
+    s->slow_s = seconds;
+    s->slow_said = false;
+    if (log)
+        s->log = *log;
     return VFX_OK;
 }
 

@@ -257,7 +257,7 @@ typedef struct rt_sph_settle_desc {
     float speed_tol;      /* stop once a step ends below this max speed [m/s] (default 0.03) */
     bool quasi_static;    /* velocities zeroed after every step instead of damped: each step's max
                            * speed is then how far the solver's step moves a fluid at rest */
-    uint32_t progress_every; /* progress(...) every this many steps and at the end (default 20) */
+    uint32_t progress_every; /* progress(...) after the first step, every this many and at the end (default 20) */
     void (*progress)(void *user, uint32_t step, uint32_t max_steps, float max_speed, float compression);
     void *user;
 } rt_sph_settle_desc;

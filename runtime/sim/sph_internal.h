@@ -123,6 +123,7 @@ struct rt_sph {
     uint32_t pbf_valid;          /* rows [0, pbf_valid) have a pressure; later rows are new */
     float pbf_D0;                /* sum_j |grad_j C_i|^2 of a lattice particle [1/m^2] (0: not yet) */
     float pbf_eps, pbf_wdq;      /* constraint-force mixing; (H^2 - dq^2)^3 of s_corr */
+    float pbf_eps_step;          /* the mixing of the current step's dt (pbf_step_eps) */
     float pbf_vmax;              /* largest speed after the last step */
     float pbf_dt;                /* the step being taken */
     uint32_t pbf_iter;           /* the Jacobi iteration being run (0: the walls are evaluated) */

@@ -204,7 +204,7 @@ static void pbf_lambda_chunk(rt_sph *s, uint32_t chunk)
     sph_chunk_rows(s, chunk, &b, &e);
     const float H = s->H, H2 = s->H2, eps2 = 1e-12f * H2, rho0 = s->p.rest_density;
     const float Vks = s->mass / rho0 * s->k_spiky, mk = s->mass * s->k_poly6;
-    const float dt2 = s->pbf_dt * s->pbf_dt, to_l = dt2 / rho0, eps = s->pbf_eps;
+    const float dt2 = s->pbf_dt * s->pbf_dt, to_l = dt2 / rho0, eps = s->pbf_eps_step;
     const bool warm = (s->p.flags & RT_SPH_PBF_WARM_START) != 0;
     const float *X = s->pc[0], *Y = s->pc[1], *Z = s->pc[2];
     /* the position pass's pair terms, when it reads them (sph_pbf_lin.c) */
@@ -724,6 +724,25 @@ static uint32_t pbf_first_bad(const rt_sph *s)
     return UINT32_MAX;
 }
 
+/* The mixing eps of a call of frame_dt: pbf_relaxation D0 at pbf_max_step and above, and
+ * (pbf_max_step / frame_dt)^2 times that below it. A fixed iteration count removes a fixed
+ * fraction of the compression per step, so without the scaling a shorter step makes a stiffer
+ * fluid whose rest state is less compressed: a pool at rest from steps of 1/60 s released its
+ * 1.3% in one step of 1e-5 s, 2 mm per particle over 1e-5 s, and flew at 190 m/s. With eps ~
+ * 1/dt^2 (a compliance fixed in physical units, as XPBD's alpha / dt^2) the rest compression
+ * and the velocities the corrections make do not depend on the call's dt. The call's CFL
+ * substeps keep its eps: they stiffen a fast flow, as before (scaled per substep, the dam
+ * break's mean compression went from 1.1% to 13%). docs/simulation.md, "Step length". */
+static float pbf_step_eps(const rt_sph *s, float dt)
+{
+    const float ref = s->p.pbf_max_step;
+    if (!(dt < ref))
+        return s->pbf_eps;
+    /* held at 1e6 (a step of 1.7e-8 s at the default): below, no correction is representable */
+    const float k = ref / dt < 1e6f ? ref / dt : 1e6f;
+    return s->pbf_eps * k * k;
+}
+
 static vfx_result pbf_substep(rt_sph *s, float dt, rt_sph_report *rep, char *err, size_t errlen)
 {
     s->pbf_dt = dt;
@@ -872,6 +891,7 @@ vfx_result rt_sph_pbf_step(rt_sph *s, float frame_dt, rt_sph_report *rep, char *
     rep->dt_min = n ? dt : 0.0;
     rep->dt_max = rep->dt_last = n ? dt : 0.0;
     rep->dt_limit = cfl > ceil((double)frame_dt / s->p.pbf_max_step - 1e-6) ? RT_SPH_DT_CFL : RT_SPH_DT_FRAME;
+    s->pbf_eps_step = pbf_step_eps(s, frame_dt);
     vfx_result r = VFX_OK;
     if (s->verlet && s->lists_valid && s->n) {
         rt_sph_parallel(s, rt_sph_disp_chunk, false); /* columns may have been moved by hand */

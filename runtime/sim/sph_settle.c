@@ -58,7 +58,7 @@ vfx_result rt_sph_settle(rt_sph *s, const rt_sph_settle_desc *desc, rt_sph_settl
         const float damp = done || d.quasi_static ? 0.f : d.damping;
         for (uint32_t i = 0; i < s->n; ++i)
             s->vx[i] *= damp, s->vy[i] *= damp, s->vz[i] *= damp;
-        if (d.progress && ((k + 1) % d.progress_every == 0 || done))
+        if (d.progress && (k == 0 || (k + 1) % d.progress_every == 0 || done))
             d.progress(d.user, k + 1, d.max_steps, sr.max_speed, sr.mean_density_error);
         if (done)
             break;

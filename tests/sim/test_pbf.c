@@ -407,6 +407,42 @@ static void test_pbf_settled_tank_at_rest(void **state)
     rt_sph_destroy(s);
 }
 
+/* The pool of the test above, settled (at the 1/60 s the game settles with), then stepped as the
+ * game's clock does for water.simulation.dt = h: 4 steps of h per frame, 30 frames. For every h in
+ * the documented (0, 0.1] the pool must stay at rest: max speed <= 0.5 m/s (the issue's bound;
+ * the settled pool moves at ~0.06 m/s at 1/60 s). Before the mixing eps followed the step
+ * (sph_pbf.c, pbf_step_eps) a step of 1e-5 s released the pool's 1.3% rest compression at once,
+ * 2 mm per particle in 1e-5 s: 186 m/s in the first frame; 1e-3 s reached 1.9 m/s. The mean
+ * compression must also stay within 0.3 points of the settled state's (it jumped to 0). */
+static void test_pbf_resting_pool_every_dt(void **state)
+{
+    (void)state;
+    const float hs[4] = {1e-5f, 1e-3f, 1.f / 60.f, 0.1f};
+    for (int k = 0; k < 4; ++k) {
+        rt_sph_desc d = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {0.6f, 0.4f, 0.3f}, .threads = 2};
+        rt_sph *s = make(d);
+        float lo[3] = {0, 0, 0}, hi[3] = {0.6f, 0.12f, 0.3f};
+        assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
+        rt_sph_settle_desc sd = {.max_steps = 120};
+        rt_sph_settle_report sr;
+        assert_int_equal(rt_sph_settle(s, &sd, &sr, NULL, 0), VFX_OK);
+        float vmax = 0.f, c = 0.f;
+        rt_sph_report r;
+        for (int f = 0; f < 30; ++f)
+            for (int q = 0; q < 4; ++q) {
+                assert_int_equal(rt_sph_step(s, hs[k], &r, NULL, 0), VFX_OK);
+                vmax = r.max_speed > vmax ? r.max_speed : vmax;
+                c = r.mean_density_error;
+            }
+        check_state(s);
+        print_message("resting pool, steps of %g s: max speed %.4f m/s over 30 frames, compression %.2f%% "
+                      "(settled %.2f%%)\n", (double)hs[k], vmax, 100.0 * c, 100.0 * sr.compression);
+        assert_true(vmax <= 0.5f);
+        assert_true(fabsf(c - sr.compression) <= 0.003f);
+        rt_sph_destroy(s);
+    }
+}
+
 /* A free block in zero gravity with 5 mm/s of noise (far from every wall): PBF's projection and
  * XSPH can only take kinetic energy away, so it must not grow over 60 frames; the reference is
  * the initial kinetic energy itself (float64 sum here). With the artificial pressure s_corr on
@@ -455,7 +491,7 @@ int main(void)
         cmocka_unit_test(test_pbf_threads_bitwise), cmocka_unit_test(test_pbf_closed_tank_energy),
         cmocka_unit_test(test_pbf_free_block_energy), cmocka_unit_test(test_pbf_stored_pairs_bitwise),
         cmocka_unit_test(test_pbf_paddle_ramp),  cmocka_unit_test(test_pbf_chebyshev_converges),
-        cmocka_unit_test(test_pbf_settled_tank_at_rest),
+        cmocka_unit_test(test_pbf_settled_tank_at_rest), cmocka_unit_test(test_pbf_resting_pool_every_dt),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

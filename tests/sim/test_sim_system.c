@@ -5,6 +5,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "ecs/particles.h"
@@ -163,6 +164,64 @@ static void test_system_settles_once(void **state)
     rt_sim_system_destroy(sys);
 }
 
+/* rt_sim_system_warn_slow: a step over the bound is said once, as a warning naming the particle
+ * count and the tank, from the settle's first step when there is one; under the bound nothing. */
+typedef struct slow_log {
+    int warnings;
+    char last[512];
+} slow_log;
+
+static void slow_sink(void *user, vfx_log_level level, const char *message)
+{
+    slow_log *l = user;
+    if (level == VFX_LOG_WARN && strstr(message, "solver step")) {
+        l->warnings++;
+        snprintf(l->last, sizeof l->last, "%s", message);
+    }
+}
+
+static void test_system_warns_slow_step(void **state)
+{
+    (void)state;
+    for (int settle = 0; settle < 2; ++settle)
+        for (int slow = 0; slow < 2; ++slow) {
+            rt_world *w = rt_world_create(NULL);
+            rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.1f, 0.2f, 0.06f},
+                              .threads = 1, .solver = RT_SPH_SOLVER_PBF};
+            rt_sim_system *sys;
+            assert_int_equal(rt_sim_system_create(w, &d, &sys, NULL, 0), VFX_OK);
+            rt_particle_components pc;
+            assert_int_equal(rt_particles_register(w, &pc), VFX_OK);
+            enum { N = 300 };
+            float x[N], y[N], z[N];
+            for (int i = 0; i < N; ++i) {
+                x[i] = 0.005f + 0.01f * (float)(i % 10);
+                y[i] = 0.005f + 0.01f * (float)((i / 10) % 5);
+                z[i] = 0.005f + 0.01f * (float)(i / 50);
+            }
+            assert_int_equal(rt_particles_spawn(w, &pc, N, x, y, z, false), VFX_OK);
+            slow_log l = {0};
+            rt_logger log = {slow_sink, &l};
+            /* 1 ns: every step is slower; 1000 s: none is */
+            assert_int_equal(rt_sim_system_warn_slow(sys, slow ? 1e-9 : 1e3, &log), VFX_OK);
+            rt_sph_settle_desc sd = {.max_steps = 5};
+            if (settle)
+                assert_int_equal(rt_sim_system_settle_next(sys, &sd, &log), VFX_OK);
+            for (int f = 0; f < 3; ++f)
+                assert_int_equal(rt_world_run_phase(w, RT_PHASE_SIMULATE, f / 60.0, 1.f / 60.f), VFX_OK);
+            assert_int_equal(l.warnings, slow);
+            if (slow) {
+                print_message("%s\n", l.last);
+                assert_non_null(strstr(l.last, "300 particles"));
+                assert_non_null(strstr(l.last, "[0, 0, 0]..[0.1, 0.2, 0.06]"));
+                assert_non_null(strstr(l.last, settle ? "settling" : "took"));
+            }
+            rt_world_destroy(w);
+            rt_sim_system_destroy(sys);
+        }
+    assert_int_equal(rt_sim_system_warn_slow(NULL, 1.0, NULL), VFX_ERR_INVALID_ARGUMENT);
+}
+
 static void test_system_reports_bad_column(void **state)
 {
     (void)state;
@@ -190,6 +249,7 @@ int main(void)
         cmocka_unit_test(test_system_writes_columns),
         cmocka_unit_test(test_system_reports_bad_column),
         cmocka_unit_test(test_system_settles_once),
+        cmocka_unit_test(test_system_warns_slow_step),
     };
     return cmocka_run_group_tests_name("sim_system", tests, NULL, NULL);
 }
