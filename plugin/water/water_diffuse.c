@@ -160,34 +160,49 @@ vfx_result volfx_water_diffuse_begin(vfx_context *ctx, volfx_water_diffuse *d, u
     return VFX_OK;
 }
 
-vfx_result volfx_water_diffuse_chunk(vfx_context *ctx, volfx_water_diffuse *d, uint32_t first,
-                                     const vfx_particle_view *v)
+vfx_result volfx_water_diffuse_chunk(vfx_context *ctx, volfx_water_diffuse *d, uint32_t first, uint32_t count,
+                                     const float *const vel[3])
 {
-    if (!v->count)
+    if (!count)
         return VFX_OK;
-    if (first + (uint64_t)v->count > d->vel_cap)
+    if (first + (uint64_t)count > d->vel_cap)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water diffuse: chunk at %u of %u particles passes the %u uploaded",
-                          first, v->count, d->vel_cap);
-    if (!v->vel[0] || !v->vel[1] || !v->vel[2]) {
+                          first, count, d->vel_cap);
+    if (!vel[0] || !vel[1] || !vel[2]) {
         d->has_vel = false; /* a chunk without velocities: no diffuse particles this frame */
         return VFX_OK;
     }
-    if (v->count > d->staging_cap) {
+    if (count > d->staging_cap) {
         volfx_free(ctx, d->staging);
-        d->staging = volfx_alloc(ctx, (size_t)v->count * 4 * sizeof *d->staging);
-        d->staging_cap = d->staging ? v->count : 0;
+        d->staging = volfx_alloc(ctx, (size_t)count * 4 * sizeof *d->staging);
+        d->staging_cap = d->staging ? count : 0;
         if (!d->staging)
-            return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water diffuse: staging for %u velocities", v->count);
+            return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water diffuse: staging for %u velocities", count);
     }
-    for (uint32_t i = 0; i < v->count; ++i) {
-        float q[3] = {v->vel[0][i], v->vel[1][i], v->vel[2][i]};
+    for (uint32_t i = 0; i < count; ++i) {
+        float q[3] = {vel[0][i], vel[1][i], vel[2][i]};
         bool ok = isfinite(q[0]) && isfinite(q[1]) && isfinite(q[2]);
         for (int k = 0; k < 3; ++k) /* non-finite: at rest (generates nothing) */
             d->staging[4 * (size_t)i + k] = ok ? q[k] : 0.0f;
         d->staging[4 * (size_t)i + 3] = 0.0f;
     }
-    glNamedBufferSubData(d->vel, (GLintptr)first * 16, (GLsizeiptr)v->count * 16, d->staging);
+    glNamedBufferSubData(d->vel, (GLintptr)first * 16, (GLsizeiptr)count * 16, d->staging);
     return VFX_OK;
+}
+
+GLuint volfx_water_diffuse_velocity_target(vfx_context *ctx, volfx_water_diffuse *d, uint32_t first, uint32_t count)
+{
+    if (first + (uint64_t)count > d->vel_cap) {
+        volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water diffuse: chunk at %u of %u particles passes the %u uploaded",
+                   first, count, d->vel_cap);
+        return 0;
+    }
+    return d->vel;
+}
+
+void volfx_water_diffuse_no_velocities(volfx_water_diffuse *d)
+{
+    d->has_vel = false;
 }
 
 bool volfx_water_diffuse_ready(const volfx_water_diffuse *d)

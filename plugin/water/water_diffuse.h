@@ -40,10 +40,15 @@ void volfx_water_diffuse_destroy(vfx_context *ctx, volfx_water_diffuse *d);
 
 /* Starts an upload of `total` particles: sizes the velocity buffer. */
 vfx_result volfx_water_diffuse_begin(vfx_context *ctx, volfx_water_diffuse *d, uint32_t total);
-/* Uploads the velocities of particles [first, first + v->count) (a chunk without them: no
- * diffuse particles this frame; non-finite ones are uploaded as 0). */
-vfx_result volfx_water_diffuse_chunk(vfx_context *ctx, volfx_water_diffuse *d, uint32_t first,
-                                     const vfx_particle_view *v);
+/* Uploads the velocities of particles [first, first + count) from the columns vel[3] (a chunk
+ * without them, vel[k] NULL: no diffuse particles this frame; non-finite ones are uploaded as 0). */
+vfx_result volfx_water_diffuse_chunk(vfx_context *ctx, volfx_water_diffuse *d, uint32_t first, uint32_t count,
+                                     const float *const vel[3]);
+/* The velocity buffer (vec4 a particle, w 0) particles [first, first + count) of a GPU-resident
+ * chunk are gathered into; 0 (with the error) when they pass what begin sized. */
+GLuint volfx_water_diffuse_velocity_target(vfx_context *ctx, volfx_water_diffuse *d, uint32_t first, uint32_t count);
+/* Marks this upload as having no velocities (a chunk without them): no diffuse particles. */
+void volfx_water_diffuse_no_velocities(volfx_water_diffuse *d);
 /* Whether every chunk of the last upload gave velocities (and there was one). */
 bool volfx_water_diffuse_ready(const volfx_water_diffuse *d);
 

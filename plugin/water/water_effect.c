@@ -75,6 +75,7 @@ static void water_destroy(vfx_context *ctx, void *state)
     volfx_water_grid_destroy(ctx, s->grid);
     volfx_water_aniso_destroy(ctx, s->aniso);
     volfx_water_diffuse_destroy(ctx, s->diffuse);
+    volfx_water_gather_destroy(ctx, s->gather);
     volfx_free(ctx, s->chunk_rev);
     glDeleteVertexArrays(1, &s->vao);
     volfx_ubo_destroy(&s->frame_ubo);
@@ -136,16 +137,52 @@ static vfx_result ensure_groups(vfx_context *ctx, water_state *s, uint32_t total
     return VFX_OK;
 }
 
-/* Asks the host for chunk `c`, offering version 2; a version-1 answer has no kernel column. */
-static vfx_result query_chunk(vfx_context *ctx, uint32_t c, vfx_particle_view2 *v)
+/* Asks the host for chunk `c` (offering version 2 of the view; a version-1 answer has no kernel
+ * column) and checks what it names: positions as CPU columns or a GL buffer, not both (the same
+ * for velocities), GL buffer columns that fit their buffers. */
+static vfx_result query_chunk(vfx_context *ctx, uint32_t c, water_chunk *out)
 {
-    memset(v, 0, sizeof *v);
-    v->v1.size = sizeof *v;
-    v->v1.version = VFX_PARTICLE_VIEW2_VERSION;
-    vfx_result r = ctx->host.particle_chunk(ctx->host.user, c, &v->v1);
-    if (r == VFX_OK && !(v->v1.version == VFX_PARTICLE_VIEW2_VERSION && v->v1.size >= sizeof *v))
-        v->kernel = NULL; /* nothing a version-1 host wrote */
-    return r;
+    vfx_particle_view2 v;
+    memset(&v, 0, sizeof v);
+    v.v1.size = sizeof v;
+    v.v1.version = VFX_PARTICLE_VIEW2_VERSION;
+    vfx_result r = ctx->host.particle_chunk(ctx->host.user, c, &v.v1);
+    if (r)
+        return volfx_fail(ctx, r, "water: particle chunk %u failed (%d)", c, (int)r);
+    if (!(v.v1.version == VFX_PARTICLE_VIEW2_VERSION && v.v1.size >= sizeof v))
+        v.kernel = NULL; /* nothing a version-1 host wrote */
+    memset(out, 0, sizeof *out);
+    out->count = v.v1.count;
+    out->revision = v.v1.revision;
+    memcpy(out->pos, v.v1.pos, sizeof out->pos);
+    memcpy(out->vel, v.v1.vel, sizeof out->vel);
+    out->radius = v.v1.radius;
+    out->kernel = v.kernel;
+    volfx_gpu_column cols[3] = {{0}};
+    if (ctx->debug.water_gpu_chunk && (r = ctx->debug.water_gpu_chunk(ctx->host.user, c, cols)))
+        return volfx_fail(ctx, r, "water: particle chunk %u's GL buffer columns failed (%d)", c, (int)r);
+    out->gpu_pos = cols[0], out->gpu_vel = cols[1], out->gpu_kernel = cols[2];
+    if (!out->count)
+        return VFX_OK;
+    bool cpu_pos = out->pos[0] || out->pos[1] || out->pos[2], cpu_vel = out->vel[0] || out->vel[1] || out->vel[2];
+    if (out->gpu_pos.buffer && cpu_pos)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u names both pos[] and gpu_pos (one of them)", c);
+    if (out->gpu_vel.buffer && cpu_vel)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u names both vel[] and gpu_vel (one of them)", c);
+    if (out->gpu_kernel.buffer)
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, "water: particle chunk %u: gpu_kernel is not supported by this plugin "
+                          "(give the kernel column as a CPU array)", c);
+    if (!out->gpu_pos.buffer && (!out->pos[0] || !out->pos[1] || !out->pos[2]))
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u has %u particles but a NULL position column",
+                          c, out->count);
+    if (out->gpu_pos.buffer && (r = volfx_water_gather_check(ctx, c, "gpu_pos", &out->gpu_pos, out->count, 12)))
+        return r;
+    if (out->gpu_vel.buffer && !out->gpu_pos.buffer)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u names gpu_vel with CPU positions "
+                          "(GL buffer velocities need gpu_pos)", c);
+    if (out->gpu_vel.buffer && (r = volfx_water_gather_check(ctx, c, "gpu_vel", &out->gpu_vel, out->count, 12)))
+        return r;
+    return VFX_OK;
 }
 
 /* The version of the parameters the host wrote into the offered struct (1 to 4). */
@@ -161,13 +198,10 @@ static uint32_t params_version(const vfx_water_params4 *p4)
     return VFX_WATER_PARAMS_VERSION;
 }
 
-static vfx_result water_update(vfx_context *ctx, void *state, double time, float dt)
+/* This update's parameters, resolved and checked, into *res (and the state's kernel, preset and
+ * diffuse parameters). */
+static vfx_result read_params(vfx_context *ctx, water_state *s, volfx_water_resolved *res)
 {
-    (void)time;
-    water_state *s = state;
-    /* a hitch or a bad clock must not throw the diffuse particles across the scene */
-    s->dt = isfinite(dt) && dt > 0 ? (dt < 0.1f ? dt : 0.1f) : 0.0f;
-    s->diffuse_due = true; /* stepped once, by the first view drawn after this update */
     /* version 4 offered; a host that answers an older version is offered the older ones in
      * turn (a host written for version 2 may test for exactly 2), then keeps what it wrote
      * (the rest stays 0: defaults) */
@@ -192,31 +226,206 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
             break;
     }
     uint32_t pver = params_version(&p4);
-    volfx_water_resolved res;
     vfx_result kr = volfx_water_params_resolve(ctx, &p4.v3, pver < VFX_WATER_PARAMS3_VERSION ? pver : VFX_WATER_PARAMS3_VERSION,
-                                               &res);
+                                               res);
     if (!kr)
         kr = volfx_water_diffuse_params_check(ctx, &p4, pver, &s->dp);
     if (kr)
         return kr;
-    s->kp = res.kp;
-    s->preset = res.preset;
+    s->kp = res->kp;
+    s->preset = res->preset;
+    return VFX_OK;
+}
+
+/* What the upload measures of the positions: the finite particles' box, the non-finite count and
+ * every stride-th finite particle for the spacing (cxyz NULL: none). */
+typedef struct water_scan {
+    float lo[3], hi[3];
+    bool seen;
+    uint32_t nan_count;
+    float *cxyz;
+    uint32_t cand, stride;
+} water_scan;
+
+/* Scans particles [off, off + n) of the concatenation, columns x, y, z. */
+static void scan_positions(water_scan *a, const float *const pos[3], uint32_t n, uint32_t off)
+{
+    /* NaN/Inf positions are uploaded as they are and skipped by the shaders (a NaN distance fails
+     * every `<` test); counted here so the host can see them. */
+    for (uint32_t i = 0; i < n; ++i) {
+        float q[3] = {pos[0][i], pos[1][i], pos[2][i]};
+        if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) {
+            ++a->nan_count;
+            continue;
+        }
+        for (int k = 0; k < 3; ++k) {
+            if (!a->seen || q[k] < a->lo[k]) a->lo[k] = q[k];
+            if (!a->seen || q[k] > a->hi[k]) a->hi[k] = q[k];
+        }
+        a->seen = true;
+        if (a->cxyz && (off + i) % a->stride == 0) {
+            memcpy(a->cxyz + 3 * (size_t)a->cand, q, sizeof q);
+            ++a->cand;
+        }
+    }
+}
+
+/* The box the passes use for the GPU chunks when nothing is read back now: the newest box read
+ * back, its faces moved outwards by twice the distance they moved per upload between the two
+ * newest readbacks times the uploads it lags (a still scene: exactly the box). */
+static void late_box(water_state *s, water_scan *box)
+{
+    volfx_water_gather_box nw, bf;
+    uint64_t uploads;
+    if (!volfx_water_gather_late(s->gather, &nw, &bf, &uploads))
+        return;
+    uint64_t lag = uploads + 1u - nw.upload, span = nw.upload > bf.upload ? nw.upload - bf.upload : 0;
+    for (int k = 0; k < 3; ++k) {
+        float dl = span && bf.lo[k] > nw.lo[k] ? (bf.lo[k] - nw.lo[k]) / (float)span : 0.0f;
+        float dh = span && nw.hi[k] > bf.hi[k] ? (nw.hi[k] - bf.hi[k]) / (float)span : 0.0f;
+        box->lo[k] = nw.lo[k] - 2.0f * (float)lag * dl;
+        box->hi[k] = nw.hi[k] + 2.0f * (float)lag * dh;
+    }
+    box->seen = true;
+    box->nan_count = nw.bad;
+    s->gpu_late = (uint32_t)lag;
+    s->gpu_outside = nw.outside;
+}
+
+/* Positions (and velocities) of a GL-buffer chunk at particle `off`: gathered into the position
+ * groups (a chunk may straddle them) and the diffuse velocities; with `a` (the blocking path) the
+ * gathered positions are read back and scanned as the CPU path scans its arrays. */
+static vfx_result upload_gpu_chunk(vfx_context *ctx, water_state *s, const water_chunk *v, uint32_t off, water_scan *a)
+{
+    vfx_result r;
+    for (uint32_t done = 0; done < v->count;) {
+        uint32_t at = off + done, g = at / s->buffer_cap, within = at - s->groups[g].first;
+        uint32_t n = s->groups[g].count - within;
+        if (n > v->count - done)
+            n = v->count - done;
+        volfx_gpu_column piece = v->gpu_pos;
+        piece.offset += (uint64_t)done * piece.stride;
+        if ((r = volfx_water_gather_positions(ctx, s->gather, &piece, n, s->groups[g].cols, within)))
+            return r;
+        if (a) {
+            float *xyz = volfx_alloc(ctx, (size_t)n * 3 * sizeof(float));
+            if (!xyz)
+                return VFX_ERR_OUT_OF_MEMORY;
+            for (int k = 0; k < 3; ++k)
+                glGetNamedBufferSubData(s->groups[g].cols[k], (GLintptr)within * 4, (GLsizeiptr)n * 4, xyz + (size_t)k * n);
+            const float *cols[3] = {xyz, xyz + n, xyz + 2 * (size_t)n};
+            scan_positions(a, cols, n, at);
+            volfx_free(ctx, xyz);
+        }
+        done += n;
+    }
+    if (!v->gpu_vel.buffer) {
+        volfx_water_diffuse_no_velocities(s->diffuse);
+        return VFX_OK;
+    }
+    GLuint vel = volfx_water_diffuse_velocity_target(ctx, s->diffuse, off, v->count);
+    return vel ? volfx_water_gather_velocities(ctx, s->gather, &v->gpu_vel, v->count, vel, off) : VFX_ERR_INVALID_ARGUMENT;
+}
+
+/* Positions of a CPU chunk at particle `off` into the position groups, scanned into `a`. */
+static void upload_cpu_chunk(water_state *s, const water_chunk *v, uint32_t off, water_scan *a)
+{
+    /* a chunk may straddle buffers: it goes in pieces, each inside one group */
+    for (uint32_t done = 0; done < v->count;) {
+        uint32_t at = off + done, g = at / s->buffer_cap, within = at - s->groups[g].first;
+        uint32_t n = s->groups[g].count - within;
+        if (n > v->count - done)
+            n = v->count - done;
+        for (int k = 0; k < 3; ++k)
+            glNamedBufferSubData(s->groups[g].cols[k], (GLintptr)within * 4, (GLsizeiptr)n * 4, v->pos[k] + done);
+        done += n;
+    }
+    scan_positions(a, v->pos, v->count, off);
+}
+
+/* Every chunk into the position groups, the kernel columns and the diffuse velocities; the box,
+ * the non-finite count and the spacing's candidates into *a (GPU chunks: measured now when
+ * `blocking`, else the late box merged in). */
+static vfx_result upload_chunks(vfx_context *ctx, water_state *s, uint32_t chunks, uint64_t total, bool any_gpu,
+                                bool blocking, water_scan *a)
+{
+    water_scan gpu_box = {.seen = false};
+    vfx_result r;
+    if (any_gpu) {
+        if (!s->gather && !(s->gather = volfx_water_gather_create(ctx)))
+            return VFX_ERR_OUT_OF_MEMORY;
+        if (!blocking)
+            late_box(s, &gpu_box);
+        else
+            s->gpu_late = 0, s->gpu_outside = 0;
+        float lo[3] = {0, 0, 0}, hi[3] = {-1, -1, -1}; /* blocking: nothing is counted outside */
+        if ((r = volfx_water_gather_begin(ctx, s->gather, gpu_box.seen ? gpu_box.lo : lo, gpu_box.seen ? gpu_box.hi : hi)))
+            return r;
+    }
+    uint32_t off = 0, gpu_count = 0;
+    for (uint32_t c = 0; c < chunks; ++c) {
+        water_chunk v;
+        r = query_chunk(ctx, c, &v);
+        if (r || off + (uint64_t)v.count > total)
+            return r ? r : volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                                      "water: particle chunk %u changed between the count and the upload", c);
+        if (v.gpu_pos.buffer) {
+            /* the blocking path scans in the same order as the CPU path (the same candidates) */
+            water_scan *sc = blocking ? a : NULL;
+            if ((r = upload_gpu_chunk(ctx, s, &v, off, sc)))
+                return r;
+            gpu_count += v.count;
+        } else {
+            upload_cpu_chunk(s, &v, off, a);
+            if ((r = volfx_water_diffuse_chunk(ctx, s->diffuse, off, v.count, v.vel)))
+                return r;
+        }
+        if (s->aniso && (r = volfx_water_aniso_columns_chunk(ctx, s->aniso, c, off, v.count, v.radius, v.kernel)))
+            return r;
+        off += v.count;
+        s->chunk_rev[c] = v.revision;
+    }
+    if (any_gpu) {
+        volfx_water_gather_end(s->gather);
+        if (blocking && a->seen)
+            volfx_water_gather_set_exact(s->gather, a->lo, a->hi, a->nan_count);
+        if (!blocking && gpu_box.seen) {
+            for (int k = 0; k < 3; ++k) {
+                a->lo[k] = a->seen && a->lo[k] < gpu_box.lo[k] ? a->lo[k] : gpu_box.lo[k];
+                a->hi[k] = a->seen && a->hi[k] > gpu_box.hi[k] ? a->hi[k] : gpu_box.hi[k];
+            }
+            a->seen = true;
+            a->nan_count += gpu_box.nan_count;
+        }
+    }
+    s->gpu_count = gpu_count;
+    return VFX_OK;
+}
+
+static vfx_result water_update(vfx_context *ctx, void *state, double time, float dt)
+{
+    (void)time;
+    water_state *s = state;
+    /* a hitch or a bad clock must not throw the diffuse particles across the scene */
+    s->dt = isfinite(dt) && dt > 0 ? (dt < 0.1f ? dt : 0.1f) : 0.0f;
+    s->diffuse_due = true; /* stepped once, by the first view drawn after this update */
+    volfx_water_resolved res;
+    vfx_result kr = read_params(ctx, s, &res);
+    if (kr)
+        return kr;
     uint32_t chunks = ctx->host.particle_chunk_count(ctx->host.user);
     uint64_t total = 0;
     /* every chunk with the nonzero revision of the last upload (0: the host tracks none) */
     int revs_same = s->chunk_rev != NULL && s->chunk_rev_count == chunks;
-    bool any_radius = false, any_kernel = false;
+    bool any_radius = false, any_kernel = false, any_gpu = false;
     for (uint32_t c = 0; c < chunks; ++c) {
-        vfx_particle_view2 v2;
-        vfx_particle_view v;
-        vfx_result r = query_chunk(ctx, c, &v2);
-        v = v2.v1;
+        water_chunk v;
+        vfx_result r = query_chunk(ctx, c, &v);
         if (r)
-            return volfx_fail(ctx, r, "water: particle chunk %u of %u failed (%d)", c, chunks, (int)r);
+            return r;
         any_radius = any_radius || (v.count && v.radius);
-        any_kernel = any_kernel || (v.count && v2.kernel);
-        if (v.count && (!v.pos[0] || !v.pos[1] || !v.pos[2]))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u has %u particles but a NULL position column", c, v.count);
+        any_kernel = any_kernel || (v.count && v.kernel);
+        any_gpu = any_gpu || (v.count && v.gpu_pos.buffer);
         total += v.count;
         revs_same = revs_same && v.revision != 0 && v.revision == s->chunk_rev[c];
     }
@@ -242,17 +451,24 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
     s->upload_skipped = same;
     if (same)
         return water_set_params(ctx, s, &res);
+    /* GL-buffer chunks are read back (blocking) only when the spacing is measured or no box of
+     * theirs has been read back yet; otherwise their box comes from a readback a few uploads old */
+    volfx_water_gather_box nb, bb;
+    uint64_t ups;
+    bool blocking = any_gpu && (spacing || !s->gather || !volfx_water_gather_late(s->gather, &nb, &bb, &ups));
     /* every stride-th finite particle, at most 2^20, for the spacing */
-    uint32_t stride = (uint32_t)(total >> 20) + 1u, cand = 0;
-    float *cxyz = spacing ? volfx_alloc(ctx, (((size_t)total + stride - 1) / stride + 1) * 3 * sizeof(float)) : NULL;
-    if (spacing && !cxyz)
+    water_scan scan = {.stride = (uint32_t)(total >> 20) + 1u};
+    scan.cxyz = spacing ? volfx_alloc(ctx, (((size_t)total + scan.stride - 1) / scan.stride + 1) * 3 * sizeof(float)) : NULL;
+    if (spacing && !scan.cxyz)
         return VFX_ERR_OUT_OF_MEMORY;
     if (chunks != s->chunk_rev_count) {
         volfx_free(ctx, s->chunk_rev);
         s->chunk_rev_count = 0;
         s->chunk_rev = chunks ? volfx_alloc(ctx, chunks * sizeof *s->chunk_rev) : NULL;
-        if (chunks && !s->chunk_rev)
+        if (chunks && !s->chunk_rev) {
+            volfx_free(ctx, scan.cxyz);
             return VFX_ERR_OUT_OF_MEMORY;
+        }
         s->chunk_rev_count = chunks;
     }
     /* cleared first: an upload that fails half way leaves 0s, so the next frame uploads again */
@@ -260,69 +476,27 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
         memset(s->chunk_rev, 0, chunks * sizeof *s->chunk_rev);
     ++s->data_rev;
     if ((any_radius || any_kernel) && !s->aniso && !(s->aniso = volfx_water_aniso_create(ctx)))
-        return VFX_ERR_OUT_OF_MEMORY;
-    if (s->aniso) {
-        vfx_result r = volfx_water_aniso_columns_begin(ctx, s->aniso, (uint32_t)total, any_radius, any_kernel);
-        if (r)
-            return r;
-    }
-    if (!s->diffuse && !(s->diffuse = volfx_water_diffuse_create(ctx)))
-        return VFX_ERR_OUT_OF_MEMORY;
-    if ((gr = volfx_water_diffuse_begin(ctx, s->diffuse, (uint32_t)total)))
+        gr = VFX_ERR_OUT_OF_MEMORY;
+    if (!gr && s->aniso)
+        gr = volfx_water_aniso_columns_begin(ctx, s->aniso, (uint32_t)total, any_radius, any_kernel);
+    if (!gr && !s->diffuse && !(s->diffuse = volfx_water_diffuse_create(ctx)))
+        gr = VFX_ERR_OUT_OF_MEMORY;
+    if (!gr)
+        gr = volfx_water_diffuse_begin(ctx, s->diffuse, (uint32_t)total);
+    if (!gr)
+        gr = upload_chunks(ctx, s, chunks, total, any_gpu, blocking, &scan);
+    if (gr) {
+        volfx_free(ctx, scan.cxyz);
         return gr;
-    uint32_t off = 0, nan_count = 0;
-    int seen = 0;
-    for (uint32_t c = 0; c < chunks; ++c) {
-        vfx_particle_view2 v2;
-        vfx_result r = query_chunk(ctx, c, &v2);
-        vfx_particle_view v = v2.v1;
-        if (r || off + (uint64_t)v.count > total)
-            return volfx_fail(ctx, r ? r : VFX_ERR_INVALID_ARGUMENT,
-                            "water: particle chunk %u changed between the count and the upload", c);
-        /* a chunk may straddle buffers: it goes in pieces, each inside one group */
-        for (uint32_t done = 0; done < v.count;) {
-            uint32_t at = off + done, g = at / s->buffer_cap, within = at - s->groups[g].first;
-            uint32_t n = s->groups[g].count - within;
-            if (n > v.count - done)
-                n = v.count - done;
-            for (int k = 0; k < 3; ++k)
-                glNamedBufferSubData(s->groups[g].cols[k], (GLintptr)within * 4, (GLsizeiptr)n * 4, v.pos[k] + done);
-            done += n;
-        }
-        /* NaN/Inf positions are uploaded as they are and skipped by the shaders (a NaN
-         * distance fails every `<` test); counted here so the host can see them. */
-        for (uint32_t i = 0; i < v.count; ++i) {
-            float q[3] = {v.pos[0][i], v.pos[1][i], v.pos[2][i]};
-            if (!isfinite(q[0]) || !isfinite(q[1]) || !isfinite(q[2])) {
-                ++nan_count;
-                continue;
-            }
-            for (int k = 0; k < 3; ++k) {
-                if (!seen || q[k] < s->lo[k]) s->lo[k] = q[k];
-                if (!seen || q[k] > s->hi[k]) s->hi[k] = q[k];
-            }
-            seen = 1;
-            if (cxyz && (off + i) % stride == 0) {
-                memcpy(cxyz + 3 * (size_t)cand, q, sizeof q);
-                ++cand;
-            }
-        }
-        if (s->aniso && (r = volfx_water_aniso_columns_chunk(ctx, s->aniso, c, off, v.count, v.radius, v2.kernel))) {
-            volfx_free(ctx, cxyz);
-            return r;
-        }
-        if ((r = volfx_water_diffuse_chunk(ctx, s->diffuse, off, &v))) {
-            volfx_free(ctx, cxyz);
-            return r;
-        }
-        off += v.count;
-        s->chunk_rev[c] = v.revision;
     }
-    s->count = off;
-    s->nan_count = nan_count;
+    s->count = (uint32_t)total;
+    s->nan_count = scan.nan_count;
+    if (scan.seen)
+        for (int k = 0; k < 3; ++k)
+            s->lo[k] = scan.lo[k], s->hi[k] = scan.hi[k];
     if (spacing) {
-        double d = volfx_water_spacing(ctx, cxyz, cand, stride);
-        volfx_free(ctx, cxyz);
+        double d = volfx_water_spacing(ctx, scan.cxyz, scan.cand, scan.stride);
+        volfx_free(ctx, scan.cxyz);
         if (d < 0)
             return VFX_ERR_OUT_OF_MEMORY;
         /* the seed's ratio h = 2 x spacing (0.61 at its 0.3); no spacing (one particle, all on
@@ -334,7 +508,7 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
         return kr;
     const char *e = volfx_gpu_error_string();
     if (e)
-        return volfx_fail(ctx, VFX_ERR_GL, "water upload of %u particles: %s", off, e);
+        return volfx_fail(ctx, VFX_ERR_GL, "water upload of %u particles: %s", s->count, e);
     return VFX_OK;
 }
 
@@ -564,6 +738,9 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
     volfx_stat_set(ctx, "water.preset", s->preset);
     volfx_stat_set(ctx, "water.nan_skipped", s->nan_count);
     volfx_stat_set(ctx, "water.upload_skipped", s->upload_skipped);
+    volfx_stat_set(ctx, "water.gpu_particles", s->gpu_count);
+    volfx_stat_set(ctx, "water.gpu_box_lag", s->gpu_late);
+    volfx_stat_set(ctx, "water.gpu_box_outside", s->gpu_outside);
     s->last_method_drawn = UINT32_MAX; /* until this frame completes: nothing for debug_pixel_class */
     vfx_result r;
     /* the seed's method and the baselines draw the isotropic kernel of radius h only */

@@ -11,6 +11,7 @@
 #include "water_tile.h"
 #include "water_aniso.h"
 #include "water_diffuse.h"
+#include "water_gather.h"
 
 /* Counter readback ring: frames the GPU may run behind before a result is dropped. */
 #define WATER_COUNTER_RING 3
@@ -40,6 +41,16 @@ typedef struct water_frame_block {
     float sizef[2];
 } water_frame_block;
 _Static_assert(sizeof(water_frame_block) == 192, "water_frame_block mirrors frame.glsl's std140 layout");
+
+/* One chunk of the host's particles as the water reads it (water_effect.c's query_chunk fills it
+ * from the particle view): CPU columns, or a GL buffer's columns for the positions and velocities
+ * (buffer 0: none). */
+typedef struct water_chunk {
+    uint32_t count;
+    uint64_t revision;
+    const float *pos[3], *vel[3], *radius, *kernel;
+    volfx_gpu_column gpu_pos, gpu_vel, gpu_kernel;
+} water_chunk;
 
 /* One position buffer triple: particles [first, first + count) of the concatenated chunks. */
 typedef struct water_group {
@@ -87,7 +98,11 @@ typedef struct water_state {
     volfx_water_diffuse_params dp; /* their parameters (vfx_water_params4), checked */
     float dt;              /* the last update's step, seconds (the diffuse particles') */
     bool diffuse_due;      /* an update since the last diffuse step */
-    float lo[3], hi[3];    /* box of the finite particles */
+    float lo[3], hi[3];    /* box of the finite particles (GPU chunks: read back late, grown) */
+    volfx_water_gather *gather; /* GPU-resident chunks' gather and late box, made on first use */
+    uint32_t gpu_count;    /* particles of the last upload that came from GL buffers */
+    uint32_t gpu_late;     /* uploads the box of the GPU chunks lagged behind (0: measured now) */
+    uint32_t gpu_outside;  /* particles outside the box used, as last read back */
     /* upload skipping: the host's per-chunk revisions of the last upload (0 = untracked: the
      * host gives none, so every frame uploads); data_rev counts uploads, which GRID keys on */
     uint64_t *chunk_rev;
