@@ -20,6 +20,7 @@ typedef struct volfx_debug_knobs {
     uint32_t water_buffer_cap; /* particles per water position buffer; 0 -> the GL limit */
     uint32_t water_max_tiles;  /* TILE's tile count limit; 0 -> the scan's 2^20 - 1 */
     uint64_t water_storage_cap; /* bytes per TILE storage block; 0 -> GL_MAX_SHADER_STORAGE_BLOCK_SIZE */
+    uint32_t layer_texture;     /* the frame view's effects layer texture */
     /* particle chunk `index`'s GL buffer columns (cols[3]: positions, velocities, kernel) beside the view */
     vfx_result (*water_gpu_chunk)(void *user, uint32_t index, struct volfx_gpu_column *cols);
 } volfx_debug_knobs;
@@ -39,6 +40,7 @@ struct vfx_context {
     unsigned no_depth_tex;      /* far depth for a frame view without depth_texture (frame_check.c) */
     uint32_t no_depth_w, no_depth_h;
     unsigned frame_block;       /* GL uniform buffer of the frame gate's VolfxFrame block */
+    unsigned layer_fbo;         /* framebuffer the effects layer is attached to (frame_check.c) */
     volfx_debug_knobs debug;
 };
 

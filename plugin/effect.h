@@ -27,7 +27,8 @@ typedef struct volfx_frame_targets {
     /* Version 3: the view's id (0 for versions 1 and 2); effects key per-view state on it. */
     uint32_t view_id;
     /* The rest of the camera (frame gate, issue 23). */
-    unsigned framebuffer;    /* where effects draw their result */
+    unsigned framebuffer;    /* where effects draw their result: the host's, or the layer's */
+    unsigned layer_texture;  /* the host's effects layer (RGBA16F, premultiplied); 0 -> none */
     uint32_t width, height;
     uint32_t effects;        /* VFX_EFFECT_BIT mask drawn this frame (the host's 0 -> all) */
     float view[16], proj[16];        /* the host's, checked finite */

@@ -210,6 +210,7 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
         drawing |= ctx->effect_state[k] && (mask & VFX_EFFECT_BIT(k));
     if ((cr = volfx_frame_gate_gl(ctx, drawing, &targets)))
         return cr;
+    checked.v1.framebuffer = targets.framebuffer; /* the effects layer's, when the host gave one */
     frame = &checked.v1;
 
     ctx->stats.count = 0;

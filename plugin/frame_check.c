@@ -306,6 +306,7 @@ vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx
     t->scene_depth = v->depth_texture;
     t->scene_color = v->color_texture;
     t->framebuffer = v->framebuffer;
+    t->layer_texture = ctx->debug.layer_texture;
     t->width = v->width, t->height = v->height;
     t->effects = v->effects ? v->effects : 0xffffffffu;
     memcpy(t->view, v->view, sizeof t->view);
@@ -349,12 +350,61 @@ static vfx_result upload_block(vfx_context *ctx, const volfx_frame_targets *t)
     return VFX_OK;
 }
 
+/* The effects layer: an RGBA16F 2D texture of the frame's size, attached (every frame: the host
+ * may have made a new texture under the same name) to the context's framebuffer, cleared to
+ * transparent black; the effects draw into it instead of the host's framebuffer. */
+static vfx_result layer_target(vfx_context *ctx, volfx_frame_targets *t)
+{
+    GLuint name = t->layer_texture;
+    if (!glIsTexture(name))
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view layer_texture %u is not a texture name "
+                          "of this GL context", name);
+    GLint target = 0, tw = 0, th = 0, fmt = 0;
+    glGetTextureParameteriv(name, GL_TEXTURE_TARGET, &target);
+    if (target != GL_TEXTURE_2D)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view layer_texture %u is a %s texture, need %s",
+                          name, target_name(target), target_name(GL_TEXTURE_2D));
+    glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_WIDTH, &tw);
+    glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_HEIGHT, &th);
+    glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_INTERNAL_FORMAT, &fmt);
+    if (fmt != GL_RGBA16F)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view layer_texture %u has internal format "
+                          "0x%04x, need GL_RGBA16F (0x%04x)", name, (unsigned)fmt, (unsigned)GL_RGBA16F);
+    if (tw != (GLint)t->width || th != (GLint)t->height)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view layer_texture %u is %dx%d, the frame view "
+                          "%ux%u (they must match)", name, tw, th, t->width, t->height);
+    if (!ctx->layer_fbo) {
+        GLuint fb = 0;
+        glCreateFramebuffers(1, &fb);
+        volfx_gpu_label(GL_FRAMEBUFFER, fb, "volfx.effects_layer");
+        ctx->layer_fbo = fb;
+    }
+    glNamedFramebufferTexture(ctx->layer_fbo, GL_COLOR_ATTACHMENT0, name, 0);
+    if (glCheckNamedFramebufferStatus(ctx->layer_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        return volfx_fail(ctx, VFX_ERR_GL, "render: frame view layer_texture %u cannot be rendered to", name);
+    t->framebuffer = ctx->layer_fbo;
+    /* the clear honours the scissor test and the colour mask: the host's, put back after */
+    GLboolean scissor = glIsEnabled(GL_SCISSOR_TEST), mask[4];
+    glGetBooleani_v(GL_COLOR_WRITEMASK, 0, mask);
+    glDisable(GL_SCISSOR_TEST);
+    glColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    const float zero[4] = {0, 0, 0, 0};
+    glClearNamedFramebufferfv(ctx->layer_fbo, GL_COLOR, 0, zero);
+    glColorMaski(0, mask[0], mask[1], mask[2], mask[3]);
+    if (scissor)
+        glEnable(GL_SCISSOR_TEST);
+    return VFX_OK;
+}
+
 vfx_result volfx_frame_gate_gl(vfx_context *ctx, bool drawing, volfx_frame_targets *t)
 {
+    vfx_result r;
+    /* an empty frame still clears the layer: the host composites it whatever was drawn */
+    if (t->layer_texture && (r = layer_target(ctx, t)))
+        return r;
     if (!drawing)
         return VFX_OK;
-    vfx_result r;
-    if (t->framebuffer && (r = check_framebuffer(ctx, t->framebuffer, t->width, t->height)))
+    if (!t->layer_texture && t->framebuffer && (r = check_framebuffer(ctx, t->framebuffer, t->width, t->height)))
         return r;
     if (t->scene_color && (r = check_texture(ctx, "color_texture", t->scene_color, WANT_COLOR, t->width, t->height)))
         return r;
@@ -365,7 +415,8 @@ vfx_result volfx_frame_gate_gl(vfx_context *ctx, bool drawing, volfx_frame_targe
         return r;
     /* framebuffer 0 is the default framebuffer, which a surfaceless context lacks: the first draw
      * into it failed with a GL error that named nothing (issue 28) */
-    if (!t->framebuffer && glCheckNamedFramebufferStatus(0, GL_DRAW_FRAMEBUFFER) == GL_FRAMEBUFFER_UNDEFINED)
+    if (!t->layer_texture && !t->framebuffer &&
+        glCheckNamedFramebufferStatus(0, GL_DRAW_FRAMEBUFFER) == GL_FRAMEBUFFER_UNDEFINED)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view framebuffer 0 is the default "
                           "framebuffer, and the current context has none (surfaceless): name a framebuffer object");
     if (!t->scene_depth && (r = far_depth(ctx, t->width, t->height, &t->scene_depth)))
@@ -381,4 +432,9 @@ void volfx_frame_check_destroy(vfx_context *ctx)
         ctx->frame_block = 0;
     }
     drop_far_depth(ctx);
+    if (ctx->layer_fbo) {
+        GLuint fb = ctx->layer_fbo;
+        glDeleteFramebuffers(1, &fb);
+        ctx->layer_fbo = 0;
+    }
 }
