@@ -25,6 +25,7 @@ typedef struct game_app_desc {
     uint32_t width, height;    /* 0 -> 640x360 */
     bool debug_gl;
     const char *plugin_path;   /* NULL -> the statically linked plugin */
+    const char *program_cache; /* the plugin keeps its program binaries here (NULL: off) */
     uint32_t profile_frames;   /* frames kept for CSV/trace; 0 -> 4096 */
     bool ldr;                  /* 8-bit output without tone mapping; default: HDR (RGBA16F, ACES) */
     float exposure;            /* HDR tone-map exposure; 0 -> 1 */

@@ -17,6 +17,7 @@ typedef struct game_options {
     double seconds;
     uint32_t width, height;
     const char *png, *csv, *trace, *plugin, *scene;
+    const char *program_cache; /* the plugin's program binaries kept in this folder (NULL: off) */
     rt_gl_mode mode;
     bool debug;
     uint32_t effects_off;
@@ -33,6 +34,7 @@ static void usage(void)
          "                  [--png FILE] [--csv FILE] [--trace FILE] [--plugin libvolfx.so.1|PATH]\n"
          "                  [--scene FILE.json] [--no-water] [--hide-water] [--no-beams] [--no-volume] [--debug-gl]\n"
          "                  [--mem-every N] [--progress S] [--dump-raw water|beams|volume FILE.pfm]\n"
+         "                  [--program-cache DIR]\n"
          "Without a display it runs headless (EGL) for 30 frames and writes volfx-game.png.\n"
          "A run longer than S seconds (default 5; 0 = never) prints a progress line to stderr every S.\n"
          "Window keys: WASD/QE fly, mouse drag orbit, 1/2/3 toggle water/beams/volume,\n"
@@ -66,6 +68,7 @@ static bool parse(int argc, char **argv, game_options *o)
         else if (!strcmp(a, "--trace")) { NEED_ARG(); CHECK(rt_arg_writable(a, v, err, sizeof err)); o->trace = v; }
         else if (!strcmp(a, "--plugin")) { NEED_ARG(); o->plugin = v; }
         else if (!strcmp(a, "--scene")) { NEED_ARG(); o->scene = v; }
+        else if (!strcmp(a, "--program-cache")) { NEED_ARG(); o->program_cache = v; }
         else if (!strcmp(a, "--no-water")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_WATER);
         else if (!strcmp(a, "--hide-water")) o->hide_water = true;
         else if (!strcmp(a, "--no-beams")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_BEAMS);
@@ -175,7 +178,7 @@ int main(int argc, char **argv)
     if (!parse(argc, argv, &o))
         return 2;
     game_app_desc d = {.mode = o.mode, .width = o.width, .height = o.height, .debug_gl = o.debug,
-                      .plugin_path = o.plugin};
+                      .plugin_path = o.plugin, .program_cache = o.program_cache};
     game_app *app;
     if (game_app_create(&d, &app)) {
         fprintf(stderr, "volfx-game: could not start (see the messages above)\n");

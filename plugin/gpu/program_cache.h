@@ -2,7 +2,9 @@
  * keyed by the driver (GL_VENDOR, GL_RENDERER, GL_VERSION) and the program's full source. An
  * entry is used only when its header, its driver and source hashes, its length and its checksum
  * all agree and the driver then accepts the binary (GL_LINK_STATUS); anything else is rebuilt
- * from source and rewritten (write to a temporary name, then rename). */
+ * from source and rewritten. The folder is opened once and held; entries are opened in it with
+ * O_NOFOLLOW and O_NONBLOCK and must be regular files; a binary is written to a fresh temporary
+ * file (O_EXCL, unpredictable name) in the folder and renamed over the entry. */
 #ifndef VOLFX_PROGRAM_CACHE_H
 #define VOLFX_PROGRAM_CACHE_H
 

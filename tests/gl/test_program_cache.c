@@ -3,8 +3,13 @@
  * an entry that is corrupt (payload bytes flipped), truncated, made by another driver, or whose
  * checksum agrees but whose binary the driver refuses is never used: the program is rebuilt
  * from source (it links and draws), the entry is rewritten and the next context loads it again.
- * The counters are the stats gpu.program_cache_loaded / _stored / _rejected. Skips (77) when
- * the driver offers no binary format (Mesa with its shader cache disabled). */
+ * The counters are the stats gpu.program_cache_loaded / _stored / _rejected. A corrupt header
+ * version or source hash is rebuilt too. test_hostile_names plants what another user of a
+ * shared folder could: a symbolic link or a FIFO under the entry's name and under the name the
+ * cache's temporary file once had (<entry>.<pid>.tmp): nothing is written through a link, no
+ * call blocks (an alarm fails the test), each is a warning naming the path, and the program
+ * still links. Skips (77) when the driver offers no binary format (Mesa with its shader cache
+ * disabled). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -14,6 +19,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "debug.h"
@@ -114,6 +120,20 @@ static void expect_rebuilt(test_log *log, const char *what)
     assert_int_equal(c.rejected, 0);
 }
 
+/* The last warning, whatever came after it. */
+typedef struct warn_log {
+    test_log base;
+    char warning[1024];
+} warn_log;
+
+static void warn_log_fn(void *user, vfx_log_level level, const char *message)
+{
+    warn_log *w = user;
+    test_log_fn(&w->base, level, message);
+    if (level == VFX_LOG_WARN)
+        snprintf(w->warning, sizeof w->warning, "%s", message);
+}
+
 static void test_cache(void **state)
 {
     (void)state;
@@ -135,6 +155,10 @@ static void test_cache(void **state)
     expect_rebuilt(&log, "foreign driver");
     patch(0, "NOTVOLFX", 8); /* not ours at all */
     expect_rebuilt(&log, "bad magic");
+    patch(8, "\x02\x00\x00\x00", 4); /* another header version */
+    expect_rebuilt(&log, "header version");
+    patch(24, NULL, 8); /* the source hash flipped: the entry's name still matches */
+    expect_rebuilt(&log, "source hash");
     /* the payload garbled with its checksum made to agree: only the driver can refuse it */
     n = file_size(g_entry);
     FILE *f = fopen(g_entry, "rb");
@@ -156,6 +180,87 @@ static void test_cache(void **state)
     assert_int_equal(log.errors, 0);
 }
 
+static const char victim_text[] = "not the cache's to write\n";
+
+static void read_victim(const char *path, char *out, size_t cap)
+{
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    size_t n = fread(out, 1, cap - 1, f);
+    out[n] = 0;
+    fclose(f);
+}
+
+/* One context with `name` planted as `kind` ('l': a link to a file outside the folder, 'f': a
+ * FIFO), the entry itself removed first unless `name` is the entry: stored, never loaded, and
+ * the file outside unchanged. */
+static void hostile(const char *name, char kind, const char *victim, bool is_entry)
+{
+    if (!is_entry)
+        remove(g_entry);
+    else
+        remove(name);
+    if (kind == 'l')
+        assert_int_equal(symlink(victim, name), 0);
+    else
+        assert_int_equal(mkfifo(name, 0644), 0);
+    warn_log log = {0};
+    alarm(60); /* a blocking open fails the test instead of hanging it */
+    const vfx_plugin_api2 *a = api2();
+    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
+                         .user = &log, .log = warn_log_fn};
+    vfx_context *ctx;
+    assert_int_equal(a->v1.create(&host, &ctx), VFX_OK);
+    assert_int_equal(a->set_program_cache(ctx, g_dir), VFX_OK);
+    GLuint p = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/composite.frag", NULL);
+    assert_int_not_equal(p, 0); /* the render goes on: the program is built from source */
+    GLint linked = 0;
+    glGetProgramiv(p, GL_LINK_STATUS, &linked);
+    assert_true(linked);
+    a->v1.destroy(ctx);
+    alarm(0);
+    char got[256];
+    read_victim(victim, got, sizeof got);
+    printf("%s %s: victim \"%.40s\", last warning: %s\n", kind == 'l' ? "link" : "FIFO", is_entry ? "entry" : "temp name",
+           got, log.warning);
+    assert_string_equal(got, victim_text); /* nothing written through the link */
+    struct stat st;
+    assert_int_equal(lstat(g_entry, &st), 0);
+    assert_true(S_ISREG(st.st_mode)); /* the entry was written, in the folder */
+    if (is_entry) {
+        assert_int_equal(log.base.warnings, 1); /* the planted entry is named, and rebuilt */
+        assert_non_null(strstr(log.warning, g_entry + strlen(g_dir) + 1));
+        assert_non_null(strstr(log.warning, kind == 'l' ? "symbolic link" : "not a regular file"));
+    } else {
+        assert_int_equal(log.base.warnings, 0);
+        remove(name);
+    }
+    assert_int_equal(log.base.errors, 0);
+}
+
+static void test_hostile_names(void **state)
+{
+    (void)state;
+    char victim[] = "/tmp/vfx_progcache_victim_XXXXXX";
+    int fd = mkstemp(victim);
+    assert_true(fd >= 0);
+    assert_int_equal(write(fd, victim_text, sizeof victim_text - 1), (ssize_t)(sizeof victim_text - 1));
+    close(fd);
+    if (!g_entry[0]) { /* run alone: make the entry first */
+        test_log log = {0};
+        one_program(&log);
+        find_entry();
+    }
+    char old_tmp[4200];
+    snprintf(old_tmp, sizeof old_tmp, "%s.%ld.tmp", g_entry, (long)getpid());
+    hostile(old_tmp, 'l', victim, false);
+    hostile(old_tmp, 'f', victim, false);
+    hostile(g_entry, 'l', victim, true);
+    hostile(g_entry, 'f', victim, true);
+    find_entry(); /* one entry, no temporary left behind */
+    remove(victim);
+}
+
 int main(void)
 {
     rt_gl_context *gl = test_gl_or_skip();
@@ -170,7 +275,7 @@ int main(void)
         rt_gl_context_destroy(gl);
         return 1;
     }
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_cache)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_cache), cmocka_unit_test(test_hostile_names)};
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     if (g_entry[0])
         remove(g_entry);
