@@ -36,6 +36,8 @@ const char *rt_mesh_format_ext(rt_mesh_format f)
     return NULL;
 }
 
+static vfx_result check_gltf_nodes(const cJSON *root, const char *name, char *err, size_t errlen);
+
 static uint32_t le32(const unsigned char *p)
 {
     return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
@@ -71,18 +73,7 @@ typedef struct ply_element {
     unsigned char size[PLY_MAX_PROPS];     /* a scalar's bytes, or a list item's */
     unsigned char list[PLY_MAX_PROPS];     /* a list's count bytes; 0 for a scalar */
     unsigned char signed_count[PLY_MAX_PROPS];
-    unsigned char kind[PLY_MAX_PROPS];     /* a scalar's or list item's type: PLY_UINT, PLY_SINT, PLY_REAL */
 } ply_element;
-
-enum { PLY_UINT, PLY_SINT, PLY_REAL };
-
-/* The kind of a type name that ply_type_size knows. */
-static unsigned char ply_type_kind(const char *t)
-{
-    if (strncmp(t, "float", 5) == 0 || strcmp(t, "double") == 0)
-        return PLY_REAL;
-    return t[0] == 'u' ? PLY_UINT : PLY_SINT;
-}
 
 /* Next header line [*pos, end) into `line` (NUL-terminated, CR dropped); 0 at the end of data. */
 static int ply_line(const unsigned char *d, size_t size, size_t *pos, char *line, size_t cap,
@@ -207,172 +198,6 @@ static vfx_result ply_walk_body(const unsigned char *d, size_t size, size_t pos,
     return VFX_OK;
 }
 
-/* ---- ASCII PLY as Assimp 5.2 reads it ----------------------------------------------------
- * ply_walk_body's lines end at '\n' and its values are whitespace-separated tokens. Assimp's
- * (IOStreamBuffer::getNextLine and PLY::PropertyInstance::ParseInstance, in its installed
- * headers and 5.2's PlyParser.cpp) differ:
- * - a line also ends at '\r', '\0' or '\f', and a line that starts at a line end skips to past
- *   the next '\n' (with no '\n' left, it reads past the end of its block);
- * - lines are copied into one buffer, never cleared: a last line with no line end, or a value
- *   parse that runs past a line's end, reads what earlier, longer lines left there;
- * - a number it cannot read leaves the parse where it was, so the next value is read from the
- *   middle of a token;
- * - a list is sized by its count (8 bytes an item) before its items are read.
- * A face line that Assimp saw where ply_walk_body saw a vertex asked for 2.9 GB
- * (fuzz_mesh_ply). So the body is walked a second time, the way Assimp walks it, over a copy of
- * its buffer, and every list count it would read must fit in the values left on its line.
- * Files above Assimp's 16 MB read-ahead block may split a line at a block edge; not mirrored. */
-
-static int ply_is_line_end(int c)
-{
-    return c == '\r' || c == '\n' || c == '\0' || c == '\f';
-}
-
-typedef struct ply_cursor {
-    const unsigned char *b; /* Assimp's line buffer: ab_len bytes, then zeros */
-    size_t len, c;
-} ply_cursor;
-
-static int ply_at(const ply_cursor *k, size_t i)
-{
-    return i < k->len ? k->b[i] : 0;
-}
-
-/* getNextLine from *pos into ab: 1 with a line, 0 without one (ab may hold part of it, as
- * Assimp's buffer does), -1 where Assimp would read past its block. */
-static int ply_assimp_line(const unsigned char *d, size_t size, size_t *pos, unsigned char *ab)
-{
-    size_t p = *pos;
-    if (p >= size)
-        return 0;
-    if (ply_is_line_end(d[p])) {
-        while (p < size && d[p] != '\n')
-            ++p;
-        if (p == size)
-            return -1;
-        if (++p >= size) {
-            *pos = p;
-            return 0;
-        }
-    }
-    size_t i = 0;
-    while (!ply_is_line_end(d[p])) {
-        ab[i++] = d[p++];
-        if (p >= size) {
-            *pos = p;
-            return 0;
-        }
-    }
-    ab[i] = '\n';
-    *pos = p + 1;
-    return 1;
-}
-
-/* strtoul10: digits, wrapping at 32 bits; none read where none are. */
-static uint32_t ply_strtoul10(ply_cursor *k)
-{
-    uint32_t v = 0;
-    while (isdigit(ply_at(k, k->c)))
-        v = v * 10u + (uint32_t)(ply_at(k, k->c++) - '0');
-    return v;
-}
-
-/* strtoul10_64 as fast_atoreal_move calls it: 0 where no digit starts it (Assimp throws); on
- * overflow Assimp returns without moving; max > 0 stops after max digits and skips the rest. */
-static int ply_strtoul10_64(ply_cursor *k, unsigned max)
-{
-    if (!isdigit(ply_at(k, k->c)))
-        return 0;
-    size_t start = k->c;
-    unsigned long long v = 0;
-    for (unsigned n = 0; isdigit(ply_at(k, k->c));) {
-        unsigned long long nv = v * 10ull + (unsigned long long)(ply_at(k, k->c) - '0');
-        if (nv < v) {
-            k->c = start;
-            return 1;
-        }
-        v = nv, ++k->c;
-        if (max && ++n == max) {
-            while (isdigit(ply_at(k, k->c)))
-                ++k->c;
-            return 1;
-        }
-    }
-    return 1;
-}
-
-/* fast_atoreal_move: 0 where Assimp throws (no number there). */
-static int ply_atoreal(ply_cursor *k)
-{
-    if (ply_at(k, k->c) == '-' || ply_at(k, k->c) == '+')
-        ++k->c;
-    const char *p = (const char *)k->b + k->c;
-    size_t left = k->c < k->len ? k->len - k->c : 0;
-    if (left >= 3 && strncasecmp(p, "nan", 3) == 0) {
-        k->c += 3;
-        return 1;
-    }
-    if (left >= 3 && strncasecmp(p, "inf", 3) == 0) {
-        k->c += left >= 8 && strncasecmp(p + 3, "inity", 5) == 0 ? 8 : 3;
-        return 1;
-    }
-    int c0 = ply_at(k, k->c), c1 = ply_at(k, k->c + 1);
-    if (!isdigit(c0) && !((c0 == '.' || c0 == ',') && isdigit(c1)))
-        return 0;
-    if (c0 != '.' && c0 != ',')
-        ply_strtoul10_64(k, 0);
-    c0 = ply_at(k, k->c), c1 = ply_at(k, k->c + 1);
-    if ((c0 == '.' || c0 == ',') && isdigit(c1)) {
-        ++k->c;
-        ply_strtoul10_64(k, 15);
-    } else if (c0 == '.') {
-        ++k->c;
-    }
-    if (ply_at(k, k->c) == 'e' || ply_at(k, k->c) == 'E') {
-        ++k->c;
-        if (ply_at(k, k->c) == '-' || ply_at(k, k->c) == '+')
-            ++k->c;
-        return ply_strtoul10_64(k, 0);
-    }
-    return 1;
-}
-
-/* ParseValue of one value of kind `kind`, with the value ConvertTo<unsigned int> makes a list
- * count of in *as_count; 0 where Assimp throws. */
-static int ply_value(ply_cursor *k, unsigned char kind, uint32_t *as_count)
-{
-    if (kind == PLY_REAL)
-        return ply_atoreal(k);
-    int neg = 0;
-    if (kind == PLY_SINT && (ply_at(k, k->c) == '-' || ply_at(k, k->c) == '+'))
-        neg = ply_at(k, k->c++) == '-';
-    uint32_t v = ply_strtoul10(k);
-    if (as_count)
-        *as_count = neg ? 0u - v : v;
-    return 1;
-}
-
-/* SkipSpaces: blanks and tabs; 0 at a line end. */
-static int ply_skip_spaces(ply_cursor *k)
-{
-    while (ply_at(k, k->c) == ' ' || ply_at(k, k->c) == '\t')
-        ++k->c;
-    return !ply_is_line_end(ply_at(k, k->c));
-}
-
-/* Values left before the next line end: the items a list's loop can read. */
-static unsigned long long ply_values_left(const ply_cursor *k)
-{
-    unsigned long long n = 0;
-    int in = 0;
-    for (size_t i = k->c; !ply_is_line_end(ply_at(k, i)); ++i) {
-        int blank = ply_at(k, i) == ' ' || ply_at(k, i) == '\t';
-        n += !blank && !in;
-        in = !blank;
-    }
-    return n;
-}
-
 /* Element names Assimp 5.2 knows (PLY::Element::ParseSemantic). It reads the count of any other
  * from the start of its name (the name is not skipped first): 0 for a name that starts with a
  * letter, so it reads none of its instances (TextureFile takes no count at all). */
@@ -385,79 +210,23 @@ static int ply_assimp_parses(const char *name)
     return 0;
 }
 
-/* One instance line in ab: every list count must fit in the values left on its line. */
-static vfx_result ply_assimp_instance(ply_cursor *k, const ply_element *e, unsigned long long n,
-                                      unsigned long long line, const char *name, char *err, size_t errlen)
+/* An ASCII body is text: printable ASCII, blanks, tabs, and lines ended by LF or CR LF. A lone
+ * CR, a NUL or a form feed is where readers disagree on line ends (Assimp 5.2 ends a line at
+ * each, so its face line was not this walk's one: a count of 4e9 read from another line). */
+static vfx_result ply_ascii_text(const unsigned char *d, size_t size, size_t pos, const char *name, char *err,
+                                 size_t errlen)
 {
-    for (unsigned p = 0; p < e->props; ++p) {
-        if (!ply_skip_spaces(k))
-            continue; /* Assimp leaves the property at its default, the parse where it is */
-        uint32_t cnt = 1;
-        if (e->list[p]) {
-            ply_value(k, e->signed_count[p] ? PLY_SINT : PLY_UINT, &cnt);
-            unsigned long long room = ply_values_left(k);
-            if (cnt > room) {
-                snprintf(err, errlen, "%s: PLY body line %llu (as Assimp splits lines: at CR, LF, NUL and FF): "
-                         "element %s %llu, property %u: a list of %u items, more than the %llu values left on "
-                         "its line", name, line, e->name, n, p, cnt, room);
-                return VFX_ERR_FORMAT;
-            }
+    for (unsigned long long line = 1; pos < size; ++pos) {
+        unsigned char ch = d[pos];
+        if (ch == '\n')
+            ++line;
+        else if ((ch < 0x20 && ch != '\t' && !(ch == '\r' && pos + 1 < size && d[pos + 1] == '\n')) || ch > 0x7e) {
+            snprintf(err, errlen, "%s: PLY body line %llu: byte 0x%02x is not ASCII text (a lone CR, NUL or form "
+                     "feed makes readers disagree on where lines end)", name, line, ch);
+            return VFX_ERR_FORMAT;
         }
-        for (uint32_t t = 0; t < cnt; ++t) {
-            if (e->list[p] && !ply_skip_spaces(k))
-                break;
-            if (!ply_value(k, e->kind[p], NULL)) {
-                snprintf(err, errlen, "%s: PLY body line %llu: element %s %llu, property %u: not a number",
-                         name, line, e->name, n, p);
-                return VFX_ERR_FORMAT;
-            }
-        }
-        while (ply_at(k, k->c) == ' ' || ply_at(k, k->c) == '\t' || ply_at(k, k->c) == '\r' ||
-               ply_at(k, k->c) == '\n') /* SkipSpacesAndLineEnd: on past the line's end */
-            ++k->c;
     }
     return VFX_OK;
-}
-
-static vfx_result ply_walk_ascii_as_assimp(const unsigned char *d, size_t size, const ply_element *el,
-                                           unsigned nel, const char *name, char *err, size_t errlen)
-{
-    unsigned char *ab = calloc(size + 2, 1); /* no line is longer than the file */
-    if (!ab) {
-        snprintf(err, errlen, "%s: out of memory (%zu bytes) checking the PLY body", name, size + 2);
-        return VFX_ERR_OUT_OF_MEMORY;
-    }
-    /* the header's lines, through end_header, go through the same buffer */
-    size_t pos = 0;
-    int got;
-    while ((got = ply_assimp_line(d, size, &pos, ab)) == 1 &&
-           strncmp((const char *)ab + strspn((const char *)ab, " \t"), "end_header", 10) != 0) {
-    }
-    vfx_result r = VFX_OK;
-    unsigned long long line = 0; /* of the body, as Assimp splits it */
-    if (got == 1) {
-        got = ply_assimp_line(d, size, &pos, ab);
-        line = 1;
-    }
-    for (unsigned i = 0; i < nel && r == VFX_OK && got >= 0; ++i) {
-        if (!ply_assimp_parses(el[i].name))
-            continue; /* no instance, as Assimp reads it (check_ply keeps these last) */
-        for (unsigned long long n = 0; n < el[i].count && r == VFX_OK && got >= 0; ++n) {
-            ply_cursor k = {ab, size + 2, 0};
-            r = ply_assimp_instance(&k, &el[i], n, line, name, err, errlen);
-            if (got != 1)
-                break; /* no line left: Assimp parses its buffer again, as just checked */
-            if ((got = ply_assimp_line(d, size, &pos, ab)) == 1)
-                ++line;
-        }
-    }
-    if (r == VFX_OK && got < 0) {
-        snprintf(err, errlen, "%s: PLY body after line %llu: a CR, NUL or FF with no LF after it (Assimp reads "
-                 "past its buffer looking for one)", name, line);
-        r = VFX_ERR_FORMAT;
-    }
-    free(ab);
-    return r;
 }
 
 static vfx_result check_ply(const unsigned char *d, size_t size, const char *name, char *err,
@@ -546,12 +315,10 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
                 e->list[e->props] = (unsigned char)sz;
                 e->signed_count[e->props] = w[2][0] != 'u';
                 e->size[e->props] = (unsigned char)isz;
-                e->kind[e->props] = ply_type_kind(w[3]);
             } else if (nw != 3 || !(sz = ply_type_size(w[1]))) {
                 return ply_fail(name, err, errlen, "unknown property type \"%s\"", ln, w[1]);
             } else {
                 e->size[e->props] = (unsigned char)sz;
-                e->kind[e->props] = ply_type_kind(w[1]);
             }
             e->props++;
             e->bytes += sz;
@@ -612,10 +379,8 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
             return VFX_ERR_FORMAT;
         }
     }
-    vfx_result r = ply_walk_body(d, size, pos, binary, el, nel, name, err, errlen);
-    if (r == VFX_OK && !binary)
-        r = ply_walk_ascii_as_assimp(d, size, el, nel, name, err, errlen);
-    return r;
+    vfx_result r = binary ? VFX_OK : ply_ascii_text(d, size, pos, name, err, errlen);
+    return r ? r : ply_walk_body(d, size, pos, binary, el, nel, name, err, errlen);
 }
 
 /* ---- STL ---------------------------------------------------------------------------------- */
@@ -692,6 +457,13 @@ static vfx_result check_glb(const unsigned char *d, size_t size, const char *nam
             snprintf(err, errlen, "%s: glb chunk 0 is not JSON (type 0x%08x)", name, ctype);
             return VFX_ERR_FORMAT;
         }
+        if (k == 0) { /* the node tree, before Assimp builds it */
+            cJSON *root = cJSON_ParseWithLength((const char *)d + off + 8, clen);
+            vfx_result r = root ? check_gltf_nodes(root, name, err, errlen) : VFX_OK; /* Assimp names bad JSON */
+            cJSON_Delete(root);
+            if (r)
+                return r;
+        }
         off += 8 + (size_t)clen;
     }
     return VFX_OK;
@@ -734,6 +506,101 @@ static vfx_result check_obj(const unsigned char *d, size_t size, const char *nam
     return VFX_OK;
 }
 
+/* ---- glTF node trees ---------------------------------------------------------------------- */
+
+/* A JSON number that is an integer in [0, n), or -1. */
+static long gltf_index(const cJSON *v, long n)
+{
+    if (!cJSON_IsNumber(v) || !(v->valuedouble >= 0) || v->valuedouble >= (double)n
+        || v->valuedouble != (double)(long)v->valuedouble)
+        return -1;
+    return (long)v->valuedouble;
+}
+
+/* The vertices mesh `m` holds: its primitives' POSITION accessor counts (0 where unreadable:
+ * Assimp checks the accessors themselves). */
+static unsigned long long gltf_mesh_vertices(const cJSON *root, const cJSON *mesh)
+{
+    const cJSON *acc = cJSON_GetObjectItemCaseSensitive(root, "accessors");
+    const cJSON *prims = cJSON_GetObjectItemCaseSensitive(mesh, "primitives");
+    unsigned long long n = 0;
+    const cJSON *p;
+    cJSON_ArrayForEach(p, prims) {
+        const cJSON *attrs = cJSON_GetObjectItemCaseSensitive(p, "attributes");
+        long a = gltf_index(cJSON_GetObjectItemCaseSensitive(attrs, "POSITION"), cJSON_GetArraySize(acc));
+        const cJSON *count = a >= 0 ? cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(acc, (int)a), "count") : NULL;
+        if (cJSON_IsNumber(count) && count->valuedouble > 0)
+            n += count->valuedouble < 1e12 ? (unsigned long long)count->valuedouble : 1000000000000ull;
+    }
+    return n;
+}
+
+/* The node tree, walked without recursion: node count, one parent a node, depth, and the
+ * vertices every node's mesh places. */
+static vfx_result check_gltf_nodes(const cJSON *root, const char *name, char *err, size_t errlen)
+{
+    const cJSON *nodes = cJSON_GetObjectItemCaseSensitive(root, "nodes");
+    const cJSON *meshes = cJSON_GetObjectItemCaseSensitive(root, "meshes");
+    int n = cJSON_GetArraySize(nodes);
+    if (n <= 0)
+        return VFX_OK;
+    if ((unsigned)n > RT_MESH_MAX_NODES) {
+        snprintf(err, errlen, "%s: glTF: %d nodes, above the cap of %u", name, n, RT_MESH_MAX_NODES);
+        return VFX_ERR_FORMAT;
+    }
+    long *parent = malloc((size_t)n * sizeof *parent);
+    if (!parent) {
+        snprintf(err, errlen, "%s: out of memory checking %d glTF nodes", name, n);
+        return VFX_ERR_OUT_OF_MEMORY;
+    }
+    for (int i = 0; i < n; ++i)
+        parent[i] = -1;
+    vfx_result r = VFX_OK;
+    unsigned long long placed = 0;
+    int i = 0;
+    const cJSON *node;
+    cJSON_ArrayForEach(node, nodes) {
+        const cJSON *c;
+        cJSON_ArrayForEach(c, cJSON_GetObjectItemCaseSensitive(node, "children")) {
+            long k = gltf_index(c, n);
+            if (k < 0 || k == i || parent[k] >= 0) {
+                if (k < 0)
+                    snprintf(err, errlen, "%s: glTF node %d: a child that is not a node index", name, i);
+                else
+                    snprintf(err, errlen, "%s: glTF node %ld is a child of node %ld and of node %d: nodes must form "
+                             "a tree (a node with two parents is placed twice, and twice again below)", name, k,
+                             k == i ? (long)i : parent[k], i);
+                r = VFX_ERR_FORMAT;
+                goto done;
+            }
+            parent[k] = i;
+        }
+        long m = gltf_index(cJSON_GetObjectItemCaseSensitive(node, "mesh"), cJSON_GetArraySize(meshes));
+        if (m >= 0)
+            placed += gltf_mesh_vertices(root, cJSON_GetArrayItem(meshes, (int)m));
+        ++i;
+    }
+    for (i = 0; i < n; ++i) { /* a cycle never reaches a root: it is too deep too */
+        unsigned depth = 0;
+        for (long k = i; parent[k] >= 0 && depth <= RT_MESH_MAX_NODE_DEPTH; k = parent[k])
+            ++depth;
+        if (depth > RT_MESH_MAX_NODE_DEPTH) {
+            snprintf(err, errlen, "%s: glTF node %d lies deeper than %u nodes below a root (or in a cycle); the "
+                     "node tree may be at most %u deep", name, i, RT_MESH_MAX_NODE_DEPTH, RT_MESH_MAX_NODE_DEPTH);
+            r = VFX_ERR_FORMAT;
+            goto done;
+        }
+    }
+    if (placed > RT_MESH_MAX_PLACED_VERTICES) {
+        snprintf(err, errlen, "%s: glTF: %llu vertices once every node's mesh is placed (%d nodes), above the cap of "
+                 "%u", name, placed, n, RT_MESH_MAX_PLACED_VERTICES);
+        r = VFX_ERR_FORMAT;
+    }
+done:
+    free(parent);
+    return r;
+}
+
 /* ---- glTF JSON ---------------------------------------------------------------------------- */
 
 /* glTF 2.0 only, as for .glb: Assimp's glTF 1.0 reader is one more format the game does not
@@ -744,13 +611,14 @@ static vfx_result check_gltf(const unsigned char *d, size_t size, const char *na
     cJSON *root = cJSON_ParseWithLength((const char *)d, size);
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(root, "asset"), "version");
     int ok = cJSON_IsString(v) && v->valuestring[0] == '2' && v->valuestring[1] == '.';
+    vfx_result r = ok ? check_gltf_nodes(root, name, err, errlen) : VFX_ERR_FORMAT;
     if (!ok)
         snprintf(err, errlen, "%s: %s", name,
                  !root ? "not JSON (a .gltf is glTF 2.0 JSON)"
                  : !cJSON_IsString(v) ? "no asset.version string (a .gltf is glTF 2.0 JSON)"
                  : "asset.version is not 2.x; only glTF 2.0 is imported");
     cJSON_Delete(root);
-    return ok ? VFX_OK : VFX_ERR_FORMAT;
+    return r;
 }
 
 vfx_result rt_mesh_check_bytes(rt_mesh_format f, const unsigned char *data, size_t size,

@@ -1,10 +1,14 @@
 /* mesh_import.c — Assimp scene flattening; node transforms applied on the CPU so one draw
- * per file is enough. Assimp never sees a file the checks of mesh_check.c have not passed, and
- * every file it opens goes through import_io below, so an .mtl or .bin it follows is held to
- * the same rules (regular file, size cap) as the mesh. */
+ * per file is enough. Assimp runs only in a child process (core/sandbox.h) with limits on its
+ * CPU time, memory and stack: a crash, hang or blow-up inside it is an error naming the file,
+ * and the host reads back only the flattened arrays, checked (counts under the caps, indices in
+ * range, every value finite). In the child, Assimp never sees a file the checks of mesh_check.c
+ * have not passed, and every file it opens goes through import_io below, so an .mtl or .bin it
+ * follows is held to the same rules (regular file, size cap) as the mesh. */
 #define _POSIX_C_SOURCE 200809L
 #include "gfx/mesh_import.h"
 #include "core/file.h"
+#include "core/sandbox.h"
 #include "gfx/mesh_check.h"
 
 #include <assimp/cfileio.h>
@@ -18,15 +22,15 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 /* ValidateDataStructure first: Assimp's later steps index vertices with the file's face
  * indices unchecked (a truncated binary PLY crashed in JoinIdenticalVertices). */
 #define IMPORT_FLAGS (aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_GenSmoothNormals \
                       | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType | aiProcess_FindInvalidData)
-/* flattened output (a mesh instanced by many nodes is copied per node): 4 M vertices hold
- * 96 MB of positions and normals */
-#define MAX_VERTICES (4u * RT_MESH_MAX_IMPORT_VERTICES)
-#define MAX_NODE_DEPTH 64
+#define MAX_VERTICES RT_MESH_MAX_PLACED_VERTICES
+#define MAX_INDICES (3ull * MAX_VERTICES)
+#define MAX_NODE_DEPTH RT_MESH_MAX_NODE_DEPTH
 #define MAX_EXTERNAL 8
 
 void rt_mesh_data_free(rt_mesh_data *m)
@@ -195,7 +199,7 @@ static int count_node(const struct aiScene *s, const struct aiNode *n, unsigned 
             if (m->mFaces[f].mNumIndices == 3)
                 *i += 3;
     }
-    for (unsigned c = 0; c < n->mNumChildren; ++c)
+    for (unsigned c = 0; c < n->mNumChildren && *v <= MAX_VERTICES; ++c) /* over the cap: counted enough */
         if (!count_node(s, n->mChildren[c], depth + 1, v, i))
             return 0;
     return 1;
@@ -261,9 +265,9 @@ static vfx_result from_scene(const struct aiScene *s, const char *what, rt_mesh_
         snprintf(err, errlen, "%s: no triangles in the file", what);
         return VFX_ERR_FORMAT;
     }
-    if (nv > MAX_VERTICES || ni > 3ull * MAX_VERTICES) {
-        snprintf(err, errlen, "%s: %llu vertices once every node's meshes are placed, above the cap of %u",
-                 what, (unsigned long long)nv, MAX_VERTICES);
+    if (nv > MAX_VERTICES || ni > MAX_INDICES) {
+        snprintf(err, errlen, "%s: %s%llu vertices once every node's meshes are placed, above the cap of %u",
+                 what, nv > MAX_VERTICES ? "over " : "", (unsigned long long)nv, MAX_VERTICES);
         return VFX_ERR_FORMAT;
     }
     out->positions = malloc(nv * 3 * sizeof(float));
@@ -316,11 +320,12 @@ static unsigned primitive_types_disagree(const struct aiScene *s)
  * bytes a vertex). Two reads, because Assimp 5.2's aiApplyPostProcessing frees the scene when
  * a step fails and then releases it again (SIGSEGV on BoxWithInfinites.glb): the one-call
  * import handles that failure correctly. The raw read costs about a sixth of the full one. */
-static vfx_result import_checked(import_io *x, rt_mesh_format fmt, rt_mesh_data *out, char *err,
+static vfx_result import_checked(import_io *x, rt_mesh_format fmt, unsigned flags, rt_mesh_data *out, char *err,
                                  size_t errlen)
 {
     const char *name = x->main_name;
-    vfx_result r = rt_mesh_check_bytes(fmt, x->main, x->main_size, name, err, errlen);
+    vfx_result r = flags & RT_MESH_IMPORT_UNCHECKED ? VFX_OK
+                   : rt_mesh_check_bytes(fmt, x->main, x->main_size, name, err, errlen);
     if (r)
         return r;
     x->io = (struct aiFileIO){.OpenProc = io_open, .CloseProc = io_close, .UserData = (aiUserData)x};
@@ -359,6 +364,132 @@ static vfx_result import_checked(import_io *x, rt_mesh_format fmt, rt_mesh_data 
     return r;
 }
 
+/* ---- the child process and what the host reads back ----------------------------------------- */
+
+/* The child's answer: this header, then msg_len bytes of error text (result != 0) or the
+ * arrays (positions, normals: 3 floats a vertex; indices), nothing else. */
+typedef struct wire_head {
+    uint32_t magic, result, msg_len, vertex_count, index_count;
+} wire_head;
+#define WIRE_MAGIC 0x4d584656u /* "VFXM" */
+#define WIRE_MAX_MSG 1024u
+
+typedef struct import_job {
+    import_io x;
+    rt_mesh_format fmt;
+    unsigned flags;
+    const char *name;
+    rt_mesh_data *out; /* the host's */
+} import_job;
+
+static int write_all(int fd, const void *data, size_t n)
+{
+    const unsigned char *p = data;
+    while (n > 0) {
+        ssize_t w = write(fd, p, n);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0)
+            return 0;
+        p += w, n -= (size_t)w;
+    }
+    return 1;
+}
+
+/* In the child: checks, Assimp, flattening; the answer to the host. */
+static vfx_result import_child(void *arg, int fd)
+{
+    import_job *job = arg;
+    rt_mesh_data m = {0};
+    char err[WIRE_MAX_MSG] = "";
+    vfx_result r = import_checked(&job->x, job->fmt, job->flags, &m, err, sizeof err);
+    wire_head h = {WIRE_MAGIC, (uint32_t)r, 0, m.vertex_count, m.index_count};
+    int ok;
+    if (r) {
+        h.msg_len = (uint32_t)strnlen(err, sizeof err - 1);
+        ok = write_all(fd, &h, sizeof h) && write_all(fd, err, h.msg_len);
+    } else {
+        size_t vb = (size_t)m.vertex_count * 3 * sizeof(float);
+        ok = write_all(fd, &h, sizeof h) && write_all(fd, m.positions, vb) && write_all(fd, m.normals, vb)
+             && write_all(fd, m.indices, (size_t)m.index_count * sizeof(uint32_t));
+    }
+    rt_mesh_data_free(&m);
+    return ok ? r : VFX_ERR_IO;
+}
+
+/* In the host: the answer, trusted in nothing: counts under the caps, every index in range,
+ * every value finite; the bounds computed here. */
+static vfx_result import_reader(void *arg, rt_sandbox_stream *st, char *err, size_t errlen)
+{
+    import_job *job = arg;
+    rt_mesh_data *out = job->out;
+    wire_head h;
+    if (rt_sandbox_read(st, &h, sizeof h))
+        return VFX_ERR_FORMAT; /* the sandbox says what happened to the child */
+    if (h.magic != WIRE_MAGIC || (h.result && (h.msg_len == 0 || h.msg_len >= WIRE_MAX_MSG))) {
+        snprintf(err, errlen, "%s: the process that reads it answered garbage", job->name);
+        return VFX_ERR_FORMAT;
+    }
+    if (h.result) {
+        char msg[WIRE_MAX_MSG];
+        if (rt_sandbox_read(st, msg, h.msg_len))
+            return VFX_ERR_FORMAT;
+        msg[h.msg_len] = 0;
+        snprintf(err, errlen, "%s", msg);
+        return h.result <= (uint32_t)VFX_ERR_UNSUPPORTED + 16 ? (vfx_result)h.result : VFX_ERR_FORMAT;
+    }
+    if (h.vertex_count == 0 || h.vertex_count > MAX_VERTICES || h.index_count == 0 || h.index_count > MAX_INDICES
+        || h.index_count % 3) {
+        snprintf(err, errlen, "%s: the process that reads it answered %u vertices and %u indices (caps %u and %llu)",
+                 job->name, h.vertex_count, h.index_count, MAX_VERTICES, MAX_INDICES);
+        return VFX_ERR_FORMAT;
+    }
+    size_t vb = (size_t)h.vertex_count * 3 * sizeof(float);
+    out->positions = malloc(vb);
+    out->normals = malloc(vb);
+    out->indices = malloc((size_t)h.index_count * sizeof(uint32_t));
+    if (!out->positions || !out->normals || !out->indices) {
+        rt_mesh_data_free(out);
+        snprintf(err, errlen, "%s: out of memory for %u vertices", job->name, h.vertex_count);
+        return VFX_ERR_OUT_OF_MEMORY;
+    }
+    if (rt_sandbox_read(st, out->positions, vb) || rt_sandbox_read(st, out->normals, vb)
+        || rt_sandbox_read(st, out->indices, (size_t)h.index_count * sizeof(uint32_t))) {
+        rt_mesh_data_free(out);
+        return VFX_ERR_FORMAT;
+    }
+    out->vertex_count = h.vertex_count, out->index_count = h.index_count;
+    const char *bad = NULL;
+    uint32_t at = 0;
+    for (int a = 0; a < 3; ++a)
+        out->bounds_min[a] = INFINITY, out->bounds_max[a] = -INFINITY;
+    for (uint32_t i = 0; i < 3 * h.vertex_count && !bad; ++i) {
+        float p = out->positions[i];
+        if (!isfinite(p) || !isfinite(out->normals[i]))
+            bad = "a non-finite position or normal", at = i / 3;
+        if (p < out->bounds_min[i % 3]) out->bounds_min[i % 3] = p;
+        if (p > out->bounds_max[i % 3]) out->bounds_max[i % 3] = p;
+    }
+    for (uint32_t i = 0; i < h.index_count && !bad; ++i)
+        if (out->indices[i] >= h.vertex_count)
+            bad = "an index past the vertices", at = i;
+    if (bad) {
+        snprintf(err, errlen, "%s: the process that reads it answered %s (at %u)", job->name, bad, at);
+        rt_mesh_data_free(out);
+        return VFX_ERR_FORMAT;
+    }
+    return VFX_OK;
+}
+
+static vfx_result import_sandboxed(import_job *job, const rt_sandbox_limits *lim, char *err, size_t errlen)
+{
+    rt_sandbox_limits def = rt_sandbox_default_limits();
+    vfx_result r = rt_sandbox_run(lim ? lim : &def, job->name, import_child, job, import_reader, job, err, errlen);
+    if (r)
+        rt_mesh_data_free(job->out);
+    return r;
+}
+
 vfx_result rt_mesh_import(const char *path, rt_mesh_data *out, char *err, size_t errlen)
 {
     if (!path || !out)
@@ -376,15 +507,16 @@ vfx_result rt_mesh_import(const char *path, rt_mesh_data *out, char *err, size_t
         free(buf);
         return rt_mesh_check_bytes(fmt, NULL, 0, path, err, errlen);
     }
-    import_io x = {.main_name = path, .main = (const unsigned char *)buf, .main_size = size,
-                   .allow_external = 1, .total = size};
-    r = import_checked(&x, fmt, out, err, errlen);
+    import_job job = {.x = {.main_name = path, .main = (const unsigned char *)buf, .main_size = size,
+                            .allow_external = 1, .total = size},
+                      .fmt = fmt, .name = path, .out = out};
+    r = import_sandboxed(&job, NULL, err, errlen);
     free(buf);
     return r;
 }
 
-vfx_result rt_mesh_import_memory(const void *data, size_t size, const char *hint,
-                                  rt_mesh_data *out, char *err, size_t errlen)
+vfx_result rt_mesh_import_memory_ex(const void *data, size_t size, const char *hint, const rt_sandbox_limits *lim,
+                                     unsigned flags, rt_mesh_data *out, char *err, size_t errlen)
 {
     if (!data || !out || !hint || size == 0 || size > RT_MESH_MAX_BYTES) {
         if (err && errlen)
@@ -399,8 +531,15 @@ vfx_result rt_mesh_import_memory(const void *data, size_t size, const char *hint
     rt_mesh_format fmt = rt_mesh_format_of_name(name);
     if (!fmt)
         return rt_mesh_check_bytes(fmt, data, size, name, err, errlen);
-    import_io x = {.main_name = name, .main = data, .main_size = size, .total = size};
-    return import_checked(&x, fmt, out, err, errlen);
+    import_job job = {.x = {.main_name = name, .main = data, .main_size = size, .total = size},
+                      .fmt = fmt, .flags = flags, .name = name, .out = out};
+    return import_sandboxed(&job, lim, err, errlen);
+}
+
+vfx_result rt_mesh_import_memory(const void *data, size_t size, const char *hint,
+                                  rt_mesh_data *out, char *err, size_t errlen)
+{
+    return rt_mesh_import_memory_ex(data, size, hint, NULL, 0, out, err, errlen);
 }
 
 vfx_result rt_mesh_make_box(const float mn[3], const float mx[3], rt_mesh_data *out)
