@@ -128,6 +128,10 @@ static vfx_result plugin_create(const vfx_host_api *host, vfx_context **out)
     return VFX_OK;
 }
 
+/* Every effect's targets at width x height. When one cannot be made (out of memory), the
+ * context goes back to its previous size and every effect is remade at it, so the next frame
+ * draws as before; an effect that cannot be remade even then is dropped and made again by the
+ * next update. The failed size is not kept. */
 static vfx_result plugin_resize(vfx_context *ctx, uint32_t width, uint32_t height)
 {
     if (!ctx)
@@ -136,15 +140,30 @@ static vfx_result plugin_resize(vfx_context *ctx, uint32_t width, uint32_t heigh
     if (width == 0 || height == 0 || width > 16384 || height > 16384)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
                         "resize: %ux%u outside 1..16384 in each direction", width, height);
+    const uint32_t old_w = ctx->width, old_h = ctx->height;
     ctx->width = width;
     ctx->height = height;
-    for (int k = 0; k < VFX_EFFECT_COUNT; ++k)
-        if (ctx->effect_state[k] && ctx->effect_ops[k]->resize) {
-            vfx_result r = ctx->effect_ops[k]->resize(ctx, ctx->effect_state[k], width, height);
-            if (r)
-                return r;
-        }
-    return VFX_OK;
+    vfx_result r = VFX_OK;
+    for (int k = 0; k < VFX_EFFECT_COUNT && !r; ++k)
+        if (ctx->effect_state[k] && ctx->effect_ops[k]->resize)
+            r = ctx->effect_ops[k]->resize(ctx, ctx->effect_state[k], width, height);
+    if (!r)
+        return VFX_OK;
+    char why[512];
+    snprintf(why, sizeof why, "%s", ctx->last_error);
+    while (glGetError() != GL_NO_ERROR) { /* the failure's GL_OUT_OF_MEMORY is not the next call's */
+    }
+    ctx->width = old_w;
+    ctx->height = old_h;
+    for (int k = 0; k < VFX_EFFECT_COUNT; ++k) {
+        const volfx_effect_ops *ops = ctx->effect_ops[k];
+        if (!ctx->effect_state[k] || !ops->resize || (old_w && ops->resize(ctx, ctx->effect_state[k], old_w, old_h) == VFX_OK))
+            continue;
+        ops->destroy(ctx, ctx->effect_state[k]); /* remade whole by the next update */
+        ctx->effect_state[k] = NULL;
+        ctx->rendered &= ~VFX_EFFECT_BIT(k);
+    }
+    return volfx_fail(ctx, r, "resize to %ux%u failed, the context stays at %ux%u: %s", width, height, old_w, old_h, why);
 }
 
 static vfx_result plugin_update(vfx_context *ctx, double time, float dt)

@@ -147,17 +147,23 @@ static vfx_result volume_resize(vfx_context *ctx, void *state, uint32_t w, uint3
         s->heap_rgba = volfx_alloc(ctx, n * 4 * sizeof(float));
     s->up_slot = 0;
     s->rgba = s->heap_rgba ? s->heap_rgba : s->up_map[0];
-    if (!s->rgba)
-        return VFX_ERR_OUT_OF_MEMORY;
-    memset(s->rgba, 0, n * 4 * sizeof(float));
     s->max_dist = volfx_alloc(ctx, n * sizeof(float));
+    vfx_result r = s->rgba && s->max_dist ? volfx_gpu_check_target(ctx, s->dist_fbo, "volume: distance target", w, h)
+                   : volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "volume: targets for %ux%u: out of memory (%.2f GB)", w, h,
+                                (double)n * 60.0 / 1e9);
+    if (r) {
+        /* nothing half made stays: no mapped pointer, no error flag left for a later check */
+        while (glGetError() != GL_NO_ERROR) {
+        }
+        release_targets(ctx, s);
+        s->width = s->height = 0;
+        return r;
+    }
+    memset(s->rgba, 0, n * 4 * sizeof(float));
     s->width = w, s->height = h;
     s->frame = 0;
     s->last_key = 0;
-    vfx_result r = volfx_gpu_check_target(ctx, s->dist_fbo, "volume: distance target", w, h);
-    if (r)
-        return r;
-    return s->max_dist ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
+    return VFX_OK;
 }
 
 /* The host's view of volume 0 as version 2 (a version-1 host leaves the version-2 fields 0). */
