@@ -150,7 +150,7 @@ static vfx_result volume_resize(vfx_context *ctx, void *state, uint32_t w, uint3
     s->max_dist = volfx_alloc(ctx, n * sizeof(float));
     vfx_result r = s->rgba && s->max_dist ? volfx_gpu_check_target(ctx, s->dist_fbo, "volume: distance target", w, h)
                    : volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "volume: targets for %ux%u: out of memory (%.2f GB)", w, h,
-                                (double)n * 60.0 / 1e9);
+                                (double)n * 64.0 / 1e9);
     if (r) {
         /* nothing half made stays: no mapped pointer, no error flag left for a later check */
         while (glGetError() != GL_NO_ERROR) {

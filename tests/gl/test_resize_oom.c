@@ -1,7 +1,7 @@
 /* A resize that runs out of memory (issue 37): in a child process whose address space may grow
  * by only 1 GiB past what it holds once the host and plugin run, the volume-showcase scene (a
- * volume and beams) at 96x54 is resized to 8192x8192 (the volume's targets alone take 60 bytes a
- * pixel, 4 GB). The resize fails with VFX_ERR_OUT_OF_MEMORY naming both sizes, the context stays
+ * volume and beams) at 96x54 is resized to 8192x8192 (the volume's targets alone take 64 bytes a
+ * pixel, 4.3 GB). The resize fails with VFX_ERR_OUT_OF_MEMORY naming both sizes, the context stays
  * at 96x54, the next frames render the same pixels as before (it crashed in volume_render, and
  * resizing back failed), and the failed size is not recorded. AddressSanitizer needs terabytes
  * of address space for its shadow, so under it the test skips (77). */
