@@ -196,6 +196,44 @@ static vfx_result parse_environment(pctx *c, const cJSON *v, rt_scene_environmen
     return rt_scene_get_float(c, v, "environment", "fog", false, (range){0, 10, false}, &env->fog);
 }
 
+/* The distance between neighbouring float32 values at magnitude x. */
+static double f32_ulp(double x)
+{
+    float f = (float)fabs(x);
+    return (double)nextafterf(f, INFINITY) - (double)f;
+}
+
+/* Warns when content the scene stores relative to the origin lies so far from it that float32
+ * cannot resolve it (an origin 1e6 away from a pool of spacing 0.05: positions 0.0625 apart,
+ * the simulation wrecked and the water drawn as a few pixels): the fluid's tank against 1/64 of
+ * its particle spacing, the camera's eye against 1/16 of its near plane. */
+static void check_origin_distance(pctx *c, const rt_scene *s)
+{
+    const double *o = s->origin;
+    if (s->has_water && s->water.source == RT_SCENE_WATER_SIMULATION && s->water.count) {
+        const rt_scene_water *w = &s->water;
+        double far = 0, vol = 1;
+        for (int k = 0; k < 3; ++k) {
+            far = fmax(far, fmax(fabs(w->tank_min[k]), fabs(w->tank_max[k])));
+            vol *= fmax(w->box_max[k] - w->box_min[k], 1e-6);
+        }
+        double spacing = cbrt(vol / w->count), u = f32_ulp(far);
+        if (u > spacing / 64)
+            rt_logf(c->log, VFX_LOG_WARN, "origin [%.9g, %.9g, %.9g]: water.simulation.tank reaches %g m from it, "
+                    "where float32 positions are %g m apart, more than 1/64 of the particle spacing %g m: the "
+                    "simulation cannot resolve the fluid; put the origin near the content (\"camera\", or leave "
+                    "the key out)", o[0], o[1], o[2], far, u, spacing);
+    }
+    double eye = 0;
+    for (int k = 0; k < 3; ++k)
+        eye = fmax(eye, fabs(s->camera.eye[k]));
+    if (f32_ulp(eye) > s->camera.near_plane / 16)
+        rt_logf(c->log, VFX_LOG_WARN, "origin [%.9g, %.9g, %.9g]: camera.eye is %g m from it, where float32 "
+                "positions are %g m apart, more than 1/16 of camera.near (%g m): the view cannot be placed; put the "
+                "origin near the camera (\"camera\", or leave the key out)", o[0], o[1], o[2], eye, f32_ulp(eye),
+                (double)s->camera.near_plane);
+}
+
 static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
 {
     static const char *const keys[] = {"version", "origin", "name", "description", "camera", "meshes", "beams",
@@ -251,6 +289,7 @@ static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
         if ((r = rt_scene_parse_volume(c, v, &s->volume)))
             return r;
     }
+    check_origin_distance(c, s);
     return VFX_OK;
 }
 

@@ -111,12 +111,20 @@ vfx_result rt_scene_number_value(pctx *c, const cJSON *v, const char *path, rang
     if (fabs(d) > FLT_MAX)
         return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "must be finite as float32, got %.9g", d);
     float f = (float)d;
-    if (f != 0 && fabsf(f) < FLT_MIN)
+    if (f != 0 && fabsf(f) < FLT_MIN) {
+        /* advise 0 only where the range takes it */
+        const bool zero_ok = (rg.lo_open ? 0 > rg.lo : 0 >= rg.lo) && 0 <= rg.hi;
         return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "%g is subnormal as float32 (magnitude "
-                           "below %.9g): give 0 or a larger value", d, (double)FLT_MIN);
+                           "below %.9g): give %sa value of magnitude %.9g or more", d, (double)FLT_MIN,
+                           zero_ok ? "0 or " : "", (double)FLT_MIN);
+    }
     if (d != 0 && f == 0) /* only reached with d below FLT_MIN/2 */
         return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, path, "%.3g is 0 as float32", d);
-    r = rt_scene_check_range(c, path, (double)f, rg);
+    /* the float against the bounds as floats: a documented end such as 0.1 is the float nearest
+     * it (0.100000001), which is above the double 0.1 (dt 0.1 was refused) */
+    volatile float flo = (float)rg.lo, fhi = (float)rg.hi; /* rounded here, not folded away */
+    range rf = {(double)flo, (double)fhi, rg.lo_open};
+    r = rt_scene_check_range(c, path, (double)f, rf);
     if (!r)
         *out = (double)f;
     return r;

@@ -134,7 +134,8 @@ static vfx_result parse_water_simulation(pctx *c, const cJSON *v, rt_scene_water
         if (!r) r = rt_scene_get_float(c, pd, PP, "amplitude", false, NONNEG, &w->paddle_amplitude);
         if (!r) r = rt_scene_get_float(c, pd, PP, "period_s", false, (range){0, 1e4, true}, &w->paddle_period_s);
         w->paddle_ramp_s = -1.f; /* absent: one period (issue 22: it started at its peak speed) */
-        if (!r) r = rt_scene_get_float(c, pd, PP, "ramp_s", false, (range){0, 1e4, true}, &w->paddle_ramp_s);
+        /* 0 is documented: full amplitude from t = 0 (the solver's motion_ramp_s 0) */
+        if (!r) r = rt_scene_get_float(c, pd, PP, "ramp_s", false, (range){0, 1e4, false}, &w->paddle_ramp_s);
         if (r)
             return r;
         if (w->paddle_ramp_s < 0.f)

@@ -12,6 +12,9 @@
 #define RT_VOLUME_MAX_FILE_BYTES (1u << 30) /* a .vtu, .node or .ele file is read whole: 1 GiB */
 #define RT_VOLUME_MAX_POINTS (1u << 24)     /* 16,777,216 points */
 #define RT_VOLUME_MAX_TETS (1u << 24)       /* 16,777,216 tetrahedra */
+/* |coordinate| of a mesh point at most (the scene's coordinate range): one node at 1e30
+ * stretched the bounds the degenerate-cell test is relative to, and every cell was dropped */
+#define RT_VOLUME_MAX_COORD 1e6
 #define RT_VTU_MAX_DECODED_BYTES (1u << 30) /* base64-decoded plus inflated array bytes, per file */
 #define RT_ZLIB_MAX_RATIO 1032u             /* deflate cannot expand a byte beyond this */
 

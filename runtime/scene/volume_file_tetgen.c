@@ -183,6 +183,11 @@ static vfx_result node_point(tg_reader *r, uint32_t i, int cols, int attr_index,
             return rt_errf(err, errlen, VFX_ERR_NUMERIC,
                            "%s:%d: point %u coordinate %c = %g is not finite as float32",
                            r->name, r->line, i, "xyz"[k], v[1 + k]);
+        if (fabs(v[1 + k]) > RT_VOLUME_MAX_COORD)
+            return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT,
+                           "%s:%d: point %u coordinate %c = %g is beyond +-%g (RT_VOLUME_MAX_COORD): so far a "
+                           "point makes every cell degenerate next to the mesh's extent",
+                           r->name, r->line, i, "xyz"[k], v[1 + k], RT_VOLUME_MAX_COORD);
     }
     if (attr_index >= 0) {
         out->scalar[i] = (float)v[4 + attr_index];

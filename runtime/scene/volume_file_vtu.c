@@ -683,8 +683,13 @@ static vfx_result vtu_assemble(vtu_state *s, const vtu_decoded *d, tet_mesh *out
     if (as) out->scalar = malloc(sizeof(float) * np);
     if (!out->points || !out->tets || (as && !out->scalar))
         return errf(s, VFX_ERR_OUT_OF_MEMORY, "out of memory for %zu points and %zu tetrahedra", np, nc);
-    for (size_t i = 0; i < 3 * np; i++)
+    for (size_t i = 0; i < 3 * np; i++) {
         out->points[i] = (float)d->pts[i];
+        if (isfinite(out->points[i]) && fabs(d->pts[i]) > RT_VOLUME_MAX_COORD) /* non-finite: tet_validate */
+            return errf(s, VFX_ERR_INVALID_ARGUMENT, "point %zu coordinate %c = %g is beyond +-%g "
+                        "(RT_VOLUME_MAX_COORD): so far a point makes every cell degenerate next to the "
+                        "mesh's extent", i / 3, "xyz"[i % 3], d->pts[i], RT_VOLUME_MAX_COORD);
+    }
     for (size_t i = 0; i < 4 * nc; i++) {
         double v = d->cells[i];
         if (!(v >= 0 && v < (double)np))

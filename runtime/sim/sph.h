@@ -273,6 +273,9 @@ typedef struct rt_sph_settle_report {
  * it was: the state is the settled positions at rest. NULL desc: defaults. */
 vfx_result rt_sph_settle(rt_sph *sim, const rt_sph_settle_desc *desc, rt_sph_settle_report *report, char *err,
                          size_t errlen);
+/* The Chebyshev weight PBF applies in its k-th iteration (1-based; 1 for k <= 1) at spectral
+ * radius rho, by the recurrence the solver steps through (Wang 2015). */
+float rt_sph_chebyshev_weight(float rho, uint32_t k);
 /* The SoA columns (see the validity note above). */
 rt_sph_columns rt_sph_get_columns(rt_sph *sim);
 /* Pressure [Pa] of row i from the last density pass (0 when i is out of range). */

@@ -743,6 +743,21 @@ static float pbf_step_eps(const rt_sph *s, float dt)
     return s->pbf_eps * k * k;
 }
 
+/* Wang 2015's weight of iteration it (0-based) from the one before: omega_1 = 1, omega_2 =
+ * 2 / (2 - rho^2), omega_k+1 = 4 / (4 - rho^2 omega_k). */
+static float pbf_chebyshev_next(float rho2, uint32_t it, float omega)
+{
+    return it == 0 ? 1.f : it == 1 ? 2.f / (2.f - rho2) : 4.f / (4.f - rho2 * omega);
+}
+
+float rt_sph_chebyshev_weight(float rho, uint32_t k)
+{
+    float omega = 1.f;
+    for (uint32_t it = 0; it < k; ++it)
+        omega = pbf_chebyshev_next(rho * rho, it, omega);
+    return omega;
+}
+
 static vfx_result pbf_substep(rt_sph *s, float dt, rt_sph_report *rep, char *err, size_t errlen)
 {
     s->pbf_dt = dt;
@@ -786,7 +801,7 @@ static vfx_result pbf_substep(rt_sph *s, float dt, rt_sph_report *rep, char *err
         s->pbf_iter = it;
         rt_sph_parallel(s, pbf_lambda_chunk, true);
         memcpy(s->pn, next_is_a ? bufA : bufB, sizeof bufA);
-        omega = it == 0 || rho2 == 0.f ? 1.f : it == 1 ? 2.f / (2.f - rho2) : 4.f / (4.f - rho2 * omega);
+        omega = rho2 == 0.f ? 1.f : pbf_chebyshev_next(rho2, it, omega);
         s->cheb_omega = omega;
         memcpy(s->cheb_prev, prev, sizeof prev);
         memcpy(prev, s->pc, sizeof prev);

@@ -304,6 +304,15 @@ static const bad_case bad_cases[] = {
      VFX_ERR_INVALID_ARGUMENT, "volume.animate.ripple.wavelength: 1e-320 is 0 as float32"},
     {"{\"volume\":{\"path\":\"a.vtu\",\"animate\":{\"ripple\":{\"amplitude\":0.1,\"period_s\":1e-40}}}}",
      VFX_ERR_INVALID_ARGUMENT, "volume.animate.ripple.period_s: 1e-40 is subnormal as float32"},
+    /* the advice names 0 only where the range takes it (h > 0 does not; amplitude >= 0 does) */
+    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"h\":-1e-40}}", VFX_ERR_INVALID_ARGUMENT,
+     "water.h: must be > 0, got -1e-40"},
+    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"threshold\":1e-40}}", VFX_ERR_INVALID_ARGUMENT,
+     "below 1.17549435e-38): give a value of magnitude 1.17549435e-38 or more"},
+    {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
+     "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"paddle\":{\"amplitude\":1e-40}}}}",
+     VFX_ERR_INVALID_ARGUMENT, "water.simulation.paddle.amplitude: 1e-40 is subnormal as float32 (magnitude below "
+     "1.17549435e-38): give 0 or a value of magnitude 1.17549435e-38 or more"},
     {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"flow\":{\"amount\":0.5,\"scale\":-1}}]}",
      VFX_ERR_INVALID_ARGUMENT, "beams[0].flow.scale: must be >= 0, got -1"},
     {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"exposure\":1e39}]}", VFX_ERR_INVALID_ARGUMENT,
@@ -475,6 +484,50 @@ static void test_unknown_keys_warn(void **state)
     assert_int_equal(log.warnings, 1);
     assert_string_equal(log.last, "name: duplicate key, the first one is used");
     assert_string_equal(s->name, "a");
+    rt_scene_free(s);
+}
+
+/* An origin far from the content: the pool of default.json's size (16,384 particles, spacing
+ * 0.053 m) stored 1e6 m from an explicit origin sits where float32 positions are 0.0625 m apart
+ * (the simulation was wrecked and the water drew 26 pixels, with nothing said): a warning names
+ * the origin, the key and the float32 step; the camera 1e6 m out against its near plane too.
+ * Without the key (camera-relative) or with the origin at the content: nothing. */
+static void test_origin_far_from_content(void **state)
+{
+    (void)state;
+    const char *pool = "\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[-1.65,0,-1.25],"
+                       "\"max\":[1.65,1.4,1.25]},\"fluid\":{\"min\":[-1.6,0.02,-1.2],\"max\":[1.6,0.34,1.2]},"
+                       "\"particle_count\":16384}}";
+    const char *origins[3] = {"\"origin\":[1e6,0,0],", "", "\"origin\":[1,0,0],"};
+    for (int k = 0; k < 3; ++k) {
+        char json[1024];
+        snprintf(json, sizeof json, "{%s\"camera\":{\"eye\":[0,2,6]},%s}", origins[k], pool);
+        test_log log = {0};
+        rt_scene *s = NULL;
+        char err[256];
+        assert_int_equal(load(json, &log, &s, err, sizeof err), VFX_OK);
+        print_message("origin case %d: %d warnings; %s\n", k, log.warnings, log.last);
+        if (k == 0) {
+            assert_int_equal(log.warnings, 2); /* the tank and the camera */
+            assert_non_null(strstr(log.last, "origin [1000000, 0, 0]: camera.eye is 1e+06 m from it"));
+        } else {
+            assert_int_equal(log.warnings, 0);
+        }
+        rt_scene_free(s);
+    }
+    /* the tank alone (a camera near the origin): its own warning */
+    char json[1024];
+    snprintf(json, sizeof json, "{\"origin\":[0,0,0],\"camera\":{\"eye\":[0,2,6]},%s}", pool);
+    char *at = strstr(json, "[-1.65,0,-1.25]");
+    assert_non_null(at);
+    memcpy(at, "[-5e5,0,-1.250]", 15); /* the tank reaching 5e5 m out */
+    test_log log = {0};
+    rt_scene *s = NULL;
+    char err[256];
+    assert_int_equal(load(json, &log, &s, err, sizeof err), VFX_OK);
+    assert_int_equal(log.warnings, 1);
+    assert_non_null(strstr(log.last, "water.simulation.tank reaches 500000 m from it, where float32 positions are "
+                                     "0.03125 m apart, more than 1/64 of the particle spacing"));
     rt_scene_free(s);
 }
 
@@ -787,7 +840,7 @@ int main(void)
         cmocka_unit_test(test_environment),
         cmocka_unit_test(test_syntax_errors),
         cmocka_unit_test(test_unknown_keys_warn),
-        cmocka_unit_test(test_origin_default),
+        cmocka_unit_test(test_origin_default), cmocka_unit_test(test_origin_far_from_content),
         cmocka_unit_test(test_keyframes),
         cmocka_unit_test(test_sample_scenes),
         cmocka_unit_test(test_relative_paths_and_io),

@@ -760,6 +760,18 @@ static void test_tetgen_strict(void **st)
     preset(err, sizeof err);
     assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_NUMERIC);
     assert_msg(err, ".node:3: point 1 coordinate x = 1e+39 is not finite as float32");
+    /* one node far out (1e30) made every cell degenerate against the mesh's extent, and the whole
+     * volume vanished: refused beyond the scene's coordinate range, naming the line; 1e6 loads */
+    write_file(node, "4 3 0 0\n0 0 0 0\n1 1e30 0 0\n2 0 1 0\n3 0 0 1\n");
+    preset(err, sizeof err);
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
+    assert_msg(err, ".node:3: point 1 coordinate x = 1e+30 is beyond +-1e+06");
+    write_file(node, "4 3 0 0\n0 0 0 0\n1 1e6 0 0\n2 0 1 0\n3 0 0 1\n");
+    assert_int_equal(rt_volume_load_tetgen(base, NULL, &m, err, sizeof err), VFX_OK);
+    tet_mesh_free(&m);
+    /* the same in a .vtu (point 4, x) */
+    assert_int_equal(load_str(make_ascii("5", "5", "-3e30 2 2", "4", "10"), "V", &m, err), VFX_ERR_INVALID_ARGUMENT);
+    assert_msg(err, "point 4 coordinate x = -3e+30 is beyond +-1e+06");
     write_file(node, "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n");
     FILE *f = fopen(node, "ab");
     fputc(0, f);
