@@ -239,6 +239,8 @@ vfx_result rt_sph_add_mesh_collider(rt_sph *sim, const float *positions, uint32_
 /* Signed distance from p to collider `index` at the current time (positive on the fluid side;
  * +Inf beyond a mesh's grid); NaN for a bad index. */
 float rt_sph_collider_distance(const rt_sph *sim, uint32_t index, const float p[3]);
+/* Centre and velocity of collider `index` at the current time (as the walls use them). */
+vfx_result rt_sph_collider_motion(const rt_sph *sim, uint32_t index, float pos[3], float vel[3]);
 /* Adds an emitter that injects disc-shaped layers of particles each time they have moved dx. */
 vfx_result rt_sph_add_emitter(rt_sph *sim, const rt_sph_emitter *e, char *err, size_t errlen);
 

@@ -317,6 +317,15 @@ float rt_sph_collider_distance(const rt_sph *s, uint32_t index, const float p[3]
     return rt_sph_surface_distance(&s->col[index], p[0], p[1], p[2], n);
 }
 
+vfx_result rt_sph_collider_motion(const rt_sph *s, uint32_t index, float pos[3], float vel[3])
+{
+    if (!s || index >= s->ncol || !pos || !vel)
+        return VFX_ERR_INVALID_ARGUMENT;
+    for (int a = 0; a < 3; ++a)
+        pos[a] = s->col[index].pos[a], vel[a] = s->col[index].vel[a];
+    return VFX_OK;
+}
+
 void rt_sph_update_colliders(rt_sph *s, double t)
 {
     for (uint32_t i = 0; i < s->ncol; ++i) {

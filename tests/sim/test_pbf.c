@@ -333,6 +333,73 @@ static void test_pbf_paddle_ramp(void **state)
     rt_sph_destroy(s);
 }
 
+/* The paddle's velocity mid-ramp against a central difference of its own positions (t = 0.25 s
+ * of a 1 s ramp, h = 1 ms): the walls push with that velocity, so a wrong derivative of the
+ * ramp (the ramp's own term d/dt[A u^2 (3 - 2u)] sin(wt) dropped: 0.11 m/s here) moves the
+ * fluid wrongly while the positions stay right. Tolerance 2e-3 m/s: the difference's
+ * truncation A (2 pi f)^3 h^2 / 6 ~ 4e-6 m/s plus float32 positions near 0.4 m (3e-8 m per
+ * ulp over 2 ms: 1.5e-5 m/s), far below the dropped term. Also the settle: it holds the clock,
+ * so a block settled beside a ramped paddle ends bitwise where it ends beside a still one. */
+static void test_pbf_paddle_velocity_and_settle(void **state)
+{
+    (void)state;
+    const double A = 0.1, f = 1.0, pi = 3.14159265358979323846;
+    rt_sph_desc d = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {1.f, 0.5f, 0.2f}, .threads = 1};
+    rt_sph *s = make(d);
+    rt_sph_collider c = {.kind = RT_SPH_BOX, .center = {0.3f, 0.25f, 0.1f}, .half = {0.01f, 0.25f, 0.1f},
+                          .motion_axis = {1, 0, 0}, .motion_amplitude = (float)A, .motion_frequency = (float)f,
+                          .motion_ramp_s = 1.f};
+    assert_int_equal(rt_sph_add_collider(s, &c, NULL, NULL, 0), VFX_OK);
+    float x[1] = {0.9f}, y[1] = {0.01f}, z[1] = {0.1f};
+    assert_int_equal(rt_sph_add_particles(s, 1, x, y, z, NULL, NULL, NULL, NULL, 0), VFX_OK);
+    rt_sph_report r;
+    const float h = 1e-3f;
+    assert_int_equal(rt_sph_step(s, 0.25f - h, &r, NULL, 0), VFX_OK);
+    float p0[3], v0[3], p1[3], v1[3], p2[3], v2[3];
+    assert_int_equal(rt_sph_collider_motion(s, 0, p0, v0), VFX_OK);
+    assert_int_equal(rt_sph_step(s, h, &r, NULL, 0), VFX_OK);
+    assert_int_equal(rt_sph_collider_motion(s, 0, p1, v1), VFX_OK);
+    double t1 = rt_sph_time(s);
+    assert_int_equal(rt_sph_step(s, h, &r, NULL, 0), VFX_OK);
+    assert_int_equal(rt_sph_collider_motion(s, 0, p2, v2), VFX_OK);
+    double fd = ((double)p2[0] - p0[0]) / (2.0 * h);
+    /* the float64 derivative of A u^2 (3 - 2u) sin(2 pi f t), u = t / 1 s */
+    double u = t1, w = 2.0 * pi * f;
+    double ref = A * (6.0 * u * (1.0 - u) * sin(w * t1) + u * u * (3.0 - 2.0 * u) * w * cos(w * t1));
+    print_message("paddle at t = %.4f s: velocity %.5f m/s, central difference %.5f, float64 %.5f\n", t1, v1[0], fd,
+                  ref);
+    assert_true(fabs(v1[0] - fd) <= 2e-3);
+    assert_true(fabs(v1[0] - ref) <= 1e-4);
+    assert_true(v1[1] == 0.f && v1[2] == 0.f);
+    assert_int_equal(rt_sph_collider_motion(s, 1, p0, v0), VFX_ERR_INVALID_ARGUMENT);
+    rt_sph_destroy(s);
+    /* settled beside a ramped paddle (amplitude 0.1, 1 s ramp) and beside a still one (0) */
+    rt_sph_columns col[2];
+    rt_sph *t[2];
+    for (int k = 0; k < 2; ++k) {
+        rt_sph_desc dd = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {0.6f, 0.4f, 0.3f}, .threads = 1};
+        t[k] = make(dd);
+        rt_sph_collider pc = {.kind = RT_SPH_BOX, .center = {0.15f, 0.2f, 0.15f}, .half = {0.01f, 0.2f, 0.15f},
+                               .motion_axis = {1, 0, 0}, .motion_amplitude = k ? 0.f : 0.1f, .motion_frequency = 0.5f,
+                               .motion_ramp_s = 2.f};
+        assert_int_equal(rt_sph_add_collider(t[k], &pc, NULL, NULL, 0), VFX_OK);
+        float lo[3] = {0.2f, 0, 0}, hi[3] = {0.6f, 0.12f, 0.3f};
+        assert_int_equal(rt_sph_add_block(t[k], lo, hi, NULL, NULL, 0), VFX_OK);
+        rt_sph_settle_desc sd = {.max_steps = 30, .speed_tol = 1e-9f};
+        rt_sph_settle_report sr;
+        assert_int_equal(rt_sph_settle(t[k], &sd, &sr, NULL, 0), VFX_OK);
+        assert_int_equal(sr.steps, 30);
+        col[k] = rt_sph_get_columns(t[k]);
+    }
+    assert_int_equal(col[0].count, col[1].count);
+    for (uint32_t i = 0; i < col[0].count; ++i) {
+        assert_int_equal(col[0].id[i], col[1].id[i]);
+        assert_true(col[0].x[i] == col[1].x[i] && col[0].y[i] == col[1].y[i] && col[0].z[i] == col[1].z[i]);
+    }
+    rt_sph_destroy(t[0]);
+    rt_sph_destroy(t[1]);
+}
+
 /* A closed tank at rest (no paddle): total energy (kinetic + gravity; PBF has no internal energy)
  * must not grow by more than 1% of the initial energy between sampled points. */
 static void test_pbf_closed_tank_energy(void **state)
@@ -515,7 +582,7 @@ int main(void)
         cmocka_unit_test(test_pbf_threads_bitwise), cmocka_unit_test(test_pbf_closed_tank_energy),
         cmocka_unit_test(test_pbf_free_block_energy), cmocka_unit_test(test_pbf_stored_pairs_bitwise),
         cmocka_unit_test(test_pbf_paddle_ramp),  cmocka_unit_test(test_pbf_chebyshev_converges),
-        cmocka_unit_test(test_pbf_chebyshev_weights),
+        cmocka_unit_test(test_pbf_chebyshev_weights), cmocka_unit_test(test_pbf_paddle_velocity_and_settle),
         cmocka_unit_test(test_pbf_settled_tank_at_rest), cmocka_unit_test(test_pbf_resting_pool_every_dt),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
