@@ -79,6 +79,9 @@ static vfx_result load_water(game_app *app, game_demo *demo, const rt_scene *sc)
         rt_logf(&app->log, VFX_LOG_ERROR, "scene water: %s", err);
         return r;
     }
+    if (n == 0 && w->source == RT_SCENE_WATER_FILE) /* valid, but drawn as nothing: say so */
+        rt_logf(&app->log, VFX_LOG_WARN, "scene water.path %s: the file holds no particles (0 bytes); no water is "
+                "drawn", w->path);
     float *px = malloc((n ? n : 1) * sizeof(float)), *py = malloc((n ? n : 1) * sizeof(float)),
           *pz = malloc((n ? n : 1) * sizeof(float));
     if (!px || !py || !pz) {
@@ -118,6 +121,8 @@ static vfx_result load_water(game_app *app, game_demo *demo, const rt_scene *sc)
         /* a step of more than 0.5 s (under 2 frames a second) is said once, naming the count and
          * the tank (200,000 particles in a 1 m tank took 14 s a step) */
         if ((r = rt_sim_system_warn_slow(demo->sim, 0.5, &app->log)))
+            goto done;
+        if ((r = rt_sim_system_set_label(demo->sim, "scene water.simulation")))
             goto done;
         /* the block starts on the calibrated lattice at rho0, which neither solver holds at rest:
          * settled into the solver's hydrostatic state before frame 0, it does not sink into it

@@ -313,6 +313,29 @@ void rt_scene_free(rt_scene *scene)
     free(scene);
 }
 
+/* How many arrays and objects are open at byte off (brackets inside strings skipped). */
+static size_t json_depth(const char *text, size_t off)
+{
+    size_t depth = 0;
+    bool str = false;
+    for (size_t i = 0; i < off && text[i]; ++i) {
+        char ch = text[i];
+        if (str) {
+            if (ch == '\\' && text[i + 1])
+                ++i;
+            else if (ch == '"')
+                str = false;
+        } else if (ch == '"') {
+            str = true;
+        } else if (ch == '[' || ch == '{') {
+            ++depth;
+        } else if ((ch == ']' || ch == '}') && depth) {
+            --depth;
+        }
+    }
+    return depth;
+}
+
 static void line_col(const char *text, size_t off, unsigned *line, unsigned *col)
 {
     *line = *col = 1;
@@ -361,8 +384,13 @@ vfx_result rt_scene_load_mem(const char *json, size_t len, const char *base_dir,
             off = strlen(text) < off ? strlen(text) : off;
         unsigned line, col;
         line_col(text, off, &line, &col);
-        vfx_result r = rt_scene_failf(&c, VFX_ERR_FORMAT, "scene", "JSON syntax error at line %u, column %u (byte %zu)%s",
-                             line, col, off, off >= len ? ": unexpected end of input" : "");
+        vfx_result r;
+        if (json_depth(text, off) >= CJSON_NESTING_LIMIT)
+            r = rt_scene_failf(&c, VFX_ERR_FORMAT, "scene", "JSON nested deeper than %d arrays and objects (the "
+                               "parser's limit) at line %u, column %u (byte %zu)", CJSON_NESTING_LIMIT, line, col, off);
+        else
+            r = rt_scene_failf(&c, VFX_ERR_FORMAT, "scene", "JSON syntax error at line %u, column %u (byte %zu)%s",
+                               line, col, off, off >= len ? ": unexpected end of input" : "");
         free(text);
         return r;
     }

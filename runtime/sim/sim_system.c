@@ -38,6 +38,7 @@ struct rt_sim_system {
     double slow_s;
     bool slow_said;
     double settle_t0;
+    char label[96]; /* " (NAME)" of rt_sim_system_set_label, or "" */
 };
 
 static double wall_s(void)
@@ -219,7 +220,7 @@ static vfx_result sim_run(rt_world *w, const rt_system_ctx *ctx)
         if ((r = rt_sph_bind(s->sph, &host, &c, err, sizeof err))) {
             rt_sph_clear(s->sph); /* the old binding's columns may have moved */
             s->bound = false;
-            return rt_world_fail(w, r, "vfx.sim.sph: %s", err);
+            return rt_world_fail(w, r, "vfx.sim.sph%s: %s", s->label, err);
         }
         s->bound = true;
     }
@@ -228,7 +229,7 @@ static vfx_result sim_run(rt_world *w, const rt_system_ctx *ctx)
         s->settle = false;
         s->settle_t0 = wall_s();
         if ((r = rt_sph_settle(s->sph, &s->settle_desc, &settled, err, sizeof err)))
-            return rt_world_fail(w, r, "vfx.sim.sph: settling: %s", err);
+            return rt_world_fail(w, r, "vfx.sim.sph%s: settling: %s", s->label, err);
         rt_logf(&s->log, VFX_LOG_INFO, "fluid settled before frame 0: %u steps, max speed %.3f m/s at the last, "
                 "mean compression %.2f%%, %.2f CPU s; velocities zeroed", settled.steps,
                 (double)settled.max_speed_last, 100.0 * settled.compression, settled.cpu_s);
@@ -237,7 +238,7 @@ static vfx_result sim_run(rt_world *w, const rt_system_ctx *ctx)
     r = sim_advance(s, ctx->dt, &settled, err, sizeof err);
     if (s->table != SIM_NO_TABLE)
         s->revision = rt_world_table_revision(w, s->table) + SIM_OWN_BUMPS;
-    return r ? rt_world_fail(w, r, "vfx.sim.sph: %s", err) : VFX_OK;
+    return r ? rt_world_fail(w, r, "vfx.sim.sph%s: %s", s->label, err) : VFX_OK;
 }
 
 vfx_result rt_sim_system_create(rt_world *world, const rt_sph_desc *desc, rt_sim_system **out,
@@ -327,6 +328,17 @@ vfx_result rt_sim_system_settle_next(rt_sim_system *s, const rt_sph_settle_desc 
     if (log)
         s->log = *log;
     s->settle = true;
+    return VFX_OK;
+}
+
+vfx_result rt_sim_system_set_label(rt_sim_system *s, const char *name)
+{
+    if (!s)
+        return VFX_ERR_INVALID_ARGUMENT;
+    if (!name || !name[0])
+        s->label[0] = 0;
+    else
+        snprintf(s->label, sizeof s->label, " (%.90s)", name);
     return VFX_OK;
 }
 

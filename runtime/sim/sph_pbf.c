@@ -716,6 +716,15 @@ static vfx_result pbf_neighbours(rt_sph *s, rt_sph_report *rep, char *err, size_
     return VFX_OK;
 }
 
+/* The value the first bad row reported (NaN or Inf). */
+static float pbf_bad_value(const rt_sph *s)
+{
+    for (uint32_t c = 0; c < sph_chunk_count(s); ++c)
+        if (s->out[c].bad != UINT32_MAX)
+            return s->out[c].bad_value;
+    return NAN;
+}
+
 static uint32_t pbf_first_bad(const rt_sph *s)
 {
     for (uint32_t c = 0; c < sph_chunk_count(s); ++c)
@@ -823,8 +832,11 @@ static vfx_result pbf_substep(rt_sph *s, float dt, rt_sph_report *rep, char *err
         bad = pbf_first_bad(s);
     if (bad != UINT32_MAX) {
         return rt_errf(err, errlen, VFX_ERR_NUMERIC, "rt_sph_step: particle %u (row %u) got a non-finite "
-                       "position or velocity at t=%.6g s (PBF); it was left at its predicted position, at rest",
-                       s->id[bad], bad, s->time);
+                       "position, velocity or density (%g) at t=%.6g s (PBF, step %.3g s) near (%g, %g, %g); it was "
+                       "left at its predicted position, at rest. The projection overflowed there: particles "
+                       "closer than float32 resolves (a tank far from the origin) or a step far above the "
+                       "spacing's (pbf_cfl)", s->id[bad], bad, (double)pbf_bad_value(s), s->time, (double)dt,
+                       (double)s->x[bad], (double)s->y[bad], (double)s->z[bad]);
     }
     return VFX_OK;
 }

@@ -9,6 +9,7 @@ dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 mkfifo "$dir/v.vtu" "$dir/t.node" "$dir/p.bin" "$dir/m.obj"
 mkdir "$dir/d.vtu"
+: > "$dir/e.bin"
 ln -s /dev/zero "$dir/z.node"
 printf 'not a tet' > "$dir/z.ele"
 cp "$dir/z.ele" "$dir/t.ele"
@@ -27,5 +28,6 @@ run 1 "t.node: is a FIFO" '{"volume":{"path":"t.node"}}'
 run 1 "d.vtu: is a directory" '{"volume":{"path":"d.vtu"}}'
 run 1 "z.node: is a character device" '{"volume":{"path":"z.node"}}'
 run 1 "p.bin: is a FIFO" '{"water":{"source":"file","path":"p.bin"}}'
+run 0 "e.bin: the file holds no particles (0 bytes); no water is drawn" '{"water":{"source":"file","path":"e.bin"}}'
 run 0 "m.obj: is a FIFO (named pipe), not a regular file, skipped" '{"meshes":[{"path":"m.obj"}]}'
 exit $fail

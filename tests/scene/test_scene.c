@@ -465,6 +465,14 @@ static void test_syntax_errors(void **state)
     memset(deep + 5 + depth, ']', depth);
     strcpy(deep + 5 + 2 * depth, "}");
     assert_int_equal(load(deep, &log, &s, err, sizeof err), VFX_ERR_FORMAT);
+    /* named as the nesting, not as a syntax error at a column (byte 1005: the 1001st bracket) */
+    assert_non_null(strstr(err, "JSON nested deeper than 1000 arrays and objects (the parser's limit) at line 1"));
+    /* 999 arrays deep (1000 with the root) parses: the unknown key is only warned about */
+    memset(deep + 5, '[', 999);
+    memset(deep + 5 + 999, ']', 999);
+    strcpy(deep + 5 + 2 * 999, "}");
+    assert_int_equal(load(deep, &log, &s, err, sizeof err), VFX_OK);
+    rt_scene_free(s);
 }
 
 static void test_unknown_keys_warn(void **state)

@@ -228,6 +228,7 @@ static void test_system_reports_bad_column(void **state)
     rt_world *w = rt_world_create(NULL);
     rt_sim_system *sys;
     assert_int_equal(rt_sim_system_create(w, NULL, &sys, NULL, 0), VFX_OK);
+    assert_int_equal(rt_sim_system_set_label(sys, "scene water.simulation"), VFX_OK);
     rt_particle_components pc;
     assert_int_equal(rt_particles_register(w, &pc), VFX_OK);
     float x[3] = {0.5f, 0.5f, 0.5f}, y[3] = {0.5f, 0.6f, 0.7f}, z[3] = {0.5f, 0.5f, 0.5f};
@@ -238,6 +239,8 @@ static void test_system_reports_bad_column(void **state)
     ((float *)rt_query_column(&it, pc.velocity, 2))[1] = NAN;
     assert_int_equal(rt_world_run_phase(w, RT_PHASE_SIMULATE, 0.0, 1.f / 60.f), VFX_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(rt_world_last_error(w), "particle 1"));
+    /* the failure names where the fluid came from */
+    assert_non_null(strstr(rt_world_last_error(w), "vfx.sim.sph (scene water.simulation): rt_sph_bind"));
     assert_non_null(strstr(rt_world_last_error(w), "vz"));
     rt_world_destroy(w);
     rt_sim_system_destroy(sys);
