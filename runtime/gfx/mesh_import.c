@@ -315,6 +315,24 @@ static unsigned primitive_types_disagree(const struct aiScene *s)
     return 0;
 }
 
+/* The first vertex position that is NaN or infinite, described in msg; false when none. */
+static bool non_finite_vertex(const struct aiScene *s, char *msg, size_t len)
+{
+    for (unsigned m = 0; m < s->mNumMeshes; ++m) {
+        const struct aiMesh *mesh = s->mMeshes[m];
+        for (unsigned v = 0; mesh->mVertices && v < mesh->mNumVertices; ++v) {
+            const float c[3] = {mesh->mVertices[v].x, mesh->mVertices[v].y, mesh->mVertices[v].z};
+            for (int k = 0; k < 3; ++k)
+                if (!isfinite(c[k])) {
+                    snprintf(msg, len, "mesh %u vertex %u has a non-finite %c (%g): a mesh with such a vertex "
+                             "cannot be drawn", m, v, "xyz"[k], (double)c[k]);
+                    return true;
+                }
+        }
+    }
+    return false;
+}
+
 /* Checks the bytes, has Assimp read them (validated, nothing else) and counts the vertices;
  * only a scene under the cap is read again with the post-processing, the costly part (~700
  * bytes a vertex). Two reads, because Assimp 5.2's aiApplyPostProcessing frees the scene when
@@ -343,7 +361,12 @@ static vfx_result import_checked(import_io *x, rt_mesh_format fmt, unsigned flag
             for (unsigned m = 0; m < s->mNumMeshes; ++m)
                 nv += s->mMeshes[m]->mNumVertices;
             unsigned bad = primitive_types_disagree(s);
-            if (bad) {
+            char nf[160];
+            if (non_finite_vertex(s, nf, sizeof nf)) {
+                /* FindInvalidData would drop the mesh: "No meshes remaining", or one mesh gone */
+                snprintf(err, errlen, "%s: %s", name, nf);
+                r = VFX_ERR_FORMAT;
+            } else if (bad) {
                 snprintf(err, errlen, "%s: mesh %u: a face of no index, or faces that disagree with the "
                          "primitive types the reader gave them (Assimp's triangulation would abort)", name, bad - 1);
                 r = VFX_ERR_FORMAT;
