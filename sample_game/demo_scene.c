@@ -122,7 +122,7 @@ static vfx_result load_water(game_app *app, game_demo *demo, const rt_scene *sc)
          * the tank (200,000 particles in a 1 m tank took 14 s a step) */
         if ((r = rt_sim_system_warn_slow(demo->sim, 0.5, &app->log)))
             goto done;
-        if ((r = rt_sim_system_set_label(demo->sim, "scene water.simulation")))
+        if ((r = rt_sim_system_set_label(demo->sim, "scene water.simulation", sc->origin)))
             goto done;
         /* the block starts on the calibrated lattice at rho0, which neither solver holds at rest:
          * settled into the solver's hydrostatic state before frame 0, it does not sink into it

@@ -38,7 +38,8 @@ struct rt_sim_system {
     double slow_s;
     bool slow_said;
     double settle_t0;
-    char label[96]; /* " (NAME)" of rt_sim_system_set_label, or "" */
+    char label[96];   /* " (NAME)" of rt_sim_system_set_label, or "" */
+    double origin[3]; /* added to the tank in messages (rt_sim_system_set_label) */
 };
 
 static double wall_s(void)
@@ -59,7 +60,8 @@ static void warn_slow(rt_sim_system *s, double took, const char *when)
     rt_logf(&s->log, VFX_LOG_WARN, "fluid simulation: one solver step of %u particles (spacing %g m) in the tank "
             "[%g, %g, %g]..[%g, %g, %g] took %.3g s %s, above %.3g s: each frame takes up to %u such steps; fewer "
             "particles (a larger spacing) make it faster", rt_sph_get_columns(s->sph).count, (double)p->spacing,
-            (double)lo[0], (double)lo[1], (double)lo[2], (double)hi[0], (double)hi[1], (double)hi[2], took, when,
+            lo[0] + s->origin[0], lo[1] + s->origin[1], lo[2] + s->origin[2], hi[0] + s->origin[0],
+            hi[1] + s->origin[1], hi[2] + s->origin[2], took, when,
             s->slow_s, s->step_dt > 0.f ? s->max_steps : 1u);
 }
 
@@ -331,10 +333,12 @@ vfx_result rt_sim_system_settle_next(rt_sim_system *s, const rt_sph_settle_desc 
     return VFX_OK;
 }
 
-vfx_result rt_sim_system_set_label(rt_sim_system *s, const char *name)
+vfx_result rt_sim_system_set_label(rt_sim_system *s, const char *name, const double origin[3])
 {
     if (!s)
         return VFX_ERR_INVALID_ARGUMENT;
+    for (int k = 0; k < 3; ++k)
+        s->origin[k] = origin ? origin[k] : 0.0;
     if (!name || !name[0])
         s->label[0] = 0;
     else

@@ -54,8 +54,9 @@ typedef struct rt_sim_stats {
  * desc's own progress callback is not used. The steps are counted in the stats (settle_steps). */
 vfx_result rt_sim_system_settle_next(rt_sim_system *sys, const rt_sph_settle_desc *desc, const rt_logger *log);
 /* Names what the fluid came from (e.g. "scene water.simulation") in every failure message:
- * "vfx.sim.sph (NAME): ...". NULL or "": none. */
-vfx_result rt_sim_system_set_label(rt_sim_system *sys, const char *name);
+ * "vfx.sim.sph (NAME): ...". NULL or "": none. origin (NULL: 0) is added to the solver's
+ * coordinates where a message gives a position, so they read as the scene wrote them. */
+vfx_result rt_sim_system_set_label(rt_sim_system *sys, const char *name, const double origin[3]);
 /* From now on the first solver step (of a run, or of the settle before frame 0) that takes more
  * than `seconds` of wall time is said once, as a warning through log (NULL: the logger already
  * set, else stderr) naming the particle count, the spacing and the tank. 0 turns it off (the

@@ -204,6 +204,8 @@ static void test_system_warns_slow_step(void **state)
             rt_logger log = {slow_sink, &l};
             /* 1 ns: every step is slower; 1000 s: none is */
             assert_int_equal(rt_sim_system_warn_slow(sys, slow ? 1e-9 : 1e3, &log), VFX_OK);
+            const double origin[3] = {10, 0, 0}; /* the tank as the scene wrote it: x + 10 */
+            assert_int_equal(rt_sim_system_set_label(sys, "scene water.simulation", origin), VFX_OK);
             rt_sph_settle_desc sd = {.max_steps = 5};
             if (settle)
                 assert_int_equal(rt_sim_system_settle_next(sys, &sd, &log), VFX_OK);
@@ -213,7 +215,7 @@ static void test_system_warns_slow_step(void **state)
             if (slow) {
                 print_message("%s\n", l.last);
                 assert_non_null(strstr(l.last, "300 particles"));
-                assert_non_null(strstr(l.last, "[0, 0, 0]..[0.1, 0.2, 0.06]"));
+                assert_non_null(strstr(l.last, "[10, 0, 0]..[10.1, 0.2, 0.06]"));
                 assert_non_null(strstr(l.last, settle ? "settling" : "took"));
             }
             rt_world_destroy(w);
@@ -228,7 +230,7 @@ static void test_system_reports_bad_column(void **state)
     rt_world *w = rt_world_create(NULL);
     rt_sim_system *sys;
     assert_int_equal(rt_sim_system_create(w, NULL, &sys, NULL, 0), VFX_OK);
-    assert_int_equal(rt_sim_system_set_label(sys, "scene water.simulation"), VFX_OK);
+    assert_int_equal(rt_sim_system_set_label(sys, "scene water.simulation", NULL), VFX_OK);
     rt_particle_components pc;
     assert_int_equal(rt_particles_register(w, &pc), VFX_OK);
     float x[3] = {0.5f, 0.5f, 0.5f}, y[3] = {0.5f, 0.6f, 0.7f}, z[3] = {0.5f, 0.5f, 0.5f};
