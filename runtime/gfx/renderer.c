@@ -29,6 +29,8 @@ struct rt_renderer {
     bool hdr;
     float exposure;
     GLuint tone_prog, tone_vao, disp_fbo, disp_color;
+    GLuint layer_prog, layer_tex;    /* the effects layer's composite and texture (made on first use) */
+    uint32_t layer_w, layer_h;
     GLint u_exposure;
     uint32_t width, height;
     float view[16], proj[16];
@@ -172,11 +174,52 @@ static void tonemap(rt_renderer *r)
     glPopDebugGroup();
 }
 
+vfx_result rt_renderer_layer(rt_renderer *r, unsigned *out)
+{
+    if (!r->layer_prog && !(r->layer_prog = link_program(&r->log, "common/fullscreen.vert", "host/layer.frag", "host.layer")))
+        return VFX_ERR_GL;
+    if (!r->tone_vao)
+        glCreateVertexArrays(1, &r->tone_vao);
+    if (!r->layer_tex || r->layer_w != r->width || r->layer_h != r->height) {
+        if (r->layer_tex)
+            glDeleteTextures(1, &r->layer_tex);
+        glCreateTextures(GL_TEXTURE_2D, 1, &r->layer_tex);
+        glTextureStorage2D(r->layer_tex, 1, GL_RGBA16F, (GLsizei)r->width, (GLsizei)r->height);
+        glObjectLabel(GL_TEXTURE, r->layer_tex, -1, "host.effects_layer");
+        r->layer_w = r->width, r->layer_h = r->height;
+    }
+    *out = r->layer_tex;
+    return glGetError() == GL_NO_ERROR ? VFX_OK : VFX_ERR_GL;
+}
+
+void rt_renderer_composite_layer(rt_renderer *r)
+{
+    glPushDebugGroup(GL_DEBUG_SOURCE_APPLICATION, 0, -1, "host.layer");
+    glBindFramebuffer(GL_FRAMEBUFFER, r->out_fbo);
+    glViewport(0, 0, (GLsizei)r->width, (GLsizei)r->height);
+    glDisable(GL_DEPTH_TEST);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    glUseProgram(r->layer_prog);
+    glBindTextureUnit(0, r->layer_tex);
+    glBindVertexArray(r->tone_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    glDisable(GL_BLEND);
+    glPopDebugGroup();
+}
+
 void rt_renderer_destroy(rt_renderer *r)
 {
     if (!r)
         return;
     free_targets(r);
+    if (r->layer_tex)
+        glDeleteTextures(1, &r->layer_tex);
+    if (r->layer_prog)
+        glDeleteProgram(r->layer_prog);
     glDeleteProgram(r->mesh_prog);
     glDeleteProgram(r->sky_prog);
     glDeleteVertexArrays(1, &r->sky_vao);

@@ -80,6 +80,12 @@ void rt_renderer_end_scene(rt_renderer *r, rt_renderer_targets *out);
 vfx_result rt_renderer_set_hdr(rt_renderer *r, bool hdr, float exposure);
 /* Reads the output colour, RGBA8 (tone-mapped in HDR mode), top row first (width*height*4 bytes). */
 vfx_result rt_renderer_read_rgba(rt_renderer *r, uint8_t *rgba);
+/* The effects layer texture (RGBA16F, the targets' size; remade when the size changed) a host
+ * hands the plugin as frame view layer_texture instead of drawing into its output. */
+vfx_result rt_renderer_layer(rt_renderer *r, unsigned *out);
+/* Composites the effects layer over the output: out = layer.rgb + out * (1 - layer.a). Call after
+ * the plugin's render, with the layer rt_renderer_layer gave. */
+void rt_renderer_composite_layer(rt_renderer *r);
 /* Blits the output to the default framebuffer of the current window. */
 void rt_renderer_present(rt_renderer *r, uint32_t window_w, uint32_t window_h);
 
