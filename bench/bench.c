@@ -80,8 +80,8 @@ static int bench_frame(int argc, char **argv)
            "\"frame_ms\":{\"p50\":%.4f,\"p95\":%.4f,\"p99\":%.4f},\"mean_fps\":%.3f,\"stats\":{",
            scene ? scene : "(default)", app->camera.width, app->camera.height, s.frames,
            rt_gl_context_renderer(app->gl), s.p50_ms, s.p95_ms, s.p99_ms, s.mean_fps);
-    vfx_stats2 st = {.size = sizeof st, .version = VFX_STATS2_VERSION};
-    app->api->get_stats(app->ctx, (vfx_stats *)&st);
+    vfx_stats st = {.type = VFX_TYPE_STATS};
+    app->api->get_stats(app->ctx, &st);
     for (uint32_t i = 0; i < st.count; ++i)
         printf("%s\"%s\":%.6g", i ? "," : "", st.entries[i].name, st.entries[i].value);
     printf("}}\n");

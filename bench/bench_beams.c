@@ -54,9 +54,10 @@ static void make_scene(bench_scene *s, uint32_t beams, uint32_t size)
     s->eye[2] = 6.0f;
     for (uint32_t i = 0; i < beams; ++i) {
         double ang = 2.0 * 3.14159265358979 * i / (beams > 0 ? beams : 1);
-        vfx_beam b = {{(float)(1.2 * cos(ang)), (float)(1.2 * sin(ang)), (float)(-0.5 * (i % 3))},
-                      2.5f, {(float)-cos(ang + 0.6), (float)-sin(ang + 0.6), 0.2f}, 0.6f, 0.3f, 0.3f,
-                      0.0f, 0.0f, {0, 0, 0, 0}};
+        vfx_beam b = {.type = VFX_TYPE_BEAM,
+                      .head = {(float)(1.2 * cos(ang)), (float)(1.2 * sin(ang)), (float)(-0.5 * (i % 3))},
+                      .length = 2.5f, .dir = {(float)-cos(ang + 0.6), (float)-sin(ang + 0.6), 0.2f},
+                      .radius = 0.6f, .a = 0.3f, .b = 0.3f};
         char err[256];
         volfx_beam_validate(&b, &s->beams[i], err, sizeof err);
     }

@@ -16,7 +16,7 @@ int bench_beams_gpu(int argc, char **argv);
 
 static double stat_of(game_app *app, const char *name)
 {
-    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+    vfx_stats st = {.type = VFX_TYPE_STATS};
     app->api->get_stats(app->ctx, &st);
     for (uint32_t k = 0; k < st.count; ++k)
         if (!strcmp(st.entries[k].name, name))
@@ -28,7 +28,7 @@ static double stat_of(game_app *app, const char *name)
  * above 10 (the 100 / 1,000-beam runs) are spread over the view on a grid of short, thin beams,
  * as a game's many projectiles would be, so a tile sees a few tens of beams rather than all. */
 /* The app's beam entities, n of them (respawned when the count changes). */
-static vfx_beam2 *beam_entities(game_app *app, uint32_t n)
+static vfx_beam *beam_entities(game_app *app, uint32_t n)
 {
     uint32_t have;
     game_app_beams(app, &have);
@@ -41,39 +41,40 @@ static vfx_beam2 *beam_entities(game_app *app, uint32_t n)
 
 static void make_beams(game_app *app, uint32_t n)
 {
-    vfx_beam2 *beams = beam_entities(app, n);
+    vfx_beam *beams = beam_entities(app, n);
     if (n > 10) {
         uint32_t cols = (uint32_t)ceil(sqrt(n * 16.0 / 9.0)), rows = (n + cols - 1) / cols;
         for (uint32_t i = 0; i < n; ++i) {
             double fx = ((i % cols) + 0.5) / cols, fy = ((i / cols) + 0.5) / rows, a = 2.4 * i;
             float L = (float)(4.0 / cols), R = (float)(1.2 / cols);
-            beams[i] = (vfx_beam2){.v1 = {.head = {(float)(-2.6 + 5.2 * fx), (float)(-1.45 + 2.9 * fy), (float)(-0.5 * sin(a))},
-                                       .dir = {(float)cos(a), (float)sin(a), 0.2f}, .length = L,
-                                       .radius = R, .a = 0.3f, .b = 0.3f, .eps = 0.0f}};
+            beams[i] = (vfx_beam){.type = VFX_TYPE_BEAM,
+                                  .head = {(float)(-2.6 + 5.2 * fx), (float)(-1.45 + 2.9 * fy), (float)(-0.5 * sin(a))},
+                                  .dir = {(float)cos(a), (float)sin(a), 0.2f}, .length = L,
+                                  .radius = R, .a = 0.3f, .b = 0.3f, .eps = 0.0f};
         }
         return;
     }
     for (uint32_t i = 0; i < n; ++i) {
         double a = 2.0 * M_PI * i / (n > 1 ? n : 1);
-        beams[i] = (vfx_beam2){.v1 = {.head = {(float)(-2.0 + 0.3 * cos(a)), (float)(0.8 * sin(a)), (float)(-0.5 * cos(a))},
-                                   .dir = {1, (float)(0.2 * sin(a)), (float)(0.1 * cos(a))}, .length = 3.0f,
-                                   .radius = 0.5f, .a = 0.3f, .b = 0.3f, .eps = 0.0f}};
+        beams[i] = (vfx_beam){.type = VFX_TYPE_BEAM,
+                              .head = {(float)(-2.0 + 0.3 * cos(a)), (float)(0.8 * sin(a)), (float)(-0.5 * cos(a))},
+                              .dir = {1, (float)(0.2 * sin(a)), (float)(0.1 * cos(a))}, .length = 3.0f,
+                              .radius = 0.5f, .a = 0.3f, .b = 0.3f, .eps = 0.0f};
     }
 }
 
-/* Issue 15's options: the beams go to the plugin as version 2 beams (the v1 fields as set, this
- * falloff, the hot ramp) with bloom on or off. falloff 0: version 1 views as before. */
+/* Issue 15's options: the beams go to the plugin with this falloff, the hot ramp and bloom on or
+ * off. falloff 0: the thesis's look (the hard support, the thesis ramp, no bloom). */
 static int g_falloff, g_bloom;
 static void sync_v2(game_app *app)
 {
-    app->beams_v2 = g_falloff != 0;
-    if (!app->beams_v2)
-        return;
     uint32_t n;
-    vfx_beam2 *beams = game_app_beams(app, &n);
-    for (uint32_t i = 0; i < n; ++i)
-        beams[i] = (vfx_beam2){.v1 = beams[i].v1, .falloff = (uint32_t)g_falloff, .ramp = VFX_BEAM_RAMP_HOT};
-    app->beams_view2 = (vfx_beams_view2){.bloom = g_bloom ? VFX_BEAMS_BLOOM_ON : VFX_BEAMS_BLOOM_OFF};
+    vfx_beam *beams = game_app_beams(app, &n);
+    for (uint32_t i = 0; i < n; ++i) {
+        beams[i].falloff = g_falloff ? (uint32_t)g_falloff : VFX_BEAM_FALLOFF_HARD;
+        beams[i].ramp = g_falloff ? VFX_BEAM_RAMP_HOT : VFX_BEAM_RAMP_THESIS;
+    }
+    app->beams_view.bloom = g_falloff && g_bloom ? VFX_BEAMS_BLOOM_ON : VFX_BEAMS_BLOOM_OFF;
 }
 
 static vfx_result frame(game_app *app)
@@ -133,7 +134,7 @@ int bench_beams_gpu(int argc, char **argv)
         rt_camera hc = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, M_PI / 3, w, h, 0.05, 50};
         ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, M_PI / 3, w, h, 0.05, 50};
         game_app_set_camera(app, &hc);
-        app->beams_view = (vfx_beams_view){.size = sizeof(vfx_beams_view), .version = VFX_BEAMS_VIEW_VERSION};
+        app->beams_view = (vfx_beams_view){.type = VFX_TYPE_BEAMS_VIEW};
         size_t np = (size_t)w * h;
         double *ref = malloc(np * sizeof(double)), *cond = malloc(np * sizeof(double));
         float *img = malloc(np * sizeof(float));
@@ -143,13 +144,13 @@ int bench_beams_gpu(int argc, char **argv)
             volfx_beam_d bd[GAME_APP_MAX_BEAMS];
             char err[128];
             for (uint32_t i = 0; i < sets[si]; ++i) {
-                volfx_beam_validate(&beam_entities(app, sets[si])[i].v1, &bd[i], err, sizeof err);
+                volfx_beam_validate(&beam_entities(app, sets[si])[i], &bd[i], err, sizeof err);
                 bd[i].smooth = g_falloff == VFX_BEAM_FALLOFF_SMOOTH;
             }
             if (timing_only) {
                 /* large sets: closed form only, frame wall times (the headless host waits for the
                  * GPU), no reference; the pass timer is reported when its ring has delivered */
-                app->beams_view.method = 0;
+                app->beams_lab.method = VFX_BEAMS_METHOD_CLOSED_FORM;
                 double g = NAN;
                 for (uint32_t f = 0; f < frames; ++f) {
                     double t0 = rt_now_ms();
@@ -189,12 +190,12 @@ int bench_beams_gpu(int argc, char **argv)
              * nothing beyond the drawing the new configuration needs. */
             {
                 double *moved = malloc(frames * sizeof(double)), *still = malloc(frames * sizeof(double));
-                app->beams_view.method = 0;
+                app->beams_lab.method = VFX_BEAMS_METHOD_CLOSED_FORM;
                 for (uint32_t f = 0; f < frames; ++f) {
                     make_beams(app, sets[si]);
                     for (uint32_t b = 0; b < sets[si]; ++b) {
                         float ph = 0.4f * (float)f + (float)b;
-                        vfx_beam *bm = &beam_entities(app, sets[si])[b].v1;
+                        vfx_beam *bm = &beam_entities(app, sets[si])[b];
                         bm->a *= 0.5f + 0.5f * sinf(ph), bm->b *= 0.5f + 0.5f * cosf(ph);
                         bm->head[0] += 0.5f * sinf(ph), bm->length *= 0.6f + 0.4f * sinf(ph);
                         bm->dir[1] += 0.3f * cosf(ph), bm->radius *= 0.8f + 0.2f * sinf(ph);
@@ -217,8 +218,8 @@ int bench_beams_gpu(int argc, char **argv)
             }
             static const uint32_t samples[4] = {0, 8, 32, 120};
             for (int mi = 0; mi < 4; ++mi) {
-                app->beams_view.method = samples[mi] ? 1 : 0;
-                app->beams_view.march_samples = samples[mi];
+                app->beams_lab.method = samples[mi] ? VFX_BEAMS_METHOD_MARCH : VFX_BEAMS_METHOD_CLOSED_FORM;
+                app->beams_lab.march_samples = samples[mi];
                 const char *pass = samples[mi] ? "beams.march.gpu_ms" : "beams.integrate.gpu_ms";
                 uint32_t n = 0;
                 for (uint32_t f = 0; f < frames + 4; ++f) { /* 4 more: the timer ring's latency */

@@ -23,10 +23,10 @@ static const char *const k_passes[] = {"beams.integrate", "beams.march", "beams.
 
 static double stat_of(game_app *app, const char *name)
 {
-    vfx_stats2 st = {.size = sizeof st, .version = VFX_STATS2_VERSION};
-    if (app->api->get_stats(app->ctx, (vfx_stats *)&st) != VFX_OK)
+    vfx_stats st = {.type = VFX_TYPE_STATS};
+    if (app->api->get_stats(app->ctx, &st) != VFX_OK)
         return NAN;
-    for (uint32_t k = 0; k < st.count && k < VFX_STATS2_MAX; ++k)
+    for (uint32_t k = 0; k < st.count && k < VFX_STATS_MAX; ++k)
         if (!strcmp(st.entries[k].name, name))
             return st.entries[k].value;
     return NAN;
@@ -90,15 +90,15 @@ static void run_variant(game_app *app, game_demo *demo, double t, const variant 
     app->time = t;
     game_demo_animate(app, demo, 0.f);
     uint32_t n;
-    vfx_beam2 *beams = game_app_beams(app, &n);
+    vfx_beam *beams = game_app_beams(app, &n);
     for (uint32_t i = 0; i < n; ++i)
         if (v->falloff)
             beams[i].falloff = (uint32_t)v->falloff;
-    app->beams_view2 = demo->scene->beams_view2;
+    app->beams_view = demo->scene->beams_view;
     if (v->bloom)
-        app->beams_view2.bloom = (uint32_t)v->bloom;
-    app->beams_view.method = v->march ? 1 : 0;
-    app->beams_view.march_samples = v->march;
+        app->beams_view.bloom = (uint32_t)v->bloom;
+    app->beams_lab.method = v->march ? VFX_BEAMS_METHOD_MARCH : VFX_BEAMS_METHOD_CLOSED_FORM;
+    app->beams_lab.march_samples = v->march;
     measure(app, frames, ms);
     char png[512];
     snprintf(png, sizeof png, "%s/beams-%s.png", dir, v->name);
@@ -165,13 +165,13 @@ int bench_beams_panel(int argc, char **argv)
         app->time = t;
         game_demo_animate(app, &demo, 0.f);
         uint32_t nb;
-        vfx_beam2 *beams = game_app_beams(app, &nb);
+        vfx_beam *beams = game_app_beams(app, &nb);
         for (uint32_t i = 0; i < nb; ++i)
             beams[i].falloff = VFX_BEAM_FALLOFF_SMOOTH;
-        app->beams_view2 = demo.scene->beams_view2;
-        app->beams_view2.bloom = VFX_BEAMS_BLOOM_OFF;
-        app->beams_view.method = 1;
-        app->beams_view.march_samples = n;
+        app->beams_view = demo.scene->beams_view;
+        app->beams_view.bloom = VFX_BEAMS_BLOOM_OFF;
+        app->beams_lab.method = VFX_BEAMS_METHOD_MARCH;
+        app->beams_lab.march_samples = n;
         measure(app, frames, ms);
         fprintf(stdout, "{\"variant\": \"%s\", \"samples\": %u, \"march_ms\": %.4f, \"closed_ms\": %.4f}\n", m.name, n,
                 ms[1], closed_ms);
@@ -187,8 +187,9 @@ int bench_beams_panel(int argc, char **argv)
     /* cost under animation: frames stepping through the loop against the same frames frozen */
     double anim[2];
     for (int a = 0; a < 2; ++a) {
-        app->beams_view.method = 0;
-        app->beams_view2 = demo.scene->beams_view2;
+        app->beams_lab.method = VFX_BEAMS_METHOD_CLOSED_FORM;
+        app->beams_lab.march_samples = 0;
+        app->beams_view = demo.scene->beams_view;
         double v[64];
         uint32_t n = 0;
         for (uint32_t f = 0; f < frames + 4 && n < 64; ++f) {

@@ -8,7 +8,7 @@
  * (distance image, PFM) --points FILE (positions as raw float32 xyz) --wave A (the particles move:
  * every frame, warm-up included, y += A sin(2 x + 0.5 f) - A sin(2 x + 0.5 (f - 1)), a wave
  * travelling along x, so temporal reuse meets a moving surface as in a game) --kernel isotropic|anisotropic
- * (vfx_water_params2.kernel; TILE only) --preset default|low|medium|high|ultra (vfx_water_params3.preset: the
+ * (vfx_water_params.kernel; TILE only) --preset default|low|medium|high|ultra (vfx_water_params.preset: the
  * method, kernel, step and refinement left to the preset; without it the method defaults to paper
  * and the kernel to isotropic, as before presets). cpu_ms_per_frame is the
  * process's CPU time over the timed frames (all llvmpipe threads) divided by the frames. Per-pass GPU ms (counters *.gpu_ms) need at least 4 frames. */
@@ -43,7 +43,8 @@ typedef struct bench_scene {
     const char *dist;    /* the distance image (PFM) */
     float wave;          /* amplitude of the travelling wave the particles follow (0: still) */
     uint32_t kernel;     /* vfx_water_kernel (set from --kernel, or from --preset as the plugin resolves it) */
-    uint32_t preset;     /* vfx_water_preset (--preset; 0: none sent, a version-2 host) */
+    uint32_t preset;     /* vfx_water_preset (--preset; 0: none sent) */
+    vfx_lab_water lab;   /* method and disable bits, chained into the parameters */
 } bench_scene;
 
 static void *bench_gl_proc(void *user, const char *name) { (void)user; return (void *)eglGetProcAddress(name); }
@@ -64,23 +65,10 @@ static vfx_result bench_chunk(void *user, uint32_t index, vfx_particle_view *out
 static vfx_result bench_params(void *user, vfx_water_params *out)
 {
     bench_scene *s = user;
-    if (s->preset && out->version >= VFX_WATER_PARAMS3_VERSION && out->size >= sizeof(vfx_water_params3)) {
-        memset(out, 0, sizeof(vfx_water_params3));
-        ((vfx_water_params3 *)out)->preset = s->preset;
-        out->size = sizeof(vfx_water_params3);
-        out->version = VFX_WATER_PARAMS3_VERSION;
-    } else if (out->version >= VFX_WATER_PARAMS2_VERSION && out->size >= sizeof(vfx_water_params2)) {
-        memset(out, 0, sizeof(vfx_water_params2));
-        ((vfx_water_params2 *)out)->kernel = s->kernel;
-        out->size = sizeof(vfx_water_params2);
-        out->version = VFX_WATER_PARAMS2_VERSION;
-    } else {
-        memset(out, 0, sizeof *out);
-        out->size = sizeof *out;
-        out->version = VFX_WATER_PARAMS_VERSION;
-    }
-    out->method = s->method;
-    out->disable = s->disable;
+    /* with a preset the kernel is the preset's (0); baselines and ablations through the lab */
+    *out = (vfx_water_params){.type = VFX_TYPE_WATER_PARAMS, .preset = s->preset, .kernel = s->preset ? 0 : s->kernel};
+    s->lab = (vfx_lab_water){.type = VFX_TYPE_LAB_WATER, .disable = s->disable, .method = s->method};
+    out->next = &s->lab;
     out->max_samples = s->max_samples;
     out->refine_iters = s->refine;
     out->pyramid_level = s->pyramid;
@@ -157,10 +145,10 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
         if (f) fclose(f);
         else fprintf(stderr, "metaballs: --points: %s\n", perr);
     }
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = bench_gl_proc, .user = &s,
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = bench_gl_proc, .user = &s,
                          .particle_chunk_count = bench_chunks, .particle_chunk = bench_chunk,
                          .water_params = bench_params};
-    vfx_plugin_api api = {.size = sizeof api};
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
     vfx_context *ctx = NULL;
     if (vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api) != VFX_OK || api.create(&host, &ctx) != VFX_OK) {
         fprintf(stderr, "metaballs: plugin create failed\n");
@@ -171,7 +159,7 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
     glTextureStorage2D(col, 1, GL_RGBA8, (GLsizei)width, (GLsizei)height);
     glCreateFramebuffers(1, &fbo);
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, col, 0);
-    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = fbo,
+    vfx_frame_view fv = {.type = VFX_TYPE_FRAME_VIEW, .framebuffer = fbo,
                          .width = width, .height = height, .fov_y = 0.9f, .near_plane = 0.1f, .far_plane = 100.f};
     static const float black[4] = {0.35f, 0.4f, 0.5f, 1}; /* the host image the water refracts (compare-vtk-fluid.py gives VTK the same background) */
     for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam.eye[k];
@@ -183,7 +171,7 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
     wave_frame(&s, y0, 0);
     int rc = 0;
     if (!s.no_warmup && (api.update(ctx, 0.0, 1.f / 60.f) != VFX_OK || api.render(ctx, &fv) != VFX_OK)) {
-        fprintf(stderr, "metaballs: warm-up frame failed: %s\n", api.last_error(ctx));
+        fprintf(stderr, "metaballs: warm-up frame failed: %s\n", api.last_error(ctx, NULL));
         rc = 1;
     }
     glFinish();
@@ -193,7 +181,7 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
         glClearNamedFramebufferfv(fbo, GL_COLOR, 0, black);
         double t0 = now_ms();
         if (api.update(ctx, f / 60.0, 1.f / 60.f) != VFX_OK || api.render(ctx, &fv) != VFX_OK) {
-            fprintf(stderr, "metaballs: frame failed: %s\n", api.last_error(ctx));
+            fprintf(stderr, "metaballs: frame failed: %s\n", api.last_error(ctx, NULL));
             rc = 1;
         }
         glFinish();
@@ -213,7 +201,7 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
            "\"near\":%.9g,\"far\":%.9g},\"h\":0.61",
            cam.eye[0], cam.eye[1], cam.eye[2], cam.target[0], cam.target[1], cam.target[2], cam.fov_y * 57.29577951308232,
            cam.near_plane, cam.far_plane);
-    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+    vfx_stats st = {.type = VFX_TYPE_STATS};
     if (api.get_stats(ctx, &st) == VFX_OK) {
         printf(",\"counters\":{");
         for (uint32_t k = 0; k < st.count; ++k)

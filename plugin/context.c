@@ -12,7 +12,7 @@
 
 /* ------------------------------------------------------------ logging, errors, memory */
 
-void volfx_log(vfx_context *ctx, vfx_log_level level, const char *fmt, ...)
+void volfx_log_id(vfx_context *ctx, vfx_log_level level, vfx_log_id id, const char *fmt, ...)
 {
     char buf[1024];
     va_list ap;
@@ -20,10 +20,10 @@ void volfx_log(vfx_context *ctx, vfx_log_level level, const char *fmt, ...)
     vsnprintf(buf, sizeof buf, fmt, ap);
     va_end(ap);
     if (ctx && ctx->host.log)
-        ctx->host.log(ctx->host.user, level, buf);
+        ctx->host.log(ctx->host.user, level, id, buf);
 }
 
-vfx_result volfx_fail(vfx_context *ctx, vfx_result code, const char *fmt, ...)
+vfx_result volfx_fail_id(vfx_context *ctx, vfx_result code, vfx_log_id id, const char *fmt, ...)
 {
     char buf[sizeof ctx->last_error];
     va_list ap;
@@ -32,10 +32,31 @@ vfx_result volfx_fail(vfx_context *ctx, vfx_result code, const char *fmt, ...)
     va_end(ap);
     if (ctx) {
         memcpy(ctx->last_error, buf, sizeof buf);
+        ctx->last_error_id = id;
         if (ctx->host.log)
-            ctx->host.log(ctx->host.user, VFX_LOG_ERROR, buf);
+            ctx->host.log(ctx->host.user, VFX_LOG_ERROR, id, buf);
     }
     return code;
+}
+
+vfx_result volfx_check_type(vfx_context *ctx, const void *p, vfx_struct_type want, const char *what)
+{
+    vfx_struct_type got = ((const vfx_chain *)p)->type;
+    if (got == want)
+        return VFX_OK;
+    return volfx_fail_id(ctx, VFX_ERR_ABI, VFX_LOG_ID_STRUCT_TYPE, "%s has type %u, need %u (VFX_TYPE_* of its struct)",
+                         what, (unsigned)got, (unsigned)want);
+}
+
+const void *volfx_chain_find(const void *next, vfx_struct_type type)
+{
+    for (int i = 0; next && i < 64; ++i) {
+        const vfx_chain *c = next;
+        if (c->type == type)
+            return c;
+        next = c->next;
+    }
+    return NULL;
 }
 
 /* Header in front of each block so free() finds the original pointer whatever the host's
@@ -79,11 +100,11 @@ void volfx_free(vfx_context *ctx, void *ptr)
 
 static vfx_stat *stat_slot(vfx_context *ctx, const char *name)
 {
-    vfx_stats2 *s = &ctx->stats;
+    vfx_stats *s = &ctx->stats;
     for (uint32_t i = 0; i < s->count; ++i)
         if (strncmp(s->entries[i].name, name, sizeof s->entries[i].name - 1) == 0)
             return &s->entries[i];
-    if (s->count >= VFX_STATS2_MAX) {
+    if (s->count >= VFX_STATS_MAX) {
         s->dropped++;
         return NULL;
     }
@@ -102,7 +123,7 @@ void volfx_stat_set(vfx_context *ctx, const char *name, double value)
 
 bool volfx_stat_has(const vfx_context *ctx, const char *name)
 {
-    const vfx_stats2 *s = &ctx->stats;
+    const vfx_stats *s = &ctx->stats;
     for (uint32_t i = 0; i < s->count; ++i)
         if (strncmp(s->entries[i].name, name, sizeof s->entries[i].name - 1) == 0)
             return true;

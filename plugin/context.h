@@ -26,16 +26,17 @@ typedef struct volfx_debug_knobs {
 } volfx_debug_knobs;
 
 struct vfx_context {
-    vfx_host_api host;          /* copy of the host's table */
+    vfx_context_desc host;      /* copy of the host's description (next cleared: not kept) */
     volfx_gpu *gpu;               /* program cache, timers, fullscreen VAO */
     struct volfx_gl_table *gl;    /* every GL command, through host.gl_get_proc_address */
     uint32_t width, height;
     void *effect_state[VFX_EFFECT_COUNT];
     uint32_t rendered;          /* VFX_EFFECT_BIT of effects rendered since their creation (read_raw) */
     const volfx_effect_ops *effect_ops[VFX_EFFECT_COUNT];
-    vfx_stats2 stats;           /* counters of the frame being made */
-    vfx_stats2 last_stats;      /* counters of the last finished frame */
+    vfx_stats stats;            /* counters of the frame being made */
+    vfx_stats last_stats;       /* counters of the last finished frame */
     char last_error[512];
+    vfx_log_id last_error_id;   /* the id of last_error */
     unsigned water_dist_tex;    /* shared target owned by the context */
     unsigned no_depth_tex;      /* far depth for a frame view without depth_texture (frame_check.c) */
     uint32_t no_depth_w, no_depth_h;
@@ -44,12 +45,20 @@ struct vfx_context {
     volfx_debug_knobs debug;
 };
 
-/* Logs through the host logger, printf-style. */
-void volfx_log(vfx_context *ctx, vfx_log_level level, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-/* Records an error (last_error + log at ERROR) and returns `code` for `return volfx_fail(...)`. */
-vfx_result volfx_fail(vfx_context *ctx, vfx_result code, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
+/* Logs through the host logger, printf-style, with the message's id. */
+void volfx_log_id(vfx_context *ctx, vfx_log_level level, vfx_log_id id, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+#define volfx_log(ctx, level, ...) volfx_log_id((ctx), (level), VFX_LOG_ID_GENERIC, __VA_ARGS__)
+/* Records an error (last_error and its id + log at ERROR) and returns `code` for
+ * `return volfx_fail_id(...)`. */
+vfx_result volfx_fail_id(vfx_context *ctx, vfx_result code, vfx_log_id id, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+#define volfx_fail(ctx, code, ...) volfx_fail_id((ctx), (code), VFX_LOG_ID_GENERIC, __VA_ARGS__)
+/* The host's struct at `p` has `want` as its type; otherwise fails ctx (VFX_ERR_ABI,
+ * VFX_LOG_ID_STRUCT_TYPE) naming `what` (the struct and where) and both types. */
+vfx_result volfx_check_type(vfx_context *ctx, const void *p, vfx_struct_type want, const char *what);
+/* The first struct of `type` in the chain at `next` (at most 64 entries walked), or NULL. */
+const void *volfx_chain_find(const void *next, vfx_struct_type type);
 /* Allocates through the host allocator; zeroed; NULL on failure (error recorded). */
 void *volfx_alloc(vfx_context *ctx, size_t size);
 /* Frees what volfx_alloc returned; NULL allowed. */

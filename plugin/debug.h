@@ -7,5 +7,6 @@
 #include "context.h"
 #include "effect.h"
 #include "gpu/gpu.h"
+#include "volfx_lab.h"
 
 #endif

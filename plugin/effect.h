@@ -20,11 +20,10 @@ typedef struct volfx_frame_targets {
     float view_proj[16];     /* proj * view */
     float inv_view_proj[16]; /* window/NDC -> position */
     float inv_view[16];      /* eye space -> position */
-    /* Version 2 fields (defaults when the host passed version 1). */
     double origin[3];        /* positions are relative to this */
     bool color_hdr;          /* framebuffer colour is float: write linear radiance */
     unsigned environment_cubemap; /* 0 -> procedural sky */
-    /* Version 3: the view's id (0 for versions 1 and 2); effects key per-view state on it. */
+    /* the view's id; effects key per-view state on it */
     uint32_t view_id;
     /* The rest of the camera (frame gate, issue 23). */
     unsigned framebuffer;    /* where effects draw their result: the host's, or the layer's */

@@ -10,6 +10,7 @@
 #include "effect.h"
 #include "context.h"
 #include "frame_check.h"
+#include "resolve.h"
 #if VFX_WITH_BEAMS
 #include "beams/beams_impact.h"
 #endif
@@ -82,27 +83,28 @@ static void plugin_destroy(vfx_context *ctx)
         volfx_gl_current = NULL; /* nothing may call GL through a freed table */
         volfx_free(ctx, ctx->gl);
     }
-    vfx_host_api host = ctx->host;
+    vfx_context_desc host = ctx->host;
     if (host.free)
         host.free(host.user, ctx);
     else
         free(ctx);
 }
 
-static vfx_result plugin_create(const vfx_host_api *host, vfx_context **out)
+static vfx_result plugin_create(const vfx_context_desc *host, vfx_context **out)
 {
     if (!out)
         return VFX_ERR_INVALID_ARGUMENT;
     *out = NULL;
-    if (!host || host->size < sizeof(vfx_host_api) || host->version != VFX_HOST_API_VERSION) {
+    if (!host || host->type != VFX_TYPE_CONTEXT_DESC) {
         if (host && host->log)
-            host->log(host->user, VFX_LOG_ERROR, "volfx create: host api is NULL or of another version");
+            host->log(host->user, VFX_LOG_ERROR, VFX_LOG_ID_STRUCT_TYPE,
+                      "volfx create: the context description is NULL or not of type VFX_TYPE_CONTEXT_DESC");
         return VFX_ERR_ABI;
     }
     char msg[160];
     if (volfx_check_host(host, msg, sizeof msg)) {
         if (host->log)
-            host->log(host->user, VFX_LOG_ERROR, msg);
+            host->log(host->user, VFX_LOG_ERROR, VFX_LOG_ID_GENERIC, msg);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     vfx_context *ctx = host->alloc ? host->alloc(host->user, sizeof *ctx, 64) : malloc(sizeof *ctx);
@@ -110,13 +112,13 @@ static vfx_result plugin_create(const vfx_host_api *host, vfx_context **out)
         return VFX_ERR_OUT_OF_MEMORY;
     memset(ctx, 0, sizeof *ctx);
     ctx->host = *host;
-    ctx->stats.size = ctx->last_stats.size = sizeof(vfx_stats2);
-    ctx->stats.version = ctx->last_stats.version = VFX_STATS2_VERSION;
+    ctx->host.next = NULL; /* the chain is the host's, valid only during this call */
+    ctx->stats.type = ctx->last_stats.type = VFX_TYPE_STATS;
     register_effects(ctx);
     vfx_result r = host->gl_get_proc_address
                        ? gl_load(ctx)
-                       : volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volfx create: host api has no gl_get_proc_address "
-                                    "(the plugin resolves every GL command through it)");
+                       : volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volfx create: the context description has no "
+                                    "gl_get_proc_address (the plugin resolves every GL command through it)");
     if (r == VFX_OK)
         r = volfx_gpu_create(ctx, &ctx->gpu);
     if (r != VFX_OK) {
@@ -214,7 +216,7 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
         return VFX_ERR_INVALID_ARGUMENT;
     gl_bind(ctx);
     volfx_frame_targets targets;
-    vfx_frame_view2 checked; /* what the effects still receive: validated, near/far filled */
+    vfx_frame_view checked; /* what the effects still receive: validated, near/far filled */
     vfx_result cr = volfx_frame_gate(ctx, frame, &targets, &checked);
     if (cr)
         return cr;
@@ -229,8 +231,8 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
         drawing |= ctx->effect_state[k] && (mask & VFX_EFFECT_BIT(k));
     if ((cr = volfx_frame_gate_gl(ctx, drawing, &targets)))
         return cr;
-    checked.v1.framebuffer = targets.framebuffer; /* the effects layer's, when the host gave one */
-    frame = &checked.v1;
+    checked.framebuffer = targets.framebuffer; /* the effects layer's, when the host gave one */
+    frame = &checked;
 
     ctx->stats.count = 0;
     ctx->stats.dropped = 0;
@@ -256,24 +258,21 @@ static vfx_result plugin_get_stats(vfx_context *ctx, vfx_stats *out)
         return VFX_ERR_INVALID_ARGUMENT;
     if (!out)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "get_stats: out is NULL");
-    if (out->version == VFX_STATS2_VERSION) {
-        if (out->size < sizeof(vfx_stats2))
-            return volfx_fail(ctx, VFX_ERR_ABI, "get_stats: stats of version 2 have size %u (need %zu)",
-                              out->size, sizeof(vfx_stats2));
-        *(vfx_stats2 *)out = ctx->last_stats;
-        return VFX_OK;
-    }
-    if (out->version != VFX_STATS_VERSION || out->size < sizeof(vfx_stats))
-        return volfx_fail(ctx, VFX_ERR_ABI, "get_stats: stats of version %u, size %u (this plugin writes "
-                          "version 1 of size %zu and version 2 of size %zu)", out->version, out->size,
-                          sizeof(vfx_stats), sizeof(vfx_stats2));
-    /* version 1: the first VFX_STATS_MAX entries */
-    out->count = ctx->last_stats.count < VFX_STATS_MAX ? ctx->last_stats.count : VFX_STATS_MAX;
-    memcpy(out->entries, ctx->last_stats.entries, out->count * sizeof out->entries[0]);
+    vfx_result r = volfx_check_type(ctx, out, VFX_TYPE_STATS, "get_stats: vfx_stats");
+    if (r)
+        return r;
+    void *next = out->next;
+    *out = ctx->last_stats;
+    out->next = next;
     return VFX_OK;
 }
 
-static const char *plugin_last_error(vfx_context *ctx) { return ctx ? ctx->last_error : "no context"; }
+static const char *plugin_last_error(vfx_context *ctx, vfx_log_id *id_out)
+{
+    if (id_out)
+        *id_out = ctx ? ctx->last_error_id : VFX_LOG_ID_NONE;
+    return ctx ? ctx->last_error : "no context";
+}
 
 static vfx_result plugin_read_raw(vfx_context *ctx, vfx_effect_kind effect, float *out, size_t count)
 {
@@ -325,11 +324,14 @@ static vfx_result plugin_get_lights(vfx_context *ctx, vfx_lights *out)
 {
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
-    if (!out || out->version != VFX_LIGHTS_VERSION || out->size < sizeof *out || (out->capacity && !out->lights))
-        return volfx_fail(ctx, VFX_ERR_ABI, "get_lights: lights of version %u, size %u, capacity %u, array %s "
-                          "(this plugin reads version %u of size %zu with a non-NULL array when capacity > 0)",
-                          out ? out->version : 0, out ? out->size : 0, out ? out->capacity : 0,
-                          out && out->lights ? "set" : "NULL", VFX_LIGHTS_VERSION, sizeof *out);
+    if (!out)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "get_lights: out is NULL");
+    vfx_result r = volfx_check_type(ctx, out, VFX_TYPE_LIGHTS, "get_lights: vfx_lights");
+    if (r)
+        return r;
+    if (out->capacity && !out->lights)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "get_lights: capacity %u with a NULL lights array",
+                          out->capacity);
     out->count = out->total = 0;
 #if VFX_WITH_BEAMS
     volfx_beams_impact *im = volfx_beams_impact_of(ctx);
@@ -339,35 +341,54 @@ static vfx_result plugin_get_lights(vfx_context *ctx, vfx_lights *out)
     return VFX_OK;
 }
 
-VFX_EXPORT vfx_result vfx_plugin_entry(uint32_t abi_version, const vfx_host_api *host,
-                                       vfx_plugin_api *out)
+/* The head of ABI 1's vfx_host_api (size, version, user, gl_get_proc_address, log), enough to
+ * tell an ABI 1 host why it is refused through its own logger. */
+typedef struct abi1_host_head {
+    uint32_t size, version;
+    void *user;
+    void *(*gl_get_proc_address)(void *user, const char *name);
+    void (*log)(void *user, vfx_log_level level, const char *message);
+} abi1_host_head;
+
+/* Tells the host why the entry refused it, through whatever logger its ABI version has. */
+static void entry_refuse(uint32_t abi_version, const void *host, vfx_log_id id, const char *msg)
+{
+    if (!host)
+        return;
+    if (abi_version == 1) {
+        /* an ABI 1 host passes a vfx_host_api of version 1 whose size covers these fields */
+        const abi1_host_head *h1 = host;
+        if (h1->version == 1 && h1->size >= sizeof *h1 && h1->log)
+            h1->log(h1->user, VFX_LOG_ERROR, msg);
+        return;
+    }
+    /* ABI 2 and every later one keep vfx_context_desc's head (type, next, user,
+     * gl_get_proc_address, log) in place (docs/abi.md), so a newer host hears why too */
+    const vfx_context_desc *d = host;
+    if (abi_version >= VFX_ABI_VERSION && d->type == VFX_TYPE_CONTEXT_DESC && d->log)
+        d->log(d->user, VFX_LOG_ERROR, id, msg);
+}
+
+VFX_EXPORT vfx_result vfx_plugin_entry(uint32_t abi_version, const vfx_context_desc *desc, vfx_plugin_api *out)
 {
     if (abi_version != VFX_ABI_VERSION) {
-        if (host && host->log) {
-            char msg[160];
-            snprintf(msg, sizeof msg, "volfx: host ABI version %u, plugin ABI version %u: refused",
-                     abi_version, VFX_ABI_VERSION);
-            host->log(host->user, VFX_LOG_ERROR, msg);
-        }
+        char msg[192];
+        snprintf(msg, sizeof msg, "volfx: host ABI version %u, plugin ABI version %u (ABI 1.0): refused; rebuild "
+                 "the host against this volfx.h", abi_version, VFX_ABI_VERSION);
+        entry_refuse(abi_version, desc, VFX_LOG_ID_ABI_VERSION, msg);
         return VFX_ERR_ABI;
     }
-    if (!out || out->size < sizeof(vfx_plugin_api)) {
-        if (host && host->log)
-            host->log(host->user, VFX_LOG_ERROR, "volfx: plugin api struct too small or NULL");
+    if (!out || out->type != VFX_TYPE_PLUGIN_API) {
+        char msg[160];
+        snprintf(msg, sizeof msg, "volfx: the plugin api table is %s (need type VFX_TYPE_PLUGIN_API = %u)",
+                 out ? "of another type" : "NULL", (unsigned)VFX_TYPE_PLUGIN_API);
+        entry_refuse(abi_version, desc, VFX_LOG_ID_STRUCT_TYPE, msg);
         return VFX_ERR_ABI;
     }
-    const bool v2 = out->size >= sizeof(vfx_plugin_api2), v3 = out->size >= sizeof(vfx_plugin_api3);
-    const size_t size = v3 ? sizeof(vfx_plugin_api3) : v2 ? sizeof(vfx_plugin_api2) : sizeof *out;
-    memset(out, 0, size);
-    out->size = (uint32_t)size;
-    out->version = v3 ? VFX_PLUGIN_API3_VERSION : v2 ? VFX_PLUGIN_API2_VERSION : VFX_PLUGIN_API_VERSION;
-    if (v3)
-        ((vfx_plugin_api3 *)out)->get_lights = plugin_get_lights;
-    if (v2) {
-        vfx_plugin_api2 *a2 = (vfx_plugin_api2 *)out;
-        a2->set_program_cache = plugin_set_program_cache;
-        a2->warm_up = plugin_warm_up;
-    }
+    void *next = out->next;
+    memset(out, 0, sizeof *out);
+    out->type = VFX_TYPE_PLUGIN_API;
+    out->next = next;
     out->name = "volfx";
     out->effects_built = (VFX_WITH_WATER ? VFX_EFFECT_BIT(VFX_EFFECT_WATER) : 0)
                          | (VFX_WITH_BEAMS ? VFX_EFFECT_BIT(VFX_EFFECT_BEAMS) : 0)
@@ -377,8 +398,12 @@ VFX_EXPORT vfx_result vfx_plugin_entry(uint32_t abi_version, const vfx_host_api 
     out->resize = plugin_resize;
     out->update = plugin_update;
     out->render = plugin_render;
+    out->warm_up = plugin_warm_up;
+    out->set_program_cache = plugin_set_program_cache;
     out->get_stats = plugin_get_stats;
+    out->get_lights = plugin_get_lights;
     out->last_error = plugin_last_error;
     out->read_raw = plugin_read_raw;
+    out->resolve_defaults = volfx_resolve_defaults;
     return VFX_OK;
 }

@@ -9,7 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
-vfx_result volfx_check_host(const vfx_host_api *host, char *msg, size_t msglen)
+vfx_result volfx_check_host(const vfx_context_desc *host, char *msg, size_t msglen)
 {
     struct { const char *a, *b; bool ha, hb; } pairs[] = {
         {"particle_chunk_count", "particle_chunk", host->particle_chunk_count != NULL, host->particle_chunk != NULL},
@@ -18,7 +18,7 @@ vfx_result volfx_check_host(const vfx_host_api *host, char *msg, size_t msglen)
     };
     for (size_t i = 0; i < sizeof pairs / sizeof pairs[0]; ++i)
         if (pairs[i].ha != pairs[i].hb) {
-            snprintf(msg, msglen, "host api: %s is set but %s is NULL (set both or neither)",
+            snprintf(msg, msglen, "context desc: %s is set but %s is NULL (set both or neither)",
                      pairs[i].ha ? pairs[i].a : pairs[i].b, pairs[i].ha ? pairs[i].b : pairs[i].a);
             return VFX_ERR_INVALID_ARGUMENT;
         }
@@ -186,63 +186,45 @@ static vfx_result far_depth(vfx_context *ctx, uint32_t w, uint32_t h, unsigned *
     return VFX_OK;
 }
 
-/* Version 3 is version 2 plus the view's id: read on as version 2. Then the version 1/2 sizes,
- * the frame size and the matrices' finiteness; *checked gets the view as version 1 or 2. */
+/* The view's type, the frame size and the matrices' finiteness; *checked gets a copy. */
 static vfx_result read_view(vfx_context *ctx, const vfx_frame_view *frame, uint32_t *view_id,
-                            vfx_frame_view2 *checked)
+                            vfx_frame_view *checked)
 {
-    *view_id = 0;
-    if (frame->version == VFX_FRAME_VIEW3_VERSION) {
-        if (frame->size < sizeof(vfx_frame_view3))
-            return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view of version 3 has size %u (need %zu)",
-                              frame->size, sizeof(vfx_frame_view3));
-        *view_id = ((const vfx_frame_view3 *)frame)->view_id;
-        memcpy(checked, frame, sizeof *checked);
-        checked->v1.size = sizeof *checked;
-        checked->v1.version = VFX_FRAME_VIEW2_VERSION;
-        frame = &checked->v1;
-    }
-    if (frame->version != VFX_FRAME_VIEW_VERSION && frame->version != VFX_FRAME_VIEW2_VERSION)
-        return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view of version %u (this plugin reads %u, %u and %u)",
-                          frame->version, VFX_FRAME_VIEW_VERSION, VFX_FRAME_VIEW2_VERSION, VFX_FRAME_VIEW3_VERSION);
-    size_t need = frame->version == VFX_FRAME_VIEW2_VERSION ? sizeof(vfx_frame_view2) : sizeof(vfx_frame_view);
-    if (frame->size < need)
-        return volfx_fail(ctx, VFX_ERR_ABI, "render: frame view of version %u has size %u (need %zu)",
-                          frame->version, frame->size, need);
+    vfx_result r = volfx_check_type(ctx, frame, VFX_TYPE_FRAME_VIEW, "render: frame view (vfx_frame_view)");
+    if (r)
+        return r;
+    if (frame->layer_texture)
+        return volfx_fail_id(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_LAYER_TEXTURE_UNSUPPORTED,
+                             "render: frame view layer_texture %u: the effects-layer output is not supported by "
+                             "this plugin yet (leave it 0)", frame->layer_texture);
+    *view_id = frame->view_id;
     if (frame->width == 0 || frame->height == 0)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame is %ux%u", frame->width,
                           frame->height);
     for (int i = 0; i < 16; ++i)
         if (!isfinite(frame->view[i]) || !isfinite(frame->proj[i]))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: camera matrix element %d is not finite", i);
-    if (frame != &checked->v1) {
-        vfx_frame_view2 copy;
-        memset(&copy, 0, sizeof copy);
-        memcpy(&copy, frame, need);
-        *checked = copy;
-    }
-    checked->v1.size = (uint32_t)need;
+    *checked = *frame;
+    checked->next = NULL;
     return VFX_OK;
 }
 
 /* Cofactors in double (volfx_mat4_invert), so near-singular projections keep their digits. */
-static vfx_result derive_camera(vfx_context *ctx, const vfx_frame_view2 *checked, volfx_frame_targets *t)
+static vfx_result derive_camera(vfx_context *ctx, const vfx_frame_view *checked, volfx_frame_targets *t)
 {
-    const vfx_frame_view *v = &checked->v1;
+    const vfx_frame_view *v = checked;
     volfx_mat4_mul(v->proj, v->view, t->view_proj);
     if (!volfx_mat4_invert(t->view_proj, t->inv_view_proj))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: view*projection is singular");
     if (!volfx_mat4_invert(v->view, t->inv_view))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: view matrix is singular");
-    if (v->version == VFX_FRAME_VIEW2_VERSION) {
-        for (int i = 0; i < 3; ++i) {
-            if (!isfinite(checked->origin[i]))
-                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view origin[%d] is not finite", i);
-            t->origin[i] = checked->origin[i];
-        }
-        t->color_hdr = checked->color_hdr != 0;
-        t->environment_cubemap = checked->environment_cubemap;
+    for (int i = 0; i < 3; ++i) {
+        if (!isfinite(checked->origin[i]))
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view origin[%d] is not finite", i);
+        t->origin[i] = checked->origin[i];
     }
+    t->color_hdr = checked->color_hdr != 0;
+    t->environment_cubemap = checked->environment_cubemap;
     /* Camera-relative: the eye is the origin, so far-away geometry keeps float32 digits when
      * effects subtract the eye in double first. */
     float view_rot[16];
@@ -259,7 +241,7 @@ static vfx_result derive_camera(vfx_context *ctx, const vfx_frame_view2 *checked
 }
 
 vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx_frame_targets *t,
-                            vfx_frame_view2 *checked)
+                            vfx_frame_view *checked)
 {
     memset(t, 0, sizeof *t);
     memset(checked, 0, sizeof *checked);
@@ -270,7 +252,7 @@ vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx
         return r;
     if ((r = derive_camera(ctx, checked, t)))
         return r;
-    vfx_frame_view *v = &checked->v1;
+    vfx_frame_view *v = checked;
     for (int k = 0; k < 3; ++k)
         if (!isfinite(v->eye[k]))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view eye[%d] is not finite", k);

@@ -13,16 +13,16 @@
 /* VFX_ERR_INVALID_ARGUMENT with "host api: particle_chunk_count is set but particle_chunk is
  * NULL" (and the same for volume_count/volume, alloc/free) into msg; VFX_OK when every pair is
  * complete or absent. */
-vfx_result volfx_check_host(const vfx_host_api *host, char *msg, size_t msglen);
+vfx_result volfx_check_host(const vfx_context_desc *host, char *msg, size_t msglen);
 
-/* The frame gate, step 1 (no GL): the frame view's version (1, 2 or 3) and size, its frame
- * size, finite view, proj, origin and eye, fov_y in [0, pi), effect bits, near/far against the
- * projection (filled from it when the host gave both 0); then everything effects read of the
- * camera into *t, the matrices multiplied and inverted here once (a singular view or
- * view*projection is refused), and the view effects still receive into *checked (version 1 or
- * 2, near/far filled). Every error names the field, through volfx_fail. */
+/* The frame gate, step 1 (no GL): the frame view's type, its frame size, finite view, proj,
+ * origin and eye, fov_y in [0, pi), effect bits, the reserved layer_texture (refused while
+ * unsupported), near/far against the projection (filled from it when the host gave both 0);
+ * then everything effects read of the camera into *t, the matrices multiplied and inverted here
+ * once (a singular view or view*projection is refused), and the view effects still receive into
+ * *checked (near/far filled, next cleared). Every error names the field, through volfx_fail. */
 vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx_frame_targets *t,
-                            vfx_frame_view2 *checked);
+                            vfx_frame_view *checked);
 
 /* The frame gate, step 2, once the context has the frame's size and `drawing` says some effect
  * will draw (else nothing is done): the frame view's GL names (framebuffer, colour and depth

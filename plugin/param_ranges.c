@@ -66,16 +66,10 @@ vfx_result volfx_range_check_vec(vfx_context *ctx, const char *what, vfx_range_i
     return VFX_OK;
 }
 
-vfx_result volfx_water_params_check_ranges(vfx_context *ctx, const vfx_water_params3 *in, uint32_t version)
+vfx_result volfx_water_params_check_ranges(vfx_context *ctx, const vfx_water_params *p)
 {
-    const vfx_water_params *p = &in->v2.v1;
     const char *w = "water";
     vfx_result r;
-    /* the version the host wrote (0: it answered VFX_ERR_NOT_FOUND, the defaults); one this
-     * plugin does not know was read as version 1 before (issue 28) */
-    if (p->version > VFX_WATER_PARAMS4_VERSION)
-        return volfx_fail(ctx, VFX_ERR_ABI, "water: host water_params of version %u (this plugin reads 1 to %u)",
-                          p->version, VFX_WATER_PARAMS4_VERSION);
     if ((r = volfx_range_check(ctx, w, VFX_RANGE_WATER_H, p->h))
         || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_THRESHOLD, p->threshold))
         || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_MAX_SAMPLES, p->max_samples))
@@ -86,9 +80,7 @@ vfx_result volfx_water_params_check_ranges(vfx_context *ctx, const vfx_water_par
         || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_ABSORPTION, p->absorption))
         || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_IOR, p->ior)))
         return r;
-    if (version < VFX_WATER_PARAMS2_VERSION)
-        return VFX_OK;
-    const vfx_water_params2 *k = &in->v2;
+    const vfx_water_params *k = p;
     if ((r = volfx_range_check(ctx, w, VFX_RANGE_WATER_ANISO_RADIUS, k->aniso_radius))
         || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_ANISO_MAX_STRETCH, k->aniso_max_stretch))
         || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_ANISO_MIN_NEIGHBOURS, k->aniso_min_neighbours))
@@ -98,7 +90,7 @@ vfx_result volfx_water_params_check_ranges(vfx_context *ctx, const vfx_water_par
     return VFX_OK;
 }
 
-vfx_result volfx_beam_check_ranges(vfx_context *ctx, uint32_t i, const vfx_beam *b, const vfx_beam2 *b2)
+vfx_result volfx_beam_check_ranges(vfx_context *ctx, uint32_t i, const vfx_beam *b)
 {
     char w[32];
     snprintf(w, sizeof w, "beams[%u]", i);
@@ -110,8 +102,7 @@ vfx_result volfx_beam_check_ranges(vfx_context *ctx, uint32_t i, const vfx_beam 
         || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_EPS, b->eps))
         || (r = volfx_range_check_vec(ctx, w, VFX_RANGE_BEAM_COLOR, b->color, 4)))
         return r;
-    if (!b2)
-        return VFX_OK;
+    const vfx_beam *b2 = b;
     if ((r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_INTENSITY, b2->intensity))
         || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_EXPOSURE, b2->exposure))
         || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_FLOW_AMOUNT, b2->flow_amount))
@@ -121,15 +112,13 @@ vfx_result volfx_beam_check_ranges(vfx_context *ctx, uint32_t i, const vfx_beam 
     return VFX_OK;
 }
 
-vfx_result volfx_beams_view_check_ranges(vfx_context *ctx, const vfx_beams_view2 *v, uint32_t version)
+vfx_result volfx_beams_view_check_ranges(vfx_context *ctx, const vfx_beams_view *v, uint32_t march_samples)
 {
     vfx_result r;
-    if ((r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_C, v->v1.saturate_c))
-        || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_FAR, v->v1.far_distance))
-        || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_MARCH_SAMPLES, v->v1.march_samples)))
+    if ((r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_C, v->saturate_c))
+        || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_FAR, v->far_distance))
+        || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_MARCH_SAMPLES, march_samples)))
         return r;
-    if (version < VFX_BEAMS_VIEW2_VERSION)
-        return VFX_OK;
     if ((r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_BLOOM_STRENGTH, v->bloom_strength))
         || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_BLOOM_LEVELS, v->bloom_levels)))
         return r;

@@ -30,12 +30,12 @@ vfx_result volfx_range_check(vfx_context *ctx, const char *what, vfx_range_id id
 /* Every one of v[0..n) (all 0 allowed where 0 is the default). */
 vfx_result volfx_range_check_vec(vfx_context *ctx, const char *what, vfx_range_id id, const float *v, int n);
 
-/* The water parameters of `version` (1..3: the fields that version has). */
-vfx_result volfx_water_params_check_ranges(vfx_context *ctx, const vfx_water_params3 *p, uint32_t version);
-/* Beam i (b2: its version-2 look, NULL for a version-1 beam). */
-vfx_result volfx_beam_check_ranges(vfx_context *ctx, uint32_t i, const vfx_beam *b, const vfx_beam2 *b2);
-/* The beams view's own numbers (version 1 or 2). */
-vfx_result volfx_beams_view_check_ranges(vfx_context *ctx, const vfx_beams_view2 *v, uint32_t version);
+/* The water parameters. */
+vfx_result volfx_water_params_check_ranges(vfx_context *ctx, const vfx_water_params *p);
+/* Beam i. */
+vfx_result volfx_beam_check_ranges(vfx_context *ctx, uint32_t i, const vfx_beam *b);
+/* The beams view's own numbers (and the lab's march samples, lab may be NULL). */
+vfx_result volfx_beams_view_check_ranges(vfx_context *ctx, const vfx_beams_view *v, uint32_t march_samples);
 /* The volume view's renderer options. */
 vfx_result volfx_volume_view_check_ranges(vfx_context *ctx, const vfx_volume_view *v);
 

@@ -12,9 +12,10 @@
 
 /* ------------------------------------------------------------ host api callbacks */
 
-static void host_log(void *user, vfx_log_level level, const char *message)
+static void host_log(void *user, vfx_log_level level, vfx_log_id id, const char *message)
 {
     game_app *app = user;
+    (void)id;
     rt_logf(&app->log, level, "%s", message);
 }
 
@@ -44,14 +45,12 @@ static vfx_result particle_chunks_collect(game_app *app)
         }
         vfx_particle_view *out = &app->chunks[n++];
         memset(out, 0, sizeof *out);
-        out->size = sizeof *out;
-        out->version = VFX_PARTICLE_VIEW_VERSION;
+        out->type = VFX_TYPE_PARTICLE_VIEW;
         out->count = it.rows;
         for (uint32_t k = 0; k < 3; ++k) {
             out->pos[k] = rt_query_column(&it, app->particles.position, k);
             out->vel[k] = rt_query_column(&it, app->particles.velocity, k);
         }
-        out->density = rt_query_column(&it, app->particles.density, 0);
         out->radius = rt_query_column(&it, app->particles.radius, 0);
         out->revision = rt_world_table_revision(app->world, it.table);
     }
@@ -75,7 +74,7 @@ static uint32_t host_particle_chunk_count(void *user)
 static vfx_result host_particle_chunk(void *user, uint32_t index, vfx_particle_view *out)
 {
     game_app *app = user;
-    if (!out || out->size < sizeof *out)
+    if (!out || out->type != VFX_TYPE_PARTICLE_VIEW)
         return VFX_ERR_ABI;
     if (!app->chunks_valid) {
         vfx_result r = particle_chunks_collect(app);
@@ -91,106 +90,51 @@ static vfx_result host_particle_chunk(void *user, uint32_t index, vfx_particle_v
 static vfx_result host_water_params(void *user, vfx_water_params *out)
 {
     game_app *app = user;
-    if (!out || out->size < sizeof *out)
+    if (!out || out->type != VFX_TYPE_WATER_PARAMS)
         return VFX_ERR_ABI;
-    if (out->version >= VFX_WATER_PARAMS3_VERSION && out->size >= sizeof(vfx_water_params3)) {
-        bool v4 = out->version >= VFX_WATER_PARAMS4_VERSION && out->size >= sizeof(vfx_water_params4);
-        vfx_water_params3 *p3 = (vfx_water_params3 *)out;
-        if (v4) /* the diffuse particles' fields; version 3's below */
-            *(vfx_water_params4 *)out = app->water_diffuse;
-        memset(p3, 0, sizeof *p3);
-        p3->v2.v1 = app->water;
-        p3->v2.v1.size = v4 ? sizeof(vfx_water_params4) : sizeof *p3;
-        p3->v2.v1.version = v4 ? VFX_WATER_PARAMS4_VERSION : VFX_WATER_PARAMS3_VERSION;
-        p3->v2.kernel = app->water.method == VFX_WATER_METHOD_TILE ? app->water_kernel : VFX_WATER_KERNEL_ISOTROPIC;
-        p3->preset = app->water_preset;
-        return VFX_OK;
-    }
-    if (out->version >= VFX_WATER_PARAMS2_VERSION && out->size >= sizeof(vfx_water_params2)) {
-        vfx_water_params2 *p2 = (vfx_water_params2 *)out;
-        memset(p2, 0, sizeof *p2);
-        p2->v1 = app->water;
-        p2->v1.size = sizeof *p2;
-        p2->v1.version = VFX_WATER_PARAMS2_VERSION;
-        /* the anisotropic kernel is TILE's; the paper method (Tab cycles to it) draws the seed's */
-        p2->kernel = app->water.method == VFX_WATER_METHOD_TILE ? app->water_kernel : VFX_WATER_KERNEL_ISOTROPIC;
-        return VFX_OK;
-    }
     *out = app->water;
-    out->size = sizeof *out;
-    out->version = VFX_WATER_PARAMS_VERSION;
+    out->type = VFX_TYPE_WATER_PARAMS;
+    const vfx_lab_water *lab = &app->water_lab;
+    bool lab_used = lab->disable || lab->method;
+    out->next = lab_used ? lab : NULL;
+    if (lab_used)
+        app->water_lab.type = VFX_TYPE_LAB_WATER;
+    /* the anisotropic kernel is TILE's; the paper method (Tab cycles to it) draws the seed's */
+    uint32_t method = lab->method ? lab->method : app->water.method;
+    out->kernel = method == VFX_WATER_METHOD_TILE ? app->water.kernel : VFX_WATER_KERNEL_ISOTROPIC;
     return VFX_OK;
 }
 
-/* The beam entities' column is the view's array (version 2, no copy); a version-1 view gets a
- * copy of each beam's v1 part. */
+/* The beam entities' column is the view's array (no copy). */
 static vfx_result host_beams(void *user, vfx_beams_view *out)
 {
     game_app *app = user;
-    if (!out || out->size < sizeof *out)
+    if (!out || out->type != VFX_TYPE_BEAMS_VIEW)
         return VFX_ERR_ABI;
     uint32_t n;
-    vfx_beam2 *beams = game_app_beams(app, &n);
+    vfx_beam *beams = game_app_beams(app, &n);
     if (n == 0)
         return VFX_ERR_NOT_FOUND;
-    if (app->beams_v3 && app->beams3_count == n && out->version >= VFX_BEAMS_VIEW3_VERSION
-        && out->size >= sizeof(vfx_beams_view3)) {
-        /* the anatomy beside the entities' column: each beam's version 2 part is the column's */
-        for (uint32_t i = 0; i < n; ++i)
-            app->beams3[i].v2 = beams[i];
-        vfx_beams_view3 *v3 = (vfx_beams_view3 *)out;
-        memset(v3, 0, sizeof *v3);
-        v3->v2 = app->beams_view2;
-        v3->v2.v1 = app->beams_view;
-        v3->v2.v1.size = sizeof *v3;
-        v3->v2.v1.version = VFX_BEAMS_VIEW3_VERSION;
-        v3->v2.v1.count = n;
-        v3->v2.v1.beams = NULL;
-        v3->v2.beams = beams;
-        v3->v2.joints = &app->joints[0][0];
-        v3->v2.joint_count = app->joint_count;
-        v3->beams3 = app->beams3;
-        return VFX_OK;
-    }
-    if (app->beams_v2 && out->version >= VFX_BEAMS_VIEW2_VERSION && out->size >= sizeof(vfx_beams_view2)) {
-        vfx_beams_view2 *v2 = (vfx_beams_view2 *)out;
-        *v2 = app->beams_view2;
-        v2->v1 = app->beams_view;
-        v2->v1.size = sizeof *v2;
-        v2->v1.version = VFX_BEAMS_VIEW2_VERSION;
-        v2->v1.count = n;
-        v2->v1.beams = NULL;
-        v2->beams = beams;
-        v2->joints = &app->joints[0][0];
-        v2->joint_count = app->joint_count;
-        return VFX_OK;
-    }
-    if (n > app->beams_v1_cap) {
-        vfx_beam *p = realloc(app->beams_v1, n * sizeof *p);
-        if (!p)
-            return VFX_ERR_OUT_OF_MEMORY;
-        app->beams_v1 = p;
-        app->beams_v1_cap = n;
-    }
-    for (uint32_t i = 0; i < n; ++i)
-        app->beams_v1[i] = beams[i].v1;
     *out = app->beams_view;
-    out->size = sizeof *out;
-    out->version = VFX_BEAMS_VIEW_VERSION;
+    out->type = VFX_TYPE_BEAMS_VIEW;
+    app->beams_lab.type = VFX_TYPE_LAB_BEAMS;
+    out->next = app->beams_lab.method || app->beams_lab.march_samples ? &app->beams_lab : NULL;
     out->count = n;
-    out->beams = app->beams_v1;
+    out->beams = beams;
+    out->joints = &app->joints[0][0];
+    out->joint_count = app->joint_count;
     return VFX_OK;
 }
 
 static uint32_t host_volume_count(void *user) { return game_app_volume_count(user); }
 
 /* The index-th volume entity's view, in query order. */
-static const vfx_volume_view2 *volume_at(game_app *app, uint32_t index)
+static const vfx_volume_view *volume_at(game_app *app, uint32_t index)
 {
     rt_query_iter it = rt_query_begin(app->world, &app->effects.volume, 1);
     while (rt_query_next(&it)) {
         if (index < it.rows)
-            return (const vfx_volume_view2 *)rt_query_column(&it, app->effects.volume, 0) + index;
+            return (const vfx_volume_view *)rt_query_column(&it, app->effects.volume, 0) + index;
         index -= it.rows;
     }
     return NULL;
@@ -199,22 +143,13 @@ static const vfx_volume_view2 *volume_at(game_app *app, uint32_t index)
 static vfx_result host_volume(void *user, uint32_t index, vfx_volume_view *out)
 {
     game_app *app = user;
-    if (!out || out->size < sizeof *out)
+    if (!out || out->type != VFX_TYPE_VOLUME_VIEW)
         return VFX_ERR_ABI;
-    const vfx_volume_view2 *v = volume_at(app, index);
+    const vfx_volume_view *v = volume_at(app, index);
     if (!v)
         return VFX_ERR_NOT_FOUND;
-    /* a plugin that offers version 2 gets it (the version-1 part first), an older one version 1 */
-    if (out->size >= sizeof(vfx_volume_view2) && out->version == VFX_VOLUME_VIEW2_VERSION) {
-        vfx_volume_view2 *o2 = (vfx_volume_view2 *)out;
-        *o2 = *v;
-        o2->v1.size = sizeof *o2;
-        o2->v1.version = VFX_VOLUME_VIEW2_VERSION;
-        return VFX_OK;
-    }
-    *out = v->v1;
-    out->size = sizeof *out;
-    out->version = VFX_VOLUME_VIEW_VERSION;
+    *out = *v;
+    out->type = VFX_TYPE_VOLUME_VIEW;
     return VFX_OK;
 }
 
@@ -299,8 +234,8 @@ vfx_result game_app_create(const game_app_desc *desc, game_app **out)
         || (r = rt_renderer_resize(app->renderer, w, h)))
         goto fail;
     app->clear_color[0] = 0.05f, app->clear_color[1] = 0.06f, app->clear_color[2] = 0.09f;
-    app->host = (vfx_host_api){
-        .size = sizeof(vfx_host_api), .version = VFX_HOST_API_VERSION, .user = app,
+    app->host = (vfx_context_desc){
+        .type = VFX_TYPE_CONTEXT_DESC, .user = app,
         .gl_get_proc_address = host_proc, .log = host_log,
         .particle_chunk_count = host_particle_chunk_count, .particle_chunk = host_particle_chunk,
         .water_params = host_water_params, .beams = host_beams,
@@ -312,7 +247,6 @@ vfx_result game_app_create(const game_app_desc *desc, game_app **out)
     if (r)
         goto fail;
     app->api = rt_plugin_host_api(app->plugin);
-    app->api3 = rt_plugin_host_api3(app->plugin); /* NULL for a plugin without lights */
     if ((r = app->api->create(&app->host, &app->ctx)))
         goto fail;
     if (app->desc.program_cache && (r = set_program_cache(app)))
@@ -333,8 +267,6 @@ void game_app_destroy(game_app *app)
         app->api->destroy(app->ctx);
     rt_plugin_host_unload(app->plugin);
     free(app->chunks);
-    free(app->beams_v1);
-    free(app->beams3);
     if (app->world) {
         rt_query_iter it = rt_query_begin(app->world, &app->mesh_comp, 1);
         while (rt_query_next(&it)) {
@@ -398,30 +330,12 @@ vfx_result game_app_add_box(game_app *app, const float mn[3], const float mx[3],
     return r ? r : add_mesh(app, &data, NULL, rgb, out);
 }
 
-vfx_result game_app_add_beams(game_app *app, const vfx_beam2 *beams, uint32_t n)
+vfx_result game_app_add_beams(game_app *app, const vfx_beam *beams, uint32_t n)
 {
     return rt_beams_spawn(app->world, &app->effects, n, beams, NULL);
 }
 
-vfx_result game_app_set_anatomy(game_app *app, const vfx_beam3 *beams, uint32_t n)
-{
-    if (n > app->beams3_cap) {
-        vfx_beam3 *p = realloc(app->beams3, n * sizeof *p);
-        if (!p)
-            return VFX_ERR_OUT_OF_MEMORY;
-        app->beams3 = p;
-        app->beams3_cap = n;
-    }
-    if (n && beams)
-        memcpy(app->beams3, beams, n * sizeof *beams);
-    else if (n)
-        memset(app->beams3, 0, n * sizeof *app->beams3);
-    app->beams3_count = n;
-    app->beams_v3 = n > 0;
-    return VFX_OK;
-}
-
-vfx_beam2 *game_app_beams(game_app *app, uint32_t *count)
+vfx_beam *game_app_beams(game_app *app, uint32_t *count)
 {
     return rt_beams_column(app->world, &app->effects, count);
 }
@@ -446,19 +360,19 @@ void game_app_clear_beams(game_app *app)
     free(ids);
 }
 
-vfx_result game_app_add_volume(game_app *app, const vfx_volume_view2 *view, rt_entity *out)
+vfx_result game_app_add_volume(game_app *app, const vfx_volume_view *view, rt_entity *out)
 {
     rt_entity e;
     vfx_result r = rt_world_spawn(app->world, 1, &app->effects.volume, 1, &e);
     if (r)
         return r;
-    *(vfx_volume_view2 *)rt_world_get(app->world, e, app->effects.volume, 0) = *view;
+    *(vfx_volume_view *)rt_world_get(app->world, e, app->effects.volume, 0) = *view;
     if (out)
         *out = e;
     return VFX_OK;
 }
 
-vfx_volume_view2 *game_app_volume(game_app *app, rt_entity e)
+vfx_volume_view *game_app_volume(game_app *app, rt_entity e)
 {
     return rt_world_get(app->world, e, app->effects.volume, 0);
 }
@@ -492,36 +406,35 @@ vfx_result game_app_frame(game_app *app, float dt)
     r = app->api->update(app->ctx, app->time, dt);
     app->chunks_valid = false; /* render-phase systems may change tables before the next call */
     if (r) {
-        rt_logf(&app->log, VFX_LOG_ERROR, "plugin update: %s", app->api->last_error(app->ctx));
+        rt_logf(&app->log, VFX_LOG_ERROR, "plugin update: %s", app->api->last_error(app->ctx, NULL));
         return r;
     }
     rt_profiler_cpu(app->profiler, "plugin.update", rt_now_ms() - t0);
     /* the frame view is filled in place: camera first (the host scene draws with the same
      * matrices), then the targets the scene pass reports; version 2 says whether the output
      * is an HDR target */
-    vfx_frame_view2 frame = {.v1 = {.size = sizeof frame, .version = VFX_FRAME_VIEW2_VERSION,
-                                    .near_plane = (float)app->camera.near_plane,
-                                    .far_plane = (float)app->camera.far_plane,
-                                    .fov_y = (float)app->camera.fov_y},
-                             .origin = {app->origin[0], app->origin[1], app->origin[2]}};
-    rt_camera_view(&app->camera, frame.v1.view);
-    rt_camera_proj(&app->camera, frame.v1.proj);
+    vfx_frame_view frame = {.type = VFX_TYPE_FRAME_VIEW,
+                            .near_plane = (float)app->camera.near_plane,
+                            .far_plane = (float)app->camera.far_plane,
+                            .fov_y = (float)app->camera.fov_y,
+                            .origin = {app->origin[0], app->origin[1], app->origin[2]}};
+    rt_camera_view(&app->camera, frame.view);
+    rt_camera_proj(&app->camera, frame.proj);
     for (int k = 0; k < 3; ++k)
-        frame.v1.eye[k] = (float)app->camera.eye[k];
+        frame.eye[k] = (float)app->camera.eye[k];
     t0 = rt_now_ms();
     if (app->environment.sky) { /* the fog is seen from the camera */
-        memcpy(app->environment.eye, frame.v1.eye, sizeof app->environment.eye);
+        memcpy(app->environment.eye, frame.eye, sizeof app->environment.eye);
         rt_renderer_set_environment(app->renderer, &app->environment);
     }
     rt_renderer_set_origin(app->renderer, app->origin);
-    if (app->api3) { /* the effects' lights on the meshes: beams' trails, heads and impacts */
+    { /* the effects' lights on the meshes: beams' trails, heads and impacts */
         vfx_light lights[RT_RENDERER_MAX_LIGHTS];
-        vfx_lights l = {.size = sizeof l, .version = VFX_LIGHTS_VERSION, .capacity = RT_RENDERER_MAX_LIGHTS,
-                        .lights = lights};
-        if (app->api3->get_lights(app->ctx, &l) == VFX_OK)
+        vfx_lights l = {.type = VFX_TYPE_LIGHTS, .capacity = RT_RENDERER_MAX_LIGHTS, .lights = lights};
+        if (app->api->get_lights(app->ctx, &l) == VFX_OK)
             rt_renderer_set_lights(app->renderer, lights, l.count);
     }
-    rt_renderer_begin_scene(app->renderer, frame.v1.view, frame.v1.proj, app->clear_color);
+    rt_renderer_begin_scene(app->renderer, frame.view, frame.proj, app->clear_color);
     rt_component draw_terms[2] = {app->mesh_comp, app->transform_comp};
     rt_query_iter it = rt_query_begin(app->world, draw_terms, 2);
     while (rt_query_next(&it)) {
@@ -532,18 +445,18 @@ vfx_result game_app_frame(game_app *app, float dt)
     }
     rt_renderer_targets tg;
     rt_renderer_end_scene(app->renderer, &tg);
-    frame.v1.framebuffer = tg.output_framebuffer;
-    frame.v1.color_texture = tg.scene_color;
-    frame.v1.depth_texture = tg.scene_depth;
-    frame.v1.width = tg.width;
-    frame.v1.height = tg.height;
+    frame.framebuffer = tg.output_framebuffer;
+    frame.color_texture = tg.scene_color;
+    frame.depth_texture = tg.scene_depth;
+    frame.width = tg.width;
+    frame.height = tg.height;
     frame.color_hdr = tg.color_hdr;
     rt_profiler_cpu(app->profiler, "host.scene", rt_now_ms() - t0);
     t0 = rt_now_ms();
     if ((r = rt_world_run_phase(app->world, RT_PHASE_RENDER, app->time, dt)))
         return r;
-    if ((r = app->api->render(app->ctx, &frame.v1))) {
-        rt_logf(&app->log, VFX_LOG_ERROR, "plugin render: %s", app->api->last_error(app->ctx));
+    if ((r = app->api->render(app->ctx, &frame))) {
+        rt_logf(&app->log, VFX_LOG_ERROR, "plugin render: %s", app->api->last_error(app->ctx, NULL));
         return r;
     }
     rt_profiler_cpu(app->profiler, "plugin.render", rt_now_ms() - t0);
@@ -557,9 +470,9 @@ vfx_result game_app_frame(game_app *app, float dt)
     } else {
         glFinish(); /* headless: make the frame time include the GPU work */
     }
-    vfx_stats2 stats = {.size = sizeof stats, .version = VFX_STATS2_VERSION};
-    if (app->api->get_stats(app->ctx, (vfx_stats *)&stats) == VFX_OK)
-        rt_profiler_gpu_stats(app->profiler, (const vfx_stats *)&stats);
+    vfx_stats stats = {.type = VFX_TYPE_STATS};
+    if (app->api->get_stats(app->ctx, &stats) == VFX_OK)
+        rt_profiler_gpu_stats(app->profiler, &stats);
     rt_profiler_frame_end(app->profiler);
     app->frame++;
     return VFX_OK;
@@ -588,7 +501,7 @@ vfx_result game_app_dump_raw(game_app *app, vfx_effect_kind effect, const char *
     vfx_result r = app->api->read_raw(app->ctx, effect, data, (size_t)w * h);
     char err[256];
     if (r)
-        rt_logf(&app->log, VFX_LOG_ERROR, "dump raw: %s", app->api->last_error(app->ctx));
+        rt_logf(&app->log, VFX_LOG_ERROR, "dump raw: %s", app->api->last_error(app->ctx, NULL));
     else if ((r = rt_write_pfm(path, w, h, data, err, sizeof err)))
         rt_logf(&app->log, VFX_LOG_ERROR, "%s", err);
     free(data);

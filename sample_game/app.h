@@ -6,6 +6,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 #include <volfx/volfx.h>
+#include <volfx_lab.h>
 
 #include "ecs/effects.h"
 #include "ecs/particles.h"
@@ -50,30 +51,22 @@ typedef struct game_app {
     rt_effect_components effects; /* beams and volumes are entities ("vfx.beam", "vfx.volume") */
     rt_plugin_host *plugin;
     const vfx_plugin_api *api;
-    const vfx_plugin_api3 *api3; /* get_lights (NULL: a plugin of api 1 or 2) */
     vfx_context *ctx;
     rt_profiler *profiler;
-    vfx_host_api host;
+    vfx_context_desc host;
     rt_camera camera;
     float clear_color[3];
     rt_renderer_environment environment; /* sky, sun and fog (zero: clear colour) */
     rt_component mesh_comp, transform_comp; /* scene meshes are entities of the world */
     uint32_t mesh_count;
     bool water_enabled;        /* particles are drawn as water when true */
+    /* every field (kernel: method TILE's; the others get isotropic); its next is set per call */
     vfx_water_params water;
-    uint32_t water_kernel;     /* vfx_water_kernel for method TILE (the others get isotropic) */
-    uint32_t water_preset;     /* vfx_water_preset (0: the plugin's default) */
-    vfx_water_params4 water_diffuse; /* the diffuse particles' fields (its v3 member unused) */
-    vfx_beams_view beams_view; /* parameters; beams/count filled per call from the beam entities */
-    bool beams_v2;             /* answer version 2 views (vfx_beam2 and beams_view2) */
-    vfx_beams_view2 beams_view2; /* bloom settings; its v1 member is beams_view */
-    float joints[GAME_APP_MAX_JOINTS][3]; /* bending beams' joints (vfx_beam2.joint_first) */
+    vfx_lab_water water_lab;   /* chained when it asks for something (lab method or bits) */
+    vfx_beams_view beams_view; /* parameters; beams/count/joints filled per call from the entities */
+    vfx_lab_beams beams_lab;   /* chained when it asks for the ray-marching baseline */
+    float joints[GAME_APP_MAX_JOINTS][3]; /* bending beams' joints (vfx_beam.joint_first) */
     uint32_t joint_count;
-    vfx_beam *beams_v1;        /* a version-1 view's copy of each beam's v1 part */
-    uint32_t beams_v1_cap;
-    bool beams_v3;             /* answer version 3 views: beams3 holds each beam entity's anatomy */
-    vfx_beam3 *beams3;         /* beams3_count of them, in the column's order (game_app_set_anatomy) */
-    uint32_t beams3_count, beams3_cap;
     double time;
     double origin[3];          /* large worlds: what every position the game holds is relative to
                                   (the scene's "origin"), handed to the plugin in frame view 2 */
@@ -98,25 +91,21 @@ vfx_result game_app_add_mesh_file(game_app *app, const char *path, const float m
 /* Adds an axis-aligned box entity to the scene; `out` may be NULL. */
 vfx_result game_app_add_box(game_app *app, const float min[3], const float max[3], const float rgb[3],
                            rt_entity *out);
-/* Spawns n beam entities (component "vfx.beam"), copies of beams (NULL: zeroed, to be filled
- * through game_app_beams); they reach the plugin with beams_view's parameters. */
-vfx_result game_app_add_beams(game_app *app, const vfx_beam2 *beams, uint32_t n);
-/* The beams as one array to read or edit in place, their number in *count (NULL, 0: none).
- * Valid until the next structural change of the world. */
-vfx_beam2 *game_app_beams(game_app *app, uint32_t *count);
-/* The beams' anatomy (version 3), in the order of game_app_beams' column: while their count is
- * the column's, a plugin that offers version 3 gets them, each with the column's version 2 part
- * (whatever the v2 members of `beams` held); beams NULL: n zeroed ones (version 2's look, to be
- * written through app->beams3); n = 0 goes back to version 2 views. */
-vfx_result game_app_set_anatomy(game_app *app, const vfx_beam3 *beams, uint32_t n);
+/* Spawns n beam entities (component "vfx.beam"), copies of beams (NULL: zeroed, of type
+ * VFX_TYPE_BEAM, to be filled through game_app_beams); they reach the plugin with beams_view's
+ * parameters. */
+vfx_result game_app_add_beams(game_app *app, const vfx_beam *beams, uint32_t n);
+/* The beams as one array to read or edit in place (keep each one's type), their number in
+ * *count (NULL, 0: none). Valid until the next structural change of the world. */
+vfx_beam *game_app_beams(game_app *app, uint32_t *count);
 /* Despawns every beam entity. */
 void game_app_clear_beams(game_app *app);
 /* Spawns a volume entity (component "vfx.volume") with a copy of the view; its arrays stay the
  * caller's and must outlive the entity. `out` may be NULL. */
-vfx_result game_app_add_volume(game_app *app, const vfx_volume_view2 *view, rt_entity *out);
-/* The volume entity's view, to edit in place (bump v1.revision when its data changed); NULL for
+vfx_result game_app_add_volume(game_app *app, const vfx_volume_view *view, rt_entity *out);
+/* The volume entity's view, to edit in place (bump revision when its data changed); NULL for
  * a stale id. Valid until the next structural change of the world. */
-vfx_volume_view2 *game_app_volume(game_app *app, rt_entity e);
+vfx_volume_view *game_app_volume(game_app *app, rt_entity e);
 /* Number of volume entities. */
 uint32_t game_app_volume_count(game_app *app);
 /* Despawns an entity (mesh, beam or volume); VFX_ERR_NOT_FOUND for a stale id. */

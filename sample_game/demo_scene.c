@@ -153,9 +153,7 @@ static vfx_result load_water(game_app *app, game_demo *demo, const rt_scene *sc)
         goto done;
     demo->particle_count = n;
     app->water = w->params;
-    app->water_kernel = w->kernel;
-    app->water_preset = w->preset;
-    app->water_diffuse = w->diffuse;
+    app->water_lab = w->lab;
     app->water_enabled = n > 0;
 done:
     free(px), free(py), free(pz);
@@ -208,7 +206,7 @@ static vfx_result volume_mesh(game_app *app, game_demo *demo, const rt_scene_vol
 
 /* The scene's transfer function as the plugin's table: every control point (one point is a
  * constant), at its position in [0,1] of the domain (version-2 view). */
-static void volume_transfer(game_demo *demo, const rt_scene_volume *v, vfx_volume_view2 *vv)
+static void volume_transfer(game_demo *demo, const rt_scene_volume *v, vfx_volume_view *vv)
 {
     uint32_t n = v->transfer_count;
     if (n == 0)
@@ -216,7 +214,7 @@ static void volume_transfer(game_demo *demo, const rt_scene_volume *v, vfx_volum
     const rt_scene_transfer_point *tp = v->transfer;
     double lo = tp[0].scalar, hi = tp[n - 1].scalar;
     if (!v->transfer_normalized)
-        vv->v1.scalar_min = (float)lo, vv->v1.scalar_max = (float)hi;
+        vv->scalar_min = (float)lo, vv->scalar_max = (float)hi;
     for (uint32_t i = 0; i < n; ++i) {
         memcpy(&demo->vol_transfer[4 * i], tp[i].rgba, 4 * sizeof(float));
         demo->vol_transfer_pos[i] = v->transfer_normalized ? tp[i].scalar
@@ -229,8 +227,8 @@ static void volume_transfer(game_demo *demo, const rt_scene_volume *v, vfx_volum
         demo->vol_transfer_pos[0] = 0.f, demo->vol_transfer_pos[1] = 1.f;
         n = 2;
     }
-    vv->v1.transfer_rgba = demo->vol_transfer;
-    vv->v1.transfer_count = n;
+    vv->transfer_rgba = demo->vol_transfer;
+    vv->transfer_count = n;
     vv->transfer_scalar = demo->vol_transfer_pos;
     demo->vol_transfer_count = n;
 }
@@ -278,24 +276,24 @@ static vfx_result load_volume(game_app *app, game_demo *demo, const rt_scene *sc
     vfx_result r = volume_mesh(app, demo, v);
     if (r)
         return r;
-    vfx_volume_view2 view, *vv = &view;
+    vfx_volume_view view, *vv = &view;
     memset(vv, 0, sizeof *vv);
-    vv->v1.size = sizeof *vv;
-    vv->v1.version = VFX_VOLUME_VIEW2_VERSION;
-    vv->v1.point_count = demo->vol_point_count;
-    vv->v1.tet_count = demo->vol_tet_count;
-    vv->v1.points = demo->vol_points;
-    vv->v1.tets = demo->vol_tets;
-    vv->v1.scalar = demo->vol_scalar;
+    vv->type = VFX_TYPE_VOLUME_VIEW;
+    vv->point_count = demo->vol_point_count;
+    vv->tet_count = demo->vol_tet_count;
+    vv->points = demo->vol_points;
+    vv->tets = demo->vol_tets;
+    vv->scalar = demo->vol_scalar;
     volume_transfer(demo, v, vv);
     vv->transfer_method = v->transfer_method;
-    vv->v1.ert_threshold = v->ert_threshold;
-    vv->v1.tiles = v->tiles;
-    vv->v1.update_c = v->update_c;
-    vv->v1.workers = v->workers;
-    vv->v1.disable = v->disable;
-    memcpy(vv->v1.model, v->model, sizeof vv->v1.model);
-    vv->v1.revision = 1;
+    vv->ert_threshold = v->ert_threshold;
+    vv->tiles = v->tiles;
+    vv->update_c = v->update_c;
+    vv->workers = v->workers;
+    demo->vol_lab = (vfx_lab_volume){.type = VFX_TYPE_LAB_VOLUME, .disable = v->disable};
+    vv->next = v->disable ? &demo->vol_lab : NULL; /* the lab's switches (the entity keeps the pointer) */
+    memcpy(vv->model, v->model, sizeof vv->model);
+    vv->revision = 1;
     if ((r = volume_prepare_animation(demo, v)))
         return r;
     return game_app_add_volume(app, vv, &demo->vol_entity);
@@ -303,12 +301,12 @@ static vfx_result load_volume(game_app *app, game_demo *demo, const rt_scene *sc
 
 /* The beams' light on the volume: per point, a Gaussian of its distance to each beam's axis
  * segment [M, M + L D] (in beam radii), scaled by gain. */
-static float beam_glow(const vfx_beam2 *beams, uint32_t beam_count, const rt_scene_volume_animation *an,
+static float beam_glow(const vfx_beam *beams, uint32_t beam_count, const rt_scene_volume_animation *an,
                        const float w[3])
 {
     float g = 0;
     for (uint32_t b = 0; b < beam_count; ++b) {
-        const vfx_beam *bm = &beams[b].v1;
+        const vfx_beam *bm = &beams[b];
         float d[3] = {w[0] - bm->head[0], w[1] - bm->head[1], w[2] - bm->head[2]};
         float dl = sqrtf(bm->dir[0] * bm->dir[0] + bm->dir[1] * bm->dir[1] + bm->dir[2] * bm->dir[2]);
         if (!(dl > 0))
@@ -332,9 +330,9 @@ static void animate_volume(game_app *app, game_demo *demo)
 {
     const rt_scene_volume *v = &demo->scene->volume;
     const rt_scene_volume_animation *an = &v->anim;
-    vfx_volume_view2 *vv = game_app_volume(app, demo->vol_entity);
+    vfx_volume_view *vv = game_app_volume(app, demo->vol_entity);
     uint32_t beam_count;
-    const vfx_beam2 *beams = game_app_beams(app, &beam_count);
+    const vfx_beam *beams = game_app_beams(app, &beam_count);
     const double t = app->time;
     if (an->ripple_amplitude > 0 || an->glow_gain > 0 || demo->vol_shield) {
         const float *M = v->model, *c = demo->vol_center;
@@ -362,7 +360,7 @@ static void animate_volume(game_app *app, game_demo *demo)
                                 beams, beam_count, t,
                                 {c[0], c[1], c[2]}, demo->vol_radius};
         game_shield_apply(demo->vol_shield, an, &sf, demo->vol_scalar);
-        vv->v1.revision++;
+        vv->revision++;
     }
     if (an->pulse_period_s > 0 && demo->vol_transfer_count >= 2) {
         /* the scene's table with 3 entries inserted: the band's edges (the table's own values
@@ -397,9 +395,9 @@ static void animate_volume(game_app *app, game_demo *demo)
         /* the animated table lives beside the scene's, which stays for the next frame */
         memcpy(demo->vol_anim_transfer, nr, (size_t)m * 4 * sizeof(float));
         memcpy(demo->vol_anim_pos, np_, (size_t)m * sizeof(float));
-        vv->v1.transfer_rgba = demo->vol_anim_transfer;
+        vv->transfer_rgba = demo->vol_anim_transfer;
         vv->transfer_scalar = demo->vol_anim_pos;
-        vv->v1.transfer_count = m;
+        vv->transfer_count = m;
     }
 }
 
@@ -410,23 +408,15 @@ static uint32_t beam_count_of(game_app *app)
     return n;
 }
 
-/* The scene's beams at time t into the beam entities (their count is the scene's, capped), and
- * their anatomy (version 3) beside them. */
+/* The scene's beams at time t into the beam entities (their count is the scene's, capped). */
 static void beams_at(game_app *app, game_demo *demo, double t)
 {
     uint32_t n;
-    vfx_beam2 *beams = game_app_beams(app, &n);
+    vfx_beam *beams = game_app_beams(app, &n);
     if (!n)
         return;
     uint32_t m = n < demo->beam_base_count ? n : demo->beam_base_count;
-    if (app->beams3_count != n && game_app_set_anatomy(app, NULL, n)) { /* no memory: version 2 only */
-        game_app_set_anatomy(app, NULL, 0);
-        rt_scene_beams2_at(demo->scene, t, beams, m, &app->joints[0][0], GAME_APP_MAX_JOINTS, &app->joint_count);
-        return;
-    }
-    rt_scene_beams3_at(demo->scene, t, app->beams3, m, &app->joints[0][0], GAME_APP_MAX_JOINTS, &app->joint_count);
-    for (uint32_t i = 0; i < m; ++i)
-        beams[i] = app->beams3[i].v2;
+    rt_scene_beams_at(demo->scene, t, beams, m, &app->joints[0][0], GAME_APP_MAX_JOINTS, &app->joint_count);
 }
 
 vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path, uint32_t effects_off)
@@ -462,8 +452,7 @@ vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path
     if (sc->beam_count && !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_BEAMS))) {
         demo->beam_base_count = sc->beam_count < GAME_APP_MAX_BEAMS ? sc->beam_count : GAME_APP_MAX_BEAMS;
         app->beams_view = sc->beams_view;
-        app->beams_view2 = sc->beams_view2;
-        app->beams_v2 = true;
+        app->beams_lab = sc->beams_lab;
         if ((r = game_app_add_beams(app, NULL, demo->beam_base_count)))
             return r;
         beams_at(app, demo, 0.0); /* the keyframes at t = 0 into the beam entities */
@@ -522,8 +511,8 @@ void game_demo_print_profile(game_app *app, FILE *out)
             fprintf(out, " %s %.4g", sim[i], rt_profiler_series_median(app->profiler, sim[i]));
         fprintf(out, "\n");
     }
-    vfx_stats2 st = {.size = sizeof st, .version = VFX_STATS2_VERSION};
-    if (app->api->get_stats(app->ctx, (vfx_stats *)&st) == VFX_OK && st.count) {
+    vfx_stats st = {.type = VFX_TYPE_STATS};
+    if (app->api->get_stats(app->ctx, &st) == VFX_OK && st.count) {
         fprintf(out, "plugin stats (last frame):");
         for (uint32_t i = 0; i < st.count; ++i)
             fprintf(out, " %s=%.4g", st.entries[i].name, st.entries[i].value);

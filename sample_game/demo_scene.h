@@ -28,7 +28,8 @@ typedef struct game_demo {
     struct game_shield *vol_shield; /* rim and hit ripples (volume_shield.h); NULL when off */
     bool vol_animated;
     rt_entity vol_entity;     /* the volume's entity (stale while the volume is switched off) */
-    vfx_volume_view2 vol_view; /* its view while switched off */
+    vfx_volume_view vol_view;  /* its view while switched off */
+    vfx_lab_volume vol_lab;    /* the scene's volume.disable (lab switches), chained into its view */
     uint32_t *vol_tets, vol_point_count, vol_tet_count;
 } game_demo;
 

@@ -197,9 +197,9 @@ uint32_t game_shield_faces(const game_shield *s)
  * axis segment (travelling from its source end M + L D towards its head M), or, for an axis
  * passing outside, the sphere's point nearest it while that gap is under two beam radii.
  * Bending beams (joints) are left out. Returns 0 when the beam does not reach the sphere. */
-static int strike_point(const vfx_beam2 *b, const double C[3], double R, double S[3], double *strength)
+static int strike_point(const vfx_beam *b, const double C[3], double R, double S[3], double *strength)
 {
-    const vfx_beam *v = &b->v1;
+    const vfx_beam *v = b;
     if (b->joint_count >= 2)
         return 0;
     double D[3] = {v->dir[0], v->dir[1], v->dir[2]}, m[3], dl = 0;

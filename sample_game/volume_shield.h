@@ -29,7 +29,7 @@ typedef struct game_shield_frame {
     const float *points;
     const float *model;
     double eye[3];
-    const vfx_beam2 *beams;
+    const vfx_beam *beams;
     uint32_t beam_count;
     double time;
     float center[3], radius;

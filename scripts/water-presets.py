@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The water quality presets' cost and error (docs/water.md "Presets"): each preset (low, medium,
-high, ultra; vfx_water_params3.preset, scene key water.quality.preset) drawn by
+high, ultra; vfx_water_params.preset, scene key water.quality.preset) drawn by
 `volfx-bench metaballs --preset P --reference` on the pool layout with a travelling wave (the
 surface moves every frame, so temporal reuse meets motion as in a game), in interleaved rounds.
 Cost: the bench's cpu_ms_per_frame (process CPU time, every llvmpipe thread, after a warm-up

@@ -98,7 +98,7 @@ vfx_result volfx_beam_validate(const vfx_beam *in, volfx_beam_d *out, char *err,
     out->a = in->a;
     out->b = in->b;
     out->eps = in->eps;
-    out->smooth = 0;      /* a v1 beam has the hard support; the effect sets the falloff */
+    out->smooth = 0;      /* hard support here; the effect sets the falloff */
     out->joint_count = 0; /* straight; volfx_beam_set_joints makes it a polyline */
     out->head_radius = out->orb_radius = out->orb_a = 0; /* no anatomy: the effect sets it */
     out->taper = out->surge = out->surge_inv_wl = out->surge_phase = 0;

@@ -27,7 +27,7 @@ typedef struct volfx_beam_d {
     int smooth; /* 1: densities times w(r) = (1 - (r/R)^2)^2 (the smooth support), 0: hard */
     int joint_count;                           /* 0: straight; 2..MAX: a polyline, head at J0 */
     double joints[VOLFX_BEAM_MAX_JOINTS][3];
-    /* the attack's anatomy (vfx_beam3; all 0: none, the field above exactly): the head sphere's
+    /* the attack's anatomy (vfx_beam; all 0: none, the field above exactly): the head sphere's
      * radius (0 -> radius), the orb at the source (the end M + L D, or the last joint) with its
      * radius (0: none) and strength, the body's radius profile (straight beams only):
      * R(u) = radius (1 - taper clamp(u / L, 0, 1)) (1 + surge bump(u surge_inv_wl + surge_phase)),

@@ -13,6 +13,7 @@
 #include "gpu/pass.h"
 #include "effect.h"
 #include "param_ranges.h"
+#include "volfx_lab.h"
 
 #define MAX_BEAMS (1u << 20)
 #define MAX_BLOOM_LEVELS 8
@@ -37,7 +38,7 @@ typedef struct beam_look {
     float intensity, exposure, flow_amount, flow_speed, flow_scale;
     float color[4];  /* the beam's colour; all 0 -> white */
     bool thesis;
-    float core, twist;    /* vfx_beam3: hue-keeping ramp's core (0: version 2's ramp), spiral */
+    float core, twist;    /* hue-keeping ramp's core (0: the hot or thesis ramp), spiral */
     uint32_t flow_kind;
     bool anatomy;         /* needs the ANATOMY program (head radius, orb, profile, core, spiral) */
 } beam_look;
@@ -55,7 +56,8 @@ typedef struct beams_state {
     uint32_t bloom_levels;                /* allocated levels */
     volfx_ubo ubo;
     volfx_beams_grid grid;                /* the target in pixels and tiles */
-    vfx_beams_view2 view;                 /* the host's answer; v1 answers padded with defaults */
+    vfx_beams_view view;                  /* the host's answer (next cleared) */
+    uint32_t march, march_samples;        /* vfx_lab_beams: the ray-marching baseline */
     double time;
     float dt;
     volfx_beams_impact *impact;           /* flares, sparks, glow, lights (beams_impact.h) */
@@ -71,32 +73,18 @@ typedef struct beams_state {
     uint32_t list_capacity, pairs;  /* list entries allocated, used this frame */
 } beams_state;
 
-/* Asks the host for its view, offering version 3, then version 2 as before issue 25 (a host
- * that answers only the exact version it knows); an older answer leaves the rest zero. */
-static vfx_result query_view(vfx_context *ctx, vfx_beams_view3 *v3)
+/* Asks the host for its view (a zeroed one with its type set); the host keeps the type. */
+static vfx_result query_view(vfx_context *ctx, vfx_beams_view *v)
 {
-    memset(v3, 0, sizeof *v3);
-    vfx_beams_view2 *v = &v3->v2;
-    v->v1.size = sizeof *v3;
-    v->v1.version = VFX_BEAMS_VIEW3_VERSION;
-    vfx_result r = ctx->host.beams(ctx->host.user, &v->v1);
-    if (r != VFX_OK) {
-        memset(v3, 0, sizeof *v3);
-        v->v1.size = sizeof *v;
-        v->v1.version = VFX_BEAMS_VIEW2_VERSION;
-        r = ctx->host.beams(ctx->host.user, &v->v1);
-    }
-    if (r == VFX_OK && v->v1.version == VFX_BEAMS_VIEW_VERSION)
-        memset((char *)v3 + sizeof v->v1, 0, sizeof *v3 - sizeof v->v1); /* nothing a v1 host wrote */
-    else if (r == VFX_OK && v->v1.version == VFX_BEAMS_VIEW2_VERSION)
-        memset((char *)v3 + sizeof *v, 0, sizeof *v3 - sizeof *v);
-    return r;
+    memset(v, 0, sizeof *v);
+    v->type = VFX_TYPE_BEAMS_VIEW;
+    return ctx->host.beams(ctx->host.user, v);
 }
 
 static bool beams_present(vfx_context *ctx)
 {
-    vfx_beams_view3 v;
-    return ctx->host.beams && query_view(ctx, &v) == VFX_OK && v.v2.v1.count > 0;
+    vfx_beams_view v;
+    return ctx->host.beams && query_view(ctx, &v) == VFX_OK && v.count > 0;
 }
 
 static void free_bloom(beams_state *s)
@@ -226,12 +214,10 @@ static vfx_result beams_resize(vfx_context *ctx, void *state, uint32_t w, uint32
     return s->ranges && s->cones ? VFX_OK : VFX_ERR_OUT_OF_MEMORY;
 }
 
-/* The look of a version 2 beam, checked; a version 1 beam gets version 1's look. */
-static vfx_result beam_look_of(vfx_context *ctx, uint32_t i, const vfx_beam2 *b2, beam_look *out)
+/* The look of a beam, checked. */
+static vfx_result beam_look_of(vfx_context *ctx, uint32_t i, const vfx_beam *b2, beam_look *out)
 {
     *out = (beam_look){.intensity = 1.f, .thesis = true};
-    if (!b2)
-        return VFX_OK;
     if (b2->falloff > VFX_BEAM_FALLOFF_HARD || b2->ramp > VFX_BEAM_RAMP_THESIS)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: falloff %u / ramp %u unknown", i,
                           b2->falloff, b2->ramp);
@@ -252,13 +238,11 @@ static vfx_result beam_look_of(vfx_context *ctx, uint32_t i, const vfx_beam2 *b2
     return VFX_OK;
 }
 
-/* A version 3 beam's anatomy, checked, into the field (bd) and the look; `time` drives the orb's
- * pulse and the surges. Version 2 beams keep none. */
-static vfx_result beam_anatomy_of(vfx_context *ctx, uint32_t i, const vfx_beam3 *b3, double time, volfx_beam_d *bd,
+/* A beam's anatomy, checked, into the field (bd) and the look; `time` drives the orb's pulse
+ * and the surges. */
+static vfx_result beam_anatomy_of(vfx_context *ctx, uint32_t i, const vfx_beam *b3, double time, volfx_beam_d *bd,
                                   beam_look *lk)
 {
-    if (!b3)
-        return VFX_OK;
     const float f[] = {b3->head_radius, b3->orb_radius, b3->orb_strength, b3->orb_pulse, b3->orb_pulse_hz, b3->taper,
                        b3->surge_amount, b3->surge_wavelength, b3->surge_speed, b3->flow_twist, b3->core};
     bool finite = true;
@@ -270,7 +254,7 @@ static vfx_result beam_anatomy_of(vfx_context *ctx, uint32_t i, const vfx_beam3 
         || !(b3->core >= 0 && b3->core <= 1) || b3->flow_kind > VFX_BEAM_FLOW_SPIRAL
         || !(fabsf(b3->flow_twist) <= 64))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
-                          "beams[%u]: vfx_beam3 needs finite head_radius, orb_radius, orb_strength >= 0, orb_pulse "
+                          "beams[%u]: vfx_beam needs finite head_radius, orb_radius, orb_strength >= 0, orb_pulse "
                           "in [0, 1], orb_pulse_hz >= 0, taper in [0, 0.95], surge_amount in [0, 4], "
                           "surge_wavelength >= 0, core in [0, 1], flow_kind 0..1, |flow_twist| <= 64 (got %g, %g, "
                           "%g, %g, %g, %g, %g, %g, %g, %u, %g)", i, (double)b3->head_radius, (double)b3->orb_radius,
@@ -301,36 +285,32 @@ static vfx_result beam_anatomy_of(vfx_context *ctx, uint32_t i, const vfx_beam3 
 static vfx_result beams_update(vfx_context *ctx, void *state, double time, float dt)
 {
     beams_state *s = state;
-    vfx_beams_view3 v3;
-    vfx_result r = query_view(ctx, &v3);
-    vfx_beams_view2 v = v3.v2;
-    uint32_t ver = v.v1.version;
-    if (r || (ver != VFX_BEAMS_VIEW_VERSION && ver != VFX_BEAMS_VIEW2_VERSION && ver != VFX_BEAMS_VIEW3_VERSION))
-        return volfx_fail(ctx, VFX_ERR_ABI, "beams: host view of version %u (need %u, %u or %u)", ver,
-                          VFX_BEAMS_VIEW_VERSION, VFX_BEAMS_VIEW2_VERSION, VFX_BEAMS_VIEW3_VERSION);
-    /* a version 3 answer without beams3 is a version 2 host that kept the offered version (the
-     * integration hosts do): read as version 2 */
-    const vfx_beam3 *b3 = ver == VFX_BEAMS_VIEW3_VERSION ? v3.beams3 : NULL;
-    if (ver == VFX_BEAMS_VIEW3_VERSION) {
-        v.v1.version = ver = VFX_BEAMS_VIEW2_VERSION;
-        if (b3) /* the version 2 parts are read from beams3 */
-            v.beams = NULL;
-    }
-    const vfx_beam2 *b2 = ver == VFX_BEAMS_VIEW2_VERSION ? v.beams : NULL;
-    if (v.v1.count > MAX_BEAMS || (!v.v1.beams && !b2 && !b3))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: %u beams (at most %u, non-NULL array)",
-                          v.v1.count, MAX_BEAMS);
-    if ((r = volfx_beams_view_check_ranges(ctx, &v, ver)))
+    vfx_beams_view v;
+    vfx_result r = query_view(ctx, &v);
+    if (r)
+        return volfx_fail(ctx, r == VFX_ERR_NOT_FOUND ? VFX_ERR_ABI : r, "beams: host beams failed (%d)", (int)r);
+    if ((r = volfx_check_type(ctx, &v, VFX_TYPE_BEAMS_VIEW, "beams: host beams view (vfx_beams_view)")))
         return r;
-    if (!(v.v1.saturate_c >= 0) || !isfinite(v.v1.saturate_c) || !(v.v1.far_distance >= 0)
-        || !isfinite(v.v1.far_distance))
+    const vfx_lab_beams *lab = volfx_chain_find(v.next, VFX_TYPE_LAB_BEAMS);
+    v.next = NULL;
+    const vfx_beam *beams = v.beams;
+    if (v.count > MAX_BEAMS || !beams)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: %u beams (at most %u, non-NULL array)",
+                          v.count, MAX_BEAMS);
+    if (lab && lab->method > VFX_BEAMS_METHOD_MARCH)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: vfx_lab_beams.method %u unknown (0 closed form, 1 march)",
+                          lab->method);
+    if ((r = volfx_beams_view_check_ranges(ctx, &v, lab ? lab->march_samples : 0)))
+        return r;
+    if (!(v.saturate_c >= 0) || !isfinite(v.saturate_c) || !(v.far_distance >= 0)
+        || !isfinite(v.far_distance))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: saturate_c and far_distance must be finite and >= 0");
     if (v.bloom > VFX_BEAMS_BLOOM_OFF || v.bloom_levels > MAX_BLOOM_LEVELS || !(v.bloom_strength >= 0)
         || !isfinite(v.bloom_strength))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
                           "beams: bloom %u (0..2), bloom_levels %u (0..%u), bloom_strength %g (finite, >= 0)",
                           v.bloom, v.bloom_levels, MAX_BLOOM_LEVELS, (double)v.bloom_strength);
-    uint32_t n = v.v1.count;
+    uint32_t n = v.count;
     if (n > s->capacity) {
         free_per_beam(ctx, s);
         s->beams = volfx_alloc(ctx, n * sizeof *s->beams);
@@ -348,29 +328,33 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
         return VFX_ERR_OUT_OF_MEMORY;
     char err[200];
     for (uint32_t i = 0; i < n; ++i) {
-        const vfx_beam2 *b2i = b3 ? &b3[i].v2 : b2 ? &b2[i] : NULL;
-        const vfx_beam *b = b2i ? &b2i->v1 : &v.v1.beams[i];
+        const vfx_beam *b2i = &beams[i];
+        char what[48];
+        snprintf(what, sizeof what, "beams[%u] (vfx_beam)", i);
+        if ((r = volfx_check_type(ctx, b2i, VFX_TYPE_BEAM, what)))
+            return r;
+        const vfx_beam *b = b2i;
         vfx_beam straight;
-        if (b2i && b2i->joint_count) { /* a bending beam's head, dir and length are ignored */
+        if (b2i->joint_count) { /* a bending beam's head, dir and length are ignored */
             straight = *b;
             straight.dir[0] = 1.f, straight.dir[1] = straight.dir[2] = 0.f;
             straight.head[0] = straight.head[1] = straight.head[2] = straight.length = 0.f;
             b = &straight;
         }
-        if ((r = volfx_beam_check_ranges(ctx, i, b, b2i)))
+        if ((r = volfx_beam_check_ranges(ctx, i, b)))
             return r;
         if (volfx_beam_validate(b, &s->beams[i], err, sizeof err))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: %s", i, err);
         if ((r = beam_look_of(ctx, i, b2i, &s->looks[i])))
             return r;
-        s->beams[i].smooth = b2i && b2i->falloff != VFX_BEAM_FALLOFF_HARD;
-        uint32_t jc = b2i ? b2i->joint_count : 0, jf = b2i ? b2i->joint_first : 0;
+        s->beams[i].smooth = b2i->falloff != VFX_BEAM_FALLOFF_HARD;
+        uint32_t jc = b2i->joint_count, jf = b2i->joint_first;
         if (jc && (!v.joints || jf > v.joint_count || jc > v.joint_count - jf))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: joints %u..%u outside the view's %u joints",
                               i, jf, jf + jc, v.joints ? v.joint_count : 0);
         if (jc && volfx_beam_set_joints(&s->beams[i], v.joints + 3 * (size_t)jf, jc, err, sizeof err))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: %s", i, err);
-        if ((r = beam_anatomy_of(ctx, i, b3 ? &b3[i] : NULL, time, &s->beams[i], &s->looks[i])))
+        if ((r = beam_anatomy_of(ctx, i, b2i, time, &s->beams[i], &s->looks[i])))
             return r;
         const float *c = b->color;
         bool none = c[0] == 0 && c[1] == 0 && c[2] == 0;
@@ -381,6 +365,8 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
     }
     s->count = n;
     s->view = v;
+    s->march = lab ? lab->method : 0;
+    s->march_samples = lab ? lab->march_samples : 0;
     s->time = time;
     s->dt = dt;
     return VFX_OK;
@@ -463,7 +449,7 @@ static void pack_beam(beams_state *s, uint32_t i, const double eye[3], float c, 
     memcpy(g->an0, an0, sizeof an0);
     memcpy(g->an1, an1, sizeof an1);
     memcpy(g->look2, look2, sizeof look2);
-    /* the thesis ramp tints with colour x intensity x 2^exposure (the v1 colour for v1 beams) */
+    /* the thesis ramp tints with colour x intensity x 2^exposure  */
     for (int k = 0; k < 4; ++k)
         g->color[k] = lk->color[k] * (lk->thesis && k < 3 ? lk->intensity * gain : 1.f);
     *bound = half + rmax;
@@ -569,26 +555,25 @@ static vfx_result gl_passes(vfx_context *ctx, beams_state *s, volfx_frame_target
         || (r = upload(ctx, s->list_buf, &s->list_cap, s->list, (size_t)s->pairs * sizeof(uint32_t)))
         || (r = upload(ctx, s->joint_buf, &s->joint_cap, s->joint_xyz, s->joint_used * sizeof s->joint_xyz[0])))
         return r;
-    bool march = s->view.v1.method == 1;
+    bool march = s->march == VFX_BEAMS_METHOD_MARCH;
     GLuint prog = integrate_program(ctx, s, march);
     if (!prog)
         return VFX_ERR_GL;
     /* bloom: on by default for version 2 hosts, off for version 1 ones (their image as it was) */
-    bool v2 = s->view.v1.version == VFX_BEAMS_VIEW2_VERSION;
-    bool bloom = v2 && s->view.bloom != VFX_BEAMS_BLOOM_OFF;
+    bool bloom = s->view.bloom != VFX_BEAMS_BLOOM_OFF;
     uint32_t levels = s->view.bloom_levels ? s->view.bloom_levels : 5;
     while (levels > 1 && ((s->grid.width >> levels) == 0 || (s->grid.height >> levels) == 0))
         levels--; /* a tiny target: no level below 1x1 */
     if (bloom && levels != s->bloom_levels && (r = make_bloom(ctx, s, levels)))
         return r;
     float strength = s->view.bloom_strength > 0 ? s->view.bloom_strength : 0.6f;
-    float far = s->view.v1.far_distance > 0 ? s->view.v1.far_distance : t->far_plane;
+    float far = s->view.far_distance > 0 ? s->view.far_distance : t->far_plane;
     if (!(far > 0))
         far = 1e30f;
     beams_block blk = {.far = far, .c = c, .tile_px = VOLFX_BEAMS_TILE_PX, .tiles_x = (int32_t)s->grid.tiles_x,
-                       .samples = (int32_t)(s->view.v1.march_samples ? s->view.v1.march_samples : 32),
+                       .samples = (int32_t)(s->march_samples ? s->march_samples : 32),
                        .has_water = t->water_dist != 0,
-                       .smooth_saturation = s->view.v1.saturation == VFX_SATURATE_SMOOTH,
+                       .smooth_saturation = s->view.saturation == VFX_SATURATE_SMOOTH,
                        .bloom = bloom, .bloom_gain = strength / (float)levels};
     volfx_ubo_update(&s->ubo, &blk, sizeof blk);
     volfx_ubo_bind(&s->ubo, 3);
@@ -623,7 +608,7 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
 {
     (void)frame;
     beams_state *s = state;
-    float c = s->view.v1.saturate_c > 0 ? s->view.v1.saturate_c : 1.f;
+    float c = s->view.saturate_c > 0 ? s->view.saturate_c : 1.f;
     vfx_result r = bin_beams(ctx, s, targets, c);
     return r ? r : gl_passes(ctx, s, targets, c);
 }

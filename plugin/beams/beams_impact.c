@@ -246,7 +246,7 @@ vfx_result volfx_beams_impact_render(vfx_context *ctx, volfx_beams_impact *im, c
     bool alive = im->impacts || im->sparks_alive || im->glows_alive;
     volfx_stat_set(ctx, "beams.impacts", im->impacts);
     volfx_stat_set(ctx, "beams.sparks", im->sparks_alive);
-    vfx_lights none = {.size = sizeof none, .version = VFX_LIGHTS_VERSION};
+    vfx_lights none = {.type = VFX_TYPE_LIGHTS};
     volfx_beams_impact_lights(im, &none);
     volfx_stat_set(ctx, "beams.lights", none.total);
     if (!live && !alive)

@@ -1,7 +1,7 @@
 /* gl.h — the GL the plugin calls. Inside the plugin (VOLFX_GL_TABLE, set for its sources only)
  * every GL command is a field of a table generated at build time from Khronos' gl.xml for exactly
  * the commands the plugin's sources use (gen_gl.py -> volfx_gl.h/.c) and filled at create through
- * the host's vfx_host_api.gl_get_proc_address; the plugin links no GL loader of its own.
+ * the host's vfx_context_desc.gl_get_proc_address; the plugin links no GL loader of its own.
  *
  * `glFoo(...)` expands to `volfx_gl_current->Foo(...)`: a per-thread pointer to the table of the
  * context whose API call is running, set on entry to every call (volfx_gl_bind). Why a

@@ -17,6 +17,7 @@
 #include "gpu/pass.h"
 #include "effect.h"
 #include "param_ranges.h"
+#include "volfx_lab.h"
 #include "tet_render.h"
 
 /* std140 mirror of shaders/volume/distance.frag's own block (the camera comes from the frame
@@ -40,7 +41,8 @@ typedef struct volume_state {
     GLsync up_fence[2];         /* the texture upload from up_pbo[k] is done once signalled */
     int up_slot;                /* buffer holding the last image */
     float *max_dist;            /* width*height ray distances to the nearest opaque surface */
-    vfx_volume_view2 view;
+    vfx_volume_view view;       /* the host's (next cleared) */
+    uint32_t lab_disable;       /* vfx_lab_volume.disable: VFX_VOLUME_NO_* */
     tet_mesh mesh;              /* points into the host's arrays (no copy) */
     uint64_t revision;
     float data_min, data_max;
@@ -166,28 +168,19 @@ static vfx_result volume_resize(vfx_context *ctx, void *state, uint32_t w, uint3
     return VFX_OK;
 }
 
-/* The host's view of volume 0 as version 2 (a version-1 host leaves the version-2 fields 0). */
-static vfx_result fetch_view(vfx_context *ctx, vfx_volume_view2 *v)
+/* The host's view of volume 0 (a zeroed one with its type set); the host keeps the type. */
+static vfx_result fetch_view(vfx_context *ctx, vfx_volume_view *v)
 {
     memset(v, 0, sizeof *v);
-    v->v1.size = sizeof *v;
-    v->v1.version = VFX_VOLUME_VIEW2_VERSION;
-    if (ctx->host.volume(ctx->host.user, 0, &v->v1) != VFX_OK)
+    v->type = VFX_TYPE_VOLUME_VIEW;
+    if (ctx->host.volume(ctx->host.user, 0, v) != VFX_OK)
         return volfx_fail(ctx, VFX_ERR_ABI, "volume[0]: the host's volume callback failed");
-    const uint32_t ver = v->v1.version;
-    if (ver == VFX_VOLUME_VIEW_VERSION) {
-        memset((char *)v + sizeof v->v1, 0, sizeof *v - sizeof v->v1);
-        return VFX_OK;
-    }
-    if (ver != VFX_VOLUME_VIEW2_VERSION)
-        return volfx_fail(ctx, VFX_ERR_ABI, "volume[0]: host view of version %u (this plugin reads %u and %u)",
-                          ver, VFX_VOLUME_VIEW_VERSION, VFX_VOLUME_VIEW2_VERSION);
-    return VFX_OK;
+    return volfx_check_type(ctx, v, VFX_TYPE_VOLUME_VIEW, "volume[0]: host volume view (vfx_volume_view)");
 }
 
-static vfx_result check_transfer(vfx_context *ctx, const vfx_volume_view2 *v)
+static vfx_result check_transfer(vfx_context *ctx, const vfx_volume_view *v)
 {
-    const vfx_volume_view *v1 = &v->v1;
+    const vfx_volume_view *v1 = v;
     if (!v1->transfer_rgba)
         return VFX_OK;
     if (v1->transfer_count < 2 || v1->transfer_count > VFX_VOLUME_MAX_TRANSFER)
@@ -220,11 +213,13 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
         volfx_log(ctx, VFX_LOG_WARN, "volume: the host has %u volumes; only the first is drawn", n);
         s->warned_many = true;
     }
-    vfx_volume_view2 v;
+    vfx_volume_view v;
     vfx_result r = fetch_view(ctx, &v);
     if (r != VFX_OK)
         return r;
-    const vfx_volume_view *v1 = &v.v1;
+    const vfx_lab_volume *lab = volfx_chain_find(v.next, VFX_TYPE_LAB_VOLUME);
+    v.next = NULL;
+    const vfx_volume_view *v1 = &v;
     if (!v1->points || !v1->tets || !v1->scalar || v1->point_count == 0 || v1->tet_count == 0)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
                           "volume[0]: needs points, tets and scalar arrays and counts > 0 (%u points, %u tets)",
@@ -242,7 +237,7 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: scalar_min %g / scalar_max %g not finite",
                           (double)v1->scalar_min, (double)v1->scalar_max);
     /* tet indices are checked once per revision: the renderer trusts them */
-    const vfx_volume_view *old = &s->view.v1;
+    const vfx_volume_view *old = &s->view;
     if (v1->revision != s->revision || v1->tets != old->tets || v1->scalar != old->scalar ||
         v1->points != old->points || v1->point_count != old->point_count || v1->tet_count != old->tet_count) {
         for (uint64_t i = 0; i < (uint64_t)v1->tet_count * 4; ++i)
@@ -264,6 +259,7 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
         s->last_key = 0; /* new data: never reuse the old image, whatever the key says */
     }
     s->view = v;
+    s->lab_disable = lab ? lab->disable : 0;
     memset(&s->mesh, 0, sizeof s->mesh);
     s->mesh.point_count = v1->point_count;
     s->mesh.tet_count = v1->tet_count;
@@ -318,7 +314,7 @@ static vfx_result read_distances(vfx_context *ctx, volume_state *s, int slot)
  * (evenly spaced, or at transfer_scalar) over the domain. */
 static void make_tf(volume_state *s, tet_tf *tf)
 {
-    const vfx_volume_view *v = &s->view.v1;
+    const vfx_volume_view *v = &s->view;
     *tf = (tet_tf){.smin = v->scalar_min, .smax = v->scalar_max, .tau_lo = 0.2f, .tau_hi = 3.0f,
                    .color_lo = {0.1f, 0.3f, 0.9f}, .color_hi = {1.0f, 0.85f, 0.3f}};
     if (!(v->scalar_max > v->scalar_min))
@@ -363,7 +359,7 @@ static uint64_t hash_bytes(uint64_t h, const void *data, size_t n)
 /* Everything the image depends on besides the mesh arrays (whose changes bump the revision). */
 static uint64_t render_key(const volume_state *s, const tet_camera *cam, const tet_tf *tf, const tet_options *o)
 {
-    const vfx_volume_view *v = &s->view.v1;
+    const vfx_volume_view *v = &s->view;
     uint64_t h = 0x51ed270b0a1f3c5dull;
     const void *ptrs[3] = {v->points, v->tets, v->scalar};
     h = hash_bytes(h, &v->revision, sizeof v->revision);
@@ -385,7 +381,7 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
                                 volfx_frame_targets *targets)
 {
     volume_state *s = state;
-    const vfx_volume_view *v = &s->view.v1;
+    const vfx_volume_view *v = &s->view;
     /* this frame's distances go to one pack buffer; the render uses the previous frame's */
     const int slot = (int)(s->frame & 1u), prev = slot ^ 1;
     (void)frame; /* everything comes from the frame gate's targets */
@@ -409,9 +405,9 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
     make_tf(s, &tf);
     tet_options o;
     tet_options_default(&o);
-    o.ert = !(v->disable & VFX_VOLUME_NO_ERT);
-    o.share = !(v->disable & VFX_VOLUME_NO_SHARE);
-    o.dlb = !(v->disable & VFX_VOLUME_NO_DLB);
+    o.ert = !(s->lab_disable & VFX_VOLUME_NO_ERT);
+    o.share = !(s->lab_disable & VFX_VOLUME_NO_SHARE);
+    o.dlb = !(s->lab_disable & VFX_VOLUME_NO_DLB);
     if (v->ert_threshold > 0) o.ert_threshold = v->ert_threshold;
     if (v->tiles) o.tiles_d = (int)v->tiles;
     if (v->update_c) o.update_c = (int)v->update_c;

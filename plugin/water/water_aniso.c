@@ -32,17 +32,12 @@ struct volfx_water_aniso {
     float grid_cs, grid_lo[3];
 };
 
-vfx_result volfx_water_kernel_params_check(vfx_context *ctx, const vfx_water_params2 *in, uint32_t version,
+vfx_result volfx_water_kernel_params_check(vfx_context *ctx, const vfx_water_params *in,
                                            volfx_water_kernel_params *out)
 {
-    vfx_water_params2 z;
-    if (version < VFX_WATER_PARAMS2_VERSION) {
-        memset(&z, 0, sizeof z);
-        in = &z;
-    }
     if (in->kernel > VFX_WATER_KERNEL_ANISOTROPIC)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
-                          "water: vfx_water_params2.kernel %u unknown (0 default, 1 isotropic, 2 anisotropic)", in->kernel);
+                          "water: vfx_water_params.kernel %u unknown (0 default, 1 isotropic, 2 anisotropic)", in->kernel);
     struct { const char *name; float v, lo, hi, def; float *dst; } f[] = {
         {"aniso_radius", in->aniso_radius, 0.5f, 4.0f, 1.5f, &out->radius},
         {"aniso_max_stretch", in->aniso_max_stretch, 1.0f, 64.0f, 2.0f, &out->max_stretch},
@@ -56,12 +51,12 @@ vfx_result volfx_water_kernel_params_check(vfx_context *ctx, const vfx_water_par
             continue;
         }
         if (!(v >= f[k].lo && v <= f[k].hi))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params2.%s %g outside [%g, %g] (0: default %g)",
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.%s %g outside [%g, %g] (0: default %g)",
                               f[k].name, v, f[k].lo, f[k].hi, f[k].def);
         *f[k].dst = v;
     }
     if (in->aniso_min_neighbours > 10000)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params2.aniso_min_neighbours %u above 10000",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.aniso_min_neighbours %u above 10000",
                           in->aniso_min_neighbours);
     out->min_neighbours = in->aniso_min_neighbours ? in->aniso_min_neighbours : 16;
     out->kernel = in->kernel == VFX_WATER_KERNEL_ANISOTROPIC ? VFX_WATER_KERNEL_ANISOTROPIC : VFX_WATER_KERNEL_ISOTROPIC;
@@ -164,14 +159,14 @@ vfx_result volfx_water_aniso_columns_chunk(vfx_context *ctx, volfx_water_aniso *
             g[k] = kernel[6 * (size_t)i + k];
             if (!isfinite(g[k]))
                 return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
-                                  "water: particle chunk %u, particle %u: kernel (vfx_particle_view2.kernel) entry %d is %g",
+                                  "water: particle chunk %u, particle %u: kernel (vfx_particle_view.kernel) entry %d is %g",
                                   chunk, i, k, g[k]);
         }
         eigen_sym3(g, ev);
         for (int k = 0; k < 3; ++k) {
             if (!(ev[k] >= COLUMN_MIN && ev[k] <= COLUMN_MAX))
                 return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
-                                  "water: particle chunk %u, particle %u: kernel (vfx_particle_view2.kernel) has eigenvalue %g, "
+                                  "water: particle chunk %u, particle %u: kernel (vfx_particle_view.kernel) has eigenvalue %g, "
                                   "outside [%g, %g] (symmetric positive definite, xx xy xz yy yz zz)",
                                   chunk, i, ev[k], COLUMN_MIN, COLUMN_MAX);
             double s = (radius ? radius[i] : 1.0) / ev[k];

@@ -11,7 +11,7 @@
 
 typedef struct volfx_water_aniso volfx_water_aniso;
 
-/* The kernel parameters of vfx_water_params2, checked and with defaults applied. */
+/* The kernel parameters of vfx_water_params, checked and with defaults applied. */
 typedef struct volfx_water_kernel_params {
     uint32_t kernel;          /* VFX_WATER_KERNEL_ISOTROPIC or _ANISOTROPIC (never DEFAULT) */
     float radius;             /* neighbourhood radius / h */
@@ -27,7 +27,7 @@ typedef struct volfx_water_kernel_params {
 
 /* Checks the v2 part of the host's parameters (version 1: all defaults) and fills out; an
  * out-of-range field fails with VFX_ERR_INVALID_ARGUMENT naming it. */
-vfx_result volfx_water_kernel_params_check(vfx_context *ctx, const vfx_water_params2 *in, uint32_t version,
+vfx_result volfx_water_kernel_params_check(vfx_context *ctx, const vfx_water_params *in,
                                            volfx_water_kernel_params *out);
 
 /* Makes the (empty) state; NULL on allocation failure. */

@@ -35,21 +35,16 @@ struct volfx_water_diffuse {
     bool stepped;         /* a step ran since the pool was made or cleared */
 };
 
-vfx_result volfx_water_diffuse_params_check(vfx_context *ctx, const vfx_water_params4 *in, uint32_t version,
+vfx_result volfx_water_diffuse_params_check(vfx_context *ctx, const vfx_water_params *in,
                                             volfx_water_diffuse_params *out)
 {
-    vfx_water_params4 z;
-    if (version < VFX_WATER_PARAMS4_VERSION) {
-        memset(&z, 0, sizeof z);
-        in = &z;
-    }
     if (in->diffuse_max > DIFFUSE_MAX_CAP)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params4.diffuse_max %u above %u",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.diffuse_max %u above %u",
                           in->diffuse_max, DIFFUSE_MAX_CAP);
     out->max = in->diffuse_max ? in->diffuse_max : 32768;
     for (int k = 0; k < 3; ++k)
         if (!isfinite(in->gravity[k]) || fabsf(in->gravity[k]) > 1e4f)
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params4.gravity[%d] %g not finite or above 1e4",
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.gravity[%d] %g not finite or above 1e4",
                               k, in->gravity[k]);
     if (in->gravity[0] == 0 && in->gravity[1] == 0 && in->gravity[2] == 0) {
         out->gravity[0] = 0; out->gravity[1] = -9.81f; out->gravity[2] = 0;
@@ -70,12 +65,12 @@ vfx_result volfx_water_diffuse_params_check(vfx_context *ctx, const vfx_water_pa
         for (int e = 0; e < 2; ++e) {
             float v = pairs[k].v[e];
             if (!(v >= 0 && v <= 1e4f))
-                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params4.%s[%d] %g outside [0, 1e4]",
+                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.%s[%d] %g outside [0, 1e4]",
                                   pairs[k].name, e, v);
             pairs[k].dst[e] = v == 0 ? pairs[k].def[e] : v;
         }
         if (!(pairs[k].dst[0] < pairs[k].dst[1]))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params4.%s [%g, %g]: min must be below max",
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.%s [%g, %g]: min must be below max",
                               pairs[k].name, pairs[k].dst[0], pairs[k].dst[1]);
     }
     struct { const char *name; float v, hi, def; float *dst; } f[] = {
@@ -87,7 +82,7 @@ vfx_result volfx_water_diffuse_params_check(vfx_context *ctx, const vfx_water_pa
     };
     for (size_t k = 0; k < sizeof f / sizeof f[0]; ++k) {
         if (!(f[k].v >= 0 && f[k].v <= f[k].hi))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params4.%s %g outside [0, %g] (0: default %g)",
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.%s %g outside [0, %g] (0: default %g)",
                               f[k].name, f[k].v, f[k].hi, f[k].def);
         *f[k].dst = f[k].v == 0 ? f[k].def : f[k].v;
     }
@@ -95,7 +90,7 @@ vfx_result volfx_water_diffuse_params_check(vfx_context *ctx, const vfx_water_pa
     out->bubble_above = in->bubble_above ? in->bubble_above : 20;
     if (out->spray_below > 10000 || out->bubble_above > 10000 || out->spray_below > out->bubble_above)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
-                          "water: vfx_water_params4.spray_below %u and bubble_above %u: each <= 10000, spray_below <= bubble_above",
+                          "water: vfx_water_params.spray_below %u and bubble_above %u: each <= 10000, spray_below <= bubble_above",
                           out->spray_below, out->bubble_above);
     return VFX_OK;
 }

@@ -17,7 +17,7 @@
 
 typedef struct volfx_water_diffuse volfx_water_diffuse;
 
-/* The diffuse parameters of vfx_water_params4, checked and with defaults applied. */
+/* The diffuse parameters of vfx_water_params, checked and with defaults applied. */
 typedef struct volfx_water_diffuse_params {
     uint32_t max;                 /* pool cap */
     float gravity[3];             /* scene units / s^2 */
@@ -30,7 +30,7 @@ typedef struct volfx_water_diffuse_params {
 
 /* Checks the v4 part of the host's parameters (version < 4: all defaults) and fills out; an
  * out-of-range field fails with VFX_ERR_INVALID_ARGUMENT naming it. */
-vfx_result volfx_water_diffuse_params_check(vfx_context *ctx, const vfx_water_params4 *in, uint32_t version,
+vfx_result volfx_water_diffuse_params_check(vfx_context *ctx, const vfx_water_params *in,
                                             volfx_water_diffuse_params *out);
 
 /* Makes the (empty) state; NULL on allocation failure. */

@@ -3,6 +3,7 @@
  * (water_paper.c), GRID (water_grid.c), TILE, ours (water_tile.c, with water_aniso.c's kernels);
  * spray, foam and bubbles in water_diffuse.c. */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "water/water_effect.h"
@@ -137,26 +138,32 @@ static vfx_result ensure_groups(vfx_context *ctx, water_state *s, uint32_t total
     return VFX_OK;
 }
 
-/* Asks the host for chunk `c` (offering version 2 of the view; a version-1 answer has no kernel
- * column) and checks what it names: positions as CPU columns or a GL buffer, not both (the same
- * for velocities), GL buffer columns that fit their buffers. */
+/* Asks the host for chunk `c` (a typed, zeroed view; the ABI's GPU columns are reserved and
+ * refused until this plugin reads them) and checks what it names: positions as CPU columns or a
+ * GL buffer, not both (the same for velocities), GL buffer columns that fit their buffers. */
 static vfx_result query_chunk(vfx_context *ctx, uint32_t c, water_chunk *out)
 {
-    vfx_particle_view2 v;
+    vfx_particle_view v;
     memset(&v, 0, sizeof v);
-    v.v1.size = sizeof v;
-    v.v1.version = VFX_PARTICLE_VIEW2_VERSION;
-    vfx_result r = ctx->host.particle_chunk(ctx->host.user, c, &v.v1);
+    v.type = VFX_TYPE_PARTICLE_VIEW;
+    vfx_result r = ctx->host.particle_chunk(ctx->host.user, c, &v);
     if (r)
         return volfx_fail(ctx, r, "water: particle chunk %u failed (%d)", c, (int)r);
-    if (!(v.v1.version == VFX_PARTICLE_VIEW2_VERSION && v.v1.size >= sizeof v))
-        v.kernel = NULL; /* nothing a version-1 host wrote */
+    char what[64];
+    snprintf(what, sizeof what, "water: particle chunk %u (vfx_particle_view)", c);
+    if ((r = volfx_check_type(ctx, &v, VFX_TYPE_PARTICLE_VIEW, what)))
+        return r;
+    if (v.gpu_pos.buffer || v.gpu_vel.buffer || v.gpu_kernel.buffer)
+        return volfx_fail_id(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_GPU_PARTICLES_UNSUPPORTED,
+                             "water: particle chunk %u names GL buffers (gpu_pos %u, gpu_vel %u, gpu_kernel %u): "
+                             "GPU-resident particles are not supported by this plugin yet (give the CPU columns)",
+                             c, v.gpu_pos.buffer, v.gpu_vel.buffer, v.gpu_kernel.buffer);
     memset(out, 0, sizeof *out);
-    out->count = v.v1.count;
-    out->revision = v.v1.revision;
-    memcpy(out->pos, v.v1.pos, sizeof out->pos);
-    memcpy(out->vel, v.v1.vel, sizeof out->vel);
-    out->radius = v.v1.radius;
+    out->count = v.count;
+    out->revision = v.revision;
+    memcpy(out->pos, v.pos, sizeof out->pos);
+    memcpy(out->vel, v.vel, sizeof out->vel);
+    out->radius = v.radius;
     out->kernel = v.kernel;
     volfx_gpu_column cols[3] = {{0}};
     if (ctx->debug.water_gpu_chunk && (r = ctx->debug.water_gpu_chunk(ctx->host.user, c, cols)))
@@ -185,51 +192,27 @@ static vfx_result query_chunk(vfx_context *ctx, uint32_t c, water_chunk *out)
     return VFX_OK;
 }
 
-/* The version of the parameters the host wrote into the offered struct (1 to 4). */
-static uint32_t params_version(const vfx_water_params4 *p4)
-{
-    const vfx_water_params *v1 = &p4->v3.v2.v1;
-    if (v1->version == VFX_WATER_PARAMS4_VERSION && v1->size >= sizeof *p4)
-        return VFX_WATER_PARAMS4_VERSION;
-    if (v1->version == VFX_WATER_PARAMS3_VERSION && v1->size >= sizeof p4->v3)
-        return VFX_WATER_PARAMS3_VERSION;
-    if (v1->version == VFX_WATER_PARAMS2_VERSION && v1->size >= sizeof p4->v3.v2)
-        return VFX_WATER_PARAMS2_VERSION;
-    return VFX_WATER_PARAMS_VERSION;
-}
-
 /* This update's parameters, resolved and checked, into *res (and the state's kernel, preset and
  * diffuse parameters). */
 static vfx_result read_params(vfx_context *ctx, water_state *s, volfx_water_resolved *res)
 {
-    /* version 4 offered; a host that answers an older version is offered the older ones in
-     * turn (a host written for version 2 may test for exactly 2), then keeps what it wrote
-     * (the rest stays 0: defaults) */
-    vfx_water_params4 p4;
-    static const struct { uint32_t version, size; } offers[] = {
-        {VFX_WATER_PARAMS4_VERSION, sizeof(vfx_water_params4)}, {VFX_WATER_PARAMS3_VERSION, sizeof(vfx_water_params3)},
-        {VFX_WATER_PARAMS2_VERSION, sizeof(vfx_water_params2)}};
-    for (size_t o = 0; o < sizeof offers / sizeof offers[0]; ++o) {
-        memset(&p4, 0, sizeof p4);
-        p4.v3.v2.v1.size = offers[o].size;
-        p4.v3.v2.v1.version = offers[o].version;
-        if (!ctx->host.water_params)
-            break;
-        vfx_result r = ctx->host.water_params(ctx->host.user, &p4.v3.v2.v1);
+    vfx_water_params wp;
+    memset(&wp, 0, sizeof wp);
+    wp.type = VFX_TYPE_WATER_PARAMS;
+    if (ctx->host.water_params) {
+        vfx_result r = ctx->host.water_params(ctx->host.user, &wp);
         if (r != VFX_OK && r != VFX_ERR_NOT_FOUND)
             return volfx_fail(ctx, r, "water: host water_params failed (%d)", (int)r);
         if (r == VFX_ERR_NOT_FOUND) {
-            memset(&p4, 0, sizeof p4);
-            break;
+            memset(&wp, 0, sizeof wp);
+            wp.type = VFX_TYPE_WATER_PARAMS;
         }
-        if (params_version(&p4) >= offers[o].version)
-            break;
+        if ((r = volfx_check_type(ctx, &wp, VFX_TYPE_WATER_PARAMS, "water: host water_params (vfx_water_params)")))
+            return r;
     }
-    uint32_t pver = params_version(&p4);
-    vfx_result kr = volfx_water_params_resolve(ctx, &p4.v3, pver < VFX_WATER_PARAMS3_VERSION ? pver : VFX_WATER_PARAMS3_VERSION,
-                                               res);
+    vfx_result kr = volfx_water_params_resolve(ctx, &wp, res);
     if (!kr)
-        kr = volfx_water_diffuse_params_check(ctx, &p4, pver, &s->dp);
+        kr = volfx_water_diffuse_params_check(ctx, &wp, &s->dp);
     if (kr)
         return kr;
     s->kp = res->kp;
@@ -681,7 +664,7 @@ static vfx_result paper_finish(vfx_context *ctx, water_state *s, const vfx_frame
  * position buffer (the grid reads one) and the shading on. */
 static bool diffuse_on(const water_state *s)
 {
-    return !(s->params.disable & (VFX_WATER_NO_DIFFUSE | VFX_WATER_NO_SHADING)) && s->group_count == 1 &&
+    return !(s->params.disable & (VFX_WATER_NO_SPRAY | VFX_WATER_NO_SHADING)) && s->group_count == 1 &&
            volfx_water_diffuse_ready(s->diffuse);
 }
 
@@ -718,7 +701,7 @@ static vfx_result diffuse_frame(vfx_context *ctx, water_state *s, const vfx_fram
 static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
                                volfx_frame_targets *targets)
 {
-    const vfx_water_params *p = &s->params;
+    const volfx_water_core *p = &s->params;
     targets->water_dist = ctx->water_dist_tex;
     volfx_stat_set(ctx, "water.position_buffers", s->group_count);
     if (s->group_count > 1 && (p->method != VFX_WATER_METHOD_PAPER || (p->disable & VFX_WATER_NO_BLEND)))
@@ -749,8 +732,8 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
         return volfx_fail(ctx, VFX_ERR_UNSUPPORTED,
                           "water: %s is drawn by method TILE (3) only; method %u draws the isotropic kernel of radius h "
                           "(scene key water.quality.kernel / method)",
-                          s->kp.kernel == VFX_WATER_KERNEL_ANISOTROPIC ? "the anisotropic kernel (vfx_water_params2.kernel)"
-                                                                        : "a per-particle radius or kernel column (vfx_particle_view.radius, vfx_particle_view2.kernel)",
+                          s->kp.kernel == VFX_WATER_KERNEL_ANISOTROPIC ? "the anisotropic kernel (vfx_water_params.kernel)"
+                                                                        : "a per-particle radius or kernel column (vfx_particle_view.radius, kernel)",
                           p->method);
     if (p->method == VFX_WATER_METHOD_PAPER) {
         r = volfx_water_paper_march(ctx, s, frame);

@@ -83,7 +83,7 @@ static void grid_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_grid_
     glUniform3iv(volfx_gpu_uniform(ctx, prog, "u_dims"), 1, dims);
 }
 
-void volfx_water_march_bind(vfx_context *ctx, GLuint prog, GLuint dist_tex, const vfx_water_params *p,
+void volfx_water_march_bind(vfx_context *ctx, GLuint prog, GLuint dist_tex, const volfx_water_core *p,
                           const vfx_frame_view *frame, const volfx_frame_targets *targets)
 {
     glBindImageTexture(0, dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
@@ -101,7 +101,7 @@ void volfx_water_march_bind(vfx_context *ctx, GLuint prog, GLuint dist_tex, cons
 vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const volfx_water_grid_input *in,
                                  const vfx_frame_view *frame, const volfx_frame_targets *targets)
 {
-    const vfx_water_params *p = in->params;
+    const volfx_water_core *p = in->params;
     float g0[3], cs;
     int dims[3];
     grid_layout(in, g0, &cs, dims);

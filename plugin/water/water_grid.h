@@ -6,6 +6,7 @@
 
 #include "gpu/gl.h"
 #include "effect.h"
+#include "water_params.h"
 
 typedef struct volfx_water_grid volfx_water_grid;
 
@@ -15,7 +16,7 @@ typedef struct volfx_water_grid_input {
     uint32_t count;                  /* particles in the columns, non-finite ones included */
     uint32_t finite;                 /* of which finite (0: nothing to draw) */
     const float *lo, *hi;            /* box of the finite particles */
-    const vfx_water_params *params;  /* defaults already applied */
+    const volfx_water_core *params;  /* defaults already applied */
     uint32_t width, height;
     GLuint dist_tex;                 /* R32F target: distance along the ray or -1 */
     GLuint counters;                 /* the effect's counter buffer (fenced readback ring) */
@@ -37,7 +38,7 @@ vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const 
  * program prog: dist_tex as image 0, the scene depth on unit 1, the ray (inverse view-projection,
  * eye), the sampling rule (h, T, step, sample cap), refinement (off with VFX_WATER_NO_REFINE)
  * and whether there is scene depth. */
-void volfx_water_march_bind(vfx_context *ctx, GLuint prog, GLuint dist_tex, const vfx_water_params *p,
+void volfx_water_march_bind(vfx_context *ctx, GLuint prog, GLuint dist_tex, const volfx_water_core *p,
                           const vfx_frame_view *frame, const volfx_frame_targets *targets);
 
 #endif

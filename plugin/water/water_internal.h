@@ -86,16 +86,16 @@ typedef struct water_state {
     uint32_t count;        /* particles uploaded (NaN ones included: the shaders skip them) */
     uint32_t nan_count;
     uint32_t width, height;
-    vfx_water_params params;
-    volfx_water_kernel_params kp; /* the kernel (vfx_water_params2), checked */
-    uint32_t preset;       /* vfx_water_params3.preset resolved (LOW..ULTRA) */
+    volfx_water_core params;
+    volfx_water_kernel_params kp; /* the kernel (vfx_water_params), checked */
+    uint32_t preset;       /* vfx_water_params.preset resolved (LOW..ULTRA) */
     float auto_h;          /* h from the particles' spacing (0: not measured yet) */
     uint32_t auto_h_count; /* the particle count it was measured at */
     volfx_water_aniso *aniso; /* per-particle kernels (TILE), made when asked for or given */
     volfx_water_grid *grid;  /* GRID baseline state, made the first time GRID is asked for */
     volfx_water_tile *tile;  /* TILE lists (TILE, and PAPER's finishing pass), made when needed */
     volfx_water_diffuse *diffuse; /* spray, foam and bubbles from the host's velocities */
-    volfx_water_diffuse_params dp; /* their parameters (vfx_water_params4), checked */
+    volfx_water_diffuse_params dp; /* their parameters (vfx_water_params), checked */
     float dt;              /* the last update's step, seconds (the diffuse particles') */
     bool diffuse_due;      /* an update since the last diffuse step */
     float lo[3], hi[3];    /* box of the finite particles (GPU chunks: read back late, grown) */

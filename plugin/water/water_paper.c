@@ -26,7 +26,7 @@ GLuint volfx_water_make_tex(GLenum fmt, uint32_t w, uint32_t h, int levels, cons
 
 void volfx_water_frame_upload(water_state *s, const vfx_frame_view *frame, const volfx_frame_targets *targets)
 {
-    const vfx_water_params *p = &s->params;
+    const volfx_water_core *p = &s->params;
     /* farthest point of the particles' box grown by h: beyond it no sample can be inside */
     float t_end = 0;
     for (int c = 0; c < 8; ++c) {
@@ -181,7 +181,7 @@ static void nearest_face_pass(vfx_context *ctx, const water_state *s, GLuint pro
  * exit from each particle's ball of radius h(1 - T)). */
 vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const vfx_frame_view *frame)
 {
-    const vfx_water_params *p = &s->params;
+    const volfx_water_core *p = &s->params;
     const int cull = !(p->disable & VFX_WATER_NO_PYRAMID);
     int level = (int)p->pyramid_level;
     if (level >= s->pyr_levels)
@@ -233,7 +233,7 @@ static void refine_step_begin(const water_state *s, GLuint prog, const vfx_frame
 
 vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame)
 {
-    const vfx_water_params *p = &s->params;
+    const volfx_water_core *p = &s->params;
     const uint32_t dis = p->disable;
     const int ns = (dis & VFX_WATER_NO_PACK4) ? 1 : 4;
     const int cull = !(dis & VFX_WATER_NO_PYRAMID);

@@ -33,34 +33,49 @@ static const preset_def PRESETS[] = {
 #define STEP_MIN_H (1.0f / 1024.0f)
 #define STEP_MAX_H 1.0f
 
-vfx_result volfx_water_params_resolve(vfx_context *ctx, const vfx_water_params3 *in, uint32_t version,
-                                      volfx_water_resolved *out)
+vfx_result volfx_water_params_resolve(vfx_context *ctx, const vfx_water_params *in, volfx_water_resolved *out)
 {
     memset(out, 0, sizeof *out);
     /* every number against its documented range first (plugin/param_ranges.c): a negative or
      * NaN h, threshold, step, absorption or ior, a colour of NaN or 1e30, an ior of Inf were
      * silently replaced by defaults or gave NaN pixels */
-    vfx_result rr = volfx_water_params_check_ranges(ctx, in, version);
+    vfx_result rr = volfx_water_params_check_ranges(ctx, in);
     if (rr)
         return rr;
-    vfx_water_params p = in->v2.v1;
-    uint32_t preset = version >= VFX_WATER_PARAMS3_VERSION ? in->preset : 0;
+    const vfx_lab_water *lab = volfx_chain_find(in->next, VFX_TYPE_LAB_WATER);
+    if (in->features_off & ~(uint32_t)(VFX_WATER_NO_SPRAY | VFX_WATER_NO_SSR))
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.features_off 0x%x has bits other "
+                          "than VFX_WATER_NO_SPRAY | VFX_WATER_NO_SSR (0x%x)", in->features_off,
+                          (unsigned)(VFX_WATER_NO_SPRAY | VFX_WATER_NO_SSR));
+    if (in->method != VFX_WATER_METHOD_DEFAULT && in->method != VFX_WATER_METHOD_TILE
+        && in->method != VFX_WATER_METHOD_PAPER)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                          "water: vfx_water_params.method %u unknown (0 default = tile, 3 tile, 4 paper)", in->method);
+    if (lab && (lab->disable & ~VFX_WATER_DISABLE_ALL))
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_lab_water.disable 0x%x has unknown bits",
+                          lab->disable);
+    volfx_water_core p = {in->h, in->threshold, in->max_samples, in->step, in->refine_iters, in->pyramid_level,
+                          in->features_off | (lab ? lab->disable : 0u), in->method,
+                          {in->color[0], in->color[1], in->color[2]}, in->absorption, in->ior};
+    if (lab && lab->method)
+        p.method = lab->method;
+    uint32_t preset = in->preset;
     if (preset > VFX_WATER_PRESET_ULTRA)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
-                          "water: vfx_water_params3.preset %u unknown (0 default, 1 low, 2 medium, 3 high, 4 ultra)", preset);
+                          "water: vfx_water_params.preset %u unknown (0 default, 1 low, 2 medium, 3 high, 4 ultra)", preset);
     if (preset == VFX_WATER_PRESET_DEFAULT)
         preset = VFX_WATER_PRESET_MEDIUM;
     const preset_def *d = &PRESETS[preset];
     if (p.method > VFX_WATER_METHOD_PAPER)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
-                          "water: vfx_water_params.method %u unknown (0 default = tile, 1 brute, 2 grid, 3 tile, 4 paper)",
+                          "water: vfx_lab_water.method %u unknown (0 default = tile, 1 brute, 2 grid, 3 tile, 4 paper)",
                           p.method);
     if (p.method == VFX_WATER_METHOD_DEFAULT)
         p.method = VFX_WATER_METHOD_TILE;
-    vfx_water_params2 k2 = version >= VFX_WATER_PARAMS2_VERSION ? in->v2 : (vfx_water_params2){0};
+    vfx_water_params k2 = *in;
     if (k2.kernel == VFX_WATER_KERNEL_DEFAULT)
         k2.kernel = p.method == VFX_WATER_METHOD_TILE ? d->kernel : VFX_WATER_KERNEL_ISOTROPIC;
-    vfx_result r = volfx_water_kernel_params_check(ctx, &k2, VFX_WATER_PARAMS2_VERSION, &out->kp);
+    vfx_result r = volfx_water_kernel_params_check(ctx, &k2, &out->kp);
     if (r)
         return r;
     if (p.method == VFX_WATER_METHOD_TILE)

@@ -6,22 +6,33 @@
 
 #include "effect.h"
 #include "water_aniso.h"
+#include "volfx_lab.h"
+
+/* The fields every method reads, resolved: the host's, with the lab's disable bits and method
+ * override folded in. */
+typedef struct volfx_water_core {
+    float h, threshold;
+    uint32_t max_samples;
+    float step;
+    uint32_t refine_iters, pyramid_level;
+    uint32_t disable;      /* VFX_WATER_NO_* (lab bits | features_off | the preset's) */
+    uint32_t method;       /* never 0 */
+    float color[3], absorption, ior;
+} volfx_water_core;
 
 /* The resolved parameters of one frame. */
 typedef struct volfx_water_resolved {
-    vfx_water_params p;          /* every default applied, method never 0; h and step 0 while
+    volfx_water_core p;          /* every default applied, method never 0; h and step 0 while
                                     h waits for the particles' spacing (volfx_water_params_set_h) */
     volfx_water_kernel_params kp;
     uint32_t preset;             /* VFX_WATER_PRESET_LOW .. _ULTRA (never DEFAULT) */
     float step_div;              /* step = h / step_div when the host gave no step */
 } volfx_water_resolved;
 
-/* Reads the host's parameters (`in` holds `version`'s fields; the rest are 0), checks them and
- * applies the preset; an unknown method, kernel or preset, or a value outside its documented
- * range that would hang or silently draw nothing, fails with VFX_ERR_INVALID_ARGUMENT naming
- * the field. */
-vfx_result volfx_water_params_resolve(vfx_context *ctx, const vfx_water_params3 *in, uint32_t version,
-                                      volfx_water_resolved *out);
+/* Reads the host's parameters (and a vfx_lab_water in their chain), checks them and applies the
+ * preset; an unknown method, kernel or preset, or a value outside its documented range that
+ * would hang or silently draw nothing, fails with VFX_ERR_INVALID_ARGUMENT naming the field. */
+vfx_result volfx_water_params_resolve(vfx_context *ctx, const vfx_water_params *in, volfx_water_resolved *out);
 /* Sets h and the preset's step that depends on it; an explicit step outside [h/1024, h] fails
  * with VFX_ERR_INVALID_ARGUMENT naming it. */
 vfx_result volfx_water_params_set_h(vfx_context *ctx, volfx_water_resolved *r, float h);

@@ -131,7 +131,7 @@ static const GLint *prog_locs(volfx_water_tile *t, GLuint prog)
 /* Fills tile.comp's block for this frame (once, after the bins' sizes are known). */
 static void tile_block_upload(const volfx_water_tile *t, const volfx_water_tile_input *in)
 {
-    const vfx_water_params *p = in->params;
+    const volfx_water_core *p = in->params;
     tile_block b;
     memset(&b, 0, sizeof b);
     memcpy(b.view_proj, in->view_proj, sizeof b.view_proj);
@@ -407,7 +407,7 @@ static bool camera_cut(const volfx_water_tile *t, const volfx_water_tile_input *
 vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
                                   const vfx_frame_view *frame, GLuint grad_tex, GLuint back_tex)
 {
-    const vfx_water_params *p = in->params;
+    const volfx_water_core *p = in->params;
     bool temporal = !(p->disable & VFX_WATER_NO_TEMPORAL);
     bool half = !(p->disable & VFX_WATER_NO_HALF_RES);
     uint32_t px = in->width * in->height;

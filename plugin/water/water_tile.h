@@ -9,6 +9,7 @@
 
 #include "gpu/gl.h"
 #include "effect.h"
+#include "water_params.h"
 
 typedef struct volfx_water_tile volfx_water_tile;
 
@@ -16,7 +17,7 @@ typedef struct volfx_water_tile volfx_water_tile;
 typedef struct volfx_water_tile_input {
     const GLuint *cols;              /* x, y, z position columns (SSBOs of `count` floats) */
     uint32_t count;                  /* particles in the columns, non-finite ones included */
-    const vfx_water_params *params;  /* defaults already applied */
+    const volfx_water_core *params;  /* defaults already applied */
     uint32_t width, height;
     GLuint dist_tex;                 /* R32F target: distance along the ray or -1 */
     GLuint counters;                 /* the effect's counter buffer (fenced readback ring) */

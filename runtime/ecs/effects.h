@@ -1,9 +1,9 @@
 /* effects.h — the beam and volume components: what the host hands the plugin as beams and
  * tetrahedral volumes, one entity each. Names are the contract:
- *   "vfx.beam"   vfx_beam2 (its v1 member is what a version-1 beams view carries); beam
+ *   "vfx.beam"   vfx_beam (of type VFX_TYPE_BEAM); beam
  *                entities carry only this component, so they share one table and its column
  *                is the contiguous array a beams view points at (no copy)
- *   "vfx.volume" vfx_volume_view2 (version 2; its arrays are owned by whoever spawned it) */
+ *   "vfx.volume" vfx_volume_view (its arrays are owned by whoever spawned it) */
 #ifndef RT_ECS_EFFECTS_H
 #define RT_ECS_EFFECTS_H
 
@@ -20,9 +20,9 @@ typedef struct rt_effect_components {
 vfx_result rt_effects_register(rt_world *world, rt_effect_components *out);
 /* Spawns n beam entities, copies of beams (NULL: zeroed); their ids into out_ids when not NULL. */
 vfx_result rt_beams_spawn(rt_world *world, const rt_effect_components *ec, uint32_t n,
-                          const vfx_beam2 *beams, rt_entity *out_ids);
+                          const vfx_beam *beams, rt_entity *out_ids);
 /* The beams as one array (the beam table's column) and their number in *count; NULL and 0
  * when there are none. Valid until the next structural change of the world. */
-vfx_beam2 *rt_beams_column(rt_world *world, const rt_effect_components *ec, uint32_t *count);
+vfx_beam *rt_beams_column(rt_world *world, const rt_effect_components *ec, uint32_t *count);
 
 #endif

@@ -39,7 +39,7 @@ void rt_gl_context_swap(rt_gl_context *ctx);
 bool rt_gl_context_should_close(rt_gl_context *ctx);
 /* GL_RENDERER string, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)". */
 const char *rt_gl_context_renderer(const rt_gl_context *ctx);
-/* Proc loader matching vfx_host_api.gl_get_proc_address (user = the rt_gl_context). */
+/* Proc loader matching vfx_context_desc.gl_get_proc_address (user = the rt_gl_context). */
 void *rt_gl_context_get_proc(void *user, const char *name);
 /* The window's framebuffer size (headless: the desc size). */
 void rt_gl_context_size(rt_gl_context *ctx, uint32_t *width, uint32_t *height);

@@ -9,42 +9,33 @@
 
 struct rt_plugin_host {
     void *handle; /* NULL for a static plugin */
-    vfx_plugin_api3 api3; /* offered as version 3; an older plugin fills its version's part */
+    vfx_plugin_api api;
 };
 
 /* Calls the entry and checks what came back, so a broken plugin never reaches the game. */
-static vfx_result handshake(vfx_plugin_entry_fn entry, uint32_t abi, const vfx_host_api *host,
+static vfx_result handshake(vfx_plugin_entry_fn entry, uint32_t abi, const vfx_context_desc *host,
                             const rt_logger *log, rt_plugin_host *h, const char *where)
 {
-    memset(&h->api3, 0, sizeof h->api3);
-    vfx_plugin_api *api = &h->api3.v2.v1;
-    api->size = sizeof h->api3;
-    api->version = VFX_PLUGIN_API_VERSION;
+    memset(&h->api, 0, sizeof h->api);
+    vfx_plugin_api *api = &h->api;
+    api->type = VFX_TYPE_PLUGIN_API;
     vfx_result r = entry(abi, host, api);
     if (r != VFX_OK) {
         rt_logf(log, VFX_LOG_ERROR, "plugin %s refused the host (host ABI %u): %s", where, abi,
                  vfx_result_name(r));
         return r;
     }
-    static const size_t sizes[4] = {0, sizeof(vfx_plugin_api), sizeof(vfx_plugin_api2), sizeof(vfx_plugin_api3)};
-    if (api->version < VFX_PLUGIN_API_VERSION || api->version > VFX_PLUGIN_API3_VERSION
-        || api->size != sizes[api->version]) {
-        rt_logf(log, VFX_LOG_ERROR,
-                 "plugin %s: plugin API version %u (size %u), this host needs version %u (size %zu), "
-                 "2 (size %zu) or 3 (size %zu)", where, api->version, api->size, VFX_PLUGIN_API_VERSION,
-                 sizes[1], sizes[2], sizes[3]);
-        return VFX_ERR_ABI;
-    }
-    if (!api->create || !api->destroy || !api->resize || !api->update || !api->render
-        || !api->get_stats || !api->last_error || !api->read_raw
-        || (api->version == VFX_PLUGIN_API3_VERSION && !h->api3.get_lights)) {
-        rt_logf(log, VFX_LOG_ERROR, "plugin %s: function table has NULL entries", where);
+    if (api->type != VFX_TYPE_PLUGIN_API || !api->create || !api->destroy || !api->resize || !api->update
+        || !api->render || !api->warm_up || !api->set_program_cache || !api->get_stats || !api->get_lights
+        || !api->last_error || !api->read_raw || !api->resolve_defaults) {
+        rt_logf(log, VFX_LOG_ERROR, "plugin %s: function table of type %u has NULL entries", where,
+                (unsigned)api->type);
         return VFX_ERR_ABI;
     }
     return VFX_OK;
 }
 
-vfx_result rt_plugin_host_load_as(const char *path, uint32_t abi, const vfx_host_api *host,
+vfx_result rt_plugin_host_load_as(const char *path, uint32_t abi, const vfx_context_desc *host,
                                    const rt_logger *log, rt_plugin_host **out)
 {
     if (!path || !out)
@@ -94,13 +85,13 @@ vfx_result rt_plugin_host_load_as(const char *path, uint32_t abi, const vfx_host
     return VFX_OK;
 }
 
-vfx_result rt_plugin_host_load(const char *path, const vfx_host_api *host, const rt_logger *log,
+vfx_result rt_plugin_host_load(const char *path, const vfx_context_desc *host, const rt_logger *log,
                                 rt_plugin_host **out)
 {
     return rt_plugin_host_load_as(path, VFX_ABI_VERSION, host, log, out);
 }
 
-vfx_result rt_plugin_host_load_static(vfx_plugin_entry_fn entry, const vfx_host_api *host,
+vfx_result rt_plugin_host_load_static(vfx_plugin_entry_fn entry, const vfx_context_desc *host,
                                        const rt_logger *log, rt_plugin_host **out)
 {
     if (!entry || !out)
@@ -118,12 +109,7 @@ vfx_result rt_plugin_host_load_static(vfx_plugin_entry_fn entry, const vfx_host_
     return VFX_OK;
 }
 
-const vfx_plugin_api *rt_plugin_host_api(const rt_plugin_host *h) { return h ? &h->api3.v2.v1 : NULL; }
-
-const vfx_plugin_api3 *rt_plugin_host_api3(const rt_plugin_host *h)
-{
-    return h && h->api3.v2.v1.version >= VFX_PLUGIN_API3_VERSION ? &h->api3 : NULL;
-}
+const vfx_plugin_api *rt_plugin_host_api(const rt_plugin_host *h) { return h ? &h->api : NULL; }
 
 void rt_plugin_host_unload(rt_plugin_host *h)
 {

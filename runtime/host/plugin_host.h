@@ -13,18 +13,16 @@ typedef struct rt_plugin_host rt_plugin_host;
  * VFX_ERR_IO (cannot open: dlerror text), VFX_ERR_NOT_FOUND (no vfx_plugin_entry symbol),
  * VFX_ERR_ABI (versions differ: the message names both), VFX_ERR_INVALID_ARGUMENT (an empty
  * path: dlopen("") would open the program itself). */
-vfx_result rt_plugin_host_load(const char *path, const vfx_host_api *host, const rt_logger *log,
+vfx_result rt_plugin_host_load(const char *path, const vfx_context_desc *host, const rt_logger *log,
                                 rt_plugin_host **out);
 /* Same, with an entry function linked into the executable (static plugin). */
-vfx_result rt_plugin_host_load_static(vfx_plugin_entry_fn entry, const vfx_host_api *host,
+vfx_result rt_plugin_host_load_static(vfx_plugin_entry_fn entry, const vfx_context_desc *host,
                                        const rt_logger *log, rt_plugin_host **out);
 /* Like load, but passes `abi_version` instead of ours (tests of the refusal path). */
-vfx_result rt_plugin_host_load_as(const char *path, uint32_t abi_version, const vfx_host_api *host,
+vfx_result rt_plugin_host_load_as(const char *path, uint32_t abi_version, const vfx_context_desc *host,
                                    const rt_logger *log, rt_plugin_host **out);
 /* The plugin's function table (valid until unload). */
 const vfx_plugin_api *rt_plugin_host_api(const rt_plugin_host *h);
-/* Its version 3 table (get_lights), or NULL for a plugin of version 1 or 2. */
-const vfx_plugin_api3 *rt_plugin_host_api3(const rt_plugin_host *h);
 /* Unloads (dlclose) the plugin. Destroy every context first. NULL allowed. */
 void rt_plugin_host_unload(rt_plugin_host *h);
 

@@ -229,7 +229,7 @@ void rt_profiler_gpu_stats(rt_profiler *p, const vfx_stats *stats)
 {
     if (!p || !stats)
         return;
-    const uint32_t cap = stats->version == VFX_STATS2_VERSION ? VFX_STATS2_MAX : VFX_STATS_MAX;
+    const uint32_t cap = VFX_STATS_MAX;
     for (uint32_t i = 0; i < stats->count && i < cap; ++i) {
         const char *n = stats->entries[i].name;
         double v = stats->entries[i].value;

@@ -40,8 +40,7 @@ void rt_profiler_cpu(rt_profiler *p, const char *name, double cpu_ms);
 void rt_profiler_counter(void *p, const char *name, double value);
 /* Records the plugin's stats for the current frame: every "<pass>.gpu_ms" (a GPU series, in the
  * stats' order) with its "<pass>.gpu_depth", gpu.timer_lag_frames, and the counters drawn as
- * counter tracks (water.particles, water.pixels_sample_cap, volume.cells_skipped_ert). Version 1
- * or 2 stats (a vfx_stats2 passed as vfx_stats: its entries are read up to VFX_STATS2_MAX). */
+ * counter tracks (water.particles, water.pixels_sample_cap, volume.cells_skipped_ert). */
 void rt_profiler_gpu_stats(rt_profiler *p, const vfx_stats *stats);
 /* Summary over frames [skip, end): skip drops warm-up frames. Exact while those frames are all
  * in the ring of max_frames; beyond, from a bounded histogram (percentiles within 0.05%, mean and

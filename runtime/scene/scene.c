@@ -265,8 +265,8 @@ static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
             s->camera.eye[i] = (float)((double)s->camera.eye[i] - c->origin[i]);
             s->camera.target[i] = (float)((double)s->camera.target[i] - c->origin[i]);
         }
-    s->beams_view = (vfx_beams_view){.size = sizeof s->beams_view, .version = VFX_BEAMS_VIEW_VERSION,
-                                     .saturation = VFX_SATURATE_SMOOTH, .saturate_c = 1};
+    s->beams_view = (vfx_beams_view){.type = VFX_TYPE_BEAMS_VIEW, .saturation = VFX_SATURATE_SMOOTH, .saturate_c = 1};
+    s->beams_lab = (vfx_lab_beams){.type = VFX_TYPE_LAB_BEAMS};
     const cJSON *v;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "camera")) && (r = parse_camera(c, v, &s->camera)))
         return r;
@@ -274,7 +274,7 @@ static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
         return r;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "beams")) && (r = rt_scene_parse_beams(c, v, s)))
         return r;
-    if ((v = cJSON_GetObjectItemCaseSensitive(root, "beam_settings")) && (r = rt_scene_parse_beam_settings(c, v, &s->beams_view, &s->beams_view2)))
+    if ((v = cJSON_GetObjectItemCaseSensitive(root, "beam_settings")) && (r = rt_scene_parse_beam_settings(c, v, &s->beams_view, &s->beams_lab)))
         return r;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "water"))) {
         s->has_water = true;

@@ -11,6 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <volfx/volfx.h>
+#include <volfx_lab.h>
 
 #include "core/log.h"
 
@@ -52,9 +53,9 @@ typedef enum rt_scene_beam_param {
     RT_BEAM_PARAM_B,          /* 1 */
     RT_BEAM_PARAM_EPS,        /* 1 */
     RT_BEAM_PARAM_COLOR,      /* 4 */
-    RT_BEAM_PARAM_INTENSITY,  /* 1 (vfx_beam2) */
-    RT_BEAM_PARAM_EXPOSURE,   /* 1 (vfx_beam2) */
-    RT_BEAM_PARAM_HEAD_RADIUS,  /* 1 (vfx_beam3, the attack's anatomy) */
+    RT_BEAM_PARAM_INTENSITY,  /* 1 */
+    RT_BEAM_PARAM_EXPOSURE,   /* 1 */
+    RT_BEAM_PARAM_HEAD_RADIUS,  /* 1 (the attack's anatomy) */
     RT_BEAM_PARAM_ORB_RADIUS,   /* 1 */
     RT_BEAM_PARAM_ORB_STRENGTH, /* 1 */
     RT_BEAM_PARAM_TAPER,        /* 1 */
@@ -70,10 +71,10 @@ typedef struct rt_scene_track {
 } rt_scene_track;
 
 typedef struct rt_scene_beam {
-    vfx_beam base;                                  /* values when not animated */
+    vfx_beam base;      /* geometry (head .. eps, color) when not animated; the rest unused */
     rt_scene_track tracks[RT_BEAM_PARAM_COUNT];   /* count 0 = not animated */
     float loop_s;                                   /* >0: time wraps modulo loop_s */
-    vfx_beam3 look;     /* falloff, ramp, intensity, exposure, flow, anatomy; v2.v1 is unused */
+    vfx_beam look;      /* falloff, ramp, intensity, exposure, flow, anatomy; geometry unused */
     uint32_t joint_count;                  /* 0 straight, 2..RT_SCENE_MAX_JOINTS: bending beam */
     float joints[RT_SCENE_MAX_JOINTS][3];  /* values when not animated */
     rt_scene_track joint_track;            /* dim 3 * joint_count; count 0 = not animated */
@@ -116,15 +117,10 @@ typedef struct rt_scene_water {
     bool no_slip;                    /* tank walls (all six faces) with wall-law friction */
     uint32_t solver;                 /* water.simulation.solver: 0 "wcsph", 1 "pbf" (rt_sph_solver); "pbf" */
     uint32_t settle_steps;           /* rt_sph_settle's steps at most before frame 0 (default 120; 0: none) */
-    /* rendering (seed 000), a full vfx_water_params with size/version filled */
+    /* rendering (seed 000): every field, type filled (next unset: the host chains lab) */
     vfx_water_params params;
-    /* water.quality.kernel (vfx_water_params2.kernel): anisotropic for method TILE unless the
-     * scene says "isotropic"; isotropic for the other methods (they draw no other) */
-    uint32_t kernel;
-    /* water.quality.preset (vfx_water_params3.preset; 0: the plugin's default, medium) */
-    uint32_t preset;
-    /* water.diffuse: the diffuse particles' fields of version 4 (its v3 member unused) */
-    vfx_water_params4 diffuse;
+    /* the lab's switches the scene asks for (water.quality.disable, baseline methods) */
+    vfx_lab_water lab;
 } rt_scene_water;
 
 typedef struct rt_scene_transfer_point {
@@ -184,8 +180,8 @@ typedef struct rt_scene {
     rt_scene_mesh *meshes;
     uint32_t beam_count;
     rt_scene_beam *beams;
-    vfx_beams_view beams_view;       /* saturation, saturate_c, far_distance, method, samples */
-    vfx_beams_view2 beams_view2;     /* bloom settings (its v1 member is unused: beams_view) */
+    vfx_beams_view beams_view;       /* saturation, saturate_c, far_distance, bloom settings */
+    vfx_lab_beams beams_lab;         /* method, march samples (the ray-marching baseline) */
     bool has_water;
     rt_scene_water water;
     bool has_volume;
@@ -204,17 +200,13 @@ vfx_result rt_scene_load_file(const char *path, const rt_logger *logger, rt_scen
 void rt_scene_free(rt_scene *scene);
 
 /* Writes the beams at `time` (keyframes interpolated linearly, clamped at the ends, wrapped by
- * loop_s) into out[0..n); returns how many were written (min(n, beam_count)). */
-uint32_t rt_scene_beams_at(const rt_scene *scene, double time, vfx_beam *out, uint32_t n);
-/* The same as version 2 beams: with falloff, ramp, intensity, exposure and flow; the joints of
- * bending beams go to joints (xyz triples, room for joint_cap of them; beams whose joints do
- * not fit are left straight), each beam's joint_first indexing into it; *joint_count (may be
- * NULL) gets how many were written. */
-uint32_t rt_scene_beams2_at(const rt_scene *scene, double time, vfx_beam2 *out, uint32_t n, float *joints,
-                            uint32_t joint_cap, uint32_t *joint_count);
-/* The same as version 3 beams (the attack's anatomy, docs/scene-format.md), joints as above. */
-uint32_t rt_scene_beams3_at(const rt_scene *scene, double time, vfx_beam3 *out, uint32_t n, float *joints,
-                            uint32_t joint_cap, uint32_t *joint_count);
+ * loop_s) into out[0..n), each with its type, falloff, ramp, intensity, exposure, flow and
+ * anatomy; the joints of bending beams go to joints (xyz triples, room for joint_cap of them;
+ * beams whose joints do not fit, or all with joints NULL, are left straight), each beam's
+ * joint_first indexing into it; *joint_count (may be NULL) gets how many were written. Returns
+ * how many beams were written (min(n, beam_count)). */
+uint32_t rt_scene_beams_at(const rt_scene *scene, double time, vfx_beam *out, uint32_t n, float *joints,
+                           uint32_t joint_cap, uint32_t *joint_count);
 /* Linear interpolation of one track at time t into out[0..dim); clamped at the ends. */
 void rt_scene_track_eval(const rt_scene_track *track, double t, float *out);
 

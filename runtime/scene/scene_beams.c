@@ -15,7 +15,7 @@ static const int beam_param_dim[RT_BEAM_PARAM_COUNT] = {3, 3, 1, 1, 1, 1, 1, 4, 
 static const char *const beam_keyframe_names[] = {
     "head", "dir", "length", "radius", "a", "b", "eps", "color", "intensity", "exposure",
     "head_radius", "orb_radius", "orb_strength", "taper", "surge", "joints", NULL};
-/* The anatomy's ranges (vfx_beam3; the plugin checks the same in beams_effect.c). */
+/* The anatomy's ranges (vfx_beam; the plugin checks the same in beams_effect.c). */
 static const range TAPER_RANGE = {0, 0.95, false};
 static const range SURGE_RANGE = {0, 4, false};
 
@@ -38,11 +38,11 @@ static range beam_param_range(int k)
     }
 }
 
-static float *beam_param_ptr(vfx_beam *b, vfx_beam3 *look, int k)
+static float *beam_param_ptr(vfx_beam *b, vfx_beam *look, int k)
 {
     switch (k) {
-    case RT_BEAM_PARAM_INTENSITY: return &look->v2.intensity;
-    case RT_BEAM_PARAM_EXPOSURE: return &look->v2.exposure;
+    case RT_BEAM_PARAM_INTENSITY: return &look->intensity;
+    case RT_BEAM_PARAM_EXPOSURE: return &look->exposure;
     case RT_BEAM_PARAM_HEAD_RADIUS: return &look->head_radius;
     case RT_BEAM_PARAM_ORB_RADIUS: return &look->orb_radius;
     case RT_BEAM_PARAM_ORB_STRENGTH: return &look->orb_strength;
@@ -189,7 +189,7 @@ static vfx_result optional_object(pctx *c, const cJSON *e, const char *P, const 
 
 /* orb {pulse, pulse_hz}, surge {wavelength, speed} and core (the keyframable sizes are
  * parameters). Scenes default the core to 0.2: the hue-keeping ramp (0 keeps version 2's). */
-static vfx_result parse_anatomy(pctx *c, const cJSON *e, const char *P, vfx_beam3 *look)
+static vfx_result parse_anatomy(pctx *c, const cJSON *e, const char *P, vfx_beam *look)
 {
     static const char *const orb_keys[] = {"pulse", "pulse_hz", NULL};
     static const char *const surge_keys[] = {"wavelength", "speed", NULL};
@@ -212,13 +212,13 @@ static vfx_result parse_anatomy(pctx *c, const cJSON *e, const char *P, vfx_beam
 
 /* falloff, ramp, flow and the anatomy's settings of one beam (intensity, exposure and the
  * anatomy's sizes are parameters, keyframable). */
-static vfx_result parse_look(pctx *c, const cJSON *e, const char *P, vfx_beam3 *look3)
+static vfx_result parse_look(pctx *c, const cJSON *e, const char *P, vfx_beam *look3)
 {
     static const char *const falloffs[] = {"smooth", "hard", NULL};
     static const char *const ramps[] = {"hot", "thesis", NULL};
     static const char *const flow_keys[] = {"amount", "speed", "scale", "kind", "twist", NULL};
     static const char *const kinds[] = {"noise", "spiral", NULL};
-    vfx_beam2 *look = &look3->v2;
+    vfx_beam *look = look3;
     uint32_t f = 0, rp = 0;
     vfx_result r = rt_scene_get_enum(c, e, P, "falloff", false, falloffs, &f);
     if (!r)
@@ -261,8 +261,10 @@ vfx_result rt_scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
         rt_scene_beam *o = &s->beams[i];
         s->beam_count = (uint32_t)i + 1; /* so that free() sees tracks of a half-parsed beam */
         vfx_beam *b = &o->base;
-        *b = (vfx_beam){.length = 1.0f, .radius = 0.5f, .a = 0.05f, .b = 0.03f, .eps = 0.02f, .color = {1, 1, 1, 1}};
-        o->look = (vfx_beam3){.v2 = {.falloff = VFX_BEAM_FALLOFF_SMOOTH, .ramp = VFX_BEAM_RAMP_HOT, .intensity = 1.0f}};
+        *b = (vfx_beam){.type = VFX_TYPE_BEAM, .length = 1.0f, .radius = 0.5f, .a = 0.05f, .b = 0.03f, .eps = 0.02f,
+                        .color = {1, 1, 1, 1}};
+        o->look = (vfx_beam){.type = VFX_TYPE_BEAM, .falloff = VFX_BEAM_FALLOFF_SMOOTH, .ramp = VFX_BEAM_RAMP_HOT,
+                             .intensity = 1.0f};
         vfx_result r = rt_scene_expect_object(c, e, P);
         if (r)
             return r;
@@ -302,7 +304,7 @@ vfx_result rt_scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
                     memcpy(dst, o->tracks[k].values, (size_t)beam_param_dim[k] * sizeof(float));
             }
         }
-        if (o->joint_count) { /* a bending beam: its v1 part describes the first segment */
+        if (o->joint_count) { /* a bending beam: its straight part describes the first segment */
             for (int k = 0; k < 3; ++k) {
                 b->head[k] = o->joints[0][k];
                 b->dir[k] = o->joints[1][k] - o->joints[0][k];
@@ -322,7 +324,7 @@ vfx_result rt_scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
     return VFX_OK;
 }
 
-vfx_result rt_scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv, vfx_beams_view2 *bv2)
+vfx_result rt_scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv, vfx_lab_beams *lab)
 {
     static const char *const keys[] = {"saturation", "c", "far_distance", "method", "march_samples",
                                        "bloom", "bloom_strength", "bloom_levels", NULL};
@@ -336,8 +338,9 @@ vfx_result rt_scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view 
     r = rt_scene_get_enum(c, v, P, "saturation", false, sat, &bv->saturation);
     if (!r) r = rt_scene_get_float_row(c, v, P, "c", VFX_RANGE_BEAMS_C, &bv->saturate_c);
     if (!r) r = rt_scene_get_float_row(c, v, P, "far_distance", VFX_RANGE_BEAMS_FAR, &bv->far_distance);
-    if (!r) r = rt_scene_get_enum(c, v, P, "method", false, meth, &bv->method);
-    if (!r) r = rt_scene_get_uint_row(c, v, P, "march_samples", VFX_RANGE_BEAMS_MARCH_SAMPLES, &bv->march_samples);
+    if (!r) r = rt_scene_get_enum(c, v, P, "method", false, meth, &lab->method);
+    if (!r) r = rt_scene_get_uint_row(c, v, P, "march_samples", VFX_RANGE_BEAMS_MARCH_SAMPLES, &lab->march_samples);
+    vfx_beams_view *bv2 = bv;
     bool bloom = true;
     if (!r && cJSON_GetObjectItemCaseSensitive(v, "bloom")) {
         r = rt_scene_get_bool(c, v, P, "bloom", &bloom);
@@ -396,17 +399,27 @@ static double beam_time(const rt_scene_beam *b, double time)
     return t;
 }
 
-/* One beam at `time`: keyframes interpolated, wrapped by loop_s. */
-static void beam_at(const rt_scene_beam *b, double time, vfx_beam3 *out)
+/* One beam at `time`: the look with the geometry of base, keyframes interpolated, wrapped by
+ * loop_s. */
+static void beam_at(const rt_scene_beam *b, double time, vfx_beam *out)
 {
     double t = beam_time(b, time);
     *out = b->look;
-    out->v2.v1 = b->base;
+    out->type = VFX_TYPE_BEAM;
+    out->next = NULL;
+    memcpy(out->head, b->base.head, sizeof out->head);
+    out->length = b->base.length;
+    memcpy(out->dir, b->base.dir, sizeof out->dir);
+    out->radius = b->base.radius;
+    out->a = b->base.a;
+    out->b = b->base.b;
+    out->eps = b->base.eps;
+    memcpy(out->color, b->base.color, sizeof out->color);
     for (int k = 0; k < RT_BEAM_PARAM_COUNT; ++k) {
         const rt_scene_track *tr = &b->tracks[k];
         if (!tr->count)
             continue;
-        float *dst = beam_param_ptr(&out->v2.v1, out, k);
+        float *dst = beam_param_ptr(out, out, k);
         rt_scene_track_eval(tr, t, dst);
         /* opposite direction keys pass through zero: hold the earlier key's direction */
         if (k == RT_BEAM_PARAM_DIR && rt_scene_is_zero3(dst))
@@ -414,60 +427,29 @@ static void beam_at(const rt_scene_beam *b, double time, vfx_beam3 *out)
     }
 }
 
-/* Evaluates beam i into out3 (or out2, its version 2 part) with its joints, as both entry points. */
-static uint32_t beams_at(const rt_scene *scene, double time, vfx_beam3 *out3, vfx_beam2 *out2, uint32_t n,
-                         float *joints, uint32_t joint_cap, uint32_t *joint_count)
+uint32_t rt_scene_beams_at(const rt_scene *scene, double time, vfx_beam *out, uint32_t n, float *joints,
+                           uint32_t joint_cap, uint32_t *joint_count)
 {
     uint32_t used = 0;
     if (joint_count)
         *joint_count = 0;
-    if (!scene || (!out3 && !out2))
+    if (!scene || !out)
         return 0;
     uint32_t count = scene->beam_count < n ? scene->beam_count : n;
     for (uint32_t i = 0; i < count; ++i) {
         const rt_scene_beam *b = &scene->beams[i];
-        vfx_beam3 b3;
-        beam_at(b, time, &b3);
+        beam_at(b, time, &out[i]);
         if (b->joint_count && joints && joint_cap - used >= b->joint_count) {
             float *dst = joints + 3 * (size_t)used;
             memcpy(dst, b->joints, 3 * b->joint_count * sizeof(float));
             if (b->joint_track.count)
                 rt_scene_track_eval(&b->joint_track, beam_time(b, time), dst);
-            b3.v2.joint_first = used;
-            b3.v2.joint_count = b->joint_count;
+            out[i].joint_first = used;
+            out[i].joint_count = b->joint_count;
             used += b->joint_count;
         }
-        if (out3)
-            out3[i] = b3;
-        else
-            out2[i] = b3.v2;
     }
     if (joint_count)
         *joint_count = used;
-    return count;
-}
-
-uint32_t rt_scene_beams3_at(const rt_scene *scene, double time, vfx_beam3 *out, uint32_t n, float *joints,
-                            uint32_t joint_cap, uint32_t *joint_count)
-{
-    return beams_at(scene, time, out, NULL, n, joints, joint_cap, joint_count);
-}
-
-uint32_t rt_scene_beams2_at(const rt_scene *scene, double time, vfx_beam2 *out, uint32_t n, float *joints,
-                            uint32_t joint_cap, uint32_t *joint_count)
-{
-    return beams_at(scene, time, NULL, out, n, joints, joint_cap, joint_count);
-}
-
-uint32_t rt_scene_beams_at(const rt_scene *scene, double time, vfx_beam *out, uint32_t n)
-{
-    if (!scene || !out)
-        return 0;
-    uint32_t count = scene->beam_count < n ? scene->beam_count : n;
-    for (uint32_t i = 0; i < count; ++i) {
-        vfx_beam3 b3;
-        beam_at(&scene->beams[i], time, &b3);
-        out[i] = b3.v2.v1;
-    }
     return count;
 }

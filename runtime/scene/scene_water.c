@@ -145,7 +145,7 @@ static vfx_result parse_water_simulation(pctx *c, const cJSON *v, rt_scene_water
 }
 
 /* water.quality (present): the method, its sample and step limits, the disabled stages and the
- * kernel; writes w->params and w->kernel. */
+ * kernel; writes w->params (and w->lab for the baselines and ablation bits). */
 static vfx_result parse_water_quality(pctx *c, const cJSON *q, rt_scene_water *w)
 {
     vfx_water_params *wp = &w->params;
@@ -174,19 +174,27 @@ static vfx_result parse_water_quality(pctx *c, const cJSON *q, rt_scene_water *w
     if (!r) r = rt_scene_get_uint_row(c, q, PQ, "pyramid_level", VFX_RANGE_WATER_PYRAMID_LEVEL, &wp->pyramid_level);
     uint32_t mi = 3;
     if (!r) r = rt_scene_get_enum(c, q, PQ, "method", false, methods, &mi);
-    wp->method = method_ids[mi];
+    /* the baselines are lab methods: chained as vfx_lab_water */
+    if (method_ids[mi] == VFX_WATER_METHOD_BRUTE || method_ids[mi] == VFX_WATER_METHOD_GRID)
+        w->lab.method = method_ids[mi];
+    else
+        wp->method = method_ids[mi];
+    uint32_t method = method_ids[mi];
     if (!r && cJSON_GetObjectItemCaseSensitive(q, "preset")) {
         uint32_t pi = 0;
         r = rt_scene_get_enum(c, q, PQ, "preset", false, presets, &pi);
-        w->preset = VFX_WATER_PRESET_LOW + pi;
+        wp->preset = VFX_WATER_PRESET_LOW + pi;
     }
-    if (!r) r = rt_scene_get_flags(c, q, PQ, "disable", flags, bits, &wp->disable);
+    uint32_t dis = 0;
+    if (!r) r = rt_scene_get_flags(c, q, PQ, "disable", flags, bits, &dis);
+    wp->features_off = dis & (VFX_WATER_NO_SPRAY | VFX_WATER_NO_SSR);
+    w->lab.disable = dis & ~(uint32_t)(VFX_WATER_NO_SPRAY | VFX_WATER_NO_SSR);
     if (!r && cJSON_GetObjectItemCaseSensitive(q, "kernel")) {
         static const char *const kernels[] = {"isotropic", "anisotropic", NULL};
         uint32_t k = 0;
         r = rt_scene_get_enum(c, q, PQ, "kernel", false, kernels, &k);
-        w->kernel = k == 1 ? VFX_WATER_KERNEL_ANISOTROPIC : VFX_WATER_KERNEL_ISOTROPIC;
-        if (!r && w->kernel == VFX_WATER_KERNEL_ANISOTROPIC && wp->method != VFX_WATER_METHOD_TILE)
+        wp->kernel = k == 1 ? VFX_WATER_KERNEL_ANISOTROPIC : VFX_WATER_KERNEL_ISOTROPIC;
+        if (!r && wp->kernel == VFX_WATER_KERNEL_ANISOTROPIC && method != VFX_WATER_METHOD_TILE)
             r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.quality.kernel",
                             "\"anisotropic\" is drawn by method \"tile\" only (method \"%s\" draws the seed's isotropic kernel)",
                             methods[mi]);
@@ -194,14 +202,13 @@ static vfx_result parse_water_quality(pctx *c, const cJSON *q, rt_scene_water *w
     return r;
 }
 
-/* water.diffuse (vfx_water_params4's fields; the plugin checks the ranges' relations). */
+/* water.diffuse (vfx_water_params' diffuse fields; the plugin checks the ranges' relations). */
 static vfx_result parse_diffuse(pctx *c, const cJSON *v, rt_scene_water *w)
 {
     static const char *const keys[] = {"max", "gravity", "trapped_air", "wave_crest", "energy", "rate_trapped_air",
                                        "rate_wave_crest", "lifetime", "buoyancy", "drag", "spray_below",
                                        "bubble_above", NULL};
-    vfx_water_params4 *d = &w->diffuse;
-    memset(d, 0, sizeof *d);
+    vfx_water_params *d = &w->params;
     const cJSON *o = cJSON_GetObjectItemCaseSensitive(v, "diffuse");
     const char *P = "water.diffuse";
     vfx_result r = VFX_OK;
@@ -273,7 +280,8 @@ vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
     }
     vfx_water_params *wp = &w->params;
     /* ours (TILE) unless water.quality.method names another */
-    *wp = (vfx_water_params){.size = sizeof *wp, .version = VFX_WATER_PARAMS_VERSION, .method = VFX_WATER_METHOD_TILE};
+    *wp = (vfx_water_params){.type = VFX_TYPE_WATER_PARAMS, .method = VFX_WATER_METHOD_TILE};
+    w->lab = (vfx_lab_water){.type = VFX_TYPE_LAB_WATER};
     /* the plugin's ranges (volfx_ranges.h) */
     r = rt_scene_get_float_row(c, v, P, "h", VFX_RANGE_WATER_H, &wp->h);
     if (!r) r = rt_scene_get_float_row(c, v, P, "threshold", VFX_RANGE_WATER_THRESHOLD, &wp->threshold);
@@ -292,9 +300,10 @@ vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
     /* the default: the preset's, as the plugin resolves it (anisotropic for TILE but at preset
      * "low": flat water flat, sheets stay sheets; docs/water.md "Presets"), the seed's isotropic
      * kernel for the other methods */
-    if (!r && w->kernel == VFX_WATER_KERNEL_DEFAULT)
-        w->kernel = wp->method == VFX_WATER_METHOD_TILE && w->preset != VFX_WATER_PRESET_LOW ? VFX_WATER_KERNEL_ANISOTROPIC
-                                                                                             : VFX_WATER_KERNEL_ISOTROPIC;
+    if (!r && wp->kernel == VFX_WATER_KERNEL_DEFAULT)
+        wp->kernel = wp->method == VFX_WATER_METHOD_TILE && !w->lab.method && wp->preset != VFX_WATER_PRESET_LOW
+                         ? VFX_WATER_KERNEL_ANISOTROPIC
+                         : VFX_WATER_KERNEL_ISOTROPIC;
     return r;
 }
 

@@ -1,4 +1,4 @@
-/* test_beam_anatomy.c — the attack's anatomy (vfx_beam3, issue 25) against the float64 adaptive
+/* test_beam_anatomy.c — the attack's anatomy (vfx_beam, issue 25) against the float64 adaptive
  * quadrature of the raw density (reference/beams_ref.c over volfx_beam_density_d, which takes
  * the definition in beam_field.h: the true R(u), no slabs).
  *
@@ -45,7 +45,7 @@ static double rnd(void)
 
 static volfx_beam_d make_beam(int smooth)
 {
-    vfx_beam b = {.head = {0.f, 0.f, 0.f}, .length = 4.f, .dir = {1.f, 0.f, 0.f}, .radius = 0.3f, .a = 1.2f,
+    vfx_beam b = {.type = VFX_TYPE_BEAM, .head = {0.f, 0.f, 0.f}, .length = 4.f, .dir = {1.f, 0.f, 0.f}, .radius = 0.3f, .a = 1.2f,
                   .b = 0.6f, .eps = 0.03f};
     volfx_beam_d d;
     char err[128];

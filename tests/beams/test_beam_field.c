@@ -167,7 +167,8 @@ static void check(tally *t, const tcase *c)
 static vfx_beam mk_beam(float mx, float my, float mz, float dx, float dy, float dz, float L,
                         float R, float a, float b, float eps)
 {
-    vfx_beam v = {{mx, my, mz}, L, {dx, dy, dz}, R, a, b, eps, 0.0f, {0, 0, 0, 0}};
+    vfx_beam v = {.type = VFX_TYPE_BEAM, .head = {mx, my, mz}, .length = L, .dir = {dx, dy, dz}, .radius = R,
+                  .a = a, .b = b, .eps = eps};
     return v;
 }
 

@@ -35,8 +35,8 @@ static void test_defaults_and_values(void **state)
                        "\"beam_settings\": {\"bloom\": false, \"bloom_strength\": 0.3, \"bloom_levels\": 3}}",
                        err, sizeof err);
     assert_non_null(s);
-    vfx_beam2 b[2];
-    assert_int_equal(rt_scene_beams2_at(s, 1.0, b, 2, NULL, 0, NULL), 2);
+    vfx_beam b[2];
+    assert_int_equal(rt_scene_beams_at(s, 1.0, b, 2, NULL, 0, NULL), 2);
     /* defaults: the smooth support, the hot ramp, intensity 1, no exposure, no flow */
     assert_int_equal(b[0].falloff, VFX_BEAM_FALLOFF_SMOOTH);
     assert_int_equal(b[0].ramp, VFX_BEAM_RAMP_HOT);
@@ -46,14 +46,12 @@ static void test_defaults_and_values(void **state)
     assert_true(fabsf(b[1].intensity - 2.f) < 1e-6f); /* keyframed: halfway from 1 to 3 */
     assert_true(fabsf(b[1].exposure - 1.f) < 1e-6f);
     assert_true(b[1].flow_amount == 0.3f && b[1].flow_speed == 4.f && b[1].flow_scale == 0.7f);
-    assert_true(b[1].v1.head[1] + s->origin[1] == 1.0); /* stored relative to the default origin (the eye) */
-    assert_int_equal(s->beams_view2.bloom, VFX_BEAMS_BLOOM_OFF);
-    assert_true(s->beams_view2.bloom_strength == 0.3f);
-    assert_int_equal(s->beams_view2.bloom_levels, 3);
-    /* rt_scene_beams_at gives the version 1 part of the same beams */
-    vfx_beam v1[2];
-    assert_int_equal(rt_scene_beams_at(s, 1.0, v1, 2), 2);
-    assert_memory_equal(&v1[1], &b[1].v1, sizeof v1[1]);
+    assert_true(b[1].head[1] + s->origin[1] == 1.0); /* stored relative to the default origin (the eye) */
+    assert_int_equal(s->beams_view.bloom, VFX_BEAMS_BLOOM_OFF);
+    assert_true(s->beams_view.bloom_strength == 0.3f);
+    assert_int_equal(s->beams_view.bloom_levels, 3);
+    assert_int_equal(b[0].type, VFX_TYPE_BEAM);
+    assert_int_equal(b[1].type, VFX_TYPE_BEAM);
     rt_scene_free(s);
 }
 
@@ -107,10 +105,10 @@ static void test_joints(void **state)
     if (!s)
         printf("%s\n", err);
     assert_non_null(s);
-    vfx_beam2 b[2];
+    vfx_beam b[2];
     float j[8][3];
     uint32_t nj = 99;
-    assert_int_equal(rt_scene_beams2_at(s, 1.0, b, 2, &j[0][0], 8, &nj), 2);
+    assert_int_equal(rt_scene_beams_at(s, 1.0, b, 2, &j[0][0], 8, &nj), 2);
     assert_int_equal(nj, 5);
     assert_int_equal(b[0].joint_first, 0);
     assert_int_equal(b[0].joint_count, 3);
@@ -121,7 +119,7 @@ static void test_joints(void **state)
     assert_true(j[2][1] + o[1] == 1.0);
     assert_true(j[3][1] + o[1] == 1.0 && j[4][0] + o[0] == 2.0 && j[4][1] + o[1] == 2.0); /* halfway */
     /* room for 4 joints: the second beam does not fit and stays straight */
-    assert_int_equal(rt_scene_beams2_at(s, 1.0, b, 2, &j[0][0], 4, &nj), 2);
+    assert_int_equal(rt_scene_beams_at(s, 1.0, b, 2, &j[0][0], 4, &nj), 2);
     assert_int_equal(nj, 3);
     assert_int_equal(b[1].joint_count, 0);
     rt_scene_free(s);
@@ -149,7 +147,7 @@ static void test_joints(void **state)
     }
 }
 
-/* The anatomy's keys (vfx_beam3): values, keyframes, defaults (core 0.2 in scenes, 0 with the
+/* The anatomy's keys (vfx_beam): values, keyframes, defaults (core 0.2 in scenes, 0 with the
  * thesis ramp) and bad values refused with their path. */
 static void test_anatomy_keys(void **state)
 {
@@ -165,18 +163,15 @@ static void test_anatomy_keys(void **state)
                        "{\"head\": [0, 0, 0], \"dir\": [1, 0, 0], \"ramp\": \"thesis\"}]}",
                        err, sizeof err);
     assert_non_null(s);
-    vfx_beam3 b[3];
-    assert_int_equal(rt_scene_beams3_at(s, 1.0, b, 3, NULL, 0, NULL), 3);
+    vfx_beam b[3];
+    assert_int_equal(rt_scene_beams_at(s, 1.0, b, 3, NULL, 0, NULL), 3);
     assert_true(b[0].core == 0.2f && b[0].head_radius == 0.f && b[0].orb_radius == 0.f && b[0].taper == 0.f);
     assert_true(b[2].core == 0.f);
     assert_true(b[1].head_radius == 0.9f && b[1].orb_radius == 0.4f && b[1].orb_pulse == 0.3f);
     assert_true(b[1].orb_pulse_hz == 2.f && b[1].taper == 0.5f && b[1].surge_wavelength == 1.5f);
     assert_true(b[1].surge_speed == 3.f && b[1].flow_kind == VFX_BEAM_FLOW_SPIRAL && b[1].flow_twist == 2.f);
-    assert_true(b[1].core == 0.3f && b[1].v2.flow_amount == 0.6f);
+    assert_true(b[1].core == 0.3f && b[1].flow_amount == 0.6f);
     assert_true(fabsf(b[1].surge_amount - 0.5f) < 1e-6f && fabsf(b[1].orb_strength - 2.f) < 1e-6f); /* halfway */
-    vfx_beam2 b2[3];
-    assert_int_equal(rt_scene_beams2_at(s, 1.0, b2, 3, NULL, 0, NULL), 3);
-    assert_memory_equal(&b2[1], &b[1].v2, sizeof b2[1]);
     rt_scene_free(s);
     static const char *const bad[][2] = {
         {"\"taper\": 0.99", "beams[0].taper"},

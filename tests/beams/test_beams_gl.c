@@ -28,14 +28,17 @@ static test_log g_log;
 static int g_smooth; /* the falloff the references integrate (set with use_v2) */
 static uint32_t g_nj;  /* joints of the bending beam the references integrate (0: straight) */
 
-static const vfx_beam k_beam = {.head = {-1.5f, 0.1f, 0.0f}, .dir = {1, 0.2f, 0}, .length = 2.5f,
-                                .radius = 0.5f, .a = 0.4f, .b = 0.25f, .eps = 0.05f};
+/* the thesis's look: the hard support, the thesis ramp (what the references integrate unless a
+ * test asks for the smooth support) */
+static const vfx_beam k_beam = {.type = VFX_TYPE_BEAM, .head = {-1.5f, 0.1f, 0.0f}, .dir = {1, 0.2f, 0}, .length = 2.5f,
+                                .radius = 0.5f, .a = 0.4f, .b = 0.25f, .eps = 0.05f,
+                                .falloff = VFX_BEAM_FALLOFF_HARD, .ramp = VFX_BEAM_RAMP_THESIS};
 
 /* The one beam entity the tests draw. */
-static vfx_beam2 *beam0(void)
+static vfx_beam *beam0(void)
 {
     uint32_t n;
-    vfx_beam2 *b = game_app_beams(g_app, &n);
+    vfx_beam *b = game_app_beams(g_app, &n);
     assert_int_equal(n, 1);
     return b;
 }
@@ -44,8 +47,8 @@ static int setup(void **state)
 {
     (void)state;
     g_app = test_app_with_camera(&g_cam, &g_log);
-    assert_int_equal(game_app_add_beams(g_app, &(vfx_beam2){.v1 = k_beam}, 1), VFX_OK);
-    g_app->beams_view = (vfx_beams_view){.size = sizeof(vfx_beams_view), .version = VFX_BEAMS_VIEW_VERSION};
+    assert_int_equal(game_app_add_beams(g_app, &k_beam, 1), VFX_OK);
+    g_app->beams_view = (vfx_beams_view){.type = VFX_TYPE_BEAMS_VIEW, .bloom = VFX_BEAMS_BLOOM_OFF};
     return 0;
 }
 
@@ -69,7 +72,7 @@ static double ref_pixel(uint32_t i, uint32_t j, double t1)
 {
     volfx_beam_d b;
     char err[128];
-    assert_int_equal(volfx_beam_validate(&beam0()->v1, &b, err, sizeof err), VFX_OK);
+    assert_int_equal(volfx_beam_validate(beam0(), &b, err, sizeof err), VFX_OK);
     b.smooth = g_smooth;
     assert_int_equal(volfx_beam_set_joints(&b, &g_app->joints[0][0], g_nj, err, sizeof err), VFX_OK);
     double dir[3];
@@ -106,7 +109,7 @@ static int compare_image(const float *gpu, double (*t1_of)(uint32_t, uint32_t), 
 {
     volfx_beam_d b;
     char err[128];
-    assert_int_equal(volfx_beam_validate(&beam0()->v1, &b, err, sizeof err), VFX_OK);
+    assert_int_equal(volfx_beam_validate(beam0(), &b, err, sizeof err), VFX_OK);
     b.smooth = g_smooth;
     assert_int_equal(volfx_beam_set_joints(&b, &g_app->joints[0][0], g_nj, err, sizeof err), VFX_OK);
     int bad = 0;
@@ -167,7 +170,7 @@ static void test_matches_reference(void **state)
     print_errors("open sky", &ie);
     assert_true(ie.max_rel_wc <= 1e-5); /* the target, where the inputs allow it */
     /* tiles the beam cannot touch were culled: the counter says so and their pixels are 0 */
-    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+    vfx_stats st = {.type = VFX_TYPE_STATS};
     assert_int_equal(g_app->api->get_stats(g_app->ctx, &st), VFX_OK);
     double pairs = -1, culled = -1;
     for (uint32_t k = 0; k < st.count; ++k) {
@@ -177,8 +180,9 @@ static void test_matches_reference(void **state)
     assert_true(pairs >= 1 && culled >= 0 && pairs + culled == 12); /* 4x3 tiles of 16 px */
     free(raw);
     /* a small beam in the top-right corner: most tiles culled, their pixels exactly 0 */
-    beam0()->v1 = (vfx_beam){.head = {1.6f, 1.1f, 0}, .dir = {1, 0, 0}, .length = 0.1f, .radius = 0.1f,
-                                 .a = 0.4f, .b = 0.25f, .eps = 0.05f};
+    *beam0() = (vfx_beam){.type = VFX_TYPE_BEAM, .head = {1.6f, 1.1f, 0}, .dir = {1, 0, 0}, .length = 0.1f, .radius = 0.1f,
+                          .a = 0.4f, .b = 0.25f, .eps = 0.05f, .falloff = VFX_BEAM_FALLOFF_HARD,
+                          .ramp = VFX_BEAM_RAMP_THESIS};
     raw = render_raw();
     assert_int_equal(g_app->api->get_stats(g_app->ctx, &st), VFX_OK);
     for (uint32_t k = 0; k < st.count; ++k)
@@ -188,7 +192,7 @@ static void test_matches_reference(void **state)
     assert_true(culled >= 9);
     assert_true(raw[(H - 1) * W + 0] == 0.f && raw[(H / 2) * W + W / 2] == 0.f);
     free(raw);
-    beam0()->v1 = k_beam;
+    *beam0() = k_beam;
 }
 
 static double g_wall_z;
@@ -289,7 +293,7 @@ static void test_mz_sweep(void **state)
         double t1 = t_wall(cx, cy), ref = ref_pixel(cx, cy, t1), dir[3], end[3];
         volfx_beam_d b;
         char err[128];
-        assert_int_equal(volfx_beam_validate(&beam0()->v1, &b, err, sizeof err), VFX_OK);
+        assert_int_equal(volfx_beam_validate(beam0(), &b, err, sizeof err), VFX_OK);
         ref_pixel_ray(&g_cam, cx, cy, dir);
         for (int c = 0; c < 3; ++c)
             end[c] = g_cam.eye[c] + t1 * dir[c];
@@ -314,8 +318,8 @@ static void test_marching_baseline(void **state)
     double err[2];
     const uint32_t samples[2] = {8, 120};
     for (int k = 0; k < 2; ++k) {
-        g_app->beams_view.method = 1;
-        g_app->beams_view.march_samples = samples[k];
+        g_app->beams_lab.method = VFX_BEAMS_METHOD_MARCH;
+        g_app->beams_lab.march_samples = samples[k];
         float *m = render_raw();
         double e = 0, n = 0;
         for (uint32_t p = 0; p < W * H; ++p)
@@ -326,7 +330,8 @@ static void test_marching_baseline(void **state)
         err[k] = e / n;
         free(m);
     }
-    g_app->beams_view.method = 0;
+    g_app->beams_lab.method = VFX_BEAMS_METHOD_CLOSED_FORM;
+    g_app->beams_lab.march_samples = 0;
     printf("marching mean relative error: 8 samples %.3g, 120 samples %.3g\n", err[0], err[1]);
     assert_true(err[1] < err[0]); /* converges towards the closed form */
     assert_true(err[1] < 0.05);
@@ -336,14 +341,14 @@ static void test_marching_baseline(void **state)
 static void test_bad_input_and_absence(void **state)
 {
     (void)state;
-    beam0()->v1.radius = -1.f;
+    beam0()->radius = -1.f;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "beams[0]"));
-    beam0()->v1 = k_beam;
-    beam0()->v1.head[1] = NAN;
+    assert_non_null(strstr(g_app->api->last_error(g_app->ctx, NULL), "beams[0]"));
+    *beam0() = k_beam;
+    beam0()->head[1] = NAN;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "beams[0]: beam head.y"));
-    beam0()->v1 = k_beam;
+    assert_non_null(strstr(g_app->api->last_error(g_app->ctx, NULL), "beams[0]: beam head.y"));
+    *beam0() = k_beam;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_non_null(g_app->ctx->effect_state[VFX_EFFECT_BEAMS]);
     /* no beams: the effect's state is freed, no pass runs, and once the timer results of the
@@ -352,31 +357,34 @@ static void test_bad_input_and_absence(void **state)
     for (int f = 0; f < 5; ++f)
         assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_null(g_app->ctx->effect_state[VFX_EFFECT_BEAMS]);
-    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+    vfx_stats st = {.type = VFX_TYPE_STATS};
     g_app->api->get_stats(g_app->ctx, &st);
     for (uint32_t k = 0; k < st.count; ++k)
         assert_null(strstr(st.entries[k].name, "beams."));
-    assert_int_equal(game_app_add_beams(g_app, &(vfx_beam2){.v1 = k_beam}, 1), VFX_OK);
+    assert_int_equal(game_app_add_beams(g_app, &k_beam, 1), VFX_OK);
 }
 
-/* The game answers version 2 views from the beam entity (k_beam with this falloff, the hot ramp,
- * bloom as given), or version 1 ones again (v2 = false). */
+/* The beam entity as k_beam with the look (this falloff, the hot ramp, a blue colour, bloom as
+ * given), or k_beam in the thesis's look again, bloom off (v2 = false). */
 static void use_v2(bool v2, bool smooth, bool bloom)
 {
-    g_app->beams_v2 = v2;
-    game_app_set_anatomy(g_app, NULL, 0);
     g_smooth = v2 && smooth;
-    vfx_beam2 *b = beam0();
-    *b = (vfx_beam2){.v1 = k_beam, .falloff = smooth ? VFX_BEAM_FALLOFF_SMOOTH : VFX_BEAM_FALLOFF_HARD,
-                     .ramp = VFX_BEAM_RAMP_HOT, .intensity = 1.f};
-    if (v2) /* coloured; a version 1 view carries k_beam as it is */
-        b->v1.color[0] = 0.2f, b->v1.color[1] = 0.5f, b->v1.color[2] = 1.f, b->v1.color[3] = 1.f;
-    g_app->beams_view2 = (vfx_beams_view2){.bloom = bloom ? VFX_BEAMS_BLOOM_ON : VFX_BEAMS_BLOOM_OFF};
+    vfx_beam *b = beam0();
+    *b = k_beam;
+    g_app->beams_view.bloom = VFX_BEAMS_BLOOM_OFF;
+    g_app->beams_view.bloom_levels = 0;
+    if (!v2)
+        return;
+    b->falloff = smooth ? VFX_BEAM_FALLOFF_SMOOTH : VFX_BEAM_FALLOFF_HARD;
+    b->ramp = VFX_BEAM_RAMP_HOT;
+    b->intensity = 1.f;
+    b->color[0] = 0.2f, b->color[1] = 0.5f, b->color[2] = 1.f, b->color[3] = 1.f;
+    g_app->beams_view.bloom = bloom ? VFX_BEAMS_BLOOM_ON : VFX_BEAMS_BLOOM_OFF;
 }
 
 static double stat_of(const char *name)
 {
-    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+    vfx_stats st = {.type = VFX_TYPE_STATS};
     assert_int_equal(g_app->api->get_stats(g_app->ctx, &st), VFX_OK);
     for (uint32_t k = 0; k < st.count; ++k)
         if (!strcmp(st.entries[k].name, name))
@@ -444,7 +452,7 @@ static void test_emission_and_bloom(void **state)
     (void)state;
     game_app_clear_beams(g_app);
     uint8_t *bg = render_rgba();
-    assert_int_equal(game_app_add_beams(g_app, &(vfx_beam2){.v1 = k_beam}, 1), VFX_OK);
+    assert_int_equal(game_app_add_beams(g_app, &k_beam, 1), VFX_OK);
     use_v2(true, true, false);
     beam0()->exposure = 3.f; /* x = 8 H: the core (H ~ 0.6) is well past the white point */
     float *raw = render_raw();
@@ -490,11 +498,16 @@ static void test_emission_and_bloom(void **state)
     free(bg), free(raw), free(plain), free(glow);
 }
 
-/* A version 3 beam (use_v2's beam and its look plus the given anatomy), answered as version 3. */
-static void use_v3(const vfx_beam3 *anat)
+/* use_v2's beam and its look plus the anatomy of `anat`. */
+static void use_v3(const vfx_beam *anat)
 {
     use_v2(true, true, false);
-    assert_int_equal(game_app_set_anatomy(g_app, anat, 1), VFX_OK);
+    vfx_beam *b = beam0();
+    b->head_radius = anat->head_radius, b->orb_radius = anat->orb_radius, b->orb_strength = anat->orb_strength;
+    b->orb_pulse = anat->orb_pulse, b->orb_pulse_hz = anat->orb_pulse_hz, b->taper = anat->taper;
+    b->surge_amount = anat->surge_amount, b->surge_wavelength = anat->surge_wavelength;
+    b->surge_speed = anat->surge_speed, b->flow_kind = anat->flow_kind, b->flow_twist = anat->flow_twist;
+    b->core = anat->core;
 }
 
 /* The anatomy on the GPU: H per pixel against the float64 closed form of the same field (head at
@@ -506,13 +519,13 @@ static void use_v3(const vfx_beam3 *anat)
 static void test_anatomy_matches_closed_form(void **state)
 {
     (void)state;
-    vfx_beam3 an = {.head_radius = 0.8f, .orb_radius = 0.45f, .orb_strength = 0.6f, .taper = 0.5f,
+    vfx_beam an = {.type = VFX_TYPE_BEAM, .head_radius = 0.8f, .orb_radius = 0.45f, .orb_strength = 0.6f, .taper = 0.5f,
                     .surge_amount = 0.6f, .surge_wavelength = 0.9f, .surge_speed = 0.f};
     use_v3(&an);
     float *raw = render_raw();
     volfx_beam_d b;
     char err[128];
-    assert_int_equal(volfx_beam_validate(&beam0()->v1, &b, err, sizeof err), VFX_OK);
+    assert_int_equal(volfx_beam_validate(beam0(), &b, err, sizeof err), VFX_OK);
     b.smooth = 1;
     b.head_radius = 0.8, b.orb_radius = 0.45, b.orb_a = 0.6, b.taper = 0.5, b.surge = 0.6;
     b.surge_inv_wl = 1.0 / 0.9, b.surge_phase = 0;
@@ -538,12 +551,12 @@ static void test_anatomy_matches_closed_form(void **state)
     assert_true(lit > 200 && loose <= lit / 50);
     free(raw), free(ref);
     /* bad anatomy is refused naming the beam and the struct; then it works again */
-    g_app->beams3[0].taper = 2.f;
+    beam0()->taper = 2.f;
     assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
-    assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "beams[0]: vfx_beam3"));
-    g_app->beams3[0].taper = 0.5f, g_app->beams3[0].orb_radius = NAN;
+    assert_non_null(strstr(g_app->api->last_error(g_app->ctx, NULL), "beams[0]: vfx_beam"));
+    beam0()->taper = 0.5f, beam0()->orb_radius = NAN;
     assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
-    g_app->beams3[0].orb_radius = 0.45f;
+    beam0()->orb_radius = 0.45f;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     use_v2(false, false, false);
 }
@@ -612,11 +625,11 @@ static void test_hue_kept(void **state)
     (void)state;
     game_app_clear_beams(g_app);
     uint8_t *bg = render_rgba();
-    assert_int_equal(game_app_add_beams(g_app, &(vfx_beam2){.v1 = k_beam}, 1), VFX_OK);
-    vfx_beam3 an = {.core = 0.2f};
+    assert_int_equal(game_app_add_beams(g_app, &k_beam, 1), VFX_OK);
+    vfx_beam an = {.type = VFX_TYPE_BEAM, .core = 0.2f};
     use_v3(&an);
     beam0()->exposure = 3.f;
-    g_app->beams_view2.bloom = VFX_BEAMS_BLOOM_ON;
+    g_app->beams_view.bloom = VFX_BEAMS_BLOOM_ON;
     float *raw = render_raw();
     uint8_t *px = render_rgba();
     double sat, lo, hi, sat_v2, lo2, hi2;
@@ -625,7 +638,7 @@ static void test_hue_kept(void **state)
     an.core = 0; /* the version 2 ramp on the same beam */
     use_v3(&an);
     beam0()->exposure = 3.f;
-    g_app->beams_view2.bloom = VFX_BEAMS_BLOOM_ON;
+    g_app->beams_view.bloom = VFX_BEAMS_BLOOM_ON;
     uint8_t *px2 = render_rgba();
     halo_colour(px2, bg, raw, &sat_v2, &lo2, &hi2, &n2);
     printf("halo (%d px): hue %.1f..%.1f, min saturation %.2f; version 2 ramp: hue %.1f..%.1f, min saturation %.2f\n",
@@ -645,15 +658,15 @@ static void test_bad_v2_input(void **state)
     use_v2(true, true, true);
     beam0()->falloff = 7;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "beams[0]: falloff"));
+    assert_non_null(strstr(g_app->api->last_error(g_app->ctx, NULL), "beams[0]: falloff"));
     use_v2(true, true, true);
     beam0()->flow_amount = 2.f;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "flow_amount"));
+    assert_non_null(strstr(g_app->api->last_error(g_app->ctx, NULL), "flow_amount"));
     use_v2(true, true, true);
-    g_app->beams_view2.bloom_levels = 99;
+    g_app->beams_view.bloom_levels = 99;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "bloom_levels"));
+    assert_non_null(strstr(g_app->api->last_error(g_app->ctx, NULL), "bloom_levels"));
     use_v2(false, false, false);
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
 }

@@ -30,3 +30,9 @@ void test_log_fn(void *user, vfx_log_level level, const char *message)
     else if (level == VFX_LOG_WARN)
         l->warnings++;
 }
+
+void test_vfx_log_fn(void *user, vfx_log_level level, vfx_log_id id, const char *message)
+{
+    ((test_log *)user)->last_id = id;
+    test_log_fn(user, level, message);
+}

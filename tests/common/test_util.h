@@ -11,14 +11,17 @@
 rt_gl_context *test_gl_or_skip(void);
 /* Path of the shared test data file `rel` (under VFX_SHARED_DATA), or exits 77 when absent. */
 const char *test_shared_data_or_skip(const char *rel, char *buf, unsigned buflen);
-/* vfx_host_api.gl_get_proc_address for the headless context of test_gl_or_skip (eglGetProcAddress;
+/* vfx_context_desc.gl_get_proc_address for the headless context of test_gl_or_skip (eglGetProcAddress;
  * user unused). */
 void *test_gl_proc(void *user, const char *name);
 /* A logger for tests that records the last message, so tests can assert on error text. */
 typedef struct test_log {
     char last[1024];
     int errors, warnings;
+    vfx_log_id last_id; /* the id of last (test_vfx_log_fn) */
 } test_log;
 void test_log_fn(void *user, vfx_log_level level, const char *message);
+/* The same as the plugin's log callback (vfx_context_desc.log): also keeps the id in last_id. */
+void test_vfx_log_fn(void *user, vfx_log_level level, vfx_log_id id, const char *message);
 
 #endif

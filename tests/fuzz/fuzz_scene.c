@@ -20,8 +20,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (rt_scene_load_mem((const char *)data, size, "/base", &lg, &s, err, sizeof err) != VFX_OK)
         return 0;
     vfx_beam b[8];
-    rt_scene_beams_at(s, 0.37, b, 8);
-    rt_scene_beams_at(s, 1e6, b, 8);
+    rt_scene_beams_at(s, 0.37, b, 8, NULL, 0, NULL);
+    rt_scene_beams_at(s, 1e6, b, 8, NULL, 0, NULL);
     /* counts up to 65,536 keep the run fast; the code paths above that are the same */
     if (s->has_water && s->water.source != RT_SCENE_WATER_FILE && s->water.count <= 65536) {
         float *xyz = NULL;

@@ -28,9 +28,9 @@ static rt_gl_context *g_gl;
 static vfx_result one_beam(void *user, vfx_beams_view *out)
 {
     (void)user;
-    static const vfx_beam b = {.head = {-1, 0, 0}, .length = 2, .dir = {1, 0, 0}, .radius = 0.6f,
+    static const vfx_beam b = {.type = VFX_TYPE_BEAM, .head = {-1, 0, 0}, .length = 2, .dir = {1, 0, 0}, .radius = 0.6f,
                                .a = 0.5f, .b = 0.5f, .eps = 0.05f, .color = {1, 1, 1, 1}};
-    *out = (vfx_beams_view){.size = sizeof *out, .version = VFX_BEAMS_VIEW_VERSION, .count = 1, .beams = &b};
+    *out = (vfx_beams_view){.type = VFX_TYPE_BEAMS_VIEW, .count = 1, .beams = &b};
     return VFX_OK;
 }
 static uint32_t one_chunk(void *user) { (void)user; return 1; }
@@ -38,14 +38,35 @@ static const float k_px[4] = {0, 0.1f, 0.2f, 0.3f}, k_py[4] = {0}, k_pz[4] = {0}
 static vfx_result four_particles(void *user, uint32_t c, vfx_particle_view *out)
 {
     (void)user, (void)c;
-    *out = (vfx_particle_view){.size = sizeof *out, .version = VFX_PARTICLE_VIEW_VERSION, .count = 4,
+    *out = (vfx_particle_view){.type = VFX_TYPE_PARTICLE_VIEW, .count = 4,
                                .pos = {k_px, k_py, k_pz}};
     return VFX_OK;
 }
 static vfx_result params_v99(void *user, vfx_water_params *out)
 {
     (void)user;
-    out->version = 99; /* a struct version this plugin cannot know */
+    out->type = (vfx_struct_type)99; /* a struct of a type this plugin cannot know */
+    return VFX_OK;
+}
+/* A chained struct of a type the plugin does not know (a later ABI's): skipped. */
+typedef struct future_ext {
+    vfx_struct_type type;
+    const void *next;
+    float anything[8];
+} future_ext;
+static const future_ext k_future = {(vfx_struct_type)0x7000abcd, NULL, {1, 2, 3}};
+static vfx_result params_future_chain(void *user, vfx_water_params *out)
+{
+    (void)user;
+    out->next = &k_future;
+    out->h = 0.5f;
+    return VFX_OK;
+}
+/* GPU-resident columns: reserved in ABI 1.0, refused until the plugin reads them. */
+static vfx_result gpu_particles(void *user, uint32_t c, vfx_particle_view *out)
+{
+    (void)user, (void)c;
+    *out = (vfx_particle_view){.type = VFX_TYPE_PARTICLE_VIEW, .count = 4, .gpu_pos = {.buffer = 5, .stride = 12}};
     return VFX_OK;
 }
 static uint32_t one_volume(void *user) { (void)user; return 1; }
@@ -54,15 +75,15 @@ static void host_free(void *user, void *p) { (void)user; free(p); }
 static const vfx_plugin_api *plugin_api(void)
 {
     static vfx_plugin_api api;
-    api.size = sizeof api;
+    api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     return &api;
 }
 
-static vfx_host_api beams_host(test_log *log)
+static vfx_context_desc beams_host(test_log *log)
 {
-    return (vfx_host_api){.size = sizeof(vfx_host_api), .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = log,
-                          .log = test_log_fn, .beams = one_beam};
+    return (vfx_context_desc){.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = log,
+                          .log = test_vfx_log_fn, .beams = one_beam};
 }
 
 typedef struct fixture {
@@ -87,7 +108,7 @@ static void make_fixture(fixture *f)
     glCreateFramebuffers(1, &f->fbo);
     glNamedFramebufferTexture(f->fbo, GL_COLOR_ATTACHMENT0, f->out_tex, 0);
     ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8, W, H, 0.1, 100};
-    f->fv = (vfx_frame_view){.size = sizeof(vfx_frame_view), .version = VFX_FRAME_VIEW_VERSION,
+    f->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW,
                              .framebuffer = f->fbo, .color_texture = f->color, .depth_texture = f->depth,
                              .width = W, .height = H, .eye = {0, 0, 5}, .near_plane = 0.1f,
                              .far_plane = 100.0f, .fov_y = 0.8f};
@@ -116,7 +137,7 @@ static void expect(const vfx_plugin_api *api, vfx_context *ctx, const vfx_frame_
                    const char *part)
 {
     vfx_result r = api->render(ctx, fv);
-    const char *msg = api->last_error(ctx);
+    const char *msg = api->last_error(ctx, NULL);
     if (r != code || (part && !strstr(msg, part)))
         fail_msg("render: got %d \"%s\", want %d containing \"%s\"", r, msg, code, part ? part : "");
     assert_int_equal(glGetError(), GL_NO_ERROR); /* the checks leave no GL error behind */
@@ -126,7 +147,7 @@ static void test_frame_fields(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_host_api host = beams_host(&log);
+    vfx_context_desc host = beams_host(&log);
     const vfx_plugin_api *api = plugin_api();
     vfx_context *ctx;
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
@@ -136,7 +157,7 @@ static void test_frame_fields(void **state)
     /* read_raw before any render (issue 28: VFX_OK with nothing rendered) */
     static float early[W * H];
     assert_int_equal(api->read_raw(ctx, VFX_EFFECT_BEAMS, early, W * H), VFX_ERR_NOT_FOUND);
-    assert_non_null(strstr(api->last_error(ctx), "read_raw: effect beams has not been rendered"));
+    assert_non_null(strstr(api->last_error(ctx, NULL), "read_raw: effect beams has not been rendered"));
     expect(api, ctx, &f.fv, VFX_OK, NULL);
     double h_ref = max_h(api, ctx);
     assert_true(h_ref > 0.1); /* the beam is in view */
@@ -238,26 +259,37 @@ static void test_frame_fields(void **state)
     v.effects = 1u << 9;
     expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "effects 0x200 has bits of no effect");
     /* version 2: the cubemap must be one */
-    vfx_frame_view2 v2 = {.v1 = f.fv};
-    v2.v1.size = sizeof v2, v2.v1.version = VFX_FRAME_VIEW2_VERSION;
+    vfx_frame_view v2 = f.fv;
     v2.environment_cubemap = f.color;
-    expect(api, ctx, &v2.v1, VFX_ERR_INVALID_ARGUMENT,
+    expect(api, ctx, &v2, VFX_ERR_INVALID_ARGUMENT,
            "environment_cubemap");
-    expect(api, ctx, &v2.v1, VFX_ERR_INVALID_ARGUMENT, "is a GL_TEXTURE_2D texture, need GL_TEXTURE_CUBE_MAP");
+    expect(api, ctx, &v2, VFX_ERR_INVALID_ARGUMENT, "is a GL_TEXTURE_2D texture, need GL_TEXTURE_CUBE_MAP");
     v2.environment_cubemap = f.cube;
-    expect(api, ctx, &v2.v1, VFX_OK, NULL);
-    /* a frame view of the wrong size is reported as that */
+    expect(api, ctx, &v2, VFX_OK, NULL);
+    /* a frame view of another type is reported as that */
     v = f.fv;
-    v.size = 8;
-    expect(api, ctx, &v, VFX_ERR_ABI, "frame view of version 1 has size 8 (need");
+    v.type = VFX_TYPE_BEAMS_VIEW;
+    expect(api, ctx, &v, VFX_ERR_ABI, "frame view (vfx_frame_view) has type 6, need 2");
+    /* the effects-layer output is reserved: refused with its own id until supported */
+    vfx_frame_view lv = f.fv;
+    lv.layer_texture = f.color;
+    expect(api, ctx, &lv, VFX_ERR_UNSUPPORTED, "layer_texture");
+    vfx_log_id id = VFX_LOG_ID_NONE;
+    api->last_error(ctx, &id);
+    assert_int_equal(id, VFX_LOG_ID_LAYER_TEXTURE_UNSUPPORTED);
+    /* a chained struct of an unknown type is skipped */
+    const future_ext ext = {(vfx_struct_type)0x7000abcd, NULL, {0}};
+    lv = f.fv;
+    lv.next = &ext;
+    expect(api, ctx, &lv, VFX_OK, NULL);
     /* the last good frame still renders */
     expect(api, ctx, &f.fv, VFX_OK, NULL);
     /* NULL outputs: their own error, not the last one */
     assert_int_equal(api->render(ctx, &v), VFX_ERR_ABI);
     assert_int_equal(api->read_raw(ctx, VFX_EFFECT_BEAMS, NULL, 0), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(api->last_error(ctx), "read_raw: out is NULL"));
+    assert_non_null(strstr(api->last_error(ctx, NULL), "read_raw: out is NULL"));
     assert_int_equal(api->get_stats(ctx, NULL), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(api->last_error(ctx), "get_stats: out is NULL"));
+    assert_non_null(strstr(api->last_error(ctx, NULL), "get_stats: out is NULL"));
     api->destroy(ctx);
     free_fixture(&f);
     assert_int_equal(glGetError(), GL_NO_ERROR);
@@ -269,7 +301,7 @@ static void test_nothing_drawn(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = &log, .log = test_log_fn};
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = &log, .log = test_vfx_log_fn};
     const vfx_plugin_api *api = plugin_api();
     vfx_context *ctx;
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
@@ -284,15 +316,15 @@ static void test_nothing_drawn(void **state)
     free_fixture(&f);
 }
 
-/* Issue 28: water parameters of an unknown version (99) refused at update, naming it (they
- * were read as version 1). */
+/* Water parameters of an unknown type (99) refused at update, naming it; an unknown chained struct
+ * is skipped; GPU-resident particle columns are refused (reserved). */
 static void test_unknown_water_params_version(void **state)
 {
     (void)state;
     test_log log = {0};
     const vfx_plugin_api *api = plugin_api();
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
-                         .user = &log, .log = test_log_fn, .particle_chunk_count = one_chunk,
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc,
+                         .user = &log, .log = test_vfx_log_fn, .particle_chunk_count = one_chunk,
                          .particle_chunk = four_particles, .water_params = params_v99};
     vfx_context *ctx;
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
@@ -301,7 +333,19 @@ static void test_unknown_water_params_version(void **state)
         return;
     }
     assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_ERR_ABI);
-    assert_non_null(strstr(api->last_error(ctx), "water: host water_params of version 99"));
+    vfx_log_id id = VFX_LOG_ID_NONE;
+    assert_non_null(strstr(api->last_error(ctx, &id), "water: host water_params (vfx_water_params) has type 99, need 4"));
+    assert_int_equal(id, VFX_LOG_ID_STRUCT_TYPE);
+    api->destroy(ctx);
+    host.water_params = params_future_chain;
+    assert_int_equal(api->create(&host, &ctx), VFX_OK);
+    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_OK);
+    api->destroy(ctx);
+    host.particle_chunk = gpu_particles;
+    assert_int_equal(api->create(&host, &ctx), VFX_OK);
+    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_ERR_UNSUPPORTED);
+    assert_non_null(strstr(api->last_error(ctx, &id), "GPU-resident particles are not supported"));
+    assert_int_equal(id, VFX_LOG_ID_GPU_PARTICLES_UNSUPPORTED);
     api->destroy(ctx);
 }
 
@@ -313,7 +357,7 @@ static void test_callback_pairs(void **state)
     test_log log = {0};
     const vfx_plugin_api *api = plugin_api();
     vfx_context *ctx = (vfx_context *)&log;
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = &log, .log = test_log_fn,
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = &log, .log = test_vfx_log_fn,
                          .particle_chunk_count = one_chunk};
     assert_int_equal(api->create(&host, &ctx), VFX_ERR_INVALID_ARGUMENT);
     assert_null(ctx);
@@ -330,25 +374,24 @@ static void test_callback_pairs(void **state)
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
     ctx->host.particle_chunk_count = one_chunk; /* the copy damaged after create */
     assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(api->last_error(ctx), "update: host api: particle_chunk_count is set"));
+    assert_non_null(strstr(api->last_error(ctx, NULL), "update: context desc: particle_chunk_count is set"));
     api->destroy(ctx);
 }
 
 /* ------------------------------------------------------------------ attacks on the v2 views */
 
 typedef struct attack_host {
-    vfx_beams_view2 bv;
-    vfx_beam2 beam;
-    vfx_volume_view2 vv;
-    bool volume_v2;
+    vfx_beams_view bv;
+    vfx_beam beam;
+    vfx_volume_view vv;
 } attack_host;
 
 static vfx_result attack_beams(void *user, vfx_beams_view *out)
 {
     attack_host *a = user;
-    if (out->version != VFX_BEAMS_VIEW2_VERSION || out->size < sizeof(vfx_beams_view2))
+    if (out->type != VFX_TYPE_BEAMS_VIEW)
         return VFX_ERR_NOT_FOUND;
-    *(vfx_beams_view2 *)out = a->bv;
+    *out = a->bv;
     return VFX_OK;
 }
 static uint32_t attack_volume_count(void *user) { (void)user; return 1; }
@@ -356,10 +399,7 @@ static vfx_result attack_volume(void *user, uint32_t index, vfx_volume_view *out
 {
     attack_host *a = user;
     (void)index;
-    if (a->volume_v2 && out->size >= sizeof(vfx_volume_view2))
-        *(vfx_volume_view2 *)out = a->vv;
-    else
-        *out = a->vv.v1, out->size = sizeof *out, out->version = VFX_VOLUME_VIEW_VERSION;
+    *out = a->vv;
     return VFX_OK;
 }
 
@@ -371,21 +411,20 @@ static const float k_rgba[8] = {0, 0, 0, 0, 1, 1, 1, 2};
 static void good_views(attack_host *a)
 {
     memset(a, 0, sizeof *a);
-    a->beam = (vfx_beam2){.v1 = {.head = {-1, 0, 0}, .length = 2, .dir = {1, 0, 0}, .radius = 0.6f, .a = 0.5f,
-                                 .b = 0.5f, .eps = 0.05f, .color = {1, 1, 1, 1}}};
-    a->bv = (vfx_beams_view2){.v1 = {.size = sizeof(vfx_beams_view2), .version = VFX_BEAMS_VIEW2_VERSION, .count = 1},
+    a->beam = (vfx_beam){.type = VFX_TYPE_BEAM, .head = {-1, 0, 0}, .length = 2, .dir = {1, 0, 0}, .radius = 0.6f, .a = 0.5f,
+                                 .b = 0.5f, .eps = 0.05f, .color = {1, 1, 1, 1}};
+    a->bv = (vfx_beams_view){.type = VFX_TYPE_BEAMS_VIEW, .count = 1,
                               .beams = &a->beam};
-    a->vv = (vfx_volume_view2){.v1 = {.size = sizeof(vfx_volume_view2), .version = VFX_VOLUME_VIEW2_VERSION,
+    a->vv = (vfx_volume_view){.type = VFX_TYPE_VOLUME_VIEW,
                                       .point_count = 4, .tet_count = 1, .points = k_pts, .tets = k_tet,
-                                      .scalar = k_scalar, .transfer_rgba = k_rgba, .transfer_count = 2}};
-    a->volume_v2 = true;
+                                      .scalar = k_scalar, .transfer_rgba = k_rgba, .transfer_count = 2};
 }
 
 /* One update + render with the attack host's views; expects `code` and `part` in the message. */
 static void attack(const vfx_plugin_api *api, attack_host *a, const fixture *f, vfx_result code, const char *part)
 {
     test_log log = {0};
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = a, .log = NULL,
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = a, .log = NULL,
                          .beams = attack_beams, .volume_count = attack_volume_count, .volume = attack_volume};
     (void)log;
     vfx_context *ctx;
@@ -393,7 +432,7 @@ static void attack(const vfx_plugin_api *api, attack_host *a, const fixture *f, 
     vfx_result r = api->update(ctx, 0.0, 0.0f);
     if (r == VFX_OK)
         r = api->render(ctx, &f->fv);
-    const char *msg = api->last_error(ctx);
+    const char *msg = api->last_error(ctx, NULL);
     if (r != code || (part && !strstr(msg, part)))
         fail_msg("attack: got %d \"%s\", want %d containing \"%s\"", r, msg, code, part ? part : "");
     api->destroy(ctx);
@@ -403,14 +442,14 @@ static void attack(const vfx_plugin_api *api, attack_host *a, const fixture *f, 
 /* Renders the attack host's views, expects OK, stat `name` == value and a finite raw image. */
 static void check_counted(const vfx_plugin_api *api, attack_host *a, const fixture *f, const char *name, double value)
 {
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = a,
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = a,
                          .volume_count = attack_volume_count, .volume = attack_volume};
     vfx_context *ctx;
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
     ctx->debug.sync_counters = true;
     if (api->update(ctx, 0.0, 0.0f) || api->render(ctx, &f->fv))
-        fail_msg("%s", api->last_error(ctx));
-    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+        fail_msg("%s", api->last_error(ctx, NULL));
+    vfx_stats st = {.type = VFX_TYPE_STATS};
     assert_int_equal(api->get_stats(ctx, &st), VFX_OK);
     double got = -1;
     for (uint32_t i = 0; i < st.count; ++i)
@@ -438,7 +477,7 @@ static void test_v2_views(void **state)
     good_views(&a);
     bool vol = api->effects_built & VFX_EFFECT_BIT(VFX_EFFECT_VOLUME);
     if (!vol)
-        a.vv.v1.point_count = 0, a.vv.v1.tet_count = 0;
+        a.vv.point_count = 0, a.vv.tet_count = 0;
     attack(api, &a, &f, VFX_OK, NULL);
     /* beams v2: each field out of range, named */
     struct { const char *field; void (*set)(attack_host *); } beam_cases[] = {
@@ -450,13 +489,13 @@ static void test_v2_views(void **state)
     good_views(&a); a.beam.falloff = 9;
     attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "falloff 9");
     good_views(&a); a.beam.intensity = NAN;
-    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "beams[0]: vfx_beam2.intensity nan outside (0, 1000000] or 0");
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "beams[0]: vfx_beam.intensity nan outside (0, 1000000] or 0");
     good_views(&a); a.beam.exposure = 1e30f;
-    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "beams[0]: vfx_beam2.exposure 1e+30 outside [-64, 64]");
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "beams[0]: vfx_beam.exposure 1e+30 outside [-64, 64]");
     good_views(&a); a.beam.flow_amount = 2;
-    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "beams[0]: vfx_beam2.flow_amount 2 outside [0, 1]");
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "beams[0]: vfx_beam.flow_amount 2 outside [0, 1]");
     good_views(&a); a.beam.flow_scale = -1;
-    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "beams[0]: vfx_beam2.flow_scale -1 outside [0, 1000000]");
+    attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "beams[0]: vfx_beam.flow_scale -1 outside [0, 1000000]");
     good_views(&a); a.bv.bloom_levels = 99;
     attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "bloom_levels 99");
     good_views(&a); a.bv.bloom_strength = -1;
@@ -465,13 +504,13 @@ static void test_v2_views(void **state)
     attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "bloom 5");
     good_views(&a); a.bv.beams = NULL;
     attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "non-NULL array");
-    good_views(&a); a.bv.v1.count = 1u << 30;
+    good_views(&a); a.bv.count = 1u << 30;
     attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "1073741824 beams (at most");
-    good_views(&a); a.beam.v1.radius = NAN;
+    good_views(&a); a.beam.radius = NAN;
     attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "beams[0]:");
     if (vol) {
         /* volume v2 */
-        good_views(&a); a.vv.v1.tets = k_bad_tet;
+        good_views(&a); a.vv.tets = k_bad_tet;
         attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "volume[0]: tet 0 uses point 9 of 4");
         static const float dec[2] = {0.5f, 0.25f}, nan2[2] = {0, NAN};
         good_views(&a); a.vv.transfer_scalar = dec;
@@ -480,27 +519,27 @@ static void test_v2_views(void **state)
         attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "transfer_scalar[1] = nan");
         good_views(&a); a.vv.transfer_method = 9;
         attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "transfer_method 9 unknown");
-        good_views(&a); a.vv.v1.transfer_count = VFX_VOLUME_MAX_TRANSFER + 1;
+        good_views(&a); a.vv.transfer_count = VFX_VOLUME_MAX_TRANSFER + 1;
         attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "transfer function of 1025 entries");
-        good_views(&a); a.vv.v1.ert_threshold = 2;
+        good_views(&a); a.vv.ert_threshold = 2;
         attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "volume[0]: vfx_volume_view.ert_threshold 2 outside (0, 1] or 0");
         /* a DxD termination table of 65,535^2 entries per worker: refused, not allocated */
-        good_views(&a); a.vv.v1.tiles = 65535;
+        good_views(&a); a.vv.tiles = 65535;
         attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "volume[0]: vfx_volume_view.tiles 65535 outside 1..1024 or 0");
-        good_views(&a); a.vv.v1.workers = 100000;
+        good_views(&a); a.vv.workers = 100000;
         attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "volume[0]: vfx_volume_view.workers 100000 outside 0..256");
-        good_views(&a); a.vv.v1.update_c = 1u << 31;
+        good_views(&a); a.vv.update_c = 1u << 31;
         attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "volume[0]: vfx_volume_view.update_c 2147483648 outside 1..1048576 or 0");
-        good_views(&a); a.vv.v1.model[0] = NAN;
+        good_views(&a); a.vv.model[0] = NAN;
         attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "volume[0]: model[0] is not finite");
-        good_views(&a); a.vv.v1.scalar_min = NAN;
+        good_views(&a); a.vv.scalar_min = NAN;
         attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "volume[0]: scalar_min nan");
         /* every scalar NaN or Inf (issue 28): named as that, with or without a given range (it
          * was reported as a bad transfer function) */
         static const float nan4[4] = {NAN, NAN, INFINITY, -NAN};
         for (int ranged = 0; ranged < 2; ++ranged) {
-            good_views(&a); a.vv.v1.scalar = nan4;
-            a.vv.v1.scalar_min = 0, a.vv.v1.scalar_max = ranged ? 3.f : 0.f;
+            good_views(&a); a.vv.scalar = nan4;
+            a.vv.scalar_min = 0, a.vv.scalar_max = ranged ? 3.f : 0.f;
             attack(api, &a, &f, VFX_ERR_INVALID_ARGUMENT, "volume[0]: all 4 scalars are NaN or infinite");
         }
         /* a NaN or Inf coordinate: that cell is skipped, the good one drawn, the image finite */
@@ -513,12 +552,12 @@ static void test_v2_views(void **state)
             memcpy(bad_pts, k_pts, sizeof k_pts);
             bad_pts[12] = 0, bad_pts[13] = 0, bad_pts[14] = inf ? INFINITY : NAN;
             good_views(&a);
-            a.vv.v1.points = bad_pts, a.vv.v1.point_count = 5, a.vv.v1.tets = two, a.vv.v1.tet_count = 2;
-            a.vv.v1.scalar = sc5;
+            a.vv.points = bad_pts, a.vv.point_count = 5, a.vv.tets = two, a.vv.tet_count = 2;
+            a.vv.scalar = sc5;
             check_counted(api, &a, &f, "volume.cells_scanned", 1); /* the good cell still drawn */
         }
-        good_views(&a); a.vv.v1.version = 7;
-        attack(api, &a, &f, VFX_ERR_ABI, "host view of version 7");
+        good_views(&a); a.vv.type = (vfx_struct_type)70;
+        attack(api, &a, &f, VFX_ERR_ABI, "host volume view (vfx_volume_view) has type 70, need 7");
     }
     free_fixture(&f);
 }
@@ -554,22 +593,20 @@ static void test_frame_block(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_host_api host = beams_host(&log);
+    vfx_context_desc host = beams_host(&log);
     const vfx_plugin_api *api = plugin_api();
     vfx_context *ctx;
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
     assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_OK);
     fixture f;
     make_fixture(&f);
-    vfx_frame_view3 v3 = {0};
-    memcpy(&v3.v2.v1, &f.fv, sizeof f.fv);
-    v3.v2.v1.size = sizeof v3, v3.v2.v1.version = VFX_FRAME_VIEW3_VERSION;
-    v3.v2.v1.near_plane = 0, v3.v2.v1.far_plane = 0; /* filled from proj by the gate */
-    v3.v2.origin[0] = 1e6, v3.v2.origin[1] = -2.5, v3.v2.origin[2] = 3.0;
-    v3.v2.color_hdr = 1;
-    v3.v2.environment_cubemap = f.cube;
+    vfx_frame_view v3 = f.fv;
+    v3.near_plane = 0, v3.far_plane = 0; /* filled from proj by the gate */
+    v3.origin[0] = 1e6, v3.origin[1] = -2.5, v3.origin[2] = 3.0;
+    v3.color_hdr = 1;
+    v3.environment_cubemap = f.cube;
     v3.view_id = 7;
-    expect(api, ctx, &v3.v2.v1, VFX_OK, NULL);
+    expect(api, ctx, &v3, VFX_OK, NULL);
     GLint buf = 0;
     glGetIntegeri_v(GL_UNIFORM_BUFFER_BINDING, VOLFX_FRAME_BINDING, &buf);
     assert_true(buf != 0);

@@ -20,16 +20,16 @@
 
 static rt_gl_context *g_gl;
 
-static vfx_host_api empty_host(test_log *log)
+static vfx_context_desc empty_host(test_log *log)
 {
-    return (vfx_host_api){.size = sizeof(vfx_host_api), .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
-                          .user = log, .log = test_log_fn};
+    return (vfx_context_desc){.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc,
+                          .user = log, .log = test_vfx_log_fn};
 }
 
 static const vfx_plugin_api *plugin_api(void)
 {
     static vfx_plugin_api api; /* test-local table; the plugin itself holds no globals */
-    api.size = sizeof api;
+    api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     return &api;
 }
@@ -79,14 +79,14 @@ static void test_timestamps_and_empty_world(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_host_api host = empty_host(&log);
+    vfx_context_desc host = empty_host(&log);
     const vfx_plugin_api *api = plugin_api();
     vfx_context *ctx;
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
-    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .width = 32, .height = 32};
+    vfx_frame_view fv = {.type = VFX_TYPE_FRAME_VIEW, .width = 32, .height = 32};
     ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8, 32, 32, 0.1, 100};
     ref_camera_matrices(&cam, fv.view, fv.proj);
-    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+    vfx_stats st = {.type = VFX_TYPE_STATS};
     /* nothing in the world: no effect state is made, no pass runs, no stat appears */
     for (int i = 0; i < 6; ++i) {
         assert_int_equal(api->update(ctx, i / 60.0, 1.f / 60.f), VFX_OK);
@@ -121,37 +121,36 @@ static void test_timestamps_and_empty_world(void **state)
             }
     }
     assert_true(seen);
-    /* more counters than version 1 holds: version 1 readers get the first VFX_STATS_MAX,
-     * version 2 readers all of them up to VFX_STATS2_MAX, and the rest are counted */
+    /* more counters than the stats hold: the first VFX_STATS_MAX are given, the rest counted */
     ctx->stats.count = 0;
     ctx->stats.dropped = 0;
-    for (int i = 0; i < VFX_STATS2_MAX + 3; ++i) {
+    for (int i = 0; i < VFX_STATS_MAX + 3; ++i) {
         char name[32];
         snprintf(name, sizeof name, "test.c%d", i);
         volfx_stat_set(ctx, name, i);
     }
     ctx->last_stats = ctx->stats;
-    vfx_stats v1 = {.size = sizeof v1, .version = VFX_STATS_VERSION};
-    assert_int_equal(api->get_stats(ctx, &v1), VFX_OK);
-    assert_int_equal(v1.count, VFX_STATS_MAX);
-    assert_string_equal(v1.entries[VFX_STATS_MAX - 1].name, "test.c63");
-    static vfx_stats2 v2;
-    v2 = (vfx_stats2){.size = sizeof v2, .version = VFX_STATS2_VERSION};
-    assert_int_equal(api->get_stats(ctx, (vfx_stats *)&v2), VFX_OK);
-    assert_int_equal(v2.count, VFX_STATS2_MAX);
+    static vfx_stats v2;
+    v2 = (vfx_stats){.type = VFX_TYPE_STATS};
+    assert_int_equal(api->get_stats(ctx, &v2), VFX_OK);
+    assert_int_equal(v2.count, VFX_STATS_MAX);
     assert_int_equal(v2.dropped, 3);
-    assert_true(v2.entries[VFX_STATS2_MAX - 1].value == VFX_STATS2_MAX - 1);
-    v2.size = sizeof(vfx_stats); /* a version 2 header on a version 1 buffer is refused */
-    assert_int_equal(api->get_stats(ctx, (vfx_stats *)&v2), VFX_ERR_ABI);
+    assert_string_equal(v2.entries[VFX_STATS_MAX - 1].name, "test.c511");
+    assert_true(v2.entries[VFX_STATS_MAX - 1].value == VFX_STATS_MAX - 1);
+    v2.type = VFX_TYPE_LIGHTS; /* a struct of another type is refused, naming it */
+    assert_int_equal(api->get_stats(ctx, &v2), VFX_ERR_ABI);
+    vfx_log_id id = VFX_LOG_ID_NONE;
+    assert_non_null(strstr(api->last_error(ctx, &id), "vfx_stats has type 9, need 8"));
+    assert_int_equal(id, VFX_LOG_ID_STRUCT_TYPE);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glDeleteFramebuffers(1, &fbo);
     glDeleteTextures(1, &tex);
     /* bad frames are refused with a message, not drawn */
     fv.proj[5] = NAN;
     assert_int_equal(api->render(ctx, &fv), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(api->last_error(ctx), "camera matrix element"));
+    assert_non_null(strstr(api->last_error(ctx, NULL), "camera matrix element"));
     fv.proj[5] = 1;
-    fv.version = 9;
+    fv.type = (vfx_struct_type)9;
     assert_int_equal(api->render(ctx, &fv), VFX_ERR_ABI);
     assert_int_equal(api->resize(ctx, 0, 10), VFX_ERR_INVALID_ARGUMENT);
     api->destroy(ctx);
@@ -161,7 +160,7 @@ static void test_shader_error_names_file_line(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_host_api host = empty_host(&log);
+    vfx_context_desc host = empty_host(&log);
     const vfx_plugin_api *api = plugin_api();
     vfx_context *ctx;
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
@@ -176,15 +175,15 @@ static void test_shader_error_names_file_line(void **state)
     const char *srcs[1] = {src}, *names[1] = {"common/depth.glsl"};
     GLenum stage = GL_FRAGMENT_SHADER;
     assert_int_equal(volfx_gpu_link_sources(ctx, 1, &stage, srcs, names), 0);
-    assert_non_null(strstr(api->last_error(ctx), "common/depth.glsl:3:"));
+    assert_non_null(strstr(api->last_error(ctx, NULL), "common/depth.glsl:3:"));
     /* an error inside an included file names that file: the integrate shader compiled with a
      * define that breaks the included beam_field.glsl is reported at beam_field.glsl */
     assert_int_equal(volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
                                      "#define fma undefined_fma"), 0);
-    assert_non_null(strstr(api->last_error(ctx), "beams/beam_field.glsl:"));
+    assert_non_null(strstr(api->last_error(ctx, NULL), "beams/beam_field.glsl:"));
     /* a shader that is not embedded is named */
     assert_int_equal(volfx_gpu_program(ctx, "common/fullscreen.vert", "nope/none.frag", NULL), 0);
-    assert_non_null(strstr(api->last_error(ctx), "nope/none.frag"));
+    assert_non_null(strstr(api->last_error(ctx, NULL), "nope/none.frag"));
     /* the real embedded program links, and is cached */
     GLuint p0 = volfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", NULL);
     assert_int_not_equal(p0, 0);
@@ -207,7 +206,7 @@ static void test_lifecycle_many(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_host_api host = empty_host(&log);
+    vfx_context_desc host = empty_host(&log);
     const vfx_plugin_api *api = plugin_api();
     /* create, resize, destroy and re-create; run under valgrind/LSan this proves no leak */
     for (int i = 0; i < 1000; ++i) {

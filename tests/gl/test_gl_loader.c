@@ -40,22 +40,22 @@ static void *count_proc(void *user, const char *name)
     return (void *)eglGetProcAddress(name);
 }
 
-static void counting_log(void *user, vfx_log_level level, const char *message)
+static void counting_log(void *user, vfx_log_level level, vfx_log_id id, const char *message)
 {
-    test_log_fn(&((counting *)user)->log, level, message);
+    test_vfx_log_fn(&((counting *)user)->log, level, id, message);
 }
 
 static const vfx_plugin_api *plugin_api(void)
 {
     static vfx_plugin_api api; /* test-local table */
-    api.size = sizeof api;
+    api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     return &api;
 }
 
 /* What the lookups are for: a block of water, a beam and a tet cube drawn for three frames. */
 static float px[512], py[512], pz[512];
-static const vfx_beam beam = {.head = {-2, 1.2f, 0}, .dir = {1, 0, 0}, .length = 4, .radius = 1, .a = 0.5f,
+static const vfx_beam beam = {.type = VFX_TYPE_BEAM, .head = {-2, 1.2f, 0}, .dir = {1, 0, 0}, .length = 4, .radius = 1, .a = 0.5f,
                               .b = 0.5f, .eps = 0.05f};
 static float points[24], scalar[8];
 static const uint32_t tets[20] = {0, 1, 2, 4, 1, 2, 3, 7, 1, 4, 5, 7, 2, 4, 6, 7, 1, 2, 4, 7};
@@ -87,7 +87,7 @@ static void test_counted_once_at_create(void **state)
         points[3 * i + 2] = -0.4f + 0.8f * (i >> 2 & 1), scalar[i] = (float)(i & 1);
     }
     const vfx_plugin_api *api = plugin_api();
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &c,
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .user = &c,
                          .gl_get_proc_address = count_proc, .log = counting_log, .particle_chunk_count = one,
                          .particle_chunk = chunk, .beams = beams, .volume_count = one, .volume = volume};
     vfx_context *ctx;
@@ -109,7 +109,7 @@ static void test_counted_once_at_create(void **state)
     glCreateFramebuffers(1, &fbo);
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, out, 0);
     float f = 1.732f, n = 0.1f, fa = 50.f;
-    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = fbo,
+    vfx_frame_view fv = {.type = VFX_TYPE_FRAME_VIEW, .framebuffer = fbo,
                          .color_texture = col, .depth_texture = dep, .width = W, .height = H,
                          .view = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, -4, 1},
                          .proj = {f * H / W, 0, 0, 0, 0, f, 0, 0, 0, 0, -(fa + n) / (fa - n), -1, 0, 0, -2 * fa * n / (fa - n), 0},
@@ -144,7 +144,7 @@ static void test_missing_command_named(void **state)
         memset(&c, 0, sizeof c);
         c.hide = hide[i];
         const vfx_plugin_api *api = plugin_api();
-        vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &c,
+        vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .user = &c,
                              .gl_get_proc_address = count_proc, .log = counting_log};
         vfx_context *ctx = (vfx_context *)&c;
         assert_int_equal(api->create(&host, &ctx), VFX_ERR_GL_UNSUPPORTED);
@@ -158,7 +158,7 @@ static void test_no_loader_refused(void **state)
     (void)state;
     test_log log = {0};
     const vfx_plugin_api *api = plugin_api();
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &log, .log = test_log_fn};
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .user = &log, .log = test_vfx_log_fn};
     vfx_context *ctx = (vfx_context *)&log;
     assert_int_equal(api->create(&host, &ctx), VFX_ERR_INVALID_ARGUMENT);
     assert_null(ctx);

@@ -46,9 +46,9 @@ int main(void)
         return VFX_TEST_SKIP;
     }
     test_log log = {0};
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = proc,
-                         .user = &log, .log = test_log_fn};
-    vfx_plugin_api api = {.size = sizeof api};
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = proc,
+                         .user = &log, .log = test_vfx_log_fn};
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
     if (vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api) != VFX_OK) {
         fprintf(stderr, "vfx_plugin_entry failed\n");
         return 1;

@@ -18,6 +18,7 @@
 #include "camera_ref.h"
 #include "context.h"
 #include "test_util.h"
+#include "volfx_lab.h"
 #include "water_ref.h"
 
 typedef struct host {
@@ -26,8 +27,9 @@ typedef struct host {
     uint32_t n;
     uint32_t method, refine;
     float h;        /* 0: 0.02 */
-    uint32_t beams_version; /* 0: VFX_BEAMS_VIEW2_VERSION */
-    vfx_beam2 beam;
+    vfx_struct_type beams_type; /* 0: VFX_TYPE_BEAMS_VIEW */
+    vfx_lab_water lab;          /* chained into the water parameters: the method */
+    vfx_beam beam;
     float saturate_c;
 } host;
 
@@ -37,7 +39,7 @@ static vfx_result chunk(void *user, uint32_t c, vfx_particle_view *out)
 {
     (void)c;
     host *s = user;
-    *out = (vfx_particle_view){.size = sizeof *out, .version = VFX_PARTICLE_VIEW_VERSION, .count = s->n,
+    *out = (vfx_particle_view){.type = VFX_TYPE_PARTICLE_VIEW, .count = s->n,
                                .pos = {s->x, s->y, s->z}};
     return VFX_OK;
 }
@@ -45,7 +47,9 @@ static vfx_result chunk(void *user, uint32_t c, vfx_particle_view *out)
 static vfx_result water_params(void *user, vfx_water_params *out)
 {
     host *s = user;
-    *out = (vfx_water_params){.size = sizeof *out, .version = VFX_WATER_PARAMS_VERSION, .method = s->method,
+    /* the method through the lab: the baselines (BRUTE, GRID) are lab methods */
+    s->lab = (vfx_lab_water){.type = VFX_TYPE_LAB_WATER, .method = s->method};
+    *out = (vfx_water_params){.type = VFX_TYPE_WATER_PARAMS, .next = &s->lab,
                               .h = s->h ? s->h : 0.02f, .refine_iters = s->refine};
     return VFX_OK;
 }
@@ -53,20 +57,18 @@ static vfx_result water_params(void *user, vfx_water_params *out)
 static vfx_result beams_view(void *user, vfx_beams_view *out)
 {
     host *s = user;
-    if (out->size < sizeof(vfx_beams_view2) || out->version < VFX_BEAMS_VIEW2_VERSION)
+    if (out->type != VFX_TYPE_BEAMS_VIEW)
         return VFX_ERR_ABI;
-    vfx_beams_view2 *v = (vfx_beams_view2 *)out;
-    memset(v, 0, sizeof *v);
-    v->v1 = (vfx_beams_view){.size = sizeof *v, .version = s->beams_version ? s->beams_version : VFX_BEAMS_VIEW2_VERSION, .count = 1,
-                             .saturate_c = s->saturate_c};
-    v->beams = &s->beam;
+    *out = (vfx_beams_view){.type = s->beams_type ? s->beams_type : VFX_TYPE_BEAMS_VIEW, .count = 1,
+                            .saturate_c = s->saturate_c};
+    out->beams = &s->beam;
     return VFX_OK;
 }
 
 typedef struct session {
     vfx_plugin_api api;
     vfx_context *ctx;
-    vfx_host_api hapi;
+    vfx_context_desc hapi;
     GLuint fbo, col, scene;
     uint32_t w, h;
 } session;
@@ -74,8 +76,8 @@ typedef struct session {
 static void session_open(session *ss, host *s, uint32_t w, uint32_t h, GLenum fmt)
 {
     memset(ss, 0, sizeof *ss);
-    ss->hapi = (vfx_host_api){.size = sizeof ss->hapi, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
-                              .user = s, .log = test_log_fn};
+    ss->hapi = (vfx_context_desc){.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc,
+                              .user = s, .log = test_vfx_log_fn};
     if (s->n) {
         ss->hapi.particle_chunk_count = one_chunk;
         ss->hapi.particle_chunk = chunk;
@@ -83,7 +85,7 @@ static void session_open(session *ss, host *s, uint32_t w, uint32_t h, GLenum fm
     } else {
         ss->hapi.beams = beams_view;
     }
-    ss->api.size = sizeof ss->api;
+    ss->api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
     assert_int_equal(ss->api.create(&ss->hapi, &ss->ctx), VFX_OK);
     ss->ctx->debug.sync_counters = true;
@@ -109,7 +111,7 @@ static void session_close(session *ss)
 
 static vfx_frame_view frame_of(const session *ss, const ref_camera *cam)
 {
-    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = ss->fbo,
+    vfx_frame_view fv = {.type = VFX_TYPE_FRAME_VIEW, .framebuffer = ss->fbo,
                          .color_texture = ss->scene, .width = (uint32_t)cam->width, .height = (uint32_t)cam->height,
                          .fov_y = (float)cam->fov_y, .near_plane = (float)cam->near_plane,
                          .far_plane = (float)cam->far_plane};
@@ -127,8 +129,8 @@ static vfx_result session_frame(session *ss, const ref_camera *cam)
 
 static double stat(session *ss, const char *name)
 {
-    vfx_stats2 st = {.size = sizeof st, .version = VFX_STATS2_VERSION};
-    assert_int_equal(ss->api.get_stats(ss->ctx, (vfx_stats *)&st), VFX_OK);
+    vfx_stats st = {.type = VFX_TYPE_STATS};
+    assert_int_equal(ss->api.get_stats(ss->ctx, &st), VFX_OK);
     for (uint32_t k = 0; k < st.count; ++k)
         if (!strcmp(st.entries[k].name, name)) return st.entries[k].value;
     return -1;
@@ -238,8 +240,8 @@ static void test_beams_extreme_gain(void **state)
     float base = 0;
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         host s = {0};
-        s.beam = (vfx_beam2){.v1 = {.head = {-1, 0, 0}, .dir = {1, 0, 0}, .length = 2, .radius = 0.5f, .a = 0.05f,
-                                    .b = 0.03f, .eps = 0.02f, .color = {1, 0.5f, 0.2f, 1}},
+        s.beam = (vfx_beam){.type = VFX_TYPE_BEAM, .head = {-1, 0, 0}, .dir = {1, 0, 0}, .length = 2, .radius = 0.5f, .a = 0.05f,
+                                    .b = 0.03f, .eps = 0.02f, .color = {1, 0.5f, 0.2f, 1},
                              .exposure = cases[k].exposure};
         s.saturate_c = cases[k].c;
         session ss;
@@ -261,8 +263,8 @@ static void test_beams_extreme_gain(void **state)
 static host beam_host(void)
 {
     host s = {0};
-    s.beam = (vfx_beam2){.v1 = {.head = {-1, 0, 0}, .dir = {1, 0, 0}, .length = 2, .radius = 0.5f, .a = 0.05f,
-                                .b = 0.03f, .eps = 0.02f}};
+    s.beam = (vfx_beam){.type = VFX_TYPE_BEAM, .head = {-1, 0, 0}, .dir = {1, 0, 0}, .length = 2, .radius = 0.5f, .a = 0.05f,
+                                .b = 0.03f, .eps = 0.02f};
     return s;
 }
 
@@ -280,9 +282,9 @@ static void test_framebuffer_zero(void **state)
     fv.framebuffer = 0;
     assert_int_equal(ss.api.update(ss.ctx, 0.0, 0.0f), VFX_OK);
     vfx_result r = ss.api.render(ss.ctx, &fv);
-    print_message("framebuffer 0: %d %s\n", r, ss.api.last_error(ss.ctx));
+    print_message("framebuffer 0: %d %s\n", r, ss.api.last_error(ss.ctx, NULL));
     assert_int_equal(r, VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(ss.api.last_error(ss.ctx), "framebuffer 0 is the default framebuffer"));
+    assert_non_null(strstr(ss.api.last_error(ss.ctx, NULL), "framebuffer 0 is the default framebuffer"));
     assert_int_equal(glGetError(), GL_NO_ERROR);
     assert_int_equal(session_frame(&ss, &cam), VFX_OK);
     session_close(&ss);
@@ -337,10 +339,10 @@ static void test_target_out_of_memory(void **state)
     vfx_result r = ss.api.update(ss.ctx, 0.0, 0.0f);
     if (!r) r = ss.api.render(ss.ctx, &fv);
     setrlimit(RLIMIT_AS, &old);
-    print_message("4096x3072 under a limit of VmSize + 64 MiB: %d %s\n", r, ss.api.last_error(ss.ctx));
+    print_message("4096x3072 under a limit of VmSize + 64 MiB: %d %s\n", r, ss.api.last_error(ss.ctx, NULL));
     assert_int_equal(r, VFX_ERR_OUT_OF_MEMORY);
-    assert_non_null(strstr(ss.api.last_error(ss.ctx), "out of memory"));
-    assert_non_null(strstr(ss.api.last_error(ss.ctx), "4096x3072"));
+    assert_non_null(strstr(ss.api.last_error(ss.ctx, NULL), "out of memory"));
+    assert_non_null(strstr(ss.api.last_error(ss.ctx, NULL), "4096x3072"));
     while (glGetError() != GL_NO_ERROR) {}
     assert_int_equal(session_frame(&ss, &small), VFX_OK);
     glDeleteFramebuffers(1, &fbo);
@@ -419,14 +421,14 @@ static void test_unknown_view_version(void **state)
     (void)state;
     const ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8, 16, 16, 0.1, 100};
     host s = beam_host();
-    s.beams_version = 99;
+    s.beams_type = (vfx_struct_type)99;
     session ss;
     session_open(&ss, &s, 16, 16, GL_RGBA8);
     vfx_result r = session_frame(&ss, &cam);
-    print_message("beams view version 99: %d %s\n", r, ss.api.last_error(ss.ctx));
+    print_message("beams view of type 99: %d %s\n", r, ss.api.last_error(ss.ctx, NULL));
     assert_int_equal(r, VFX_ERR_ABI);
-    assert_non_null(strstr(ss.api.last_error(ss.ctx), "99"));
-    s.beams_version = 0;
+    assert_non_null(strstr(ss.api.last_error(ss.ctx, NULL), "vfx_beams_view) has type 99"));
+    s.beams_type = VFX_TYPE_NONE;
     assert_int_equal(session_frame(&ss, &cam), VFX_OK);
     session_close(&ss);
 }

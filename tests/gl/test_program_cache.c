@@ -29,13 +29,12 @@
 static char g_dir[] = "/tmp/vfx_progcache_XXXXXX";
 static char g_entry[4096];
 
-static const vfx_plugin_api2 *api2(void)
+static const vfx_plugin_api *api2(void)
 {
-    static vfx_plugin_api2 api;
-    api.v1.size = sizeof api;
-    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api.v1), VFX_OK);
-    assert_int_equal(api.v1.version, VFX_PLUGIN_API2_VERSION);
-    assert_int_equal(api.v1.size, sizeof api);
+    static vfx_plugin_api api;
+    api.type = VFX_TYPE_PLUGIN_API;
+    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
+    assert_int_equal(api.type, VFX_TYPE_PLUGIN_API);
     assert_non_null(api.set_program_cache);
     assert_non_null(api.warm_up);
     return &api;
@@ -44,11 +43,11 @@ static const vfx_plugin_api2 *api2(void)
 /* A fresh context with the cache on, one program asked for; returns the cache's counts. */
 static volfx_program_cache_counts one_program(test_log *log)
 {
-    const vfx_plugin_api2 *a = api2();
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
-                         .user = log, .log = test_log_fn};
+    const vfx_plugin_api *a = api2();
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc,
+                         .user = log, .log = test_vfx_log_fn};
     vfx_context *ctx;
-    assert_int_equal(a->v1.create(&host, &ctx), VFX_OK);
+    assert_int_equal(a->create(&host, &ctx), VFX_OK);
     assert_int_equal(a->set_program_cache(ctx, g_dir), VFX_OK);
     GLuint p = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/composite.frag", NULL);
     assert_int_not_equal(p, 0);
@@ -56,14 +55,14 @@ static volfx_program_cache_counts one_program(test_log *log)
     glGetProgramiv(p, GL_LINK_STATUS, &linked);
     assert_true(linked);
     volfx_gpu_frame_end(ctx); /* the counts reach the frame's stats */
-    const vfx_stats2 st = ctx->stats;
+    const vfx_stats st = ctx->stats;
     volfx_program_cache_counts c = {0};
     for (uint32_t i = 0; i < st.count; ++i) {
         if (!strcmp(st.entries[i].name, "gpu.program_cache_loaded")) c.loaded = (uint32_t)st.entries[i].value;
         if (!strcmp(st.entries[i].name, "gpu.program_cache_stored")) c.stored = (uint32_t)st.entries[i].value;
         if (!strcmp(st.entries[i].name, "gpu.program_cache_rejected")) c.rejected = (uint32_t)st.entries[i].value;
     }
-    a->v1.destroy(ctx);
+    a->destroy(ctx);
     return c;
 }
 

@@ -40,7 +40,8 @@ cmake -S "$dest/host" -B "$dest/host/build" -DCMAKE_PREFIX_PATH="$dest/root$pref
 grep "volfx .* from $lib/cmake/volfx" "$dest/configure.log" || { cat "$dest/configure.log"; fail "volfx not found in the DESTDIR"; }
 cmake --build "$dest/host/build" >"$dest/build.log" 2>&1 || { cat "$dest/build.log"; fail "the host does not build against volfx::volfx"; }
 exe=$dest/host/build/tiny_host
-readelf -d "$exe" | grep -q "NEEDED.*\[libvolfx.so.1\]" || fail "the host does not need libvolfx.so.1"
+soname=$(sed -n 's/^#define VFX_SONAME "\(.*\)"/\1/p' "$dest/root$prefix/include/volfx/volfx.h")
+readelf -d "$exe" | grep -q "NEEDED.*\[$soname\]" || fail "the host does not need $soname"
 grep -rq -- "-I$dest/root$prefix/include\|isystem $dest/root$prefix/include" "$dest/host/build/CMakeFiles" \
   || fail "volfx.h's include directory is not the installed one"
 

@@ -17,12 +17,13 @@ fail() { echo "check_install: $*" >&2; exit 1; }
 
 meson install -C "$build" --no-rebuild --quiet --destdir "$dest" >/dev/null
 case $libdir in /*) lib=$dest$libdir ;; *) lib=$dest$prefix/$libdir ;; esac
-for f in "$lib/libvolfx.so.1" "$lib/libvolfx.so" "$lib/pkgconfig/volfx.pc" "$dest$prefix/include/volfx/volfx.h"; do
+abi=$(sed -n 's/^#define VFX_ABI_VERSION \([0-9]*\)u/\1/p' "$src/plugin/include/volfx/volfx.h")
+for f in "$lib/libvolfx.so.$abi" "$lib/libvolfx.so" "$lib/pkgconfig/volfx.pc" "$dest$prefix/include/volfx/volfx.h"; do
   [ -e "$f" ] || fail "not installed: ${f#"$dest"}"
 done
-soname=$(readelf -d "$lib/libvolfx.so.1" | sed -n 's/.*Library soname: \[\(.*\)\]/\1/p')
+[ ! -e "$dest$prefix/include/volfx/volfx_lab.h" ] || fail "the lab header is installed"
+soname=$(readelf -d "$lib/libvolfx.so.$abi" | sed -n 's/.*Library soname: \[\(.*\)\]/\1/p')
 header_soname=$(sed -n 's/^#define VFX_SONAME "\(.*\)"/\1/p' "$dest$prefix/include/volfx/volfx.h")
-abi=$(sed -n 's/^#define VFX_ABI_VERSION \([0-9]*\)u/\1/p' "$dest$prefix/include/volfx/volfx.h")
 [ "$soname" = "libvolfx.so.$abi" ] || fail "soname '$soname', ABI version $abi"
 [ "$soname" = "$header_soname" ] || fail "soname '$soname', VFX_SONAME '$header_soname'"
 
@@ -49,7 +50,7 @@ rc=0; "$dest/minimal_host" || rc=$?
 out=$("$dest$prefix/bin/volfx-game" --headless --frames 2 --size 64x36 --no-volume --png "$dest/g.png" \
       --plugin "$soname" 2>&1) || { echo "$out"; fail "installed volfx-game --plugin $soname failed"; }
 echo "$out" | grep "loaded from" || { echo "$out"; fail "the game did not report the plugin's path"; }
-echo "$out" | grep -q "loaded from $lib/libvolfx.so.1" || fail "plugin not loaded from the DESTDIR"
+echo "$out" | grep -q "loaded from $lib/libvolfx.so.$abi" || fail "plugin not loaded from the DESTDIR"
 # The installed game with the source tree gone: the default scene (its dome mesh is a relative
 # path in the scene) must come from the installed share/volfx/scenes. The source tree is hidden
 # under an empty tmpfs in a private mount namespace where unshare can make one (root); elsewhere

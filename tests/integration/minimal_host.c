@@ -27,8 +27,9 @@ typedef struct game {
     int errors;
 } game;
 
-static void on_log(void *user, vfx_log_level level, const char *msg)
+static void on_log(void *user, vfx_log_level level, vfx_log_id id, const char *msg)
 {
+    (void)id; /* the text is enough for this host */
     game *g = user;
     if (level >= VFX_LOG_WARN)
         fprintf(stderr, "volfx: %s\n", msg);
@@ -42,14 +43,14 @@ static vfx_result on_chunk(void *user, uint32_t i, vfx_particle_view *v)
     game *g = user;
     if (i != 0)
         return VFX_ERR_NOT_FOUND;
-    *v = (vfx_particle_view){.size = sizeof *v, .version = VFX_PARTICLE_VIEW_VERSION, .count = NP,
+    *v = (vfx_particle_view){.type = VFX_TYPE_PARTICLE_VIEW, .count = NP,
                              .pos = {g->x, g->y, g->z}, .revision = g->frame};
     return VFX_OK;
 }
 static vfx_result on_beams(void *user, vfx_beams_view *v)
 {
     game *g = user;
-    *v = (vfx_beams_view){.size = sizeof *v, .version = VFX_BEAMS_VIEW_VERSION, .count = 1, .beams = &g->beam};
+    *v = (vfx_beams_view){.type = VFX_TYPE_BEAMS_VIEW, .count = 1, .beams = &g->beam};
     return VFX_OK;
 }
 
@@ -76,9 +77,9 @@ int main(int argc, char **argv)
         g.y[i] = -0.6f + 0.15f * ((i / 8) % 8);
         g.z[i] = -0.6f + 0.15f * (i / 64);
     }
-    g.beam = (vfx_beam){.head = {-2, 1.2f, 0}, .dir = {1, 0, 0}, .length = 4, .radius = 1,
+    g.beam = (vfx_beam){.type = VFX_TYPE_BEAM, .head = {-2, 1.2f, 0}, .dir = {1, 0, 0}, .length = 4, .radius = 1,
                         .a = 0.5f, .b = 0.5f, .eps = 0.05f};
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &g,
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .user = &g,
                          .gl_get_proc_address = on_proc, .log = on_log, .particle_chunk_count = on_chunks,
                          .particle_chunk = on_chunk, .beams = on_beams};
     vfx_plugin_entry_fn entry = vfx_plugin_entry; /* linked: -lvolfx */
@@ -92,7 +93,7 @@ int main(int argc, char **argv)
         }
         memcpy(&entry, &sym, sizeof entry); /* object-to-function pointer, as POSIX allows */
     }
-    vfx_plugin_api api = {.size = sizeof api};
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
     if (entry(VFX_ABI_VERSION, &host, &api) != VFX_OK)
         return 1;
     vfx_context *ctx;
@@ -113,7 +114,7 @@ int main(int argc, char **argv)
     glNamedFramebufferTexture(out_fbo, GL_COLOR_ATTACHMENT0, out_c, 0);
     /* camera at z = 4 looking at the origin, 60 degrees, GL conventions */
     float f = 1.f / tanf(0.5f * 1.0472f), n = 0.1f, fa = 50.f;
-    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = out_fbo,
+    vfx_frame_view fv = {.type = VFX_TYPE_FRAME_VIEW, .framebuffer = out_fbo,
                          .color_texture = scene_c, .depth_texture = scene_d, .width = W, .height = H,
                          .view = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, -4, 1},
                          .proj = {f * H / W, 0, 0, 0, 0, f, 0, 0, 0, 0, -(fa + n) / (fa - n), -1, 0, 0, -2 * fa * n / (fa - n), 0},
@@ -126,7 +127,7 @@ int main(int argc, char **argv)
         glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
         glBlitNamedFramebuffer(scene_fbo, out_fbo, 0, 0, W, H, 0, 0, W, H, GL_COLOR_BUFFER_BIT, GL_NEAREST);
         if (api.update(ctx, frame / 60.0, 1.f / 60.f) || api.render(ctx, &fv)) {
-            fprintf(stderr, "frame %d: %s\n", frame, api.last_error(ctx));
+            fprintf(stderr, "frame %d: %s\n", frame, api.last_error(ctx, NULL));
             return 1;
         }
     }
@@ -135,7 +136,7 @@ int main(int argc, char **argv)
     int lit = 0;
     for (int i = 0; i < W * H; ++i)
         lit += px[4 * i] + px[4 * i + 1] + px[4 * i + 2] > 30;
-    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+    vfx_stats st = {.type = VFX_TYPE_STATS};
     api.get_stats(ctx, &st);
     printf("effects built 0x%x, %d of %d pixels lit, %u stats, %d errors\n", api.effects_built, lit,
            W * H, st.count, g.errors);

@@ -43,8 +43,9 @@ typedef struct game {
     int errors;
 } game;
 
-static void on_log(void *user, vfx_log_level level, const char *msg)
+static void on_log(void *user, vfx_log_level level, vfx_log_id id, const char *msg)
 {
+    (void)id; /* the text is enough for this host */
     game *g = user;
     if (level >= VFX_LOG_WARN)
         fprintf(stderr, "volfx: %s\n", msg);
@@ -118,9 +119,9 @@ static void setup(game *g)
         g->x[i] = s * cosf(a), g->z[i] = s * sinf(a), g->y[i] = -1.2f + 0.6f * u[2];
         g->vx[i] = 0.6f * g->x[i], g->vz[i] = 0.6f * g->z[i], g->vy[i] = 1.5f * u[2];
     }
-    g->beams[0] = (vfx_beam){.head = {-2.2f, 1.1f, -0.5f}, .dir = {1, 0, 0}, .length = 2.5f, .radius = 0.35f,
+    g->beams[0] = (vfx_beam){.type = VFX_TYPE_BEAM, .head = {-2.2f, 1.1f, -0.5f}, .dir = {1, 0, 0}, .length = 2.5f, .radius = 0.35f,
                              .a = 0.3f, .b = 0.3f, .eps = 0.03f, .color = {1.0f, 0.5f, 0.2f, 1}};
-    g->beams[1] = (vfx_beam){.head = {2.2f, 0.7f, -0.5f}, .dir = {-1, 0.1f, 0}, .length = 1.5f, .radius = 0.3f,
+    g->beams[1] = (vfx_beam){.type = VFX_TYPE_BEAM, .head = {2.2f, 0.7f, -0.5f}, .dir = {-1, 0.1f, 0}, .length = 1.5f, .radius = 0.3f,
                              .a = 0.3f, .b = 0.3f, .eps = 0.03f, .color = {0.3f, 0.6f, 1.0f, 1}};
     /* a unit cube of 5 tetrahedra at the right, scalar rising with height */
     for (int i = 0; i < 8; ++i) {
@@ -186,7 +187,7 @@ int main(int argc, char **argv)
 
     static game g;
     setup(&g);
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &g,
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .user = &g,
                          .gl_get_proc_address = on_proc, .log = on_log,
                          .particle_chunk_count = on_chunks, .particle_chunk = on_chunk, .water_params = on_water,
                          .beams = on_beams, .volume_count = on_volumes, .volume = on_volume};
@@ -201,10 +202,10 @@ int main(int argc, char **argv)
         }
         memcpy(&entry, &sym, sizeof entry);
     }
-    vfx_plugin_api api = {.size = sizeof api};
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
     vfx_context *ctx = NULL;
     if (entry(VFX_ABI_VERSION, &host, &api) != VFX_OK || api.create(&host, &ctx) != VFX_OK) {
-        fprintf(stderr, "plugin: %s\n", ctx ? api.last_error(ctx) : "create failed");
+        fprintf(stderr, "plugin: %s\n", ctx ? api.last_error(ctx, NULL) : "create failed");
         return 1;
     }
     if (api.resize(ctx, W, H) != VFX_OK)
@@ -237,7 +238,7 @@ int main(int argc, char **argv)
     float u[3] = {s[1] * f[2] - s[2] * f[1], s[2] * f[0] - s[0] * f[2], s[0] * f[1] - s[1] * f[0]};
     float fov = 0.96f, n = 0.1f, fa = 60, t = 1 / tanf(0.5f * fov);
     vfx_frame_view fv = {
-        .size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = out_fbo, .color_texture = scene_c,
+        .type = VFX_TYPE_FRAME_VIEW, .framebuffer = out_fbo, .color_texture = scene_c,
         .depth_texture = scene_d, .width = W, .height = H,
         .view = {s[0], u[0], -f[0], 0, s[1], u[1], -f[1], 0, s[2], u[2], -f[2], 0,
                  -(s[0] * eye[0] + s[1] * eye[1] + s[2] * eye[2]), -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]),
@@ -256,7 +257,7 @@ int main(int argc, char **argv)
         gl.ClearNamedFramebufferfv(scene_fbo, GL_DEPTH, 0, (const float[1]){1});
         gl.BlitNamedFramebuffer(scene_fbo, out_fbo, 0, 0, W, H, 0, 0, W, H, GL_COLOR_BUFFER_BIT, GL_NEAREST);
         if (api.update(ctx, frame / 60.0, 1.f / 60.f) != VFX_OK || api.render(ctx, &fv) != VFX_OK) {
-            fprintf(stderr, "frame %d: %s\n", frame, api.last_error(ctx));
+            fprintf(stderr, "frame %d: %s\n", frame, api.last_error(ctx, NULL));
             rc = 1;
             break;
         }

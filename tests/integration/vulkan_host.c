@@ -52,8 +52,9 @@ typedef struct game {
     int errors;
 } game;
 
-static void on_log(void *user, vfx_log_level level, const char *msg)
+static void on_log(void *user, vfx_log_level level, vfx_log_id id, const char *msg)
 {
+    (void)id; /* the text is enough for this host */
     game *g = user;
     if (level >= VFX_LOG_WARN)
         fprintf(stderr, "volfx: %s\n", msg);
@@ -95,7 +96,7 @@ static vfx_result on_volume(void *user, uint32_t i, vfx_volume_view *v)
 static vfx_frame_view camera(void)
 {
     float f = 1.f / tanf(0.5f * 1.0472f), n = 0.1f, fa = 50.f;
-    return (vfx_frame_view){.size = sizeof(vfx_frame_view), .version = VFX_FRAME_VIEW_VERSION, .width = W, .height = H,
+    return (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW, .width = W, .height = H,
                             .view = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, -4, 1},
                             .proj = {f * H / W, 0, 0, 0, 0, f, 0, 0, 0, 0, -(fa + n) / (fa - n), -1, 0, 0, -2 * fa * n / (fa - n), 0},
                             .eye = {0, 0, 4}, .near_plane = n, .far_plane = fa, .fov_y = 1.0472f};
@@ -129,7 +130,7 @@ static void setup(game *g)
         g->y[i] = -1.0f + 0.15f * (float)((i / 8) % 8);
         g->z[i] = -0.6f + 0.15f * (float)(i / 64);
     }
-    g->beam = (vfx_beam){.head = {-2, 1.2f, 0}, .dir = {1, 0, 0}, .length = 4, .radius = 0.6f,
+    g->beam = (vfx_beam){.type = VFX_TYPE_BEAM, .head = {-2, 1.2f, 0}, .dir = {1, 0, 0}, .length = 4, .radius = 0.6f,
                          .a = 0.5f, .b = 0.5f, .eps = 0.05f, .color = {1.0f, 0.6f, 0.3f, 1}};
     for (int i = 0; i < 8; ++i) { /* a unit cube of 5 tetrahedra at the right, half under the floor */
         g->points[3 * i + 0] = 1.3f + 0.9f * (float)(i & 1);
@@ -763,7 +764,7 @@ static bool run_frames(const vfx_plugin_api *api, vfx_context *ctx, game *g, con
         if (!scene(scene_user))
             return false;
         if (api->update(ctx, frame / 60.0, 1.f / 60.f) != VFX_OK || api->render(ctx, &fv) != VFX_OK) {
-            fprintf(stderr, "%s frame %d: %s\n", name, frame, api->last_error(ctx));
+            fprintf(stderr, "%s frame %d: %s\n", name, frame, api->last_error(ctx, NULL));
             return false;
         }
         glFinish(); /* GL's writes done before the engine (Vulkan) reads the output */
@@ -775,7 +776,7 @@ static bool read_raws(const vfx_plugin_api *api, vfx_context *ctx, result *r)
 {
     for (int e = 0; e < VFX_EFFECT_COUNT; ++e)
         if ((api->effects_built & VFX_EFFECT_BIT(e)) && api->read_raw(ctx, (vfx_effect_kind)e, r->raw[e], W * H) != VFX_OK) {
-            fprintf(stderr, "read_raw(%d): %s\n", e, api->last_error(ctx));
+            fprintf(stderr, "read_raw(%d): %s\n", e, api->last_error(ctx, NULL));
             return false;
         }
     return true;
@@ -846,7 +847,7 @@ static void write_ppm(const char *prefix, const char *which, const unsigned char
 static bool vk_scene_cb(void *user) { return vk_scene_frame(user); }
 static bool gl_scene_cb(void *user) { gl_scene_draw(user); return true; }
 
-static int run(vfx_plugin_api *api, vfx_host_api *host, game *g, vk *v, gl_scene *gs, result *vkr, result *glr)
+static int run(vfx_plugin_api *api, vfx_context_desc *host, game *g, vk *v, gl_scene *gs, result *vkr, result *glr)
 {
     vfx_context *cv = NULL, *cg = NULL;
     int rc = 1;
@@ -883,10 +884,10 @@ int main(int argc, char **argv)
     static gl_scene gs;
     static result vkr, glr;
     setup(&g);
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .user = &g, .gl_get_proc_address = on_proc,
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .user = &g, .gl_get_proc_address = on_proc,
                          .log = on_log, .particle_chunk_count = on_chunks, .particle_chunk = on_chunk, .beams = on_beams,
                          .volume_count = on_volumes, .volume = on_volume};
-    vfx_plugin_api api = {.size = sizeof api};
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
     int rc = 1;
     if (!vk_create(&v, &g) || !gl_scene_create(&gs, &g)) {
         fprintf(stderr, "vulkan host: set-up failed\n");

@@ -81,8 +81,9 @@ static void test_every_field(void **state)
     assert_int_equal(s->beams_view.saturation, VFX_SATURATE_CLAMP);
     assert_close(s->beams_view.saturate_c, 2.5);
     assert_close(s->beams_view.far_distance, 30);
-    assert_int_equal(s->beams_view.method, 1);
-    assert_int_equal(s->beams_view.march_samples, 64);
+    assert_int_equal(s->beams_view.type, VFX_TYPE_BEAMS_VIEW);
+    assert_int_equal(s->beams_lab.method, VFX_BEAMS_METHOD_MARCH);
+    assert_int_equal(s->beams_lab.march_samples, 64);
     assert_int_equal(s->beam_count, 1);
     const vfx_beam *b = &s->beams[0].base;
     assert_close(b->head[1], 2);
@@ -98,16 +99,16 @@ static void test_every_field(void **state)
     assert_int_equal(s->water.source, RT_SCENE_WATER_FILE);
     assert_string_equal(s->water.path, "/base/p.bin");
     const vfx_water_params *wp = &s->water.params;
-    assert_int_equal(wp->size, sizeof *wp);
-    assert_int_equal(wp->version, VFX_WATER_PARAMS_VERSION);
+    assert_int_equal(wp->type, VFX_TYPE_WATER_PARAMS);
     assert_close(wp->h, 0.3);
     assert_close(wp->threshold, 0.5);
     assert_int_equal(wp->max_samples, 32);
     assert_close(wp->step, 0.01);
     assert_int_equal(wp->refine_iters, 5);
     assert_int_equal(wp->pyramid_level, 2);
-    assert_int_equal(wp->method, VFX_WATER_METHOD_GRID);
-    assert_int_equal(wp->disable, VFX_WATER_NO_SKIP | VFX_WATER_NO_PACK4);
+    assert_int_equal(s->water.lab.method, VFX_WATER_METHOD_GRID); /* a lab method: chained by the host */
+    assert_int_equal(s->water.lab.disable, VFX_WATER_NO_SKIP | VFX_WATER_NO_PACK4);
+    assert_int_equal(wp->features_off, 0);
     assert_close(wp->color[1], 0.4);
     assert_close(wp->absorption, 1.5);
     assert_close(wp->ior, 1.2);
@@ -153,7 +154,7 @@ static void test_defaults(void **state)
     };
     for (size_t k = 0; k < sizeof kcases / sizeof kcases[0]; ++k) {
         assert_int_equal(load(kcases[k].json, &log, &s, err, sizeof err), VFX_OK);
-        assert_int_equal(s->water.kernel, kcases[k].kernel);
+        assert_int_equal(s->water.params.kernel, kcases[k].kernel);
         rt_scene_free(s);
     }
     /* water.simulation.solver: "pbf" when absent (issue 22), "wcsph" when asked for */
@@ -605,10 +606,10 @@ static void test_keyframes(void **state)
     /* hand-computed: length keys (1,2) (3,6) (4,4) */
     struct { double t, length; } L[] = {{-5, 2}, {1, 2}, {2, 4}, {2.5, 5}, {3, 6}, {3.25, 5.5}, {4, 4}, {100, 4}};
     for (size_t i = 0; i < sizeof L / sizeof L[0]; ++i) {
-        assert_int_equal(rt_scene_beams_at(s, L[i].t, b, 4), 2);
+        assert_int_equal(rt_scene_beams_at(s, L[i].t, b, 4, NULL, 0, NULL), 2);
         assert_close(b[0].length, L[i].length);
     }
-    rt_scene_beams_at(s, 0.5, b, 4);
+    rt_scene_beams_at(s, 0.5, b, 4, NULL, 0, NULL);
     assert_close(b[0].head[0], 0.5);
     assert_close(b[0].head[1], -1);
     assert_close(b[0].head[2], 2);
@@ -618,18 +619,18 @@ static void test_keyframes(void **state)
     assert_close(b[0].dir[0], 0.5);
     assert_close(b[0].radius, 0.5); /* not animated: the default */
     /* opposite direction keys pass through zero at t=1: the earlier key's direction is held */
-    rt_scene_beams_at(s, 1.0, b, 4);
+    rt_scene_beams_at(s, 1.0, b, 4, NULL, 0, NULL);
     assert_close(b[0].dir[0], 1);
     /* beam 1 loops every 2 s: t=5 -> 1 -> radius 2; t=-0.5 -> 1.5 -> 2.5; static head */
-    rt_scene_beams_at(s, 5.0, b, 4);
+    rt_scene_beams_at(s, 5.0, b, 4, NULL, 0, NULL);
     assert_close(b[1].radius, 2);
     assert_close(b[1].head[0], 5);
-    rt_scene_beams_at(s, -0.5, b, 4);
+    rt_scene_beams_at(s, -0.5, b, 4, NULL, 0, NULL);
     assert_close(b[1].radius, 2.5);
     /* non-finite time is treated as 0; n smaller than the count writes n */
-    assert_int_equal(rt_scene_beams_at(s, NAN, b, 1), 1);
+    assert_int_equal(rt_scene_beams_at(s, NAN, b, 1, NULL, 0, NULL), 1);
     assert_close(b[0].length, 2);
-    assert_int_equal(rt_scene_beams_at(s, 0, NULL, 4), 0);
+    assert_int_equal(rt_scene_beams_at(s, 0, NULL, 4, NULL, 0, NULL), 0);
     rt_scene_free(s);
     /* an animated head with no static head takes the first key as the base */
     assert_int_equal(load("{\"beams\":[{\"dir\":[1,0,0],\"keyframes\":{\"head\":[{\"t\":0,\"value\":[7,8,9]}]}}]}",

@@ -45,10 +45,10 @@ static int setup(void **state)
         sv.gen_min[k] = -0.7f, sv.gen_max[k] = 0.7f;
     char err[256];
     assert_int_equal(rt_scene_volume_generate(&sv, &g_points, &g_np, &g_tets, &g_nt, &g_scalar, err, sizeof err), VFX_OK);
-    vfx_volume_view2 view = {.v1 = {.size = sizeof(vfx_volume_view), .version = VFX_VOLUME_VIEW_VERSION,
+    vfx_volume_view view = {.type = VFX_TYPE_VOLUME_VIEW,
                                     .point_count = g_np, .tet_count = g_nt, .points = g_points, .tets = g_tets,
                                     .scalar = g_scalar, .scalar_min = 0, .scalar_max = 1, .workers = 1,
-                                    .revision = 1}};
+                                    .revision = 1};
     assert_int_equal(game_app_add_volume(g_app, &view, &g_vol), VFX_OK);
     return 0;
 }
@@ -64,7 +64,7 @@ static int teardown(void **state)
 /* A counter of the last frame (NAN when absent). */
 static double stat(const char *name)
 {
-    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+    vfx_stats st = {.type = VFX_TYPE_STATS};
     assert_int_equal(g_app->api->get_stats(g_app->ctx, &st), VFX_OK);
     for (uint32_t i = 0; i < st.count; ++i)
         if (!strcmp(st.entries[i].name, name))
@@ -173,13 +173,13 @@ static void test_bad_view_and_absence(void **state)
     (void)state;
     uint32_t saved = g_tets[5];
     g_tets[5] = g_np + 7;
-    game_app_volume(g_app, g_vol)->v1.revision = 2;
+    game_app_volume(g_app, g_vol)->revision = 2;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(g_app->api->last_error(g_app->ctx), "volume[0]: tet 1 uses point"));
+    assert_non_null(strstr(g_app->api->last_error(g_app->ctx, NULL), "volume[0]: tet 1 uses point"));
     g_tets[5] = saved;
-    game_app_volume(g_app, g_vol)->v1.revision = 3;
+    game_app_volume(g_app, g_vol)->revision = 3;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
-    vfx_volume_view2 keep = *game_app_volume(g_app, g_vol);
+    vfx_volume_view keep = *game_app_volume(g_app, g_vol);
     assert_int_equal(game_app_remove(g_app, g_vol), VFX_OK);
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_null(g_app->ctx->effect_state[VFX_EFFECT_VOLUME]);
@@ -191,7 +191,7 @@ static void test_bad_view_and_absence(void **state)
 static void test_skip_when_unchanged(void **state)
 {
     (void)state;
-    vfx_volume_view *v = &game_app_volume(g_app, g_vol)->v1;
+    vfx_volume_view *v = game_app_volume(g_app, g_vol);
     float *a = render_alpha();
     float *b = render_alpha();
     assert_true(stat("volume.render_skipped") == 1);
@@ -232,11 +232,11 @@ static void test_skip_when_unchanged(void **state)
 static void test_view2_breakpoints(void **state)
 {
     (void)state;
-    vfx_volume_view2 *v2 = game_app_volume(g_app, g_vol);
+    vfx_volume_view *v2 = game_app_volume(g_app, g_vol);
     float rgba[3 * 4] = {0.2f, 0.4f, 1.0f, 0.5f, 1, 1, 1, 9.0f, 1.0f, 0.5f, 0.1f, 2.0f};
     float pos[3] = {0.2f, 0.5f, 0.9f};
-    v2->v1.transfer_rgba = rgba;
-    v2->v1.transfer_count = 3;
+    v2->transfer_rgba = rgba;
+    v2->transfer_count = 3;
     v2->transfer_scalar = pos;
     float *gpu = render_alpha();
     tet_mesh m = {.point_count = g_np, .tet_count = g_nt, .points = g_points, .tets = g_tets, .scalar = g_scalar};
@@ -260,8 +260,8 @@ static void test_view2_breakpoints(void **state)
         }
     printf("view 2 breakpoints 0.2/0.5/0.9: plugin vs renderer max |d alpha| %.3g (max alpha %.3f)\n", d, amax);
     assert_true(amax > 0.3 && d < 1e-6);
-    v2->v1.transfer_rgba = NULL;
-    v2->v1.transfer_count = 0;
+    v2->transfer_rgba = NULL;
+    v2->transfer_count = 0;
     v2->transfer_scalar = NULL;
     free(gpu), free(img);
 }
@@ -380,13 +380,13 @@ static void test_showcase_animates(void **state)
     game_demo demo;
     assert_int_equal(game_demo_load(g_app, &demo, g_showcase, VFX_EFFECT_BIT(VFX_EFFECT_WATER)), VFX_OK);
     assert_true(demo.vol_animated);
-    uint64_t rev = game_app_volume(g_app, demo.vol_entity)->v1.revision;
+    uint64_t rev = game_app_volume(g_app, demo.vol_entity)->revision;
     float *prev = NULL;
     for (int f = 0; f < 3; ++f) {
         g_app->time = 2.6 + 0.1 * f; /* the beam crosses the dome */
         game_demo_animate(g_app, &demo, 0.1f);
         float *a = render_alpha();
-        assert_true(game_app_volume(g_app, demo.vol_entity)->v1.revision == rev + 1 + (uint64_t)f);
+        assert_true(game_app_volume(g_app, demo.vol_entity)->revision == rev + 1 + (uint64_t)f);
         if (prev) {
             assert_true(stat("volume.render_skipped") == 0);
             double d = 0;
@@ -403,7 +403,7 @@ static void test_showcase_animates(void **state)
     uint32_t nb;
     game_app_beams(g_app, &nb);
     assert_true(nb == demo.beam_base_count && nb > 0);
-    uint64_t rev_off = game_app_volume(g_app, demo.vol_entity)->v1.revision;
+    uint64_t rev_off = game_app_volume(g_app, demo.vol_entity)->revision;
     game_demo_toggle(g_app, &demo, VFX_EFFECT_VOLUME);
     game_demo_toggle(g_app, &demo, VFX_EFFECT_BEAMS);
     assert_int_equal(game_app_volume_count(g_app), 0);
@@ -415,9 +415,9 @@ static void test_showcase_animates(void **state)
     game_demo_toggle(g_app, &demo, VFX_EFFECT_BEAMS);
     game_demo_animate(g_app, &demo, 0.1f);
     assert_int_equal(game_app_volume_count(g_app), 1);
-    assert_true(game_app_volume(g_app, demo.vol_entity)->v1.revision == rev_off + 1);
-    const vfx_beam2 *beams = game_app_beams(g_app, &nb);
-    assert_true(nb == demo.beam_base_count && beams[0].v1.length > 0);
+    assert_true(game_app_volume(g_app, demo.vol_entity)->revision == rev_off + 1);
+    const vfx_beam *beams = game_app_beams(g_app, &nb);
+    assert_true(nb == demo.beam_base_count && beams[0].length > 0);
     assert_int_equal(game_app_frame(g_app, 0.1f), VFX_OK);
     game_demo_free(g_app, &demo);
 }

@@ -149,10 +149,10 @@ static void test_hit_ripple(void **state)
     game_shield *s;
     assert_int_equal(game_shield_create(g_points, g_np, g_tets, g_nt, -100.f, &s), VFX_OK);
     rt_scene_volume_animation an = {.hit_gain = 1.5f, .hit_wavelength = 0.5f, .hit_speed = 1.0f, .hit_reach = 0.8f};
-    vfx_beam2 b[2];
+    vfx_beam b[2];
     memset(b, 0, sizeof b);
-    b[0].v1 = (vfx_beam){.head = {0, 0, 0.5f}, .length = 5, .dir = {0, 0, 1}, .radius = 0.2f};
-    b[1].v1 = (vfx_beam){.head = {9, 9, 9}, .length = 1, .dir = {1, 1, 1}, .radius = 0.2f};
+    b[0] = (vfx_beam){.type = VFX_TYPE_BEAM, .head = {0, 0, 0.5f}, .length = 5, .dir = {0, 0, 1}, .radius = 0.2f};
+    b[1] = (vfx_beam){.type = VFX_TYPE_BEAM, .head = {9, 9, 9}, .length = 1, .dir = {1, 1, 1}, .radius = 0.2f};
     const double t = 0.3, k = 2 * M_PI / 0.5;
     float *sc = calloc(g_np, sizeof *sc);
     game_shield_frame f = {.points = g_points, .eye = {0, 0, 100}, .beams = b, .beam_count = 2, .time = t,

@@ -227,22 +227,23 @@ static void test_effect_components(void **state)
     uint32_t n = 7;
     assert_null(rt_beams_column(w, &ec, &n));
     assert_int_equal(n, 0);
-    vfx_beam2 b[5];
+    vfx_beam b[5];
     memset(b, 0, sizeof b);
     for (int i = 0; i < 5; ++i)
-        b[i].v1.length = (float)(i + 1);
+        b[i].length = (float)(i + 1);
     rt_entity ids[5];
     assert_int_equal(rt_beams_spawn(w, &ec, 3, b, ids), VFX_OK);
     assert_int_equal(rt_beams_spawn(w, &ec, 2, b + 3, ids + 3), VFX_OK);
-    vfx_beam2 *col = rt_beams_column(w, &ec, &n);
+    vfx_beam *col = rt_beams_column(w, &ec, &n);
     assert_int_equal(n, 5);
     for (int i = 0; i < 5; ++i) {
-        assert_true(col[i].v1.length == (float)(i + 1));
+        assert_true(col[i].length == (float)(i + 1));
         assert_ptr_equal(rt_world_get(w, ids[i], ec.beam, 0), &col[i]);
     }
     assert_int_equal(rt_beams_spawn(w, &ec, 2, NULL, NULL), VFX_OK); /* zeroed */
     col = rt_beams_column(w, &ec, &n);
-    assert_true(n == 7 && col[5].v1.length == 0.f && col[6].v1.length == 0.f);
+    assert_true(n == 7 && col[5].length == 0.f && col[6].length == 0.f);
+    assert_true(col[5].type == VFX_TYPE_BEAM && col[6].type == VFX_TYPE_BEAM); /* typed, ready for a view */
     rt_entity v;
     assert_int_equal(rt_world_spawn(w, 1, &ec.volume, 1, &v), VFX_OK);
     assert_int_equal(rt_query_count(w, &ec.volume, 1), 1);

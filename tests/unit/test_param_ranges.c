@@ -110,8 +110,8 @@ static void test_water_abi_values(void **state)
         {5, -2, "vfx_water_params.absorption -2"},     {5, NAN, "vfx_water_params.absorption nan"},
     };
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
-        vfx_water_params3 p = {0};
-        vfx_water_params *v = &p.v2.v1;
+        vfx_water_params p = {.type = VFX_TYPE_WATER_PARAMS};
+        vfx_water_params *v = &p;
         switch (bad[k].field) {
         case 0: v->color[0] = bad[k].v, v->color[1] = v->color[2] = 0.5f; break;
         case 1: v->ior = bad[k].v; break;
@@ -121,23 +121,23 @@ static void test_water_abi_values(void **state)
         default: v->absorption = bad[k].v; break;
         }
         volfx_water_resolved out;
-        expect(c, volfx_water_params_resolve(c, &p, VFX_WATER_PARAMS3_VERSION, &out), VFX_ERR_INVALID_ARGUMENT,
+        expect(c, volfx_water_params_resolve(c, &p, &out), VFX_ERR_INVALID_ARGUMENT,
                bad[k].needle);
     }
     /* a value at the edge of its range is used as given, not swapped for the default */
-    vfx_water_params3 p = {0};
-    p.v2.v1.ior = 1.0f;
-    p.v2.v1.h = 0.2f;
+    vfx_water_params p = {.type = VFX_TYPE_WATER_PARAMS};
+    p.ior = 1.0f;
+    p.h = 0.2f;
     volfx_water_resolved out;
-    expect(c, volfx_water_params_resolve(c, &p, VFX_WATER_PARAMS3_VERSION, &out), VFX_OK, NULL);
+    expect(c, volfx_water_params_resolve(c, &p, &out), VFX_OK, NULL);
     assert_true(out.p.ior == 1.0f); /* was 1.333: "!(ior > 1)" took 1 for unset */
     /* max_samples and refine_iters: loop bounds, 4e9 hung a paper-method frame */
-    p = (vfx_water_params3){0};
-    p.v2.v1.max_samples = 4000000000u;
-    expect(c, volfx_water_params_resolve(c, &p, 3, &out), VFX_ERR_INVALID_ARGUMENT, "max_samples 4000000000 outside 1..4096");
-    p = (vfx_water_params3){0};
-    p.v2.v1.refine_iters = 4000000000u;
-    expect(c, volfx_water_params_resolve(c, &p, 3, &out), VFX_ERR_INVALID_ARGUMENT, "refine_iters 4000000000 outside 1..64");
+    p = (vfx_water_params){.type = VFX_TYPE_WATER_PARAMS};
+    p.max_samples = 4000000000u;
+    expect(c, volfx_water_params_resolve(c, &p, &out), VFX_ERR_INVALID_ARGUMENT, "max_samples 4000000000 outside 1..4096");
+    p = (vfx_water_params){.type = VFX_TYPE_WATER_PARAMS};
+    p.refine_iters = 4000000000u;
+    expect(c, volfx_water_params_resolve(c, &p, &out), VFX_ERR_INVALID_ARGUMENT, "refine_iters 4000000000 outside 1..64");
     free(c);
 }
 
@@ -145,24 +145,25 @@ static void test_beam_abi_values(void **state)
 {
     (void)state;
     vfx_context *c = fake_ctx();
-    vfx_beam good = {.dir = {1, 0, 0}, .length = 1, .radius = 0.5f, .a = 0.05f, .b = 0.03f, .eps = 0.02f};
-    vfx_beam2 look = {.v1 = good, .intensity = 1};
-    expect(c, volfx_beam_check_ranges(c, 3, &good, &look), VFX_OK, NULL);
+    vfx_beam good = {.type = VFX_TYPE_BEAM, .dir = {1, 0, 0}, .length = 1, .radius = 0.5f, .a = 0.05f, .b = 0.03f,
+                     .eps = 0.02f, .intensity = 1};
+    expect(c, volfx_beam_check_ranges(c, 3, &good), VFX_OK, NULL);
     vfx_beam b = good;
     b.radius = 3e38f; /* gave NaN for H */
-    expect(c, volfx_beam_check_ranges(c, 3, &b, NULL), VFX_ERR_INVALID_ARGUMENT, "beams[3]: vfx_beam.radius 3e+38");
+    expect(c, volfx_beam_check_ranges(c, 3, &b), VFX_ERR_INVALID_ARGUMENT, "beams[3]: vfx_beam.radius 3e+38");
     b = good;
     b.color[1] = NAN; /* an invisible beam */
-    expect(c, volfx_beam_check_ranges(c, 3, &b, NULL), VFX_ERR_INVALID_ARGUMENT, "beams[3]: vfx_beam.color[1] nan");
-    vfx_beam2 l = look;
+    expect(c, volfx_beam_check_ranges(c, 3, &b), VFX_ERR_INVALID_ARGUMENT, "beams[3]: vfx_beam.color[1] nan");
+    vfx_beam l = good;
     l.intensity = 3e38f; /* an invisible beam */
-    expect(c, volfx_beam_check_ranges(c, 3, &good, &l), VFX_ERR_INVALID_ARGUMENT, "vfx_beam2.intensity 3e+38");
-    l = look;
+    expect(c, volfx_beam_check_ranges(c, 3, &l), VFX_ERR_INVALID_ARGUMENT, "vfx_beam.intensity 3e+38");
+    l = good;
     l.exposure = NAN;
-    expect(c, volfx_beam_check_ranges(c, 3, &good, &l), VFX_ERR_INVALID_ARGUMENT, "vfx_beam2.exposure nan");
-    vfx_beams_view2 v = {.v1 = {.saturate_c = -1}};
-    expect(c, volfx_beams_view_check_ranges(c, &v, VFX_BEAMS_VIEW2_VERSION), VFX_ERR_INVALID_ARGUMENT,
-           "vfx_beams_view.saturate_c -1");
+    expect(c, volfx_beam_check_ranges(c, 3, &l), VFX_ERR_INVALID_ARGUMENT, "vfx_beam.exposure nan");
+    vfx_beams_view v = {.type = VFX_TYPE_BEAMS_VIEW, .saturate_c = -1};
+    expect(c, volfx_beams_view_check_ranges(c, &v, 0), VFX_ERR_INVALID_ARGUMENT, "vfx_beams_view.saturate_c -1");
+    v.saturate_c = 0;
+    expect(c, volfx_beams_view_check_ranges(c, &v, 5000), VFX_ERR_INVALID_ARGUMENT, "vfx_lab_beams.march_samples 5000");
     free(c);
 }
 

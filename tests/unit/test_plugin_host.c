@@ -17,26 +17,24 @@
 
 static const char *g_plugin, *g_nosym, *g_badver;
 
-static vfx_host_api host_with(test_log *log)
+static vfx_context_desc host_with(test_log *log)
 {
-    return (vfx_host_api){.size = sizeof(vfx_host_api), .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
-                          .user = log, .log = test_log_fn};
+    return (vfx_context_desc){.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc,
+                          .user = log, .log = test_vfx_log_fn};
 }
 
 static void test_good_plugin(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_host_api host = host_with(&log);
+    vfx_context_desc host = host_with(&log);
     rt_logger lg = {test_log_fn, &log};
     rt_plugin_host *h = NULL;
     assert_int_equal(rt_plugin_host_load(g_plugin, &host, &lg, &h), VFX_OK);
     const vfx_plugin_api *api = rt_plugin_host_api(h);
-    /* the host offers version 3 (get_lights) and this plugin answers it */
-    assert_int_equal(api->version, VFX_PLUGIN_API3_VERSION);
-    assert_int_equal(api->size, sizeof(vfx_plugin_api3));
-    assert_non_null(rt_plugin_host_api3(h));
-    assert_non_null(rt_plugin_host_api3(h)->get_lights);
+    assert_int_equal(api->type, VFX_TYPE_PLUGIN_API);
+    assert_non_null(api->get_lights);
+    assert_non_null(api->resolve_defaults);
     assert_string_equal(api->name, "volfx");
     assert_non_null(api->create);
     assert_non_null(api->render);
@@ -50,7 +48,7 @@ static void test_wrong_abi_refused(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_host_api host = host_with(&log);
+    vfx_context_desc host = host_with(&log);
     rt_logger lg = {test_log_fn, &log};
     rt_plugin_host *h = NULL;
     assert_int_equal(rt_plugin_host_load_as(g_plugin, VFX_ABI_VERSION + 1, &host, &lg, &h), VFX_ERR_ABI);
@@ -59,22 +57,63 @@ static void test_wrong_abi_refused(void **state)
     char want[96];
     snprintf(want, sizeof want, "host ABI version %u, plugin ABI version %u", VFX_ABI_VERSION + 1, VFX_ABI_VERSION);
     assert_true(log.errors >= 2); /* plugin's message + host's */
-    assert_non_null(strstr(log.last, "host ABI 2"));
-    vfx_plugin_api api = {.size = sizeof api};
+    assert_non_null(strstr(log.last, "host ABI 3")); /* the host's own line: VFX_ABI_VERSION + 1 */
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
     test_log log2 = {0};
-    vfx_host_api host2 = host_with(&log2);
+    vfx_context_desc host2 = host_with(&log2);
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION + 1, &host2, &api), VFX_ERR_ABI);
     assert_non_null(strstr(log2.last, want));
-    /* a host table too small for the plugin is refused too */
-    vfx_plugin_api small = {.size = 8};
-    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, &host2, &small), VFX_ERR_ABI);
+    assert_int_equal(log2.last_id, VFX_LOG_ID_ABI_VERSION);
+    /* a host table of another type is refused too, and left as it was */
+    vfx_plugin_api other = {.type = VFX_TYPE_STATS};
+    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, &host2, &other), VFX_ERR_ABI);
+    assert_int_equal(log2.last_id, VFX_LOG_ID_STRUCT_TYPE);
+    assert_null(other.create);
+}
+
+/* ABI 1's host description as an ABI 1 host lays it out (size, version, user, loader, a logger
+ * without ids, ...): what such a host passes to vfx_plugin_entry. */
+typedef struct abi1_host {
+    uint32_t size, version;
+    void *user;
+    void *(*gl_get_proc_address)(void *user, const char *name);
+    void (*log)(void *user, vfx_log_level level, const char *message);
+    void *rest[9]; /* alloc, free and the data callbacks */
+} abi1_host;
+
+typedef struct abi1_api { /* ABI 1's vfx_plugin_api head: size, version, then pointers */
+    uint32_t size, version;
+    void *rest[16];
+} abi1_api;
+
+static void test_abi1_host_refused(void **state)
+{
+    (void)state;
+    test_log log = {0};
+    abi1_host old = {.size = sizeof old, .version = 1, .user = &log, .gl_get_proc_address = test_gl_proc,
+                     .log = test_log_fn};
+    abi1_api out = {.size = sizeof out, .version = 1};
+    abi1_api before = out;
+    /* the call an ABI 1 host makes, through the entry's type as it finds it with dlsym */
+    vfx_plugin_entry_fn entry = vfx_plugin_entry;
+    assert_int_equal(entry(1, (const vfx_context_desc *)(const void *)&old, (vfx_plugin_api *)(void *)&out),
+                     VFX_ERR_ABI);
+    assert_int_equal(log.errors, 1);
+    assert_non_null(strstr(log.last, "host ABI version 1, plugin ABI version 2"));
+    assert_memory_equal(&out, &before, sizeof out); /* nothing written into the old table */
+    /* an ABI 1 header with a size too small for its logger: no call through it */
+    test_log log2 = {0};
+    abi1_host tiny = {.size = 8, .version = 1, .user = &log2, .log = test_log_fn};
+    assert_int_equal(entry(1, (const vfx_context_desc *)(const void *)&tiny, NULL), VFX_ERR_ABI);
+    assert_int_equal(log2.errors, 0);
+    assert_int_equal(entry(1, NULL, NULL), VFX_ERR_ABI);
 }
 
 static void test_missing_symbol(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_host_api host = host_with(&log);
+    vfx_context_desc host = host_with(&log);
     rt_logger lg = {test_log_fn, &log};
     rt_plugin_host *h = NULL;
     assert_int_equal(rt_plugin_host_load(g_nosym, &host, &lg, &h), VFX_ERR_NOT_FOUND);
@@ -86,18 +125,18 @@ static void test_table_version_refused(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_host_api host = host_with(&log);
+    vfx_context_desc host = host_with(&log);
     rt_logger lg = {test_log_fn, &log};
     rt_plugin_host *h = NULL;
     assert_int_equal(rt_plugin_host_load(g_badver, &host, &lg, &h), VFX_ERR_ABI);
-    assert_non_null(strstr(log.last, "plugin API version 99"));
+    assert_non_null(strstr(log.last, "function table of type 99"));
 }
 
 static void test_missing_file(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_host_api host = host_with(&log);
+    vfx_context_desc host = host_with(&log);
     rt_logger lg = {test_log_fn, &log};
     rt_plugin_host *h = NULL;
     assert_int_equal(rt_plugin_host_load("/nonexistent/libvolfx.so", &host, &lg, &h), VFX_ERR_IO);
@@ -110,7 +149,7 @@ static void test_special_file_plugin(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_host_api host = host_with(&log);
+    vfx_context_desc host = host_with(&log);
     rt_logger lg = {test_log_fn, &log};
     rt_plugin_host *h = NULL;
     char dir[] = "/tmp/vfx_plug_XXXXXX", fifo[64];
@@ -137,12 +176,12 @@ static void test_special_file_plugin(void **state)
 static void test_create_refuses_bad_host(void **state)
 {
     (void)state;
-    vfx_plugin_api api = {.size = sizeof api};
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     vfx_context *ctx = NULL;
     test_log log = {0};
-    vfx_host_api host = host_with(&log);
-    host.version = 7; /* a host api of another version */
+    vfx_context_desc host = host_with(&log);
+    host.type = VFX_TYPE_FRAME_VIEW; /* a struct of another type */
     assert_int_equal(api.create(&host, &ctx), VFX_ERR_ABI);
     assert_null(ctx);
     assert_int_equal(api.create(NULL, &ctx), VFX_ERR_ABI);
@@ -158,6 +197,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_good_plugin),
         cmocka_unit_test(test_wrong_abi_refused),
+        cmocka_unit_test(test_abi1_host_refused),
         cmocka_unit_test(test_missing_symbol),
         cmocka_unit_test(test_table_version_refused),
         cmocka_unit_test(test_missing_file),

@@ -109,7 +109,7 @@ static void test_csv_gpu_rows(void **s)
     enum { FRAMES = 8, LAG = 3 };
     rt_profiler *p = rt_profiler_create(64);
     for (int f = 0; f < FRAMES; ++f) {
-        vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+        vfx_stats st = {.type = VFX_TYPE_STATS};
         snprintf(st.entries[st.count].name, sizeof st.entries[0].name, "gpu.timer_lag_frames");
         st.entries[st.count++].value = LAG;
         if (f >= LAG) { /* the timers of frame f - LAG have arrived */

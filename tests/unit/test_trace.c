@@ -91,7 +91,7 @@ static void test_trace_nested(void **state)
         rt_profiler_frame_begin(p);
         rt_profiler_cpu(p, "host.scene", 0.001);
         rt_profiler_cpu(p, "plugin.render", 0.002);
-        vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+        vfx_stats st = {.type = VFX_TYPE_STATS};
         /* the GPU frame (14.5 ms scaled by 4) is longer than the CPU frame: GPU frames queue */
         if (f >= 3)
             gpu_frame_stats(&st, 4.0);

@@ -25,8 +25,8 @@ typedef struct scene {
     test_log log;
     float *x, *y, *z, *radius, *kernel;
     uint32_t n, chunk;
-    vfx_water_params2 params;
-    bool v1_host; /* answers version 1 (no kernel parameters) */
+    vfx_water_params params;
+    vfx_lab_water lab;  /* chained into params: the ablation bits */
 } scene;
 
 static uint32_t chunk_count(void *user)
@@ -40,19 +40,16 @@ static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
     scene *s = user;
     uint32_t first = water_test_chunk(s->x, s->y, s->z, s->n, s->chunk, index, out);
     out->radius = s->radius ? s->radius + first : NULL;
-    if (out->version == VFX_PARTICLE_VIEW2_VERSION && out->size >= sizeof(vfx_particle_view2))
-        ((vfx_particle_view2 *)out)->kernel = s->kernel ? s->kernel + 6 * (size_t)first : NULL;
+    out->kernel = s->kernel ? s->kernel + 6 * (size_t)first : NULL;
     return VFX_OK;
 }
 
 static vfx_result water_params(void *user, vfx_water_params *out)
 {
     scene *s = user;
-    if (!s->v1_host && out->version >= VFX_WATER_PARAMS2_VERSION && out->size >= sizeof(vfx_water_params2)) {
-        *(vfx_water_params2 *)out = s->params;
-        return VFX_OK;
-    }
-    *out = s->params.v1;
+    *out = s->params;
+    s->lab.type = VFX_TYPE_LAB_WATER;
+    out->next = &s->lab;
     return VFX_OK;
 }
 
@@ -65,14 +62,13 @@ static scene make_scene(uint32_t n, float h)
     s.x = calloc(n + 1, sizeof(float));
     s.y = calloc(n + 1, sizeof(float));
     s.z = calloc(n + 1, sizeof(float));
-    s.params.v1.size = sizeof s.params;
-    s.params.v1.version = VFX_WATER_PARAMS2_VERSION;
-    s.params.v1.method = VFX_WATER_METHOD_TILE;
-    s.params.v1.h = h;
+    s.params.type = VFX_TYPE_WATER_PARAMS;
+    s.params.method = VFX_WATER_METHOD_TILE;
+    s.params.h = h;
     s.params.kernel = VFX_WATER_KERNEL_ANISOTROPIC;
     /* every pixel marched (the reduced-resolution march interpolates where its coarse rays
      * agree: its own error is test_water_gl's); test_aniso_vs_reference also runs it on */
-    s.params.v1.disable = VFX_WATER_NO_HALF_RES;
+    s.lab.disable = VFX_WATER_NO_HALF_RES;
     return s;
 }
 
@@ -138,9 +134,9 @@ static scene spray_scene(float h)
 
 static ref_water_aniso_params ref_aniso_of(const scene *s)
 {
-    const vfx_water_params2 *p = &s->params;
+    const vfx_water_params *p = &s->params;
     /* the documented defaults (volfx.h) */
-    ref_water_aniso_params a = {p->v1.h, p->aniso_radius > 0 ? p->aniso_radius : 1.5,
+    ref_water_aniso_params a = {p->h, p->aniso_radius > 0 ? p->aniso_radius : 1.5,
                                 p->aniso_max_stretch > 0 ? p->aniso_max_stretch : 2.0,
                                 p->aniso_min_neighbours ? p->aniso_min_neighbours : 16,
                                 p->aniso_scale > 0 ? p->aniso_scale : 1.15, p->aniso_smoothing};
@@ -188,17 +184,17 @@ typedef struct run {
     float *dist;     /* w x h, top row first */
     float *kern;     /* 16 per particle (NULL when none) */
     uint32_t *nbrs;
-    vfx_stats2 stats;
+    vfx_stats stats;
 } run;
 
 static run render_plugin(scene *s, const ref_camera *cam)
 {
     run out;
     memset(&out, 0, sizeof out);
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
-                         .user = s, .log = test_log_fn, .particle_chunk_count = chunk_count,
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc,
+                         .user = s, .log = test_vfx_log_fn, .particle_chunk_count = chunk_count,
                          .particle_chunk = chunk_view, .water_params = water_params};
-    vfx_plugin_api api = {.size = sizeof api};
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     vfx_context *ctx;
     assert_int_equal(api.create(&host, &ctx), VFX_OK);
@@ -209,7 +205,7 @@ static run render_plugin(scene *s, const ref_camera *cam)
     glTextureStorage2D(col, 1, GL_RGBA8, (GLsizei)w, (GLsizei)h);
     glCreateFramebuffers(1, &fbo);
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, col, 0);
-    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = fbo, .width = w,
+    vfx_frame_view fv = {.type = VFX_TYPE_FRAME_VIEW, .framebuffer = fbo, .width = w,
                          .height = h, .fov_y = (float)cam->fov_y, .near_plane = (float)cam->near_plane,
                          .far_plane = (float)cam->far_plane};
     for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam->eye[k];
@@ -228,9 +224,8 @@ static run render_plugin(scene *s, const ref_camera *cam)
             free(kb);
             free(nb);
         }
-        out.stats.size = sizeof out.stats;
-        out.stats.version = VFX_STATS2_VERSION;
-        assert_int_equal(api.get_stats(ctx, (vfx_stats *)&out.stats), VFX_OK);
+        out.stats.type = VFX_TYPE_STATS;
+        assert_int_equal(api.get_stats(ctx, &out.stats), VFX_OK);
     }
     api.destroy(ctx);
     glDeleteFramebuffers(1, &fbo);
@@ -254,7 +249,7 @@ static void reference_dist(const scene *s, const ref_kernels *k, const ref_camer
     ref_water_camera rc = {{cam->eye[0], cam->eye[1], cam->eye[2]}, {fwd[0], fwd[1], fwd[2]},
                            {up[0], up[1], up[2]}, cam->fov_y, cam->width, cam->height};
     ref_water_params rp = ref_water_default_params();
-    rp.h = s->params.v1.h;
+    rp.h = s->params.h;
     rp.step = rp.h / 32;
     rp.G = k->G;
     char err[256];
@@ -283,14 +278,14 @@ static void compare_kernels(const scene *s, const run *r, const ref_kernels *k, 
         stretched += fabs(gg[0] - 1) + fabs(gg[3] - 1) + fabs(gg[5] - 1) > 1e-3;
     }
     print_message("%s kernels: %u particles, %u stretched, neighbour counts differing %u, G rel error max %.2e, "
-                  "centre max %.2e h\n", name, s->n, stretched, nb_diff, worst, worst_c / s->params.v1.h);
+                  "centre max %.2e h\n", name, s->n, stretched, nb_diff, worst, worst_c / s->params.h);
     /* the jitter keeps every neighbour distance off the radius: the counts agree exactly */
     assert_int_equal(nb_diff, 0);
     /* float32 sums of ~250 weighted products (relative rounding ~1e-6), six Jacobi sweeps (they
      * converge quadratically: float precision after three) and the normalisation's cube root:
      * measured ~1e-5; 1e-3 leaves room for llvmpipe's and a GPU's rounding */
     assert_true(worst < 1e-3);
-    assert_true(worst_c < 1e-4 * s->params.v1.h);
+    assert_true(worst_c < 1e-4 * s->params.h);
 }
 
 /* GPU hits against the reference ray cast with the reference's own kernels. */
@@ -301,7 +296,7 @@ static ref_water_error compare_dist(const scene *s, const run *r, const ref_kern
     float *ref = malloc(n * 4);
     reference_dist(s, k, cam, ref);
     ref_water_error e;
-    assert_int_equal(ref_water_compare(r->dist, NULL, ref, NULL, n, s->params.v1.h, &e), 0);
+    assert_int_equal(ref_water_compare(r->dist, NULL, ref, NULL, n, s->params.h, &e), 0);
     print_message("%s: ref hits %u holes %.4f false %.4f dist mean %.2e p99 %.2e (x h), undecided %.0f, "
                   "stretched %.0f isotropic %.0f\n",
                   name, e.ref_hits, e.hole_rate, e.false_hit_rate, e.dist_mean_rel_h, e.dist_p99_rel_h,
@@ -350,7 +345,7 @@ static void test_aniso_vs_reference(void **state)
         assert_true(e.dist_mean_rel_h < 1e-3);
         assert_true(e.dist_p99_rel_h < 2e-2);
         /* the default reduced-resolution march on the same scene: still no hole */
-        s.params.v1.disable = 0;
+        s.lab.disable = 0;
         run rh = render_plugin(&s, &cam);
         ref_water_error eh = compare_dist(&s, &rh, &k, &cam, "  (reduced-resolution march)");
         assert_true(eh.hole_rate == 0.0 && eh.false_hit_rate < 0.01);
@@ -392,7 +387,7 @@ static void test_flat_pool_is_flat(void **state)
     (void)state;
     scene s = pool_scene_jit(16, 16, 4, 0.1f, 0.0);
     ref_water_params rp = ref_water_default_params();
-    rp.h = s.params.v1.h;
+    rp.h = s.params.h;
     enum { V = 5 };
     double mean[V], sd[V];
     /* kernel (0 isotropic), kr, ks, lambda */
@@ -542,7 +537,7 @@ static void test_refused(void **state)
             for (int i = 0; i < 30; ++i) s.kernel[6 * i] = s.kernel[6 * i + 3] = s.kernel[6 * i + 5] = 1;
             if (bad[b].v < 0) s.kernel[6 * 9 + 1] = 3; else s.kernel[6 * 9 + 4] = bad[b].v; /* not positive definite; NaN */
             break;
-        case 8: s.params.v1.method = VFX_WATER_METHOD_PAPER; break;
+        case 8: s.params.method = VFX_WATER_METHOD_PAPER; break;
         }
         run r = render_plugin(&s, &cam);
         print_message("refused (%s): %s\n", bad[b].field, s.log.last);
@@ -555,18 +550,16 @@ static void test_refused(void **state)
     }
 }
 
-/* A version-1 host (no kernel field) gets the default kernel, TILE's anisotropic one (zero means
- * the recommended look): its image is the version-2 host's with kernel ANISOTROPIC; the isotropic
- * kernel a version-2 host asks for runs no kernel pass and differs from it on the pool. */
+/* A host that leaves the kernel 0 gets the default kernel, TILE's anisotropic one (zero means the
+ * recommended look): its image is the one with kernel ANISOTROPIC; the isotropic kernel a host
+ * asks for runs no kernel pass and differs from it on the pool. */
 static void test_default_kernel(void **state)
 {
     (void)state;
     ref_camera cam = {{0.3, 0.9, 1.4}, {0, -0.1, 0}, {0, 1, 0}, 0.9, 40, 32, 0.05, 50};
     scene s = pool_scene(12, 12, 3, 0.1f);
-    s.v1_host = true;
     s.params.kernel = 0;
     run r1 = render_plugin(&s, &cam);
-    s.v1_host = false;
     s.params.kernel = VFX_WATER_KERNEL_ISOTROPIC;
     run r2 = render_plugin(&s, &cam);
     s.params.kernel = VFX_WATER_KERNEL_ANISOTROPIC;

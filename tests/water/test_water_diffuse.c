@@ -25,7 +25,7 @@ typedef struct host {
     test_log log;
     uint32_t n;
     float *x, *y, *z, *vx, *vy, *vz;
-    vfx_water_params4 p;
+    vfx_water_params p;
 } host;
 
 static uint32_t chunk_count(void *user) { return ((host *)user)->n ? 1 : 0; }
@@ -43,11 +43,7 @@ static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
 static vfx_result water_params(void *user, vfx_water_params *out)
 {
     host *h = user;
-    if (out->version == VFX_WATER_PARAMS4_VERSION && out->size >= sizeof h->p) {
-        *(vfx_water_params4 *)out = h->p;
-        return VFX_OK;
-    }
-    *out = h->p.v3.v2.v1; /* never asked here: the plugin offers version 4 first */
+    *out = h->p;
     return VFX_OK;
 }
 
@@ -61,10 +57,10 @@ typedef struct session {
 static void session_open(session *ss, host *h)
 {
     memset(ss, 0, sizeof *ss);
-    vfx_host_api api = {.size = sizeof api, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
-                        .user = h, .log = test_log_fn, .particle_chunk_count = chunk_count,
+    vfx_context_desc api = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc,
+                        .user = h, .log = test_vfx_log_fn, .particle_chunk_count = chunk_count,
                         .particle_chunk = chunk_view, .water_params = water_params};
-    ss->api.size = sizeof ss->api;
+    ss->api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
     assert_int_equal(ss->api.create(&api, &ss->ctx), VFX_OK);
     ss->ctx->debug.sync_counters = true;
@@ -73,7 +69,7 @@ static void session_open(session *ss, host *h)
     glTextureStorage2D(ss->col, 1, GL_RGBA8, w, hh);
     glCreateFramebuffers(1, &ss->fbo);
     glNamedFramebufferTexture(ss->fbo, GL_COLOR_ATTACHMENT0, ss->col, 0);
-    ss->fv = (vfx_frame_view){.size = sizeof ss->fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = ss->fbo,
+    ss->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW, .framebuffer = ss->fbo,
                               .width = w, .height = hh, .fov_y = 0.9f, .near_plane = 0.05f, .far_plane = 100.0f};
     /* a camera looking at the slab from above and in front: the draws run too */
     const float eye[3] = {0.5f, 1.5f, 2.5f};
@@ -93,7 +89,7 @@ static void session_frame(session *ss, float dt)
 
 static double stat_of(session *ss, const char *name)
 {
-    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+    vfx_stats st = {.type = VFX_TYPE_STATS};
     assert_int_equal(ss->api.get_stats(ss->ctx, &st), VFX_OK);
     for (uint32_t k = 0; k < st.count; ++k)
         if (!strcmp(st.entries[k].name, name)) return st.entries[k].value;
@@ -132,9 +128,8 @@ static host make_host(uint32_t nx, uint32_t ny, uint32_t nz, float h)
                 s.vy[i] = 3.5f * top * top * (1.0f + 0.5f * sinf(11.0f * s.x[i]));
                 s.vz[i] = 0.7f * cosf(5.0f * s.z[i] - 2.0f * s.x[i]);
             }
-    s.p.v3.v2.v1.size = sizeof s.p;
-    s.p.v3.v2.v1.version = VFX_WATER_PARAMS4_VERSION;
-    s.p.v3.v2.v1.h = h;
+    s.p.type = VFX_TYPE_WATER_PARAMS;
+    s.p.h = h;
     /* clamp ranges and rates set explicitly (not the defaults): the field spans them */
     s.p.trapped_air[0] = 1.5f, s.p.trapped_air[1] = 6.0f;
     s.p.wave_crest[0] = 0.3f, s.p.wave_crest[1] = 1.5f;
@@ -400,7 +395,7 @@ static void test_refused(void **state)
         session ss;
         session_open(&ss, &s);
         assert_int_equal(ss.api.update(ss.ctx, 0.0, 1.0f / 60.0f), VFX_ERR_INVALID_ARGUMENT);
-        const char *msg = ss.api.last_error(ss.ctx);
+        const char *msg = ss.api.last_error(ss.ctx, NULL);
         print_message("refused (%s): %s\n", names[k], msg);
         assert_non_null(strstr(msg, names[k]));
         session_close(&ss);

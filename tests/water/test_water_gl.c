@@ -23,9 +23,10 @@ typedef struct scene {
     test_log log;
     float *x, *y, *z;
     float *vel[3];     /* optional velocity columns (spray) */
-    uint32_t kernel;   /* vfx_water_params2.kernel when nonzero (the plugin offers version 2) */
+    uint32_t kernel;   /* vfx_water_params.kernel when nonzero */
     uint32_t n, chunk; /* particles per chunk: several chunks exercise the concatenation */
-    vfx_water_params params;
+    vfx_water_params params; /* method may be a lab method (BRUTE, GRID): sent through lab */
+    vfx_lab_water lab;       /* disable bits (and the lab method, set by water_params) */
     uint64_t rev; /* the chunks' revision: 0 (untracked, every frame uploads) unless a test sets it */
 } scene;
 
@@ -47,26 +48,29 @@ static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
 
 static vfx_result water_params(void *user, vfx_water_params *out)
 {
-    const scene *s = user;
-    uint32_t offered = out->size;
+    scene *s = user;
     *out = s->params;
-    if (s->kernel && offered >= sizeof(vfx_water_params2)) {
-        vfx_water_params2 *p2 = (vfx_water_params2 *)out;
-        p2->v1.size = sizeof *p2;
-        p2->v1.version = VFX_WATER_PARAMS2_VERSION;
-        p2->kernel = s->kernel;
+    out->type = VFX_TYPE_WATER_PARAMS;
+    if (s->kernel)
+        out->kernel = s->kernel;
+    s->lab.type = VFX_TYPE_LAB_WATER;
+    s->lab.method = 0;
+    if (out->method == VFX_WATER_METHOD_BRUTE || out->method == VFX_WATER_METHOD_GRID) {
+        s->lab.method = out->method; /* the baselines are lab methods */
+        out->method = 0;
     }
+    out->next = &s->lab;
     return VFX_OK;
 }
 
 /* Renders the scene with the plugin and the reference; returns the error; *stats optional. */
 static ref_water_error render_and_compare(scene *s, const ref_camera *cam, vfx_stats *stats_out)
 {
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = s,
-                         .log = test_log_fn, .particle_chunk_count = chunk_count,
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = s,
+                         .log = test_vfx_log_fn, .particle_chunk_count = chunk_count,
                          .particle_chunk = chunk_view, .water_params = water_params};
     /* the logger's user is the scene, whose first member is the test_log */
-    vfx_plugin_api api = {.size = sizeof api};
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     vfx_context *ctx;
     assert_int_equal(api.create(&host, &ctx), VFX_OK);
@@ -77,7 +81,7 @@ static ref_water_error render_and_compare(scene *s, const ref_camera *cam, vfx_s
     glTextureStorage2D(col, 1, GL_RGBA8, (GLsizei)w, (GLsizei)h);
     glCreateFramebuffers(1, &fbo);
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, col, 0);
-    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = fbo,
+    vfx_frame_view fv = {.type = VFX_TYPE_FRAME_VIEW, .framebuffer = fbo,
                          .width = w, .height = h, .fov_y = (float)cam->fov_y,
                          .near_plane = (float)cam->near_plane, .far_plane = (float)cam->far_plane};
     for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam->eye[k];
@@ -101,8 +105,7 @@ static ref_water_error render_and_compare(scene *s, const ref_camera *cam, vfx_s
         assert_int_equal(ref_water_compare(gpu, NULL, ref, NULL, (size_t)w * h, rp.h, &e), 0);
     }
     if (stats_out) {
-        stats_out->size = sizeof *stats_out;
-        stats_out->version = VFX_STATS_VERSION;
+        stats_out->type = VFX_TYPE_STATS;
         assert_int_equal(api.get_stats(ctx, stats_out), VFX_OK);
     }
     free(gpu);
@@ -129,8 +132,7 @@ static scene make_scene(uint32_t n)
     s.x = malloc((n + 1) * sizeof(float));
     s.y = malloc((n + 1) * sizeof(float));
     s.z = malloc((n + 1) * sizeof(float));
-    s.params.size = sizeof s.params;
-    s.params.version = VFX_WATER_PARAMS_VERSION;
+    s.params.type = VFX_TYPE_WATER_PARAMS;
     s.params.method = VFX_WATER_METHOD_BRUTE;
     /* the reference's kernel: the seed's h and the isotropic kernel (zero would mean h from the
      * spacing and, for TILE, the anisotropic kernel) */
@@ -295,7 +297,7 @@ static void test_paper_ablation_bits(void **state)
     for (unsigned b = 0; b < sizeof bits / sizeof bits[0]; ++b) {
         scene s = make_scene(200);
         s.params.method = VFX_WATER_METHOD_PAPER;
-        s.params.disable = bits[b];
+        s.lab.disable = bits[b];
         ref_water_blobs(s.n, 3, 0.8, 0.3, 11, s.x, s.y, s.z);
         ref_camera cam = {{0.3, 0.8, 4.0}, {0, 0, 0}, {0, 1, 0}, 0.8, 48, 48, 0.1, 100};
         ref_water_error e = render_and_compare(&s, &cam, NULL);
@@ -324,7 +326,7 @@ static void test_grid_blobs_vs_reference(void **state)
     double samples[2];
     for (int k = 0; k < 2; ++k) {
         scene s = blob_scene(VFX_WATER_METHOD_GRID);
-        s.params.disable = k ? VFX_WATER_NO_SKIP : 0;
+        s.lab.disable = k ? VFX_WATER_NO_SKIP : 0;
         ref_camera cam = blob_camera(64);
         vfx_stats st;
         ref_water_error e = render_and_compare(&s, &cam, &st);
@@ -443,15 +445,15 @@ static void test_unknown_method(void **state)
     scene s = make_scene(3);
     s.params.method = 7;
     for (uint32_t k = 0; k < 3; ++k) s.x[k] = s.y[k] = s.z[k] = 0.1f * (float)k;
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = &s,
-                         .log = test_log_fn, .particle_chunk_count = chunk_count,
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = &s,
+                         .log = test_vfx_log_fn, .particle_chunk_count = chunk_count,
                          .particle_chunk = chunk_view, .water_params = water_params};
-    vfx_plugin_api api = {.size = sizeof api};
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     vfx_context *ctx;
     assert_int_equal(api.create(&host, &ctx), VFX_OK);
     ref_camera cam = {{0, 0, 3.0}, {0, 0, 0}, {0, 1, 0}, 0.6, 16, 16, 0.1, 100};
-    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = 0,
+    vfx_frame_view fv = {.type = VFX_TYPE_FRAME_VIEW, .framebuffer = 0,
                          .width = 16, .height = 16, .fov_y = 0.6f, .near_plane = 0.1f, .far_plane = 100.0f};
     fv.eye[2] = 3.0f;
     ref_camera_matrices(&cam, fv.view, fv.proj);
@@ -459,7 +461,7 @@ static void test_unknown_method(void **state)
      * blamed on the anisotropic kernel) */
     s.kernel = 0;
     assert_int_equal(api.update(ctx, 0.0, 0.0f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(api.last_error(ctx), "method 7 unknown"));
+    assert_non_null(strstr(api.last_error(ctx, NULL), "method 7 unknown"));
     (void)fv;
     api.destroy(ctx);
     free_scene(&s);
@@ -497,10 +499,10 @@ static void session_open(session *ss, scene *s, const ref_camera *cam, const flo
 {
     memset(ss, 0, sizeof *ss);
     /* the plugin keeps a copy of the table */
-    vfx_host_api host_api = {.size = sizeof host_api, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = s,
-                             .log = test_log_fn, .particle_chunk_count = chunk_count,
+    vfx_context_desc host_api = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = s,
+                             .log = test_vfx_log_fn, .particle_chunk_count = chunk_count,
                              .particle_chunk = chunk_view, .water_params = water_params};
-    ss->api.size = sizeof ss->api;
+    ss->api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
     assert_int_equal(ss->api.create(&host_api, &ss->ctx), VFX_OK);
     ss->ctx->debug.sync_counters = sync;
@@ -514,7 +516,7 @@ static void session_open(session *ss, scene *s, const ref_camera *cam, const flo
     glClearTexImage(ss->scene_col, 0, GL_RGBA, GL_FLOAT, host);
     glCreateFramebuffers(1, &ss->fbo);
     glNamedFramebufferTexture(ss->fbo, GL_COLOR_ATTACHMENT0, ss->col, 0);
-    ss->fv = (vfx_frame_view){.size = sizeof ss->fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = ss->fbo,
+    ss->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW, .framebuffer = ss->fbo,
                               .color_texture = ss->scene_col, .width = w, .height = h,
                               .fov_y = (float)cam->fov_y, .near_plane = (float)cam->near_plane,
                               .far_plane = (float)cam->far_plane};
@@ -564,7 +566,7 @@ static void reference_image(const scene *s, const ref_camera *cam, float *dist, 
 
 static double stat_of_ctx(session *ss, const char *name)
 {
-    vfx_stats st = {.size = sizeof st, .version = VFX_STATS_VERSION};
+    vfx_stats st = {.type = VFX_TYPE_STATS};
     assert_int_equal(ss->api.get_stats(ss->ctx, &st), VFX_OK);
     return stat_of(&st, name);
 }
@@ -807,7 +809,7 @@ static void test_diffuse_off(void **state)
         v[1][0] = v[2][0] = 0;
         if (c > 0)
             for (int k = 0; k < 3; ++k) s.vel[k] = v[k];
-        if (c == 3) s.params.disable = VFX_WATER_NO_DIFFUSE;
+        if (c == 3) s.lab.disable = VFX_WATER_NO_DIFFUSE;
         session ss;
         session_open(&ss, &s, &cam, host, 0, true);
         assert_int_equal(session_frame(&ss), VFX_OK);
@@ -853,7 +855,7 @@ static void test_chunked_buffers(void **state)
             /* brute force reads one buffer: refused with the counts, not a wrong image */
             s.params.method = VFX_WATER_METHOD_BRUTE;
             assert_int_equal(session_frame(&ss), VFX_ERR_UNSUPPORTED);
-            const char *msg = ss.api.last_error(ss.ctx);
+            const char *msg = ss.api.last_error(ss.ctx, NULL);
             print_message("brute with 3 buffers: %s\n", msg);
             assert_non_null(strstr(msg, "3000 particles span 3 position buffers of at most 1000"));
             s.params.method = VFX_WATER_METHOD_PAPER;
@@ -904,17 +906,17 @@ static void test_count_overflow_refused(void **state)
         memset(&hh, 0, sizeof hh);
         hh.chunks = chunks[k];
         hh.count = counts[k];
-        vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc, .user = &hh,
-                             .log = test_log_fn, .particle_chunk_count = huge_chunk_count,
+        vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = &hh,
+                             .log = test_vfx_log_fn, .particle_chunk_count = huge_chunk_count,
                              .particle_chunk = huge_chunk};
-        vfx_plugin_api api = {.size = sizeof api};
+        vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
         assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
         vfx_context *ctx;
         assert_int_equal(api.create(&host, &ctx), VFX_OK);
         assert_int_equal(api.update(ctx, 0.0, 0.0f), VFX_ERR_INVALID_ARGUMENT);
-        print_message("overflow %d: %s\n", k, api.last_error(ctx));
-        assert_non_null(strstr(api.last_error(ctx), totals[k]));
-        assert_non_null(strstr(api.last_error(ctx), "more than the limit of 1073741824"));
+        print_message("overflow %d: %s\n", k, api.last_error(ctx, NULL));
+        assert_non_null(strstr(api.last_error(ctx, NULL), totals[k]));
+        assert_non_null(strstr(api.last_error(ctx, NULL), "more than the limit of 1073741824"));
         assert_int_equal(hh.log.errors, 1);
         api.destroy(ctx);
     }
@@ -979,7 +981,7 @@ static void test_paper_sample_cap_counted(void **state)
         scene s = blob_scene(VFX_WATER_METHOD_PAPER);
         s.params.max_samples = caps[c];
         if (!finish)
-            s.params.disable |= VFX_WATER_NO_FINISH;
+            s.lab.disable |= VFX_WATER_NO_FINISH;
         ref_camera cam = blob_camera(48);
         const size_t n = 48 * 48;
         static const float host[4] = {0, 0, 0, 1};
@@ -1087,7 +1089,7 @@ static void test_tile_vs_reference(void **state)
             const char *name = tile_scene(sc, &s, &cam);
             static const uint32_t bits[4] = {0, VFX_WATER_NO_TILES, VFX_WATER_NO_LOCAL_LIST, VFX_WATER_NO_SUBDIVIDE};
             /* the full-resolution march (the half-resolution path has its own test) */
-            s.params.disable = bits[ab] | VFX_WATER_NO_HALF_RES;
+            s.lab.disable = bits[ab] | VFX_WATER_NO_HALF_RES;
             vfx_stats st;
             ref_water_error e = render_and_compare(&s, &cam, &st);
             double found = stat_of(&st, "water.pixels_found"), left = stat_of(&st, "water.pixels_left"),
@@ -1148,8 +1150,8 @@ static void test_tile_temporal_moving(void **state)
 {
     (void)state;
     scene s[2] = {blob_scene(VFX_WATER_METHOD_TILE), blob_scene(VFX_WATER_METHOD_TILE)};
-    s[0].params.disable = VFX_WATER_NO_HALF_RES;
-    s[1].params.disable = VFX_WATER_NO_HALF_RES | VFX_WATER_NO_TEMPORAL;
+    s[0].lab.disable = VFX_WATER_NO_HALF_RES;
+    s[1].lab.disable = VFX_WATER_NO_HALF_RES | VFX_WATER_NO_TEMPORAL;
     ref_camera cam = blob_camera(64);
     const size_t n = 64 * 64;
     float *x0 = malloc(300 * 4), *y0 = malloc(300 * 4);
@@ -1226,7 +1228,7 @@ static void test_tile_temporal_fallback(void **state)
 {
     (void)state;
     scene s = blob_scene(VFX_WATER_METHOD_TILE);
-    s.params.disable = VFX_WATER_NO_HALF_RES;
+    s.lab.disable = VFX_WATER_NO_HALF_RES;
     ref_camera cam = blob_camera(64);
     const size_t n = 64 * 64;
     static const float host[4] = {0.2f, 0.3f, 0.4f, 1};
@@ -1278,7 +1280,7 @@ static void test_tile_half_res(void **state)
         float *d[2] = {malloc(n * 4), malloc(n * 4)}, *grad = malloc(n * 16), *nrm[2] = {malloc(n * 12), malloc(n * 12)};
         double up = 0, rem = 0;
         for (int k = 0; k < 2; ++k) {
-            s.params.disable = VFX_WATER_NO_TEMPORAL | (k ? VFX_WATER_NO_HALF_RES : 0);
+            s.lab.disable = VFX_WATER_NO_TEMPORAL | (k ? VFX_WATER_NO_HALF_RES : 0);
             session ss;
             session_open(&ss, &s, &cam, host, 0, true);
             assert_int_equal(session_frame(&ss), VFX_OK);

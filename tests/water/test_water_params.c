@@ -24,8 +24,8 @@ typedef struct host {
     test_log log;
     float *x, *y, *z;
     uint32_t n;
-    uint32_t pver;         /* the parameters' version the host answers with: 1 or 3 */
-    vfx_water_params3 p;   /* its fields (size and version are written by water_params) */
+    vfx_water_params p;   /* its fields (the type is written by water_params) */
+    vfx_lab_water lab;    /* chained when it holds disable bits */
 } host;
 
 static uint32_t chunk_count(void *user)
@@ -43,16 +43,11 @@ static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
 
 static vfx_result water_params(void *user, vfx_water_params *out)
 {
-    const host *s = user;
-    if (s->pver == 3 && out->version >= VFX_WATER_PARAMS3_VERSION && out->size >= sizeof(vfx_water_params3)) {
-        *(vfx_water_params3 *)out = s->p;
-        out->size = sizeof(vfx_water_params3);
-        out->version = VFX_WATER_PARAMS3_VERSION;
-        return VFX_OK;
-    }
-    *out = s->p.v2.v1;
-    out->size = sizeof *out;
-    out->version = VFX_WATER_PARAMS_VERSION;
+    host *s = user;
+    *out = s->p;
+    out->type = VFX_TYPE_WATER_PARAMS;
+    s->lab.type = VFX_TYPE_LAB_WATER;
+    out->next = s->lab.disable ? &s->lab : NULL;
     return VFX_OK;
 }
 
@@ -73,7 +68,6 @@ static host pool_host(uint32_t nx, uint32_t nz, uint32_t ny, float spacing)
                 s.y[i] = (float)y * spacing;
                 s.z[i] = ((float)z - 0.5f * (float)(nz - 1)) * spacing;
             }
-    s.pver = 1;
     return s;
 }
 
@@ -82,7 +76,7 @@ static void free_host(host *s) { free(s->x); free(s->y); free(s->z); }
 typedef struct session {
     vfx_plugin_api api;
     vfx_context *ctx;
-    vfx_host_api host;
+    vfx_context_desc host;
     GLuint fbo, col;
     uint32_t w, h;
 } session;
@@ -90,10 +84,10 @@ typedef struct session {
 static void session_open(session *ss, host *s, uint32_t w, uint32_t h)
 {
     memset(ss, 0, sizeof *ss);
-    ss->host = (vfx_host_api){.size = sizeof ss->host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
-                              .user = s, .log = test_log_fn, .particle_chunk_count = chunk_count,
+    ss->host = (vfx_context_desc){.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc,
+                              .user = s, .log = test_vfx_log_fn, .particle_chunk_count = chunk_count,
                               .particle_chunk = chunk_view, .water_params = water_params};
-    ss->api.size = sizeof ss->api;
+    ss->api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
     assert_int_equal(ss->api.create(&ss->host, &ss->ctx), VFX_OK);
     ss->ctx->debug.sync_counters = true;
@@ -115,7 +109,7 @@ static void session_close(session *ss)
 /* One update and render of `cam` (a frame view of version 1). */
 static vfx_result session_frame(session *ss, const ref_camera *cam)
 {
-    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = ss->fbo, .width = ss->w,
+    vfx_frame_view fv = {.type = VFX_TYPE_FRAME_VIEW, .framebuffer = ss->fbo, .width = ss->w,
                          .height = ss->h, .fov_y = (float)cam->fov_y, .near_plane = (float)cam->near_plane,
                          .far_plane = (float)cam->far_plane};
     for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam->eye[k];
@@ -126,8 +120,8 @@ static vfx_result session_frame(session *ss, const ref_camera *cam)
 
 static double stat(session *ss, const char *name)
 {
-    vfx_stats2 st = {.size = sizeof st, .version = VFX_STATS2_VERSION};
-    assert_int_equal(ss->api.get_stats(ss->ctx, (vfx_stats *)&st), VFX_OK);
+    vfx_stats st = {.type = VFX_TYPE_STATS};
+    assert_int_equal(ss->api.get_stats(ss->ctx, &st), VFX_OK);
     for (uint32_t k = 0; k < st.count; ++k)
         if (!strcmp(st.entries[k].name, name)) return st.entries[k].value;
     return -1;
@@ -191,8 +185,7 @@ static void test_presets(void **state)
 {
     (void)state;
     host s = pool_host(12, 12, 3, 0.1f);
-    s.pver = 3;
-    s.p.v2.v1.h = 0.2f;
+    s.p.h = 0.2f;
     for (uint32_t pr = VFX_WATER_PRESET_LOW; pr <= VFX_WATER_PRESET_ULTRA; ++pr) {
         s.p.preset = pr;
         session ss;
@@ -215,14 +208,14 @@ static void test_presets(void **state)
     }
     /* the paper method by name: no tile lists, its sample counters */
     s.p.preset = 0;
-    s.p.v2.v1.method = VFX_WATER_METHOD_PAPER;
+    s.p.method = VFX_WATER_METHOD_PAPER;
     session ss;
     session_open(&ss, &s, POOL_CAM.width, POOL_CAM.height);
     assert_int_equal(session_frame(&ss, &POOL_CAM), VFX_OK);
     assert_true(stat(&ss, "water.pixels_sample_cap") >= 0);
     assert_true(stat(&ss, "water.aniso_stretched") < 0);
     session_close(&ss);
-    s.p.v2.v1.method = 0;
+    s.p.method = 0;
     s.p.preset = 9;
     session_open(&ss, &s, POOL_CAM.width, POOL_CAM.height);
     assert_int_equal(session_frame(&ss, &POOL_CAM), VFX_ERR_INVALID_ARGUMENT);
@@ -245,15 +238,14 @@ static void test_step_and_loop_bounds(void **state)
     s.n = 1000;
     s.x = malloc(s.n * 4); s.y = malloc(s.n * 4); s.z = malloc(s.n * 4);
     ref_water_layers(s.n, 0.3, s.x, s.y, s.z);
-    s.p.v2.v1.h = 0.61f;
-    s.p.v2.v1.method = VFX_WATER_METHOD_TILE;
-    s.p.v2.v1.disable = VFX_WATER_NO_HALF_RES;
-    s.pver = 3;
-    s.p.v2.kernel = VFX_WATER_KERNEL_ISOTROPIC; /* the reference's */
+    s.p.h = 0.61f;
+    s.p.method = VFX_WATER_METHOD_TILE;
+    s.lab.disable = VFX_WATER_NO_HALF_RES;
+    s.p.kernel = VFX_WATER_KERNEL_ISOTROPIC; /* the reference's */
     const ref_camera cam = {{0, 4.3, 8}, {0, 0.15, 0}, {0, 1, 0}, 0.9, 96, 64, 0.1, 100};
     const float steps[] = {0.61f, 0.61f / 1000.0f};
     for (int k = 0; k < 2; ++k) {
-        s.p.v2.v1.step = steps[k];
+        s.p.step = steps[k];
         session ss;
         session_open(&ss, &s, cam.width, cam.height);
         assert_int_equal(session_frame(&ss, &cam), VFX_OK);
@@ -278,10 +270,10 @@ static void test_step_and_loop_bounds(void **state)
         {"refine_iters", 0, 0, 65, VFX_WATER_METHOD_TILE},
     };
     for (size_t b = 0; b < sizeof bad / sizeof bad[0]; ++b) {
-        s.p.v2.v1.step = bad[b].step;
-        s.p.v2.v1.max_samples = bad[b].samples;
-        s.p.v2.v1.refine_iters = bad[b].refine;
-        s.p.v2.v1.method = bad[b].method;
+        s.p.step = bad[b].step;
+        s.p.max_samples = bad[b].samples;
+        s.p.refine_iters = bad[b].refine;
+        s.p.method = bad[b].method;
         session ss;
         session_open(&ss, &s, 16, 16);
         assert_int_equal(session_frame(&ss, &cam), VFX_ERR_INVALID_ARGUMENT);
@@ -307,18 +299,18 @@ static view_target target_make(uint32_t w, uint32_t h)
 
 static vfx_result view_frame(session *ss, const view_target *t, const ref_camera *cam, uint32_t id, float *dist)
 {
-    vfx_frame_view3 fv;
+    vfx_frame_view fv;
     memset(&fv, 0, sizeof fv);
-    fv.v2.v1 = (vfx_frame_view){.size = sizeof fv, .version = VFX_FRAME_VIEW3_VERSION, .framebuffer = t->fbo, .width = t->w,
+    fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW, .framebuffer = t->fbo, .width = t->w,
                                 .height = t->h, .fov_y = (float)cam->fov_y, .near_plane = (float)cam->near_plane,
                                 .far_plane = (float)cam->far_plane};
     fv.view_id = id;
-    for (int k = 0; k < 3; ++k) fv.v2.v1.eye[k] = (float)cam->eye[k];
-    ref_camera_matrices(cam, fv.v2.v1.view, fv.v2.v1.proj);
+    for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam->eye[k];
+    ref_camera_matrices(cam, fv.view, fv.proj);
     const uint8_t grey[4] = {90, 100, 110, 255}; /* the host's background under the water */
     glClearTexImage(t->col, 0, GL_RGBA, GL_UNSIGNED_BYTE, grey);
     vfx_result r = ss->api.update(ss->ctx, 0.0, 0.0f);
-    if (!r) r = ss->api.render(ss->ctx, &fv.v2.v1);
+    if (!r) r = ss->api.render(ss->ctx, &fv);
     if (!r) r = ss->api.read_raw(ss->ctx, VFX_EFFECT_WATER, dist, (size_t)t->w * t->h);
     return r;
 }
@@ -413,9 +405,8 @@ static void test_tile_coverage_any_size(void **state)
 {
     (void)state;
     host s = pool_host(12, 12, 3, 0.1f);
-    s.pver = 3;
-    s.p.v2.v1.h = 0.2f;
-    s.p.v2.kernel = VFX_WATER_KERNEL_ISOTROPIC; /* the reference's */
+    s.p.h = 0.2f;
+    s.p.kernel = VFX_WATER_KERNEL_ISOTROPIC; /* the reference's */
     const ref_camera cam = {{0.2, 0.9, 1.3}, {0, 0.1, 0}, {0, 1, 0}, 0.9, 64, 48, 0.05, 50};
     for (int k = 0; k < 3; ++k) {
         session ss;
@@ -439,9 +430,9 @@ static void test_tile_coverage_any_size(void **state)
         if (k == 0) {
             water_state *ws = ss.ctx->effect_state[VFX_EFFECT_WATER];
             assert_int_equal(volfx_water_view_begin(ss.ctx, ws, 77, 16384, 16384, false), VFX_ERR_UNSUPPORTED);
-            print_message("16384^2: %s\n", ss.api.last_error(ss.ctx));
-            assert_non_null(strstr(ss.api.last_error(ss.ctx), "6.0 GiB"));
-            assert_non_null(strstr(ss.api.last_error(ss.ctx), "nothing was allocated"));
+            print_message("16384^2: %s\n", ss.api.last_error(ss.ctx, NULL));
+            assert_non_null(strstr(ss.api.last_error(ss.ctx, NULL), "6.0 GiB"));
+            assert_non_null(strstr(ss.api.last_error(ss.ctx, NULL), "nothing was allocated"));
             volfx_water_view_end(ws, false);
             assert_int_equal(session_frame(&ss, &cam), VFX_OK);
             assert_true(stat(&ss, "water.pixels_found") > 500);

@@ -25,27 +25,27 @@
     X(WATER_COLOR, "vfx_water_params.color", "water.color", 0, 1, VFX_RANGE_ZERO, "all 0: sea water") \
     X(WATER_ABSORPTION, "vfx_water_params.absorption", "water.absorption", 0, 1e3, VFX_RANGE_ZERO, "") \
     X(WATER_IOR, "vfx_water_params.ior", "water.ior", 1, 3, VFX_RANGE_ZERO, "") \
-    X(WATER_ANISO_RADIUS, "vfx_water_params2.aniso_radius", "-", 0.5, 4, VFX_RANGE_ZERO, "in units of h") \
-    X(WATER_ANISO_MAX_STRETCH, "vfx_water_params2.aniso_max_stretch", "-", 1, 64, VFX_RANGE_ZERO, "") \
-    X(WATER_ANISO_MIN_NEIGHBOURS, "vfx_water_params2.aniso_min_neighbours", "-", 1, 10000, VFX_RANGE_INT | VFX_RANGE_ZERO, "") \
-    X(WATER_ANISO_SCALE, "vfx_water_params2.aniso_scale", "-", 0.25, 4, VFX_RANGE_ZERO, "") \
-    X(WATER_ANISO_SMOOTHING, "vfx_water_params2.aniso_smoothing", "-", 0, 1, 0, "") \
+    X(WATER_ANISO_RADIUS, "vfx_water_params.aniso_radius", "-", 0.5, 4, VFX_RANGE_ZERO, "in units of h") \
+    X(WATER_ANISO_MAX_STRETCH, "vfx_water_params.aniso_max_stretch", "-", 1, 64, VFX_RANGE_ZERO, "") \
+    X(WATER_ANISO_MIN_NEIGHBOURS, "vfx_water_params.aniso_min_neighbours", "-", 1, 10000, VFX_RANGE_INT | VFX_RANGE_ZERO, "") \
+    X(WATER_ANISO_SCALE, "vfx_water_params.aniso_scale", "-", 0.25, 4, VFX_RANGE_ZERO, "") \
+    X(WATER_ANISO_SMOOTHING, "vfx_water_params.aniso_smoothing", "-", 0, 1, 0, "") \
     X(BEAM_LENGTH, "vfx_beam.length", "beams[i].length", 0, 1e6, 0, "") \
     X(BEAM_RADIUS, "vfx_beam.radius", "beams[i].radius", 0, 1e6, VFX_RANGE_LO_OPEN, "") \
     X(BEAM_A, "vfx_beam.a", "beams[i].a", 0, 1e6, 0, "") \
     X(BEAM_B, "vfx_beam.b", "beams[i].b", 0, 1e6, 0, "") \
     X(BEAM_EPS, "vfx_beam.eps", "beams[i].eps", 0, 1e6, 0, "") \
     X(BEAM_COLOR, "vfx_beam.color", "beams[i].color", 0, 1000, VFX_RANGE_ZERO, "all 0: white") \
-    X(BEAM_INTENSITY, "vfx_beam2.intensity", "beams[i].intensity", 0, 1e6, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "0: 1") \
-    X(BEAM_EXPOSURE, "vfx_beam2.exposure", "beams[i].exposure", -64, 64, 0, "stops applied to H") \
-    X(BEAM_FLOW_AMOUNT, "vfx_beam2.flow_amount", "beams[i].flow.amount", 0, 1, 0, "") \
-    X(BEAM_FLOW_SPEED, "vfx_beam2.flow_speed", "beams[i].flow.speed", -1e6, 1e6, 0, "") \
-    X(BEAM_FLOW_SCALE, "vfx_beam2.flow_scale", "beams[i].flow.scale", 0, 1e6, 0, "0: 2 x radius") \
+    X(BEAM_INTENSITY, "vfx_beam.intensity", "beams[i].intensity", 0, 1e6, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "0: 1") \
+    X(BEAM_EXPOSURE, "vfx_beam.exposure", "beams[i].exposure", -64, 64, 0, "stops applied to H") \
+    X(BEAM_FLOW_AMOUNT, "vfx_beam.flow_amount", "beams[i].flow.amount", 0, 1, 0, "") \
+    X(BEAM_FLOW_SPEED, "vfx_beam.flow_speed", "beams[i].flow.speed", -1e6, 1e6, 0, "") \
+    X(BEAM_FLOW_SCALE, "vfx_beam.flow_scale", "beams[i].flow.scale", 0, 1e6, 0, "0: 2 x radius") \
     X(BEAMS_C, "vfx_beams_view.saturate_c", "beam_settings.c", 0, 1e6, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "") \
     X(BEAMS_FAR, "vfx_beams_view.far_distance", "beam_settings.far_distance", 0, 1e6, 0, "0: the camera's far plane") \
-    X(BEAMS_MARCH_SAMPLES, "vfx_beams_view.march_samples", "beam_settings.march_samples", 1, 4096, VFX_RANGE_INT | VFX_RANGE_ZERO, "") \
-    X(BEAMS_BLOOM_STRENGTH, "vfx_beams_view2.bloom_strength", "beam_settings.bloom_strength", 0, 1e6, 0, "0: 0.6") \
-    X(BEAMS_BLOOM_LEVELS, "vfx_beams_view2.bloom_levels", "beam_settings.bloom_levels", 1, 8, VFX_RANGE_INT | VFX_RANGE_ZERO, "") \
+    X(BEAMS_MARCH_SAMPLES, "vfx_lab_beams.march_samples", "beam_settings.march_samples", 1, 4096, VFX_RANGE_INT | VFX_RANGE_ZERO, "") \
+    X(BEAMS_BLOOM_STRENGTH, "vfx_beams_view.bloom_strength", "beam_settings.bloom_strength", 0, 1e6, 0, "0: 0.6") \
+    X(BEAMS_BLOOM_LEVELS, "vfx_beams_view.bloom_levels", "beam_settings.bloom_levels", 1, 8, VFX_RANGE_INT | VFX_RANGE_ZERO, "") \
     X(VOLUME_ERT_THRESHOLD, "vfx_volume_view.ert_threshold", "volume.ert_threshold", 0, 1, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "") \
     X(VOLUME_TILES, "vfx_volume_view.tiles", "volume.tiles", 1, 1024, VFX_RANGE_INT | VFX_RANGE_ZERO, "a DxD table per worker") \
     X(VOLUME_UPDATE_C, "vfx_volume_view.update_c", "volume.update_c", 1, 1048576, VFX_RANGE_INT | VFX_RANGE_ZERO, "") \
