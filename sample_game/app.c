@@ -180,19 +180,13 @@ vfx_result game_app_set_environment(game_app *app, bool sky, const float sun_dir
     return r;
 }
 
-/* --program-cache: the plugin's binary cache in the host's folder (a plugin of api 1 has none) */
+/* --program-cache: the plugin's binary cache in the host's folder */
 static vfx_result set_program_cache(game_app *app)
 {
-    if (app->api->version < VFX_PLUGIN_API2_VERSION) {
-        rt_logf(&app->log, VFX_LOG_ERROR, "app: --program-cache %s: the plugin (api %u) has no program cache",
-                app->desc.program_cache, app->api->version);
-        return VFX_ERR_UNSUPPORTED;
-    }
-    const vfx_plugin_api2 *a2 = (const vfx_plugin_api2 *)app->api; /* v1 is its first member */
-    vfx_result r = a2->set_program_cache(app->ctx, app->desc.program_cache);
+    vfx_result r = app->api->set_program_cache(app->ctx, app->desc.program_cache);
     if (r)
         rt_logf(&app->log, VFX_LOG_ERROR, "app: --program-cache %s: %s", app->desc.program_cache,
-                app->api->last_error(app->ctx));
+                app->api->last_error(app->ctx, NULL));
     return r;
 }
 

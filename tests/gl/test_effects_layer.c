@@ -89,7 +89,7 @@ static void make_host(host *s)
                 s->vx[i] = 2.5f * sinf(9.0f * s->x[i]), s->vy[i] = 3.5f * top * top, s->vz[i] = 0.7f * cosf(5.0f * s->z[i]);
             }
     /* a beam across the view in front of the water, partly over it */
-    s->beam = (vfx_beam){.head = {0.6f, 0.15f, 0.2f}, .length = 1.2f, .dir = {1, 0, 0}, .radius = 0.06f, .a = 1.0f,
+    s->beam = (vfx_beam){.type = VFX_TYPE_BEAM, .head = {0.6f, 0.15f, 0.2f}, .length = 1.2f, .dir = {1, 0, 0}, .radius = 0.06f, .a = 1.0f,
                          .b = 0.6f, .eps = 0.01f, .color = {0.3f, 0.6f, 1.0f, 1.0f}};
     /* a tetrahedron on the right, partly over the water, the default transfer function */
     const float pts[12] = {0.1f, -0.35f, -0.2f, 0.7f, -0.35f, -0.1f, 0.35f, 0.35f, -0.15f, 0.4f, -0.2f, 0.35f};
@@ -110,7 +110,7 @@ typedef struct session {
     vfx_plugin_api api;
     vfx_context *ctx;
     GLuint fbo, out, scene, layer;
-    vfx_frame_view2 fv;
+    vfx_frame_view fv;
 } session;
 
 /* the host's scene colour: a pattern, in [0, 1.5] (an HDR host's colour passes 1) */
@@ -135,11 +135,11 @@ static GLuint texture(GLenum fmt)
 static void session_open(session *ss, host *h, bool layer)
 {
     memset(ss, 0, sizeof *ss);
-    vfx_host_api api = {.size = sizeof api, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
-                        .user = h, .log = test_log_fn, .particle_chunk_count = chunk_count,
+    vfx_context_desc api = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc,
+                        .user = h, .log = test_vfx_log_fn, .particle_chunk_count = chunk_count,
                         .particle_chunk = chunk_view, .beams = beams_view, .volume_count = volume_count,
                         .volume = volume_view};
-    ss->api.size = sizeof ss->api;
+    ss->api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
     assert_int_equal(ss->api.create(&api, &ss->ctx), VFX_OK);
     ss->out = texture(GL_RGBA16F);
@@ -155,19 +155,19 @@ static void session_open(session *ss, host *h, bool layer)
         ss->layer = texture(GL_RGBA16F);
         ss->ctx->debug.layer_texture = ss->layer;
     }
-    ss->fv = (vfx_frame_view2){.v1 = {.size = sizeof ss->fv, .version = VFX_FRAME_VIEW2_VERSION,
+    ss->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW,
                                       .framebuffer = layer ? 0 : ss->fbo, .color_texture = ss->scene, .width = W,
-                                      .height = H, .fov_y = 0.9f, .near_plane = 0.05f, .far_plane = 100.0f},
+                                      .height = H, .fov_y = 0.9f, .near_plane = 0.05f, .far_plane = 100.0f,
                                .color_hdr = 1};
     const float eye[3] = {0.0f, 0.5f, 1.6f};
-    memcpy(ss->fv.v1.eye, eye, sizeof eye);
+    memcpy(ss->fv.eye, eye, sizeof eye);
     const float c = cosf(0.3f), s = sinf(0.3f);
     const float view[16] = {1, 0, 0, 0, 0, c, s, 0, 0, -s, c, 0,
                             0, -(c * eye[1] - s * eye[2]), -(s * eye[1] + c * eye[2]), 1};
     const float f = 1.0f / tanf(0.45f), nn = 0.05f, ff = 100.0f, asp = (float)W / H;
     const float proj[16] = {f / asp, 0, 0, 0, 0, f, 0, 0, 0, 0, (ff + nn) / (nn - ff), -1, 0, 0, 2 * ff * nn / (nn - ff), 0};
-    memcpy(ss->fv.v1.view, view, sizeof view);
-    memcpy(ss->fv.v1.proj, proj, sizeof proj);
+    memcpy(ss->fv.view, view, sizeof view);
+    memcpy(ss->fv.proj, proj, sizeof proj);
 }
 
 static void session_close(session *ss)
@@ -188,8 +188,8 @@ static void render(host *h, bool layer, float *out)
         /* the host draws its scene anew each frame: its colour into its framebuffer */
         glCopyImageSubData(ss.scene, GL_TEXTURE_2D, 0, 0, 0, 0, ss.out, GL_TEXTURE_2D, 0, 0, 0, 0, W, H, 1);
         assert_int_equal(ss.api.update(ss.ctx, f / 60.0, 1.0f / 60.0f), VFX_OK);
-        if (ss.api.render(ss.ctx, &ss.fv.v1) != VFX_OK)
-            fail_msg("render: %s", ss.api.last_error(ss.ctx));
+        if (ss.api.render(ss.ctx, &ss.fv) != VFX_OK)
+            fail_msg("render: %s", ss.api.last_error(ss.ctx, NULL));
     }
     glGetTextureImage(layer ? ss.layer : ss.out, 0, GL_RGBA, GL_FLOAT, sizeof(float) * 4 * W * H, out);
     session_close(&ss);
@@ -259,7 +259,7 @@ static void test_empty_frame_clears(void **state)
     glClearTexImage(ss.layer, 0, GL_RGBA, GL_FLOAT, junk);
     h.water = h.beams = h.volume = false;
     assert_int_equal(ss.api.update(ss.ctx, 0.0, 1.0f / 60.0f), VFX_OK);
-    assert_int_equal(ss.api.render(ss.ctx, &ss.fv.v1), VFX_OK);
+    assert_int_equal(ss.api.render(ss.ctx, &ss.fv), VFX_OK);
     float *px = malloc(sizeof(float) * 4 * W * H);
     glGetTextureImage(ss.layer, 0, GL_RGBA, GL_FLOAT, sizeof(float) * 4 * W * H, px);
     for (int i = 0; i < 4 * W * H; ++i)
@@ -287,8 +287,8 @@ static void test_layer_refused(void **state)
         session_open(&ss, &h, true);
         ss.ctx->debug.layer_texture = cases[k].tex;
         assert_int_equal(ss.api.update(ss.ctx, 0.0, 1.0f / 60.0f), VFX_OK);
-        assert_int_equal(ss.api.render(ss.ctx, &ss.fv.v1), VFX_ERR_INVALID_ARGUMENT);
-        const char *msg = ss.api.last_error(ss.ctx);
+        assert_int_equal(ss.api.render(ss.ctx, &ss.fv), VFX_ERR_INVALID_ARGUMENT);
+        const char *msg = ss.api.last_error(ss.ctx, NULL);
         printf("case %zu: %s\n", k, msg);
         assert_non_null(strstr(msg, "layer_texture"));
         assert_non_null(strstr(msg, cases[k].what));

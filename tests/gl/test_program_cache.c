@@ -125,10 +125,10 @@ typedef struct warn_log {
     char warning[1024];
 } warn_log;
 
-static void warn_log_fn(void *user, vfx_log_level level, const char *message)
+static void warn_log_fn(void *user, vfx_log_level level, vfx_log_id id, const char *message)
 {
     warn_log *w = user;
-    test_log_fn(&w->base, level, message);
+    test_vfx_log_fn(&w->base, level, id, message);
     if (level == VFX_LOG_WARN)
         snprintf(w->warning, sizeof w->warning, "%s", message);
 }
@@ -205,18 +205,18 @@ static void hostile(const char *name, char kind, const char *victim, bool is_ent
         assert_int_equal(mkfifo(name, 0644), 0);
     warn_log log = {0};
     alarm(60); /* a blocking open fails the test instead of hanging it */
-    const vfx_plugin_api2 *a = api2();
-    vfx_host_api host = {.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
+    const vfx_plugin_api *a = api2();
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc,
                          .user = &log, .log = warn_log_fn};
     vfx_context *ctx;
-    assert_int_equal(a->v1.create(&host, &ctx), VFX_OK);
+    assert_int_equal(a->create(&host, &ctx), VFX_OK);
     assert_int_equal(a->set_program_cache(ctx, g_dir), VFX_OK);
     GLuint p = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/composite.frag", NULL);
     assert_int_not_equal(p, 0); /* the render goes on: the program is built from source */
     GLint linked = 0;
     glGetProgramiv(p, GL_LINK_STATUS, &linked);
     assert_true(linked);
-    a->v1.destroy(ctx);
+    a->destroy(ctx);
     alarm(0);
     char got[256];
     read_victim(victim, got, sizeof got);

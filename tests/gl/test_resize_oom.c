@@ -69,9 +69,9 @@ static void body(void)
     assert_int_equal(setrlimit(RLIMIT_AS, &r), 0);
     vfx_result res = app->api->resize(app->ctx, 8192, 8192);
     printf("resize 8192x8192 under %.2f GB of address space: %s: %s\n", (double)r.rlim_cur / 1e9, vfx_result_name(res),
-           app->api->last_error(app->ctx));
+           app->api->last_error(app->ctx, NULL));
     assert_int_equal(res, VFX_ERR_OUT_OF_MEMORY);
-    assert_non_null(strstr(app->api->last_error(app->ctx), "resize to 8192x8192 failed, the context stays at 96x54"));
+    assert_non_null(strstr(app->api->last_error(app->ctx, NULL), "resize to 8192x8192 failed, the context stays at 96x54"));
     assert_int_equal(app->ctx->width, W); /* the failed size is not recorded */
     assert_int_equal(app->ctx->height, H);
     frame_pixels(app, &demo, after);

@@ -33,7 +33,7 @@ typedef struct host {
     float *x, *y, *z, *vx, *vy, *vz;
     float *base;                /* frame 0's positions, xyz a particle */
     float move[3];              /* what every particle moves by each frame */
-    vfx_water_params4 p;
+    vfx_water_params p;
     bool gpu;                   /* hand the GL buffer instead of the arrays */
     GLuint buf;
     volfx_gpu_column pos, vel;  /* the columns handed over (tests break them) */
@@ -65,7 +65,7 @@ static vfx_result gpu_chunk(void *user, uint32_t index, volfx_gpu_column *cols)
 static vfx_result water_params(void *user, vfx_water_params *out)
 {
     host *h = user;
-    *(vfx_water_params4 *)out = h->p;
+    *(vfx_water_params *)out = h->p;
     return VFX_OK;
 }
 
@@ -93,8 +93,7 @@ static void make_host(host *s, uint32_t nx, uint32_t ny, uint32_t nz)
             }
     /* one particle NaN: skipped by both paths and counted */
     s->y[7] = NAN;
-    s->p.v3.v2.v1.size = sizeof s->p;
-    s->p.v3.v2.v1.version = VFX_WATER_PARAMS4_VERSION;
+    s->p.type = VFX_TYPE_WATER_PARAMS;
     /* h left 0: estimated from the spacing, by both paths */
     s->base = malloc(3 * sizeof(float) * s->n);
     for (uint32_t p = 0; p < s->n; ++p)
@@ -138,10 +137,10 @@ typedef struct session {
 static void session_open(session *ss, host *h)
 {
     memset(ss, 0, sizeof *ss);
-    vfx_host_api api = {.size = sizeof api, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
-                        .user = h, .log = test_log_fn, .particle_chunk_count = chunk_count,
+    vfx_context_desc api = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc,
+                        .user = h, .log = test_vfx_log_fn, .particle_chunk_count = chunk_count,
                         .particle_chunk = chunk_view, .water_params = water_params};
-    ss->api.size = sizeof ss->api;
+    ss->api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
     assert_int_equal(ss->api.create(&api, &ss->ctx), VFX_OK);
     ss->ctx->debug.water_gpu_chunk = gpu_chunk;
@@ -160,7 +159,7 @@ static void session_open(session *ss, host *h)
     glTextureStorage2D(ss->scene, 1, GL_RGBA8, W, H);
     glTextureSubImage2D(ss->scene, 0, 0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, pix);
     free(pix);
-    ss->fv = (vfx_frame_view){.size = sizeof ss->fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = ss->fbo,
+    ss->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW, .framebuffer = ss->fbo,
                               .color_texture = ss->scene, .width = W, .height = H, .fov_y = 0.9f,
                               .near_plane = 0.05f, .far_plane = 100.0f};
     const float eye[3] = {0.0f, 0.9f, 1.8f};
@@ -185,8 +184,8 @@ static void session_close(session *ss)
 
 static double stat_of(session *ss, const char *name)
 {
-    vfx_stats2 st = {.size = sizeof st, .version = VFX_STATS2_VERSION};
-    assert_int_equal(ss->api.get_stats(ss->ctx, (vfx_stats *)&st), VFX_OK);
+    vfx_stats st = {.type = VFX_TYPE_STATS};
+    assert_int_equal(ss->api.get_stats(ss->ctx, &st), VFX_OK);
     for (uint32_t k = 0; k < st.count; ++k)
         if (!strcmp(st.entries[k].name, name)) return st.entries[k].value;
     return -1;
@@ -204,7 +203,7 @@ typedef struct shot {
 static void render(host *h, bool gpu, uint32_t method, shot *out)
 {
     h->gpu = gpu;
-    h->p.v3.v2.v1.method = method;
+    h->p.method = method;
     session ss;
     session_open(&ss, h);
     for (int f = 0; f < FRAMES; ++f) {
@@ -213,7 +212,7 @@ static void render(host *h, bool gpu, uint32_t method, shot *out)
         glClearNamedFramebufferfv(ss.fbo, GL_COLOR, 0, clear);
         assert_int_equal(ss.api.update(ss.ctx, f / 60.0, 1.0f / 60.0f), VFX_OK);
         if (ss.api.render(ss.ctx, &ss.fv) != VFX_OK)
-            fail_msg("render: %s", ss.api.last_error(ss.ctx));
+            fail_msg("render: %s", ss.api.last_error(ss.ctx, NULL));
     }
     glGetTextureImage(ss.col, 0, GL_RGBA, GL_UNSIGNED_BYTE, sizeof out->rgba, out->rgba);
     assert_int_equal(ss.api.read_raw(ss.ctx, VFX_EFFECT_WATER, out->raw, W * H), VFX_OK);
@@ -321,7 +320,7 @@ static void test_refused(void **state)
         session ss;
         session_open(&ss, &h);
         vfx_result r = ss.api.update(ss.ctx, 0.0, 1.0f / 60.0f);
-        const char *msg = ss.api.last_error(ss.ctx);
+        const char *msg = ss.api.last_error(ss.ctx, NULL);
         printf("case %zu: %s\n", k, msg);
         assert_int_equal(r, VFX_ERR_INVALID_ARGUMENT);
         assert_non_null(strstr(msg, cases[k].field));
