@@ -105,7 +105,7 @@ static vfx_result check_framebuffer(vfx_context *ctx, GLuint fb, uint32_t w, uin
 
 /* near/far the projection maps to clip z = -w and +w (GL convention), when it is the usual
  * perspective or orthographic form; false otherwise. far may be +Inf (infinite projection). */
-static bool projection_planes(const float *P, double *n, double *f, double *far_tol)
+bool volfx_projection_planes(const float *P, double *n, double *f, double *far_tol)
 {
     double p10 = P[10], p14 = P[14];
     if (P[3] != 0 || P[7] != 0)
@@ -129,7 +129,7 @@ static bool projection_planes(const float *P, double *n, double *f, double *far_
 static vfx_result check_planes(vfx_context *ctx, vfx_frame_view *v)
 {
     double n = 0, f = 0, ftol = 0;
-    bool known = projection_planes(v->proj, &n, &f, &ftol);
+    bool known = volfx_projection_planes(v->proj, &n, &f, &ftol);
     if (known && !(n > 0 && f > n))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view proj maps near %g and far %g "
                           "(from proj[10], proj[14]); need 0 < near < far", n, f);

@@ -31,6 +31,10 @@ vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx
  * VolfxFrame block (volfx_frame_block) is uploaded and bound at VOLFX_FRAME_BINDING. */
 vfx_result volfx_frame_gate_gl(vfx_context *ctx, bool drawing, volfx_frame_targets *t);
 
+/* near/far the projection P maps to clip z = -w and +w (GL convention) when it is the usual
+ * perspective or orthographic form (far may be +Inf), with far's tolerance; false otherwise. */
+bool volfx_projection_planes(const float *P, double *n, double *f, double *far_tol);
+
 /* Deletes the context's far-depth texture and frame block buffer (if any). */
 void volfx_frame_check_destroy(vfx_context *ctx);
 

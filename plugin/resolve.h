@@ -5,8 +5,9 @@
 
 #include "context.h"
 
-/* Fills every zero field of the typed struct at inout with its default (by its type); ctx may be
- * NULL. VFX_ERR_INVALID_ARGUMENT for NULL, VFX_ERR_UNSUPPORTED for a type it does not resolve. */
+/* Fills every zero field of the typed struct at inout with its default (by its type; docs/abi.md
+ * "Resolved defaults"); ctx may be NULL. VFX_ERR_INVALID_ARGUMENT for NULL or a type without
+ * defaults, or the error update() would give for a value out of range. */
 vfx_result volfx_resolve_defaults(vfx_context *ctx, void *inout);
 
 #endif

@@ -167,6 +167,42 @@ static void test_beam_abi_values(void **state)
     free(c);
 }
 
+/* resolve_defaults without a context: what a zero beam, beams view, volume view and frame view
+ * resolve to (the constants beams_effect.c, volume_effect.c and the frame gate apply), fields the
+ * host set left alone, and a struct of no defaults refused. */
+static void test_resolve_defaults(void **state)
+{
+    (void)state;
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
+    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
+    vfx_beam b = {.type = VFX_TYPE_BEAM, .radius = 0.5f, .a = 0.3f, .orb_radius = 0.2f, .intensity = 2};
+    assert_int_equal(api.resolve_defaults(NULL, &b), VFX_OK);
+    assert_int_equal(b.falloff, VFX_BEAM_FALLOFF_SMOOTH);
+    assert_int_equal(b.ramp, VFX_BEAM_RAMP_HOT);
+    assert_true(b.intensity == 2 && b.color[0] == 1 && b.color[3] == 1 && b.flow_scale == 1.0f);
+    assert_true(b.head_radius == 0.5f && b.surge_wavelength == 4.0f && b.orb_strength == 0.3f && b.flow_twist == 1);
+    vfx_beams_view bv = {.type = VFX_TYPE_BEAMS_VIEW, .bloom_levels = 3};
+    assert_int_equal(api.resolve_defaults(NULL, &bv), VFX_OK);
+    assert_true(bv.saturate_c == 1 && bv.bloom == VFX_BEAMS_BLOOM_ON && bv.bloom_levels == 3 && bv.bloom_strength == 0.6f);
+    assert_true(bv.far_distance == 0); /* the camera's far plane: known only per frame */
+    vfx_volume_view vv = {.type = VFX_TYPE_VOLUME_VIEW};
+    assert_int_equal(api.resolve_defaults(NULL, &vv), VFX_OK);
+    assert_true(vv.ert_threshold == 0.9f && vv.tiles == 20 && vv.update_c == 100 && vv.workers >= 1);
+    assert_true(vv.model[0] == 1 && vv.model[5] == 1 && vv.model[15] == 1 && vv.model[1] == 0);
+    /* a frame view: the eye from the view matrix, near/far from a perspective projection
+     * (n 0.1, f 50: proj[10] = -(f+n)/(f-n), proj[14] = -2fn/(f-n)) */
+    const float n = 0.1f, f = 50.f;
+    vfx_frame_view fv = {.type = VFX_TYPE_FRAME_VIEW,
+                         .view = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -1, -2, -4, 1},
+                         .proj = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -(f + n) / (f - n), -1, 0, 0, -2 * f * n / (f - n), 0}};
+    assert_int_equal(api.resolve_defaults(NULL, &fv), VFX_OK);
+    assert_true(fabsf(fv.eye[0] - 1) < 1e-6f && fabsf(fv.eye[1] - 2) < 1e-6f && fabsf(fv.eye[2] - 4) < 1e-6f);
+    assert_true(fabsf(fv.near_plane - n) < 1e-5f && fabsf(fv.far_plane - f) < 1e-2f);
+    vfx_stats st = {.type = VFX_TYPE_STATS};
+    assert_int_equal(api.resolve_defaults(NULL, &st), VFX_ERR_INVALID_ARGUMENT);
+    assert_int_equal(api.resolve_defaults(NULL, NULL), VFX_ERR_INVALID_ARGUMENT);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -185,6 +221,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_every_row),
         cmocka_unit_test(test_water_abi_values),
         cmocka_unit_test(test_beam_abi_values),
+        cmocka_unit_test(test_resolve_defaults),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -170,6 +170,24 @@ static void test_zero_params_recommended(void **state)
     assert_true(stat(&ss, "water.tile_entries") > 0);
     assert_true(stat(&ss, "water.aniso_stretched") > 0);
     assert_true(stat(&ss, "water.pixels_found") > 200);
+    /* resolve_defaults says the same of the zero parameters: h from this context's last update
+     * (the spacing), the preset's step h/8, TILE, the anisotropic kernel; without a context h and
+     * the step it needs stay 0 */
+    vfx_water_params z = {.type = VFX_TYPE_WATER_PARAMS};
+    assert_int_equal(ss.api.resolve_defaults(ss.ctx, &z), VFX_OK);
+    assert_true(fabs(z.h - stat(&ss, "water.h")) < 1e-6 && fabs(z.step - z.h / 8) < 1e-7);
+    assert_int_equal(z.method, VFX_WATER_METHOD_TILE);
+    assert_int_equal(z.preset, VFX_WATER_PRESET_MEDIUM);
+    assert_int_equal(z.kernel, VFX_WATER_KERNEL_ANISOTROPIC);
+    assert_true(z.threshold > 0 && z.ior > 1 && z.absorption > 0 && z.refine_iters == 3 && z.diffuse_max > 0);
+    vfx_water_params none = {.type = VFX_TYPE_WATER_PARAMS};
+    assert_int_equal(ss.api.resolve_defaults(NULL, &none), VFX_OK);
+    assert_true(none.h == 0 && none.step == 0 && none.threshold == z.threshold && none.gravity[1] == z.gravity[1]);
+    /* the resolved parameters, handed back, draw the same water as the zeros (the same h) */
+    s.p = z;
+    assert_int_equal(session_frame(&ss, &POOL_CAM), VFX_OK);
+    assert_true(fabs(stat(&ss, "water.h") - z.h) < 1e-7);
+    s.p = (vfx_water_params){.type = VFX_TYPE_WATER_PARAMS};
     /* h stays what it was measured at while the count holds (a breathing h would drop the
      * temporal history every frame): a second frame reuses the history */
     assert_int_equal(session_frame(&ss, &POOL_CAM), VFX_OK);

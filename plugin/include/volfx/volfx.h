@@ -555,10 +555,10 @@ typedef struct vfx_plugin_api {
      * first): water ray distance (-1 = miss), beams H, volume accumulated opacity. */
     vfx_result (*read_raw)(vfx_context *ctx, vfx_effect_kind effect, float *out, size_t count);
     /* Fills every zero field of the typed struct at `inout` (by its `type`: water params, beam,
-     * beams view, volume view, frame view, context desc) with the value zero resolves to, and
-     * leaves the fields the host set. Values that depend on data (the water's h from the
-     * particles' spacing) come from ctx's last update when ctx is given and has one, else stay
-     * 0. ctx may be NULL. */
+     * beams view, volume view, frame view; a context desc or particle view has none) with the
+     * value zero resolves to, and leaves the fields the host set (docs/abi.md "Resolved
+     * defaults"). Values that depend on data (the water's h from the particles' spacing) come
+     * from ctx's last update when ctx is given and has one, else stay 0. ctx may be NULL. */
     vfx_result (*resolve_defaults)(vfx_context *ctx, void *inout);
 } vfx_plugin_api;
 
