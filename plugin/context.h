@@ -7,6 +7,8 @@
 #include <stdbool.h>
 #include <volfx/volfx.h>
 
+#include "gpu/gl_state.h"
+
 typedef struct volfx_gpu volfx_gpu;
 struct volfx_gl_table; /* gpu/volfx_gl.h, generated: the GL commands, resolved at create */
 typedef struct volfx_effect_ops volfx_effect_ops;
@@ -43,6 +45,13 @@ struct vfx_context {
     unsigned frame_block;       /* GL uniform buffer of the frame gate's VolfxFrame block */
     unsigned layer_fbo;         /* framebuffer the effects layer is attached to (frame_check.c) */
     volfx_debug_knobs debug;
+    /* the GL state contract (gpu/gl_state.h): the host's state saved on entry to the outermost
+     * API call that touches GL (gl_calls counts the nesting: warm_up calls render, render
+     * resize), put back on its return unless the host said it resets its own state */
+    volfx_gl_saved gl_saved;
+    uint32_t gl_calls;
+    bool gl_compat;             /* the context is a compatibility profile */
+    bool gl_skip_restore;       /* the host resets its own state: no save, no restore */
 };
 
 /* Logs through the host logger, printf-style, with the message's id. */

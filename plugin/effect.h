@@ -38,6 +38,8 @@ typedef struct volfx_frame_targets {
     float fov_y;                     /* radians, [0, pi) */
     float cam_view_proj[16];         /* camera-relative: proj * view without its translation */
     float inv_cam_view_proj[16];     /* window/NDC -> direction from the eye */
+    bool output_srgb;                /* framebuffer's colour attachment 0 is sRGB-encoded: the
+                                      * frame gate turns GL_FRAMEBUFFER_SRGB on for the frame */
 } volfx_frame_targets;
 
 /* The shared std140 block of the frame gate (shaders/common/frame.glsl, `VolfxFrame`): uploaded

@@ -23,6 +23,48 @@ static void gl_bind(vfx_context *ctx)
     volfx_gl_current = ctx->gl;
 }
 
+/* The GL state contract (gpu/gl_state.h, docs/integration.md): the outermost API call that
+ * touches GL saves the host's state, sets the baseline every pass depends on, and gl_leave puts
+ * the host's state back; calls made inside it (warm_up's render, render's resize) only count. A
+ * host that resets its own state skips the save and the restore, never the baseline. */
+static void gl_enter(vfx_context *ctx)
+{
+    gl_bind(ctx);
+    if (ctx->gl_calls++ == 0) {
+        if (!ctx->gl_skip_restore)
+            volfx_gl_state_save(&ctx->gl_saved, ctx->gl_compat);
+        volfx_gl_state_baseline(ctx->gl_compat);
+    }
+}
+
+static vfx_result gl_leave(vfx_context *ctx, vfx_result r)
+{
+    if (--ctx->gl_calls == 0 && !ctx->gl_skip_restore)
+        volfx_gl_state_restore(&ctx->gl_saved);
+    return r;
+}
+
+/* Which profile the context has (a compatibility profile also has GL_ALPHA_TEST to turn off),
+ * and a context that cannot serve refused with its version and profile: desktop GL 4.5, core
+ * or compatibility, with every command resolved (gl_load). */
+static vfx_result gl_profile(vfx_context *ctx)
+{
+    GLint mask = 0, major = 0, minor = 0;
+    glGetIntegerv(GL_CONTEXT_PROFILE_MASK, &mask);
+    glGetIntegerv(GL_MAJOR_VERSION, &major);
+    glGetIntegerv(GL_MINOR_VERSION, &minor);
+    const char *version = glGetString(GL_VERSION) ? (const char *)glGetString(GL_VERSION) : "(none)";
+    const char *profile = (mask & GL_CONTEXT_CORE_PROFILE_BIT) ? "core profile"
+                          : (mask & GL_CONTEXT_COMPATIBILITY_PROFILE_BIT) ? "compatibility profile"
+                          : "no profile";
+    if (major * 10 + minor < 45 || !strncmp(version, "OpenGL ES", 9))
+        return volfx_fail(ctx, VFX_ERR_GL_UNSUPPORTED, "volfx needs desktop GL 4.5 (core or compatibility "
+                          "profile), the current context is %s, %s", version, profile);
+    ctx->gl_compat = (mask & GL_CONTEXT_COMPATIBILITY_PROFILE_BIT) != 0;
+    volfx_log(ctx, VFX_LOG_DEBUG, "GL context %s, %s", version, profile);
+    return VFX_OK;
+}
+
 /* Resolves every GL command the plugin uses through the host's loader; a missing one is refused
  * with its name. The version is checked first when it can be, since a 3.3 context missing 4.5
  * commands says more as "needs 4.5, got 3.3". */
@@ -39,8 +81,7 @@ static vfx_result gl_load(vfx_context *ctx)
         glGetIntegerv(GL_MAJOR_VERSION, &major);
         glGetIntegerv(GL_MINOR_VERSION, &minor);
         if (major * 10 + minor < 45)
-            return volfx_fail(ctx, VFX_ERR_GL_UNSUPPORTED, "volfx needs desktop GL 4.5, the current context is %s",
-                              glGetString(GL_VERSION) ? (const char *)glGetString(GL_VERSION) : "(none)");
+            return gl_profile(ctx); /* the refusal naming version and profile */
     }
     if (missing)
         return volfx_fail(ctx, VFX_ERR_GL_UNSUPPORTED,
@@ -119,8 +160,10 @@ static vfx_result plugin_create(const vfx_context_desc *host, vfx_context **out)
                        ? gl_load(ctx)
                        : volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volfx create: the context description has no "
                                     "gl_get_proc_address (the plugin resolves every GL command through it)");
-    if (r == VFX_OK)
-        r = volfx_gpu_create(ctx, &ctx->gpu);
+    if (r == VFX_OK && (r = gl_profile(ctx)) == VFX_OK) {
+        gl_enter(ctx);
+        r = gl_leave(ctx, volfx_gpu_create(ctx, &ctx->gpu));
+    }
     if (r != VFX_OK) {
         /* keep the message: the caller has no context to ask */
         plugin_destroy(ctx);
@@ -134,11 +177,8 @@ static vfx_result plugin_create(const vfx_context_desc *host, vfx_context **out)
  * context goes back to its previous size and every effect is remade at it, so the next frame
  * draws as before; an effect that cannot be remade even then is dropped and made again by the
  * next update. The failed size is not kept. */
-static vfx_result plugin_resize(vfx_context *ctx, uint32_t width, uint32_t height)
+static vfx_result resize(vfx_context *ctx, uint32_t width, uint32_t height)
 {
-    if (!ctx)
-        return VFX_ERR_INVALID_ARGUMENT;
-    gl_bind(ctx);
     if (width == 0 || height == 0 || width > 16384 || height > 16384)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
                         "resize: %ux%u outside 1..16384 in each direction", width, height);
@@ -168,11 +208,16 @@ static vfx_result plugin_resize(vfx_context *ctx, uint32_t width, uint32_t heigh
     return volfx_fail(ctx, r, "resize to %ux%u failed, the context stays at %ux%u: %s", width, height, old_w, old_h, why);
 }
 
-static vfx_result plugin_update(vfx_context *ctx, double time, float dt)
+static vfx_result plugin_resize(vfx_context *ctx, uint32_t width, uint32_t height)
 {
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
-    gl_bind(ctx);
+    gl_enter(ctx);
+    return gl_leave(ctx, resize(ctx, width, height));
+}
+
+static vfx_result update(vfx_context *ctx, double time, float dt)
+{
     if (!isfinite(time) || !isfinite(dt))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "update: time %g or dt %g is not finite",
                         time, (double)dt);
@@ -210,18 +255,23 @@ static vfx_result plugin_update(vfx_context *ctx, double time, float dt)
 
 /* The frame gate (frame_check.c) checks the view and derives the camera once; the effects then
  * read it from targets (and the VolfxFrame block it binds). */
-static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
+static vfx_result plugin_update(vfx_context *ctx, double time, float dt)
 {
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
-    gl_bind(ctx);
+    gl_enter(ctx);
+    return gl_leave(ctx, update(ctx, time, dt));
+}
+
+static vfx_result render(vfx_context *ctx, const vfx_frame_view *frame)
+{
     volfx_frame_targets targets;
     vfx_frame_view checked; /* what the effects still receive: validated, near/far filled */
     vfx_result cr = volfx_frame_gate(ctx, frame, &targets, &checked);
     if (cr)
         return cr;
     if (targets.width != ctx->width || targets.height != ctx->height) {
-        vfx_result r = plugin_resize(ctx, targets.width, targets.height);
+        vfx_result r = resize(ctx, targets.width, targets.height);
         if (r)
             return r;
     }
@@ -252,6 +302,14 @@ static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
     return result;
 }
 
+static vfx_result plugin_render(vfx_context *ctx, const vfx_frame_view *frame)
+{
+    if (!ctx)
+        return VFX_ERR_INVALID_ARGUMENT;
+    gl_enter(ctx);
+    return gl_leave(ctx, render(ctx, frame));
+}
+
 static vfx_result plugin_get_stats(vfx_context *ctx, vfx_stats *out)
 {
     if (!ctx)
@@ -274,11 +332,8 @@ static const char *plugin_last_error(vfx_context *ctx, vfx_log_id *id_out)
     return ctx ? ctx->last_error : "no context";
 }
 
-static vfx_result plugin_read_raw(vfx_context *ctx, vfx_effect_kind effect, float *out, size_t count)
+static vfx_result read_raw(vfx_context *ctx, vfx_effect_kind effect, float *out, size_t count)
 {
-    if (!ctx)
-        return VFX_ERR_INVALID_ARGUMENT;
-    gl_bind(ctx);
     if (!out)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "read_raw: out is NULL (count %zu)", count);
     if ((unsigned)effect >= VFX_EFFECT_COUNT)
@@ -297,13 +352,21 @@ static vfx_result plugin_read_raw(vfx_context *ctx, vfx_effect_kind effect, floa
     return ctx->effect_ops[effect]->read_raw(ctx, ctx->effect_state[effect], out, count);
 }
 
+static vfx_result plugin_read_raw(vfx_context *ctx, vfx_effect_kind effect, float *out, size_t count)
+{
+    if (!ctx)
+        return VFX_ERR_INVALID_ARGUMENT;
+    gl_enter(ctx);
+    return gl_leave(ctx, read_raw(ctx, effect, out, count));
+}
+
 /* Program binaries kept in a host folder (gpu/program_cache.c). */
 static vfx_result plugin_set_program_cache(vfx_context *ctx, const char *dir)
 {
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
-    gl_bind(ctx);
-    return volfx_gpu_set_program_cache(ctx, dir);
+    gl_enter(ctx);
+    return gl_leave(ctx, volfx_gpu_set_program_cache(ctx, dir));
 }
 
 /* Warm-up: one render of the frame (it compiles exactly the variants the frame uses, and
@@ -313,10 +376,11 @@ static vfx_result plugin_warm_up(vfx_context *ctx, const vfx_frame_view *frame)
 {
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
-    vfx_result r = plugin_render(ctx, frame);
+    gl_enter(ctx);
+    vfx_result r = render(ctx, frame);
     if (r == VFX_OK)
         glFinish();
-    return r;
+    return gl_leave(ctx, r);
 }
 
 /* The lights of the effects as of the last update (only the beams cast any). */

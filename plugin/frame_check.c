@@ -28,15 +28,58 @@ vfx_result volfx_check_host(const vfx_context_desc *host, char *msg, size_t msgl
 static const char *target_name(GLint t)
 {
     switch (t) {
-    case GL_TEXTURE_2D: return "GL_TEXTURE_2D";
-    case GL_TEXTURE_CUBE_MAP: return "GL_TEXTURE_CUBE_MAP";
-    case GL_TEXTURE_2D_MULTISAMPLE: return "GL_TEXTURE_2D_MULTISAMPLE";
-    case GL_TEXTURE_2D_ARRAY: return "GL_TEXTURE_2D_ARRAY";
-    case GL_TEXTURE_3D: return "GL_TEXTURE_3D";
-    case GL_TEXTURE_1D: return "GL_TEXTURE_1D";
-    case GL_TEXTURE_RECTANGLE: return "GL_TEXTURE_RECTANGLE";
-    default: return "another kind of";
+    case GL_TEXTURE_2D: return "a GL_TEXTURE_2D";
+    case GL_TEXTURE_CUBE_MAP: return "a GL_TEXTURE_CUBE_MAP";
+    case GL_TEXTURE_2D_MULTISAMPLE: return "a GL_TEXTURE_2D_MULTISAMPLE";
+    case GL_TEXTURE_2D_ARRAY: return "a GL_TEXTURE_2D_ARRAY";
+    case GL_TEXTURE_3D: return "a GL_TEXTURE_3D";
+    case GL_TEXTURE_1D: return "a GL_TEXTURE_1D";
+    case GL_TEXTURE_RECTANGLE: return "a GL_TEXTURE_RECTANGLE";
+    default: return "an unknown kind of";
     }
+}
+
+static GLenum binding_of(GLenum target)
+{
+    switch (target) {
+    case GL_TEXTURE_2D: return GL_TEXTURE_BINDING_2D;
+    case GL_TEXTURE_CUBE_MAP: return GL_TEXTURE_BINDING_CUBE_MAP;
+    case GL_TEXTURE_2D_MULTISAMPLE: return GL_TEXTURE_BINDING_2D_MULTISAMPLE;
+    case GL_TEXTURE_2D_ARRAY: return GL_TEXTURE_BINDING_2D_ARRAY;
+    case GL_TEXTURE_3D: return GL_TEXTURE_BINDING_3D;
+    case GL_TEXTURE_1D: return GL_TEXTURE_BINDING_1D;
+    default: return GL_TEXTURE_BINDING_RECTANGLE;
+    }
+}
+
+/* The target a texture was made for. GL_TEXTURE_TARGET answers in a core context; Mesa's
+ * compatibility profile refuses that query (GL_INVALID_ENUM, nothing written), so there each
+ * candidate target is tried by binding the texture to it on unit 0 (binding to another target
+ * than its own is GL_INVALID_OPERATION) and the unit's binding put back at once. That path reads
+ * the GL error flag, so it clears errors the host left pending: only compatibility contexts. */
+static GLint texture_target(GLuint name)
+{
+    GLint target = 0;
+    glGetTextureParameteriv(name, GL_TEXTURE_TARGET, &target);
+    if (target)
+        return target;
+    for (int i = 0; i < 8 && glGetError() != GL_NO_ERROR; ++i)
+        ;
+    static const GLenum candidates[] = {GL_TEXTURE_2D, GL_TEXTURE_CUBE_MAP, GL_TEXTURE_2D_MULTISAMPLE,
+                                        GL_TEXTURE_2D_ARRAY, GL_TEXTURE_3D, GL_TEXTURE_1D, GL_TEXTURE_RECTANGLE};
+    GLint active = GL_TEXTURE0;
+    glGetIntegerv(GL_ACTIVE_TEXTURE, &active);
+    glActiveTexture(GL_TEXTURE0);
+    for (size_t i = 0; i < sizeof candidates / sizeof candidates[0] && !target; ++i) {
+        GLint prev = 0;
+        glGetIntegerv(binding_of(candidates[i]), &prev);
+        glBindTexture(candidates[i], name);
+        if (glGetError() == GL_NO_ERROR)
+            target = (GLint)candidates[i];
+        glBindTexture(candidates[i], (GLuint)prev);
+    }
+    glActiveTexture((GLenum)active);
+    return target;
 }
 
 enum { WANT_COLOR, WANT_DEPTH, WANT_CUBE };
@@ -47,11 +90,10 @@ static vfx_result check_texture(vfx_context *ctx, const char *field, GLuint name
     if (!glIsTexture(name))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view %s %u is not a texture name "
                           "of this GL context", field, name);
-    GLint target = 0;
-    glGetTextureParameteriv(name, GL_TEXTURE_TARGET, &target);
+    GLint target = texture_target(name);
     GLint need = want == WANT_CUBE ? GL_TEXTURE_CUBE_MAP : GL_TEXTURE_2D;
     if (target != need)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view %s %u is a %s texture, need %s",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view %s %u is %s texture, need %s texture",
                           field, name, target_name(target), target_name(need));
     if (want == WANT_CUBE)
         return VFX_OK;
@@ -73,7 +115,7 @@ static vfx_result check_texture(vfx_context *ctx, const char *field, GLuint name
     return VFX_OK;
 }
 
-static vfx_result check_framebuffer(vfx_context *ctx, GLuint fb, uint32_t w, uint32_t h)
+static vfx_result check_framebuffer(vfx_context *ctx, GLuint fb, uint32_t w, uint32_t h, bool *srgb)
 {
     if (!glIsFramebuffer(fb))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view framebuffer %u is not a "
@@ -88,6 +130,10 @@ static vfx_result check_framebuffer(vfx_context *ctx, GLuint fb, uint32_t w, uin
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "render: frame view framebuffer %u has no colour "
                           "attachment 0", fb);
     glGetNamedFramebufferAttachmentParameteriv(fb, GL_COLOR_ATTACHMENT0, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &obj);
+    GLint encoding = GL_LINEAR;
+    glGetNamedFramebufferAttachmentParameteriv(fb, GL_COLOR_ATTACHMENT0, GL_FRAMEBUFFER_ATTACHMENT_COLOR_ENCODING,
+                                               &encoding);
+    *srgb = encoding == GL_SRGB;
     if (type == GL_TEXTURE) {
         GLint level = 0;
         glGetNamedFramebufferAttachmentParameteriv(fb, GL_COLOR_ATTACHMENT0, GL_FRAMEBUFFER_ATTACHMENT_TEXTURE_LEVEL, &level);
@@ -386,8 +432,13 @@ vfx_result volfx_frame_gate_gl(vfx_context *ctx, bool drawing, volfx_frame_targe
         return r;
     if (!drawing)
         return VFX_OK;
-    if (!t->layer_texture && t->framebuffer && (r = check_framebuffer(ctx, t->framebuffer, t->width, t->height)))
+    if (!t->layer_texture && t->framebuffer
+        && (r = check_framebuffer(ctx, t->framebuffer, t->width, t->height, &t->output_srgb)))
         return r;
+    /* linear shading: an sRGB output attachment gets encoded writes and decoded blending; the
+     * plugin's own targets are float, which sRGB encoding leaves alone (the baseline had it off) */
+    if (t->output_srgb)
+        glEnable(GL_FRAMEBUFFER_SRGB);
     if (t->scene_color && (r = check_texture(ctx, "color_texture", t->scene_color, WANT_COLOR, t->width, t->height)))
         return r;
     if (t->scene_depth && (r = check_texture(ctx, "depth_texture", t->scene_depth, WANT_DEPTH, t->width, t->height)))

@@ -204,7 +204,8 @@ vfx_result game_app_create(const game_app_desc *desc, game_app **out)
 #define VFX_GL_DEBUG_DEFAULT 0
 #endif
     rt_gl_context_desc gd = {.mode = app->desc.mode, .width = w, .height = h, .title = "volfx",
-                              .debug = app->desc.debug_gl || VFX_GL_DEBUG_DEFAULT, .logger = app->log};
+                              .debug = app->desc.debug_gl || VFX_GL_DEBUG_DEFAULT,
+                              .compat_profile = app->desc.gl_compat, .logger = app->log};
     vfx_result r = rt_gl_context_create(&gd, &app->gl);
     if (r)
         goto fail;

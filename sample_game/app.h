@@ -25,6 +25,7 @@ typedef struct game_app_desc {
     rt_gl_mode mode;
     uint32_t width, height;    /* 0 -> 640x360 */
     bool debug_gl;
+    bool gl_compat;            /* headless: a GL 4.5 compatibility-profile context (default core) */
     const char *plugin_path;   /* NULL -> the statically linked plugin */
     const char *program_cache; /* the plugin keeps its program binaries here (NULL: off) */
     uint32_t profile_frames;   /* frames kept for CSV/trace; 0 -> 4096 */

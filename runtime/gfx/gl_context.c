@@ -92,9 +92,10 @@ static vfx_result make_headless(rt_gl_context *c)
             eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL)};
     if (allow_device)
         tries[nt++] = (egl_try){"device-software", egl_open_device(false)};
-    static const EGLint attrs[] = {
-        EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-        EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+    const EGLint attrs[] = {
+        EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+        c->desc.compat_profile ? EGL_CONTEXT_OPENGL_COMPATIBILITY_PROFILE_BIT : EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+        EGL_NONE};
     /* Leak checking only (VFX_EGL_KEEP_DRIVER): eglTerminate unloads Mesa's driver, after
      * which LeakSanitizer cannot name the driver's own allocations to suppress them. */
     const bool keep_driver = getenv("VFX_EGL_KEEP_DRIVER") != NULL;

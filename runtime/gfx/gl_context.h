@@ -19,6 +19,8 @@ typedef struct rt_gl_context_desc {
     const char *title;      /* window title; NULL -> "volfx" */
     bool debug;             /* GL debug output to the logger (KHR_debug) */
     bool vsync;
+    bool compat_profile;    /* headless: a 4.5 compatibility-profile context instead of core
+                               (what OGRE's GLX code makes; tests run the plugin in both) */
     rt_logger logger;
 } rt_gl_context_desc;
 

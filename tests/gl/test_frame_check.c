@@ -183,7 +183,7 @@ static void test_frame_fields(void **state)
     expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "is 16x16, the frame view 32x32");
     v = f.fv;
     v.color_texture = f.cube;
-    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "is a GL_TEXTURE_CUBE_MAP texture, need GL_TEXTURE_2D");
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "is a GL_TEXTURE_CUBE_MAP texture, need a GL_TEXTURE_2D texture");
     /* a frame view four times larger than its textures */
     v = f.fv;
     v.width = 2 * W, v.height = 2 * H;
@@ -263,7 +263,7 @@ static void test_frame_fields(void **state)
     v2.environment_cubemap = f.color;
     expect(api, ctx, &v2, VFX_ERR_INVALID_ARGUMENT,
            "environment_cubemap");
-    expect(api, ctx, &v2, VFX_ERR_INVALID_ARGUMENT, "is a GL_TEXTURE_2D texture, need GL_TEXTURE_CUBE_MAP");
+    expect(api, ctx, &v2, VFX_ERR_INVALID_ARGUMENT, "is a GL_TEXTURE_2D texture, need a GL_TEXTURE_CUBE_MAP texture");
     v2.environment_cubemap = f.cube;
     expect(api, ctx, &v2, VFX_OK, NULL);
     /* a frame view of another type is reported as that */
@@ -606,6 +606,7 @@ static void test_frame_block(void **state)
     v3.color_hdr = 1;
     v3.environment_cubemap = f.cube;
     v3.view_id = 7;
+    ctx->gl_skip_restore = true; /* the block stays bound after the call only without the restore */
     expect(api, ctx, &v3, VFX_OK, NULL);
     GLint buf = 0;
     glGetIntegeri_v(GL_UNIFORM_BUFFER_BINDING, VOLFX_FRAME_BINDING, &buf);

@@ -45,7 +45,8 @@ readelf -d "$exe" | grep -q "NEEDED.*\[$soname\]" || fail "the host does not nee
 grep -rq -- "-I$dest/root$prefix/include\|isystem $dest/root$prefix/include" "$dest/host/build/CMakeFiles" \
   || fail "volfx.h's include directory is not the installed one"
 
-rc=0; LD_LIBRARY_PATH="$lib" "$exe" || rc=$?
+# no LD_LIBRARY_PATH: CMake puts the imported library's folder in the build tree's RUNPATH
+rc=0; env -u LD_LIBRARY_PATH "$exe" || rc=$?
 [ $rc -eq 77 ] && exit 77
 [ $rc -eq 0 ] || fail "the CMake-built host failed ($rc)"
 

@@ -40,6 +40,23 @@ cc -std=c11 -M $flags $(pkg-config --cflags epoxy) "$src/tests/integration/minim
   | grep -q "^$dest.*/include/volfx/volfx.h$" || fail "volfx.h did not come from the installed tree"
 readelf -d "$dest/minimal_host" | grep -q "NEEDED.*\[$soname\]" || fail "minimal host does not need $soname"
 
+# Outside /usr, volfx.pc carries -Wl,-rpath,${libdir}: a host built with it runs, and dlopens the
+# plugin by soname, with no LD_LIBRARY_PATH (pkg-config's prefix pointed at the DESTDIR tree, as
+# if the prefix were there).
+if [ "$prefix" != /usr ]; then
+  # shellcheck disable=SC2046
+  rflags=$(PKG_CONFIG_SYSROOT_DIR= pkg-config --define-variable=prefix="$dest$prefix" --cflags --libs volfx)
+  echo "$rflags" | grep -q -- "-Wl,-rpath,$lib" || fail "volfx.pc gives no rpath to $lib: $rflags"
+  # shellcheck disable=SC2086
+  cc -std=c11 -D_POSIX_C_SOURCE=200809L $san_flags -o "$dest/rpath_host" "$src/tests/integration/minimal_host.c" \
+    $rflags $(pkg-config --cflags --libs epoxy) -ldl -lm || fail "a host does not build with volfx.pc's rpath"
+  rc=0; env -u LD_LIBRARY_PATH "$dest/rpath_host" || rc=$?
+  [ $rc -eq 77 ] && exit 77
+  [ $rc -eq 0 ] || fail "a host built with volfx.pc failed without LD_LIBRARY_PATH ($rc)"
+  env -u LD_LIBRARY_PATH "$dest/rpath_host" "$soname" || fail "a host built with volfx.pc cannot dlopen $soname without LD_LIBRARY_PATH"
+  echo "no LD_LIBRARY_PATH needed: rpath $lib"
+fi
+
 export LD_LIBRARY_PATH="$lib"
 rc=0; "$dest/minimal_host" || rc=$?
 [ $rc -eq 77 ] && exit 77
