@@ -622,10 +622,44 @@ static int bench(int frames)
     return 0;
 }
 
+/* The save + restore pair alone (what one API call adds), n times after a frame of the
+ * default scene, in batches of 100: the median batch's time per pair. */
+static int bench_pair(int n)
+{
+    test_log log = {0};
+    game_demo demo;
+    game_app *app = open_app(false, &log, &demo);
+    game_demo_animate(app, &demo, 1.f / 60.f);
+    if (game_app_frame(app, 1.f / 60.f))
+        return 1;
+    /* the plugin's table is still this thread's after its last call (gpu/gl.h) */
+    volfx_gl_saved *s = malloc(sizeof *s);
+    int batches = n / 100 > 0 ? n / 100 : 1;
+    double *t = calloc((size_t)batches, sizeof(double));
+    for (int b = 0; b < batches; ++b) {
+        double t0 = cpu_ms();
+        for (int i = 0; i < 100; ++i) {
+            volfx_gl_state_save(s, false);
+            volfx_gl_state_restore(s);
+        }
+        t[b] = (cpu_ms() - t0) / 100;
+    }
+    qsort(t, (size_t)batches, sizeof(double), cmp_d);
+    printf("save + restore CPU us a call (calling thread), median of %d batches of 100: %.2f\n", batches,
+           1e3 * t[batches / 2]);
+    free(t);
+    free(s);
+    game_demo_free(app, &demo);
+    game_app_destroy(app);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc == 3 && !strcmp(argv[1], "--bench"))
         return bench(atoi(argv[2]));
+    if (argc == 3 && !strcmp(argv[1], "--bench-pair"))
+        return bench_pair(atoi(argv[2]));
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hostile_host),
         cmocka_unit_test(test_compat_profile),
