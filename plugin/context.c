@@ -70,13 +70,13 @@ void *volfx_alloc(vfx_context *ctx, size_t size)
 {
     const size_t align = 64;
     if (size > SIZE_MAX - align - sizeof(alloc_header)) {
-        volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "allocation of %zu bytes is too large", size);
+        volfx_fail_id(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_OUT_OF_MEMORY, "allocation of %zu bytes is too large", size);
         return NULL;
     }
     size_t total = size + align + sizeof(alloc_header);
     void *base = ctx->host.alloc ? ctx->host.alloc(ctx->host.user, total, 16) : malloc(total);
     if (!base) {
-        volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "out of memory allocating %zu bytes", size);
+        volfx_fail_id(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_OUT_OF_MEMORY, "out of memory allocating %zu bytes", size);
         return NULL;
     }
     uintptr_t p = ((uintptr_t)base + sizeof(alloc_header) + align - 1) & ~(uintptr_t)(align - 1);

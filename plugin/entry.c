@@ -58,7 +58,7 @@ static vfx_result gl_profile(vfx_context *ctx)
                           : (mask & GL_CONTEXT_COMPATIBILITY_PROFILE_BIT) ? "compatibility profile"
                           : "no profile";
     if (major * 10 + minor < 45 || !strncmp(version, "OpenGL ES", 9))
-        return volfx_fail(ctx, VFX_ERR_GL_UNSUPPORTED, "volfx needs desktop GL 4.5 (core or compatibility "
+        return volfx_fail_id(ctx, VFX_ERR_GL_UNSUPPORTED, VFX_LOG_ID_GL_VERSION, "volfx needs desktop GL 4.5 (core or compatibility "
                           "profile), the current context is %s, %s", version, profile);
     ctx->gl_compat = (mask & GL_CONTEXT_COMPATIBILITY_PROFILE_BIT) != 0;
     volfx_log(ctx, VFX_LOG_DEBUG, "GL context %s, %s", version, profile);
@@ -84,8 +84,8 @@ static vfx_result gl_load(vfx_context *ctx)
             return gl_profile(ctx); /* the refusal naming version and profile */
     }
     if (missing)
-        return volfx_fail(ctx, VFX_ERR_GL_UNSUPPORTED,
-                          "host gl_get_proc_address found no '%s' (one of the %u GL 4.5 commands volfx uses)",
+        return volfx_fail_id(ctx, VFX_ERR_GL_UNSUPPORTED, VFX_LOG_ID_GL_COMMAND_MISSING,
+                             "host gl_get_proc_address found no '%s' (one of the %u GL 4.5 commands volfx uses)",
                           missing, lookups);
     volfx_log(ctx, VFX_LOG_DEBUG, "%u GL commands resolved through the host's gl_get_proc_address", lookups);
     return VFX_OK;

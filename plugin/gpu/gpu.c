@@ -81,8 +81,8 @@ vfx_result volfx_gpu_create(vfx_context *ctx, volfx_gpu **out)
     glGetIntegerv(GL_MAJOR_VERSION, &major);
     glGetIntegerv(GL_MINOR_VERSION, &minor);
     if (major * 10 + minor < 45 || strncmp((const char *)version, "OpenGL ES", 9) == 0)
-        return volfx_fail(ctx, VFX_ERR_GL_UNSUPPORTED,
-                        "volfx needs desktop GL 4.5, the current context is %s", (const char *)version);
+        return volfx_fail_id(ctx, VFX_ERR_GL_UNSUPPORTED, VFX_LOG_ID_GL_VERSION,
+                             "volfx needs desktop GL 4.5, the current context is %s", (const char *)version);
     volfx_gpu *g = volfx_alloc(ctx, sizeof *g);
     if (!g)
         return VFX_ERR_OUT_OF_MEMORY;

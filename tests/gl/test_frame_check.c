@@ -258,6 +258,9 @@ static void test_frame_fields(void **state)
     v = f.fv;
     v.effects = 1u << 9;
     expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "effects 0x200 has bits of no effect");
+    vfx_log_id fid = VFX_LOG_ID_NONE;
+    api->last_error(ctx, &fid);
+    assert_int_equal(fid, VFX_LOG_ID_FRAME_VIEW);
     /* version 2: the cubemap must be one */
     vfx_frame_view v2 = f.fv;
     v2.environment_cubemap = f.color;

@@ -55,7 +55,7 @@ int main(void)
     }
     vfx_context *ctx = NULL;
     vfx_result r = api.create(&host, &ctx);
-    int ok = r == VFX_ERR_GL_UNSUPPORTED && ctx == NULL && strstr(log.last, "needs desktop GL 4.5")
+    int ok = r == VFX_ERR_GL_UNSUPPORTED && ctx == NULL && strstr(log.last, "needs desktop GL 4.5") && log.last_id == VFX_LOG_ID_GL_VERSION
              && strstr(log.last, version);
     fprintf(ok ? stdout : stderr, "GL %s: create gave %d, ctx %p: %s\n", version, r, (void *)ctx, log.last);
     if (ctx)

@@ -123,6 +123,7 @@ static void test_water_abi_values(void **state)
         volfx_water_resolved out;
         expect(c, volfx_water_params_resolve(c, &p, &out), VFX_ERR_INVALID_ARGUMENT,
                bad[k].needle);
+        assert_int_equal(c->last_error_id, VFX_LOG_ID_PARAM_RANGE); /* the id is the contract */
     }
     /* a value at the edge of its range is used as given, not swapped for the default */
     vfx_water_params p = {.type = VFX_TYPE_WATER_PARAMS};

@@ -383,14 +383,20 @@ typedef struct vfx_volume_view {
 
 /* Stable ids of the plugin's messages (docs/abi.md "Log ids"): the log callback and last_error
  * give one beside the text, so a host can react to a kind of message without matching text.
- * Values are never renumbered or reused. */
+ * GENERIC is every message not yet given a kind of its own. Values are never renumbered or
+ * reused. */
 #define VFX_LOG_ID_LIST(X) \
     X(NONE, 0) \
     X(GENERIC, 1) \
     X(ABI_VERSION, 2) \
     X(STRUCT_TYPE, 3) \
     X(GPU_PARTICLES_UNSUPPORTED, 4) \
-    X(LAYER_TEXTURE_UNSUPPORTED, 5)
+    X(LAYER_TEXTURE_UNSUPPORTED, 5) \
+    X(PARAM_RANGE, 6)         /* a number outside its documented range (volfx_ranges.h) */ \
+    X(FRAME_VIEW, 7)          /* a frame view field or target refused by the frame gate */ \
+    X(OUT_OF_MEMORY, 8)       /* an allocation through the host allocator failed */ \
+    X(GL_VERSION, 9)          /* the current context is below desktop GL 4.5 */ \
+    X(GL_COMMAND_MISSING, 10) /* gl_get_proc_address found no entry point for a command */
 
 typedef enum vfx_log_id {
 #define VFX_LOG_ID_ENUM_(name, value) VFX_LOG_ID_##name = value,
