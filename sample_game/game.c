@@ -26,7 +26,11 @@ typedef struct game_options {
     double progress_s;         /* a progress line on stderr every this many seconds (0 = never) */
     const char *raw_effect, *raw_path;
     vfx_effect_kind raw_kind;
+    uint32_t shots[16], shot_count; /* --shots: frames (1-based) whose image is written on the way */
+    bool shot_variants;        /* --shot-variants: the last shot again without water / beams / both */
 } game_options;
+
+#define GAME_MAX_SHOTS 16
 
 static void usage(void)
 {
@@ -34,7 +38,12 @@ static void usage(void)
          "                  [--png FILE] [--csv FILE] [--trace FILE] [--plugin libvolfx.so.1|PATH]\n"
          "                  [--scene FILE.json] [--no-water] [--hide-water] [--no-beams] [--no-volume] [--debug-gl]\n"
          "                  [--mem-every N] [--progress S] [--dump-raw water|beams|volume FILE.pfm]\n"
-         "                  [--program-cache DIR]\n"
+         "                  [--program-cache DIR] [--shots N,N,...] [--shot-variants]\n"
+         "--shots writes STEM-fN.png (STEM: --png without .png) after frame N, up to 16 frames; with\n"
+         "--shot-variants the last frame's shot is drawn again (no time passes) with the beams off\n"
+         "(-nobeams), the water hidden (-hidewater) and both (-nobeams-hidewater), and the water's raw\n"
+         "distance is written to STEM-fN-water.pfm: what scripts/water-look.py measures. (Only the\n"
+         "last: switching the beams off and on restarts their growth, hiding the water drops its foam.)\n"
          "Without a display it runs headless (EGL) for 30 frames and writes volfx-game.png.\n"
          "A run longer than S seconds (default 5; 0 = never) prints a progress line to stderr every S.\n"
          "Window keys: WASD/QE fly, mouse drag orbit, 1/2/3 toggle water/beams/volume,\n"

@@ -217,6 +217,7 @@ static vfx_result read_params(vfx_context *ctx, water_state *s, volfx_water_reso
         return kr;
     s->kp = res->kp;
     s->preset = res->preset;
+    s->look = res->look;
     return VFX_OK;
 }
 
@@ -786,6 +787,8 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_env"), targets->environment_cubemap != 0);
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_hdr"), targets->color_hdr);
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_ssr"), !(p->disable & VFX_WATER_NO_SSR));
+    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_host_light"), (s->look & WATER_LOOK_HOST_LIGHT) != 0);
+    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_ggx"), (s->look & WATER_LOOK_GGX) != 0);
     if (layer)
         glBindTextureUnit(6, layer);
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_diffuse"), layer != 0);

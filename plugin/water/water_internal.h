@@ -89,6 +89,7 @@ typedef struct water_state {
     volfx_water_core params;
     volfx_water_kernel_params kp; /* the kernel (vfx_water_params), checked */
     uint32_t preset;       /* vfx_water_params.preset resolved (LOW..ULTRA) */
+    uint32_t look;         /* its WATER_LOOK_* bits */
     float auto_h;          /* h from the particles' spacing (0: not measured yet) */
     uint32_t auto_h_count; /* the particle count it was measured at */
     volfx_water_aniso *aniso; /* per-particle kernels (TILE), made when asked for or given */

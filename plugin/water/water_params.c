@@ -16,13 +16,16 @@ typedef struct preset_def {
     uint32_t disable;   /* added to the host's bits */
     float step_div;     /* step = h / step_div */
     uint32_t refine_iters;
+    uint32_t look;      /* WATER_LOOK_* */
 } preset_def;
 
 static const preset_def PRESETS[] = {
-    [VFX_WATER_PRESET_LOW] = {"low", VFX_WATER_KERNEL_ISOTROPIC, 0, 6.0f, 2},
-    [VFX_WATER_PRESET_MEDIUM] = {"medium", VFX_WATER_KERNEL_ANISOTROPIC, 0, 8.0f, 3},
-    [VFX_WATER_PRESET_HIGH] = {"high", VFX_WATER_KERNEL_ANISOTROPIC, VFX_WATER_NO_HALF_RES, 8.0f, 3},
-    [VFX_WATER_PRESET_ULTRA] = {"ultra", VFX_WATER_KERNEL_ANISOTROPIC, VFX_WATER_NO_HALF_RES, 16.0f, 5},
+#define LOOK_ALL (WATER_LOOK_HOST_LIGHT | WATER_LOOK_GGX | WATER_LOOK_FOAM_LAYER)
+    /* low keeps the cheap GGX lobe and drops the per-pixel host-light reads and the foam pass */
+    [VFX_WATER_PRESET_LOW] = {"low", VFX_WATER_KERNEL_ISOTROPIC, 0, 6.0f, 2, WATER_LOOK_GGX},
+    [VFX_WATER_PRESET_MEDIUM] = {"medium", VFX_WATER_KERNEL_ANISOTROPIC, 0, 8.0f, 3, LOOK_ALL},
+    [VFX_WATER_PRESET_HIGH] = {"high", VFX_WATER_KERNEL_ANISOTROPIC, VFX_WATER_NO_HALF_RES, 8.0f, 3, LOOK_ALL},
+    [VFX_WATER_PRESET_ULTRA] = {"ultra", VFX_WATER_KERNEL_ANISOTROPIC, VFX_WATER_NO_HALF_RES, 16.0f, 5, LOOK_ALL},
 };
 
 /* The step's range, relative to h (docs/water.md "Presets"): below h/1024 a pixel's march through
@@ -88,10 +91,13 @@ vfx_result volfx_water_params_resolve(vfx_context *ctx, const vfx_water_params *
     if (p.color[0] == 0 && p.color[1] == 0 && p.color[2] == 0) {
         p.color[0] = 0.15f; p.color[1] = 0.55f; p.color[2] = 0.6f;
     }
-    if (p.absorption == 0) p.absorption = 0.6f;
+    /* no absorption: one relative to h (set_h), so that any scene's water, whatever its units,
+     * is clear where it is thin and coloured where it is several h deep */
+    out->absorption_per_h = p.absorption == 0;
     if (p.ior == 0) p.ior = 1.333f;
     out->step_div = d->step_div;
     out->preset = preset;
+    out->look = d->look;
     float step = p.step;
     p.step = 0;
     if (step > 0) {
@@ -105,6 +111,8 @@ vfx_result volfx_water_params_resolve(vfx_context *ctx, const vfx_water_params *
 vfx_result volfx_water_params_set_h(vfx_context *ctx, volfx_water_resolved *r, float h)
 {
     r->p.h = h;
+    if (r->absorption_per_h)
+        r->p.absorption = WATER_ABSORPTION_H / h;
     if (r->step_div > 0) {
         r->p.step = h / r->step_div;
         return VFX_OK;

@@ -27,7 +27,18 @@ typedef struct volfx_water_resolved {
     volfx_water_kernel_params kp;
     uint32_t preset;             /* VFX_WATER_PRESET_LOW .. _ULTRA (never DEFAULT) */
     float step_div;              /* step = h / step_div when the host gave no step */
+    uint32_t look;               /* WATER_LOOK_* bits of the preset */
+    bool absorption_per_h;       /* the host gave no absorption: WATER_ABSORPTION_H / h */
 } volfx_water_resolved;
+
+/* The look's parts each preset switches on (docs/water.md "The look"): the host's image as the
+ * surroundings' light, the sun's GGX lobe, the foam layer with a lifetime. */
+#define WATER_LOOK_HOST_LIGHT 1u
+#define WATER_LOOK_GGX 2u
+#define WATER_LOOK_FOAM_LAYER 4u
+/* The default absorption, per unit of h: a pool 3 h deep takes 1 - e^-2 of the red light
+ * behind it (tint's 1 - 0.15) and fills with the deep colour; a sheet h/4 thick keeps 84% (red) to 92% (blue). */
+#define WATER_ABSORPTION_H 0.8f
 
 /* Reads the host's parameters (and a vfx_lab_water in their chain), checks them and applies the
  * preset; an unknown method, kernel or preset, or a value outside its documented range that

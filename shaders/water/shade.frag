@@ -33,8 +33,19 @@ uniform bool u_refract_view;        // ablation: the view ray's thickness and a 
 uniform float u_absorption, u_ior;
 uniform vec3 u_tint;
 uniform bool u_flat, u_has_color, u_has_depth, u_has_env, u_hdr, u_ssr, u_has_diffuse;
+// the look's switches (the quality presets, water_params.c): the host image as the
+// surroundings' light, the sun's GGX lobe (else the old narrow Phong glint)
+uniform bool u_host_light, u_ggx;
 out vec4 o_color;
-#define WATER_SCATTER 0.35
+// single scattering: the body's albedo (the share of the absorbed light that the water's
+// particles scatter back towards the eye, lit by the water's light)
+#define WATER_ALBEDO 1.0
+// the sun's lobe on the surface: GGX, alpha = roughness^2 (calm water; the waves the normals
+// carry make the glints)
+#define WATER_GGX_ALPHA 0.01
+// the host image's light: the mean of a WATER_HOST_GRID^2 grid of its pixels, weighted
+#define WATER_HOST_GRID 4
+#define WATER_HOST_K 0.6
 // SSR: SSR_STEPS steps growing as k^2 over SSR_REACH x the eye's distance (at least 40 h), a
 // hit where the ray passes behind the host depth by less than the step (or h), refined by
 // SSR_BISECT halvings; both bounds hold for any input
@@ -42,7 +53,7 @@ out vec4 o_color;
 #define SSR_BISECT 5
 #define SSR_REACH 2.0
 // foam opacity per unit of splatted thickness, bubbles' brightness per unit
-#define FOAM_K 0.35
+#define FOAM_K 0.6
 #define BUBBLE_K 0.5
 // The refracted ray's trace: REFRACT_STEPS even steps over twice the view ray's thickness (plus
 // h), then REFRACT_BISECT halvings of the step where it left; both bounds hold for any input.
@@ -69,20 +80,22 @@ bool in_water(vec3 y, out ivec2 pix)
 }
 
 // Length of the refracted ray x + s rd inside the water, up to s_max; *exit_pix the pixel where
-// it leaves (-1 when it leaves the screen, and then the length is where it did).
-float refracted_thickness(vec3 x, vec3 rd, float s_max, out ivec2 exit_pix)
+// it leaves (-1 when it leaves the screen, and then the length is where it did), *inside_pix
+// the last sample's pixel that was inside (-1: none).
+float refracted_thickness(vec3 x, vec3 rd, float s_max, out ivec2 exit_pix, out ivec2 inside_pix)
 {
     float ds = s_max / float(REFRACT_STEPS), s0 = 0.0;
     ivec2 pix;
     exit_pix = ivec2(-1);
+    inside_pix = ivec2(-1);
     for (int k = 1; k <= REFRACT_STEPS; ++k) {
         float s1 = ds * float(k);
-        if (in_water(x + s1 * rd, pix)) { s0 = s1; continue; }
+        if (in_water(x + s1 * rd, pix)) { s0 = s1; inside_pix = pix; continue; }
         // left between s0 and s1: halve the step (the first sample sits just inside the front)
         exit_pix = pix;
         for (int b = 0; b < REFRACT_BISECT; ++b) {
             float sm = 0.5 * (s0 + s1);
-            if (in_water(x + sm * rd, pix)) s0 = sm;
+            if (in_water(x + sm * rd, pix)) { s0 = sm; inside_pix = pix; }
             else { s1 = sm; exit_pix = pix; }
         }
         return 0.5 * (s0 + s1);
@@ -128,6 +141,77 @@ bool ssr(vec3 x, vec3 r, float t, out vec3 col, out float fade)
     return false;
 }
 
+// The surroundings' light from the host's image (what the host drew before the water: its
+// lighting, whatever it is): the mean of a fixed grid of its pixels. Every pixel reads the
+// same grid, so the light is one value a frame.
+vec3 water_host_light()
+{
+    if (!u_host_light || !u_has_color)
+        return vec3(0.0);
+    vec3 sum = vec3(0.0);
+    ivec2 size = textureSize(u_scene_color, 0);
+    for (int j = 0; j < WATER_HOST_GRID; ++j)
+        for (int i = 0; i < WATER_HOST_GRID; ++i)
+            sum += min(texelFetch(u_scene_color, (ivec2(i, j) * 2 + 1) * size / (2 * WATER_HOST_GRID), 0).rgb, vec3(4.0));
+    return WATER_HOST_K * sum / float(WATER_HOST_GRID * WATER_HOST_GRID);
+}
+
+// The body: Beer-Lambert over the refracted thickness (per channel, (1 - tint) x absorption),
+// and the light the body scatters back: single scattering towards the deep colour (the tint
+// times the water's light, WATER_ALBEDO), filling in as the water thickens. Shallow water
+// (thickness << 1 / absorption) stays clear.
+vec3 water_body(vec3 behind, float thickness, vec3 light)
+{
+    vec3 trans = exp(-u_absorption * thickness * (vec3(1.0) - u_tint));
+    vec3 deep = WATER_ALBEDO * u_tint * light;
+    return behind * trans + deep * (vec3(1.0) - trans);
+}
+
+// The surface: Schlick Fresnel (ior u_ior) between the body seen through it and the reflected
+// environment, plus the sun's specular (GGX, Smith's visibility, Schlick's F at the half
+// vector) or, with u_ggx off, the old narrow glint on the reflected ray.
+vec3 water_surface(vec3 body, vec3 env, vec3 n, vec3 v)
+{
+    float c = clamp(dot(v, n), 0.0, 1.0);
+    float r0 = pow((u_ior - 1.0) / (u_ior + 1.0), 2.0);
+    float fresnel = r0 + (1.0 - r0) * pow(1.0 - c, 5.0);
+    vec3 col = mix(body, env, fresnel);
+    if (!u_ggx)
+        return col + vec3(2.0, 1.5, 1.1) * pow(max(dot(reflect(-v, n), WATER_SUN), 0.0), 400.0);
+    float nl = dot(n, WATER_SUN);
+    if (nl <= 0.0 || c <= 0.0)
+        return col;
+    vec3 hv = normalize(v + WATER_SUN);
+    float nh = max(dot(n, hv), 0.0), a2 = WATER_GGX_ALPHA * WATER_GGX_ALPHA;
+    float dd = nh * nh * (a2 - 1.0) + 1.0;
+    float D = a2 / (3.14159265 * dd * dd);
+    float k = 0.5 * WATER_GGX_ALPHA;        // Smith-Schlick for GGX
+    float vis = 1.0 / (4.0 * (c * (1.0 - k) + k) * (nl * (1.0 - k) + k));
+    float F = r0 + (1.0 - r0) * pow(1.0 - max(dot(v, hv), 0.0), 5.0);
+    // radiance = D F vis E_sun n.l, E_sun = pi x WATER_SUN_E (irradiance / pi)
+    return col + D * F * vis * 3.14159265 * WATER_SUN_E * nl;
+}
+
+// The refracted ray's exit pixel is the host colour behind the water only if the host there is
+// not in front of the water: an object standing in front of the surface (its outline near the
+// pixel) would lend its colour. Then the trace falls back to the pixel where the ray was last
+// inside the water, else the unrefracted pixel.
+ivec2 water_behind_pixel(ivec2 pix, ivec2 ep, ivec2 inside, float exit_dist)
+{
+    if (ep.x < 0)
+        return pix;
+    if (!u_has_depth)
+        return ep;
+    vec2 endc = (vec2(ep) + 0.5) / g_size * 2.0 - 1.0;
+    float host = volfx_depth_distance(u_inv_view_proj, u_eye, endc, texelFetch(u_scene_depth, ep, 0).r);
+    float front = texelFetch(u_dist, ep, 0).r;
+    // the host at the exit pixel lies in front of where the ray left the water (by more than
+    // the trace's resolution) and in front of the water's front there: an occluder
+    if (host < exit_dist - 2.0 * u_h && (front < 0.0 || host < front))
+        return inside.x >= 0 ? inside : pix;
+    return ep;
+}
+
 void main()
 {
     ivec2 pix = ivec2(gl_FragCoord.xy);
@@ -140,9 +224,6 @@ void main()
     vec3 g = texelFetch(u_grad, pix, 0).xyz;
     // a zero gradient (the eye inside a symmetric blob) has no direction: face the viewer
     vec3 n = dot(g, g) > 0.0 ? -normalize(g) : -dir;
-    float c = clamp(dot(-dir, n), 0.0, 1.0);
-    float r0 = pow((u_ior - 1.0) / (u_ior + 1.0), 2.0);
-    float fresnel = r0 + (1.0 - r0) * pow(1.0 - c, 5.0);
     vec3 r = reflect(dir, n);
     vec3 sky = u_has_env ? texture(u_env, r).rgb : volfx_sky(r, WATER_SUN);
     g_size = size;
@@ -163,23 +244,27 @@ void main()
     if (u_refract_view || dot(rd, rd) == 0.0) {
         if (u_has_color) behind = texture(u_scene_color, (vec2(pix) + 0.5) / size + rd.xy * 0.03).rgb;
     } else {
-        ivec2 ep;
+        ivec2 ep, inside;
         // a step past the front so the first sample is inside (the front's refine tolerance)
         vec3 x = u_eye + (t + 1.0e-3 * u_h) * dir;
-        thickness = refracted_thickness(x, rd, 2.0 * thickness + u_h, ep);
-        if (u_has_color) behind = texelFetch(u_scene_color, ep.x < 0 ? pix : ep, 0).rgb;
+        thickness = refracted_thickness(x, rd, 2.0 * thickness + u_h, ep, inside);
+        if (u_has_color)
+            behind = texelFetch(u_scene_color, water_behind_pixel(pix, ep, inside, length(x + thickness * rd - u_eye)), 0).rgb;
     }
-    // what the water takes out of the light from behind it comes back partly as its own
-    // colour (light scattered in the body): a deep pool reads as tinted water, not black
-    vec3 trans = exp(-u_absorption * thickness * (vec3(1.0) - u_tint));
-    vec3 body = behind * trans + WATER_SCATTER * u_tint * (vec3(1.0) - trans);
+    // the water's light: the sky (the host's cubemap or the procedural sky), the sun through the
+    // surface, the surroundings (the host's image), the plugin's lights at the surface
+    vec3 zen = u_has_env ? texture(u_env, vec3(0.0, 1.0, 0.0)).rgb : volfx_sky(vec3(0.0, 1.0, 0.0), WATER_SUN);
+    vec3 sun_h = normalize(vec3(WATER_SUN.x, 0.15, WATER_SUN.z));
+    vec3 hor = u_has_env ? texture(u_env, sun_h).rgb : volfx_sky(sun_h, WATER_SUN);
+    vec3 ambient = water_sky_ambient(zen, hor) + water_host_light();
+    vec3 p = u_eye + t * dir;
+    vec3 light = ambient + WATER_SUN_E * max(WATER_SUN.y, 0.0) + water_fx_lights(p, vec3(0.0));
+    vec3 body = water_body(behind, thickness, light);
     vec2 foam_bub = u_has_diffuse ? texelFetch(u_diffuse, pix, 0).rg : vec2(0.0);
-    vec3 white = water_white_light();
+    vec3 white = water_white(ambient, p, vec3(0.0, 1.0, 0.0));
     // bubbles: white specks behind the surface (already attenuated by the water in front)
-    body += white * (1.0 - exp(-BUBBLE_K * foam_bub.g)) * u_tint * 1.5;
-    // the sun's highlight on the reflected ray: a warm glint on every wave facing it
-    float sun = pow(max(dot(r, WATER_SUN), 0.0), 400.0);
-    vec3 col = mix(body, sky, fresnel) + vec3(2.0, 1.5, 1.1) * sun;
+    body += water_white(ambient, p, vec3(0.0)) * (1.0 - exp(-BUBBLE_K * foam_bub.g)) * u_tint * 1.5;
+    vec3 col = water_surface(body, sky, n, -dir);
     // foam on the surface hides what is under it, the glint too
     col = mix(col, white, 1.0 - exp(-FOAM_K * foam_bub.r));
     o_color = vec4(u_hdr ? col : min(col, vec3(1.0)), 1.0);

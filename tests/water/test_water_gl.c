@@ -652,8 +652,29 @@ static void sky_d(const double d0[3], const double sun0[3], double out[3])
     }
 }
 
-/* The shading formula of shaders/water/shade.frag, in double, for a checked pixel; returns the
- * share of the sun (highlight and the sky's disc), whose pixels the caller leaves out. */
+/* The water's light of shaders/water/white.glsl and shade.frag, in double, for a host whose
+ * image is one colour `host` (the host-light grid's mean is that colour): the sky's ambient
+ * (zenith and the sun-side horizon, x 1.5 / 2), 0.6 x the host, the sun (1, 0.72, 0.48) x 1.7
+ * over a horizontal surface. */
+static const double SUN_D[3] = {-0.4653, 0.3619, -0.8079};
+static const double SUN_E[3] = {1.7, 0.72 * 1.7, 0.48 * 1.7};
+static void water_light_d(const float host[4], double ambient[3], double light[3])
+{
+    double zen[3], hor[3], up[3] = {0, 1, 0};
+    double hl = sqrt(SUN_D[0] * SUN_D[0] + 0.15 * 0.15 + SUN_D[2] * SUN_D[2]);
+    double sh[3] = {SUN_D[0] / hl, 0.15 / hl, SUN_D[2] / hl};
+    sky_d(up, SUN_D, zen);
+    sky_d(sh, SUN_D, hor);
+    for (int k = 0; k < 3; ++k) {
+        ambient[k] = 0.5 * (zen[k] + hor[k]) * 1.5 + 0.6 * fmin(host[k], 4.0);
+        light[k] = ambient[k] + SUN_E[k] * SUN_D[1];
+    }
+}
+
+/* The shading formula of shaders/water/shade.frag, in double, for a checked pixel: Schlick
+ * Fresnel between the body and the sky, plus the sun's GGX lobe (alpha 0.01, Smith-Schlick
+ * visibility, Schlick F at the half vector). Returns the sun's share (the lobe and the sky's
+ * disc), whose pixels the caller leaves out. */
 static double expected_shade(const double dir[3], const double n[3], double ior, const double behind[3],
                            double out[3])
 {
@@ -662,15 +683,24 @@ static double expected_shade(const double dir[3], const double n[3], double ior,
     double r0 = pow((ior - 1) / (ior + 1), 2), f = r0 + (1 - r0) * pow(1 - c, 5);
     double dn = dir[0] * n[0] + dir[1] * n[1] + dir[2] * n[2];
     double r[3] = {dir[0] - 2 * dn * n[0], dir[1] - 2 * dn * n[1], dir[2] - 2 * dn * n[2]};
-    const double sun[3] = {-0.4653, 0.3619, -0.8079};
-    double rs = r[0] * sun[0] + r[1] * sun[1] + r[2] * sun[2];
-    double spec = pow(rs > 0 ? rs : 0, 400.0), disc = 14.0 * pow(rs > 0 ? rs : 0, 2400.0);
+    double rs = r[0] * SUN_D[0] + r[1] * SUN_D[1] + r[2] * SUN_D[2];
+    double disc = 14.0 * pow(rs > 0 ? rs : 0, 2400.0);
     double sky[3];
-    sky_d(r, sun, sky);
-    const double glint[3] = {2.0, 1.5, 1.1};
+    sky_d(r, SUN_D, sky);
+    double nl = n[0] * SUN_D[0] + n[1] * SUN_D[1] + n[2] * SUN_D[2], spec = 0;
+    if (nl > 0 && c > 0) {
+        double hv[3] = {SUN_D[0] - dir[0], SUN_D[1] - dir[1], SUN_D[2] - dir[2]};
+        double hlen = sqrt(hv[0] * hv[0] + hv[1] * hv[1] + hv[2] * hv[2]);
+        for (int k = 0; k < 3; ++k) hv[k] /= hlen;
+        double nh = fmax(n[0] * hv[0] + n[1] * hv[1] + n[2] * hv[2], 0.0), a = 0.01, a2 = a * a;
+        double dd = nh * nh * (a2 - 1) + 1, D = a2 / (3.14159265358979323846 * dd * dd), kk = 0.5 * a;
+        double vis = 1 / (4 * (c * (1 - kk) + kk) * (nl * (1 - kk) + kk));
+        double vh = fmax(-(dir[0] * hv[0] + dir[1] * hv[1] + dir[2] * hv[2]), 0.0);
+        spec = D * (r0 + (1 - r0) * pow(1 - vh, 5)) * vis * 3.14159265358979323846 * nl;
+    }
     for (int k = 0; k < 3; ++k)
-        out[k] = fmin(behind[k] + (sky[k] - behind[k]) * f + glint[k] * spec, 1.0);
-    return 2.0 * spec + disc;
+        out[k] = fmin(behind[k] + (sky[k] - behind[k]) * f + spec * SUN_E[k], 1.0);
+    return spec + disc;
 }
 
 /* Shaded pixels: (a) the blob scene with a white tint (no absorption): every water pixel is
@@ -739,13 +769,16 @@ static void test_shading_pixels(void **state)
                     thick = -2 * rho * nrd;
                     thick_view = 2 * sqrt(rho * rho - perp2);
                 }
+                double ambient[3], light[3];
+                water_light_d(host, ambient, light);
                 for (int k = 0; k < 3; ++k) {
-                    /* transmitted host colour plus the in-scattered body colour (0.35 tint) */
+                    /* transmitted host colour plus the single scattering towards the deep
+                     * colour: albedo 1 x tint x the water's light */
                     double tr = exp(-s.params.absorption * thick * (1 - s.params.color[k]));
-                    behind[k] = host[k] * tr + 0.35 * s.params.color[k] * (1 - tr);
+                    behind[k] = host[k] * tr + s.params.color[k] * light[k] * (1 - tr);
                 }
-                /* the highlight (exponent 400) moves by ~800 x the normal's angle error: its few
-                 * pixels are left out of the bound */
+                /* the sun's lobe (alpha 0.01) moves by ~1/alpha^2 x the normal's angle error:
+                 * its few pixels are left out of the bound */
                 if (expected_shade(dir, nr, 1.333, behind, want) > 1e-3) continue;
                 /* a normal off by an angle a moves F by <= 5 (1-c)^4 sin(a) and the sky by
                  * sin(a): with the measured normal error (mean 0.04 deg, p99 0.3 deg) that is
@@ -760,7 +793,7 @@ static void test_shading_pixels(void **state)
                     double bv[3], wv[3], ev = 0;
                     for (int k = 0; k < 3; ++k) {
                         double tr = exp(-s.params.absorption * thick_view * (1 - s.params.color[k]));
-                        bv[k] = host[k] * tr + 0.35 * s.params.color[k] * (1 - tr);
+                        bv[k] = host[k] * tr + s.params.color[k] * light[k] * (1 - tr);
                     }
                     expected_shade(dir, nr, 1.333, bv, wv);
                     for (int k = 0; k < 3; ++k) ev = fmax(ev, fabs(c[k] - wv[k]));

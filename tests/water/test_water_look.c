@@ -1,0 +1,284 @@
+/* GL tests of the water's look (shaders/water/shade.frag, docs/water.md "The look"): properties
+ * the shading must have whatever its constants, each of which a wrong shader breaks:
+ * - refraction never reads a host pixel in front of the water (an occluder's colour changes no
+ *   water pixel beside it);
+ * - deep water is more tinted than shallow water, and a one-particle sheet stays near clear;
+ * - the surface reflects more at a grazing view than from above (Fresnel). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <epoxy/gl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "camera_ref.h"
+#include "test_util.h"
+#include "water_test_host.h"
+
+typedef struct scene {
+    test_log log;
+    float *x, *y, *z;
+    uint32_t n;
+    vfx_water_params params;
+    uint32_t preset;
+} scene;
+
+static uint32_t chunk_count(void *user) { return water_test_chunk_count(((scene *)user)->n, 128); }
+
+static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
+{
+    scene *s = user;
+    water_test_chunk(s->x, s->y, s->z, s->n, 128, index, out);
+    return VFX_OK;
+}
+
+/* Version 3 (the preset) when the plugin offers it; the isotropic kernel, as the references. */
+static vfx_result water_params(void *user, vfx_water_params *out)
+{
+    const scene *s = user;
+    uint32_t offered = out->size;
+    *out = s->params;
+    if (offered >= sizeof(vfx_water_params3)) {
+        vfx_water_params3 *p3 = (vfx_water_params3 *)out;
+        memset((char *)p3 + sizeof(vfx_water_params), 0, sizeof *p3 - sizeof(vfx_water_params));
+        p3->v2.v1.size = sizeof *p3;
+        p3->v2.v1.version = VFX_WATER_PARAMS3_VERSION;
+        p3->v2.kernel = VFX_WATER_KERNEL_ISOTROPIC;
+        p3->preset = s->preset;
+    }
+    return VFX_OK;
+}
+
+static scene make_scene(uint32_t n)
+{
+    scene s;
+    memset(&s, 0, sizeof s);
+    s.n = n;
+    s.x = calloc(n, sizeof(float));
+    s.y = calloc(n, sizeof(float));
+    s.z = calloc(n, sizeof(float));
+    s.params.size = sizeof s.params;
+    s.params.version = VFX_WATER_PARAMS_VERSION;
+    s.params.method = VFX_WATER_METHOD_BRUTE;
+    s.params.h = 0.61f;
+    return s;
+}
+
+static void free_scene(scene *s) { free(s->x); free(s->y); free(s->z); }
+
+/* A slab of nx x nx x layers particles at spacing h/2, centred on x = z = 0, its top at y = 0. */
+static scene slab_scene(uint32_t nx, uint32_t layers)
+{
+    scene s = make_scene(nx * nx * layers);
+    float d = 0.305f;
+    for (uint32_t i = 0; i < s.n; ++i) {
+        s.x[i] = d * ((float)(i % nx) - 0.5f * (float)(nx - 1));
+        s.z[i] = d * ((float)((i / nx) % nx) - 0.5f * (float)(nx - 1));
+        s.y[i] = -d * (float)(i / (nx * nx));
+    }
+    return s;
+}
+
+/* One frame of the plugin over a host image of colour `col` (and `col2` left of column
+ * `split`) and, when `depth` is given, a host depth texture (`depth2` left of `split`); the
+ * RGBA32F framebuffer, top row first, and the water's distance image. */
+static void render(scene *s, const ref_camera *cam, const float col[4], const float col2[4], uint32_t split,
+                   const float *depth, float depth2, float *px, float *dist)
+{
+    vfx_host_api host_api = {.size = sizeof host_api, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
+                             .user = s, .log = test_log_fn, .particle_chunk_count = chunk_count,
+                             .particle_chunk = chunk_view, .water_params = water_params};
+    vfx_plugin_api api = {.size = sizeof api};
+    vfx_context *ctx;
+    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
+    assert_int_equal(api.create(&host_api, &ctx), VFX_OK);
+    uint32_t w = cam->width, h = cam->height;
+    GLuint tex[3] = {0, 0, 0}, fbo;
+    glCreateTextures(GL_TEXTURE_2D, 3, tex);
+    glTextureStorage2D(tex[0], 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
+    glTextureStorage2D(tex[1], 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
+    glTextureStorage2D(tex[2], 1, GL_DEPTH_COMPONENT32F, (GLsizei)w, (GLsizei)h);
+    glClearTexImage(tex[1], 0, GL_RGBA, GL_FLOAT, col);
+    if (split)
+        glClearTexSubImage(tex[1], 0, 0, 0, 0, (GLsizei)split, (GLsizei)h, 1, GL_RGBA, GL_FLOAT, col2);
+    if (depth) {
+        glClearTexImage(tex[2], 0, GL_DEPTH_COMPONENT, GL_FLOAT, depth);
+        if (split)
+            glClearTexSubImage(tex[2], 0, 0, 0, 0, (GLsizei)split, (GLsizei)h, 1, GL_DEPTH_COMPONENT, GL_FLOAT, &depth2);
+    }
+    glClearTexImage(tex[0], 0, GL_RGBA, GL_FLOAT, col);
+    glCreateFramebuffers(1, &fbo);
+    glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, tex[0], 0);
+    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = fbo,
+                         .color_texture = tex[1], .depth_texture = depth ? tex[2] : 0, .width = w, .height = h,
+                         .fov_y = (float)cam->fov_y, .near_plane = (float)cam->near_plane,
+                         .far_plane = (float)cam->far_plane};
+    for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam->eye[k];
+    ref_camera_matrices(cam, fv.view, fv.proj);
+    assert_int_equal(api.update(ctx, 0.0, 0.0f), VFX_OK);
+    assert_int_equal(api.render(ctx, &fv), VFX_OK);
+    float *tmp = malloc((size_t)w * h * 16);
+    glGetTextureImage(tex[0], 0, GL_RGBA, GL_FLOAT, (GLsizei)(w * h * 16), tmp);
+    for (uint32_t j = 0; j < h; ++j)
+        memcpy(px + (size_t)j * w * 4, tmp + (size_t)(h - 1 - j) * w * 4, (size_t)w * 16);
+    free(tmp);
+    assert_int_equal(api.read_raw(ctx, VFX_EFFECT_WATER, dist, (size_t)w * h), VFX_OK);
+    api.destroy(ctx);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteTextures(3, tex);
+}
+
+/* The window depth of the point at distance d along the camera's axis. */
+static float axis_depth(const ref_camera *cam, double d)
+{
+    double n = cam->near_plane, f = cam->far_plane;
+    double z_ndc = (f + n) / (f - n) - 2.0 * f * n / ((f - n) * d);
+    return (float)(0.5 * z_ndc + 0.5);
+}
+
+/* A host object in front of the water covers the left half of the screen (its depth there is
+ * half the water's distance). Drawn twice, the object green and the object black: no water pixel
+ * may change, since the water is behind the object (the OGRE host's finding: its colour bled
+ * into the water beside its outline through the refracted ray). The look's host light (which
+ * legitimately reads the whole host image) and SSR are off: the preset low and NO_SSR. */
+static void test_refraction_not_in_front(void **state)
+{
+    (void)state;
+    scene s = make_scene(300);
+    /* a ball of water particles near the origin, its left half behind the object */
+    for (uint32_t i = 0; i < s.n; ++i) {
+        double u = (double)i / s.n, a = 2.399963 * i;
+        double r = 0.9 * cbrt(u + 0.002), ct = 1 - 2 * fmod(u * 7.31, 1.0), st = sqrt(1 - ct * ct);
+        s.x[i] = (float)(r * st * cos(a));
+        s.y[i] = (float)(r * ct);
+        s.z[i] = (float)(r * st * sin(a));
+    }
+    s.preset = VFX_WATER_PRESET_LOW;
+    s.params.disable = VFX_WATER_NO_SSR;
+    const ref_camera cam = {{0, 0.6, 5.0}, {0, 0, 0}, {0, 1, 0}, 0.6, 64, 64, 0.1, 100};
+    const size_t n = (size_t)cam.width * cam.height;
+    const uint32_t split = cam.width / 2;
+    static const float blue[4] = {0.1f, 0.2f, 0.9f, 1.0f}, green[4] = {0.0f, 1.0f, 0.0f, 1.0f},
+                       black[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+    const float far = 1.0f, near = axis_depth(&cam, 2.5);
+    float *px[2] = {malloc(n * 16), malloc(n * 16)}, *dist = malloc(n * 4), *dist2 = malloc(n * 4);
+    render(&s, &cam, blue, green, split, &far, near, px[0], dist);
+    render(&s, &cam, blue, black, split, &far, near, px[1], dist2);
+    uint32_t water = 0, near_edge = 0, changed = 0;
+    for (uint32_t j = 0; j < cam.height; ++j)
+        for (uint32_t i = split; i < cam.width; ++i) {
+            size_t q = (size_t)j * cam.width + i;
+            if (dist[q] < 0)
+                continue;
+            ++water;
+            near_edge += i < split + 6;
+            double d = 0;
+            for (int k = 0; k < 3; ++k) d = fmax(d, fabs(px[0][4 * q + k] - px[1][4 * q + k]));
+            changed += d > 1e-6;
+        }
+    /* the object hides the water on its side: no water is drawn there */
+    for (uint32_t j = 0; j < cam.height; ++j)
+        for (uint32_t i = 0; i < split; ++i)
+            assert_true(dist[(size_t)j * cam.width + i] < 0);
+    print_message("refraction beside an object in front: %u water pixels (%u within 6 of its outline), %u changed with "
+                  "the object's colour\n", water, near_edge, changed);
+    assert_true(water > 300 && near_edge > 40);
+    /* exact: a water pixel's colour comes from the host pixels behind the water only; the
+     * object's pixels are never read (any read shows as a change of 1 in green) */
+    assert_int_equal(changed, 0);
+    free(px[0]); free(px[1]); free(dist); free(dist2);
+    free_scene(&s);
+}
+
+/* Mean over the water pixels of the inner half of the image of |colour - host| (max channel)
+ * and the pixel count. */
+static double water_change(const float *px, const float *dist, const ref_camera *cam, const float host[4], uint32_t *count)
+{
+    double sum = 0;
+    *count = 0;
+    for (uint32_t j = cam->height / 4; j < 3 * cam->height / 4; ++j)
+        for (uint32_t i = cam->width / 4; i < 3 * cam->width / 4; ++i) {
+            size_t q = (size_t)j * cam->width + i;
+            if (dist[q] < 0)
+                continue;
+            double d = 0;
+            for (int k = 0; k < 3; ++k) d = fmax(d, fabs(px[4 * q + k] - host[k]));
+            sum += d;
+            ++*count;
+        }
+    return *count ? sum / *count : 0;
+}
+
+/* Deep water is tinted, shallow water stays clear: a one-layer sheet and an eight-layer slab
+ * (zero-filled colour and absorption: the defaults) seen from above over a light grey floor.
+ * Beer-Lambert with the default absorption 0.8 / h and tint (0.15, 0.55, 0.6): the sheet (its
+ * surface ~2 h (1 - T) = 0.29 thick) keeps >= 73% of every channel of the floor (so its change
+ * is at most ~0.3), the slab (~2.4 thick) keeps <= 10% of red and scatters back at most the
+ * tint's 0.15 x its light (< 2 here: sky, sun, 0.6 x floor) = 0.3: its red is <= 0.37, a change
+ * of >= 0.33. The reflection (F ~ 0.02 from above) adds < 0.05 to both. Measured 0.13 / 0.41. */
+static void test_deep_tinted_shallow_clear(void **state)
+{
+    (void)state;
+    const ref_camera cam = {{0.05, 6.0, 0.3}, {0, 0, 0}, {0, 1, 0}, 0.5, 48, 48, 0.1, 100};
+    const size_t n = (size_t)cam.width * cam.height;
+    static const float floor_col[4] = {0.7f, 0.7f, 0.7f, 1.0f};
+    double change[2];
+    for (int deep = 0; deep < 2; ++deep) {
+        scene s = slab_scene(16, deep ? 8 : 1);
+        float *px = malloc(n * 16), *dist = malloc(n * 4);
+        render(&s, &cam, floor_col, NULL, 0, NULL, 0, px, dist);
+        uint32_t count;
+        change[deep] = water_change(px, dist, &cam, floor_col, &count);
+        print_message("%s: %u water pixels, mean |colour - floor| %.3f\n", deep ? "8-layer slab" : "one-layer sheet", count,
+                      change[deep]);
+        assert_true(count > n / 8);
+        free(px); free(dist);
+        free_scene(&s);
+    }
+    assert_true(change[0] < 0.3);
+    assert_true(change[1] > 0.3);
+    assert_true(change[1] > 2.0 * change[0]);
+}
+
+/* Fresnel: a clear slab (white tint: no absorption, no scattering) over a black floor shows only
+ * what its surface reflects. Seen from above F = 0.02 of the zenith sky; at a grazing view
+ * (~10 degrees) F ~ 0.35 of the horizon: the grazing view is at least 5 times as bright. */
+static void test_fresnel_grazing(void **state)
+{
+    (void)state;
+    static const float black[4] = {0, 0, 0, 1};
+    const ref_camera views[2] = {{{0.05, 6.0, 0.3}, {0, 0, 0}, {0, 1, 0}, 0.4, 48, 48, 0.1, 100},
+                                 {{0.0, 0.9, 6.0}, {0, 0, 0}, {0, 1, 0}, 0.3, 48, 48, 0.1, 100}};
+    double lum[2];
+    for (int v = 0; v < 2; ++v) {
+        scene s = slab_scene(24, 2);
+        s.params.color[0] = s.params.color[1] = s.params.color[2] = 1.0f;
+        const size_t n = (size_t)views[v].width * views[v].height;
+        float *px = malloc(n * 16), *dist = malloc(n * 4);
+        render(&s, &views[v], black, NULL, 0, NULL, 0, px, dist);
+        uint32_t count;
+        lum[v] = water_change(px, dist, &views[v], black, &count);
+        print_message("%s view: %u water pixels, mean brightest channel %.4f\n", v ? "grazing" : "top", count, lum[v]);
+        assert_true(count > 100);
+        free(px); free(dist);
+        free_scene(&s);
+    }
+    assert_true(lum[1] > 5.0 * lum[0]);
+}
+
+int main(void)
+{
+    rt_gl_context *gl = test_gl_or_skip();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_refraction_not_in_front),
+        cmocka_unit_test(test_deep_tinted_shallow_clear),
+        cmocka_unit_test(test_fresnel_grazing),
+    };
+    int r = cmocka_run_group_tests(tests, NULL, NULL);
+    rt_gl_context_destroy(gl);
+    return r;
+}
