@@ -26,6 +26,7 @@ struct volfx_water_aniso {
     volfx_water_kernel_params done_kp;
     bool done_radius, done_kernel, done;
     bool searched;         /* the last pass counted neighbours (the anisotropic kernel, computed) */
+    bool shape_fresh;      /* the last pass computed the shapes (the half rate's next one moves centres) */
     /* the hashed grid in sorted/start: built from data_rev grid_rev (0: none), these cells */
     uint64_t grid_rev;
     uint32_t grid_count, grid_buckets;
@@ -358,6 +359,32 @@ vfx_result volfx_water_aniso_grid_build(vfx_context *ctx, volfx_water_aniso *a, 
     return VFX_OK;
 }
 
+/* The half rate's other upload: the centres to the new positions, the shapes (and the neighbour
+ * counts the spray reads) kept from the last full pass. */
+static vfx_result centre_pass(vfx_context *ctx, volfx_water_aniso *a, const volfx_water_aniso_input *in)
+{
+    GLuint prog = volfx_gpu_compute(ctx, "water/aniso.comp", "#define MODE_CENTRE\n");
+    if (!prog)
+        return VFX_ERR_GL;
+    bind_all(a, in);
+    GLuint groups = (in->count + 63u) / 64u;
+    GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
+    volfx_gpu_pass_begin(ctx, "water.aniso_centre");
+    glUseProgram(prog);
+    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_count"), in->count);
+    if (groups)
+        glDispatchCompute(gx, gy, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    volfx_gpu_pass_end(ctx);
+    const char *e = volfx_gpu_error_string();
+    if (e)
+        return volfx_fail(ctx, VFX_ERR_GL, "water aniso centre pass over %u particles: %s", in->count, e);
+    a->shape_fresh = false;
+    a->done_rev = in->data_rev;
+    volfx_stat_set(ctx, "water.aniso_half_skipped", 1);
+    return VFX_OK;
+}
+
 vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, const volfx_water_aniso_input *in)
 {
     const volfx_water_kernel_params *kp = in->kp;
@@ -371,6 +398,11 @@ vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, con
     vfx_result r = ensure_buffers(ctx, a, in);
     if (r)
         return r;
+    bool same_setup = a->done && a->done_count == in->count && a->done_h == in->h && !memcmp(&a->done_kp, kp, sizeof *kp) &&
+                      a->done_radius == a->has_radius && a->done_kernel == a->has_kernel;
+    if (in->half_rate && aniso && a->searched && a->shape_fresh && same_setup && kp->smoothing == 0)
+        return centre_pass(ctx, a, in);
+    volfx_stat_set(ctx, "water.aniso_half_skipped", 0);
     uint32_t need, buckets = grid_buckets(in->count, &need), nscan = buckets + 1;
     GLuint kern = volfx_gpu_compute(ctx, "water/aniso.comp", "#define MODE_KERNEL\n");
     if (!kern)
@@ -404,6 +436,7 @@ vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, con
     a->done_radius = a->has_radius;
     a->done_kernel = a->has_kernel;
     a->searched = aniso;
+    a->shape_fresh = true;
     volfx_stat_set(ctx, "water.aniso_buckets", aniso ? buckets : 0);
     return VFX_OK;
 }

@@ -56,10 +56,13 @@ typedef struct volfx_water_aniso_input {
     const volfx_water_kernel_params *kp;
     GLuint counters;          /* the effect's counter buffer: slots 24 (stretched), 25 (isotropic) */
     uint64_t data_rev;        /* changes whenever the columns were uploaded again */
+    bool half_rate;           /* the shapes every other upload (the preset, a frame with dt > 0; smoothing 0 only) */
 } volfx_water_aniso_input;
 
 /* Computes the kernel buffer (pass water.aniso) unless the positions, columns and parameters
- * are those of the last pass (water.aniso_skipped 1). */
+ * are those of the last pass (water.aniso_skipped 1); at the half rate, an upload after a full
+ * pass only moves the centres to the new positions (pass water.aniso_centre,
+ * water.aniso_half_skipped 1) and keeps the shapes one upload old. */
 vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, const volfx_water_aniso_input *in);
 /* The kernel buffer of the last pass (VOLFX_WATER_KERNEL_STRIDE bytes a particle); 0 before. */
 GLuint volfx_water_aniso_kernels(const volfx_water_aniso *a);

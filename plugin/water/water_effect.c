@@ -634,7 +634,10 @@ static vfx_result tile_lists(vfx_context *ctx, water_state *s, volfx_water_tile_
         (s->kp.kernel == VFX_WATER_KERNEL_ANISOTROPIC || volfx_water_aniso_has_columns(s->aniso))) {
         if (!s->aniso && !(s->aniso = volfx_water_aniso_create(ctx)))
             return VFX_ERR_OUT_OF_MEMORY;
-        volfx_water_aniso_input ai = {s->cols, s->count, s->lo, s->hi, s->params.h, &s->kp, s->counters, s->data_rev};
+        volfx_water_aniso_input ai = {s->cols, s->count, s->lo, s->hi, s->params.h, &s->kp, s->counters, s->data_rev,
+                                      /* a running simulation only: a paused frame (dt 0) or a host
+                                       * that steps without time keeps every shape exact */
+                                      (s->look & WATER_LOOK_ANISO_HALF_RATE) != 0 && s->dt > 0};
         vfx_result r = volfx_water_aniso_compute(ctx, s->aniso, &ai);
         if (r)
             return r;
@@ -685,7 +688,7 @@ static vfx_result diffuse_frame(vfx_context *ctx, water_state *s, const vfx_fram
     if (s->diffuse_due) {
         if (!s->aniso && !(s->aniso = volfx_water_aniso_create(ctx)))
             return VFX_ERR_OUT_OF_MEMORY;
-        volfx_water_aniso_input ai = {s->cols, s->count, s->lo, s->hi, s->params.h, &s->kp, s->counters, s->data_rev};
+        volfx_water_aniso_input ai = {s->cols, s->count, s->lo, s->hi, s->params.h, &s->kp, s->counters, s->data_rev, false};
         volfx_water_aniso_grid grid;
         if ((r = volfx_water_aniso_grid_build(ctx, s->aniso, &ai, &grid)))
             return r;

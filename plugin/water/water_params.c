@@ -22,8 +22,9 @@ typedef struct preset_def {
 static const preset_def PRESETS[] = {
 #define LOOK_ALL (WATER_LOOK_HOST_LIGHT | WATER_LOOK_GGX | WATER_LOOK_FOAM_LAYER)
     /* low keeps the cheap GGX lobe and drops the per-pixel host-light reads and the foam pass */
-    [VFX_WATER_PRESET_LOW] = {"low", VFX_WATER_KERNEL_ISOTROPIC, 0, 6.0f, 2, WATER_LOOK_GGX},
-    [VFX_WATER_PRESET_MEDIUM] = {"medium", VFX_WATER_KERNEL_ANISOTROPIC, 0, 8.0f, 3, LOOK_ALL},
+    [VFX_WATER_PRESET_LOW] = {"low", VFX_WATER_KERNEL_ISOTROPIC, 0, 6.0f, 2, WATER_LOOK_GGX | WATER_LOOK_ANISO_HALF_RATE},
+    /* medium: the anisotropic shapes every other upload (high and ultra every upload) */
+    [VFX_WATER_PRESET_MEDIUM] = {"medium", VFX_WATER_KERNEL_ANISOTROPIC, 0, 8.0f, 3, LOOK_ALL | WATER_LOOK_ANISO_HALF_RATE},
     [VFX_WATER_PRESET_HIGH] = {"high", VFX_WATER_KERNEL_ANISOTROPIC, VFX_WATER_NO_HALF_RES, 8.0f, 3, LOOK_ALL},
     [VFX_WATER_PRESET_ULTRA] = {"ultra", VFX_WATER_KERNEL_ANISOTROPIC, VFX_WATER_NO_HALF_RES, 16.0f, 5, LOOK_ALL},
 };

@@ -5,6 +5,10 @@
 //                 neighbourhood radius, so a particle's neighbours lie in its 27 cells)
 //   (prefix sum: grid.comp MODE_SCAN / SCAN_TOP / SCAN_ADD on the same buffers)
 //   MODE_SCATTER  per particle: sorted[start[bucket] + fill[bucket]++] = (position, index)
+//   MODE_CENTRE   per particle: the centre moved to the current position, the shape (G, the
+//                 bounding radius and half-extents) kept from the last MODE_KERNEL (the half
+//                 rate: the shapes follow every other upload; smoothing 0 only, where the
+//                 centre is the position)
 //   MODE_KERNEL   per particle: the weighted mean and covariance of its neighbours (weight
 //                 1 - (r/R)^3 within R), the centre moved towards the mean by lambda, the
 //                 covariance's eigen-decomposition (Jacobi, fixed sweeps), the axes (eigenvalues,
@@ -28,7 +32,11 @@ layout(std430, binding = 4) buffer Counters { uint c_slots_[24]; uint c_stretche
 layout(std430, binding = 5) buffer Start { uint start[]; };
 layout(std430, binding = 7) buffer Sorted { vec4 sorted[]; };   // xyz position, w the index's bits
 // per particle 4 vec4: centre (w: bounding radius), G (xx xy xz yy), G (yz zz, 0, 0), half-extents
+#if defined(MODE_CENTRE)
+layout(std430, binding = 8) buffer Kern { vec4 kern[]; };
+#else
 layout(std430, binding = 8) writeonly buffer Kern { vec4 kern[]; };
+#endif
 layout(std430, binding = 9) writeonly buffer Nbr { uint nbr[]; };  // neighbours within R
 layout(std430, binding = 10) readonly buffer Radius { float radius[]; };
 layout(std430, binding = 11) readonly buffer HostG { float hostg[]; };   // 6 per particle
@@ -94,6 +102,8 @@ void main()
         uint b = bucket_of(cell_of(p));
         sorted[start[b] + atomicAdd(count[b], 1u)] = vec4(p, uintBitsToFloat(i));
     }
+#elif defined(MODE_CENTRE)
+    kern[4u * i].xyz = p;
 #elif defined(MODE_KERNEL)
     float rho = u_radius ? radius[i] : 1.0;   // checked on the CPU: finite, in [1e-3, 1e3]
     vec3 axes = vec3(1.0);                     // semi-axes in units of h
@@ -117,6 +127,10 @@ void main()
         uint cand = 0u;
         for (int k = 0; k < 27; ++k) {
             ivec3 c = c0 + ivec3(k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1);
+            // a cell whose box lies R or more from p holds no neighbour: ~6 of the 27 on
+            // average (the edge and corner cells), never read
+            vec3 lo = u_g0 + vec3(c) * u_cs, dc = max(max(lo - p, p - (lo + u_cs)), vec3(0.0));
+            if (dot(dc, dc) >= R2) continue;
             uint b = bucket_of(c);
             uint a = start[b], e = start[b + 1u];
             // bounded: at most MAX_CAND candidates in all (coincident heaps of particles)
