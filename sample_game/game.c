@@ -97,6 +97,22 @@ static bool parse(int argc, char **argv, game_options *o)
             o->raw_path = argv[++i];
             CHECK(rt_arg_writable(a, o->raw_path, err, sizeof err));
         }
+        else if (!strcmp(a, "--shots")) {
+            NEED_ARG();
+            const char *c = v;
+            while (*c) {
+                char *end;
+                unsigned long n = strtoul(c, &end, 10);
+                if (end == c || n < 1 || n > UINT32_MAX - 1 || (*end && *end != ',') || o->shot_count == GAME_MAX_SHOTS) {
+                    fprintf(stderr, "volfx-game: --shots wants up to %d frame numbers >= 1 separated by commas, got '%s'\n",
+                            GAME_MAX_SHOTS, v);
+                    return false;
+                }
+                o->shots[o->shot_count++] = (uint32_t)n;
+                c = *end ? end + 1 : end;
+            }
+        }
+        else if (!strcmp(a, "--shot-variants")) o->shot_variants = true;
         else if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(); exit(0); }
         else { fprintf(stderr, "volfx-game: unknown option '%s'\n", a); usage(); return false; }
 #undef CHECK
@@ -107,6 +123,54 @@ static bool parse(int argc, char **argv, game_options *o)
         return false;
     }
     return true;
+}
+
+/* One shot's file: STEM-fN[SUFFIX].EXT, STEM being --png without its .png. */
+static void shot_path(char *out, size_t cap, const char *png, uint32_t frame, const char *suffix, const char *ext)
+{
+    size_t n = strlen(png);
+    int stem = (int)(n > 4 && !strcmp(png + n - 4, ".png") ? n - 4 : n);
+    snprintf(out, cap, "%.*s-f%u%s.%s", stem, png, frame, suffix, ext);
+}
+
+/* The shot after frame `frame`: the image as drawn, then (variants, the last frame only: the
+ * beams switched off and on restart their growth, the water hidden drops its foam and history)
+ * the same instant again (dt 0: no simulation step, the beams at the same time) with the beams
+ * off, then with the water hidden, and both; the water's raw distance beside them. The last
+ * frame's --png and --dump-raw are written before the variants (*final_done). */
+static vfx_result take_shot(game_app *app, game_demo *demo, const game_options *o, const char *png, uint32_t frame,
+                            bool last, bool *final_done)
+{
+    char path[1100];
+    shot_path(path, sizeof path, png, frame, "", "png");
+    vfx_result r = game_app_screenshot(app, path);
+    if (r || !o->shot_variants || !last)
+        return r;
+    if ((r = game_app_screenshot(app, png)) || (o->raw_effect && (r = game_app_dump_raw(app, o->raw_kind, o->raw_path))))
+        return r;
+    *final_done = true;
+    bool water = !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_WATER)) && app->water_enabled;
+    bool beams = !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_BEAMS));
+    if (water) {
+        shot_path(path, sizeof path, png, frame, "-water", "pfm");
+        if ((r = game_app_dump_raw(app, VFX_EFFECT_WATER, path)))
+            return r;
+    }
+    static const struct { bool hide_water, no_beams; const char *suffix; } variants[3] = {
+        {false, true, "-nobeams"}, {true, false, "-hidewater"}, {true, true, "-nobeams-hidewater"}};
+    for (int k = 0; k < 3 && !r; ++k) {
+        if (variants[k].hide_water && water) game_demo_toggle(app, demo, VFX_EFFECT_WATER);
+        if (variants[k].no_beams && beams) game_demo_toggle(app, demo, VFX_EFFECT_BEAMS);
+        game_demo_animate(app, demo, 0.f);
+        r = game_app_frame(app, 0.f);
+        shot_path(path, sizeof path, png, frame, variants[k].suffix, "png");
+        if (!r)
+            r = game_app_screenshot(app, path);
+        if (variants[k].hide_water && water) game_demo_toggle(app, demo, VFX_EFFECT_WATER);
+        if (variants[k].no_beams && beams) game_demo_toggle(app, demo, VFX_EFFECT_BEAMS);
+        game_demo_animate(app, demo, 0.f); /* the beams back where they were */
+    }
+    return r;
 }
 
 /* A long run says where it is: frame, elapsed time, the fps of the last 60 frames and, when the
@@ -210,6 +274,7 @@ int main(int argc, char **argv)
     double start = rt_now_ms(), last_ms = start;
     double next_progress = start + o.progress_s * 1000.0;
     int rc = 0;
+    bool final_done = false; /* the last shot wrote --png and --dump-raw before its variants */
     for (uint32_t f = 0; f < frames; ++f) {
         if (o.seconds > 0 && (rt_now_ms() - start) > o.seconds * 1000.0)
             break;
@@ -230,6 +295,14 @@ int main(int argc, char **argv)
             rc = 1;
             break;
         }
+        for (uint32_t k = 0; k < o.shot_count && rc == 0; ++k)
+            if (o.shots[k] == f + 1 && take_shot(app, &demo, &o, o.png ? o.png : "volfx-game.png", f + 1, f + 1 == frames,
+                                                 &final_done)) {
+                fprintf(stderr, "volfx-game: --shots: the shot after frame %u failed\n", f + 1);
+                rc = 1;
+            }
+        if (rc)
+            break;
         if (f == 0 && o.raw_effect && frames > 1 && game_app_dump_raw(app, o.raw_kind, o.raw_path) != VFX_OK) {
             /* the effect is absent from this scene: say so now, not after the whole run */
             fprintf(stderr, "volfx-game: cannot dump '%s' to %s\n", o.raw_effect, o.raw_path);
@@ -260,13 +333,13 @@ int main(int argc, char **argv)
            s.frames, warm, s.mean_fps, s.p50_ms, s.p95_ms, s.p99_ms, s.max_ms);
     game_demo_print_profile(app, stdout);
     const char *png = o.png ? o.png : (headless ? "volfx-game.png" : NULL);
-    if (png && rc == 0) {
+    if (png && rc == 0 && !final_done) {
         if (game_app_screenshot(app, png) == VFX_OK)
             printf("screenshot: %s\n", png);
         else
             rc = 1;
     }
-    if (o.raw_effect && rc == 0) {
+    if (o.raw_effect && rc == 0 && !final_done) {
         if (game_app_dump_raw(app, o.raw_kind, o.raw_path) != VFX_OK) {
             fprintf(stderr, "volfx-game: cannot dump '%s' to %s\n", o.raw_effect, o.raw_path);
             rc = 1;

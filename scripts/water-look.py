@@ -18,7 +18,7 @@ pixels where the water's raw distance dump hits, and the 8x8 blocks more than ha
                  zero-filled water parameters, the plugin's defaults.
 
 usage: scripts/water-look.py [--game build/sample_game/volfx-game] [--plugin PATH] [--size 640x360]
-       [--zero-params] [--keep DIR] SCENE.json FRAME [FRAME...]
+       [--zero-params] [--keep DIR] [--panels N,N,...] SCENE.json FRAME [FRAME...]
 Prints one line a frame: scene, frame, change, beams, surface pixels, blocks. Needs numpy, PIL
 (Debian: python3-numpy python3-pil; run with /usr/bin/python3).
 """
@@ -101,6 +101,7 @@ def main():
     ap.add_argument('--plugin', help="volfx-game's --plugin (another build's libvolfx.so.1)")
     ap.add_argument('--zero-params', action='store_true')
     ap.add_argument('--keep', help='write the images here (default: a temporary folder)')
+    ap.add_argument('--panels', default='', help='also write the images of these frames (N,N,...) on the way: STEM-fN.png')
     a = ap.parse_args()
     out = a.keep or tempfile.mkdtemp(prefix='water-look-')
     os.makedirs(out, exist_ok=True)
@@ -117,7 +118,8 @@ def run_frames(a, scene, name, out):
     for frame in a.frames:
         stem = os.path.join(out, name)
         cmd = [a.game, '--headless', '--scene', scene, '--frames', str(frame), '--size', a.size,
-               '--png', stem + '.png', '--shots', str(frame), '--shot-variants', '--progress', '0'] + (['--plugin', a.plugin] if a.plugin else [])
+               '--png', stem + '.png', '--shots', ','.join(sorted({str(frame)} | {f for f in a.panels.split(',') if f and int(f) < frame}, key=int)),
+               '--shot-variants', '--progress', '0'] + (['--plugin', a.plugin] if a.plugin else [])
         run = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         if run.returncode:
             sys.stderr.write(run.stdout)

@@ -31,12 +31,11 @@ typedef struct volfx_water_resolved {
     bool absorption_per_h;       /* the host gave no absorption: WATER_ABSORPTION_H / h */
 } volfx_water_resolved;
 
-/* The look's parts and the savings each preset switches on (docs/water.md "The look"): the
- * host's image as the surroundings' light, the sun's GGX lobe, the foam layer with a lifetime,
- * the anisotropic shapes at half rate (every other upload). */
+/* The look's parts and the savings each preset switches on (docs/water.md "Shading"): the
+ * host's image as the surroundings' light, the sun's GGX lobe, the anisotropic shapes at half
+ * rate (every other upload). */
 #define WATER_LOOK_HOST_LIGHT 1u
 #define WATER_LOOK_GGX 2u
-#define WATER_LOOK_FOAM_LAYER 4u
 #define WATER_LOOK_ANISO_HALF_RATE 8u
 /* The default absorption, per unit of h: a pool 3 h deep takes 1 - e^-2 of the red light
  * behind it (tint's 1 - 0.15) and fills with the deep colour; a sheet h/4 thick keeps 84% (red) to 92% (blue). */

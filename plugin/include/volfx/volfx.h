@@ -211,7 +211,7 @@ typedef struct vfx_water_params {
     uint32_t features_off; /* VFX_WATER_NO_SPRAY | VFX_WATER_NO_SSR; 0 = everything on */
     uint32_t method;       /* vfx_water_method; 0 -> TILE */
     float color[3];        /* absorption tint; all 0 -> sea water */
-    float absorption;      /* per unit length; 0 -> 0.6 */
+    float absorption;      /* per unit length; 0 -> 0.8 / h (clear where thin, tinted a few h deep) */
     float ior;             /* 0 -> 1.333 */
     uint32_t preset;       /* vfx_water_preset */
     /* the kernel; defaults measured on a flat pool (docs/water.md "Anisotropic kernels") */
