@@ -17,6 +17,7 @@
 
 #include "camera_ref.h"
 #include "test_util.h"
+#include "volfx_lab.h"
 #include "water_test_host.h"
 
 typedef struct scene {
@@ -24,7 +25,7 @@ typedef struct scene {
     float *x, *y, *z;
     uint32_t n;
     vfx_water_params params;
-    uint32_t preset;
+    vfx_lab_water lab; /* the lab method BRUTE and the NO_* bits */
 } scene;
 
 static uint32_t chunk_count(void *user) { return water_test_chunk_count(((scene *)user)->n, 128); }
@@ -36,20 +37,16 @@ static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
     return VFX_OK;
 }
 
-/* Version 3 (the preset) when the plugin offers it; the isotropic kernel, as the references. */
+/* The scene's parameters, the isotropic kernel (as the references), the lab method BRUTE. */
 static vfx_result water_params(void *user, vfx_water_params *out)
 {
-    const scene *s = user;
-    uint32_t offered = out->size;
+    scene *s = user;
     *out = s->params;
-    if (offered >= sizeof(vfx_water_params3)) {
-        vfx_water_params3 *p3 = (vfx_water_params3 *)out;
-        memset((char *)p3 + sizeof(vfx_water_params), 0, sizeof *p3 - sizeof(vfx_water_params));
-        p3->v2.v1.size = sizeof *p3;
-        p3->v2.v1.version = VFX_WATER_PARAMS3_VERSION;
-        p3->v2.kernel = VFX_WATER_KERNEL_ISOTROPIC;
-        p3->preset = s->preset;
-    }
+    out->type = VFX_TYPE_WATER_PARAMS;
+    out->kernel = VFX_WATER_KERNEL_ISOTROPIC;
+    s->lab.type = VFX_TYPE_LAB_WATER;
+    s->lab.method = VFX_WATER_METHOD_BRUTE;
+    out->next = &s->lab;
     return VFX_OK;
 }
 
@@ -61,9 +58,6 @@ static scene make_scene(uint32_t n)
     s.x = calloc(n, sizeof(float));
     s.y = calloc(n, sizeof(float));
     s.z = calloc(n, sizeof(float));
-    s.params.size = sizeof s.params;
-    s.params.version = VFX_WATER_PARAMS_VERSION;
-    s.params.method = VFX_WATER_METHOD_BRUTE;
     s.params.h = 0.61f;
     return s;
 }
@@ -89,10 +83,10 @@ static scene slab_scene(uint32_t nx, uint32_t layers)
 static void render(scene *s, const ref_camera *cam, const float col[4], const float col2[4], uint32_t split,
                    const float *depth, float depth2, float *px, float *dist)
 {
-    vfx_host_api host_api = {.size = sizeof host_api, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
-                             .user = s, .log = test_log_fn, .particle_chunk_count = chunk_count,
-                             .particle_chunk = chunk_view, .water_params = water_params};
-    vfx_plugin_api api = {.size = sizeof api};
+    vfx_context_desc host_api = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = s,
+                                 .log = test_vfx_log_fn, .particle_chunk_count = chunk_count,
+                                 .particle_chunk = chunk_view, .water_params = water_params};
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
     vfx_context *ctx;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     assert_int_equal(api.create(&host_api, &ctx), VFX_OK);
@@ -113,7 +107,7 @@ static void render(scene *s, const ref_camera *cam, const float col[4], const fl
     glClearTexImage(tex[0], 0, GL_RGBA, GL_FLOAT, col);
     glCreateFramebuffers(1, &fbo);
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, tex[0], 0);
-    vfx_frame_view fv = {.size = sizeof fv, .version = VFX_FRAME_VIEW_VERSION, .framebuffer = fbo,
+    vfx_frame_view fv = {.type = VFX_TYPE_FRAME_VIEW, .framebuffer = fbo,
                          .color_texture = tex[1], .depth_texture = depth ? tex[2] : 0, .width = w, .height = h,
                          .fov_y = (float)cam->fov_y, .near_plane = (float)cam->near_plane,
                          .far_plane = (float)cam->far_plane};
@@ -157,8 +151,8 @@ static void test_refraction_not_in_front(void **state)
         s.y[i] = (float)(r * ct);
         s.z[i] = (float)(r * st * sin(a));
     }
-    s.preset = VFX_WATER_PRESET_LOW;
-    s.params.disable = VFX_WATER_NO_SSR;
+    s.params.preset = VFX_WATER_PRESET_LOW;
+    s.params.features_off = VFX_WATER_NO_SSR;
     const ref_camera cam = {{0, 0.6, 5.0}, {0, 0, 0}, {0, 1, 0}, 0.6, 64, 64, 0.1, 100};
     const size_t n = (size_t)cam.width * cam.height;
     const uint32_t split = cam.width / 2;
