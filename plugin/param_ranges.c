@@ -18,9 +18,9 @@ const volfx_range *volfx_range_row(vfx_range_id id)
 char *volfx_range_text(const volfx_range *r, char *out, size_t n)
 {
     if (r->flags & VFX_RANGE_INT)
-        snprintf(out, n, "%.17g..%.17g%s", r->lo, r->hi, r->flags & VFX_RANGE_ZERO ? " or 0" : "");
+        snprintf(out, n, "%.9g..%.9g%s", r->lo, r->hi, r->flags & VFX_RANGE_ZERO ? " or 0" : "");
     else
-        snprintf(out, n, "%c%.17g, %.17g]%s", r->flags & VFX_RANGE_LO_OPEN ? '(' : '[', r->lo, r->hi,
+        snprintf(out, n, "%c%.9g, %.9g]%s", r->flags & VFX_RANGE_LO_OPEN ? '(' : '[', r->lo, r->hi,
                  r->flags & VFX_RANGE_ZERO ? " or 0" : "");
     return out;
 }
@@ -29,7 +29,12 @@ static int fits(const volfx_range *r, double v)
 {
     if (v == 0 && (r->flags & VFX_RANGE_ZERO))
         return 1;
-    return (r->flags & VFX_RANGE_LO_OPEN ? v > r->lo : v >= r->lo) && v <= r->hi; /* NaN fails */
+    if ((r->flags & VFX_RANGE_LO_OPEN ? v > r->lo : v >= r->lo) && v <= r->hi) /* NaN fails */
+        return 1;
+    /* a float field at an end that is no float32 (1e-6, 0.95) holds the float nearest it, which
+     * may lie just outside the double: the ends as float32 decide then */
+    volatile float lo = (float)r->lo, hi = (float)r->hi;
+    return !(r->flags & VFX_RANGE_INT) && (r->flags & VFX_RANGE_LO_OPEN ? v > lo : v >= lo) && v <= hi;
 }
 
 static vfx_result refuse(vfx_context *ctx, const char *what, const volfx_range *r, const char *index, double v)
@@ -108,6 +113,20 @@ vfx_result volfx_beam_check_ranges(vfx_context *ctx, uint32_t i, const vfx_beam 
         || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_FLOW_AMOUNT, b2->flow_amount))
         || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_FLOW_SPEED, b2->flow_speed))
         || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_FLOW_SCALE, b2->flow_scale)))
+        return r;
+    /* the anatomy's fields: a surge_wavelength of 1e-40 made the body's profile NaN and an
+     * orb_strength of 3e38 Inf, and the beam vanished (they were checked for being finite only) */
+    if ((r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_FLOW_TWIST, b->flow_twist))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_HEAD_RADIUS, b->head_radius))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_ORB_RADIUS, b->orb_radius))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_ORB_STRENGTH, b->orb_strength))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_ORB_PULSE, b->orb_pulse))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_ORB_PULSE_HZ, b->orb_pulse_hz))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_TAPER, b->taper))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_SURGE_AMOUNT, b->surge_amount))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_SURGE_WAVELENGTH, b->surge_wavelength))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_SURGE_SPEED, b->surge_speed))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_CORE, b->core)))
         return r;
     return VFX_OK;
 }

@@ -600,7 +600,9 @@ static void counters_frame_end(vfx_context *ctx, water_state *s, uint32_t method
         s->fence[slot] = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
         s->ring_frame[slot] = s->frame_no;
         s->ring_method[slot] = method;
-        if (ctx->debug.sync_counters)
+        /* the first frame's are waited for too (one stall, once): a warning about them (pixels
+         * undecided) then comes with frame 1, not frame 2, and a one-frame run says it */
+        if (ctx->debug.sync_counters || !s->have_last)
             glClientWaitSync(s->fence[slot], GL_SYNC_FLUSH_COMMANDS_BIT, forever);
         else
             break;

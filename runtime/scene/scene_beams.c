@@ -205,6 +205,13 @@ static vfx_result parse_anatomy(pctx *c, const cJSON *e, const char *P, vfx_beam
     if (!r) r = optional_object(c, e, P, "surges", surge_keys, &surge, PS);
     if (!r && surge) {
         r = rt_scene_get_float(c, surge, PS, "wavelength", false, NONNEG, &look->surge_wavelength);
+        /* the plugin's row (vfx_beam.surge_wavelength): 0 or at least 1e-6 (1e-40 made the profile NaN) */
+        if (!r && look->surge_wavelength > 0.f && look->surge_wavelength < 1e-6f) {
+            char p[JPATH];
+            rt_scene_join(p, PS, "wavelength");
+            r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, p, "must be 0 (8 x radius) or >= 1e-06, got %g",
+                               (double)look->surge_wavelength);
+        }
         if (!r) r = rt_scene_get_float(c, surge, PS, "speed", false, COORD, &look->surge_speed);
     }
     return r;

@@ -191,6 +191,20 @@ static void test_frame_fields(void **state)
     v.framebuffer = 0;
     expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "color_texture");
     expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "is 32x32, the frame view 64x64");
+    /* only too short: a frame view W x 2H over the W x H attachment (the 2W x 2H case above
+     * passes a check that wants both sides short) */
+    v = f.fv;
+    v.height = 2 * H;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "framebuffer");
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "is 32x32, smaller than the frame view 32x64");
+    /* a colour texture with no colour bits at all: stencil only (depth has its own case above) */
+    GLuint stencil;
+    glCreateTextures(GL_TEXTURE_2D, 1, &stencil);
+    glTextureStorage2D(stencil, 1, GL_STENCIL_INDEX8, W, H);
+    v = f.fv;
+    v.color_texture = stencil;
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "not a colour format");
+    glDeleteTextures(1, &stencil);
     v = f.fv;
     v.framebuffer = 777;
     expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "framebuffer 777 is not a framebuffer name");
@@ -202,6 +216,9 @@ static void test_frame_fields(void **state)
     v = f.fv;
     v.near_plane = 0.5f;
     expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "near_plane 0.5, but proj has near 0.1");
+    v = f.fv;
+    v.near_plane = 0.101f; /* 1% off: the planes disagree (the 5x case passes a loose check) */
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "near_plane 0.101, but proj has near 0.1");
     v = f.fv;
     v.far_plane = 50;
     expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "far_plane 50, but proj has far 100");

@@ -305,6 +305,9 @@ static const bad_case bad_cases[] = {
      VFX_ERR_INVALID_ARGUMENT, "volume.animate.ripple.wavelength: 1e-320 is 0 as float32"},
     {"{\"volume\":{\"path\":\"a.vtu\",\"animate\":{\"ripple\":{\"amplitude\":0.1,\"period_s\":1e-40}}}}",
      VFX_ERR_INVALID_ARGUMENT, "volume.animate.ripple.period_s: 1e-40 is subnormal as float32"},
+    /* below the plugin's row for vfx_beam.surge_wavelength (1e-40 made the beam's profile NaN) */
+    {"{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0],\"surges\":{\"wavelength\":1e-7}}]}", VFX_ERR_INVALID_ARGUMENT,
+     "beams[0].surges.wavelength: must be 0 (8 x radius) or >= 1e-06, got 1e-07"},
     /* the advice names 0 only where the range takes it (h > 0 does not; amplitude >= 0 does) */
     {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"h\":-1e-40}}", VFX_ERR_INVALID_ARGUMENT,
      "water.h: must be > 0, got -1e-40"},

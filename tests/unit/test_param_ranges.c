@@ -161,6 +161,16 @@ static void test_beam_abi_values(void **state)
     l = good;
     l.exposure = NAN;
     expect(c, volfx_beam_check_ranges(c, 3, &l), VFX_ERR_INVALID_ARGUMENT, "vfx_beam.exposure nan");
+    /* the anatomy's fields (the beam vanished: NaN and Inf values) */
+    l = good;
+    l.surge_amount = 1, l.surge_wavelength = 1e-40f;
+    expect(c, volfx_beam_check_ranges(c, 3, &l), VFX_ERR_INVALID_ARGUMENT, "beams[3]: vfx_beam.surge_wavelength 9.99995e-41 outside [1e-06, 1000000] or 0");
+    l = good;
+    l.orb_radius = 0.2f, l.orb_strength = 3e38f;
+    expect(c, volfx_beam_check_ranges(c, 3, &l), VFX_ERR_INVALID_ARGUMENT, "beams[3]: vfx_beam.orb_strength 3e+38");
+    l = good;
+    l.surge_amount = 4, l.surge_wavelength = 1e-6f, l.orb_radius = 0.2f, l.orb_strength = 1e6f, l.taper = 0.95f, l.core = 1;
+    expect(c, volfx_beam_check_ranges(c, 3, &l), VFX_OK, NULL);
     vfx_beams_view v = {.type = VFX_TYPE_BEAMS_VIEW, .saturate_c = -1};
     expect(c, volfx_beams_view_check_ranges(c, &v, 0), VFX_ERR_INVALID_ARGUMENT, "vfx_beams_view.saturate_c -1");
     v.saturate_c = 0;

@@ -41,6 +41,17 @@
     X(BEAM_FLOW_AMOUNT, "vfx_beam.flow_amount", "beams[i].flow.amount", 0, 1, 0, "") \
     X(BEAM_FLOW_SPEED, "vfx_beam.flow_speed", "beams[i].flow.speed", -1e6, 1e6, 0, "") \
     X(BEAM_FLOW_SCALE, "vfx_beam.flow_scale", "beams[i].flow.scale", 0, 1e6, 0, "0: 2 x radius") \
+    X(BEAM_FLOW_TWIST, "vfx_beam.flow_twist", "beams[i].flow.twist", -64, 64, 0, "0: 1 turn per flow wavelength") \
+    X(BEAM_HEAD_RADIUS, "vfx_beam.head_radius", "beams[i].head_radius", 0, 1e6, 0, "0: radius") \
+    X(BEAM_ORB_RADIUS, "vfx_beam.orb_radius", "beams[i].orb_radius", 0, 1e6, 0, "0: no orb") \
+    X(BEAM_ORB_STRENGTH, "vfx_beam.orb_strength", "beams[i].orb_strength", 0, 1e6, 0, "0: a") \
+    X(BEAM_ORB_PULSE, "vfx_beam.orb_pulse", "beams[i].orb.pulse", 0, 1, 0, "") \
+    X(BEAM_ORB_PULSE_HZ, "vfx_beam.orb_pulse_hz", "beams[i].orb.pulse_hz", 0, 1e6, 0, "") \
+    X(BEAM_TAPER, "vfx_beam.taper", "beams[i].taper", 0, 0.95, 0, "") \
+    X(BEAM_SURGE_AMOUNT, "vfx_beam.surge_amount", "beams[i].surge", 0, 4, 0, "") \
+    X(BEAM_SURGE_WAVELENGTH, "vfx_beam.surge_wavelength", "beams[i].surges.wavelength", 1e-6, 1e6, VFX_RANGE_ZERO, "0: 8 x radius") \
+    X(BEAM_SURGE_SPEED, "vfx_beam.surge_speed", "beams[i].surges.speed", -1e6, 1e6, 0, "") \
+    X(BEAM_CORE, "vfx_beam.core", "beams[i].core", 0, 1, 0, "") \
     X(BEAMS_C, "vfx_beams_view.saturate_c", "beam_settings.c", 0, 1e6, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "") \
     X(BEAMS_FAR, "vfx_beams_view.far_distance", "beam_settings.far_distance", 0, 1e6, 0, "0: the camera's far plane") \
     X(BEAMS_MARCH_SAMPLES, "vfx_lab_beams.march_samples", "beam_settings.march_samples", 1, 4096, VFX_RANGE_INT | VFX_RANGE_ZERO, "") \
