@@ -12,7 +12,6 @@
 typedef struct volfx_gpu volfx_gpu;
 struct volfx_gl_table; /* gpu/volfx_gl.h, generated: the GL commands, resolved at create */
 typedef struct volfx_effect_ops volfx_effect_ops;
-struct volfx_gpu_column; /* water/water_gather.h */
 
 /* Knobs that only tests and benchmarks set (through this header: hosts of the shared library
  * cannot reach them). Zero is the production behaviour. */
@@ -22,9 +21,6 @@ typedef struct volfx_debug_knobs {
     uint32_t water_buffer_cap; /* particles per water position buffer; 0 -> the GL limit */
     uint32_t water_max_tiles;  /* TILE's tile count limit; 0 -> the scan's 2^20 - 1 */
     uint64_t water_storage_cap; /* bytes per TILE storage block; 0 -> GL_MAX_SHADER_STORAGE_BLOCK_SIZE */
-    uint32_t layer_texture;     /* the frame view's effects layer texture */
-    /* particle chunk `index`'s GL buffer columns (cols[3]: positions, velocities, kernel) beside the view */
-    vfx_result (*water_gpu_chunk)(void *user, uint32_t index, struct volfx_gpu_column *cols);
 } volfx_debug_knobs;
 
 struct vfx_context {

@@ -239,10 +239,6 @@ static vfx_result read_view(vfx_context *ctx, const vfx_frame_view *frame, uint3
     vfx_result r = volfx_check_type(ctx, frame, VFX_TYPE_FRAME_VIEW, "render: frame view (vfx_frame_view)");
     if (r)
         return r;
-    if (frame->layer_texture)
-        return volfx_fail_id(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_LAYER_TEXTURE_UNSUPPORTED,
-                             "render: frame view layer_texture %u: the effects-layer output is not supported by "
-                             "this plugin yet (leave it 0)", frame->layer_texture);
     *view_id = frame->view_id;
     if (frame->width == 0 || frame->height == 0)
         return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame is %ux%u", frame->width,
@@ -334,7 +330,7 @@ vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx
     t->scene_depth = v->depth_texture;
     t->scene_color = v->color_texture;
     t->framebuffer = v->framebuffer;
-    t->layer_texture = ctx->debug.layer_texture;
+    t->layer_texture = v->layer_texture;
     t->width = v->width, t->height = v->height;
     t->effects = v->effects ? v->effects : 0xffffffffu;
     memcpy(t->view, v->view, sizeof t->view);
@@ -385,21 +381,21 @@ static vfx_result layer_target(vfx_context *ctx, volfx_frame_targets *t)
 {
     GLuint name = t->layer_texture;
     if (!glIsTexture(name))
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view layer_texture %u is not a texture name "
+        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_LAYER_TEXTURE, "render: frame view layer_texture %u is not a texture name "
                           "of this GL context", name);
     GLint target = 0, tw = 0, th = 0, fmt = 0;
     glGetTextureParameteriv(name, GL_TEXTURE_TARGET, &target);
     if (target != GL_TEXTURE_2D)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view layer_texture %u is a %s texture, need %s",
+        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_LAYER_TEXTURE, "render: frame view layer_texture %u is a %s texture, need %s",
                           name, target_name(target), target_name(GL_TEXTURE_2D));
     glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_WIDTH, &tw);
     glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_HEIGHT, &th);
     glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_INTERNAL_FORMAT, &fmt);
     if (fmt != GL_RGBA16F)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view layer_texture %u has internal format "
+        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_LAYER_TEXTURE, "render: frame view layer_texture %u has internal format "
                           "0x%04x, need GL_RGBA16F (0x%04x)", name, (unsigned)fmt, (unsigned)GL_RGBA16F);
     if (tw != (GLint)t->width || th != (GLint)t->height)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view layer_texture %u is %dx%d, the frame view "
+        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_LAYER_TEXTURE, "render: frame view layer_texture %u is %dx%d, the frame view "
                           "%ux%u (they must match)", name, tw, th, t->width, t->height);
     if (!ctx->layer_fbo) {
         GLuint fb = 0;

@@ -56,6 +56,15 @@ static vfx_result particle_chunks_collect(game_app *app)
     }
     app->chunk_count = n;
     app->chunks_valid = true;
+    if (app->desc.gpu_particles) { /* the columns copied into one GL buffer, the views naming it */
+        double t0 = rt_now_ms();
+        vfx_result r = game_gpu_particles_upload(&app->gpu, app->chunks, n);
+        rt_profiler_cpu(app->profiler, "host.gpu_particles", rt_now_ms() - t0);
+        if (r) {
+            app->chunks_valid = false;
+            return r;
+        }
+    }
     return VFX_OK;
 }
 
@@ -64,8 +73,9 @@ static uint32_t host_particle_chunk_count(void *user)
     game_app *app = user;
     if (!app->water_enabled)
         return 0;
-    if (particle_chunks_collect(app) != VFX_OK) {
-        rt_logf(&app->log, VFX_LOG_ERROR, "particle chunks: out of memory");
+    /* collected already this frame (the GL buffer upload, before update) or collected now */
+    if (!app->chunks_valid && particle_chunks_collect(app) != VFX_OK) {
+        rt_logf(&app->log, VFX_LOG_ERROR, "particle chunks: out of memory or no GL buffer");
         return 0;
     }
     return app->chunk_count;
@@ -262,6 +272,7 @@ void game_app_destroy(game_app *app)
         app->api->destroy(app->ctx);
     rt_plugin_host_unload(app->plugin);
     free(app->chunks);
+    game_gpu_particles_free(&app->gpu);
     if (app->world) {
         rt_query_iter it = rt_query_begin(app->world, &app->mesh_comp, 1);
         while (rt_query_next(&it)) {
@@ -398,6 +409,11 @@ vfx_result game_app_frame(game_app *app, float dt)
         return r;
     double t0 = rt_now_ms();
     app->chunks_valid = false; /* the systems above may have moved or resized tables */
+    /* GPU particles: the host's copy into its GL buffer is its own cost, outside plugin.update */
+    if (app->desc.gpu_particles && app->water_enabled && (r = particle_chunks_collect(app))) {
+        rt_logf(&app->log, VFX_LOG_ERROR, "particle chunks: GL buffer upload failed: %s", vfx_result_name(r));
+        return r;
+    }
     r = app->api->update(app->ctx, app->time, dt);
     app->chunks_valid = false; /* render-phase systems may change tables before the next call */
     if (r) {
@@ -446,6 +462,8 @@ vfx_result game_app_frame(game_app *app, float dt)
     frame.width = tg.width;
     frame.height = tg.height;
     frame.color_hdr = tg.color_hdr;
+    if (app->desc.effects_layer && (r = rt_renderer_layer(app->renderer, &frame.layer_texture)))
+        return r;
     rt_profiler_cpu(app->profiler, "host.scene", rt_now_ms() - t0);
     t0 = rt_now_ms();
     if ((r = rt_world_run_phase(app->world, RT_PHASE_RENDER, app->time, dt)))
@@ -455,6 +473,8 @@ vfx_result game_app_frame(game_app *app, float dt)
         return r;
     }
     rt_profiler_cpu(app->profiler, "plugin.render", rt_now_ms() - t0);
+    if (app->desc.effects_layer) /* the host's own composite: out = layer.rgb + out (1 - layer.a) */
+        rt_renderer_composite_layer(app->renderer);
     if ((r = rt_world_run_phase(app->world, RT_PHASE_POST_RENDER, app->time, dt)))
         return r;
     if (rt_gl_context_has_window(app->gl)) {

@@ -18,6 +18,8 @@
 #include "host/plugin_host.h"
 #include "profile/profiler.h"
 
+#include "gpu_particles.h"
+
 #define GAME_APP_MAX_BEAMS 1024  /* beams a scene may spawn */
 #define GAME_APP_MAX_JOINTS 4096
 
@@ -31,6 +33,8 @@ typedef struct game_app_desc {
     uint32_t profile_frames;   /* frames kept for CSV/trace; 0 -> 4096 */
     bool ldr;                  /* 8-bit output without tone mapping; default: HDR (RGBA16F, ACES) */
     float exposure;            /* HDR tone-map exposure; 0 -> 1 */
+    bool gpu_particles;        /* hand the particles as one GL buffer (gpu_pos / gpu_vel), not CPU arrays */
+    bool effects_layer;        /* the plugin renders into an RGBA16F layer the host composites itself */
     rt_logger logger;
 } game_app_desc;
 
@@ -77,6 +81,7 @@ typedef struct game_app {
     vfx_particle_view *chunks;
     uint32_t chunk_count, chunk_cap;
     bool chunks_valid;
+    game_gpu_particles gpu;    /* desc.gpu_particles: the GL buffer the chunks name */
 } game_app;
 
 /* Sets the world around the meshes: the procedural sky (or the clear colour), the sun's

@@ -21,6 +21,8 @@ typedef struct game_options {
     rt_gl_mode mode;
     bool debug;
     uint32_t effects_off;
+    bool gpu_particles;        /* particles to the plugin as a GL buffer (gpu_pos / gpu_vel) */
+    bool effects_layer;        /* effects into an RGBA16F layer the game composites (layer_texture) */
     bool hide_water;           /* simulate the water but draw none (as key 1): the rest of the frame's cost */
     uint32_t mem_every;        /* print RSS and GL object counts every N frames (0 = never) */
     double progress_s;         /* a progress line on stderr every this many seconds (0 = never) */
@@ -38,13 +40,17 @@ static void usage(void)
          "                  [--png FILE] [--csv FILE] [--trace FILE] [--plugin libvolfx.so.1|PATH]\n"
          "                  [--scene FILE.json] [--no-water] [--hide-water] [--no-beams] [--no-volume] [--debug-gl]\n"
          "                  [--mem-every N] [--progress S] [--dump-raw water|beams|volume FILE.pfm]\n"
-         "                  [--program-cache DIR] [--shots N,N,...] [--shot-variants]\n"
+         "                  [--program-cache DIR] [--gpu-particles] [--effects-layer]\n"
+         "                  [--shots N,N,...] [--shot-variants]\n"
          "--shots writes STEM-fN.png (STEM: --png without .png) after frame N, up to 16 frames; with\n"
          "--shot-variants the last frame's shot is drawn again (no time passes) with the beams off\n"
          "(-nobeams), the water hidden (-hidewater) and both (-nobeams-hidewater), and the water's raw\n"
          "distance is written to STEM-fN-water.pfm: what scripts/water-look.py measures. (Only the\n"
          "last: switching the beams off and on restarts their growth, hiding the water drops its foam.)\n"
          "Without a display it runs headless (EGL) for 30 frames and writes volfx-game.png.\n"
+         "--gpu-particles hands the particles to the plugin as one GL buffer (positions and velocities\n"
+         "interleaved) instead of CPU arrays; --effects-layer has the plugin render into an RGBA16F\n"
+         "layer that the game composites over its scene itself (docs/integration.md).\n"
          "A run longer than S seconds (default 5; 0 = never) prints a progress line to stderr every S.\n"
          "Window keys: WASD/QE fly, mouse drag orbit, 1/2/3 toggle water/beams/volume,\n"
          "             Tab cycle water method (tile; paper at 16/32/54/64 samples), P pause, N single step, Esc quit.");
@@ -80,6 +86,8 @@ static bool parse(int argc, char **argv, game_options *o)
         else if (!strcmp(a, "--program-cache")) { NEED_ARG(); o->program_cache = v; }
         else if (!strcmp(a, "--no-water")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_WATER);
         else if (!strcmp(a, "--hide-water")) o->hide_water = true;
+        else if (!strcmp(a, "--gpu-particles")) o->gpu_particles = true;
+        else if (!strcmp(a, "--effects-layer")) o->effects_layer = true;
         else if (!strcmp(a, "--no-beams")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_BEAMS);
         else if (!strcmp(a, "--no-volume")) o->effects_off |= VFX_EFFECT_BIT(VFX_EFFECT_VOLUME);
         else if (!strcmp(a, "--debug-gl")) o->debug = true;
@@ -251,7 +259,8 @@ int main(int argc, char **argv)
     if (!parse(argc, argv, &o))
         return 2;
     game_app_desc d = {.mode = o.mode, .width = o.width, .height = o.height, .debug_gl = o.debug,
-                      .plugin_path = o.plugin, .program_cache = o.program_cache};
+                      .plugin_path = o.plugin, .program_cache = o.program_cache,
+                      .gpu_particles = o.gpu_particles, .effects_layer = o.effects_layer};
     game_app *app;
     if (game_app_create(&d, &app)) {
         fprintf(stderr, "volfx-game: could not start (see the messages above)\n");

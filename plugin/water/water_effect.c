@@ -138,9 +138,9 @@ static vfx_result ensure_groups(vfx_context *ctx, water_state *s, uint32_t total
     return VFX_OK;
 }
 
-/* Asks the host for chunk `c` (a typed, zeroed view; the ABI's GPU columns are reserved and
- * refused until this plugin reads them) and checks what it names: positions as CPU columns or a
- * GL buffer, not both (the same for velocities), GL buffer columns that fit their buffers. */
+/* Asks the host for chunk `c` (a typed, zeroed view) and checks what it names: positions as CPU
+ * columns or a GL buffer, not both (the same for velocities), GL buffer columns that fit their
+ * buffers; a GL buffer kernel column is refused (not read from GL buffers). */
 static vfx_result query_chunk(vfx_context *ctx, uint32_t c, water_chunk *out)
 {
     vfx_particle_view v;
@@ -153,11 +153,6 @@ static vfx_result query_chunk(vfx_context *ctx, uint32_t c, water_chunk *out)
     snprintf(what, sizeof what, "water: particle chunk %u (vfx_particle_view)", c);
     if ((r = volfx_check_type(ctx, &v, VFX_TYPE_PARTICLE_VIEW, what)))
         return r;
-    if (v.gpu_pos.buffer || v.gpu_vel.buffer || v.gpu_kernel.buffer)
-        return volfx_fail_id(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_GPU_PARTICLES_UNSUPPORTED,
-                             "water: particle chunk %u names GL buffers (gpu_pos %u, gpu_vel %u, gpu_kernel %u): "
-                             "GPU-resident particles are not supported by this plugin yet (give the CPU columns)",
-                             c, v.gpu_pos.buffer, v.gpu_vel.buffer, v.gpu_kernel.buffer);
     memset(out, 0, sizeof *out);
     out->count = v.count;
     out->revision = v.revision;
@@ -165,28 +160,29 @@ static vfx_result query_chunk(vfx_context *ctx, uint32_t c, water_chunk *out)
     memcpy(out->vel, v.vel, sizeof out->vel);
     out->radius = v.radius;
     out->kernel = v.kernel;
-    volfx_gpu_column cols[3] = {{0}};
-    if (ctx->debug.water_gpu_chunk && (r = ctx->debug.water_gpu_chunk(ctx->host.user, c, cols)))
-        return volfx_fail(ctx, r, "water: particle chunk %u's GL buffer columns failed (%d)", c, (int)r);
-    out->gpu_pos = cols[0], out->gpu_vel = cols[1], out->gpu_kernel = cols[2];
+    out->gpu_pos = v.gpu_pos, out->gpu_vel = v.gpu_vel, out->gpu_kernel = v.gpu_kernel;
     if (!out->count)
         return VFX_OK;
     bool cpu_pos = out->pos[0] || out->pos[1] || out->pos[2], cpu_vel = out->vel[0] || out->vel[1] || out->vel[2];
     if (out->gpu_pos.buffer && cpu_pos)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u names both pos[] and gpu_pos (one of them)", c);
+        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
+                             "water: particle chunk %u names both pos[] and gpu_pos (one of them)", c);
     if (out->gpu_vel.buffer && cpu_vel)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u names both vel[] and gpu_vel (one of them)", c);
+        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
+                             "water: particle chunk %u names both vel[] and gpu_vel (one of them)", c);
     if (out->gpu_kernel.buffer)
-        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, "water: particle chunk %u: gpu_kernel is not supported by this plugin "
-                          "(give the kernel column as a CPU array)", c);
+        return volfx_fail_id(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_GPU_PARTICLES_UNSUPPORTED,
+                             "water: particle chunk %u: gpu_kernel %u: the kernel column is not read from GL buffers "
+                             "by this plugin (give it as the CPU array kernel)", c, out->gpu_kernel.buffer);
     if (!out->gpu_pos.buffer && (!out->pos[0] || !out->pos[1] || !out->pos[2]))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u has %u particles but a NULL position column",
                           c, out->count);
     if (out->gpu_pos.buffer && (r = volfx_water_gather_check(ctx, c, "gpu_pos", &out->gpu_pos, out->count, 12)))
         return r;
     if (out->gpu_vel.buffer && !out->gpu_pos.buffer)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u names gpu_vel with CPU positions "
-                          "(GL buffer velocities need gpu_pos)", c);
+        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
+                             "water: particle chunk %u names gpu_vel with CPU positions (GL buffer velocities need "
+                             "gpu_pos)", c);
     if (out->gpu_vel.buffer && (r = volfx_water_gather_check(ctx, c, "gpu_vel", &out->gpu_vel, out->count, 12)))
         return r;
     return VFX_OK;

@@ -40,22 +40,22 @@ vfx_result volfx_water_gather_check(vfx_context *ctx, uint32_t chunk, const char
                                     uint32_t count, uint32_t elem)
 {
     if (!glIsBuffer(col->buffer))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
                           "water: particle chunk %u: %s.buffer %u is not a buffer object of this GL context", chunk, field,
                           col->buffer);
     if (col->stride < elem || col->stride % 4u)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
                           "water: particle chunk %u: %s.stride %u must be a multiple of 4 of at least the element's %u bytes",
                           chunk, field, col->stride, elem);
     if (col->offset % 4u)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u: %s.offset %llu is not a multiple of 4",
+        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN, "water: particle chunk %u: %s.offset %llu is not a multiple of 4",
                           chunk, field, (unsigned long long)col->offset);
     GLint64 size = 0;
     glGetNamedBufferParameteri64v(col->buffer, GL_BUFFER_SIZE, &size);
     /* count <= 2^30 and stride < 2^32: the product fits; the offset is compared first */
     uint64_t need = (uint64_t)col->stride * (count - 1u) + elem;
     if (col->offset > (uint64_t)size || need > (uint64_t)size - col->offset)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
                           "water: particle chunk %u: %s.offset %llu + %s.stride %u x (%u - 1) + %u bytes passes the buffer's "
                           "GL_BUFFER_SIZE of %lld bytes", chunk, field, (unsigned long long)col->offset, field, col->stride,
                           count, elem, (long long)size);

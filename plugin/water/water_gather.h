@@ -11,12 +11,9 @@
 #include "gpu/gl.h"
 #include "context.h"
 
-/* One column of a host GL buffer: particle i's element starts at offset + i * stride bytes. */
-typedef struct volfx_gpu_column {
-    uint32_t buffer; /* GL buffer name; 0 -> none */
-    uint32_t stride; /* bytes from one particle to the next */
-    uint64_t offset; /* bytes to particle 0 */
-} volfx_gpu_column;
+/* One column of a host GL buffer (the ABI's vfx_gpu_column): particle i's element starts at
+ * offset + i * stride bytes; buffer 0: none. */
+typedef vfx_gpu_column volfx_gpu_column;
 
 /* Readbacks of the box in flight: a result is read once its fence has signalled, never waited for. */
 #define WATER_GATHER_RING 4
@@ -39,7 +36,7 @@ void volfx_water_gather_destroy(vfx_context *ctx, volfx_water_gather *g);
 /* Checks column `field` ("gpu_pos", "gpu_vel") of chunk `chunk` for `count` particles of `elem`
  * bytes: a buffer name of this context (glIsBuffer), stride >= elem and a multiple of 4, offset a
  * multiple of 4, and offset + stride * (count - 1) + elem within its GL_BUFFER_SIZE. Every refusal
- * is VFX_ERR_INVALID_ARGUMENT naming the field. */
+ * is VFX_ERR_INVALID_ARGUMENT (VFX_LOG_ID_GPU_COLUMN) naming the field. */
 vfx_result volfx_water_gather_check(vfx_context *ctx, uint32_t chunk, const char *field, const volfx_gpu_column *col,
                                     uint32_t count, uint32_t elem);
 

@@ -151,14 +151,12 @@ static void session_open(session *ss, host *h, bool layer)
     free(px);
     glCreateFramebuffers(1, &ss->fbo);
     glNamedFramebufferTexture(ss->fbo, GL_COLOR_ATTACHMENT0, ss->out, 0);
-    if (layer) {
+    if (layer)
         ss->layer = texture(GL_RGBA16F);
-        ss->ctx->debug.layer_texture = ss->layer;
-    }
     ss->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW,
                                       .framebuffer = layer ? 0 : ss->fbo, .color_texture = ss->scene, .width = W,
                                       .height = H, .fov_y = 0.9f, .near_plane = 0.05f, .far_plane = 100.0f,
-                               .color_hdr = 1};
+                               .color_hdr = 1, .layer_texture = ss->layer};
     const float eye[3] = {0.0f, 0.5f, 1.6f};
     memcpy(ss->fv.eye, eye, sizeof eye);
     const float c = cosf(0.3f), s = sinf(0.3f);
@@ -285,10 +283,12 @@ static void test_layer_refused(void **state)
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         session ss;
         session_open(&ss, &h, true);
-        ss.ctx->debug.layer_texture = cases[k].tex;
+        ss.fv.layer_texture = cases[k].tex;
         assert_int_equal(ss.api.update(ss.ctx, 0.0, 1.0f / 60.0f), VFX_OK);
         assert_int_equal(ss.api.render(ss.ctx, &ss.fv), VFX_ERR_INVALID_ARGUMENT);
-        const char *msg = ss.api.last_error(ss.ctx, NULL);
+        vfx_log_id id = VFX_LOG_ID_NONE;
+        const char *msg = ss.api.last_error(ss.ctx, &id);
+        assert_int_equal(id, VFX_LOG_ID_LAYER_TEXTURE);
         printf("case %zu: %s\n", k, msg);
         assert_non_null(strstr(msg, "layer_texture"));
         assert_non_null(strstr(msg, cases[k].what));

@@ -66,7 +66,15 @@ static vfx_result params_future_chain(void *user, vfx_water_params *out)
 static vfx_result gpu_particles(void *user, uint32_t c, vfx_particle_view *out)
 {
     (void)user, (void)c;
-    *out = (vfx_particle_view){.type = VFX_TYPE_PARTICLE_VIEW, .count = 4, .gpu_pos = {.buffer = 5, .stride = 12}};
+    *out = (vfx_particle_view){.type = VFX_TYPE_PARTICLE_VIEW, .count = 4, .gpu_pos = {.buffer = 5000, .stride = 12}};
+    return VFX_OK;
+}
+static vfx_result gpu_kernel(void *user, uint32_t c, vfx_particle_view *out)
+{
+    static const float xyz[4] = {0, 0, 0, 0};
+    (void)user, (void)c;
+    *out = (vfx_particle_view){.type = VFX_TYPE_PARTICLE_VIEW, .count = 4, .pos = {xyz, xyz, xyz},
+                               .gpu_kernel = {.buffer = 5000, .stride = 24}};
     return VFX_OK;
 }
 static uint32_t one_volume(void *user) { (void)user; return 1; }
@@ -290,13 +298,14 @@ static void test_frame_fields(void **state)
     v = f.fv;
     v.type = VFX_TYPE_BEAMS_VIEW;
     expect(api, ctx, &v, VFX_ERR_ABI, "frame view (vfx_frame_view) has type 6, need 2");
-    /* the effects-layer output is reserved: refused with its own id until supported */
+    /* an effects layer must be an RGBA16F texture: refused naming the field, with its own id
+     * (gl/effects_layer checks the rest) */
     vfx_frame_view lv = f.fv;
     lv.layer_texture = f.color;
-    expect(api, ctx, &lv, VFX_ERR_UNSUPPORTED, "layer_texture");
+    expect(api, ctx, &lv, VFX_ERR_INVALID_ARGUMENT, "layer_texture");
     vfx_log_id id = VFX_LOG_ID_NONE;
     api->last_error(ctx, &id);
-    assert_int_equal(id, VFX_LOG_ID_LAYER_TEXTURE_UNSUPPORTED);
+    assert_int_equal(id, VFX_LOG_ID_LAYER_TEXTURE);
     /* a chained struct of an unknown type is skipped */
     const future_ext ext = {(vfx_struct_type)0x7000abcd, NULL, {0}};
     lv = f.fv;
@@ -337,7 +346,8 @@ static void test_nothing_drawn(void **state)
 }
 
 /* Water parameters of an unknown type (99) refused at update, naming it; an unknown chained struct
- * is skipped; GPU-resident particle columns are refused (reserved). */
+ * is skipped; a GL buffer column that names no buffer is refused (water/water_gpu checks the rest),
+ * and a GL buffer kernel column is not supported. */
 static void test_unknown_water_params_version(void **state)
 {
     (void)state;
@@ -363,8 +373,14 @@ static void test_unknown_water_params_version(void **state)
     api->destroy(ctx);
     host.particle_chunk = gpu_particles;
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
+    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(api->last_error(ctx, &id), "gpu_pos.buffer 5000 is not a buffer object"));
+    assert_int_equal(id, VFX_LOG_ID_GPU_COLUMN);
+    api->destroy(ctx);
+    host.particle_chunk = gpu_kernel;
+    assert_int_equal(api->create(&host, &ctx), VFX_OK);
     assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_ERR_UNSUPPORTED);
-    assert_non_null(strstr(api->last_error(ctx, &id), "GPU-resident particles are not supported"));
+    assert_non_null(strstr(api->last_error(ctx, &id), "gpu_kernel 5000"));
     assert_int_equal(id, VFX_LOG_ID_GPU_PARTICLES_UNSUPPORTED);
     api->destroy(ctx);
 }

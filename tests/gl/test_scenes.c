@@ -60,6 +60,38 @@ static void test_bad_scene_refused(void **state)
     game_app_destroy(app);
 }
 
+/* The game's --gpu-particles and --effects-layer: the default scene's particles reach the water
+ * from the game's GL buffer (every one of them, none outside the box it used) and the effects
+ * through the layer the game composites, with no error. */
+static void test_gpu_particles_and_layer(void **state)
+{
+    (void)state;
+    test_log log = {0};
+    game_app_desc d = {.mode = RT_GL_HEADLESS, .width = 64, .height = 36, .logger = {test_log_fn, &log},
+                       .gpu_particles = true, .effects_layer = true};
+    game_app *app;
+    if (game_app_create(&d, &app) != VFX_OK)
+        exit(VFX_TEST_SKIP);
+    game_demo demo;
+    assert_int_equal(game_demo_load(app, &demo, NULL, 0), VFX_OK);
+    for (int f = 0; f < 3; ++f) {
+        game_demo_animate(app, &demo, 1.f / 60.f);
+        assert_int_equal(game_app_frame(app, 1.f / 60.f), VFX_OK);
+    }
+    double gpu = -1, total = -2, outside = -1;
+    for (uint32_t k = 0; k < app->ctx->last_stats.count; ++k) {
+        const vfx_stat *e = &app->ctx->last_stats.entries[k];
+        if (!strcmp(e->name, "water.gpu_particles")) gpu = e->value;
+        if (!strcmp(e->name, "water.particles")) total = e->value;
+        if (!strcmp(e->name, "water.gpu_box_outside")) outside = e->value;
+    }
+    assert_true(total > 0 && gpu == total);
+    assert_true(outside == 0);
+    assert_int_equal(log.errors, 0);
+    game_demo_free(app, &demo);
+    game_app_destroy(app);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -67,6 +99,7 @@ int main(void)
         cmocka_unit_test(test_beams_only), cmocka_unit_test(test_water_only),
         cmocka_unit_test(test_empty),
         cmocka_unit_test(test_long_run), cmocka_unit_test(test_bad_scene_refused),
+        cmocka_unit_test(test_gpu_particles_and_layer),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

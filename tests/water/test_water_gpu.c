@@ -18,7 +18,6 @@
 
 #include "context.h"
 #include "test_util.h"
-#include "water/water_gather.h"
 
 #define W 96
 #define H 64
@@ -36,7 +35,7 @@ typedef struct host {
     vfx_water_params p;
     bool gpu;                   /* hand the GL buffer instead of the arrays */
     GLuint buf;
-    volfx_gpu_column pos, vel;  /* the columns handed over (tests break them) */
+    vfx_gpu_column pos, vel;    /* the columns handed over (tests break them) */
 } host;
 
 static uint32_t chunk_count(void *user) { return ((host *)user)->n ? 1 : 0; }
@@ -49,16 +48,9 @@ static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
     if (!h->gpu) {
         out->pos[0] = h->x, out->pos[1] = h->y, out->pos[2] = h->z;
         out->vel[0] = h->vx, out->vel[1] = h->vy, out->vel[2] = h->vz;
+    } else {
+        out->gpu_pos = h->pos, out->gpu_vel = h->vel;
     }
-    return VFX_OK;
-}
-
-static vfx_result gpu_chunk(void *user, uint32_t index, volfx_gpu_column *cols)
-{
-    host *h = user;
-    (void)index;
-    if (h->gpu)
-        cols[0] = h->pos, cols[1] = h->vel;
     return VFX_OK;
 }
 
@@ -100,8 +92,8 @@ static void make_host(host *s, uint32_t nx, uint32_t ny, uint32_t nz)
         s->base[3 * p] = s->x[p], s->base[3 * p + 1] = s->y[p], s->base[3 * p + 2] = s->z[p];
     glCreateBuffers(1, &s->buf);
     glNamedBufferStorage(s->buf, (GLsizeiptr)(LEAD + (size_t)s->n * STRIDE), NULL, GL_DYNAMIC_STORAGE_BIT);
-    s->pos = (volfx_gpu_column){s->buf, STRIDE, LEAD};
-    s->vel = (volfx_gpu_column){s->buf, STRIDE, LEAD + 16u};
+    s->pos = (vfx_gpu_column){s->buf, STRIDE, LEAD};
+    s->vel = (vfx_gpu_column){s->buf, STRIDE, LEAD + 16u};
 }
 
 /* Frame f's positions (frame 0's moved f times) into the columns and the interleaved buffer. */
@@ -143,7 +135,6 @@ static void session_open(session *ss, host *h)
     ss->api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
     assert_int_equal(ss->api.create(&api, &ss->ctx), VFX_OK);
-    ss->ctx->debug.water_gpu_chunk = gpu_chunk;
     glCreateTextures(GL_TEXTURE_2D, 1, &ss->col);
     glTextureStorage2D(ss->col, 1, GL_RGBA8, W, H);
     glCreateFramebuffers(1, &ss->fbo);
@@ -304,7 +295,7 @@ static void test_refused(void **state)
     h.gpu = true;
     GLuint never = 0;
     glGenBuffers(1, &never); /* a name, never bound: not a buffer object yet */
-    const struct { volfx_gpu_column pos, vel; const char *field; } cases[] = {
+    const struct { vfx_gpu_column pos, vel; const char *field; } cases[] = {
         {{never, STRIDE, LEAD}, {0, 0, 0}, "gpu_pos.buffer"},
         {{h.buf + 1000, STRIDE, LEAD}, {0, 0, 0}, "gpu_pos.buffer"},
         {{h.buf, 8, LEAD}, {0, 0, 0}, "gpu_pos.stride"},
@@ -320,7 +311,9 @@ static void test_refused(void **state)
         session ss;
         session_open(&ss, &h);
         vfx_result r = ss.api.update(ss.ctx, 0.0, 1.0f / 60.0f);
-        const char *msg = ss.api.last_error(ss.ctx, NULL);
+        vfx_log_id id = VFX_LOG_ID_NONE;
+        const char *msg = ss.api.last_error(ss.ctx, &id);
+        assert_int_equal(id, VFX_LOG_ID_GPU_COLUMN);
         printf("case %zu: %s\n", k, msg);
         assert_int_equal(r, VFX_ERR_INVALID_ARGUMENT);
         assert_non_null(strstr(msg, cases[k].field));

@@ -121,8 +121,10 @@ typedef struct vfx_chain {
 /* ---------------------------------------------------------------- data the host hands over */
 
 /* A GL buffer object holding one column of particle data: element i at offset + i * stride
- * (bytes). Reserved in ABI 1.0: this plugin refuses a particle view that names one
- * (VFX_ERR_UNSUPPORTED, VFX_LOG_ID_GPU_PARTICLES_UNSUPPORTED). */
+ * (bytes), so one interleaved buffer can hold several columns. The buffer must be a buffer object
+ * of the current context, stride a multiple of 4 of at least the element's size, offset a multiple
+ * of 4, the last element inside GL_BUFFER_SIZE (refused otherwise, VFX_LOG_ID_GPU_COLUMN). The
+ * plugin reads it on the GPU at update (docs/integration.md "Particles in GL buffers"). */
 typedef struct vfx_gpu_column {
     uint32_t buffer;  /* GL buffer name; 0 -> not used */
     uint32_t stride;  /* bytes between elements */
@@ -148,7 +150,9 @@ typedef struct vfx_particle_view {
      * radius, when given too, divides G. Each eigenvalue must lie in [1e-3, 1e3]. */
     const float *kernel;
     uint64_t revision;
-    /* GPU-resident columns instead of pos/vel/kernel (reserved: refused by this plugin). */
+    /* GPU-resident columns instead of pos / vel (leave those NULL): gpu_pos 3 floats x y z a
+     * particle, gpu_vel 3 floats; buffer 0 -> not used. gpu_kernel (6 floats) is refused with
+     * VFX_ERR_UNSUPPORTED (VFX_LOG_ID_GPU_PARTICLES_UNSUPPORTED): give `kernel` instead. */
     vfx_gpu_column gpu_pos, gpu_vel, gpu_kernel;
 } vfx_particle_view;
 
@@ -396,7 +400,9 @@ typedef struct vfx_volume_view {
     X(FRAME_VIEW, 7)          /* a frame view field or target refused by the frame gate */ \
     X(OUT_OF_MEMORY, 8)       /* an allocation through the host allocator failed */ \
     X(GL_VERSION, 9)          /* the current context is below desktop GL 4.5 */ \
-    X(GL_COMMAND_MISSING, 10) /* gl_get_proc_address found no entry point for a command */
+    X(GL_COMMAND_MISSING, 10) /* gl_get_proc_address found no entry point for a command */ \
+    X(GPU_COLUMN, 11)         /* a particle view's GL buffer column refused (gpu_pos, gpu_vel) */ \
+    X(LAYER_TEXTURE, 12)      /* a frame view's layer_texture refused */
 
 typedef enum vfx_log_id {
 #define VFX_LOG_ID_ENUM_(name, value) VFX_LOG_ID_##name = value,
@@ -458,8 +464,10 @@ typedef struct vfx_frame_view {
      * alternately with the first keeps each one's history and sizes. The plugin keeps the
      * VFX_MAX_VIEWS most recently rendered ids; an older one starts afresh. */
     uint32_t view_id;       /* any value */
-    /* An effects-layer output texture (reserved: this plugin refuses a nonzero one with
-     * VFX_ERR_UNSUPPORTED, VFX_LOG_ID_LAYER_TEXTURE_UNSUPPORTED). */
+    /* An effects layer instead of `framebuffer`: a 2D GL_RGBA16F texture of width x height the
+     * plugin clears and renders the effects into, premultiplied, for the host to composite as
+     * dst = layer.rgb + dst * (1 - layer.a); alpha: water 1, beams 0 (additive), volumes their
+     * opacity (docs/integration.md "Effects layer"). 0 -> draw into `framebuffer`. */
     uint32_t layer_texture;
 } vfx_frame_view;
 
