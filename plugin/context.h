@@ -47,7 +47,7 @@ struct vfx_context {
     volfx_gl_saved gl_saved;
     uint32_t gl_calls;
     bool gl_compat;             /* the context is a compatibility profile */
-    bool gl_skip_restore;       /* the host resets its own state: no save, no restore */
+    bool gl_skip_restore;       /* vfx_gl_state_desc.skip_restore: the host resets its own state, no save, no restore */
 };
 
 /* Logs through the host logger, printf-style, with the message's id. */

@@ -153,6 +153,8 @@ static vfx_result plugin_create(const vfx_context_desc *host, vfx_context **out)
         return VFX_ERR_OUT_OF_MEMORY;
     memset(ctx, 0, sizeof *ctx);
     ctx->host = *host;
+    const vfx_gl_state_desc *gs = volfx_chain_find(host->next, VFX_TYPE_GL_STATE_DESC);
+    ctx->gl_skip_restore = gs && gs->skip_restore;
     ctx->host.next = NULL; /* the chain is the host's, valid only during this call */
     ctx->stats.type = ctx->last_stats.type = VFX_TYPE_STATS;
     register_effects(ctx);

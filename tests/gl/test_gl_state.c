@@ -551,6 +551,62 @@ static void test_compat_profile(void **state)
     free(compat);
 }
 
+/* vfx_gl_state_desc.skip_restore, read at create(), whose baseline pass is the call watched: with
+ * it the host's hostile state is left changed (at least culling and the depth test, which the
+ * baseline turns off), without it every value the test tracks reads as before. */
+static int create_under_hostile(game_app *app, hostile *h, const vfx_gl_state_desc *gs, test_log *log)
+{
+    vfx_context_desc d = {.type = VFX_TYPE_CONTEXT_DESC, .next = gs, .gl_get_proc_address = test_gl_proc,
+                          .user = log, .log = test_vfx_log_fn};
+    snap *b = malloc(sizeof *b), *a = malloc(sizeof *a);
+    b->n = a->n = 0;
+    hostile_apply(h);
+    take(b);
+    vfx_context *ctx = NULL;
+    assert_int_equal(app->api->create(&d, &ctx), VFX_OK);
+    take(a);
+    assert_int_equal(a->n, b->n);
+    int changed = 0;
+    for (int i = 0; i < b->n; ++i)
+        changed += a->v[i] != b->v[i];
+    if (!gs || !gs->skip_restore)
+        expect_same(b, a, "create");
+    else {
+        int seen = 0;
+        for (int i = 0; i < b->n; ++i)
+            if (!strcmp(b->name[i], "enabled GL_CULL_FACE") || !strcmp(b->name[i], "enabled GL_DEPTH_TEST")) {
+                assert_true(b->v[i] == 1 && a->v[i] == 0);
+                ++seen;
+            }
+        assert_int_equal(seen, 2);
+    }
+    app->api->destroy(ctx);
+    gl_initial();
+    free(a);
+    free(b);
+    return changed;
+}
+
+static void test_skip_restore(void **state)
+{
+    (void)state;
+    test_log log = {0};
+    game_demo demo;
+    game_app *app = open_app(false, &log, &demo);
+    hostile h;
+    hostile_make(&h);
+    vfx_gl_state_desc keep = {.type = VFX_TYPE_GL_STATE_DESC}, skip = {.type = VFX_TYPE_GL_STATE_DESC, .skip_restore = 1};
+    assert_int_equal(create_under_hostile(app, &h, NULL, &log), 0);
+    assert_int_equal(create_under_hostile(app, &h, &keep, &log), 0);
+    int changed = create_under_hostile(app, &h, &skip, &log);
+    fprintf(stderr, "skip_restore: %d state values left changed by create\n", changed);
+    assert_true(changed >= 2);
+    assert_int_equal(log.errors, 0);
+    hostile_free(&h);
+    game_demo_free(app, &demo);
+    game_app_destroy(app);
+}
+
 /* ----------------------------------------------------------------- the cost */
 
 static double cpu_ms(void)
@@ -663,6 +719,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hostile_host),
         cmocka_unit_test(test_compat_profile),
+        cmocka_unit_test(test_skip_restore),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -109,6 +109,7 @@ typedef enum vfx_struct_type {
     VFX_TYPE_STATS = 8,
     VFX_TYPE_LIGHTS = 9,
     VFX_TYPE_PLUGIN_API = 10,
+    VFX_TYPE_GL_STATE_DESC = 11,
     VFX_TYPE_MAX_ENUM = 0x7fffffff
 } vfx_struct_type;
 
@@ -435,6 +436,16 @@ typedef struct vfx_context_desc {
     uint32_t (*volume_count)(void *user);
     vfx_result (*volume)(void *user, uint32_t index, vfx_volume_view *out);
 } vfx_context_desc;
+
+/* Chained into vfx_context_desc.next: how the plugin treats the host's GL state (docs/integration.md,
+ * "GL state contract"). Read at create(). */
+typedef struct vfx_gl_state_desc {
+    vfx_struct_type type;  /* VFX_TYPE_GL_STATE_DESC */
+    const void *next;
+    /* Nonzero: the host sets its own state again after every plugin call, so the plugin skips
+     * saving and restoring it (it still sets the state its passes depend on, and leaves it). */
+    uint32_t skip_restore;
+} vfx_gl_state_desc;
 
 /* ------------------------------------------------------------------------ per frame */
 
