@@ -30,6 +30,7 @@ struct vfx_context {
     uint32_t width, height;
     void *effect_state[VFX_EFFECT_COUNT];
     uint32_t rendered;          /* VFX_EFFECT_BIT of effects rendered since their creation (read_raw) */
+    uint32_t prepared;          /* VFX_EFFECT_BIT of effects whose prepare step ran this render */
     const volfx_effect_ops *effect_ops[VFX_EFFECT_COUNT];
     vfx_stats stats;            /* counters of the frame being made */
     vfx_stats last_stats;       /* counters of the last finished frame */

@@ -40,6 +40,11 @@ typedef struct volfx_frame_targets {
     float inv_cam_view_proj[16];     /* window/NDC -> direction from the eye */
     bool output_srgb;                /* framebuffer's colour attachment 0 is sRGB-encoded: the
                                       * frame gate turns GL_FRAMEBUFFER_SRGB on for the frame */
+    /* The beams' prepare step (before the water's shading): their light in front of the water
+     * surface (or of the scene where no water), RGBA16F linear, a = white cores, flares and sparks
+     * included; and their light behind the water surface (0: no water this frame). 0, 0 when the
+     * beams draw nothing. */
+    unsigned beams_light, beams_behind;
 } volfx_frame_targets;
 
 /* The shared std140 block of the frame gate (shaders/common/frame.glsl, `VolfxFrame`): uploaded
@@ -68,12 +73,21 @@ struct volfx_effect_ops {
     vfx_result (*resize)(vfx_context *ctx, void *state, uint32_t width, uint32_t height);
     /* Pulls host data (uploads columns, meshes). */
     vfx_result (*update)(vfx_context *ctx, void *state, double time, float dt);
+    /* Optional: the part of a frame other effects read (the beams' light, split at the water's
+     * surface), into the effect's own targets, published in targets. Runs once a render for each
+     * drawn effect, before the water's shading (volfx_effects_prepare), and always before render. */
+    vfx_result (*prepare)(vfx_context *ctx, void *state, volfx_frame_targets *targets);
     /* Draws into frame->framebuffer. */
     vfx_result (*render)(vfx_context *ctx, void *state, const vfx_frame_view *frame,
                          volfx_frame_targets *targets);
     /* Copies the raw quantity of the last render, top row first. */
     vfx_result (*read_raw)(vfx_context *ctx, void *state, float *out, size_t count);
 };
+
+/* Runs the prepare step of every effect drawn this render that has one and has not run it yet
+ * (entry.c): the water calls it between its surface and its shading, so that the shading sees
+ * the beams' light; entry.c calls it before each render for the rest. */
+vfx_result volfx_effects_prepare(vfx_context *ctx, volfx_frame_targets *targets);
 
 #if VFX_WITH_WATER
 extern const volfx_effect_ops volfx_water_ops;

@@ -255,6 +255,21 @@ static vfx_result update(vfx_context *ctx, double time, float dt)
     return VFX_OK;
 }
 
+vfx_result volfx_effects_prepare(vfx_context *ctx, volfx_frame_targets *targets)
+{
+    for (int k = 0; k < VFX_EFFECT_COUNT; ++k) {
+        const volfx_effect_ops *ops = ctx->effect_ops[k];
+        if (!ops || !ops->prepare || !ctx->effect_state[k] || !(targets->effects & VFX_EFFECT_BIT(k))
+            || (ctx->prepared & VFX_EFFECT_BIT(k)))
+            continue;
+        ctx->prepared |= VFX_EFFECT_BIT(k);
+        vfx_result r = ops->prepare(ctx, ctx->effect_state[k], targets);
+        if (r)
+            return r;
+    }
+    return VFX_OK;
+}
+
 /* The frame gate (frame_check.c) checks the view and derives the camera once; the effects then
  * read it from targets (and the VolfxFrame block it binds). */
 static vfx_result plugin_update(vfx_context *ctx, double time, float dt)
@@ -288,6 +303,8 @@ static vfx_result render(vfx_context *ctx, const vfx_frame_view *frame)
 
     ctx->stats.count = 0;
     ctx->stats.dropped = 0;
+    ctx->prepared = 0;
+    targets.beams_light = targets.beams_behind = 0;
     static const vfx_effect_kind order[VFX_EFFECT_COUNT] = {VFX_EFFECT_WATER, VFX_EFFECT_VOLUME,
                                                             VFX_EFFECT_BEAMS};
     vfx_result result = VFX_OK;
@@ -295,6 +312,9 @@ static vfx_result render(vfx_context *ctx, const vfx_frame_view *frame)
         vfx_effect_kind k = order[i];
         if (!ctx->effect_state[k] || !(mask & VFX_EFFECT_BIT(k)))
             continue;
+        /* the water has run it before its shading; without water, the beams' prepare runs here */
+        if (k != VFX_EFFECT_WATER && (result = volfx_effects_prepare(ctx, &targets)))
+            break;
         result = ctx->effect_ops[k]->render(ctx, ctx->effect_state[k], frame, &targets);
         if (result == VFX_OK)
             ctx->rendered |= VFX_EFFECT_BIT(k);

@@ -44,13 +44,19 @@ typedef struct beam_look {
 } beam_look;
 
 typedef struct beams_state {
-    GLuint prog_integrate[16]; /* [march | smooth << 1 | polyline << 2 | anatomy << 3]: code only where needed */
+    GLuint prog_integrate[32]; /* [march | smooth << 1 | polyline << 2 | anatomy << 3 | water << 4]: code only
+                                * where needed */
     GLuint prog_composite, prog_down, prog_up;
     GLuint beam_buf, range_buf, list_buf, joint_buf;
     size_t beam_cap, range_cap, list_cap, joint_cap; /* bytes */
     float (*joint_xyz)[4];      /* polyline joints this frame, eye-relative (capacity: beams x max) */
     uint32_t joint_used;
-    GLuint acc_tex, light_tex, acc_fbo;   /* H (R32F) and light (RGBA16F), one framebuffer */
+    GLuint acc_tex, light_tex, acc_fbo;   /* H (RG32F: in front of the water, behind it) and light (RGBA16F) */
+    GLuint behind_tex, split_fbo;         /* light behind the water (RGBA16F), and the 3-target framebuffer:
+                                           * made the first frame with water */
+    bool prepared;                        /* the integrate pass ran this render (beams_prepare) */
+    bool bloom;                           /* this render's bloom, and its levels */
+    uint32_t levels;
     GLuint bloom_tex[MAX_BLOOM_LEVELS + 1], bloom_fbo[MAX_BLOOM_LEVELS + 1]; /* [1..levels] */
     uint32_t bloom_w[MAX_BLOOM_LEVELS + 1], bloom_h[MAX_BLOOM_LEVELS + 1];
     uint32_t bloom_levels;                /* allocated levels */
@@ -119,6 +125,8 @@ static void beams_destroy(vfx_context *ctx, void *state)
     glDeleteTextures(1, &s->acc_tex);
     glDeleteTextures(1, &s->light_tex);
     glDeleteFramebuffers(1, &s->acc_fbo);
+    glDeleteTextures(1, &s->behind_tex);
+    glDeleteFramebuffers(1, &s->split_fbo);
     free_bloom(s);
     volfx_ubo_destroy(&s->ubo);
     volfx_beams_impact_destroy(ctx, s->impact);
@@ -195,8 +203,11 @@ static vfx_result beams_resize(vfx_context *ctx, void *state, uint32_t w, uint32
     glDeleteTextures(1, &s->acc_tex);
     glDeleteTextures(1, &s->light_tex);
     glDeleteFramebuffers(1, &s->acc_fbo);
+    glDeleteTextures(1, &s->behind_tex);
+    glDeleteFramebuffers(1, &s->split_fbo);
+    s->behind_tex = s->split_fbo = 0;
     free_bloom(s);
-    s->acc_tex = make_target(GL_R32F, w, h, false, "beams.H");
+    s->acc_tex = make_target(GL_RG32F, w, h, false, "beams.H");
     s->light_tex = make_target(GL_RGBA16F, w, h, true, "beams.light");
     glCreateFramebuffers(1, &s->acc_fbo);
     glNamedFramebufferTexture(s->acc_fbo, GL_COLOR_ATTACHMENT0, s->acc_tex, 0);
@@ -500,18 +511,20 @@ static vfx_result bin_beams(vfx_context *ctx, beams_state *s, const volfx_frame_
 }
 
 /* The integrate program for this frame's beams: code only for what some beam needs. */
-static GLuint integrate_program(vfx_context *ctx, beams_state *s, bool march)
+static GLuint integrate_program(vfx_context *ctx, beams_state *s, bool march, bool water)
 {
     bool any_smooth = false, any_poly = false, any_anat = false;
     for (uint32_t i = 0; i < s->count; ++i)
         any_smooth |= s->beams[i].smooth != 0, any_poly |= s->beams[i].joint_count >= 2,
             any_anat |= s->looks[i].anatomy;
-    unsigned variant = (unsigned)march | (unsigned)any_smooth << 1 | (unsigned)any_poly << 2 | (unsigned)any_anat << 3;
+    unsigned variant = (unsigned)march | (unsigned)any_smooth << 1 | (unsigned)any_poly << 2 | (unsigned)any_anat << 3
+                       | (unsigned)water << 4;
     if (!s->prog_integrate[variant]) {
-        static const char *const names[4] = {"#define VOLFX_BEAMS_MARCH 1\n", "#define VOLFX_BEAMS_SMOOTH 1\n",
-                                             "#define VOLFX_BEAMS_POLYLINE 1\n", "#define VOLFX_BEAMS_ANATOMY 1\n"};
-        char defs[160] = "";
-        for (unsigned k = 0; k < 4; ++k)
+        static const char *const names[5] = {"#define VOLFX_BEAMS_MARCH 1\n", "#define VOLFX_BEAMS_SMOOTH 1\n",
+                                             "#define VOLFX_BEAMS_POLYLINE 1\n", "#define VOLFX_BEAMS_ANATOMY 1\n",
+                                             "#define VOLFX_BEAMS_WATER 1\n"};
+        char defs[200] = "";
+        for (unsigned k = 0; k < 5; ++k)
             if (variant >> k & 1u)
                 strncat(defs, names[k], sizeof defs - strlen(defs) - 1);
         s->prog_integrate[variant] = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
@@ -543,10 +556,28 @@ static void bloom_passes(vfx_context *ctx, beams_state *s, uint32_t levels)
     }
 }
 
-/* The GL half of a frame: uploads, the integrate (or march) pass into H and light, the bloom
- * chain, the composite into the frame gate's framebuffer. The camera comes from the VolfxFrame
- * block (shaders/common/frame.glsl), bound by the frame gate. */
-static vfx_result gl_passes(vfx_context *ctx, beams_state *s, volfx_frame_targets *t, float c)
+/* The 3-target framebuffer of a frame with water: H, the light in front of the water surface,
+ * the light behind it (made the first frame with water, kept until a resize). */
+static vfx_result split_targets(vfx_context *ctx, beams_state *s)
+{
+    if (s->split_fbo)
+        return VFX_OK;
+    s->behind_tex = make_target(GL_RGBA16F, s->grid.width, s->grid.height, false, "beams.behind_water");
+    glCreateFramebuffers(1, &s->split_fbo);
+    glNamedFramebufferTexture(s->split_fbo, GL_COLOR_ATTACHMENT0, s->acc_tex, 0);
+    glNamedFramebufferTexture(s->split_fbo, GL_COLOR_ATTACHMENT1, s->light_tex, 0);
+    glNamedFramebufferTexture(s->split_fbo, GL_COLOR_ATTACHMENT2, s->behind_tex, 0);
+    static const GLenum bufs[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+    glNamedFramebufferDrawBuffers(s->split_fbo, 3, bufs);
+    return volfx_gpu_check_target(ctx, s->split_fbo, "beams: H, light and behind-the-water targets", s->grid.width,
+                                  s->grid.height);
+}
+
+/* The first GL half of a frame, before the water's shading: uploads, the integrate (or march)
+ * pass into H and light (split at the water's surface when there is water: the light in front of
+ * it and the light behind it), the impacts. The camera comes from the VolfxFrame block
+ * (shaders/common/frame.glsl), bound by the frame gate. */
+static vfx_result integrate_passes(vfx_context *ctx, beams_state *s, volfx_frame_targets *t, float c)
 {
     uint32_t ntiles = s->grid.tiles_x * s->grid.tiles_y;
     vfx_result r;
@@ -555,32 +586,35 @@ static vfx_result gl_passes(vfx_context *ctx, beams_state *s, volfx_frame_target
         || (r = upload(ctx, s->list_buf, &s->list_cap, s->list, (size_t)s->pairs * sizeof(uint32_t)))
         || (r = upload(ctx, s->joint_buf, &s->joint_cap, s->joint_xyz, s->joint_used * sizeof s->joint_xyz[0])))
         return r;
-    bool march = s->march == VFX_BEAMS_METHOD_MARCH;
-    GLuint prog = integrate_program(ctx, s, march);
+    bool march = s->march == VFX_BEAMS_METHOD_MARCH, water = t->water_dist != 0;
+    GLuint prog = integrate_program(ctx, s, march, water);
     if (!prog)
         return VFX_ERR_GL;
-    /* bloom: on by default for version 2 hosts, off for version 1 ones (their image as it was) */
-    bool bloom = s->view.bloom != VFX_BEAMS_BLOOM_OFF;
+    if (water && (r = split_targets(ctx, s)))
+        return r;
+    /* bloom: on unless the view says off */
+    s->bloom = s->view.bloom != VFX_BEAMS_BLOOM_OFF;
     uint32_t levels = s->view.bloom_levels ? s->view.bloom_levels : 5;
     while (levels > 1 && ((s->grid.width >> levels) == 0 || (s->grid.height >> levels) == 0))
         levels--; /* a tiny target: no level below 1x1 */
-    if (bloom && levels != s->bloom_levels && (r = make_bloom(ctx, s, levels)))
+    if (s->bloom && levels != s->bloom_levels && (r = make_bloom(ctx, s, levels)))
         return r;
+    s->levels = levels;
     float strength = s->view.bloom_strength > 0 ? s->view.bloom_strength : 0.6f;
     float far = s->view.far_distance > 0 ? s->view.far_distance : t->far_plane;
     if (!(far > 0))
         far = 1e30f;
     beams_block blk = {.far = far, .c = c, .tile_px = VOLFX_BEAMS_TILE_PX, .tiles_x = (int32_t)s->grid.tiles_x,
                        .samples = (int32_t)(s->march_samples ? s->march_samples : 32),
-                       .has_water = t->water_dist != 0,
+                       .has_water = water,
                        .smooth_saturation = s->view.saturation == VFX_SATURATE_SMOOTH,
-                       .bloom = bloom, .bloom_gain = strength / (float)levels};
+                       .bloom = s->bloom, .bloom_gain = strength / (float)levels};
     volfx_ubo_update(&s->ubo, &blk, sizeof blk);
     volfx_ubo_bind(&s->ubo, 3);
 
     volfx_pass_begin(ctx, &(volfx_pass_desc){.name = march ? "beams.march" : "beams.integrate",
-                                             .framebuffer = s->acc_fbo, .width = s->grid.width,
-                                             .height = s->grid.height});
+                                             .framebuffer = water ? s->split_fbo : s->acc_fbo,
+                                             .width = s->grid.width, .height = s->grid.height});
     glUseProgram(prog);
     glBindTextureUnit(0, t->scene_depth);
     glBindTextureUnit(1, t->water_dist);
@@ -592,25 +626,42 @@ static vfx_result gl_passes(vfx_context *ctx, beams_state *s, volfx_frame_target
     volfx_pass_end(ctx);
     if ((r = volfx_beams_impact_render(ctx, s->impact, t, s->light_tex, s->time, s->dt)))
         return r;
-    if (bloom)
-        bloom_passes(ctx, s, levels);
-    volfx_stat_set(ctx, "beams.bloom_levels", bloom ? levels : 0);
-    glBindTextureUnit(0, s->light_tex);
-    glBindTextureUnit(1, bloom ? s->bloom_tex[1] : s->light_tex);
-    volfx_composite_targets(ctx, t, "beams.composite", s->prog_composite, VOLFX_BLEND_ADD);
+    t->beams_light = s->light_tex;
+    t->beams_behind = water ? s->behind_tex : 0;
     const char *e = volfx_gpu_error_string();
-    return e ? volfx_fail(ctx, VFX_ERR_GL, "beams render: %s", e) : VFX_OK;
+    return e ? volfx_fail(ctx, VFX_ERR_GL, "beams integrate: %s", e) : VFX_OK;
 }
 
-/* Reads only the frame gate (targets): CPU binning, then the GL passes. */
-static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
-                               volfx_frame_targets *targets)
+/* The prepare step (effect.h): CPU binning, then the integrate pass and the impacts, before the
+ * water's shading reads the light. Reads only the frame gate (targets). */
+static vfx_result beams_prepare(vfx_context *ctx, void *state, volfx_frame_targets *targets)
 {
-    (void)frame;
     beams_state *s = state;
     float c = s->view.saturate_c > 0 ? s->view.saturate_c : 1.f;
     vfx_result r = bin_beams(ctx, s, targets, c);
-    return r ? r : gl_passes(ctx, s, targets, c);
+    s->prepared = r == VFX_OK && (r = integrate_passes(ctx, s, targets, c)) == VFX_OK;
+    return r;
+}
+
+/* The second half, after the water and the volume: the bloom chain over the light in front of
+ * the water, and the composite into the frame gate's framebuffer. */
+static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
+                               volfx_frame_targets *t)
+{
+    (void)frame;
+    beams_state *s = state;
+    if (!s->prepared)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams render: the prepare step did not run this render");
+    s->prepared = false;
+    if (s->bloom)
+        bloom_passes(ctx, s, s->levels);
+    volfx_stat_set(ctx, "beams.bloom_levels", s->bloom ? s->levels : 0);
+    glBindTextureUnit(0, s->light_tex);
+    glBindTextureUnit(1, s->bloom ? s->bloom_tex[1] : s->light_tex);
+    volfx_ubo_bind(&s->ubo, 3);
+    volfx_composite_targets(ctx, t, "beams.composite", s->prog_composite, VOLFX_BLEND_ADD);
+    const char *e = volfx_gpu_error_string();
+    return e ? volfx_fail(ctx, VFX_ERR_GL, "beams render: %s", e) : VFX_OK;
 }
 
 static vfx_result beams_read_raw(vfx_context *ctx, void *state, float *out, size_t count)
@@ -620,6 +671,17 @@ static vfx_result beams_read_raw(vfx_context *ctx, void *state, float *out, size
     if (count < n)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams read_raw: %zu floats < %zu", count, n);
     return volfx_gpu_read_top_first(ctx, s->acc_tex, GL_RED, 1, 0, s->grid.width, s->grid.height, out);
+}
+
+vfx_result volfx_beams_debug_split(vfx_context *ctx, float *out, size_t count)
+{
+    beams_state *s = ctx->effect_state[VFX_EFFECT_BEAMS];
+    if (!s || !s->acc_tex)
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "beams debug split: no beams effect or no render yet");
+    size_t n = (size_t)s->grid.width * s->grid.height * 2;
+    if (!out || count < n)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams debug split: %zu floats, need %zu", count, n);
+    return volfx_gpu_read_top_first(ctx, s->acc_tex, GL_RG, 2, -1, s->grid.width, s->grid.height, out);
 }
 
 volfx_beams_impact *volfx_beams_impact_of(vfx_context *ctx)
@@ -636,6 +698,7 @@ const volfx_effect_ops volfx_beams_ops = {
     .destroy = beams_destroy,
     .resize = beams_resize,
     .update = beams_update,
+    .prepare = beams_prepare,
     .render = beams_render,
     .read_raw = beams_read_raw,
 };

@@ -49,6 +49,10 @@ uint32_t volfx_beams_impact_debug_hits(volfx_beams_impact *im, float (*out)[8], 
 /* Tests: copies the spark pool (stalls): 12 floats a spark (position, age; velocity, lifetime;
  * colour, 0), age < 0 or age >= lifetime: dead. Returns the pool size. */
 uint32_t volfx_beams_impact_debug_sparks(volfx_beams_impact *im, float (*out)[12], uint32_t n);
+/* Tests: the last integrate pass's H split at the water's surface, 2 floats a pixel, top row first:
+ * the integral from the eye to the nearer of the water and the scene, and from the water on to
+ * the scene (0 without water in front). count >= 2 x width x height. */
+vfx_result volfx_beams_debug_split(vfx_context *ctx, float *out, size_t count);
 /* Tests and the lights entry point: the beams effect's impact state (NULL when beams are absent). */
 volfx_beams_impact *volfx_beams_impact_of(vfx_context *ctx);
 

@@ -77,6 +77,7 @@ static void water_destroy(vfx_context *ctx, void *state)
     volfx_water_aniso_destroy(ctx, s->aniso);
     volfx_water_diffuse_destroy(ctx, s->diffuse);
     volfx_water_gather_destroy(ctx, s->gather);
+    volfx_water_lights_destroy(&s->effect_lights);
     volfx_free(ctx, s->chunk_rev);
     glDeleteVertexArrays(1, &s->vao);
     volfx_ubo_destroy(&s->frame_ubo);
@@ -761,7 +762,20 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
     GLuint layer = 0;
     if ((r = diffuse_frame(ctx, s, frame, targets, &layer)))
         return r;
-    GLuint shade = volfx_gpu_program(ctx, "common/fullscreen.vert", "water/shade.frag", NULL);
+    /* the beams' light split at this surface (their prepare step) before the shading reads it */
+    if ((r = volfx_effects_prepare(ctx, targets)))
+        return r;
+    /* the beams' light and the light loop are compiled in only for a frame that has them (the
+     * lights are the beams': none when the beams are not drawn) */
+    bool beams = targets->beams_light && targets->beams_behind;
+    uint32_t nlights = 0;
+    if (beams && !(p->disable & VFX_WATER_NO_SHADING) && (r = volfx_water_lights_frame(ctx, &s->effect_lights, &nlights)))
+        return r;
+    GLuint shade = nlights ? volfx_gpu_program(ctx, "common/fullscreen.vert", "water/shade.frag",
+                                               "#define WATER_BEAMS 1\n#define WATER_EFFECT_LIGHTS 1\n"
+                                               "#define WATER_MAX_LIGHTS 32\n")
+                   : beams ? volfx_gpu_program(ctx, "common/fullscreen.vert", "water/shade.frag", "#define WATER_BEAMS 1\n")
+                           : volfx_gpu_program(ctx, "common/fullscreen.vert", "water/shade.frag", NULL);
     if (!shade)
         return VFX_ERR_GL;
     volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.shade", .framebuffer = frame->framebuffer,
@@ -792,6 +806,10 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_ggx"), (s->look & WATER_LOOK_GGX) != 0);
     if (layer)
         glBindTextureUnit(6, layer);
+    if (beams) {
+        glBindTextureUnit(7, targets->beams_light);
+        glBindTextureUnit(8, targets->beams_behind);
+    }
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_diffuse"), layer != 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->counters);
     volfx_gpu_fullscreen(ctx);

@@ -12,6 +12,7 @@
 #include "water_aniso.h"
 #include "water_diffuse.h"
 #include "water_gather.h"
+#include "water_lights.h"
 
 /* Counter readback ring: frames the GPU may run behind before a result is dropped. */
 #define WATER_COUNTER_RING 3
@@ -77,6 +78,7 @@ typedef struct water_view {
 } water_view;
 
 typedef struct water_state {
+    volfx_water_lights effect_lights; /* the beams' lights on the water (water_lights.h) */
     GLuint cols[3];        /* group 0's columns: the compute paths (brute, NO_BLEND) read only it */
     water_group *groups;   /* position buffers of at most buffer_cap particles each */
     uint32_t group_count;

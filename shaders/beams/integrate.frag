@@ -1,6 +1,8 @@
 // Per pixel: H = sum over the beams binned to this pixel's tile of the closed-form integral
 // from the eye to the first surface (host depth, water), or the ray-marching baseline when
-// VOLFX_BEAMS_MARCH is defined. Writes H (R32F, read_raw) and the beams' linear radiance
+// VOLFX_BEAMS_MARCH is defined. With VOLFX_BEAMS_WATER the ray is split at the water's surface:
+// the part in front goes to the light (composited over the water), the part behind it to its own
+// target, which the water's shading sees through its refraction (docs/beams.md "In the water"). Writes H (R32F, read_raw) and the beams' linear radiance
 // (RGBA16F): each hot-ramp beam through its own ramp, the thesis-ramp beams through the clamp
 // of their summed H (docs/beams.md "Emission").
 layout(std430, binding = 4) readonly buffer Joints { vec4 joints[]; }; // xyz relative to the eye
@@ -10,8 +12,14 @@ vec3 volfx_joint(uint i) { return joints[i].xyz; }
 #include "beams/frame.glsl"
 
 in vec2 v_ndc;
+#ifdef VOLFX_BEAMS_WATER
+layout(location = 0) out vec2 o_acc;    // H in front of the water, H behind it
+layout(location = 1) out vec4 o_light;
+layout(location = 2) out vec4 o_behind; // the light behind the water's surface (the water refracts it)
+#else
 layout(location = 0) out float o_acc;
 layout(location = 1) out vec4 o_light;
+#endif
 // the light's cap: 12 stops above white (tone-mapped white long before), so the light and the
 // bloom chain's sum of up to 9 levels stay finite in their RGBA16F targets (largest 65504)
 const float LIGHT_MAX = 4096.0;
@@ -145,6 +153,122 @@ vec3 volfx_poly_nearest(uint first, int nj, vec3 V)
 #endif
 #endif
 
+// H of one beam along the pixel ray t V over [t0, t1] (the closed form, or the marching baseline)
+float volfx_beam_h(Beam bm, vec3 V, float t0, float t1)
+{
+    bool soft = bm.mode.x != 0u;
+#ifdef VOLFX_BEAMS_POLYLINE
+    bool poly = bm.mode.w >= 2u;
+#endif
+    float h;
+#ifdef VOLFX_BEAMS_MARCH
+    // baseline: midpoint samples over the ray's chord through the beam's bounding sphere
+    vec3 C = bm.m_l.xyz + 0.5 * bm.m_l.w * bm.d_r.xyz;
+    float rad = 0.5 * bm.m_l.w + bm.d_r.w;
+    float tc = dot(C, V);
+    float disc = rad * rad - (dot(C, C) - tc * tc);
+    h = 0.0;
+    if (disc > 0.0) {
+        float ta = max(tc - sqrt(disc), t0), tb = min(tc + sqrt(disc), t1);
+        float dt = (tb - ta) / float(u_samples);
+        for (int i = 0; i < u_samples && tb > ta; ++i) {
+            vec3 P = (ta + (float(i) + 0.5) * dt) * V;
+#ifdef VOLFX_BEAMS_POLYLINE
+            if (poly)
+                h += volfx_polyline_density(bm.mode.z, int(bm.mode.w), bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
+                                            bm.ab_eps.z, soft, P) * dt;
+            else
+#endif
+                h += volfx_beam_density(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x,
+                                        bm.ab_eps.y, bm.ab_eps.z, soft, P) * dt;
+        }
+    }
+#else
+#ifdef VOLFX_BEAMS_POLYLINE
+    if (poly) {
+#ifdef VOLFX_BEAMS_ANATOMY
+        // the head at its own radius and the orb at the last joint: sphere pieces
+        float eps = max(bm.ab_eps.z, VOLFX_BEAM_EPS_FLOOR * bm.d_r.w);
+        h = volfx_polyline_integral(bm.mode.z, int(bm.mode.w), bm.d_r.w, bm.an0.x > 0.0 ? 0.0 : bm.ab_eps.x,
+                                    bm.ab_eps.y, bm.ab_eps.z, soft, V, t0, t1);
+        if (bm.an0.x > 0.0 && bm.ab_eps.x > 0.0)
+            h += bm.ab_eps.x * volfx_prim_piece(V, volfx_joint(bm.mode.z), vec3(0.0), 0.0, false, bm.an0.x, eps,
+                                                t0, t1, soft);
+        if (bm.an0.y > 0.0 && bm.an0.z > 0.0 && t1 > t0)
+            h += bm.an0.z * volfx_prim_piece(V, volfx_joint(bm.mode.z + bm.mode.w - 1u), vec3(0.0), 0.0, false,
+                                             bm.an0.y, eps, t0, t1, soft);
+#else
+        h = volfx_polyline_integral(bm.mode.z, int(bm.mode.w), bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
+                                    bm.ab_eps.z, soft, V, t0, t1);
+#endif
+    } else
+#endif
+#ifdef VOLFX_BEAMS_ANATOMY
+        h = volfx_beam_integral_anat(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
+                                     bm.ab_eps.z, soft, bm.an0, bm.an1, V, t0, t1);
+#else
+        h = volfx_beam_integral(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
+                                bm.ab_eps.z, soft, V, t0, t1);
+#endif
+#endif
+    return h;
+}
+
+// The light of a hot-ramp beam whose H along the ray is h > 0: rgb, and a = the hue-keeping
+// ramp's white core (the composite adds it as white; the bloom never sees it)
+vec4 volfx_beam_light(Beam bm, float h, vec3 V)
+{
+    // capped where the pixel is white anyway: beam_settings.c 1e-30 or exposure 64 made
+    // x * x Inf, the ramp Inf / Inf NaN, and the beam vanished (issue 28)
+    float x = min(h * bm.look.y, LIGHT_MAX);
+#ifdef VOLFX_BEAMS_POLYLINE
+    bool poly = bm.mode.w >= 2u;
+#endif
+#ifdef VOLFX_BEAMS_ANATOMY
+    if (bm.look2.x > 0.0 || bm.look2.y > 0.0) {
+#ifdef VOLFX_BEAMS_POLYLINE
+        vec3 nr = poly ? volfx_poly_nearest(bm.mode.z, int(bm.mode.w), V)
+                       : volfx_nearest(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, V);
+#else
+        vec3 nr = volfx_nearest(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, V);
+#endif
+        if (bm.look.z > 0.0) {
+            float ph = nr.x * bm.ab_eps.w - bm.look.w, n;
+            if (bm.look2.y > 0.0) { // a helix: stripes slanted by twist wavelengths across the tube
+                float phi = asin(clamp(nr.z / bm.d_r.w, -1.0, 1.0));
+                float c = 0.5 + 0.5 * cos(6.2831853 * (ph + bm.look2.z * phi / 3.14159265));
+                n = c * c;
+            } else {
+                n = volfx_flow_noise(ph);
+            }
+            x *= 1.0 + bm.look.z * (2.0 * n - 1.0);
+        }
+        if (bm.look2.x > 0.0)
+            return volfx_core_ramp(bm, x, nr.y, V);
+    } else
+#endif
+    if (bm.look.z > 0.0) {
+#ifdef VOLFX_BEAMS_POLYLINE
+        float u = poly ? volfx_poly_nearest_u(bm.mode.z, int(bm.mode.w), V)
+                       : volfx_nearest_u(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, V);
+#else
+        float u = volfx_nearest_u(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, V);
+#endif
+        x *= 1.0 + bm.look.z * (2.0 * volfx_flow_noise(u * bm.ab_eps.w - bm.look.w) - 1.0);
+    }
+    float x2 = x * x;
+    return vec4(bm.look.x * x * (bm.color.rgb + (1.0 - bm.color.rgb) * (x2 / (x2 + 9.0))), 0.0);
+}
+
+// the thesis ramp's light of the summed H of its beams (tint: their H-weighted colour sum)
+vec3 volfx_thesis_light(float Hth, vec3 tint)
+{
+    if (!(Hth > 0.0))
+        return vec3(0.0);
+    float I = u_smooth_saturation != 0 ? 1.0 - exp(-Hth / u_c) : min(Hth / u_c, 1.0);
+    return tint / Hth * I;
+}
+
 void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
@@ -156,124 +280,60 @@ void main()
         vec4 s = vfx_inv_cam_view_proj * vec4(v_ndc, depth * 2.0 - 1.0, 1.0);
         tmax = min(tmax, length(s.xyz / s.w));
     }
+    // the water's surface splits the ray: [0, tw] is seen over the water, [tw, tmax] through it
+    // (the closed form is additive: H(0, tmax) = H(0, tw) + H(tw, tmax))
+    float tw = tmax;
     if (u_has_water != 0) {
         float wd = texelFetch(u_water_dist, px, 0).r;
         if (wd >= 0.0)
-            tmax = min(tmax, wd);
+            tw = min(tmax, wd);
     }
     uvec2 range = ranges[(px.y / u_tile_px) * u_tiles_x + px.x / u_tile_px];
     float H = 0.0, Hth = 0.0;
-    vec3 tint = vec3(0.0), light = vec3(0.0);
-    float white = 0.0; // the hue-keeping beams' white cores: added by the composite, not bloomed
+    vec3 tint = vec3(0.0);
+    vec4 light = vec4(0.0); // rgb; a: the hue-keeping beams' white cores (added by the composite, not bloomed)
+#ifdef VOLFX_BEAMS_WATER
+    float Hb = 0.0, Hth_b = 0.0;
+    vec3 tint_b = vec3(0.0);
+    vec4 behind = vec4(0.0);
+    bool split = tw < tmax;
+#endif
     for (uint k = 0u; k < range.y; ++k) {
         Beam bm = beams[list[range.x + k]];
-        bool soft = bm.mode.x != 0u;
-#ifdef VOLFX_BEAMS_POLYLINE
-        bool poly = bm.mode.w >= 2u;
-#endif
-        float h;
-#ifdef VOLFX_BEAMS_MARCH
-        // baseline: midpoint samples over the ray's chord through the beam's bounding sphere
-        vec3 C = bm.m_l.xyz + 0.5 * bm.m_l.w * bm.d_r.xyz;
-        float rad = 0.5 * bm.m_l.w + bm.d_r.w;
-        float tc = dot(C, V);
-        float disc = rad * rad - (dot(C, C) - tc * tc);
-        h = 0.0;
-        if (disc > 0.0) {
-            float ta = max(tc - sqrt(disc), 0.0), tb = min(tc + sqrt(disc), tmax);
-            float dt = (tb - ta) / float(u_samples);
-            for (int i = 0; i < u_samples && tb > ta; ++i) {
-                vec3 P = (ta + (float(i) + 0.5) * dt) * V;
-#ifdef VOLFX_BEAMS_POLYLINE
-                if (poly)
-                    h += volfx_polyline_density(bm.mode.z, int(bm.mode.w), bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
-                                                bm.ab_eps.z, soft, P) * dt;
-                else
-#endif
-                    h += volfx_beam_density(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x,
-                                            bm.ab_eps.y, bm.ab_eps.z, soft, P) * dt;
-            }
+        float h = volfx_beam_h(bm, V, 0.0, tw);
+        H += h;
+#ifdef VOLFX_BEAMS_WATER
+        // behind the surface: the light of the whole ray less the light in front, so that where
+        // the water is clear the two add up to the beam's light without water (the ramp is not
+        // linear in H); a pixel without water in front has nothing behind
+        float hb = split ? volfx_beam_h(bm, V, tw, tmax) : 0.0;
+        Hb += hb;
+        if (bm.mode.y != 0u) {
+            Hth += h, Hth_b += hb;
+            tint += h * bm.color.rgb, tint_b += hb * bm.color.rgb;
+        } else {
+            vec4 lf = h > 0.0 ? volfx_beam_light(bm, h, V) : vec4(0.0);
+            light += lf;
+            if (hb > 0.0)
+                behind += max(volfx_beam_light(bm, h + hb, V) - lf, vec4(0.0));
         }
 #else
-#ifdef VOLFX_BEAMS_POLYLINE
-        if (poly) {
-#ifdef VOLFX_BEAMS_ANATOMY
-            // the head at its own radius and the orb at the last joint: sphere pieces
-            float eps = max(bm.ab_eps.z, VOLFX_BEAM_EPS_FLOOR * bm.d_r.w);
-            h = volfx_polyline_integral(bm.mode.z, int(bm.mode.w), bm.d_r.w, bm.an0.x > 0.0 ? 0.0 : bm.ab_eps.x,
-                                        bm.ab_eps.y, bm.ab_eps.z, soft, V, 0.0, tmax);
-            if (bm.an0.x > 0.0 && bm.ab_eps.x > 0.0)
-                h += bm.ab_eps.x * volfx_prim_piece(V, volfx_joint(bm.mode.z), vec3(0.0), 0.0, false, bm.an0.x, eps,
-                                                    0.0, tmax, soft);
-            if (bm.an0.y > 0.0 && bm.an0.z > 0.0 && tmax > 0.0)
-                h += bm.an0.z * volfx_prim_piece(V, volfx_joint(bm.mode.z + bm.mode.w - 1u), vec3(0.0), 0.0, false,
-                                                 bm.an0.y, eps, 0.0, tmax, soft);
-#else
-            h = volfx_polyline_integral(bm.mode.z, int(bm.mode.w), bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
-                                        bm.ab_eps.z, soft, V, 0.0, tmax);
-#endif
-        } else
-#endif
-#ifdef VOLFX_BEAMS_ANATOMY
-            h = volfx_beam_integral_anat(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
-                                         bm.ab_eps.z, soft, bm.an0, bm.an1, V, 0.0, tmax);
-#else
-            h = volfx_beam_integral(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, bm.d_r.w, bm.ab_eps.x, bm.ab_eps.y,
-                                    bm.ab_eps.z, soft, V, 0.0, tmax);
-#endif
-#endif
-        H += h;
         if (bm.mode.y != 0u) {
             Hth += h;
             tint += h * bm.color.rgb;
         } else if (h > 0.0) {
-            // capped where the pixel is white anyway: beam_settings.c 1e-30 or exposure 64 made
-            // x * x Inf, the ramp Inf / Inf NaN, and the beam vanished (issue 28)
-            float x = min(h * bm.look.y, LIGHT_MAX);
-#ifdef VOLFX_BEAMS_ANATOMY
-            if (bm.look2.x > 0.0 || bm.look2.y > 0.0) {
-#ifdef VOLFX_BEAMS_POLYLINE
-                vec3 nr = poly ? volfx_poly_nearest(bm.mode.z, int(bm.mode.w), V)
-                               : volfx_nearest(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, V);
-#else
-                vec3 nr = volfx_nearest(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, V);
-#endif
-                if (bm.look.z > 0.0) {
-                    float ph = nr.x * bm.ab_eps.w - bm.look.w, n;
-                    if (bm.look2.y > 0.0) { // a helix: stripes slanted by twist wavelengths across the tube
-                        float phi = asin(clamp(nr.z / bm.d_r.w, -1.0, 1.0));
-                        float c = 0.5 + 0.5 * cos(6.2831853 * (ph + bm.look2.z * phi / 3.14159265));
-                        n = c * c;
-                    } else {
-                        n = volfx_flow_noise(ph);
-                    }
-                    x *= 1.0 + bm.look.z * (2.0 * n - 1.0);
-                }
-                if (bm.look2.x > 0.0) {
-                    vec4 lw = volfx_core_ramp(bm, x, nr.y, V);
-                    light += lw.rgb;
-                    white += lw.a;
-                    continue;
-                }
-            } else
-#endif
-            if (bm.look.z > 0.0) {
-#ifdef VOLFX_BEAMS_POLYLINE
-                float u = poly ? volfx_poly_nearest_u(bm.mode.z, int(bm.mode.w), V)
-                               : volfx_nearest_u(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, V);
-#else
-                float u = volfx_nearest_u(bm.m_l.xyz, bm.d_r.xyz, bm.m_l.w, V);
-#endif
-                x *= 1.0 + bm.look.z * (2.0 * volfx_flow_noise(u * bm.ab_eps.w - bm.look.w) - 1.0);
-            }
-            float x2 = x * x;
-            light += bm.look.x * x * (bm.color.rgb + (1.0 - bm.color.rgb) * (x2 / (x2 + 9.0)));
+            light += volfx_beam_light(bm, h, V);
         }
+#endif
     }
-    if (Hth > 0.0) {
-        float I = u_smooth_saturation != 0 ? 1.0 - exp(-Hth / u_c) : min(Hth / u_c, 1.0);
-        light += tint / Hth * I;
-    }
+    light.rgb += volfx_thesis_light(Hth, tint);
+#ifdef VOLFX_BEAMS_WATER
+    if (Hth_b > 0.0)
+        behind.rgb += max(volfx_thesis_light(Hth + Hth_b, tint + tint_b) - volfx_thesis_light(Hth, tint), vec3(0.0));
+    o_acc = vec2(H, Hb);
+    o_behind = min(behind, vec4(LIGHT_MAX));
+#else
     o_acc = H;
-    o_light = vec4(min(light, vec3(LIGHT_MAX)), min(white, LIGHT_MAX)); // finite whatever the gain
+#endif
+    o_light = min(light, vec4(LIGHT_MAX)); // finite whatever the gain
 }

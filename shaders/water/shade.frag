@@ -17,6 +17,8 @@
 #include "common/depth.glsl"
 #include "common/sky.glsl"
 #include "water/white.glsl"
+#include "water/effect_lights.glsl"
+#include "water/effect_beams.glsl"
 layout(binding = 0) uniform sampler2D u_dist;
 layout(binding = 1) uniform sampler2D u_scene_color;
 layout(binding = 2) uniform sampler2D u_grad;   // xyz = grad sum P, w = sum P
@@ -134,6 +136,9 @@ bool ssr(vec3 x, vec3 r, float t, out vec3 col, out float fade)
             else a = m;
         }
         col = texelFetch(u_scene_color, pix, 0).rgb;
+#ifdef WATER_BEAMS
+        col += water_beams_seen(pix);
+#endif
         vec2 edge = smoothstep(vec2(1.0), vec2(0.85), abs(ndc.xy));
         fade = edge.x * edge.y * (1.0 - f * f);
         return true;
@@ -248,8 +253,12 @@ void main()
         // a step past the front so the first sample is inside (the front's refine tolerance)
         vec3 x = u_eye + (t + 1.0e-3 * u_h) * dir;
         thickness = refracted_thickness(x, rd, 2.0 * thickness + u_h, ep, inside);
+        ivec2 bp = water_behind_pixel(pix, ep, inside, length(x + thickness * rd - u_eye));
         if (u_has_color)
-            behind = texelFetch(u_scene_color, water_behind_pixel(pix, ep, inside, length(x + thickness * rd - u_eye)), 0).rgb;
+            behind = texelFetch(u_scene_color, bp, 0).rgb;
+#ifdef WATER_BEAMS
+        behind += water_beams_behind(bp);
+#endif
     }
     // the water's light: the sky (the host's cubemap or the procedural sky), the sun through the
     // surface, the surroundings (the host's image), the plugin's lights at the surface
@@ -265,6 +274,18 @@ void main()
     // bubbles: white specks behind the surface (already attenuated by the water in front)
     body += water_white(ambient, p, vec3(0.0)) * (1.0 - exp(-BUBBLE_K * foam_bub.g)) * u_tint * 1.5;
     vec3 col = water_surface(body, sky, n, -dir);
+#ifdef WATER_EFFECT_LIGHTS
+    {
+        // the beams' lights: a streak along the reflected beam (weighted by Fresnel) and the
+        // glow scattered in the body (weighted by what the body absorbs), as water_surface and
+        // water_body weigh the sun and the sky
+        float c = clamp(dot(-dir, n), 0.0, 1.0);
+        float r0 = pow((u_ior - 1.0) / (u_ior + 1.0), 2.0);
+        float fresnel = r0 + (1.0 - r0) * pow(1.0 - c, 5.0);
+        vec3 trans = exp(-u_absorption * thickness * (vec3(1.0) - u_tint));
+        col += water_effect_light_radiance(p, r, fresnel, trans, u_tint);
+    }
+#endif
     // foam on the surface hides what is under it, the glint too
     col = mix(col, white, 1.0 - exp(-FOAM_K * foam_bub.r));
     o_color = vec4(u_hdr ? col : min(col, vec3(1.0)), 1.0);

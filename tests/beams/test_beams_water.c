@@ -1,0 +1,136 @@
+/* Beams in the water (docs/beams.md "In the water"): a beam dipping into a pool of real water
+ * (the water effect over a slab of particles, the sample host), each pixel's ray split at the
+ * water's surface by the integrate pass: H over [0, t_water] (composited over the water) and
+ * H over [t_water, t_scene] (seen through the water's refraction), each held to the float64
+ * quadrature of the raw density over the same interval (reference/beams_ref.c), like
+ * test_beams_gl.c holds the unsplit H. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "app.h"
+#include "beams_ref.h"
+#include "beams/beams_impact.h"
+#include "debug.h"
+#include "test_camera.h"
+#include "test_util.h"
+
+#define W 64
+#define H 48
+#define T_FAR 50.0 /* the camera's far plane: where a ray with no surface ends */
+
+static game_app *g_app;
+static const ref_camera g_cam = {{0.2, 1.3, 4}, {0, -0.2, 0}, {0, 1, 0}, 0.9, W, H, 0.05, T_FAR};
+static test_log g_log;
+/* the beam dips from above the pool into it: its lower half is under the surface (y ~ 0) */
+static const vfx_beam k_beam = {.head = {-1.5f, 0.1f, 0.0f}, .dir = {1, -0.1f, 0}, .length = 2.5f,
+                                .radius = 0.5f, .a = 0.4f, .b = 0.25f, .eps = 0.05f};
+
+static int setup(void **state)
+{
+    (void)state;
+    g_app = test_app_with_camera(&g_cam, &g_log);
+    assert_int_equal(game_app_add_beams(g_app, &(vfx_beam2){.v1 = k_beam}, 1), VFX_OK);
+    g_app->beams_view = (vfx_beams_view){.size = sizeof(vfx_beams_view), .version = VFX_BEAMS_VIEW_VERSION};
+    /* a slab of water, spacing 0.08, its top at y ~ 0 */
+    enum { NX = 40, NY = 6, NZ = 25 };
+    static float px[NX * NY * NZ], py[NX * NY * NZ], pz[NX * NY * NZ];
+    uint32_t n = 0;
+    for (int i = 0; i < NX; ++i)
+        for (int j = 0; j < NY; ++j)
+            for (int k = 0; k < NZ; ++k, ++n)
+                px[n] = -1.6f + 0.08f * i, py[n] = -0.04f - 0.08f * j, pz[n] = -1.0f + 0.08f * k;
+    assert_int_equal(rt_particles_spawn(g_app->world, &g_app->particles, n, px, py, pz, false), VFX_OK);
+    g_app->water_enabled = true;
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    game_app_destroy(g_app);
+    return 0;
+}
+
+/* Every pixel: the front and the behind H against the quadrature over the same interval, with
+ * the same float32 t_water the GPU used (read back from the water's distance image). Tolerance as
+ * test_beams_gl.c's: 1e-5 ref + cond + cut where ref > 1e-6 of the image maximum (1e-6 of the
+ * maximum below), cond = the change of the exact H when a float32 input (ray, head) moves by 2 ulps
+ * (ref_beams_cond_abs, over the interval), cut = rho(t_water) x 1e-6 t_water: the split point
+ * enters the closed form as a float32 ray parameter measured from the closest approach, rounded
+ * to a few ulps of t (2^-24 t each), which moves H by rho there. */
+static void test_split_matches_reference(void **state)
+{
+    (void)state;
+    vfx_result fr = game_app_frame(g_app, 0.f);
+    if (fr)
+        printf("frame: %s\n", g_log.last);
+    assert_int_equal(fr, VFX_OK);
+    float *wd = malloc(W * H * sizeof(float)), *split = malloc(2 * W * H * sizeof(float));
+    assert_int_equal(g_app->api->read_raw(g_app->ctx, VFX_EFFECT_WATER, wd, W * H), VFX_OK);
+    assert_int_equal(volfx_beams_debug_split(g_app->ctx, split, 2 * W * H), VFX_OK);
+    volfx_beam_d b;
+    char err[128];
+    assert_int_equal(volfx_beam_validate(&k_beam, &b, err, sizeof err), VFX_OK);
+    double *ref = malloc(2 * W * H * sizeof(double)), hmax = 0;
+    for (uint32_t k = 0; k < W * H; ++k) {
+        double dir[3], tw = wd[k] >= 0 ? fmin(wd[k], T_FAR) : T_FAR;
+        ref_pixel_ray(&g_cam, k % W, k / W, dir);
+        ref[2 * k] = ref_beams_integral(&b, 1, g_cam.eye, dir, 0.0, tw, 1e-10, NULL);
+        ref[2 * k + 1] = tw < T_FAR ? ref_beams_integral(&b, 1, g_cam.eye, dir, tw, T_FAR, 1e-10, NULL) : 0.0;
+        hmax = fmax(hmax, ref[2 * k] + ref[2 * k + 1]);
+    }
+    int bad = 0, pixels = 0, split_px = 0, cond_needed = 0;
+    double max_ratio = 0, max_rel_wc = 0;
+    for (uint32_t k = 0; k < W * H; ++k) {
+        double dir[3], end[3], tw = wd[k] >= 0 ? fmin(wd[k], T_FAR) : T_FAR;
+        ref_pixel_ray(&g_cam, k % W, k / W, dir);
+        for (int c = 0; c < 3; ++c)
+            end[c] = g_cam.eye[c] + tw * dir[c];
+        double cut = tw < T_FAR ? volfx_beam_density_d(&b, end) * 1e-6 * tw : 0.0;
+        if (ref[2 * k + 1] > 1e-3 * hmax && ref[2 * k] > 1e-3 * hmax)
+            split_px++;
+        for (int part = 0; part < 2; ++part) {
+            double r = ref[2 * k + part], e = fabs(split[2 * k + part] - r);
+            double cond = ref_beams_cond_abs(&b, 1, g_cam.eye, dir, part ? tw : 0.0, part ? T_FAR : tw, 2.0);
+            bool bright = r > 1e-6 * hmax;
+            double tol = (bright ? 1e-5 * r : 1e-6 * hmax) + cond + cut;
+            max_ratio = fmax(max_ratio, e / tol);
+            if (bright) {
+                pixels++;
+                if (cond + cut < 1e-6 * r)
+                    max_rel_wc = fmax(max_rel_wc, e / r);
+                if (e / r > 1e-5)
+                    cond_needed++;
+            }
+            if (e > tol) {
+                printf("pixel %u %s: gpu %.7g ref %.7g err %.3g tol %.3g (cond %.3g cut %.3g, t_water %.6g)\n", k,
+                       part ? "behind" : "front", split[2 * k + part], r, e, tol, cond, cut, tw);
+                bad++;
+            }
+        }
+    }
+    printf("split at the water: %d pixels both sides above 1e-3 of max; %d pixel-parts above 1e-6 of max: "
+           "max rel err %.3g where well conditioned, %d above 1e-5 (within their conditioning), max err/tol %.3g\n",
+           split_px, pixels, max_rel_wc, cond_needed, max_ratio);
+    assert_int_equal(bad, 0);
+    assert_true(split_px >= 50);          /* the beam does cross the surface in view */
+    assert_true(max_rel_wc <= 1e-5);      /* the target, where the inputs allow it */
+    free(wd);
+    free(split);
+    free(ref);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_split_matches_reference),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
