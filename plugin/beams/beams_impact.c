@@ -256,13 +256,15 @@ vfx_result volfx_beams_impact_render(vfx_context *ctx, volfx_beams_impact *im, c
     im->emit_carry = want > 32.f ? 0.f : want - (float)emit;
     impact_block blk = {.eye_dt = {(float)t->view_eye[0], (float)t->view_eye[1], (float)t->view_eye[2], dt},
                         .params = {(float)fmod(time, 4096.0), GRAVITY, 0.025f, GLOW_TAU_S},
-                        .counts = {live ? im->count : 0, emit, im->frame++, 0}};
+                        .counts = {live ? im->count : 0, emit, im->frame++, t->water_dist != 0}};
     volfx_ubo_update(&im->ubo, &blk, sizeof blk);
     volfx_ubo_bind(&im->ubo, 5);
     glNamedBufferSubData(im->beam_buf, 0, (GLsizeiptr)(im->count ? im->count : 1) * sizeof(impact_beam_gpu), im->gpu);
     GLuint zero = 0;
     glClearNamedBufferSubData(im->counter_buf, GL_R32UI, 0, 3 * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     glBindTextureUnit(0, t->scene_depth);
+    if (t->water_dist)
+        glBindTextureUnit(1, t->water_dist);
     GLuint bufs[5] = {im->beam_buf, im->hit_buf, im->counter_buf, im->spark_buf, im->glow_buf};
     for (GLuint k = 0; k < 5; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, k, bufs[k]);
@@ -365,6 +367,35 @@ void volfx_beams_impact_lights(const volfx_beams_impact *im, vfx_lights *out)
         put_light(out, VFX_LIGHT_POINT, VFX_LIGHT_BEAM_IMPACT, i, p, p, im->beams[i].rgb,
                   IMPACT_INTENSITY * im->beams[i].gain);
     }
+}
+
+uint32_t volfx_beams_impact_water_events(const volfx_beams_impact *im, volfx_impact_event *out, uint32_t cap)
+{
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < im->known_beams && i < im->count; ++i) {
+        const float *h = im->known_hits[i];
+        const impact_beam *b = &im->beams[i];
+        if (h[3] == 0.f || h[7] == 0.f || b->n < 2)
+            continue;
+        if (n < cap) {
+            volfx_impact_event *e = &out[n];
+            /* the direction of travel: from the segment behind the head toward the head */
+            double d[3], len = 0;
+            for (int k = 0; k < 3; ++k)
+                d[k] = b->p[0][k] - b->p[1][k], len += d[k] * d[k];
+            len = sqrt(len);
+            for (int k = 0; k < 3; ++k) {
+                e->position[k] = h[k];
+                e->normal[k] = h[4 + k];
+                e->direction[k] = len > 0 ? (float)(d[k] / len) : -h[4 + k];
+            }
+            float m = fmaxf(b->rgb[0], fmaxf(b->rgb[1], b->rgb[2]));
+            e->energy = IMPACT_INTENSITY * b->gain * m;
+            e->beam = i;
+        }
+        n++;
+    }
+    return n;
 }
 
 uint32_t volfx_beams_impact_debug_hits(volfx_beams_impact *im, float (*out)[8], uint32_t n)

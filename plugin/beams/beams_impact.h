@@ -43,8 +43,20 @@ vfx_result volfx_beams_impact_render(vfx_context *ctx, volfx_beams_impact *im, c
  * writes at most out->capacity of them, sets out->count and out->total. */
 void volfx_beams_impact_lights(const volfx_beams_impact *im, vfx_lights *out);
 
+/* Where a beam struck the water (the newest read-back: one to three frames late), for the host's
+ * fluid: position relative to the origin, the surface's unit normal (facing the beam), the beam's
+ * unit direction of travel there, its energy (the impact light's intensity, 8 x intensity x
+ * 2^exposure x the colour's largest component), the beam's index. */
+typedef struct volfx_impact_event {
+    float position[3], normal[3], direction[3], energy;
+    uint32_t beam;
+} volfx_impact_event;
+/* Writes at most cap of this frame's impacts on the water into out (NULL with cap 0: count
+ * only); returns how many there are. */
+uint32_t volfx_beams_impact_water_events(const volfx_beams_impact *im, volfx_impact_event *out, uint32_t cap);
+
 /* Tests: copies the last hit pass's hits (stalls): per beam 8 floats, the hit position relative
- * to the origin and 1 (0: no hit), the surface normal and 0. At most n beams; returns how many. */
+ * to the origin and 1 (0: no hit), the surface normal and 1 on the water (0: the host's scene). At most n beams; returns how many. */
 uint32_t volfx_beams_impact_debug_hits(volfx_beams_impact *im, float (*out)[8], uint32_t n);
 /* Tests: copies the spark pool (stalls): 12 floats a spark (position, age; velocity, lifetime;
  * colour, 0), age < 0 or age >= lifetime: dead. Returns the pool size. */

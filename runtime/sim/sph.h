@@ -278,6 +278,14 @@ vfx_result rt_sph_settle(rt_sph *sim, const rt_sph_settle_desc *desc, rt_sph_set
 /* The Chebyshev weight PBF applies in its k-th iteration (1-based; 1 for k <= 1) at spectral
  * radius rho, by the recurrence the solver steps through (Wang 2015). */
 float rt_sph_chebyshev_weight(float rho, uint32_t k);
+/* An impulse where something hit the fluid (a beam striking the water; docs/simulation.md
+ * "Impacts"): every particle within `radius` of `centre` gets its velocity's component along
+ * u = normalize(unit(x - centre) - 0.7 dir) (dir: the hitting thing's direction of travel, NULL or
+ * zero for none) raised to speed (1 - r / radius)^2 when it is below that, never lowered. So a
+ * particle never leaves an impulse faster than |v| + speed, and repeated impulses (a beam held on
+ * the water) never drive the component past speed. Returns the particles changed; 0 for a
+ * non-positive or non-finite radius or speed. Call between steps. */
+uint32_t rt_sph_impulse(rt_sph *sim, const float centre[3], const float dir[3], float radius, float speed);
 /* The SoA columns (see the validity note above). */
 rt_sph_columns rt_sph_get_columns(rt_sph *sim);
 /* Pressure [Pa] of row i from the last density pass (0 when i is out of range). */

@@ -5,7 +5,7 @@
 layout(std140, binding = 5) uniform ImpactFrame {
     vec4 u_eye_dt;      // xyz: the eye relative to the origin (float), w: dt [s]
     vec4 u_params;      // x time (wrapped), y gravity [m/s^2], z spark shutter [s], w glow decay tau [s]
-    uvec4 u_counts;     // x beams, y sparks emitted per hit this frame, z frame seed, w 0
+    uvec4 u_counts;     // x beams, y sparks emitted per hit this frame, z frame seed, w 1: water in the frame
 };
 struct ImpactBeam {
     vec4 p[6];          // axis, camera-relative: head p[0] .. source p[n-1]
@@ -18,6 +18,7 @@ layout(std430, binding = 2) buffer Counters { uint counters[]; }; // hits, spark
 layout(std430, binding = 3) buffer Sparks { vec4 sparks[]; };   // 3 per spark: pos+age, vel+life, colour
 layout(std430, binding = 4) buffer Glows { vec4 glows[]; };     // 3 per glow: pos+age, normal+radius, energy+life
 layout(binding = 0) uniform sampler2D u_depth;
+layout(binding = 1) uniform sampler2D u_water;  // the water's ray distance (-1: none), when u_counts.w
 
 // The pixel that camera-relative P falls in; false behind the eye or off screen.
 bool impact_project(vec3 P, out ivec2 px)
@@ -34,12 +35,33 @@ bool impact_project(vec3 P, out ivec2 px)
     return true;
 }
 
-// The surface seen at pixel px (its centre's ray at the host depth), camera-relative; false for
-// the far plane (sky: no surface).
+// Whether the surface seen at pixel px is the water's (nearer than the host's there).
+bool impact_water_at(ivec2 px)
+{
+    if (u_counts.w == 0u)
+        return false;
+    float wd = texelFetch(u_water, px, 0).r;
+    if (!(wd >= 0.0))
+        return false;
+    float d = texelFetch(u_depth, px, 0).r;
+    if (d >= 1.0)
+        return true;
+    vec2 ndc = (vec2(px) + 0.5) / vfx_planes_size.zw * 2.0 - 1.0;
+    vec4 s = vfx_inv_cam_view_proj * vec4(ndc, d * 2.0 - 1.0, 1.0);
+    return wd < length(s.xyz / s.w);
+}
+
+// The surface seen at pixel px (its centre's ray at the host depth, or at the water's surface
+// where that is nearer), camera-relative; false for the far plane with no water (sky: no surface).
 bool impact_surface(ivec2 px, out vec3 S)
 {
     float d = texelFetch(u_depth, px, 0).r;
     vec2 ndc = (vec2(px) + 0.5) / vfx_planes_size.zw * 2.0 - 1.0;
+    if (impact_water_at(px)) {
+        vec4 m = vfx_inv_cam_view_proj * vec4(ndc, 0.0, 1.0);
+        S = normalize(m.xyz / m.w) * texelFetch(u_water, px, 0).r;
+        return true;
+    }
     vec4 s = vfx_inv_cam_view_proj * vec4(ndc, d * 2.0 - 1.0, 1.0);
     S = s.xyz / s.w;
     return d < 1.0;

@@ -1,6 +1,7 @@
 // impact_hit.comp — one invocation per beam: where the beam's axis, walked from its source to its
 // head and on past the head by R, first goes from in front of the host's depth to behind it.
-// The crossing is bisected to float precision; it is an impact only if the surface there is the
+// The surface is the nearer of the host's depth and the water's (a beam striking the water is an
+// impact on it, flagged for the host's fluid). The crossing is bisected to float precision; it is an impact only if the surface there is the
 // one the crossing went through (the point within a few pixel footprints of the surface seen at
 // its pixel), so a beam passing behind a pillar is not an impact. A hit emits this frame's sparks
 // and one glow spot (energy x dt, so the glow's level does not depend on the frame rate).
@@ -74,7 +75,9 @@ void main()
         return;
     vec3 pos = P + u_eye_dt.xyz;
     hits[3u * i] = vec4(pos, 1.0);
-    hits[3u * i + 1u] = vec4(nrm, 0.0);
+    ivec2 hp;
+    bool water = impact_project(P, hp) && impact_water_at(hp);
+    hits[3u * i + 1u] = vec4(nrm, water ? 1.0 : 0.0); // w: the surface hit is the water's
     hits[3u * i + 2u] = bm.color;
     atomicAdd(counters[0], 1u);
     atomicAdd(counters[2], 1u); // the glow spot below (impact_step counted the older ones)

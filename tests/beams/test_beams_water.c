@@ -127,10 +127,53 @@ static void test_split_matches_reference(void **state)
     free(ref);
 }
 
+/* A beam striking the water from above: its impact is found on the water's surface (not on the
+ * sky behind it: this scene has no host geometry at all), flagged as the water's, and reported as
+ * a water impact event with the beam's direction of travel. */
+static void test_impact_on_water(void **state)
+{
+    (void)state;
+    uint32_t nb;
+    vfx_beam2 *b = game_app_beams(g_app, &nb);
+    assert_int_equal(nb, 1);
+    /* head 0.25 under the slab's top particles, the trail rising to the caster above and behind */
+    const float head[3] = {0.3f, -0.3f, 0.2f}, dir[3] = {-0.8f, 0.6f, 0.0f};
+    b->v1 = k_beam;
+    memcpy(b->v1.head, head, sizeof head);
+    memcpy(b->v1.dir, dir, sizeof dir);
+    b->v1.length = 2.0f;
+    b->v1.radius = 0.15f;
+    for (int f = 0; f < 4; ++f) /* the events are read back one to three frames late */
+        assert_int_equal(game_app_frame(g_app, 1.f / 60), VFX_OK);
+    volfx_beams_impact *im = volfx_beams_impact_of(g_app->ctx);
+    assert_non_null(im);
+    float hits[1][8];
+    assert_int_equal(volfx_beams_impact_debug_hits(im, hits, 1), 1);
+    printf("hit at (%.3f, %.3f, %.3f), normal (%.3f, %.3f, %.3f), on the water: %g\n", hits[0][0], hits[0][1],
+           hits[0][2], hits[0][4], hits[0][5], hits[0][6], hits[0][7]);
+    assert_true(hits[0][3] == 1.f); /* a hit, */
+    assert_true(hits[0][7] == 1.f); /* on the water */
+    /* on the axis, at the water's surface: between the top particles (y -0.04) and a kernel
+     * radius above them (the metaball surface lies there) */
+    assert_true(hits[0][1] > -0.06f && hits[0][1] < 0.12f);
+    double t = (hits[0][1] - head[1]) / dir[1];
+    assert_float_equal(hits[0][0], head[0] + t * dir[0], 0.02);
+    assert_float_equal(hits[0][2], head[2], 0.02);
+    assert_true(hits[0][5] > 0.5f); /* the surface faces up */
+    volfx_impact_event ev[2];
+    assert_int_equal(volfx_beams_impact_water_events(im, ev, 2), 1);
+    /* travel: from the caster toward the head, i.e. -dir */
+    assert_float_equal(ev[0].direction[0], 0.8f, 1e-5);
+    assert_float_equal(ev[0].direction[1], -0.6f, 1e-5);
+    assert_true(ev[0].energy > 0 && ev[0].beam == 0);
+    b->v1 = k_beam;
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_split_matches_reference),
+        cmocka_unit_test(test_impact_on_water),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
