@@ -26,7 +26,7 @@ vfx_result volfx_water_lights_frame(vfx_context *ctx, volfx_water_lights *wl, ui
     if (!im)
         return VFX_OK;
     vfx_light src[VOLFX_WATER_MAX_LIGHTS];
-    vfx_lights l = {.size = sizeof l, .version = VFX_LIGHTS_VERSION, .capacity = VOLFX_WATER_MAX_LIGHTS, .lights = src};
+    vfx_lights l = {.type = VFX_TYPE_LIGHTS, .capacity = VOLFX_WATER_MAX_LIGHTS, .lights = src};
     volfx_beams_impact_lights(im, &l);
     volfx_stat_set(ctx, "water.effect_lights", l.count);
     if (l.total > l.count)

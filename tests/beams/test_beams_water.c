@@ -29,15 +29,16 @@ static game_app *g_app;
 static const ref_camera g_cam = {{0.2, 1.3, 4}, {0, -0.2, 0}, {0, 1, 0}, 0.9, W, H, 0.05, T_FAR};
 static test_log g_log;
 /* the beam dips from above the pool into it: its lower half is under the surface (y ~ 0) */
-static const vfx_beam k_beam = {.head = {-1.5f, 0.1f, 0.0f}, .dir = {1, -0.1f, 0}, .length = 2.5f,
-                                .radius = 0.5f, .a = 0.4f, .b = 0.25f, .eps = 0.05f};
+static const vfx_beam k_beam = {.type = VFX_TYPE_BEAM, .head = {-1.5f, 0.1f, 0.0f}, .dir = {1, -0.1f, 0},
+                                .length = 2.5f, .radius = 0.5f, .a = 0.4f, .b = 0.25f, .eps = 0.05f,
+                                .falloff = VFX_BEAM_FALLOFF_HARD, .ramp = VFX_BEAM_RAMP_THESIS};
 
 static int setup(void **state)
 {
     (void)state;
     g_app = test_app_with_camera(&g_cam, &g_log);
-    assert_int_equal(game_app_add_beams(g_app, &(vfx_beam2){.v1 = k_beam}, 1), VFX_OK);
-    g_app->beams_view = (vfx_beams_view){.size = sizeof(vfx_beams_view), .version = VFX_BEAMS_VIEW_VERSION};
+    assert_int_equal(game_app_add_beams(g_app, &k_beam, 1), VFX_OK);
+    g_app->beams_view = (vfx_beams_view){.type = VFX_TYPE_BEAMS_VIEW, .bloom = VFX_BEAMS_BLOOM_OFF};
     /* a slab of water, spacing 0.08, its top at y ~ 0 */
     enum { NX = 40, NY = 6, NZ = 25 };
     static float px[NX * NY * NZ], py[NX * NY * NZ], pz[NX * NY * NZ];
@@ -134,15 +135,15 @@ static void test_impact_on_water(void **state)
 {
     (void)state;
     uint32_t nb;
-    vfx_beam2 *b = game_app_beams(g_app, &nb);
+    vfx_beam *b = game_app_beams(g_app, &nb);
     assert_int_equal(nb, 1);
     /* head 0.25 under the slab's top particles, the trail rising to the caster above and behind */
     const float head[3] = {0.3f, -0.3f, 0.2f}, dir[3] = {-0.8f, 0.6f, 0.0f};
-    b->v1 = k_beam;
-    memcpy(b->v1.head, head, sizeof head);
-    memcpy(b->v1.dir, dir, sizeof dir);
-    b->v1.length = 2.0f;
-    b->v1.radius = 0.15f;
+    *b = k_beam;
+    memcpy(b->head, head, sizeof head);
+    memcpy(b->dir, dir, sizeof dir);
+    b->length = 2.0f;
+    b->radius = 0.15f;
     for (int f = 0; f < 4; ++f) /* the events are read back one to three frames late */
         assert_int_equal(game_app_frame(g_app, 1.f / 60), VFX_OK);
     volfx_beams_impact *im = volfx_beams_impact_of(g_app->ctx);
@@ -166,7 +167,7 @@ static void test_impact_on_water(void **state)
     assert_float_equal(ev[0].direction[0], 0.8f, 1e-5);
     assert_float_equal(ev[0].direction[1], -0.6f, 1e-5);
     assert_true(ev[0].energy > 0 && ev[0].beam == 0);
-    b->v1 = k_beam;
+    *b = k_beam;
 }
 
 int main(void)

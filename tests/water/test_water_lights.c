@@ -232,11 +232,11 @@ static int setup(void **state)
 {
     (void)state;
     static test_log log;
-    static vfx_host_api host;
-    host = (vfx_host_api){.size = sizeof host, .version = VFX_HOST_API_VERSION, .gl_get_proc_address = test_gl_proc,
-                          .user = &log, .log = test_log_fn};
+    static vfx_context_desc host;
+    host = (vfx_context_desc){.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = &log,
+                              .log = test_vfx_log_fn};
     static vfx_plugin_api api;
-    api.size = sizeof api;
+    api.type = VFX_TYPE_PLUGIN_API;
     if (vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api) != VFX_OK || api.create(&host, &g_ctx) != VFX_OK)
         return -1;
     g_api = &api;
