@@ -419,10 +419,21 @@ static vfx_result plugin_get_lights(vfx_context *ctx, vfx_lights *out)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "get_lights: capacity %u with a NULL lights array",
                           out->capacity);
     out->count = out->total = 0;
+    /* a chained vfx_impact_events (ABI 1.1) is an output too: the host's, so not const */
+    vfx_impact_events *ev = (vfx_impact_events *)volfx_chain_find(out->next, VFX_TYPE_IMPACT_EVENTS);
+    if (ev && ev->capacity && !ev->events)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "get_lights: vfx_impact_events capacity %u with a NULL "
+                          "events array", ev->capacity);
+    if (ev)
+        ev->count = ev->total = 0;
 #if VFX_WITH_BEAMS
     volfx_beams_impact *im = volfx_beams_impact_of(ctx);
     if (im)
         volfx_beams_impact_lights(im, out);
+    if (im && ev) {
+        ev->total = volfx_beams_impact_water_events(im, (volfx_impact_event *)ev->events, ev->capacity);
+        ev->count = ev->total < ev->capacity ? ev->total : ev->capacity;
+    }
 #endif
     return VFX_OK;
 }

@@ -441,9 +441,15 @@ vfx_result game_app_frame(game_app *app, float dt)
     rt_renderer_set_origin(app->renderer, app->origin);
     { /* the effects' lights on the meshes: beams' trails, heads and impacts */
         vfx_light lights[RT_RENDERER_MAX_LIGHTS];
-        vfx_lights l = {.type = VFX_TYPE_LIGHTS, .capacity = RT_RENDERER_MAX_LIGHTS, .lights = lights};
-        if (app->api->get_lights(app->ctx, &l) == VFX_OK)
+        /* and where beams struck the water (ABI 1.1), for the scene's fluid (game_demo_animate) */
+        vfx_impact_events ev = {.type = VFX_TYPE_IMPACT_EVENTS, .capacity = GAME_APP_MAX_IMPACTS,
+                                .events = app->impacts};
+        vfx_lights l = {.type = VFX_TYPE_LIGHTS, .next = &ev, .capacity = RT_RENDERER_MAX_LIGHTS, .lights = lights};
+        app->impact_count = 0;
+        if (app->api->get_lights(app->ctx, &l) == VFX_OK) {
             rt_renderer_set_lights(app->renderer, lights, l.count);
+            app->impact_count = ev.count;
+        }
     }
     rt_renderer_begin_scene(app->renderer, frame.view, frame.proj, app->clear_color);
     rt_component draw_terms[2] = {app->mesh_comp, app->transform_comp};

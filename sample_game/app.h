@@ -65,6 +65,10 @@ typedef struct game_app {
     rt_component mesh_comp, transform_comp; /* scene meshes are entities of the world */
     uint32_t mesh_count;
     bool water_enabled;        /* particles are drawn as water when true */
+    /* where beams struck the water, as of the last frame's get_lights (vfx_impact_events) */
+#define GAME_APP_MAX_IMPACTS 16
+    vfx_impact_event impacts[GAME_APP_MAX_IMPACTS];
+    uint32_t impact_count;
     /* every field (kernel: method TILE's; the others get isotropic); its next is set per call */
     vfx_water_params water;
     vfx_lab_water water_lab;   /* chained when it asks for something (lab method or bits) */

@@ -109,6 +109,7 @@ static vfx_result load_water(game_app *app, game_demo *demo, const rt_scene *sc)
             sd.flags |= RT_SPH_NO_GRAVITY;
         if (w->no_slip)
             sd.no_slip_faces = 0x3fu; /* every tank face */
+        demo->impact_strength = w->impact_strength, demo->impact_radius = w->impact_radius;
         if ((r = rt_sim_system_create(app->world, &sd, &demo->sim, err, sizeof err))) {
             rt_logf(&app->log, VFX_LOG_ERROR, "scene water simulation: %s", err);
             goto done;
@@ -467,9 +468,26 @@ vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path
     return VFX_OK;
 }
 
+/* Where a beam struck the water (the plugin's impact events of the last frame), the fluid is
+ * pushed (rt_sph_impulse; docs/simulation.md "Impacts"), before this frame's simulation step. */
+static void strike_water(game_app *app, game_demo *demo)
+{
+    if (!demo->sim || !(demo->impact_strength > 0) || (demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_WATER)))
+        return;
+    for (uint32_t i = 0; i < app->impact_count; ++i) {
+        const vfx_impact_event *e = &app->impacts[i];
+        if (rt_sph_impulse(rt_sim_system_solver(demo->sim), e->position, e->direction, demo->impact_radius,
+                           demo->impact_strength)) {
+            demo->impacts_applied++;
+            memcpy(demo->last_impact, e->position, sizeof demo->last_impact);
+        }
+    }
+}
+
 void game_demo_animate(game_app *app, game_demo *demo, float dt)
 {
-    (void)dt;
+    if (dt > 0)
+        strike_water(app, demo);
     if (demo->scene) /* keyframed: grow, thicken, move, turn */
         beams_at(app, demo, app->time);
     if (demo->scene && demo->vol_animated && game_app_volume(app, demo->vol_entity)) /* after the beams: they light it */

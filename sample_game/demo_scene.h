@@ -18,6 +18,9 @@ typedef struct game_demo {
     bool mouse_down;
     double mouse_x, mouse_y;
     rt_sim_system *sim;       /* SPH writing the particle columns (NULL without water) */
+    float impact_strength, impact_radius; /* water.simulation.impact_*: the push where a beam strikes */
+    uint32_t impacts_applied;  /* pushes so far, and where the last one was (tests) */
+    float last_impact[3];
     float *vol_points, *vol_scalar;
     /* the volume's table (the animated pulse adds 3 entries) and, when the scene animates the
      * volume, its loaded points and scalars that each frame starts from */

@@ -47,10 +47,7 @@ void volfx_beams_impact_lights(const volfx_beams_impact *im, vfx_lights *out);
  * fluid: position relative to the origin, the surface's unit normal (facing the beam), the beam's
  * unit direction of travel there, its energy (the impact light's intensity, 8 x intensity x
  * 2^exposure x the colour's largest component), the beam's index. */
-typedef struct volfx_impact_event {
-    float position[3], normal[3], direction[3], energy;
-    uint32_t beam;
-} volfx_impact_event;
+typedef vfx_impact_event volfx_impact_event;
 /* Writes at most cap of this frame's impacts on the water into out (NULL with cap 0: count
  * only); returns how many there are. */
 uint32_t volfx_beams_impact_water_events(const volfx_beams_impact *im, volfx_impact_event *out, uint32_t cap);

@@ -117,6 +117,9 @@ typedef struct rt_scene_water {
     bool no_slip;                    /* tank walls (all six faces) with wall-law friction */
     uint32_t solver;                 /* water.simulation.solver: 0 "wcsph", 1 "pbf" (rt_sph_solver); "pbf" */
     uint32_t settle_steps;           /* rt_sph_settle's steps at most before frame 0 (default 120; 0: none) */
+    float impact_strength;           /* m/s: a beam striking the water pushes the fluid near the hit up to
+                                      * this speed (rt_sph_impulse; default 4, 0: off) */
+    float impact_radius;             /* m: within this of the hit (default 0.25) */
     /* rendering (seed 000): every field, type filled (next unset: the host chains lab) */
     vfx_water_params params;
     /* the lab's switches the scene asks for (water.quality.disable, baseline methods) */

@@ -96,7 +96,7 @@ static vfx_result parse_water_generator(pctx *c, const cJSON *v, rt_scene_water 
 static vfx_result parse_water_simulation(pctx *c, const cJSON *v, rt_scene_water *w)
 {
     static const char *const skeys[] = {"tank", "fluid", "particle_count", "gravity", "dt", "paddle", "no_slip",
-                                        "solver", "settle_steps", NULL};
+                                        "solver", "settle_steps", "impact_strength", "impact_radius", NULL};
     static const char *const solvers[] = {"wcsph", "pbf", NULL}; /* rt_sph_solver order */
     vfx_result r;
     const char *PS = "water.simulation";
@@ -119,6 +119,10 @@ static vfx_result parse_water_simulation(pctx *c, const cJSON *v, rt_scene_water
     if (!r) r = rt_scene_get_enum(c, s, PS, "solver", false, solvers, &w->solver);
     w->settle_steps = 120; /* absent: the block settles before frame 0 (issue 22: it sank at ~1 m/s) */
     if (!r) r = rt_scene_get_uint(c, s, PS, "settle_steps", false, 0, 10000, &w->settle_steps);
+    /* a beam striking the water pushes the fluid (docs/simulation.md "Impacts"); 0 switches it off */
+    w->impact_strength = 4.f, w->impact_radius = 0.25f;
+    if (!r) r = rt_scene_get_float(c, s, PS, "impact_strength", false, (range){0, 50, false}, &w->impact_strength);
+    if (!r) r = rt_scene_get_float(c, s, PS, "impact_radius", false, (range){0.01, 10, false}, &w->impact_radius);
     if (r)
         return r;
     const cJSON *pd = cJSON_GetObjectItemCaseSensitive(s, "paddle");

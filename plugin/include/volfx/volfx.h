@@ -110,6 +110,7 @@ typedef enum vfx_struct_type {
     VFX_TYPE_LIGHTS = 9,
     VFX_TYPE_PLUGIN_API = 10,
     VFX_TYPE_GL_STATE_DESC = 11,
+    VFX_TYPE_IMPACT_EVENTS = 12, /* 1.1: chained into vfx_lights.next */
     VFX_TYPE_MAX_ENUM = 0x7fffffff
 } vfx_struct_type;
 
@@ -535,6 +536,27 @@ typedef struct vfx_lights {
     uint32_t total;      /* out: lights the plugin had (more than count when capacity fell short) */
     vfx_light *lights;
 } vfx_lights;
+
+/* Where a beam struck the water (ABI 1.1): an impact of a beam's axis on the water's surface, read
+ * back with the impact lights (one to three frames late), for a host whose fluid should answer it
+ * (the sample game pushes its particles there: docs/simulation.md "Impacts"). */
+typedef struct vfx_impact_event {
+    float position[3];   /* on the water's surface, relative to the frame's origin */
+    float normal[3];     /* the surface's unit normal there, facing the beam */
+    float direction[3];  /* the beam's unit direction of travel */
+    float energy;        /* the impact's radiant intensity (the I of its VFX_LIGHT_BEAM_IMPACT light) */
+    uint32_t beam;       /* the beam's index in the host's beams view */
+} vfx_impact_event;
+
+/* Chained into the vfx_lights given to get_lights (lights.next): the plugin fills it too. */
+typedef struct vfx_impact_events {
+    vfx_struct_type type; /* VFX_TYPE_IMPACT_EVENTS (set by the host) */
+    void *next;
+    uint32_t capacity;    /* entries at events */
+    uint32_t count;       /* out: entries written (<= capacity) */
+    uint32_t total;       /* out: impacts on the water the plugin had */
+    vfx_impact_event *events;
+} vfx_impact_events;
 
 /* ---------------------------------------------------------------------- plugin api */
 
