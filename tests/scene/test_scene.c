@@ -672,7 +672,7 @@ static void test_sample_scenes(void **state)
             free(xyz);
         }
         if (i == 0) {
-            assert_true(s->beam_count >= 3 && s->beam_count <= 4);
+            assert_true(s->beam_count >= 3 && s->beam_count <= 5); /* the fifth strikes the pool */
             assert_true(s->beams[0].joint_count >= 2 && s->beams[0].joint_track.count >= 2); /* it bends, animated */
             assert_true(s->has_water && s->water.source == RT_SCENE_WATER_SIMULATION && s->water.paddle);
             /* ramp_s absent: the paddle's amplitude ramps in over one period */
