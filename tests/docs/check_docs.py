@@ -18,8 +18,6 @@ PAGE_RULE_EXCEPTIONS = {
     "docs/abi.md",
     "docs/scene-format.md",
     # being rewritten by the docs helper, in the commits that follow
-    "docs/tetvol.md",
-    "docs/tetvol-mpi.md",
     "docs/benchmarks.md",
     "docs/benchmarks-beams.md",
     "docs/benchmarks-sim.md",
