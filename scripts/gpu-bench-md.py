@@ -2,14 +2,14 @@
 """Writes the markdown of docs/benchmarks-gpu.md from the JSON files scripts/gpu-bench.sh wrote.
 usage: gpu-bench-md.py DIR > docs/benchmarks-gpu.md     (DIR: gpu-bench.sh's --out)
        gpu-bench-md.py --none > docs/benchmarks-gpu.md  (the page before any GPU run)
-scripts/run-benchmarks.sh puts that page into docs/benchmarks.md with the other parts."""
+scripts/run-benchmarks.sh lists that page in docs/benchmarks.md with the other parts."""
 import json, os, sys
 
-HEAD = """# GPU figures (scripts/gpu-bench.sh)
+HEAD = """# GPU figures
 
 `scripts/gpu-bench.sh --prepare` here, then `scripts/gpu-bench.sh --out DIR` on a machine with an
 NVIDIA GPU (the device tool: carry `[".gl"]`), then `scripts/gpu-bench-md.py DIR >
-docs/benchmarks-gpu.md` and `scripts/run-benchmarks.sh --skip-effects`. Frame times are the
+docs/benchmarks-gpu.md` and `scripts/run-benchmarks.sh --index-only`. Frame times are the
 host's wall clock around update+render to `glFinish`, medians; "ms per pass" are the plugin's GPU
 timer queries (`<pass>.gpu_ms`) of the last frame. Water runs use flat shading (`--disable 64`).
 """

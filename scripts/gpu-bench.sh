@@ -22,7 +22,7 @@
 # water-table1.json, water-methods.json, beams-1080p.json, default-scene-1080p.json (each: command
 # lines, rows as the benches print them, configurations that ran out of time), gpu-bench.log and
 # benchmarks-gpu.md (scripts/gpu-bench-md.py): copy it to docs/benchmarks-gpu.md, then
-# scripts/run-benchmarks.sh --skip-effects puts it into docs/benchmarks.md ("GPU figures").
+# scripts/run-benchmarks.sh --index-only lists it in docs/benchmarks.md ("Figures by area").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD

@@ -18,10 +18,6 @@ PAGE_RULE_EXCEPTIONS = {
     "docs/abi.md",
     "docs/scene-format.md",
     # being rewritten by the docs helper, in the commits that follow
-    "docs/benchmarks.md",
-    "docs/benchmarks-beams.md",
-    "docs/benchmarks-sim.md",
-    "docs/benchmarks-water.md",
 }
 LINK = re.compile(r"!?\[[^\]]*\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)")
 
