@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
-"""The docs are reference pages (issue 36): every relative link and image in README.md,
-CONTRIBUTING.md and docs/*.md points at a file that exists, no page in docs/ is over 400 lines,
-and no heading is keyed to an issue, a round, a stop, a date or a superseded state (history
-stays in git). usage: check_docs.py SOURCE_ROOT"""
+"""The docs are reference pages: every relative link and image in README.md, CONTRIBUTING.md
+and docs/*.md points at a file that exists, every docs/<page>.md they name exists, no page in
+docs/ is over 400 lines, and no heading is keyed to an issue, a round, a stop, a date or a
+superseded state (history stays in git). usage: check_docs.py SOURCE_ROOT"""
 import os
 import re
 import sys
@@ -47,6 +47,9 @@ def check(root, rel):
             continue
         if ruled and line.startswith("#") and DIARY.search(line):
             fails.append("%s:%d: heading keyed to an issue/round/stop/date: %s" % (rel, n, line.strip()))
+        for page in re.findall(r"(?<![\w/.-])docs/[\w.-]+\.md\b", line):
+            if not os.path.isfile(os.path.join(root, page)):
+                fails.append("%s:%d: names %s, which does not exist" % (rel, n, page))
         for target in LINK.findall(line):
             if re.match(r"^[a-z][a-z0-9+.-]*:", target, re.I) or target.startswith("#"):
                 continue  # a URL or an anchor in the same page
