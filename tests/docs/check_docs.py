@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """The docs are reference pages: every relative link and image in README.md, CONTRIBUTING.md
-and docs/*.md points at a file that exists, every docs/<page>.md they name exists, no page in
-docs/ is over 400 lines, and no heading is keyed to an issue, a round, a stop, a date or a
-superseded state (history stays in git). usage: check_docs.py SOURCE_ROOT"""
+and docs/*.md points at a file that exists (at a heading, for an anchor), every docs/<page>.md
+they name exists, no page in docs/ is over 400 lines, and no heading is keyed to an issue, a
+round, a stop, a date or a superseded state (history stays in git).
+usage: check_docs.py SOURCE_ROOT"""
 import os
 import re
 import sys
@@ -20,6 +21,24 @@ PAGE_RULE_EXCEPTIONS = {
     # being rewritten by the docs helper, in the commits that follow
 }
 LINK = re.compile(r"!?\[[^\]]*\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)")
+
+
+def anchors(path):
+    """The anchors of a page's headings as GitHub makes them: lower case, punctuation but '-' and
+    '_' dropped, spaces as '-', a repeated heading suffixed -1, -2, ..."""
+    out, seen, fence = set(), {}, False
+    with open(path, encoding="utf-8") as f:
+        for line in f:
+            if line.lstrip().startswith("```"):
+                fence = not fence
+                continue
+            m = None if fence else re.match(r"#+\s+(.*)", line)
+            if m:
+                a = re.sub(r"[^\w\- ]", "", m.group(1).strip().lower()).replace(" ", "-")
+                n = seen.get(a, -1) + 1
+                seen[a] = n
+                out.add(a if n == 0 else "%s-%d" % (a, n))
+    return out
 
 
 def pages(root):
@@ -51,12 +70,18 @@ def check(root, rel):
             if not os.path.isfile(os.path.join(root, page)):
                 fails.append("%s:%d: names %s, which does not exist" % (rel, n, page))
         for target in LINK.findall(line):
-            if re.match(r"^[a-z][a-z0-9+.-]*:", target, re.I) or target.startswith("#"):
-                continue  # a URL or an anchor in the same page
-            file_part = target.split("#", 1)[0]
+            if re.match(r"^[a-z][a-z0-9+.-]*:", target, re.I):
+                continue  # a URL
+            if target.startswith("#"):
+                if target[1:] not in anchors(path):
+                    fails.append("%s:%d: no heading for the anchor %s" % (rel, n, target))
+                continue
+            file_part, _, anchor = target.partition("#")
             dest = os.path.normpath(os.path.join(os.path.dirname(path), file_part))
             if not os.path.exists(dest):
                 fails.append("%s:%d: broken link %s" % (rel, n, target))
+            elif anchor and dest.endswith(".md") and anchor not in anchors(dest):
+                fails.append("%s:%d: no heading for the anchor of %s" % (rel, n, target))
     return fails
 
 
