@@ -12,7 +12,7 @@
 
 /* ------------------------------------------------------------ logging, errors, memory */
 
-void volfx_log_id(vfx_context *ctx, vfx_log_level level, vfx_log_id id, const char *fmt, ...)
+void volfx_log(vfx_context *ctx, vfx_log_level level, vfx_log_id id, const char *fmt, ...)
 {
     char buf[1024];
     va_list ap;
@@ -23,7 +23,7 @@ void volfx_log_id(vfx_context *ctx, vfx_log_level level, vfx_log_id id, const ch
         ctx->host.log(ctx->host.user, level, id, buf);
 }
 
-vfx_result volfx_fail_id(vfx_context *ctx, vfx_result code, vfx_log_id id, const char *fmt, ...)
+vfx_result volfx_fail(vfx_context *ctx, vfx_result code, vfx_log_id id, const char *fmt, ...)
 {
     char buf[sizeof ctx->last_error];
     va_list ap;
@@ -44,7 +44,8 @@ vfx_result volfx_check_type(vfx_context *ctx, const void *p, vfx_struct_type wan
     vfx_struct_type got = ((const vfx_chain *)p)->type;
     if (got == want)
         return VFX_OK;
-    return volfx_fail_id(ctx, VFX_ERR_ABI, VFX_LOG_ID_STRUCT_TYPE, "%s has type %u, need %u (VFX_TYPE_* of its struct)",
+    return volfx_fail(ctx, VFX_ERR_ABI, VFX_LOG_ID_STRUCT_TYPE,
+                      "%s has type %u, need %u (VFX_TYPE_* of its struct)",
                          what, (unsigned)got, (unsigned)want);
 }
 
@@ -70,13 +71,15 @@ void *volfx_alloc(vfx_context *ctx, size_t size)
 {
     const size_t align = 64;
     if (size > SIZE_MAX - align - sizeof(alloc_header)) {
-        volfx_fail_id(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_OUT_OF_MEMORY, "allocation of %zu bytes is too large", size);
+        volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_OUT_OF_MEMORY,
+                   "allocation of %zu bytes is too large", size);
         return NULL;
     }
     size_t total = size + align + sizeof(alloc_header);
     void *base = ctx->host.alloc ? ctx->host.alloc(ctx->host.user, total, 16) : malloc(total);
     if (!base) {
-        volfx_fail_id(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_OUT_OF_MEMORY, "out of memory allocating %zu bytes", size);
+        volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_OUT_OF_MEMORY,
+                   "out of memory allocating %zu bytes", size);
         return NULL;
     }
     uintptr_t p = ((uintptr_t)base + sizeof(alloc_header) + align - 1) & ~(uintptr_t)(align - 1);

@@ -51,15 +51,14 @@ struct vfx_context {
     bool gl_skip_restore;       /* vfx_gl_state_desc.skip_restore: the host resets its own state, no save, no restore */
 };
 
-/* Logs through the host logger, printf-style, with the message's id. */
-void volfx_log_id(vfx_context *ctx, vfx_log_level level, vfx_log_id id, const char *fmt, ...)
+/* Logs through the host logger, printf-style, with the message's stable id (VFX_LOG_ID_LIST:
+ * add one there for a new kind of message). */
+void volfx_log(vfx_context *ctx, vfx_log_level level, vfx_log_id id, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
-#define volfx_log(ctx, level, ...) volfx_log_id((ctx), (level), VFX_LOG_ID_GENERIC, __VA_ARGS__)
 /* Records an error (last_error and its id + log at ERROR) and returns `code` for
- * `return volfx_fail_id(...)`. */
-vfx_result volfx_fail_id(vfx_context *ctx, vfx_result code, vfx_log_id id, const char *fmt, ...)
+ * `return volfx_fail(...)`. */
+vfx_result volfx_fail(vfx_context *ctx, vfx_result code, vfx_log_id id, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
-#define volfx_fail(ctx, code, ...) volfx_fail_id((ctx), (code), VFX_LOG_ID_GENERIC, __VA_ARGS__)
 /* The host's struct at `p` has `want` as its type; otherwise fails ctx (VFX_ERR_ABI,
  * VFX_LOG_ID_STRUCT_TYPE) naming `what` (the struct and where) and both types. */
 vfx_result volfx_check_type(vfx_context *ctx, const void *p, vfx_struct_type want, const char *what);

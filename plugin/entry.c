@@ -58,10 +58,11 @@ static vfx_result gl_profile(vfx_context *ctx)
                           : (mask & GL_CONTEXT_COMPATIBILITY_PROFILE_BIT) ? "compatibility profile"
                           : "no profile";
     if (major * 10 + minor < 45 || !strncmp(version, "OpenGL ES", 9))
-        return volfx_fail_id(ctx, VFX_ERR_GL_UNSUPPORTED, VFX_LOG_ID_GL_VERSION, "volfx needs desktop GL 4.5 (core or compatibility "
+        return volfx_fail(ctx, VFX_ERR_GL_UNSUPPORTED, VFX_LOG_ID_GL_VERSION,
+                          "volfx needs desktop GL 4.5 (core or compatibility "
                           "profile), the current context is %s, %s", version, profile);
     ctx->gl_compat = (mask & GL_CONTEXT_COMPATIBILITY_PROFILE_BIT) != 0;
-    volfx_log(ctx, VFX_LOG_DEBUG, "GL context %s, %s", version, profile);
+    volfx_log(ctx, VFX_LOG_DEBUG, VFX_LOG_ID_GL_INFO, "GL context %s, %s", version, profile);
     return VFX_OK;
 }
 
@@ -84,10 +85,11 @@ static vfx_result gl_load(vfx_context *ctx)
             return gl_profile(ctx); /* the refusal naming version and profile */
     }
     if (missing)
-        return volfx_fail_id(ctx, VFX_ERR_GL_UNSUPPORTED, VFX_LOG_ID_GL_COMMAND_MISSING,
+        return volfx_fail(ctx, VFX_ERR_GL_UNSUPPORTED, VFX_LOG_ID_GL_COMMAND_MISSING,
                              "host gl_get_proc_address found no '%s' (one of the %u GL 4.5 commands volfx uses)",
                           missing, lookups);
-    volfx_log(ctx, VFX_LOG_DEBUG, "%u GL commands resolved through the host's gl_get_proc_address", lookups);
+    volfx_log(ctx, VFX_LOG_DEBUG, VFX_LOG_ID_GL_INFO,
+              "%u GL commands resolved through the host's gl_get_proc_address", lookups);
     return VFX_OK;
 }
 
@@ -145,7 +147,7 @@ static vfx_result plugin_create(const vfx_context_desc *host, vfx_context **out)
     char msg[160];
     if (volfx_check_host(host, msg, sizeof msg)) {
         if (host->log)
-            host->log(host->user, VFX_LOG_ERROR, VFX_LOG_ID_GENERIC, msg);
+            host->log(host->user, VFX_LOG_ERROR, VFX_LOG_ID_CONTEXT_DESC, msg);
         return VFX_ERR_INVALID_ARGUMENT;
     }
     vfx_context *ctx = host->alloc ? host->alloc(host->user, sizeof *ctx, 64) : malloc(sizeof *ctx);
@@ -160,7 +162,8 @@ static vfx_result plugin_create(const vfx_context_desc *host, vfx_context **out)
     register_effects(ctx);
     vfx_result r = host->gl_get_proc_address
                        ? gl_load(ctx)
-                       : volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volfx create: the context description has no "
+                       : volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_CONTEXT_DESC,
+                                    "volfx create: the context description has no "
                                     "gl_get_proc_address (the plugin resolves every GL command through it)");
     if (r == VFX_OK && (r = gl_profile(ctx)) == VFX_OK) {
         gl_enter(ctx);
@@ -182,7 +185,7 @@ static vfx_result plugin_create(const vfx_context_desc *host, vfx_context **out)
 static vfx_result resize(vfx_context *ctx, uint32_t width, uint32_t height)
 {
     if (width == 0 || height == 0 || width > 16384 || height > 16384)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_RESIZE_RANGE,
                         "resize: %ux%u outside 1..16384 in each direction", width, height);
     const uint32_t old_w = ctx->width, old_h = ctx->height;
     ctx->width = width;
@@ -195,6 +198,7 @@ static vfx_result resize(vfx_context *ctx, uint32_t width, uint32_t height)
         return VFX_OK;
     char why[512];
     snprintf(why, sizeof why, "%s", ctx->last_error);
+    const vfx_log_id why_id = ctx->last_error_id; /* the cause's kind is the failure's */
     while (glGetError() != GL_NO_ERROR) { /* the failure's GL_OUT_OF_MEMORY is not the next call's */
     }
     ctx->width = old_w;
@@ -207,7 +211,8 @@ static vfx_result resize(vfx_context *ctx, uint32_t width, uint32_t height)
         ctx->effect_state[k] = NULL;
         ctx->rendered &= ~VFX_EFFECT_BIT(k);
     }
-    return volfx_fail(ctx, r, "resize to %ux%u failed, the context stays at %ux%u: %s", width, height, old_w, old_h, why);
+    return volfx_fail(ctx, r, why_id,
+                      "resize to %ux%u failed, the context stays at %ux%u: %s", width, height, old_w, old_h, why);
 }
 
 static vfx_result plugin_resize(vfx_context *ctx, uint32_t width, uint32_t height)
@@ -221,11 +226,12 @@ static vfx_result plugin_resize(vfx_context *ctx, uint32_t width, uint32_t heigh
 static vfx_result update(vfx_context *ctx, double time, float dt)
 {
     if (!isfinite(time) || !isfinite(dt))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "update: time %g or dt %g is not finite",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_UPDATE_TIME,
+                          "update: time %g or dt %g is not finite",
                         time, (double)dt);
     char msg[160];
     if (volfx_check_host(&ctx->host, msg, sizeof msg))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "update: %s", msg);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_CONTEXT_DESC, "update: %s", msg);
     for (int k = 0; k < VFX_EFFECT_COUNT; ++k) {
         const volfx_effect_ops *ops = ctx->effect_ops[k];
         if (!ops)
@@ -237,14 +243,15 @@ static vfx_result update(vfx_context *ctx, double time, float dt)
             vfx_result r = ops->create(ctx, &ctx->effect_state[k]);
             if (r)
                 return r;
-            volfx_log(ctx, VFX_LOG_DEBUG, "effect %s created", ops->name);
+            volfx_log(ctx, VFX_LOG_DEBUG, VFX_LOG_ID_EFFECT_CREATED, "effect %s created", ops->name);
             if (ctx->width && ops->resize
                 && (r = ops->resize(ctx, ctx->effect_state[k], ctx->width, ctx->height)))
                 return r;
         } else if (!present && ctx->effect_state[k]) {
             ops->destroy(ctx, ctx->effect_state[k]);
             ctx->effect_state[k] = NULL;
-            volfx_log(ctx, VFX_LOG_DEBUG, "effect %s destroyed (absent from the world)", ops->name);
+            volfx_log(ctx, VFX_LOG_DEBUG, VFX_LOG_ID_EFFECT_DESTROYED,
+                      "effect %s destroyed (absent from the world)", ops->name);
         }
         if (ctx->effect_state[k]) {
             vfx_result r = ops->update(ctx, ctx->effect_state[k], time, dt);
@@ -337,7 +344,7 @@ static vfx_result plugin_get_stats(vfx_context *ctx, vfx_stats *out)
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
     if (!out)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "get_stats: out is NULL");
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_API_ARGUMENT, "get_stats: out is NULL");
     vfx_result r = volfx_check_type(ctx, out, VFX_TYPE_STATS, "get_stats: vfx_stats");
     if (r)
         return r;
@@ -357,19 +364,25 @@ static const char *plugin_last_error(vfx_context *ctx, vfx_log_id *id_out)
 static vfx_result read_raw(vfx_context *ctx, vfx_effect_kind effect, float *out, size_t count)
 {
     if (!out)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "read_raw: out is NULL (count %zu)", count);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_API_ARGUMENT,
+                          "read_raw: out is NULL (count %zu)", count);
     if ((unsigned)effect >= VFX_EFFECT_COUNT)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "read_raw: effect %d out of range", (int)effect);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_API_ARGUMENT,
+                          "read_raw: effect %d out of range", (int)effect);
     if (!ctx->effect_ops[effect])
-        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, "read_raw: effect %d is not built in", (int)effect);
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_EFFECT_NOT_BUILT,
+                          "read_raw: effect %d is not built in", (int)effect);
     if (!ctx->effect_state[effect])
-        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "read_raw: effect %s is absent from the world",
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, VFX_LOG_ID_EFFECT_NOT_RENDERED,
+                          "read_raw: effect %s is absent from the world",
                         ctx->effect_ops[effect]->name);
     if (!(ctx->rendered & VFX_EFFECT_BIT(effect)))
-        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "read_raw: effect %s has not been rendered since it was "
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, VFX_LOG_ID_EFFECT_NOT_RENDERED,
+                          "read_raw: effect %s has not been rendered since it was "
                           "created (nothing to read)", ctx->effect_ops[effect]->name);
     if (count < (size_t)ctx->width * ctx->height)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "read_raw: buffer of %zu floats, need %ux%u",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_READ_BUFFER_SIZE,
+                          "read_raw: buffer of %zu floats, need %ux%u",
                         count, ctx->width, ctx->height);
     return ctx->effect_ops[effect]->read_raw(ctx, ctx->effect_state[effect], out, count);
 }
@@ -411,18 +424,20 @@ static vfx_result plugin_get_lights(vfx_context *ctx, vfx_lights *out)
     if (!ctx)
         return VFX_ERR_INVALID_ARGUMENT;
     if (!out)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "get_lights: out is NULL");
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_API_ARGUMENT, "get_lights: out is NULL");
     vfx_result r = volfx_check_type(ctx, out, VFX_TYPE_LIGHTS, "get_lights: vfx_lights");
     if (r)
         return r;
     if (out->capacity && !out->lights)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "get_lights: capacity %u with a NULL lights array",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_API_ARGUMENT,
+                          "get_lights: capacity %u with a NULL lights array",
                           out->capacity);
     out->count = out->total = 0;
     /* a chained vfx_impact_events (ABI 1.1) is an output too: the host's, so not const */
     vfx_impact_events *ev = (vfx_impact_events *)volfx_chain_find(out->next, VFX_TYPE_IMPACT_EVENTS);
     if (ev && ev->capacity && !ev->events)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "get_lights: vfx_impact_events capacity %u with a NULL "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_API_ARGUMENT,
+                          "get_lights: vfx_impact_events capacity %u with a NULL "
                           "events array", ev->capacity);
     if (ev)
         ev->count = ev->total = 0;

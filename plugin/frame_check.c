@@ -88,12 +88,14 @@ static vfx_result check_texture(vfx_context *ctx, const char *field, GLuint name
                                 uint32_t h)
 {
     if (!glIsTexture(name))
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view %s %u is not a texture name "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view %s %u is not a texture name "
                           "of this GL context", field, name);
     GLint target = texture_target(name);
     GLint need = want == WANT_CUBE ? GL_TEXTURE_CUBE_MAP : GL_TEXTURE_2D;
     if (target != need)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view %s %u is %s texture, need %s texture",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view %s %u is %s texture, need %s texture",
                           field, name, target_name(target), target_name(need));
     if (want == WANT_CUBE)
         return VFX_OK;
@@ -104,13 +106,16 @@ static vfx_result check_texture(vfx_context *ctx, const char *field, GLuint name
     glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_DEPTH_SIZE, &dbits);
     glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_RED_SIZE, &rbits);
     if (want == WANT_DEPTH && dbits == 0)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view depth_texture %u has internal "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view depth_texture %u has internal "
                           "format 0x%04x, not a depth format", name, (unsigned)fmt);
     if (want == WANT_COLOR && (dbits > 0 || rbits == 0))
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view color_texture %u has internal "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view color_texture %u has internal "
                           "format 0x%04x, not a colour format", name, (unsigned)fmt);
     if (tw != (GLint)w || th != (GLint)h)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view %s %u is %dx%d, the frame view "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view %s %u is %dx%d, the frame view "
                           "%ux%u (they must match)", field, name, tw, th, w, h);
     return VFX_OK;
 }
@@ -118,16 +123,19 @@ static vfx_result check_texture(vfx_context *ctx, const char *field, GLuint name
 static vfx_result check_framebuffer(vfx_context *ctx, GLuint fb, uint32_t w, uint32_t h, bool *srgb)
 {
     if (!glIsFramebuffer(fb))
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view framebuffer %u is not a "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view framebuffer %u is not a "
                           "framebuffer name of this GL context", fb);
     GLenum st = glCheckNamedFramebufferStatus(fb, GL_DRAW_FRAMEBUFFER);
     if (st != GL_FRAMEBUFFER_COMPLETE)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view framebuffer %u is not complete "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view framebuffer %u is not complete "
                           "(status 0x%04x)", fb, (unsigned)st);
     GLint type = GL_NONE, obj = 0, aw = -1, ah = -1;
     glGetNamedFramebufferAttachmentParameteriv(fb, GL_COLOR_ATTACHMENT0, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
     if (type == GL_NONE)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view framebuffer %u has no colour "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view framebuffer %u has no colour "
                           "attachment 0", fb);
     glGetNamedFramebufferAttachmentParameteriv(fb, GL_COLOR_ATTACHMENT0, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &obj);
     GLint encoding = GL_LINEAR;
@@ -144,7 +152,8 @@ static vfx_result check_framebuffer(vfx_context *ctx, GLuint fb, uint32_t w, uin
         glGetNamedRenderbufferParameteriv((GLuint)obj, GL_RENDERBUFFER_HEIGHT, &ah);
     }
     if (aw >= 0 && (aw < (GLint)w || ah < (GLint)h))
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view framebuffer %u colour attachment "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view framebuffer %u colour attachment "
                           "is %dx%d, smaller than the frame view %ux%u", fb, aw, ah, w, h);
     return VFX_OK;
 }
@@ -177,27 +186,33 @@ static vfx_result check_planes(vfx_context *ctx, vfx_frame_view *v)
     double n = 0, f = 0, ftol = 0;
     bool known = volfx_projection_planes(v->proj, &n, &f, &ftol);
     if (known && !(n > 0 && f > n))
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view proj maps near %g and far %g "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view proj maps near %g and far %g "
                           "(from proj[10], proj[14]); need 0 < near < far", n, f);
     if (v->near_plane == 0 && v->far_plane == 0) {
         if (!known)
-            return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view near_plane and far_plane are "
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                              "render: frame view near_plane and far_plane are "
                               "0 and proj is neither perspective nor orthographic: give both");
         v->near_plane = (float)n;
         v->far_plane = isinf(f) || f > FLT_MAX ? FLT_MAX : (float)f;
         return VFX_OK;
     }
     if (!isfinite(v->near_plane) || !(v->near_plane > 0))
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view near_plane %g must be > 0",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view near_plane %g must be > 0",
                           (double)v->near_plane);
     if (!isfinite(v->far_plane) || !(v->far_plane > v->near_plane))
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view far_plane %g must be finite and "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view far_plane %g must be finite and "
                           "> near_plane %g", (double)v->far_plane, (double)v->near_plane);
     if (known && fabs(v->near_plane - n) > 1e-3 * n)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view near_plane %g, but proj has near "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view near_plane %g, but proj has near "
                           "%g", (double)v->near_plane, n);
     if (known && !isinf(f) && fabs(v->far_plane - f) > ftol * f)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view far_plane %g, but proj has far %g",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view far_plane %g, but proj has far %g",
                           (double)v->far_plane, f);
     return VFX_OK;
 }
@@ -223,7 +238,8 @@ static vfx_result far_depth(vfx_context *ctx, uint32_t w, uint32_t h, unsigned *
         glClearTexImage(t, 0, GL_DEPTH_COMPONENT, GL_FLOAT, &one);
         volfx_gpu_label(GL_TEXTURE, t, "volfx.no_scene_depth");
         if (!t)
-            return volfx_fail_id(ctx, VFX_ERR_GL, VFX_LOG_ID_FRAME_VIEW, "render: could not make the far-depth texture for depth_texture 0");
+            return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR,
+                              "render: could not make the far-depth texture for depth_texture 0");
         ctx->no_depth_tex = t;
         ctx->no_depth_w = w;
         ctx->no_depth_h = h;
@@ -241,11 +257,13 @@ static vfx_result read_view(vfx_context *ctx, const vfx_frame_view *frame, uint3
         return r;
     *view_id = frame->view_id;
     if (frame->width == 0 || frame->height == 0)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame is %ux%u", frame->width,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame is %ux%u", frame->width,
                           frame->height);
     for (int i = 0; i < 16; ++i)
         if (!isfinite(frame->view[i]) || !isfinite(frame->proj[i]))
-            return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: camera matrix element %d is not finite", i);
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                              "render: camera matrix element %d is not finite", i);
     *checked = *frame;
     checked->next = NULL;
     return VFX_OK;
@@ -257,12 +275,15 @@ static vfx_result derive_camera(vfx_context *ctx, const vfx_frame_view *checked,
     const vfx_frame_view *v = checked;
     volfx_mat4_mul(v->proj, v->view, t->view_proj);
     if (!volfx_mat4_invert(t->view_proj, t->inv_view_proj))
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: view*projection is singular");
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: view*projection is singular");
     if (!volfx_mat4_invert(v->view, t->inv_view))
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: view matrix is singular");
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: view matrix is singular");
     for (int i = 0; i < 3; ++i) {
         if (!isfinite(checked->origin[i]))
-            return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view origin[%d] is not finite", i);
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                              "render: frame view origin[%d] is not finite", i);
         t->origin[i] = checked->origin[i];
     }
     t->color_hdr = checked->color_hdr != 0;
@@ -274,7 +295,8 @@ static vfx_result derive_camera(vfx_context *ctx, const vfx_frame_view *checked,
     view_rot[12] = view_rot[13] = view_rot[14] = 0.f;
     volfx_mat4_mul(v->proj, view_rot, t->cam_view_proj);
     if (!volfx_mat4_invert(t->cam_view_proj, t->inv_cam_view_proj))
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: camera rotation*projection is singular");
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: camera rotation*projection is singular");
     /* eye = -R^T t from the view matrix (exact for the matrices used, whatever eye says) */
     for (int k = 0; k < 3; ++k)
         t->view_eye[k] = -((double)v->view[k * 4 + 0] * v->view[12] + (double)v->view[k * 4 + 1] * v->view[13]
@@ -288,7 +310,7 @@ vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx
     memset(t, 0, sizeof *t);
     memset(checked, 0, sizeof *checked);
     if (!frame)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view is NULL");
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view is NULL");
     vfx_result r = read_view(ctx, frame, &t->view_id, checked);
     if (r)
         return r;
@@ -297,7 +319,8 @@ vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx
     vfx_frame_view *v = checked;
     for (int k = 0; k < 3; ++k)
         if (!isfinite(v->eye[k]))
-            return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view eye[%d] is not finite", k);
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                              "render: frame view eye[%d] is not finite", k);
     /* eye against the view matrix's own (inverse translation, double cofactors rounded once to
      * float): a host's float32 lookAt rounds R and t (~1 ulp each), leaves R^T R - I at a few
      * ulps and t's dot products at ~3, so the two differ by <~ 20 FLT_EPSILON max(|eye|, |t|, 1);
@@ -315,15 +338,18 @@ vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx
         for (int k = 0; k < 3; ++k)
             v->eye[k] = t->inv_view[12 + k];
     if (!unset && off > 256 * FLT_EPSILON * scale)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view eye (%g, %g, %g) is not the view "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view eye (%g, %g, %g) is not the view "
                           "matrix's eye (%g, %g, %g): off by %g, more than %g", (double)v->eye[0], (double)v->eye[1],
                           (double)v->eye[2], (double)t->inv_view[12], (double)t->inv_view[13],
                           (double)t->inv_view[14], off, 256 * FLT_EPSILON * scale);
     if (!isfinite(v->fov_y) || v->fov_y < 0 || v->fov_y >= 3.14159265f)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view fov_y %g outside [0, pi) radians",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view fov_y %g outside [0, pi) radians",
                           (double)v->fov_y);
     if (v->effects & ~((1u << VFX_EFFECT_COUNT) - 1))
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view effects 0x%x has bits of no effect "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view effects 0x%x has bits of no effect "
                           "(known: 0x%x)", v->effects, (1u << VFX_EFFECT_COUNT) - 1);
     if ((r = check_planes(ctx, v)))
         return r;
@@ -381,21 +407,25 @@ static vfx_result layer_target(vfx_context *ctx, volfx_frame_targets *t)
 {
     GLuint name = t->layer_texture;
     if (!glIsTexture(name))
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_LAYER_TEXTURE, "render: frame view layer_texture %u is not a texture name "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_LAYER_TEXTURE,
+                          "render: frame view layer_texture %u is not a texture name "
                           "of this GL context", name);
     GLint target = 0, tw = 0, th = 0, fmt = 0;
     glGetTextureParameteriv(name, GL_TEXTURE_TARGET, &target);
     if (target != GL_TEXTURE_2D)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_LAYER_TEXTURE, "render: frame view layer_texture %u is a %s texture, need %s",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_LAYER_TEXTURE,
+                          "render: frame view layer_texture %u is a %s texture, need %s",
                           name, target_name(target), target_name(GL_TEXTURE_2D));
     glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_WIDTH, &tw);
     glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_HEIGHT, &th);
     glGetTextureLevelParameteriv(name, 0, GL_TEXTURE_INTERNAL_FORMAT, &fmt);
     if (fmt != GL_RGBA16F)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_LAYER_TEXTURE, "render: frame view layer_texture %u has internal format "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_LAYER_TEXTURE,
+                          "render: frame view layer_texture %u has internal format "
                           "0x%04x, need GL_RGBA16F (0x%04x)", name, (unsigned)fmt, (unsigned)GL_RGBA16F);
     if (tw != (GLint)t->width || th != (GLint)t->height)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_LAYER_TEXTURE, "render: frame view layer_texture %u is %dx%d, the frame view "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_LAYER_TEXTURE,
+                          "render: frame view layer_texture %u is %dx%d, the frame view "
                           "%ux%u (they must match)", name, tw, th, t->width, t->height);
     if (!ctx->layer_fbo) {
         GLuint fb = 0;
@@ -405,7 +435,8 @@ static vfx_result layer_target(vfx_context *ctx, volfx_frame_targets *t)
     }
     glNamedFramebufferTexture(ctx->layer_fbo, GL_COLOR_ATTACHMENT0, name, 0);
     if (glCheckNamedFramebufferStatus(ctx->layer_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-        return volfx_fail_id(ctx, VFX_ERR_GL, VFX_LOG_ID_FRAME_VIEW, "render: frame view layer_texture %u cannot be rendered to", name);
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_LAYER_TEXTURE,
+                          "render: frame view layer_texture %u cannot be rendered to", name);
     t->framebuffer = ctx->layer_fbo;
     /* the clear honours the scissor test and the colour mask: the host's, put back after */
     GLboolean scissor = glIsEnabled(GL_SCISSOR_TEST), mask[4];
@@ -446,7 +477,8 @@ vfx_result volfx_frame_gate_gl(vfx_context *ctx, bool drawing, volfx_frame_targe
      * into it failed with a GL error that named nothing (issue 28) */
     if (!t->layer_texture && !t->framebuffer &&
         glCheckNamedFramebufferStatus(0, GL_DRAW_FRAMEBUFFER) == GL_FRAMEBUFFER_UNDEFINED)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view framebuffer 0 is the default "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
+                          "render: frame view framebuffer 0 is the default "
                           "framebuffer, and the current context has none (surfaceless): name a framebuffer object");
     if (!t->scene_depth && (r = far_depth(ctx, t->width, t->height, &t->scene_depth)))
         return r;

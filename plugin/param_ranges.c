@@ -41,7 +41,8 @@ static vfx_result refuse(vfx_context *ctx, const char *what, const volfx_range *
 {
     char t[96], val[40];
     snprintf(val, sizeof val, r->flags & VFX_RANGE_INT ? "%.0f" : "%g", v); /* integers in full */
-    return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE, "%s: %s%s %s outside %s%s%s%s", what, r->field, index, val,
+    return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
+                      "%s: %s%s %s outside %s%s%s%s", what, r->field, index, val,
                       volfx_range_text(r, t, sizeof t), r->note[0] ? " (" : "", r->note, r->note[0] ? ")" : "");
 }
 

@@ -131,14 +131,16 @@ static void resolve_frame_view(vfx_frame_view *v)
 vfx_result volfx_resolve_defaults(vfx_context *ctx, void *inout)
 {
     if (!inout)
-        return ctx ? volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "resolve_defaults: inout is NULL") : VFX_ERR_INVALID_ARGUMENT;
+        return ctx ? volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_API_ARGUMENT,
+                                "resolve_defaults: inout is NULL") : VFX_ERR_INVALID_ARGUMENT;
     vfx_struct_type type = ((const vfx_chain *)inout)->type;
     switch (type) {
     case VFX_TYPE_WATER_PARAMS:
 #if VFX_WITH_WATER
         return resolve_water(ctx, inout);
 #else
-        return ctx ? volfx_fail(ctx, VFX_ERR_UNSUPPORTED, "resolve_defaults: the water is not built in") : VFX_ERR_UNSUPPORTED;
+        return ctx ? volfx_fail(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_EFFECT_NOT_BUILT,
+                                "resolve_defaults: the water is not built in") : VFX_ERR_UNSUPPORTED;
 #endif
     case VFX_TYPE_BEAM: resolve_beam(inout); return VFX_OK;
     case VFX_TYPE_BEAMS_VIEW: resolve_beams_view(inout); return VFX_OK;
@@ -152,7 +154,7 @@ vfx_result volfx_resolve_defaults(vfx_context *ctx, void *inout)
         break;
     }
     if (ctx)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_STRUCT_TYPE,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_STRUCT_TYPE,
                              "resolve_defaults: a struct of type %u has no defaults to resolve", (unsigned)type);
     return VFX_ERR_INVALID_ARGUMENT;
 }

@@ -230,12 +230,13 @@ static vfx_result beam_look_of(vfx_context *ctx, uint32_t i, const vfx_beam *b2,
 {
     *out = (beam_look){.intensity = 1.f, .thesis = true};
     if (b2->falloff > VFX_BEAM_FALLOFF_HARD || b2->ramp > VFX_BEAM_RAMP_THESIS)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: falloff %u / ramp %u unknown", i,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_BEAM_FIELD,
+                          "beams[%u]: falloff %u / ramp %u unknown", i,
                           b2->falloff, b2->ramp);
     if (!(b2->intensity >= 0) || !isfinite(b2->intensity) || !isfinite(b2->exposure)
         || fabsf(b2->exposure) > 64.f || !(b2->flow_amount >= 0 && b2->flow_amount <= 1)
         || !isfinite(b2->flow_speed) || !(b2->flow_scale >= 0) || !isfinite(b2->flow_scale))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
                           "beams[%u]: needs intensity >= 0, |exposure| <= 64, flow_amount in [0, 1], finite "
                           "flow_speed, flow_scale >= 0 (got %g, %g, %g, %g, %g)", i, (double)b2->intensity,
                           (double)b2->exposure, (double)b2->flow_amount, (double)b2->flow_speed,
@@ -264,7 +265,7 @@ static vfx_result beam_anatomy_of(vfx_context *ctx, uint32_t i, const vfx_beam *
         || !(b3->surge_amount >= 0 && b3->surge_amount <= 4) || !(b3->surge_wavelength >= 0)
         || !(b3->core >= 0 && b3->core <= 1) || b3->flow_kind > VFX_BEAM_FLOW_SPIRAL
         || !(fabsf(b3->flow_twist) <= 64))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
                           "beams[%u]: vfx_beam needs finite head_radius, orb_radius, orb_strength >= 0, orb_pulse "
                           "in [0, 1], orb_pulse_hz >= 0, taper in [0, 0.95], surge_amount in [0, 4], "
                           "surge_wavelength >= 0, core in [0, 1], flow_kind 0..1, |flow_twist| <= 64 (got %g, %g, "
@@ -299,26 +300,30 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
     vfx_beams_view v;
     vfx_result r = query_view(ctx, &v);
     if (r)
-        return volfx_fail(ctx, r == VFX_ERR_NOT_FOUND ? VFX_ERR_ABI : r, "beams: host beams failed (%d)", (int)r);
+        return volfx_fail(ctx, r == VFX_ERR_NOT_FOUND ? VFX_ERR_ABI : r, VFX_LOG_ID_HOST_CALLBACK,
+                          "beams: host beams failed (%d)", (int)r);
     if ((r = volfx_check_type(ctx, &v, VFX_TYPE_BEAMS_VIEW, "beams: host beams view (vfx_beams_view)")))
         return r;
     const vfx_lab_beams *lab = volfx_chain_find(v.next, VFX_TYPE_LAB_BEAMS);
     v.next = NULL;
     const vfx_beam *beams = v.beams;
     if (v.count > MAX_BEAMS || !beams)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: %u beams (at most %u, non-NULL array)",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_BEAMS_COUNT,
+                          "beams: %u beams (at most %u, non-NULL array)",
                           v.count, MAX_BEAMS);
     if (lab && lab->method > VFX_BEAMS_METHOD_MARCH)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: vfx_lab_beams.method %u unknown (0 closed form, 1 march)",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_BEAMS_VIEW_FIELD,
+                          "beams: vfx_lab_beams.method %u unknown (0 closed form, 1 march)",
                           lab->method);
     if ((r = volfx_beams_view_check_ranges(ctx, &v, lab ? lab->march_samples : 0)))
         return r;
     if (!(v.saturate_c >= 0) || !isfinite(v.saturate_c) || !(v.far_distance >= 0)
         || !isfinite(v.far_distance))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: saturate_c and far_distance must be finite and >= 0");
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
+                          "beams: saturate_c and far_distance must be finite and >= 0");
     if (v.bloom > VFX_BEAMS_BLOOM_OFF || v.bloom_levels > MAX_BLOOM_LEVELS || !(v.bloom_strength >= 0)
         || !isfinite(v.bloom_strength))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
                           "beams: bloom %u (0..2), bloom_levels %u (0..%u), bloom_strength %g (finite, >= 0)",
                           v.bloom, v.bloom_levels, MAX_BLOOM_LEVELS, (double)v.bloom_strength);
     uint32_t n = v.count;
@@ -355,16 +360,17 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
         if ((r = volfx_beam_check_ranges(ctx, i, b)))
             return r;
         if (volfx_beam_validate(b, &s->beams[i], err, sizeof err))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: %s", i, err);
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_BEAM_FIELD, "beams[%u]: %s", i, err);
         if ((r = beam_look_of(ctx, i, b2i, &s->looks[i])))
             return r;
         s->beams[i].smooth = b2i->falloff != VFX_BEAM_FALLOFF_HARD;
         uint32_t jc = b2i->joint_count, jf = b2i->joint_first;
         if (jc && (!v.joints || jf > v.joint_count || jc > v.joint_count - jf))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: joints %u..%u outside the view's %u joints",
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_BEAM_JOINTS,
+                              "beams[%u]: joints %u..%u outside the view's %u joints",
                               i, jf, jf + jc, v.joints ? v.joint_count : 0);
         if (jc && volfx_beam_set_joints(&s->beams[i], v.joints + 3 * (size_t)jf, jc, err, sizeof err))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams[%u]: %s", i, err);
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_BEAM_JOINTS, "beams[%u]: %s", i, err);
         if ((r = beam_anatomy_of(ctx, i, b2i, time, &s->beams[i], &s->looks[i])))
             return r;
         const float *c = b->color;
@@ -394,7 +400,8 @@ static vfx_result upload(vfx_context *ctx, GLuint buf, size_t *cap, const void *
     if (data)
         glNamedBufferSubData(buf, 0, (GLsizeiptr)bytes, data);
     const char *e = volfx_gpu_error_string();
-    return e ? volfx_fail(ctx, VFX_ERR_GL, "beams: buffer upload of %zu bytes: %s", bytes, e) : VFX_OK;
+    return e ? volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR,
+                          "beams: buffer upload of %zu bytes: %s", bytes, e) : VFX_OK;
 }
 
 /* Beam i as the integrate pass reads it (camera-relative: heads are M - eye in double, so a
@@ -478,7 +485,8 @@ static vfx_result bin_beams(vfx_context *ctx, beams_state *s, const volfx_frame_
     }
     uint64_t bound = volfx_beams_bin_pairs((const uint32_t(*)[4])s->rects, s->visible, s->count);
     if (bound > UINT32_MAX / 2)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams: %llu beam-tile pairs", (unsigned long long)bound);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_BEAMS_TILE_PAIRS,
+                          "beams: %llu beam-tile pairs", (unsigned long long)bound);
     if (bound > s->list_capacity) {
         volfx_free(ctx, s->list);
         s->list = volfx_alloc(ctx, bound * sizeof(uint32_t));
@@ -629,7 +637,7 @@ static vfx_result integrate_passes(vfx_context *ctx, beams_state *s, volfx_frame
     t->beams_light = s->light_tex;
     t->beams_behind = water ? s->behind_tex : 0;
     const char *e = volfx_gpu_error_string();
-    return e ? volfx_fail(ctx, VFX_ERR_GL, "beams integrate: %s", e) : VFX_OK;
+    return e ? volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR, "beams integrate: %s", e) : VFX_OK;
 }
 
 /* The prepare step (effect.h): CPU binning, then the integrate pass and the impacts, before the
@@ -651,7 +659,8 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
     (void)frame;
     beams_state *s = state;
     if (!s->prepared)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams render: the prepare step did not run this render");
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_EFFECT_ORDER,
+                          "beams render: the prepare step did not run this render");
     s->prepared = false;
     if (s->bloom)
         bloom_passes(ctx, s, s->levels);
@@ -661,7 +670,7 @@ static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_vi
     volfx_ubo_bind(&s->ubo, 3);
     volfx_composite_targets(ctx, t, "beams.composite", s->prog_composite, VOLFX_BLEND_ADD);
     const char *e = volfx_gpu_error_string();
-    return e ? volfx_fail(ctx, VFX_ERR_GL, "beams render: %s", e) : VFX_OK;
+    return e ? volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR, "beams render: %s", e) : VFX_OK;
 }
 
 static vfx_result beams_read_raw(vfx_context *ctx, void *state, float *out, size_t count)
@@ -669,7 +678,8 @@ static vfx_result beams_read_raw(vfx_context *ctx, void *state, float *out, size
     beams_state *s = state;
     size_t n = (size_t)s->grid.width * s->grid.height;
     if (count < n)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams read_raw: %zu floats < %zu", count, n);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_READ_BUFFER_SIZE,
+                          "beams read_raw: %zu floats < %zu", count, n);
     return volfx_gpu_read_top_first(ctx, s->acc_tex, GL_RED, 1, 0, s->grid.width, s->grid.height, out);
 }
 
@@ -677,10 +687,12 @@ vfx_result volfx_beams_debug_split(vfx_context *ctx, float *out, size_t count)
 {
     beams_state *s = ctx->effect_state[VFX_EFFECT_BEAMS];
     if (!s || !s->acc_tex)
-        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "beams debug split: no beams effect or no render yet");
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, VFX_LOG_ID_EFFECT_NOT_RENDERED,
+                          "beams debug split: no beams effect or no render yet");
     size_t n = (size_t)s->grid.width * s->grid.height * 2;
     if (!out || count < n)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "beams debug split: %zu floats, need %zu", count, n);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_READ_BUFFER_SIZE,
+                          "beams debug split: %zu floats, need %zu", count, n);
     return volfx_gpu_read_top_first(ctx, s->acc_tex, GL_RG, 2, -1, s->grid.width, s->grid.height, out);
 }
 

@@ -120,7 +120,7 @@ vfx_result volfx_beams_impact_create(vfx_context *ctx, volfx_beams_impact **out)
     const char *e = volfx_gpu_error_string();
     if (e) {
         volfx_beams_impact_destroy(ctx, im);
-        return volfx_fail(ctx, VFX_ERR_GL, "beams impact: buffers: %s", e);
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR, "beams impact: buffers: %s", e);
     }
     *out = im;
     return VFX_OK;
@@ -304,7 +304,7 @@ vfx_result volfx_beams_impact_render(vfx_context *ctx, volfx_beams_impact *im, c
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     issue_readback(im, live ? im->count : 0);
     const char *e = volfx_gpu_error_string();
-    return e ? volfx_fail(ctx, VFX_ERR_GL, "beams impact: %s", e) : VFX_OK;
+    return e ? volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR, "beams impact: %s", e) : VFX_OK;
 }
 
 /* The distance past which a light's irradiance at normal incidence is below 1/256 of its value

@@ -62,11 +62,13 @@ vfx_result volfx_gpu_check_target(vfx_context *ctx, GLuint fb, const char *what,
 {
     const char *e = volfx_gpu_error_string();
     if (e && !strcmp(e, "GL_OUT_OF_MEMORY")) /* reported as "incomplete framebuffer" before (issue 28) */
-        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "%s %ux%u: out of memory making its textures (GL_OUT_OF_MEMORY)",
+        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_GPU_OUT_OF_MEMORY,
+                          "%s %ux%u: out of memory making its textures (GL_OUT_OF_MEMORY)",
                           what, w, h);
     GLenum st = glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER);
     if (st != GL_FRAMEBUFFER_COMPLETE || e)
-        return volfx_fail(ctx, VFX_ERR_GL, "%s %ux%u: framebuffer status 0x%x%s%s", what, w, h, st, e ? ", " : "",
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_FRAMEBUFFER_INCOMPLETE,
+                          "%s %ux%u: framebuffer status 0x%x%s%s", what, w, h, st, e ? ", " : "",
                           e ? e : "");
     return VFX_OK;
 }
@@ -76,12 +78,13 @@ vfx_result volfx_gpu_create(vfx_context *ctx, volfx_gpu **out)
     *out = NULL;
     const GLubyte *version = glGetString(GL_VERSION);
     if (!version)
-        return volfx_fail(ctx, VFX_ERR_GL, "volfx needs a current GL context on the calling thread");
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_NO_CONTEXT,
+                          "volfx needs a current GL context on the calling thread");
     GLint major = 0, minor = 0;
     glGetIntegerv(GL_MAJOR_VERSION, &major);
     glGetIntegerv(GL_MINOR_VERSION, &minor);
     if (major * 10 + minor < 45 || strncmp((const char *)version, "OpenGL ES", 9) == 0)
-        return volfx_fail_id(ctx, VFX_ERR_GL_UNSUPPORTED, VFX_LOG_ID_GL_VERSION,
+        return volfx_fail(ctx, VFX_ERR_GL_UNSUPPORTED, VFX_LOG_ID_GL_VERSION,
                              "volfx needs desktop GL 4.5, the current context is %s", (const char *)version);
     volfx_gpu *g = volfx_alloc(ctx, sizeof *g);
     if (!g)
@@ -94,7 +97,7 @@ vfx_result volfx_gpu_create(vfx_context *ctx, volfx_gpu **out)
     const char *err = volfx_gpu_error_string();
     if (err) {
         volfx_gpu_destroy(ctx, g);
-        return volfx_fail(ctx, VFX_ERR_GL, "volfx gpu setup: %s", err);
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR, "volfx gpu setup: %s", err);
     }
     *out = g;
     return VFX_OK;
@@ -139,7 +142,7 @@ GLuint volfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *s
         if (!status) {
             glGetShaderInfoLog(shaders[i], sizeof log, NULL, log);
             volfx_shader_rewrite_log(log, pretty, sizeof pretty, names[i]);
-            volfx_fail(ctx, VFX_ERR_GL, "shader compile failed: %s", pretty);
+            volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_SHADER_COMPILE, "shader compile failed: %s", pretty);
             ok = false;
         } else {
             glAttachShader(prog, shaders[i]);
@@ -153,7 +156,7 @@ GLuint volfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *s
         glGetProgramiv(prog, GL_LINK_STATUS, &status);
         if (!status) {
             glGetProgramInfoLog(prog, sizeof log, NULL, log);
-            volfx_fail(ctx, VFX_ERR_GL, "program link failed (%s%s%s): %s", names[0],
+            volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_PROGRAM_LINK, "program link failed (%s%s%s): %s", names[0],
                      stage_count > 1 ? " + " : "", stage_count > 1 ? names[1] : "", log);
             ok = false;
         }
@@ -199,7 +202,7 @@ static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const c
     size_t klen = strlen(paths[0]) + (n > 1 ? strlen(paths[1]) : 0) + (defines ? strlen(defines) : 0) + 3;
     char *key = malloc(klen);
     if (!key) {
-        volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "program cache: out of memory");
+        volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_OUT_OF_MEMORY, "program cache: out of memory");
         return 0;
     }
     snprintf(key, klen, "%s|%s|%s", paths[0], n > 1 ? paths[1] : "", defines ? defines : "");
@@ -210,7 +213,8 @@ static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const c
         }
     if (g->program_count >= GPU_MAX_PROGRAMS) {
         free(key);
-        volfx_fail(ctx, VFX_ERR_GL, "program cache full (%d programs)", GPU_MAX_PROGRAMS);
+        volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_PROGRAM_LIMIT,
+                   "program cache full (%d programs)", GPU_MAX_PROGRAMS);
         return 0;
     }
     char *bufs[2] = {NULL, NULL};
@@ -219,7 +223,7 @@ static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const c
     bool ok = true;
     for (int i = 0; i < n && ok; ++i)
         if (!(bufs[i] = volfx_shader_expand(paths[i], defines, err, sizeof err))) {
-            volfx_fail(ctx, VFX_ERR_GL, "%s", err);
+            volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_SHADER_COMPILE, "%s", err);
             ok = false;
         }
     if (ok && g->cache)

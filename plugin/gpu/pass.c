@@ -79,7 +79,7 @@ bool volfx_ubo_create(vfx_context *ctx, volfx_ubo *ubo, uint32_t bytes, const ch
     ubo->bytes = (bytes + 15u) & ~15u;
     glCreateBuffers(1, &ubo->buffer);
     if (!ubo->buffer) {
-        volfx_fail(ctx, VFX_ERR_GL, "%s: cannot create a uniform buffer", label);
+        volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR, "%s: cannot create a uniform buffer", label);
         return false;
     }
     glNamedBufferStorage(ubo->buffer, ubo->bytes, NULL, GL_DYNAMIC_STORAGE_BIT);

@@ -58,22 +58,26 @@ vfx_result volfx_program_cache_open(vfx_context *ctx, const char *dir, volfx_pro
     GLint formats = 0;
     glGetIntegerv(GL_NUM_PROGRAM_BINARY_FORMATS, &formats);
     if (formats <= 0) {
-        volfx_log(ctx, VFX_LOG_INFO, "program cache %s: the driver offers no program binary format; off", dir);
+        volfx_log(ctx, VFX_LOG_INFO, VFX_LOG_ID_PROGRAM_CACHE_OFF,
+                  "program cache %s: the driver offers no program binary format; off", dir);
         return VFX_OK;
     }
     struct stat st;
     if (mkdir(dir, 0755) != 0 && errno != EEXIST)
-        return volfx_fail(ctx, VFX_ERR_IO, "program cache %s: cannot make the folder: %s", dir, strerror(errno));
+        return volfx_fail(ctx, VFX_ERR_IO, VFX_LOG_ID_PROGRAM_CACHE_DIR,
+                          "program cache %s: cannot make the folder: %s", dir, strerror(errno));
     /* O_NONBLOCK: a FIFO of that name must not block the open (O_DIRECTORY refuses it after) */
     int fd = open(dir, O_RDONLY | O_DIRECTORY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0 || fstat(fd, &st) != 0 || !S_ISDIR(st.st_mode)) {
         int e = errno;
         if (fd >= 0)
             close(fd);
-        return volfx_fail(ctx, VFX_ERR_IO, "program cache %s: not a folder (%s)", dir, strerror(e));
+        return volfx_fail(ctx, VFX_ERR_IO, VFX_LOG_ID_PROGRAM_CACHE_DIR,
+                          "program cache %s: not a folder (%s)", dir, strerror(e));
     }
     if ((st.st_mode & S_IWOTH) && !(st.st_mode & S_ISVTX))
-        volfx_log(ctx, VFX_LOG_WARN, "program cache %s: the folder is writable by every user and not sticky: another "
+        volfx_log(ctx, VFX_LOG_WARN, VFX_LOG_ID_PROGRAM_CACHE_UNSAFE,
+                  "program cache %s: the folder is writable by every user and not sticky: another "
                   "user can replace entries (each is still checked before use)", dir);
     volfx_program_cache *pc = volfx_alloc(ctx, sizeof *pc);
     char *copy = volfx_alloc(ctx, strlen(dir) + 1);
@@ -217,7 +221,8 @@ GLuint volfx_program_cache_load(vfx_context *ctx, volfx_program_cache *pc, int n
     free(b);
     if (why) {
         pc->counts.rejected++;
-        volfx_log(ctx, VFX_LOG_WARN, "program cache %s/%s: %s; rebuilt from source", pc->dir, name, why);
+        volfx_log(ctx, VFX_LOG_WARN, VFX_LOG_ID_PROGRAM_CACHE_ENTRY,
+                  "program cache %s/%s: %s; rebuilt from source", pc->dir, name, why);
         return 0;
     }
     pc->counts.loaded++;
@@ -296,6 +301,7 @@ void volfx_program_cache_store(vfx_context *ctx, volfx_program_cache *pc, int n,
     if (!why)
         pc->counts.stored++;
     else
-        volfx_log(ctx, VFX_LOG_WARN, "program cache %s/%s: binary not stored: %s%s%s", pc->dir, name, why,
+        volfx_log(ctx, VFX_LOG_WARN, VFX_LOG_ID_PROGRAM_CACHE_STORE,
+                  "program cache %s/%s: binary not stored: %s%s%s", pc->dir, name, why,
                   err ? ": " : "", err ? strerror(err) : "");
 }

@@ -59,6 +59,12 @@ _Static_assert(TET_OK == (int)VFX_OK && TET_ERR_INVALID_ARGUMENT == (int)VFX_ERR
                    TET_ERR_FORMAT == (int)VFX_ERR_FORMAT && TET_ERR_NUMERIC == (int)VFX_ERR_NUMERIC,
                "tet_result and vfx_result codes differ");
 static vfx_result from_tet(tet_result r) { return (vfx_result)r; }
+/* The log id of a tet library failure: the plugin checks the view's fields before (ranges,
+ * transfer function, indices), so what the library still refuses is memory or the mesh. */
+static vfx_log_id tet_log_id(tet_result r)
+{
+    return r == TET_ERR_OUT_OF_MEMORY ? VFX_LOG_ID_OUT_OF_MEMORY : VFX_LOG_ID_VOLUME_MESH;
+}
 
 static bool volume_present(vfx_context *ctx)
 {
@@ -151,7 +157,8 @@ static vfx_result volume_resize(vfx_context *ctx, void *state, uint32_t w, uint3
     s->rgba = s->heap_rgba ? s->heap_rgba : s->up_map[0];
     s->max_dist = volfx_alloc(ctx, n * sizeof(float));
     vfx_result r = s->rgba && s->max_dist ? volfx_gpu_check_target(ctx, s->dist_fbo, "volume: distance target", w, h)
-                   : volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "volume: targets for %ux%u: out of memory (%.2f GB)", w, h,
+                   : volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_OUT_OF_MEMORY,
+                                "volume: targets for %ux%u: out of memory (%.2f GB)", w, h,
                                 (double)n * 64.0 / 1e9);
     if (r) {
         /* nothing half made stays: no mapped pointer, no error flag left for a later check */
@@ -174,7 +181,8 @@ static vfx_result fetch_view(vfx_context *ctx, vfx_volume_view *v)
     memset(v, 0, sizeof *v);
     v->type = VFX_TYPE_VOLUME_VIEW;
     if (ctx->host.volume(ctx->host.user, 0, v) != VFX_OK)
-        return volfx_fail(ctx, VFX_ERR_ABI, "volume[0]: the host's volume callback failed");
+        return volfx_fail(ctx, VFX_ERR_ABI, VFX_LOG_ID_HOST_CALLBACK,
+                          "volume[0]: the host's volume callback failed");
     return volfx_check_type(ctx, v, VFX_TYPE_VOLUME_VIEW, "volume[0]: host volume view (vfx_volume_view)");
 }
 
@@ -184,23 +192,25 @@ static vfx_result check_transfer(vfx_context *ctx, const vfx_volume_view *v)
     if (!v1->transfer_rgba)
         return VFX_OK;
     if (v1->transfer_count < 2 || v1->transfer_count > VFX_VOLUME_MAX_TRANSFER)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: transfer function of %u entries (need 2..%u)",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_VOLUME_TRANSFER,
+                          "volume[0]: transfer function of %u entries (need 2..%u)",
                           v1->transfer_count, VFX_VOLUME_MAX_TRANSFER);
     for (uint32_t i = 0; i < 4 * v1->transfer_count; ++i)
         if (!isfinite(v1->transfer_rgba[i]) || (i % 4 == 3 && v1->transfer_rgba[i] < 0))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_VOLUME_TRANSFER,
                               "volume[0]: transfer_rgba[%u] component %u is %g (finite, alpha >= 0)", i / 4, i % 4,
                               (double)v1->transfer_rgba[i]);
     if (v->transfer_scalar)
         for (uint32_t i = 0; i < v1->transfer_count; ++i) {
             float t = v->transfer_scalar[i];
             if (!(t >= 0 && t <= 1) || (i > 0 && !(t > v->transfer_scalar[i - 1])))
-                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_VOLUME_TRANSFER,
                                   "volume[0]: transfer_scalar[%u] = %g (need increasing values in [0, 1])", i,
                                   (double)t);
         }
     if (v->transfer_method > VFX_VOLUME_TRANSFER_PREINTEGRATED)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: transfer_method %u unknown", v->transfer_method);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_VOLUME_TRANSFER,
+                          "volume[0]: transfer_method %u unknown", v->transfer_method);
     return VFX_OK;
 }
 
@@ -210,7 +220,8 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
     volume_state *s = state;
     uint32_t n = ctx->host.volume_count(ctx->host.user);
     if (n > 1 && !s->warned_many) {
-        volfx_log(ctx, VFX_LOG_WARN, "volume: the host has %u volumes; only the first is drawn", n);
+        volfx_log(ctx, VFX_LOG_WARN, VFX_LOG_ID_VOLUME_EXTRA,
+                  "volume: the host has %u volumes; only the first is drawn", n);
         s->warned_many = true;
     }
     vfx_volume_view v;
@@ -221,7 +232,7 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
     v.next = NULL;
     const vfx_volume_view *v1 = &v;
     if (!v1->points || !v1->tets || !v1->scalar || v1->point_count == 0 || v1->tet_count == 0)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_VOLUME_MESH,
                           "volume[0]: needs points, tets and scalar arrays and counts > 0 (%u points, %u tets)",
                           v1->point_count, v1->tet_count);
     if ((r = check_transfer(ctx, &v)) != VFX_OK)
@@ -232,9 +243,11 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
         return r;
     for (int i = 0; i < 16; ++i)
         if (!isfinite(v1->model[i]))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: model[%d] is not finite", i);
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_VOLUME_MODEL,
+                              "volume[0]: model[%d] is not finite", i);
     if (!isfinite(v1->scalar_min) || !isfinite(v1->scalar_max))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: scalar_min %g / scalar_max %g not finite",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_VOLUME_SCALAR,
+                          "volume[0]: scalar_min %g / scalar_max %g not finite",
                           (double)v1->scalar_min, (double)v1->scalar_max);
     /* tet indices are checked once per revision: the renderer trusts them */
     const vfx_volume_view *old = &s->view;
@@ -242,7 +255,8 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
         v1->points != old->points || v1->point_count != old->point_count || v1->tet_count != old->tet_count) {
         for (uint64_t i = 0; i < (uint64_t)v1->tet_count * 4; ++i)
             if (v1->tets[i] >= v1->point_count)
-                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: tet %llu uses point %u of %u",
+                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_VOLUME_MESH,
+                                  "volume[0]: tet %llu uses point %u of %u",
                                   (unsigned long long)(i / 4), v1->tets[i], v1->point_count);
         s->data_min = INFINITY, s->data_max = -INFINITY;
         for (uint32_t i = 0; i < v1->point_count; ++i)
@@ -253,7 +267,8 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
         /* nothing finite: the renderer would skip every cell, and the empty range reached the
          * transfer function as a bad one (issue 28) */
         if (!(s->data_min <= s->data_max))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume[0]: all %u scalars are NaN or infinite "
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_VOLUME_SCALAR,
+                              "volume[0]: all %u scalars are NaN or infinite "
                               "(nothing to draw)", v1->point_count);
         s->revision = v1->revision;
         s->last_key = 0; /* new data: never reuse the old image, whatever the key says */
@@ -300,11 +315,12 @@ static vfx_result read_distances(vfx_context *ctx, volume_state *s, int slot)
     const GLuint64 forever = 5000000000ull; /* 5 s */
     GLenum st = glClientWaitSync(s->fence[slot], GL_SYNC_FLUSH_COMMANDS_BIT, forever);
     if (st != GL_ALREADY_SIGNALED && st != GL_CONDITION_SATISFIED)
-        return volfx_fail(ctx, VFX_ERR_GL, "volume: distance readback did not complete (0x%x)", st);
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR,
+                          "volume: distance readback did not complete (0x%x)", st);
     size_t bytes = (size_t)s->width * s->height * sizeof(float);
     const void *p = glMapNamedBufferRange(s->pbo[slot], 0, (GLsizeiptr)bytes, GL_MAP_READ_BIT);
     if (!p)
-        return volfx_fail(ctx, VFX_ERR_GL, "volume: cannot map the distance readback");
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR, "volume: cannot map the distance readback");
     memcpy(s->max_dist, p, bytes);
     glUnmapNamedBuffer(s->pbo[slot]);
     return VFX_OK;
@@ -420,7 +436,7 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
         s->pool = NULL;
     }
     if (!s->pool && (r = from_tet(tet_pool_create(o.workers, &s->pool, err, sizeof err))) != VFX_OK)
-        return volfx_fail(ctx, r, "volume[0]: %s", err);
+        return volfx_fail(ctx, r, tet_log_id((tet_result)r), "volume[0]: %s", err);
 
     const uint64_t key = render_key(s, &cam, &tf, &o);
     if (key == s->last_key) {
@@ -442,7 +458,7 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
         }
         tet_result rr = tet_render_pool(s->pool, &s->mesh, &cam, &tf, &o, dst, &c, NULL, err, sizeof err);
         if (rr != TET_OK)
-            return volfx_fail(ctx, from_tet(rr), "volume[0]: %s", err);
+            return volfx_fail(ctx, from_tet(rr), tet_log_id(rr), "volume[0]: %s", err);
         s->last_key = key;
         volfx_stat_set(ctx, "volume.render_skipped", 0);
         volfx_stat_set(ctx, "volume.cells_scanned", (double)c.cells_scanned);
@@ -467,14 +483,15 @@ static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_v
     glBindTextureUnit(0, s->tex);
     volfx_composite_targets(ctx, targets, "volume.composite", s->prog, VOLFX_BLEND_OVER_PREMUL);
     const char *e = volfx_gpu_error_string();
-    return e ? volfx_fail(ctx, VFX_ERR_GL, "volume render: %s", e) : VFX_OK;
+    return e ? volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR, "volume render: %s", e) : VFX_OK;
 }
 
 static vfx_result volume_read_raw(vfx_context *ctx, void *state, float *out, size_t count)
 {
     volume_state *s = state;
     if (count < (size_t)s->width * s->height)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "volume read_raw: buffer too small");
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_READ_BUFFER_SIZE,
+                          "volume read_raw: buffer too small");
     for (uint32_t y = 0; y < s->height; ++y) /* accumulated opacity, top row first */
         for (uint32_t x = 0; x < s->width; ++x)
             out[(size_t)y * s->width + x] = s->rgba[4 * ((size_t)(s->height - 1 - y) * s->width + x) + 3];

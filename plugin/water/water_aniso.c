@@ -37,7 +37,7 @@ vfx_result volfx_water_kernel_params_check(vfx_context *ctx, const vfx_water_par
                                            volfx_water_kernel_params *out)
 {
     if (in->kernel > VFX_WATER_KERNEL_ANISOTROPIC)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARAM,
                           "water: vfx_water_params.kernel %u unknown (0 default, 1 isotropic, 2 anisotropic)", in->kernel);
     struct { const char *name; float v, lo, hi, def; float *dst; } f[] = {
         {"aniso_radius", in->aniso_radius, 0.5f, 4.0f, 1.5f, &out->radius},
@@ -52,12 +52,14 @@ vfx_result volfx_water_kernel_params_check(vfx_context *ctx, const vfx_water_par
             continue;
         }
         if (!(v >= f[k].lo && v <= f[k].hi))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.%s %g outside [%g, %g] (0: default %g)",
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
+                              "water: vfx_water_params.%s %g outside [%g, %g] (0: default %g)",
                               f[k].name, v, f[k].lo, f[k].hi, f[k].def);
         *f[k].dst = v;
     }
     if (in->aniso_min_neighbours > 10000)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.aniso_min_neighbours %u above 10000",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
+                          "water: vfx_water_params.aniso_min_neighbours %u above 10000",
                           in->aniso_min_neighbours);
     out->min_neighbours = in->aniso_min_neighbours ? in->aniso_min_neighbours : 16;
     out->kernel = in->kernel == VFX_WATER_KERNEL_ANISOTROPIC ? VFX_WATER_KERNEL_ANISOTROPIC : VFX_WATER_KERNEL_ISOTROPIC;
@@ -140,7 +142,8 @@ vfx_result volfx_water_aniso_columns_begin(vfx_context *ctx, volfx_water_aniso *
     }
     const char *e = volfx_gpu_error_string();
     if (e)
-        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water: kernel columns for %u particles: %s", total, e);
+        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_GPU_OUT_OF_MEMORY,
+                          "water: kernel columns for %u particles: %s", total, e);
     return VFX_OK;
 }
 
@@ -151,7 +154,7 @@ vfx_result volfx_water_aniso_columns_chunk(vfx_context *ctx, volfx_water_aniso *
         return VFX_OK;
     for (uint32_t i = 0; radius && i < count; ++i)
         if (!(radius[i] >= COLUMN_MIN && radius[i] <= COLUMN_MAX))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARTICLE_VALUE,
                               "water: particle chunk %u, particle %u: radius %g (vfx_particle_view.radius) must be finite and in [%g, %g]",
                               chunk, i, radius[i], COLUMN_MIN, COLUMN_MAX);
     for (uint32_t i = 0; kernel && i < count; ++i) {
@@ -159,14 +162,14 @@ vfx_result volfx_water_aniso_columns_chunk(vfx_context *ctx, volfx_water_aniso *
         for (int k = 0; k < 6; ++k) {
             g[k] = kernel[6 * (size_t)i + k];
             if (!isfinite(g[k]))
-                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARTICLE_VALUE,
                                   "water: particle chunk %u, particle %u: kernel (vfx_particle_view.kernel) entry %d is %g",
                                   chunk, i, k, g[k]);
         }
         eigen_sym3(g, ev);
         for (int k = 0; k < 3; ++k) {
             if (!(ev[k] >= COLUMN_MIN && ev[k] <= COLUMN_MAX))
-                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARTICLE_VALUE,
                                   "water: particle chunk %u, particle %u: kernel (vfx_particle_view.kernel) has eigenvalue %g, "
                                   "outside [%g, %g] (symmetric positive definite, xx xy xz yy yz zz)",
                                   chunk, i, ev[k], COLUMN_MIN, COLUMN_MAX);
@@ -190,7 +193,8 @@ vfx_result volfx_water_aniso_columns_chunk(vfx_context *ctx, volfx_water_aniso *
         /* this chunk gives none: the identity (the isotropic kernel) */
         float *id = volfx_alloc(ctx, (size_t)count * 24);
         if (!id)
-            return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water: identity kernels for chunk %u (%u particles)", chunk, count);
+            return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_OUT_OF_MEMORY,
+                              "water: identity kernels for chunk %u (%u particles)", chunk, count);
         for (uint32_t i = 0; i < count; ++i) {
             float *g = id + 6 * (size_t)i;
             g[0] = g[3] = g[5] = 1.0f;
@@ -295,7 +299,8 @@ static vfx_result ensure_buffers(vfx_context *ctx, volfx_water_aniso *a, const v
         a->hostg = regrow(a->hostg, 24, "water.aniso_host_kernel");
     const char *e = volfx_gpu_error_string();
     if (e)
-        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water aniso: buffers for %u particles: %s", in->count, e);
+        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_GPU_OUT_OF_MEMORY,
+                          "water aniso: buffers for %u particles: %s", in->count, e);
     return VFX_OK;
 }
 
@@ -378,7 +383,8 @@ static vfx_result centre_pass(vfx_context *ctx, volfx_water_aniso *a, const volf
     volfx_gpu_pass_end(ctx);
     const char *e = volfx_gpu_error_string();
     if (e)
-        return volfx_fail(ctx, VFX_ERR_GL, "water aniso centre pass over %u particles: %s", in->count, e);
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR,
+                          "water aniso centre pass over %u particles: %s", in->count, e);
     a->shape_fresh = false;
     a->done_rev = in->data_rev;
     volfx_stat_set(ctx, "water.aniso_half_skipped", 1);
@@ -427,7 +433,8 @@ vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, con
     volfx_gpu_pass_end(ctx);
     const char *e = volfx_gpu_error_string();
     if (e)
-        return volfx_fail(ctx, VFX_ERR_GL, "water aniso pass over %u particles: %s", in->count, e);
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR,
+                          "water aniso pass over %u particles: %s", in->count, e);
     a->done = true;
     a->done_rev = in->data_rev;
     a->done_count = in->count;

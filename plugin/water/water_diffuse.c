@@ -39,12 +39,14 @@ vfx_result volfx_water_diffuse_params_check(vfx_context *ctx, const vfx_water_pa
                                             volfx_water_diffuse_params *out)
 {
     if (in->diffuse_max > DIFFUSE_MAX_CAP)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.diffuse_max %u above %u",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
+                          "water: vfx_water_params.diffuse_max %u above %u",
                           in->diffuse_max, DIFFUSE_MAX_CAP);
     out->max = in->diffuse_max ? in->diffuse_max : 32768;
     for (int k = 0; k < 3; ++k)
         if (!isfinite(in->gravity[k]) || fabsf(in->gravity[k]) > 1e4f)
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.gravity[%d] %g not finite or above 1e4",
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
+                              "water: vfx_water_params.gravity[%d] %g not finite or above 1e4",
                               k, in->gravity[k]);
     if (in->gravity[0] == 0 && in->gravity[1] == 0 && in->gravity[2] == 0) {
         out->gravity[0] = 0; out->gravity[1] = -9.81f; out->gravity[2] = 0;
@@ -65,12 +67,14 @@ vfx_result volfx_water_diffuse_params_check(vfx_context *ctx, const vfx_water_pa
         for (int e = 0; e < 2; ++e) {
             float v = pairs[k].v[e];
             if (!(v >= 0 && v <= 1e4f))
-                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.%s[%d] %g outside [0, 1e4]",
+                return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
+                                  "water: vfx_water_params.%s[%d] %g outside [0, 1e4]",
                                   pairs[k].name, e, v);
             pairs[k].dst[e] = v == 0 ? pairs[k].def[e] : v;
         }
         if (!(pairs[k].dst[0] < pairs[k].dst[1]))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.%s [%g, %g]: min must be below max",
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARAM,
+                              "water: vfx_water_params.%s [%g, %g]: min must be below max",
                               pairs[k].name, pairs[k].dst[0], pairs[k].dst[1]);
     }
     struct { const char *name; float v, hi, def; float *dst; } f[] = {
@@ -82,14 +86,15 @@ vfx_result volfx_water_diffuse_params_check(vfx_context *ctx, const vfx_water_pa
     };
     for (size_t k = 0; k < sizeof f / sizeof f[0]; ++k) {
         if (!(f[k].v >= 0 && f[k].v <= f[k].hi))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.%s %g outside [0, %g] (0: default %g)",
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
+                              "water: vfx_water_params.%s %g outside [0, %g] (0: default %g)",
                               f[k].name, f[k].v, f[k].hi, f[k].def);
         *f[k].dst = f[k].v == 0 ? f[k].def : f[k].v;
     }
     out->spray_below = in->spray_below ? in->spray_below : 6;
     out->bubble_above = in->bubble_above ? in->bubble_above : 20;
     if (out->spray_below > 10000 || out->bubble_above > 10000 || out->spray_below > out->bubble_above)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARAM,
                           "water: vfx_water_params.spray_below %u and bubble_above %u: each <= 10000, spray_below <= bubble_above",
                           out->spray_below, out->bubble_above);
     return VFX_OK;
@@ -151,7 +156,8 @@ vfx_result volfx_water_diffuse_begin(vfx_context *ctx, volfx_water_diffuse *d, u
     d->vel = volfx_gpu_storage((GLsizeiptr)total * 16, "water.diffuse_fluid_velocity");
     d->vel_cap = d->vel ? total : 0;
     if (!d->vel || volfx_gpu_error_string())
-        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water diffuse: velocities of %u particles", total);
+        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_GPU_OUT_OF_MEMORY,
+                          "water diffuse: velocities of %u particles", total);
     return VFX_OK;
 }
 
@@ -161,7 +167,8 @@ vfx_result volfx_water_diffuse_chunk(vfx_context *ctx, volfx_water_diffuse *d, u
     if (!count)
         return VFX_OK;
     if (first + (uint64_t)count > d->vel_cap)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water diffuse: chunk at %u of %u particles passes the %u uploaded",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARTICLE_CHUNK,
+                          "water diffuse: chunk at %u of %u particles passes the %u uploaded",
                           first, count, d->vel_cap);
     if (!vel[0] || !vel[1] || !vel[2]) {
         d->has_vel = false; /* a chunk without velocities: no diffuse particles this frame */
@@ -172,7 +179,8 @@ vfx_result volfx_water_diffuse_chunk(vfx_context *ctx, volfx_water_diffuse *d, u
         d->staging = volfx_alloc(ctx, (size_t)count * 4 * sizeof *d->staging);
         d->staging_cap = d->staging ? count : 0;
         if (!d->staging)
-            return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water diffuse: staging for %u velocities", count);
+            return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_OUT_OF_MEMORY,
+                              "water diffuse: staging for %u velocities", count);
     }
     for (uint32_t i = 0; i < count; ++i) {
         float q[3] = {vel[0][i], vel[1][i], vel[2][i]};
@@ -188,7 +196,8 @@ vfx_result volfx_water_diffuse_chunk(vfx_context *ctx, volfx_water_diffuse *d, u
 GLuint volfx_water_diffuse_velocity_target(vfx_context *ctx, volfx_water_diffuse *d, uint32_t first, uint32_t count)
 {
     if (first + (uint64_t)count > d->vel_cap) {
-        volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water diffuse: chunk at %u of %u particles passes the %u uploaded",
+        volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARTICLE_CHUNK,
+                   "water diffuse: chunk at %u of %u particles passes the %u uploaded",
                    first, count, d->vel_cap);
         return 0;
     }
@@ -227,7 +236,8 @@ static vfx_result ensure_step_buffers(vfx_context *ctx, volfx_water_diffuse *d, 
     }
     const char *e = volfx_gpu_error_string();
     if (e)
-        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water diffuse: buffers for %u fluid and %u diffuse particles: %s",
+        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_GPU_OUT_OF_MEMORY,
+                          "water diffuse: buffers for %u fluid and %u diffuse particles: %s",
                           fluid, cap, e);
     return VFX_OK;
 }
@@ -307,7 +317,8 @@ vfx_result volfx_water_diffuse_step(vfx_context *ctx, volfx_water_diffuse *d, co
     d->stepped = true;
     const char *e = volfx_gpu_error_string();
     if (e)
-        return volfx_fail(ctx, VFX_ERR_GL, "water diffuse step over %u fluid particles: %s", in->count, e);
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR,
+                          "water diffuse step over %u fluid particles: %s", in->count, e);
     return VFX_OK;
 }
 
@@ -392,7 +403,8 @@ vfx_result volfx_water_diffuse_debug(vfx_context *ctx, volfx_water_diffuse *d, f
                                      float *pool, size_t pool_cap, uint32_t *alive)
 {
     if (!d || !d->stepped)
-        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "water diffuse debug: no diffuse step ran yet");
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, VFX_LOG_ID_EFFECT_NOT_RENDERED,
+                          "water diffuse debug: no diffuse step ran yet");
     uint32_t hdr[HEADER_UINTS];
     glGetNamedBufferSubData(d->header, 0, sizeof hdr, hdr);
     uint32_t n = hdr[3] < d->pool_cap ? hdr[3] : d->pool_cap;
@@ -400,16 +412,18 @@ vfx_result volfx_water_diffuse_debug(vfx_context *ctx, volfx_water_diffuse *d, f
         *alive = n;
     if (pot) {
         if (fluid > d->fluid_cap)
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water diffuse debug: %zu fluid particles, %u computed", fluid,
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_READ_BUFFER_SIZE,
+                              "water diffuse debug: %zu fluid particles, %u computed", fluid,
                               d->fluid_cap);
         glGetNamedBufferSubData(d->pot, 0, (GLsizeiptr)fluid * 16, pot);
     }
     if (pool) {
         if (pool_cap < n)
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water diffuse debug: room for %zu, %u alive", pool_cap, n);
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_READ_BUFFER_SIZE,
+                              "water diffuse debug: room for %zu, %u alive", pool_cap, n);
         if (n)
             glGetNamedBufferSubData(d->pool[d->cur], 0, (GLsizeiptr)n * 32, pool);
     }
     const char *e = volfx_gpu_error_string();
-    return e ? volfx_fail(ctx, VFX_ERR_GL, "water diffuse debug: %s", e) : VFX_OK;
+    return e ? volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR, "water diffuse debug: %s", e) : VFX_OK;
 }

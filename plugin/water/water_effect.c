@@ -133,7 +133,8 @@ static vfx_result ensure_groups(vfx_context *ctx, water_state *s, uint32_t total
     const char *e = volfx_gpu_error_string();
     if (e) {
         groups_free(ctx, s);
-        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water: position buffers for %u particles (%u buffers of at most %u): %s",
+        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_GPU_OUT_OF_MEMORY,
+                          "water: position buffers for %u particles (%u buffers of at most %u): %s",
                         total, need, cap, e);
     }
     return VFX_OK;
@@ -149,7 +150,8 @@ static vfx_result query_chunk(vfx_context *ctx, uint32_t c, water_chunk *out)
     v.type = VFX_TYPE_PARTICLE_VIEW;
     vfx_result r = ctx->host.particle_chunk(ctx->host.user, c, &v);
     if (r)
-        return volfx_fail(ctx, r, "water: particle chunk %u failed (%d)", c, (int)r);
+        return volfx_fail(ctx, r, VFX_LOG_ID_HOST_CALLBACK,
+                          "water: particle chunk %u failed (%d)", c, (int)r);
     char what[64];
     snprintf(what, sizeof what, "water: particle chunk %u (vfx_particle_view)", c);
     if ((r = volfx_check_type(ctx, &v, VFX_TYPE_PARTICLE_VIEW, what)))
@@ -166,22 +168,23 @@ static vfx_result query_chunk(vfx_context *ctx, uint32_t c, water_chunk *out)
         return VFX_OK;
     bool cpu_pos = out->pos[0] || out->pos[1] || out->pos[2], cpu_vel = out->vel[0] || out->vel[1] || out->vel[2];
     if (out->gpu_pos.buffer && cpu_pos)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
                              "water: particle chunk %u names both pos[] and gpu_pos (one of them)", c);
     if (out->gpu_vel.buffer && cpu_vel)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
                              "water: particle chunk %u names both vel[] and gpu_vel (one of them)", c);
     if (out->gpu_kernel.buffer)
-        return volfx_fail_id(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_GPU_PARTICLES_UNSUPPORTED,
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_GPU_PARTICLES_UNSUPPORTED,
                              "water: particle chunk %u: gpu_kernel %u: the kernel column is not read from GL buffers "
                              "by this plugin (give it as the CPU array kernel)", c, out->gpu_kernel.buffer);
     if (!out->gpu_pos.buffer && (!out->pos[0] || !out->pos[1] || !out->pos[2]))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: particle chunk %u has %u particles but a NULL position column",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARTICLE_CHUNK,
+                          "water: particle chunk %u has %u particles but a NULL position column",
                           c, out->count);
     if (out->gpu_pos.buffer && (r = volfx_water_gather_check(ctx, c, "gpu_pos", &out->gpu_pos, out->count, 12)))
         return r;
     if (out->gpu_vel.buffer && !out->gpu_pos.buffer)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
                              "water: particle chunk %u names gpu_vel with CPU positions (GL buffer velocities need "
                              "gpu_pos)", c);
     if (out->gpu_vel.buffer && (r = volfx_water_gather_check(ctx, c, "gpu_vel", &out->gpu_vel, out->count, 12)))
@@ -199,7 +202,8 @@ static vfx_result read_params(vfx_context *ctx, water_state *s, volfx_water_reso
     if (ctx->host.water_params) {
         vfx_result r = ctx->host.water_params(ctx->host.user, &wp);
         if (r != VFX_OK && r != VFX_ERR_NOT_FOUND)
-            return volfx_fail(ctx, r, "water: host water_params failed (%d)", (int)r);
+            return volfx_fail(ctx, r, VFX_LOG_ID_HOST_CALLBACK,
+                              "water: host water_params failed (%d)", (int)r);
         if (r == VFX_ERR_NOT_FOUND) {
             memset(&wp, 0, sizeof wp);
             wp.type = VFX_TYPE_WATER_PARAMS;
@@ -348,7 +352,7 @@ static vfx_result upload_chunks(vfx_context *ctx, water_state *s, uint32_t chunk
         water_chunk v;
         r = query_chunk(ctx, c, &v);
         if (r || off + (uint64_t)v.count > total)
-            return r ? r : volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+            return r ? r : volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARTICLE_CHUNK,
                                       "water: particle chunk %u changed between the count and the upload", c);
         if (v.gpu_pos.buffer) {
             /* the blocking path scans in the same order as the CPU path (the same candidates) */
@@ -411,7 +415,7 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
         revs_same = revs_same && v.revision != 0 && v.revision == s->chunk_rev[c];
     }
     if (total > WATER_MAX_PARTICLES)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARTICLE_COUNT,
                         "water: %u particle chunks hold %llu particles, more than the limit of %u (2^30)",
                         chunks, (unsigned long long)total, WATER_MAX_PARTICLES);
     GLuint before = s->groups ? s->groups[0].cols[0] : 0;
@@ -489,7 +493,8 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
         return kr;
     const char *e = volfx_gpu_error_string();
     if (e)
-        return volfx_fail(ctx, VFX_ERR_GL, "water upload of %u particles: %s", s->count, e);
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR,
+                          "water upload of %u particles: %s", s->count, e);
     return VFX_OK;
 }
 
@@ -527,7 +532,8 @@ static void publish_counters(vfx_context *ctx, water_state *s)
         if (c[12] && !s->undecided_warned) {
             /* not drawn: said once, never a silent miss (issue 28) */
             s->undecided_warned = 1;
-            volfx_log(ctx, VFX_LOG_WARN, "water: %u pixels undecided (not drawn) in frame %llu: the march ran past "
+            volfx_log(ctx, VFX_LOG_WARN, VFX_LOG_ID_WATER_UNDECIDED_PIXELS,
+                      "water: %u pixels undecided (not drawn) in frame %llu: the march ran past "
                       "MAX_STEPS or the driver ended its loops (llvmpipe: 65,535 loop iterations a shader invocation; "
                       "%u tile entries this frame); a higher resolution, a larger h or method grid draws them",
                       c[12], (unsigned long long)s->last_frame, c[10]);
@@ -708,7 +714,7 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
     targets->water_dist = ctx->water_dist_tex;
     volfx_stat_set(ctx, "water.position_buffers", s->group_count);
     if (s->group_count > 1 && (p->method != VFX_WATER_METHOD_PAPER || (p->disable & VFX_WATER_NO_BLEND)))
-        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED,
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_WATER_METHOD,
                         "water: %u particles span %u position buffers of at most %u; method %u%s reads one "
                         "buffer (only the paper method's billboard passes draw several)",
                         s->count, s->group_count, s->buffer_cap, p->method,
@@ -732,7 +738,7 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
     /* the seed's method and the baselines draw the isotropic kernel of radius h only */
     if (p->method != VFX_WATER_METHOD_TILE &&
         (s->kp.kernel == VFX_WATER_KERNEL_ANISOTROPIC || volfx_water_aniso_has_columns(s->aniso)))
-        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED,
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_WATER_METHOD,
                           "water: %s is drawn by method TILE (3) only; method %u draws the isotropic kernel of radius h "
                           "(scene key water.quality.kernel / method)",
                           s->kp.kernel == VFX_WATER_KERNEL_ANISOTROPIC ? "the anisotropic kernel (vfx_water_params.kernel)"
@@ -751,7 +757,8 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
     else if (p->method == VFX_WATER_METHOD_GRID)
         r = grid_march(ctx, s, frame, targets);
     else
-        r = volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: unknown method %u in vfx_water_params (0 paper, 1 brute, 2 grid, 3 tile)", p->method);
+        r = volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_METHOD,
+                       "water: unknown method %u in vfx_water_params (0 paper, 1 brute, 2 grid, 3 tile)", p->method);
     if (r != VFX_OK)
         return r;
     /* TILE wrote the gradient and back distance from its own lists */
@@ -825,7 +832,7 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
     s->last_method_drawn = p->method;
     const char *e = volfx_gpu_error_string();
     if (e)
-        return volfx_fail(ctx, VFX_ERR_GL, "water render: %s", e);
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR, "water render: %s", e);
     return VFX_OK;
 }
 
@@ -849,10 +856,12 @@ vfx_result volfx_water_debug_gradient(vfx_context *ctx, float *out, size_t count
 {
     water_state *s = ctx->effect_state[VFX_EFFECT_WATER];
     if (!s || !s->grad)
-        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "water debug gradient: no water effect or no render yet");
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, VFX_LOG_ID_EFFECT_NOT_RENDERED,
+                          "water debug gradient: no water effect or no render yet");
     size_t n = (size_t)s->width * s->height * 4;
     if (!out || count < n)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water debug gradient: %zu floats, need %zu", count, n);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_READ_BUFFER_SIZE,
+                          "water debug gradient: %zu floats, need %zu", count, n);
     return volfx_gpu_read_top_first(ctx, s->grad, GL_RGBA, 4, -1, s->width, s->height, out);
 }
 
@@ -860,10 +869,12 @@ vfx_result volfx_water_debug_pixel_class(vfx_context *ctx, uint8_t *out, size_t 
 {
     water_state *s = ctx->effect_state[VFX_EFFECT_WATER];
     if (!s || !s->st || s->frame_no == 0 || s->last_method_drawn != VFX_WATER_METHOD_PAPER)
-        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "water debug pixel class: no paper-method frame rendered yet");
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, VFX_LOG_ID_EFFECT_NOT_RENDERED,
+                          "water debug pixel class: no paper-method frame rendered yet");
     size_t n = (size_t)s->width * s->height;
     if (!out || count < n)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water debug pixel class: %zu bytes, need %zu", count, n);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_READ_BUFFER_SIZE,
+                          "water debug pixel class: %zu bytes, need %zu", count, n);
     float *cls = volfx_alloc(ctx, n * sizeof *cls);
     if (!cls)
         return VFX_ERR_OUT_OF_MEMORY;
@@ -879,16 +890,18 @@ vfx_result volfx_water_debug_kernels(vfx_context *ctx, float *out, uint32_t *nbr
     water_state *s = ctx->effect_state[VFX_EFFECT_WATER];
     GLuint kern = s ? volfx_water_aniso_kernels(s->aniso) : 0, nb = s ? volfx_water_aniso_neighbours(s->aniso) : 0;
     if (!kern)
-        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "water debug kernels: no per-particle kernels computed yet");
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, VFX_LOG_ID_EFFECT_NOT_RENDERED,
+                          "water debug kernels: no per-particle kernels computed yet");
     if (!out || particles < s->count)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water debug kernels: room for %zu particles, need %u", particles, s->count);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_READ_BUFFER_SIZE,
+                          "water debug kernels: room for %zu particles, need %u", particles, s->count);
     glGetNamedBufferSubData(kern, 0, (GLsizeiptr)s->count * VOLFX_WATER_KERNEL_STRIDE, out);
     if (nbrs && nb)
         glGetNamedBufferSubData(nb, 0, (GLsizeiptr)s->count * 4, nbrs);
     else if (nbrs)
         memset(nbrs, 0, (size_t)s->count * 4); /* no neighbour search ran */
     const char *e = volfx_gpu_error_string();
-    return e ? volfx_fail(ctx, VFX_ERR_GL, "water debug kernels: %s", e) : VFX_OK;
+    return e ? volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR, "water debug kernels: %s", e) : VFX_OK;
 }
 
 vfx_result volfx_water_debug_diffuse(vfx_context *ctx, float *pot, size_t fluid, float *pool, size_t pool_cap,
@@ -896,7 +909,8 @@ vfx_result volfx_water_debug_diffuse(vfx_context *ctx, float *pot, size_t fluid,
 {
     water_state *s = ctx->effect_state[VFX_EFFECT_WATER];
     if (!s || !s->diffuse)
-        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "water debug diffuse: no water effect or no upload yet");
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, VFX_LOG_ID_EFFECT_NOT_RENDERED,
+                          "water debug diffuse: no water effect or no upload yet");
     return volfx_water_diffuse_debug(ctx, s->diffuse, pot, fluid, pool, pool_cap, alive);
 }
 
@@ -905,9 +919,11 @@ static vfx_result water_read_raw(vfx_context *ctx, void *state, float *out, size
     water_state *s = state;
     size_t n = (size_t)s->width * s->height;
     if (!ctx->water_dist_tex || s->last_method_drawn == UINT32_MAX || s->frame_no == 0)
-        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, "water read_raw: no water frame drawn yet");
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, VFX_LOG_ID_EFFECT_NOT_RENDERED,
+                          "water read_raw: no water frame drawn yet");
     if (count < n)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water read_raw: %zu floats, need %zu", count, n);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_READ_BUFFER_SIZE,
+                          "water read_raw: %zu floats, need %zu", count, n);
     return volfx_gpu_read_top_first(ctx, ctx->water_dist_tex, GL_RED, 1, -1, s->width, s->height, out);
 }
 

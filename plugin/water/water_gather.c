@@ -40,22 +40,23 @@ vfx_result volfx_water_gather_check(vfx_context *ctx, uint32_t chunk, const char
                                     uint32_t count, uint32_t elem)
 {
     if (!glIsBuffer(col->buffer))
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
                           "water: particle chunk %u: %s.buffer %u is not a buffer object of this GL context", chunk, field,
                           col->buffer);
     if (col->stride < elem || col->stride % 4u)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
                           "water: particle chunk %u: %s.stride %u must be a multiple of 4 of at least the element's %u bytes",
                           chunk, field, col->stride, elem);
     if (col->offset % 4u)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN, "water: particle chunk %u: %s.offset %llu is not a multiple of 4",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
+                          "water: particle chunk %u: %s.offset %llu is not a multiple of 4",
                           chunk, field, (unsigned long long)col->offset);
     GLint64 size = 0;
     glGetNamedBufferParameteri64v(col->buffer, GL_BUFFER_SIZE, &size);
     /* count <= 2^30 and stride < 2^32: the product fits; the offset is compared first */
     uint64_t need = (uint64_t)col->stride * (count - 1u) + elem;
     if (col->offset > (uint64_t)size || need > (uint64_t)size - col->offset)
-        return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
                           "water: particle chunk %u: %s.offset %llu + %s.stride %u x (%u - 1) + %u bytes passes the buffer's "
                           "GL_BUFFER_SIZE of %lld bytes", chunk, field, (unsigned long long)col->offset, field, col->stride,
                           count, elem, (long long)size);
@@ -110,7 +111,7 @@ vfx_result volfx_water_gather_begin(vfx_context *ctx, volfx_water_gather *g, con
             glNamedBufferStorage(g->ring[k], 32, NULL, 0);
         const char *e = volfx_gpu_error_string();
         if (e)
-            return volfx_fail(ctx, VFX_ERR_GL, "water gather: box buffers: %s", e);
+            return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR, "water gather: box buffers: %s", e);
     }
     collect(g);
     ++g->upload;
@@ -156,7 +157,8 @@ static vfx_result gather(vfx_context *ctx, volfx_water_gather *g, const char *de
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     const char *e = volfx_gpu_error_string();
     if (e)
-        return volfx_fail(ctx, VFX_ERR_GL, "water gather of %u particles from buffer %u: %s", count, col->buffer, e);
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR,
+                          "water gather of %u particles from buffer %u: %s", count, col->buffer, e);
     return VFX_OK;
 }
 

@@ -207,6 +207,7 @@ vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const 
     volfx_stat_set(ctx, "water.grid_cell_size", cs);
     const char *e = volfx_gpu_error_string();
     if (e)
-        return volfx_fail(ctx, VFX_ERR_GL, "water grid (%dx%dx%d cells of %g): %s", dims[0], dims[1], dims[2], (double)cs, e);
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR,
+                          "water grid (%dx%dx%d cells of %g): %s", dims[0], dims[1], dims[2], (double)cs, e);
     return VFX_OK;
 }

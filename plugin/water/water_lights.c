@@ -49,7 +49,8 @@ vfx_result volfx_water_lights_frame(vfx_context *ctx, volfx_water_lights *wl, ui
     if (!wl->buffer) {
         glCreateBuffers(1, &wl->buffer);
         if (!wl->buffer)
-            return volfx_fail(ctx, VFX_ERR_GL, "water lights: cannot create a uniform buffer");
+            return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR,
+                              "water lights: cannot create a uniform buffer");
         glNamedBufferStorage(wl->buffer, sizeof blk, NULL, GL_DYNAMIC_STORAGE_BIT);
         volfx_gpu_label(GL_BUFFER, wl->buffer, "water.effect_lights");
     }

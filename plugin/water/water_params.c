@@ -48,15 +48,17 @@ vfx_result volfx_water_params_resolve(vfx_context *ctx, const vfx_water_params *
         return rr;
     const vfx_lab_water *lab = volfx_chain_find(in->next, VFX_TYPE_LAB_WATER);
     if (in->features_off & ~(uint32_t)(VFX_WATER_NO_SPRAY | VFX_WATER_NO_SSR))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_water_params.features_off 0x%x has bits other "
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARAM,
+                          "water: vfx_water_params.features_off 0x%x has bits other "
                           "than VFX_WATER_NO_SPRAY | VFX_WATER_NO_SSR (0x%x)", in->features_off,
                           (unsigned)(VFX_WATER_NO_SPRAY | VFX_WATER_NO_SSR));
     if (in->method != VFX_WATER_METHOD_DEFAULT && in->method != VFX_WATER_METHOD_TILE
         && in->method != VFX_WATER_METHOD_PAPER)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARAM,
                           "water: vfx_water_params.method %u unknown (0 default = tile, 3 tile, 4 paper)", in->method);
     if (lab && (lab->disable & ~VFX_WATER_DISABLE_ALL))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, "water: vfx_lab_water.disable 0x%x has unknown bits",
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARAM,
+                          "water: vfx_lab_water.disable 0x%x has unknown bits",
                           lab->disable);
     volfx_water_core p = {in->h, in->threshold, in->max_samples, in->step, in->refine_iters, in->pyramid_level,
                           in->features_off | (lab ? lab->disable : 0u), in->method,
@@ -65,13 +67,13 @@ vfx_result volfx_water_params_resolve(vfx_context *ctx, const vfx_water_params *
         p.method = lab->method;
     uint32_t preset = in->preset;
     if (preset > VFX_WATER_PRESET_ULTRA)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARAM,
                           "water: vfx_water_params.preset %u unknown (0 default, 1 low, 2 medium, 3 high, 4 ultra)", preset);
     if (preset == VFX_WATER_PRESET_DEFAULT)
         preset = VFX_WATER_PRESET_MEDIUM;
     const preset_def *d = &PRESETS[preset];
     if (p.method > VFX_WATER_METHOD_PAPER)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARAM,
                           "water: vfx_lab_water.method %u unknown (0 default = tile, 1 brute, 2 grid, 3 tile, 4 paper)",
                           p.method);
     if (p.method == VFX_WATER_METHOD_DEFAULT)
@@ -119,7 +121,7 @@ vfx_result volfx_water_params_set_h(vfx_context *ctx, volfx_water_resolved *r, f
         return VFX_OK;
     }
     if (!(r->p.step >= STEP_MIN_H * h && r->p.step <= STEP_MAX_H * h))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT,
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
                           "water: vfx_water_params.step %g outside [h/1024, h] = [%g, %g] (h %g): a smaller step "
                           "takes more than 2^15 steps a pixel, a larger one passes whole drops",
                           (double)r->p.step, (double)(STEP_MIN_H * h), (double)(STEP_MAX_H * h), (double)h);

@@ -211,7 +211,8 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
             break;
     }
     if (tiles > max_tiles) /* 16384^2 at 64x64 tiles is 65,536 of them: only a debug cap gets here */
-        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, "water tile: %ux%u pixels make %llu tiles of %ux%u, more than %u",
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_WATER_VIEW_TOO_LARGE,
+                          "water tile: %ux%u pixels make %llu tiles of %ux%u, more than %u",
                           in->width, in->height, (unsigned long long)tiles, 1u << TILE_SHIFT_MAX, 1u << TILE_SHIFT_MAX,
                           max_tiles);
     volfx_stat_set(ctx, "water.tile_pixels", 1u << t->shift);
@@ -281,7 +282,8 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
     }
     const char *e = volfx_gpu_error_string();
     if (e)
-        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water tile: buffers for %llu tiles and %u entries: %s",
+        return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_GPU_OUT_OF_MEMORY,
+                          "water tile: buffers for %llu tiles and %u entries: %s",
                           (unsigned long long)tiles, t->entry_cap, e);
     GLuint count, scatter;
     if (in->kernels) {
@@ -384,7 +386,8 @@ static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const vol
     volfx_gpu_pass_end(ctx);
     const char *e = volfx_gpu_error_string();
     if (e)
-        return volfx_fail(ctx, VFX_ERR_GL, "%s %ux%u: %s", finish ? "water finish" : "water tile march",
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR,
+                          "%s %ux%u: %s", finish ? "water finish" : "water tile march",
                           in->width, in->height, e);
     return VFX_OK;
 }
@@ -427,7 +430,8 @@ vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const v
         t->hits_valid = 0;
         const char *e = volfx_gpu_error_string();
         if (e)
-            return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water tile: temporal buffers for %ux%u pixels: %s",
+            return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_GPU_OUT_OF_MEMORY,
+                              "water tile: temporal buffers for %ux%u pixels: %s",
                               in->width, in->height, e);
     }
     /* the view's forward direction: -(third row of the view rotation) */
@@ -470,7 +474,8 @@ vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const v
         t->remarch_px = px;
         const char *e = volfx_gpu_error_string();
         if (e)
-            return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, "water tile: remarch list for %ux%u pixels: %s",
+            return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_GPU_OUT_OF_MEMORY,
+                              "water tile: remarch list for %ux%u pixels: %s",
                               in->width, in->height, e);
     }
     vfx_result r = tile_dispatch(ctx, t, in, frame, false, grad_tex, back_tex, half ? 1 : 0, temporal, reuse);

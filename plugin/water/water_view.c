@@ -35,7 +35,7 @@ static vfx_result targets_make(vfx_context *ctx, water_view *v, uint32_t width, 
     uint64_t px = (uint64_t)width * height;
     uint64_t bytes = px * (TILE_TARGET_BYTES + (paper ? PAPER_TARGET_BYTES : 0u));
     if (bytes > WATER_VIEW_BYTES_MAX)
-        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED,
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_WATER_VIEW_TOO_LARGE,
                           "water: a %ux%u view needs %.1f GiB of water targets (%u bytes a pixel%s), more than the %.0f GiB "
                           "one view's water may take (docs/water.md \"Views\"); nothing was allocated",
                           width, height, (double)bytes / (1u << 30), TILE_TARGET_BYTES + (paper ? PAPER_TARGET_BYTES : 0u),
@@ -74,14 +74,16 @@ static vfx_result targets_make(vfx_context *ctx, water_view *v, uint32_t width, 
     const char *e = volfx_gpu_error_string();
     if (e) {
         targets_free(v);
-        return volfx_fail(ctx, e && strstr(e, "OUT_OF_MEMORY") ? VFX_ERR_OUT_OF_MEMORY : VFX_ERR_GL,
-                          "water: targets of a %ux%u view (%.2f GiB): %s", width, height, (double)bytes / (1u << 30), e);
+        const bool oom = strstr(e, "OUT_OF_MEMORY") != NULL;
+        return volfx_fail(ctx, oom ? VFX_ERR_OUT_OF_MEMORY : VFX_ERR_GL,
+                          oom ? VFX_LOG_ID_GPU_OUT_OF_MEMORY : VFX_LOG_ID_GL_ERROR, "water: targets of a %ux%u view (%.2f GiB): %s", width, height, (double)bytes / (1u << 30), e);
     }
     GLuint fbs[] = {v->fbo_grad, v->fbo_back, v->fbo_dist, v->fbo_pot};
     for (int k = 0; k < 4; ++k)
         if (fbs[k] && glCheckNamedFramebufferStatus(fbs[k], GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
             targets_free(v);
-            return volfx_fail(ctx, VFX_ERR_GL, "water: targets of a %ux%u view: incomplete framebuffer", width, height);
+            return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_FRAMEBUFFER_INCOMPLETE,
+                              "water: targets of a %ux%u view: incomplete framebuffer", width, height);
         }
     return VFX_OK;
 }

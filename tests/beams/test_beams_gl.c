@@ -343,11 +343,11 @@ static void test_bad_input_and_absence(void **state)
     (void)state;
     beam0()->radius = -1.f;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(g_app->api->last_error(g_app->ctx, NULL), "beams[0]"));
+    assert_true(test_last_error_is(g_app->api, g_app->ctx, VFX_LOG_ID_PARAM_RANGE, "beams[0]"));
     *beam0() = k_beam;
     beam0()->head[1] = NAN;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(g_app->api->last_error(g_app->ctx, NULL), "beams[0]: beam head.y"));
+    assert_true(test_last_error_is(g_app->api, g_app->ctx, VFX_LOG_ID_BEAM_FIELD, "beams[0]: beam head.y"));
     *beam0() = k_beam;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_non_null(g_app->ctx->effect_state[VFX_EFFECT_BEAMS]);
@@ -553,7 +553,7 @@ static void test_anatomy_matches_closed_form(void **state)
     /* bad anatomy is refused naming the beam and the struct; then it works again */
     beam0()->taper = 2.f;
     assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
-    assert_non_null(strstr(g_app->api->last_error(g_app->ctx, NULL), "beams[0]: vfx_beam"));
+    assert_true(test_last_error_is(g_app->api, g_app->ctx, VFX_LOG_ID_PARAM_RANGE, "beams[0]: vfx_beam"));
     beam0()->taper = 0.5f, beam0()->orb_radius = NAN;
     assert_int_not_equal(game_app_frame(g_app, 0.f), VFX_OK);
     beam0()->orb_radius = 0.45f;
@@ -658,15 +658,15 @@ static void test_bad_v2_input(void **state)
     use_v2(true, true, true);
     beam0()->falloff = 7;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(g_app->api->last_error(g_app->ctx, NULL), "beams[0]: falloff"));
+    assert_true(test_last_error_is(g_app->api, g_app->ctx, VFX_LOG_ID_BEAM_FIELD, "beams[0]: falloff"));
     use_v2(true, true, true);
     beam0()->flow_amount = 2.f;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(g_app->api->last_error(g_app->ctx, NULL), "flow_amount"));
+    assert_true(test_last_error_is(g_app->api, g_app->ctx, VFX_LOG_ID_PARAM_RANGE, "flow_amount"));
     use_v2(true, true, true);
     g_app->beams_view.bloom_levels = 99;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(g_app->api->last_error(g_app->ctx, NULL), "bloom_levels"));
+    assert_true(test_last_error_is(g_app->api, g_app->ctx, VFX_LOG_ID_PARAM_RANGE, "bloom_levels"));
     use_v2(false, false, false);
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
 }

@@ -361,7 +361,7 @@ static void test_lights(void **state)
     assert_int_equal(out.total, 3);
     out.type = (vfx_struct_type)7;
     assert_int_equal(api.get_lights(g_app->ctx, &out), VFX_ERR_ABI);
-    assert_non_null(strstr(api.last_error(g_app->ctx, NULL), "vfx_lights has type 7"));
+    assert_true(test_last_error_is(&api, g_app->ctx, VFX_LOG_ID_STRUCT_TYPE, "vfx_lights has type 7"));
 }
 
 int main(void)

@@ -23,5 +23,11 @@ typedef struct test_log {
 void test_log_fn(void *user, vfx_log_level level, const char *message);
 /* The same as the plugin's log callback (vfx_context_desc.log): also keeps the id in last_id. */
 void test_vfx_log_fn(void *user, vfx_log_level level, vfx_log_id id, const char *message);
+/* True when the plugin's last error on ctx has the id `want` and, unless `part` is NULL, contains
+ * `part` (text checks only where the text is the point: the field or value it names); prints
+ * what it got otherwise. */
+bool test_last_error_is(const vfx_plugin_api *api, vfx_context *ctx, vfx_log_id want, const char *part);
+/* The same for the last message a test_log recorded through test_vfx_log_fn. */
+bool test_log_is(const test_log *log, vfx_log_id want, const char *part);
 
 #endif

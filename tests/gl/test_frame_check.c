@@ -165,7 +165,7 @@ static void test_frame_fields(void **state)
     /* read_raw before any render (issue 28: VFX_OK with nothing rendered) */
     static float early[W * H];
     assert_int_equal(api->read_raw(ctx, VFX_EFFECT_BEAMS, early, W * H), VFX_ERR_NOT_FOUND);
-    assert_non_null(strstr(api->last_error(ctx, NULL), "read_raw: effect beams has not been rendered"));
+    assert_true(test_last_error_is(api, ctx, VFX_LOG_ID_EFFECT_NOT_RENDERED, "read_raw: effect beams"));
     expect(api, ctx, &f.fv, VFX_OK, NULL);
     double h_ref = max_h(api, ctx);
     assert_true(h_ref > 0.1); /* the beam is in view */
@@ -316,9 +316,9 @@ static void test_frame_fields(void **state)
     /* NULL outputs: their own error, not the last one */
     assert_int_equal(api->render(ctx, &v), VFX_ERR_ABI);
     assert_int_equal(api->read_raw(ctx, VFX_EFFECT_BEAMS, NULL, 0), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(api->last_error(ctx, NULL), "read_raw: out is NULL"));
+    assert_true(test_last_error_is(api, ctx, VFX_LOG_ID_API_ARGUMENT, "read_raw: out"));
     assert_int_equal(api->get_stats(ctx, NULL), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(api->last_error(ctx, NULL), "get_stats: out is NULL"));
+    assert_true(test_last_error_is(api, ctx, VFX_LOG_ID_API_ARGUMENT, "get_stats: out"));
     api->destroy(ctx);
     free_fixture(&f);
     assert_int_equal(glGetError(), GL_NO_ERROR);
@@ -397,20 +397,20 @@ static void test_callback_pairs(void **state)
                          .particle_chunk_count = one_chunk};
     assert_int_equal(api->create(&host, &ctx), VFX_ERR_INVALID_ARGUMENT);
     assert_null(ctx);
-    assert_non_null(strstr(log.last, "particle_chunk_count is set but particle_chunk is NULL"));
+    assert_true(test_log_is(&log, VFX_LOG_ID_CONTEXT_DESC, "particle_chunk_count is set but particle_chunk is NULL"));
     host.particle_chunk_count = NULL;
     host.volume_count = one_volume;
     assert_int_equal(api->create(&host, &ctx), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(log.last, "volume_count is set but volume is NULL"));
+    assert_true(test_log_is(&log, VFX_LOG_ID_CONTEXT_DESC, "volume_count is set but volume is NULL"));
     host.volume_count = NULL;
     host.free = host_free;
     assert_int_equal(api->create(&host, &ctx), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(log.last, "free is set but alloc is NULL"));
+    assert_true(test_log_is(&log, VFX_LOG_ID_CONTEXT_DESC, "free is set but alloc is NULL"));
     host.free = NULL;
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
     ctx->host.particle_chunk_count = one_chunk; /* the copy damaged after create */
     assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(api->last_error(ctx, NULL), "update: context desc: particle_chunk_count is set"));
+    assert_true(test_last_error_is(api, ctx, VFX_LOG_ID_CONTEXT_DESC, "update: context desc: particle_chunk_count"));
     api->destroy(ctx);
 }
 

@@ -148,11 +148,12 @@ static void test_timestamps_and_empty_world(void **state)
     /* bad frames are refused with a message, not drawn */
     fv.proj[5] = NAN;
     assert_int_equal(api->render(ctx, &fv), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(api->last_error(ctx, NULL), "camera matrix element"));
+    assert_true(test_last_error_is(api, ctx, VFX_LOG_ID_FRAME_VIEW, "camera matrix element"));
     fv.proj[5] = 1;
     fv.type = (vfx_struct_type)9;
     assert_int_equal(api->render(ctx, &fv), VFX_ERR_ABI);
     assert_int_equal(api->resize(ctx, 0, 10), VFX_ERR_INVALID_ARGUMENT);
+    assert_true(test_last_error_is(api, ctx, VFX_LOG_ID_RESIZE_RANGE, "0x10"));
     api->destroy(ctx);
 }
 
@@ -175,15 +176,15 @@ static void test_shader_error_names_file_line(void **state)
     const char *srcs[1] = {src}, *names[1] = {"common/depth.glsl"};
     GLenum stage = GL_FRAGMENT_SHADER;
     assert_int_equal(volfx_gpu_link_sources(ctx, 1, &stage, srcs, names), 0);
-    assert_non_null(strstr(api->last_error(ctx, NULL), "common/depth.glsl:3:"));
+    assert_true(test_last_error_is(api, ctx, VFX_LOG_ID_SHADER_COMPILE, "common/depth.glsl:3:"));
     /* an error inside an included file names that file: the integrate shader compiled with a
      * define that breaks the included beam_field.glsl is reported at beam_field.glsl */
     assert_int_equal(volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
                                      "#define fma undefined_fma"), 0);
-    assert_non_null(strstr(api->last_error(ctx, NULL), "beams/beam_field.glsl:"));
+    assert_true(test_last_error_is(api, ctx, VFX_LOG_ID_SHADER_COMPILE, "beams/beam_field.glsl:"));
     /* a shader that is not embedded is named */
     assert_int_equal(volfx_gpu_program(ctx, "common/fullscreen.vert", "nope/none.frag", NULL), 0);
-    assert_non_null(strstr(api->last_error(ctx, NULL), "nope/none.frag"));
+    assert_true(test_last_error_is(api, ctx, VFX_LOG_ID_SHADER_COMPILE, "nope/none.frag"));
     /* the real embedded program links, and is cached */
     GLuint p0 = volfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", NULL);
     assert_int_not_equal(p0, 0);

@@ -123,6 +123,7 @@ static void expect_rebuilt(test_log *log, const char *what)
 typedef struct warn_log {
     test_log base;
     char warning[1024];
+    vfx_log_id warning_id;
 } warn_log;
 
 static void warn_log_fn(void *user, vfx_log_level level, vfx_log_id id, const char *message)
@@ -130,7 +131,7 @@ static void warn_log_fn(void *user, vfx_log_level level, vfx_log_id id, const ch
     warn_log *w = user;
     test_vfx_log_fn(&w->base, level, id, message);
     if (level == VFX_LOG_WARN)
-        snprintf(w->warning, sizeof w->warning, "%s", message);
+        snprintf(w->warning, sizeof w->warning, "%s", message), w->warning_id = id;
 }
 
 static void test_cache(void **state)
@@ -229,6 +230,7 @@ static void hostile(const char *name, char kind, const char *victim, bool is_ent
     if (is_entry) {
         assert_int_equal(log.base.warnings, 1); /* the planted entry is named, and rebuilt */
         assert_non_null(strstr(log.warning, g_entry + strlen(g_dir) + 1));
+        assert_int_equal(log.warning_id, VFX_LOG_ID_PROGRAM_CACHE_ENTRY);
         assert_non_null(strstr(log.warning, kind == 'l' ? "symbolic link" : "not a regular file"));
     } else {
         assert_int_equal(log.base.warnings, 0);

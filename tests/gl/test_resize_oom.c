@@ -71,7 +71,9 @@ static void body(void)
     printf("resize 8192x8192 under %.2f GB of address space: %s: %s\n", (double)r.rlim_cur / 1e9, vfx_result_name(res),
            app->api->last_error(app->ctx, NULL));
     assert_int_equal(res, VFX_ERR_OUT_OF_MEMORY);
-    assert_non_null(strstr(app->api->last_error(app->ctx, NULL), "resize to 8192x8192 failed, the context stays at 96x54"));
+    vfx_log_id id = VFX_LOG_ID_NONE; /* the cause's id: host memory or GL memory ran out */
+    assert_non_null(strstr(app->api->last_error(app->ctx, &id), "resize to 8192x8192 failed, the context stays at 96x54"));
+    assert_true(id == VFX_LOG_ID_OUT_OF_MEMORY || id == VFX_LOG_ID_GPU_OUT_OF_MEMORY);
     assert_int_equal(app->ctx->width, W); /* the failed size is not recorded */
     assert_int_equal(app->ctx->height, H);
     frame_pixels(app, &demo, after);

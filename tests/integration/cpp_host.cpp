@@ -25,7 +25,10 @@ void on_log(void *user, vfx_log_level level, vfx_log_id id, const char *msg)
 {
     auto *g = static_cast<game *>(user);
     if (level >= VFX_LOG_WARN)
-        std::fprintf(stderr, "volfx (id %d): %s\n", static_cast<int>(id), msg);
+    {
+        const char *name = vfx_log_id_name(id); // NULL: an id newer than this header
+        std::fprintf(stderr, "volfx (%s, id %d): %s\n", name ? name : "?", static_cast<int>(id), msg);
+    }
     if (level == VFX_LOG_ERROR)
         g->errors++;
 }

@@ -175,7 +175,7 @@ static void test_bad_view_and_absence(void **state)
     g_tets[5] = g_np + 7;
     game_app_volume(g_app, g_vol)->revision = 2;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(g_app->api->last_error(g_app->ctx, NULL), "volume[0]: tet 1 uses point"));
+    assert_true(test_last_error_is(g_app->api, g_app->ctx, VFX_LOG_ID_VOLUME_MESH, "volume[0]: tet 1 uses point"));
     g_tets[5] = saved;
     game_app_volume(g_app, g_vol)->revision = 3;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);

@@ -64,6 +64,8 @@ static void test_wrong_abi_refused(void **state)
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION + 1, &host2, &api), VFX_ERR_ABI);
     assert_non_null(strstr(log2.last, want));
     assert_int_equal(log2.last_id, VFX_LOG_ID_ABI_VERSION);
+    assert_string_equal(vfx_log_id_name(log2.last_id), "ABI_VERSION"); /* the header-only name */
+    assert_null(vfx_log_id_name((vfx_log_id)100000)); /* an id of a newer plugin: no name */
     /* a host table of another type is refused too, and left as it was */
     vfx_plugin_api other = {.type = VFX_TYPE_STATS};
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, &host2, &other), VFX_ERR_ABI);

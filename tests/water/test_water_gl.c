@@ -461,7 +461,7 @@ static void test_unknown_method(void **state)
      * blamed on the anisotropic kernel) */
     s.kernel = 0;
     assert_int_equal(api.update(ctx, 0.0, 0.0f), VFX_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(api.last_error(ctx, NULL), "method 7 unknown"));
+    assert_true(test_last_error_is(&api, ctx, VFX_LOG_ID_WATER_PARAM, "method 7 unknown"));
     (void)fv;
     api.destroy(ctx);
     free_scene(&s);
@@ -891,6 +891,7 @@ static void test_chunked_buffers(void **state)
             const char *msg = ss.api.last_error(ss.ctx, NULL);
             print_message("brute with 3 buffers: %s\n", msg);
             assert_non_null(strstr(msg, "3000 particles span 3 position buffers of at most 1000"));
+            assert_true(test_last_error_is(&ss.api, ss.ctx, VFX_LOG_ID_WATER_METHOD, NULL));
             s.params.method = VFX_WATER_METHOD_PAPER;
             /* the same context goes on rendering once the method reads several again */
             assert_int_equal(session_frame(&ss), VFX_OK);
@@ -948,7 +949,7 @@ static void test_count_overflow_refused(void **state)
         assert_int_equal(api.create(&host, &ctx), VFX_OK);
         assert_int_equal(api.update(ctx, 0.0, 0.0f), VFX_ERR_INVALID_ARGUMENT);
         print_message("overflow %d: %s\n", k, api.last_error(ctx, NULL));
-        assert_non_null(strstr(api.last_error(ctx, NULL), totals[k]));
+        assert_true(test_last_error_is(&api, ctx, VFX_LOG_ID_WATER_PARTICLE_COUNT, totals[k]));
         assert_non_null(strstr(api.last_error(ctx, NULL), "more than the limit of 1073741824"));
         assert_int_equal(hh.log.errors, 1);
         api.destroy(ctx);

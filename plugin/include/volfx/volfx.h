@@ -388,23 +388,64 @@ typedef struct vfx_volume_view {
 /* -------------------------------------------------------------------------- context */
 
 /* Stable ids of the plugin's messages (docs/abi.md "Log ids"): the log callback and last_error
- * give one beside the text, so a host can react to a kind of message without matching text.
- * GENERIC is every message not yet given a kind of its own. Values are never renumbered or
- * reused. */
+ * give one beside the text, so a host can react to a kind of message without matching text
+ * (the text names the field or call and the values; the id names the kind). Every message the
+ * plugin logs has an id of its own kind; ids are appended, never renumbered or reused. */
 #define VFX_LOG_ID_LIST(X) \
-    X(NONE, 0) \
-    X(GENERIC, 1) \
-    X(ABI_VERSION, 2) \
-    X(STRUCT_TYPE, 3) \
-    X(GPU_PARTICLES_UNSUPPORTED, 4) \
-    X(LAYER_TEXTURE_UNSUPPORTED, 5) \
-    X(PARAM_RANGE, 6)         /* a number outside its documented range (volfx_ranges.h) */ \
+    X(NONE, 0)                /* no message (last_error before any failure) */ \
+    X(GENERIC, 1)             /* no longer emitted: every message has a kind of its own */ \
+    X(ABI_VERSION, 2)         /* the host passed another ABI version to vfx_plugin_entry */ \
+    X(STRUCT_TYPE, 3)         /* a struct's type is not the VFX_TYPE_* its place needs */ \
+    X(GPU_PARTICLES_UNSUPPORTED, 4) /* a particle view's gpu_kernel (not read from GL buffers) */ \
+    X(LAYER_TEXTURE_UNSUPPORTED, 5) /* no longer emitted (layer_texture is drawn since ABI 1.0) */ \
+    X(PARAM_RANGE, 6)         /* a number outside its documented range (volfx_ranges.h; names the field) */ \
     X(FRAME_VIEW, 7)          /* a frame view field or target refused by the frame gate */ \
     X(OUT_OF_MEMORY, 8)       /* an allocation through the host allocator failed */ \
     X(GL_VERSION, 9)          /* the current context is below desktop GL 4.5 */ \
     X(GL_COMMAND_MISSING, 10) /* gl_get_proc_address found no entry point for a command */ \
     X(GPU_COLUMN, 11)         /* a particle view's GL buffer column refused (gpu_pos, gpu_vel) */ \
-    X(LAYER_TEXTURE, 12)      /* a frame view's layer_texture refused */
+    X(LAYER_TEXTURE, 12)      /* a frame view's layer_texture refused */ \
+    X(API_ARGUMENT, 13)       /* an API call's argument NULL or out of range (names the call and it) */ \
+    X(CONTEXT_DESC, 14)       /* the context desc lacks gl_get_proc_address or half a callback pair */ \
+    X(RESIZE_RANGE, 15)       /* resize outside 1..16384 in a direction */ \
+    X(UPDATE_TIME, 16)        /* update's time or dt not finite */ \
+    X(HOST_CALLBACK, 17)      /* a host callback (particle_chunk, water_params, beams, volume) failed */ \
+    X(EFFECT_NOT_BUILT, 18)   /* an effect this build of the plugin leaves out was asked for */ \
+    X(EFFECT_NOT_RENDERED, 19) /* read_raw or a lab read before the effect exists or has drawn */ \
+    X(READ_BUFFER_SIZE, 20)   /* read_raw or a lab read given less room than the data */ \
+    X(GL_ERROR, 21)           /* a GL command of a pass raised a GL error (names the pass, GL_*) */ \
+    X(GPU_OUT_OF_MEMORY, 22)  /* GL could not allocate a buffer or texture (GL_OUT_OF_MEMORY) */ \
+    X(GL_NO_CONTEXT, 23)      /* no current GL context on the calling thread */ \
+    X(FRAMEBUFFER_INCOMPLETE, 24) /* a framebuffer of the plugin's own targets is incomplete */ \
+    X(SHADER_COMPILE, 25)     /* an embedded shader did not compile (the driver's log follows) */ \
+    X(PROGRAM_LINK, 26)       /* a program did not link (the driver's log follows) */ \
+    X(PROGRAM_LIMIT, 27)      /* the plugin's table of GL programs is full */ \
+    X(PROGRAM_CACHE_DIR, 28)  /* set_program_cache: the folder cannot be made or is no folder */ \
+    X(PROGRAM_CACHE_UNSAFE, 29) /* warning: the cache folder is writable by every user, not sticky */ \
+    X(PROGRAM_CACHE_OFF, 30)  /* info: the driver offers no program binary format; no cache */ \
+    X(PROGRAM_CACHE_ENTRY, 31) /* warning: a cached binary refused; the program rebuilt from source */ \
+    X(PROGRAM_CACHE_STORE, 32) /* warning: a program binary could not be stored */ \
+    X(GL_INFO, 33)            /* debug: the GL context's version and profile, commands resolved */ \
+    X(EFFECT_CREATED, 34)     /* debug: an effect made (its data appeared in the world) */ \
+    X(EFFECT_DESTROYED, 35)   /* debug: an effect freed (its data left the world) */ \
+    X(EFFECT_ORDER, 36)       /* an effect's render ran without its prepare step (a plugin defect) */ \
+    X(BEAM_FIELD, 37)         /* a vfx_beam field not finite, unknown (falloff, ramp) or degenerate */ \
+    X(BEAM_JOINTS, 38)        /* a bending beam's joints refused (range in the view, count, values) */ \
+    X(BEAMS_COUNT, 39)        /* more than 2^20 beams, or a count with a NULL array */ \
+    X(BEAMS_VIEW_FIELD, 40)   /* a vfx_beams_view or vfx_lab_beams value unknown (lab method) */ \
+    X(BEAMS_TILE_PAIRS, 41)   /* the beams cover more beam-tile pairs than the binning holds */ \
+    X(WATER_PARAM, 42)        /* a vfx_water_params value unknown (method, preset, bits...) or two at odds */ \
+    X(WATER_PARTICLE_VALUE, 43) /* a particle's radius or kernel column value refused */ \
+    X(WATER_PARTICLE_CHUNK, 44) /* a particle chunk without positions, or changed during the update */ \
+    X(WATER_PARTICLE_COUNT, 45) /* more particles than the water's limit of 2^30 */ \
+    X(WATER_METHOD, 46)       /* the water's method cannot draw these particles or this kernel */ \
+    X(WATER_VIEW_TOO_LARGE, 47) /* the view is too large for the water's targets or tile limit */ \
+    X(WATER_UNDECIDED_PIXELS, 48) /* warning: water pixels left undrawn (the march ran out of steps) */ \
+    X(VOLUME_MESH, 49)        /* a volume's points or tets refused (missing, index out of range) */ \
+    X(VOLUME_SCALAR, 50)      /* a volume's scalar domain not finite, or every scalar NaN */ \
+    X(VOLUME_TRANSFER, 51)    /* a volume's transfer function refused */ \
+    X(VOLUME_MODEL, 52)       /* a volume's model matrix not finite */ \
+    X(VOLUME_EXTRA, 53)       /* warning: the host has several volumes, only the first is drawn */
 
 typedef enum vfx_log_id {
 #define VFX_LOG_ID_ENUM_(name, value) VFX_LOG_ID_##name = value,
@@ -412,6 +453,19 @@ typedef enum vfx_log_id {
 #undef VFX_LOG_ID_ENUM_
     VFX_LOG_ID_MAX_ENUM = 0x7fffffff
 } vfx_log_id;
+
+/* The id's name without the prefix ("WATER_PARAM"), or NULL for a value not in this header's
+ * list (a newer plugin's id: print the number). Header-only: no ABI entry. */
+static inline const char *vfx_log_id_name(vfx_log_id id)
+{
+    switch (id) {
+#define VFX_LOG_ID_NAME_(name, value) case VFX_LOG_ID_##name: return #name;
+    VFX_LOG_ID_LIST(VFX_LOG_ID_NAME_)
+#undef VFX_LOG_ID_NAME_
+    case VFX_LOG_ID_MAX_ENUM: break;
+    }
+    return NULL;
+}
 
 /* What create() needs: the GL loader, the logger and allocator, and the callbacks through which
  * update() pulls the host's data (each hands the host a zeroed struct with `type` set). */
