@@ -10,15 +10,16 @@ import sys
 
 MAX_LINES = 400
 DIARY = re.compile(r"\b(issues?|rounds?|stops?|superseded|state of the work)\b|\b20\d\d\b", re.I)
-# Pages other helpers were rewriting when this check landed: their links are checked, their
-# length and headings not yet. Remove a page from here once it meets the rules.
-PAGE_RULE_EXCEPTIONS = {
-    "docs/water.md",
-    "docs/integration.md",
-    "docs/robustness.md",
-    "docs/abi.md",
-    "docs/scene-format.md",
-    # being rewritten by the docs helper, in the commits that follow
+# Pages that do not meet a rule yet, each named with the rule it misses; take a page out once it
+# meets it (the test then holds it there). Their links are checked like every page's.
+OVER_LENGTH = {
+    "docs/water.md",        # 925 lines: to be split into topic pages like simulation-*.md
+    "docs/integration.md",  # 603 lines
+    "docs/robustness.md",   # 401 lines
+}
+DIARY_HEADINGS = {
+    "docs/water.md",       # "state of the work", issues 4, 14 and 24, years in headings
+    "docs/robustness.md",  # issues 18 and 28
 }
 LINK = re.compile(r"!?\[[^\]]*\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)")
 
@@ -54,8 +55,8 @@ def check(root, rel):
         lines = f.read().split("\n")
     if lines and lines[-1] == "":
         lines.pop()
-    ruled = rel.startswith("docs/") and rel not in PAGE_RULE_EXCEPTIONS
-    if ruled and len(lines) > MAX_LINES:
+    ruled = rel.startswith("docs/")
+    if ruled and rel not in OVER_LENGTH and len(lines) > MAX_LINES:
         fails.append("%s: %d lines (at most %d: split it into topic pages)" % (rel, len(lines), MAX_LINES))
     fence = False
     for n, line in enumerate(lines, 1):
@@ -64,7 +65,7 @@ def check(root, rel):
             continue
         if fence:
             continue
-        if ruled and line.startswith("#") and DIARY.search(line):
+        if ruled and rel not in DIARY_HEADINGS and line.startswith("#") and DIARY.search(line):
             fails.append("%s:%d: heading keyed to an issue/round/stop/date: %s" % (rel, n, line.strip()))
         for page in re.findall(r"(?<![\w/.-])docs/[\w.-]+\.md\b", line):
             if not os.path.isfile(os.path.join(root, page)):
@@ -92,7 +93,7 @@ def main():
     fails = []
     for rel in pages(root):
         fails += check(root, rel)
-    for stale in sorted(PAGE_RULE_EXCEPTIONS):
+    for stale in sorted(OVER_LENGTH | DIARY_HEADINGS):
         if not os.path.isfile(os.path.join(root, stale)):
             fails.append("exception for a page that does not exist: " + stale)
     for f in fails:
