@@ -23,6 +23,26 @@ typedef struct volfx_debug_knobs {
     uint64_t water_storage_cap; /* bytes per TILE storage block; 0 -> GL_MAX_SHADER_STORAGE_BLOCK_SIZE */
 } volfx_debug_knobs;
 
+/* The engine's own depth (docs/integration.md, "The engine's own depth"): this frame's
+ * vfx_frame_depth as the frame gate read it. Zero is the standard: depth_texture holds window
+ * depth of proj under GL_NEGATIVE_ONE_TO_ONE, rows bottom first. */
+typedef struct volfx_frame_depth {
+    unsigned depth_renderbuffer; /* a depth renderbuffer of the frame's size, read instead of depth_texture */
+    unsigned depth_framebuffer;  /* or a framebuffer whose depth attachment is read (renderbuffer or texture) */
+    bool flip_y;                 /* colour and depth rows are stored top first, and the output is expected so */
+    bool zero_to_one;            /* the depth was written under glClipControl(.., GL_ZERO_TO_ONE) */
+} volfx_frame_depth;
+
+/* The frame gate's depth objects (frame_check.c): a same-format copy of a renderbuffer's depth,
+ * and the depth converted to the standard convention. */
+typedef struct volfx_depth_targets {
+    unsigned src_fbo;            /* the host's renderbuffer attached, to blit from */
+    unsigned copy_tex, copy_fbo; /* the blit's target, of the host's depth format */
+    int copy_format;
+    unsigned std_tex, std_fbo;   /* DEPTH_COMPONENT32F, the standard convention */
+    uint32_t w, h;               /* size of copy_tex and std_tex */
+} volfx_depth_targets;
+
 struct vfx_context {
     vfx_context_desc host;      /* copy of the host's description (next cleared: not kept) */
     volfx_gpu *gpu;               /* program cache, timers, fullscreen VAO */
@@ -49,6 +69,8 @@ struct vfx_context {
     uint32_t gl_calls;
     bool gl_compat;             /* the context is a compatibility profile */
     bool gl_skip_restore;       /* vfx_gl_state_desc.skip_restore: the host resets its own state, no save, no restore */
+    volfx_frame_depth frame_depth; /* this frame's vfx_frame_depth (zero: the standard depth) */
+    volfx_depth_targets depth;
 };
 
 /* Logs through the host logger, printf-style, with the message's stable id (VFX_LOG_ID_LIST:

@@ -38,6 +38,8 @@ typedef struct volfx_frame_targets {
     float fov_y;                     /* radians, [0, pi) */
     float cam_view_proj[16];         /* camera-relative: proj * view without its translation */
     float inv_cam_view_proj[16];     /* window/NDC -> direction from the eye */
+    bool depth_convert;              /* the host's depth is rewritten in the standard convention */
+    double depth_host[4], depth_std[2]; /* its parameters (shaders/common/depth_convert.frag) */
     bool output_srgb;                /* framebuffer's colour attachment 0 is sRGB-encoded: the
                                       * frame gate turns GL_FRAMEBUFFER_SRGB on for the frame */
     /* The beams' prepare step (before the water's shading): their light in front of the water

@@ -305,6 +305,9 @@ static vfx_result render(vfx_context *ctx, const vfx_frame_view *frame)
         drawing |= ctx->effect_state[k] && (mask & VFX_EFFECT_BIT(k));
     if ((cr = volfx_frame_gate_gl(ctx, drawing, &targets)))
         return cr;
+    if (targets.scene_depth != checked.depth_texture
+        && (checked.depth_texture || ctx->frame_depth.depth_renderbuffer || ctx->frame_depth.depth_framebuffer))
+        checked.depth_texture = targets.scene_depth; /* the engine's own depth, as the gate made it */
     checked.framebuffer = targets.framebuffer; /* the effects layer's, when the host gave one */
     frame = &checked;
 

@@ -269,6 +269,58 @@ static vfx_result read_view(vfx_context *ctx, const vfx_frame_view *frame, uint3
     return VFX_OK;
 }
 
+/* The engine's own depth, step 1 (no GL): a projection written for another clip control or
+ * reversed (near at depth 1), or stored row-flipped, becomes the standard projection of the same
+ * camera that every effect reads (GL_NEGATIVE_ONE_TO_ONE, near at -1, far +1, +Inf allowed); the
+ * host's depth is then rewritten for it (depth_convert, step 2). Flipped rows are a projection
+ * whose y is negated: what the effects draw and read lands on the stored rows, no copy. */
+static vfx_result standardize(vfx_context *ctx, vfx_frame_view *v, volfx_frame_targets *t)
+{
+    const volfx_frame_depth *fd = &ctx->frame_depth;
+    float *P = v->proj;
+    bool persp = P[3] == 0 && P[7] == 0 && P[11] == -1 && P[15] == 0;
+    bool ortho = P[3] == 0 && P[7] == 0 && P[11] == 0 && P[15] == 1 && P[10] != 0;
+    double p10 = P[10], p14 = P[14], lo = fd->zero_to_one ? 0.0 : -1.0;
+    /* view depth at NDC z = a: perspective p14 / (a + p10), orthographic (p14 - a) / p10 */
+    double d_lo = persp ? (lo + p10 == 0 ? INFINITY : p14 / (lo + p10)) : ortho ? (p14 - lo) / p10 : 0;
+    double d_hi = persp ? (1 + p10 == 0 ? INFINITY : p14 / (1 + p10)) : ortho ? (p14 - 1) / p10 : 0;
+    bool reversed = (persp || ortho) && d_lo > d_hi;
+    if (fd->zero_to_one || reversed) {
+        if ((!persp && !ortho) || P[2] != 0 || P[6] != 0)
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_DEPTH, "render: frame view proj is neither a perspective nor "
+                              "an orthographic projection with z from view depth alone (proj[2], proj[6] 0): "
+                              "its GL_ZERO_TO_ONE depth cannot be converted");
+        double n = fmin(d_lo, d_hi), f = fmax(d_lo, d_hi);
+        if (!(n > 0) || !(f > n) || (!persp && isinf(f)))
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_DEPTH, "render: frame view proj (%s clip depth) maps its depth "
+                              "range to view depths %g and %g; need 0 < near < far", fd->zero_to_one ?
+                              "GL_ZERO_TO_ONE" : "GL_NEGATIVE_ONE_TO_ONE", d_lo, d_hi);
+        double s10, s14;
+        if (persp && isinf(f))
+            s10 = -1, s14 = -2 * n;
+        else if (persp)
+            s10 = -(f + n) / (f - n), s14 = -2 * f * n / (f - n);
+        else
+            s10 = -2 / (f - n), s14 = -(f + n) / (f - n);
+        t->depth_convert = true;
+        t->depth_host[0] = p10, t->depth_host[1] = p14, t->depth_host[2] = fd->zero_to_one, t->depth_host[3] = persp;
+        t->depth_std[0] = s10, t->depth_std[1] = s14;
+        P[10] = (float)s10, P[14] = (float)s14;
+        /* the host's own planes must be the projection's (as check_planes asks of a standard one);
+         * then the planes come from the new projection (far FLT_MAX when infinite) */
+        if ((v->near_plane != 0 || v->far_plane != 0)
+            && (fabs(v->near_plane - n) > 1e-3 * n || (!isinf(f) && fabs(v->far_plane - f) > 1e-3 * f)))
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_DEPTH, "render: frame view near_plane %g, far_plane %g, but "
+                              "proj (%s clip depth) has near %g, far %g", (double)v->near_plane,
+                              (double)v->far_plane, fd->zero_to_one ? "GL_ZERO_TO_ONE" : "GL_NEGATIVE_ONE_TO_ONE", n, f);
+        v->near_plane = v->far_plane = 0;
+    }
+    if (fd->flip_y)
+        for (int c = 0; c < 4; ++c)
+            P[c * 4 + 1] = -P[c * 4 + 1];
+    return VFX_OK;
+}
+
 /* Cofactors in double (volfx_mat4_invert), so near-singular projections keep their digits. */
 static vfx_result derive_camera(vfx_context *ctx, const vfx_frame_view *checked, volfx_frame_targets *t)
 {
@@ -313,6 +365,25 @@ vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view is NULL");
     vfx_result r = read_view(ctx, frame, &t->view_id, checked);
     if (r)
+        return r;
+    /* the engine's own depth: this frame's chained vfx_frame_depth, or the standard depth */
+    const vfx_frame_depth *fd = volfx_chain_find(frame->next, VFX_TYPE_FRAME_DEPTH);
+    memset(&ctx->frame_depth, 0, sizeof ctx->frame_depth);
+    if (fd) {
+        if (fd->depth_convention > VFX_DEPTH_ZERO_TO_ONE)
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_DEPTH, "render: frame view's vfx_frame_depth depth_convention "
+                              "%u is none of VFX_DEPTH_STANDARD (0), VFX_DEPTH_ZERO_TO_ONE (1)",
+                              (unsigned)fd->depth_convention);
+        if (fd->depth_renderbuffer && fd->depth_framebuffer)
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_DEPTH, "render: frame view's vfx_frame_depth names both "
+                              "depth_renderbuffer %u and depth_framebuffer %u: give one", fd->depth_renderbuffer,
+                              fd->depth_framebuffer);
+        ctx->frame_depth = (volfx_frame_depth){.depth_renderbuffer = fd->depth_renderbuffer,
+                                               .depth_framebuffer = fd->depth_framebuffer,
+                                               .flip_y = fd->flip_y != 0,
+                                               .zero_to_one = fd->depth_convention == VFX_DEPTH_ZERO_TO_ONE};
+    }
+    if ((r = standardize(ctx, checked, t)))
         return r;
     if ((r = derive_camera(ctx, checked, t)))
         return r;
@@ -451,6 +522,142 @@ static vfx_result layer_target(vfx_context *ctx, volfx_frame_targets *t)
     return VFX_OK;
 }
 
+/* Makes (or keeps, at the same size and format) a depth texture and a depth-only framebuffer. */
+static vfx_result depth_target(vfx_context *ctx, unsigned *tex, unsigned *fbo, GLenum format, uint32_t w,
+                               uint32_t h, const char *label)
+{
+    if (*tex)
+        return VFX_OK;
+    GLuint t = 0, f = 0;
+    glCreateTextures(GL_TEXTURE_2D, 1, &t);
+    glTextureStorage2D(t, 1, format, (GLsizei)w, (GLsizei)h);
+    glCreateFramebuffers(1, &f);
+    glNamedFramebufferTexture(f, GL_DEPTH_ATTACHMENT, t, 0);
+    glNamedFramebufferDrawBuffer(f, GL_NONE);
+    glNamedFramebufferReadBuffer(f, GL_NONE);
+    volfx_gpu_label(GL_TEXTURE, t, label);
+    *tex = t, *fbo = f;
+    return volfx_gpu_check_target(ctx, f, label, w, h);
+}
+
+static void drop_depth_targets(vfx_context *ctx)
+{
+    volfx_depth_targets *d = &ctx->depth;
+    GLuint tex[2] = {d->copy_tex, d->std_tex}, fbo[3] = {d->copy_fbo, d->std_fbo, d->src_fbo};
+    glDeleteTextures(2, tex);
+    glDeleteFramebuffers(3, fbo);
+    memset(d, 0, sizeof *d);
+}
+
+/* The internal format of a depth renderbuffer, or of a framebuffer's depth attachment; 0 with an
+ * error naming the field when there is none. */
+static GLint depth_source_format(vfx_context *ctx, GLuint *read_fb)
+{
+    const volfx_frame_depth *fd = &ctx->frame_depth;
+    GLint format = 0;
+    if (fd->depth_renderbuffer) {
+        if (!glIsRenderbuffer(fd->depth_renderbuffer)) {
+            volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_DEPTH, "render: frame depth depth_renderbuffer %u is not a "
+                       "renderbuffer name of this GL context", fd->depth_renderbuffer);
+            return 0;
+        }
+        glGetNamedRenderbufferParameteriv(fd->depth_renderbuffer, GL_RENDERBUFFER_INTERNAL_FORMAT, &format);
+        if (!ctx->depth.src_fbo)
+            glCreateFramebuffers(1, &ctx->depth.src_fbo);
+        GLint dbits = 0, sbits = 0;
+        glGetNamedRenderbufferParameteriv(fd->depth_renderbuffer, GL_RENDERBUFFER_DEPTH_SIZE, &dbits);
+        glGetNamedRenderbufferParameteriv(fd->depth_renderbuffer, GL_RENDERBUFFER_STENCIL_SIZE, &sbits);
+        if (!dbits) {
+            volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_DEPTH, "render: frame depth depth_renderbuffer %u has internal format "
+                       "0x%04x, not a depth format", fd->depth_renderbuffer, (unsigned)format);
+            return 0;
+        }
+        glNamedFramebufferRenderbuffer(ctx->depth.src_fbo, sbits ? GL_DEPTH_STENCIL_ATTACHMENT : GL_DEPTH_ATTACHMENT,
+                                       GL_RENDERBUFFER, fd->depth_renderbuffer);
+        *read_fb = ctx->depth.src_fbo;
+        return format;
+    }
+    if (!glIsFramebuffer(fd->depth_framebuffer)) {
+        volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_DEPTH, "render: frame depth depth_framebuffer %u is not a framebuffer "
+                   "name of this GL context", fd->depth_framebuffer);
+        return 0;
+    }
+    GLint type = GL_NONE, obj = 0;
+    glGetNamedFramebufferAttachmentParameteriv(fd->depth_framebuffer, GL_DEPTH_ATTACHMENT,
+                                               GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
+    glGetNamedFramebufferAttachmentParameteriv(fd->depth_framebuffer, GL_DEPTH_ATTACHMENT,
+                                               GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &obj);
+    if (type == GL_RENDERBUFFER)
+        glGetNamedRenderbufferParameteriv((GLuint)obj, GL_RENDERBUFFER_INTERNAL_FORMAT, &format);
+    else if (type == GL_TEXTURE)
+        glGetTextureLevelParameteriv((GLuint)obj, 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
+    if (!format)
+        volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_DEPTH, "render: frame depth depth_framebuffer %u has no depth attachment",
+                   fd->depth_framebuffer);
+    *read_fb = fd->depth_framebuffer;
+    return format;
+}
+
+/* The engine's own depth, step 2: a renderbuffer's (or a framebuffer's) depth blitted into a
+ * texture of its format, then, for another convention, rewritten in the standard one
+ * (shaders/common/depth_convert.frag) into a DEPTH_COMPONENT32F texture; t->scene_depth is what
+ * the effects read. */
+static vfx_result own_depth(vfx_context *ctx, volfx_frame_targets *t)
+{
+    const volfx_frame_depth *fd = &ctx->frame_depth;
+    volfx_depth_targets *d = &ctx->depth;
+    if (d->w != t->width || d->h != t->height)
+        drop_depth_targets(ctx);
+    d->w = t->width, d->h = t->height;
+    vfx_result r;
+    if (fd->depth_renderbuffer || fd->depth_framebuffer) {
+        GLuint read_fb = 0;
+        GLint format = depth_source_format(ctx, &read_fb);
+        if (!format)
+            return VFX_ERR_INVALID_ARGUMENT;
+        if (d->copy_tex && d->copy_format != format) {
+            GLuint tex = d->copy_tex, fbo = d->copy_fbo;
+            glDeleteTextures(1, &tex);
+            glDeleteFramebuffers(1, &fbo);
+            d->copy_tex = d->copy_fbo = 0;
+        }
+        if ((r = depth_target(ctx, &d->copy_tex, &d->copy_fbo, (GLenum)format, d->w, d->h, "volfx.depth_copy")))
+            return r;
+        d->copy_format = format;
+        glBlitNamedFramebuffer(read_fb, d->copy_fbo, 0, 0, (GLint)d->w, (GLint)d->h, 0, 0, (GLint)d->w, (GLint)d->h,
+                               GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+        const char *e = volfx_gpu_error_string();
+        if (e)
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_DEPTH, "render: the frame's depth (%s %u, format 0x%04x) cannot be "
+                              "copied at %ux%u: %s", fd->depth_renderbuffer ? "depth_renderbuffer" : "depth_framebuffer",
+                              fd->depth_renderbuffer ? fd->depth_renderbuffer : fd->depth_framebuffer,
+                              (unsigned)format, d->w, d->h, e);
+        t->scene_depth = d->copy_tex;
+    }
+    if (!t->depth_convert)
+        return VFX_OK;
+    if ((r = depth_target(ctx, &d->std_tex, &d->std_fbo, GL_DEPTH_COMPONENT32F, d->w, d->h, "volfx.depth_standard")))
+        return r;
+    GLuint prog = volfx_gpu_program(ctx, "common/fullscreen.vert", "common/depth_convert.frag", NULL);
+    if (!prog)
+        return VFX_ERR_GL;
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "volfx.depth_convert", .framebuffer = d->std_fbo,
+                                             .width = d->w, .height = d->h, .clear_depth = true,
+                                             .depth = VOLFX_DEPTH_TEST_WRITE});
+    glDepthFunc(GL_ALWAYS);
+    glUseProgram(prog);
+    glUniform4d(volfx_gpu_uniform(ctx, prog, "u_host"), t->depth_host[0], t->depth_host[1], t->depth_host[2],
+                t->depth_host[3]);
+    glUniform2d(volfx_gpu_uniform(ctx, prog, "u_std"), t->depth_std[0], t->depth_std[1]);
+    glBindTextureUnit(0, t->scene_depth);
+    volfx_gpu_fullscreen(ctx);
+    glUseProgram(0);
+    glDepthFunc(GL_LESS);
+    volfx_pass_end(ctx);
+    t->scene_depth = d->std_tex;
+    return VFX_OK;
+}
+
 vfx_result volfx_frame_gate_gl(vfx_context *ctx, bool drawing, volfx_frame_targets *t)
 {
     vfx_result r;
@@ -468,7 +675,10 @@ vfx_result volfx_frame_gate_gl(vfx_context *ctx, bool drawing, volfx_frame_targe
         glEnable(GL_FRAMEBUFFER_SRGB);
     if (t->scene_color && (r = check_texture(ctx, "color_texture", t->scene_color, WANT_COLOR, t->width, t->height)))
         return r;
-    if (t->scene_depth && (r = check_texture(ctx, "depth_texture", t->scene_depth, WANT_DEPTH, t->width, t->height)))
+    const volfx_frame_depth *fd = &ctx->frame_depth;
+    bool own = fd->depth_renderbuffer || fd->depth_framebuffer;
+    if (!own && t->scene_depth
+        && (r = check_texture(ctx, "depth_texture", t->scene_depth, WANT_DEPTH, t->width, t->height)))
         return r;
     if (t->environment_cubemap &&
         (r = check_texture(ctx, "environment_cubemap", t->environment_cubemap, WANT_CUBE, 0, 0)))
@@ -480,6 +690,8 @@ vfx_result volfx_frame_gate_gl(vfx_context *ctx, bool drawing, volfx_frame_targe
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
                           "render: frame view framebuffer 0 is the default "
                           "framebuffer, and the current context has none (surfaceless): name a framebuffer object");
+    if ((own || (t->depth_convert && t->scene_depth)) && (r = own_depth(ctx, t)))
+        return r;
     if (!t->scene_depth && (r = far_depth(ctx, t->width, t->height, &t->scene_depth)))
         return r;
     return upload_block(ctx, t);
@@ -498,4 +710,5 @@ void volfx_frame_check_destroy(vfx_context *ctx)
         glDeleteFramebuffers(1, &fb);
         ctx->layer_fbo = 0;
     }
+    drop_depth_targets(ctx);
 }

@@ -149,6 +149,7 @@ vfx_result volfx_resolve_defaults(vfx_context *ctx, void *inout)
     case VFX_TYPE_CONTEXT_DESC: /* NULL alloc/free mean the C library's: nothing a value can say */
     case VFX_TYPE_PARTICLE_VIEW: /* no defaulted field */
     case VFX_TYPE_GL_STATE_DESC: /* skip_restore 0 is the save and restore */
+    case VFX_TYPE_FRAME_DEPTH: /* zero is the standard depth */
         return VFX_OK;
     default:
         break;

@@ -18,6 +18,7 @@
 #include "app.h"
 #include "beams/beams_impact.h"
 #include "debug.h"
+#include "depth_modes.h"
 #include "test_camera.h"
 #include "test_util.h"
 
@@ -364,6 +365,48 @@ static void test_lights(void **state)
     assert_true(test_last_error_is(&api, g_app->ctx, VFX_LOG_ID_STRUCT_TYPE, "vfx_lights has type 7"));
 }
 
+/* The engine's own depth (tests/common/depth_modes.h): the same hit against the same float64
+ * reference with the same bounds, the same non-hits, and sparks that stay above the floor, when
+ * the plugin gets the host's depth in a renderbuffer, reversed-Z with an infinite far plane under
+ * GL_ZERO_TO_ONE, row-flipped, and all three at once. The reversed depth is rounded once to
+ * float32 from the view depth (double): near/D keeps 2^-24 relative, a view depth error of
+ * 2^-24 D = 2e-7 m at 3.3 m, under the standard path's 1e-5 m, so the bounds hold as they are. */
+static void in_depth_mode(int mode, void (*test)(void **))
+{
+    depth_mode_set(g_app, mode);
+    test(NULL);
+    depth_mode_set(g_app, DEPTH_STANDARD);
+}
+
+static void test_own_depth_renderbuffer(void **state)
+{
+    (void)state;
+    in_depth_mode(DEPTH_RENDERBUFFER, test_hit_matches_reference);
+    in_depth_mode(DEPTH_RENDERBUFFER, test_no_false_hit);
+}
+
+static void test_own_depth_reversed_z(void **state)
+{
+    (void)state;
+    in_depth_mode(DEPTH_REVERSED, test_hit_matches_reference);
+    in_depth_mode(DEPTH_REVERSED, test_no_false_hit);
+}
+
+static void test_own_depth_flipped(void **state)
+{
+    (void)state;
+    in_depth_mode(DEPTH_FLIPPED, test_hit_matches_reference);
+    in_depth_mode(DEPTH_FLIPPED, test_no_false_hit);
+}
+
+static void test_own_depth_engine(void **state)
+{
+    (void)state;
+    in_depth_mode(DEPTH_ENGINE, test_hit_matches_reference);
+    in_depth_mode(DEPTH_ENGINE, test_no_false_hit);
+    in_depth_mode(DEPTH_ENGINE, test_sparks_stay_above_floor);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -372,6 +415,10 @@ int main(void)
         cmocka_unit_test(test_sparks_stay_above_floor),
         cmocka_unit_test(test_counts_bounded),
         cmocka_unit_test(test_lights),
+        cmocka_unit_test(test_own_depth_renderbuffer),
+        cmocka_unit_test(test_own_depth_reversed_z),
+        cmocka_unit_test(test_own_depth_flipped),
+        cmocka_unit_test(test_own_depth_engine),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

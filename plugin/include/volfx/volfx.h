@@ -111,6 +111,7 @@ typedef enum vfx_struct_type {
     VFX_TYPE_PLUGIN_API = 10,
     VFX_TYPE_GL_STATE_DESC = 11,
     VFX_TYPE_IMPACT_EVENTS = 12, /* 1.1: chained into vfx_lights.next */
+    VFX_TYPE_FRAME_DEPTH = 13, /* 1.1: chained into vfx_frame_view.next */
     VFX_TYPE_MAX_ENUM = 0x7fffffff
 } vfx_struct_type;
 
@@ -445,7 +446,8 @@ typedef struct vfx_volume_view {
     X(VOLUME_SCALAR, 50)      /* a volume's scalar domain not finite, or every scalar NaN */ \
     X(VOLUME_TRANSFER, 51)    /* a volume's transfer function refused */ \
     X(VOLUME_MODEL, 52)       /* a volume's model matrix not finite */ \
-    X(VOLUME_EXTRA, 53)       /* warning: the host has several volumes, only the first is drawn */
+    X(VOLUME_EXTRA, 53)       /* warning: the host has several volumes, only the first is drawn */ \
+    X(FRAME_DEPTH, 54)        /* a vfx_frame_depth refused, or a proj its depth_convention cannot convert */
 
 typedef enum vfx_log_id {
 #define VFX_LOG_ID_ENUM_(name, value) VFX_LOG_ID_##name = value,
@@ -536,6 +538,29 @@ typedef struct vfx_frame_view {
      * opacity (docs/integration.md "Effects layer"). 0 -> draw into `framebuffer`. */
     uint32_t layer_texture;
 } vfx_frame_view;
+
+/* vfx_frame_depth.depth_convention: the clip control the host's depth was written under. */
+typedef enum vfx_depth_convention {
+    VFX_DEPTH_STANDARD = 0,    /* glClipControl(.., GL_NEGATIVE_ONE_TO_ONE), GL's default */
+    VFX_DEPTH_ZERO_TO_ONE = 1, /* glClipControl(.., GL_ZERO_TO_ONE) (reversed-Z engines use it) */
+    VFX_DEPTH_CONVENTION_MAX_ENUM = 0x7fffffff
+} vfx_depth_convention;
+
+/* Chained into vfx_frame_view.next: the engine's own depth, when it is not a standard depth
+ * texture (docs/integration.md, "The engine's own depth"). A reversed-Z or infinite-far `proj`
+ * needs nothing here: the plugin reads it from the projection. Read every render(). */
+typedef struct vfx_frame_depth {
+    vfx_struct_type type;  /* VFX_TYPE_FRAME_DEPTH */
+    const void *next;
+    /* A depth renderbuffer of the frame's size, read instead of depth_texture (copied each frame). */
+    uint32_t depth_renderbuffer;
+    /* Or a framebuffer whose depth attachment (renderbuffer or texture) is read; not both. */
+    uint32_t depth_framebuffer;
+    /* Nonzero: colour and depth rows are stored top row first, and the output is expected so. */
+    uint32_t flip_y;
+    /* How the depth and proj were written: VFX_DEPTH_STANDARD or VFX_DEPTH_ZERO_TO_ONE. */
+    vfx_depth_convention depth_convention;
+} vfx_frame_depth;
 
 typedef struct vfx_stat {
     char name[40];  /* "water.potential.gpu_ms", "beams.pairs_culled", ...: docs/stats.md lists all */
