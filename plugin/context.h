@@ -31,6 +31,7 @@ typedef struct volfx_frame_depth {
     unsigned depth_framebuffer;  /* or a framebuffer whose depth attachment is read (renderbuffer or texture) */
     bool flip_y;                 /* colour and depth rows are stored top first, and the output is expected so */
     bool zero_to_one;            /* the depth was written under glClipControl(.., GL_ZERO_TO_ONE) */
+    bool chained;                /* the host chained one: a reversed proj is then read as reversed-Z */
 } volfx_frame_depth;
 
 /* The frame gate's depth objects (frame_check.c): a same-format copy of a renderbuffer's depth,

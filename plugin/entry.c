@@ -387,7 +387,18 @@ static vfx_result read_raw(vfx_context *ctx, vfx_effect_kind effect, float *out,
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_READ_BUFFER_SIZE,
                           "read_raw: buffer of %zu floats, need %ux%u",
                         count, ctx->width, ctx->height);
-    return ctx->effect_ops[effect]->read_raw(ctx, ctx->effect_state[effect], out, count);
+    vfx_result r = ctx->effect_ops[effect]->read_raw(ctx, ctx->effect_state[effect], out, count);
+    if (r || !ctx->frame_depth.flip_y)
+        return r;
+    /* a flipped frame's rows are stored top first, so the effect's bottom-first read came out
+     * upside down: turn it back to the image's top row first */
+    for (uint32_t j = 0, w = ctx->width; j < ctx->height / 2; ++j)
+        for (uint32_t i = 0; i < w; ++i) {
+            float t = out[(size_t)j * w + i];
+            out[(size_t)j * w + i] = out[(size_t)(ctx->height - 1 - j) * w + i];
+            out[(size_t)(ctx->height - 1 - j) * w + i] = t;
+        }
+    return VFX_OK;
 }
 
 static vfx_result plugin_read_raw(vfx_context *ctx, vfx_effect_kind effect, float *out, size_t count)
@@ -520,5 +531,14 @@ VFX_EXPORT vfx_result vfx_plugin_entry(uint32_t abi_version, const vfx_context_d
     out->last_error = plugin_last_error;
     out->read_raw = plugin_read_raw;
     out->resolve_defaults = volfx_resolve_defaults;
+    /* what this plugin reads, for a host about to chain an extension a 1.0 plugin would skip */
+    vfx_plugin_info *info = (vfx_plugin_info *)volfx_chain_find(next, VFX_TYPE_PLUGIN_INFO);
+    if (info) {
+        info->abi_minor = VFX_ABI_MINOR;
+        info->type_count = 64;
+        info->known_types = 0;
+        for (uint32_t t = VFX_TYPE_CONTEXT_DESC; t <= VFX_TYPE_PLUGIN_INFO; ++t)
+            info->known_types |= 1ull << t;
+    }
     return VFX_OK;
 }

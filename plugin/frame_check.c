@@ -186,9 +186,9 @@ static vfx_result check_planes(vfx_context *ctx, vfx_frame_view *v)
     double n = 0, f = 0, ftol = 0;
     bool known = volfx_projection_planes(v->proj, &n, &f, &ftol);
     if (known && !(n > 0 && f > n))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
-                          "render: frame view proj maps near %g and far %g "
-                          "(from proj[10], proj[14]); need 0 < near < far", n, f);
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW, "render: frame view proj maps near %g and far %g "
+                          "(from proj[10], proj[14]); need 0 < near < far (a reversed-Z proj needs a chained "
+                          "vfx_frame_depth)", n, f);
     if (v->near_plane == 0 && v->far_plane == 0) {
         if (!known)
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_VIEW,
@@ -284,7 +284,9 @@ static vfx_result standardize(vfx_context *ctx, vfx_frame_view *v, volfx_frame_t
     /* view depth at NDC z = a: perspective p14 / (a + p10), orthographic (p14 - a) / p10 */
     double d_lo = persp ? (lo + p10 == 0 ? INFINITY : p14 / (lo + p10)) : ortho ? (p14 - lo) / p10 : 0;
     double d_hi = persp ? (1 + p10 == 0 ? INFINITY : p14 / (1 + p10)) : ortho ? (p14 - 1) / p10 : 0;
-    bool reversed = (persp || ortho) && d_lo > d_hi;
+    /* reversed-Z only from a host that chained a vfx_frame_depth: without one a proj whose near
+     * lies beyond its far stays the mistake check_planes refuses (as a 1.0 plugin does) */
+    bool reversed = fd->chained && (persp || ortho) && d_lo > d_hi;
     if (fd->zero_to_one || reversed) {
         if ((!persp && !ortho) || P[2] != 0 || P[6] != 0)
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_DEPTH, "render: frame view proj is neither a perspective nor "
@@ -381,7 +383,8 @@ vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx
         ctx->frame_depth = (volfx_frame_depth){.depth_renderbuffer = fd->depth_renderbuffer,
                                                .depth_framebuffer = fd->depth_framebuffer,
                                                .flip_y = fd->flip_y != 0,
-                                               .zero_to_one = fd->depth_convention == VFX_DEPTH_ZERO_TO_ONE};
+                                               .zero_to_one = fd->depth_convention == VFX_DEPTH_ZERO_TO_ONE,
+                                               .chained = true};
     }
     if ((r = standardize(ctx, checked, t)))
         return r;

@@ -685,11 +685,94 @@ static void test_frame_block(void **state)
     free_fixture(&f);
 }
 
+/* vfx_frame_depth (docs/integration.md "The engine's own depth"): each bad field refused with its
+ * name and VFX_LOG_ID_FRAME_DEPTH; a reversed proj (near beyond far) refused without the chain and
+ * read as reversed-Z with it, so a depth of 1 is then the near plane (the beam hidden) and 0 the
+ * far plane (the beam as with no depth); a depth renderbuffer and a framebuffer's depth read as
+ * the same depth texture is. */
+static void expect_depth_id(const vfx_plugin_api *api, vfx_context *ctx, const vfx_frame_view *fv, const char *part)
+{
+    expect(api, ctx, fv, VFX_ERR_INVALID_ARGUMENT, part);
+    vfx_log_id id = VFX_LOG_ID_NONE;
+    api->last_error(ctx, &id);
+    assert_int_equal(id, VFX_LOG_ID_FRAME_DEPTH);
+}
+
+static void test_frame_depth_fields(void **state)
+{
+    (void)state;
+    test_log log = {0};
+    vfx_context_desc host = beams_host(&log);
+    const vfx_plugin_api *api = plugin_api();
+    vfx_context *ctx;
+    assert_int_equal(api->create(&host, &ctx), VFX_OK);
+    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_OK);
+    fixture f;
+    make_fixture(&f);
+    expect(api, ctx, &f.fv, VFX_OK, NULL);
+    double h_ref = max_h(api, ctx);
+    assert_true(h_ref > 0.1);
+    GLuint rb[2], fb_depth, fb_none;
+    glCreateRenderbuffers(2, rb);
+    glNamedRenderbufferStorage(rb[0], GL_DEPTH24_STENCIL8, W, H);
+    glNamedRenderbufferStorage(rb[1], GL_RGBA8, W, H);
+    glCreateFramebuffers(1, &fb_depth);
+    glNamedFramebufferRenderbuffer(fb_depth, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, rb[0]);
+    glCreateFramebuffers(1, &fb_none);
+    glNamedFramebufferRenderbuffer(fb_none, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[1]);
+    vfx_frame_depth fd = {.type = VFX_TYPE_FRAME_DEPTH};
+    vfx_frame_view v = f.fv;
+    v.next = &fd;
+    fd.depth_convention = (vfx_depth_convention)7;
+    expect_depth_id(api, ctx, &v, "vfx_frame_depth depth_convention 7 is none of");
+    fd = (vfx_frame_depth){.type = VFX_TYPE_FRAME_DEPTH, .depth_renderbuffer = rb[0], .depth_framebuffer = fb_depth};
+    expect_depth_id(api, ctx, &v, "names both depth_renderbuffer");
+    fd = (vfx_frame_depth){.type = VFX_TYPE_FRAME_DEPTH, .depth_renderbuffer = 4242};
+    expect_depth_id(api, ctx, &v, "depth_renderbuffer 4242 is not a renderbuffer name");
+    fd.depth_renderbuffer = rb[1];
+    expect_depth_id(api, ctx, &v, "not a depth format");
+    fd = (vfx_frame_depth){.type = VFX_TYPE_FRAME_DEPTH, .depth_framebuffer = 4243};
+    expect_depth_id(api, ctx, &v, "depth_framebuffer 4243 is not a framebuffer name");
+    fd.depth_framebuffer = fb_none;
+    expect_depth_id(api, ctx, &v, "has no depth attachment");
+    /* the renderbuffer and the framebuffer at depth 1 (far): the beam as with the texture */
+    glClearNamedFramebufferfi(fb_depth, GL_DEPTH_STENCIL, 0, 1.0f, 0);
+    fd = (vfx_frame_depth){.type = VFX_TYPE_FRAME_DEPTH, .depth_renderbuffer = rb[0]};
+    expect(api, ctx, &v, VFX_OK, NULL);
+    assert_true(fabs(max_h(api, ctx) - h_ref) <= 1e-6 * h_ref);
+    fd = (vfx_frame_depth){.type = VFX_TYPE_FRAME_DEPTH, .depth_framebuffer = fb_depth};
+    expect(api, ctx, &v, VFX_OK, NULL);
+    assert_true(fabs(max_h(api, ctx) - h_ref) <= 1e-6 * h_ref);
+    /* at depth 0 (the near plane) the beam is hidden: the renderbuffer's depth is what is read */
+    glClearNamedFramebufferfi(fb_depth, GL_DEPTH_STENCIL, 0, 0.0f, 0);
+    expect(api, ctx, &v, VFX_OK, NULL);
+    assert_true(max_h(api, ctx) == 0.0);
+    /* a reversed proj: refused without the chain, reversed-Z with it */
+    ref_camera rev = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8, W, H, 100, 0.1};
+    v = f.fv;
+    ref_camera_matrices(&rev, v.view, v.proj);
+    expect(api, ctx, &v, VFX_ERR_INVALID_ARGUMENT, "a reversed-Z proj needs a chained vfx_frame_depth");
+    fd = (vfx_frame_depth){.type = VFX_TYPE_FRAME_DEPTH};
+    v.next = &fd;
+    expect(api, ctx, &v, VFX_OK, NULL); /* f.depth holds 1: the near plane now */
+    assert_true(max_h(api, ctx) == 0.0);
+    const float zero = 0.0f;
+    glClearTexImage(f.depth, 0, GL_DEPTH_COMPONENT, GL_FLOAT, &zero);
+    expect(api, ctx, &v, VFX_OK, NULL); /* 0: the far plane, 100 */
+    assert_true(fabs(max_h(api, ctx) - h_ref) <= 1e-6 * h_ref);
+    glDeleteRenderbuffers(2, rb);
+    glDeleteFramebuffers(1, &fb_depth);
+    glDeleteFramebuffers(1, &fb_none);
+    free_fixture(&f);
+    api->destroy(ctx);
+}
+
 int main(void)
 {
     g_gl = test_gl_or_skip();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_frame_fields),
+        cmocka_unit_test(test_frame_depth_fields),
         cmocka_unit_test(test_nothing_drawn),
         cmocka_unit_test(test_callback_pairs),
         cmocka_unit_test(test_unknown_water_params_version),

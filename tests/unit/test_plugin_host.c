@@ -189,6 +189,32 @@ static void test_create_refuses_bad_host(void **state)
     assert_int_equal(api.create(NULL, &ctx), VFX_ERR_ABI);
 }
 
+/* vfx_plugin_info chained into the table (docs/abi.md "Extensions an older plugin would
+ * misread"): the entry fills the minor version and the types it reads, 13 (vfx_frame_depth) among
+ * them and none past the last it knows; the rest of the chain is left to the host. */
+static void test_plugin_info(void **state)
+{
+    (void)state;
+    typedef struct other { vfx_struct_type type; void *next; } other;
+    vfx_plugin_info info = {.type = VFX_TYPE_PLUGIN_INFO};
+    other o = {(vfx_struct_type)0x7000beef, &info};
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API, .next = &o};
+    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
+    assert_ptr_equal(api.next, &o);
+    assert_ptr_equal(o.next, &info);
+    assert_null(info.next);
+    assert_int_equal(info.abi_minor, VFX_ABI_MINOR);
+    assert_int_equal(info.type_count, 64);
+    assert_true(info.known_types & (1ull << VFX_TYPE_FRAME_DEPTH));
+    assert_true(info.known_types & (1ull << VFX_TYPE_GL_STATE_DESC));
+    assert_false(info.known_types & (1ull << VFX_TYPE_NONE));
+    assert_false(info.known_types & (1ull << (VFX_TYPE_PLUGIN_INFO + 1)));
+    /* without it the table is filled as before */
+    vfx_plugin_api plain = {.type = VFX_TYPE_PLUGIN_API};
+    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &plain), VFX_OK);
+    assert_null(plain.next);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 4) {
@@ -198,6 +224,7 @@ int main(int argc, char **argv)
     g_plugin = argv[1], g_nosym = argv[2], g_badver = argv[3];
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_good_plugin),
+        cmocka_unit_test(test_plugin_info),
         cmocka_unit_test(test_wrong_abi_refused),
         cmocka_unit_test(test_abi1_host_refused),
         cmocka_unit_test(test_missing_symbol),

@@ -23,6 +23,9 @@ extern "C" {
 #endif
 
 #define VFX_ABI_VERSION 2u
+/* The additions within VFX_ABI_VERSION this header describes (1 for ABI 1.1). A plugin tells its
+ * own in vfx_plugin_info.abi_minor (docs/abi.md "Extensions an older plugin would misread"). */
+#define VFX_ABI_MINOR 1u
 #define VFX_ENTRY_SYMBOL "vfx_plugin_entry"
 /* The installed library's soname (libvolfx.so.<VFX_ABI_VERSION>): dlopen(VFX_SONAME, ...) finds
  * it through the loader's search path, as the game's --plugin does. */
@@ -112,6 +115,7 @@ typedef enum vfx_struct_type {
     VFX_TYPE_GL_STATE_DESC = 11,
     VFX_TYPE_IMPACT_EVENTS = 12, /* 1.1: chained into vfx_lights.next */
     VFX_TYPE_FRAME_DEPTH = 13, /* 1.1: chained into vfx_frame_view.next */
+    VFX_TYPE_PLUGIN_INFO = 14, /* 1.1: chained into vfx_plugin_api.next */
     VFX_TYPE_MAX_ENUM = 0x7fffffff
 } vfx_struct_type;
 
@@ -687,6 +691,18 @@ typedef struct vfx_plugin_api {
      * from ctx's last update when ctx is given and has one, else stay 0. ctx may be NULL. */
     vfx_result (*resolve_defaults)(vfx_context *ctx, void *inout);
 } vfx_plugin_api;
+
+/* Chained by the host into the table it gives vfx_plugin_entry (api.next): the entry fills it
+ * with what this plugin reads. A 1.0 plugin skips it and it stays zero. Before chaining an
+ * extension whose absence would draw something wrong (vfx_frame_depth), a host checks that the
+ * plugin knows it (docs/abi.md "Extensions an older plugin would misread"). */
+typedef struct vfx_plugin_info {
+    vfx_struct_type type; /* VFX_TYPE_PLUGIN_INFO (set by the host) */
+    void *next;
+    uint32_t abi_minor;   /* out: VFX_ABI_MINOR of the plugin's build (1: ABI 1.1); 0: a 1.0 plugin */
+    uint32_t type_count;  /* out: bits meaningful in known_types (64) */
+    uint64_t known_types; /* out: bit t set for every VFX_TYPE_* value t the plugin reads */
+} vfx_plugin_info;
 
 /* The one exported symbol. The host passes its ABI version, its context description (optional
  * here: only its log callback is used, to explain a refusal) and the table to fill, whose type
