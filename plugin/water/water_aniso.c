@@ -147,11 +147,12 @@ vfx_result volfx_water_aniso_columns_begin(vfx_context *ctx, volfx_water_aniso *
     return VFX_OK;
 }
 
-vfx_result volfx_water_aniso_columns_chunk(vfx_context *ctx, volfx_water_aniso *a, uint32_t chunk, uint32_t first,
-                                           uint32_t count, const float *radius, const float *kernel)
+/* One chunk's columns checked and uploaded; `field` names the kernel column in messages
+ * ("kernel", "gpu_kernel"); `kernel_there`: the kernels are in hostg already (gathered), `kernel`
+ * their copy read back for the checks. */
+static vfx_result columns_chunk(vfx_context *ctx, volfx_water_aniso *a, uint32_t chunk, uint32_t first, uint32_t count,
+                                const float *radius, const float *kernel, const char *field, bool kernel_there)
 {
-    if ((!a->has_radius && !a->has_kernel) || count == 0)
-        return VFX_OK;
     for (uint32_t i = 0; radius && i < count; ++i)
         if (!(radius[i] >= COLUMN_MIN && radius[i] <= COLUMN_MAX))
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARTICLE_VALUE,
@@ -163,16 +164,16 @@ vfx_result volfx_water_aniso_columns_chunk(vfx_context *ctx, volfx_water_aniso *
             g[k] = kernel[6 * (size_t)i + k];
             if (!isfinite(g[k]))
                 return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARTICLE_VALUE,
-                                  "water: particle chunk %u, particle %u: kernel (vfx_particle_view.kernel) entry %d is %g",
-                                  chunk, i, k, g[k]);
+                                  "water: particle chunk %u, particle %u: kernel (vfx_particle_view.%s) entry %d is %g",
+                                  chunk, i, field, k, g[k]);
         }
         eigen_sym3(g, ev);
         for (int k = 0; k < 3; ++k) {
             if (!(ev[k] >= COLUMN_MIN && ev[k] <= COLUMN_MAX))
                 return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARTICLE_VALUE,
-                                  "water: particle chunk %u, particle %u: kernel (vfx_particle_view.kernel) has eigenvalue %g, "
+                                  "water: particle chunk %u, particle %u: kernel (vfx_particle_view.%s) has eigenvalue %g, "
                                   "outside [%g, %g] (symmetric positive definite, xx xy xz yy yz zz)",
-                                  chunk, i, ev[k], COLUMN_MIN, COLUMN_MAX);
+                                  chunk, i, field, ev[k], COLUMN_MIN, COLUMN_MAX);
             double s = (radius ? radius[i] : 1.0) / ev[k];
             if (s > a->host_sigma_max)
                 a->host_sigma_max = (float)s;
@@ -188,7 +189,8 @@ vfx_result volfx_water_aniso_columns_chunk(vfx_context *ctx, volfx_water_aniso *
         glClearNamedBufferSubData(a->radius, GL_R32F, (GLintptr)first * 4, (GLsizeiptr)count * 4, GL_RED, GL_FLOAT, &one);
     }
     if (kernel) {
-        glNamedBufferSubData(a->hostg, (GLintptr)first * 24, (GLsizeiptr)count * 24, kernel);
+        if (!kernel_there)
+            glNamedBufferSubData(a->hostg, (GLintptr)first * 24, (GLsizeiptr)count * 24, kernel);
     } else if (a->has_kernel) {
         /* this chunk gives none: the identity (the isotropic kernel) */
         float *id = volfx_alloc(ctx, (size_t)count * 24);
@@ -207,6 +209,35 @@ vfx_result volfx_water_aniso_columns_chunk(vfx_context *ctx, volfx_water_aniso *
         volfx_free(ctx, id);
     }
     return VFX_OK;
+}
+
+vfx_result volfx_water_aniso_columns_chunk(vfx_context *ctx, volfx_water_aniso *a, uint32_t chunk, uint32_t first,
+                                           uint32_t count, const float *radius, const float *kernel)
+{
+    if ((!a->has_radius && !a->has_kernel) || count == 0)
+        return VFX_OK;
+    return columns_chunk(ctx, a, chunk, first, count, radius, kernel, "kernel", false);
+}
+
+vfx_result volfx_water_aniso_columns_gpu_chunk(vfx_context *ctx, volfx_water_aniso *a, volfx_water_gather *g,
+                                               uint32_t chunk, uint32_t first, uint32_t count, const float *radius,
+                                               const volfx_gpu_column *kernel)
+{
+    if (count == 0)
+        return VFX_OK;
+    vfx_result r = volfx_water_gather_kernels(ctx, g, kernel, count, a->hostg, first);
+    if (r)
+        return r;
+    /* the same checks as the CPU column's, on the gathered floats read back: a kernel outside
+     * [1e-3, 1e3] is refused naming the particle, and the largest 1 / eigenvalue bounds TILE's
+     * binning this upload (a GPU reduction read late could not: the bound must hold now) */
+    float *copy = volfx_alloc(ctx, (size_t)count * 24);
+    if (!copy)
+        return VFX_ERR_OUT_OF_MEMORY;
+    glGetNamedBufferSubData(a->hostg, (GLintptr)first * 24, (GLsizeiptr)count * 24, copy);
+    r = columns_chunk(ctx, a, chunk, first, count, radius, copy, "gpu_kernel", true);
+    volfx_free(ctx, copy);
+    return r;
 }
 
 bool volfx_water_aniso_has_columns(const volfx_water_aniso *a)

@@ -8,6 +8,7 @@
 
 #include "gpu/gl.h"
 #include "effect.h"
+#include "water/water_gather.h"
 
 typedef struct volfx_water_aniso volfx_water_aniso;
 
@@ -43,6 +44,12 @@ vfx_result volfx_water_aniso_columns_begin(vfx_context *ctx, volfx_water_aniso *
                                            bool kernel);
 vfx_result volfx_water_aniso_columns_chunk(vfx_context *ctx, volfx_water_aniso *a, uint32_t chunk, uint32_t first,
                                            uint32_t count, const float *radius, const float *kernel);
+/* The same for a chunk whose kernel column is in a GL buffer (vfx_particle_view.gpu_kernel,
+ * checked by volfx_water_gather_check): gathered on the GPU into the kernels' buffer, then read
+ * back for the same checks (messages name gpu_kernel). */
+vfx_result volfx_water_aniso_columns_gpu_chunk(vfx_context *ctx, volfx_water_aniso *a, volfx_water_gather *g,
+                                               uint32_t chunk, uint32_t first, uint32_t count, const float *radius,
+                                               const volfx_gpu_column *kernel);
 /* Whether the last columns_begin had a radius or a kernel column (then TILE needs the kernels
  * even for the isotropic kernel). */
 bool volfx_water_aniso_has_columns(const volfx_water_aniso *a);

@@ -141,8 +141,8 @@ static vfx_result ensure_groups(vfx_context *ctx, water_state *s, uint32_t total
 }
 
 /* Asks the host for chunk `c` (a typed, zeroed view) and checks what it names: positions as CPU
- * columns or a GL buffer, not both (the same for velocities), GL buffer columns that fit their
- * buffers; a GL buffer kernel column is refused (not read from GL buffers). */
+ * columns or a GL buffer, not both (the same for velocities and kernels), GL buffer columns that
+ * fit their buffers (GL buffer velocities and kernels with GL buffer positions). */
 static vfx_result query_chunk(vfx_context *ctx, uint32_t c, water_chunk *out)
 {
     vfx_particle_view v;
@@ -173,10 +173,9 @@ static vfx_result query_chunk(vfx_context *ctx, uint32_t c, water_chunk *out)
     if (out->gpu_vel.buffer && cpu_vel)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
                              "water: particle chunk %u names both vel[] and gpu_vel (one of them)", c);
-    if (out->gpu_kernel.buffer)
-        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_GPU_PARTICLES_UNSUPPORTED,
-                             "water: particle chunk %u: gpu_kernel %u: the kernel column is not read from GL buffers "
-                             "by this plugin (give it as the CPU array kernel)", c, out->gpu_kernel.buffer);
+    if (out->gpu_kernel.buffer && out->kernel)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
+                          "water: particle chunk %u names both kernel and gpu_kernel (one of them)", c);
     if (!out->gpu_pos.buffer && (!out->pos[0] || !out->pos[1] || !out->pos[2]))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARTICLE_CHUNK,
                           "water: particle chunk %u has %u particles but a NULL position column",
@@ -188,6 +187,13 @@ static vfx_result query_chunk(vfx_context *ctx, uint32_t c, water_chunk *out)
                              "water: particle chunk %u names gpu_vel with CPU positions (GL buffer velocities need "
                              "gpu_pos)", c);
     if (out->gpu_vel.buffer && (r = volfx_water_gather_check(ctx, c, "gpu_vel", &out->gpu_vel, out->count, 12)))
+        return r;
+    if (out->gpu_kernel.buffer && !out->gpu_pos.buffer)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_GPU_COLUMN,
+                          "water: particle chunk %u names gpu_kernel with CPU positions (GL buffer kernels need "
+                          "gpu_pos)", c);
+    if (out->gpu_kernel.buffer
+        && (r = volfx_water_gather_check(ctx, c, "gpu_kernel", &out->gpu_kernel, out->count, 24)))
         return r;
     return VFX_OK;
 }
@@ -365,7 +371,11 @@ static vfx_result upload_chunks(vfx_context *ctx, water_state *s, uint32_t chunk
             if ((r = volfx_water_diffuse_chunk(ctx, s->diffuse, off, v.count, v.vel)))
                 return r;
         }
-        if (s->aniso && (r = volfx_water_aniso_columns_chunk(ctx, s->aniso, c, off, v.count, v.radius, v.kernel)))
+        if (s->aniso && v.gpu_kernel.buffer)
+            r = volfx_water_aniso_columns_gpu_chunk(ctx, s->aniso, s->gather, c, off, v.count, v.radius, &v.gpu_kernel);
+        else if (s->aniso)
+            r = volfx_water_aniso_columns_chunk(ctx, s->aniso, c, off, v.count, v.radius, v.kernel);
+        if (r)
             return r;
         off += v.count;
         s->chunk_rev[c] = v.revision;
@@ -409,7 +419,7 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
         if (r)
             return r;
         any_radius = any_radius || (v.count && v.radius);
-        any_kernel = any_kernel || (v.count && v.kernel);
+        any_kernel = any_kernel || (v.count && (v.kernel || v.gpu_kernel.buffer));
         any_gpu = any_gpu || (v.count && v.gpu_pos.buffer);
         total += v.count;
         revs_same = revs_same && v.revision != 0 && v.revision == s->chunk_rev[c];

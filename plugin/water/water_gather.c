@@ -126,12 +126,11 @@ vfx_result volfx_water_gather_begin(vfx_context *ctx, volfx_water_gather *g, con
 
 /* One column through gather.comp in pieces whose bound range fits one storage block. */
 static vfx_result gather(vfx_context *ctx, volfx_water_gather *g, const char *defines, const volfx_gpu_column *col,
-                         uint32_t count, uint32_t first, bool pos)
+                         uint32_t count, uint32_t first, bool pos, uint32_t elem)
 {
     GLuint prog = volfx_gpu_compute(ctx, "water/gather.comp", defines);
     if (!prog)
         return VFX_ERR_GL;
-    const uint32_t elem = 12;
     uint64_t per = ((uint64_t)g->block_max - (uint64_t)g->align - elem) / col->stride + 1u;
     if (per > 65535u * 256u)
         per = 65535u * 256u;
@@ -171,7 +170,7 @@ vfx_result volfx_water_gather_positions(vfx_context *ctx, volfx_water_gather *g,
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1 + k, cols[k]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, g->box);
     volfx_gpu_pass_begin(ctx, "water.gather");
-    vfx_result r = gather(ctx, g, "#define MODE_POS\n", col, count, first, true);
+    vfx_result r = gather(ctx, g, "#define MODE_POS\n", col, count, first, true, 12);
     volfx_gpu_pass_end(ctx);
     return r;
 }
@@ -183,7 +182,19 @@ vfx_result volfx_water_gather_velocities(vfx_context *ctx, volfx_water_gather *g
         return VFX_OK;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, vel);
     volfx_gpu_pass_begin(ctx, "water.gather");
-    vfx_result r = gather(ctx, g, "#define MODE_VEL\n", col, count, first, false);
+    vfx_result r = gather(ctx, g, "#define MODE_VEL\n", col, count, first, false, 12);
+    volfx_gpu_pass_end(ctx);
+    return r;
+}
+
+vfx_result volfx_water_gather_kernels(vfx_context *ctx, volfx_water_gather *g, const volfx_gpu_column *col,
+                                      uint32_t count, GLuint kern, uint32_t first)
+{
+    if (!count)
+        return VFX_OK;
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, kern);
+    volfx_gpu_pass_begin(ctx, "water.gather");
+    vfx_result r = gather(ctx, g, "#define MODE_KERNEL\n", col, count, first, false, 24);
     volfx_gpu_pass_end(ctx);
     return r;
 }

@@ -1,7 +1,7 @@
-/* water_gather.h — GPU-resident particles: the host's GL buffers (positions, velocities) checked
- * and gathered on the GPU into the water's own layout (shaders/water/gather.comp), and what the
- * CPU path measures on the CPU arrays (the particles' box, the non-finite count) answered from a
- * GPU reduction read back a few frames late (docs/water.md "Input"). */
+/* water_gather.h — GPU-resident particles: the host's GL buffers (positions, velocities,
+ * kernels) checked and gathered on the GPU into the water's own layout (shaders/water/gather.comp),
+ * and what the CPU path measures on the CPU arrays (the particles' box, the non-finite count)
+ * answered from a GPU reduction read back a few frames late (docs/water.md "Input"). */
 #ifndef VOLFX_WATER_GATHER_H
 #define VOLFX_WATER_GATHER_H
 
@@ -33,7 +33,7 @@ volfx_water_gather *volfx_water_gather_create(vfx_context *ctx);
 /* Deletes its buffers and fences; NULL allowed. */
 void volfx_water_gather_destroy(vfx_context *ctx, volfx_water_gather *g);
 
-/* Checks column `field` ("gpu_pos", "gpu_vel") of chunk `chunk` for `count` particles of `elem`
+/* Checks column `field` ("gpu_pos", "gpu_vel", "gpu_kernel") of chunk `chunk` for `count` particles of `elem`
  * bytes: a buffer name of this context (glIsBuffer), stride >= elem and a multiple of 4, offset a
  * multiple of 4, and offset + stride * (count - 1) + elem within its GL_BUFFER_SIZE. Every refusal
  * is VFX_ERR_INVALID_ARGUMENT (VFX_LOG_ID_GPU_COLUMN) naming the field. */
@@ -51,6 +51,10 @@ vfx_result volfx_water_gather_positions(vfx_context *ctx, volfx_water_gather *g,
 /* Velocities of `count` particles from `col` into `vel` (vec4 each) at particle `first`. */
 vfx_result volfx_water_gather_velocities(vfx_context *ctx, volfx_water_gather *g, const volfx_gpu_column *col,
                                          uint32_t count, GLuint vel, uint32_t first);
+/* Kernel columns (6 floats) of `count` particles from `col` into `kern` (6 floats a particle) at
+ * particle `first`, unchanged. */
+vfx_result volfx_water_gather_kernels(vfx_context *ctx, volfx_water_gather *g, const volfx_gpu_column *col,
+                                      uint32_t count, GLuint kern, uint32_t first);
 /* Ends the upload: its box is copied for a readback a few frames later (fenced). */
 void volfx_water_gather_end(volfx_water_gather *g);
 /* The newest box read back so far and the one before it (false when none); `uploads` the

@@ -9,6 +9,8 @@
 //             reduced into Box (per work group in shared memory, then one atomic each)
 //   MODE_VEL  xyz into the diffuse particles' velocity (vec4, w 0; a non-finite one is at rest,
 //             as on the CPU path)
+//   MODE_KERNEL  the 6 floats of the kernel column (xx xy xz yy yz zz) unchanged into the host
+//             kernels' buffer, 6 floats a particle (checked after, on the CPU: water_aniso.c)
 layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer Src { float src[]; };
 #ifdef MODE_POS
@@ -19,6 +21,8 @@ layout(std430, binding = 3) writeonly buffer PZ { float pz[]; };
 layout(std430, binding = 5) buffer Box { uint b_lo[3]; uint b_hi[3]; uint b_bad; uint b_outside; };
 uniform vec3 u_lo, u_hi;
 shared uint s_lo[3], s_hi[3], s_bad, s_outside;
+#elif defined(MODE_KERNEL)
+layout(std430, binding = 1) writeonly buffer Kern { float kern[]; };
 #else
 layout(std430, binding = 1) writeonly buffer Vel { vec4 vel[]; };
 #endif
@@ -35,6 +39,10 @@ void main()
     uint i = gl_GlobalInvocationID.x;
     bool live = i < u_count;
     uint s = u_base + (live ? i : 0u) * u_stride;
+#ifdef MODE_KERNEL
+    if (live)
+        for (uint k = 0u; k < 6u; ++k) kern[6u * (u_first + i) + k] = src[s + k];
+#else
     vec3 v = live ? vec3(src[s], src[s + 1u], src[s + 2u]) : vec3(0.0);
     bool finite = !any(isnan(v)) && !any(isinf(v));
 #ifdef MODE_POS
@@ -69,5 +77,6 @@ void main()
     }
 #else
     if (live) vel[u_first + i] = vec4(finite ? v : vec3(0.0), 0.0);
+#endif
 #endif
 }

@@ -379,9 +379,8 @@ static void test_unknown_water_params_version(void **state)
     api->destroy(ctx);
     host.particle_chunk = gpu_kernel;
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
-    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_ERR_UNSUPPORTED);
-    assert_non_null(strstr(api->last_error(ctx, &id), "gpu_kernel 5000"));
-    assert_int_equal(id, VFX_LOG_ID_GPU_PARTICLES_UNSUPPORTED);
+    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_ERR_INVALID_ARGUMENT); /* GL kernels need GL positions */
+    assert_true(test_last_error_is(api, ctx, VFX_LOG_ID_GPU_COLUMN, "gpu_kernel with CPU positions"));
     api->destroy(ctx);
 }
 

@@ -3,8 +3,9 @@
  * in one buffer, at an offset that is not a multiple of the storage-buffer alignment) give the
  * same image and the same water raw dump, with methods TILE (anisotropic kernels, temporal reuse,
  * diffuse particles) and PAPER, over several frames (the first frame reads the GL buffer's box
- * back, the later ones use the box read back a few frames late); and every malformed buffer
- * column is refused with the field's name. */
+ * back, the later ones use the box read back a few frames late); with a kernel column (6 floats
+ * a particle, in a second buffer at its own offset and stride) TILE draws the same from kernel[]
+ * and gpu_kernel; and every malformed buffer column is refused with the field's name. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -25,6 +26,9 @@
  * x y z, a float of padding, vx vy vz (28 bytes: neither 16 nor the alignment divides it) */
 #define LEAD 16u
 #define STRIDE 28u
+/* the kernel buffer: 8 bytes first, then 6 floats and 2 of padding a particle */
+#define KLEAD 8u
+#define KSTRIDE 32u
 
 typedef struct host {
     test_log log;
@@ -36,6 +40,11 @@ typedef struct host {
     bool gpu;                   /* hand the GL buffer instead of the arrays */
     GLuint buf;
     vfx_gpu_column pos, vel;    /* the columns handed over (tests break them) */
+    bool with_kernel;           /* hand the kernel column too (kernel[] or gpu_kernel) */
+    bool kern_both;             /* hand kernel[] beside gpu_kernel (refused) */
+    float *kern;                /* 6 floats a particle: xx xy xz yy yz zz */
+    GLuint kbuf;
+    vfx_gpu_column kcol;
 } host;
 
 static uint32_t chunk_count(void *user) { return ((host *)user)->n ? 1 : 0; }
@@ -51,6 +60,10 @@ static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
     } else {
         out->gpu_pos = h->pos, out->gpu_vel = h->vel;
     }
+    if (h->with_kernel && (!h->gpu || h->kern_both))
+        out->kernel = h->kern;
+    if (h->with_kernel && h->gpu)
+        out->gpu_kernel = h->kcol;
     return VFX_OK;
 }
 
@@ -94,6 +107,22 @@ static void make_host(host *s, uint32_t nx, uint32_t ny, uint32_t nz)
     glNamedBufferStorage(s->buf, (GLsizeiptr)(LEAD + (size_t)s->n * STRIDE), NULL, GL_DYNAMIC_STORAGE_BIT);
     s->pos = (vfx_gpu_column){s->buf, STRIDE, LEAD};
     s->vel = (vfx_gpu_column){s->buf, STRIDE, LEAD + 16u};
+    /* kernels: diagonally dominant (eigenvalues within [0.6, 1.5]), stretched and sheared
+     * differently from particle to particle, so a wrong component or particle shows */
+    s->kern = malloc(6 * sizeof(float) * s->n);
+    size_t kbytes = KLEAD + (size_t)s->n * KSTRIDE;
+    unsigned char *img = calloc(1, kbytes);
+    for (uint32_t p = 0; p < s->n; ++p) {
+        float *g = s->kern + 6 * (size_t)p;
+        g[0] = 1.0f + 0.3f * sinf(0.7f * (float)p), g[1] = 0.1f * cosf(1.3f * (float)p), g[2] = 0.05f;
+        g[3] = 0.9f + 0.2f * cosf(0.4f * (float)p), g[4] = -0.08f * sinf(2.1f * (float)p), g[5] = 1.1f;
+        float rec[8] = {g[0], g[1], g[2], g[3], g[4], g[5], -7.0f, -7.0f}; /* padding never read */
+        memcpy(img + KLEAD + (size_t)p * KSTRIDE, rec, sizeof rec);
+    }
+    glCreateBuffers(1, &s->kbuf);
+    glNamedBufferStorage(s->kbuf, (GLsizeiptr)kbytes, img, 0);
+    free(img);
+    s->kcol = (vfx_gpu_column){s->kbuf, KSTRIDE, KLEAD};
 }
 
 /* Frame f's positions (frame 0's moved f times) into the columns and the interleaved buffer. */
@@ -114,9 +143,10 @@ static void host_frame(host *s, int f)
 
 static void free_host(host *s)
 {
-    float *cols[] = {s->x, s->y, s->z, s->vx, s->vy, s->vz, s->base};
-    for (int k = 0; k < 7; ++k) free(cols[k]);
+    float *cols[] = {s->x, s->y, s->z, s->vx, s->vy, s->vz, s->base, s->kern};
+    for (int k = 0; k < 8; ++k) free(cols[k]);
     glDeleteBuffers(1, &s->buf);
+    glDeleteBuffers(1, &s->kbuf);
 }
 
 typedef struct session {
@@ -231,10 +261,11 @@ static void render(host *h, bool gpu, uint32_t method, shot *out)
  * Moving water: the GPU path's box is the late one grown by its motion, not the exact one, which
  * changes only where sums start (the neighbour grid's origin, TILE's depth slabs): the same
  * bounds on the size of the differences hold, not on their number. */
-static void compare_paths(uint32_t method, bool moving)
+static void compare_paths(uint32_t method, bool moving, bool kernel)
 {
     host h;
     make_host(&h, 16, 8, 16);
+    h.with_kernel = kernel;
     if (moving) /* a fifth of the spacing a frame: the late box must be grown to cover it */
         h.move[0] = 0.01f, h.move[1] = 0.004f, h.move[2] = -0.006f;
     static shot cpu, gpu;
@@ -256,7 +287,7 @@ static void compare_paths(uint32_t method, bool moving)
             maxr = d > maxr ? d : maxr;
         }
     }
-    printf("%s method %u: h %.4f, %u water pixels, %u raw and %u colour pixels differ, diffuse %g / %g, max colour %d raw %g, box lag %g\n", moving ? "moving" : "still", method, cpu.h,
+    printf("%s%s method %u: h %.4f, %u water pixels, %u raw and %u colour pixels differ, diffuse %g / %g, max colour %d raw %g, box lag %g\n", moving ? "moving" : "still", kernel ? " kernel column" : "", method, cpu.h,
            water, rawdiff, diff, cpu.diffuse, gpu.diffuse, maxc, maxr, gpu.lag);
     assert_true(cpu.h > 0);
     assert_true(cpu.h == gpu.h);
@@ -279,12 +310,15 @@ static void compare_paths(uint32_t method, bool moving)
     free_host(&h);
 }
 
-static void test_tile(void **state) { (void)state; compare_paths(VFX_WATER_METHOD_TILE, false); }
-static void test_paper(void **state) { (void)state; compare_paths(VFX_WATER_METHOD_PAPER, false); }
+static void test_tile(void **state) { (void)state; compare_paths(VFX_WATER_METHOD_TILE, false, false); }
+static void test_paper(void **state) { (void)state; compare_paths(VFX_WATER_METHOD_PAPER, false, false); }
+/* the host's kernels (TILE only: the paper method refuses a kernel column), as kernel[] and as
+ * gpu_kernel: the gather copies the floats unchanged, so the same bounds hold */
+static void test_tile_kernel(void **state) { (void)state; compare_paths(VFX_WATER_METHOD_TILE, false, true); }
 /* moving water: the box the passes use lags and is grown by its recent motion; no particle falls
  * outside it and the image is the CPU path's */
-static void test_tile_moving(void **state) { (void)state; compare_paths(VFX_WATER_METHOD_TILE, true); }
-static void test_paper_moving(void **state) { (void)state; compare_paths(VFX_WATER_METHOD_PAPER, true); }
+static void test_tile_moving(void **state) { (void)state; compare_paths(VFX_WATER_METHOD_TILE, true, false); }
+static void test_paper_moving(void **state) { (void)state; compare_paths(VFX_WATER_METHOD_PAPER, true, false); }
 
 /* One broken field at a time: update refuses it with VFX_ERR_INVALID_ARGUMENT naming it. */
 static void test_refused(void **state)
@@ -323,6 +357,46 @@ static void test_refused(void **state)
     free_host(&h);
 }
 
+/* The kernel column in a GL buffer: each malformed column refused naming gpu_kernel's field
+ * (VFX_LOG_ID_GPU_COLUMN), kernel[] beside gpu_kernel refused, and a kernel that is not positive
+ * definite refused naming the particle (the CPU column's check, on the gathered floats). */
+static void test_kernel_refused(void **state)
+{
+    (void)state;
+    host h;
+    make_host(&h, 4, 4, 4);
+    h.gpu = true, h.with_kernel = true;
+    /* a copy of the kernel buffer with particle 5's xx negative (kbuf itself is immutable) */
+    GLsizeiptr kbytes = KLEAD + (GLsizeiptr)h.n * KSTRIDE;
+    GLuint bad;
+    glCreateBuffers(1, &bad);
+    glNamedBufferStorage(bad, kbytes, NULL, GL_DYNAMIC_STORAGE_BIT);
+    glCopyNamedBufferSubData(h.kbuf, bad, 0, 0, kbytes);
+    const float minus = -1.0f;
+    glNamedBufferSubData(bad, KLEAD + 5 * KSTRIDE, 4, &minus);
+    const struct { vfx_gpu_column kcol; bool both; vfx_log_id id; const char *field; } cases[] = {
+        {{h.kbuf, 20, KLEAD}, false, VFX_LOG_ID_GPU_COLUMN, "gpu_kernel.stride"}, /* shorter than 6 floats */
+        {{h.kbuf, KSTRIDE, 2}, false, VFX_LOG_ID_GPU_COLUMN, "gpu_kernel.offset"},
+        {{h.kbuf, KSTRIDE, KLEAD + 16}, false, VFX_LOG_ID_GPU_COLUMN, "GL_BUFFER_SIZE"},
+        {{h.kbuf + 1000, KSTRIDE, KLEAD}, false, VFX_LOG_ID_GPU_COLUMN, "gpu_kernel.buffer"},
+        {{h.kbuf, KSTRIDE, KLEAD}, true, VFX_LOG_ID_GPU_COLUMN, "names both kernel and gpu_kernel"},
+        {{bad, KSTRIDE, KLEAD}, false, VFX_LOG_ID_WATER_PARTICLE_VALUE,
+         "particle 5: kernel (vfx_particle_view.gpu_kernel) has eigenvalue"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        h.kcol = cases[k].kcol, h.kern_both = cases[k].both;
+        session ss;
+        session_open(&ss, &h);
+        vfx_result r = ss.api.update(ss.ctx, 0.0, 1.0f / 60.0f);
+        printf("kernel case %zu: %s\n", k, ss.api.last_error(ss.ctx, NULL));
+        assert_int_equal(r, VFX_ERR_INVALID_ARGUMENT);
+        assert_true(test_last_error_is(&ss.api, ss.ctx, cases[k].id, cases[k].field));
+        session_close(&ss);
+    }
+    glDeleteBuffers(1, &bad);
+    free_host(&h);
+}
+
 int main(void)
 {
     rt_gl_context *gl = test_gl_or_skip();
@@ -332,6 +406,8 @@ int main(void)
         cmocka_unit_test(test_tile_moving),
         cmocka_unit_test(test_paper_moving),
         cmocka_unit_test(test_refused),
+        cmocka_unit_test(test_tile_kernel),
+        cmocka_unit_test(test_kernel_refused),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     rt_gl_context_destroy(gl);

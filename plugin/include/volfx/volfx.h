@@ -157,9 +157,9 @@ typedef struct vfx_particle_view {
      * radius, when given too, divides G. Each eigenvalue must lie in [1e-3, 1e3]. */
     const float *kernel;
     uint64_t revision;
-    /* GPU-resident columns instead of pos / vel (leave those NULL): gpu_pos 3 floats x y z a
-     * particle, gpu_vel 3 floats; buffer 0 -> not used. gpu_kernel (6 floats) is refused with
-     * VFX_ERR_UNSUPPORTED (VFX_LOG_ID_GPU_PARTICLES_UNSUPPORTED): give `kernel` instead. */
+    /* GPU-resident columns instead of pos / vel / kernel (leave those NULL): gpu_pos 3 floats
+     * x y z a particle, gpu_vel 3 floats, gpu_kernel 6 floats as `kernel` (read back once an
+     * upload for its checks); buffer 0 -> not used. gpu_vel and gpu_kernel need gpu_pos. */
     vfx_gpu_column gpu_pos, gpu_vel, gpu_kernel;
 } vfx_particle_view;
 
@@ -401,14 +401,14 @@ typedef struct vfx_volume_view {
     X(GENERIC, 1)             /* no longer emitted: every message has a kind of its own */ \
     X(ABI_VERSION, 2)         /* the host passed another ABI version to vfx_plugin_entry */ \
     X(STRUCT_TYPE, 3)         /* a struct's type is not the VFX_TYPE_* its place needs */ \
-    X(GPU_PARTICLES_UNSUPPORTED, 4) /* a particle view's gpu_kernel (not read from GL buffers) */ \
+    X(GPU_PARTICLES_UNSUPPORTED, 4) /* no longer emitted (gpu_kernel is read) */ \
     X(LAYER_TEXTURE_UNSUPPORTED, 5) /* no longer emitted (layer_texture is drawn since ABI 1.0) */ \
     X(PARAM_RANGE, 6)         /* a number outside its documented range (volfx_ranges.h; names the field) */ \
     X(FRAME_VIEW, 7)          /* a frame view field or target refused by the frame gate */ \
     X(OUT_OF_MEMORY, 8)       /* an allocation through the host allocator failed */ \
     X(GL_VERSION, 9)          /* the current context is below desktop GL 4.5 */ \
     X(GL_COMMAND_MISSING, 10) /* gl_get_proc_address found no entry point for a command */ \
-    X(GPU_COLUMN, 11)         /* a particle view's GL buffer column refused (gpu_pos, gpu_vel) */ \
+    X(GPU_COLUMN, 11)         /* a GL buffer column refused (gpu_pos, gpu_vel, gpu_kernel) */ \
     X(LAYER_TEXTURE, 12)      /* a frame view's layer_texture refused */ \
     X(API_ARGUMENT, 13)       /* an API call's argument NULL or out of range (names the call and it) */ \
     X(CONTEXT_DESC, 14)       /* the context desc lacks gl_get_proc_address or half a callback pair */ \
