@@ -1,12 +1,12 @@
 #!/usr/bin/python3
-"""compare-pysph.py — the dam break of docs/simulation.md (Martin & Moyce 1952, n^2 = 2,
+"""compare-pysph.py — the dam break of docs/simulation-validation.md (Martin & Moyce 1952, n^2 = 2,
 a = 2.25 in) in PySPH and in volfx, interleaved, same particle count, tank and duration.
 
 volfx: `volfx-bench sim --dam-break --res 20 --no-slip --solver wcsph|pbf --threads 2`
 (a = 20 dx, 3,200 particles: a column a x 2a, 4 layers deep, in a tank 10a x 2.5a).
 PySPH: the same 3,200 fluid particles (a/dx = 20, 4 layers deep), the tank's floor, end and
 depth walls as 3 layers of boundary particles each (PySPH's boundary particles, its own wall
-model, where ours are the semi-analytic walls of docs/simulation.md), schemes WCSPH (Tait, gamma 7, c0 = 10 sqrt(2 g 2a), artificial
+model, where ours are the semi-analytic walls of docs/simulation-wcsph.md), schemes WCSPH (Tait, gamma 7, c0 = 10 sqrt(2 g 2a), artificial
 viscosity alpha 0.1), EDAC (alpha 0.1, PySPH's dam-break settings) and IISPH, cubic spline kernel, h = 1.3 dx, to T = 5.685 (t = 0.307 s).
 Both are timed by process CPU time (volfx: its own figure, both worker threads; PySPH: single
 threaded unless --openmp); the surge front (largest fluid x, over a) at Martin & Moyce's
@@ -18,7 +18,7 @@ IISPH lost particles through the boundary (\"LinkedListNNPS requires too many ce
 first try, so the default schemes are wcsph,edac.
 Run with the system Python (the Debian package):
     /usr/bin/python3 scripts/compare-pysph.py [--build build] [--reps 3] [--schemes wcsph,edac]
-Prints one JSON line per run and a markdown table of medians (docs/simulation.md, "A peer").
+Prints one JSON line per run and a markdown table of medians (docs/simulation-validation.md, "A peer: PySPH and SPlisHSPlasH").
 """
 import argparse
 import json

@@ -16,7 +16,7 @@ Runs, in this order (each a command a reader can run alone):
 
 Usage: /usr/bin/python3 scripts/sim-goals.py [--build build-release] [--game-build build]
        [--settle 120] [--skip-game] [--png FILE]
-Prints one markdown table (docs/simulation.md, "Measured against WCSPH") and the machine line.
+Prints one markdown table (docs/simulation.md, "Measured figures") and the machine line.
 """
 import argparse
 import csv

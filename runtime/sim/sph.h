@@ -38,7 +38,7 @@ enum {
     /* the grid sort and 5x5x5 cell scan on every substep instead of Verlet lists (the
      * baseline the benchmark compares against) */
     RT_SPH_REBUILD_EVERY_SUBSTEP = 1u << 2,
-    /* PBF: turn off a part of the solver (each measured in docs/simulation.md) */
+    /* PBF: turn off a part of the solver (each measured in docs/simulation-pbf.md) */
     RT_SPH_PBF_WARM_START = 1u << 3,    /* experiment: pressures carried between steps (unstable) */
     RT_SPH_PBF_NO_SCORR = 1u << 4,      /* no artificial pressure s_corr */
     RT_SPH_PBF_NO_XSPH = 1u << 5,       /* no XSPH viscosity */
@@ -84,12 +84,12 @@ typedef struct rt_sph_desc {
     uint32_t threads;           /* worker threads; all online cores */
     float neighbor_skin;        /* Verlet skin as a fraction of H, 0 < skin <= 1; 0.3 */
     uint32_t flags;             /* RT_SPH_* */
-    /* Wall friction (smooth-wall law of the wall, see docs/simulation.md): box faces that are
+    /* Wall friction (smooth-wall law of the wall, docs/simulation-wcsph.md): box faces that are
      * no-slip (RT_SPH_FACE_* bits; 0 = every face free-slip) and the fluid's molecular
      * kinematic viscosity that sets their shear stress [m^2/s]; 1.0e-6 (water at 20 C). */
     uint32_t no_slip_faces;
     float kinematic_viscosity;
-    /* Position Based Fluids (solver = RT_SPH_SOLVER_PBF; docs/simulation.md "PBF"): a call of
+    /* Position Based Fluids (solver = RT_SPH_SOLVER_PBF; docs/simulation-pbf.md): a call of
      * rt_sph_step takes ceil(frame_dt / pbf_max_step) steps, more when a particle would move
      * more than pbf_cfl * H in one (up to max_substeps; the frame is always covered). */
     uint32_t solver;            /* rt_sph_solver; WCSPH */

@@ -44,20 +44,21 @@ static vfx_result fill_params(rt_sph_desc *p, char *err, size_t err_len)
                  "RT_SPH_FACE_* faces", p->no_slip_faces);
         return VFX_ERR_INVALID_ARGUMENT;
     }
-    p->neighbor_skin = def(p->neighbor_skin, 0.3f); /* measured: docs/simulation.md */
+    p->neighbor_skin = def(p->neighbor_skin, 0.3f); /* measured: docs/simulation-wcsph.md */
     if (p->solver > RT_SPH_SOLVER_PBF) {
         snprintf(err, err_len, "rt_sph_create: desc.solver %u is not a solver (0 WCSPH, 1 PBF)", p->solver);
         return VFX_ERR_INVALID_ARGUMENT;
     }
-    /* PBF defaults: measured in docs/simulation.md ("PBF", the cost/accuracy table): 6 iterations
-     * at eps = 0.2 D0 bring the default pool's mean compression from 2.7% (4 at 1.0) to 0.8% */
+    /* PBF defaults: 6 plain iterations at eps = 0.2 D0 brought the default pool's mean compression
+     * from 2.7% (4 at 1.0) to 0.8% (the cost/accuracy table in docs/simulation.md's git history);
+     * the accelerated iterations below: docs/simulation-pbf.md, "Chebyshev acceleration" */
     if (!p->pbf_iterations) p->pbf_iterations = 5;
     p->pbf_max_step = def(p->pbf_max_step, 1.f / 60.f);
     p->pbf_cfl = def(p->pbf_cfl, 0.5f);
     /* 0.5 with the Chebyshev acceleration (rho 0.8): the default pool as compressed as with 0.2 and
      * rho 0.7 (0.53% against 0.48%), but a third of the kinetic energy left at rest after 300
      * frames (0.26 J against 0.72 J): the larger mixing damps the iteration's highest-frequency
-     * mode, which the extrapolation otherwise amplifies (docs/simulation.md, "Chebyshev") */
+     * mode, which the extrapolation otherwise amplifies (docs/simulation-pbf.md, "Chebyshev") */
     p->pbf_relaxation = def(p->pbf_relaxation, 0.5f);
     /* s_corr off by default: in zero gravity a free block with 0.5 cm/s of noise gained 9x its
      * kinetic energy in 2 s with k = 0.001 and lost 78% without (the artificial pressure pushes
@@ -68,7 +69,7 @@ static vfx_result fill_params(rt_sph_desc *p, char *err, size_t err_len)
     /* 0.8 with 5 iterations (and eps 0.5 D0): the default pool at 0.53% mean compression against
      * 0.76% with the old 6 plain ones, and the dam break within 10% at all 9 points (worst 9.6%);
      * 0.9 stirred the pool up (66 J of kinetic energy against 53.5 J at frame 120), and 2
-     * iterations at 0.8 more (240 J) (docs/simulation.md, "Chebyshev acceleration") */
+     * iterations at 0.8 more (240 J) (docs/simulation-pbf.md, "Chebyshev acceleration") */
     p->pbf_chebyshev_rho = def(p->pbf_chebyshev_rho, 0.8f);
 
     const float *fields[] = {&p->spacing, &p->support_ratio, &p->rest_density, &p->sound_speed,

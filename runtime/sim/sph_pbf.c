@@ -10,14 +10,14 @@
  * (lambda <= 0: the constraint only pushes, so the deficient density at a free surface does not
  * pull particles together). The Jacobi update is damped by the constraint-force mixing eps
  * (pbf_relaxation, a fraction of the lattice's sum |grad C|^2): at 0.05 of it the iteration
- * amplified the highest-frequency modes (measured, docs/simulation.md "PBF").
+ * amplified the highest-frequency modes (measured, docs/simulation-pbf.md).
  *
  * The iterates are accelerated by Chebyshev semi-iteration (Wang 2015, for PBD's Jacobi):
  * x_k+1 = omega_k+1 (Jacobi(x_k) - x_k-1) + x_k-1, from the second iteration on, with the weights
  * of an assumed spectral radius (pbf_chebyshev_rho). Its only state is the iterate before the
  * current one, which the ping-pong buffers already hold, so it costs one multiply-add per
  * particle and iteration; 5 accelerated iterations compress the default pool less than the old
- * 6 plain ones (docs/simulation.md, "Chebyshev acceleration").
+ * 6 plain ones (docs/simulation-pbf.md, "Chebyshev acceleration").
  *
  * RT_SPH_PBF_WARM_START (an experiment, off by default): each particle keeps its pressure p_i
  * between steps in pr (Pa; lambda_i = -p_i dt^2 / rho0), a step first applies the correction of
@@ -402,7 +402,7 @@ static void pbf_delta(rt_sph *s, uint32_t chunk, const pbf_delta_args *a)
          * sum_j l_j grad_i C_j: a wall has no constraint of its own). Measured against the
          * wall as a mirror image (2 l_i) over the kernel's fluid share, as sph_wall_accel does
          * for WCSPH: 4,281 against 828 of 17,484 particles faster than 0.1 m/s after 2 s of a
-         * resting pool (docs/simulation.md, PBF) */
+         * resting pool (docs/simulation-pbf.md) */
         float wall_rho, gw[3];
         pbf_walls_iter(s, i, px, py, pz, false, &wall_rho, gw);
         (void)wall_rho;
@@ -741,7 +741,7 @@ static uint32_t pbf_first_bad(const rt_sph *s)
  * 1/dt^2 (a compliance fixed in physical units, as XPBD's alpha / dt^2) the rest compression
  * and the velocities the corrections make do not depend on the call's dt. The call's CFL
  * substeps keep its eps: they stiffen a fast flow, as before (scaled per substep, the dam
- * break's mean compression went from 1.1% to 13%). docs/simulation.md, "Step length". */
+ * break's mean compression went from 1.1% to 13%). docs/simulation-pbf.md, "Step length". */
 static float pbf_step_eps(const rt_sph *s, float dt)
 {
     const float ref = s->p.pbf_max_step;

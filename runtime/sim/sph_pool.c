@@ -3,7 +3,7 @@
  * is 0, the workers 1..n) runs the same contiguous share of the chunks in every pass: a chunk's
  * neighbour lists and stored pair terms, written by one pass, are read by the next from the same
  * core's cache. (Taken from a shared counter instead, a chunk moved between cores from pass to
- * pass: 2 threads cost 1.35x the CPU of one on the default pool, docs/simulation.md.) */
+ * pass: 2 threads cost 1.35x the CPU of one on the default pool, docs/simulation-wcsph.md.) */
 #include "sim/sph_internal.h"
 
 #include <stdlib.h>

@@ -110,7 +110,7 @@ void rt_sph_wall_accel(const rt_sph *s, const float p[3], const float vel[3], fl
      *     truncated kernel (it would be by the fraction f missing: a wall layer half a
      *     spacing from a side wall needed a 1/(1 - f) = 1.28x steeper pressure to hold
      *     its weight).
-     * Measured in a resting column (docs/simulation.md): the earlier single-sided form
+     * Measured in a resting column (docs/simulation-wcsph.md): the earlier single-sided form
      * p_i/rho_i^2 read +58% in the wall layer and +26% overall; (1) without the image
      * viscosity pumped energy into a resting tank; (2) alone compressed the wall layer. */
     int nw = rt_sph_gather_walls(s, p[0], p[1], p[2], walls, SPH_MAX_WALLS);

@@ -80,7 +80,7 @@ static void test_pbf_params(void **state)
  * default, all at the default eps 0.5 D0) after 4 iterations must be nearer to it than plain
  * Jacobi after 4 (measured 0.74x; 0.79x at the earlier rho 0.7 and eps 0.2) and no farther than
  * Jacobi after 6 (0.89x; 0.99x); 0.9x and 1.1x bound them. (Not so for a compressed block floating free in zero gravity: there 4 accelerated
- * iterations overshoot, 3.3x farther than 4 plain ones at rho 0.7: docs/simulation.md, "Chebyshev".) */
+ * iterations overshoot, 3.3x farther than 4 plain ones at rho 0.7: docs/simulation-pbf.md.) */
 static double pbf_one_step(uint32_t iters, bool chebyshev, float **ref, uint32_t *count)
 {
     rt_sph_desc d = {.spacing = 0.01f, .domain_min = {-0.05f, -0.05f, -0.05f}, .domain_max = {0.05f, 0.4f, 0.05f},
@@ -537,9 +537,9 @@ static void test_pbf_resting_pool_every_dt(void **state)
 /* A free block in zero gravity with 5 mm/s of noise (far from every wall): PBF's projection and
  * XSPH can only take kinetic energy away, so it must not grow over 60 frames; the reference is
  * the initial kinetic energy itself (float64 sum here). With the artificial pressure s_corr on
- * (k = 0.001, the old default) it grew 2.5x in 40 frames and 9x in 2 s (docs/simulation.md): the
- * check fails then. Both runs are measured; the slack 1e-3 of the initial energy is far below
- * that growth and above the float32 rounding of the energy sums. */
+ * (k = 0.001, the old default) it grew 2.5x in 40 frames and 9x in 2 s
+ * (docs/simulation-pbf.md): the check fails then. Both runs are measured; the slack 1e-3 of the
+ * initial energy is far below that growth and above the float32 rounding of the energy sums. */
 static void test_pbf_free_block_energy(void **state)
 {
     (void)state;

@@ -769,7 +769,7 @@ static void test_hydrostatic(void **state)
      * of all particles is held to rho0 g within 5% and each bin to 8%; the wall layer and the
      * inner particles on their own within 10% (fewer particles, ~2x the noise; the earlier
      * single-sided wall force read +58% in the wall layer, +26% overall). Measured:
-     * docs/simulation.md. */
+     * docs/simulation-validation.md, "Hydrostatic column". */
     static const char *gname[3] = {"all", "wall layer", "inner"};
     for (int gi = 0; gi < 3; ++gi) {
         double xs[BINS], ys[BINS];
@@ -802,7 +802,7 @@ static void test_dam_break_small(void **state)
     dam_break_run(10);
 }
 
-/* The documented validation resolution (docs/simulation.md, Validation): a/dx = 20, 3,200
+/* The documented validation resolution (docs/simulation-validation.md): a/dx = 20, 3,200
  * particles, the same walls and front, every point within 10% (measured +8.9% at worst). */
 static void test_dam_break_validation(void **state)
 {
@@ -819,9 +819,9 @@ static void dam_break_run(int res)
      * of the slab stand for a 2D flow and stay free-slip): every point of the measured range
      * within the 10% target (measured 2026-12-01: +2.6 ... +4.2% and -4.0%; free-slip walls
      * gave up to +5.7%). a/dx = 20 and 40 are in the bench, `volfx-bench sim --dam-break
-     * --no-slip`, docs/simulation.md. Front: where the fluid volume fraction on the floor falls
-     * to 1/2 (the edge of the continuum the particles stand for; a lone particle thrown ahead
-     * is spray), as in the bench. */
+     * --no-slip`, docs/simulation-validation.md. Front: where the fluid volume fraction on the
+     * floor falls to 1/2 (the edge of the continuum the particles stand for; a lone particle
+     * thrown ahead is spray), as in the bench. */
     static const double T_mm[] = {0.832, 1.219, 1.997, 2.547, 3.345, 4.034, 4.418, 5.091, 5.685};
     static const double Z_mm[] = {1.217, 1.474, 2.292, 2.995, 4.134, 4.944, 5.881, 6.980, 7.945};
     const double a = 0.05715, g = 9.81;
