@@ -14,6 +14,7 @@ pkgs=(
   assimp-testmodels tetgen
   xvfb xauth
   libsdl2-dev          # tests/integration/sdl_host.c, the second host
+  libogre-1.12-dev     # tests/integration/ogre_host.cpp: an OGRE 1.12 application (GL3Plus on GLX: xvfb above)
   khronos-api          # gl.xml: the plugin's GL loader is generated from it (plugin/gpu/gen_gl.py)
   glslang-tools        # glslangValidator: every shader variant validated at build time
   libvulkan-dev mesa-vulkan-drivers glslc vulkan-validationlayers  # tests/integration/vulkan_host.c: Vulkan (lavapipe), its SPIR-V, validation
