@@ -15,6 +15,7 @@
 #include "app.h"
 #include "beams_ref.h"
 #include "debug.h"
+#include "depth_modes.h"
 #include "test_camera.h"
 #include "test_util.h"
 
@@ -671,11 +672,51 @@ static void test_bad_v2_input(void **state)
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
 }
 
+/* The engine's own depth (tests/common/depth_modes.h): the open sky and the wall through the
+ * beam's support against the same float64 quadrature with the same bounds as the standard path
+ * (compare_image), when the depth comes in a renderbuffer, reversed-Z with an infinite far plane
+ * under GL_ZERO_TO_ONE, row-flipped, with an infinite far plane, and all at once. The bound's
+ * "cut" term (2e-5 of the end distance) covers the converted depth too: the mode's depth is the
+ * standard float32 depth turned into view depth and back in double, each rounding once to float32
+ * (2^-24 relative in near/D, ~1e-7 of D here, or one standard-depth ulp: D^2/near x 6e-8 =
+ * 2e-5 D at D = 4 with near 0.05 ... the same size as the standard path's own rounding). */
+static void test_depth_modes_match_reference(void **state)
+{
+    (void)state;
+    g_wall_z = 0.1;
+    rt_entity wall;
+    for (size_t m = 0; m < DEPTH_MODES_COUNT; ++m) {
+        depth_mode_set(g_app, depth_modes_all[m].mode);
+        float *raw = render_raw();
+        image_errors ie;
+        int bad = compare_image(raw, t_far, &ie);
+        free(raw);
+        char what[96];
+        snprintf(what, sizeof what, "open sky, %s", depth_modes_all[m].name);
+        print_errors(what, &ie);
+        assert_int_equal(bad, 0);
+        assert_true(ie.max_rel_wc <= 1e-5);
+        assert_int_equal(game_app_add_box(g_app, (float[3]){-20, -20, (float)g_wall_z - 1}, (float[3]){20, 20, (float)g_wall_z},
+                                         (float[3]){0.5f, 0.5f, 0.5f}, &wall), VFX_OK);
+        raw = render_raw();
+        bad = compare_image(raw, t_wall, &ie);
+        free(raw);
+        game_app_mesh *mm = rt_world_get(g_app->world, wall, g_app->mesh_comp, 0);
+        rt_mesh_gpu_destroy(&mm->gpu);
+        assert_int_equal(rt_world_despawn(g_app->world, wall), VFX_OK);
+        snprintf(what, sizeof what, "wall at z=%.2f, %s", g_wall_z, depth_modes_all[m].name);
+        print_errors(what, &ie);
+        assert_int_equal(bad, 0);
+    }
+    depth_mode_set(g_app, DEPTH_STANDARD);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_matches_reference),
         cmocka_unit_test(test_hidden_by_depth),
+        cmocka_unit_test(test_depth_modes_match_reference),
         cmocka_unit_test(test_hidden_by_assimp_mesh),
         cmocka_unit_test(test_mz_sweep),
         cmocka_unit_test(test_marching_baseline),

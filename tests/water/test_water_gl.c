@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "debug.h"
+#include "depth_modes.h"
 #include "camera_ref.h"
 #include "test_util.h"
 #include "water/water_effect.h"
@@ -28,6 +29,10 @@ typedef struct scene {
     vfx_water_params params; /* method may be a lab method (BRUTE, GRID): sent through lab */
     vfx_lab_water lab;       /* disable bits (and the lab method, set by water_params) */
     uint64_t rev; /* the chunks' revision: 0 (untracked, every frame uploads) unless a test sets it */
+    double wall;  /* > 0: a host depth with a wall at this view depth over the lower half (the
+                   * reference's hits behind it removed), far above (a lost row flip shows) */
+    int depth_mode; /* how that depth reaches the plugin (tests/common/depth_modes.h) */
+    uint32_t wall_hidden, wall_gpu_hits, wall_band; /* out: reference hits the wall removed; GPU hits below its top */
 } scene;
 
 static uint32_t chunk_count(void *user)
@@ -86,8 +91,19 @@ static ref_water_error render_and_compare(scene *s, const ref_camera *cam, vfx_s
                          .near_plane = (float)cam->near_plane, .far_plane = (float)cam->far_plane};
     for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam->eye[k];
     ref_camera_matrices(cam, fv.view, fv.proj);
+    GLuint depth = 0;
+    if (s->wall > 0) { /* window depth of view depth D: (f + n) / (f - n) - 2 f n / ((f - n) D), halved */
+        double n = cam->near_plane, f = cam->far_plane, z = (f + n) / (f - n) - 2.0 * f * n / ((f - n) * s->wall);
+        const float wall = (float)(0.5 * z + 0.5), far = 1.f;
+        glCreateTextures(GL_TEXTURE_2D, 1, &depth);
+        glTextureStorage2D(depth, 1, GL_DEPTH_COMPONENT32F, (GLsizei)w, (GLsizei)h);
+        glClearTexImage(depth, 0, GL_DEPTH_COMPONENT, GL_FLOAT, &far);
+        glClearTexSubImage(depth, 0, 0, 0, 0, (GLsizei)w, (GLsizei)(h / 2), 1, GL_DEPTH_COMPONENT, GL_FLOAT, &wall);
+        fv.depth_texture = depth;
+    }
+    depth_mode_state dm = {.mode = s->depth_mode};
     assert_int_equal(api.update(ctx, 0.0, 0.0f), VFX_OK);
-    assert_int_equal(api.render(ctx, &fv), VFX_OK);
+    assert_int_equal(depth_mode_render_with(&dm, api.render, ctx, &fv), VFX_OK);
     float *gpu = malloc((size_t)w * h * sizeof *gpu), *ref = malloc((size_t)w * h * sizeof *ref);
     ref_water_error e;
     memset(&e, 0, sizeof e);
@@ -102,6 +118,22 @@ static ref_water_error render_and_compare(scene *s, const ref_camera *cam, vfx_s
         rp.step = rp.h / 32;
         char err[256];
         assert_int_equal(ref_water_render(&rc, s->x, s->y, s->z, s->n, &rp, ref, NULL, NULL, err), 0);
+        for (uint32_t j = h - h / 2; s->wall > 0 && j < h; ++j) /* rows top first: the lower half */
+            for (uint32_t i = 0; i < w; ++i) { /* behind the wall: no hit, in float64 */
+                double dir[3];
+                ref_pixel_ray(cam, i, j, dir);
+                double t_wall = s->wall / (dir[0] * fwd[0] + dir[1] * fwd[1] + dir[2] * fwd[2]);
+                size_t q = (size_t)j * w + i;
+                if (ref[q] >= 0 && ref[q] > t_wall - 0.25 * rp.h && ref[q] <= t_wall) {
+                    /* within two march steps (h/8) in front of the wall: the march may stop at
+                     * the wall before it brackets the surface; left out of the comparison */
+                    ref[q] = gpu[q] = -1.f, ++s->wall_band;
+                    continue;
+                }
+                if (ref[q] >= 0 && ref[q] > t_wall)
+                    ref[q] = -1.f, ++s->wall_hidden;
+                s->wall_gpu_hits += gpu[q] >= 0;
+            }
         assert_int_equal(ref_water_compare(gpu, NULL, ref, NULL, (size_t)w * h, rp.h, &e), 0);
     }
     if (stats_out) {
@@ -111,6 +143,8 @@ static ref_water_error render_and_compare(scene *s, const ref_camera *cam, vfx_s
     free(gpu);
     free(ref);
     api.destroy(ctx);
+    depth_mode_free(&dm);
+    glDeleteTextures(1, &depth);
     glDeleteFramebuffers(1, &fbo);
     glDeleteTextures(1, &col);
     return e;
@@ -1431,11 +1465,44 @@ static void test_grid_rebuild_only_on_change(void **state)
     free_scene(&s);
 }
 
+/* The host's depth clips the water the same in every depth the plugin accepts
+ * (tests/common/depth_modes.h): the blobs with a wall at view depth 4.0 over the lower half (in
+ * front of part of the water, behind the rest) against the float64 reference whose hits behind
+ * the wall are removed, with test_blobs_vs_reference's bounds, for the standard depth texture,
+ * a renderbuffer, reversed-Z with an infinite far plane under GL_ZERO_TO_ONE, flipped rows, an
+ * infinite far plane and all at once. Reference hits within h/4 in front of the wall are left out (the march stops at the wall, maybe
+ * before it brackets such a surface). A depth ulp at 4 m is ~2e-5 m (D^2/near x 6e-8), 3e-5 h:
+ * it moves the clip only for a hit within that of the wall, inside the bounds' 1% of silhouette
+ * pixels. */
+static void test_blobs_clipped_by_depth_modes(void **state)
+{
+    (void)state;
+    ref_camera cam = blob_camera(48);
+    for (size_t m = 0; m <= DEPTH_MODES_COUNT; ++m) {
+        scene s = blob_scene(VFX_WATER_METHOD_BRUTE);
+        s.wall = 4.0;
+        s.depth_mode = m ? depth_modes_all[m - 1].mode : DEPTH_STANDARD;
+        ref_water_error e = render_and_compare(&s, &cam, NULL);
+        print_message("blobs behind a wall, %s: ref hits %u holes %.4f false %.4f dist mean %.2e p99 %.2e (x h)\n",
+                      m ? depth_modes_all[m - 1].name : "standard", e.ref_hits, e.hole_rate, e.false_hit_rate,
+                      e.dist_mean_rel_h, e.dist_p99_rel_h);
+        print_message("  %u reference hits hidden by the wall, %u GPU hits in its rows, %u left out within h/4 in front of it\n", s.wall_hidden, s.wall_gpu_hits, s.wall_band);
+        assert_true(e.ref_hits > 150 && s.wall_hidden > 100 && s.wall_band < s.wall_hidden / 2); /* the wall hides some water, not all */
+        assert_true(s.wall_gpu_hits > 20);
+        assert_true(e.hole_rate < 0.02);
+        assert_true(e.false_hit_rate < 0.01);
+        assert_true(e.dist_mean_rel_h < 1e-3);
+        assert_true(e.dist_p99_rel_h < 1e-2);
+        free_scene(&s);
+    }
+}
+
 int main(void)
 {
     rt_gl_context *gl = test_gl_or_skip();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_blobs_vs_reference),
+        cmocka_unit_test(test_blobs_clipped_by_depth_modes),
         cmocka_unit_test(test_normals_vs_reference),
         cmocka_unit_test(test_shading_pixels),
         cmocka_unit_test(test_diffuse_off),
