@@ -1,6 +1,7 @@
 /* resolve.c — see resolve.h. Each struct's zero fields are resolved by the code the effects run
- * (water_params.c, water_aniso.c, water_diffuse.c, frame_check.c) or, where an effect applies a
- * constant inline, by the same constant named here once (beams_effect.c, volume_effect.c). */
+ * (water_params.c, water_aniso.c, water_diffuse.c, frame_check.c; the volume's by the renderer's
+ * tet_options_default) or, where an effect applies a constant inline, by the same constant named
+ * here once (beams_effect.c). */
 #include "resolve.h"
 
 #include <float.h>
@@ -12,6 +13,9 @@
 #if VFX_WITH_WATER
 #include "water/water_internal.h"
 #include "water/water_params.h"
+#endif
+#if VFX_WITH_TETVOL
+#include "tet_render.h"
 #endif
 
 #define SET0(field, value) do { if ((field) == 0) (field) = (value); } while (0)
@@ -102,9 +106,18 @@ static void resolve_beams_view(vfx_beams_view *v)
 
 static void resolve_volume_view(vfx_volume_view *v)
 {
-    SET0(v->ert_threshold, 0.9f);
+#if VFX_WITH_TETVOL
+    /* volume_effect.c leaves a zero field at the renderer's default: ask it */
+    tet_options o;
+    tet_options_default(&o);
+    SET0(v->ert_threshold, o.ert_threshold);
+    SET0(v->tiles, (uint32_t)o.tiles_d);
+    SET0(v->update_c, (uint32_t)o.update_c);
+#else
+    SET0(v->ert_threshold, 0.9f); /* tet_options_default's, for a build without the renderer */
     SET0(v->tiles, 20u);
     SET0(v->update_c, 100u);
+#endif
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     SET0(v->workers, (uint32_t)(cores > 0 ? (cores < 64 ? cores : 64) : 1));
     bool zero = true;

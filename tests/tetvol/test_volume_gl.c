@@ -88,9 +88,12 @@ static float *direct_alpha(void)
     ref_camera_matrices(&g_cam, cam.view, cam.proj);
     tet_tf tf = {.smin = 0, .smax = 1, .tau_lo = 0.2f, .tau_hi = 3.0f, .color_lo = {0.1f, 0.3f, 0.9f},
                      .color_hi = {1.0f, 0.85f, 0.3f}};
+    /* the effect's settings as the plugin resolves the host's view (not restated here) */
+    vfx_volume_view vv = *game_app_volume(g_app, g_vol);
+    assert_int_equal(g_app->api->resolve_defaults(g_app->ctx, &vv), VFX_OK);
     tet_options o;
     tet_options_default(&o);
-    o.ert_threshold = 0.9f;
+    o.ert_threshold = vv.ert_threshold, o.tiles_d = (int)vv.tiles, o.update_c = (int)vv.update_c;
     o.workers = 1;
     float *rgba = malloc(W * H * 4 * sizeof(float)), *a = malloc(W * H * sizeof(float));
     char err[256];
