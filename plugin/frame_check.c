@@ -4,6 +4,7 @@
 
 #include "gpu/gpu.h"
 #include "gpu/pass.h"
+#include "param_ranges.h"
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -426,6 +427,8 @@ vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx
                           "render: frame view effects 0x%x has bits of no effect "
                           "(known: 0x%x)", v->effects, (1u << VFX_EFFECT_COUNT) - 1);
     if ((r = check_planes(ctx, v)))
+        return r;
+    if ((r = volfx_frame_view_check_ranges(ctx, v))) /* every number against its row (volfx_ranges.h) */
         return r;
     t->scene_depth = v->depth_texture;
     t->scene_color = v->color_texture;

@@ -17,7 +17,11 @@ const volfx_range *volfx_range_row(vfx_range_id id)
 
 char *volfx_range_text(const volfx_range *r, char *out, size_t n)
 {
-    if (r->flags & VFX_RANGE_INT)
+    if (r->flags & VFX_RANGE_ANY)
+        snprintf(out, n, "any");
+    else if (r->flags & VFX_RANGE_MASK)
+        snprintf(out, n, "bits of 0x%llx", (unsigned long long)r->hi);
+    else if (r->flags & VFX_RANGE_INT)
         snprintf(out, n, "%.9g..%.9g%s", r->lo, r->hi, r->flags & VFX_RANGE_ZERO ? " or 0" : "");
     else
         snprintf(out, n, "%c%.9g, %.9g]%s", r->flags & VFX_RANGE_LO_OPEN ? '(' : '[', r->lo, r->hi,
@@ -27,6 +31,10 @@ char *volfx_range_text(const volfx_range *r, char *out, size_t n)
 
 static int fits(const volfx_range *r, double v)
 {
+    if (r->flags & VFX_RANGE_ANY)
+        return 1;
+    if (r->flags & VFX_RANGE_MASK)
+        return v >= 0 && v <= 4294967295.0 && ((uint32_t)v & ~(uint32_t)r->hi) == 0;
     if (v == 0 && (r->flags & VFX_RANGE_ZERO))
         return 1;
     if ((r->flags & VFX_RANGE_LO_OPEN ? v > r->lo : v >= r->lo) && v <= r->hi) /* NaN fails */
@@ -34,15 +42,17 @@ static int fits(const volfx_range *r, double v)
     /* a float field at an end that is no float32 (1e-6, 0.95) holds the float nearest it, which
      * may lie just outside the double: the ends as float32 decide then */
     volatile float lo = (float)r->lo, hi = (float)r->hi;
-    return !(r->flags & VFX_RANGE_INT) && (r->flags & VFX_RANGE_LO_OPEN ? v > lo : v >= lo) && v <= hi;
+    return !(r->flags & VFX_RANGE_INT) && isfinite(v) && (r->flags & VFX_RANGE_LO_OPEN ? v > lo : v >= lo) && v <= hi;
 }
 
 static vfx_result refuse(vfx_context *ctx, const char *what, const volfx_range *r, const char *index, double v)
 {
     char t[96], val[40];
-    snprintf(val, sizeof val, r->flags & VFX_RANGE_INT ? "%.0f" : "%g", v); /* integers in full */
-    return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
-                      "%s: %s%s %s outside %s%s%s%s", what, r->field, index, val,
+    if (r->flags & VFX_RANGE_MASK)
+        snprintf(val, sizeof val, "0x%x", (unsigned)v);
+    else
+        snprintf(val, sizeof val, r->flags & VFX_RANGE_INT ? "%.0f" : "%g", v); /* integers in full */
+    return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE, "%s: %s%s %s outside %s%s%s%s", what, r->field, index, val,
                       volfx_range_text(r, t, sizeof t), r->note[0] ? " (" : "", r->note, r->note[0] ? ")" : "");
 }
 
@@ -93,6 +103,52 @@ vfx_result volfx_water_params_check_ranges(vfx_context *ctx, const vfx_water_par
         || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_ANISO_SCALE, k->aniso_scale))
         || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_ANISO_SMOOTHING, k->aniso_smoothing)))
         return r;
+    if ((r = volfx_range_check(ctx, w, VFX_RANGE_WATER_METHOD, p->method))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_PRESET, p->preset))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_KERNEL, p->kernel))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_FEATURES_OFF, p->features_off)))
+        return r;
+    return volfx_water_diffuse_check_ranges(ctx, p);
+}
+
+/* Component k of a vector field against row id (0 fits where the row allows it). */
+static vfx_result check_at(vfx_context *ctx, const char *what, vfx_range_id id, double v, int k)
+{
+    if (fits(&ROWS[id], v))
+        return VFX_OK;
+    char idx[16];
+    snprintf(idx, sizeof idx, "[%d]", k);
+    return refuse(ctx, what, &ROWS[id], idx, v);
+}
+
+/* Each end of a potential's clamp range alone: 0 is that end's default. */
+static vfx_result check_pair(vfx_context *ctx, vfx_range_id id, const float v[2])
+{
+    vfx_result r;
+    for (int e = 0; e < 2; ++e)
+        if ((r = check_at(ctx, "water", id, v[e], e)))
+            return r;
+    return VFX_OK;
+}
+
+vfx_result volfx_water_diffuse_check_ranges(vfx_context *ctx, const vfx_water_params *p)
+{
+    const char *w = "water";
+    vfx_result r;
+    if ((r = volfx_range_check(ctx, w, VFX_RANGE_WATER_DIFFUSE_MAX, p->diffuse_max))
+        || (r = volfx_range_check_vec(ctx, w, VFX_RANGE_WATER_GRAVITY, p->gravity, 3))
+        || (r = check_pair(ctx, VFX_RANGE_WATER_TRAPPED_AIR, p->trapped_air))
+        || (r = check_pair(ctx, VFX_RANGE_WATER_WAVE_CREST, p->wave_crest))
+        || (r = check_pair(ctx, VFX_RANGE_WATER_ENERGY, p->energy)))
+        return r;
+    if ((r = volfx_range_check(ctx, w, VFX_RANGE_WATER_RATE_TRAPPED_AIR, p->rate_trapped_air))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_RATE_WAVE_CREST, p->rate_wave_crest))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_LIFETIME, p->lifetime))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_BUOYANCY, p->buoyancy))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_DRAG, p->drag))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_SPRAY_BELOW, p->spray_below))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_BUBBLE_ABOVE, p->bubble_above)))
+        return r;
     return VFX_OK;
 }
 
@@ -101,6 +157,13 @@ vfx_result volfx_beam_check_ranges(vfx_context *ctx, uint32_t i, const vfx_beam 
     char w[32];
     snprintf(w, sizeof w, "beams[%u]", i);
     vfx_result r;
+    if ((r = volfx_range_check_vec(ctx, w, VFX_RANGE_BEAM_HEAD, b->head, 3))
+        || (r = volfx_range_check_vec(ctx, w, VFX_RANGE_BEAM_DIR, b->dir, 3))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_FALLOFF, b->falloff))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_RAMP, b->ramp))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_FLOW_KIND, b->flow_kind))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_JOINT_COUNT, b->joint_count)))
+        return r;
     if ((r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_LENGTH, b->length))
         || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_RADIUS, b->radius))
         || (r = volfx_range_check(ctx, w, VFX_RANGE_BEAM_A, b->a))
@@ -135,6 +198,10 @@ vfx_result volfx_beam_check_ranges(vfx_context *ctx, uint32_t i, const vfx_beam 
 vfx_result volfx_beams_view_check_ranges(vfx_context *ctx, const vfx_beams_view *v, uint32_t march_samples)
 {
     vfx_result r;
+    if ((r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_COUNT, v->count))
+        || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_SATURATION, v->saturation))
+        || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_BLOOM, v->bloom)))
+        return r;
     if ((r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_C, v->saturate_c))
         || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_FAR, v->far_distance))
         || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_MARCH_SAMPLES, march_samples)))
@@ -154,5 +221,33 @@ vfx_result volfx_volume_view_check_ranges(vfx_context *ctx, const vfx_volume_vie
         || (r = volfx_range_check(ctx, w, VFX_RANGE_VOLUME_UPDATE_C, v->update_c))
         || (r = volfx_range_check(ctx, w, VFX_RANGE_VOLUME_WORKERS, v->workers)))
         return r;
+    if ((r = volfx_range_check(ctx, w, VFX_RANGE_VOLUME_SCALAR_MIN, v->scalar_min))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_VOLUME_SCALAR_MAX, v->scalar_max))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_VOLUME_TRANSFER_COUNT, v->transfer_count))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_VOLUME_TRANSFER_METHOD, v->transfer_method))
+        || (r = volfx_range_check_vec(ctx, w, VFX_RANGE_VOLUME_MODEL, v->model, 16)))
+        return r;
+    return VFX_OK;
+}
+
+vfx_result volfx_frame_view_check_ranges(vfx_context *ctx, const vfx_frame_view *v)
+{
+    const char *w = "render";
+    vfx_result r;
+    if ((r = volfx_range_check(ctx, w, VFX_RANGE_FRAME_WIDTH, v->width))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_FRAME_HEIGHT, v->height))
+        || (r = volfx_range_check_vec(ctx, w, VFX_RANGE_FRAME_VIEW_MATRIX, v->view, 16))
+        || (r = volfx_range_check_vec(ctx, w, VFX_RANGE_FRAME_PROJ, v->proj, 16))
+        || (r = volfx_range_check_vec(ctx, w, VFX_RANGE_FRAME_EYE, v->eye, 3)))
+        return r;
+    if ((r = volfx_range_check(ctx, w, VFX_RANGE_FRAME_NEAR, v->near_plane))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_FRAME_FAR, v->far_plane))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_FRAME_FOV_Y, v->fov_y))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_FRAME_EFFECTS, v->effects))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_FRAME_COLOR_HDR, v->color_hdr)))
+        return r;
+    for (int k = 0; k < 3; ++k) /* double: checked as it is, not through a float */
+        if ((r = check_at(ctx, w, VFX_RANGE_FRAME_ORIGIN, v->origin[k], k)))
+            return r;
     return VFX_OK;
 }

@@ -32,11 +32,16 @@ vfx_result volfx_range_check_vec(vfx_context *ctx, const char *what, vfx_range_i
 
 /* The water parameters. */
 vfx_result volfx_water_params_check_ranges(vfx_context *ctx, const vfx_water_params *p);
+/* The diffuse particles' fields alone (volfx_water_params_check_ranges includes them). */
+vfx_result volfx_water_diffuse_check_ranges(vfx_context *ctx, const vfx_water_params *p);
 /* Beam i. */
 vfx_result volfx_beam_check_ranges(vfx_context *ctx, uint32_t i, const vfx_beam *b);
 /* The beams view's own numbers (and the lab's march samples, lab may be NULL). */
 vfx_result volfx_beams_view_check_ranges(vfx_context *ctx, const vfx_beams_view *v, uint32_t march_samples);
 /* The volume view's renderer options. */
 vfx_result volfx_volume_view_check_ranges(vfx_context *ctx, const vfx_volume_view *v);
+/* The frame view's numbers, each against its row alone (the frame gate checks the relations:
+ * near against proj, eye against view, the GL names). */
+vfx_result volfx_frame_view_check_ranges(vfx_context *ctx, const vfx_frame_view *v);
 
 #endif

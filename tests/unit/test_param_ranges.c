@@ -17,7 +17,9 @@
 
 #include "context.h"
 #include "param_ranges.h"
+#include "lab/volfx_lab.h"
 #include "water/water_params.h"
+#include <float.h>
 
 static const char *g_doc;
 
@@ -44,7 +46,7 @@ static void test_docs_table(void **state)
     (void)state;
     FILE *f = fopen(g_doc, "rb");
     assert_non_null(f);
-    static char doc[1 << 18], want[1 << 14];
+    static char doc[1 << 18], want[1 << 16];
     size_t n = fread(doc, 1, sizeof doc - 1, f);
     fclose(f);
     doc[n] = 0;
@@ -75,13 +77,15 @@ static void test_every_row(void **state)
     for (int i = 0; i < VFX_RANGE_COUNT; ++i) {
         const volfx_range *r = volfx_range_row((vfx_range_id)i);
         const char *fld = strchr(r->field, '.') + 1;
+        if (r->flags & (VFX_RANGE_ANY | VFX_RANGE_MASK))
+            continue; /* test_struct_walk: every value fits / bits */
         double lo_in = r->flags & VFX_RANGE_LO_OPEN ? (r->lo == 0 ? 1e-6 : r->lo * 1.0001) : r->lo;
         expect(c, volfx_range_check(c, "t", (vfx_range_id)i, lo_in), VFX_OK, NULL);
         expect(c, volfx_range_check(c, "t", (vfx_range_id)i, r->hi), VFX_OK, NULL);
         double over = r->flags & VFX_RANGE_INT ? r->hi + 1 : r->hi * 1.001 + 1e-6;
         expect(c, volfx_range_check(c, "t", (vfx_range_id)i, over), VFX_ERR_INVALID_ARGUMENT, fld);
         if (r->lo != 0 || (r->flags & VFX_RANGE_LO_OPEN) || !(r->flags & VFX_RANGE_INT)) {
-            double under = r->flags & VFX_RANGE_LO_OPEN ? r->lo : r->lo - (r->flags & VFX_RANGE_INT ? 1 : 1e-3);
+            double under = r->flags & VFX_RANGE_LO_OPEN ? r->lo : r->lo - (r->flags & VFX_RANGE_INT ? 1 : fmax(1e-3, fabs(r->lo) * 1e-3));
             if (!(under == 0 && (r->flags & VFX_RANGE_ZERO)) && !(r->flags & VFX_RANGE_INT && under < 0))
                 expect(c, volfx_range_check(c, "t", (vfx_range_id)i, under), VFX_ERR_INVALID_ARGUMENT, fld);
         }
@@ -92,6 +96,223 @@ static void test_every_row(void **state)
         expect(c, volfx_range_check(c, "t", (vfx_range_id)i, 0),
                (r->flags & VFX_RANGE_ZERO) || zero_in ? VFX_OK : VFX_ERR_INVALID_ARGUMENT, NULL);
     }
+    free(c);
+}
+
+/* Where each row's field lies: the row's field text must be the struct and member named here
+ * (so a row cannot name a field that does not exist), and test_struct_walk sets the member in a
+ * valid struct and calls the check the effect calls. Every row must be here. */
+enum { K_NONE, K_WATER, K_BEAM, K_BEAMS_VIEW, K_LAB_BEAMS, K_VOLUME, K_FRAME, K_OTHER };
+enum { T_F32 = 1, T_U32, T_F64, T_U64 };
+typedef struct fmap {
+    int kind;
+    const char *name;
+    size_t off;
+    int type, n;
+} fmap;
+#define TYPE_OF_(x) _Generic((x), float: T_F32, uint32_t: T_U32, double: T_F64, uint64_t: T_U64)
+#define M_(id, k, s, m) [VFX_RANGE_##id] = {k, #s "." #m, offsetof(s, m), TYPE_OF_(((s *)0)->m), \
+                                            (int)(sizeof(((s *)0)->m) / 4 / (TYPE_OF_(((s *)0)->m) >= T_F64 ? 2 : 1))},
+#define MA_(id, k, s, m) [VFX_RANGE_##id] = {k, #s "." #m, offsetof(s, m), TYPE_OF_(((s *)0)->m[0]), \
+                                            (int)(sizeof(((s *)0)->m) / sizeof(((s *)0)->m[0]))},
+static const fmap MAP[VFX_RANGE_COUNT] = {
+    M_(WATER_H, K_WATER, vfx_water_params, h) M_(WATER_THRESHOLD, K_WATER, vfx_water_params, threshold)
+    M_(WATER_MAX_SAMPLES, K_WATER, vfx_water_params, max_samples) M_(WATER_STEP, K_WATER, vfx_water_params, step)
+    M_(WATER_REFINE_ITERS, K_WATER, vfx_water_params, refine_iters)
+    M_(WATER_PYRAMID_LEVEL, K_WATER, vfx_water_params, pyramid_level) MA_(WATER_COLOR, K_WATER, vfx_water_params, color)
+    M_(WATER_ABSORPTION, K_WATER, vfx_water_params, absorption) M_(WATER_IOR, K_WATER, vfx_water_params, ior)
+    M_(WATER_ANISO_RADIUS, K_WATER, vfx_water_params, aniso_radius)
+    M_(WATER_ANISO_MAX_STRETCH, K_WATER, vfx_water_params, aniso_max_stretch)
+    M_(WATER_ANISO_MIN_NEIGHBOURS, K_WATER, vfx_water_params, aniso_min_neighbours)
+    M_(WATER_ANISO_SCALE, K_WATER, vfx_water_params, aniso_scale)
+    M_(WATER_ANISO_SMOOTHING, K_WATER, vfx_water_params, aniso_smoothing)
+    M_(WATER_METHOD, K_WATER, vfx_water_params, method) M_(WATER_PRESET, K_WATER, vfx_water_params, preset)
+    M_(WATER_KERNEL, K_WATER, vfx_water_params, kernel) M_(WATER_FEATURES_OFF, K_WATER, vfx_water_params, features_off)
+    M_(WATER_DIFFUSE_MAX, K_WATER, vfx_water_params, diffuse_max) MA_(WATER_GRAVITY, K_WATER, vfx_water_params, gravity)
+    MA_(WATER_TRAPPED_AIR, K_WATER, vfx_water_params, trapped_air)
+    MA_(WATER_WAVE_CREST, K_WATER, vfx_water_params, wave_crest) MA_(WATER_ENERGY, K_WATER, vfx_water_params, energy)
+    M_(WATER_RATE_TRAPPED_AIR, K_WATER, vfx_water_params, rate_trapped_air)
+    M_(WATER_RATE_WAVE_CREST, K_WATER, vfx_water_params, rate_wave_crest)
+    M_(WATER_LIFETIME, K_WATER, vfx_water_params, lifetime) M_(WATER_BUOYANCY, K_WATER, vfx_water_params, buoyancy)
+    M_(WATER_DRAG, K_WATER, vfx_water_params, drag) M_(WATER_SPRAY_BELOW, K_WATER, vfx_water_params, spray_below)
+    M_(WATER_BUBBLE_ABOVE, K_WATER, vfx_water_params, bubble_above)
+    M_(PARTICLE_COUNT, K_OTHER, vfx_particle_view, count) M_(PARTICLE_REVISION, K_OTHER, vfx_particle_view, revision)
+    M_(GPU_COLUMN_BUFFER, K_OTHER, vfx_gpu_column, buffer) M_(GPU_COLUMN_STRIDE, K_OTHER, vfx_gpu_column, stride)
+    M_(GPU_COLUMN_OFFSET, K_OTHER, vfx_gpu_column, offset)
+    MA_(BEAM_HEAD, K_BEAM, vfx_beam, head) MA_(BEAM_DIR, K_BEAM, vfx_beam, dir)
+    M_(BEAM_LENGTH, K_BEAM, vfx_beam, length) M_(BEAM_RADIUS, K_BEAM, vfx_beam, radius) M_(BEAM_A, K_BEAM, vfx_beam, a)
+    M_(BEAM_B, K_BEAM, vfx_beam, b) M_(BEAM_EPS, K_BEAM, vfx_beam, eps) MA_(BEAM_COLOR, K_BEAM, vfx_beam, color)
+    M_(BEAM_INTENSITY, K_BEAM, vfx_beam, intensity) M_(BEAM_EXPOSURE, K_BEAM, vfx_beam, exposure)
+    M_(BEAM_FLOW_AMOUNT, K_BEAM, vfx_beam, flow_amount) M_(BEAM_FLOW_SPEED, K_BEAM, vfx_beam, flow_speed)
+    M_(BEAM_FLOW_SCALE, K_BEAM, vfx_beam, flow_scale) M_(BEAM_FLOW_TWIST, K_BEAM, vfx_beam, flow_twist)
+    M_(BEAM_HEAD_RADIUS, K_BEAM, vfx_beam, head_radius) M_(BEAM_ORB_RADIUS, K_BEAM, vfx_beam, orb_radius)
+    M_(BEAM_ORB_STRENGTH, K_BEAM, vfx_beam, orb_strength) M_(BEAM_ORB_PULSE, K_BEAM, vfx_beam, orb_pulse)
+    M_(BEAM_ORB_PULSE_HZ, K_BEAM, vfx_beam, orb_pulse_hz) M_(BEAM_TAPER, K_BEAM, vfx_beam, taper)
+    M_(BEAM_SURGE_AMOUNT, K_BEAM, vfx_beam, surge_amount) M_(BEAM_SURGE_WAVELENGTH, K_BEAM, vfx_beam, surge_wavelength)
+    M_(BEAM_SURGE_SPEED, K_BEAM, vfx_beam, surge_speed) M_(BEAM_CORE, K_BEAM, vfx_beam, core)
+    M_(BEAM_FALLOFF, K_BEAM, vfx_beam, falloff) M_(BEAM_RAMP, K_BEAM, vfx_beam, ramp)
+    M_(BEAM_FLOW_KIND, K_BEAM, vfx_beam, flow_kind) M_(BEAM_JOINT_FIRST, K_BEAM, vfx_beam, joint_first)
+    M_(BEAM_JOINT_COUNT, K_BEAM, vfx_beam, joint_count)
+    M_(BEAMS_COUNT, K_BEAMS_VIEW, vfx_beams_view, count) M_(BEAMS_SATURATION, K_BEAMS_VIEW, vfx_beams_view, saturation)
+    M_(BEAMS_BLOOM, K_BEAMS_VIEW, vfx_beams_view, bloom) M_(BEAMS_JOINT_COUNT, K_BEAMS_VIEW, vfx_beams_view, joint_count)
+    M_(BEAMS_C, K_BEAMS_VIEW, vfx_beams_view, saturate_c) M_(BEAMS_FAR, K_BEAMS_VIEW, vfx_beams_view, far_distance)
+    M_(BEAMS_MARCH_SAMPLES, K_LAB_BEAMS, vfx_lab_beams, march_samples)
+    M_(BEAMS_BLOOM_STRENGTH, K_BEAMS_VIEW, vfx_beams_view, bloom_strength)
+    M_(BEAMS_BLOOM_LEVELS, K_BEAMS_VIEW, vfx_beams_view, bloom_levels)
+    M_(VOLUME_POINT_COUNT, K_VOLUME, vfx_volume_view, point_count) M_(VOLUME_TET_COUNT, K_VOLUME, vfx_volume_view, tet_count)
+    M_(VOLUME_SCALAR_MIN, K_VOLUME, vfx_volume_view, scalar_min) M_(VOLUME_SCALAR_MAX, K_VOLUME, vfx_volume_view, scalar_max)
+    M_(VOLUME_TRANSFER_COUNT, K_VOLUME, vfx_volume_view, transfer_count)
+    M_(VOLUME_TRANSFER_METHOD, K_VOLUME, vfx_volume_view, transfer_method)
+    MA_(VOLUME_MODEL, K_VOLUME, vfx_volume_view, model) M_(VOLUME_REVISION, K_VOLUME, vfx_volume_view, revision)
+    M_(VOLUME_ERT_THRESHOLD, K_VOLUME, vfx_volume_view, ert_threshold) M_(VOLUME_TILES, K_VOLUME, vfx_volume_view, tiles)
+    M_(VOLUME_UPDATE_C, K_VOLUME, vfx_volume_view, update_c) M_(VOLUME_WORKERS, K_VOLUME, vfx_volume_view, workers)
+    M_(FRAME_FRAMEBUFFER, K_FRAME, vfx_frame_view, framebuffer) M_(FRAME_COLOR_TEXTURE, K_FRAME, vfx_frame_view, color_texture)
+    M_(FRAME_DEPTH_TEXTURE, K_FRAME, vfx_frame_view, depth_texture) M_(FRAME_WIDTH, K_FRAME, vfx_frame_view, width)
+    M_(FRAME_HEIGHT, K_FRAME, vfx_frame_view, height) MA_(FRAME_VIEW_MATRIX, K_FRAME, vfx_frame_view, view)
+    MA_(FRAME_PROJ, K_FRAME, vfx_frame_view, proj) MA_(FRAME_EYE, K_FRAME, vfx_frame_view, eye)
+    M_(FRAME_NEAR, K_FRAME, vfx_frame_view, near_plane) M_(FRAME_FAR, K_FRAME, vfx_frame_view, far_plane)
+    M_(FRAME_FOV_Y, K_FRAME, vfx_frame_view, fov_y) M_(FRAME_EFFECTS, K_FRAME, vfx_frame_view, effects)
+    MA_(FRAME_ORIGIN, K_FRAME, vfx_frame_view, origin) M_(FRAME_COLOR_HDR, K_FRAME, vfx_frame_view, color_hdr)
+    M_(FRAME_ENVIRONMENT_CUBEMAP, K_FRAME, vfx_frame_view, environment_cubemap)
+    M_(FRAME_VIEW_ID, K_FRAME, vfx_frame_view, view_id) M_(FRAME_LAYER_TEXTURE, K_FRAME, vfx_frame_view, layer_texture)
+    M_(GL_STATE_SKIP_RESTORE, K_OTHER, vfx_gl_state_desc, skip_restore)
+    M_(LIGHTS_CAPACITY, K_OTHER, vfx_lights, capacity)
+    M_(IMPACT_EVENTS_CAPACITY, K_OTHER, vfx_impact_events, capacity)
+};
+
+/* One valid struct of each kind, a member set, and the check the plugin runs on it. */
+typedef union any_struct {
+    vfx_water_params w;
+    vfx_beam b;
+    vfx_beams_view bv;
+    vfx_lab_beams lb;
+    vfx_volume_view vv;
+    vfx_frame_view fv;
+} any_struct;
+
+static void baseline(int kind, any_struct *u)
+{
+    memset(u, 0, sizeof *u);
+    switch (kind) {
+    case K_WATER:
+        u->w = (vfx_water_params){.type = VFX_TYPE_WATER_PARAMS, .color = {0.5f, 0.5f, 0.5f},
+                                  .gravity = {0, -9.81f, 0}, .spray_below = 1, .bubble_above = 10000};
+        break;
+    case K_BEAM:
+        u->b = (vfx_beam){.type = VFX_TYPE_BEAM, .head = {1, 1, 1}, .dir = {1, 0, 0}, .length = 1, .radius = 0.5f,
+                          .a = 0.05f, .b = 0.03f, .eps = 0.02f, .color = {1, 1, 1, 1}};
+        break;
+    case K_FRAME:
+        u->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW, .width = 64, .height = 64, .fov_y = 1,
+                                 .view = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1},
+                                 .proj = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -1, -1, 0, 0, -0.2f, 0}};
+        break;
+    case K_VOLUME:
+        for (int k = 0; k < 16; ++k)
+            u->vv.model[k] = k % 5 == 0 ? 1.f : 0.f;
+        u->vv.type = VFX_TYPE_VOLUME_VIEW;
+        break;
+    default:
+        u->bv.type = VFX_TYPE_BEAMS_VIEW;
+        break;
+    }
+}
+
+static vfx_result run_check(vfx_context *c, int kind, any_struct *u)
+{
+    volfx_water_resolved out;
+    switch (kind) {
+    case K_WATER: return volfx_water_params_resolve(c, &u->w, &out);
+    case K_BEAM: return volfx_beam_check_ranges(c, 0, &u->b);
+    case K_BEAMS_VIEW: return volfx_beams_view_check_ranges(c, &u->bv, 0);
+    case K_LAB_BEAMS: {
+        vfx_beams_view v = {.type = VFX_TYPE_BEAMS_VIEW};
+        return volfx_beams_view_check_ranges(c, &v, u->lb.march_samples);
+    }
+    case K_VOLUME: return volfx_volume_view_check_ranges(c, &u->vv);
+    case K_FRAME: return volfx_frame_view_check_ranges(c, &u->fv);
+    }
+    return VFX_OK;
+}
+
+static void set_member(any_struct *u, const fmap *m, int comp, double v)
+{
+    char *at = (char *)u + m->off;
+    switch (m->type) {
+    case T_F32: ((float *)at)[comp] = (float)v; break;
+    case T_U32: ((uint32_t *)at)[comp] = (uint32_t)v; break;
+    case T_F64: ((double *)at)[comp] = v; break;
+    default: ((uint64_t *)at)[comp] = (uint64_t)v; break;
+    }
+}
+
+/* The next value of the member's type past x towards `to` (the member holds it exactly). */
+static double next_of(const fmap *m, double x, double to)
+{
+    if (m->type == T_F32)
+        return nextafterf((float)x, (float)to);
+    if (m->type == T_F64)
+        return nextafter(x, to);
+    return to > x ? x + 1 : x - 1;
+}
+
+/* Every row, through the struct: each end set in a valid struct is accepted by the check the
+ * effect calls, and the member's next value outside each end refused naming the field (the
+ * lower end on the first component, the upper on the last: a clamp pair's min and max). A row
+ * whose field the plugin never checks, or checks against another row, fails here. */
+static void test_struct_walk(void **state)
+{
+    (void)state;
+    vfx_context *c = fake_ctx();
+    int walked = 0;
+    for (int i = 0; i < VFX_RANGE_COUNT; ++i) {
+        const volfx_range *r = volfx_range_row((vfx_range_id)i);
+        const fmap *m = &MAP[i];
+        if (m->kind == K_NONE)
+            fail_msg("row %s has no entry in this test's MAP", r->field);
+        if (strcmp(m->name, r->field) != 0)
+            fail_msg("row %d names %s, but its member is %s", i, r->field, m->name);
+        if ((r->flags & VFX_RANGE_ANY) || m->kind == K_OTHER)
+            continue;
+        assert_true(m->kind != K_OTHER); /* a checked row must name a checked struct */
+        any_struct u;
+        double ins[2], outs[2];
+        int nin = 0, nout = 0;
+        if (r->flags & VFX_RANGE_MASK) {
+            ins[nin++] = r->hi;
+            uint32_t bit = 1;
+            while (bit & (uint32_t)r->hi)
+                bit <<= 1;
+            outs[nout++] = bit;
+        } else {
+            ins[nin++] = r->flags & VFX_RANGE_LO_OPEN ? next_of(m, r->lo, INFINITY) : r->lo;
+            ins[nin++] = r->hi;
+            double under = r->flags & VFX_RANGE_LO_OPEN ? r->lo : next_of(m, r->lo, -INFINITY);
+            if (!(under == 0 && (r->flags & VFX_RANGE_ZERO)) && !(m->type == T_U32 && under < 0))
+                outs[nout++] = under;
+            if (!(m->type == T_U32 && r->hi >= 4294967295.0))
+                outs[nout++] = next_of(m, r->hi, INFINITY);
+        }
+        for (int k = 0; k < nin; ++k) {
+            baseline(m->kind, &u);
+            set_member(&u, m, k == 0 ? 0 : m->n - 1, ins[k]);
+            vfx_result res = run_check(c, m->kind, &u);
+            if (res != VFX_OK)
+                fail_msg("%s = %.9g (an end of its row) refused: %s", r->field, ins[k], c->last_error);
+        }
+        for (int k = 0; k < nout; ++k) {
+            baseline(m->kind, &u);
+            int comp = (r->flags & VFX_RANGE_MASK) || outs[k] < r->lo ? 0 : m->n - 1;
+            set_member(&u, m, comp, outs[k]);
+            vfx_result res = run_check(c, m->kind, &u);
+            if (res != VFX_ERR_INVALID_ARGUMENT || !strstr(c->last_error, r->field))
+                fail_msg("%s = %.9g (just outside its row) gave %d \"%s\"", r->field, outs[k], res,
+                         res ? c->last_error : "");
+            assert_int_equal(c->last_error_id, VFX_LOG_ID_PARAM_RANGE);
+        }
+        ++walked;
+    }
+    assert_true(walked >= 80); /* the walk cannot silently shrink */
     free(c);
 }
 
@@ -222,7 +443,7 @@ int main(int argc, char **argv)
     }
     g_doc = argv[1];
     if (argc > 2 && strcmp(argv[2], "--print") == 0) {
-        static char t[1 << 14];
+        static char t[1 << 16];
         table_text(t, sizeof t);
         fputs(t, stdout);
         return 0;
@@ -230,6 +451,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_docs_table),
         cmocka_unit_test(test_every_row),
+        cmocka_unit_test(test_struct_walk),
         cmocka_unit_test(test_water_abi_values),
         cmocka_unit_test(test_beam_abi_values),
         cmocka_unit_test(test_resolve_defaults),
