@@ -208,9 +208,6 @@ static vfx_result check_transfer(vfx_context *ctx, const vfx_volume_view *v)
                                   "volume[0]: transfer_scalar[%u] = %g (need increasing values in [0, 1])", i,
                                   (double)t);
         }
-    if (v->transfer_method > VFX_VOLUME_TRANSFER_PREINTEGRATED)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_VOLUME_TRANSFER,
-                          "volume[0]: transfer_method %u unknown", v->transfer_method);
     return VFX_OK;
 }
 
@@ -235,20 +232,13 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_VOLUME_MESH,
                           "volume[0]: needs points, tets and scalar arrays and counts > 0 (%u points, %u tets)",
                           v1->point_count, v1->tet_count);
-    if ((r = check_transfer(ctx, &v)) != VFX_OK)
-        return r;
-    /* ert_threshold, tiles (a DxD table per worker: 65,535 asked for 4.3e9 entries each, issue
-     * 18), update_c, workers: their documented ranges (plugin/param_ranges.c) */
+    /* every number against its documented range first (plugin/param_ranges.c): ert_threshold,
+     * tiles (a DxD table per worker: 65,535 asked for 4.3e9 entries each), update_c, workers,
+     * the transfer's count and method, the model matrix, the scalar domain */
     if ((r = volfx_volume_view_check_ranges(ctx, v1)) != VFX_OK)
         return r;
-    for (int i = 0; i < 16; ++i)
-        if (!isfinite(v1->model[i]))
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_VOLUME_MODEL,
-                              "volume[0]: model[%d] is not finite", i);
-    if (!isfinite(v1->scalar_min) || !isfinite(v1->scalar_max))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_VOLUME_SCALAR,
-                          "volume[0]: scalar_min %g / scalar_max %g not finite",
-                          (double)v1->scalar_min, (double)v1->scalar_max);
+    if ((r = check_transfer(ctx, &v)) != VFX_OK)
+        return r;
     /* tet indices are checked once per revision: the renderer trusts them */
     const vfx_volume_view *old = &s->view;
     if (v1->revision != s->revision || v1->tets != old->tets || v1->scalar != old->scalar ||

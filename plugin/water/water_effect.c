@@ -14,6 +14,7 @@
 
 #include "water_internal.h"
 #include "water_params.h"
+#include "param_ranges.h"
 
 
 static void groups_free(vfx_context *ctx, water_state *s)
@@ -496,7 +497,16 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
             return VFX_ERR_OUT_OF_MEMORY;
         /* the seed's ratio h = 2 x spacing (0.61 at its 0.3); no spacing (one particle, all on
          * one point): the seed's 0.61 */
-        s->auto_h = d > 0 && isfinite(d) ? (float)(2.0 * d) : 0.61f;
+        double h = d > 0 && isfinite(d) ? 2.0 * d : 0.61;
+        /* particles spaced 1e-40 apart gave h = 2e-40 and drew nothing: below the row's end h^3
+         * is no normal float32 (the kernels underflow); refused, naming what was measured */
+        const volfx_range *hr = volfx_range_row(VFX_RANGE_WATER_H);
+        if (h < hr->lo)
+            return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
+                                 "water: the particles' spacing %g (the median nearest-neighbour distance of %u "
+                                 "particles) gives h %g, below vfx_water_params.h's %g: give h, or particles "
+                                 "spaced at least %g apart", d, scan.cand, h, hr->lo, hr->lo / 2);
+        s->auto_h = (float)h;
         s->auto_h_count = (uint32_t)total;
     }
     if ((kr = water_set_params(ctx, s, &res)))

@@ -265,7 +265,7 @@ static const bad_case bad_cases[] = {
     {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
      "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"solver\":\"sph\"}}}",
      VFX_ERR_INVALID_ARGUMENT, "water.simulation.solver: unknown value \"sph\"; expected one of \"wcsph\", \"pbf\""},
-    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"h\":0}}", VFX_ERR_INVALID_ARGUMENT, "water.h: must be > 0, got 0"},
+    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"h\":0}}", VFX_ERR_INVALID_ARGUMENT, "water.h: must be >= 1e-12, got 0"},
     {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"disable\":[\"pyramid\",\"magic\"]}}}",
      VFX_ERR_INVALID_ARGUMENT, "water.quality.disable[1]: unknown flag \"magic\""},
     {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"max_samples\":0}}}", VFX_ERR_INVALID_ARGUMENT,
@@ -284,9 +284,9 @@ static const bad_case bad_cases[] = {
      VFX_ERR_INVALID_ARGUMENT, "water.generator.radius: 1e-320 is 0 as float32"},
     {"{\"water\":{\"source\":\"generator\",\"generator\":{\"kind\":\"layers\",\"count\":10,\"spacing\":1e-320}}}",
      VFX_ERR_INVALID_ARGUMENT, "water.generator.spacing: 1e-320 is 0 as float32"},
-    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"h\":1e-320}}", VFX_ERR_INVALID_ARGUMENT, "water.h: 1e-320 is 0 as float32"},
+    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"h\":1e-320}}", VFX_ERR_INVALID_ARGUMENT, "water.h: must be >= 1e-12, got 9.99988867e-321"},
     {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"h\":1e-40}}", VFX_ERR_INVALID_ARGUMENT,
-     "water.h: 1e-40 is subnormal as float32"},
+     "water.h: must be >= 1e-12, got 1e-40"},
     {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"step\":1e-320}}}", VFX_ERR_INVALID_ARGUMENT,
      "water.quality.step: 1e-320 is 0 as float32"},
     {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
@@ -310,7 +310,7 @@ static const bad_case bad_cases[] = {
      "beams[0].surges.wavelength: must be 0 (8 x radius) or >= 1e-06, got 1e-07"},
     /* the advice names 0 only where the range takes it (h > 0 does not; amplitude >= 0 does) */
     {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"h\":-1e-40}}", VFX_ERR_INVALID_ARGUMENT,
-     "water.h: must be > 0, got -1e-40"},
+     "water.h: must be >= 1e-12, got -1e-40"},
     {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"threshold\":1e-40}}", VFX_ERR_INVALID_ARGUMENT,
      "below 1.17549435e-38): give a value of magnitude 1.17549435e-38 or more"},
     {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"

@@ -196,6 +196,33 @@ static void test_zero_params_recommended(void **state)
     free_host(&s);
 }
 
+/* Particles spaced 1e-40 apart measured h = 2e-40 and drew nothing (h^3 underflows float32):
+ * refused at update naming the spacing and h; spaced 1e-5 apart (h 2e-5) they are taken. */
+static void test_subnormal_spacing(void **state)
+{
+    (void)state;
+    host s = pool_host(6, 6, 2, 1e-40f);
+    session ss;
+    session_open(&ss, &s, POOL_CAM.width, POOL_CAM.height);
+    vfx_log_id id = VFX_LOG_ID_NONE;
+    assert_int_equal(ss.api.update(ss.ctx, 0.0, 0.0f), VFX_ERR_INVALID_ARGUMENT);
+    const char *e = ss.api.last_error(ss.ctx, &id);
+    print_message("spaced 1e-40: %s\n", e);
+    assert_non_null(strstr(e, "the particles' spacing 9.99995e-41"));
+    assert_non_null(strstr(e, "gives h 1.99999e-40, below vfx_water_params.h's 1e-12"));
+    assert_int_equal(id, VFX_LOG_ID_PARAM_RANGE);
+    session_close(&ss);
+    free_host(&s);
+    s = pool_host(6, 6, 2, 1e-5f);
+    session_open(&ss, &s, POOL_CAM.width, POOL_CAM.height);
+    assert_int_equal(ss.api.update(ss.ctx, 0.0, 0.0f), VFX_OK);
+    vfx_water_params z = {.type = VFX_TYPE_WATER_PARAMS}; /* h as measured by this update */
+    assert_int_equal(ss.api.resolve_defaults(ss.ctx, &z), VFX_OK);
+    assert_true(fabs(z.h - 2e-5) < 1e-9);
+    session_close(&ss);
+    free_host(&s);
+}
+
 /* Each preset resolves to what docs/water.md says it sets; the paper method is chosen by name;
  * an unknown preset is refused by name. The isotropic preset "low" against the float64
  * reference: hole rate 0 (its march is exact up to the reduced resolution's interpolation). */
@@ -465,6 +492,7 @@ int main(void)
     rt_gl_context *gl = test_gl_or_skip();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_zero_params_recommended),
+        cmocka_unit_test(test_subnormal_spacing),
         cmocka_unit_test(test_presets),
         cmocka_unit_test(test_step_and_loop_bounds),
         cmocka_unit_test(test_two_views),

@@ -23,7 +23,7 @@
 
 /* X(ID, ABI field, scene key or "-", lo, hi, flags, note): every vector component is checked. */
 #define VFX_RANGE_TABLE(X) \
-    X(WATER_H, "vfx_water_params.h", "water.h", 0, 1e3, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "0: 2 x the particles' spacing") \
+    X(WATER_H, "vfx_water_params.h", "water.h", 1e-12, 1e3, VFX_RANGE_ZERO, "0: 2 x the particles' spacing, refused below 1e-12 too (h^3 is a normal float32)") \
     X(WATER_THRESHOLD, "vfx_water_params.threshold", "water.threshold", 0, 1e3, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "") \
     X(WATER_MAX_SAMPLES, "vfx_water_params.max_samples", "water.quality.max_samples", 1, 4096, VFX_RANGE_INT | VFX_RANGE_ZERO, "a loop bound per pixel") \
     X(WATER_STEP, "vfx_water_params.step", "water.quality.step", 0, 1e3, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "and within [h/1024, h] once h is known") \
