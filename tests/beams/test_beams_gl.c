@@ -348,7 +348,7 @@ static void test_bad_input_and_absence(void **state)
     *beam0() = k_beam;
     beam0()->head[1] = NAN;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_true(test_last_error_is(g_app->api, g_app->ctx, VFX_LOG_ID_BEAM_FIELD, "beams[0]: beam head.y"));
+    assert_true(test_last_error_is(g_app->api, g_app->ctx, VFX_LOG_ID_PARAM_RANGE, "beams[0]: vfx_beam.head[1] nan outside"));
     *beam0() = k_beam;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
     assert_non_null(g_app->ctx->effect_state[VFX_EFFECT_BEAMS]);
@@ -659,7 +659,7 @@ static void test_bad_v2_input(void **state)
     use_v2(true, true, true);
     beam0()->falloff = 7;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
-    assert_true(test_last_error_is(g_app->api, g_app->ctx, VFX_LOG_ID_BEAM_FIELD, "beams[0]: falloff"));
+    assert_true(test_last_error_is(g_app->api, g_app->ctx, VFX_LOG_ID_PARAM_RANGE, "beams[0]: vfx_beam.falloff 7 outside"));
     use_v2(true, true, true);
     beam0()->flow_amount = 2.f;
     assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);

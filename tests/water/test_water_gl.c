@@ -495,7 +495,7 @@ static void test_unknown_method(void **state)
      * blamed on the anisotropic kernel) */
     s.kernel = 0;
     assert_int_equal(api.update(ctx, 0.0, 0.0f), VFX_ERR_INVALID_ARGUMENT);
-    assert_true(test_last_error_is(&api, ctx, VFX_LOG_ID_WATER_PARAM, "method 7 unknown"));
+    assert_true(test_last_error_is(&api, ctx, VFX_LOG_ID_PARAM_RANGE, "vfx_water_params.method 7 outside 3..4 or 0"));
     (void)fv;
     api.destroy(ctx);
     free_scene(&s);
