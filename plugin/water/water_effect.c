@@ -502,7 +502,7 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
          * is no normal float32 (the kernels underflow); refused, naming what was measured */
         const volfx_range *hr = volfx_range_row(VFX_RANGE_WATER_H);
         if (h < hr->lo)
-            return volfx_fail_id(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
+            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
                                  "water: the particles' spacing %g (the median nearest-neighbour distance of %u "
                                  "particles) gives h %g, below vfx_water_params.h's %g: give h, or particles "
                                  "spaced at least %g apart", d, scan.cand, h, hr->lo, hr->lo / 2);
