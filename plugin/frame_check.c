@@ -377,6 +377,8 @@ vfx_result volfx_frame_gate(vfx_context *ctx, const vfx_frame_view *frame, volfx
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_DEPTH, "render: frame view's vfx_frame_depth depth_convention "
                               "%u is none of VFX_DEPTH_STANDARD (0), VFX_DEPTH_ZERO_TO_ONE (1)",
                               (unsigned)fd->depth_convention);
+        if ((r = volfx_frame_depth_check_ranges(ctx, fd))) /* its rows (volfx_ranges.h) */
+            return r;
         if (fd->depth_renderbuffer && fd->depth_framebuffer)
             return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_FRAME_DEPTH, "render: frame view's vfx_frame_depth names both "
                               "depth_renderbuffer %u and depth_framebuffer %u: give one", fd->depth_renderbuffer,

@@ -251,3 +251,8 @@ vfx_result volfx_frame_view_check_ranges(vfx_context *ctx, const vfx_frame_view 
             return r;
     return VFX_OK;
 }
+
+vfx_result volfx_frame_depth_check_ranges(vfx_context *ctx, const vfx_frame_depth *d)
+{
+    return volfx_range_check(ctx, "render", VFX_RANGE_FRAME_DEPTH_CONVENTION, (double)d->depth_convention);
+}

@@ -43,5 +43,7 @@ vfx_result volfx_volume_view_check_ranges(vfx_context *ctx, const vfx_volume_vie
 /* The frame view's numbers, each against its row alone (the frame gate checks the relations:
  * near against proj, eye against view, the GL names). */
 vfx_result volfx_frame_view_check_ranges(vfx_context *ctx, const vfx_frame_view *v);
+/* A chained vfx_frame_depth's numbers against their rows. */
+vfx_result volfx_frame_depth_check_ranges(vfx_context *ctx, const vfx_frame_depth *d);
 
 #endif

@@ -16,6 +16,8 @@ OUTPUT_STRUCTS = {"vfx_stat", "vfx_stats", "vfx_light", "vfx_impact_event", "vfx
 
 def fields(header_text):
     out = set()
+    # an enum-typed member is a number too (vfx_struct_type is the typed header)
+    enums = set(re.findall(r"typedef enum \w+ \{.*?\} (\w+);", header_text, re.S)) - {"vfx_struct_type"}
     for m in re.finditer(r"typedef struct (\w+) \{(.*?)\n\} \1;", header_text, re.S):
         name, body = m.group(1), m.group(2)
         if name in OUTPUT_STRUCTS:
@@ -26,7 +28,7 @@ def fields(header_text):
             if not code or code.startswith("*") or "(" in code or "*" in code:
                 continue
             d = re.match(r"(?:const\s+)?(\w+)\s+(.*);$", code)
-            if not d or d.group(1) not in NUMERIC:
+            if not d or (d.group(1) not in NUMERIC and d.group(1) not in enums):
                 continue
             if re.search(r"/\*\s*out:", line):
                 continue

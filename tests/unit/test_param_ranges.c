@@ -102,7 +102,7 @@ static void test_every_row(void **state)
 /* Where each row's field lies: the row's field text must be the struct and member named here
  * (so a row cannot name a field that does not exist), and test_struct_walk sets the member in a
  * valid struct and calls the check the effect calls. Every row must be here. */
-enum { K_NONE, K_WATER, K_BEAM, K_BEAMS_VIEW, K_LAB_BEAMS, K_VOLUME, K_FRAME, K_OTHER };
+enum { K_NONE, K_WATER, K_BEAM, K_BEAMS_VIEW, K_LAB_BEAMS, K_VOLUME, K_FRAME, K_FRAME_DEPTH, K_OTHER };
 enum { T_F32 = 1, T_U32, T_F64, T_U64 };
 typedef struct fmap {
     int kind;
@@ -175,6 +175,10 @@ static const fmap MAP[VFX_RANGE_COUNT] = {
     MA_(FRAME_ORIGIN, K_FRAME, vfx_frame_view, origin) M_(FRAME_COLOR_HDR, K_FRAME, vfx_frame_view, color_hdr)
     M_(FRAME_ENVIRONMENT_CUBEMAP, K_FRAME, vfx_frame_view, environment_cubemap)
     M_(FRAME_VIEW_ID, K_FRAME, vfx_frame_view, view_id) M_(FRAME_LAYER_TEXTURE, K_FRAME, vfx_frame_view, layer_texture)
+    M_(FRAME_DEPTH_RENDERBUFFER, K_FRAME_DEPTH, vfx_frame_depth, depth_renderbuffer)
+    M_(FRAME_DEPTH_FRAMEBUFFER, K_FRAME_DEPTH, vfx_frame_depth, depth_framebuffer)
+    M_(FRAME_DEPTH_FLIP_Y, K_FRAME_DEPTH, vfx_frame_depth, flip_y)
+    M_(FRAME_DEPTH_CONVENTION, K_FRAME_DEPTH, vfx_frame_depth, depth_convention)
     M_(GL_STATE_SKIP_RESTORE, K_OTHER, vfx_gl_state_desc, skip_restore)
     M_(LIGHTS_CAPACITY, K_OTHER, vfx_lights, capacity)
     M_(IMPACT_EVENTS_CAPACITY, K_OTHER, vfx_impact_events, capacity)
@@ -188,6 +192,7 @@ typedef union any_struct {
     vfx_lab_beams lb;
     vfx_volume_view vv;
     vfx_frame_view fv;
+    vfx_frame_depth fd;
 } any_struct;
 
 static void baseline(int kind, any_struct *u)
@@ -231,6 +236,7 @@ static vfx_result run_check(vfx_context *c, int kind, any_struct *u)
     }
     case K_VOLUME: return volfx_volume_view_check_ranges(c, &u->vv);
     case K_FRAME: return volfx_frame_view_check_ranges(c, &u->fv);
+    case K_FRAME_DEPTH: return volfx_frame_depth_check_ranges(c, &u->fd);
     }
     return VFX_OK;
 }

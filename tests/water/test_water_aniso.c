@@ -512,11 +512,11 @@ static void test_host_columns(void **state)
     }
 }
 
-/* The log id of test_refused's case `what`: a number outside its range, an unknown kernel, a
- * particle's column value, the paper method asked for a kernel. */
+/* The log id of test_refused's case `what`: a number outside its range (an unknown kernel too:
+ * its row is 1..2 or 0), a particle's column value, the paper method asked for a kernel. */
 static vfx_log_id refused_id(int what)
 {
-    return what == 4 ? VFX_LOG_ID_WATER_PARAM : what == 6 || what == 7 ? VFX_LOG_ID_WATER_PARTICLE_VALUE
+    return what == 6 || what == 7 ? VFX_LOG_ID_WATER_PARTICLE_VALUE
            : what == 8 ? VFX_LOG_ID_WATER_METHOD : VFX_LOG_ID_PARAM_RANGE;
 }
 

@@ -264,7 +264,7 @@ static void test_presets(void **state)
     s.p.preset = 9;
     session_open(&ss, &s, POOL_CAM.width, POOL_CAM.height);
     assert_int_equal(session_frame(&ss, &POOL_CAM), VFX_ERR_INVALID_ARGUMENT);
-    assert_true(test_log_is(&s.log, VFX_LOG_ID_WATER_PARAM, "preset 9"));
+    assert_true(test_log_is(&s.log, VFX_LOG_ID_PARAM_RANGE, "vfx_water_params.preset 9 outside 1..4 or 0"));
     session_close(&ss);
     free_host(&s);
 }

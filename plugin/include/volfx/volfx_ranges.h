@@ -125,6 +125,10 @@
     X(FRAME_ENVIRONMENT_CUBEMAP, "vfx_frame_view.environment_cubemap", "-", 0, 0, VFX_RANGE_ANY, "a GL cubemap texture name") \
     X(FRAME_VIEW_ID, "vfx_frame_view.view_id", "-", 0, 0, VFX_RANGE_ANY, "any id") \
     X(FRAME_LAYER_TEXTURE, "vfx_frame_view.layer_texture", "-", 0, 0, VFX_RANGE_ANY, "a GL RGBA16F texture name, checked as one") \
+    X(FRAME_DEPTH_RENDERBUFFER, "vfx_frame_depth.depth_renderbuffer", "-", 0, 0, VFX_RANGE_ANY, "a GL renderbuffer name, checked as one") \
+    X(FRAME_DEPTH_FRAMEBUFFER, "vfx_frame_depth.depth_framebuffer", "-", 0, 0, VFX_RANGE_ANY, "a GL framebuffer name, checked as one; not with depth_renderbuffer") \
+    X(FRAME_DEPTH_FLIP_Y, "vfx_frame_depth.flip_y", "-", 0, 0, VFX_RANGE_ANY, "0 or nonzero") \
+    X(FRAME_DEPTH_CONVENTION, "vfx_frame_depth.depth_convention", "-", 0, 1, VFX_RANGE_INT, "0 standard, 1 zero to one") \
     X(GL_STATE_SKIP_RESTORE, "vfx_gl_state_desc.skip_restore", "-", 0, 0, VFX_RANGE_ANY, "0 or nonzero") \
     X(LIGHTS_CAPACITY, "vfx_lights.capacity", "-", 0, 0, VFX_RANGE_ANY, "entries at lights; the plugin writes at most this many") \
     X(IMPACT_EVENTS_CAPACITY, "vfx_impact_events.capacity", "-", 0, 0, VFX_RANGE_ANY, "entries at events; the plugin writes at most this many")
