@@ -365,6 +365,105 @@ static void test_lights(void **state)
     assert_true(test_last_error_is(&api, g_app->ctx, VFX_LOG_ID_STRUCT_TYPE, "vfx_lights has type 7"));
 }
 
+/* A head 0.5 R above the floor still strikes it: the hit is searched R past the head (a head
+ * within its radius of a surface touches it), and lands on the floor's plane within the hit's
+ * tolerance (test_hit_matches_reference). A march stopped at the head finds nothing. */
+static void test_head_near_floor_hits(void **state)
+{
+    (void)state;
+    const double R = 0.2, src[3] = {-0.4, 1.5, 0.2}, head[3] = {0.1, 0.5 * R, 0.2};
+    beam_entities(1)[0] = beam_from_to(src, head, (float)R);
+    assert_int_equal(game_app_frame(g_app, DT), VFX_OK);
+    float gpu[1][8];
+    assert_int_equal(volfx_beams_impact_debug_hits(volfx_beams_impact_of(g_app->ctx), gpu, 1), 1);
+    printf("head 0.5 R above the floor: hit %g at (%.4f %.4f %.4f)\n", gpu[0][3], gpu[0][0], gpu[0][1], gpu[0][2]);
+    assert_true(gpu[0][3] == 1.f);
+    assert_true(fabs(gpu[0][1]) < 2e-3);
+}
+
+/* A beam aimed at the sky (its head in the air, nothing within R past it) gives its body and head
+ * lights and no impact light: none at the origin, where an unset hit would put one. */
+static void test_sky_beam_no_impact_light(void **state)
+{
+    (void)state;
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
+    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, &g_app->host, &api), VFX_OK);
+    const double src[3] = {-0.5, 0.6, 0.2}, head[3] = {0.2, 2.5, 0.0};
+    beam_entities(1)[0] = beam_from_to(src, head, 0.2f);
+    for (int f = 0; f < 5; ++f) /* impacts are read back 1-3 frames late */
+        assert_int_equal(game_app_frame(g_app, DT), VFX_OK);
+    vfx_light l[8];
+    vfx_lights out = {.type = VFX_TYPE_LIGHTS, .capacity = 8, .lights = l};
+    assert_int_equal(api.get_lights(g_app->ctx, &out), VFX_OK);
+    assert_int_equal(out.total, 2);
+    for (uint32_t i = 0; i < out.count; ++i) {
+        assert_true(l[i].source != VFX_LIGHT_BEAM_IMPACT);
+        assert_false(l[i].p0[0] == 0 && l[i].p0[1] == 0 && l[i].p0[2] == 0);
+    }
+}
+
+/* Irradiance at distance d from the middle of a segment of length L (I per unit length), on a
+ * surface facing it: the integral of I cos(theta) / r^2 over the segment by 5-point
+ * Gauss-Legendre on 2,000 pieces, in double (independent of the plugin's closed form). */
+static double line_irradiance(double I, double L, double d)
+{
+    static const double x[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
+    static const double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
+                                0.2369268850561891};
+    const int pieces = 2000;
+    double e = 0, hp = L / pieces / 2;
+    for (int p = 0; p < pieces; ++p) {
+        double c = -L / 2 + (2 * p + 1) * hp;
+        for (int k = 0; k < 5; ++k) {
+            double s = c + hp * x[k], r2 = s * s + d * d;
+            e += w[k] * hp * I * (d / sqrt(r2)) / r2;
+        }
+    }
+    return e;
+}
+
+/* The lights' formulas against their contract, computed independently: a line light's intensity
+ * 3 x intensity x 2^exposure x b / 0.5 per unit length and a head's 4 x ... x a, both times the
+ * colour's largest channel (the colour divided by it); a line's radius is where its irradiance,
+ * facing the segment's middle, falls to 1/256 of that at 1 unit: at most 1/256 there (1e-6 of
+ * quadrature slack) and not far beyond it (above 1/256 x 0.99: the radius is the one asked, not
+ * a loose bound); a point's I / d^2 gives 16. Lengths 0.05 (point-like), 2.26 (the
+ * transition, where the former 16 sqrt(L / 2) fell 13% short) and 40 (line-like). */
+static void test_light_formulas(void **state)
+{
+    (void)state;
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
+    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, &g_app->host, &api), VFX_OK);
+    const double lens[3] = {0.05, 2.26, 40.0};
+    for (int c = 0; c < 3; ++c) {
+        const double src[3] = {-0.5, 1.2 + lens[c], 0.2}, head[3] = {-0.5, 1.2, 0.2};
+        vfx_beam *b = beam_entities(1);
+        b[0] = beam_from_to(src, head, 0.1f);
+        b[0].intensity = 2.f, b[0].exposure = 1.f, b[0].a = 0.3f, b[0].b = 0.4f;
+        b[0].color[0] = 0.5f, b[0].color[1] = 0.25f, b[0].color[2] = 0.1f;
+        assert_int_equal(game_app_frame(g_app, DT), VFX_OK);
+        vfx_light l[8];
+        vfx_lights out = {.type = VFX_TYPE_LIGHTS, .capacity = 8, .lights = l};
+        assert_int_equal(api.get_lights(g_app->ctx, &out), VFX_OK);
+        assert_true(out.count >= 2);
+        assert_int_equal(l[0].kind, VFX_LIGHT_LINE);
+        assert_int_equal(l[1].source, VFX_LIGHT_BEAM_HEAD);
+        double gain = 2.0 * 2.0, cmax = 0.5;
+        double want_line = 3.0 * gain * 0.4 / 0.5 * cmax, want_head = 4.0 * gain * 0.3 * cmax;
+        assert_true(fabs(l[0].intensity - want_line) <= 1e-6 * want_line);
+        assert_true(fabs(l[1].intensity - want_head) <= 1e-6 * want_head);
+        assert_true(fabsf(l[0].color[0] - 1.f) < 1e-6f && fabsf(l[0].color[1] - 0.5f) < 1e-6f
+                    && fabsf(l[0].color[2] - 0.2f) < 1e-6f);
+        double L = lens[c], I = l[0].intensity;
+        double ratio = line_irradiance(I, L, l[0].radius) / line_irradiance(I, L, 1.0);
+        printf("line light L %.2f: radius %.3f, irradiance there / at 1 unit = 1/%.1f\n", L, (double)l[0].radius,
+               1.0 / ratio);
+        assert_true(ratio <= (1.0 + 1e-6) / 256.0);
+        assert_true(ratio >= 0.99 / 256.0);
+        assert_true(l[1].radius == 16.f); /* I / 16^2 = (I / 1^2) / 256 */
+    }
+}
+
 /* The engine's own depth (tests/common/depth_modes.h): the same hit against the same float64
  * reference with the same bounds, the same non-hits, and sparks that stay above the floor, when
  * the plugin gets the host's depth in a renderbuffer, reversed-Z with an infinite far plane under
@@ -415,6 +514,9 @@ int main(void)
         cmocka_unit_test(test_sparks_stay_above_floor),
         cmocka_unit_test(test_counts_bounded),
         cmocka_unit_test(test_lights),
+        cmocka_unit_test(test_head_near_floor_hits),
+        cmocka_unit_test(test_sky_beam_no_impact_light),
+        cmocka_unit_test(test_light_formulas),
         cmocka_unit_test(test_own_depth_renderbuffer),
         cmocka_unit_test(test_own_depth_reversed_z),
         cmocka_unit_test(test_own_depth_flipped),
