@@ -403,6 +403,60 @@ static void test_refused(void **state)
     }
 }
 
+/* Bubble drag with drag x dt > 1 (drag 60, dt 0.05: 3) does not overshoot: the pull towards the
+ * fluid's velocity is at most the whole difference. After 12 steps of the moving slab the fluid
+ * is stopped (every velocity 0) and one step taken: every bubble then moves at the fluid's 0 plus
+ * the step's buoyancy, k_b |g| dt = 2 x 9.81 x 0.05 up, within 1e-4 (float32 sums of weights
+ * times 0; the buoyancy's rounding is 1e-7). An unclamped drag gives -2 v + buoyancy: the
+ * bubbles before the stop moved at up to 0.2 and more, checked, so it cannot pass. */
+static void test_bubble_drag_no_overshoot(void **state)
+{
+    (void)state;
+    host s = make_host(12, 6, 10, 0.2f);
+    s.p.drag = 60.0f;
+    session ss;
+    session_open(&ss, &s);
+    for (int f = 0; f < 12; ++f) session_frame(&ss, 1.0f / 60.0f);
+    uint32_t alive = 0;
+    assert_int_equal(volfx_water_debug_diffuse(ss.ctx, NULL, 0, NULL, 0, &alive), VFX_OK);
+    float *pool = malloc((size_t)(alive ? alive : 1) * 32);
+    assert_int_equal(volfx_water_debug_diffuse(ss.ctx, NULL, 0, pool, alive, &alive), VFX_OK);
+    uint32_t bubbles = 0;
+    double vmax = 0;
+    for (uint32_t i = 0; i < alive; ++i) {
+        const float *e = pool + 8 * (size_t)i;
+        if (e[7] != 2.f) continue;
+        ++bubbles;
+        vmax = fmax(vmax, sqrt((double)e[4] * e[4] + (double)e[5] * e[5] + (double)e[6] * e[6]));
+    }
+    free(pool);
+    print_message("bubble drag: %u bubbles moving at up to %.3f before the fluid stops\n", bubbles, vmax);
+    assert_true(bubbles > 0 && vmax > 0.2);
+    memset(s.vx, 0, s.n * sizeof(float));
+    memset(s.vy, 0, s.n * sizeof(float));
+    memset(s.vz, 0, s.n * sizeof(float));
+    const float dt = 0.05f;
+    session_frame(&ss, dt);
+    assert_int_equal(volfx_water_debug_diffuse(ss.ctx, NULL, 0, NULL, 0, &alive), VFX_OK);
+    pool = malloc((size_t)(alive ? alive : 1) * 32);
+    assert_int_equal(volfx_water_debug_diffuse(ss.ctx, NULL, 0, pool, alive, &alive), VFX_OK);
+    const double up = 2.0 * 9.81 * dt;
+    double worst = 0;
+    uint32_t after = 0;
+    for (uint32_t i = 0; i < alive; ++i) {
+        const float *e = pool + 8 * (size_t)i;
+        if (e[7] != 2.f) continue;
+        ++after;
+        worst = fmax(worst, fmax(fabs(e[4]), fmax(fabs(e[5] - up), fabs(e[6]))));
+    }
+    print_message("bubble drag: %u bubbles after the step, worst |v - buoyancy| %.2e\n", after, worst);
+    assert_true(after > 0);
+    assert_true(worst < 1e-4);
+    free(pool);
+    session_close(&ss);
+    free_host(&s);
+}
+
 int main(void)
 {
     rt_gl_context *gl = test_gl_or_skip();
@@ -411,6 +465,7 @@ int main(void)
         cmocka_unit_test(test_classification),
         cmocka_unit_test(test_repeat_and_cap),
         cmocka_unit_test(test_refused),
+        cmocka_unit_test(test_bubble_drag_no_overshoot),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     rt_gl_context_destroy(gl);
