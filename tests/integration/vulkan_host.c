@@ -830,6 +830,29 @@ static int compare(const result *vkr, const result *glr, uint32_t effects)
     return fail | !ok;
 }
 
+/* The comparison's self-test: a comparison that never fails passes any import. The GL result
+ * against itself must match, and against itself shifted `dx` pixels to the right (the left
+ * columns filled with the first one's) must not: a shift of 4 moves every edge of the scene and
+ * its effects by more than the 1% of covered pixels and the 1% of channels the tolerances allow. */
+static int compare_self_test(const result *glr, uint32_t effects, int dx)
+{
+    static result sh;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            int sx = x - dx < 0 ? 0 : x - dx;
+            memcpy(&sh.rgba[4 * (y * W + x)], &glr->rgba[4 * (y * W + sx)], 4);
+            for (int e = 0; e < VFX_EFFECT_COUNT; ++e)
+                sh.raw[e][y * W + x] = glr->raw[e][y * W + sx];
+        }
+    printf("self-test: GL against itself\n");
+    int same = compare(glr, glr, effects);
+    printf("self-test: GL against itself shifted %d px (must mismatch)\n", dx);
+    int shifted = compare(&sh, glr, effects);
+    bool ok = same == 0 && shifted != 0;
+    printf("self-test of the comparison: %s\n", ok ? "ok" : "FAILED (a shifted image passed, or an identical one failed)");
+    return ok ? 0 : 1;
+}
+
 static void write_ppm(const char *prefix, const char *which, const unsigned char *rgba)
 {
     char path[512];
@@ -859,6 +882,7 @@ static int run(vfx_plugin_api *api, vfx_context_desc *host, game *g, vk *v, gl_s
         goto out;
     glGetTextureImage(gs->t.out, 0, GL_RGBA, GL_UNSIGNED_BYTE, sizeof glr->rgba, glr->rgba);
     rc = compare(vkr, glr, api->effects_built);
+    rc |= compare_self_test(glr, api->effects_built, 4);
 out:
     api->destroy(cv);
     api->destroy(cg);
