@@ -766,12 +766,140 @@ static void test_frame_depth_fields(void **state)
     api->destroy(ctx);
 }
 
+/* docs/integration.md "Conventions", colour and alpha: the beams (additive, alpha 0) into a linear
+ * RGBA16F target and into a GL_SRGB8_ALPHA8 one, both cleared to black with alpha 0.5. The sRGB
+ * target holds the linear target's radiance encoded (the plugin turns GL_FRAMEBUFFER_SRGB on for
+ * the frame and the host's off comes back): |byte/255 - srgb(L)| <= 1/255 (the byte's rounding,
+ * twice: the beams' blend reads the stored byte back, decodes, adds and encodes again; measured
+ * 0.64/255 at most on llvmpipe) + 12.92 x 2^-11 L (RGBA16F's rounding of L, times the encoding's
+ * largest slope); destination
+ * alpha stays 0.5 in both. A plugin that wrote linear values into the sRGB target, or alpha 1,
+ * fails. */
+static double srgb_encode(double l)
+{
+    l = l < 0 ? 0 : l > 1 ? 1 : l;
+    return l <= 0.0031308 ? 12.92 * l : 1.055 * pow(l, 1 / 2.4) - 0.055;
+}
+
+static void test_conventions_colour_alpha(void **state)
+{
+    (void)state;
+    test_log log = {0};
+    vfx_context_desc host = beams_host(&log);
+    const vfx_plugin_api *api = plugin_api();
+    vfx_context *ctx;
+    assert_int_equal(api->create(&host, &ctx), VFX_OK);
+    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_OK);
+    fixture f;
+    make_fixture(&f);
+    GLuint tex[2], fbo[2];
+    const GLenum fmt[2] = {GL_RGBA16F, GL_SRGB8_ALPHA8};
+    glCreateTextures(GL_TEXTURE_2D, 2, tex);
+    glCreateFramebuffers(2, fbo);
+    static float px[2][W * H * 4];
+    for (int k = 0; k < 2; ++k) {
+        glTextureStorage2D(tex[k], 1, fmt[k], W, H);
+        glNamedFramebufferTexture(fbo[k], GL_COLOR_ATTACHMENT0, tex[k], 0);
+        const float clear[4] = {0, 0, 0, 0.5f};
+        glClearNamedFramebufferfv(fbo[k], GL_COLOR, 0, clear);
+        vfx_frame_view v = f.fv;
+        v.framebuffer = fbo[k];
+        glDisable(GL_FRAMEBUFFER_SRGB);
+        expect(api, ctx, &v, VFX_OK, NULL);
+        assert_false(glIsEnabled(GL_FRAMEBUFFER_SRGB)); /* the host's state back */
+        if (k == 0)
+            glGetTextureImage(tex[k], 0, GL_RGBA, GL_FLOAT, (GLsizei)sizeof px[k], px[k]);
+    }
+    static uint8_t enc[W * H * 4];
+    glGetTextureImage(tex[1], 0, GL_RGBA, GL_UNSIGNED_BYTE, (GLsizei)sizeof enc, enc);
+    int lit = 0;
+    double worst = 0;
+    for (int q = 0; q < W * H; ++q) {
+        assert_true(fabs(px[0][4 * q + 3] - 0.5) <= 1e-3); /* RGBA16F's 0.5 is exact; nothing written */
+        assert_true(abs((int)enc[4 * q + 3] - 128) <= 1);  /* 0.5 in 8 bits: 127.5 rounded */
+        for (int c = 0; c < 3; ++c) {
+            double l = px[0][4 * q + c], want = srgb_encode(l), got = enc[4 * q + c] / 255.0;
+            double tol = 1.0 / 255 + 12.92 * 0x1p-11 * fmin(l, 1.0) + 1e-6;
+            worst = fmax(worst, fabs(got - want) / tol);
+            if (fabs(got - want) > tol)
+                fail_msg("pixel %d channel %d: linear %.6g, sRGB byte %u (%.6g), want %.6g (linear as is %.6g)", q, c,
+                         l, enc[4 * q + c], got, want, fmin(l, 1.0));
+            lit += c == 0 && l > 0.05;
+        }
+    }
+    print_message("sRGB target vs linear: %d lit pixels, largest error/bound %.3g\n", lit, worst);
+    assert_true(lit > 20); /* the beam is in view */
+    glDeleteFramebuffers(2, fbo);
+    glDeleteTextures(2, tex);
+    free_fixture(&f);
+    api->destroy(ctx);
+}
+
+/* docs/integration.md "Conventions", destination alpha of the water: a particle lattice drawn into an
+ * RGBA16F target cleared with alpha 0.5: alpha 1 exactly where the water is (read_raw's distance
+ * >= 0: it replaces), 0.5 untouched elsewhere. */
+static vfx_result lattice_particles(void *user, uint32_t c, vfx_particle_view *out)
+{
+    static float x[216], y[216], z[216];
+    (void)user, (void)c;
+    for (int i = 0; i < 216; ++i) /* a 6x6x6 lattice of spacing 0.2 around the origin */
+        x[i] = 0.2f * (float)(i % 6) - 0.5f, y[i] = 0.2f * (float)(i / 6 % 6) - 0.5f, z[i] = 0.2f * (float)(i / 36) - 0.5f;
+    *out = (vfx_particle_view){.type = VFX_TYPE_PARTICLE_VIEW, .count = 216, .pos = {x, y, z}};
+    return VFX_OK;
+}
+
+static void test_conventions_water_alpha(void **state)
+{
+    (void)state;
+    test_log log = {0};
+    vfx_context_desc host = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = &log,
+                             .log = test_vfx_log_fn, .particle_chunk_count = one_chunk,
+                             .particle_chunk = lattice_particles};
+    const vfx_plugin_api *api = plugin_api();
+    if (!(api->effects_built & VFX_EFFECT_BIT(VFX_EFFECT_WATER)))
+        skip();
+    vfx_context *ctx;
+    assert_int_equal(api->create(&host, &ctx), VFX_OK);
+    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_OK);
+    fixture f;
+    make_fixture(&f);
+    GLuint tex, fbo;
+    glCreateTextures(GL_TEXTURE_2D, 1, &tex);
+    glTextureStorage2D(tex, 1, GL_RGBA16F, W, H);
+    glCreateFramebuffers(1, &fbo);
+    glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, tex, 0);
+    const float clear[4] = {0.2f, 0.2f, 0.2f, 0.5f};
+    glClearNamedFramebufferfv(fbo, GL_COLOR, 0, clear);
+    vfx_frame_view v = f.fv;
+    v.framebuffer = fbo;
+    expect(api, ctx, &v, VFX_OK, NULL);
+    static float px[W * H * 4], dist[W * H];
+    glGetTextureImage(tex, 0, GL_RGBA, GL_FLOAT, (GLsizei)sizeof px, px);
+    assert_int_equal(api->read_raw(ctx, VFX_EFFECT_WATER, dist, W * H), VFX_OK);
+    int water = 0;
+    for (int j = 0; j < H; ++j)
+        for (int i = 0; i < W; ++i) {
+            float a = px[4 * ((H - 1 - j) * W + i) + 3]; /* read_raw is top row first, GL bottom first */
+            bool wet = dist[j * W + i] >= 0;
+            water += wet;
+            assert_true(a == (wet ? 1.0f : 0.5f));
+        }
+    print_message("water destination alpha: %d water pixels at 1, the rest 0.5\n", water);
+    assert_true(water > 40);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteTextures(1, &tex);
+    free_fixture(&f);
+    api->destroy(ctx);
+}
+
 int main(void)
 {
     g_gl = test_gl_or_skip();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_frame_fields),
         cmocka_unit_test(test_frame_depth_fields),
+        cmocka_unit_test(test_conventions_colour_alpha),
+        cmocka_unit_test(test_conventions_water_alpha),
         cmocka_unit_test(test_nothing_drawn),
         cmocka_unit_test(test_callback_pairs),
         cmocka_unit_test(test_unknown_water_params_version),

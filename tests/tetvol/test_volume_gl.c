@@ -17,6 +17,7 @@
 #include "demo_scene.h"
 #include "tet_testmesh.h"
 #include "debug.h"
+#include "depth_modes.h"
 #include "scene/scene.h"
 #include "test_camera.h"
 #include "test_util.h"
@@ -120,9 +121,10 @@ static void test_matches_renderer(void **state)
     free(gpu), free(cpu);
 }
 
-static void test_hidden_by_depth(void **state)
+/* The wall clips the volume with the host's depth given in `mode` (tests/common/depth_modes.h). */
+static void hidden_by_depth_in(int mode)
 {
-    (void)state;
+    depth_mode_set(g_app, mode);
     /* a wall in front of the whole volume, covering everything left of x = 0.1 */
     float *open = render_alpha();
     rt_entity e;
@@ -169,6 +171,26 @@ static void test_hidden_by_depth(void **state)
     /* the wall is gone: two frames bring the open image back */
     free(render_alpha());
     free(render_alpha());
+    depth_mode_set(g_app, DEPTH_STANDARD);
+}
+
+static void test_hidden_by_depth(void **state)
+{
+    (void)state;
+    hidden_by_depth_in(DEPTH_STANDARD);
+}
+
+/* The same clip, exactly (nothing behind the wall, the rest untouched to 1e-6, one frame late),
+ * when the depth comes in a renderbuffer, reversed-Z with an infinite far plane under
+ * GL_ZERO_TO_ONE, with flipped rows (the wall spans every row: a lost flip shows in the image's
+ * rows, not here), with an infinite far plane, and all at once. */
+static void test_hidden_by_depth_modes(void **state)
+{
+    (void)state;
+    for (size_t m = 0; m < DEPTH_MODES_COUNT; ++m) {
+        printf("depth mode %s: ", depth_modes_all[m].name);
+        hidden_by_depth_in(depth_modes_all[m].mode);
+    }
 }
 
 static void test_bad_view_and_absence(void **state)
@@ -431,6 +453,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_matches_renderer),
         cmocka_unit_test(test_hidden_by_depth),
+        cmocka_unit_test(test_hidden_by_depth_modes),
         cmocka_unit_test(test_bad_view_and_absence),
         cmocka_unit_test(test_skip_when_unchanged),
         cmocka_unit_test(test_view2_breakpoints),
