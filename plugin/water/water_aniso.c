@@ -395,6 +395,23 @@ vfx_result volfx_water_aniso_grid_build(vfx_context *ctx, volfx_water_aniso *a, 
     return VFX_OK;
 }
 
+/* One invocation a particle (groups of 64, rows of at most 65535 groups) of the bound program,
+ * then the barrier, the end of the open pass's timer and the GL error check (`what` names the
+ * pass in the message). */
+static vfx_result particle_dispatch_end(vfx_context *ctx, uint32_t count, const char *what)
+{
+    GLuint groups = (count + 63u) / 64u;
+    GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
+    if (groups)
+        glDispatchCompute(gx, gy, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    volfx_gpu_pass_end(ctx);
+    const char *e = volfx_gpu_error_string();
+    if (e)
+        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR, "water aniso %s over %u particles: %s", what, count, e);
+    return VFX_OK;
+}
+
 /* The half rate's other upload: the centres to the new positions, the shapes (and the neighbour
  * counts the spray reads) kept from the last full pass. */
 static vfx_result centre_pass(vfx_context *ctx, volfx_water_aniso *a, const volfx_water_aniso_input *in)
@@ -403,19 +420,12 @@ static vfx_result centre_pass(vfx_context *ctx, volfx_water_aniso *a, const volf
     if (!prog)
         return VFX_ERR_GL;
     bind_all(a, in);
-    GLuint groups = (in->count + 63u) / 64u;
-    GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
     volfx_gpu_pass_begin(ctx, "water.aniso_centre");
     glUseProgram(prog);
     glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_count"), in->count);
-    if (groups)
-        glDispatchCompute(gx, gy, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    volfx_gpu_pass_end(ctx);
-    const char *e = volfx_gpu_error_string();
-    if (e)
-        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR,
-                          "water aniso centre pass over %u particles: %s", in->count, e);
+    vfx_result r = particle_dispatch_end(ctx, in->count, "centre pass");
+    if (r)
+        return r;
     a->shape_fresh = false;
     a->done_rev = in->data_rev;
     volfx_stat_set(ctx, "water.aniso_half_skipped", 1);
@@ -426,8 +436,9 @@ vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, con
 {
     const volfx_water_kernel_params *kp = in->kp;
     bool aniso = kp->kernel == VFX_WATER_KERNEL_ANISOTROPIC && !a->has_kernel;
-    if (a->done && a->done_rev == in->data_rev && in->data_rev && a->done_count == in->count && a->done_h == in->h &&
-        !memcmp(&a->done_kp, kp, sizeof *kp) && a->done_radius == a->has_radius && a->done_kernel == a->has_kernel) {
+    bool same_setup = a->done && a->done_count == in->count && a->done_h == in->h && !memcmp(&a->done_kp, kp, sizeof *kp) &&
+                      a->done_radius == a->has_radius && a->done_kernel == a->has_kernel;
+    if (same_setup && in->data_rev && a->done_rev == in->data_rev) {
         volfx_stat_set(ctx, "water.aniso_skipped", 1);
         return VFX_OK;
     }
@@ -435,8 +446,6 @@ vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, con
     vfx_result r = ensure_buffers(ctx, a, in);
     if (r)
         return r;
-    bool same_setup = a->done && a->done_count == in->count && a->done_h == in->h && !memcmp(&a->done_kp, kp, sizeof *kp) &&
-                      a->done_radius == a->has_radius && a->done_kernel == a->has_kernel;
     if (in->half_rate && aniso && a->searched && a->shape_fresh && same_setup && kp->smoothing == 0)
         return centre_pass(ctx, a, in);
     volfx_stat_set(ctx, "water.aniso_half_skipped", 0);
@@ -446,8 +455,6 @@ vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, con
         return VFX_ERR_GL;
     bind_all(a, in);
     float cs = kp->radius * in->h;
-    GLuint groups = (in->count + 63u) / 64u;
-    GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
     volfx_gpu_pass_begin(ctx, "water.aniso");
     if (aniso && (r = grid_steps(ctx, a, in))) {
         volfx_gpu_pass_end(ctx);
@@ -458,14 +465,8 @@ vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, con
     glUniform1i(volfx_gpu_uniform(ctx, kern, "u_radius"), a->has_radius);
     glUniform1i(volfx_gpu_uniform(ctx, kern, "u_host"), a->has_kernel);
     glUniform1i(volfx_gpu_uniform(ctx, kern, "u_aniso"), aniso);
-    if (groups)
-        glDispatchCompute(gx, gy, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    volfx_gpu_pass_end(ctx);
-    const char *e = volfx_gpu_error_string();
-    if (e)
-        return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR,
-                          "water aniso pass over %u particles: %s", in->count, e);
+    if ((r = particle_dispatch_end(ctx, in->count, "pass")))
+        return r;
     a->done = true;
     a->done_rev = in->data_rev;
     a->done_count = in->count;
