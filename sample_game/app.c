@@ -474,10 +474,14 @@ vfx_result game_app_frame(game_app *app, float dt)
     t0 = rt_now_ms();
     if ((r = rt_world_run_phase(app->world, RT_PHASE_RENDER, app->time, dt)))
         return r;
+    double c0 = rt_thread_cpu_ms();
     if ((r = app->api->render(app->ctx, &frame))) {
         rt_logf(&app->log, VFX_LOG_ERROR, "plugin render: %s", app->api->last_error(app->ctx, NULL));
         return r;
     }
+    /* plugin.render: wall time of the call (with the render phase); plugin.render_thread_cpu:
+     * the render call's CPU time on this thread (all of llvmpipe's work under LP_NUM_THREADS=0) */
+    rt_profiler_cpu(app->profiler, "plugin.render_thread_cpu", rt_thread_cpu_ms() - c0);
     rt_profiler_cpu(app->profiler, "plugin.render", rt_now_ms() - t0);
     if (app->desc.effects_layer) /* the host's own composite: out = layer.rgb + out (1 - layer.a) */
         rt_renderer_composite_layer(app->renderer);

@@ -513,7 +513,8 @@ void game_demo_toggle(game_app *app, game_demo *demo, vfx_effect_kind kind)
 
 void game_demo_print_profile(game_app *app, FILE *out)
 {
-    static const char *series[] = {"vfx.sim.sph", "plugin.update", "host.scene", "plugin.render"};
+    static const char *series[] = {"vfx.sim.sph", "plugin.update", "host.scene", "plugin.render",
+                                   "plugin.render_thread_cpu"};
     static const char *sim[] = {"sim.steps", "sim.iterations", "sim.realtime_factor", "sim.max_speed",
                                 "sim.density_error"};
     fprintf(out, "cpu ms (median):");

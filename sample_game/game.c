@@ -43,7 +43,7 @@ static void usage(void)
          "                  [--program-cache DIR] [--gpu-particles] [--effects-layer]\n"
          "                  [--shots N,N,...] [--shot-variants]\n"
          "--shots writes STEM-fN.png (STEM: --png without .png) after frame N, up to 16 frames; with\n"
-         "--shot-variants the last frame's shot is drawn again (no time passes) with the beams off\n"
+         "--shot-variants the last frame's shot is drawn again (no time passes) as it is (-again), with the beams off\n"
          "(-nobeams), the water hidden (-hidewater) and both (-nobeams-hidewater), and the water's raw\n"
          "distance is written to STEM-fN-water.pfm: what scripts/water-look.py measures. (Only the\n"
          "last: switching the beams off and on restarts their growth, hiding the water drops its foam.)\n"
@@ -164,9 +164,12 @@ static vfx_result take_shot(game_app *app, game_demo *demo, const game_options *
         if ((r = game_app_dump_raw(app, VFX_EFFECT_WATER, path)))
             return r;
     }
-    static const struct { bool hide_water, no_beams; const char *suffix; } variants[3] = {
-        {false, true, "-nobeams"}, {true, false, "-hidewater"}, {true, true, "-nobeams-hidewater"}};
-    for (int k = 0; k < 3 && !r; ++k) {
+    /* -again: the shot drawn again with nothing toggled, so that the variants are compared with
+     * a frame drawn the same way (dt 0: no diffuse generation, a full anisotropic pass), not with
+     * the frame of the running simulation */
+    static const struct { bool hide_water, no_beams; const char *suffix; } variants[4] = {
+        {false, false, "-again"}, {false, true, "-nobeams"}, {true, false, "-hidewater"}, {true, true, "-nobeams-hidewater"}};
+    for (int k = 0; k < 4 && !r; ++k) {
         if (variants[k].hide_water && water) game_demo_toggle(app, demo, VFX_EFFECT_WATER);
         if (variants[k].no_beams && beams) game_demo_toggle(app, demo, VFX_EFFECT_BEAMS);
         game_demo_animate(app, demo, 0.f);

@@ -1,18 +1,27 @@
 #!/bin/sh
-# bench-water-look-cost.sh — the default scene's plugin.render CPU ms per frame (volfx-game's
-# median over the frames after 5 warm-up ones) with two plugin builds, interleaved, ROUNDS
-# rounds; prints one line a run and the median per build. The same host binary draws both.
-# usage: scripts/bench-water-look-cost.sh GAME BEFORE.so AFTER.so [ROUNDS] [FRAMES] [SCENE]
+# bench-water-look-cost.sh — the default scene's plugin.render cost per frame with two builds,
+# each its own game and plugin (an ABI change means one host cannot load both), interleaved,
+# ROUNDS rounds; prints one line a run and the median per build. LP_NUM_THREADS=0: llvmpipe works
+# on the calling thread, so plugin.render_thread_cpu (the render call's CPU time on that thread;
+# a game without it: plugin.render, wall time) measures the plugin's CPU cost under any load.
+# Each game prints the median over the frames after its 5 warm-up ones.
+# usage: scripts/bench-water-look-cost.sh BEFORE_GAME AFTER_GAME [ROUNDS] [FRAMES] [BEFORE_SCENE] [AFTER_SCENE]
+#   (the scenes default to each build's own sample_game/scenes/default.json, found beside its game)
 set -eu
-game=$1 before=$2 after=$3 rounds=${4:-3} frames=${5:-16} scene=${6:-sample_game/scenes/default.json}
+before=$1 after=$2 rounds=${3:-3} frames=${4:-12}
+scene_of() { echo "$(dirname "$1")/../../sample_game/scenes/default.json"; }
+bscene=${5:-$(scene_of "$before")} ascene=${6:-$(scene_of "$after")}
 out=$(mktemp -d)
 for r in $(seq "$rounds"); do
     for which in before after; do
-        so=$before; [ "$which" = after ] && so=$after
-        ms=$("$game" --headless --scene "$scene" --frames "$frames" --size 640x360 --png "$out/x.png" \
-             --progress 0 --plugin "$so" 2>/dev/null | sed -n 's/.*plugin.render \([0-9.]*\).*/\1/p')
-        echo "round $r $which plugin.render $ms"
-        echo "$ms" >> "$out/$which"
+        game=$before scene=$bscene
+        [ "$which" = after ] && game=$after scene=$ascene
+        line=$(LP_NUM_THREADS=0 "$game" --headless --scene "$scene" --frames "$frames" --size 640x360 \
+               --png "$out/x.png" --progress 0 2>/dev/null | grep '^cpu ms')
+        wall=$(echo "$line" | sed -n 's/.*plugin.render \([0-9.]*\).*/\1/p')
+        cpu=$(echo "$line" | sed -n 's/.*plugin.render_thread_cpu \([0-9.]*\).*/\1/p')
+        echo "round $r $which plugin.render wall $wall thread_cpu ${cpu:-none}"
+        echo "${cpu:-$wall}" >> "$out/$which"
     done
 done
 for which in before after; do

@@ -2,8 +2,8 @@
 """water-look.py — how much the water changes the image, and what it adds to the beams' light.
 
 Renders a scene at a frame with volfx-game (one run: `--shots F --shot-variants` draws the last
-frame again, no time passing, with the water hidden, the beams off and both; the same pixels as
-separate runs with `--hide-water` / `--no-beams`) and reports, over the water's surface (the
+frame again, no time passing, as it is, with the water hidden, the beams off and both; the same
+pixels as separate runs with `--hide-water` / `--no-beams`) and reports, over the water's surface (the
 pixels where the water's raw distance dump hits, and the 8x8 blocks more than half covered):
 
   change  the median over the surface's 8x8 blocks of the block-mean colour change the water
@@ -12,13 +12,16 @@ pixels where the water's raw distance dump hits, and the 8x8 blocks more than ha
           reflection and light.
   beams   the 95th percentile over the surface's pixels of [the beams' luminance change with the
           water shown] - [the same with it hidden] (Rec. 709 luminance of the sRGB values): the
-          light the water adds to the beams (reflected, lit). 0 in a scene without beams.
+          light the water adds to the beams (reflected, lit), every image of it drawn at the same
+          instant with dt 0 (-again, -nobeams, ...). 0 in a scene without beams.
 
   --zero-params  the scene with its water's colour, absorption, ior and diffuse block removed:
                  zero-filled water parameters, the plugin's defaults.
 
 usage: scripts/water-look.py [--game build/sample_game/volfx-game] [--plugin PATH] [--size 640x360]
-       [--zero-params] [--keep DIR] [--panels N,N,...] SCENE.json FRAME [FRAME...]
+       [--zero-params] [--keep DIR] [--panels N,N,...] [--panel-image OUT.png] SCENE.json FRAME [FRAME...]
+--panel-image writes the images of the --panels frames and the measured frames, half size, three
+a row, each labelled with its frame (the panels of docs/water.md).
 Prints one line a frame: scene, frame, change, beams, surface pixels, blocks. Needs numpy, PIL
 (Debian: python3-numpy python3-pil; run with /usr/bin/python3).
 """
@@ -30,7 +33,7 @@ import sys
 import tempfile
 
 import numpy as np
-from PIL import Image
+from PIL import Image, ImageDraw
 
 BLOCK = 8
 
@@ -71,7 +74,10 @@ def measure(stem, frame):
     res = {'pixels': int(hit.sum()), 'blocks': int(blocks.sum()),
            'change': float(np.median(change[blocks])) if blocks.any() else 0.0, 'beams': 0.0}
     if os.path.exists(base + '-nobeams.png') and hit.any():
-        d_shown = luminance(shown) - luminance(load(base + '-nobeams.png'))
+        # the beams' change between frames drawn alike (the variants are drawn again at dt 0); a
+        # game without the -again variant compares with the frame as first drawn
+        again = load(base + '-again.png') if os.path.exists(base + '-again.png') else shown
+        d_shown = luminance(again) - luminance(load(base + '-nobeams.png'))
         d_hidden = luminance(hidden) - luminance(load(base + '-nobeams-hidewater.png'))
         res['beams'] = float(np.percentile((d_shown - d_hidden)[hit], 95))
     return res
@@ -102,6 +108,7 @@ def main():
     ap.add_argument('--zero-params', action='store_true')
     ap.add_argument('--keep', help='write the images here (default: a temporary folder)')
     ap.add_argument('--panels', default='', help='also write the images of these frames (N,N,...) on the way: STEM-fN.png')
+    ap.add_argument('--panel-image', help='compose the --panels frames and the measured frames into this PNG')
     a = ap.parse_args()
     out = a.keep or tempfile.mkdtemp(prefix='water-look-')
     os.makedirs(out, exist_ok=True)
@@ -112,6 +119,24 @@ def main():
     finally:
         if scene != a.scene:
             os.remove(scene)
+    if a.panel_image:
+        frames = sorted({int(f) for f in a.panels.split(',') if f} | set(a.frames))
+        compose_panels([(f, os.path.join(out, f'{name}-f{f}.png')) for f in frames], a.panel_image)
+
+
+def compose_panels(shots, path, per_row=3):
+    """The shots (frame, png) at half size, per_row a row, each labelled 'frame N'."""
+    imgs = [(f, Image.open(p).convert('RGB')) for f, p in shots]
+    w, h = imgs[0][1].width // 2, imgs[0][1].height // 2
+    rows = (len(imgs) + per_row - 1) // per_row
+    sheet = Image.new('RGB', (w * min(per_row, len(imgs)), h * rows), (0, 0, 0))
+    draw = ImageDraw.Draw(sheet)
+    for k, (f, im) in enumerate(imgs):
+        x, y = (k % per_row) * w, (k // per_row) * h
+        sheet.paste(im.resize((w, h), Image.LANCZOS), (x, y))
+        draw.rectangle([x, y, x + 64, y + 14], fill=(0, 0, 0))
+        draw.text((x + 4, y + 2), f'frame {f}', fill=(255, 255, 255))
+    sheet.save(path)
 
 
 def run_frames(a, scene, name, out):

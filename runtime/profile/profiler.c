@@ -54,6 +54,13 @@ struct rt_profiler {
     double sum_ms, tail_max;
 };
 
+double rt_thread_cpu_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
 double rt_now_ms(void)
 {
     struct timespec ts;

@@ -71,5 +71,8 @@ typedef struct rt_frame_pcts {
 rt_frame_pcts rt_frame_percentiles(double *v, uint32_t n);
 /* Monotonic clock in ms. */
 double rt_now_ms(void);
+/* The calling thread's CPU time in ms (CLOCK_THREAD_CPUTIME_ID): with LP_NUM_THREADS=0 llvmpipe
+ * does its work on the calling thread, so a call's CPU cost, whatever else loads the machine. */
+double rt_thread_cpu_ms(void);
 
 #endif
