@@ -796,7 +796,8 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
      * lights are the beams': none when the beams are not drawn) */
     bool beams = targets->beams_light && targets->beams_behind;
     uint32_t nlights = 0;
-    if (beams && !(p->disable & VFX_WATER_NO_SHADING) && (r = volfx_water_lights_frame(ctx, &s->effect_lights, &nlights)))
+    if (beams && (s->look & WATER_LOOK_FX_LIGHTS) && !(p->disable & VFX_WATER_NO_SHADING) &&
+        (r = volfx_water_lights_frame(ctx, &s->effect_lights, &nlights)))
         return r;
     GLuint shade = nlights ? volfx_gpu_program(ctx, "common/fullscreen.vert", "water/shade.frag",
                                                "#define WATER_BEAMS 1\n#define WATER_EFFECT_LIGHTS 1\n"
