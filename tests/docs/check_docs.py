@@ -13,14 +13,11 @@ DIARY = re.compile(r"\b(issues?|rounds?|stops?|superseded|state of the work)\b|\
 # Pages that do not meet a rule yet, each named with the rule it misses; take a page out once it
 # meets it (the test then holds it there). Their links are checked like every page's.
 OVER_LENGTH = {
-    "docs/water.md",        # 925 lines: to be split into topic pages like simulation-*.md
-    "docs/integration.md",  # 603 lines
-    "docs/robustness.md",   # 401 lines
+    "docs/water.md",        # 928 lines: to be split into topic pages like simulation-*.md
+    "docs/integration.md",  # 673 lines
+    "docs/robustness.md",   # 436 lines
 }
-DIARY_HEADINGS = {
-    "docs/water.md",       # "state of the work", issues 4, 14 and 24, years in headings
-    "docs/robustness.md",  # issues 18 and 28
-}
+DIARY_HEADINGS = set()  # every page's headings meet the rule now
 LINK = re.compile(r"!?\[[^\]]*\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)")
 
 
