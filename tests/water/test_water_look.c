@@ -264,6 +264,103 @@ static void test_fresnel_grazing(void **state)
     assert_true(lum[1] > 5.0 * lum[0]);
 }
 
+/* SSR: a bright red wall (x in [-2, 2], y in [0, 2]) stands behind a clear pool, in the host's
+ * colour and depth (window depth of each pixel's ray meeting the plane z = -4.5; black and far
+ * elsewhere), seen at a grazing view. With SSR the reflected rays find the wall (water.ssr_hits)
+ * and the water pixels that reflect it move towards red: the mean of red - blue over the water
+ * pixels rises by more than 0.05 against the same frame with VFX_WATER_NO_SSR, which sees only
+ * the procedural sky there (measured 0.06 -> 0.23, 436 hits). An SSR that never hits, or reads
+ * the wrong channels (planted: .bgr, -0.15), fails it. What it does not catch: a false hit under
+ * a floating object's edge (an inverted depth comparison passes here, redder still). */
+static void test_ssr_reflects_host(void **state)
+{
+    (void)state;
+    const ref_camera cam = {{0.0, 0.9, 6.0}, {0, 0, 0}, {0, 1, 0}, 0.5, 64, 48, 0.1, 100};
+    const uint32_t w = cam.width, h = cam.height;
+    const size_t n = (size_t)w * h;
+    float *col = malloc(n * 16), *dep = malloc(n * 4);
+    double fwd[3], right[3], up[3];
+    ref_camera_basis(&cam, fwd, right, up);
+    uint32_t wall = 0;
+    for (uint32_t j = 0; j < h; ++j) /* GL rows: j = 0 the bottom */
+        for (uint32_t i = 0; i < w; ++i) {
+            size_t q = (size_t)j * w + i;
+            double dir[3];
+            ref_pixel_ray(&cam, i, h - 1 - j, dir);
+            double t = (-4.5 - cam.eye[2]) / dir[2], p[3];
+            for (int k = 0; k < 3; ++k) p[k] = cam.eye[k] + t * dir[k];
+            bool on = t > 0 && fabs(p[0]) <= 2 && p[1] >= 0 && p[1] <= 2;
+            float c[4] = {on ? 3.0f : 0.0f, 0.0f, 0.0f, 1.0f};
+            memcpy(col + 4 * q, c, sizeof c);
+            double ze = t * (dir[0] * fwd[0] + dir[1] * fwd[1] + dir[2] * fwd[2]);
+            dep[q] = on ? (float)(0.5 * ((cam.far_plane + cam.near_plane) / (cam.far_plane - cam.near_plane)
+                                         - 2.0 * cam.far_plane * cam.near_plane / ((cam.far_plane - cam.near_plane) * ze)) + 0.5)
+                        : 1.0f;
+            wall += on;
+        }
+    double redness[2];
+    double hits[2];
+    for (int on = 0; on < 2; ++on) {
+        scene s = slab_scene(24, 2);
+        s.params.color[0] = s.params.color[1] = s.params.color[2] = 1.0f; /* clear: what it reflects shows */
+        s.params.features_off = on ? 0u : VFX_WATER_NO_SSR;
+        vfx_context_desc host_api = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = &s,
+                                     .log = test_vfx_log_fn, .particle_chunk_count = chunk_count,
+                                     .particle_chunk = chunk_view, .water_params = water_params};
+        vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
+        vfx_context *ctx;
+        assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
+        assert_int_equal(api.create(&host_api, &ctx), VFX_OK);
+        GLuint tex[3], fbo;
+        glCreateTextures(GL_TEXTURE_2D, 3, tex);
+        glTextureStorage2D(tex[0], 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
+        glTextureStorage2D(tex[1], 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
+        glTextureStorage2D(tex[2], 1, GL_DEPTH_COMPONENT32F, (GLsizei)w, (GLsizei)h);
+        glTextureSubImage2D(tex[1], 0, 0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_FLOAT, col);
+        glTextureSubImage2D(tex[2], 0, 0, 0, (GLsizei)w, (GLsizei)h, GL_DEPTH_COMPONENT, GL_FLOAT, dep);
+        glTextureSubImage2D(tex[0], 0, 0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_FLOAT, col);
+        glCreateFramebuffers(1, &fbo);
+        glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, tex[0], 0);
+        vfx_frame_view fv = {.type = VFX_TYPE_FRAME_VIEW, .framebuffer = fbo, .color_texture = tex[1],
+                             .depth_texture = tex[2], .width = w, .height = h, .fov_y = (float)cam.fov_y,
+                             .near_plane = (float)cam.near_plane, .far_plane = (float)cam.far_plane, .color_hdr = 1};
+        for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam.eye[k];
+        ref_camera_matrices(&cam, fv.view, fv.proj);
+        assert_int_equal(api.update(ctx, 0.0, 0.0f), VFX_OK);
+        assert_int_equal(api.render(ctx, &fv), VFX_OK);
+        assert_int_equal(api.render(ctx, &fv), VFX_OK); /* the counters of a frame are read a frame late */
+        float *px = malloc(n * 16), *dist = malloc(n * 4);
+        glGetTextureImage(tex[0], 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * 16), px);
+        assert_int_equal(api.read_raw(ctx, VFX_EFFECT_WATER, dist, n), VFX_OK);
+        vfx_stats st = {.type = VFX_TYPE_STATS};
+        assert_int_equal(api.get_stats(ctx, &st), VFX_OK);
+        hits[on] = -1;
+        for (uint32_t k = 0; k < st.count; ++k)
+            if (!strcmp(st.entries[k].name, "water.ssr_hits")) hits[on] = st.entries[k].value;
+        double sum = 0;
+        uint32_t count = 0;
+        for (uint32_t j = 0; j < h; ++j)
+            for (uint32_t i = 0; i < w; ++i) {
+                size_t qd = (size_t)(h - 1 - j) * w + i, q = (size_t)j * w + i; /* dist: top row first */
+                if (dist[qd] < 0 || col[4 * q] > 0) continue; /* water pixels not covered by the wall */
+                sum += px[4 * q] - px[4 * q + 2];
+                ++count;
+            }
+        redness[on] = count ? sum / count : 0;
+        print_message("SSR %s: %u host wall pixels, %u water pixels, mean red - blue %.4f, ssr_hits %.0f\n",
+                      on ? "on" : "off", wall, count, redness[on], hits[on]);
+        assert_true(count > 200);
+        free(px); free(dist);
+        api.destroy(ctx);
+        glDeleteFramebuffers(1, &fbo);
+        glDeleteTextures(3, tex);
+        free_scene(&s);
+    }
+    assert_true(hits[1] > 50);
+    assert_true(redness[1] > redness[0] + 0.05);
+    free(col); free(dep);
+}
+
 int main(void)
 {
     rt_gl_context *gl = test_gl_or_skip();
@@ -271,6 +368,7 @@ int main(void)
         cmocka_unit_test(test_refraction_not_in_front),
         cmocka_unit_test(test_deep_tinted_shallow_clear),
         cmocka_unit_test(test_fresnel_grazing),
+        cmocka_unit_test(test_ssr_reflects_host),
     };
     int r = cmocka_run_group_tests(tests, NULL, NULL);
     rt_gl_context_destroy(gl);
