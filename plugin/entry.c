@@ -537,7 +537,7 @@ VFX_EXPORT vfx_result vfx_plugin_entry(uint32_t abi_version, const vfx_context_d
         info->abi_minor = VFX_ABI_MINOR;
         info->type_count = 64;
         info->known_types = 0;
-        for (uint32_t t = VFX_TYPE_CONTEXT_DESC; t <= VFX_TYPE_PLUGIN_INFO; ++t)
+        for (uint32_t t = VFX_TYPE_CONTEXT_DESC; t <= VFX_TYPE_WATER_FOAM; ++t)
             info->known_types |= 1ull << t;
     }
     return VFX_OK;

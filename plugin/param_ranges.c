@@ -152,6 +152,22 @@ vfx_result volfx_water_diffuse_check_ranges(vfx_context *ctx, const vfx_water_pa
     return VFX_OK;
 }
 
+vfx_result volfx_water_foam_check_ranges(vfx_context *ctx, const vfx_water_foam *f)
+{
+    const char *w = "water";
+    vfx_result r;
+    if ((r = volfx_range_check(ctx, w, VFX_RANGE_WATER_FOAM_LAYER, f->layer))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_FOAM_IMPACTS, f->impacts))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_FOAM_LIFETIME, f->lifetime))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_FOAM_CELL, f->cell))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_FOAM_DIFFUSION, f->diffusion))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_FOAM_DEPOSIT, f->deposit))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_FOAM_IMPACT_RATE, f->impact_rate))
+        || (r = volfx_range_check(ctx, w, VFX_RANGE_WATER_FOAM_IMPACT_SPEED, f->impact_speed)))
+        return r;
+    return VFX_OK;
+}
+
 vfx_result volfx_beam_check_ranges(vfx_context *ctx, uint32_t i, const vfx_beam *b)
 {
     char w[32];

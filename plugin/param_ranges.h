@@ -34,6 +34,8 @@ vfx_result volfx_range_check_vec(vfx_context *ctx, const char *what, vfx_range_i
 vfx_result volfx_water_params_check_ranges(vfx_context *ctx, const vfx_water_params *p);
 /* The diffuse particles' fields alone (volfx_water_params_check_ranges includes them). */
 vfx_result volfx_water_diffuse_check_ranges(vfx_context *ctx, const vfx_water_params *p);
+/* The water's foam struct (chained into the water parameters). */
+vfx_result volfx_water_foam_check_ranges(vfx_context *ctx, const vfx_water_foam *f);
 /* Beam i. */
 vfx_result volfx_beam_check_ranges(vfx_context *ctx, uint32_t i, const vfx_beam *b);
 /* The beams view's own numbers (and the lab's march samples, lab may be NULL). */

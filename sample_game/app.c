@@ -109,6 +109,14 @@ static vfx_result host_water_params(void *user, vfx_water_params *out)
     out->next = lab_used ? lab : NULL;
     if (lab_used)
         app->water_lab.type = VFX_TYPE_LAB_WATER;
+    /* the foam struct first, the lab's after it (each names its type; the plugin finds both) */
+    vfx_water_foam *foam = &app->water_foam;
+    if (foam->layer || foam->impacts || foam->lifetime != 0 || foam->cell != 0 || foam->diffusion != 0 ||
+        foam->deposit != 0 || foam->impact_rate != 0 || foam->impact_speed != 0) {
+        foam->type = VFX_TYPE_WATER_FOAM;
+        foam->next = out->next;
+        out->next = foam;
+    }
     /* the anisotropic kernel is TILE's; the paper method (Tab cycles to it) draws the seed's */
     uint32_t method = lab->method ? lab->method : app->water.method;
     out->kernel = method == VFX_WATER_METHOD_TILE ? app->water.kernel : VFX_WATER_KERNEL_ISOTROPIC;

@@ -72,6 +72,7 @@ typedef struct game_app {
     /* every field (kernel: method TILE's; the others get isotropic); its next is set per call */
     vfx_water_params water;
     vfx_lab_water water_lab;   /* chained when it asks for something (lab method or bits) */
+    vfx_water_foam water_foam; /* chained when the scene sets anything in water.foam */
     vfx_beams_view beams_view; /* parameters; beams/count/joints filled per call from the entities */
     vfx_lab_beams beams_lab;   /* chained when it asks for the ray-marching baseline */
     float joints[GAME_APP_MAX_JOINTS][3]; /* bending beams' joints (vfx_beam.joint_first) */

@@ -155,6 +155,7 @@ static vfx_result load_water(game_app *app, game_demo *demo, const rt_scene *sc)
     demo->particle_count = n;
     app->water = w->params;
     app->water_lab = w->lab;
+    app->water_foam = w->foam;
     app->water_enabled = n > 0;
 done:
     free(px), free(py), free(pz);

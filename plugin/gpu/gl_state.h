@@ -12,7 +12,7 @@
 #include <stdbool.h>
 #include "gpu/gl.h"
 
-#define VOLFX_GL_TEXTURE_UNITS 9   /* units 0..8: sampler2D/samplerCube bindings of the shaders (8: the water reads the beams behind it) */
+#define VOLFX_GL_TEXTURE_UNITS 10  /* units 0..9: sampler2D/samplerCube bindings of the shaders (8: the water reads the beams behind it, 9: its foam layer) */
 #define VOLFX_GL_UBO_BINDINGS 8    /* uniform blocks at bindings 0..7 */
 #define VOLFX_GL_SSBO_BINDINGS 16  /* storage blocks at bindings 0..15 */
 #define VOLFX_GL_IMAGE_UNITS 8     /* image units 0..7 */

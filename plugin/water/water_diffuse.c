@@ -273,6 +273,20 @@ static void step_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_diffu
     glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_hi"), 1, in->hi);
 }
 
+/* Drops each impact throws this step: impact_rate x dt, the fraction carried by a hash of the
+ * frame (a rate below one a step still throws some), at most IMPACT_DROPS_MAX. */
+#define IMPACT_DROPS_MAX 256u
+static uint32_t impact_drops(const volfx_water_diffuse_input *in)
+{
+    if (!in->impact_count || !(in->impact_rate > 0))
+        return 0;
+    double want = (double)in->impact_rate * in->dt;
+    uint32_t x = (uint32_t)(in->frame * 2654435761u);
+    x ^= x >> 15, x *= 2246822519u, x ^= x >> 13;
+    double n = floor(want + (double)(x >> 8) / 16777216.0);
+    return n > IMPACT_DROPS_MAX ? IMPACT_DROPS_MAX : (uint32_t)n;
+}
+
 vfx_result volfx_water_diffuse_step(vfx_context *ctx, volfx_water_diffuse *d, const volfx_water_diffuse_input *in)
 {
     vfx_result r = ensure_step_buffers(ctx, d, in->count, in->dp->max);
@@ -283,7 +297,8 @@ vfx_result volfx_water_diffuse_step(vfx_context *ctx, volfx_water_diffuse *d, co
     GLuint prep = volfx_gpu_compute(ctx, "water/diffuse.comp", "#define MODE_PREP\n");
     GLuint adv = volfx_gpu_compute(ctx, "water/diffuse.comp", "#define MODE_ADVECT\n");
     GLuint fin = volfx_gpu_compute(ctx, "water/diffuse.comp", "#define MODE_FINAL\n");
-    if (!normal || !gen || !prep || !adv || !fin)
+    GLuint emit = in->impact_count ? volfx_gpu_compute(ctx, "water/diffuse.comp", "#define MODE_EMIT\n") : 0;
+    if (!normal || !gen || !prep || !adv || !fin || (in->impact_count && !emit))
         return VFX_ERR_GL;
     GLuint bind[] = {in->cols[0], in->cols[1], in->cols[2], d->vel, in->counters, in->grid->start, d->header,
                      in->grid->sorted, d->nrm, d->pot, d->pool[d->cur], d->pool[1 - d->cur]};
@@ -299,6 +314,22 @@ vfx_result volfx_water_diffuse_step(vfx_context *ctx, volfx_water_diffuse *d, co
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         step_uniforms(ctx, gen, in);
         glDispatchCompute(gx, gy, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
+    uint32_t per = in->dt > 0 ? impact_drops(in) : 0;
+    if (per) {
+        step_uniforms(ctx, emit, in);
+        float imp[VOLFX_WATER_DIFFUSE_IMPACTS][8];
+        memset(imp, 0, sizeof imp);
+        for (uint32_t e = 0; e < in->impact_count; ++e) {
+            memcpy(imp[e], in->impacts[e], 3 * sizeof(float));
+            memcpy(imp[e] + 4, in->impacts[e] + 3, 3 * sizeof(float));
+        }
+        glUniform4fv(volfx_gpu_uniform(ctx, emit, "u_imp"), (GLsizei)(2 * in->impact_count), imp[0]);
+        glUniform1ui(volfx_gpu_uniform(ctx, emit, "u_imp_n"), in->impact_count);
+        glUniform1ui(volfx_gpu_uniform(ctx, emit, "u_imp_per"), per);
+        glUniform1f(volfx_gpu_uniform(ctx, emit, "u_imp_speed"), in->impact_speed);
+        glDispatchCompute((in->impact_count * per + 63u) / 64u, 1, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     }
     step_uniforms(ctx, prep, in);
@@ -320,6 +351,13 @@ vfx_result volfx_water_diffuse_step(vfx_context *ctx, volfx_water_diffuse *d, co
         return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR,
                           "water diffuse step over %u fluid particles: %s", in->count, e);
     return VFX_OK;
+}
+
+void volfx_water_diffuse_buffers(const volfx_water_diffuse *d, GLuint *vel, GLuint *pool, GLuint *header)
+{
+    *vel = d->vel;
+    *pool = d->pool[d->cur];
+    *header = d->header;
 }
 
 /* The uniforms both draws read; binds the live pool at SSBO 0. */

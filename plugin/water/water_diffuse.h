@@ -62,7 +62,16 @@ typedef struct volfx_water_diffuse_input {
     const volfx_water_aniso_grid *grid; /* the fluid's hashed grid, this frame's positions */
     GLuint counters;              /* the effect's counter buffer: slots 27-30 (spray, foam, bubbles, generated) */
     uint64_t frame;               /* seeds the generation's random numbers */
+    /* where beams strike the water (vfx_water_foam.impacts): per impact its surface point and
+     * unit normal; spray is thrown up there at impact_rate drops a second, at up to
+     * impact_speed x sqrt(|g| h) */
+    const float (*impacts)[6];
+    uint32_t impact_count;        /* at most VOLFX_WATER_DIFFUSE_IMPACTS */
+    float impact_rate, impact_speed;
 } volfx_water_diffuse_input;
+
+/* impacts one step throws spray at, at most */
+#define VOLFX_WATER_DIFFUSE_IMPACTS 8u
 
 /* One step (pass water.diffuse): normals, potentials and generation over the fluid particles,
  * then every diffuse particle classified and advected into the other half of the pool. */
@@ -84,6 +93,10 @@ vfx_result volfx_water_diffuse_splat(vfx_context *ctx, volfx_water_diffuse *d, c
 /* Draws the spray streaked along its velocity over frame->framebuffer (pass water.spray). */
 vfx_result volfx_water_diffuse_spray(vfx_context *ctx, volfx_water_diffuse *d, const volfx_water_diffuse_draw *dd,
                                      const vfx_frame_view *frame, const volfx_frame_targets *targets);
+/* The buffers the foam layer reads (borrowed): the fluid velocities (vec4 a particle), the live
+ * pool (2 vec4 a particle) and the header (diffuse.comp's; after a step its first 3 words are an
+ * indirect dispatch of 64-wide groups covering the live pool, word 3 the pool's count). */
+void volfx_water_diffuse_buffers(const volfx_water_diffuse *d, GLuint *vel, GLuint *pool, GLuint *header);
 /* Forgets every diffuse particle (the next step starts from an empty pool). */
 void volfx_water_diffuse_clear(volfx_water_diffuse *d);
 

@@ -15,6 +15,9 @@
 #include "water_internal.h"
 #include "water_params.h"
 #include "param_ranges.h"
+#if VFX_WITH_BEAMS
+#include "beams/beams_impact.h"
+#endif
 
 
 static void groups_free(vfx_context *ctx, water_state *s)
@@ -77,6 +80,7 @@ static void water_destroy(vfx_context *ctx, void *state)
     volfx_water_grid_destroy(ctx, s->grid);
     volfx_water_aniso_destroy(ctx, s->aniso);
     volfx_water_diffuse_destroy(ctx, s->diffuse);
+    volfx_water_foam_destroy(ctx, s->foam);
     volfx_water_gather_destroy(ctx, s->gather);
     volfx_water_lights_destroy(&s->effect_lights);
     volfx_free(ctx, s->chunk_rev);
@@ -221,6 +225,8 @@ static vfx_result read_params(vfx_context *ctx, water_state *s, volfx_water_reso
     vfx_result kr = volfx_water_params_resolve(ctx, &wp, res);
     if (!kr)
         kr = volfx_water_diffuse_params_check(ctx, &wp, &s->dp);
+    if (!kr)
+        kr = volfx_water_foam_params_resolve(ctx, &wp, (res->look & WATER_LOOK_FOAM_LAYER) != 0, &s->fp);
     if (kr)
         return kr;
     s->kp = res->kp;
@@ -697,9 +703,54 @@ static bool diffuse_on(const water_state *s)
            volfx_water_diffuse_ready(s->diffuse);
 }
 
+/* the froth's cellular noise repeats every this many of its large cells (shade.frag) */
+#define WATER_FOAM_NOISE_PERIOD 4096.0
+
+/* Where beams strike the water this frame (the newest read-back), for the spray thrown there:
+ * point and normal each, at most VOLFX_WATER_DIFFUSE_IMPACTS; none without beams or with
+ * vfx_water_foam.impacts off. */
+static uint32_t water_impacts(vfx_context *ctx, const water_state *s, float (*out)[6])
+{
+    uint32_t n = 0;
+#if VFX_WITH_BEAMS
+    volfx_beams_impact *im = s->fp.impacts ? volfx_beams_impact_of(ctx) : NULL;
+    volfx_impact_event ev[VOLFX_WATER_DIFFUSE_IMPACTS];
+    n = im ? volfx_beams_impact_water_events(im, ev, VOLFX_WATER_DIFFUSE_IMPACTS) : 0;
+    n = n > VOLFX_WATER_DIFFUSE_IMPACTS ? VOLFX_WATER_DIFFUSE_IMPACTS : n;
+    for (uint32_t e = 0; e < n; ++e) {
+        memcpy(out[e], ev[e].position, 3 * sizeof(float));
+        memcpy(out[e] + 3, ev[e].normal, 3 * sizeof(float));
+    }
+#else
+    (void)ctx, (void)s, (void)out;
+#endif
+    return n;
+}
+
+/* The foam layer's update after the diffuse step (its foam particles deposit into it); with the
+ * layer off, it is forgotten. */
+static vfx_result foam_update(vfx_context *ctx, water_state *s, const volfx_frame_targets *targets)
+{
+    if (!s->fp.layer) {
+        volfx_water_foam_clear(s->foam);
+        return VFX_OK;
+    }
+    if (!s->foam && !(s->foam = volfx_water_foam_create(ctx)))
+        return VFX_ERR_OUT_OF_MEMORY;
+    const float *g = s->dp.gravity;
+    float gl = sqrtf(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    volfx_water_foam_input in = {.cols = s->cols, .count = s->count, .lo = s->lo, .hi = s->hi, .h = s->params.h,
+                                 .dt = s->dt, .vref = sqrtf((gl > 0 ? gl : 9.81f) * s->params.h), .fp = &s->fp,
+                                 /* slot 28: the foam particles of the newest counters read back */
+                                 .foam_seen = s->have_last && s->last[28] > 0,
+                                 .origin = {targets->origin[0], targets->origin[2]}};
+    volfx_water_diffuse_buffers(s->diffuse, &in.vel, &in.pool, &in.header);
+    return volfx_water_foam_step(ctx, s->foam, &in);
+}
+
 /* The diffuse particles' step over this update's fluid (once per update: the first view drawn
- * steps them, the others draw the same pool) and their foam and bubble layer in this view
- * (*layer, 0: none). */
+ * steps them, the others draw the same pool), the foam layer's update, and their foam and bubble
+ * layer in this view (*layer, 0: none). */
 static vfx_result diffuse_frame(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
                                 const volfx_frame_targets *targets, GLuint *layer)
 {
@@ -707,6 +758,7 @@ static vfx_result diffuse_frame(vfx_context *ctx, water_state *s, const vfx_fram
     if (!diffuse_on(s)) {
         if (s->diffuse)
             volfx_water_diffuse_clear(s->diffuse);
+        volfx_water_foam_clear(s->foam);
         return VFX_OK;
     }
     vfx_result r;
@@ -717,9 +769,13 @@ static vfx_result diffuse_frame(vfx_context *ctx, water_state *s, const vfx_fram
         volfx_water_aniso_grid grid;
         if ((r = volfx_water_aniso_grid_build(ctx, s->aniso, &ai, &grid)))
             return r;
+        float imp[VOLFX_WATER_DIFFUSE_IMPACTS][6];
         volfx_water_diffuse_input in = {s->cols, s->count, s->lo, s->hi, s->params.h, s->dt, &s->dp, &grid,
-                                        s->counters, s->frame_no};
+                                        s->counters, s->frame_no, imp, water_impacts(ctx, s, imp),
+                                        s->fp.impact_rate, s->fp.impact_speed};
         if ((r = volfx_water_diffuse_step(ctx, s->diffuse, &in)))
+            return r;
+        if ((r = foam_update(ctx, s, targets)))
             return r;
         s->diffuse_due = false;
     }
@@ -839,6 +895,18 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
         glBindTextureUnit(8, targets->beams_behind);
     }
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_diffuse"), layer != 0);
+    float fgrid[4] = {0, 0, 0, 0};
+    const double at[2] = {targets->origin[0], targets->origin[2]};
+    GLuint foam = layer ? volfx_water_foam_texture(s->foam, at, fgrid) : 0;
+    if (foam)
+        glBindTextureUnit(9, foam);
+    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_foam"), foam != 0);
+    glUniform4fv(volfx_gpu_uniform(ctx, shade, "u_foam_grid"), 1, fgrid);
+    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_foam_layer"), s->fp.layer);
+    /* the froth's noise is fixed in the world: the origin, modulo the noise's period */
+    double period = WATER_FOAM_NOISE_PERIOD * 0.33 * p->h;
+    glUniform2f(volfx_gpu_uniform(ctx, shade, "u_foam_offset"), period > 0 ? (float)fmod(at[0], period) : 0.0f,
+                period > 0 ? (float)fmod(at[1], period) : 0.0f);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->counters);
     volfx_gpu_fullscreen(ctx);
     /* the SSR hits counted by the fragments reach the counter copy */
@@ -933,6 +1001,28 @@ vfx_result volfx_water_debug_diffuse(vfx_context *ctx, float *pot, size_t fluid,
         return volfx_fail(ctx, VFX_ERR_NOT_FOUND, VFX_LOG_ID_EFFECT_NOT_RENDERED,
                           "water debug diffuse: no water effect or no upload yet");
     return volfx_water_diffuse_debug(ctx, s->diffuse, pot, fluid, pool, pool_cap, alive);
+}
+
+vfx_result volfx_water_debug_foam(vfx_context *ctx, volfx_water_foam_grid *g, float *out, size_t cap)
+{
+    water_state *s = ctx->effect_state[VFX_EFFECT_WATER];
+    if (!s || !s->foam)
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, VFX_LOG_ID_EFFECT_NOT_RENDERED, "water debug foam: no foam layer yet");
+    return volfx_water_foam_debug_read(ctx, s->foam, g, out, cap);
+}
+
+vfx_result volfx_water_debug_foam_write(vfx_context *ctx, const float *in, size_t n)
+{
+    water_state *s = ctx->effect_state[VFX_EFFECT_WATER];
+    if (!s)
+        return volfx_fail(ctx, VFX_ERR_NOT_FOUND, VFX_LOG_ID_EFFECT_NOT_RENDERED, "water debug foam: no water effect");
+    if (!s->foam && !(s->foam = volfx_water_foam_create(ctx)))
+        return VFX_ERR_OUT_OF_MEMORY;
+    if (!in) {
+        volfx_water_foam_debug_wake(s->foam);
+        return VFX_OK;
+    }
+    return volfx_water_foam_debug_write(ctx, s->foam, in, n);
 }
 
 static vfx_result water_read_raw(vfx_context *ctx, void *state, float *out, size_t count)

@@ -3,6 +3,7 @@
 #define VOLFX_WATER_EFFECT_H
 
 #include "context.h"
+#include "water/water_foam.h"
 
 /* Copies the surface gradient target of the last water render: 4 floats per pixel, top row
  * first, (grad sum P, sum P) at the found surface point, zeros where no water. The shading
@@ -25,5 +26,12 @@ vfx_result volfx_water_debug_kernels(vfx_context *ctx, float *out, uint32_t *nbr
  * no step ran. */
 vfx_result volfx_water_debug_diffuse(vfx_context *ctx, float *pot, size_t fluid, float *pool, size_t pool_cap,
                                      uint32_t *alive);
+
+/* The foam layer (water_foam.h): its grid and, if out != NULL, its density (nx x nz floats, row
+ * by row from z0). VFX_ERR_NOT_FOUND before the layer has run. */
+vfx_result volfx_water_debug_foam(vfx_context *ctx, volfx_water_foam_grid *g, float *out, size_t cap);
+/* Overwrites the foam layer's density (nx x nz floats); with in NULL it only wakes the layer (its
+ * next update runs and makes the grid, as if foam had been seen). */
+vfx_result volfx_water_debug_foam_write(vfx_context *ctx, const float *in, size_t n);
 
 #endif

@@ -13,6 +13,7 @@
 #include "water_diffuse.h"
 #include "water_gather.h"
 #include "water_lights.h"
+#include "water_foam.h"
 
 /* Counter readback ring: frames the GPU may run behind before a result is dropped. */
 #define WATER_COUNTER_RING 3
@@ -99,6 +100,8 @@ typedef struct water_state {
     volfx_water_tile *tile;  /* TILE lists (TILE, and PAPER's finishing pass), made when needed */
     volfx_water_diffuse *diffuse; /* spray, foam and bubbles from the host's velocities */
     volfx_water_diffuse_params dp; /* their parameters (vfx_water_params), checked */
+    volfx_water_foam_layer *foam;  /* the foam layer, made when first run */
+    volfx_water_foam_params fp;    /* its parameters (vfx_water_foam), resolved */
     float dt;              /* the last update's step, seconds (the diffuse particles') */
     bool diffuse_due;      /* an update since the last diffuse step */
     float lo[3], hi[3];    /* box of the finite particles (GPU chunks: read back late, grown) */

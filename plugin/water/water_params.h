@@ -39,6 +39,8 @@ typedef struct volfx_water_resolved {
 #define WATER_LOOK_ANISO_HALF_RATE 8u
 /* the plugin's own lights (the beams' line and point lights) on the surface and in the body */
 #define WATER_LOOK_FX_LIGHTS 16u
+/* the foam layer (water_foam.h); without it the diffuse splat's per-particle foam */
+#define WATER_LOOK_FOAM_LAYER 32u
 /* The default absorption, per unit of h: a pool 3 h deep takes 1 - e^-2 of the red light
  * behind it (tint's 1 - 0.15) and fills with the deep colour; a sheet h/4 thick keeps 84% (red) to 92% (blue). */
 #define WATER_ABSORPTION_H 0.8f

@@ -124,6 +124,8 @@ typedef struct rt_scene_water {
     vfx_water_params params;
     /* the lab's switches the scene asks for (water.quality.disable, baseline methods) */
     vfx_lab_water lab;
+    /* water.foam: the foam layer and the spray at beam impacts (type filled; chained by the host) */
+    vfx_water_foam foam;
 } rt_scene_water;
 
 typedef struct rt_scene_transfer_point {

@@ -253,10 +253,40 @@ static vfx_result parse_diffuse(pctx *c, const cJSON *v, rt_scene_water *w)
     return r;
 }
 
+/* water.foam (vfx_water_foam; each number against its row of volfx_ranges.h). */
+static vfx_result parse_foam(pctx *c, const cJSON *v, rt_scene_water *w)
+{
+    static const char *const keys[] = {"layer", "impacts", "lifetime", "cell", "diffusion", "deposit",
+                                       "impact_rate", "impact_speed", NULL};
+    static const char *const onoff[] = {"on", "off", NULL};
+    vfx_water_foam *f = &w->foam;
+    f->type = VFX_TYPE_WATER_FOAM;
+    const cJSON *o = cJSON_GetObjectItemCaseSensitive(v, "foam");
+    const char *P = "water.foam";
+    if (!o)
+        return VFX_OK;
+    vfx_result r = rt_scene_expect_object(c, o, P);
+    if (r)
+        return r;
+    rt_scene_check_keys(c, o, P, keys);
+    uint32_t k = 0;
+    if (cJSON_GetObjectItemCaseSensitive(o, "layer") && !(r = rt_scene_get_enum(c, o, P, "layer", false, onoff, &k)))
+        f->layer = k == 0 ? VFX_WATER_FOAM_ON : VFX_WATER_FOAM_OFF;
+    if (!r && cJSON_GetObjectItemCaseSensitive(o, "impacts") && !(r = rt_scene_get_enum(c, o, P, "impacts", false, onoff, &k)))
+        f->impacts = k == 0 ? VFX_WATER_FOAM_ON : VFX_WATER_FOAM_OFF;
+    if (!r) r = rt_scene_get_float_row(c, o, P, "lifetime", VFX_RANGE_WATER_FOAM_LIFETIME, &f->lifetime);
+    if (!r) r = rt_scene_get_float_row(c, o, P, "cell", VFX_RANGE_WATER_FOAM_CELL, &f->cell);
+    if (!r) r = rt_scene_get_float_row(c, o, P, "diffusion", VFX_RANGE_WATER_FOAM_DIFFUSION, &f->diffusion);
+    if (!r) r = rt_scene_get_float_row(c, o, P, "deposit", VFX_RANGE_WATER_FOAM_DEPOSIT, &f->deposit);
+    if (!r) r = rt_scene_get_float_row(c, o, P, "impact_rate", VFX_RANGE_WATER_FOAM_IMPACT_RATE, &f->impact_rate);
+    if (!r) r = rt_scene_get_float_row(c, o, P, "impact_speed", VFX_RANGE_WATER_FOAM_IMPACT_SPEED, &f->impact_speed);
+    return r;
+}
+
 vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
 {
     static const char *const keys[] = {"source", "path", "generator", "simulation", "h", "threshold",
-                                       "quality", "color", "absorption", "ior", "diffuse", NULL};
+                                       "quality", "color", "absorption", "ior", "diffuse", "foam", NULL};
     static const char *const sources[] = {"file", "generator", "simulation", NULL};
     const char *P = "water";
     vfx_result r = rt_scene_expect_object(c, v, P);
@@ -301,6 +331,8 @@ vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
         r = parse_water_quality(c, q, w);
     if (!r)
         r = parse_diffuse(c, v, w);
+    if (!r)
+        r = parse_foam(c, v, w);
     /* the default: the preset's, as the plugin resolves it (anisotropic for TILE but at preset
      * "low": flat water flat, sheets stay sheets; docs/water.md "Presets"), the seed's isotropic
      * kernel for the other methods */

@@ -11,6 +11,11 @@
 //                  n = Phi(E) (k_ta Phi(I_ta) + k_wc Phi(I_wc)) dt new particles (Phi the clamp
 //                  of eq. 1; where Phi(E) = 0 the neighbours are not visited), placed in a cylinder of radius h/2 around the particle along its
 //                  velocity, appended to the pool while it has room
+//   MODE_EMIT      per drop thrown where a beam strikes the water (u_imp: point and normal of
+//                  each impact, u_imp_per drops each): a spray drop placed 0.6-1.2 h above the
+//                  surface within 0.75 h of the point, launched along the normal tilted outwards
+//                  (a crown) at 0.35-1 x u_imp_speed v_ref; appended to the pool like generated
+//                  particles (they count in the generated counter)
 //   MODE_PREP      one invocation: the pool's count clamped to the cap, the advection's
 //                  indirect dispatch
 //   MODE_ADVECT    per diffuse particle: its fluid neighbours within h classify it (fewer than
@@ -55,6 +60,9 @@ uniform vec2 u_ta, u_wc, u_ek;
 uniform float u_rate_ta, u_rate_wc, u_life, u_buoy, u_drag;
 uniform uint u_spray_below, u_bubble_above, u_seed;
 uniform vec3 u_lo, u_hi;    // the fluid's box: a diffuse particle far outside it is dropped
+uniform vec4 u_imp[16];     // MODE_EMIT: per impact its point and unit normal (xyz)
+uniform uint u_imp_n, u_imp_per;
+uniform float u_imp_speed;
 
 #define MAX_CAND 4096u
 #define MAX_NEW 8u
@@ -125,6 +133,26 @@ void main()
     hdr[3] = hdr[8];
     c_generated = hdr[9];
     hdr[9] = 0u;
+#elif defined(MODE_EMIT)
+    uint k = gl_GlobalInvocationID.x;
+    if (k >= u_imp_n * u_imp_per) return;
+    uint e = k / u_imp_per;
+    vec3 c = u_imp[2u * e].xyz, nrm = u_imp[2u * e + 1u].xyz;
+    if (!finite3(c) || !(dot(nrm, nrm) > 0.5)) return;
+    uint s = pcg(k ^ pcg(u_seed ^ 0x9e3779b9u));
+    vec3 ref = abs(nrm.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+    vec3 e1 = normalize(cross(nrm, ref)), e2 = cross(nrm, e1);
+    float th = 6.2831853 * rnd(s), rr = sqrt(rnd(s));
+    vec3 side = cos(th) * e1 + sin(th) * e2;
+    vec3 x = c + nrm * u_h * (0.6 + 0.6 * rnd(s)) + side * (rr * 0.75 * u_h);
+    float sp = u_imp_speed * u_vref * (0.35 + 0.65 * rnd(s));
+    vec3 v = sp * normalize(nrm + side * (0.3 + 0.9 * rr));
+    float life = u_life * (0.5 + 0.5 * rnd(s));
+    atomicAdd(hdr[9], 1u);
+    uint at = atomicAdd(hdr[3], 1u);
+    if (at >= u_cap) return;
+    pin[2u * at] = vec4(x, life);
+    pin[2u * at + 1u] = vec4(v, 0.0);
 #elif defined(MODE_ADVECT)
     uint i = gl_GlobalInvocationID.x;
     if (i >= hdr[3]) return;

@@ -26,6 +26,7 @@ layout(binding = 3) uniform sampler2D u_back;   // farthest ball exit along the 
 layout(binding = 4) uniform sampler2D u_scene_depth;
 layout(binding = 5) uniform samplerCube u_env;  // the host's environment (frame view 2)
 layout(binding = 6) uniform sampler2D u_diffuse; // R foam thickness, G bubbles (u_has_diffuse)
+layout(binding = 9) uniform sampler2D u_foam;    // the foam layer: density over world x, z (u_has_foam)
 // the effect's counter buffer: slot 26 counts the reflected rays that met the host's scene
 layout(std430, binding = 4) buffer Counters { uint c_slots_[26]; uint c_ssr_hits; };
 uniform mat4 u_inv_view_proj, u_view_proj;
@@ -38,6 +39,11 @@ uniform bool u_flat, u_has_color, u_has_depth, u_has_env, u_hdr, u_ssr, u_has_di
 // the look's switches (the quality presets, water_params.c): the host image as the
 // surroundings' light, the sun's GGX lobe (else the old narrow Phong glint)
 uniform bool u_host_light, u_ggx;
+// the foam layer (plugin/water/water_foam.c): its grid (x0, z0, 1 / width, 1 / depth); with
+// u_foam_layer the diffuse layer's per-particle foam (R) is not drawn
+uniform vec4 u_foam_grid;
+uniform vec2 u_foam_offset;         // the frame's origin (x, z) modulo the froth's period
+uniform bool u_has_foam, u_foam_layer;
 out vec4 o_color;
 // single scattering: the body's albedo (the share of the absorbed light that the water's
 // particles scatter back towards the eye, lit by the water's light)
@@ -63,6 +69,39 @@ out vec4 o_color;
 #define REFRACT_BISECT 6
 
 vec2 g_size;
+
+// Cellular noise: the distance from x to the nearest of one jittered point per unit cell (about
+// 0 at a bubble's centre, 0.5-0.8 at the walls between bubbles), repeating every `period` cells.
+float water_cells(vec2 x, float period)
+{
+    vec2 c = floor(x), f = x - c;
+    float d = 8.0;
+    for (int j = -1; j <= 1; ++j)
+        for (int i = -1; i <= 1; ++i) {
+            vec2 o = vec2(i, j), q = mod(c + o, period);
+            vec2 jit = fract(sin(vec2(dot(q, vec2(127.1, 311.7)), dot(q, vec2(269.5, 183.3)))) * 43758.5453);
+            d = min(d, length(o + jit - f));
+        }
+    return d;
+}
+
+// The foam layer's cover at density d and world x, z: 1 - e^-d on average, as a froth: where thin
+// only the walls between bubbles (cellular noise of two sizes, h/3 and h/9, fixed in the world)
+// are white, and the bubbles fill in as it thickens. Where a pixel spans a bubble or more
+// (fwidth of x, z) the froth gives way to its mean, the plain cover: no sub-pixel grain.
+float water_foam_cover(float d, vec2 xz, float footprint)
+{
+    if (!(d > 1.0e-3))
+        return 0.0;
+    float c = 1.0 - exp(-d);
+    // the world's x, z modulo the period: WATER_FOAM_NOISE_PERIOD large cells, 3 times as many small
+    xz += u_foam_offset;
+    float big = water_cells(xz / (0.33 * u_h), 4096.0), small = water_cells(xz / (0.11 * u_h), 3.0 * 4096.0);
+    small = mix(small, 0.5, smoothstep(0.25, 0.7, footprint / (0.11 * u_h)));
+    float walls = 0.65 * big + 0.35 * small;
+    float froth = clamp(max(smoothstep(0.95 - 0.8 * c, 1.1 - 0.8 * c, walls), c * c) * min(3.0 * c, 1.0), 0.0, 1.0);
+    return mix(froth, c, smoothstep(0.25, 0.7, footprint / (0.33 * u_h)));
+}
 
 // Is the point inside the water's screen-space volume? false off screen too; *pix its pixel.
 bool in_water(vec3 y, out ivec2 pix)
@@ -286,7 +325,23 @@ void main()
         col += water_effect_light_radiance(p, r, fresnel, trans, u_tint);
     }
 #endif
-    // foam on the surface hides what is under it, the glint too
-    col = mix(col, white, 1.0 - exp(-FOAM_K * foam_bub.r));
+    // foam on the surface hides what is under it, the glint too: the per-particle foam, or the
+    // foam layer on the surface where it faces up, lit as a white scatterer with the surface's
+    // normal (sun, sky, the host's light, the plugin's lights)
+    if (!u_foam_layer)
+        col = mix(col, white, 1.0 - exp(-FOAM_K * foam_bub.r));
+    float foam_d = u_has_foam ? texture(u_foam, (p.xz - u_foam_grid.xy) * u_foam_grid.zw).r : 0.0;
+    vec2 fw = fwidth(p.xz);
+    float foam_a = water_foam_cover(foam_d, p.xz, max(fw.x, fw.y)) * smoothstep(-0.2, 0.5, n.y);
+    if (foam_a > 0.0) {
+        vec3 froth = water_white(ambient, p, n);
+#ifdef WATER_EFFECT_LIGHTS
+        // a Lambertian scatterer under the lights: albedo 0.9 x fluence / (2 pi) (cos 1/2 on average)
+        vec3 fl_spec, fl;
+        water_effect_lights(p, r, WATER_LIGHT_LOBE, fl_spec, fl);
+        froth += 0.9 * 0.1591549 * fl;
+#endif
+        col = mix(col, froth, foam_a);
+    }
     o_color = vec4(u_hdr ? col : min(col, vec3(1.0)), 1.0);
 }

@@ -102,7 +102,7 @@ static void test_every_row(void **state)
 /* Where each row's field lies: the row's field text must be the struct and member named here
  * (so a row cannot name a field that does not exist), and test_struct_walk sets the member in a
  * valid struct and calls the check the effect calls. Every row must be here. */
-enum { K_NONE, K_WATER, K_BEAM, K_BEAMS_VIEW, K_LAB_BEAMS, K_VOLUME, K_FRAME, K_FRAME_DEPTH, K_OTHER };
+enum { K_NONE, K_WATER, K_BEAM, K_BEAMS_VIEW, K_LAB_BEAMS, K_VOLUME, K_FRAME, K_FRAME_DEPTH, K_WATER_FOAM, K_OTHER };
 enum { T_F32 = 1, T_U32, T_F64, T_U64 };
 typedef struct fmap {
     int kind;
@@ -182,6 +182,12 @@ static const fmap MAP[VFX_RANGE_COUNT] = {
     M_(GL_STATE_SKIP_RESTORE, K_OTHER, vfx_gl_state_desc, skip_restore)
     M_(LIGHTS_CAPACITY, K_OTHER, vfx_lights, capacity)
     M_(IMPACT_EVENTS_CAPACITY, K_OTHER, vfx_impact_events, capacity)
+    M_(WATER_FOAM_LAYER, K_WATER_FOAM, vfx_water_foam, layer) M_(WATER_FOAM_IMPACTS, K_WATER_FOAM, vfx_water_foam, impacts)
+    M_(WATER_FOAM_LIFETIME, K_WATER_FOAM, vfx_water_foam, lifetime) M_(WATER_FOAM_CELL, K_WATER_FOAM, vfx_water_foam, cell)
+    M_(WATER_FOAM_DIFFUSION, K_WATER_FOAM, vfx_water_foam, diffusion)
+    M_(WATER_FOAM_DEPOSIT, K_WATER_FOAM, vfx_water_foam, deposit)
+    M_(WATER_FOAM_IMPACT_RATE, K_WATER_FOAM, vfx_water_foam, impact_rate)
+    M_(WATER_FOAM_IMPACT_SPEED, K_WATER_FOAM, vfx_water_foam, impact_speed)
 };
 
 /* One valid struct of each kind, a member set, and the check the plugin runs on it. */
@@ -193,6 +199,7 @@ typedef union any_struct {
     vfx_volume_view vv;
     vfx_frame_view fv;
     vfx_frame_depth fd;
+    vfx_water_foam wf;
 } any_struct;
 
 static void baseline(int kind, any_struct *u)
@@ -211,6 +218,9 @@ static void baseline(int kind, any_struct *u)
         u->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW, .width = 64, .height = 64, .fov_y = 1,
                                  .view = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1},
                                  .proj = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -1, -1, 0, 0, -0.2f, 0}};
+        break;
+    case K_WATER_FOAM:
+        u->wf.type = VFX_TYPE_WATER_FOAM;
         break;
     case K_VOLUME:
         for (int k = 0; k < 16; ++k)
@@ -237,6 +247,7 @@ static vfx_result run_check(vfx_context *c, int kind, any_struct *u)
     case K_VOLUME: return volfx_volume_view_check_ranges(c, &u->vv);
     case K_FRAME: return volfx_frame_view_check_ranges(c, &u->fv);
     case K_FRAME_DEPTH: return volfx_frame_depth_check_ranges(c, &u->fd);
+    case K_WATER_FOAM: return volfx_water_foam_check_ranges(c, &u->wf);
     }
     return VFX_OK;
 }

@@ -208,7 +208,8 @@ static void test_plugin_info(void **state)
     assert_true(info.known_types & (1ull << VFX_TYPE_FRAME_DEPTH));
     assert_true(info.known_types & (1ull << VFX_TYPE_GL_STATE_DESC));
     assert_false(info.known_types & (1ull << VFX_TYPE_NONE));
-    assert_false(info.known_types & (1ull << (VFX_TYPE_PLUGIN_INFO + 1)));
+    assert_true(info.known_types & (1ull << VFX_TYPE_WATER_FOAM));
+    assert_false(info.known_types & (1ull << (VFX_TYPE_WATER_FOAM + 1)));
     /* without it the table is filled as before */
     vfx_plugin_api plain = {.type = VFX_TYPE_PLUGIN_API};
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &plain), VFX_OK);

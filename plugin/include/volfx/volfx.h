@@ -116,6 +116,7 @@ typedef enum vfx_struct_type {
     VFX_TYPE_IMPACT_EVENTS = 12, /* 1.1: chained into vfx_lights.next */
     VFX_TYPE_FRAME_DEPTH = 13, /* 1.1: chained into vfx_frame_view.next */
     VFX_TYPE_PLUGIN_INFO = 14, /* 1.1: chained into vfx_plugin_api.next */
+    VFX_TYPE_WATER_FOAM = 15,  /* 1.1: chained into vfx_water_params.next */
     VFX_TYPE_MAX_ENUM = 0x7fffffff
 } vfx_struct_type;
 
@@ -252,6 +253,31 @@ typedef struct vfx_water_params {
      * bubble_above -> bubble, else foam; 0 -> 6 and 20 (Ihmsen's); spray_below <= bubble_above */
     uint32_t spray_below, bubble_above;
 } vfx_water_params;
+
+/* The water's foam layer and its whitewater at beam impacts (ABI 1.1; docs/water.md "Foam
+ * layer"), chained into vfx_water_params.next. Absent or zero-filled: every default. The layer is
+ * a foam density over the water's horizontal extent (world x and z, texels of `cell` x h): each
+ * update the foam particles of the diffuse pool deposit into it, it is carried by the water's
+ * depth-averaged velocity, spreads by `diffusion` and fades as exp(-dt / lifetime); the shading
+ * draws it where it is dense as a white, lit foam on the surface. */
+typedef enum vfx_water_foam_switch {
+    VFX_WATER_FOAM_DEFAULT = 0, /* layer: the preset's (on from medium up); impacts: on */
+    VFX_WATER_FOAM_ON = 1,
+    VFX_WATER_FOAM_OFF = 2,
+} vfx_water_foam_switch;
+
+typedef struct vfx_water_foam {
+    vfx_struct_type type;  /* VFX_TYPE_WATER_FOAM */
+    const void *next;
+    uint32_t layer;        /* vfx_water_foam_switch: the foam layer (off: the per-particle foam) */
+    uint32_t impacts;      /* vfx_water_foam_switch: spray thrown up where a beam strikes the water */
+    float lifetime;        /* seconds the layer's foam takes to fade to 1/e; 0 -> 3 */
+    float cell;            /* the layer's texel in units of h; 0 -> 0.5 */
+    float diffusion;       /* the layer's spread, h^2 per second; 0 -> 0.5 */
+    float deposit;         /* density a foam particle adds per second to its texel area h^2; 0 -> 1 */
+    float impact_rate;     /* spray drops a second at a beam's impact on the water; 0 -> 600 */
+    float impact_speed;    /* their launch speed in units of sqrt(|g| h); 0 -> 4 */
+} vfx_water_foam;
 
 /* Support falloff of a beam (docs/beams.md "Smooth support"): the hard one cuts the densities at
  * R; the smooth one multiplies both densities by w(r) = (1 - (r/R)^2)^2, r < R. */
