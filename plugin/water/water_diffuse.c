@@ -424,7 +424,9 @@ vfx_result volfx_water_diffuse_spray(vfx_context *ctx, volfx_water_diffuse *d, c
 {
     if (!d->stepped)
         return VFX_OK;
-    GLuint prog = volfx_gpu_program(ctx, "water/diffuse.vert", "water/diffuse.frag", "#define STREAK\n");
+    GLuint prog = volfx_gpu_program(ctx, "water/diffuse.vert", "water/diffuse.frag",
+                                    dd->lights ? "#define STREAK\n#define WATER_EFFECT_LIGHTS 1\n#define WATER_MAX_LIGHTS 32\n"
+                                               : "#define STREAK\n");
     if (!prog)
         return VFX_ERR_GL;
     volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.spray", .framebuffer = frame->framebuffer,

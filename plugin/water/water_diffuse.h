@@ -83,6 +83,8 @@ typedef struct volfx_water_diffuse_draw {
     GLuint dist_tex;              /* the water's front distance (-1 miss) */
     GLuint vao;                   /* empty: quads from gl_VertexID / gl_InstanceID */
     float shutter;                /* seconds a spray streak spans */
+    bool lights;                  /* the plugin's lights are bound (uniform block 7, water_lights.h):
+                                     the spray is lit by them too */
 } volfx_water_diffuse_draw;
 
 /* Splats foam (R: thickness) and bubbles (G: attenuated by the water in front) into the layer

@@ -779,7 +779,7 @@ static vfx_result diffuse_frame(vfx_context *ctx, water_state *s, const vfx_fram
             return r;
         s->diffuse_due = false;
     }
-    volfx_water_diffuse_draw dd = {s->params.h, s->params.absorption, ctx->water_dist_tex, s->vao, WATER_SHUTTER_S};
+    volfx_water_diffuse_draw dd = {s->params.h, s->params.absorption, ctx->water_dist_tex, s->vao, WATER_SHUTTER_S, false};
     return volfx_water_diffuse_splat(ctx, s->diffuse, &dd, frame, targets, layer);
 }
 
@@ -913,7 +913,9 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     volfx_pass_end(ctx);
     if (layer) {
-        volfx_water_diffuse_draw dd = {p->h, p->absorption, ctx->water_dist_tex, s->vao, WATER_SHUTTER_S};
+        volfx_water_diffuse_draw dd = {p->h, p->absorption, ctx->water_dist_tex, s->vao, WATER_SHUTTER_S, nlights > 0};
+        if (nlights)
+            glBindBufferBase(GL_UNIFORM_BUFFER, 7, s->effect_lights.buffer);
         if ((r = volfx_water_diffuse_spray(ctx, s->diffuse, &dd, frame, targets)))
             return r;
     }

@@ -3,11 +3,12 @@
 // it); G bubbles, a disc inside the water attenuated by the water in front of it,
 // exp(-absorption x depth under the front). STREAK (premultiplied over the frame): spray as a
 // capsule whose opacity is spread over its length (a fast drop streaks, it does not brighten),
-// hidden behind the host's depth and fading fast under the water's front. Both are hidden
-// behind the host's geometry.
+// hidden behind the host's depth and fading fast under the water's front, lit by the sky, the sun
+// and (WATER_EFFECT_LIGHTS) the plugin's own lights. Both are hidden behind the host's geometry.
 #include "common/depth.glsl"
 #include "common/sky.glsl"
 #include "water/white.glsl"
+#include "water/effect_lights.glsl"
 layout(binding = 0) uniform sampler2D u_dist;
 layout(binding = 1) uniform sampler2D u_scene_depth;
 uniform mat4 u_inv_view_proj;
@@ -50,6 +51,13 @@ void main()
     if (under > 0.0) a *= exp(-under / (0.25 * u_h));
     if (a <= 0.0) discard;
     vec3 col = water_white_light();
+#ifdef WATER_EFFECT_LIGHTS
+    // the plugin's lights (a beam's line, its head, its impact): a drop scatters their fluence
+    // evenly, albedo 0.9 x fluence / 4 pi; a drop beside a strike shines in the beam's colour
+    vec3 fl_spec, fl;
+    water_effect_lights(v_world, normalize(v_world - u_eye), WATER_LIGHT_LOBE, fl_spec, fl);
+    col += 0.9 * 0.0795775 * fl;
+#endif
     if (!u_hdr) col = min(col, vec3(1.0));
     o_color = vec4(col * a, a);
 #endif
