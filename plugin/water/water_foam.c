@@ -46,7 +46,7 @@ vfx_result volfx_water_foam_params_resolve(vfx_context *ctx, const vfx_water_par
     out->lifetime = f->lifetime ? f->lifetime : 3.0f;
     out->cell = f->cell ? f->cell : 0.5f;
     out->diffusion = f->diffusion ? f->diffusion : 0.5f;
-    out->deposit = f->deposit ? f->deposit : 1.0f;
+    out->deposit = f->deposit ? f->deposit : 0.1f;
     out->impact_rate = f->impact_rate ? f->impact_rate : 600.0f;
     out->impact_speed = f->impact_speed ? f->impact_speed : 4.0f;
     return VFX_OK;

@@ -274,7 +274,7 @@ typedef struct vfx_water_foam {
     float lifetime;        /* seconds the layer's foam takes to fade to 1/e; 0 -> 3 */
     float cell;            /* the layer's texel in units of h; 0 -> 0.5 */
     float diffusion;       /* the layer's spread, h^2 per second; 0 -> 0.5 */
-    float deposit;         /* density a foam particle adds per second to its texel area h^2; 0 -> 1 */
+    float deposit;         /* density a foam particle adds per second to its texel area h^2; 0 -> 0.1 */
     float impact_rate;     /* spray drops a second at a beam's impact on the water; 0 -> 600 */
     float impact_speed;    /* their launch speed in units of sqrt(|g| h); 0 -> 4 */
 } vfx_water_foam;

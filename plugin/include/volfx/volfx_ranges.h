@@ -65,7 +65,7 @@
     X(WATER_FOAM_LIFETIME, "vfx_water_foam.lifetime", "water.foam.lifetime", 0.05, 600, VFX_RANGE_ZERO, "seconds; 0: 3") \
     X(WATER_FOAM_CELL, "vfx_water_foam.cell", "water.foam.cell", 0.25, 2, VFX_RANGE_ZERO, "in units of h; 0: 0.5") \
     X(WATER_FOAM_DIFFUSION, "vfx_water_foam.diffusion", "water.foam.diffusion", 0, 100, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "h^2 / s; 0: 0.5") \
-    X(WATER_FOAM_DEPOSIT, "vfx_water_foam.deposit", "water.foam.deposit", 0, 1e4, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "per foam particle per second; 0: 1") \
+    X(WATER_FOAM_DEPOSIT, "vfx_water_foam.deposit", "water.foam.deposit", 0, 1e4, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "per foam particle per second; 0: 0.1") \
     X(WATER_FOAM_IMPACT_RATE, "vfx_water_foam.impact_rate", "water.foam.impact_rate", 0, 1e6, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "drops per second; 0: 600") \
     X(WATER_FOAM_IMPACT_SPEED, "vfx_water_foam.impact_speed", "water.foam.impact_speed", 0, 100, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "in units of sqrt(|g| h); 0: 4") \
     X(BEAM_LENGTH, "vfx_beam.length", "beams[i].length", 0, 1e6, 0, "") \
