@@ -37,7 +37,7 @@ typedef struct game_options {
 static void usage(void)
 {
     puts("usage: volfx-game [--headless|--window] [--frames N] [--seconds S] [--size WxH]\n"
-         "                  [--png FILE] [--csv FILE] [--trace FILE] [--plugin libvolfx.so.1|PATH]\n"
+         "                  [--png FILE] [--csv FILE] [--trace FILE] [--plugin libvolfx.so.2|PATH]\n"
          "                  [--scene FILE.json] [--no-water] [--hide-water] [--no-beams] [--no-volume] [--debug-gl]\n"
          "                  [--mem-every N] [--progress S] [--dump-raw water|beams|volume FILE.pfm]\n"
          "                  [--program-cache DIR] [--gpu-particles] [--effects-layer]\n"

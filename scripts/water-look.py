@@ -104,7 +104,7 @@ def main():
     ap.add_argument('frames', type=int, nargs='+')
     ap.add_argument('--game', default='build/sample_game/volfx-game')
     ap.add_argument('--size', default='640x360')
-    ap.add_argument('--plugin', help="volfx-game's --plugin (another build's libvolfx.so.1)")
+    ap.add_argument('--plugin', help="volfx-game's --plugin (another build's libvolfx.so.2)")
     ap.add_argument('--zero-params', action='store_true')
     ap.add_argument('--keep', help='write the images here (default: a temporary folder)')
     ap.add_argument('--panels', default='', help='also write the images of these frames (N,N,...) on the way: STEM-fN.png')

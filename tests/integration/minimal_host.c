@@ -1,6 +1,6 @@
 /* minimal_host.c — a game engine's view of volfx: its own EGL context, its own framebuffers,
  * plain C arrays for particles and beams. Nothing from runtime/.
- * usage: minimal_host [libvolfx.so.1 | path/to/libvolfx.so]
+ * usage: minimal_host [libvolfx.so.2 | path/to/libvolfx.so]
  * With an argument the plugin is loaded with dlopen (a bare soname goes through the loader's
  * search path); without one the host calls the vfx_plugin_entry it was linked against
  * (cc minimal_host.c $(pkg-config --cflags --libs volfx) ...).

@@ -2,7 +2,7 @@
  * context, every GL function (the host's and the plugin's) from SDL_GL_GetProcAddress, no
  * libepoxy, nothing from runtime/. The game keeps its own particle array (a fountain stepped on
  * the CPU), two beams and a small tetrahedral volume, and draws them over its opaque pass.
- * usage: sdl_host [libvolfx.so.1] [--frames N] [--ppm FILE]
+ * usage: sdl_host [libvolfx.so.2] [--frames N] [--ppm FILE]
  *   runs N frames (default 8) in a 240x135 window, checks that the water, the beams and the
  *   volume each covered pixels where they should, writes the last frame as a PPM.
  * Exits 0 on success, 77 when SDL finds no display or no GL 4.5 core context. */
