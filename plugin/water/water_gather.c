@@ -175,28 +175,29 @@ vfx_result volfx_water_gather_positions(vfx_context *ctx, volfx_water_gather *g,
     return r;
 }
 
-vfx_result volfx_water_gather_velocities(vfx_context *ctx, volfx_water_gather *g, const volfx_gpu_column *col,
-                                         uint32_t count, GLuint vel, uint32_t first)
+/* A column copied as it is (velocities, kernels) into `out`, `bytes` a particle: no box. */
+static vfx_result gather_copy(vfx_context *ctx, volfx_water_gather *g, const char *mode, const volfx_gpu_column *col,
+                              uint32_t count, GLuint out, uint32_t first, uint32_t bytes)
 {
     if (!count)
         return VFX_OK;
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, vel);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out);
     volfx_gpu_pass_begin(ctx, "water.gather");
-    vfx_result r = gather(ctx, g, "#define MODE_VEL\n", col, count, first, false, 12);
+    vfx_result r = gather(ctx, g, mode, col, count, first, false, bytes);
     volfx_gpu_pass_end(ctx);
     return r;
+}
+
+vfx_result volfx_water_gather_velocities(vfx_context *ctx, volfx_water_gather *g, const volfx_gpu_column *col,
+                                         uint32_t count, GLuint vel, uint32_t first)
+{
+    return gather_copy(ctx, g, "#define MODE_VEL\n", col, count, vel, first, 12);
 }
 
 vfx_result volfx_water_gather_kernels(vfx_context *ctx, volfx_water_gather *g, const volfx_gpu_column *col,
                                       uint32_t count, GLuint kern, uint32_t first)
 {
-    if (!count)
-        return VFX_OK;
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, kern);
-    volfx_gpu_pass_begin(ctx, "water.gather");
-    vfx_result r = gather(ctx, g, "#define MODE_KERNEL\n", col, count, first, false, 24);
-    volfx_gpu_pass_end(ctx);
-    return r;
+    return gather_copy(ctx, g, "#define MODE_KERNEL\n", col, count, kern, first, 24);
 }
 
 void volfx_water_gather_end(volfx_water_gather *g)
