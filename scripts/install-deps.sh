@@ -5,7 +5,7 @@
 set -euo pipefail
 # python3: the shader/scene embedders, tests/gl/check_bench_dump.sh, scripts/testlog-count.py and
 # scripts/make-tet-mesh.sh call it directly (meson pulls it in too). Checked on a debootstrap
-# minbase bookworm by scripts/check-fresh-debian.sh (docs/robustness.md, "Fresh machine").
+# minbase bookworm by scripts/check-fresh-debian.sh (docs/robustness-testing.md, "Fresh machine").
 pkgs=(
   build-essential meson ninja-build pkg-config python3
   libglfw3-dev libepoxy-dev libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri
