@@ -9,14 +9,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "volfx_shaders.h"
-
 /* ------------------------------------------------------------------- shader text */
 
-int volfx_shader_index(const char *path)
+int volfx_shader_index(const volfx_shader_table *t, const char *path)
 {
-    for (unsigned i = 0; i < volfx_embedded_shader_count; ++i)
-        if (strcmp(volfx_embedded_shaders[i].path, path) == 0)
+    for (unsigned i = 0; i < t->count; ++i)
+        if (strcmp(t->entries[i].path, path) == 0)
             return (int)i;
     return -1;
 }
@@ -91,11 +89,12 @@ long volfx_shader_line_base(int index) { return (long)(index + 1) * VOLFX_SHADER
 
 /* Expands one level of #include "x" with #line directives so the driver's line numbers point
  * into the right file: source-string number = the file's index in the embedded table. */
-static bool expand(strbuf *out, const char *path, const char *defines, int depth, char *err, size_t errlen)
+static bool expand(strbuf *out, const volfx_shader_table *t, const char *path, const char *defines, int depth,
+                   char *err, size_t errlen)
 {
-    int idx = volfx_shader_index(path);
+    int idx = volfx_shader_index(t, path);
     char *override = load_override(path);
-    const char *src = override ? override : (idx >= 0 ? volfx_embedded_shaders[idx].source : NULL);
+    const char *src = override ? override : (idx >= 0 ? t->entries[idx].source : NULL);
     if (!src) {
         snprintf(err, errlen, "shader '%s' is not embedded (listed in shaders/*/meson.build?)", path);
         return false;
@@ -124,7 +123,7 @@ static bool expand(strbuf *out, const char *path, const char *defines, int depth
             }
             char inc[128];
             snprintf(inc, sizeof inc, "%.*s", (int)(b - a - 1), a + 1);
-            if (!expand(out, inc, NULL, depth + 1, err, errlen)) {
+            if (!expand(out, t, inc, NULL, depth + 1, err, errlen)) {
                 free(override);
                 return false;
             }
@@ -141,7 +140,8 @@ static bool expand(strbuf *out, const char *path, const char *defines, int depth
 }
 
 /* Rewrites "N:L(C): msg" (Mesa) and "N(L) : msg" (NVIDIA) into "file:L: msg". */
-void volfx_shader_rewrite_log(const char *log, char *out, size_t cap, const char *fallback)
+void volfx_shader_rewrite_log(const volfx_shader_table *t, const char *log, char *out, size_t cap,
+                              const char *fallback)
 {
     size_t o = 0;
     for (const char *p = log; *p && o + 1 < cap;) {
@@ -166,8 +166,7 @@ void volfx_shader_rewrite_log(const char *log, char *out, size_t cap, const char
             file = line / VOLFX_SHADER_LINE_STRIDE - 1;
             line %= VOLFX_SHADER_LINE_STRIDE;
         }
-        const char *name = (line >= 0 && file >= 0 && file < (long)volfx_embedded_shader_count)
-                               ? volfx_embedded_shaders[file].path : fallback;
+        const char *name = (line >= 0 && file >= 0 && file < (long)t->count) ? t->entries[file].path : fallback;
         int w;
         if (line >= 0)
             w = snprintf(out + o, cap - o, "%s:%ld: %.*s\n", name, line, (int)(n - (size_t)(rest - p)), rest);
@@ -181,10 +180,11 @@ void volfx_shader_rewrite_log(const char *log, char *out, size_t cap, const char
     out[o < cap ? o : cap - 1] = 0;
 }
 
-char *volfx_shader_expand(const char *path, const char *defines, char *err, size_t errlen)
+char *volfx_shader_expand(const volfx_shader_table *t, const char *path, const char *defines, char *err,
+                          size_t errlen)
 {
     strbuf b = {0};
-    if (!expand(&b, path, defines, 0, err, errlen) || b.oom) {
+    if (!expand(&b, t, path, defines, 0, err, errlen) || b.oom) {
         if (b.oom)
             snprintf(err, errlen, "out of memory expanding shader '%s'", path);
         free(b.p);

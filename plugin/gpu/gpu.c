@@ -141,7 +141,7 @@ GLuint volfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *s
         glGetShaderiv(shaders[i], GL_COMPILE_STATUS, &status);
         if (!status) {
             glGetShaderInfoLog(shaders[i], sizeof log, NULL, log);
-            volfx_shader_rewrite_log(log, pretty, sizeof pretty, names[i]);
+            volfx_shader_rewrite_log(&volfx_plugin_shaders, log, pretty, sizeof pretty, names[i]);
             volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_SHADER_COMPILE, "shader compile failed: %s", pretty);
             ok = false;
         } else {
@@ -222,7 +222,7 @@ static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const c
     GLuint prog = 0;
     bool ok = true;
     for (int i = 0; i < n && ok; ++i)
-        if (!(bufs[i] = volfx_shader_expand(paths[i], defines, err, sizeof err))) {
+        if (!(bufs[i] = volfx_shader_expand(&volfx_plugin_shaders, paths[i], defines, err, sizeof err))) {
             volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_SHADER_COMPILE, "%s", err);
             ok = false;
         }

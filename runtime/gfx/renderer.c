@@ -39,7 +39,7 @@ struct rt_renderer {
 static GLuint compile(const rt_logger *log, GLenum stage, const char *path)
 {
     char err[256], raw[4096], pretty[8192];
-    char *src = volfx_shader_expand(path, NULL, err, sizeof err);
+    char *src = volfx_shader_expand(&rt_host_shaders, path, NULL, err, sizeof err);
     if (!src) {
         rt_logf(log, VFX_LOG_ERROR, "host shader: %s", err);
         return 0;
@@ -52,7 +52,7 @@ static GLuint compile(const rt_logger *log, GLenum stage, const char *path)
     glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
     if (!ok) {
         glGetShaderInfoLog(s, sizeof raw, NULL, raw);
-        volfx_shader_rewrite_log(raw, pretty, sizeof pretty, path);
+        volfx_shader_rewrite_log(&rt_host_shaders, raw, pretty, sizeof pretty, path);
         rt_logf(log, VFX_LOG_ERROR, "host shader compile failed: %s", pretty);
         glDeleteShader(s);
         return 0;

@@ -14,6 +14,7 @@
 
 #include "app.h"
 #include "gpu/gpu.h"
+#include "shader_text.h"
 #include "debug.h"
 #include "camera_ref.h"
 #include "test_util.h"
@@ -166,9 +167,7 @@ static void test_shader_error_names_file_line(void **state)
     vfx_context *ctx;
     assert_int_equal(api->create(&host, &ctx), VFX_OK);
     char src[256];
-    extern int volfx_shader_index(const char *path);
-    extern long volfx_shader_line_base(int index);
-    int idx = volfx_shader_index("common/depth.glsl");
+    int idx = volfx_shader_index(&volfx_plugin_shaders, "common/depth.glsl");
     assert_true(idx >= 0);
     /* line 3 of the named file has the error */
     snprintf(src, sizeof src, "#version 450 core\n#line %ld\nvoid f() {}\n\nvoid main() { undefined_thing = 1; }\n",
@@ -185,10 +184,13 @@ static void test_shader_error_names_file_line(void **state)
     /* a shader that is not embedded is named */
     assert_int_equal(volfx_gpu_program(ctx, "common/fullscreen.vert", "nope/none.frag", NULL), 0);
     assert_true(test_last_error_is(api, ctx, VFX_LOG_ID_SHADER_COMPILE, "nope/none.frag"));
+    /* the host's shaders are not the plugin's */
+    assert_int_equal(volfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", NULL), 0);
+    assert_true(test_last_error_is(api, ctx, VFX_LOG_ID_SHADER_COMPILE, "host/mesh.vert"));
     /* the real embedded program links, and is cached */
-    GLuint p0 = volfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", NULL);
+    GLuint p0 = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/composite.frag", NULL);
     assert_int_not_equal(p0, 0);
-    assert_int_equal(volfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", NULL), p0);
+    assert_int_equal(volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/composite.frag", NULL), p0);
     /* define sets that differ only far into the string are different programs */
     char d1[400], d2[400];
     memset(d1, 0, sizeof d1);
@@ -197,8 +199,8 @@ static void test_shader_error_names_file_line(void **state)
     memcpy(d2, d1, sizeof d1);
     strcat(d1, "\n#define VARIANT 1");
     strcat(d2, "\n#define VARIANT 2");
-    GLuint p1 = volfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", d1);
-    GLuint p2 = volfx_gpu_program(ctx, "host/mesh.vert", "host/mesh.frag", d2);
+    GLuint p1 = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/composite.frag", d1);
+    GLuint p2 = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/composite.frag", d2);
     assert_true(p1 != 0 && p2 != 0 && p1 != p2 && p1 != p0);
     api->destroy(ctx);
 }

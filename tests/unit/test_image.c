@@ -74,24 +74,24 @@ static void test_png_valid(void **state)
 static void test_shader_log_rewrite(void **state)
 {
     (void)state;
-    int idx = volfx_shader_index("common/fullscreen.vert");
+    int idx = volfx_shader_index(&rt_host_shaders, "common/fullscreen.vert");
     assert_true(idx >= 0);
     char log[128], out[256];
     /* Mesa's and NVIDIA's formats both come back as file:line */
     snprintf(log, sizeof log, "%d:7(12): error: syntax error\n", idx);
-    volfx_shader_rewrite_log(log, out, sizeof out, "x");
+    volfx_shader_rewrite_log(&rt_host_shaders, log, out, sizeof out, "x");
     assert_non_null(strstr(out, "common/fullscreen.vert:7: error: syntax error"));
     snprintf(log, sizeof log, "%d(9) : error C0000: bad\n", idx);
-    volfx_shader_rewrite_log(log, out, sizeof out, "x");
+    volfx_shader_rewrite_log(&rt_host_shaders, log, out, sizeof out, "x");
     assert_non_null(strstr(out, "common/fullscreen.vert:9:"));
     /* Mesa prints source string 0 whatever #line said: the file comes from the line number */
     snprintf(log, sizeof log, "0:%ld(3): error: x\n", volfx_shader_line_base(idx) + 42);
-    volfx_shader_rewrite_log(log, out, sizeof out, "x");
+    volfx_shader_rewrite_log(&rt_host_shaders, log, out, sizeof out, "x");
     assert_non_null(strstr(out, "common/fullscreen.vert:42: error: x"));
     char err[128];
-    assert_null(volfx_shader_expand("nope/missing.frag", NULL, err, sizeof err));
+    assert_null(volfx_shader_expand(&rt_host_shaders, "nope/missing.frag", NULL, err, sizeof err));
     assert_non_null(strstr(err, "nope/missing.frag"));
-    char *src = volfx_shader_expand("common/fullscreen.vert", "#define X 1", err, sizeof err);
+    char *src = volfx_shader_expand(&rt_host_shaders, "common/fullscreen.vert", "#define X 1", err, sizeof err);
     assert_non_null(src);
     assert_true(strncmp(src, "#version 450 core\n#define X 1\n", 30) == 0);
     free(src);

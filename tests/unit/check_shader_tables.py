@@ -1,0 +1,33 @@
+#!/usr/bin/env python3
+"""check_shader_tables.py LIB SHADER_ROOT --plugin FILE... --host FILE...
+The plugin ships its own shaders and none of the sample host's: every file of the plugin's table
+is in LIB's bytes (embed.py keeps the text verbatim), and no host-only file (listed in the
+host's table, not in the plugin's) is."""
+import os
+import sys
+
+lib, root = sys.argv[1], sys.argv[2]
+args = sys.argv[3:]
+plugin = args[args.index("--plugin") + 1: args.index("--host")]
+host = args[args.index("--host") + 1:]
+data = open(lib, "rb").read()
+rel = lambda f: os.path.relpath(os.path.abspath(f), os.path.abspath(root))
+
+
+def embedded(f):
+    # embed.py keeps the text verbatim: a file is in the binary when each of its lines is
+    # (C string concatenation joins them); a line shorter than 24 bytes proves nothing alone
+    lines = [l for l in open(f, encoding="utf-8").read().split("\n") if len(l.strip()) >= 24]
+    return bool(lines) and all(l.encode() in data for l in lines)
+
+
+plugin_rel = {rel(f) for f in plugin}
+bad = [rel(f) for f in host if rel(f) not in plugin_rel and embedded(f)]
+missing = [rel(f) for f in plugin if not embedded(f) and any(len(l.strip()) >= 24 for l in open(f))]
+if missing:
+    print("%s: the plugin's own shaders are not found in it (the check is blind): %s" % (lib, ", ".join(missing)))
+if bad:
+    print("%s carries the host's shaders: %s" % (lib, ", ".join(bad)))
+if missing or bad:
+    sys.exit(1)
+print("%s: %d plugin shaders embedded, none of the host's %d" % (lib, len(plugin), len([f for f in host if rel(f) not in plugin_rel])))
