@@ -26,6 +26,7 @@ typedef struct scene {
     uint32_t n;
     vfx_water_params params;
     vfx_lab_water lab; /* the lab method BRUTE and the NO_* bits */
+    bool tile;         /* method TILE (the default) instead of BRUTE: a pool too large for BRUTE */
 } scene;
 
 static uint32_t chunk_count(void *user) { return water_test_chunk_count(((scene *)user)->n, 128); }
@@ -37,13 +38,16 @@ static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
     return VFX_OK;
 }
 
-/* The scene's parameters, the isotropic kernel (as the references), the lab method BRUTE. */
+/* The scene's parameters, the isotropic kernel (as the references), the lab method BRUTE (or
+ * TILE at full resolution). */
 static vfx_result water_params(void *user, vfx_water_params *out)
 {
     scene *s = user;
     *out = s->params;
     out->type = VFX_TYPE_WATER_PARAMS;
     out->kernel = VFX_WATER_KERNEL_ISOTROPIC;
+    if (s->tile)
+        return VFX_OK;
     s->lab.type = VFX_TYPE_LAB_WATER;
     s->lab.method = VFX_WATER_METHOD_BRUTE;
     out->next = &s->lab;
@@ -64,18 +68,23 @@ static scene make_scene(uint32_t n)
 
 static void free_scene(scene *s) { free(s->x); free(s->y); free(s->z); }
 
-/* A slab of nx x nx x layers particles at spacing h/2, centred on x = z = 0, its top at y = 0. */
-static scene slab_scene(uint32_t nx, uint32_t layers)
+/* A slab of nx x nz x layers particles at spacing d (h = 2 d), centred on (x, z) = (0, cz), its
+ * top at y = 0. */
+static scene pool_scene(uint32_t nx, uint32_t nz, uint32_t layers, float d, float cz)
 {
-    scene s = make_scene(nx * nx * layers);
-    float d = 0.305f;
+    scene s = make_scene(nx * nz * layers);
+    s.params.h = 2.0f * d;
     for (uint32_t i = 0; i < s.n; ++i) {
         s.x[i] = d * ((float)(i % nx) - 0.5f * (float)(nx - 1));
-        s.z[i] = d * ((float)((i / nx) % nx) - 0.5f * (float)(nx - 1));
-        s.y[i] = -d * (float)(i / (nx * nx));
+        s.z[i] = cz + d * ((float)((i / nx) % nz) - 0.5f * (float)(nz - 1));
+        s.y[i] = -d * (float)(i / (nx * nz));
     }
     return s;
 }
+
+/* A slab of nx x nx x layers particles at spacing h/2 (h 0.61), centred on x = z = 0, its top at
+ * y = 0. */
+static scene slab_scene(uint32_t nx, uint32_t layers) { return pool_scene(nx, nx, layers, 0.305f, 0.0f); }
 
 /* One frame of the plugin over a host image of colour `col` (and `col2` left of column
  * `split`) and, when `depth` is given, a host depth texture (`depth2` left of `split`); the
@@ -126,12 +135,60 @@ static void render(scene *s, const ref_camera *cam, const float col[4], const fl
     glDeleteTextures(3, tex);
 }
 
-/* The window depth of the point at distance d along the camera's axis. */
+/* The window depth of a point at distance d along the camera's axis (its view depth). */
 static float axis_depth(const ref_camera *cam, double d)
 {
     double n = cam->near_plane, f = cam->far_plane;
     double z_ndc = (f + n) / (f - n) - 2.0 * f * n / ((f - n) * d);
     return (float)(0.5 * z_ndc + 0.5);
+}
+
+/* One frame of the plugin over the host image `col` (RGBA32F) and depth `dep`, both GL rows
+ * (bottom first), with or without SSR, rendered twice (a frame's counters are read a frame
+ * late): the RGBA32F result (GL rows), the water's distance image (top row first) and
+ * water.ssr_hits. */
+static double render_host(scene *s, const ref_camera *cam, const float *col, const float *dep, bool ssr, float *px,
+                          float *dist)
+{
+    const uint32_t w = cam->width, h = cam->height;
+    const size_t n = (size_t)w * h;
+    s->params.features_off = ssr ? 0u : VFX_WATER_NO_SSR;
+    vfx_context_desc host_api = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = s,
+                                 .log = test_vfx_log_fn, .particle_chunk_count = chunk_count,
+                                 .particle_chunk = chunk_view, .water_params = water_params};
+    vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
+    vfx_context *ctx;
+    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
+    assert_int_equal(api.create(&host_api, &ctx), VFX_OK);
+    GLuint tex[3], fbo;
+    glCreateTextures(GL_TEXTURE_2D, 3, tex);
+    glTextureStorage2D(tex[0], 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
+    glTextureStorage2D(tex[1], 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
+    glTextureStorage2D(tex[2], 1, GL_DEPTH_COMPONENT32F, (GLsizei)w, (GLsizei)h);
+    glTextureSubImage2D(tex[1], 0, 0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_FLOAT, col);
+    glTextureSubImage2D(tex[2], 0, 0, 0, (GLsizei)w, (GLsizei)h, GL_DEPTH_COMPONENT, GL_FLOAT, dep);
+    glTextureSubImage2D(tex[0], 0, 0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_FLOAT, col);
+    glCreateFramebuffers(1, &fbo);
+    glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, tex[0], 0);
+    vfx_frame_view fv = {.type = VFX_TYPE_FRAME_VIEW, .framebuffer = fbo, .color_texture = tex[1],
+                         .depth_texture = tex[2], .width = w, .height = h, .fov_y = (float)cam->fov_y,
+                         .near_plane = (float)cam->near_plane, .far_plane = (float)cam->far_plane, .color_hdr = 1};
+    for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam->eye[k];
+    ref_camera_matrices(cam, fv.view, fv.proj);
+    assert_int_equal(api.update(ctx, 0.0, 0.0f), VFX_OK);
+    assert_int_equal(api.render(ctx, &fv), VFX_OK);
+    assert_int_equal(api.render(ctx, &fv), VFX_OK);
+    glGetTextureImage(tex[0], 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * 16), px);
+    assert_int_equal(api.read_raw(ctx, VFX_EFFECT_WATER, dist, n), VFX_OK);
+    vfx_stats st = {.type = VFX_TYPE_STATS};
+    assert_int_equal(api.get_stats(ctx, &st), VFX_OK);
+    double hits = -1;
+    for (uint32_t k = 0; k < st.count; ++k)
+        if (!strcmp(st.entries[k].name, "water.ssr_hits")) hits = st.entries[k].value;
+    api.destroy(ctx);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteTextures(3, tex);
+    return hits;
 }
 
 /* A host object in front of the water covers the left half of the screen (its depth there is
@@ -271,7 +328,8 @@ static void test_fresnel_grazing(void **state)
  * pixels rises by more than 0.05 against the same frame with VFX_WATER_NO_SSR, which sees only
  * the procedural sky there (measured 0.06 -> 0.23, 436 hits). An SSR that never hits, or reads
  * the wrong channels (planted: .bgr, -0.15), fails it. What it does not catch: a false hit under
- * a floating object's edge (an inverted depth comparison passes here, redder still). */
+ * a floating object's edge (an inverted depth comparison passes here, redder still: 0.35);
+ * test_ssr_under_floating_object does. */
 static void test_ssr_reflects_host(void **state)
 {
     (void)state;
@@ -292,10 +350,7 @@ static void test_ssr_reflects_host(void **state)
             bool on = t > 0 && fabs(p[0]) <= 2 && p[1] >= 0 && p[1] <= 2;
             float c[4] = {on ? 3.0f : 0.0f, 0.0f, 0.0f, 1.0f};
             memcpy(col + 4 * q, c, sizeof c);
-            double ze = t * (dir[0] * fwd[0] + dir[1] * fwd[1] + dir[2] * fwd[2]);
-            dep[q] = on ? (float)(0.5 * ((cam.far_plane + cam.near_plane) / (cam.far_plane - cam.near_plane)
-                                         - 2.0 * cam.far_plane * cam.near_plane / ((cam.far_plane - cam.near_plane) * ze)) + 0.5)
-                        : 1.0f;
+            dep[q] = on ? axis_depth(&cam, t * (dir[0] * fwd[0] + dir[1] * fwd[1] + dir[2] * fwd[2])) : 1.0f;
             wall += on;
         }
     double redness[2];
@@ -303,40 +358,8 @@ static void test_ssr_reflects_host(void **state)
     for (int on = 0; on < 2; ++on) {
         scene s = slab_scene(24, 2);
         s.params.color[0] = s.params.color[1] = s.params.color[2] = 1.0f; /* clear: what it reflects shows */
-        s.params.features_off = on ? 0u : VFX_WATER_NO_SSR;
-        vfx_context_desc host_api = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = &s,
-                                     .log = test_vfx_log_fn, .particle_chunk_count = chunk_count,
-                                     .particle_chunk = chunk_view, .water_params = water_params};
-        vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
-        vfx_context *ctx;
-        assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
-        assert_int_equal(api.create(&host_api, &ctx), VFX_OK);
-        GLuint tex[3], fbo;
-        glCreateTextures(GL_TEXTURE_2D, 3, tex);
-        glTextureStorage2D(tex[0], 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
-        glTextureStorage2D(tex[1], 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);
-        glTextureStorage2D(tex[2], 1, GL_DEPTH_COMPONENT32F, (GLsizei)w, (GLsizei)h);
-        glTextureSubImage2D(tex[1], 0, 0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_FLOAT, col);
-        glTextureSubImage2D(tex[2], 0, 0, 0, (GLsizei)w, (GLsizei)h, GL_DEPTH_COMPONENT, GL_FLOAT, dep);
-        glTextureSubImage2D(tex[0], 0, 0, 0, (GLsizei)w, (GLsizei)h, GL_RGBA, GL_FLOAT, col);
-        glCreateFramebuffers(1, &fbo);
-        glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, tex[0], 0);
-        vfx_frame_view fv = {.type = VFX_TYPE_FRAME_VIEW, .framebuffer = fbo, .color_texture = tex[1],
-                             .depth_texture = tex[2], .width = w, .height = h, .fov_y = (float)cam.fov_y,
-                             .near_plane = (float)cam.near_plane, .far_plane = (float)cam.far_plane, .color_hdr = 1};
-        for (int k = 0; k < 3; ++k) fv.eye[k] = (float)cam.eye[k];
-        ref_camera_matrices(&cam, fv.view, fv.proj);
-        assert_int_equal(api.update(ctx, 0.0, 0.0f), VFX_OK);
-        assert_int_equal(api.render(ctx, &fv), VFX_OK);
-        assert_int_equal(api.render(ctx, &fv), VFX_OK); /* the counters of a frame are read a frame late */
         float *px = malloc(n * 16), *dist = malloc(n * 4);
-        glGetTextureImage(tex[0], 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * 16), px);
-        assert_int_equal(api.read_raw(ctx, VFX_EFFECT_WATER, dist, n), VFX_OK);
-        vfx_stats st = {.type = VFX_TYPE_STATS};
-        assert_int_equal(api.get_stats(ctx, &st), VFX_OK);
-        hits[on] = -1;
-        for (uint32_t k = 0; k < st.count; ++k)
-            if (!strcmp(st.entries[k].name, "water.ssr_hits")) hits[on] = st.entries[k].value;
+        hits[on] = render_host(&s, &cam, col, dep, on, px, dist);
         double sum = 0;
         uint32_t count = 0;
         for (uint32_t j = 0; j < h; ++j)
@@ -351,14 +374,138 @@ static void test_ssr_reflects_host(void **state)
                       on ? "on" : "off", wall, count, redness[on], hits[on]);
         assert_true(count > 200);
         free(px); free(dist);
-        api.destroy(ctx);
-        glDeleteFramebuffers(1, &fbo);
-        glDeleteTextures(3, tex);
         free_scene(&s);
     }
     assert_true(hits[1] > 50);
     assert_true(redness[1] > redness[0] + 0.05);
     free(col); free(dep);
+}
+
+/* The floating plate of test_ssr_under_floating_object: x in [-1.2, 1.2], y in [0.75, 1.75],
+ * z in [-2.3, -2.0], grown by g on every side. */
+static bool plate_hit(const double o[3], const double d[3], double g, double *t_out)
+{
+    const double lo[3] = {-1.2 - g, 0.75 - g, -2.3 - g}, hi[3] = {1.2 + g, 1.75 + g, -2.0 + g};
+    double t0 = 0.0, t1 = 1e30;
+    for (int k = 0; k < 3; ++k) {
+        if (fabs(d[k]) < 1e-12) {
+            if (o[k] < lo[k] || o[k] > hi[k]) return false;
+            continue;
+        }
+        double a = (lo[k] - o[k]) / d[k], b = (hi[k] - o[k]) / d[k];
+        if (a > b) { double c = a; a = b; b = c; }
+        t0 = fmax(t0, a);
+        t1 = fmin(t1, b);
+    }
+    if (t0 > t1) return false;
+    *t_out = t0;
+    return true;
+}
+
+/* A reflected ray the march must not take the plate's colour on, whatever its steps: from x along
+ * r it passes under the plate (grown by 0.2: clear of its edge), and wherever it is seen behind
+ * the plate from the eye it is behind the plate's front by more than the march's thickness
+ * bound there, max(step, h) (shade.frag ssr: 24 steps at reach (k/24)^2), plus 0.3. */
+static bool passes_under_plate(const ref_camera *cam, const double x[3], const double r[3], double reach, double hh)
+{
+    double t;
+    if (plate_hit(x, r, 0.2, &t)) return false;
+    double s_front = (-2.0 - x[2]) / r[2], y = x[1] + s_front * r[1], xx = x[0] + s_front * r[0];
+    if (!(s_front > 0 && y < 0.55 && fabs(xx) < 1.0)) return false; /* under it, not beside or over */
+    for (double s = 0.05; s <= reach; s += 0.05) {
+        double q[3], d[3], len = 0;
+        for (int k = 0; k < 3; ++k) { q[k] = x[k] + s * r[k]; d[k] = q[k] - cam->eye[k]; len += d[k] * d[k]; }
+        len = sqrt(len);
+        for (int k = 0; k < 3; ++k) d[k] /= len;
+        double kk = ceil(24.0 * sqrt(s / reach)), step = reach * (2.0 * kk - 1.0) / 576.0;
+        if (plate_hit(cam->eye, d, 0.0, &t) && t < len && len - t < fmax(step, hh) + 0.3) return false;
+    }
+    return true;
+}
+
+/* SSR with a floating object: a bright red plate (above) hovers over a clear pool (h 0.3, a
+ * finer pool than h 0.61, so the gap under the plate is 2 h above the surface and the pool's flat
+ * middle holds both kinds of pixel below) in front of a dark blue wall (z = -8), in the host's
+ * colour and depth. The expected reflection of each water pixel is traced here in double: its
+ * surface point from the water's distance image, the normal straight up (the slab's surface is
+ * flat to 1e-3 h), pixels within 2 h of the slab's sides left out.
+ * - Rays that hit the plate's face (0.15 inside its edges): SSR takes its red (mean red - blue up
+ *   by more than 0.1 against NO_SSR).
+ * - Rays that pass under the plate (passes_under_plate) must not take its colour: the wall they
+ *   meet is hidden behind the plate from the eye, so the march finds nothing and they keep the
+ *   sky; their mean red - blue may not rise by more than 0.02, nor 2% of them by 0.1.
+ * Measured (llvmpipe, 128x96): 320 pixels reflecting the plate, up 0.53; 152 passing under it,
+ * up 0.0000. Planted, each fails it: the depth comparison inverted (`<=` as `>=`: the first
+ * samples "hit" the wall behind the water; the plate's pixels -0.12) and the thickness rule
+ * removed (a ray seen behind the plate takes its colour: all 152 up, mean 0.90); the first
+ * passes test_ssr_reflects_host, the second too. */
+static void test_ssr_under_floating_object(void **state)
+{
+    (void)state;
+    const ref_camera cam = {{0.0, 1.0, 6.0}, {0.0, 0.5, -2.0}, {0, 1, 0}, 0.6, 128, 96, 0.1, 100};
+    const uint32_t w = cam.width, h = cam.height;
+    const size_t n = (size_t)w * h;
+    float *col = malloc(n * 16), *dep = malloc(n * 4);
+    double fwd[3], right[3], up[3];
+    ref_camera_basis(&cam, fwd, right, up);
+    uint32_t plate = 0;
+    for (uint32_t j = 0; j < h; ++j) /* GL rows: j = 0 the bottom */
+        for (uint32_t i = 0; i < w; ++i) {
+            size_t q = (size_t)j * w + i;
+            double dir[3], t, t_wall;
+            ref_pixel_ray(&cam, i, h - 1 - j, dir);
+            bool on = plate_hit(cam.eye, dir, 0.0, &t);
+            t_wall = (-8.0 - cam.eye[2]) / dir[2];
+            if (!on) t = t_wall;
+            float c[4] = {on ? 3.0f : 0.0f, 0.0f, on ? 0.0f : 0.2f, 1.0f};
+            memcpy(col + 4 * q, c, sizeof c);
+            dep[q] = axis_depth(&cam, t * (dir[0] * fwd[0] + dir[1] * fwd[1] + dir[2] * fwd[2]));
+            plate += on;
+        }
+    float *px[2] = {malloc(n * 16), malloc(n * 16)}, *dist = malloc(n * 4);
+    double hits[2];
+    const float d = 0.15f, cz = 0.8f;
+    const uint32_t nx = 32, nz = 32;
+    for (int on = 0; on < 2; ++on) {
+        scene s = pool_scene(nx, nz, 2, d, cz);
+        s.tile = true;
+        s.params.preset = VFX_WATER_PRESET_HIGH; /* full resolution: every pixel's own normal */
+        s.params.color[0] = s.params.color[1] = s.params.color[2] = 1.0f; /* clear: what it reflects shows */
+        hits[on] = render_host(&s, &cam, col, dep, on, px[on], dist);
+        free_scene(&s);
+    }
+    const double half_x = 0.5 * d * (nx - 1) - 4.0 * d, half_z = 0.5 * d * (nz - 1) - 4.0 * d;
+    double rise[2] = {0, 0};
+    uint32_t count[2] = {0, 0}, big = 0;
+    for (uint32_t j = 0; j < h; ++j)
+        for (uint32_t i = 0; i < w; ++i) {
+            size_t qd = (size_t)(h - 1 - j) * w + i, q = (size_t)j * w + i; /* dist: top row first */
+            if (dist[qd] < 0) continue;
+            double dir[3], x[3], r[3], t;
+            ref_pixel_ray(&cam, i, h - 1 - j, dir);
+            for (int k = 0; k < 3; ++k) x[k] = cam.eye[k] + dist[qd] * dir[k];
+            if (fabs(x[0]) > half_x || fabs(x[2] - cz) > half_z) continue;
+            r[0] = dir[0]; r[1] = -dir[1]; r[2] = dir[2];
+            double reach = fmax(2.0 * dist[qd], 40.0 * 2.0 * d); /* the march's (shade.frag SSR_REACH) */
+            int kind = -1;
+            if (plate_hit(x, r, -0.15, &t)) kind = 0;
+            else if (passes_under_plate(&cam, x, r, reach, 2.0 * d)) kind = 1;
+            if (kind < 0) continue;
+            double dr = (px[1][4 * q] - px[1][4 * q + 2]) - (px[0][4 * q] - px[0][4 * q + 2]);
+            rise[kind] += dr;
+            ++count[kind];
+            big += kind == 1 && dr > 0.1;
+        }
+    for (int k = 0; k < 2; ++k) rise[k] = count[k] ? rise[k] / count[k] : 0;
+    print_message("SSR, floating plate: %u plate pixels, ssr_hits %.0f / %.0f; %u water pixels reflecting the plate "
+                  "(red - blue up %.4f), %u passing under it (up %.4f, %u by > 0.1)\n",
+                  plate, hits[0], hits[1], count[0], rise[0], count[1], rise[1], big);
+    assert_true(count[0] > 100 && count[1] > 100);
+    assert_true(hits[1] > 100);
+    assert_true(rise[0] > 0.1);
+    assert_true(rise[1] < 0.02);
+    assert_true(big <= count[1] / 50);
+    free(px[0]); free(px[1]); free(dist); free(col); free(dep);
 }
 
 int main(void)
@@ -369,6 +516,7 @@ int main(void)
         cmocka_unit_test(test_deep_tinted_shallow_clear),
         cmocka_unit_test(test_fresnel_grazing),
         cmocka_unit_test(test_ssr_reflects_host),
+        cmocka_unit_test(test_ssr_under_floating_object),
     };
     int r = cmocka_run_group_tests(tests, NULL, NULL);
     rt_gl_context_destroy(gl);
