@@ -17,15 +17,14 @@
 #include <string.h>
 
 #include "context.h"
+#include "test_particle_host.h"
 #include "test_util.h"
 
 #define W 96
 #define H 64
 
 typedef struct host {
-    test_log log;
-    uint32_t n;
-    float *x, *y, *z, *vx, *vy, *vz;
+    test_particle_host ph; /* first: the particles, and the log the plugin's user pointer reaches */
     vfx_beam beam;
     float points[12];
     uint32_t tet[4];
@@ -35,15 +34,6 @@ typedef struct host {
 
 static uint32_t chunk_count(void *user) { return ((host *)user)->water ? 1 : 0; }
 
-static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
-{
-    host *h = user;
-    (void)index;
-    out->count = h->n;
-    out->pos[0] = h->x, out->pos[1] = h->y, out->pos[2] = h->z;
-    out->vel[0] = h->vx, out->vel[1] = h->vy, out->vel[2] = h->vz;
-    return VFX_OK;
-}
 
 static vfx_result beams_view(void *user, vfx_beams_view *out)
 {
@@ -72,9 +62,9 @@ static void make_host(host *s)
 {
     memset(s, 0, sizeof *s);
     const uint32_t nx = 14, ny = 6, nz = 10;
-    s->n = nx * ny * nz;
-    float **cols[] = {&s->x, &s->y, &s->z, &s->vx, &s->vy, &s->vz};
-    for (int k = 0; k < 6; ++k) *cols[k] = malloc(s->n * sizeof(float));
+    s->ph.n = nx * ny * nz;
+    float **cols[] = {&s->ph.x, &s->ph.y, &s->ph.z, &s->ph.vx, &s->ph.vy, &s->ph.vz};
+    for (int k = 0; k < 6; ++k) *cols[k] = malloc(s->ph.n * sizeof(float));
     uint32_t i = 0, seed = 99;
     for (uint32_t a = 0; a < nx; ++a)
         for (uint32_t b = 0; b < ny; ++b)
@@ -84,9 +74,9 @@ static void make_host(host *s)
                     seed = seed * 1664525u + 1013904223u;
                     j[k] = ((float)(seed >> 8) / 16777216.0f - 0.5f) * 0.02f;
                 }
-                s->x[i] = 0.05f * a + j[0] - 0.55f, s->y[i] = 0.05f * b + j[1] - 0.3f, s->z[i] = 0.05f * c + j[2] - 0.3f;
+                s->ph.x[i] = 0.05f * a + j[0] - 0.55f, s->ph.y[i] = 0.05f * b + j[1] - 0.3f, s->ph.z[i] = 0.05f * c + j[2] - 0.3f;
                 float top = (float)b / (float)(ny - 1);
-                s->vx[i] = 2.5f * sinf(9.0f * s->x[i]), s->vy[i] = 3.5f * top * top, s->vz[i] = 0.7f * cosf(5.0f * s->z[i]);
+                s->ph.vx[i] = 2.5f * sinf(9.0f * s->ph.x[i]), s->ph.vy[i] = 3.5f * top * top, s->ph.vz[i] = 0.7f * cosf(5.0f * s->ph.z[i]);
             }
     /* a beam across the view in front of the water, partly over it */
     s->beam = (vfx_beam){.type = VFX_TYPE_BEAM, .head = {0.6f, 0.15f, 0.2f}, .length = 1.2f, .dir = {1, 0, 0}, .radius = 0.06f, .a = 1.0f,
@@ -102,7 +92,7 @@ static void make_host(host *s)
 
 static void free_host(host *s)
 {
-    float *cols[] = {s->x, s->y, s->z, s->vx, s->vy, s->vz};
+    float *cols[] = {s->ph.x, s->ph.y, s->ph.z, s->ph.vx, s->ph.vy, s->ph.vz};
     for (int k = 0; k < 6; ++k) free(cols[k]);
 }
 
@@ -137,7 +127,7 @@ static void session_open(session *ss, host *h, bool layer)
     memset(ss, 0, sizeof *ss);
     vfx_context_desc api = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc,
                         .user = h, .log = test_vfx_log_fn, .particle_chunk_count = chunk_count,
-                        .particle_chunk = chunk_view, .beams = beams_view, .volume_count = volume_count,
+                        .particle_chunk = test_particle_host_chunk, .beams = beams_view, .volume_count = volume_count,
                         .volume = volume_view};
     ss->api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
@@ -153,19 +143,11 @@ static void session_open(session *ss, host *h, bool layer)
     glNamedFramebufferTexture(ss->fbo, GL_COLOR_ATTACHMENT0, ss->out, 0);
     if (layer)
         ss->layer = texture(GL_RGBA16F);
-    ss->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW,
-                                      .framebuffer = layer ? 0 : ss->fbo, .color_texture = ss->scene, .width = W,
-                                      .height = H, .fov_y = 0.9f, .near_plane = 0.05f, .far_plane = 100.0f,
-                               .color_hdr = 1, .layer_texture = ss->layer};
+    ss->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW, .framebuffer = layer ? 0 : ss->fbo,
+                              .color_texture = ss->scene, .width = W, .height = H, .color_hdr = 1,
+                              .layer_texture = ss->layer};
     const float eye[3] = {0.0f, 0.5f, 1.6f};
-    memcpy(ss->fv.eye, eye, sizeof eye);
-    const float c = cosf(0.3f), s = sinf(0.3f);
-    const float view[16] = {1, 0, 0, 0, 0, c, s, 0, 0, -s, c, 0,
-                            0, -(c * eye[1] - s * eye[2]), -(s * eye[1] + c * eye[2]), 1};
-    const float f = 1.0f / tanf(0.45f), nn = 0.05f, ff = 100.0f, asp = (float)W / H;
-    const float proj[16] = {f / asp, 0, 0, 0, 0, f, 0, 0, 0, 0, (ff + nn) / (nn - ff), -1, 0, 0, 2 * ff * nn / (nn - ff), 0};
-    memcpy(ss->fv.view, view, sizeof view);
-    memcpy(ss->fv.proj, proj, sizeof proj);
+    test_frame_view_look(&ss->fv, eye, 0.3f);
 }
 
 static void session_close(session *ss)

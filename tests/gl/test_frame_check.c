@@ -151,17 +151,24 @@ static void expect(const vfx_plugin_api *api, vfx_context *ctx, const vfx_frame_
     assert_int_equal(glGetError(), GL_NO_ERROR); /* the checks leave no GL error behind */
 }
 
+/* A context over the beams host (its messages in *log), updated once, and the fixture's frame. */
+static vfx_context *open_beams(test_log *log, fixture *f)
+{
+    vfx_context_desc host = beams_host(log);
+    vfx_context *ctx;
+    assert_int_equal(plugin_api()->create(&host, &ctx), VFX_OK);
+    assert_int_equal(plugin_api()->update(ctx, 0.0, 0.0f), VFX_OK);
+    make_fixture(f);
+    return ctx;
+}
+
 static void test_frame_fields(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_context_desc host = beams_host(&log);
-    const vfx_plugin_api *api = plugin_api();
-    vfx_context *ctx;
-    assert_int_equal(api->create(&host, &ctx), VFX_OK);
-    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_OK);
     fixture f;
-    make_fixture(&f);
+    vfx_context *ctx = open_beams(&log, &f);
+    const vfx_plugin_api *api = plugin_api();
     /* read_raw before any render (issue 28: VFX_OK with nothing rendered) */
     static float early[W * H];
     assert_int_equal(api->read_raw(ctx, VFX_EFFECT_BEAMS, early, W * H), VFX_ERR_NOT_FOUND);
@@ -628,13 +635,9 @@ static void test_frame_block(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_context_desc host = beams_host(&log);
-    const vfx_plugin_api *api = plugin_api();
-    vfx_context *ctx;
-    assert_int_equal(api->create(&host, &ctx), VFX_OK);
-    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_OK);
     fixture f;
-    make_fixture(&f);
+    vfx_context *ctx = open_beams(&log, &f);
+    const vfx_plugin_api *api = plugin_api();
     vfx_frame_view v3 = f.fv;
     v3.near_plane = 0, v3.far_plane = 0; /* filled from proj by the gate */
     v3.origin[0] = 1e6, v3.origin[1] = -2.5, v3.origin[2] = 3.0;
@@ -701,13 +704,9 @@ static void test_frame_depth_fields(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_context_desc host = beams_host(&log);
-    const vfx_plugin_api *api = plugin_api();
-    vfx_context *ctx;
-    assert_int_equal(api->create(&host, &ctx), VFX_OK);
-    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_OK);
     fixture f;
-    make_fixture(&f);
+    vfx_context *ctx = open_beams(&log, &f);
+    const vfx_plugin_api *api = plugin_api();
     expect(api, ctx, &f.fv, VFX_OK, NULL);
     double h_ref = max_h(api, ctx);
     assert_true(h_ref > 0.1);
@@ -785,13 +784,9 @@ static void test_conventions_colour_alpha(void **state)
 {
     (void)state;
     test_log log = {0};
-    vfx_context_desc host = beams_host(&log);
-    const vfx_plugin_api *api = plugin_api();
-    vfx_context *ctx;
-    assert_int_equal(api->create(&host, &ctx), VFX_OK);
-    assert_int_equal(api->update(ctx, 0.0, 0.0f), VFX_OK);
     fixture f;
-    make_fixture(&f);
+    vfx_context *ctx = open_beams(&log, &f);
+    const vfx_plugin_api *api = plugin_api();
     GLuint tex[2], fbo[2];
     const GLenum fmt[2] = {GL_RGBA16F, GL_SRGB8_ALPHA8};
     glCreateTextures(GL_TEXTURE_2D, 2, tex);

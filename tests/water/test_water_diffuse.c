@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "debug.h"
+#include "test_particle_host.h"
 #include "test_util.h"
 #include "water/water_effect.h"
 
@@ -21,31 +22,8 @@
 #define SURFACE 0.12
 #define CREST_VN 0.6
 
-typedef struct host {
-    test_log log;
-    uint32_t n;
-    float *x, *y, *z, *vx, *vy, *vz;
-    vfx_water_params p;
-} host;
-
-static uint32_t chunk_count(void *user) { return ((host *)user)->n ? 1 : 0; }
-
-static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
-{
-    host *h = user;
-    (void)index;
-    out->count = h->n;
-    out->pos[0] = h->x, out->pos[1] = h->y, out->pos[2] = h->z;
-    out->vel[0] = h->vx, out->vel[1] = h->vy, out->vel[2] = h->vz;
-    return VFX_OK;
-}
-
-static vfx_result water_params(void *user, vfx_water_params *out)
-{
-    host *h = user;
-    *out = h->p;
-    return VFX_OK;
-}
+/* the particles with velocities, one chunk */
+typedef test_particle_host host;
 
 typedef struct session {
     vfx_plugin_api api;
@@ -57,9 +35,7 @@ typedef struct session {
 static void session_open(session *ss, host *h)
 {
     memset(ss, 0, sizeof *ss);
-    vfx_context_desc api = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc,
-                        .user = h, .log = test_vfx_log_fn, .particle_chunk_count = chunk_count,
-                        .particle_chunk = chunk_view, .water_params = water_params};
+    vfx_context_desc api = test_particle_host_desc(h);
     ss->api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
     assert_int_equal(ss->api.create(&api, &ss->ctx), VFX_OK);
@@ -69,16 +45,10 @@ static void session_open(session *ss, host *h)
     glTextureStorage2D(ss->col, 1, GL_RGBA8, w, hh);
     glCreateFramebuffers(1, &ss->fbo);
     glNamedFramebufferTexture(ss->fbo, GL_COLOR_ATTACHMENT0, ss->col, 0);
-    ss->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW, .framebuffer = ss->fbo,
-                              .width = w, .height = hh, .fov_y = 0.9f, .near_plane = 0.05f, .far_plane = 100.0f};
+    ss->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW, .framebuffer = ss->fbo, .width = w, .height = hh};
     /* a camera looking at the slab from above and in front: the draws run too */
     const float eye[3] = {0.5f, 1.5f, 2.5f};
-    memcpy(ss->fv.eye, eye, sizeof eye);
-    const float view[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -eye[0], -eye[1], -eye[2], 1};
-    const float f = 1.0f / tanf(0.45f), nn = 0.05f, ff = 100.0f;
-    const float proj[16] = {f, 0, 0, 0, 0, f, 0, 0, 0, 0, (ff + nn) / (nn - ff), -1, 0, 0, 2 * ff * nn / (nn - ff), 0};
-    memcpy(ss->fv.view, view, sizeof view);
-    memcpy(ss->fv.proj, proj, sizeof proj);
+    test_frame_view_look(&ss->fv, eye, 0.0f);
 }
 
 static void session_frame(session *ss, float dt)
@@ -87,14 +57,7 @@ static void session_frame(session *ss, float dt)
     assert_int_equal(ss->api.render(ss->ctx, &ss->fv), VFX_OK);
 }
 
-static double stat_of(session *ss, const char *name)
-{
-    vfx_stats st = {.type = VFX_TYPE_STATS};
-    assert_int_equal(ss->api.get_stats(ss->ctx, &st), VFX_OK);
-    for (uint32_t k = 0; k < st.count; ++k)
-        if (!strcmp(st.entries[k].name, name)) return st.entries[k].value;
-    return -1;
-}
+static double stat_of(session *ss, const char *name) { return test_stat(&ss->api, ss->ctx, name); }
 
 static void session_close(session *ss)
 {
@@ -128,13 +91,13 @@ static host make_host(uint32_t nx, uint32_t ny, uint32_t nz, float h)
                 s.vy[i] = 3.5f * top * top * (1.0f + 0.5f * sinf(11.0f * s.x[i]));
                 s.vz[i] = 0.7f * cosf(5.0f * s.z[i] - 2.0f * s.x[i]);
             }
-    s.p.type = VFX_TYPE_WATER_PARAMS;
-    s.p.h = h;
+    s.params.type = VFX_TYPE_WATER_PARAMS;
+    s.params.h = h;
     /* clamp ranges and rates set explicitly (not the defaults): the field spans them */
-    s.p.trapped_air[0] = 1.5f, s.p.trapped_air[1] = 6.0f;
-    s.p.wave_crest[0] = 0.3f, s.p.wave_crest[1] = 1.5f;
-    s.p.energy[0] = 0.5f, s.p.energy[1] = 4.0f;
-    s.p.rate_trapped_air = 40.0f, s.p.rate_wave_crest = 60.0f;
+    s.params.trapped_air[0] = 1.5f, s.params.trapped_air[1] = 6.0f;
+    s.params.wave_crest[0] = 0.3f, s.params.wave_crest[1] = 1.5f;
+    s.params.energy[0] = 0.5f, s.params.energy[1] = 4.0f;
+    s.params.rate_trapped_air = 40.0f, s.params.rate_wave_crest = 60.0f;
     return s;
 }
 
@@ -370,8 +333,8 @@ static void test_repeat_and_cap(void **state)
     assert_true(a_n > 0 && worst < 1e-4 * h);
     free(a), free(b);
 
-    s.p.diffuse_max = 200;
-    s.p.rate_trapped_air = s.p.rate_wave_crest = 1e4f;
+    s.params.diffuse_max = 200;
+    s.params.rate_trapped_air = s.params.rate_wave_crest = 1e4f;
     float *c = run_pool(&s, 20, &a_n, &peak, &gen);
     print_message("cap 200: peak %u, %u at the end, %.0f asked for over 20 steps\n", peak, a_n, gen);
     assert_true(peak <= 200 && gen > 20 * 200);
@@ -387,11 +350,11 @@ static void test_refused(void **state)
     const char *names[] = {"diffuse_max", "trapped_air", "spray_below", "lifetime", "gravity"};
     for (int k = 0; k < 5; ++k) {
         host s = make_host(4, 4, 4, 0.2f);
-        if (k == 0) s.p.diffuse_max = (1u << 22) + 1;
-        if (k == 1) s.p.trapped_air[0] = 5, s.p.trapped_air[1] = 2;
-        if (k == 2) s.p.spray_below = 30, s.p.bubble_above = 10;
-        if (k == 3) s.p.lifetime = -1;
-        if (k == 4) s.p.gravity[1] = NAN;
+        if (k == 0) s.params.diffuse_max = (1u << 22) + 1;
+        if (k == 1) s.params.trapped_air[0] = 5, s.params.trapped_air[1] = 2;
+        if (k == 2) s.params.spray_below = 30, s.params.bubble_above = 10;
+        if (k == 3) s.params.lifetime = -1;
+        if (k == 4) s.params.gravity[1] = NAN;
         session ss;
         session_open(&ss, &s);
         assert_int_equal(ss.api.update(ss.ctx, 0.0, 1.0f / 60.0f), VFX_ERR_INVALID_ARGUMENT);
@@ -413,7 +376,7 @@ static void test_bubble_drag_no_overshoot(void **state)
 {
     (void)state;
     host s = make_host(12, 6, 10, 0.2f);
-    s.p.drag = 60.0f;
+    s.params.drag = 60.0f;
     session ss;
     session_open(&ss, &s);
     for (int f = 0; f < 12; ++f) session_frame(&ss, 1.0f / 60.0f);

@@ -18,39 +18,15 @@
 #include <string.h>
 
 #include "debug.h"
+#include "test_particle_host.h"
 #include "test_util.h"
 #include "water/water_effect.h"
 
 #define H 0.1f
 #define DT (1.0f / 60.0f)
 
-typedef struct host {
-    test_log log;
-    uint32_t n;
-    float *x, *y, *z, *vx, *vy, *vz;
-    vfx_water_params p;
-    vfx_water_foam foam;
-} host;
-
-static uint32_t chunk_count(void *user) { return ((host *)user)->n ? 1 : 0; }
-
-static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
-{
-    host *h = user;
-    (void)index;
-    out->count = h->n;
-    out->pos[0] = h->x, out->pos[1] = h->y, out->pos[2] = h->z;
-    out->vel[0] = h->vx, out->vel[1] = h->vy, out->vel[2] = h->vz;
-    return VFX_OK;
-}
-
-static vfx_result water_params(void *user, vfx_water_params *out)
-{
-    host *h = user;
-    *out = h->p;
-    out->next = h->foam.type ? &h->foam : NULL;
-    return VFX_OK;
-}
+/* the particles with velocities, one chunk; a test's vfx_water_foam chained as params_next */
+typedef test_particle_host host;
 
 typedef struct session {
     vfx_plugin_api api;
@@ -62,9 +38,7 @@ typedef struct session {
 static void session_open(session *ss, host *h)
 {
     memset(ss, 0, sizeof *ss);
-    vfx_context_desc api = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = h,
-                            .log = test_vfx_log_fn, .particle_chunk_count = chunk_count, .particle_chunk = chunk_view,
-                            .water_params = water_params};
+    vfx_context_desc api = test_particle_host_desc(h);
     ss->api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
     assert_int_equal(ss->api.create(&api, &ss->ctx), VFX_OK);
@@ -74,15 +48,9 @@ static void session_open(session *ss, host *h)
     glTextureStorage2D(ss->col, 1, GL_RGBA8, w, hh);
     glCreateFramebuffers(1, &ss->fbo);
     glNamedFramebufferTexture(ss->fbo, GL_COLOR_ATTACHMENT0, ss->col, 0);
-    ss->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW, .framebuffer = ss->fbo, .width = w, .height = hh,
-                              .fov_y = 0.9f, .near_plane = 0.05f, .far_plane = 100.0f};
+    ss->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW, .framebuffer = ss->fbo, .width = w, .height = hh};
     const float eye[3] = {0.8f, 1.5f, 3.0f};
-    memcpy(ss->fv.eye, eye, sizeof eye);
-    const float view[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -eye[0], -eye[1], -eye[2], 1};
-    const float f = 1.0f / tanf(0.45f), nn = 0.05f, ff = 100.0f;
-    const float proj[16] = {f, 0, 0, 0, 0, f, 0, 0, 0, 0, (ff + nn) / (nn - ff), -1, 0, 0, 2 * ff * nn / (nn - ff), 0};
-    memcpy(ss->fv.view, view, sizeof view);
-    memcpy(ss->fv.proj, proj, sizeof proj);
+    test_frame_view_look(&ss->fv, eye, 0.0f);
 }
 
 static void session_frame(session *ss)
@@ -91,15 +59,7 @@ static void session_frame(session *ss)
     assert_int_equal(ss->api.render(ss->ctx, &ss->fv), VFX_OK);
 }
 
-static double stat_of(session *ss, const char *name)
-{
-    vfx_stats st = {.type = VFX_TYPE_STATS};
-    assert_int_equal(ss->api.get_stats(ss->ctx, &st), VFX_OK);
-    for (uint32_t k = 0; k < st.count; ++k)
-        if (!strcmp(st.entries[k].name, name))
-            return st.entries[k].value;
-    return -1;
-}
+static double stat_of(session *ss, const char *name) { return test_stat(&ss->api, ss->ctx, name); }
 
 static void session_close(session *ss)
 {
@@ -125,8 +85,8 @@ static host make_slab(uint32_t n, float ux, float uz)
                 s.x[i] = 0.5f * H * a, s.y[i] = 0.5f * H * b, s.z[i] = 0.5f * H * c;
                 s.vx[i] = ux, s.vy[i] = 0, s.vz[i] = uz;
             }
-    s.p.type = VFX_TYPE_WATER_PARAMS;
-    s.p.h = H;
+    s.params.type = VFX_TYPE_WATER_PARAMS;
+    s.params.h = H;
     return s;
 }
 
@@ -178,7 +138,8 @@ static void test_fade_and_spread(void **state)
 {
     (void)state;
     host h = make_slab(32, 0, 0);
-    h.foam = (vfx_water_foam){.type = VFX_TYPE_WATER_FOAM, .lifetime = 0.5f, .diffusion = 0.5f};
+    vfx_water_foam foam = {.type = VFX_TYPE_WATER_FOAM, .lifetime = 0.5f, .diffusion = 0.5f};
+    h.params_next = &foam;
     session ss;
     session_open(&ss, &h);
     volfx_water_foam_grid g;
@@ -218,8 +179,9 @@ static void test_drift(void **state)
     host h = make_slab(40, ux, uz);
     /* the slab's leading edges would be wave crests: an energy range far above the flow's keeps
      * every particle from generating (foam there would add to the blob) */
-    h.p.energy[0] = 50.0f, h.p.energy[1] = 100.0f;
-    h.foam = (vfx_water_foam){.type = VFX_TYPE_WATER_FOAM, .lifetime = 2.0f, .diffusion = 1e-6f};
+    h.params.energy[0] = 50.0f, h.params.energy[1] = 100.0f;
+    vfx_water_foam foam = {.type = VFX_TYPE_WATER_FOAM, .lifetime = 2.0f, .diffusion = 1e-6f};
+    h.params_next = &foam;
     session ss;
     session_open(&ss, &h);
     volfx_water_foam_grid g;
@@ -256,11 +218,11 @@ static host make_churn(void)
         s.vy[i] = 3.5f * top * top * (1.0f + 0.5f * sinf(11.0f * s.x[i]));
         s.vz[i] = 0.7f * cosf(5.0f * s.z[i] - 2.0f * s.x[i]);
     }
-    s.p.trapped_air[0] = 1.5f, s.p.trapped_air[1] = 6.0f;
-    s.p.wave_crest[0] = 0.3f, s.p.wave_crest[1] = 1.5f;
-    s.p.energy[0] = 0.5f, s.p.energy[1] = 4.0f;
-    s.p.rate_trapped_air = 40.0f, s.p.rate_wave_crest = 60.0f;
-    s.p.spray_below = 2, s.p.bubble_above = 60; /* most of them foam */
+    s.params.trapped_air[0] = 1.5f, s.params.trapped_air[1] = 6.0f;
+    s.params.wave_crest[0] = 0.3f, s.params.wave_crest[1] = 1.5f;
+    s.params.energy[0] = 0.5f, s.params.energy[1] = 4.0f;
+    s.params.rate_trapped_air = 40.0f, s.params.rate_wave_crest = 60.0f;
+    s.params.spray_below = 2, s.params.bubble_above = 60; /* most of them foam */
     return s;
 }
 
@@ -270,7 +232,8 @@ static void test_gathers_where_deposited(void **state)
     (void)state;
     host h = make_churn();
     const float dep = 3.0f;
-    h.foam = (vfx_water_foam){.type = VFX_TYPE_WATER_FOAM, .deposit = dep};
+    vfx_water_foam foam = {.type = VFX_TYPE_WATER_FOAM, .deposit = dep};
+    h.params_next = &foam;
     session ss;
     session_open(&ss, &h);
     for (int k = 0; k < 8; ++k)
@@ -333,10 +296,11 @@ static void test_off_and_ranges(void **state)
     (void)state;
     for (int v = 0; v < 2; ++v) {
         host h = make_churn();
+        vfx_water_foam foam = {.type = VFX_TYPE_WATER_FOAM, .layer = VFX_WATER_FOAM_OFF};
         if (v == 0)
-            h.p.preset = VFX_WATER_PRESET_LOW;
+            h.params.preset = VFX_WATER_PRESET_LOW;
         else
-            h.foam = (vfx_water_foam){.type = VFX_TYPE_WATER_FOAM, .layer = VFX_WATER_FOAM_OFF};
+            h.params_next = &foam;
         session ss;
         session_open(&ss, &h);
         for (int k = 0; k < 6; ++k)
@@ -348,7 +312,8 @@ static void test_off_and_ranges(void **state)
         free_host(&h);
     }
     host h = make_slab(8, 0, 0);
-    h.foam = (vfx_water_foam){.type = VFX_TYPE_WATER_FOAM, .lifetime = 0.01f};
+    vfx_water_foam foam = {.type = VFX_TYPE_WATER_FOAM, .lifetime = 0.01f};
+    h.params_next = &foam;
     session ss;
     session_open(&ss, &h);
     assert_int_not_equal(ss.api.update(ss.ctx, 0.0, DT), VFX_OK);

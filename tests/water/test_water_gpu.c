@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "context.h"
+#include "test_particle_host.h"
 #include "test_util.h"
 
 #define W 96
@@ -31,12 +32,9 @@
 #define KSTRIDE 32u
 
 typedef struct host {
-    test_log log;
-    uint32_t n;
-    float *x, *y, *z, *vx, *vy, *vz;
+    test_particle_host ph;      /* first: the CPU columns, the parameters and the log */
     float *base;                /* frame 0's positions, xyz a particle */
     float move[3];              /* what every particle moves by each frame */
-    vfx_water_params p;
     bool gpu;                   /* hand the GL buffer instead of the arrays */
     GLuint buf;
     vfx_gpu_column pos, vel;    /* the columns handed over (tests break them) */
@@ -47,16 +45,14 @@ typedef struct host {
     vfx_gpu_column kcol;
 } host;
 
-static uint32_t chunk_count(void *user) { return ((host *)user)->n ? 1 : 0; }
-
 static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
 {
     host *h = user;
     (void)index;
-    out->count = h->n;
+    out->count = h->ph.n;
     if (!h->gpu) {
-        out->pos[0] = h->x, out->pos[1] = h->y, out->pos[2] = h->z;
-        out->vel[0] = h->vx, out->vel[1] = h->vy, out->vel[2] = h->vz;
+        out->pos[0] = h->ph.x, out->pos[1] = h->ph.y, out->pos[2] = h->ph.z;
+        out->vel[0] = h->ph.vx, out->vel[1] = h->ph.vy, out->vel[2] = h->ph.vz;
     } else {
         out->gpu_pos = h->pos, out->gpu_vel = h->vel;
     }
@@ -67,20 +63,14 @@ static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
     return VFX_OK;
 }
 
-static vfx_result water_params(void *user, vfx_water_params *out)
-{
-    host *h = user;
-    *(vfx_water_params *)out = h->p;
-    return VFX_OK;
-}
 
 /* A jittered slab of particles at spacing 0.05 with a shearing, rising velocity field (spray). */
 static void make_host(host *s, uint32_t nx, uint32_t ny, uint32_t nz)
 {
     memset(s, 0, sizeof *s);
-    s->n = nx * ny * nz;
-    float **cols[] = {&s->x, &s->y, &s->z, &s->vx, &s->vy, &s->vz};
-    for (int k = 0; k < 6; ++k) *cols[k] = malloc(s->n * sizeof(float));
+    s->ph.n = nx * ny * nz;
+    float **cols[] = {&s->ph.x, &s->ph.y, &s->ph.z, &s->ph.vx, &s->ph.vy, &s->ph.vz};
+    for (int k = 0; k < 6; ++k) *cols[k] = malloc(s->ph.n * sizeof(float));
     uint32_t i = 0, seed = 777;
     for (uint32_t a = 0; a < nx; ++a)
         for (uint32_t b = 0; b < ny; ++b)
@@ -90,29 +80,29 @@ static void make_host(host *s, uint32_t nx, uint32_t ny, uint32_t nz)
                     seed = seed * 1664525u + 1013904223u;
                     j[k] = ((float)(seed >> 8) / 16777216.0f - 0.5f) * 0.02f;
                 }
-                s->x[i] = 0.05f * a + j[0] - 0.4f, s->y[i] = 0.05f * b + j[1] - 0.2f, s->z[i] = 0.05f * c + j[2] - 0.4f;
+                s->ph.x[i] = 0.05f * a + j[0] - 0.4f, s->ph.y[i] = 0.05f * b + j[1] - 0.2f, s->ph.z[i] = 0.05f * c + j[2] - 0.4f;
                 float top = (float)b / (float)(ny - 1);
-                s->vx[i] = 2.5f * sinf(9.0f * s->x[i] + 4.0f * s->z[i]);
-                s->vy[i] = 3.5f * top * top;
-                s->vz[i] = 0.7f * cosf(5.0f * s->z[i] - 2.0f * s->x[i]);
+                s->ph.vx[i] = 2.5f * sinf(9.0f * s->ph.x[i] + 4.0f * s->ph.z[i]);
+                s->ph.vy[i] = 3.5f * top * top;
+                s->ph.vz[i] = 0.7f * cosf(5.0f * s->ph.z[i] - 2.0f * s->ph.x[i]);
             }
     /* one particle NaN: skipped by both paths and counted */
-    s->y[7] = NAN;
-    s->p.type = VFX_TYPE_WATER_PARAMS;
+    s->ph.y[7] = NAN;
+    s->ph.params.type = VFX_TYPE_WATER_PARAMS;
     /* h left 0: estimated from the spacing, by both paths */
-    s->base = malloc(3 * sizeof(float) * s->n);
-    for (uint32_t p = 0; p < s->n; ++p)
-        s->base[3 * p] = s->x[p], s->base[3 * p + 1] = s->y[p], s->base[3 * p + 2] = s->z[p];
+    s->base = malloc(3 * sizeof(float) * s->ph.n);
+    for (uint32_t p = 0; p < s->ph.n; ++p)
+        s->base[3 * p] = s->ph.x[p], s->base[3 * p + 1] = s->ph.y[p], s->base[3 * p + 2] = s->ph.z[p];
     glCreateBuffers(1, &s->buf);
-    glNamedBufferStorage(s->buf, (GLsizeiptr)(LEAD + (size_t)s->n * STRIDE), NULL, GL_DYNAMIC_STORAGE_BIT);
+    glNamedBufferStorage(s->buf, (GLsizeiptr)(LEAD + (size_t)s->ph.n * STRIDE), NULL, GL_DYNAMIC_STORAGE_BIT);
     s->pos = (vfx_gpu_column){s->buf, STRIDE, LEAD};
     s->vel = (vfx_gpu_column){s->buf, STRIDE, LEAD + 16u};
     /* kernels: diagonally dominant (eigenvalues within [0.6, 1.5]), stretched and sheared
      * differently from particle to particle, so a wrong component or particle shows */
-    s->kern = malloc(6 * sizeof(float) * s->n);
-    size_t kbytes = KLEAD + (size_t)s->n * KSTRIDE;
+    s->kern = malloc(6 * sizeof(float) * s->ph.n);
+    size_t kbytes = KLEAD + (size_t)s->ph.n * KSTRIDE;
     unsigned char *img = calloc(1, kbytes);
-    for (uint32_t p = 0; p < s->n; ++p) {
+    for (uint32_t p = 0; p < s->ph.n; ++p) {
         float *g = s->kern + 6 * (size_t)p;
         g[0] = 1.0f + 0.3f * sinf(0.7f * (float)p), g[1] = 0.1f * cosf(1.3f * (float)p), g[2] = 0.05f;
         g[3] = 0.9f + 0.2f * cosf(0.4f * (float)p), g[4] = -0.08f * sinf(2.1f * (float)p), g[5] = 1.1f;
@@ -128,13 +118,13 @@ static void make_host(host *s, uint32_t nx, uint32_t ny, uint32_t nz)
 /* Frame f's positions (frame 0's moved f times) into the columns and the interleaved buffer. */
 static void host_frame(host *s, int f)
 {
-    size_t bytes = LEAD + (size_t)s->n * STRIDE;
+    size_t bytes = LEAD + (size_t)s->ph.n * STRIDE;
     unsigned char *img = calloc(1, bytes);
-    for (uint32_t p = 0; p < s->n; ++p) {
-        s->x[p] = s->base[3 * p] + (float)f * s->move[0];
-        s->y[p] = s->base[3 * p + 1] + (float)f * s->move[1];
-        s->z[p] = s->base[3 * p + 2] + (float)f * s->move[2];
-        float rec[7] = {s->x[p], s->y[p], s->z[p], -1.0f, s->vx[p], s->vy[p], s->vz[p]};
+    for (uint32_t p = 0; p < s->ph.n; ++p) {
+        s->ph.x[p] = s->base[3 * p] + (float)f * s->move[0];
+        s->ph.y[p] = s->base[3 * p + 1] + (float)f * s->move[1];
+        s->ph.z[p] = s->base[3 * p + 2] + (float)f * s->move[2];
+        float rec[7] = {s->ph.x[p], s->ph.y[p], s->ph.z[p], -1.0f, s->ph.vx[p], s->ph.vy[p], s->ph.vz[p]};
         memcpy(img + LEAD + (size_t)p * STRIDE, rec, sizeof rec);
     }
     glNamedBufferSubData(s->buf, 0, (GLsizeiptr)bytes, img);
@@ -143,7 +133,7 @@ static void host_frame(host *s, int f)
 
 static void free_host(host *s)
 {
-    float *cols[] = {s->x, s->y, s->z, s->vx, s->vy, s->vz, s->base, s->kern};
+    float *cols[] = {s->ph.x, s->ph.y, s->ph.z, s->ph.vx, s->ph.vy, s->ph.vz, s->base, s->kern};
     for (int k = 0; k < 8; ++k) free(cols[k]);
     glDeleteBuffers(1, &s->buf);
     glDeleteBuffers(1, &s->kbuf);
@@ -159,9 +149,8 @@ typedef struct session {
 static void session_open(session *ss, host *h)
 {
     memset(ss, 0, sizeof *ss);
-    vfx_context_desc api = {.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc,
-                        .user = h, .log = test_vfx_log_fn, .particle_chunk_count = chunk_count,
-                        .particle_chunk = chunk_view, .water_params = water_params};
+    vfx_context_desc api = test_particle_host_desc(&h->ph);
+    api.particle_chunk = chunk_view; /* the CPU columns or the GL buffer's */
     ss->api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
     assert_int_equal(ss->api.create(&api, &ss->ctx), VFX_OK);
@@ -181,18 +170,10 @@ static void session_open(session *ss, host *h)
     glTextureSubImage2D(ss->scene, 0, 0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, pix);
     free(pix);
     ss->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW, .framebuffer = ss->fbo,
-                              .color_texture = ss->scene, .width = W, .height = H, .fov_y = 0.9f,
-                              .near_plane = 0.05f, .far_plane = 100.0f};
-    const float eye[3] = {0.0f, 0.9f, 1.8f};
-    memcpy(ss->fv.eye, eye, sizeof eye);
+                              .color_texture = ss->scene, .width = W, .height = H};
     /* looking down the -z axis, tilted 25 degrees down */
-    const float c = cosf(0.44f), s = sinf(0.44f);
-    const float view[16] = {1, 0, 0, 0, 0, c, s, 0, 0, -s, c, 0,
-                            0, -(c * eye[1] - s * eye[2]), -(s * eye[1] + c * eye[2]), 1};
-    const float f = 1.0f / tanf(0.45f), nn = 0.05f, ff = 100.0f, asp = (float)W / H;
-    const float proj[16] = {f / asp, 0, 0, 0, 0, f, 0, 0, 0, 0, (ff + nn) / (nn - ff), -1, 0, 0, 2 * ff * nn / (nn - ff), 0};
-    memcpy(ss->fv.view, view, sizeof view);
-    memcpy(ss->fv.proj, proj, sizeof proj);
+    const float eye[3] = {0.0f, 0.9f, 1.8f};
+    test_frame_view_look(&ss->fv, eye, 0.44f);
 }
 
 static void session_close(session *ss)
@@ -203,14 +184,7 @@ static void session_close(session *ss)
     glDeleteTextures(2, t);
 }
 
-static double stat_of(session *ss, const char *name)
-{
-    vfx_stats st = {.type = VFX_TYPE_STATS};
-    assert_int_equal(ss->api.get_stats(ss->ctx, &st), VFX_OK);
-    for (uint32_t k = 0; k < st.count; ++k)
-        if (!strcmp(st.entries[k].name, name)) return st.entries[k].value;
-    return -1;
-}
+static double stat_of(session *ss, const char *name) { return test_stat(&ss->api, ss->ctx, name); }
 
 typedef struct shot {
     uint8_t rgba[W * H * 4];
@@ -224,7 +198,7 @@ typedef struct shot {
 static void render(host *h, bool gpu, uint32_t method, shot *out)
 {
     h->gpu = gpu;
-    h->p.method = method;
+    h->ph.params.method = method;
     session ss;
     session_open(&ss, h);
     for (int f = 0; f < FRAMES; ++f) {
@@ -293,7 +267,7 @@ static void compare_paths(uint32_t method, bool moving, bool kernel)
     assert_true(cpu.h == gpu.h);
     assert_true(cpu.nan == 1 && gpu.nan == 1);
     if (!getenv("CPU_TWICE")) {
-        assert_true(cpu.gpu == 0 && gpu.gpu == h.n);
+        assert_true(cpu.gpu == 0 && gpu.gpu == h.ph.n);
         /* the last frames used the late box, and no particle lay outside it */
         assert_true(gpu.lag >= 1);
         assert_true(gpu.outside == 0);
@@ -367,7 +341,7 @@ static void test_kernel_refused(void **state)
     make_host(&h, 4, 4, 4);
     h.gpu = true, h.with_kernel = true;
     /* a copy of the kernel buffer with particle 5's xx negative (kbuf itself is immutable) */
-    GLsizeiptr kbytes = KLEAD + (GLsizeiptr)h.n * KSTRIDE;
+    GLsizeiptr kbytes = KLEAD + (GLsizeiptr)h.ph.n * KSTRIDE;
     GLuint bad;
     glCreateBuffers(1, &bad);
     glNamedBufferStorage(bad, kbytes, NULL, GL_DYNAMIC_STORAGE_BIT);
