@@ -10,6 +10,7 @@
 #include "gpu/gl_state.h"
 
 typedef struct volfx_gpu volfx_gpu;
+typedef struct volfx_scan volfx_scan;
 struct volfx_gl_table; /* gpu/volfx_gl.h, generated: the GL commands, resolved at create */
 typedef struct volfx_effect_ops volfx_effect_ops;
 
@@ -47,6 +48,7 @@ typedef struct volfx_depth_targets {
 struct vfx_context {
     vfx_context_desc host;      /* copy of the host's description (next cleared: not kept) */
     volfx_gpu *gpu;               /* program cache, timers, fullscreen VAO */
+    volfx_scan *scan;             /* the GPU prefix sum's programs and block sums (gpu/scan.h), made on first use */
     struct volfx_gl_table *gl;    /* every GL command, through host.gl_get_proc_address */
     uint32_t width, height;
     void *effect_state[VFX_EFFECT_COUNT];

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "gpu/gpu.h"
+#include "gpu/scan.h"
 #include "effect.h"
 #include "context.h"
 #include "frame_check.h"
@@ -122,6 +123,7 @@ static void plugin_destroy(vfx_context *ctx)
         }
     if (ctx->gl) {
         volfx_frame_check_destroy(ctx);
+        volfx_gpu_scan_destroy(ctx);
         volfx_gpu_destroy(ctx, ctx->gpu);
         volfx_gl_current = NULL; /* nothing may call GL through a freed table */
         volfx_free(ctx, ctx->gl);

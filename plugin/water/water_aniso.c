@@ -1,20 +1,21 @@
 /* water_aniso.c — per-particle kernels for method TILE (see water_aniso.h): the host columns'
  * checks and upload, and the GPU pass of shaders/water/aniso.comp (hashed grid by counting sort
- * with grid.comp's prefix sum, then one kernel per particle). */
+ * with the plugin's GPU scan, gpu/scan.h, then one kernel per particle). */
 #include <math.h>
 #include <string.h>
 
 #include "gpu/gpu.h"
+#include "gpu/scan.h"
 #include "water_aniso.h"
 
-/* the two-level scan of grid.comp holds 2^20 entries: buckets + 1 must fit */
-#define ANISO_MAX_BUCKETS (1u << 19)
+/* a power of two with buckets + 1 within the scan's VOLFX_SCAN_MAX */
+#define ANISO_MAX_BUCKETS (VOLFX_SCAN_MAX / 2u)
 /* the columns a host may give: radius and kernel eigenvalues in this range */
 #define COLUMN_MIN 1e-3
 #define COLUMN_MAX 1e3
 
 struct volfx_water_aniso {
-    GLuint count, start, blocks, sorted, kern, nbr, radius, hostg;
+    GLuint count, start, sorted, kern, nbr, radius, hostg;
     uint32_t bucket_cap, particle_cap, column_cap;
     bool has_radius, has_kernel;
     float radius_max;      /* largest radius column value (1 without one) */
@@ -71,7 +72,6 @@ volfx_water_aniso *volfx_water_aniso_create(vfx_context *ctx)
     volfx_water_aniso *a = volfx_alloc(ctx, sizeof *a);
     if (!a)
         return NULL;
-    a->blocks = volfx_gpu_storage(1024 * sizeof(uint32_t), "water.aniso_blocks");
     a->radius_max = 1.0f;
     return a;
 }
@@ -80,7 +80,7 @@ void volfx_water_aniso_destroy(vfx_context *ctx, volfx_water_aniso *a)
 {
     if (!a)
         return;
-    GLuint b[] = {a->count, a->start, a->blocks, a->sorted, a->kern, a->nbr, a->radius, a->hostg};
+    GLuint b[] = {a->count, a->start, a->sorted, a->kern, a->nbr, a->radius, a->hostg};
     for (size_t k = 0; k < sizeof b / sizeof b[0]; ++k)
         if (b[k])
             glDeleteBuffers(1, &b[k]);
@@ -337,7 +337,7 @@ static vfx_result ensure_buffers(vfx_context *ctx, volfx_water_aniso *a, const v
 
 static void bind_all(const volfx_water_aniso *a, const volfx_water_aniso_input *in)
 {
-    GLuint bind[] = {in->cols[0], in->cols[1], in->cols[2], a->count, in->counters, a->start, a->blocks, a->sorted,
+    GLuint bind[] = {in->cols[0], in->cols[1], in->cols[2], a->count, in->counters, a->start, 0, a->sorted,
                      a->kern, a->nbr, a->radius, a->hostg};
     for (GLuint k = 0; k < sizeof bind / sizeof bind[0]; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, k, bind[k]);
@@ -349,21 +349,18 @@ static vfx_result grid_steps(vfx_context *ctx, volfx_water_aniso *a, const volfx
 {
     GLuint count = volfx_gpu_compute(ctx, "water/aniso.comp", "#define MODE_COUNT\n");
     GLuint scatter = volfx_gpu_compute(ctx, "water/aniso.comp", "#define MODE_SCATTER\n");
-    GLuint scan = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n");
-    GLuint top = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n#define SCAN_TOP\n");
-    GLuint add = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN_ADD\n");
-    if (!count || !scatter || !scan || !top || !add)
+    if (!count || !scatter)
         return VFX_ERR_GL;
     uint32_t need, buckets = grid_buckets(in->count, &need), nscan = buckets + 1;
     float cs = in->kp->radius * in->h;
-    GLuint groups = (in->count + 63u) / 64u, blocks = need / 1024u;
+    GLuint groups = (in->count + 63u) / 64u;
     GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
     glClearNamedBufferSubData(a->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     aniso_step(ctx, count, in, buckets, cs, nscan, gx, gy, GL_SHADER_STORAGE_BARRIER_BIT);
-    aniso_step(ctx, scan, in, buckets, cs, nscan, blocks, 1, GL_SHADER_STORAGE_BARRIER_BIT);
-    aniso_step(ctx, top, in, buckets, cs, blocks, 1, 1, GL_SHADER_STORAGE_BARRIER_BIT);
-    aniso_step(ctx, add, in, buckets, cs, nscan, (nscan + 255u) / 256u, 1,
-               GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    vfx_result r = volfx_gpu_scan(ctx, a->count, a->start, nscan, "water aniso grid");
+    if (r)
+        return r;
+    bind_all(a, in);
     glClearNamedBufferSubData(a->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     aniso_step(ctx, scatter, in, buckets, cs, nscan, gx, gy, GL_SHADER_STORAGE_BARRIER_BIT);
     a->grid_rev = in->data_rev;

@@ -1,7 +1,7 @@
 /* water_grid.c — GRID baseline: uniform grid of cell h (grown when it would exceed
  * GRID_MAX_CELLS), built on the GPU from the position columns whenever they were uploaded
  * again or h changed (a static scene keeps its grid): count per cell,
- * exclusive prefix sum (two levels of 1024), scatter of the positions into cell order. The
+ * exclusive prefix sum (gpu/scan.h), scatter of the positions into cell order. The
  * march (grid.comp MODE_MARCH) then sums each sample's potential over the cells its h-ball
  * touches and jumps over empty space. Cell size and origin come from the box the CPU already
  * computes while counting NaNs in water_update, so the only CPU work here is a few uniforms. */
@@ -9,13 +9,14 @@
 #include <string.h>
 
 #include "gpu/gpu.h"
+#include "gpu/scan.h"
 #include "water_grid.h"
 
-/* 1024 scan blocks of 1024 entries: the top-level scan fits one workgroup. */
-#define GRID_MAX_CELLS ((1u << 20) - 1u)
+/* cells + 1 entries must fit the scan */
+#define GRID_MAX_CELLS (VOLFX_SCAN_MAX - 1u)
 
 struct volfx_water_grid {
-    GLuint count, start, blocks, sorted;
+    GLuint count, start, sorted;
     uint32_t cell_cap;     /* entries count/start hold (ncells + 1, rounded up to 1024) */
     uint32_t sorted_cap;   /* particles `sorted` holds */
     /* what the grid in the buffers was built from: the same, and it is still right */
@@ -30,7 +31,6 @@ volfx_water_grid *volfx_water_grid_create(vfx_context *ctx)
     volfx_water_grid *g = volfx_alloc(ctx, sizeof *g);
     if (!g)
         return NULL;
-    g->blocks = volfx_gpu_storage(1024 * sizeof(uint32_t), "water.grid_blocks");
     return g;
 }
 
@@ -38,8 +38,8 @@ void volfx_water_grid_destroy(vfx_context *ctx, volfx_water_grid *g)
 {
     if (!g)
         return;
-    GLuint b[] = {g->count, g->start, g->blocks, g->sorted};
-    for (int k = 0; k < 4; ++k)
+    GLuint b[] = {g->count, g->start, g->sorted};
+    for (int k = 0; k < 3; ++k)
         if (b[k])
             glDeleteBuffers(1, &b[k]);
     volfx_free(ctx, g);
@@ -72,12 +72,21 @@ static void grid_layout(const volfx_water_grid_input *in, float g0[3], float *cs
     *cs_out = (float)cs;
 }
 
+/* The storage buffers of every grid.comp mode. */
+static void grid_bind(const volfx_water_grid *g, const volfx_water_grid_input *in)
+{
+    for (int k = 0; k < 3; ++k)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, in->cols[k]);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, g->count);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, in->counters);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, g->start);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, g->sorted);
+}
 
 static void grid_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_grid_input *in, const float g0[3], float cs,
-                          const int dims[3], uint32_t n)
+                          const int dims[3])
 {
     glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_count"), in->count);
-    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_n"), n);
     glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_g0"), 1, g0);
     glUniform1f(volfx_gpu_uniform(ctx, prog, "u_cs"), cs);
     glUniform3iv(volfx_gpu_uniform(ctx, prog, "u_dims"), 1, dims);
@@ -129,48 +138,33 @@ vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const 
     int rebuild = !g->built || g->built_rev != in->data_rev || g->built_count != in->count ||
                   memcmp(&g->built_h, &p->h, sizeof p->h) != 0;
     GLuint count = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_COUNT\n");
-    GLuint scan = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n");
-    GLuint top = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n#define SCAN_TOP\n");
-    GLuint add = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN_ADD\n");
     GLuint scatter = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCATTER\n");
     GLuint march = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_MARCH\n");
-    if (!count || !scan || !top || !add || !scatter || !march)
+    if (!count || !scatter || !march)
         return VFX_ERR_GL;
-    for (int k = 0; k < 3; ++k)
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, in->cols[k]);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, g->count);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, in->counters);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, g->start);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, g->blocks);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, g->sorted);
+    grid_bind(g, in);
     /* per-particle passes as 2D dispatches: GL promises only 65535 groups per dimension */
-    GLuint groups = (in->count + 63u) / 64u, blocks = need / 1024u;
+    GLuint groups = (in->count + 63u) / 64u;
     GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
 
     if (rebuild) {
         volfx_gpu_pass_begin(ctx, "water.grid_build");
         glClearNamedBufferSubData(g->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
         glUseProgram(count);
-        grid_uniforms(ctx, count, in, g0, cs, dims, nscan);
+        grid_uniforms(ctx, count, in, g0, cs, dims);
         if (groups)
             glDispatchCompute(gx, gy, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        glUseProgram(scan);
-        grid_uniforms(ctx, scan, in, g0, cs, dims, nscan);
-        glDispatchCompute(blocks, 1, 1);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        glUseProgram(top);
-        grid_uniforms(ctx, top, in, g0, cs, dims, blocks);
-        glDispatchCompute(1, 1, 1);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        glUseProgram(add);
-        grid_uniforms(ctx, add, in, g0, cs, dims, nscan);
-        glDispatchCompute((nscan + 255u) / 256u, 1, 1);
+        vfx_result r = volfx_gpu_scan(ctx, g->count, g->start, nscan, "water grid");
+        if (r) {
+            volfx_gpu_pass_end(ctx);
+            return r;
+        }
+        grid_bind(g, in);
         /* the counts are spent: the same buffer becomes the per-cell fill cursor of the scatter */
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
         glClearNamedBufferSubData(g->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
         glUseProgram(scatter);
-        grid_uniforms(ctx, scatter, in, g0, cs, dims, nscan);
+        grid_uniforms(ctx, scatter, in, g0, cs, dims);
         if (groups)
             glDispatchCompute(gx, gy, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -184,7 +178,7 @@ vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const 
     /* the counters were cleared by the effect at the start of the frame */
     volfx_gpu_pass_begin(ctx, "water.grid_march");
     glUseProgram(march);
-    grid_uniforms(ctx, march, in, g0, cs, dims, nscan);
+    grid_uniforms(ctx, march, in, g0, cs, dims);
     float blo[3], bhi[3];
     for (int k = 0; k < 3; ++k) {
         blo[k] = in->finite ? in->lo[k] - p->h : 0.0f;

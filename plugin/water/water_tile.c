@@ -4,20 +4,21 @@
  * every particle instead (correct, slower; its pixels are counted, water.tile_overflow_pixels),
  * and the capacity grows to what a recent frame needed (water.tile_entries), up to
  * TILE_MAX_ENTRIES.
- * The prefix sum is grid.comp's (MODE_SCAN / SCAN_TOP / SCAN_ADD). */
+ * The prefix sum is the plugin's one GPU scan (gpu/scan.h). */
 #include <math.h>
 #include <string.h>
 
 #include "gpu/gpu.h"
 #include "gpu/pass.h"
+#include "gpu/scan.h"
 #include "water_tile.h"
 
 /* tiles of 8x8 pixels, or 16, 32 or 64 a side when 8x8 tiles would pass TILE_MAX_TILES
  * (8192x8192 makes 2^20 tiles of 8: one too many for the scan) */
 #define TILE_SHIFT_MIN 3
 #define TILE_SHIFT_MAX 6
-/* the two-level scan of grid.comp: 1024 blocks of 1024 */
-#define TILE_MAX_TILES ((1u << 20) - 1u)
+/* tiles + 1 entries must fit the scan */
+#define TILE_MAX_TILES (VOLFX_SCAN_MAX - 1u)
 /* 256 MiB of entries at most */
 #define TILE_MAX_ENTRIES (1u << 24)
 /* a particle whose cube covers more tiles than this (512x512 pixels) goes to the global list,
@@ -47,8 +48,8 @@ typedef struct tile_block {
 _Static_assert(sizeof(tile_block) == 240, "tile_block mirrors tile.comp's std140 WaterTile");
 
 /* The loose uniforms that differ between the dispatches of one frame, resolved once per
- * program: grid.comp's scan length, tile.comp's march switches. */
-enum { LOC_N, LOC_HALF, LOC_TEMPORAL, LOC_REUSE, LOC_COUNT };
+ * program: tile.comp's march switches. */
+enum { LOC_HALF, LOC_TEMPORAL, LOC_REUSE, LOC_COUNT };
 #define TILE_PROG_CACHE 8
 typedef struct tile_prog_locs {
     GLuint prog;
@@ -56,7 +57,7 @@ typedef struct tile_prog_locs {
 } tile_prog_locs;
 
 struct volfx_water_tile {
-    GLuint count, start, blocks, entries, globals;
+    GLuint count, start, entries, globals;
     GLuint entry_ids;    /* ANISO: the particle of each entry (entry_cap of them) */
     uint32_t id_cap;
     uint32_t tile_cap;   /* entries count/start hold */
@@ -88,7 +89,6 @@ volfx_water_tile *volfx_water_tile_create(vfx_context *ctx)
     volfx_water_tile *t = volfx_alloc(ctx, sizeof *t);
     if (!t)
         return NULL;
-    t->blocks = volfx_gpu_storage(1024 * sizeof(uint32_t), "water.tile_blocks");
     GLint64 block = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
     t->ssbo_max = block > 0 ? (uint64_t)block : (1u << 27); /* GL 4.5's minimum is 2^27 */
@@ -105,8 +105,8 @@ void volfx_water_tile_destroy(vfx_context *ctx, volfx_water_tile *t)
 {
     if (!t)
         return;
-    GLuint b[] = {t->count, t->start, t->blocks, t->entries, t->globals, t->hits, t->guess, t->remarch, t->entry_ids};
-    for (int k = 0; k < 9; ++k)
+    GLuint b[] = {t->count, t->start, t->entries, t->globals, t->hits, t->guess, t->remarch, t->entry_ids};
+    for (int k = 0; k < 8; ++k)
         if (b[k])
             glDeleteBuffers(1, &b[k]);
     volfx_ubo_destroy(&t->ubo);
@@ -121,7 +121,7 @@ static const GLint *prog_locs(volfx_water_tile *t, GLuint prog)
     for (uint32_t k = 0; k < t->nprogs && k < TILE_PROG_CACHE; ++k)
         if (t->progs[k].prog == prog)
             return t->progs[k].loc;
-    static const char *const names[LOC_COUNT] = {"u_n", "u_half", "u_temporal", "u_reuse"};
+    static const char *const names[LOC_COUNT] = {"u_half", "u_temporal", "u_reuse"};
     tile_prog_locs *e = &t->progs[t->nprogs++ % TILE_PROG_CACHE];
     e->prog = prog;
     volfx_program_uniforms(prog, names, e->loc, LOC_COUNT);
@@ -180,7 +180,6 @@ static void bind_buffers(const volfx_water_tile *t, const volfx_water_tile_input
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, t->count);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, in->counters);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, t->start);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, t->blocks);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, t->entries);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 8, t->globals);
     if (in->kernels) {
@@ -293,14 +292,11 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
         count = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_COUNT\n");
         scatter = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_SCATTER\n");
     }
-    GLuint scan = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n");
-    GLuint top = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN\n#define SCAN_TOP\n");
-    GLuint add = volfx_gpu_compute(ctx, "water/grid.comp", "#define MODE_SCAN_ADD\n");
-    if (!count || !scatter || !scan || !top || !add)
+    if (!count || !scatter)
         return VFX_ERR_GL;
     tile_block_upload(t, in);
     bind_buffers(t, in);
-    GLuint groups = (in->count + 63u) / 64u, blocks = need / 1024u;
+    GLuint groups = (in->count + 63u) / 64u;
     GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
     volfx_gpu_pass_begin(ctx, "water.tile_bin");
     glClearNamedBufferSubData(t->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
@@ -309,20 +305,14 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
     if (groups)
         glDispatchCompute(gx, gy, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glUseProgram(scan);
-    glUniform1ui(prog_locs(t, scan)[LOC_N], nscan);
-    glDispatchCompute(blocks, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glUseProgram(top);
-    glUniform1ui(prog_locs(t, top)[LOC_N], blocks);
-    glDispatchCompute(1, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    glUseProgram(add);
-    glUniform1ui(prog_locs(t, add)[LOC_N], nscan);
-    glDispatchCompute((nscan + 255u) / 256u, 1, 1);
+    vfx_result r = volfx_gpu_scan(ctx, t->count, t->start, nscan, "water tile bins");
+    if (r) {
+        volfx_gpu_pass_end(ctx);
+        return r;
+    }
+    bind_buffers(t, in);
     /* the counts are spent: the same buffer becomes the per-tile fill cursor of the scatter,
      * and ends holding each tile's count again */
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     glClearNamedBufferSubData(t->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     glUseProgram(scatter);
     if (groups)

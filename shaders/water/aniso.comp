@@ -3,7 +3,7 @@
 // P(|G (x - c)|) (P the isotropic kernel of radius h) around a centre c. One MODE_* per dispatch:
 //   MODE_COUNT    per particle: count[bucket of its cell] += 1 (hashed uniform grid, cell = the
 //                 neighbourhood radius, so a particle's neighbours lie in its 27 cells)
-//   (prefix sum: grid.comp MODE_SCAN / SCAN_TOP / SCAN_ADD on the same buffers)
+//   (prefix sum of count[] into start[]: common/scan.comp, plugin/gpu/scan.h)
 //   MODE_SCATTER  per particle: sorted[start[bucket] + fill[bucket]++] = (position, index)
 //   MODE_CENTRE   per particle: the centre moved to the current position, the shape (G, the
 //                 bounding radius and half-extents) kept from the last MODE_KERNEL (the half
@@ -18,11 +18,7 @@
 //                 G, the bounding radius and the axis-aligned half-extents of the ellipsoid.
 // Every loop is bounded: the 27 cells, the candidates of a particle (at most MAX_CAND), the
 // Jacobi sweeps. Non-finite input gives the isotropic kernel (and the binning skips it).
-#if defined(MODE_SCAN) || defined(MODE_SCAN_ADD)
-layout(local_size_x = 256) in;
-#else
 layout(local_size_x = 64) in;
-#endif
 layout(std430, binding = 0) readonly buffer PX { float px[]; };
 layout(std430, binding = 1) readonly buffer PY { float py[]; };
 layout(std430, binding = 2) readonly buffer PZ { float pz[]; };

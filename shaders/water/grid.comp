@@ -1,9 +1,7 @@
 // Baseline GRID (vfx_water_params.method = GRID): a uniform particle grid built on the GPU,
 // then a per-pixel ray march over it. One MODE_* define per dispatch:
 //   MODE_COUNT    per particle: count[cell] += 1 (non-finite particles skipped)
-//   MODE_SCAN     exclusive prefix sum of count[] into start[], 1024 cells per workgroup,
-//                 block totals into blocks[] (SCAN_TOP: the same on blocks[], one workgroup)
-//   MODE_SCAN_ADD start[i] += blocks[i / 1024]
+//   (prefix sum of count[] into start[]: common/scan.comp, plugin/gpu/scan.h)
 //   MODE_SCATTER  per particle: sorted[start[cell] + fill[cell]++] = position
 //   MODE_MARCH    per pixel: the same sampling rule as brute.comp (step w, at most max_samples
 //                 field samples, eq. 5 then eq. 6 regula falsi) with the field summed over the
@@ -13,8 +11,6 @@
 #include "common/depth.glsl"
 #if defined(MODE_MARCH)
 layout(local_size_x = 8, local_size_y = 8) in;
-#elif defined(MODE_SCAN) || defined(MODE_SCAN_ADD)
-layout(local_size_x = 256) in;
 #else
 layout(local_size_x = 64) in;
 #endif
@@ -28,10 +24,8 @@ layout(std430, binding = 4) buffer Counters {
     uint c_culled_, c_frags_, c_samples, c_found, c_cap, c_left, c_gculled_, c_gfrags_, c_cells, c_tests;
 };
 layout(std430, binding = 5) buffer Start { uint start[]; };   // ncells + 1 entries (+ padding)
-layout(std430, binding = 6) buffer Blocks { uint blocks[]; };
 layout(std430, binding = 7) buffer Sorted { vec4 sorted[]; };
 uniform uint u_count;   // particles in the columns (non-finite included)
-uniform uint u_n;       // entries to scan
 uniform vec3 u_g0;      // grid origin
 uniform float u_cs;     // cell size (>= h)
 uniform ivec3 u_dims;
@@ -42,10 +36,6 @@ ivec3 cell_of(vec3 p)
 }
 
 uint linear(ivec3 c) { return uint(c.x + u_dims.x * (c.y + u_dims.y * c.z)); }
-
-#if defined(MODE_SCAN)
-shared uint sh[256];
-#endif
 
 #if defined(MODE_MARCH)
 layout(r32f, binding = 0) uniform writeonly image2D u_dist;
@@ -133,44 +123,6 @@ void main()
 #else
     sorted[start[c] + atomicAdd(count[c], 1u)] = vec4(p, 0.0);
 #endif
-#elif defined(MODE_SCAN)
-    // Each thread owns 4 consecutive entries; a Hillis-Steele scan of the 256 thread sums.
-    uint lid = gl_LocalInvocationID.x, base = gl_WorkGroupID.x * 1024u + lid * 4u;
-    uint v[4];
-    uint tot = 0u;
-    for (int k = 0; k < 4; ++k) {
-#if defined(SCAN_TOP)
-        v[k] = base + uint(k) < u_n ? blocks[base + uint(k)] : 0u;
-#else
-        v[k] = base + uint(k) < u_n ? count[base + uint(k)] : 0u;
-#endif
-        tot += v[k];
-    }
-    sh[lid] = tot;
-    barrier();
-    for (uint off = 1u; off < 256u; off <<= 1) {
-        uint add = lid >= off ? sh[lid - off] : 0u;
-        barrier();
-        sh[lid] += add;
-        barrier();
-    }
-    uint run = sh[lid] - tot;
-    for (int k = 0; k < 4; ++k) {
-        if (base + uint(k) < u_n) {
-#if defined(SCAN_TOP)
-            blocks[base + uint(k)] = run;
-#else
-            start[base + uint(k)] = run;
-#endif
-        }
-        run += v[k];
-    }
-#if !defined(SCAN_TOP)
-    if (lid == 255u) blocks[gl_WorkGroupID.x] = sh[255];
-#endif
-#elif defined(MODE_SCAN_ADD)
-    uint i = gl_GlobalInvocationID.x;
-    if (i < u_n) start[i] += blocks[i / 1024u];
 #elif defined(MODE_MARCH)
     ivec2 pix = ivec2(gl_GlobalInvocationID.xy);
     ivec2 size = imageSize(u_dist);

@@ -2,7 +2,7 @@
 // then a per-pixel march over the tile's list that cannot end undecided. One MODE_* per dispatch:
 //   MODE_COUNT    per particle: the tiles its cube of half-size h projects onto; count[tile] += 1
 //                 (a particle over more than u_global_tiles tiles goes to the global list instead)
-//   (prefix sum: grid.comp MODE_SCAN / SCAN_TOP / SCAN_ADD on the same buffers)
+//   (prefix sum of count[] into start[]: common/scan.comp, plugin/gpu/scan.h)
 //   MODE_SCATTER  per particle: entries[start[tile] + fill[tile]++] = position (while it fits
 //                 the capacity; a tile that does not fit reads every particle instead)
 //   MODE_MARCH    per pixel: exact ray interval from the tile's list (first sphere entry), then
