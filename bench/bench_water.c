@@ -150,7 +150,8 @@ static int run_one(uint32_t n, uint32_t size, uint32_t frames, int reference, co
                          .water_params = bench_params};
     vfx_plugin_api api = {.type = VFX_TYPE_PLUGIN_API};
     vfx_context *ctx = NULL;
-    if (vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api) != VFX_OK || api.create(&host, &ctx) != VFX_OK) {
+    if (vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api) != VFX_OK || api.create(&host, &ctx) != VFX_OK ||
+        volfx_lab_attach(ctx) != VFX_OK) {
         fprintf(stderr, "metaballs: plugin create failed\n");
         return 1;
     }

@@ -11,6 +11,7 @@
 
 typedef struct volfx_gpu volfx_gpu;
 typedef struct volfx_scan volfx_scan;
+typedef struct volfx_lab_hooks volfx_lab_hooks; /* lab_hooks.h */
 struct volfx_gl_table; /* gpu/volfx_gl.h, generated: the GL commands, resolved at create */
 typedef struct volfx_effect_ops volfx_effect_ops;
 
@@ -65,6 +66,8 @@ struct vfx_context {
     unsigned frame_block;       /* GL uniform buffer of the frame gate's VolfxFrame block */
     unsigned layer_fbo;         /* framebuffer the effects layer is attached to (frame_check.c) */
     volfx_debug_knobs debug;
+    /* the laboratory's functions (lab_hooks.h): NULL in the product; volfx_lab_attach fills it */
+    const volfx_lab_hooks *lab;
     /* the GL state contract (gpu/gl_state.h): the host's state saved on entry to the outermost
      * API call that touches GL (gl_calls counts the nesting: warm_up calls render, render
      * resize), put back on its return unless the host said it resets its own state */

@@ -1,12 +1,19 @@
-/* volfx_lab.h — the research switches of the plugin: ablation bits, baseline methods, the
- * volume renderer's and the beams' baselines. NOT installed and not part of the ABI's promise:
- * tests, benches and the in-tree sample game chain these structs into a public struct's `next`
- * to reproduce the measurements in docs/ (docs/abi.md "Lab structs"). An installed plugin reads
- * them like any chained struct; a host outside this tree has no header for them. */
+/* volfx_lab.h — the laboratory: the research switches of the plugin (ablation bits, baseline
+ * methods, the volume renderer's and the beams' baselines) and the lab library that draws the
+ * water's baselines (plugin/lab). NOT installed and not part of the ABI's promise: tests and
+ * benches link the lab library, attach it to their context and chain these structs into a public
+ * struct's `next` to reproduce the measurements in docs/ (docs/abi.md "Lab structs"). libvolfx
+ * holds no lab code: without volfx_lab_attach a vfx_lab_water, or a lab method, is refused by
+ * name (VFX_ERR_UNSUPPORTED). */
 #ifndef VOLFX_LAB_H
 #define VOLFX_LAB_H
 
 #include <volfx/volfx.h>
+
+/* Attaches the lab library to ctx (a context of the statically linked plugin, in the same
+ * program): from now on ctx reads vfx_lab_water and draws the water's BRUTE and GRID methods.
+ * VFX_ERR_INVALID_ARGUMENT for NULL. Lab library only (tests, benches): libvolfx has no such symbol. */
+vfx_result volfx_lab_attach(vfx_context *ctx);
 
 /* Type values of the lab structs, far from the public ones. */
 #define VFX_TYPE_LAB_WATER ((vfx_struct_type)0x4c414201)

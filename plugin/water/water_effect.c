@@ -1,7 +1,8 @@
 /* water_effect.c — metaball water (seed 000, Mishima et al.): the effect's create, resize,
- * upload, per-frame method choice, shading and counter readback. The methods: PAPER and BRUTE
- * (water_paper.c), GRID (water_grid.c), TILE, ours (water_tile.c, with water_aniso.c's kernels);
- * spray, foam and bubbles in water_diffuse.c. */
+ * upload, per-frame method choice, shading and counter readback. The methods: PAPER
+ * (water_paper.c), TILE, ours (water_tile.c, with water_aniso.c's kernels), and the lab's BRUTE
+ * and GRID when a lab is attached (lab_hooks.h, plugin/lab); spray, foam and bubbles in
+ * water_diffuse.c. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -14,6 +15,7 @@
 
 #include "water_internal.h"
 #include "water_params.h"
+#include "lab_hooks.h"
 #include "param_ranges.h"
 #if VFX_WITH_BEAMS
 #include "beams/beams_impact.h"
@@ -77,7 +79,8 @@ static void water_destroy(vfx_context *ctx, void *state)
     water_state *s = state;
     groups_free(ctx, s);
     volfx_water_views_destroy(ctx, s);
-    volfx_water_grid_destroy(ctx, s->grid);
+    if (s->lab_state && ctx->lab)
+        ctx->lab->water_free(ctx, s->lab_state);
     volfx_water_aniso_destroy(ctx, s->aniso);
     volfx_water_diffuse_destroy(ctx, s->diffuse);
     volfx_water_foam_destroy(ctx, s->foam);
@@ -641,14 +644,17 @@ static void counters_frame_end(vfx_context *ctx, water_state *s, uint32_t method
         publish_counters(ctx, s);
 }
 
-static vfx_result grid_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                             const volfx_frame_targets *targets)
+/* BRUTE and GRID, the lab's baselines (lab_hooks.h): a method only a vfx_lab_water asks for,
+ * which a context without the lab refuses (water_params.c). */
+static vfx_result lab_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
+                            const volfx_frame_targets *targets)
 {
-    if (!s->grid && !(s->grid = volfx_water_grid_create(ctx)))
-        return VFX_ERR_OUT_OF_MEMORY;
-    volfx_water_grid_input in = {s->cols, s->count, s->count - s->nan_count, s->lo, s->hi, &s->params,
-                               s->width, s->height, ctx->water_dist_tex, s->counters, s->data_rev};
-    return volfx_water_grid_render(ctx, s->grid, &in, frame, targets);
+    if (!ctx->lab)
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_WATER_METHOD,
+                          "water: method %u is a lab method; this plugin has no lab attached", s->params.method);
+    volfx_lab_water_input in = {s->cols, s->count, s->count - s->nan_count, s->lo, s->hi, &s->params,
+                                s->width, s->height, ctx->water_dist_tex, s->counters, s->data_rev};
+    return ctx->lab->water_march(ctx, &s->lab_state, s->params.method, &in, frame, targets);
 }
 
 static vfx_result tile_lists(vfx_context *ctx, water_state *s, volfx_water_tile_input *in,
@@ -828,10 +834,8 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
             r = paper_finish(ctx, s, frame, targets);
     } else if (p->method == VFX_WATER_METHOD_TILE)
         r = tile_march(ctx, s, frame, targets);
-    else if (p->method == VFX_WATER_METHOD_BRUTE)
-        r = volfx_water_brute_march(ctx, s, frame, targets);
-    else if (p->method == VFX_WATER_METHOD_GRID)
-        r = grid_march(ctx, s, frame, targets);
+    else if (p->method == VFX_WATER_METHOD_BRUTE || p->method == VFX_WATER_METHOD_GRID)
+        r = lab_march(ctx, s, frame, targets);
     else
         r = volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_METHOD,
                        "water: unknown method %u in vfx_water_params (0 paper, 1 brute, 2 grid, 3 tile)", p->method);

@@ -1,13 +1,12 @@
 /* water_internal.h — the water effect's state, shared by its files: water_effect.c (create,
- * upload, render, counters) and water_paper.c (the seed's billboard method and the BRUTE
- * baseline). Nothing outside plugin/water includes it. */
+ * upload, render, counters) and water_paper.c (the seed's billboard method). Nothing outside
+ * plugin/water includes it. */
 #ifndef VOLFX_WATER_INTERNAL_H
 #define VOLFX_WATER_INTERNAL_H
 
 #include "gpu/gl.h"
 #include "effect.h"
 #include "gpu/pass.h"
-#include "water_grid.h"
 #include "water_tile.h"
 #include "water_aniso.h"
 #include "water_diffuse.h"
@@ -96,7 +95,7 @@ typedef struct water_state {
     float auto_h;          /* h from the particles' spacing (0: not measured yet) */
     uint32_t auto_h_count; /* the particle count it was measured at */
     volfx_water_aniso *aniso; /* per-particle kernels (TILE), made when asked for or given */
-    volfx_water_grid *grid;  /* GRID baseline state, made the first time GRID is asked for */
+    void *lab_state;         /* the lab methods' state (ctx->lab's, lab_hooks.h), made on their first frame */
     volfx_water_tile *tile;  /* TILE lists (TILE, and PAPER's finishing pass), made when needed */
     volfx_water_diffuse *diffuse; /* spray, foam and bubbles from the host's velocities */
     volfx_water_diffuse_params dp; /* their parameters (vfx_water_params), checked */
@@ -161,12 +160,9 @@ void volfx_water_frame_upload(water_state *s, const vfx_frame_view *frame, const
 void volfx_water_bind_depth(const vfx_frame_view *frame);
 /* One invocation per pixel in 8x8 groups, then a full barrier. */
 void volfx_water_dispatch(const water_state *s);
-/* Method BRUTE: the per-pixel march over every particle (pass water.brute). */
-vfx_result volfx_water_brute_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                                   volfx_frame_targets *targets);
 /* Method PAPER: billboard init, the sample loop and refinement (seed 000, eqs. 1-6). */
 vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame);
-/* The gradient and back-distance billboard passes that shade PAPER's, BRUTE's and GRID's hits. */
+/* The gradient and back-distance billboard passes that shade PAPER's hits and the lab methods'. */
 vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const vfx_frame_view *frame);
 
 #endif

@@ -2,8 +2,7 @@
  * by depth test (eq. 1), potentials by additive blending into RGBA16F at 4 samples per texel,
  * sample update with two distance buffers and depth-tested gap jumping (eqs. 2-4), min/max
  * pyramid culling, eq. 5 interpolation and eq. 6 regula falsi (each pass again by blending);
- * the gradient and back-distance passes that shade it; and method BRUTE (per-pixel compute
- * march over every particle). */
+ * the gradient and back-distance passes that shade it (and the lab methods' hits). */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -98,24 +97,6 @@ static void draw_billboards(vfx_context *ctx, const water_state *s)
     for (int k = 0; k < 3; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, s->cols[k]);
     glMemoryBarrier(GL_ALL_BARRIER_BITS);
-}
-
-vfx_result volfx_water_brute_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                              volfx_frame_targets *targets)
-{
-    GLuint prog = volfx_gpu_compute(ctx, "water/brute.comp", NULL);
-    if (!prog)
-        return VFX_ERR_GL;
-    volfx_gpu_pass_begin(ctx, "water.brute");
-    glUseProgram(prog);
-    for (int k = 0; k < 3; ++k)
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, s->cols[k]);
-    volfx_water_march_bind(ctx, prog, ctx->water_dist_tex, &s->params, frame, targets);
-    glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_count"), s->count);
-    glDispatchCompute((s->width + 7) / 8, (s->height + 7) / 8, 1);
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
-    volfx_gpu_pass_end(ctx);
-    return VFX_OK;
 }
 
 /* Potentials at the current samples (tex `at`, NS samples from it) into s->pot: additive

@@ -7,6 +7,7 @@
 #include "context.h"
 #include "param_ranges.h"
 #include "water_params.h"
+#include "lab_hooks.h"
 
 /* What each preset sets in the fields the host left 0. The measured cost and error of each are in
  * docs/water.md ("Presets"); MEDIUM is the recommended default. */
@@ -48,7 +49,6 @@ vfx_result volfx_water_params_resolve(vfx_context *ctx, const vfx_water_params *
     vfx_result rr = volfx_water_params_check_ranges(ctx, in);
     if (rr)
         return rr;
-    const vfx_lab_water *lab = volfx_chain_find(in->next, VFX_TYPE_LAB_WATER);
     if (in->features_off & ~(uint32_t)(VFX_WATER_NO_SPRAY | VFX_WATER_NO_SSR))
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARAM,
                           "water: vfx_water_params.features_off 0x%x has bits other "
@@ -58,15 +58,21 @@ vfx_result volfx_water_params_resolve(vfx_context *ctx, const vfx_water_params *
         && in->method != VFX_WATER_METHOD_PAPER)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARAM,
                           "water: vfx_water_params.method %u unknown (0 default = tile, 3 tile, 4 paper)", in->method);
-    if (lab && (lab->disable & ~VFX_WATER_DISABLE_ALL))
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARAM,
-                          "water: vfx_lab_water.disable 0x%x has unknown bits",
-                          lab->disable);
+    /* the lab's struct (ablation bits, baseline methods): read by the lab library only */
+    uint32_t lab_disable = 0, lab_method = 0;
+    const void *lab = volfx_chain_find(in->next, VFX_TYPE_LAB_WATER);
+    if (lab && !ctx->lab)
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_WATER_PARAM,
+                          "water: a vfx_lab_water (type 0x%x) is chained into vfx_water_params: lab structs are read "
+                          "only with the lab library attached (volfx_lab_attach: tests and benches), not by libvolfx",
+                          (unsigned)VFX_TYPE_LAB_WATER);
+    if (lab && (rr = ctx->lab->water_struct(ctx, lab, &lab_disable, &lab_method)))
+        return rr;
     volfx_water_core p = {in->h, in->threshold, in->max_samples, in->step, in->refine_iters, in->pyramid_level,
-                          in->features_off | (lab ? lab->disable : 0u), in->method,
+                          in->features_off | lab_disable, in->method,
                           {in->color[0], in->color[1], in->color[2]}, in->absorption, in->ior};
-    if (lab && lab->method)
-        p.method = lab->method;
+    if (lab_method)
+        p.method = lab_method;
     uint32_t preset = in->preset;
     if (preset > VFX_WATER_PRESET_ULTRA)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARAM,

@@ -88,6 +88,7 @@ static void session_open(session *ss, host *s, uint32_t w, uint32_t h, GLenum fm
     ss->api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
     assert_int_equal(ss->api.create(&ss->hapi, &ss->ctx), VFX_OK);
+    assert_int_equal(volfx_lab_attach(ss->ctx), VFX_OK); /* the lab's methods and bits */
     ss->ctx->debug.sync_counters = true;
     ss->w = w, ss->h = h;
     glCreateTextures(GL_TEXTURE_2D, 1, &ss->col);

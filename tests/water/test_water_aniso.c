@@ -198,6 +198,7 @@ static run render_plugin(scene *s, const ref_camera *cam)
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     vfx_context *ctx;
     assert_int_equal(api.create(&host, &ctx), VFX_OK);
+    assert_int_equal(volfx_lab_attach(ctx), VFX_OK); /* the lab's methods and bits */
     ctx->debug.sync_counters = true;
     uint32_t w = cam->width, h = cam->height;
     GLuint fbo, col;
@@ -610,6 +611,7 @@ static void stepper_init(stepper *st, scene *s, const ref_camera *cam)
     st->api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &st->api), VFX_OK);
     assert_int_equal(st->api.create(&host, &st->ctx), VFX_OK);
+    assert_int_equal(volfx_lab_attach(st->ctx), VFX_OK); /* the lab's methods and bits */
     st->ctx->debug.sync_counters = true;
     glCreateTextures(GL_TEXTURE_2D, 1, &st->col);
     glTextureStorage2D(st->col, 1, GL_RGBA8, (GLsizei)cam->width, (GLsizei)cam->height);

@@ -79,6 +79,7 @@ static ref_water_error render_and_compare(scene *s, const ref_camera *cam, vfx_s
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     vfx_context *ctx;
     assert_int_equal(api.create(&host, &ctx), VFX_OK);
+    assert_int_equal(volfx_lab_attach(ctx), VFX_OK); /* the lab's methods and bits */
     ctx->debug.sync_counters = true; /* this frame's counters, not the last finished one's */
     uint32_t w = cam->width, h = cam->height;
     GLuint fbo, col;
@@ -486,6 +487,7 @@ static void test_unknown_method(void **state)
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     vfx_context *ctx;
     assert_int_equal(api.create(&host, &ctx), VFX_OK);
+    assert_int_equal(volfx_lab_attach(ctx), VFX_OK); /* the lab's methods and bits */
     ref_camera cam = {{0, 0, 3.0}, {0, 0, 0}, {0, 1, 0}, 0.6, 16, 16, 0.1, 100};
     vfx_frame_view fv = {.type = VFX_TYPE_FRAME_VIEW, .framebuffer = 0,
                          .width = 16, .height = 16, .fov_y = 0.6f, .near_plane = 0.1f, .far_plane = 100.0f};
@@ -539,6 +541,7 @@ static void session_open(session *ss, scene *s, const ref_camera *cam, const flo
     ss->api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
     assert_int_equal(ss->api.create(&host_api, &ss->ctx), VFX_OK);
+    assert_int_equal(volfx_lab_attach(ss->ctx), VFX_OK); /* the lab's methods and bits */
     ss->ctx->debug.sync_counters = sync;
     ss->ctx->debug.water_buffer_cap = buffer_cap;
     memcpy(ss->host, host, sizeof ss->host);
@@ -981,6 +984,7 @@ static void test_count_overflow_refused(void **state)
         assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
         vfx_context *ctx;
         assert_int_equal(api.create(&host, &ctx), VFX_OK);
+        assert_int_equal(volfx_lab_attach(ctx), VFX_OK); /* the lab's methods and bits */
         assert_int_equal(api.update(ctx, 0.0, 0.0f), VFX_ERR_INVALID_ARGUMENT);
         print_message("overflow %d: %s\n", k, api.last_error(ctx, NULL));
         assert_true(test_last_error_is(&api, ctx, VFX_LOG_ID_WATER_PARTICLE_COUNT, totals[k]));

@@ -99,6 +99,7 @@ static void render(scene *s, const ref_camera *cam, const float col[4], const fl
     vfx_context *ctx;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     assert_int_equal(api.create(&host_api, &ctx), VFX_OK);
+    assert_int_equal(volfx_lab_attach(ctx), VFX_OK); /* the lab's methods and bits */
     uint32_t w = cam->width, h = cam->height;
     GLuint tex[3] = {0, 0, 0}, fbo;
     glCreateTextures(GL_TEXTURE_2D, 3, tex);
@@ -160,6 +161,7 @@ static double render_host(scene *s, const ref_camera *cam, const float *col, con
     vfx_context *ctx;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api), VFX_OK);
     assert_int_equal(api.create(&host_api, &ctx), VFX_OK);
+    assert_int_equal(volfx_lab_attach(ctx), VFX_OK); /* the lab's methods and bits */
     GLuint tex[3], fbo;
     glCreateTextures(GL_TEXTURE_2D, 3, tex);
     glTextureStorage2D(tex[0], 1, GL_RGBA32F, (GLsizei)w, (GLsizei)h);

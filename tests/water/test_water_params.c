@@ -90,6 +90,7 @@ static void session_open(session *ss, host *s, uint32_t w, uint32_t h)
     ss->api.type = VFX_TYPE_PLUGIN_API;
     assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
     assert_int_equal(ss->api.create(&ss->host, &ss->ctx), VFX_OK);
+    assert_int_equal(volfx_lab_attach(ss->ctx), VFX_OK); /* the lab's methods and bits */
     ss->ctx->debug.sync_counters = true;
     ss->w = w;
     ss->h = h;
@@ -487,6 +488,35 @@ static void test_tile_coverage_any_size(void **state)
     free_host(&s);
 }
 
+/* The product and its laboratory: a context as libvolfx makes it (no lab attached) refuses a
+ * chained vfx_lab_water by name, whatever it asks for (ablation bits, the GRID method), and
+ * draws on without it; the same host's struct is read once the lab is attached. */
+static void test_lab_struct_needs_the_lab(void **state)
+{
+    (void)state;
+    host s = pool_host(6, 6, 2, 0.1f);
+    s.p.h = 0.2f;
+    const ref_camera cam = {{0.2, 0.9, 1.3}, {0, 0.1, 0}, {0, 1, 0}, 0.9, 32, 24, 0.05, 50};
+    session ss;
+    session_open(&ss, &s, cam.width, cam.height);
+    ss.ctx->lab = NULL; /* as libvolfx.so, which has no volfx_lab_attach */
+    s.lab.disable = VFX_WATER_NO_SKIP;
+    s.lab.method = VFX_WATER_METHOD_GRID;
+    assert_int_equal(session_frame(&ss, &cam), VFX_ERR_UNSUPPORTED);
+    print_message("without the lab: %s\n", ss.api.last_error(ss.ctx, NULL));
+    assert_true(test_last_error_is(&ss.api, ss.ctx, VFX_LOG_ID_WATER_PARAM, "vfx_lab_water"));
+    s.lab.disable = 0; /* nothing chained: the product's TILE draws */
+    assert_int_equal(session_frame(&ss, &cam), VFX_OK);
+    assert_true(stat(&ss, "water.pixels_found") > 50);
+    assert_int_equal(volfx_lab_attach(ss.ctx), VFX_OK);
+    s.lab.disable = VFX_WATER_NO_SKIP;
+    assert_int_equal(session_frame(&ss, &cam), VFX_OK); /* GRID, the lab's */
+    assert_true(stat(&ss, "water.grid_cells") > 0);
+    assert_true(stat(&ss, "water.pixels_found") > 50);
+    session_close(&ss);
+    free_host(&s);
+}
+
 int main(void)
 {
     rt_gl_context *gl = test_gl_or_skip();
@@ -497,6 +527,7 @@ int main(void)
         cmocka_unit_test(test_step_and_loop_bounds),
         cmocka_unit_test(test_two_views),
         cmocka_unit_test(test_tile_coverage_any_size),
+        cmocka_unit_test(test_lab_struct_needs_the_lab),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     rt_gl_context_destroy(gl);

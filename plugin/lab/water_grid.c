@@ -1,4 +1,4 @@
-/* water_grid.c — GRID baseline: uniform grid of cell h (grown when it would exceed
+/* water_grid.c — the lab's GRID baseline of the water: uniform grid of cell h (grown when it would exceed
  * GRID_MAX_CELLS), built on the GPU from the position columns whenever they were uploaded
  * again or h changed (a static scene keeps its grid): count per cell,
  * exclusive prefix sum (gpu/scan.h), scatter of the positions into cell order. The
@@ -48,7 +48,7 @@ void volfx_water_grid_destroy(vfx_context *ctx, volfx_water_grid *g)
 /* Grid geometry: origin one cell below the box, cell >= h (times 1 + 1e-4 so that rounding in
  * floor() never puts a particle within h of a sample two cells away), grown by the cube root of
  * the excess when the box would need more than GRID_MAX_CELLS cells (h tiny against the extent). */
-static void grid_layout(const volfx_water_grid_input *in, float g0[3], float *cs_out, int dims[3])
+static void grid_layout(const volfx_lab_water_input *in, float g0[3], float *cs_out, int dims[3])
 {
     double cs = (double)in->params->h * (1.0 + 1e-4);
     double lo[3] = {0, 0, 0}, ext[3] = {0, 0, 0};
@@ -73,7 +73,7 @@ static void grid_layout(const volfx_water_grid_input *in, float g0[3], float *cs
 }
 
 /* The storage buffers of every grid.comp mode. */
-static void grid_bind(const volfx_water_grid *g, const volfx_water_grid_input *in)
+static void grid_bind(const volfx_water_grid *g, const volfx_lab_water_input *in)
 {
     for (int k = 0; k < 3; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, in->cols[k]);
@@ -83,7 +83,7 @@ static void grid_bind(const volfx_water_grid *g, const volfx_water_grid_input *i
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, g->sorted);
 }
 
-static void grid_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_grid_input *in, const float g0[3], float cs,
+static void grid_uniforms(vfx_context *ctx, GLuint prog, const volfx_lab_water_input *in, const float g0[3], float cs,
                           const int dims[3])
 {
     glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_count"), in->count);
@@ -107,7 +107,7 @@ void volfx_water_march_bind(vfx_context *ctx, GLuint prog, GLuint dist_tex, cons
     glUniform1i(volfx_gpu_uniform(ctx, prog, "u_has_depth"), frame->depth_texture != 0);
 }
 
-vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const volfx_water_grid_input *in,
+vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const volfx_lab_water_input *in,
                                  const vfx_frame_view *frame, const volfx_frame_targets *targets)
 {
     const volfx_water_core *p = in->params;

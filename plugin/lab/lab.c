@@ -1,0 +1,17 @@
+/* lab.c — volfx_lab_attach: the lab's hook table (lab_hooks.h), one constant table shared by
+ * every context it is attached to. */
+#include "lab_water.h"
+
+static const volfx_lab_hooks LAB_HOOKS = {
+    .water_struct = volfx_lab_water_struct,
+    .water_march = volfx_lab_water_march,
+    .water_free = volfx_lab_water_free,
+};
+
+vfx_result volfx_lab_attach(vfx_context *ctx)
+{
+    if (!ctx)
+        return VFX_ERR_INVALID_ARGUMENT;
+    ctx->lab = &LAB_HOOKS;
+    return VFX_OK;
+}

@@ -1,0 +1,41 @@
+/* lab_hooks.h — the product's one door to the laboratory (plugin/lab: the research baselines
+ * and ablation switches, a library that tests and benches link and libvolfx does not contain).
+ * A context holds a table of the lab's functions in ctx->lab: NULL in the product, filled by
+ * volfx_lab_attach (volfx_lab.h). Without it a lab struct or method is refused by name. */
+#ifndef VOLFX_LAB_HOOKS_H
+#define VOLFX_LAB_HOOKS_H
+
+#include <stdint.h>
+
+#include "gpu/gl.h"
+#include "effect.h"
+
+struct volfx_water_core; /* water/water_params.h */
+
+/* What a lab method of the water draws from: the water's state, borrowed for the call. */
+typedef struct volfx_lab_water_input {
+    const GLuint *cols;              /* x, y, z position columns (SSBOs of `count` floats) */
+    uint32_t count;                  /* particles in the columns, non-finite ones included */
+    uint32_t finite;                 /* of which finite (0: nothing to draw) */
+    const float *lo, *hi;            /* box of the finite particles */
+    const struct volfx_water_core *params; /* defaults already applied */
+    uint32_t width, height;
+    GLuint dist_tex;                 /* R32F target: distance along the ray or -1 */
+    GLuint counters;                 /* the effect's counter buffer (fenced readback ring) */
+    uint64_t data_rev;               /* changes whenever the columns were uploaded again */
+} volfx_lab_water_input;
+
+struct volfx_lab_hooks {
+    /* Reads the vfx_lab_water at `lab` (its type already matched): *disable gets its VFX_WATER_NO_*
+     * bits, *method its method (0: the host's); unknown bits fail with VFX_ERR_INVALID_ARGUMENT
+     * naming the field. */
+    vfx_result (*water_struct)(vfx_context *ctx, const void *lab, uint32_t *disable, uint32_t *method);
+    /* Draws lab method `method` (VFX_WATER_METHOD_BRUTE or _GRID) into in->dist_tex, adding its
+     * counts into in->counters; *state is the lab's own, NULL until its first call. */
+    vfx_result (*water_march)(vfx_context *ctx, void **state, uint32_t method, const volfx_lab_water_input *in,
+                              const vfx_frame_view *frame, const volfx_frame_targets *targets);
+    /* Frees what water_march made in *state (NULL allowed). */
+    void (*water_free)(vfx_context *ctx, void *state);
+};
+
+#endif
