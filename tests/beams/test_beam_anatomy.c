@@ -10,7 +10,8 @@
  *    Its error is measured here per ray class and held to bounds set from the measurement with
  *    margin (see PROFILE_* below); a side view crosses the body at one u and is exact.
  *  - float32 against float64 closed form: 1e-5 of the beam's peak H plus 1e-5 relative (the
- *    float32 inputs round by an ulp; the torture-level conditioning is test_beam_field.c's).
+ *    float32 inputs round by an ulp; the torture-level conditioning is test_beam_field.c's). The
+ *    float32 closed form is the shader's, beam_field.glsl run on the ray by beam_probe.h.
  *  - Zero anatomy is version 2's field bit for bit (the same code path). */
 #include <float.h>
 #include <math.h>
@@ -25,6 +26,11 @@
 
 #include "beams/beam_field.h"
 #include "beams_ref.h"
+#include "beam_probe.h"
+
+static vfx_context *g_ctx; /* the shader probe's plugin context */
+static const vfx_plugin_api *g_api;
+static rt_gl_context *g_gl;
 
 /* Error of the profiled body, as max |H - H_ref| over the class's rays divided by the largest
  * H_ref of the class (what a pixel shows against the beam's brightest), measured 2026-12-03 with
@@ -84,7 +90,9 @@ static void check_f32(const volfx_beam_d *b, const double o[3], const double v[3
     float of[3] = {(float)o[0], (float)o[1], (float)o[2]}, vf[3] = {(float)v[0], (float)v[1], (float)v[2]};
     double od[3] = {of[0], of[1], of[2]}, vd[3] = {vf[0], vf[1], vf[2]};
     double exact = volfx_beam_integral_d(b, od, vd, 0, (float)t1);
-    double hf = volfx_beam_integral_f(b, of, vf, 0, (float)t1);
+    beam_probe_ray ray = {b, {of[0], of[1], of[2]}, {vf[0], vf[1], vf[2]}, 0.f, (float)t1};
+    float hf = NAN;
+    assert_true(beam_probe_eval(g_ctx, &ray, 1, &hf));
     (void)hd;
     if (!(fabs(hf - exact) <= 1e-5 * peak + 1e-5 * exact))
         fail_msg("float32 %.9g vs float64 %.9g (peak %g)", hf, exact, peak);
@@ -179,5 +187,11 @@ int main(void)
         cmocka_unit_test(test_head_and_orb_exact),
         cmocka_unit_test(test_profile_bounded),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    g_gl = test_gl_or_skip();
+    if (!(g_ctx = beam_probe_open(&g_api)))
+        return 1;
+    int rc = cmocka_run_group_tests(tests, NULL, NULL);
+    g_api->destroy(g_ctx);
+    rt_gl_context_destroy(g_gl);
+    return rc;
 }

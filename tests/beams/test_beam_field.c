@@ -1,9 +1,11 @@
-/* test_beam_field.c — the closed form of plugin/beams/beam_field.c against the float64
- * adaptive quadrature of the raw density (reference/beams_ref.c): a torture set of
- * singular and near-singular rays plus seeded random beams and rays.
+/* test_beam_field.c — the closed form against the float64 adaptive quadrature of the raw density
+ * (reference/beams_ref.c): a torture set of singular and near-singular rays plus seeded random
+ * beams and rays. The float32 closed form is the shader's own, shaders/beams/beam_field.glsl run
+ * on these rays by a compute probe (beam_probe.h) on the test's GL (llvmpipe in CI); the float64
+ * one is plugin/beams/beam_field.c's.
  *
  * Tolerances.
- *  - float32 closed form: relative error <= 1e-6 + cond, where cond is the spread of the exact
+ *  - float32 closed form (GLSL): relative error <= 1e-6 + cond, where cond is the spread of the exact
  *    answer (float64 closed form) when the float32 inputs (ray origin, direction, head M, end
  *    t1) move by 2 float32 ulps. A float32 algorithm cannot do better than the float32 rounding
  *    of its own inputs: a ray 1e6 units away from a beam of radius 1 moves by 0.1 when its
@@ -25,6 +27,9 @@
 
 #include "beams/beam_field.h"
 #include "beams_ref.h"
+#include "beam_probe.h"
+
+static vfx_context *g_ctx; /* the probe's plugin context */
 
 typedef struct tcase {
     const char *name;
@@ -92,7 +97,7 @@ typedef struct tally {
     double max_rel_f, max_rel_d, max_rel_f_wellcond, max_ratio_f;
 } tally;
 
-static void check(tally *t, const tcase *c)
+static void check(tally *t, const tcase *c, float hf)
 {
     double od[3] = {c->o[0], c->o[1], c->o[2]}, vd[3] = {c->v[0], c->v[1], c->v[2]};
     /* The float direction is unit only to ~6e-8; the float64 paths take t as arc length, so
@@ -117,7 +122,6 @@ static void check(tally *t, const tcase *c)
     if (getenv("VFX_TEST_VERBOSE"))
         fprintf(stderr, "  %llu evaluations\n", (unsigned long long)evals);
     double hd = volfx_beam_integral_d(&bd, od, vd, c->t0, c->t1);
-    float hf = volfx_beam_integral_f(&bd, c->o, c->v, (float)c->t0, (float)c->t1);
     if (!isfinite(hf) || !isfinite(hd)) {
         printf("FAIL %s: non-finite H (f32 %g, f64 %g)\n", c->name, hf, hd);
         t->failures++;
@@ -243,15 +247,18 @@ static int run(int smooth)
         mk("parallel to the axis at r = 0.99 R", std, -5, 0.99f, 0, 1, 0, 0, 100),
         mk("parallel to the axis at r = 0.9999 R", std, -5, 0.9999f, 0, 1, 0, 0, 100),
     };
-    for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; ++i) {
+    enum { NFIXED = sizeof fixed / sizeof fixed[0], NRANDOM = 400 };
+    static tcase all[NFIXED + NRANDOM];
+    int nc = 0;
+    for (size_t i = 0; i < NFIXED; ++i) {
         fixed[i].smooth = smooth;
-        check(&t, &fixed[i]);
+        all[nc++] = fixed[i];
     }
-    int fixed_cases = t.cases;
+    int fixed_cases = nc;
 
     uint64_t seed = 0x5eed0005beau;
-    char names[400][48];
-    for (int i = 0; i < 400; ++i) {
+    static char names[NRANDOM][48];
+    for (int i = 0; i < NRANDOM; ++i) {
         double S = pow(10.0, -3.0 + 8.0 * rnd(&seed)); /* scene scale 1e-3 .. 1e5 */
         vfx_beam b;
         memset(&b, 0, sizeof b);
@@ -288,11 +295,29 @@ static int run(int smooth)
         c.t0 = 0.0f;
         c.t1 = rnd(&seed) < 0.3 ? (float)(dist * (0.5 + rnd(&seed))) : (float)(dist * 10.0 + 10.0 * S);
         c.smooth = smooth;
-        check(&t, &c);
+        all[nc++] = c;
     }
+    /* the shader's H of every case in one dispatch, then each case against the references */
+    static volfx_beam_d bds[NFIXED + NRANDOM];
+    static beam_probe_ray rays[NFIXED + NRANDOM];
+    static float hf[NFIXED + NRANDOM];
+    for (int i = 0; i < nc; ++i) {
+        char err[256];
+        if (volfx_beam_validate(&all[i].beam, &bds[i], err, sizeof err) != VFX_OK)
+            memset(&bds[i], 0, sizeof bds[i]); /* refused: check() reports it */
+        bds[i].smooth = all[i].smooth;
+        rays[i] = (beam_probe_ray){&bds[i], {all[i].o[0], all[i].o[1], all[i].o[2]},
+                                   {all[i].v[0], all[i].v[1], all[i].v[2]}, all[i].t0, all[i].t1};
+    }
+    if (!beam_probe_eval(g_ctx, rays, (uint32_t)nc, hf)) {
+        printf("FAIL the shader probe did not run\n");
+        return 1;
+    }
+    for (int i = 0; i < nc; ++i)
+        check(&t, &all[i], hf[i]);
     printf("beam field, %s support: %d cases (%d torture, %d random), %d failures\n", smooth ? "smooth" : "hard", t.cases, fixed_cases,
            t.cases - fixed_cases, t.failures);
-    printf("max relative error: float32 %.3g (%.3g where cond < 1e-6; %d cases above 1e-5, all "
+    printf("max relative error: float32 (GLSL) %.3g (%.3g where cond < 1e-6; %d cases above 1e-5, all "
            "within their input conditioning; max error / (1e-6 + cond) %.3g), float64 %.3g\n",
            t.max_rel_f, t.max_rel_f_wellcond, t.cond_limited, t.max_ratio_f, t.max_rel_d);
     return t.failures;
@@ -329,8 +354,12 @@ static int run_polylines(int smooth)
             return 1;
         }
         bd.smooth = smooth;
-        for (int r = 0; r < 70; ++r) {
-            float o[3], v[3];
+        enum { NRAYS = 70 };
+        float os[NRAYS][3], vs[NRAYS][3], hfs[NRAYS];
+        double t1s[NRAYS];
+        beam_probe_ray rays[NRAYS];
+        for (int r = 0; r < NRAYS; ++r) {
+            float *o = os[r], *v = vs[r];
             double t1;
             if (r < 10) { /* a sweep across joint 1 along the ray direction z, 0.3 off the line */
                 const float *J = P[p][1];
@@ -350,13 +379,23 @@ static int run_polylines(int smooth)
                 normalize3f(v);
                 t1 = rnd(&seed) < 0.3 ? dist * (0.7 + 0.6 * rnd(&seed)) : 100.0;
             }
+            t1s[r] = t1;
+            rays[r] = (beam_probe_ray){&bd, {o[0], o[1], o[2]}, {v[0], v[1], v[2]}, 0.f, (float)t1};
+        }
+        if (!beam_probe_eval(g_ctx, rays, NRAYS, hfs)) {
+            printf("FAIL the shader probe did not run\n");
+            return 1;
+        }
+        for (int r = 0; r < NRAYS; ++r) {
+            const float *o = os[r], *v = vs[r];
+            double t1 = t1s[r];
+            float hf = hfs[r];
             double od[3] = {o[0], o[1], o[2]}, vd[3] = {v[0], v[1], v[2]};
             double vn = sqrt(vd[0] * vd[0] + vd[1] * vd[1] + vd[2] * vd[2]);
             for (int c = 0; c < 3; ++c)
                 vd[c] /= vn;
             double ref = ref_beams_integral(&bd, 1, od, vd, 0, t1, 1e-12, NULL);
             double hd = volfx_beam_integral_d(&bd, od, vd, 0, t1);
-            float hf = volfx_beam_integral_f(&bd, o, v, 0.f, (float)t1);
             double cond = ref_beams_cond_abs(&bd, 1, od, vd, 0, t1, 2.0);
             cases++;
             double ef = fabs(hf - ref), ed = fabs(hd - ref);
@@ -401,9 +440,17 @@ static int run_polylines(int smooth)
 
 int main(void)
 {
+    rt_gl_context *gl = test_gl_or_skip();
+    const vfx_plugin_api *api = NULL;
+    if (!(g_ctx = beam_probe_open(&api))) {
+        printf("FAIL no plugin context for the shader probe\n");
+        return 1;
+    }
     int failures = run(0);
     failures += run(1);
     failures += run_polylines(0);
     failures += run_polylines(1);
+    api->destroy(g_ctx);
+    rt_gl_context_destroy(gl);
     return failures ? 1 : 0;
 }
