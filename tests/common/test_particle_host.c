@@ -5,6 +5,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <cmocka.h>
@@ -36,6 +37,36 @@ vfx_context_desc test_particle_host_desc(test_particle_host *host)
                               .log = test_vfx_log_fn, .particle_chunk_count = test_particle_host_chunk_count,
                               .particle_chunk = test_particle_host_chunk,
                               .water_params = test_particle_host_water_params};
+}
+
+void test_particle_host_lattice(test_particle_host *h, uint32_t nx, uint32_t ny, uint32_t nz, float spacing,
+                                const float origin[3], float jitter, uint32_t seed)
+{
+    h->n = nx * ny * nz;
+    float **cols[] = {&h->x, &h->y, &h->z, &h->vx, &h->vy, &h->vz};
+    for (int k = 0; k < 6; ++k) {
+        *cols[k] = calloc(h->n, sizeof(float));
+        assert_non_null(*cols[k]);
+    }
+    uint32_t i = 0;
+    for (uint32_t a = 0; a < nx; ++a)
+        for (uint32_t b = 0; b < ny; ++b)
+            for (uint32_t c = 0; c < nz; ++c, ++i) {
+                float j[3];
+                for (int k = 0; k < 3; ++k) {
+                    seed = seed * 1664525u + 1013904223u;
+                    j[k] = ((float)(seed >> 8) / 16777216.0f - 0.5f) * jitter;
+                }
+                h->x[i] = spacing * (float)a + j[0] + origin[0];
+                h->y[i] = spacing * (float)b + j[1] + origin[1];
+                h->z[i] = spacing * (float)c + j[2] + origin[2];
+            }
+}
+
+void test_particle_host_free(test_particle_host *h)
+{
+    float *cols[] = {h->x, h->y, h->z, h->vx, h->vy, h->vz};
+    for (int k = 0; k < 6; ++k) free(cols[k]);
 }
 
 void test_frame_view_look(vfx_frame_view *fv, const float eye[3], float pitch)

@@ -28,6 +28,14 @@ vfx_result test_particle_host_water_params(void *user, vfx_water_params *out);
 /* The context description of a particle host (user = the host, its log, the headless GL
  * context's loader, the three callbacks above); a test adds its own callbacks to it. */
 vfx_context_desc test_particle_host_desc(test_particle_host *host);
+/* nx x ny x nz particles on a lattice of `spacing` from `origin`, particle (a, b, c) at index
+ * (a * ny + b) * nz + c, each coordinate moved by (u - 0.5) x jitter with u uniform in [0, 1)
+ * from a linear congruential sequence started at `seed`; the six columns allocated, the
+ * velocities zeroed. */
+void test_particle_host_lattice(test_particle_host *h, uint32_t nx, uint32_t ny, uint32_t nz, float spacing,
+                                const float origin[3], float jitter, uint32_t seed);
+/* Frees the six columns. */
+void test_particle_host_free(test_particle_host *h);
 /* A camera for fv (its width and height set): at `eye`, looking down -z tilted down by `pitch`
  * radians, a vertical field of view of 0.9 rad, near 0.05, far 100; fills fov_y, the planes,
  * eye, view and proj. */

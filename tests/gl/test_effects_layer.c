@@ -62,22 +62,12 @@ static void make_host(host *s)
 {
     memset(s, 0, sizeof *s);
     const uint32_t nx = 14, ny = 6, nz = 10;
-    s->ph.n = nx * ny * nz;
-    float **cols[] = {&s->ph.x, &s->ph.y, &s->ph.z, &s->ph.vx, &s->ph.vy, &s->ph.vz};
-    for (int k = 0; k < 6; ++k) *cols[k] = malloc(s->ph.n * sizeof(float));
-    uint32_t i = 0, seed = 99;
-    for (uint32_t a = 0; a < nx; ++a)
-        for (uint32_t b = 0; b < ny; ++b)
-            for (uint32_t c = 0; c < nz; ++c, ++i) {
-                float j[3];
-                for (int k = 0; k < 3; ++k) {
-                    seed = seed * 1664525u + 1013904223u;
-                    j[k] = ((float)(seed >> 8) / 16777216.0f - 0.5f) * 0.02f;
-                }
-                s->ph.x[i] = 0.05f * a + j[0] - 0.55f, s->ph.y[i] = 0.05f * b + j[1] - 0.3f, s->ph.z[i] = 0.05f * c + j[2] - 0.3f;
-                float top = (float)b / (float)(ny - 1);
-                s->ph.vx[i] = 2.5f * sinf(9.0f * s->ph.x[i]), s->ph.vy[i] = 3.5f * top * top, s->ph.vz[i] = 0.7f * cosf(5.0f * s->ph.z[i]);
-            }
+    const float origin[3] = {-0.55f, -0.3f, -0.3f};
+    test_particle_host_lattice(&s->ph, nx, ny, nz, 0.05f, origin, 0.02f, 99);
+    for (uint32_t i = 0; i < s->ph.n; ++i) {
+        float top = (float)((i / nz) % ny) / (float)(ny - 1);
+        s->ph.vx[i] = 2.5f * sinf(9.0f * s->ph.x[i]), s->ph.vy[i] = 3.5f * top * top, s->ph.vz[i] = 0.7f * cosf(5.0f * s->ph.z[i]);
+    }
     /* a beam across the view in front of the water, partly over it */
     s->beam = (vfx_beam){.type = VFX_TYPE_BEAM, .head = {0.6f, 0.15f, 0.2f}, .length = 1.2f, .dir = {1, 0, 0}, .radius = 0.06f, .a = 1.0f,
                          .b = 0.6f, .eps = 0.01f, .color = {0.3f, 0.6f, 1.0f, 1.0f}};
@@ -90,11 +80,7 @@ static void make_host(host *s)
     s->water = s->beams = s->volume = true;
 }
 
-static void free_host(host *s)
-{
-    float *cols[] = {s->ph.x, s->ph.y, s->ph.z, s->ph.vx, s->ph.vy, s->ph.vz};
-    for (int k = 0; k < 6; ++k) free(cols[k]);
-}
+static void free_host(host *s) { test_particle_host_free(&s->ph); }
 
 typedef struct session {
     vfx_plugin_api api;

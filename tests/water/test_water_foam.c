@@ -19,6 +19,7 @@
 
 #include "debug.h"
 #include "test_particle_host.h"
+#include "water_test_session.h"
 #include "test_util.h"
 #include "water/water_effect.h"
 
@@ -28,45 +29,20 @@
 /* the particles with velocities, one chunk; a test's vfx_water_foam chained as params_next */
 typedef test_particle_host host;
 
-typedef struct session {
-    vfx_plugin_api api;
-    vfx_context *ctx;
-    GLuint fbo, col;
-    vfx_frame_view fv;
-} session;
+typedef water_session session;
 
+/* the camera looks at the slab from above and in front: the draws run too */
 static void session_open(session *ss, host *h)
 {
-    memset(ss, 0, sizeof *ss);
-    vfx_context_desc api = test_particle_host_desc(h);
-    ss->api.type = VFX_TYPE_PLUGIN_API;
-    assert_int_equal(vfx_plugin_entry(VFX_ABI_VERSION, NULL, &ss->api), VFX_OK);
-    assert_int_equal(ss->api.create(&api, &ss->ctx), VFX_OK);
-    ss->ctx->debug.sync_counters = true;
-    const uint32_t w = 32, hh = 32;
-    glCreateTextures(GL_TEXTURE_2D, 1, &ss->col);
-    glTextureStorage2D(ss->col, 1, GL_RGBA8, w, hh);
-    glCreateFramebuffers(1, &ss->fbo);
-    glNamedFramebufferTexture(ss->fbo, GL_COLOR_ATTACHMENT0, ss->col, 0);
-    ss->fv = (vfx_frame_view){.type = VFX_TYPE_FRAME_VIEW, .framebuffer = ss->fbo, .width = w, .height = hh};
     const float eye[3] = {0.8f, 1.5f, 3.0f};
-    test_frame_view_look(&ss->fv, eye, 0.0f);
+    water_session_open(ss, h, 32, 32, eye);
 }
 
-static void session_frame(session *ss)
-{
-    assert_int_equal(ss->api.update(ss->ctx, 0.0, DT), VFX_OK);
-    assert_int_equal(ss->api.render(ss->ctx, &ss->fv), VFX_OK);
-}
+static void session_frame(session *ss) { water_session_frame(ss, DT); }
 
-static double stat_of(session *ss, const char *name) { return test_stat(&ss->api, ss->ctx, name); }
+static double stat_of(session *ss, const char *name) { return water_session_stat(ss, name); }
 
-static void session_close(session *ss)
-{
-    ss->api.destroy(ss->ctx);
-    glDeleteFramebuffers(1, &ss->fbo);
-    glDeleteTextures(1, &ss->col);
-}
+static void session_close(session *ss) { water_session_close(ss); }
 
 /* A flat slab of n x 3 x n particles at spacing h/2 from the origin, every one moving at
  * (ux, 0, uz). */
@@ -90,10 +66,7 @@ static host make_slab(uint32_t n, float ux, float uz)
     return s;
 }
 
-static void free_host(host *s)
-{
-    free(s->x), free(s->y), free(s->z), free(s->vx), free(s->vy), free(s->vz);
-}
+static void free_host(host *s) { test_particle_host_free(s); }
 
 /* Mass (sum x cell^2), centre and variance (world x, z) of a density on the grid. */
 typedef struct moments {

@@ -68,24 +68,14 @@ static vfx_result chunk_view(void *user, uint32_t index, vfx_particle_view *out)
 static void make_host(host *s, uint32_t nx, uint32_t ny, uint32_t nz)
 {
     memset(s, 0, sizeof *s);
-    s->ph.n = nx * ny * nz;
-    float **cols[] = {&s->ph.x, &s->ph.y, &s->ph.z, &s->ph.vx, &s->ph.vy, &s->ph.vz};
-    for (int k = 0; k < 6; ++k) *cols[k] = malloc(s->ph.n * sizeof(float));
-    uint32_t i = 0, seed = 777;
-    for (uint32_t a = 0; a < nx; ++a)
-        for (uint32_t b = 0; b < ny; ++b)
-            for (uint32_t c = 0; c < nz; ++c, ++i) {
-                float j[3];
-                for (int k = 0; k < 3; ++k) {
-                    seed = seed * 1664525u + 1013904223u;
-                    j[k] = ((float)(seed >> 8) / 16777216.0f - 0.5f) * 0.02f;
-                }
-                s->ph.x[i] = 0.05f * a + j[0] - 0.4f, s->ph.y[i] = 0.05f * b + j[1] - 0.2f, s->ph.z[i] = 0.05f * c + j[2] - 0.4f;
-                float top = (float)b / (float)(ny - 1);
-                s->ph.vx[i] = 2.5f * sinf(9.0f * s->ph.x[i] + 4.0f * s->ph.z[i]);
-                s->ph.vy[i] = 3.5f * top * top;
-                s->ph.vz[i] = 0.7f * cosf(5.0f * s->ph.z[i] - 2.0f * s->ph.x[i]);
-            }
+    const float origin[3] = {-0.4f, -0.2f, -0.4f};
+    test_particle_host_lattice(&s->ph, nx, ny, nz, 0.05f, origin, 0.02f, 777);
+    for (uint32_t i = 0; i < s->ph.n; ++i) {
+        float top = (float)((i / nz) % ny) / (float)(ny - 1);
+        s->ph.vx[i] = 2.5f * sinf(9.0f * s->ph.x[i] + 4.0f * s->ph.z[i]);
+        s->ph.vy[i] = 3.5f * top * top;
+        s->ph.vz[i] = 0.7f * cosf(5.0f * s->ph.z[i] - 2.0f * s->ph.x[i]);
+    }
     /* one particle NaN: skipped by both paths and counted */
     s->ph.y[7] = NAN;
     s->ph.params.type = VFX_TYPE_WATER_PARAMS;
@@ -133,8 +123,8 @@ static void host_frame(host *s, int f)
 
 static void free_host(host *s)
 {
-    float *cols[] = {s->ph.x, s->ph.y, s->ph.z, s->ph.vx, s->ph.vy, s->ph.vz, s->base, s->kern};
-    for (int k = 0; k < 8; ++k) free(cols[k]);
+    test_particle_host_free(&s->ph);
+    free(s->base), free(s->kern);
     glDeleteBuffers(1, &s->buf);
     glDeleteBuffers(1, &s->kbuf);
 }

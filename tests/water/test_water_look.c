@@ -323,6 +323,42 @@ static void test_fresnel_grazing(void **state)
     assert_true(lum[1] > 5.0 * lum[0]);
 }
 
+/* What a host pixel's ray meets: false and nothing else written where it meets nothing (depth
+ * far, colour black); else *t its distance and rgba its colour. */
+typedef bool (*host_hit_fn)(const double eye[3], const double dir[3], double *t, float rgba[4]);
+
+/* The host's colour (RGBA32F) and window depth, GL rows (bottom first), of the scene `hit`
+ * traced from cam's pixels; returns how many pixels met something red (the bright object). */
+static uint32_t host_image(const ref_camera *cam, host_hit_fn hit, float *col, float *dep)
+{
+    const uint32_t w = cam->width, h = cam->height;
+    double fwd[3], right[3], up[3];
+    ref_camera_basis(cam, fwd, right, up);
+    uint32_t count = 0;
+    for (uint32_t j = 0; j < h; ++j)
+        for (uint32_t i = 0; i < w; ++i) {
+            size_t q = (size_t)j * w + i;
+            double dir[3], t;
+            float c[4] = {0.0f, 0.0f, 0.0f, 1.0f};
+            ref_pixel_ray(cam, i, h - 1 - j, dir);
+            bool on = hit(cam->eye, dir, &t, c);
+            memcpy(col + 4 * q, c, sizeof c);
+            dep[q] = on ? axis_depth(cam, t * (dir[0] * fwd[0] + dir[1] * fwd[1] + dir[2] * fwd[2])) : 1.0f;
+            count += on && c[0] > 0.0f;
+        }
+    return count;
+}
+
+/* test_ssr_reflects_host's host: a red wall x in [-2, 2], y in [0, 2] on the plane z = -4.5. */
+static bool wall_hit(const double eye[3], const double dir[3], double *t, float rgba[4])
+{
+    *t = (-4.5 - eye[2]) / dir[2];
+    double x = eye[0] + *t * dir[0], y = eye[1] + *t * dir[1];
+    if (!(*t > 0 && fabs(x) <= 2 && y >= 0 && y <= 2)) return false;
+    rgba[0] = 3.0f;
+    return true;
+}
+
 /* SSR: a bright red wall (x in [-2, 2], y in [0, 2]) stands behind a clear pool, in the host's
  * colour and depth (window depth of each pixel's ray meeting the plane z = -4.5; black and far
  * elsewhere), seen at a grazing view. With SSR the reflected rays find the wall (water.ssr_hits)
@@ -339,22 +375,7 @@ static void test_ssr_reflects_host(void **state)
     const uint32_t w = cam.width, h = cam.height;
     const size_t n = (size_t)w * h;
     float *col = malloc(n * 16), *dep = malloc(n * 4);
-    double fwd[3], right[3], up[3];
-    ref_camera_basis(&cam, fwd, right, up);
-    uint32_t wall = 0;
-    for (uint32_t j = 0; j < h; ++j) /* GL rows: j = 0 the bottom */
-        for (uint32_t i = 0; i < w; ++i) {
-            size_t q = (size_t)j * w + i;
-            double dir[3];
-            ref_pixel_ray(&cam, i, h - 1 - j, dir);
-            double t = (-4.5 - cam.eye[2]) / dir[2], p[3];
-            for (int k = 0; k < 3; ++k) p[k] = cam.eye[k] + t * dir[k];
-            bool on = t > 0 && fabs(p[0]) <= 2 && p[1] >= 0 && p[1] <= 2;
-            float c[4] = {on ? 3.0f : 0.0f, 0.0f, 0.0f, 1.0f};
-            memcpy(col + 4 * q, c, sizeof c);
-            dep[q] = on ? axis_depth(&cam, t * (dir[0] * fwd[0] + dir[1] * fwd[1] + dir[2] * fwd[2])) : 1.0f;
-            wall += on;
-        }
+    const uint32_t wall = host_image(&cam, wall_hit, col, dep);
     double redness[2];
     double hits[2];
     for (int on = 0; on < 2; ++on) {
@@ -425,6 +446,18 @@ static bool passes_under_plate(const ref_camera *cam, const double x[3], const d
     return true;
 }
 
+/* test_ssr_under_floating_object's host: the red plate, else a dark blue wall on z = -8. */
+static bool plate_scene_hit(const double eye[3], const double dir[3], double *t, float rgba[4])
+{
+    if (plate_hit(eye, dir, 0.0, t)) {
+        rgba[0] = 3.0f;
+        return true;
+    }
+    *t = (-8.0 - eye[2]) / dir[2];
+    rgba[2] = 0.2f;
+    return true;
+}
+
 /* SSR with a floating object: a bright red plate (above) hovers over a clear pool (h 0.3, a
  * finer pool than h 0.61, so the gap under the plate is 2 h above the surface and the pool's flat
  * middle holds both kinds of pixel below) in front of a dark blue wall (z = -8), in the host's
@@ -448,22 +481,7 @@ static void test_ssr_under_floating_object(void **state)
     const uint32_t w = cam.width, h = cam.height;
     const size_t n = (size_t)w * h;
     float *col = malloc(n * 16), *dep = malloc(n * 4);
-    double fwd[3], right[3], up[3];
-    ref_camera_basis(&cam, fwd, right, up);
-    uint32_t plate = 0;
-    for (uint32_t j = 0; j < h; ++j) /* GL rows: j = 0 the bottom */
-        for (uint32_t i = 0; i < w; ++i) {
-            size_t q = (size_t)j * w + i;
-            double dir[3], t, t_wall;
-            ref_pixel_ray(&cam, i, h - 1 - j, dir);
-            bool on = plate_hit(cam.eye, dir, 0.0, &t);
-            t_wall = (-8.0 - cam.eye[2]) / dir[2];
-            if (!on) t = t_wall;
-            float c[4] = {on ? 3.0f : 0.0f, 0.0f, on ? 0.0f : 0.2f, 1.0f};
-            memcpy(col + 4 * q, c, sizeof c);
-            dep[q] = axis_depth(&cam, t * (dir[0] * fwd[0] + dir[1] * fwd[1] + dir[2] * fwd[2]));
-            plate += on;
-        }
+    const uint32_t plate = host_image(&cam, plate_scene_hit, col, dep);
     float *px[2] = {malloc(n * 16), malloc(n * 16)}, *dist = malloc(n * 4);
     double hits[2];
     const float d = 0.15f, cz = 0.8f;
