@@ -106,26 +106,6 @@ static vfx_result parse_camera(pctx *c, const cJSON *v, rt_scene_camera *cam)
     return VFX_OK;
 }
 
-/* The prologue every array of objects shares: `v` must be an array of at most `cap` items;
- * *out gets calloc'd room for them (NULL when empty). */
-vfx_result rt_scene_alloc_array(pctx *c, const cJSON *v, const char *name, int cap, size_t elem,
-                              void **out, int *count)
-{
-    *out = NULL;
-    *count = 0;
-    if (!cJSON_IsArray(v))
-        return rt_scene_failf(c, VFX_ERR_FORMAT, name, "expected an array, got %s", rt_scene_type_name(v));
-    int n = cJSON_GetArraySize(v);
-    if (n > cap)
-        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, name, "%d %s, above the cap of %d", n, name, cap);
-    if (n == 0)
-        return VFX_OK;
-    if (!(*out = calloc((size_t)n, elem)))
-        return rt_scene_failf(c, VFX_ERR_OUT_OF_MEMORY, name, "out of memory");
-    *count = n;
-    return VFX_OK;
-}
-
 static vfx_result parse_meshes(pctx *c, const cJSON *v, rt_scene *s)
 {
     static const char *const keys[] = {"path", "box", "translate", "rotate_deg", "scale", "matrix", "color", NULL};

@@ -59,11 +59,6 @@ static float *beam_param_ptr(vfx_beam *b, vfx_beam *look, int k)
     }
 }
 
-bool rt_scene_is_zero3(const float *v)
-{
-    return (double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2] < 1e-24;
-}
-
 /* A joints value: an array of n [x, y, z] (n = *count when given, else 2..RT_SCENE_MAX_JOINTS). */
 static vfx_result joints_value(pctx *c, const cJSON *v, const char *P, uint32_t *count, float *dst)
 {

@@ -429,3 +429,27 @@ vfx_result rt_scene_get_uint_row(pctx *c, const cJSON *obj, const char *path, co
 {
     return rt_scene_get_uint(c, obj, path, key, false, range_rows[id].lo, range_rows[id].hi, out);
 }
+
+/* The prologue every array of objects shares (meshes, beams, transfer points). */
+vfx_result rt_scene_alloc_array(pctx *c, const cJSON *v, const char *name, int cap, size_t elem,
+                              void **out, int *count)
+{
+    *out = NULL;
+    *count = 0;
+    if (!cJSON_IsArray(v))
+        return rt_scene_failf(c, VFX_ERR_FORMAT, name, "expected an array, got %s", rt_scene_type_name(v));
+    int n = cJSON_GetArraySize(v);
+    if (n > cap)
+        return rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, name, "%d %s, above the cap of %d", n, name, cap);
+    if (n == 0)
+        return VFX_OK;
+    if (!(*out = calloc((size_t)n, elem)))
+        return rt_scene_failf(c, VFX_ERR_OUT_OF_MEMORY, name, "out of memory");
+    *count = n;
+    return VFX_OK;
+}
+
+bool rt_scene_is_zero3(const float *v)
+{
+    return (double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2] < 1e-24;
+}

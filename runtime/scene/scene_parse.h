@@ -27,6 +27,8 @@ typedef struct range {
     bool lo_open; /* value must be > lo rather than >= lo */
 } range;
 
+/* The array v, named name, of at most cap elements: *out calloc'd with *count of elem bytes
+ * (NULL and 0 for an empty array); an error naming it when v is no array or holds too many. */
 vfx_result rt_scene_alloc_array(pctx *c, const cJSON *v, const char *name, int cap, size_t elem,
                               void **out, int *count);
 void rt_scene_check_keys(pctx *c, const cJSON *obj, const char *path, const char *const *allowed);
@@ -65,6 +67,7 @@ vfx_result rt_scene_get_uint(pctx *c, const cJSON *obj, const char *path, const 
                            double lo, double hi, uint32_t *out);
 vfx_result rt_scene_get_vec(pctx *c, const cJSON *obj, const char *path, const char *key, int n,
                           bool required, range rg, float *out);
+/* True when the vector's length is below 1e-12 (a direction that names none). */
 bool rt_scene_is_zero3(const float *v);
 void rt_scene_join(char *out, const char *parent, const char *key);
 void rt_scene_join_index(char *out, const char *parent, int i);

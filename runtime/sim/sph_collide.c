@@ -1,6 +1,6 @@
 /* sph_collide.c — colliders: planes, spheres, boxes and triangle meshes (a signed distance
  * field sampled once), static or moving as paddles. */
-#include "sim/sph_internal.h"
+#include "sim/sph_collide.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -1,6 +1,6 @@
 /* sph_grid.c — the neighbour grid: particles sorted by cell of H/2 for locality and the
  * cell scans, and the volume fraction read from it. */
-#include "sim/sph_internal.h"
+#include "sim/sph_wall.h"
 
 #include <string.h>
 

@@ -4,7 +4,9 @@
  * sph_collide.c (colliders, mesh distance fields), sph_grid.c (cell sort, volume fraction),
  * sph_wall.c (wall integrals, wall law, wall terms of the passes), sph_kernels.c (the
  * per-chunk passes and their SSE2 pair loops), sph_emit.c (emitters), sph_step.c (substeps),
- * sph_pbf.c (Position Based Fluids), sph_pbf_lin.c (its pair terms, computed once per iteration). */
+ * sph_pbf.c (Position Based Fluids), sph_pbf_lin.c (its pair terms, computed once per iteration).
+ * The colliders' and the walls' shared functions have their own headers, sph_collide.h and
+ * sph_wall.h (the walls use the colliders, never the other way): this header calls no file. */
 #ifndef RT_SIM_SPH_INTERNAL_H
 #define RT_SIM_SPH_INTERNAL_H
 
@@ -189,25 +191,6 @@ static inline void sph_neighbor_ranges(const rt_sph *s, float px, float py, floa
     }
 }
 
-
-/* Walls of the domain box and every collider: density fraction and force integral. */
-typedef struct sph_wall_hit {
-    float n[3], d, vel[3];
-    bool is_box, no_slip;
-} sph_wall_hit;
-
-
-#define SPH_MAX_WALLS (6 + SPH_MAX_COLLIDERS)
-
-/* Number of leading box walls in a gather_walls list (they come before the colliders). */
-static inline int sph_walls_box(const sph_wall_hit *w, int nw)
-{
-    int k = 0;
-    while (k < nw && w[k].is_box)
-        k++;
-    return k;
-}
-
 /* sph_pool.c: starts the workers (fewer when a thread cannot be made: p.threads then says how
  * many run; out of memory for their handles is an error); stops and joins them */
 vfx_result rt_sph_pool_start(rt_sph *s);
@@ -227,66 +210,9 @@ void rt_sph_commit_state(rt_sph *s);
 /* Takes the host's column pointers. */
 void rt_sph_take_columns(rt_sph *s, const rt_sph_columns *c);
 
-/* sph_collide.c */
-/* Signed distance of p to a collider surface (positive on the fluid side), outward normal in n. */
-float rt_sph_surface_distance(const sph_collider_state *st, float px, float py, float pz, float n[3]);
-/* True when p is surely farther than limit (> 0) from a box's or a sphere's surface on the fluid
- * side, from one axis alone: the callers only act within H of a collider, and most particles are
- * far from every one (the default scene's paddle: rt_sph_surface_distance was 13% of all PBF
- * instructions, callgrind). The 1e-4 margin keeps the answer exact against the rounding of
- * rt_sph_surface_distance's sqrt (an ulp), so results are bitwise those of the full test. Planes
- * and meshes answer false (the full test is needed or cheap). */
-static inline bool sph_collider_beyond(const sph_collider_state *st, float px, float py, float pz, float limit)
-{
-    const rt_sph_collider *c = &st->c;
-    if (st->sdf || c->kind == RT_SPH_PLANE)
-        return false;
-    const float d[3] = {px - st->pos[0], py - st->pos[1], pz - st->pos[2]};
-    for (int a = 0; a < 3; ++a) {
-        float q = fabsf(d[a]) - (c->kind == RT_SPH_BOX ? c->half[a] : c->radius);
-        if (q > 1.0001f * limit)
-            return true;
-    }
-    return false;
-}
-/* Moves every collider to its position and velocity at time t. */
-void rt_sph_update_colliders(rt_sph *s, double t);
-
 /* sph_grid.c: sorts the particles by cell (all columns follow, through the host when bound),
  * cell_start is rebuilt; an error when the host could not reorder (nothing changed then) */
 vfx_result rt_sph_build_grid(rt_sph *s, char *err, size_t errlen);
-
-/* sph_wall.c */
-/* The walls within H of p (box faces first, then colliders); their number. */
-int rt_sph_gather_walls(const rt_sph *s, float px, float py, float pz, sph_wall_hit *w, int max);
-/* Kernel share of the walls: inside = prod over box walls of (1 - f), extra = sum over
- * colliders of f; each wall's f in fr[] when fr is not NULL. Inline: it runs per particle in
- * the density and force passes (out of line it cost ~2% of a substep's instructions). */
-static inline void sph_wall_share(const rt_sph *s, const sph_wall_hit *w, int nw, float *fr, float *inside,
-                    float *extra)
-{
-    /* The box walls are perpendicular: the region beyond them is a union of half-spaces,
-     * counted as 1 - prod(1 - f) (exact for a separable kernel, close for poly6) so the
-     * edges and corners are not compressed by double counting. Colliders just add. */
-    int nb = sph_walls_box(w, nw);
-    float in = 1.f, ex = 0.f;
-    for (int k = 0; k < nw; ++k) {
-        float f = s->wall_scale * (float)rt_sph_wall_density_fraction(w[k].d, s->H);
-        if (fr)
-            fr[k] = f;
-        if (k < nb)
-            in *= 1.f - f;
-        else
-            ex += f;
-    }
-    *inside = in, *extra = ex;
-}
-
-/* Wall terms of the force pass for particle (p, v) with pressure term pri, density rhoi:
- * adds the mirror-image pressure and viscosity to a, divides by the fluid share, adds the
- * wall-law friction of no-slip walls (gravity not included). */
-void rt_sph_wall_accel(const rt_sph *s, const float p[3], const float vel[3], float pri, float rhoi,
-                    float a[3], sph_wall_hit *walls);
 
 /* sph_kernels.c: the passes run by rt_sph_parallel */
 void rt_sph_density_chunk(rt_sph *s, uint32_t chunk);

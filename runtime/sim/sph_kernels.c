@@ -1,6 +1,7 @@
 /* sph_kernels.c — the per-chunk passes: density (cell scan or Verlet walk), forces,
  * integration, displacement; the pair loops take four pairs at a time with SSE2. */
-#include "sim/sph_internal.h"
+#include "sim/sph_collide.h"
+#include "sim/sph_wall.h"
 
 #include <stdlib.h>
 

@@ -23,7 +23,8 @@
  * between steps in pr (Pa; lambda_i = -p_i dt^2 / rho0), a step first applies the correction of
  * last step's pressures, and a fresh fluid starts from the hydrostatic rho0 |g| depth. Measured
  * unstable with 3 iterations (the carried pressure acts as an integral of the compression). */
-#include "sim/sph_internal.h"
+#include "sim/sph_collide.h"
+#include "sim/sph_wall.h"
 #include "core/error.h"
 
 #include <stdlib.h>

@@ -23,7 +23,7 @@
  * Storage: three float arrays per work item parallel to the exact neighbour list cnb[chunk]
  * (same offsets nb_start[i]), and per particle the count of coincident stored pairs and the
  * room; grown as needed, valid within a step. */
-#include "sim/sph_internal.h"
+#include "sim/sph_collide.h"
 #include "core/error.h"
 
 #include <float.h>

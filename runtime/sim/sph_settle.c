@@ -7,7 +7,7 @@
  * (docs/simulation.md "Start at rest"). Damped steps do the same sinking before frame 0; the
  * clock is held, so the colliders stay at their rest pose and the scene's time starts at 0; the
  * emitters do not run. */
-#include "sim/sph_internal.h"
+#include "sim/sph_collide.h"
 #include "core/error.h"
 
 #include <time.h>

@@ -1,6 +1,6 @@
 /* sph_step.c — a frame: adaptive substeps (dt selection, the redo loop on a blow-up) and
  * the end-of-frame reductions of the report. */
-#include "sim/sph_internal.h"
+#include "sim/sph_collide.h"
 
 #include <stdlib.h>
 

@@ -1,6 +1,7 @@
 /* sph_wall.c — semi-analytic walls: the closed-form kernel integrals beyond a plane, the
  * smooth-wall law of the wall, and the wall terms the density and force passes add. */
-#include "sim/sph_internal.h"
+#include "sim/sph_collide.h"
+#include "sim/sph_wall.h"
 
 /* ---- closed-form wall integrals ------------------------------------------------------------ */
 
