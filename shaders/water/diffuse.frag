@@ -54,8 +54,8 @@ void main()
 #ifdef WATER_EFFECT_LIGHTS
     // the plugin's lights (a beam's line, its head, its impact): a drop scatters their fluence
     // evenly, albedo 0.9 x fluence / 4 pi; a drop beside a strike shines in the beam's colour
-    vec3 fl_spec, fl;
-    water_effect_lights(v_world, normalize(v_world - u_eye), WATER_LIGHT_LOBE, fl_spec, fl);
+    vec3 fl_spec, fl, fl_irr;
+    water_effect_lights(v_world, normalize(v_world - u_eye), WATER_LIGHT_LOBE, vec3(0.0), fl_spec, fl, fl_irr);
     col += 0.9 * 0.0795775 * fl;
 #endif
     if (!u_hdr) col = min(col, vec3(1.0));

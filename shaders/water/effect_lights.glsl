@@ -8,12 +8,19 @@
 //    over the light: L = F x I x integral D(l(u)) du / d(u)^2 (a mirror with a blur: the radiance
 //    of a line of I per unit length seen along r, spread over the lobe). A line light gives a
 //    streak along the reflected beam.
-//  - in-scatter: the light's fluence rate at the surface point, integral I du / d(u)^2 (isotropic
-//    scattering: every direction counts), which the body turns into glow.
+//  - fluence: the light's fluence rate at the surface point, integral I du / d(u)^2 (isotropic
+//    scattering: every direction counts; a spray drop scatters it).
+//  - irradiance on the surface's normal n: integral I max(n.l, 0) du / d(u)^2, which the body and
+//    the foam scatter as they scatter the sun's and the sky's (tint x E / pi, a Lambertian of the
+//    water's deep colour where the water is opaque): the glow under a beam.
 //
 // On the segment p(u) = f + u e (f the foot of x on the line, e the unit direction, h = |f - x|)
 // the direction from x is l = cos(phi) a + sin(phi) e with a = (f - x) / h and phi = atan(u / h),
-// and du / d^2 = dphi / h. So the fluence is (phi1 - phi0) / h exactly, and with
+// and du / d^2 = dphi / h. So the fluence is (phi1 - phi0) / h exactly; the irradiance on n is
+// (1 / h) integral max(A cos(phi) + B sin(phi), 0) dphi (A = n.a, B = n.e) = (1 / h) integral
+// R max(cos(phi - psi), 0) dphi (R = sqrt(A^2 + B^2), psi = atan(B, A)): over phi in [phi0, phi1]
+// clipped to [psi - pi/2, psi + pi/2], R (sin(hi - psi) - sin(lo - psi)) / h exactly (phi stays in
+// (-pi/2, pi/2), so the clip needs no wrap); and with
 // r = cos(delta) (cos(phi*) a + sin(phi*) e) + sin(delta) (a x e) (spherical Pythagoras),
 // r.l = cos(delta) cos(phi - phi*): the lobe along the segment is
 // exp((cos(delta) - 1) / s^2) exp(c (cos(phi - phi*) - 1)), c = cos(delta) / s^2. With
@@ -41,23 +48,25 @@ float water_lobe_norm(float s)
     return 1.0 / (6.2831853 * s * s * (1.0 - exp(-2.0 / (s * s))));
 }
 
-// Point light at p seen from x: (specular lobe integral, fluence), both per unit intensity.
-vec2 water_point_light(vec3 x, vec3 r, float s, vec3 p, float h_min)
+// Point light at p seen from x with the normal n: (specular lobe integral, fluence, irradiance on
+// n), per unit intensity.
+vec3 water_point_light(vec3 x, vec3 r, float s, vec3 p, float h_min, vec3 n)
 {
     vec3 dx = p - x;
     float d2 = max(dot(dx, dx), h_min * h_min);
-    float rl = dot(r, dx) * inversesqrt(max(dot(dx, dx), 1e-30));
-    return vec2(water_lobe_norm(s) * exp((rl - 1.0) / (s * s)), 1.0) / d2;
+    float inv = inversesqrt(max(dot(dx, dx), 1e-30));
+    float rl = dot(r, dx) * inv;
+    return vec3(water_lobe_norm(s) * exp((rl - 1.0) / (s * s)), 1.0, max(dot(n, dx) * inv, 0.0)) / d2;
 }
 
-// Line light p0..p1 (intensity per unit length 1) seen from x with the reflected ray r and lobe
-// width s (radians): (specular lobe integral, fluence).
-vec2 water_line_light(vec3 x, vec3 r, float s, vec3 p0, vec3 p1, float h_min)
+// Line light p0..p1 (intensity per unit length 1) seen from x with the reflected ray r, lobe
+// width s (radians) and the normal n: (specular lobe integral, fluence, irradiance on n).
+vec3 water_line_light(vec3 x, vec3 r, float s, vec3 p0, vec3 p1, float h_min, vec3 n)
 {
     vec3 seg = p1 - p0;
     float len = length(seg);
     if (!(len > 0.0))
-        return water_point_light(x, r, s, p0, h_min) * 0.0;
+        return vec3(0.0);
     vec3 e = seg / len;
     float u0 = dot(p0 - x, e);               // the segment runs over [u0, u0 + len] from the foot
     vec3 f = p0 - u0 * e;                     // the foot of x on the line
@@ -68,6 +77,9 @@ vec2 water_line_light(vec3 x, vec3 r, float s, vec3 p0, vec3 p1, float h_min)
     vec3 a = h_true > 1e-6 * len ? fa / h_true : normalize(cross(e, abs(e.x) < 0.9 ? vec3(1, 0, 0) : vec3(0, 1, 0)));
     float phi0 = atan(u0, h), phi1 = atan(u0 + len, h);
     float fluence = (phi1 - phi0) / h;
+    float na = dot(n, a), ne = dot(n, e), psi = atan(ne, na);
+    float lo = max(phi0, psi - 1.5707963), hi = min(phi1, psi + 1.5707963);
+    float irr = hi > lo ? sqrt(na * na + ne * ne) * (sin(hi - psi) - sin(lo - psi)) / h : 0.0;
     float ra = dot(r, a), re = dot(r, e);
     float cd = sqrt(ra * ra + re * re);       // cos(delta)
     float spec = 0.0;
@@ -81,7 +93,7 @@ vec2 water_line_light(vec3 x, vec3 r, float s, vec3 p0, vec3 p1, float h_min)
         g = (1.0 + 0.125 / c) * g - 0.125 / c * (yb * exp(-0.5 * c * yb * yb) - ya * exp(-0.5 * c * ya * ya));
         spec = water_lobe_norm(s) * exp((cd - 1.0) / (s * s)) * g / h;
     }
-    return vec2(spec, fluence);
+    return vec3(spec, fluence, irr);
 }
 
 #ifdef WATER_EFFECT_LIGHTS
@@ -97,33 +109,35 @@ layout(std140, binding = 7) uniform WaterLights {
     WaterLight u_lights[WATER_MAX_LIGHTS];
 };
 
-// Sum over the lights at surface point x with reflected ray r: rgb specular (before Fresnel),
-// rgb fluence.
-void water_effect_lights(vec3 x, vec3 r, float s, out vec3 spec, out vec3 fluence)
+// Sum over the lights at surface point x with reflected ray r and normal n: rgb specular (before
+// Fresnel), rgb fluence, rgb irradiance on n.
+void water_effect_lights(vec3 x, vec3 r, float s, vec3 n, out vec3 spec, out vec3 fluence, out vec3 irr)
 {
     spec = vec3(0.0);
     fluence = vec3(0.0);
+    irr = vec3(0.0);
     for (uint i = 0u; i < u_light_count.x; ++i) {
         WaterLight l = u_lights[i];
-        vec2 sf = l.p0_kind.w > 0.5 ? water_line_light(x, r, s, l.p0_kind.xyz, l.p1_hmin.xyz, l.p1_hmin.w)
-                                    : water_point_light(x, r, s, l.p0_kind.xyz, l.p1_hmin.w);
+        vec3 sf = l.p0_kind.w > 0.5 ? water_line_light(x, r, s, l.p0_kind.xyz, l.p1_hmin.xyz, l.p1_hmin.w, n)
+                                    : water_point_light(x, r, s, l.p0_kind.xyz, l.p1_hmin.w, n);
         spec += sf.x * l.color_i.rgb;
         fluence += sf.y * l.color_i.rgb;
+        irr += sf.z * l.color_i.rgb;
     }
 }
 
 // the surface's reflection lobe (radians; VOLFX_WATER_LIGHT_LOBE in plugin/water/water_lights.h)
 #define WATER_LIGHT_LOBE 0.12
-// share of the lights' fluence the body scatters toward the eye where it is opaque (with the
-// isotropic phase 1 / 4 pi); scaled by 1 - transmittance like the ambient in-scatter
-#define WATER_LIGHT_SCATTER 0.8
 
-// What the effect lights add at the surface point x: the specular streak through Fresnel, and
-// the glow the body scatters (through the surface: 1 - Fresnel).
-vec3 water_effect_light_radiance(vec3 x, vec3 r, float fresnel, vec3 trans, vec3 tint)
+// What the effect lights add at the surface point x (normal n): the specular streak through
+// Fresnel, and the glow the body scatters as it scatters the sun and the sky (shade.frag
+// water_body: albedo x tint x irradiance / pi where it is opaque, 1 - trans of it), through the
+// surface (1 - Fresnel). *irr: the lights' irradiance on n (the foam on the surface scatters it).
+vec3 water_effect_light_radiance(vec3 x, vec3 r, vec3 n, float fresnel, vec3 trans, vec3 tint, float albedo,
+                                 out vec3 irr)
 {
     vec3 spec, flu;
-    water_effect_lights(x, r, WATER_LIGHT_LOBE, spec, flu);
-    return fresnel * spec + (1.0 - fresnel) * WATER_LIGHT_SCATTER * 0.0795775 * tint * (vec3(1.0) - trans) * flu;
+    water_effect_lights(x, r, WATER_LIGHT_LOBE, n, spec, flu, irr);
+    return fresnel * spec + (1.0 - fresnel) * albedo * 0.3183099 * tint * (vec3(1.0) - trans) * irr;
 }
 #endif

@@ -8,9 +8,10 @@ struct ProbeCase {
     vec4 r_kind;  // reflected ray (unit), kind (0 point, 1 line)
     vec4 p0_hmin; // light start, h_min
     vec4 p1;      // light end
+    vec4 n;       // the surface's normal (unit) for the irradiance
 };
 layout(std430, binding = 0) readonly buffer Cases { ProbeCase cases[]; };
-layout(std430, binding = 1) writeonly buffer Results { vec2 results[]; };
+layout(std430, binding = 1) writeonly buffer Results { vec4 results[]; };  // spec, fluence, irradiance
 uniform uint u_count;
 
 void main()
@@ -19,6 +20,7 @@ void main()
     if (i >= u_count)
         return;
     ProbeCase c = cases[i];
-    results[i] = c.r_kind.w > 0.5 ? water_line_light(c.x_s.xyz, c.r_kind.xyz, c.x_s.w, c.p0_hmin.xyz, c.p1.xyz, c.p0_hmin.w)
-                                  : water_point_light(c.x_s.xyz, c.r_kind.xyz, c.x_s.w, c.p0_hmin.xyz, c.p0_hmin.w);
+    vec3 t = c.r_kind.w > 0.5 ? water_line_light(c.x_s.xyz, c.r_kind.xyz, c.x_s.w, c.p0_hmin.xyz, c.p1.xyz, c.p0_hmin.w, c.n.xyz)
+                              : water_point_light(c.x_s.xyz, c.r_kind.xyz, c.x_s.w, c.p0_hmin.xyz, c.p0_hmin.w, c.n.xyz);
+    results[i] = vec4(t, 0.0);
 }

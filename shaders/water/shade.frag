@@ -313,6 +313,7 @@ void main()
     // bubbles: white specks behind the surface (already attenuated by the water in front)
     body += water_white(ambient, p, vec3(0.0)) * (1.0 - exp(-BUBBLE_K * foam_bub.g)) * u_tint * 1.5;
     vec3 col = water_surface(body, sky, n, -dir);
+    vec3 fx_irr = vec3(0.0);   // the plugin's lights' irradiance on the surface (the foam's too)
 #ifdef WATER_EFFECT_LIGHTS
     {
         // the beams' lights: a streak along the reflected beam (weighted by Fresnel) and the
@@ -322,7 +323,7 @@ void main()
         float r0 = pow((u_ior - 1.0) / (u_ior + 1.0), 2.0);
         float fresnel = r0 + (1.0 - r0) * pow(1.0 - c, 5.0);
         vec3 trans = exp(-u_absorption * thickness * (vec3(1.0) - u_tint));
-        col += water_effect_light_radiance(p, r, fresnel, trans, u_tint);
+        col += water_effect_light_radiance(p, r, n, fresnel, trans, u_tint, WATER_ALBEDO, fx_irr);
     }
 #endif
     // foam on the surface hides what is under it, the glint too: the per-particle foam, or the
@@ -334,13 +335,8 @@ void main()
     vec2 fw = fwidth(p.xz);
     float foam_a = water_foam_cover(foam_d, p.xz, max(fw.x, fw.y)) * smoothstep(-0.2, 0.5, n.y);
     if (foam_a > 0.0) {
-        vec3 froth = water_white(ambient, p, n);
-#ifdef WATER_EFFECT_LIGHTS
-        // a Lambertian scatterer under the lights: albedo 0.9 x fluence / (2 pi) (cos 1/2 on average)
-        vec3 fl_spec, fl;
-        water_effect_lights(p, r, WATER_LIGHT_LOBE, fl_spec, fl);
-        froth += 0.9 * 0.1591549 * fl;
-#endif
+        // a Lambertian scatterer under the lights too: albedo 0.9 x their irradiance / pi
+        vec3 froth = water_white(ambient, p, n) + 0.9 * 0.3183099 * fx_irr;
         col = mix(col, froth, foam_a);
     }
     o_color = vec4(u_hdr ? col : min(col, vec3(1.0)), 1.0);

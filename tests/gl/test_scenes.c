@@ -42,6 +42,7 @@ static void test_default(void **s) { (void)s; run_scene(NULL, true, true, true);
 static void test_default_file(void **s) { (void)s; run_scene("default.json", true, true, true); }
 static void test_beams_only(void **s) { (void)s; run_scene("beams-only.json", false, true, false); }
 static void test_water_only(void **s) { (void)s; run_scene("water-only.json", true, false, false); }
+static void test_beam_over_water(void **s) { (void)s; run_scene("beam-over-water.json", true, true, false); }
 static void test_empty(void **s) { (void)s; run_scene("empty.json", false, false, false); }
 static void test_long_run(void **s) { (void)s; run_scene("long-run.json", true, true, true); }
 
@@ -96,7 +97,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_default), cmocka_unit_test(test_default_file),
-        cmocka_unit_test(test_beams_only), cmocka_unit_test(test_water_only),
+        cmocka_unit_test(test_beams_only), cmocka_unit_test(test_water_only), cmocka_unit_test(test_beam_over_water),
         cmocka_unit_test(test_empty),
         cmocka_unit_test(test_long_run), cmocka_unit_test(test_bad_scene_refused),
         cmocka_unit_test(test_gpu_particles_and_layer),
