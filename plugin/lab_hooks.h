@@ -10,7 +10,8 @@
 #include "gpu/gl.h"
 #include "effect.h"
 
-struct volfx_water_core; /* water/water_params.h */
+struct volfx_water_core;    /* water/water_params.h */
+struct volfx_shader_table;  /* volfx_shaders.h */
 
 /* What a lab method of the water draws from: the water's state, borrowed for the call. */
 typedef struct volfx_lab_water_input {
@@ -26,6 +27,9 @@ typedef struct volfx_lab_water_input {
 } volfx_lab_water_input;
 
 struct volfx_lab_hooks {
+    /* The lab's embedded GLSL (volfx_lab_shaders): the program cache (gpu/gpu.c) builds a path
+     * the product's table lacks from it. */
+    const struct volfx_shader_table *shaders;
     /* Reads the vfx_lab_water at `lab` (its type already matched): *disable gets its VFX_WATER_NO_*
      * bits, *method its method (0: the host's); unknown bits fail with VFX_ERR_INVALID_ARGUMENT
      * naming the field. */

@@ -21,5 +21,8 @@ extern const volfx_shader_table volfx_plugin_shaders;
 /* The sample host's shaders (runtime/meson.build: shaders/meson.build's host_shader_files);
  * linked into the runtime only, never into libvolfx. */
 extern const volfx_shader_table rt_host_shaders;
+/* The lab's shaders (plugin/lab/meson.build: shaders/meson.build's lab_shader_files): the
+ * baselines and the tests' probes, in the lab library only, reached through ctx->lab. */
+extern const volfx_shader_table volfx_lab_shaders;
 
 #endif

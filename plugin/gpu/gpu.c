@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "gpu/program_cache.h"
+#include "lab_hooks.h"
 #include "volfx_shaders.h"
 #include "shader_text.h"
 
@@ -126,8 +127,9 @@ void volfx_gpu_label(GLenum kind, GLuint object, const char *label)
         glObjectLabel(kind, object, -1, label);
 }
 
-GLuint volfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *stages,
-                            const char *const *sources, const char *const *names)
+/* volfx_gpu_link_sources with the table whose line numbers the driver's log decodes by. */
+static GLuint link_sources(vfx_context *ctx, const volfx_shader_table *table, int stage_count, const GLenum *stages,
+                           const char *const *sources, const char *const *names)
 {
     GLuint prog = glCreateProgram();
     GLuint shaders[3] = {0};
@@ -141,7 +143,7 @@ GLuint volfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *s
         glGetShaderiv(shaders[i], GL_COMPILE_STATUS, &status);
         if (!status) {
             glGetShaderInfoLog(shaders[i], sizeof log, NULL, log);
-            volfx_shader_rewrite_log(&volfx_plugin_shaders, log, pretty, sizeof pretty, names[i]);
+            volfx_shader_rewrite_log(table, log, pretty, sizeof pretty, names[i]);
             volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_SHADER_COMPILE, "shader compile failed: %s", pretty);
             ok = false;
         } else {
@@ -195,6 +197,21 @@ static void read_uniforms(vfx_context *ctx, program_entry *e)
     }
 }
 
+GLuint volfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *stages,
+                            const char *const *sources, const char *const *names)
+{
+    return link_sources(ctx, &volfx_plugin_shaders, stage_count, stages, sources, names);
+}
+
+/* The product's table, or for a path it lacks the lab's when a lab is attached (lab_hooks.h):
+ * libvolfx embeds no lab shader. */
+static const volfx_shader_table *table_of(const vfx_context *ctx, const char *path)
+{
+    if (volfx_shader_index(&volfx_plugin_shaders, path) < 0 && ctx->lab && ctx->lab->shaders)
+        return ctx->lab->shaders;
+    return &volfx_plugin_shaders;
+}
+
 static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const char *const *paths,
                           const char *defines)
 {
@@ -221,15 +238,16 @@ static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const c
     char err[256];
     GLuint prog = 0;
     bool ok = true;
+    const volfx_shader_table *table = table_of(ctx, paths[0]);
     for (int i = 0; i < n && ok; ++i)
-        if (!(bufs[i] = volfx_shader_expand(&volfx_plugin_shaders, paths[i], defines, err, sizeof err))) {
+        if (!(bufs[i] = volfx_shader_expand(table, paths[i], defines, err, sizeof err))) {
             volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_SHADER_COMPILE, "%s", err);
             ok = false;
         }
     if (ok && g->cache)
         prog = volfx_program_cache_load(ctx, g->cache, n, stages, (const char *const *)bufs);
     if (ok && !prog) {
-        prog = volfx_gpu_link_sources(ctx, n, stages, (const char *const *)bufs, paths);
+        prog = link_sources(ctx, table, n, stages, (const char *const *)bufs, paths);
         if (prog && g->cache)
             volfx_program_cache_store(ctx, g->cache, n, stages, (const char *const *)bufs, prog);
     }

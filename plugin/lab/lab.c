@@ -1,8 +1,10 @@
 /* lab.c — volfx_lab_attach: the lab's hook table (lab_hooks.h), one constant table shared by
  * every context it is attached to. */
 #include "lab_water.h"
+#include "volfx_shaders.h"
 
 static const volfx_lab_hooks LAB_HOOKS = {
+    .shaders = &volfx_lab_shaders,
     .water_struct = volfx_lab_water_struct,
     .water_march = volfx_lab_water_march,
     .water_free = volfx_lab_water_free,

@@ -25,7 +25,7 @@ typedef struct beam_probe_case {
     float m_l[4], d_r[4], ab_eps[4], an0[4], an1[4], v_t0[4], t1_poly[4];
 } beam_probe_case;
 
-/* A plugin context on the current GL context (the program cache and its file:line errors). */
+/* A plugin context with the lab on the current GL context (the program cache, file:line errors). */
 static inline vfx_context *beam_probe_open(const vfx_plugin_api **api_out)
 {
     static test_log log;
@@ -35,7 +35,9 @@ static inline vfx_context *beam_probe_open(const vfx_plugin_api **api_out)
                               .log = test_vfx_log_fn};
     api.type = VFX_TYPE_PLUGIN_API;
     vfx_context *ctx = NULL;
-    if (vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api) != VFX_OK || api.create(&host, &ctx) != VFX_OK)
+    /* the probe is a lab shader (volfx_lab_shaders): a context with the lab attached builds it */
+    if (vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api) != VFX_OK || api.create(&host, &ctx) != VFX_OK ||
+        volfx_lab_attach(ctx) != VFX_OK)
         return NULL;
     *api_out = &api;
     return ctx;
