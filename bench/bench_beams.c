@@ -16,6 +16,7 @@
 #include <time.h>
 
 #include "beams/beam_field.h"
+#include "beam_field_f.h"
 #include "beams_ref.h"
 
 typedef struct bench_scene {

@@ -1,48 +1,14 @@
-/* beam_field.c — float and double instances of the closed form, validation, density. */
+/* beam_field.c — the float64 instance of the closed form (beam_field_impl.inc), validation,
+ * density. The float32 closed form the effect runs is the shader, beams/beam_field.glsl (the tests
+ * check it through a compute probe); a C float32 instance for the CPU benches is the lab's
+ * (plugin/lab/beam_field_f.c). */
 #include "beams/beam_field.h"
 
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
 
-/* log1p(z)/z for z >= 0. The float version mirrors the GLSL, where log() near 1 is only good
- * to an absolute 2^-21: a series below 0.1 (terms to z^9, under float epsilon), log above. */
-static float log1p_over_f(float z)
-{
-    if (z < 0.1f) {
-        float s = 1.f / 10.f;
-        for (int n = 9; n >= 1; --n)
-            s = 1.f / (float)n - z * s;
-        return s;
-    }
-    return logf(1.f + z) / z;
-}
-
 static double log1p_over_d(double z) { return z > 0 ? log1p(z) / z : 1.0; }
-
-#define REAL float
-#define SFX(n) n##_f
-#define R_SQRT sqrtf
-#define R_COS cosf
-#define R_FLOOR floorf
-#define R_FMA fmaf
-#define R_FABS fabsf
-#define R_LOG1P_OVER log1p_over_f
-#define R_EDGE_TERMS 12   /* (1/4)^12 = 6e-8 */
-#define R_GRAZING_M 0.25f /* the closed form loses at most ~60 ulps above it (3.7e-6 seen) */
-#define R_SERIES_TERMS 12 /* (1/4)^12 = 6e-8: under float epsilon */
-#include "beam_field_impl.inc"
-#undef REAL
-#undef SFX
-#undef R_SQRT
-#undef R_COS
-#undef R_FLOOR
-#undef R_FMA
-#undef R_FABS
-#undef R_LOG1P_OVER
-#undef R_SERIES_TERMS
-#undef R_EDGE_TERMS
-#undef R_GRAZING_M
 
 #define REAL double
 #define SFX(n) n##_d
@@ -105,72 +71,9 @@ vfx_result volfx_beam_validate(const vfx_beam *in, volfx_beam_d *out, char *err,
     return VFX_OK;
 }
 
-#define SFXF(n) n##_f
+#include "beams/beam_field_anat.h"
+
 #define SFXD(n) n##_d
-
-/* The anatomy as beam_integral_anat reads it; false when there is none (version 2's field). */
-static bool anatomy_d(const volfx_beam_d *bm, double an[8])
-{
-    double v[8] = {bm->head_radius, bm->orb_radius, bm->orb_a, 0, bm->taper, bm->surge, bm->surge_inv_wl,
-                   bm->surge_phase};
-    if (bm->joint_count >= 2)
-        v[4] = v[5] = 0; /* a polyline has no body profile */
-    bool any = false;
-    for (int k = 0; k < 8; ++k)
-        an[k] = v[k], any |= v[k] != 0;
-    return any;
-}
-
-/* A polyline's head at its own radius and its orb at the last joint (sphere pieces); the head
- * is left out of the polyline's own integral when it has its own radius. */
-#define POLY_ANATOMY(REAL, SFX, J, nj)                                                                   \
-    do {                                                                                                 \
-        REAL zero[3] = {0, 0, 0}, eps = (REAL)bm->eps, Rr = (REAL)bm->radius;                           \
-        eps = eps > (REAL)VOLFX_BEAM_EPS_FLOOR * Rr ? eps : (REAL)VOLFX_BEAM_EPS_FLOOR * Rr;             \
-        if (an[0] > 0 && bm->a > 0)                                                                      \
-            H += (REAL)bm->a * SFX(prim_piece)(O, V, J[0], zero, 0, 0, (REAL)an[0], eps, t0, t1, bm->smooth); \
-        if (an[1] > 0 && an[2] > 0)                                                                      \
-            H += (REAL)an[2] * SFX(prim_piece)(O, V, J[nj - 1], zero, 0, 0, (REAL)an[1], eps, t0, t1, bm->smooth); \
-    } while (0)
-
-float volfx_beam_integral_f(const volfx_beam_d *bm, const float O[3], const float V[3], float t0, float t1)
-{
-    double and[8];
-    bool anat = anatomy_d(bm, and);
-    float an[8];
-    for (int k = 0; k < 8; ++k)
-        an[k] = (float)and[k];
-    if (bm->joint_count >= 2 && anat) {
-        float J[VOLFX_BEAM_MAX_JOINTS][3];
-        for (int k = 0; k < bm->joint_count; ++k)
-            for (int i = 0; i < 3; ++i)
-                J[k][i] = (float)bm->joints[k][i];
-        float H = polyline_integral_f((const float(*)[3])J, bm->joint_count, (float)bm->radius,
-                                      an[0] > 0 ? 0.f : (float)bm->a, (float)bm->b, (float)bm->eps, bm->smooth, O,
-                                      V, t0, t1);
-        if (t1 > t0)
-            POLY_ANATOMY(float, SFXF, J, bm->joint_count);
-        return H;
-    }
-    if (anat) {
-        float M[3] = {(float)bm->head[0], (float)bm->head[1], (float)bm->head[2]};
-        float D[3] = {(float)bm->dir[0], (float)bm->dir[1], (float)bm->dir[2]};
-        return beam_integral_anat_f(M, D, (float)bm->length, (float)bm->radius, (float)bm->a, (float)bm->b,
-                                    (float)bm->eps, bm->smooth, an, O, V, t0, t1);
-    }
-    if (bm->joint_count >= 2) {
-        float J[VOLFX_BEAM_MAX_JOINTS][3];
-        for (int k = 0; k < bm->joint_count; ++k)
-            for (int i = 0; i < 3; ++i)
-                J[k][i] = (float)bm->joints[k][i];
-        return polyline_integral_f((const float(*)[3])J, bm->joint_count, (float)bm->radius, (float)bm->a,
-                                   (float)bm->b, (float)bm->eps, bm->smooth, O, V, t0, t1);
-    }
-    float M[3] = {(float)bm->head[0], (float)bm->head[1], (float)bm->head[2]};
-    float D[3] = {(float)bm->dir[0], (float)bm->dir[1], (float)bm->dir[2]};
-    return beam_integral_f(M, D, (float)bm->length, (float)bm->radius, (float)bm->a, (float)bm->b,
-                           (float)bm->eps, bm->smooth, O, V, t0, t1);
-}
 
 double volfx_beam_integral_d(const volfx_beam_d *bm, const double O[3], const double V[3], double t0, double t1)
 {

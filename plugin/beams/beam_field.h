@@ -11,7 +11,8 @@
  * each piece is an integral of 1/sqrt((s x + beta)^2 + Q^2), done by volfx_beam_segment_integral.
  * The softening is floored at VOLFX_BEAM_EPS_FLOOR * R so that eps = 0 with a ray exactly
  * through M or the axis gives a large finite H, not Inf/NaN (the reference uses the same floor).
- * docs/beams.md has the derivation; shaders/beams/beam_field.glsl is the same code in GLSL. */
+ * docs/beams.md has the derivation; shaders/beams/beam_field.glsl is the float32 closed form the
+ * effect runs, checked against the float64 references by the tests (tests/beams/beam_probe.h). */
 #ifndef VOLFX_BEAM_FIELD_H
 #define VOLFX_BEAM_FIELD_H
 
@@ -46,19 +47,15 @@ vfx_result volfx_beam_validate(const vfx_beam *in, volfx_beam_d *out, char *err,
 vfx_result volfx_beam_set_joints(volfx_beam_d *bm, const float *xyz, uint32_t count, char *err, size_t errlen);
 
 /* Integral over x in [x0, x1] of 1/sqrt((s x + beta)^2 + Q^2), s >= 0, Q > 0, without
- * cancellation: float and double versions of the same code. */
-float volfx_beam_segment_integral_f(float x0, float x1, float s, float beta, float Q);
+ * cancellation (float64; the lab's beam_field_f.h has the float32 instance). */
 double volfx_beam_segment_integral_d(double x0, double x1, double s, double beta, double Q);
 /* The smooth support's piece: integral over x in [x0, x1] of (h^2 - y^2)^2 / sqrt(y^2 + Q^2),
  * y = s x + beta, for |y| <= h (values in units of R, h and Q of order 1 or less). */
-float volfx_beam_segment_integral_smooth_f(float x0, float x1, float s, float beta, float Q, float h);
 double volfx_beam_segment_integral_smooth_d(double x0, double x1, double s, double beta, double Q,
                                             double h);
 
-/* H of one beam along the ray origin + t*dir (|dir| = 1), t in [t0, t1]. _f is float32
- * throughout (it mirrors the GLSL), _d float64. */
-float volfx_beam_integral_f(const volfx_beam_d *beam, const float origin[3], const float dir[3],
-                          float t0, float t1);
+/* H of one beam along the ray origin + t*dir (|dir| = 1), t in [t0, t1], float64 (the shader is
+ * the float32 closed form; the lab's beam_field_f.h a C float32 instance for the benches). */
 double volfx_beam_integral_d(const volfx_beam_d *beam, const double origin[3], const double dir[3],
                            double t0, double t1);
 
