@@ -237,8 +237,7 @@ vfx_result game_app_create(const game_app_desc *desc, game_app **out)
     }
     if ((r = rt_particles_register(app->world, &app->particles)) || (r = rt_effects_register(app->world, &app->effects)))
         goto fail;
-    if ((r = rt_world_register(app->world, &(rt_component_desc){"vfx.mesh", sizeof(game_app_mesh), 8, 1}, &app->mesh_comp))
-        || (r = rt_world_register(app->world, &(rt_component_desc){"vfx.transform", 64, 16, 1}, &app->transform_comp)))
+    if ((r = rt_mesh_components_register(app->world, &app->meshes)))
         goto fail;
     if ((r = rt_renderer_create(&app->log, &app->renderer)))
         goto fail;
@@ -282,9 +281,9 @@ void game_app_destroy(game_app *app)
     free(app->chunks);
     game_gpu_particles_free(&app->gpu);
     if (app->world) {
-        rt_query_iter it = rt_query_begin(app->world, &app->mesh_comp, 1);
+        rt_query_iter it = rt_query_begin(app->world, &app->meshes.mesh, 1);
         while (rt_query_next(&it)) {
-            game_app_mesh *m = rt_query_column(&it, app->mesh_comp, 0);
+            rt_mesh_component *m = rt_query_column(&it, app->meshes.mesh, 0);
             for (uint32_t i = 0; i < it.rows; ++i)
                 rt_mesh_gpu_destroy(&m[i].gpu);
         }
@@ -294,33 +293,6 @@ void game_app_destroy(game_app *app)
     rt_profiler_destroy(app->profiler);
     rt_gl_context_destroy(app->gl);
     free(app);
-}
-
-static vfx_result add_mesh(game_app *app, rt_mesh_data *data, const float model[16],
-                           const float rgb[3], rt_entity *out)
-{
-    game_app_mesh m;
-    memset(&m, 0, sizeof m);
-    vfx_result r = rt_mesh_upload(data, &m.gpu);
-    memcpy(m.bounds_min, data->bounds_min, sizeof m.bounds_min);
-    memcpy(m.bounds_max, data->bounds_max, sizeof m.bounds_max);
-    rt_mesh_data_free(data);
-    if (r)
-        return r;
-    memcpy(m.color, rgb, sizeof m.color);
-    rt_component comps[2] = {app->mesh_comp, app->transform_comp};
-    rt_entity e;
-    if ((r = rt_world_spawn(app->world, 1, comps, 2, &e))) {
-        rt_mesh_gpu_destroy(&m.gpu);
-        return r;
-    }
-    static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    memcpy(rt_world_get(app->world, e, app->mesh_comp, 0), &m, sizeof m);
-    memcpy(rt_world_get(app->world, e, app->transform_comp, 0), model ? model : identity, 64);
-    app->mesh_count++;
-    if (out)
-        *out = e;
-    return VFX_OK;
 }
 
 vfx_result game_app_add_mesh_file(game_app *app, const char *path, const float model[16],
@@ -333,7 +305,7 @@ vfx_result game_app_add_mesh_file(game_app *app, const char *path, const float m
         rt_logf(&app->log, VFX_LOG_ERROR, "%s", err);
         return r;
     }
-    return add_mesh(app, &data, model, rgb, out);
+    return rt_mesh_spawn(app->world, &app->meshes, &data, model, rgb, out);
 }
 
 vfx_result game_app_add_box(game_app *app, const float mn[3], const float mx[3], const float rgb[3],
@@ -341,7 +313,7 @@ vfx_result game_app_add_box(game_app *app, const float mn[3], const float mx[3],
 {
     rt_mesh_data data;
     vfx_result r = rt_mesh_make_box(mn, mx, &data);
-    return r ? r : add_mesh(app, &data, NULL, rgb, out);
+    return r ? r : rt_mesh_spawn(app->world, &app->meshes, &data, NULL, rgb, out);
 }
 
 vfx_result game_app_add_beams(game_app *app, const vfx_beam *beams, uint32_t n)
@@ -398,11 +370,9 @@ uint32_t game_app_volume_count(game_app *app)
 
 vfx_result game_app_remove(game_app *app, rt_entity e)
 {
-    game_app_mesh *m = rt_world_get(app->world, e, app->mesh_comp, 0);
-    if (m) {
+    rt_mesh_component *m = rt_world_get(app->world, e, app->meshes.mesh, 0);
+    if (m)
         rt_mesh_gpu_destroy(&m->gpu);
-        app->mesh_count--;
-    }
     return rt_world_despawn(app->world, e);
 }
 
@@ -460,11 +430,11 @@ vfx_result game_app_frame(game_app *app, float dt)
         }
     }
     rt_renderer_begin_scene(app->renderer, frame.view, frame.proj, app->clear_color);
-    rt_component draw_terms[2] = {app->mesh_comp, app->transform_comp};
+    rt_component draw_terms[2] = {app->meshes.mesh, app->meshes.transform};
     rt_query_iter it = rt_query_begin(app->world, draw_terms, 2);
     while (rt_query_next(&it)) {
-        const game_app_mesh *m = rt_query_column(&it, app->mesh_comp, 0);
-        const float *xf = rt_query_column(&it, app->transform_comp, 0);
+        const rt_mesh_component *m = rt_query_column(&it, app->meshes.mesh, 0);
+        const float *xf = rt_query_column(&it, app->meshes.transform, 0);
         for (uint32_t i = 0; i < it.rows; ++i)
             rt_renderer_draw_mesh(app->renderer, &m[i].gpu, xf + 16 * (size_t)i, m[i].color);
     }

@@ -17,6 +17,7 @@
 #include "gfx/renderer.h"
 #include "host/plugin_host.h"
 #include "profile/profiler.h"
+#include "spawn/scene_spawn.h"
 
 #include "gpu_particles.h"
 
@@ -38,14 +39,6 @@ typedef struct game_app_desc {
     rt_logger logger;
 } game_app_desc;
 
-/* Component "vfx.mesh": a drawable mesh with its colour and model-space bounds. The transform
- * is the separate component "vfx.transform" (float[16], column-major). */
-typedef struct game_app_mesh {
-    rt_mesh_gpu gpu;
-    float color[3];
-    float bounds_min[3], bounds_max[3];
-} game_app_mesh;
-
 typedef struct game_app {
     game_app_desc desc;
     rt_logger log;
@@ -62,8 +55,7 @@ typedef struct game_app {
     rt_camera camera;
     float clear_color[3];
     rt_renderer_environment environment; /* sky, sun and fog (zero: clear colour) */
-    rt_component mesh_comp, transform_comp; /* scene meshes are entities of the world */
-    uint32_t mesh_count;
+    rt_mesh_components meshes; /* meshes are entities of the world ("vfx.mesh", "vfx.transform") */
     bool water_enabled;        /* particles are drawn as water when true */
     /* where beams struck the water, as of the last frame's get_lights (vfx_impact_events) */
 #define GAME_APP_MAX_IMPACTS 16

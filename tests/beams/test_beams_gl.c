@@ -218,7 +218,7 @@ static void test_hidden_by_depth(void **state)
     image_errors ie;
     int bad = compare_image(raw, t_wall, &ie);
     free(raw);
-    game_app_mesh *m = rt_world_get(g_app->world, wall, g_app->mesh_comp, 0);
+    rt_mesh_component *m = rt_world_get(g_app->world, wall, g_app->meshes.mesh, 0);
     rt_mesh_gpu_destroy(&m->gpu);
     assert_int_equal(rt_world_despawn(g_app->world, wall), VFX_OK);
     char what[64];
@@ -260,7 +260,7 @@ static void test_hidden_by_assimp_mesh(void **state)
     image_errors ie;
     int bad = compare_image(raw, t_box, &ie);
     free(raw);
-    game_app_mesh *mm = rt_world_get(g_app->world, e, g_app->mesh_comp, 0);
+    rt_mesh_component *mm = rt_world_get(g_app->world, e, g_app->meshes.mesh, 0);
     rt_mesh_gpu_destroy(&mm->gpu);
     assert_int_equal(rt_world_despawn(g_app->world, e), VFX_OK);
     print_errors("beam through box.obj", &ie);
@@ -287,7 +287,7 @@ static void test_mz_sweep(void **state)
         float *raw = render_raw();
         double h = raw[cy * W + cx];
         free(raw);
-        game_app_mesh *m = rt_world_get(g_app->world, wall, g_app->mesh_comp, 0);
+        rt_mesh_component *m = rt_world_get(g_app->world, wall, g_app->meshes.mesh, 0);
         rt_mesh_gpu_destroy(&m->gpu);
         assert_int_equal(rt_world_despawn(g_app->world, wall), VFX_OK);
         g_wall_z = zs[k];
@@ -701,7 +701,7 @@ static void test_depth_modes_match_reference(void **state)
         raw = render_raw();
         bad = compare_image(raw, t_wall, &ie);
         free(raw);
-        game_app_mesh *mm = rt_world_get(g_app->world, wall, g_app->mesh_comp, 0);
+        rt_mesh_component *mm = rt_world_get(g_app->world, wall, g_app->meshes.mesh, 0);
         rt_mesh_gpu_destroy(&mm->gpu);
         assert_int_equal(rt_world_despawn(g_app->world, wall), VFX_OK);
         snprintf(what, sizeof what, "wall at z=%.2f, %s", g_wall_z, depth_modes_all[m].name);

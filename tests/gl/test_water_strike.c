@@ -93,7 +93,7 @@ static run_result run(double strength, bool spray, int frames)
             res.first_event = fr;
             memcpy(hit, demo.last_impact, sizeof hit);
             /* the particles near the hit now (by id: steps reorder the rows) */
-            rt_sph_columns c = rt_sph_get_columns(rt_sim_system_solver(demo.sim));
+            rt_sph_columns c = rt_sph_get_columns(rt_sim_system_solver(demo.spawned.sim));
             near = calloc(c.count + 1, sizeof *near);
             for (uint32_t i = 0; i < c.count; ++i) {
                 float o[3] = {c.x[i] - hit[0], c.y[i] - hit[1], c.z[i] - hit[2]};
@@ -104,7 +104,7 @@ static run_result run(double strength, bool spray, int frames)
         game_demo_animate(app, &demo, 1.f / 60.f);
         assert_int_equal(game_app_frame(app, 1.f / 60.f), VFX_OK);
         if (pushed_now) {
-            rt_sph_columns c = rt_sph_get_columns(rt_sim_system_solver(demo.sim));
+            rt_sph_columns c = rt_sph_get_columns(rt_sim_system_solver(demo.spawned.sim));
             double sum = 0;
             uint32_t n = 0;
             for (uint32_t i = 0; i < c.count; ++i) {
@@ -124,7 +124,7 @@ static run_result run(double strength, bool spray, int frames)
             printf("frame %d spray %g generated %g foam %g\n", fr, spray, stat(app, "water.diffuse_generated"),
                    stat(app, "water.diffuse_foam"));
         res.spray_max = fmax(res.spray_max, spray);
-        res.vmax = fmaxf(res.vmax, rt_sim_system_stats(demo.sim)->max_speed);
+        res.vmax = fmaxf(res.vmax, rt_sim_system_stats(demo.spawned.sim)->max_speed);
         if (res.first_event >= 0 && res.first_spray < 0 && spray > 0)
             res.first_spray = fr;
     }

@@ -135,7 +135,7 @@ static void hidden_by_depth_in(int mode)
     float *late = render_alpha();
     assert_true(stat("volume.clip_frames_late") == 1);
     float *a = render_alpha();
-    game_app_mesh *m = rt_world_get(g_app->world, e, g_app->mesh_comp, 0);
+    rt_mesh_component *m = rt_world_get(g_app->world, e, g_app->meshes.mesh, 0);
     rt_mesh_gpu_destroy(&m->gpu);
     assert_int_equal(rt_world_despawn(g_app->world, e), VFX_OK);
     /* the wall's edge (x = 0.1, z = 1.2) projected to a pixel column */
@@ -405,13 +405,13 @@ static void test_showcase_animates(void **state)
     game_demo demo;
     assert_int_equal(game_demo_load(g_app, &demo, g_showcase, VFX_EFFECT_BIT(VFX_EFFECT_WATER)), VFX_OK);
     assert_true(demo.vol_animated);
-    uint64_t rev = game_app_volume(g_app, demo.vol_entity)->revision;
+    uint64_t rev = game_app_volume(g_app, demo.spawned.volume)->revision;
     float *prev = NULL;
     for (int f = 0; f < 3; ++f) {
         g_app->time = 2.6 + 0.1 * f; /* the beam crosses the dome */
         game_demo_animate(g_app, &demo, 0.1f);
         float *a = render_alpha();
-        assert_true(game_app_volume(g_app, demo.vol_entity)->revision == rev + 1 + (uint64_t)f);
+        assert_true(game_app_volume(g_app, demo.spawned.volume)->revision == rev + 1 + (uint64_t)f);
         if (prev) {
             assert_true(stat("volume.render_skipped") == 0);
             double d = 0;
@@ -428,7 +428,7 @@ static void test_showcase_animates(void **state)
     uint32_t nb;
     game_app_beams(g_app, &nb);
     assert_true(nb == demo.beam_base_count && nb > 0);
-    uint64_t rev_off = game_app_volume(g_app, demo.vol_entity)->revision;
+    uint64_t rev_off = game_app_volume(g_app, demo.spawned.volume)->revision;
     game_demo_toggle(g_app, &demo, VFX_EFFECT_VOLUME);
     game_demo_toggle(g_app, &demo, VFX_EFFECT_BEAMS);
     assert_int_equal(game_app_volume_count(g_app), 0);
@@ -440,7 +440,7 @@ static void test_showcase_animates(void **state)
     game_demo_toggle(g_app, &demo, VFX_EFFECT_BEAMS);
     game_demo_animate(g_app, &demo, 0.1f);
     assert_int_equal(game_app_volume_count(g_app), 1);
-    assert_true(game_app_volume(g_app, demo.vol_entity)->revision == rev_off + 1);
+    assert_true(game_app_volume(g_app, demo.spawned.volume)->revision == rev_off + 1);
     const vfx_beam *beams = game_app_beams(g_app, &nb);
     assert_true(nb == demo.beam_base_count && beams[0].length > 0);
     assert_int_equal(game_app_frame(g_app, 0.1f), VFX_OK);
