@@ -269,14 +269,14 @@ vfx_result volfx_beams_impact_render(vfx_context *ctx, volfx_beams_impact *im, c
     for (GLuint k = 0; k < 5; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, k, bufs[k]);
     if (alive) {
-        volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "beams.impact_step", .no_framebuffer = true});
+        volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "beams.impact_step", .compute = true});
         glUseProgram(im->prog_step);
         glDispatchCompute(VOLFX_IMPACT_MAX_SPARKS / 64, 1, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         volfx_pass_end(ctx);
     }
     if (live) {
-        volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "beams.impact_hit", .no_framebuffer = true});
+        volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "beams.impact_hit", .compute = true});
         glUseProgram(im->prog_hit);
         glDispatchCompute((im->count + 63) / 64, 1, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);

@@ -308,7 +308,7 @@ GLuint volfx_gpu_compute(vfx_context *ctx, const char *comp, const char *defines
 
 /* ------------------------------------------------------------------------ timers */
 
-void volfx_gpu_pass_begin(vfx_context *ctx, const char *name)
+void volfx_gpu_timer_begin(vfx_context *ctx, const char *name)
 {
     volfx_gpu *g = ctx->gpu;
     glPushDebugGroup(GL_DEBUG_SOURCE_APPLICATION, 0, -1, name);
@@ -325,7 +325,7 @@ void volfx_gpu_pass_begin(vfx_context *ctx, const char *name)
     g->open[g->open_count++] = slot;
 }
 
-void volfx_gpu_pass_end(vfx_context *ctx)
+void volfx_gpu_timer_end(vfx_context *ctx)
 {
     volfx_gpu *g = ctx->gpu;
     if (g->open_count == 0)
@@ -340,7 +340,7 @@ void volfx_gpu_frame_end(vfx_context *ctx)
 {
     volfx_gpu *g = ctx->gpu;
     while (g->open_count)
-        volfx_gpu_pass_end(ctx);
+        volfx_gpu_timer_end(ctx);
     /* The oldest slot was recorded GPU_RING-1 frames ago: read it only if it is ready. */
     uint32_t oldest = (g->frame + 1) % GPU_RING;
     timer_frame *f = &g->ring[oldest];

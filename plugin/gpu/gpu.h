@@ -25,14 +25,15 @@ GLuint volfx_gpu_compute(vfx_context *ctx, const char *comp, const char *defines
  * when it was linked (no GL call); -1 when the program has no such active uniform. */
 GLint volfx_gpu_uniform(vfx_context *ctx, GLuint prog, const char *name);
 
-/* Opens a named pass: a debug group (RenderDoc shows it) and a timestamp pair. Names are
- * "effect.pass", e.g. "water.potential"; the GPU ms of the pass reach the stats as
- * "<name>.gpu_ms" gpu.timer_lag_frames frames later, without stalling (passes of one name in a
- * frame summed; the stats in the order of the first runs), and for a pass opened inside
- * others "<name>.gpu_depth", how many were open. */
-void volfx_gpu_pass_begin(vfx_context *ctx, const char *name);
-/* Closes the innermost open pass. */
-void volfx_gpu_pass_end(vfx_context *ctx);
+/* The timer under volfx_pass_begin/end (gpu/pass.h), which every pass calls instead: a debug
+ * group (RenderDoc shows it) and a timestamp pair. Names are "effect.pass", e.g.
+ * "water.potential"; the GPU ms of the pass reach the stats as "<name>.gpu_ms"
+ * gpu.timer_lag_frames frames later, without stalling (passes of one name in a frame summed; the
+ * stats in the order of the first runs), and for a pass opened inside others "<name>.gpu_depth",
+ * how many were open. */
+void volfx_gpu_timer_begin(vfx_context *ctx, const char *name);
+/* Closes the innermost open timer. */
+void volfx_gpu_timer_end(vfx_context *ctx);
 /* Called once per frame by the plugin: collects finished timer results. */
 void volfx_gpu_frame_end(vfx_context *ctx);
 

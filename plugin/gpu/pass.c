@@ -31,17 +31,15 @@ static void apply_blend(volfx_blend b)
 
 void volfx_pass_apply(vfx_context *ctx, const volfx_pass_desc *d)
 {
-    if (!d->no_framebuffer) {
-        glBindFramebuffer(GL_FRAMEBUFFER, d->framebuffer);
-        glViewport(0, 0, (GLsizei)(d->width ? d->width : ctx->width),
-                   (GLsizei)(d->height ? d->height : ctx->height));
-        if (d->clear_color)
-            glClearNamedFramebufferfv(d->framebuffer, GL_COLOR, 0, d->clear_rgba);
-        if (d->clear_depth) {
-            glDepthMask(GL_TRUE); /* a clear honours the mask a DEPTH_NONE pass left off */
-            float one = d->clear_depth_value != 0.f ? d->clear_depth_value : 1.f;
-            glClearNamedFramebufferfv(d->framebuffer, GL_DEPTH, 0, &one);
-        }
+    glBindFramebuffer(GL_FRAMEBUFFER, d->framebuffer);
+    glViewport(0, 0, (GLsizei)(d->width ? d->width : ctx->width),
+               (GLsizei)(d->height ? d->height : ctx->height));
+    if (d->clear_color)
+        glClearNamedFramebufferfv(d->framebuffer, GL_COLOR, 0, d->clear_rgba);
+    if (d->clear_depth) {
+        glDepthMask(GL_TRUE); /* a clear honours the mask a DEPTH_NONE pass left off */
+        float one = d->clear_depth_value != 0.f ? d->clear_depth_value : 1.f;
+        glClearNamedFramebufferfv(d->framebuffer, GL_DEPTH, 0, &one);
     }
     apply_blend(d->blend);
     if (d->depth == VOLFX_DEPTH_NONE) {
@@ -56,8 +54,9 @@ void volfx_pass_apply(vfx_context *ctx, const volfx_pass_desc *d)
 
 void volfx_pass_begin(vfx_context *ctx, const volfx_pass_desc *d)
 {
-    volfx_gpu_pass_begin(ctx, d->name);
-    volfx_pass_apply(ctx, d);
+    volfx_gpu_timer_begin(ctx, d->name);
+    if (!d->compute)
+        volfx_pass_apply(ctx, d);
 }
 
 void volfx_pass_reset(void)
@@ -71,7 +70,7 @@ void volfx_pass_reset(void)
 void volfx_pass_end(vfx_context *ctx)
 {
     volfx_pass_reset();
-    volfx_gpu_pass_end(ctx);
+    volfx_gpu_timer_end(ctx);
 }
 
 bool volfx_ubo_create(vfx_context *ctx, volfx_ubo *ubo, uint32_t bytes, const char *label)

@@ -1,7 +1,7 @@
-/* pass.h — GL state for a pass in one place (sokol style: a desc struct where zero means
- * default), std140 uniform blocks uploaded once per frame, uniform locations resolved when a
- * program is made, and the one composite every effect ends with. Nothing here looks anything up
- * by name on the frame path. */
+/* pass.h — the one way a pass begins, raster or compute (sokol style: a desc struct where zero
+ * means default): its debug group, its GPU timer and its GL state in one call; std140 uniform
+ * blocks uploaded once per frame, uniform locations resolved when a program is made, and the one
+ * composite every effect ends with. Nothing here looks anything up by name on the frame path. */
 #ifndef VOLFX_PASS_H
 #define VOLFX_PASS_H
 
@@ -23,7 +23,11 @@ typedef enum volfx_depth {
 } volfx_depth;
 
 typedef struct volfx_pass_desc {
-    const char *name;        /* "effect.pass": debug group and GPU timer; required */
+    const char *name;        /* "effect.pass": debug group and GPU timer ("<name>.gpu_ms"); required */
+    /* A compute pass (dispatches only), or a timed group of steps that each apply their own
+     * state with volfx_pass_apply: begin leaves the framebuffer, viewport, clears, blend and depth
+     * alone (a dispatch reads none of them), and every field below is ignored. */
+    bool compute;
     GLuint framebuffer;      /* 0 -> the default framebuffer */
     uint32_t width, height;  /* viewport; 0 -> the context's size */
     bool clear_color;        /* clear colour attachments to clear_rgba first */
@@ -32,10 +36,11 @@ typedef struct volfx_pass_desc {
     float clear_depth_value;
     volfx_blend blend;
     volfx_depth depth;
-    bool no_framebuffer;     /* compute-only pass: leave the framebuffer and viewport alone */
 } volfx_pass_desc;
 
-/* Opens a timed, labelled pass and applies its framebuffer, viewport, clears, blend and depth. */
+/* Opens a timed, labelled pass (gpu.h's timer ring: its GPU ms reach the stats as
+ * "<name>.gpu_ms") and, unless desc->compute, applies its framebuffer, viewport, clears, blend
+ * and depth. Every pass of the plugin, raster or compute, begins here. */
 void volfx_pass_begin(vfx_context *ctx, const volfx_pass_desc *desc);
 /* Closes the innermost pass; leaves blending and depth testing off (the effect state rule). */
 void volfx_pass_end(vfx_context *ctx);

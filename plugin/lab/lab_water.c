@@ -4,6 +4,7 @@
 #include "lab_water.h"
 
 #include "gpu/gpu.h"
+#include "gpu/pass.h"
 #include "water_grid.h"
 
 /* The lab's state in the water effect: the GRID's, made the first time GRID is drawn. */
@@ -29,7 +30,7 @@ static vfx_result brute_march(vfx_context *ctx, const volfx_lab_water_input *in,
     GLuint prog = volfx_gpu_compute(ctx, "water/brute.comp", NULL);
     if (!prog)
         return VFX_ERR_GL;
-    volfx_gpu_pass_begin(ctx, "water.brute");
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.brute", .compute = true});
     glUseProgram(prog);
     for (int k = 0; k < 3; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, in->cols[k]);
@@ -37,7 +38,7 @@ static vfx_result brute_march(vfx_context *ctx, const volfx_lab_water_input *in,
     glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_count"), in->count);
     glDispatchCompute((in->width + 7) / 8, (in->height + 7) / 8, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
     return VFX_OK;
 }
 

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "gpu/gpu.h"
+#include "gpu/pass.h"
 #include "gpu/scan.h"
 #include "water_grid.h"
 
@@ -148,7 +149,7 @@ vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const 
     GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
 
     if (rebuild) {
-        volfx_gpu_pass_begin(ctx, "water.grid_build");
+        volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.grid_build", .compute = true});
         glClearNamedBufferSubData(g->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
         glUseProgram(count);
         grid_uniforms(ctx, count, in, g0, cs, dims);
@@ -157,7 +158,7 @@ vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const 
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         vfx_result r = volfx_gpu_scan(ctx, g->count, g->start, nscan, "water grid");
         if (r) {
-            volfx_gpu_pass_end(ctx);
+            volfx_pass_end(ctx);
             return r;
         }
         grid_bind(g, in);
@@ -168,7 +169,7 @@ vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const 
         if (groups)
             glDispatchCompute(gx, gy, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        volfx_gpu_pass_end(ctx);
+        volfx_pass_end(ctx);
         g->built = 1;
         g->built_rev = in->data_rev;
         g->built_count = in->count;
@@ -176,7 +177,7 @@ vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const 
     }
 
     /* the counters were cleared by the effect at the start of the frame */
-    volfx_gpu_pass_begin(ctx, "water.grid_march");
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.grid_march", .compute = true});
     glUseProgram(march);
     grid_uniforms(ctx, march, in, g0, cs, dims);
     float blo[3], bhi[3];
@@ -194,7 +195,7 @@ vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const 
     glDispatchCompute((in->width + 7) / 8, (in->height + 7) / 8, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
 
     volfx_stat_set(ctx, "water.grid_rebuilt", rebuild);
     volfx_stat_set(ctx, "water.grid_cells", ncells);

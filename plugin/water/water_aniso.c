@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "gpu/gpu.h"
+#include "gpu/pass.h"
 #include "gpu/scan.h"
 #include "water_aniso.h"
 
@@ -381,9 +382,9 @@ vfx_result volfx_water_aniso_grid_build(vfx_context *ctx, volfx_water_aniso *a, 
         if (r)
             return r;
         bind_all(a, in);
-        volfx_gpu_pass_begin(ctx, "water.aniso_grid");
+        volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.aniso_grid", .compute = true});
         r = grid_steps(ctx, a, in);
-        volfx_gpu_pass_end(ctx);
+        volfx_pass_end(ctx);
         if (r)
             return r;
     }
@@ -402,7 +403,7 @@ static vfx_result particle_dispatch_end(vfx_context *ctx, uint32_t count, const 
     if (groups)
         glDispatchCompute(gx, gy, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
     const char *e = volfx_gpu_error_string();
     if (e)
         return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR, "water aniso %s over %u particles: %s", what, count, e);
@@ -417,7 +418,7 @@ static vfx_result centre_pass(vfx_context *ctx, volfx_water_aniso *a, const volf
     if (!prog)
         return VFX_ERR_GL;
     bind_all(a, in);
-    volfx_gpu_pass_begin(ctx, "water.aniso_centre");
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.aniso_centre", .compute = true});
     glUseProgram(prog);
     glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_count"), in->count);
     vfx_result r = particle_dispatch_end(ctx, in->count, "centre pass");
@@ -452,9 +453,9 @@ vfx_result volfx_water_aniso_compute(vfx_context *ctx, volfx_water_aniso *a, con
         return VFX_ERR_GL;
     bind_all(a, in);
     float cs = kp->radius * in->h;
-    volfx_gpu_pass_begin(ctx, "water.aniso");
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.aniso", .compute = true});
     if (aniso && (r = grid_steps(ctx, a, in))) {
-        volfx_gpu_pass_end(ctx);
+        volfx_pass_end(ctx);
         return r;
     }
     glUseProgram(kern);

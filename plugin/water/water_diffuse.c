@@ -306,7 +306,7 @@ vfx_result volfx_water_diffuse_step(vfx_context *ctx, volfx_water_diffuse *d, co
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, k, bind[k]);
     GLuint groups = (in->count + 63u) / 64u;
     GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
-    volfx_gpu_pass_begin(ctx, "water.diffuse");
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.diffuse", .compute = true});
     /* paused (dt 0): nothing is generated; the pool is still classified (the stats) */
     if (gx && in->dt > 0) {
         step_uniforms(ctx, normal, in);
@@ -343,7 +343,7 @@ vfx_result volfx_water_diffuse_step(vfx_context *ctx, volfx_water_diffuse *d, co
     step_uniforms(ctx, fin, in);
     glDispatchCompute(1, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
     d->cur = 1 - d->cur;
     d->stepped = true;
     const char *e = volfx_gpu_error_string();

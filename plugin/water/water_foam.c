@@ -6,6 +6,7 @@
 
 #include "context.h"
 #include "gpu/gpu.h"
+#include "gpu/pass.h"
 #include "param_ranges.h"
 #include "water_foam.h"
 
@@ -225,7 +226,7 @@ vfx_result volfx_water_foam_step(vfx_context *ctx, volfx_water_foam_layer *f, co
     GLuint bind[] = {in->cols[0], in->cols[1], in->cols[2], in->vel, f->vsum, f->dep, in->header, in->pool};
     for (GLuint k = 0; k < sizeof bind / sizeof bind[0]; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, k, bind[k]);
-    volfx_gpu_pass_begin(ctx, "water.foam");
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.foam", .compute = true});
     GLuint groups = (in->count + 63u) / 64u;
     GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
     if (gx) {
@@ -246,7 +247,7 @@ vfx_result volfx_water_foam_step(vfx_context *ctx, volfx_water_foam_layer *f, co
     glBindImageTexture(0, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     glClearNamedBufferData(f->vsum, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     glClearNamedBufferData(f->dep, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
     /* a regrid's old texture is the 1x1 placeholder or the old size: remade at the grid's size */
     if (old.nx != f->grid.nx || old.nz != f->grid.nz) {
         glDeleteTextures(1, &f->tex[f->cur]);

@@ -3,6 +3,7 @@
 
 #include "water/water_gather.h"
 #include "gpu/gpu.h"
+#include "gpu/pass.h"
 
 struct volfx_water_gather {
     GLuint box;                      /* this upload's reduction: 8 uints (gather.comp's Box) */
@@ -169,9 +170,9 @@ vfx_result volfx_water_gather_positions(vfx_context *ctx, volfx_water_gather *g,
     for (int k = 0; k < 3; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1 + k, cols[k]);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, g->box);
-    volfx_gpu_pass_begin(ctx, "water.gather");
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.gather", .compute = true});
     vfx_result r = gather(ctx, g, "#define MODE_POS\n", col, count, first, true, 12);
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
     return r;
 }
 
@@ -182,9 +183,9 @@ static vfx_result gather_copy(vfx_context *ctx, volfx_water_gather *g, const cha
     if (!count)
         return VFX_OK;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, out);
-    volfx_gpu_pass_begin(ctx, "water.gather");
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.gather", .compute = true});
     vfx_result r = gather(ctx, g, mode, col, count, first, false, bytes);
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
     return r;
 }
 

@@ -226,7 +226,7 @@ vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_f
     char defs[96];
 
     /* (1) initial sample: nearest cube front face per pixel by the depth test (eq. 1) */
-    volfx_gpu_pass_begin(ctx, "water.init");
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.init", .compute = true});
     if (dis & VFX_WATER_NO_BILLBOARD_INIT) {
         float nearv[4] = {frame->near_plane, 0, 0, 0};
         glClearTexImage(s->cur, 0, GL_RED, GL_FLOAT, nearv);
@@ -236,7 +236,7 @@ vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_f
             return VFX_ERR_GL;
         nearest_face_pass(ctx, s, prog, frame, 0);
     }
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
 
     uint32_t iters = (p->max_samples + (uint32_t)ns - 1) / (uint32_t)ns;
     snprintf(defs, sizeof defs, "#define MODE_UPDATE\n#define NS %d\n", ns);
@@ -250,22 +250,22 @@ vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_f
     int level = (int)p->pyramid_level;
     if (level >= s->pyr_levels)
         level = s->pyr_levels - 1;
-    volfx_gpu_pass_begin(ctx, "water.march");
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.march", .compute = true});
     for (uint32_t it = 0; it < iters; ++it) {
         /* (5) min/max pyramid of the current samples, 2x2 reductions down to `level` */
         if (cull) {
-            volfx_gpu_pass_begin(ctx, "water.pyramid");
+            volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.pyramid", .compute = true});
             build_pyramid(s, pyr0, pyrd, frame, s->cur, level);
-            volfx_gpu_pass_end(ctx);
+            volfx_pass_end(ctx);
         }
         /* (3)+(4) potentials at NS consecutive samples */
-        volfx_gpu_pass_begin(ctx, "water.potential");
+        volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.potential", .compute = true});
         vfx_result r = potential_pass(ctx, s, frame, s->cur, ns, cull);
-        volfx_gpu_pass_end(ctx);
+        volfx_pass_end(ctx);
         if (r)
             return r;
         /* inside/outside, stop flag, t'_next = t + NS w (eq. 2) into buffer 1 */
-        volfx_gpu_pass_begin(ctx, "water.update");
+        volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.update", .compute = true});
         glUseProgram(upd);
         volfx_water_bind_depth(frame);
         glBindImageTexture(0, s->st, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
@@ -274,10 +274,10 @@ vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_f
         glBindImageTexture(3, s->next1, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
         glBindTextureUnit(0, s->pot);
         volfx_water_dispatch(s);
-        volfx_gpu_pass_end(ctx);
+        volfx_pass_end(ctx);
         /* (2) jump over gaps: buffer 2 = nearest candidate region at or after t'_next
          * (eqs. 3-4, depth test); without it the next sample is t'_next itself */
-        volfx_gpu_pass_begin(ctx, "water.skip");
+        volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.skip", .compute = true});
         if (dis & VFX_WATER_NO_SKIP) {
             GLuint t = s->cur;
             s->cur = s->next1;
@@ -286,13 +286,13 @@ vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_f
         } else {
             nearest_face_pass(ctx, s, skip, frame, s->next1);
         }
-        volfx_gpu_pass_end(ctx);
+        volfx_pass_end(ctx);
     }
 
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
 
     /* (6) eq. 5 then eq. 6 regula falsi, each iteration's potential again by blending */
-    volfx_gpu_pass_begin(ctx, "water.refine");
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.refine", .compute = true});
     GLuint interp = volfx_gpu_compute(ctx, "water/march.comp", "#define MODE_INTERP\n#define NS 1\n");
     GLuint refine = volfx_gpu_compute(ctx, "water/march.comp", "#define MODE_REFINE\n#define NS 1\n");
     GLuint fin = volfx_gpu_compute(ctx, "water/march.comp", "#define MODE_FINAL\n#define NS 1\n");
@@ -313,6 +313,6 @@ vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_f
     glBindImageTexture(3, ctx->water_dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     glBindImageTexture(4, s->cur, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
     volfx_water_dispatch(s);
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
     return VFX_OK;
 }

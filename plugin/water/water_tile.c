@@ -298,7 +298,7 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
     bind_buffers(t, in);
     GLuint groups = (in->count + 63u) / 64u;
     GLuint gx = groups < 65535u ? groups : 65535u, gy = gx ? (groups + gx - 1) / gx : 0;
-    volfx_gpu_pass_begin(ctx, "water.tile_bin");
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.tile_bin", .compute = true});
     glClearNamedBufferSubData(t->count, GL_R32UI, 0, (GLsizeiptr)need * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     glClearNamedBufferSubData(t->globals, GL_R32UI, 0, 16, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     glUseProgram(count);
@@ -307,7 +307,7 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     vfx_result r = volfx_gpu_scan(ctx, t->count, t->start, nscan, "water tile bins");
     if (r) {
-        volfx_gpu_pass_end(ctx);
+        volfx_pass_end(ctx);
         return r;
     }
     bind_buffers(t, in);
@@ -318,7 +318,7 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
     if (groups)
         glDispatchCompute(gx, gy, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
     volfx_stat_set(ctx, "water.tile_entry_capacity", t->entry_cap);
     return VFX_OK;
 }
@@ -342,9 +342,10 @@ static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const vol
     if (!prog)
         return VFX_ERR_GL;
     GLenum access = finish ? GL_READ_ONLY : GL_READ_WRITE;
-    volfx_gpu_pass_begin(ctx, finish ? "water.finish"
-                              : half == 2 ? "water.tile_upsample"
-                              : half == 3 ? "water.tile_remarch" : "water.tile_march");
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = finish      ? "water.finish"
+                                                     : half == 2 ? "water.tile_upsample"
+                                                     : half == 3 ? "water.tile_remarch" : "water.tile_march",
+                                             .compute = true});
     glUseProgram(prog);
     bind_buffers(t, in);
     glBindImageTexture(0, in->dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
@@ -373,7 +374,7 @@ static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const vol
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                     GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT |
                     GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
-    volfx_gpu_pass_end(ctx);
+    volfx_pass_end(ctx);
     const char *e = volfx_gpu_error_string();
     if (e)
         return volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_GL_ERROR,
@@ -441,7 +442,7 @@ vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const v
         GLuint prog = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_REPROJECT\n");
         if (!prog)
             return VFX_ERR_GL;
-        volfx_gpu_pass_begin(ctx, "water.tile_reproject");
+        volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.tile_reproject", .compute = true});
         const uint32_t none = 0xffffffffu;
         glClearNamedBufferSubData(t->guess, GL_R32UI, 0, (GLsizeiptr)px * 4, GL_RED_INTEGER, GL_UNSIGNED_INT, &none);
         glUseProgram(prog);
@@ -451,7 +452,7 @@ vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const v
         glDispatchComputeIndirect(0);
         glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, 0);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        volfx_gpu_pass_end(ctx);
+        volfx_pass_end(ctx);
     }
     if (temporal) {
         /* this frame's hit points replace last frame's: no group, one row, one layer, none */

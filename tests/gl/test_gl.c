@@ -14,6 +14,7 @@
 
 #include "app.h"
 #include "gpu/gpu.h"
+#include "gpu/pass.h"
 #include "shader_text.h"
 #include "debug.h"
 #include "camera_ref.h"
@@ -108,11 +109,10 @@ static void test_timestamps_and_empty_world(void **state)
     bool seen = false;
     for (int frame = 0; frame < 12 && !seen; ++frame) {
         ctx->stats.count = 0;
-        volfx_gpu_pass_begin(ctx, "test.clear");
-        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-        glClearColor(0.1f * frame, 0, 0, 1);
-        glClear(GL_COLOR_BUFFER_BIT);
-        volfx_gpu_pass_end(ctx);
+        volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "test.clear", .framebuffer = fbo, .width = 256,
+                                                 .height = 256, .clear_color = true,
+                                                 .clear_rgba = {0.1f * frame, 0, 0, 1}});
+        volfx_pass_end(ctx);
         glFinish();
         volfx_gpu_frame_end(ctx);
         for (uint32_t i = 0; i < ctx->stats.count; ++i)
