@@ -10,11 +10,14 @@
 /* The frame gate (plugin/frame_check.c): what effects read of the camera, computed once a frame
  * from the checked frame view, and the targets effects share during one render. Effects run in
  * a fixed order: water (writes water_dist), volume (over, clipped by scene depth and water),
- * beams (additive, integrated up to the nearer of scene and water). No effect multiplies or
- * inverts these matrices, and none reads the camera from the frame view: the `frame` argument of
- * render() stays only until every effect reads this (docs/architecture.md "Frame gate"). */
+ * beams (additive, integrated up to the nearer of scene and water). Effects read the frame
+ * through this alone (render() is given no frame view); none multiplies or inverts these
+ * matrices (docs/architecture.md "Frame gate"). */
 typedef struct volfx_frame_targets {
     unsigned scene_depth;  /* host depth texture (window depth [0,1]); a far-depth one for 0 */
+    unsigned host_depth;   /* scene_depth when the host gave depth (a depth texture or a chained
+                            * vfx_frame_depth), 0 when scene_depth is the far-depth stand-in: the
+                            * water then binds none and tells its shaders it has no depth */
     unsigned scene_color;  /* host colour texture */
     unsigned water_dist;   /* R32F distance along the view ray to water, -1 miss; 0 = no water */
     float view_proj[16];     /* proj * view */
@@ -79,9 +82,9 @@ struct volfx_effect_ops {
      * surface), into the effect's own targets, published in targets. Runs once a render for each
      * drawn effect, before the water's shading (volfx_effects_prepare), and always before render. */
     vfx_result (*prepare)(vfx_context *ctx, void *state, volfx_frame_targets *targets);
-    /* Draws into frame->framebuffer. */
-    vfx_result (*render)(vfx_context *ctx, void *state, const vfx_frame_view *frame,
-                         volfx_frame_targets *targets);
+    /* Draws into targets->framebuffer, reading the camera and the host's textures from targets
+     * alone (the frame gate's). */
+    vfx_result (*render)(vfx_context *ctx, void *state, volfx_frame_targets *targets);
     /* Copies the raw quantity of the last render, top row first. */
     vfx_result (*read_raw)(vfx_context *ctx, void *state, float *out, size_t count);
 };

@@ -292,7 +292,7 @@ static vfx_result plugin_update(vfx_context *ctx, double time, float dt)
 static vfx_result render(vfx_context *ctx, const vfx_frame_view *frame)
 {
     volfx_frame_targets targets;
-    vfx_frame_view checked; /* what the effects still receive: validated, near/far filled */
+    vfx_frame_view checked; /* the frame view validated, near/far filled: the gate's scratch */
     vfx_result cr = volfx_frame_gate(ctx, frame, &targets, &checked);
     if (cr)
         return cr;
@@ -307,11 +307,9 @@ static vfx_result render(vfx_context *ctx, const vfx_frame_view *frame)
         drawing |= ctx->effect_state[k] && (mask & VFX_EFFECT_BIT(k));
     if ((cr = volfx_frame_gate_gl(ctx, drawing, &targets)))
         return cr;
-    if (targets.scene_depth != checked.depth_texture
-        && (checked.depth_texture || ctx->frame_depth.depth_renderbuffer || ctx->frame_depth.depth_framebuffer))
-        checked.depth_texture = targets.scene_depth; /* the engine's own depth, as the gate made it */
-    checked.framebuffer = targets.framebuffer; /* the effects layer's, when the host gave one */
-    frame = &checked;
+    /* the engine's own depth, as the gate made it, where the host gave depth in any form */
+    targets.host_depth = checked.depth_texture || ctx->frame_depth.depth_renderbuffer
+                                 || ctx->frame_depth.depth_framebuffer ? targets.scene_depth : 0;
 
     ctx->stats.count = 0;
     ctx->stats.dropped = 0;
@@ -327,7 +325,7 @@ static vfx_result render(vfx_context *ctx, const vfx_frame_view *frame)
         /* the water has run it before its shading; without water, the beams' prepare runs here */
         if (k != VFX_EFFECT_WATER && (result = volfx_effects_prepare(ctx, &targets)))
             break;
-        result = ctx->effect_ops[k]->render(ctx, ctx->effect_state[k], frame, &targets);
+        result = ctx->effect_ops[k]->render(ctx, ctx->effect_state[k], &targets);
         if (result == VFX_OK)
             ctx->rendered |= VFX_EFFECT_BIT(k);
     }

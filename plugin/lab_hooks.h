@@ -37,7 +37,7 @@ struct volfx_lab_hooks {
     /* Draws lab method `method` (VFX_WATER_METHOD_BRUTE or _GRID) into in->dist_tex, adding its
      * counts into in->counters; *state is the lab's own, NULL until its first call. */
     vfx_result (*water_march)(vfx_context *ctx, void **state, uint32_t method, const volfx_lab_water_input *in,
-                              const vfx_frame_view *frame, const volfx_frame_targets *targets);
+                              const volfx_frame_targets *targets);
     /* Frees what water_march made in *state (NULL allowed). */
     void (*water_free)(vfx_context *ctx, void *state);
 };

@@ -653,10 +653,8 @@ static vfx_result beams_prepare(vfx_context *ctx, void *state, volfx_frame_targe
 
 /* The second half, after the water and the volume: the bloom chain over the light in front of
  * the water, and the composite into the frame gate's framebuffer. */
-static vfx_result beams_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
-                               volfx_frame_targets *t)
+static vfx_result beams_render(vfx_context *ctx, void *state, volfx_frame_targets *t)
 {
-    (void)frame;
     beams_state *s = state;
     if (!s->prepared)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_EFFECT_ORDER,

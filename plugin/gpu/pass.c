@@ -109,25 +109,13 @@ void volfx_program_uniforms(GLuint prog, const char *const *names, GLint *locs, 
         locs[i] = prog ? glGetUniformLocation(prog, names[i]) : -1;
 }
 
-static void composite(vfx_context *ctx, unsigned framebuffer, uint32_t w, uint32_t h, const char *name,
-                      GLuint prog, volfx_blend blend)
+void volfx_composite_targets(vfx_context *ctx, const volfx_frame_targets *t, const char *name,
+                             GLuint prog, volfx_blend blend)
 {
-    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = name, .framebuffer = framebuffer,
-                                             .width = w, .height = h, .blend = blend});
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = name, .framebuffer = t->framebuffer,
+                                             .width = t->width, .height = t->height, .blend = blend});
     glUseProgram(prog);
     volfx_gpu_fullscreen(ctx);
     glUseProgram(0);
     volfx_pass_end(ctx);
-}
-
-void volfx_composite(vfx_context *ctx, const vfx_frame_view *frame, const char *name, GLuint prog,
-                     volfx_blend blend)
-{
-    composite(ctx, frame->framebuffer, frame->width, frame->height, name, prog, blend);
-}
-
-void volfx_composite_targets(vfx_context *ctx, const volfx_frame_targets *t, const char *name,
-                             GLuint prog, volfx_blend blend)
-{
-    composite(ctx, t->framebuffer, t->width, t->height, name, prog, blend);
 }

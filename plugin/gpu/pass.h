@@ -69,12 +69,9 @@ void volfx_ubo_destroy(volfx_ubo *ubo);
  * gets -1 (GL ignores it). Never call it on the frame path. */
 void volfx_program_uniforms(GLuint prog, const char *const *names, GLint *locs, uint32_t n);
 
-/* Draws `prog` (which uses common/fullscreen.vert) over the whole of frame->framebuffer with
- * `blend`, timed as `name`, textures bound by the caller: the final pass of every effect. */
-void volfx_composite(vfx_context *ctx, const vfx_frame_view *frame, const char *name, GLuint prog,
-                     volfx_blend blend);
-/* The same into the frame gate's framebuffer and size (effect.h): what effects call once they
- * read only volfx_frame_targets. */
+/* Draws `prog` (which uses common/fullscreen.vert) over the whole of the frame gate's framebuffer
+ * (effect.h) with `blend`, timed as `name`, textures bound by the caller: the final pass of an
+ * effect. */
 struct volfx_frame_targets;
 void volfx_composite_targets(vfx_context *ctx, const struct volfx_frame_targets *t, const char *name,
                              GLuint prog, volfx_blend blend);

@@ -24,8 +24,7 @@ vfx_result volfx_lab_water_struct(vfx_context *ctx, const void *lab, uint32_t *d
 }
 
 /* BRUTE: the per-pixel march over every particle (pass water.brute). */
-static vfx_result brute_march(vfx_context *ctx, const volfx_lab_water_input *in, const vfx_frame_view *frame,
-                              const volfx_frame_targets *targets)
+static vfx_result brute_march(vfx_context *ctx, const volfx_lab_water_input *in, const volfx_frame_targets *targets)
 {
     GLuint prog = volfx_gpu_compute(ctx, "water/brute.comp", NULL);
     if (!prog)
@@ -34,7 +33,7 @@ static vfx_result brute_march(vfx_context *ctx, const volfx_lab_water_input *in,
     glUseProgram(prog);
     for (int k = 0; k < 3; ++k)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)k, in->cols[k]);
-    volfx_water_march_bind(ctx, prog, in->dist_tex, in->params, frame, targets);
+    volfx_water_march_bind(ctx, prog, in->dist_tex, in->params, targets);
     glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_count"), in->count);
     glDispatchCompute((in->width + 7) / 8, (in->height + 7) / 8, 1);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
@@ -43,10 +42,10 @@ static vfx_result brute_march(vfx_context *ctx, const volfx_lab_water_input *in,
 }
 
 vfx_result volfx_lab_water_march(vfx_context *ctx, void **state, uint32_t method, const volfx_lab_water_input *in,
-                                 const vfx_frame_view *frame, const volfx_frame_targets *targets)
+                                 const volfx_frame_targets *targets)
 {
     if (method == VFX_WATER_METHOD_BRUTE)
-        return brute_march(ctx, in, frame, targets);
+        return brute_march(ctx, in, targets);
     if (method != VFX_WATER_METHOD_GRID)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_METHOD,
                           "water: lab method %u unknown (1 brute, 2 grid)", method);
@@ -58,7 +57,7 @@ vfx_result volfx_lab_water_march(vfx_context *ctx, void **state, uint32_t method
     }
     if (!s->grid && !(s->grid = volfx_water_grid_create(ctx)))
         return VFX_ERR_OUT_OF_MEMORY;
-    return volfx_water_grid_render(ctx, s->grid, in, frame, targets);
+    return volfx_water_grid_render(ctx, s->grid, in, targets);
 }
 
 void volfx_lab_water_free(vfx_context *ctx, void *state)

@@ -10,7 +10,7 @@
 vfx_result volfx_lab_water_struct(vfx_context *ctx, const void *lab, uint32_t *disable, uint32_t *method);
 /* lab_hooks.h water_march: BRUTE or GRID into in->dist_tex. */
 vfx_result volfx_lab_water_march(vfx_context *ctx, void **state, uint32_t method, const volfx_lab_water_input *in,
-                                 const vfx_frame_view *frame, const volfx_frame_targets *targets);
+                                 const volfx_frame_targets *targets);
 /* lab_hooks.h water_free. */
 void volfx_lab_water_free(vfx_context *ctx, void *state);
 

@@ -94,22 +94,22 @@ static void grid_uniforms(vfx_context *ctx, GLuint prog, const volfx_lab_water_i
 }
 
 void volfx_water_march_bind(vfx_context *ctx, GLuint prog, GLuint dist_tex, const volfx_water_core *p,
-                          const vfx_frame_view *frame, const volfx_frame_targets *targets)
+                          const volfx_frame_targets *targets)
 {
     glBindImageTexture(0, dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-    glBindTextureUnit(1, frame->depth_texture);
+    glBindTextureUnit(1, targets->host_depth);
     glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
-    glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_eye"), 1, frame->eye);
+    glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_eye"), 1, targets->eye);
     glUniform1f(volfx_gpu_uniform(ctx, prog, "u_h"), p->h);
     glUniform1f(volfx_gpu_uniform(ctx, prog, "u_T"), p->threshold);
     glUniform1f(volfx_gpu_uniform(ctx, prog, "u_step"), p->step);
     glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_max_samples"), p->max_samples);
     glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_refine_iters"), (p->disable & VFX_WATER_NO_REFINE) ? 0u : p->refine_iters);
-    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_has_depth"), frame->depth_texture != 0);
+    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_has_depth"), targets->host_depth != 0);
 }
 
 vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const volfx_lab_water_input *in,
-                                 const vfx_frame_view *frame, const volfx_frame_targets *targets)
+                                 const volfx_frame_targets *targets)
 {
     const volfx_water_core *p = in->params;
     float g0[3], cs;
@@ -187,7 +187,7 @@ vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const 
     }
     glUniform3fv(volfx_gpu_uniform(ctx, march, "u_blo"), 1, blo);
     glUniform3fv(volfx_gpu_uniform(ctx, march, "u_bhi"), 1, bhi);
-    volfx_water_march_bind(ctx, march, in->dist_tex, p, frame, targets);
+    volfx_water_march_bind(ctx, march, in->dist_tex, p, targets);
     /* the paper's technique bits mean the same here: 1 = start at the box entry instead of the
      * first sphere entry, 2 = fixed steps after the start (no jump over empty space) */
     glUniform1i(volfx_gpu_uniform(ctx, march, "u_seek_init"), !(p->disable & VFX_WATER_NO_BILLBOARD_INIT));

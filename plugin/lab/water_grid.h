@@ -20,13 +20,13 @@ void volfx_water_grid_destroy(vfx_context *ctx, volfx_water_grid *g);
  * grid cells visited / sphere tests into in->counters (no readback here); sets water.grid_cells,
  * water.grid_cell_size and water.grid_rebuilt (0/1). */
 vfx_result volfx_water_grid_render(vfx_context *ctx, volfx_water_grid *g, const volfx_lab_water_input *in,
-                                 const vfx_frame_view *frame, const volfx_frame_targets *targets);
+                                 const volfx_frame_targets *targets);
 
 /* The march inputs BRUTE (brute.comp) and GRID (grid.comp MODE_MARCH) share, on the current
  * program prog: dist_tex as image 0, the scene depth on unit 1, the ray (inverse view-projection,
  * eye), the sampling rule (h, T, step, sample cap), refinement (off with VFX_WATER_NO_REFINE)
  * and whether there is scene depth. */
 void volfx_water_march_bind(vfx_context *ctx, GLuint prog, GLuint dist_tex, const volfx_water_core *p,
-                          const vfx_frame_view *frame, const volfx_frame_targets *targets);
+                          const volfx_frame_targets *targets);
 
 #endif

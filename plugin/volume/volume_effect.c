@@ -383,14 +383,12 @@ static uint64_t render_key(const volume_state *s, const tet_camera *cam, const t
     return h ? h : 1;
 }
 
-static vfx_result volume_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
-                                volfx_frame_targets *targets)
+static vfx_result volume_render(vfx_context *ctx, void *state, volfx_frame_targets *targets)
 {
     volume_state *s = state;
     const vfx_volume_view *v = &s->view;
     /* this frame's distances go to one pack buffer; the render uses the previous frame's */
     const int slot = (int)(s->frame & 1u), prev = slot ^ 1;
-    (void)frame; /* everything comes from the frame gate's targets */
     distance_pass(ctx, s, targets, slot);
     const bool late = s->frame > 0 && s->fence[prev];
     vfx_result r = read_distances(ctx, s, late ? prev : slot);

@@ -362,46 +362,46 @@ void volfx_water_diffuse_buffers(const volfx_water_diffuse *d, GLuint *vel, GLui
 
 /* The uniforms both draws read; binds the live pool at SSBO 0. */
 static void draw_uniforms(vfx_context *ctx, GLuint prog, volfx_water_diffuse *d, const volfx_water_diffuse_draw *dd,
-                          const vfx_frame_view *frame, const volfx_frame_targets *targets, float radius)
+                          const volfx_frame_targets *targets, float radius)
 {
     glUseProgram(prog);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, d->pool[d->cur]);
     glBindTextureUnit(0, dd->dist_tex);
-    glBindTextureUnit(1, frame->depth_texture);
+    glBindTextureUnit(1, targets->host_depth);
     glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_view_proj"), 1, GL_FALSE, targets->view_proj);
     glUniformMatrix4fv(volfx_gpu_uniform(ctx, prog, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
-    glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_eye"), 1, frame->eye);
+    glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_eye"), 1, targets->eye);
     glUniform1f(volfx_gpu_uniform(ctx, prog, "u_radius"), radius * dd->h);
     glUniform1f(volfx_gpu_uniform(ctx, prog, "u_h"), dd->h);
     glUniform1f(volfx_gpu_uniform(ctx, prog, "u_absorption"), dd->absorption);
     glUniform1f(volfx_gpu_uniform(ctx, prog, "u_shutter"), dd->shutter);
-    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_has_depth"), frame->depth_texture != 0);
+    glUniform1i(volfx_gpu_uniform(ctx, prog, "u_has_depth"), targets->host_depth != 0);
     glUniform1i(volfx_gpu_uniform(ctx, prog, "u_hdr"), targets->color_hdr);
     glBindVertexArray(dd->vao);
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, d->header);
 }
 
 vfx_result volfx_water_diffuse_splat(vfx_context *ctx, volfx_water_diffuse *d, const volfx_water_diffuse_draw *dd,
-                                     const vfx_frame_view *frame, const volfx_frame_targets *targets, GLuint *layer)
+                                     const volfx_frame_targets *targets, GLuint *layer)
 {
     *layer = 0;
     if (!d->stepped)
         return VFX_OK;
-    if (!d->layer || d->layer_w != frame->width || d->layer_h != frame->height) {
+    if (!d->layer || d->layer_w != targets->width || d->layer_h != targets->height) {
         if (d->layer)
             glDeleteTextures(1, &d->layer);
         if (d->fbo)
             glDeleteFramebuffers(1, &d->fbo);
         glCreateTextures(GL_TEXTURE_2D, 1, &d->layer);
-        glTextureStorage2D(d->layer, 1, GL_RG16F, (GLsizei)frame->width, (GLsizei)frame->height);
+        glTextureStorage2D(d->layer, 1, GL_RG16F, (GLsizei)targets->width, (GLsizei)targets->height);
         glTextureParameteri(d->layer, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTextureParameteri(d->layer, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
         volfx_gpu_label(GL_TEXTURE, d->layer, "water.diffuse_layer");
         glCreateFramebuffers(1, &d->fbo);
         glNamedFramebufferTexture(d->fbo, GL_COLOR_ATTACHMENT0, d->layer, 0);
-        d->layer_w = frame->width;
-        d->layer_h = frame->height;
-        vfx_result r = volfx_gpu_check_target(ctx, d->fbo, "water diffuse: layer", frame->width, frame->height);
+        d->layer_w = targets->width;
+        d->layer_h = targets->height;
+        vfx_result r = volfx_gpu_check_target(ctx, d->fbo, "water diffuse: layer", targets->width, targets->height);
         if (r)
             return r;
     }
@@ -409,9 +409,9 @@ vfx_result volfx_water_diffuse_splat(vfx_context *ctx, volfx_water_diffuse *d, c
     if (!prog)
         return VFX_ERR_GL;
     volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.diffuse_splat", .framebuffer = d->fbo,
-                                             .width = frame->width, .height = frame->height, .clear_color = true,
+                                             .width = targets->width, .height = targets->height, .clear_color = true,
                                              .blend = VOLFX_BLEND_ADD});
-    draw_uniforms(ctx, prog, d, dd, frame, targets, FOAM_RADIUS_H);
+    draw_uniforms(ctx, prog, d, dd, targets, FOAM_RADIUS_H);
     glDrawArraysIndirect(GL_TRIANGLE_STRIP, (const void *)(uintptr_t)(4 * sizeof(uint32_t)));
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
     volfx_pass_end(ctx);
@@ -420,7 +420,7 @@ vfx_result volfx_water_diffuse_splat(vfx_context *ctx, volfx_water_diffuse *d, c
 }
 
 vfx_result volfx_water_diffuse_spray(vfx_context *ctx, volfx_water_diffuse *d, const volfx_water_diffuse_draw *dd,
-                                     const vfx_frame_view *frame, const volfx_frame_targets *targets)
+                                     const volfx_frame_targets *targets)
 {
     if (!d->stepped)
         return VFX_OK;
@@ -429,10 +429,10 @@ vfx_result volfx_water_diffuse_spray(vfx_context *ctx, volfx_water_diffuse *d, c
                                                : "#define STREAK\n");
     if (!prog)
         return VFX_ERR_GL;
-    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.spray", .framebuffer = frame->framebuffer,
-                                             .width = frame->width, .height = frame->height,
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.spray", .framebuffer = targets->framebuffer,
+                                             .width = targets->width, .height = targets->height,
                                              .blend = VOLFX_BLEND_OVER_PREMUL});
-    draw_uniforms(ctx, prog, d, dd, frame, targets, SPRAY_RADIUS_H);
+    draw_uniforms(ctx, prog, d, dd, targets, SPRAY_RADIUS_H);
     glDrawArraysIndirect(GL_TRIANGLE_STRIP, (const void *)(uintptr_t)(4 * sizeof(uint32_t)));
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
     volfx_pass_end(ctx);

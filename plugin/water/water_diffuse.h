@@ -91,10 +91,10 @@ typedef struct volfx_water_diffuse_draw {
  * texture (pass water.diffuse_splat), sized to the frame; returns it through *layer (0 when
  * there is nothing to splat: the shading reads no layer). */
 vfx_result volfx_water_diffuse_splat(vfx_context *ctx, volfx_water_diffuse *d, const volfx_water_diffuse_draw *dd,
-                                     const vfx_frame_view *frame, const volfx_frame_targets *targets, GLuint *layer);
-/* Draws the spray streaked along its velocity over frame->framebuffer (pass water.spray). */
+                                     const volfx_frame_targets *targets, GLuint *layer);
+/* Draws the spray streaked along its velocity over targets->framebuffer (pass water.spray). */
 vfx_result volfx_water_diffuse_spray(vfx_context *ctx, volfx_water_diffuse *d, const volfx_water_diffuse_draw *dd,
-                                     const vfx_frame_view *frame, const volfx_frame_targets *targets);
+                                     const volfx_frame_targets *targets);
 /* The buffers the foam layer reads (borrowed): the fluid velocities (vec4 a particle), the live
  * pool (2 vec4 a particle) and the header (diffuse.comp's; after a step its first 3 words are an
  * indirect dispatch of 64-wide groups covering the live pool, word 3 the pool's count). */

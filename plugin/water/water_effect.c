@@ -646,26 +646,25 @@ static void counters_frame_end(vfx_context *ctx, water_state *s, uint32_t method
 
 /* BRUTE and GRID, the lab's baselines (lab_hooks.h): a method only a vfx_lab_water asks for,
  * which a context without the lab refuses (water_params.c). */
-static vfx_result lab_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                            const volfx_frame_targets *targets)
+static vfx_result lab_march(vfx_context *ctx, water_state *s, const volfx_frame_targets *targets)
 {
     if (!ctx->lab)
         return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_WATER_METHOD,
                           "water: method %u is a lab method; this plugin has no lab attached", s->params.method);
     volfx_lab_water_input in = {s->cols, s->count, s->count - s->nan_count, s->lo, s->hi, &s->params,
                                 s->width, s->height, ctx->water_dist_tex, s->counters, s->data_rev};
-    return ctx->lab->water_march(ctx, &s->lab_state, s->params.method, &in, frame, targets);
+    return ctx->lab->water_march(ctx, &s->lab_state, s->params.method, &in, targets);
 }
 
 static vfx_result tile_lists(vfx_context *ctx, water_state *s, volfx_water_tile_input *in,
-                             const vfx_frame_view *frame, const volfx_frame_targets *targets)
+                             const volfx_frame_targets *targets)
 {
     if (!s->tile && !(s->tile = volfx_water_tile_create(ctx)))
         return VFX_ERR_OUT_OF_MEMORY;
     *in = (volfx_water_tile_input){s->cols, s->count, &s->params, s->width, s->height, ctx->water_dist_tex,
                                    s->counters, s->have_last ? s->last[10] : 0, s->view_proj, s->lo, s->hi,
-                                   frame->eye, fabsf(frame->proj[5]) * 0.5f * (float)s->height, volfx_water_view_frames(s), 0, 0.0f,
-                                   targets->inv_view_proj, frame->depth_texture != 0};
+                                   targets->eye, fabsf(targets->proj[5]) * 0.5f * (float)s->height, volfx_water_view_frames(s), 0, 0.0f,
+                                   targets->inv_view_proj, targets->host_depth != 0};
     /* per-particle kernels: the anisotropic ones, or the host's radius / kernel columns */
     if (s->params.method == VFX_WATER_METHOD_TILE &&
         (s->kp.kernel == VFX_WATER_KERNEL_ANISOTROPIC || volfx_water_aniso_has_columns(s->aniso))) {
@@ -684,21 +683,19 @@ static vfx_result tile_lists(vfx_context *ctx, water_state *s, volfx_water_tile_
     return volfx_water_tile_bin(ctx, s->tile, in);
 }
 
-static vfx_result tile_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                             const volfx_frame_targets *targets)
+static vfx_result tile_march(vfx_context *ctx, water_state *s, const volfx_frame_targets *targets)
 {
     volfx_water_tile_input in;
-    vfx_result r = tile_lists(ctx, s, &in, frame, targets);
-    return r ? r : volfx_water_tile_march(ctx, s->tile, &in, frame, s->grad, s->back);
+    vfx_result r = tile_lists(ctx, s, &in, targets);
+    return r ? r : volfx_water_tile_march(ctx, s->tile, &in, targets, s->grad, s->back);
 }
 
 /* The paper method's sample-cap pixels, finished by TILE's march from where they stopped. */
-static vfx_result paper_finish(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                               const volfx_frame_targets *targets)
+static vfx_result paper_finish(vfx_context *ctx, water_state *s, const volfx_frame_targets *targets)
 {
     volfx_water_tile_input in;
-    vfx_result r = tile_lists(ctx, s, &in, frame, targets);
-    return r ? r : volfx_water_tile_finish(ctx, s->tile, &in, frame, s->st, s->cur);
+    vfx_result r = tile_lists(ctx, s, &in, targets);
+    return r ? r : volfx_water_tile_finish(ctx, s->tile, &in, targets, s->st, s->cur);
 }
 
 /* Whether this frame has diffuse particles: the host's velocities, not switched off, one
@@ -757,8 +754,7 @@ static vfx_result foam_update(vfx_context *ctx, water_state *s, const volfx_fram
 /* The diffuse particles' step over this update's fluid (once per update: the first view drawn
  * steps them, the others draw the same pool), the foam layer's update, and their foam and bubble
  * layer in this view (*layer, 0: none). */
-static vfx_result diffuse_frame(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                                const volfx_frame_targets *targets, GLuint *layer)
+static vfx_result diffuse_frame(vfx_context *ctx, water_state *s, const volfx_frame_targets *targets, GLuint *layer)
 {
     *layer = 0;
     if (!diffuse_on(s)) {
@@ -786,11 +782,10 @@ static vfx_result diffuse_frame(vfx_context *ctx, water_state *s, const vfx_fram
         s->diffuse_due = false;
     }
     volfx_water_diffuse_draw dd = {s->params.h, s->params.absorption, ctx->water_dist_tex, s->vao, WATER_SHUTTER_S, false};
-    return volfx_water_diffuse_splat(ctx, s->diffuse, &dd, frame, targets, layer);
+    return volfx_water_diffuse_splat(ctx, s->diffuse, &dd, targets, layer);
 }
 
-static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_view *frame,
-                               volfx_frame_targets *targets)
+static vfx_result render_view(vfx_context *ctx, water_state *s, volfx_frame_targets *targets)
 {
     const volfx_water_core *p = &s->params;
     targets->water_dist = ctx->water_dist_tex;
@@ -804,7 +799,7 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
     /* the frame gate's product (the same proj * view, made once a frame), kept for next frame's reprojection */
     memcpy(s->view_proj, targets->view_proj, sizeof s->view_proj);
     if (p->method != VFX_WATER_METHOD_TILE) /* TILE's passes set their own uniforms */
-        volfx_water_frame_upload(s, frame, targets);
+        volfx_water_frame_upload(s, targets);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->counters);
     glClearNamedBufferData(s->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, NULL);
     volfx_stat_set(ctx, "water.particles", s->count);
@@ -827,15 +822,15 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
                                                                         : "a per-particle radius or kernel column (vfx_particle_view.radius, kernel)",
                           p->method);
     if (p->method == VFX_WATER_METHOD_PAPER) {
-        r = volfx_water_paper_march(ctx, s, frame);
+        r = volfx_water_paper_march(ctx, s, targets);
         /* the tile lists read one position buffer: with several, the cap pixels stay holes
          * (counted in water.pixels_undecided) */
         if (r == VFX_OK && !(p->disable & VFX_WATER_NO_FINISH) && s->group_count == 1)
-            r = paper_finish(ctx, s, frame, targets);
+            r = paper_finish(ctx, s, targets);
     } else if (p->method == VFX_WATER_METHOD_TILE)
-        r = tile_march(ctx, s, frame, targets);
+        r = tile_march(ctx, s, targets);
     else if (p->method == VFX_WATER_METHOD_BRUTE || p->method == VFX_WATER_METHOD_GRID)
-        r = lab_march(ctx, s, frame, targets);
+        r = lab_march(ctx, s, targets);
     else
         r = volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_METHOD,
                        "water: unknown method %u in vfx_water_params (0 paper, 1 brute, 2 grid, 3 tile)", p->method);
@@ -843,11 +838,11 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
         return r;
     /* TILE wrote the gradient and back distance from its own lists */
     if (!(p->disable & VFX_WATER_NO_SHADING) && p->method != VFX_WATER_METHOD_TILE &&
-        (r = volfx_water_surface_passes(ctx, s, frame)) != VFX_OK)
+        (r = volfx_water_surface_passes(ctx, s, targets)) != VFX_OK)
         return r;
 
     GLuint layer = 0;
-    if ((r = diffuse_frame(ctx, s, frame, targets, &layer)))
+    if ((r = diffuse_frame(ctx, s, targets, &layer)))
         return r;
     /* the beams' light split at this surface (their prepare step) before the shading reads it */
     if ((r = volfx_effects_prepare(ctx, targets)))
@@ -866,25 +861,25 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
                            : volfx_gpu_program(ctx, "common/fullscreen.vert", "water/shade.frag", NULL);
     if (!shade)
         return VFX_ERR_GL;
-    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.shade", .framebuffer = frame->framebuffer,
-                                             .width = frame->width, .height = frame->height});
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.shade", .framebuffer = targets->framebuffer,
+                                             .width = targets->width, .height = targets->height});
     glUseProgram(shade);
     glBindTextureUnit(0, ctx->water_dist_tex);
-    glBindTextureUnit(1, frame->color_texture);
+    glBindTextureUnit(1, targets->scene_color);
     glBindTextureUnit(2, s->grad);
     glBindTextureUnit(3, s->back);
-    glBindTextureUnit(4, frame->depth_texture);
+    glBindTextureUnit(4, targets->host_depth);
     glUniformMatrix4fv(volfx_gpu_uniform(ctx, shade, "u_inv_view_proj"), 1, GL_FALSE, targets->inv_view_proj);
     glUniformMatrix4fv(volfx_gpu_uniform(ctx, shade, "u_view_proj"), 1, GL_FALSE, targets->view_proj);
-    glUniform3fv(volfx_gpu_uniform(ctx, shade, "u_eye"), 1, frame->eye);
+    glUniform3fv(volfx_gpu_uniform(ctx, shade, "u_eye"), 1, targets->eye);
     glUniform1f(volfx_gpu_uniform(ctx, shade, "u_h"), p->h);
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_refract_view"), (p->disable & VFX_WATER_NO_REFRACT_TRACE) != 0);
     glUniform1f(volfx_gpu_uniform(ctx, shade, "u_absorption"), p->absorption);
     glUniform1f(volfx_gpu_uniform(ctx, shade, "u_ior"), p->ior);
     glUniform3fv(volfx_gpu_uniform(ctx, shade, "u_tint"), 1, p->color);
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_flat"), (p->disable & VFX_WATER_NO_SHADING) != 0);
-    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_color"), frame->color_texture != 0);
-    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_depth"), frame->depth_texture != 0);
+    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_color"), targets->scene_color != 0);
+    glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_depth"), targets->host_depth != 0);
     if (targets->environment_cubemap)
         glBindTextureUnit(5, targets->environment_cubemap);
     glUniform1i(volfx_gpu_uniform(ctx, shade, "u_has_env"), targets->environment_cubemap != 0);
@@ -920,7 +915,7 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
         volfx_water_diffuse_draw dd = {p->h, p->absorption, ctx->water_dist_tex, s->vao, WATER_SHUTTER_S, nlights > 0};
         if (nlights)
             glBindBufferBase(GL_UNIFORM_BUFFER, 7, s->effect_lights.buffer);
-        if ((r = volfx_water_diffuse_spray(ctx, s->diffuse, &dd, frame, targets)))
+        if ((r = volfx_water_diffuse_spray(ctx, s->diffuse, &dd, targets)))
             return r;
     }
     counters_frame_end(ctx, s, p->method);
@@ -931,18 +926,17 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, const vfx_frame_
     return VFX_OK;
 }
 
-static vfx_result water_render(vfx_context *ctx, void *state, const vfx_frame_view *frame,
-                               volfx_frame_targets *targets)
+static vfx_result water_render(vfx_context *ctx, void *state, volfx_frame_targets *targets)
 {
     water_state *s = state;
     if (s->counters == 0) {
         glCreateBuffers(1, &s->counters);
         glNamedBufferStorage(s->counters, WATER_COUNTERS * sizeof(uint32_t), NULL, GL_DYNAMIC_STORAGE_BIT);
     }
-    vfx_result r = volfx_water_view_begin(ctx, s, targets->view_id, frame->width, frame->height,
+    vfx_result r = volfx_water_view_begin(ctx, s, targets->view_id, targets->width, targets->height,
                                           s->params.method != VFX_WATER_METHOD_TILE);
     if (r == VFX_OK)
-        r = render_view(ctx, s, frame, targets);
+        r = render_view(ctx, s, targets);
     volfx_water_view_end(s, r == VFX_OK);
     return r;
 }

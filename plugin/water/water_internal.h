@@ -155,14 +155,14 @@ void volfx_water_views_destroy(vfx_context *ctx, water_state *s);
 GLuint volfx_water_make_tex(GLenum fmt, uint32_t w, uint32_t h, int levels, const char *label);
 /* Fills and binds the WaterFrame block (binding 4) from this frame's camera, parameters and
  * particle box (s->view_proj already this frame's). */
-void volfx_water_frame_upload(water_state *s, const vfx_frame_view *frame, const volfx_frame_targets *targets);
+void volfx_water_frame_upload(water_state *s, const volfx_frame_targets *targets);
 /* Binds the host depth at texture unit 1 (the passes that clip at it); none: nothing bound. */
-void volfx_water_bind_depth(const vfx_frame_view *frame);
+void volfx_water_bind_depth(const volfx_frame_targets *targets);
 /* One invocation per pixel in 8x8 groups, then a full barrier. */
 void volfx_water_dispatch(const water_state *s);
 /* Method PAPER: billboard init, the sample loop and refinement (seed 000, eqs. 1-6). */
-vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const vfx_frame_view *frame);
+vfx_result volfx_water_paper_march(vfx_context *ctx, water_state *s, const volfx_frame_targets *targets);
 /* The gradient and back-distance billboard passes that shade PAPER's hits and the lab methods'. */
-vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const vfx_frame_view *frame);
+vfx_result volfx_water_surface_passes(vfx_context *ctx, water_state *s, const volfx_frame_targets *targets);
 
 #endif

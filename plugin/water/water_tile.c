@@ -327,7 +327,7 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
  * MODE_FINISH reads the paper method's state and next step and finishes its sample-cap pixels.
  * The two differ only in the define, the pass name and how images 1 and 2 are bound. */
 static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
-                                const vfx_frame_view *frame, bool finish, GLuint img1, GLuint img2, int half, bool temporal, bool reuse)
+                                const volfx_frame_targets *targets, bool finish, GLuint img1, GLuint img2, int half, bool temporal, bool reuse)
 {
     GLuint prog;
     if (finish) /* the paper method's kernel: isotropic */
@@ -349,7 +349,7 @@ static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const vol
     glUseProgram(prog);
     bind_buffers(t, in);
     glBindImageTexture(0, in->dist_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-    glBindTextureUnit(1, frame->depth_texture);
+    glBindTextureUnit(1, targets->host_depth);
     glBindImageTexture(1, img1, 0, GL_FALSE, 0, access, GL_RGBA32F);
     glBindImageTexture(2, img2, 0, GL_FALSE, 0, access, GL_R32F);
     uint32_t w = in->width, h = in->height;
@@ -399,7 +399,7 @@ static bool camera_cut(const volfx_water_tile *t, const volfx_water_tile_input *
 }
 
 vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
-                                  const vfx_frame_view *frame, GLuint grad_tex, GLuint back_tex)
+                                  const volfx_frame_targets *targets, GLuint grad_tex, GLuint back_tex)
 {
     const volfx_water_core *p = in->params;
     bool temporal = !(p->disable & VFX_WATER_NO_TEMPORAL);
@@ -426,7 +426,7 @@ vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const v
                               in->width, in->height, e);
     }
     /* the view's forward direction: -(third row of the view rotation) */
-    const float fwd[3] = {-frame->view[2], -frame->view[6], -frame->view[10]};
+    const float fwd[3] = {-targets->view[2], -targets->view[6], -targets->view[10]};
     /* last frame's hits hold for this one if they are of the previous water frame (a method or
      * ablation switch in between skips a frame), the same image size and the same field; the
      * particles may have moved (every frame in a game): each guess is only a start, proven or
@@ -469,14 +469,14 @@ vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const v
                               "water tile: remarch list for %ux%u pixels: %s",
                               in->width, in->height, e);
     }
-    vfx_result r = tile_dispatch(ctx, t, in, frame, false, grad_tex, back_tex, half ? 1 : 0, temporal, reuse);
+    vfx_result r = tile_dispatch(ctx, t, in, targets, false, grad_tex, back_tex, half ? 1 : 0, temporal, reuse);
     if (r == VFX_OK && half) {
         /* no group, one row, one layer, no pixel */
         const uint32_t args[4] = {0, 1, 1, 0};
         glNamedBufferSubData(t->remarch, 0, sizeof args, args);
-        r = tile_dispatch(ctx, t, in, frame, false, grad_tex, back_tex, 2, temporal, reuse);
+        r = tile_dispatch(ctx, t, in, targets, false, grad_tex, back_tex, 2, temporal, reuse);
         if (r == VFX_OK)
-            r = tile_dispatch(ctx, t, in, frame, false, grad_tex, back_tex, 3, temporal, reuse);
+            r = tile_dispatch(ctx, t, in, targets, false, grad_tex, back_tex, 3, temporal, reuse);
     }
     t->hits_valid = temporal && r == VFX_OK;
     t->hits_frame = in->frame_no;
@@ -491,7 +491,7 @@ vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const v
 }
 
 vfx_result volfx_water_tile_finish(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
-                                   const vfx_frame_view *frame, GLuint st_tex, GLuint next_tex)
+                                   const volfx_frame_targets *targets, GLuint st_tex, GLuint next_tex)
 {
-    return tile_dispatch(ctx, t, in, frame, true, st_tex, next_tex, 0, false, false);
+    return tile_dispatch(ctx, t, in, targets, true, st_tex, next_tex, 0, false, false);
 }

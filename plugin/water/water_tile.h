@@ -32,7 +32,7 @@ typedef struct volfx_water_tile_input {
     GLuint kernels;
     float rbound;                    /* every particle's bounding radius is at most this */
     const float *inv_view_proj;      /* the frame gate's inverse of view_proj (the march's rays) */
-    bool has_depth;                  /* the host's depth texture is bound (frame->depth_texture) */
+    bool has_depth;                  /* the host's depth texture is bound (targets->host_depth) */
 } volfx_water_tile_input;
 
 /* Makes the (empty) tile state; NULL on allocation failure. */
@@ -47,11 +47,11 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
  * each start proven by the field bound), and marches one ray per 2x2 block, then upsamples or
  * marches the other pixels (pass water.tile_upsample). */
 vfx_result volfx_water_tile_march(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
-                                  const vfx_frame_view *frame, GLuint grad_tex, GLuint back_tex);
+                                  const volfx_frame_targets *targets, GLuint grad_tex, GLuint back_tex);
 /* Finishes the paper method's sample-cap pixels (state texture x == 3) from its next sample
  * (next_tex), its last outside sample starting the bracket (pass water.finish); writes
  * in->dist_tex at those pixels only. */
 vfx_result volfx_water_tile_finish(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
-                                   const vfx_frame_view *frame, GLuint st_tex, GLuint next_tex);
+                                   const volfx_frame_targets *targets, GLuint st_tex, GLuint next_tex);
 
 #endif
