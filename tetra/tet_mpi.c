@@ -195,6 +195,89 @@ static tet_result exchange(MPI_Comm comm, MPI_Datatype segt, const tet_seglists 
     return rc;
 }
 
+/* What the stages of one composite share: the communicator, the segment type, this rank, the
+ * ranks, the power of two that swaps, the screen, the count scratch and the bytes sent. */
+typedef struct composite_run {
+    MPI_Comm comm;
+    MPI_Datatype segt;
+    int rank, P, G, partial;
+    size_t npix;
+    uint32_t *counts;
+    uint64_t bytes;
+    char *err;
+    size_t errlen;
+} composite_run;
+
+/* Fold: ranks G..P-1 hand their whole screen to rank - G, so the swap runs on 2^k ranks; *cur
+ * is this rank's lists before and after. */
+static tet_result composite_fold(composite_run *c, tet_seglists *cur)
+{
+    tet_seglists in, merged;
+    memset(&merged, 0, sizeof merged);
+    int rank = c->rank, G = c->G, P = c->P;
+    int dst = rank >= G ? rank - G : -1, src = rank + G < P ? rank + G : -1;
+    tet_result rc = exchange(c->comm, c->segt, cur, dst, 0, c->npix, src, 0, c->npix, c->counts, &in, &c->bytes,
+                             c->err, c->errlen);
+    tet_result r2 = TET_OK;
+    if (rc == TET_OK && src >= 0) {
+        if (tet_seglists_merge(cur, &in, c->partial, &merged) != 0) {
+            tet_errf(c->err, c->errlen, "tet_mpi: out of memory folding rank %d's lists", src);
+            r2 = TET_ERR_OUT_OF_MEMORY;
+        } else {
+            tet_seglists_free(cur);
+            *cur = merged;
+        }
+    }
+    if (rc == TET_OK && dst >= 0)
+        tet_seglists_free(cur);
+    tet_seglists_free(&in);
+    if (rc == TET_OK)
+        rc = agree(c->comm, r2, c->err, c->errlen, "fold");
+    return rc;
+}
+
+/* Binary swap: at stage s the pair (rank, rank ^ 2^s) splits its common range in halves;
+ * the lower rank keeps the first. Lists are merged by depth, so the result is exact
+ * however the two ranks' cells interleave along the rays. Ranks >= G only take part in
+ * the agreements. *cur ends as this rank's lists of pixels [*p0, *p1). */
+static tet_result composite_swap(composite_run *c, tet_seglists *cur, size_t *p0_out, size_t *p1_out)
+{
+    tet_seglists in, keep, merged;
+    memset(&merged, 0, sizeof merged);
+    int rank = c->rank;
+    tet_result rc = TET_OK;
+    size_t p0 = 0, p1 = c->npix;
+    for (int bit = 1; rc == TET_OK && bit < c->G; bit <<= 1) {
+        int partner = rank < c->G ? rank ^ bit : -1;
+        size_t mid = p0 + (p1 - p0) / 2;
+        size_t k0 = (rank & bit) ? mid : p0, k1 = (rank & bit) ? p1 : mid;
+        size_t s0 = (rank & bit) ? p0 : mid, s1 = (rank & bit) ? mid : p1;
+        rc = exchange(c->comm, c->segt, cur, partner, s0, s1, partner, k0, k1, c->counts, &in, &c->bytes,
+                      c->err, c->errlen);
+        if (rc != TET_OK)
+            break;
+        tet_result r2 = TET_OK;
+        if (partner >= 0) {
+            if (slice_lists(cur, k0, k1, &keep) != 0 ||
+                tet_seglists_merge(&keep, &in, c->partial, &merged) != 0) {
+                tet_errf(c->err, c->errlen, "tet_mpi: out of memory in binary swap stage %d", bit);
+                r2 = TET_ERR_OUT_OF_MEMORY;
+            }
+            tet_seglists_free(&keep);
+            tet_seglists_free(&in);
+            tet_seglists_free(cur);
+            *cur = merged;
+            memset(&merged, 0, sizeof merged);
+            p0 = k0;
+            p1 = k1;
+        }
+        rc = agree(c->comm, r2, c->err, c->errlen, "binary swap");
+    }
+    *p0_out = p0;
+    *p1_out = p1;
+    return rc;
+}
+
 tet_result tet_mpi_composite(MPI_Comm comm, int W, int H, tet_seglists *lists, int partial,
                           float *rgba, tet_mpi_stats *st, char *err, size_t errlen)
 {
@@ -206,7 +289,6 @@ tet_result tet_mpi_composite(MPI_Comm comm, int W, int H, tet_seglists *lists, i
     MPI_Type_contiguous(6, MPI_FLOAT, &segt);
     MPI_Type_commit(&segt);
     const size_t npix = (size_t)W * H;
-    uint64_t bytes = 0;
     uint32_t *counts = malloc((npix + 1) * sizeof *counts);
     if (!counts) {
         tet_errf(err, errlen, "tet_mpi: out of memory for %zu pixel counts", npix);
@@ -220,60 +302,15 @@ tet_result tet_mpi_composite(MPI_Comm comm, int W, int H, tet_seglists *lists, i
     int G = 1;
     while (G * 2 <= P)
         G *= 2;
-    tet_seglists cur = *lists, in, keep, merged;
+    composite_run run = {comm, segt, rank, P, G, partial, npix, counts, 0, err, errlen};
+    tet_seglists cur = *lists;
     memset(lists, 0, sizeof *lists);
-    memset(&merged, 0, sizeof merged);
-    /* Fold: ranks G..P-1 hand their whole screen to rank - G, so the swap runs on 2^k ranks. */
-    if (rc == TET_OK && P > G) {
-        int dst = rank >= G ? rank - G : -1, src = rank + G < P ? rank + G : -1;
-        rc = exchange(comm, segt, &cur, dst, 0, npix, src, 0, npix, counts, &in, &bytes, err, errlen);
-        tet_result r2 = TET_OK;
-        if (rc == TET_OK && src >= 0) {
-            if (tet_seglists_merge(&cur, &in, partial, &merged) != 0) {
-                tet_errf(err, errlen, "tet_mpi: out of memory folding rank %d's lists", src);
-                r2 = TET_ERR_OUT_OF_MEMORY;
-            } else {
-                tet_seglists_free(&cur);
-                cur = merged;
-            }
-        }
-        if (rc == TET_OK && dst >= 0)
-            tet_seglists_free(&cur);
-        tet_seglists_free(&in);
-        if (rc == TET_OK)
-            rc = agree(comm, r2, err, errlen, "fold");
-    }
-    /* Binary swap: at stage s the pair (rank, rank ^ 2^s) splits its common range in halves;
-     * the lower rank keeps the first. Lists are merged by depth, so the result is exact
-     * however the two ranks' cells interleave along the rays. Ranks >= G only take part in
-     * the agreements. */
+    if (rc == TET_OK && P > G)
+        rc = composite_fold(&run, &cur);
     size_t p0 = 0, p1 = npix;
-    for (int bit = 1; rc == TET_OK && bit < G; bit <<= 1) {
-        int partner = rank < G ? rank ^ bit : -1;
-        size_t mid = p0 + (p1 - p0) / 2;
-        size_t k0 = (rank & bit) ? mid : p0, k1 = (rank & bit) ? p1 : mid;
-        size_t s0 = (rank & bit) ? p0 : mid, s1 = (rank & bit) ? mid : p1;
-        rc = exchange(comm, segt, &cur, partner, s0, s1, partner, k0, k1, counts, &in, &bytes,
-                      err, errlen);
-        if (rc != TET_OK)
-            break;
-        tet_result r2 = TET_OK;
-        if (partner >= 0) {
-            if (slice_lists(&cur, k0, k1, &keep) != 0 ||
-                tet_seglists_merge(&keep, &in, partial, &merged) != 0) {
-                tet_errf(err, errlen, "tet_mpi: out of memory in binary swap stage %d", bit);
-                r2 = TET_ERR_OUT_OF_MEMORY;
-            }
-            tet_seglists_free(&keep);
-            tet_seglists_free(&in);
-            tet_seglists_free(&cur);
-            cur = merged;
-            memset(&merged, 0, sizeof merged);
-            p0 = k0;
-            p1 = k1;
-        }
-        rc = agree(comm, r2, err, errlen, "binary swap");
-    }
+    if (rc == TET_OK)
+        rc = composite_swap(&run, &cur, &p0, &p1);
+    uint64_t bytes = run.bytes;
     double t1 = tet_now_ms();
     /* Final composition of this rank's part, then gather to rank 0. */
     size_t mine = rank < G ? p1 - p0 : 0;

@@ -785,7 +785,10 @@ static vfx_result diffuse_frame(vfx_context *ctx, water_state *s, const volfx_fr
     return volfx_water_diffuse_splat(ctx, s->diffuse, &dd, targets, layer);
 }
 
-static vfx_result render_view(vfx_context *ctx, water_state *s, volfx_frame_targets *targets)
+/* The frame's set-up before any pass: one position buffer unless the method draws several, the
+ * view-projection kept for the next frame's reprojection, the frame block, the cleared counters
+ * and the frame's stats. */
+static vfx_result view_setup(vfx_context *ctx, water_state *s, volfx_frame_targets *targets)
 {
     const volfx_water_core *p = &s->params;
     targets->water_dist = ctx->water_dist_tex;
@@ -811,6 +814,14 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, volfx_frame_targ
     volfx_stat_set(ctx, "water.gpu_box_lag", s->gpu_late);
     volfx_stat_set(ctx, "water.gpu_box_outside", s->gpu_outside);
     s->last_method_drawn = UINT32_MAX; /* until this frame completes: nothing for debug_pixel_class */
+    return VFX_OK;
+}
+
+/* The surface: the chosen method's march into the distance texture, then (all but TILE, which
+ * writes them from its own lists) the gradient and back-distance passes the shading reads. */
+static vfx_result march_surface(vfx_context *ctx, water_state *s, volfx_frame_targets *targets)
+{
+    const volfx_water_core *p = &s->params;
     vfx_result r;
     /* the seed's method and the baselines draw the isotropic kernel of radius h only */
     if (p->method != VFX_WATER_METHOD_TILE &&
@@ -840,20 +851,15 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, volfx_frame_targ
     if (!(p->disable & VFX_WATER_NO_SHADING) && p->method != VFX_WATER_METHOD_TILE &&
         (r = volfx_water_surface_passes(ctx, s, targets)) != VFX_OK)
         return r;
+    return VFX_OK;
+}
 
-    GLuint layer = 0;
-    if ((r = diffuse_frame(ctx, s, targets, &layer)))
-        return r;
-    /* the beams' light split at this surface (their prepare step) before the shading reads it */
-    if ((r = volfx_effects_prepare(ctx, targets)))
-        return r;
-    /* the beams' light and the light loop are compiled in only for a frame that has them (the
-     * lights are the beams': none when the beams are not drawn) */
-    bool beams = targets->beams_light && targets->beams_behind;
-    uint32_t nlights = 0;
-    if (beams && (s->look & WATER_LOOK_FX_LIGHTS) && !(p->disable & VFX_WATER_NO_SHADING) &&
-        (r = volfx_water_lights_frame(ctx, &s->effect_lights, &nlights)))
-        return r;
+/* The shading pass (water.shade) over the frame gate's framebuffer: refraction, reflection, the
+ * diffuse layer and foam, the beams' light split at the surface and their lights when `nlights`. */
+static vfx_result shade_pass(vfx_context *ctx, water_state *s, const volfx_frame_targets *targets, GLuint layer,
+                             bool beams, uint32_t nlights)
+{
+    const volfx_water_core *p = &s->params;
     GLuint shade = nlights ? volfx_gpu_program(ctx, "common/fullscreen.vert", "water/shade.frag",
                                                "#define WATER_BEAMS 1\n#define WATER_EFFECT_LIGHTS 1\n"
                                                "#define WATER_MAX_LIGHTS 32\n")
@@ -911,6 +917,32 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, volfx_frame_targ
     /* the SSR hits counted by the fragments reach the counter copy */
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     volfx_pass_end(ctx);
+    return VFX_OK;
+}
+
+/* One view's frame: set-up, the surface, the diffuse particles, the beams' prepare step, the
+ * shading, the spray over it, then the counters. */
+static vfx_result render_view(vfx_context *ctx, water_state *s, volfx_frame_targets *targets)
+{
+    const volfx_water_core *p = &s->params;
+    vfx_result r = view_setup(ctx, s, targets);
+    if (r || (r = march_surface(ctx, s, targets)))
+        return r;
+    GLuint layer = 0;
+    if ((r = diffuse_frame(ctx, s, targets, &layer)))
+        return r;
+    /* the beams' light split at this surface (their prepare step) before the shading reads it */
+    if ((r = volfx_effects_prepare(ctx, targets)))
+        return r;
+    /* the beams' light and the light loop are compiled in only for a frame that has them (the
+     * lights are the beams': none when the beams are not drawn) */
+    bool beams = targets->beams_light && targets->beams_behind;
+    uint32_t nlights = 0;
+    if (beams && (s->look & WATER_LOOK_FX_LIGHTS) && !(p->disable & VFX_WATER_NO_SHADING) &&
+        (r = volfx_water_lights_frame(ctx, &s->effect_lights, &nlights)))
+        return r;
+    if ((r = shade_pass(ctx, s, targets, layer, beams, nlights)))
+        return r;
     if (layer) {
         volfx_water_diffuse_draw dd = {p->h, p->absorption, ctx->water_dist_tex, s->vao, WATER_SHUTTER_S, nlights > 0};
         if (nlights)

@@ -195,11 +195,11 @@ static void bind_buffers(const volfx_water_tile *t, const volfx_water_tile_input
     volfx_ubo_bind(&t->ubo, TILE_UBO_BINDING);
 }
 
-vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in)
+/* The tile size (the smallest power of two from 2^TILE_SHIFT_MIN whose tiles number at most
+ * the cap) and the depth slabs a tile splits into: *tiles_out screen tiles. */
+static vfx_result tile_grid(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
+                            uint32_t max_tiles, uint64_t *tiles_out)
 {
-    uint32_t max_tiles = TILE_MAX_TILES;
-    if (ctx->debug.water_max_tiles && ctx->debug.water_max_tiles < max_tiles)
-        max_tiles = ctx->debug.water_max_tiles;
     uint64_t tiles = 0;
     for (t->shift = TILE_SHIFT_MIN; t->shift <= TILE_SHIFT_MAX; ++t->shift) {
         uint32_t px = 1u << t->shift;
@@ -215,13 +215,18 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
                           in->width, in->height, (unsigned long long)tiles, 1u << TILE_SHIFT_MAX, 1u << TILE_SHIFT_MAX,
                           max_tiles);
     volfx_stat_set(ctx, "water.tile_pixels", 1u << t->shift);
-    /* entries of 16 bytes in one storage block */
-    uint64_t max_entries = t->ssbo_max / 16u < TILE_MAX_ENTRIES ? t->ssbo_max / 16u : TILE_MAX_ENTRIES;
     t->slabs = TILE_SLABS;
     while (t->slabs > 1 && tiles * t->slabs > max_tiles)
         t->slabs /= 2;
-    /* the particles' distances from the eye: from the box (0 when the eye is inside) to its
-     * farthest corner */
+    *tiles_out = tiles;
+    return VFX_OK;
+}
+
+/* The slabs' depth range: the particles' distances from the eye, from the box (0 when the eye
+ * is inside) to its farthest corner, widened for per-particle kernels; *dmin_out the nearest and
+ * *hx_out the largest kernel radius (h, or the kernels' bound). */
+static void tile_depth_range(volfx_water_tile *t, const volfx_water_tile_input *in, double *dmin_out, double *hx_out)
+{
     double dmin2 = 0, dmax2 = 0;
     for (int k = 0; k < 3; ++k) {
         double e = in->eye[k], a = in->lo[k], b = in->hi[k];
@@ -238,6 +243,17 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
     }
     t->d0 = (float)dmin;
     t->ds = (float)(span > 1e-30 ? span / t->slabs * (1.0 + 1e-6) : 1.0);
+    *dmin_out = dmin;
+    *hx_out = hx;
+}
+
+/* The lists' buffers, grown to this frame's tiles and slabs and to the entries it may need
+ * (dmin, hx from tile_depth_range); VFX_ERR_OUT_OF_MEMORY when GL cannot make them. */
+static vfx_result tile_buffers(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in,
+                               uint64_t tiles, double dmin, double hx)
+{
+    /* entries of 16 bytes in one storage block */
+    uint64_t max_entries = t->ssbo_max / 16u < TILE_MAX_ENTRIES ? t->ssbo_max / 16u : TILE_MAX_ENTRIES;
     uint32_t nscan = (uint32_t)(tiles * t->slabs) + 1;
     uint32_t need = (nscan + 1023u) & ~1023u;
     if (need > t->tile_cap) {
@@ -284,6 +300,24 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
         return volfx_fail(ctx, VFX_ERR_OUT_OF_MEMORY, VFX_LOG_ID_GPU_OUT_OF_MEMORY,
                           "water tile: buffers for %llu tiles and %u entries: %s",
                           (unsigned long long)tiles, t->entry_cap, e);
+    return VFX_OK;
+}
+
+vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const volfx_water_tile_input *in)
+{
+    uint32_t max_tiles = TILE_MAX_TILES;
+    if (ctx->debug.water_max_tiles && ctx->debug.water_max_tiles < max_tiles)
+        max_tiles = ctx->debug.water_max_tiles;
+    uint64_t tiles = 0;
+    double dmin, hx;
+    vfx_result r = tile_grid(ctx, t, in, max_tiles, &tiles);
+    if (r)
+        return r;
+    tile_depth_range(t, in, &dmin, &hx);
+    if ((r = tile_buffers(ctx, t, in, tiles, dmin, hx)))
+        return r;
+    uint32_t nscan = (uint32_t)(tiles * t->slabs) + 1;
+    uint32_t need = (nscan + 1023u) & ~1023u;
     GLuint count, scatter;
     if (in->kernels) {
         count = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_COUNT\n#define ANISO\n");
@@ -305,7 +339,7 @@ vfx_result volfx_water_tile_bin(vfx_context *ctx, volfx_water_tile *t, const vol
     if (groups)
         glDispatchCompute(gx, gy, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    vfx_result r = volfx_gpu_scan(ctx, t->count, t->start, nscan, "water tile bins");
+    r = volfx_gpu_scan(ctx, t->count, t->start, nscan, "water tile bins");
     if (r) {
         volfx_pass_end(ctx);
         return r;

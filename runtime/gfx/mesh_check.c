@@ -229,6 +229,88 @@ static vfx_result ply_ascii_text(const unsigned char *d, size_t size, size_t pos
     return VFX_OK;
 }
 
+/* One "property" line of the header (its words w[0..nw-1], line ln) into element e (NULL before
+ * any element): its size, or a list's count and item sizes; props_end is the line that ended
+ * the element's properties for Assimp (0 while none has). */
+static vfx_result ply_property(ply_element *e, char w[5][64], int nw, unsigned ln, unsigned props_end,
+                               const char *name, char *err, size_t errlen)
+{
+    if (!e)
+        return ply_fail(name, err, errlen, "%s", ln, "a property before any element");
+    if (props_end) {
+        char why[96];
+        snprintf(why, sizeof why, "a property after line %u, which is not one (Assimp 5.2 ends the", props_end);
+        return ply_fail(name, err, errlen, "%s element's properties there and would drop this one; move "
+                        "that line above the element)", ln, why);
+    }
+    unsigned sz;
+    if (e->props == PLY_MAX_PROPS)
+        return ply_fail(name, err, errlen, "more than %s properties in one element", ln, "32");
+    if (strcmp(w[1], "list") == 0) {
+        /* a list takes at least its count: it may hold no item */
+        unsigned isz = ply_type_size(w[3]);
+        if (nw != 5 || !(sz = ply_type_size(w[2])) || !isz)
+            return ply_fail(name, err, errlen, "%s", ln, "a list property needs two types and a name");
+        if (strstr(w[2], "float") || strcmp(w[2], "double") == 0)
+            return ply_fail(name, err, errlen, "a list count of type %s", ln, w[2]);
+        e->list[e->props] = (unsigned char)sz;
+        e->signed_count[e->props] = w[2][0] != 'u';
+        e->size[e->props] = (unsigned char)isz;
+    } else if (nw != 3 || !(sz = ply_type_size(w[1]))) {
+        return ply_fail(name, err, errlen, "unknown property type \"%s\"", ln, w[1]);
+    } else {
+        e->size[e->props] = (unsigned char)sz;
+    }
+    e->props++;
+    e->bytes += sz;
+    return VFX_OK;
+}
+
+/* The header's element counts against the caps, the properties they need and the body's
+ * `body` bytes (binary: fixed sizes; ASCII: a character and a separator a value). */
+static vfx_result ply_counts(const ply_element *el, unsigned nel, int binary, size_t body, const char *name,
+                             char *err, size_t errlen)
+{
+    /* the least body the header's counts need: binary adds up fixed sizes; ASCII needs one
+     * character and one separator a value (the last separator may be missing) */
+    unsigned long long need = 0;
+    for (unsigned i = 0; i < nel; ++i) {
+        const ply_element *e = &el[i];
+        if (e->count > 4ull * RT_MESH_MAX_IMPORT_VERTICES
+            || (strcmp(e->name, "vertex") == 0 && e->count > RT_MESH_MAX_IMPORT_VERTICES)) {
+            snprintf(err, errlen, "%s: PLY header line %u: element %s claims %llu, above the cap of %u", name,
+                     e->line, e->name, e->count,
+                     strcmp(e->name, "vertex") == 0 ? RT_MESH_MAX_IMPORT_VERTICES : 4u * RT_MESH_MAX_IMPORT_VERTICES);
+            return VFX_ERR_FORMAT;
+        }
+        if (e->count > 0 && e->props == 0) {
+            snprintf(err, errlen, "%s: PLY header line %u: element %s claims %llu but has no property",
+                     name, e->line, e->name, e->count);
+            return VFX_ERR_FORMAT;
+        }
+        /* an element Assimp does not know is empty to it, so the data of the next one it knows
+         * would be read from this one's bytes (a uint list count of 4e9 from a float: 32 GB asked,
+         * found by fuzz_mesh_ply in CI) */
+        for (unsigned j = i + 1; e->count > 0 && !ply_assimp_parses(e->name) && j < nel; ++j)
+            if (ply_assimp_parses(el[j].name)) {
+                snprintf(err, errlen, "%s: PLY header line %u: element %s (%llu) comes before element %s, and "
+                         "Assimp 5.2 reads an element it does not know as empty: it would read %s from %s's "
+                         "data; put %s after the mesh's elements or leave it out", name, e->line, e->name,
+                         e->count, el[j].name, el[j].name, e->name, e->name);
+                return VFX_ERR_FORMAT;
+            }
+        need += e->count * (binary ? e->bytes : 2ull * e->props); /* <= 2^24 * 16 * 8 * ...: no overflow */
+        if (need > body + (binary ? 0 : 1)) {
+            snprintf(err, errlen,
+                     "%s: PLY header line %u: element %s claims %llu, which needs at least %llu bytes "
+                     "of %s data; the file holds %zu after the header (truncated or lying)",
+                     name, e->line, e->name, e->count, need - (binary ? 0 : 1), binary ? "binary" : "ASCII", body);
+            return VFX_ERR_FORMAT;
+        }
+    }
+    return VFX_OK;
+}
+
 static vfx_result check_ply(const unsigned char *d, size_t size, const char *name, char *err,
                             size_t errlen)
 {
@@ -293,35 +375,9 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
             e->line = ln;
             props_end = 0;
         } else if (strcmp(w[0], "property") == 0) {
-            if (nel == 0)
-                return ply_fail(name, err, errlen, "%s", ln, "a property before any element");
-            if (props_end) {
-                char why[96];
-                snprintf(why, sizeof why, "a property after line %u, which is not one (Assimp 5.2 ends the", props_end);
-                return ply_fail(name, err, errlen, "%s element's properties there and would drop this one; move "
-                                "that line above the element)", ln, why);
-            }
-            ply_element *e = &el[nel - 1];
-            unsigned sz;
-            if (e->props == PLY_MAX_PROPS)
-                return ply_fail(name, err, errlen, "more than %s properties in one element", ln, "32");
-            if (strcmp(w[1], "list") == 0) {
-                /* a list takes at least its count: it may hold no item */
-                unsigned isz = ply_type_size(w[3]);
-                if (nw != 5 || !(sz = ply_type_size(w[2])) || !isz)
-                    return ply_fail(name, err, errlen, "%s", ln, "a list property needs two types and a name");
-                if (strstr(w[2], "float") || strcmp(w[2], "double") == 0)
-                    return ply_fail(name, err, errlen, "a list count of type %s", ln, w[2]);
-                e->list[e->props] = (unsigned char)sz;
-                e->signed_count[e->props] = w[2][0] != 'u';
-                e->size[e->props] = (unsigned char)isz;
-            } else if (nw != 3 || !(sz = ply_type_size(w[1]))) {
-                return ply_fail(name, err, errlen, "unknown property type \"%s\"", ln, w[1]);
-            } else {
-                e->size[e->props] = (unsigned char)sz;
-            }
-            e->props++;
-            e->bytes += sz;
+            vfx_result r = ply_property(nel ? &el[nel - 1] : NULL, w, nw, ln, props_end, name, err, errlen);
+            if (r)
+                return r;
         } else if (strcmp(w[0], "end_header") == 0) {
             ended = 1;
         } /* other lines are skipped, as Assimp does (Blender wrote "Created by ..." there) */
@@ -341,45 +397,10 @@ static vfx_result check_ply(const unsigned char *d, size_t size, const char *nam
         snprintf(err, errlen, "%s: PLY header %s", name, !ended ? "has no end_header (truncated?)" : "has no format line");
         return VFX_ERR_FORMAT;
     }
-    size_t body = size - pos;
-    /* the least body the header's counts need: binary adds up fixed sizes; ASCII needs one
-     * character and one separator a value (the last separator may be missing) */
-    unsigned long long need = 0;
-    for (unsigned i = 0; i < nel; ++i) {
-        const ply_element *e = &el[i];
-        if (e->count > 4ull * RT_MESH_MAX_IMPORT_VERTICES
-            || (strcmp(e->name, "vertex") == 0 && e->count > RT_MESH_MAX_IMPORT_VERTICES)) {
-            snprintf(err, errlen, "%s: PLY header line %u: element %s claims %llu, above the cap of %u", name,
-                     e->line, e->name, e->count,
-                     strcmp(e->name, "vertex") == 0 ? RT_MESH_MAX_IMPORT_VERTICES : 4u * RT_MESH_MAX_IMPORT_VERTICES);
-            return VFX_ERR_FORMAT;
-        }
-        if (e->count > 0 && e->props == 0) {
-            snprintf(err, errlen, "%s: PLY header line %u: element %s claims %llu but has no property",
-                     name, e->line, e->name, e->count);
-            return VFX_ERR_FORMAT;
-        }
-        /* an element Assimp does not know is empty to it, so the data of the next one it knows
-         * would be read from this one's bytes (a uint list count of 4e9 from a float: 32 GB asked,
-         * found by fuzz_mesh_ply in CI) */
-        for (unsigned j = i + 1; e->count > 0 && !ply_assimp_parses(e->name) && j < nel; ++j)
-            if (ply_assimp_parses(el[j].name)) {
-                snprintf(err, errlen, "%s: PLY header line %u: element %s (%llu) comes before element %s, and "
-                         "Assimp 5.2 reads an element it does not know as empty: it would read %s from %s's "
-                         "data; put %s after the mesh's elements or leave it out", name, e->line, e->name,
-                         e->count, el[j].name, el[j].name, e->name, e->name);
-                return VFX_ERR_FORMAT;
-            }
-        need += e->count * (binary ? e->bytes : 2ull * e->props); /* <= 2^24 * 16 * 8 * ...: no overflow */
-        if (need > body + (binary ? 0 : 1)) {
-            snprintf(err, errlen,
-                     "%s: PLY header line %u: element %s claims %llu, which needs at least %llu bytes "
-                     "of %s data; the file holds %zu after the header (truncated or lying)",
-                     name, e->line, e->name, e->count, need - (binary ? 0 : 1), binary ? "binary" : "ASCII", body);
-            return VFX_ERR_FORMAT;
-        }
-    }
-    vfx_result r = binary ? VFX_OK : ply_ascii_text(d, size, pos, name, err, errlen);
+    vfx_result r = ply_counts(el, nel, binary, size - pos, name, err, errlen);
+    if (r)
+        return r;
+    r = binary ? VFX_OK : ply_ascii_text(d, size, pos, name, err, errlen);
     return r ? r : ply_walk_body(d, size, pos, binary, el, nel, name, err, errlen);
 }
 

@@ -386,6 +386,106 @@ void rt_sph_coincident_dir(uint32_t a, uint32_t b, float out[3])
     out[0] = sg * sz * cosf(th), out[1] = sg * sz * sinf(th), out[2] = sg * cz;
 }
 
+/* What the pair sums of one chunk read: the particles' columns and the kernel's constants. */
+typedef struct sph_force_in {
+    const float *X, *Y, *Z, *VX, *VY, *VZ, *R, *P;
+    float H, h, eps2, hh, visc;
+} sph_force_in;
+
+/* The pair sums of particle i over its nn neighbours L (pressure with Monaghan's viscosity, and
+ * the continuity term), before the constant -m ks: out = sum coef w d (3) and sum v.d w. */
+static inline void sph_force_pairs(const rt_sph *s, const sph_force_in *f, uint32_t i, const uint32_t *L,
+                                   uint32_t nn, float out[4])
+{
+    const float *X = f->X, *Y = f->Y, *Z = f->Z, *VX = f->VX, *VY = f->VY, *VZ = f->VZ;
+    const float *R = f->R, *P = f->P;
+    const float H = f->H, h = f->h, eps2 = f->eps2, hh = f->hh, visc = f->visc;
+    const float px = X[i], py = Y[i], pz = Z[i], vxi = VX[i], vyi = VY[i], vzi = VZ[i];
+    const float pri = P[i], rhoi = R[i];
+    /* Per pair, with d = x_i - x_j, r = |d|: grad_i W = -ks (H - r)^2 d / r, so the
+     * constant -ks and the mass leave the loop (applied to the sums after it) and the
+     * unit vector is never formed; v.u r = v.d in the viscosity term. Fewer live values
+     * per pair: the loop had spilled to the stack on every iteration. */
+    float sx = 0.f, sy = 0.f, sz = 0.f, sd = 0.f;
+    uint32_t coincident = 0, k = 0;
+#if SPH_SSE
+    /* four pairs at a time: the same operations lane by lane (IEEE, so each pair's
+     * terms are the scalar ones), summed per lane and then across */
+    {
+        const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), vpz = _mm_set1_ps(pz);
+        const __m128 vvx = _mm_set1_ps(vxi), vvy = _mm_set1_ps(vyi), vvz = _mm_set1_ps(vzi);
+        const __m128 veps = _mm_set1_ps(eps2), vH = _mm_set1_ps(H), vh = _mm_set1_ps(h);
+        const __m128 vhh = _mm_set1_ps(hh), vrho = _mm_set1_ps(rhoi), vpri = _mm_set1_ps(pri);
+        const __m128 vvisc = _mm_set1_ps(visc), zero = _mm_setzero_ps();
+        __m128 ax4 = zero, ay4 = zero, az4 = zero, ad4 = zero;
+        for (; k + 4 <= nn; k += 4) {
+            uint32_t j0 = L[k], j1 = L[k + 1], j2 = L[k + 2], j3 = L[k + 3];
+#define SPH_G4(A) _mm_setr_ps(A[j0], A[j1], A[j2], A[j3])
+            __m128 dx = vpx - SPH_G4(X), dy = vpy - SPH_G4(Y), dz = vpz - SPH_G4(Z);
+            __m128 dvx = vvx - SPH_G4(VX), dvy = vvy - SPH_G4(VY), dvz = vvz - SPH_G4(VZ);
+            __m128 rj = SPH_G4(R), pj = SPH_G4(P);
+#undef SPH_G4
+            __m128 r2 = dx * dx + dy * dy + dz * dz;
+            __m128 valid = _mm_cmpgt_ps(r2, veps);
+            /* lanes with r^2 <= eps2, counted by a nibble table: __builtin_popcount
+             * is a libgcc call without -mpopcnt (4% of all instructions) */
+            coincident += (0x4332322132212110ull >> (4 * (~_mm_movemask_ps(valid) & 15))) & 15u;
+            __m128 rl = _mm_sqrt_ps(r2), hr = vH - rl;
+            /* one division for w = (H - r)^2 / r and the viscosity's denominator (the
+             * divider is as busy as everything else in this loop); r = 0 lanes get
+             * inv = 0, so w = mu = 0 there, not inf or NaN */
+            __m128 den = (r2 + vhh) * (vrho + rj);
+            __m128 inv = _mm_and_ps(valid, _mm_set1_ps(1.f) / (rl * den));
+            __m128 w = hr * hr * den * inv;
+            __m128 vdotd = dvx * dx + dvy * dy + dvz * dz;
+            __m128 vneg = _mm_min_ps(vdotd, zero);
+            __m128 mu = vh * vneg * rl * inv;
+            __m128 coef = (vpri + pj - vvisc * mu) * w;
+            ax4 += coef * dx, ay4 += coef * dy, az4 += coef * dz;
+            ad4 += vdotd * w;
+        }
+        sx = sph_hsum(ax4), sy = sph_hsum(ay4), sz = sph_hsum(az4), sd = sph_hsum(ad4);
+    }
+#endif
+    for (; k < nn; ++k) {
+        uint32_t j = L[k];
+        float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
+        float r2 = dx * dx + dy * dy + dz * dz;
+        float dvx = vxi - VX[j], dvy = vyi - VY[j], dvz = vzi - VZ[j];
+        if (r2 > eps2) {
+            float rl = sqrtf(r2);
+            float hr = H - rl;
+            float w = hr * hr / rl; /* |grad W| / (ks r) */
+            float vdotd = dvx * dx + dvy * dy + dvz * dz;
+            /* Monaghan (1992) artificial viscosity, mu = h v.r/(r^2 + 0.01 h^2),
+             * approaching pairs only; branch-free (the sign is a coin flip) */
+            float vneg = vdotd < 0.f ? vdotd : 0.f;
+            float mu = h * vneg / ((r2 + hh) * (rhoi + R[j]));
+            float coef = (pri + P[j] - visc * mu) * w;
+            sx += coef * dx, sy += coef * dy, sz += coef * dz;
+            sd += vdotd * w;
+        } else {
+            coincident++;
+        }
+    }
+    /* exactly coincident pairs (r = 0): the deterministic direction u, (H - r)^2 = H^2.
+     * In a loop of their own: a call inside the main loop made the compiler keep its
+     * array pointers on the stack */
+    for (uint32_t k = 0; coincident && k < nn; ++k) {
+        uint32_t j = L[k];
+        float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
+        if (!(dx * dx + dy * dy + dz * dz <= eps2))
+            continue;
+        float u[3];
+        rt_sph_coincident_dir(s->id[i], s->id[j], u);
+        float coef = (pri + P[j]) * H * H;
+        sx += coef * u[0], sy += coef * u[1], sz += coef * u[2];
+        sd += ((vxi - VX[j]) * u[0] + (vyi - VY[j]) * u[1] + (vzi - VZ[j]) * u[2]) * H * H;
+        coincident--;
+    }
+    out[0] = sx, out[1] = sy, out[2] = sz, out[3] = sd;
+}
+
 void rt_sph_force_chunk(rt_sph *s, uint32_t chunk)
 {
     uint32_t b, e;
@@ -401,98 +501,15 @@ void rt_sph_force_chunk(rt_sph *s, uint32_t chunk)
      * cache line and run on different threads (false sharing on every particle otherwise) */
     sph_chunk_out acc = s->out[chunk], *o = &acc;
     sph_wall_hit walls[SPH_MAX_WALLS];
+    const sph_force_in fin = {X, Y, Z, VX, VY, VZ, R, P, H, h, eps2, hh, visc};
     for (uint32_t i = b; i < e; ++i) {
         float px = X[i], py = Y[i], pz = Z[i], vxi = VX[i], vyi = VY[i], vzi = VZ[i];
         float pri = P[i], rhoi = R[i];
-        float ax = 0.f, ay = 0.f, az = 0.f, dr = 0.f;
         const uint32_t *L = s->cnb[chunk] + s->nb_start[i];
-        const uint32_t nn = s->nb_count[i];
-        {
-            /* Per pair, with d = x_i - x_j, r = |d|: grad_i W = -ks (H - r)^2 d / r, so the
-             * constant -ks and the mass leave the loop (applied to the sums after it) and the
-             * unit vector is never formed; v.u r = v.d in the viscosity term. Fewer live values
-             * per pair: the loop had spilled to the stack on every iteration. */
-            float sx = 0.f, sy = 0.f, sz = 0.f, sd = 0.f;
-            uint32_t coincident = 0, k = 0;
-#if SPH_SSE
-            /* four pairs at a time: the same operations lane by lane (IEEE, so each pair's
-             * terms are the scalar ones), summed per lane and then across */
-            {
-                const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), vpz = _mm_set1_ps(pz);
-                const __m128 vvx = _mm_set1_ps(vxi), vvy = _mm_set1_ps(vyi), vvz = _mm_set1_ps(vzi);
-                const __m128 veps = _mm_set1_ps(eps2), vH = _mm_set1_ps(H), vh = _mm_set1_ps(h);
-                const __m128 vhh = _mm_set1_ps(hh), vrho = _mm_set1_ps(rhoi), vpri = _mm_set1_ps(pri);
-                const __m128 vvisc = _mm_set1_ps(visc), zero = _mm_setzero_ps();
-                __m128 ax4 = zero, ay4 = zero, az4 = zero, ad4 = zero;
-                for (; k + 4 <= nn; k += 4) {
-                    uint32_t j0 = L[k], j1 = L[k + 1], j2 = L[k + 2], j3 = L[k + 3];
-#define SPH_G4(A) _mm_setr_ps(A[j0], A[j1], A[j2], A[j3])
-                    __m128 dx = vpx - SPH_G4(X), dy = vpy - SPH_G4(Y), dz = vpz - SPH_G4(Z);
-                    __m128 dvx = vvx - SPH_G4(VX), dvy = vvy - SPH_G4(VY), dvz = vvz - SPH_G4(VZ);
-                    __m128 rj = SPH_G4(R), pj = SPH_G4(P);
-#undef SPH_G4
-                    __m128 r2 = dx * dx + dy * dy + dz * dz;
-                    __m128 valid = _mm_cmpgt_ps(r2, veps);
-                    /* lanes with r^2 <= eps2, counted by a nibble table: __builtin_popcount
-                     * is a libgcc call without -mpopcnt (4% of all instructions) */
-                    coincident += (0x4332322132212110ull >> (4 * (~_mm_movemask_ps(valid) & 15))) & 15u;
-                    __m128 rl = _mm_sqrt_ps(r2), hr = vH - rl;
-                    /* one division for w = (H - r)^2 / r and the viscosity's denominator (the
-                     * divider is as busy as everything else in this loop); r = 0 lanes get
-                     * inv = 0, so w = mu = 0 there, not inf or NaN */
-                    __m128 den = (r2 + vhh) * (vrho + rj);
-                    __m128 inv = _mm_and_ps(valid, _mm_set1_ps(1.f) / (rl * den));
-                    __m128 w = hr * hr * den * inv;
-                    __m128 vdotd = dvx * dx + dvy * dy + dvz * dz;
-                    __m128 vneg = _mm_min_ps(vdotd, zero);
-                    __m128 mu = vh * vneg * rl * inv;
-                    __m128 coef = (vpri + pj - vvisc * mu) * w;
-                    ax4 += coef * dx, ay4 += coef * dy, az4 += coef * dz;
-                    ad4 += vdotd * w;
-                }
-                sx = sph_hsum(ax4), sy = sph_hsum(ay4), sz = sph_hsum(az4), sd = sph_hsum(ad4);
-            }
-#endif
-            for (; k < nn; ++k) {
-                uint32_t j = L[k];
-                float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
-                float r2 = dx * dx + dy * dy + dz * dz;
-                float dvx = vxi - VX[j], dvy = vyi - VY[j], dvz = vzi - VZ[j];
-                if (r2 > eps2) {
-                    float rl = sqrtf(r2);
-                    float hr = H - rl;
-                    float w = hr * hr / rl; /* |grad W| / (ks r) */
-                    float vdotd = dvx * dx + dvy * dy + dvz * dz;
-                    /* Monaghan (1992) artificial viscosity, mu = h v.r/(r^2 + 0.01 h^2),
-                     * approaching pairs only; branch-free (the sign is a coin flip) */
-                    float vneg = vdotd < 0.f ? vdotd : 0.f;
-                    float mu = h * vneg / ((r2 + hh) * (rhoi + R[j]));
-                    float coef = (pri + P[j] - visc * mu) * w;
-                    sx += coef * dx, sy += coef * dy, sz += coef * dz;
-                    sd += vdotd * w;
-                } else {
-                    coincident++;
-                }
-            }
-            /* exactly coincident pairs (r = 0): the deterministic direction u, (H - r)^2 = H^2.
-             * In a loop of their own: a call inside the main loop made the compiler keep its
-             * array pointers on the stack */
-            for (uint32_t k = 0; coincident && k < nn; ++k) {
-                uint32_t j = L[k];
-                float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
-                if (!(dx * dx + dy * dy + dz * dz <= eps2))
-                    continue;
-                float u[3];
-                rt_sph_coincident_dir(s->id[i], s->id[j], u);
-                float coef = (pri + P[j]) * H * H;
-                sx += coef * u[0], sy += coef * u[1], sz += coef * u[2];
-                sd += ((vxi - VX[j]) * u[0] + (vyi - VY[j]) * u[1] + (vzi - VZ[j]) * u[2]) * H * H;
-                coincident--;
-            }
-            /* a_i = -sum m coef grad W = m ks sum coef w d; d rho_i/dt = sum m v.grad W */
-            ax = mks * sx, ay = mks * sy, az = mks * sz;
-            dr = -mks * sd;
-        }
+        float sum[4];
+        sph_force_pairs(s, &fin, i, L, s->nb_count[i], sum);
+        /* a_i = -sum m coef grad W = m ks sum coef w d; d rho_i/dt = sum m v.grad W */
+        float ax = mks * sum[0], ay = mks * sum[1], az = mks * sum[2], dr = -mks * sum[3];
         /* the walls (sph_wall.c): mirror image of the missing fluid, division by the fluid's
          * kernel share, wall-law friction */
         {

@@ -8,7 +8,8 @@
 
 static float def(float v, float d) { return v != 0.f ? v : d; }
 
-static vfx_result fill_params(rt_sph_desc *p, char *err, size_t err_len)
+/* The defaults of every zero field (and the two enum checks that come with them). */
+static vfx_result default_params(rt_sph_desc *p, char *err, size_t err_len)
 {
     p->spacing = def(p->spacing, 0.02f);
     p->support_ratio = def(p->support_ratio, 2.0f);
@@ -71,7 +72,13 @@ static vfx_result fill_params(rt_sph_desc *p, char *err, size_t err_len)
      * 0.9 stirred the pool up (66 J of kinetic energy against 53.5 J at frame 120), and 2
      * iterations at 0.8 more (240 J) (docs/simulation-pbf.md, "Chebyshev acceleration") */
     p->pbf_chebyshev_rho = def(p->pbf_chebyshev_rho, 0.8f);
+    return VFX_OK;
+}
 
+/* Every float of the completed desc finite and in its range, the domain at least two spacings
+ * thick; the thread count capped at 256. */
+static vfx_result check_params(rt_sph_desc *p, char *err, size_t err_len)
+{
     const float *fields[] = {&p->spacing, &p->support_ratio, &p->rest_density, &p->sound_speed,
                              &p->stiffness, &p->gamma, &p->viscosity, &p->cfl, &p->velocity_limit,
                              &p->density_change_limit, &p->kinematic_viscosity,
@@ -128,6 +135,13 @@ static vfx_result fill_params(rt_sph_desc *p, char *err, size_t err_len)
     if (p->threads > 256)
         p->threads = 256;
     return VFX_OK;
+}
+
+/* The desc completed with its defaults, then checked. */
+static vfx_result fill_params(rt_sph_desc *p, char *err, size_t err_len)
+{
+    vfx_result r = default_params(p, err, err_len);
+    return r ? r : check_params(p, err, err_len);
 }
 
 /* Kernel constants, particle mass and the wall scales, each calibrated on the lattice the
