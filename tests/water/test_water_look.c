@@ -1,4 +1,4 @@
-/* GL tests of the water's look (shaders/water/shade.frag, docs/water.md "The look"): properties
+/* GL tests of the water's look (shaders/water/shade.frag, docs/water-look.md): properties
  * the shading must have whatever its constants, each of which a wrong shader breaks:
  * - refraction never reads a host pixel in front of the water (an occluder's colour changes no
  *   water pixel beside it);
