@@ -564,7 +564,7 @@ static void publish_counters(vfx_context *ctx, water_state *s)
             volfx_log(ctx, VFX_LOG_WARN, VFX_LOG_ID_WATER_UNDECIDED_PIXELS,
                       "water: %u pixels undecided (not drawn) in frame %llu: the march ran past "
                       "MAX_STEPS or the driver ended its loops (llvmpipe: 65,535 loop iterations a shader invocation; "
-                      "%u tile entries this frame); a higher resolution, a larger h or method grid draws them",
+                      "%u tile entries this frame); a higher resolution or a larger h draws them",
                       c[12], (unsigned long long)s->last_frame, c[10]);
         }
     }
