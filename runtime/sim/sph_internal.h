@@ -229,6 +229,10 @@ void rt_sph_coincident_dir(uint32_t a, uint32_t b, float out[3]);
 
 /* sph_pbf.c: a frame of Position Based Fluids (the WCSPH frame is in sph_step.c) */
 vfx_result rt_sph_pbf_step(rt_sph *s, float frame_dt, rt_sph_report *rep, char *err, size_t errlen);
+/* sph_pbf.c: the calibrated constants PBF steps with (calibrated on first use, as the first
+ * step does): the lattice's sum |grad C|^2, the mixing eps of a call of frame_dt, (H^2 - dq^2)^3
+ * (the GPU solver's, sph_gpu.c) */
+void rt_sph_pbf_constants(rt_sph *s, float frame_dt, float *D0, float *eps, float *wdq);
 /* sph_pbf.c: the walls' density rho0 * (missing fraction) at p and its gradient / rho0 */
 void rt_sph_pbf_walls(const rt_sph *s, float px, float py, float pz, float *wall_rho, float g[3]);
 /* sph_pbf.c: moves p out of every collider and the domain box to the clamp margin (dx/4) */

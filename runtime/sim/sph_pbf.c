@@ -760,6 +760,13 @@ static float pbf_chebyshev_next(float rho2, uint32_t it, float omega)
     return it == 0 ? 1.f : it == 1 ? 2.f / (2.f - rho2) : 4.f / (4.f - rho2 * omega);
 }
 
+void rt_sph_pbf_constants(rt_sph *s, float frame_dt, float *D0, float *eps, float *wdq)
+{
+    if (s->pbf_D0 == 0.f)
+        pbf_calibrate(s);
+    *D0 = s->pbf_D0, *eps = pbf_step_eps(s, frame_dt), *wdq = s->pbf_wdq;
+}
+
 float rt_sph_chebyshev_weight(float rho, uint32_t k)
 {
     float omega = 1.f;
