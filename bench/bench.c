@@ -84,7 +84,14 @@ static int bench_frame(int argc, char **argv)
     app->api->get_stats(app->ctx, &st);
     for (uint32_t i = 0; i < st.count; ++i)
         printf("%s\"%s\":%.6g", i ? "," : "", st.entries[i].name, st.entries[i].value);
-    printf("}}\n");
+    printf("}");
+    if (demo.spawned.sim) { /* the simulation's last frame (docs/stats.md sim.*) and its median CPU ms */
+        const rt_sim_stats *ss = rt_sim_system_stats(demo.spawned.sim);
+        printf(",\"sim\":{\"device\":%u,\"particles\":%u,\"steps\":%u,\"iterations\":%u,\"max_speed\":%.4g,"
+               "\"density_error\":%.4g,\"cpu_ms_p50\":%.4f}", ss->device, demo.spawned.particle_count, ss->steps, ss->iterations,
+               ss->max_speed, ss->density_error, rt_profiler_series_median(app->profiler, "vfx.sim.sph"));
+    }
+    printf("}\n");
     game_demo_free(app, &demo);
     game_app_destroy(app);
     return rc;

@@ -18,6 +18,7 @@
 
 #include "profile/profiler.h"
 #include "sim/sph.h"
+#include "bench_sim_device.h"
 #include "bench_sim_pool.h"
 
 int bench_sim(int argc, char **argv);
@@ -361,8 +362,38 @@ static int parse_list(const char *s, uint32_t *out, int max)
     return n;
 }
 
+/* `sim --device gpu [--sizes L] [--frames F] [--iterations I] [--threads T]` (bench_sim_device.c) */
+static int bench_sim_device_args(int argc, char **argv, int from)
+{
+    bench_device_opts o = {.sizes = {16384, 65536, 262144}, .nsizes = 3, .frames = 10, .threads = 2};
+    bool bad = from + 1 >= argc || strcmp(argv[from + 1], "gpu") != 0;
+    for (int k = from + 2; k < argc && !bad; ++k) {
+        const bool more = k + 1 < argc;
+        if (!strcmp(argv[k], "--sizes") && more)
+            bad = (o.nsizes = parse_list(argv[++k], o.sizes, 8)) <= 0;
+        else if (!strcmp(argv[k], "--frames") && more)
+            o.frames = atoi(argv[++k]);
+        else if (!strcmp(argv[k], "--iterations") && more)
+            o.iterations = (uint32_t)atoi(argv[++k]);
+        else if (!strcmp(argv[k], "--threads") && more)
+            o.threads = (uint32_t)atoi(argv[++k]);
+        else if (strcmp(argv[k], "--json") != 0)
+            bad = true;
+    }
+    if (bad || o.frames < 1 || o.frames > 100000 || o.iterations > 1000 || o.threads > 64) {
+        fprintf(stderr, "volfx-bench sim --device gpu [--sizes 16384,65536,262144] [--frames 10 (1..100000)]\n"
+                        "                 [--iterations I (PBF Jacobi iterations, 0..1000; 0 = 5)] [--threads 2 "
+                        "(the CPU solver's; 0 = all cores)]\n");
+        return 2;
+    }
+    return bench_sim_device(&o);
+}
+
 int bench_sim(int argc, char **argv)
 {
+    for (int i = 1; i < argc; ++i)
+        if (!strcmp(argv[i], "--device"))
+            return bench_sim_device_args(argc, argv, i);
     uint32_t sizes[8] = {4096, 16384, 65536}, threads[8] = {1, 2};
     int nsizes = 3, nthreads = 2, substeps = 20, reps = 5, res = 20;
     bool dam = false;
@@ -493,6 +524,8 @@ int bench_sim(int argc, char **argv)
             no_slip = RT_SPH_FACE_Y_MIN | RT_SPH_FACE_X_MIN;
         } else if (!strcmp(argv[i], "--help")) {
             puts("volfx-bench sim [--sizes 4096,16384,65536] [--threads 1,2] [--substeps 20] [--reps 5]\n"
+                 "volfx-bench sim --device gpu [--sizes 16384,65536,262144] [--frames 10] [--iterations I] [--threads 2]\n"
+                 "                (PBF on the CPU and in compute shaders side by side: particle-steps/s)\n"
                  "                [--warmup-s 0.2 (simulated s of the collapse before timing)]\n"
                  "                [--methods rebuild,verlet] [--skin 0 (neighbor_skin / H, up to 4 in a comma\n"
                  "                list, one set of Verlet solvers each; 0 = default)]\n"

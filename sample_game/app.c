@@ -33,6 +33,16 @@ static vfx_result particle_chunks_collect(game_app *app)
 {
     rt_component t = particle_terms(app);
     uint32_t n = 0;
+    if (app->particle_source) { /* a GPU simulation's buffers: one chunk, nothing to copy */
+        if (!app->chunk_cap) {
+            if (!(app->chunks = calloc(1, sizeof *app->chunks)))
+                return VFX_ERR_OUT_OF_MEMORY;
+            app->chunk_cap = 1;
+        }
+        app->chunk_count = app->particle_source(app->particle_source_user, &app->chunks[0]) ? 1 : 0;
+        app->chunks_valid = true;
+        return VFX_OK;
+    }
     rt_query_iter it = rt_query_begin(app->world, &t, 1);
     while (rt_query_next(&it)) {
         if (n == app->chunk_cap) {
@@ -388,7 +398,7 @@ vfx_result game_app_frame(game_app *app, float dt)
     double t0 = rt_now_ms();
     app->chunks_valid = false; /* the systems above may have moved or resized tables */
     /* GPU particles: the host's copy into its GL buffer is its own cost, outside plugin.update */
-    if (app->desc.gpu_particles && app->water_enabled && (r = particle_chunks_collect(app))) {
+    if (app->desc.gpu_particles && !app->particle_source && app->water_enabled && (r = particle_chunks_collect(app))) {
         rt_logf(&app->log, VFX_LOG_ERROR, "particle chunks: GL buffer upload failed: %s", vfx_result_name(r));
         return r;
     }
@@ -509,4 +519,11 @@ vfx_result game_app_dump_raw(game_app *app, vfx_effect_kind effect, const char *
         rt_logf(&app->log, VFX_LOG_ERROR, "%s", err);
     free(data);
     return r;
+}
+
+void game_app_set_particle_source(game_app *app, bool (*source)(void *user, vfx_particle_view *out), void *user)
+{
+    app->particle_source = source;
+    app->particle_source_user = user;
+    app->chunks_valid = false;
 }

@@ -79,7 +79,15 @@ typedef struct game_app {
     uint32_t chunk_count, chunk_cap;
     bool chunks_valid;
     game_gpu_particles gpu;    /* desc.gpu_particles: the GL buffer the chunks name */
+    /* game_app_set_particle_source: a simulation holding the particles in GL buffers */
+    bool (*particle_source)(void *user, vfx_particle_view *out);
+    void *particle_source_user;
 } game_app;
+
+/* The water's particles from `source` from now on instead of the world's particle table: one chunk
+ * of GL buffer columns (a GPU simulation's state, handed over with no CPU copy); source returns
+ * false while it has none. NULL: the world's table again. */
+void game_app_set_particle_source(game_app *app, bool (*source)(void *user, vfx_particle_view *out), void *user);
 
 /* Sets the world around the meshes: the procedural sky (or the clear colour), the sun's
  * direction (towards it) and fog per metre. VFX_ERR_GL when the sky's shader fails. */

@@ -207,6 +207,14 @@ static vfx_result read_scene(game_app *app, game_demo *demo, const char *scene_p
     return game_app_set_camera(app, &cam);
 }
 
+/* game_app_set_particle_source: the GPU solver's buffers as the one particle chunk (none before
+ * the first simulation run made them). */
+static bool game_demo_gpu_view(void *user, vfx_particle_view *out)
+{
+    const game_demo *demo = user;
+    return rt_sim_gpu_view(demo->sim_gpu, out);
+}
+
 vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path, uint32_t effects_off)
 {
     memset(demo, 0, sizeof *demo);
@@ -230,6 +238,20 @@ vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path
         return r;
     }
     const rt_scene_spawned *sp = &demo->spawned;
+    /* water.simulation.device: "auto" is the GPU on a hardware GL driver (the CPU solver on a
+     * software rasteriser such as llvmpipe, where the compute passes run on the same cores slower
+     * than the C solver: docs/simulation-gpu.md); "cpu" compiles no compute program */
+    const rt_scene_water *w = &sc->water;
+    bool gpu = sp->sim && (w->device == RT_SCENE_SIM_GPU || (w->device == RT_SCENE_SIM_AUTO &&
+                                                             w->solver == RT_SPH_SOLVER_PBF &&
+                                                             !rt_sph_gpu_software_renderer()));
+    if (gpu && (r = rt_sim_gpu_attach(sp->sim, &demo->sim_gpu, err, sizeof err))) {
+        rt_logf(&app->log, VFX_LOG_ERROR, "scene water.simulation.device: %s", err);
+        game_demo_free(app, demo);
+        return r;
+    }
+    if (gpu) /* the plugin reads the solver's GL buffers instead of the particle table */
+        game_app_set_particle_source(app, game_demo_gpu_view, demo);
     if (sc->has_water && !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_WATER))) {
         app->water = sc->water.params;
         app->water_lab = sc->water.lab;
@@ -261,7 +283,7 @@ static void strike_water(game_app *app, game_demo *demo)
         return;
     for (uint32_t i = 0; i < app->impact_count; ++i) {
         const vfx_impact_event *e = &app->impacts[i];
-        if (rt_sph_impulse(rt_sim_system_solver(demo->spawned.sim), e->position, e->direction, demo->impact_radius,
+        if (rt_sim_system_impulse(demo->spawned.sim, e->position, e->direction, demo->impact_radius,
                            demo->impact_strength)) {
             demo->impacts_applied++;
             memcpy(demo->last_impact, e->position, sizeof demo->last_impact);
@@ -301,7 +323,7 @@ void game_demo_print_profile(game_app *app, FILE *out)
     static const char *series[] = {"vfx.sim.sph", "plugin.update", "host.scene", "plugin.render",
                                    "plugin.render_thread_cpu"};
     static const char *sim[] = {"sim.steps", "sim.iterations", "sim.realtime_factor", "sim.max_speed",
-                                "sim.density_error"};
+                                "sim.density_error", "sim.device"};
     fprintf(out, "cpu ms (median):");
     for (size_t i = 0; i < sizeof series / sizeof series[0]; ++i) {
         double m = rt_profiler_series_median(app->profiler, series[i]);
@@ -331,6 +353,8 @@ void game_demo_free(game_app *app, game_demo *demo)
         if (rep->cap_hit)
             rt_logf(&app->log, VFX_LOG_WARN, "water simulation: substep cap hit in the last frame");
     }
+    if (demo->sim_gpu)
+        game_app_set_particle_source(app, NULL, NULL);
     rt_scene_despawn(app->world, &demo->spawned); /* the world must not run the simulation after this */
     rt_scene_free(demo->scene);
     free(demo->vol_base_points);

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include "app.h"
 #include "scene/scene.h"
+#include "sim/sim_gpu.h"
 #include "sim/sim_system.h"
 #include "spawn/scene_spawn.h"
 
@@ -14,6 +15,7 @@ typedef struct game_demo {
     uint32_t effects_off;      /* VFX_EFFECT_BIT mask switched off by options or keys */
     rt_scene *scene;          /* the loaded scene (beams are re-evaluated from it each frame) */
     rt_scene_spawned spawned;  /* what the scene spawned: the simulation, the volume and its arrays */
+    rt_sim_gpu *sim_gpu;       /* the simulation's GPU device (water.simulation.device; NULL: the CPU) */
     uint32_t beam_base_count;  /* beams in the scene (restored when toggled back on) */
     bool key_latch[8];
     bool mouse_down;

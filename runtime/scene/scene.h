@@ -92,6 +92,13 @@ typedef enum rt_scene_generator {
     RT_SCENE_GEN_SPHERE = 2,   /* a lattice inside a sphere, filled from the bottom */
 } rt_scene_generator;
 
+/* water.simulation.device: which solver steps the fluid (docs/scene-format.md) */
+enum {
+    RT_SCENE_SIM_AUTO = 0, /* the GPU on a hardware GL driver, the CPU on a software one (llvmpipe) */
+    RT_SCENE_SIM_CPU = 1,
+    RT_SCENE_SIM_GPU = 2,
+};
+
 typedef struct rt_scene_water {
     rt_scene_water_source source;
     double scene_origin[3];          /* the scene's origin, subtracted from a particle file */
@@ -117,6 +124,7 @@ typedef struct rt_scene_water {
     bool no_slip;                    /* tank walls (all six faces) with wall-law friction */
     uint32_t solver;                 /* water.simulation.solver: 0 "wcsph", 1 "pbf" (rt_sph_solver); "pbf" */
     uint32_t settle_steps;           /* rt_sph_settle's steps at most before frame 0 (default 120; 0: none) */
+    uint32_t device;                 /* water.simulation.device: RT_SCENE_SIM_AUTO (default), _CPU, _GPU */
     float impact_strength;           /* m/s: a beam striking the water pushes the fluid near the hit up to
                                       * this speed (rt_sph_impulse; default 4, 0: off) */
     float impact_radius;             /* m: within this of the hit (default 0.25) */

@@ -96,7 +96,7 @@ static vfx_result parse_water_generator(pctx *c, const cJSON *v, rt_scene_water 
 static vfx_result parse_water_simulation(pctx *c, const cJSON *v, rt_scene_water *w)
 {
     static const char *const skeys[] = {"tank", "fluid", "particle_count", "gravity", "dt", "paddle", "no_slip",
-                                        "solver", "settle_steps", "impact_strength", "impact_radius", NULL};
+                                        "solver", "settle_steps", "impact_strength", "impact_radius", "device", NULL};
     static const char *const solvers[] = {"wcsph", "pbf", NULL}; /* rt_sph_solver order */
     vfx_result r;
     const char *PS = "water.simulation";
@@ -117,6 +117,12 @@ static vfx_result parse_water_simulation(pctx *c, const cJSON *v, rt_scene_water
     if (!r) r = rt_scene_get_bool(c, s, PS, "no_slip", &w->no_slip);
     w->solver = 1; /* "pbf" when the key is absent (issue 22: 5-7x cheaper per frame, calmer at rest) */
     if (!r) r = rt_scene_get_enum(c, s, PS, "solver", false, solvers, &w->solver);
+    static const char *const devices[] = {"auto", "cpu", "gpu", NULL}; /* RT_SCENE_SIM_* order */
+    w->device = RT_SCENE_SIM_AUTO;
+    if (!r) r = rt_scene_get_enum(c, s, PS, "device", false, devices, &w->device);
+    if (!r && w->device == RT_SCENE_SIM_GPU && w->solver != 1)
+        r = rt_scene_failf(c, VFX_ERR_INVALID_ARGUMENT, "water.simulation.device",
+                           "\"gpu\" runs the PBF solver only: set water.simulation.solver to \"pbf\" (or device \"cpu\")");
     w->settle_steps = 120; /* absent: the block settles before frame 0 (issue 22: it sank at ~1 m/s) */
     if (!r) r = rt_scene_get_uint(c, s, PS, "settle_steps", false, 0, 10000, &w->settle_steps);
     /* a beam striking the water pushes the fluid (docs/simulation.md "Impacts"); 0 switches it off */

@@ -39,6 +39,8 @@ struct rt_sim_system {
     bool slow_said;
     double settle_t0;
     char label[96];   /* " (NAME)" of rt_sim_system_set_label, or "" */
+    rt_sim_device dev; /* rt_sim_system_set_device (step NULL: none) */
+    bool dev_started, ran;
     double origin[3]; /* added to the tank in messages (rt_sim_system_set_label) */
 };
 
@@ -91,7 +93,7 @@ static vfx_result sim_advance(rt_sim_system *s, float frame_dt, const rt_sph_set
     for (uint32_t i = 0; i < n && !r; ++i) {
         rt_sph_report rep;
         double ts = wall_s();
-        r = rt_sph_step(s->sph, dt, &rep, err, errlen);
+        r = s->dev_started ? s->dev.step(s->dev.user, dt, &rep, err, errlen) : rt_sph_step(s->sph, dt, &rep, err, errlen);
         warn_slow(s, wall_s() - ts, "(wall clock)");
         st.steps += rep.substeps;
         st.iterations += rep.iterations;
@@ -100,11 +102,12 @@ static vfx_result sim_advance(rt_sim_system *s, float frame_dt, const rt_sph_set
         sum.substeps = st.steps;
     }
     if (n == 0) /* no whole step this frame: the state's figures as they are */
-        r = rt_sph_step(s->sph, 0.f, &sum, err, errlen);
+        r = s->dev_started ? s->dev.step(s->dev.user, 0.f, &sum, err, errlen) : rt_sph_step(s->sph, 0.f, &sum, err, errlen);
     double wall = wall_s() - t0;
     st.realtime_factor = wall > 0 ? st.simulated_s / wall : 0;
     st.max_speed = sum.max_speed;
     st.density_error = sum.mean_density_error;
+    st.device = s->dev_started ? s->dev.id : 0;
     s->report = sum;
     s->stats = st;
     if (s->sink) {
@@ -114,6 +117,7 @@ static vfx_result sim_advance(rt_sim_system *s, float frame_dt, const rt_sph_set
         s->sink(s->sink_user, "sim.max_speed", st.max_speed);
         s->sink(s->sink_user, "sim.density_error", st.density_error);
         s->sink(s->sink_user, "sim.settle_steps", st.settle_steps);
+        s->sink(s->sink_user, "sim.device", st.device);
     }
     return r;
 }
@@ -212,8 +216,9 @@ static vfx_result sim_run(rt_world *w, const rt_system_ctx *ctx)
      * (moves are caught by the step's displacement check). A structural change (spawn,
      * despawn, reorder) or a write by another system moves the revision: bind again, which
      * checks the values and rebuilds the neighbour lists. */
-    bool same = s->bound && table == s->table &&
-                (table == SIM_NO_TABLE || rt_world_table_revision(w, table) == s->revision);
+    /* a device steps its own copy of the first bound state: the table is not bound again */
+    bool same = s->dev_started || (s->bound && table == s->table &&
+                (table == SIM_NO_TABLE || rt_world_table_revision(w, table) == s->revision));
     if (!same) {
         s->table = table;
         rt_sph_columns c;
@@ -226,11 +231,19 @@ static vfx_result sim_run(rt_world *w, const rt_system_ctx *ctx)
         }
         s->bound = true;
     }
+    s->ran = true;
+    if (s->dev.step && !s->dev_started) {
+        if ((r = s->dev.start(s->dev.user, s->sph, err, sizeof err)))
+            return rt_world_fail(w, r, "vfx.sim.sph%s: %s", s->label, err);
+        s->dev_started = true;
+    }
     rt_sph_settle_report settled = {0};
     if (s->settle) {
         s->settle = false;
         s->settle_t0 = wall_s();
-        if ((r = rt_sph_settle(s->sph, &s->settle_desc, &settled, err, sizeof err)))
+        r = s->dev_started ? s->dev.settle(s->dev.user, &s->settle_desc, &settled, err, sizeof err)
+                           : rt_sph_settle(s->sph, &s->settle_desc, &settled, err, sizeof err);
+        if (r)
             return rt_world_fail(w, r, "vfx.sim.sph%s: settling: %s", s->label, err);
         rt_logf(&s->log, VFX_LOG_INFO, "fluid settled before frame 0: %u steps, max speed %.3f m/s at the last, "
                 "mean compression %.2f%%, %.2f CPU s; velocities zeroed", settled.steps,
@@ -290,6 +303,8 @@ void rt_sim_system_destroy(rt_sim_system *s)
 {
     if (!s)
         return;
+    if (s->dev.destroy)
+        s->dev.destroy(s->dev.user);
     rt_sph_destroy(s->sph);
     free(s);
 }
@@ -364,4 +379,23 @@ void rt_sim_system_set_stats_sink(rt_sim_system *s, void (*sink)(void *user, con
 {
     if (s)
         s->sink = sink, s->sink_user = user;
+}
+
+vfx_result rt_sim_system_set_device(rt_sim_system *s, const rt_sim_device *dev)
+{
+    if (!s || !dev || s->ran || s->dev.step || !dev->start || !dev->step || !dev->settle || !dev->impulse ||
+        !dev->destroy)
+        return VFX_ERR_INVALID_ARGUMENT;
+    s->dev = *dev;
+    return VFX_OK;
+}
+
+uint32_t rt_sim_system_impulse(rt_sim_system *s, const float centre[3], const float dir[3], float radius, float speed)
+{
+    if (!s)
+        return 0;
+    if (!s->dev_started)
+        return rt_sph_impulse(s->sph, centre, dir, radius, speed);
+    s->dev.impulse(s->dev.user, centre, dir, radius, speed);
+    return 1;
 }

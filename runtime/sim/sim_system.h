@@ -47,6 +47,7 @@ typedef struct rt_sim_stats {
     float density_error;     /* mean max(0, rho/rho0 - 1), end of the frame */
     uint32_t settle_steps;   /* rt_sph_settle steps run before this frame's steps (0 but once) */
     double settle_cpu_s;     /* their process CPU seconds */
+    uint32_t device;         /* 0 the CPU solver, else the device's id (1 GPU) */
 } rt_sim_stats;
 /* The next run settles the particles before its first step (rt_sph_settle, desc NULL: its
  * defaults), once: a fluid block placed in a scene then starts in the solver's equilibrium at
@@ -64,6 +65,27 @@ vfx_result rt_sim_system_set_label(rt_sim_system *sys, const char *name, const d
 vfx_result rt_sim_system_warn_slow(rt_sim_system *sys, double seconds, const rt_logger *log);
 /* The last run's figures (zero before the first). */
 const rt_sim_stats *rt_sim_system_stats(const rt_sim_system *sys);
+/* A solver that steps the particles somewhere else than the CPU columns (sim_gpu.h: the GPU PBF
+ * solver). At the system's first run, after it bound the table, start is handed the CPU solver
+ * (its parameters, colliders and the bound particles); from then on the settle, the steps and
+ * rt_sim_system_impulse go through the device, the table is not bound again and its rows keep
+ * the state of that first run. destroy is called with the system's. */
+typedef struct rt_sim_device {
+    void *user;
+    uint32_t id; /* the stat sim.device (0 is the CPU solver; 1 the GPU) */
+    vfx_result (*start)(void *user, rt_sph *sph, char *err, size_t errlen);
+    vfx_result (*step)(void *user, float dt, rt_sph_report *rep, char *err, size_t errlen);
+    vfx_result (*settle)(void *user, const rt_sph_settle_desc *d, rt_sph_settle_report *rep, char *err,
+                         size_t errlen);
+    void (*impulse)(void *user, const float centre[3], const float dir[3], float radius, float speed);
+    void (*destroy)(void *user);
+} rt_sim_device;
+/* Sets the device (copied); VFX_ERR_INVALID_ARGUMENT once the system has run or a callback is NULL. */
+vfx_result rt_sim_system_set_device(rt_sim_system *sys, const rt_sim_device *dev);
+/* rt_sph_impulse on whatever steps the particles: the particles changed, or 1 on a device (its count
+ * stays on the GPU). */
+uint32_t rt_sim_system_impulse(rt_sim_system *sys, const float centre[3], const float dir[3], float radius,
+                               float speed);
 /* Called at the end of every run with each sim.* figure (e.g. rt_profiler_counter); NULL: none. */
 void rt_sim_system_set_stats_sink(rt_sim_system *sys, void (*sink)(void *user, const char *name, double value),
                                   void *user);

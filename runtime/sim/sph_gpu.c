@@ -1,6 +1,7 @@
 /* sph_gpu.c — see sph_gpu.h: the host side of the GPU PBF solver (programs, buffers, the pass
  * sequence of a step, the fenced stats ring). The passes are shaders/sim/pbf_*.comp. */
 #include "sim/sph_gpu.h"
+#include "sim/sph_collide.h"
 #include "sim/sph_internal.h"
 #include "core/error.h"
 

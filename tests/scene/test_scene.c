@@ -168,6 +168,18 @@ static void test_defaults(void **state)
         assert_int_equal(s->water.solver, k == 1 ? 0u : 1u); /* rt_sph_solver: 0 WCSPH, 1 PBF */
         rt_scene_free(s);
     }
+    /* water.simulation.device: "auto" when absent */
+    static const char *const device_cases[] = {"", ",\"device\":\"cpu\"", ",\"device\":\"gpu\"", ",\"device\":\"auto\""};
+    static const uint32_t device_ids[] = {RT_SCENE_SIM_AUTO, RT_SCENE_SIM_CPU, RT_SCENE_SIM_GPU, RT_SCENE_SIM_AUTO};
+    for (int k = 0; k < 4; ++k) {
+        char json[512];
+        snprintf(json, sizeof json, "{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],"
+                 "\"max\":[1,1,1]},\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10%s}}}",
+                 device_cases[k]);
+        assert_int_equal(load(json, &log, &s, err, sizeof err), VFX_OK);
+        assert_int_equal(s->water.device, device_ids[k]);
+        rt_scene_free(s);
+    }
     /* beam defaults: only head and dir given */
     assert_int_equal(load("{\"beams\":[{\"head\":[0,0,0],\"dir\":[1,0,0]}]}", &log, &s, err, sizeof err), VFX_OK);
     assert_close(s->beams[0].base.radius, 0.5);
@@ -265,6 +277,12 @@ static const bad_case bad_cases[] = {
     {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
      "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"solver\":\"sph\"}}}",
      VFX_ERR_INVALID_ARGUMENT, "water.simulation.solver: unknown value \"sph\"; expected one of \"wcsph\", \"pbf\""},
+    {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
+     "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"device\":\"tpu\"}}}",
+     VFX_ERR_INVALID_ARGUMENT, "water.simulation.device: unknown value \"tpu\"; expected one of \"auto\", \"cpu\", \"gpu\""},
+    {"{\"water\":{\"source\":\"simulation\",\"simulation\":{\"tank\":{\"min\":[0,0,0],\"max\":[1,1,1]},"
+     "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"solver\":\"wcsph\",\"device\":\"gpu\"}}}",
+     VFX_ERR_INVALID_ARGUMENT, "water.simulation.device: \"gpu\" runs the PBF solver only"},
     {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"h\":0}}", VFX_ERR_INVALID_ARGUMENT, "water.h: must be >= 1e-12, got 0"},
     {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"disable\":[\"pyramid\",\"magic\"]}}}",
      VFX_ERR_INVALID_ARGUMENT, "water.quality.disable[1]: unknown flag \"magic\""},
