@@ -77,6 +77,21 @@ def main():
           ["size", "frames", "frame ms p50", "p95", "p99", "fps", "ms per pass"],
           [["%dx%d" % (r["width"], r["height"]), str(r["frames"]), fmt(r["frame_ms"]["p50"]), fmt(r["frame_ms"]["p95"]),
             fmt(r["frame_ms"]["p99"]), fmt(r.get("mean_fps"), 1), passes(r, "")] for r in s["rows"]])
+    if os.path.exists(os.path.join(d, "sim-device.json")):
+        v = load("sim-device.json")
+        table(out, "Fluid solver (PBF) on the CPU and the GPU, the same dam-break block", v["commands"],
+              v["not_finished"], ["particles", "iterations", "CPU threads", "CPU Mparticle-steps/s",
+                                  "GPU Mparticle-steps/s", "GPU / CPU wall (median frame)"],
+              [[str(r["particles"]), str(r["iterations"]), str(r["threads"]),
+                fmt(r["cpu"]["particle_steps_per_s"] / 1e6), fmt(r["gpu"]["particle_steps_per_s"] / 1e6),
+                fmt(r["gpu_wall_over_cpu_median"], 3)] for r in v["rows"]])
+    if os.path.exists(os.path.join(d, "sim-water-1m-1080p.json")):
+        f = load("sim-water-1m-1080p.json")
+        table(out, "Simulation on the GPU and water in one frame", f["commands"], f["not_finished"],
+              ["particles", "size", "frames", "frame ms p50", "p95", "sim device", "sim CPU ms p50", "ms per pass"],
+              [[str(r.get("sim", {}).get("particles")), "%dx%d" % (r["width"], r["height"]), str(r["frames"]),
+                fmt(r["frame_ms"]["p50"]), fmt(r["frame_ms"]["p95"]), str(r.get("sim", {}).get("device")),
+                fmt(r.get("sim", {}).get("cpu_ms_p50")), passes(r, "water.")] for r in f["rows"]])
     print("\n".join(out))
 
 

@@ -4,7 +4,9 @@
 # within a time budget (default 480 s for the tables):
 #   water Table 1 (4,096 / 16,384 / 65,536 particles at 128^2 / 256^2 / 512^2, and 262,144 and
 #   1,048,576 at 1920x1080), every water method at 1920x1080 and against the float64 reference,
-#   beams 100 and 1,000 at 1920x1080, the default scene at 1920x1080.
+#   beams 100 and 1,000 at 1920x1080, the default scene at 1920x1080; the fluid solver on the CPU
+#   and the GPU side by side (16,384 / 65,536 / 262,144 particles, volfx-bench sim --device gpu),
+#   and 1,048,576 particles simulated on the GPU and drawn as water at 1920x1080 in one frame.
 # On llvmpipe the test suite runs it with --small (tiny sizes, two GL tests), so it cannot rot.
 #
 # Usage:
@@ -198,6 +200,21 @@ run() {
     echo "volfx-bench $*" >> "$tmp/$table.late"; say "ran out of time or failed after $(( $(date +%s) - t0 )) s: $*"
   fi
 }
+# pool_scene FILE N SETTLE: the default scene's tank and pool (paddle, method TILE) with N particles
+# simulated on the GPU (water.simulation.device "gpu"), no beams or volume: simulation and water
+pool_scene() {
+  cat > "$1" <<JSON
+{"version": 1, "name": "gpu-pool-$2",
+ "camera": {"eye": [-0.7, 2.5, 3.2], "target": [0.7, 0.15, -0.9], "fov_y_deg": 55, "near": 0.05, "far": 100},
+ "environment": {"sky": "dusk", "fog": 0.025},
+ "meshes": [{"box": {"min": [-40, -0.2, -40], "max": [40, 0, 40]}, "color": [0.55, 0.5, 0.45]}],
+ "water": {"source": "simulation", "simulation": {"tank": {"min": [-1.65, 0, -1.25], "max": [1.65, 1.4, 1.25]},
+   "fluid": {"min": [-1.6, 0.02, -1.2], "max": [1.6, 0.34, 1.2]}, "particle_count": $2, "gravity": [0, -9.81, 0],
+   "dt": 0.016666667, "solver": "pbf", "device": "gpu", "settle_steps": $3,
+   "paddle": {"axis": "x", "amplitude": 0.25, "period_s": 2.5}},
+  "threshold": 0.765625, "quality": {"method": "tile"}, "color": [0.15, 0.6, 0.65], "absorption": 3.0, "ior": 1.333}}
+JSON
+}
 # The water methods the bench knows (its own error message lists them), so a new one is included.
 methods=$("$bench" metaballs --method '?' 2>&1 | sed -n 's/.*--method \([a-z|_]*\),.*/\1/p' | tr '|' ' ' || true)
 [ -n "$methods" ] || methods="paper brute grid"
@@ -208,6 +225,9 @@ if [ $small = 1 ]; then
   for m in $methods; do run water-methods 60 metaballs --method "$m" --particles 1024 --size 48 --height 27 --frames 2 --reference $F; done
   run beams-1080p 60 beams --gpu --timing-only --sets 1,10 --size 64x36 --frames 2 --json
   run default-scene-1080p 60 frame --size 64x36 --frames 2 --json
+  run sim-device 60 sim --device gpu --sizes 1024 --frames 2 --json
+  pool_scene "$tmp/pool.json" 2048 5
+  run sim-water-1m-1080p 60 frame --scene "$tmp/pool.json" --size 64x36 --frames 2 --json
 else
   run water-table1 120 metaballs --method paper --particles 4096 --particles 16384 --particles 65536 \
       --size 128 --size 256 --size 512 --frames 8 $F
@@ -219,6 +239,11 @@ else
   done
   run beams-1080p 60 beams --gpu --timing-only --sets 100,1000 --size 1920x1080 --frames 20 --json
   run default-scene-1080p 60 frame --size 1920x1080 --frames 30 --json
+  # PBF at 5 iterations on the CPU (all cores) and in compute shaders, the same blocks, in turn
+  run sim-device 240 sim --device gpu --sizes 16384,65536,262144 --frames 10 --threads 0 --json
+  # 1,048,576 particles: settled (120 GPU steps before frame 0), then simulation + water each frame
+  pool_scene "$tmp/pool.json" 1048576 120
+  run sim-water-1m-1080p 240 frame --scene "$tmp/pool.json" --size 1920x1080 --frames 20 --json
 fi
 
 # 5. One JSON file per table, plus the machine.
@@ -227,7 +252,8 @@ python3 - "$tmp" "$out" "$small" "$(( $(date +%s) - t_start ))" <<'PY' 2>&1 | te
 import glob, json, os, platform, subprocess, sys
 tmp, out, small, secs = sys.argv[1], sys.argv[2], sys.argv[3] == "1", int(sys.argv[4])
 renderer = None
-for table in ("water-table1", "water-methods", "beams-1080p", "default-scene-1080p"):
+for table in ("water-table1", "water-methods", "beams-1080p", "default-scene-1080p", "sim-device",
+              "sim-water-1m-1080p"):
     def lines(ext):
         p = os.path.join(tmp, table + ext)
         return [l.rstrip("\n") for l in open(p)] if os.path.exists(p) else []
@@ -255,7 +281,8 @@ print("GL_RENDERER %s, %d s in all" % (renderer, secs))
 # exit status: 1 when a GL test failed or a table has no row (the JSON is written either way)
 tests = json.load(open(os.path.join(out, "tests.json"))) if os.path.exists(os.path.join(out, "tests.json")) else {"tests": []}
 bad = [t["name"] for t in tests["tests"] if t["result"] == "failed"]
-empty = [t for t in ("water-table1", "water-methods", "beams-1080p", "default-scene-1080p")
+empty = [t for t in ("water-table1", "water-methods", "beams-1080p", "default-scene-1080p", "sim-device",
+                     "sim-water-1m-1080p")
          if not json.load(open(os.path.join(out, t + ".json")))["rows"]]
 if bad or empty or not tests["tests"]:
     print("gpu-bench: failed tests %s, tables without rows %s" % (bad, empty))
