@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""CPU cost of the water's screen-space reflections (docs/water.md "Reflections"): runs
+"""CPU cost of the water's screen-space reflections (docs/water-look.md, "Reflections' cost"): runs
 volfx-game on a scene with and without VFX_WATER_NO_SSR (the scene flag "ssr" added to
 water.quality.disable), interleaved A B A B ..., and prints each run's process CPU time (all
 llvmpipe threads: user + sys of the child) per frame, the medians and their ratio, and the SSR

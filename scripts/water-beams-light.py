@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""What the water adds to the beams' light over its surface (docs/water.md "Lit by the beams").
+"""What the water adds to the beams' light over its surface (docs/water-look.md, "Beams in the water").
 
 Renders a scene four times (water shown / hidden x beams on / off, --no-beams) and the water's ray
 distance (--dump-raw water: the surface is where it is >= 0), then per pixel of the surface

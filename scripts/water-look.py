@@ -21,7 +21,7 @@ pixels where the water's raw distance dump hits, and the 8x8 blocks more than ha
 usage: scripts/water-look.py [--game build/sample_game/volfx-game] [--plugin PATH] [--size 640x360]
        [--zero-params] [--keep DIR] [--panels N,N,...] [--panel-image OUT.png] SCENE.json FRAME [FRAME...]
 --panel-image writes the images of the --panels frames and the measured frames, half size, three
-a row, each labelled with its frame (the panels of docs/water.md).
+a row, each labelled with its frame (the panels of docs/water-look.md).
 Prints one line a frame: scene, frame, change, beams, surface pixels, blocks. Needs numpy, PIL
 (Debian: python3-numpy python3-pil; run with /usr/bin/python3).
 """
