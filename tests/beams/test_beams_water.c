@@ -170,11 +170,45 @@ static void test_impact_on_water(void **state)
     *b = k_beam;
 }
 
+/* The stat's value in the last frame, -1 when the frame did not set it. */
+static double last_stat(const char *name)
+{
+    for (uint32_t k = 0; k < g_app->ctx->last_stats.count; ++k)
+        if (!strcmp(g_app->ctx->last_stats.entries[k].name, name))
+            return g_app->ctx->last_stats.entries[k].value;
+    return -1;
+}
+
+/* Preset low switches the water's loop over the plugin's lights off (docs/water.md "Presets"):
+ * with the beam over the pool, the default preset packs its lights for the shading (stat
+ * water.effect_lights: the shade program's WATER_EFFECT_LIGHTS variant runs only then), low packs
+ * none and the frame still draws the beams' light split at the surface without error. */
+static void test_preset_low_drops_the_lights(void **state)
+{
+    (void)state;
+    uint32_t preset = g_app->water.preset;
+    double lights[2];
+    for (int k = 0; k < 2; ++k) {
+        g_app->water.preset = k ? VFX_WATER_PRESET_LOW : VFX_WATER_PRESET_DEFAULT;
+        for (int f = 0; f < 3; ++f) /* the impact lights are read back one to three frames late */
+            assert_int_equal(game_app_frame(g_app, 1.f / 60), VFX_OK);
+        lights[k] = last_stat("water.effect_lights");
+        printf("preset %s: water.effect_lights %g, beams.lights %g\n", k ? "low" : "default", lights[k],
+               last_stat("beams.lights"));
+        assert_true(last_stat("beams.lights") > 0); /* the beams do give lights */
+    }
+    g_app->water.preset = preset;
+    assert_true(lights[0] > 0);
+    assert_true(lights[1] < 0); /* low never packs them */
+    assert_int_equal(g_log.errors, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_split_matches_reference),
         cmocka_unit_test(test_impact_on_water),
+        cmocka_unit_test(test_preset_low_drops_the_lights),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
