@@ -407,6 +407,64 @@ static vfx_result upload_chunks(vfx_context *ctx, water_state *s, uint32_t chunk
     return VFX_OK;
 }
 
+/* What the host's particle chunks hold this update: their count and total, whether every
+ * chunk has the nonzero revision of the last upload (0: the host tracks none), and whether any
+ * gives a radius, a kernel or GL buffers. */
+typedef struct water_survey {
+    uint32_t chunks;
+    uint64_t total;
+    int revs_same;
+    bool any_radius, any_kernel, any_gpu;
+} water_survey;
+
+static vfx_result survey_chunks(vfx_context *ctx, const water_state *s, water_survey *out)
+{
+    uint32_t chunks = ctx->host.particle_chunk_count(ctx->host.user);
+    water_survey sv = {.chunks = chunks, .revs_same = s->chunk_rev != NULL && s->chunk_rev_count == chunks};
+    for (uint32_t c = 0; c < chunks; ++c) {
+        water_chunk v;
+        vfx_result r = query_chunk(ctx, c, &v);
+        if (r)
+            return r;
+        sv.any_radius = sv.any_radius || (v.count && v.radius);
+        sv.any_kernel = sv.any_kernel || (v.count && (v.kernel || v.gpu_kernel.buffer));
+        sv.any_gpu = sv.any_gpu || (v.count && v.gpu_pos.buffer);
+        sv.total += v.count;
+        sv.revs_same = sv.revs_same && v.revision != 0 && v.revision == s->chunk_rev[c];
+    }
+    if (sv.total > WATER_MAX_PARTICLES)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARTICLE_COUNT,
+                        "water: %u particle chunks hold %llu particles, more than the limit of %u (2^30)",
+                        chunks, (unsigned long long)sv.total, WATER_MAX_PARTICLES);
+    *out = sv;
+    return VFX_OK;
+}
+
+/* h from the particles' spacing (the scan's sample of `total`, freed here): the seed's ratio,
+ * refused below the range of vfx_water_params.h; kept with the count it was measured at. */
+static vfx_result measure_h(vfx_context *ctx, water_state *s, water_scan *scan, uint32_t total)
+{
+    double d = volfx_water_spacing(ctx, scan->cxyz, scan->cand, scan->stride);
+    volfx_free(ctx, scan->cxyz);
+    scan->cxyz = NULL;
+    if (d < 0)
+        return VFX_ERR_OUT_OF_MEMORY;
+    /* the seed's ratio h = 2 x spacing (0.61 at its 0.3); no spacing (one particle, all on
+     * one point): the seed's 0.61 */
+    double h = d > 0 && isfinite(d) ? 2.0 * d : 0.61;
+    /* particles spaced 1e-40 apart gave h = 2e-40 and drew nothing: below the row's end h^3
+     * is no normal float32 (the kernels underflow); refused, naming what was measured */
+    const volfx_range *hr = volfx_range_row(VFX_RANGE_WATER_H);
+    if (h < hr->lo)
+        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
+                             "water: the particles' spacing %g (the median nearest-neighbour distance of %u "
+                             "particles) gives h %g, below vfx_water_params.h's %g: give h, or particles "
+                             "spaced at least %g apart", d, scan->cand, h, hr->lo, hr->lo / 2);
+    s->auto_h = (float)h;
+    s->auto_h_count = total;
+    return VFX_OK;
+}
+
 static vfx_result water_update(vfx_context *ctx, void *state, double time, float dt)
 {
     (void)time;
@@ -418,26 +476,13 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
     vfx_result kr = read_params(ctx, s, &res);
     if (kr)
         return kr;
-    uint32_t chunks = ctx->host.particle_chunk_count(ctx->host.user);
-    uint64_t total = 0;
-    /* every chunk with the nonzero revision of the last upload (0: the host tracks none) */
-    int revs_same = s->chunk_rev != NULL && s->chunk_rev_count == chunks;
-    bool any_radius = false, any_kernel = false, any_gpu = false;
-    for (uint32_t c = 0; c < chunks; ++c) {
-        water_chunk v;
-        vfx_result r = query_chunk(ctx, c, &v);
-        if (r)
-            return r;
-        any_radius = any_radius || (v.count && v.radius);
-        any_kernel = any_kernel || (v.count && (v.kernel || v.gpu_kernel.buffer));
-        any_gpu = any_gpu || (v.count && v.gpu_pos.buffer);
-        total += v.count;
-        revs_same = revs_same && v.revision != 0 && v.revision == s->chunk_rev[c];
-    }
-    if (total > WATER_MAX_PARTICLES)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_WATER_PARTICLE_COUNT,
-                        "water: %u particle chunks hold %llu particles, more than the limit of %u (2^30)",
-                        chunks, (unsigned long long)total, WATER_MAX_PARTICLES);
+    water_survey sv = {0};
+    if ((kr = survey_chunks(ctx, s, &sv)))
+        return kr;
+    const uint32_t chunks = sv.chunks;
+    const uint64_t total = sv.total;
+    const bool any_radius = sv.any_radius, any_kernel = sv.any_kernel, any_gpu = sv.any_gpu;
+    const int revs_same = sv.revs_same;
     GLuint before = s->groups ? s->groups[0].cols[0] : 0;
     uint32_t before_groups = s->group_count;
     vfx_result gr = ensure_groups(ctx, s, (uint32_t)total);
@@ -499,25 +544,8 @@ static vfx_result water_update(vfx_context *ctx, void *state, double time, float
     if (scan.seen)
         for (int k = 0; k < 3; ++k)
             s->lo[k] = scan.lo[k], s->hi[k] = scan.hi[k];
-    if (spacing) {
-        double d = volfx_water_spacing(ctx, scan.cxyz, scan.cand, scan.stride);
-        volfx_free(ctx, scan.cxyz);
-        if (d < 0)
-            return VFX_ERR_OUT_OF_MEMORY;
-        /* the seed's ratio h = 2 x spacing (0.61 at its 0.3); no spacing (one particle, all on
-         * one point): the seed's 0.61 */
-        double h = d > 0 && isfinite(d) ? 2.0 * d : 0.61;
-        /* particles spaced 1e-40 apart gave h = 2e-40 and drew nothing: below the row's end h^3
-         * is no normal float32 (the kernels underflow); refused, naming what was measured */
-        const volfx_range *hr = volfx_range_row(VFX_RANGE_WATER_H);
-        if (h < hr->lo)
-            return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_PARAM_RANGE,
-                                 "water: the particles' spacing %g (the median nearest-neighbour distance of %u "
-                                 "particles) gives h %g, below vfx_water_params.h's %g: give h, or particles "
-                                 "spaced at least %g apart", d, scan.cand, h, hr->lo, hr->lo / 2);
-        s->auto_h = (float)h;
-        s->auto_h_count = (uint32_t)total;
-    }
+    if (spacing && (kr = measure_h(ctx, s, &scan, (uint32_t)total)))
+        return kr;
     if ((kr = water_set_params(ctx, s, &res)))
         return kr;
     const char *e = volfx_gpu_error_string();
