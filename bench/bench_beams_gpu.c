@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "app.h"
+#include "volfx_lab.h"
 #include "beams/beam_field.h"
 #include "beams_ref.h"
 #include "camera_ref.h"
@@ -130,6 +131,8 @@ int bench_beams_gpu(int argc, char **argv)
         game_app *app;
         if (game_app_create(&d, &app))
             return 1;
+        vfx_lab_beams lab_beams = {.type = VFX_TYPE_LAB_BEAMS}, *lab = &lab_beams; /* closed form or march */
+        app->beams_next = lab;
         /* the host's camera and the float64 reference's: the same numbers */
         rt_camera hc = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, M_PI / 3, w, h, 0.05, 50};
         ref_camera cam = {{0, 0, 5}, {0, 0, 0}, {0, 1, 0}, M_PI / 3, w, h, 0.05, 50};
@@ -150,7 +153,7 @@ int bench_beams_gpu(int argc, char **argv)
             if (timing_only) {
                 /* large sets: closed form only, frame wall times (the headless host waits for the
                  * GPU), no reference; the pass timer is reported when its ring has delivered */
-                app->beams_lab.method = VFX_BEAMS_METHOD_CLOSED_FORM;
+                lab->method = VFX_BEAMS_METHOD_CLOSED_FORM;
                 double g = NAN;
                 for (uint32_t f = 0; f < frames; ++f) {
                     double t0 = rt_now_ms();
@@ -190,7 +193,7 @@ int bench_beams_gpu(int argc, char **argv)
              * nothing beyond the drawing the new configuration needs. */
             {
                 double *moved = malloc(frames * sizeof(double)), *still = malloc(frames * sizeof(double));
-                app->beams_lab.method = VFX_BEAMS_METHOD_CLOSED_FORM;
+                lab->method = VFX_BEAMS_METHOD_CLOSED_FORM;
                 for (uint32_t f = 0; f < frames; ++f) {
                     make_beams(app, sets[si]);
                     for (uint32_t b = 0; b < sets[si]; ++b) {
@@ -218,8 +221,8 @@ int bench_beams_gpu(int argc, char **argv)
             }
             static const uint32_t samples[4] = {0, 8, 32, 120};
             for (int mi = 0; mi < 4; ++mi) {
-                app->beams_lab.method = samples[mi] ? VFX_BEAMS_METHOD_MARCH : VFX_BEAMS_METHOD_CLOSED_FORM;
-                app->beams_lab.march_samples = samples[mi];
+                lab->method = samples[mi] ? VFX_BEAMS_METHOD_MARCH : VFX_BEAMS_METHOD_CLOSED_FORM;
+                lab->march_samples = samples[mi];
                 const char *pass = samples[mi] ? "beams.march.gpu_ms" : "beams.integrate.gpu_ms";
                 uint32_t n = 0;
                 for (uint32_t f = 0; f < frames + 4; ++f) { /* 4 more: the timer ring's latency */

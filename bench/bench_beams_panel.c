@@ -14,6 +14,7 @@
 
 #include "app.h"
 #include "demo_scene.h"
+#include "volfx_lab.h"
 
 int bench_beams_panel(int argc, char **argv);
 
@@ -84,8 +85,8 @@ typedef struct variant {
 } variant;
 
 /* One variant: set, render, measure, write the PNG. The scene's beams are re-evaluated first. */
-static void run_variant(game_app *app, game_demo *demo, double t, const variant *v, const char *dir, uint32_t frames,
-                        double ms[NPASS])
+static void run_variant(game_app *app, game_demo *demo, vfx_lab_beams *lab, double t, const variant *v,
+                        const char *dir, uint32_t frames, double ms[NPASS])
 {
     app->time = t;
     game_demo_animate(app, demo, 0.f);
@@ -97,8 +98,8 @@ static void run_variant(game_app *app, game_demo *demo, double t, const variant 
     app->beams_view = demo->scene->beams_view;
     if (v->bloom)
         app->beams_view.bloom = (uint32_t)v->bloom;
-    app->beams_lab.method = v->march ? VFX_BEAMS_METHOD_MARCH : VFX_BEAMS_METHOD_CLOSED_FORM;
-    app->beams_lab.march_samples = v->march;
+    lab->method = v->march ? VFX_BEAMS_METHOD_MARCH : VFX_BEAMS_METHOD_CLOSED_FORM;
+    lab->march_samples = v->march;
     measure(app, frames, ms);
     char png[512];
     snprintf(png, sizeof png, "%s/beams-%s.png", dir, v->name);
@@ -143,6 +144,8 @@ int bench_beams_panel(int argc, char **argv)
         game_app_destroy(app);
         return 1;
     }
+    vfx_lab_beams lab_beams = {.type = VFX_TYPE_LAB_BEAMS}, *lab = &lab_beams; /* closed form or march */
+    app->beams_next = lab;
     fprintf(stdout, "{\"gl_renderer\": \"%s\", \"scene\": \"%s\", \"time\": %g, \"frames\": %u}\n",
             (const char *)glGetString(GL_RENDERER), scene, t, frames);
     static const variant vs[] = {
@@ -153,7 +156,7 @@ int bench_beams_panel(int argc, char **argv)
     };
     double ms[NPASS], closed_ms = NAN;
     for (size_t i = 0; i < sizeof vs / sizeof vs[0]; ++i) {
-        run_variant(app, &demo, t, &vs[i], dir, frames, ms);
+        run_variant(app, &demo, lab, t, &vs[i], dir, frames, ms);
         if (!strcmp(vs[i].name, "smooth"))
             closed_ms = ms[0];
     }
@@ -170,8 +173,8 @@ int bench_beams_panel(int argc, char **argv)
             beams[i].falloff = VFX_BEAM_FALLOFF_SMOOTH;
         app->beams_view = demo.scene->beams_view;
         app->beams_view.bloom = VFX_BEAMS_BLOOM_OFF;
-        app->beams_lab.method = VFX_BEAMS_METHOD_MARCH;
-        app->beams_lab.march_samples = n;
+        lab->method = VFX_BEAMS_METHOD_MARCH;
+        lab->march_samples = n;
         measure(app, frames, ms);
         fprintf(stdout, "{\"variant\": \"%s\", \"samples\": %u, \"march_ms\": %.4f, \"closed_ms\": %.4f}\n", m.name, n,
                 ms[1], closed_ms);
@@ -182,13 +185,13 @@ int bench_beams_panel(int argc, char **argv)
             break;
     }
     variant m = {"march-equal-time", VFX_BEAM_FALLOFF_SMOOTH, VFX_BEAMS_BLOOM_OFF, best};
-    run_variant(app, &demo, t, &m, dir, frames, ms);
+    run_variant(app, &demo, lab, t, &m, dir, frames, ms);
     fprintf(stdout, "{\"variant\": \"equal-time\", \"samples\": %u}\n", best);
     /* cost under animation: frames stepping through the loop against the same frames frozen */
     double anim[2];
     for (int a = 0; a < 2; ++a) {
-        app->beams_lab.method = VFX_BEAMS_METHOD_CLOSED_FORM;
-        app->beams_lab.march_samples = 0;
+        lab->method = VFX_BEAMS_METHOD_CLOSED_FORM;
+        lab->march_samples = 0;
         app->beams_view = demo.scene->beams_view;
         double v[64];
         uint32_t n = 0;

@@ -114,12 +114,7 @@ static vfx_result host_water_params(void *user, vfx_water_params *out)
         return VFX_ERR_ABI;
     *out = app->water;
     out->type = VFX_TYPE_WATER_PARAMS;
-    const vfx_lab_water *lab = &app->water_lab;
-    bool lab_used = lab->disable || lab->method;
-    out->next = lab_used ? lab : NULL;
-    if (lab_used)
-        app->water_lab.type = VFX_TYPE_LAB_WATER;
-    /* the foam struct first, the lab's after it (each names its type; the plugin finds both) */
+    out->next = NULL;
     vfx_water_foam *foam = &app->water_foam;
     if (foam->layer || foam->impacts || foam->lifetime != 0 || foam->cell != 0 || foam->diffusion != 0 ||
         foam->deposit != 0 || foam->impact_rate != 0 || foam->impact_speed != 0) {
@@ -128,8 +123,7 @@ static vfx_result host_water_params(void *user, vfx_water_params *out)
         out->next = foam;
     }
     /* the anisotropic kernel is TILE's; the paper method (Tab cycles to it) draws the seed's */
-    uint32_t method = lab->method ? lab->method : app->water.method;
-    out->kernel = method == VFX_WATER_METHOD_TILE ? app->water.kernel : VFX_WATER_KERNEL_ISOTROPIC;
+    out->kernel = app->water.method == VFX_WATER_METHOD_TILE ? app->water.kernel : VFX_WATER_KERNEL_ISOTROPIC;
     return VFX_OK;
 }
 
@@ -145,8 +139,7 @@ static vfx_result host_beams(void *user, vfx_beams_view *out)
         return VFX_ERR_NOT_FOUND;
     *out = app->beams_view;
     out->type = VFX_TYPE_BEAMS_VIEW;
-    app->beams_lab.type = VFX_TYPE_LAB_BEAMS;
-    out->next = app->beams_lab.method || app->beams_lab.march_samples ? &app->beams_lab : NULL;
+    out->next = app->beams_next;
     out->count = n;
     out->beams = beams;
     out->joints = &app->joints[0][0];

@@ -6,7 +6,6 @@
 #include <stdbool.h>
 #include <stdint.h>
 #include <volfx/volfx.h>
-#include <volfx_lab.h>
 
 #include "ecs/effects.h"
 #include "ecs/particles.h"
@@ -63,10 +62,11 @@ typedef struct game_app {
     uint32_t impact_count;
     /* every field (kernel: method TILE's; the others get isotropic); its next is set per call */
     vfx_water_params water;
-    vfx_lab_water water_lab;   /* chained when it asks for something (lab method or bits) */
     vfx_water_foam water_foam; /* chained when the scene sets anything in water.foam */
     vfx_beams_view beams_view; /* parameters; beams/count/joints filled per call from the entities */
-    vfx_lab_beams beams_lab;   /* chained when it asks for the ray-marching baseline */
+    /* chained after the beams view the game hands the plugin (NULL: none): tests and benches
+     * chain their lab structs here; the game itself knows none */
+    const void *beams_next;
     float joints[GAME_APP_MAX_JOINTS][3]; /* bending beams' joints (vfx_beam.joint_first) */
     uint32_t joint_count;
     double time;

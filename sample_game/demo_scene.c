@@ -48,16 +48,6 @@ static vfx_result volume_prepare_animation(game_demo *demo, const rt_scene_volum
     return VFX_OK;
 }
 
-/* The scene's volume.disable (lab switches), chained into the spawned volume's view; and the
- * animation's starting arrays. */
-static vfx_result prepare_volume(game_app *app, game_demo *demo, const rt_scene_volume *v)
-{
-    vfx_volume_view *vv = game_app_volume(app, demo->spawned.volume);
-    demo->vol_lab = (vfx_lab_volume){.type = VFX_TYPE_LAB_VOLUME, .disable = v->disable};
-    vv->next = v->disable ? &demo->vol_lab : NULL; /* the lab's switches (the entity keeps the pointer) */
-    return volume_prepare_animation(demo, v);
-}
-
 /* The beams' light on the volume: per point, a Gaussian of its distance to each beam's axis
  * segment [M, M + L D] (in beam radii), scaled by gain. */
 static float beam_glow(const vfx_beam *beams, uint32_t beam_count, const rt_scene_volume_animation *an,
@@ -254,7 +244,6 @@ vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path
         game_app_set_particle_source(app, game_demo_gpu_view, demo);
     if (sc->has_water && !(demo->effects_off & VFX_EFFECT_BIT(VFX_EFFECT_WATER))) {
         app->water = sc->water.params;
-        app->water_lab = sc->water.lab;
         app->water_foam = sc->water.foam;
         app->water_enabled = sp->particle_count > 0;
         demo->impact_strength = sc->water.impact_strength, demo->impact_radius = sc->water.impact_radius;
@@ -262,10 +251,9 @@ vfx_result game_demo_load(game_app *app, game_demo *demo, const char *scene_path
     if (sp->beam_count) {
         demo->beam_base_count = sp->beam_count;
         app->beams_view = sc->beams_view;
-        app->beams_lab = sc->beams_lab;
         app->joint_count = sp->joint_count;
     }
-    if (sp->has_volume && (r = prepare_volume(app, demo, &sc->volume))) {
+    if (sp->has_volume && (r = volume_prepare_animation(demo, &sc->volume))) {
         game_demo_free(app, demo);
         return r;
     }

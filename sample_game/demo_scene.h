@@ -30,7 +30,6 @@ typedef struct game_demo {
     struct game_shield *vol_shield; /* rim and hit ripples (volume_shield.h); NULL when off */
     bool vol_animated;
     vfx_volume_view vol_view;  /* the volume's view while switched off */
-    vfx_lab_volume vol_lab;    /* the scene's volume.disable (lab switches), chained into its view */
 } game_demo;
 
 /* Loads the scene file `scene_path` (NULL -> the built-in default, sample_game/scenes/

@@ -246,7 +246,6 @@ static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
             s->camera.target[i] = (float)((double)s->camera.target[i] - c->origin[i]);
         }
     s->beams_view = (vfx_beams_view){.type = VFX_TYPE_BEAMS_VIEW, .saturation = VFX_SATURATE_SMOOTH, .saturate_c = 1};
-    s->beams_lab = (vfx_lab_beams){.type = VFX_TYPE_LAB_BEAMS};
     const cJSON *v;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "camera")) && (r = parse_camera(c, v, &s->camera)))
         return r;
@@ -254,7 +253,7 @@ static vfx_result parse_root(pctx *c, const cJSON *root, rt_scene *s)
         return r;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "beams")) && (r = rt_scene_parse_beams(c, v, s)))
         return r;
-    if ((v = cJSON_GetObjectItemCaseSensitive(root, "beam_settings")) && (r = rt_scene_parse_beam_settings(c, v, &s->beams_view, &s->beams_lab)))
+    if ((v = cJSON_GetObjectItemCaseSensitive(root, "beam_settings")) && (r = rt_scene_parse_beam_settings(c, v, &s->beams_view)))
         return r;
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "water"))) {
         s->has_water = true;

@@ -11,7 +11,6 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <volfx/volfx.h>
-#include <volfx_lab.h>
 
 #include "core/log.h"
 
@@ -128,10 +127,8 @@ typedef struct rt_scene_water {
     float impact_strength;           /* m/s: a beam striking the water pushes the fluid near the hit up to
                                       * this speed (rt_sph_impulse; default 4, 0: off) */
     float impact_radius;             /* m: within this of the hit (default 0.25) */
-    /* rendering (seed 000): every field, type filled (next unset: the host chains lab) */
+    /* rendering (seed 000): every field, type filled (next unset: the host chains the foam) */
     vfx_water_params params;
-    /* the lab's switches the scene asks for (water.quality.disable, baseline methods) */
-    vfx_lab_water lab;
     /* water.foam: the foam layer and the spray at beam impacts (type filled; chained by the host) */
     vfx_water_foam foam;
 } rt_scene_water;
@@ -171,7 +168,7 @@ typedef struct rt_scene_volume {
     uint32_t transfer_method;        /* vfx_volume_transfer_method ("exact", "preintegrated") */
     rt_scene_transfer_point transfer[RT_SCENE_MAX_TRANSFER];
     float ert_threshold;             /* 0 -> plugin default */
-    uint32_t tiles, update_c, workers, disable;
+    uint32_t tiles, update_c, workers;
     float model[16];
     rt_scene_volume_animation anim;  /* per-frame changes (none when all zero) */
 } rt_scene_volume;
@@ -194,7 +191,6 @@ typedef struct rt_scene {
     uint32_t beam_count;
     rt_scene_beam *beams;
     vfx_beams_view beams_view;       /* saturation, saturate_c, far_distance, bloom settings */
-    vfx_lab_beams beams_lab;         /* method, march samples (the ray-marching baseline) */
     bool has_water;
     rt_scene_water water;
     bool has_volume;

@@ -326,12 +326,11 @@ vfx_result rt_scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s)
     return VFX_OK;
 }
 
-vfx_result rt_scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv, vfx_lab_beams *lab)
+vfx_result rt_scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv)
 {
-    static const char *const keys[] = {"saturation", "c", "far_distance", "method", "march_samples",
-                                       "bloom", "bloom_strength", "bloom_levels", NULL};
+    static const char *const keys[] = {"saturation", "c", "far_distance", "bloom", "bloom_strength", "bloom_levels",
+                                       NULL};
     static const char *const sat[] = {"clamp", "smooth", NULL};
-    static const char *const meth[] = {"closed_form", "march", NULL};
     const char *P = "beam_settings";
     vfx_result r = rt_scene_expect_object(c, v, P);
     if (r)
@@ -340,8 +339,6 @@ vfx_result rt_scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view 
     r = rt_scene_get_enum(c, v, P, "saturation", false, sat, &bv->saturation);
     if (!r) r = rt_scene_get_float_row(c, v, P, "c", VFX_RANGE_BEAMS_C, &bv->saturate_c);
     if (!r) r = rt_scene_get_float_row(c, v, P, "far_distance", VFX_RANGE_BEAMS_FAR, &bv->far_distance);
-    if (!r) r = rt_scene_get_enum(c, v, P, "method", false, meth, &lab->method);
-    if (!r) r = rt_scene_get_uint_row(c, v, P, "march_samples", VFX_RANGE_BEAMS_MARCH_SAMPLES, &lab->march_samples);
     vfx_beams_view *bv2 = bv;
     bool bloom = true;
     if (!r && cJSON_GetObjectItemCaseSensitive(v, "bloom")) {

@@ -84,7 +84,7 @@ vfx_result rt_scene_point_value(pctx *c, const cJSON *v, const char *p, int n, f
 vfx_result rt_scene_get_point(pctx *c, const cJSON *obj, const char *path, const char *key, bool required,
                             float out[3]);
 vfx_result rt_scene_parse_beams(pctx *c, const cJSON *v, rt_scene *s);
-vfx_result rt_scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv, vfx_lab_beams *lab);
+vfx_result rt_scene_parse_beam_settings(pctx *c, const cJSON *v, vfx_beams_view *bv);
 vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w);
 vfx_result rt_scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol);
 bool rt_scene_ends_with(const char *s, const char *suffix);

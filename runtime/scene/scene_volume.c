@@ -108,7 +108,7 @@ static vfx_result parse_animation(pctx *c, const cJSON *a, rt_scene_volume_anima
 vfx_result rt_scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol)
 {
     static const char *const keys[] = {"path", "generator", "scalar", "transfer", "transfer_normalized",
-                                       "ert_threshold", "tiles", "update_c", "workers", "disable",
+                                       "ert_threshold", "tiles", "update_c", "workers",
                                        "translate", "rotate_deg", "scale", "matrix", "transfer_method", "animate", NULL};
     const char *P = "volume";
     vfx_result r = rt_scene_expect_object(c, v, P);
@@ -151,11 +151,6 @@ vfx_result rt_scene_parse_volume(pctx *c, const cJSON *v, rt_scene_volume *vol)
     if (!r) r = rt_scene_get_uint_row(c, v, P, "tiles", VFX_RANGE_VOLUME_TILES, &vol->tiles);
     if (!r) r = rt_scene_get_uint_row(c, v, P, "update_c", VFX_RANGE_VOLUME_UPDATE_C, &vol->update_c);
     if (!r) r = rt_scene_get_uint_row(c, v, P, "workers", VFX_RANGE_VOLUME_WORKERS, &vol->workers);
-    if (!r) {
-        static const char *const flags[] = {"ert", "share", "dlb", NULL};
-        static const uint32_t bits[] = {VFX_VOLUME_NO_ERT, VFX_VOLUME_NO_SHARE, VFX_VOLUME_NO_DLB};
-        r = rt_scene_get_flags(c, v, P, "disable", flags, bits, &vol->disable);
-    }
     if (!r) {
         char method[32] = "exact";
         r = rt_scene_get_string(c, v, P, "transfer_method", false, method, sizeof method);

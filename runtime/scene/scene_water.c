@@ -154,25 +154,19 @@ static vfx_result parse_water_simulation(pctx *c, const cJSON *v, rt_scene_water
     return VFX_OK;
 }
 
-/* water.quality (present): the method, its sample and step limits, the disabled stages and the
- * kernel; writes w->params (and w->lab for the baselines and ablation bits). */
+/* water.quality (present): the method, its sample and step limits, the features switched off and
+ * the kernel; writes w->params. The lab's baselines and ablation bits are no scene keys: tests and
+ * benches chain vfx_lab_water themselves. */
 static vfx_result parse_water_quality(pctx *c, const cJSON *q, rt_scene_water *w)
 {
     vfx_water_params *wp = &w->params;
     static const char *const qkeys[] = {"max_samples", "step", "refine_iters", "pyramid_level", "method",
                                         "disable", "kernel", "preset", NULL};
-    static const char *const methods[] = {"paper", "brute", "grid", "tile", NULL};
-    static const uint32_t method_ids[] = {VFX_WATER_METHOD_PAPER, VFX_WATER_METHOD_BRUTE, VFX_WATER_METHOD_GRID,
-                                          VFX_WATER_METHOD_TILE};
+    static const char *const methods[] = {"paper", "tile", NULL};
+    static const uint32_t method_ids[] = {VFX_WATER_METHOD_PAPER, VFX_WATER_METHOD_TILE};
     static const char *const presets[] = {"low", "medium", "high", "ultra", NULL};
-    static const char *const flags[] = {"billboard_init", "skip", "blend", "pack4", "pyramid", "refine",
-                                        "shading", "finish", "local_list", "subdivide", "tiles", "refract_trace",
-                                        "temporal", "half_res", "spray", "ssr", NULL};
-    static const uint32_t bits[] = {VFX_WATER_NO_BILLBOARD_INIT, VFX_WATER_NO_SKIP, VFX_WATER_NO_BLEND,
-                                    VFX_WATER_NO_PACK4, VFX_WATER_NO_PYRAMID, VFX_WATER_NO_REFINE,
-                                    VFX_WATER_NO_SHADING, VFX_WATER_NO_FINISH, VFX_WATER_NO_LOCAL_LIST,
-                                    VFX_WATER_NO_SUBDIVIDE, VFX_WATER_NO_TILES, VFX_WATER_NO_REFRACT_TRACE,
-                                    VFX_WATER_NO_TEMPORAL, VFX_WATER_NO_HALF_RES, VFX_WATER_NO_SPRAY, VFX_WATER_NO_SSR};
+    static const char *const flags[] = {"spray", "ssr", NULL};
+    static const uint32_t bits[] = {VFX_WATER_NO_SPRAY, VFX_WATER_NO_SSR}; /* vfx_water_params.features_off */
     vfx_result r;
     const char *PQ = "water.quality";
     if ((r = rt_scene_expect_object(c, q, PQ)))
@@ -182,23 +176,16 @@ static vfx_result parse_water_quality(pctx *c, const cJSON *q, rt_scene_water *w
     if (!r) r = rt_scene_get_float_row(c, q, PQ, "step", VFX_RANGE_WATER_STEP, &wp->step);
     if (!r) r = rt_scene_get_uint_row(c, q, PQ, "refine_iters", VFX_RANGE_WATER_REFINE_ITERS, &wp->refine_iters);
     if (!r) r = rt_scene_get_uint_row(c, q, PQ, "pyramid_level", VFX_RANGE_WATER_PYRAMID_LEVEL, &wp->pyramid_level);
-    uint32_t mi = 3;
+    uint32_t mi = 1;
     if (!r) r = rt_scene_get_enum(c, q, PQ, "method", false, methods, &mi);
-    /* the baselines are lab methods: chained as vfx_lab_water */
-    if (method_ids[mi] == VFX_WATER_METHOD_BRUTE || method_ids[mi] == VFX_WATER_METHOD_GRID)
-        w->lab.method = method_ids[mi];
-    else
-        wp->method = method_ids[mi];
+    wp->method = method_ids[mi];
     uint32_t method = method_ids[mi];
     if (!r && cJSON_GetObjectItemCaseSensitive(q, "preset")) {
         uint32_t pi = 0;
         r = rt_scene_get_enum(c, q, PQ, "preset", false, presets, &pi);
         wp->preset = VFX_WATER_PRESET_LOW + pi;
     }
-    uint32_t dis = 0;
-    if (!r) r = rt_scene_get_flags(c, q, PQ, "disable", flags, bits, &dis);
-    wp->features_off = dis & (VFX_WATER_NO_SPRAY | VFX_WATER_NO_SSR);
-    w->lab.disable = dis & ~(uint32_t)(VFX_WATER_NO_SPRAY | VFX_WATER_NO_SSR);
+    if (!r) r = rt_scene_get_flags(c, q, PQ, "disable", flags, bits, &wp->features_off);
     if (!r && cJSON_GetObjectItemCaseSensitive(q, "kernel")) {
         static const char *const kernels[] = {"isotropic", "anisotropic", NULL};
         uint32_t k = 0;
@@ -321,7 +308,6 @@ vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
     vfx_water_params *wp = &w->params;
     /* ours (TILE) unless water.quality.method names another */
     *wp = (vfx_water_params){.type = VFX_TYPE_WATER_PARAMS, .method = VFX_WATER_METHOD_TILE};
-    w->lab = (vfx_lab_water){.type = VFX_TYPE_LAB_WATER};
     /* the plugin's ranges (volfx_ranges.h) */
     r = rt_scene_get_float_row(c, v, P, "h", VFX_RANGE_WATER_H, &wp->h);
     if (!r) r = rt_scene_get_float_row(c, v, P, "threshold", VFX_RANGE_WATER_THRESHOLD, &wp->threshold);
@@ -343,7 +329,7 @@ vfx_result rt_scene_parse_water(pctx *c, const cJSON *v, rt_scene_water *w)
      * "low": flat water flat, sheets stay sheets; docs/water.md "Presets"), the seed's isotropic
      * kernel for the other methods */
     if (!r && wp->kernel == VFX_WATER_KERNEL_DEFAULT)
-        wp->kernel = wp->method == VFX_WATER_METHOD_TILE && !w->lab.method && wp->preset != VFX_WATER_PRESET_LOW
+        wp->kernel = wp->method == VFX_WATER_METHOD_TILE && wp->preset != VFX_WATER_PRESET_LOW
                          ? VFX_WATER_KERNEL_ANISOTROPIC
                          : VFX_WATER_KERNEL_ISOTROPIC;
     return r;

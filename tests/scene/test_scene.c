@@ -40,17 +40,16 @@ static void test_every_field(void **state)
         "\"color\":[0.1,0.2,0.3]},"
         "{\"box\":{\"min\":[0,0,0],\"max\":[1,2,3]},\"matrix\":[1,0,0,0,0,1,0,0,0,0,1,0,5,6,7,1]},"
         "{\"path\":\"/abs/x.ply\"}],"
-        "\"beam_settings\":{\"saturation\":\"clamp\",\"c\":2.5,\"far_distance\":30,\"method\":\"march\","
-        "\"march_samples\":64},"
+        "\"beam_settings\":{\"saturation\":\"clamp\",\"c\":2.5,\"far_distance\":30},"
         "\"beams\":[{\"head\":[1,2,3],\"dir\":[0,0,-1],\"length\":4,\"radius\":0.7,\"a\":0.1,\"b\":0.2,"
         "\"eps\":0.03,\"color\":[1,0.5,0.25,1],\"loop_s\":2}],"
         "\"water\":{\"source\":\"file\",\"path\":\"p.bin\",\"h\":0.3,\"threshold\":0.5,"
         "\"quality\":{\"max_samples\":32,\"step\":0.01,\"refine_iters\":5,\"pyramid_level\":2,"
-        "\"method\":\"grid\",\"disable\":[\"skip\",\"pack4\"]},\"color\":[0.2,0.4,0.6],"
+        "\"method\":\"paper\",\"disable\":[\"ssr\"]},\"color\":[0.2,0.4,0.6],"
         "\"absorption\":1.5,\"ior\":1.2},"
         "\"volume\":{\"path\":\"v/pipe.vtu\",\"scalar\":\"Velocity\",\"transfer\":[{\"scalar\":-1,"
         "\"rgba\":[0,0,0,0]},{\"scalar\":3,\"rgba\":[1,1,1,2]}],\"ert_threshold\":0.8,\"tiles\":8,"
-        "\"update_c\":4,\"workers\":2,\"disable\":[\"share\"],\"translate\":[0,0,-2]}}";
+        "\"update_c\":4,\"workers\":2,\"translate\":[0,0,-2]}}";
     test_log log = {0};
     rt_scene *s = NULL;
     char err[256];
@@ -82,8 +81,6 @@ static void test_every_field(void **state)
     assert_close(s->beams_view.saturate_c, 2.5);
     assert_close(s->beams_view.far_distance, 30);
     assert_int_equal(s->beams_view.type, VFX_TYPE_BEAMS_VIEW);
-    assert_int_equal(s->beams_lab.method, VFX_BEAMS_METHOD_MARCH);
-    assert_int_equal(s->beams_lab.march_samples, 64);
     assert_int_equal(s->beam_count, 1);
     const vfx_beam *b = &s->beams[0].base;
     assert_close(b->head[1], 2);
@@ -106,9 +103,8 @@ static void test_every_field(void **state)
     assert_close(wp->step, 0.01);
     assert_int_equal(wp->refine_iters, 5);
     assert_int_equal(wp->pyramid_level, 2);
-    assert_int_equal(s->water.lab.method, VFX_WATER_METHOD_GRID); /* a lab method: chained by the host */
-    assert_int_equal(s->water.lab.disable, VFX_WATER_NO_SKIP | VFX_WATER_NO_PACK4);
-    assert_int_equal(wp->features_off, 0);
+    assert_int_equal(wp->method, VFX_WATER_METHOD_PAPER);
+    assert_int_equal(wp->features_off, VFX_WATER_NO_SSR);
     assert_close(wp->color[1], 0.4);
     assert_close(wp->absorption, 1.5);
     assert_close(wp->ior, 1.2);
@@ -122,7 +118,6 @@ static void test_every_field(void **state)
     assert_int_equal(s->volume.tiles, 8);
     assert_int_equal(s->volume.update_c, 4);
     assert_int_equal(s->volume.workers, 2);
-    assert_int_equal(s->volume.disable, VFX_VOLUME_NO_SHARE);
     assert_close(s->volume.model[14], -2);
     rt_scene_free(s);
 }
@@ -149,7 +144,7 @@ static void test_defaults(void **state)
         {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"kernel\":\"anisotropic\"}}}", VFX_WATER_KERNEL_ANISOTROPIC},
         {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"kernel\":\"isotropic\"}}}", VFX_WATER_KERNEL_ISOTROPIC},
         {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"method\":\"paper\"}}}", VFX_WATER_KERNEL_ISOTROPIC},
-        {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"method\":\"grid\",\"kernel\":\"isotropic\"}}}",
+        {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"method\":\"paper\",\"kernel\":\"isotropic\"}}}",
          VFX_WATER_KERNEL_ISOTROPIC},
     };
     for (size_t k = 0; k < sizeof kcases / sizeof kcases[0]; ++k) {
@@ -284,8 +279,13 @@ static const bad_case bad_cases[] = {
      "\"fluid\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_count\":10,\"solver\":\"wcsph\",\"device\":\"gpu\"}}}",
      VFX_ERR_INVALID_ARGUMENT, "water.simulation.device: \"gpu\" runs the PBF solver only"},
     {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"h\":0}}", VFX_ERR_INVALID_ARGUMENT, "water.h: must be >= 1e-12, got 0"},
-    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"disable\":[\"pyramid\",\"magic\"]}}}",
+    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"disable\":[\"spray\",\"magic\"]}}}",
      VFX_ERR_INVALID_ARGUMENT, "water.quality.disable[1]: unknown flag \"magic\""},
+    /* the lab's baselines and ablation bits are no scene keys (tests and benches chain the lab) */
+    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"method\":\"grid\"}}}",
+     VFX_ERR_INVALID_ARGUMENT, "water.quality.method: unknown value \"grid\"; expected one of \"paper\", \"tile\""},
+    {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"disable\":[\"pyramid\"]}}}",
+     VFX_ERR_INVALID_ARGUMENT, "water.quality.disable[0]: unknown flag \"pyramid\""},
     {"{\"water\":{\"source\":\"file\",\"path\":\"p\",\"quality\":{\"max_samples\":0}}}", VFX_ERR_INVALID_ARGUMENT,
      "water.quality.max_samples: must be >= 1"},
     {"{\"volume\":{}}", VFX_ERR_FORMAT, "volume: needs exactly one of"},

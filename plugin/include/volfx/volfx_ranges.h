@@ -101,7 +101,7 @@
     X(BEAMS_JOINT_COUNT, "vfx_beams_view.joint_count", "-", 0, 0, VFX_RANGE_ANY, "the joints array's triples") \
     X(BEAMS_C, "vfx_beams_view.saturate_c", "beam_settings.c", 0, 1e6, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "") \
     X(BEAMS_FAR, "vfx_beams_view.far_distance", "beam_settings.far_distance", 0, 1e6, 0, "0: the camera's far plane") \
-    X(BEAMS_MARCH_SAMPLES, "vfx_lab_beams.march_samples", "beam_settings.march_samples", 1, 4096, VFX_RANGE_INT | VFX_RANGE_ZERO, "") \
+    X(BEAMS_MARCH_SAMPLES, "vfx_lab_beams.march_samples", "-", 1, 4096, VFX_RANGE_INT | VFX_RANGE_ZERO, "") \
     X(BEAMS_BLOOM_STRENGTH, "vfx_beams_view.bloom_strength", "beam_settings.bloom_strength", 0, 1e6, 0, "0: 0.6") \
     X(BEAMS_BLOOM_LEVELS, "vfx_beams_view.bloom_levels", "beam_settings.bloom_levels", 1, 8, VFX_RANGE_INT | VFX_RANGE_ZERO, "") \
     X(VOLUME_POINT_COUNT, "vfx_volume_view.point_count", "-", 0, 0, VFX_RANGE_ANY, "the points array's; every tet index is checked against it") \
