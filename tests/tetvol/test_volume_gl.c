@@ -15,6 +15,7 @@
 
 #include "app.h"
 #include "demo_scene.h"
+#include "volfx_lab.h"
 #include "tet_testmesh.h"
 #include "debug.h"
 #include "depth_modes.h"
@@ -338,7 +339,7 @@ static void test_file_volume_in_scene(void **state)
     assert_non_null(f);
     fprintf(f, "{\"version\": 1, \"origin\": [0, 0, 0], \"name\": \"vtu64\", \"camera\": {\"eye\": [0.9, 1.3, 3.4], \"target\": [0, 0, 0],"
                " \"up\": [0, 1, 0], \"fov_y_deg\": 55, \"width\": %d, \"height\": %d, \"near\": 0.1, \"far\": 50},"
-               " \"volume\": {\"path\": \"grid.vtu\", \"scalar\": \"f\", \"workers\": 1, \"disable\": [\"ert\"], \"transfer\": [", W, H);
+               " \"volume\": {\"path\": \"grid.vtu\", \"scalar\": \"f\", \"workers\": 1, \"transfer\": [", W, H);
     for (int i = 0; i < 64; ++i) {
         double u = i < 40 ? 0.58 * i / 39.0 : i < 43 ? 0.595 + 0.005 * (i - 40) : 0.61 + 0.39 * (i - 43) / 20.0;
         tet_tf_point *p = &pts[i];
@@ -355,6 +356,9 @@ static void test_file_volume_in_scene(void **state)
     game_app_remove(g_app, g_vol); /* the scene's volume replaces it (stale after the first) */
     game_demo demo;
     assert_int_equal(game_demo_load(g_app, &demo, scene, 0), VFX_OK);
+    /* no early ray termination, as the float64 reference (a lab switch: chained by the test) */
+    vfx_lab_volume lab = {.type = VFX_TYPE_LAB_VOLUME, .disable = VFX_VOLUME_NO_ERT};
+    game_app_volume(g_app, demo.spawned.volume)->next = &lab;
     float *a = render_alpha();
     free(a);
     a = render_alpha(); /* the second frame clips with this scene's distances */
