@@ -507,35 +507,21 @@ void rt_sph_gpu_impulse(rt_sph_gpu *g, const float centre[3], const float dir[3]
     g->vmax_known += speed; /* an impulse adds at most speed to a particle's */
 }
 
-static double gpu_cpu_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
 vfx_result rt_sph_gpu_settle(rt_sph_gpu *g, const rt_sph_settle_desc *desc, rt_sph_settle_report *rep, char *err,
                              size_t errlen)
 {
-    rt_sph_settle_desc d = desc ? *desc : (rt_sph_settle_desc){0};
+    rt_sph_settle_desc d;
     rt_sph_settle_report out = {0};
     if (rep)
         *rep = out;
     if (!g)
         return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_gpu_settle: NULL solver");
-    if (!(d.step_dt >= 0.f) || !isfinite(d.step_dt) || !(d.damping >= 0.f && d.damping <= 1.f) ||
-        !(d.speed_tol >= 0.f) || !isfinite(d.speed_tol))
-        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_gpu_settle: step_dt %g, damping %g or "
-                       "speed_tol %g out of range (finite, >= 0; damping <= 1)", (double)d.step_dt,
-                       (double)d.damping, (double)d.speed_tol);
-    /* rt_sph_settle's defaults and stopping rule */
-    d.max_steps = d.max_steps ? d.max_steps : 120u;
-    d.step_dt = d.step_dt > 0.f ? d.step_dt : 1.f / 60.f;
-    d.damping = d.damping > 0.f ? d.damping : 0.9f;
-    d.speed_tol = d.speed_tol > 0.f ? d.speed_tol : 0.03f;
-    d.progress_every = d.progress_every ? d.progress_every : 20u;
+    /* rt_sph_settle's checks, defaults and stopping rule */
+    vfx_result rr = rt_sph_settle_resolve(desc, &d, "rt_sph_gpu_settle", err, errlen);
+    if (rr != VFX_OK)
+        return rr;
     rt_sph *s = g->s;
-    const double t_start = s->time, c0 = gpu_cpu_s();
+    const double t_start = s->time, c0 = rt_sph_process_cpu_s();
     const bool sync = g->sync;
     g->sync = true;
     vfx_result r = VFX_OK;
@@ -561,7 +547,7 @@ vfx_result rt_sph_gpu_settle(rt_sph_gpu *g, const rt_sph_settle_desc *desc, rt_s
     g->sync = sync;
     s->time = t_start;
     rt_sph_update_colliders(s, t_start);
-    out.cpu_s = gpu_cpu_s() - c0;
+    out.cpu_s = rt_sph_process_cpu_s() - c0;
     if (rep)
         *rep = out;
     return r;

@@ -254,5 +254,11 @@ bool rt_sph_pbf_may_reach_wall(const rt_sph *s, uint32_t i, const float p[3]);
 
 /* sph_emit.c: runs the emitters for dt (0 on the first substep); count added to *emitted */
 vfx_result rt_sph_emit(rt_sph *s, double dt, uint32_t *emitted, char *err, size_t errlen);
+/* rt_sph_settle's desc checked (refused naming `who`) and its zero fields given the defaults, for
+ * the CPU and GPU settles alike. */
+vfx_result rt_sph_settle_resolve(const rt_sph_settle_desc *desc, rt_sph_settle_desc *out, const char *who,
+                                 char *err, size_t errlen);
+/* The process's CPU seconds (all threads), for the settle reports. */
+double rt_sph_process_cpu_s(void);
 
 #endif

@@ -12,34 +12,44 @@
 
 #include <time.h>
 
-static double settle_cpu_s(void)
+double rt_sph_process_cpu_s(void)
 {
     struct timespec t;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
+vfx_result rt_sph_settle_resolve(const rt_sph_settle_desc *desc, rt_sph_settle_desc *d, const char *who, char *err,
+                                 size_t errlen)
+{
+    *d = desc ? *desc : (rt_sph_settle_desc){0};
+    if (!(d->step_dt >= 0.f) || !isfinite(d->step_dt) || !(d->damping >= 0.f && d->damping <= 1.f) ||
+        !(d->speed_tol >= 0.f) || !isfinite(d->speed_tol)) {
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "%s: step_dt %g, damping %g or speed_tol "
+                       "%g out of range (finite, >= 0; damping <= 1)", who, (double)d->step_dt,
+                       (double)d->damping, (double)d->speed_tol);
+    }
+    d->max_steps = d->max_steps ? d->max_steps : 120u;
+    d->step_dt = d->step_dt > 0.f ? d->step_dt : 1.f / 60.f;
+    d->damping = d->damping > 0.f ? d->damping : 0.9f;
+    d->speed_tol = d->speed_tol > 0.f ? d->speed_tol : 0.03f;
+    d->progress_every = d->progress_every ? d->progress_every : 20u;
+    return VFX_OK;
+}
+
 vfx_result rt_sph_settle(rt_sph *s, const rt_sph_settle_desc *desc, rt_sph_settle_report *rep, char *err,
                          size_t errlen)
 {
-    rt_sph_settle_desc d = desc ? *desc : (rt_sph_settle_desc){0};
+    rt_sph_settle_desc d;
     rt_sph_settle_report out = {0};
     if (rep)
         *rep = out;
     if (!s)
         return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_settle: NULL solver");
-    if (!(d.step_dt >= 0.f) || !isfinite(d.step_dt) || !(d.damping >= 0.f && d.damping <= 1.f) ||
-        !(d.speed_tol >= 0.f) || !isfinite(d.speed_tol)) {
-        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_settle: step_dt %g, damping %g or speed_tol "
-                       "%g out of range (finite, >= 0; damping <= 1)", (double)d.step_dt, (double)d.damping,
-                       (double)d.speed_tol);
-    }
-    d.max_steps = d.max_steps ? d.max_steps : 120u;
-    d.step_dt = d.step_dt > 0.f ? d.step_dt : 1.f / 60.f;
-    d.damping = d.damping > 0.f ? d.damping : 0.9f;
-    d.speed_tol = d.speed_tol > 0.f ? d.speed_tol : 0.03f;
-    d.progress_every = d.progress_every ? d.progress_every : 20u;
-    const double t_start = s->time, c0 = settle_cpu_s();
+    vfx_result rr = rt_sph_settle_resolve(desc, &d, "rt_sph_settle", err, errlen);
+    if (rr != VFX_OK)
+        return rr;
+    const double t_start = s->time, c0 = rt_sph_process_cpu_s();
     const uint32_t nem = s->nem; /* the emitters wait for frame 0 */
     s->nem = 0;
     vfx_result r = VFX_OK;
@@ -66,7 +76,7 @@ vfx_result rt_sph_settle(rt_sph *s, const rt_sph_settle_desc *desc, rt_sph_settl
     s->nem = nem;
     s->time = t_start;
     rt_sph_update_colliders(s, t_start);
-    out.cpu_s = settle_cpu_s() - c0;
+    out.cpu_s = rt_sph_process_cpu_s() - c0;
     if (rep)
         *rep = out;
     return r;
