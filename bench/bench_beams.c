@@ -15,8 +15,8 @@
 #include <string.h>
 #include <time.h>
 
-#include "beams/beam_field.h"
-#include "beam_field_f.h"
+#include "lab/beam_field_d.h"
+#include "lab/beam_field_f.h"
 #include "beams_ref.h"
 
 typedef struct bench_scene {

@@ -9,7 +9,7 @@
 
 #include "app.h"
 #include "volfx_lab.h"
-#include "beams/beam_field.h"
+#include "lab/beam_field_d.h"
 #include "beams_ref.h"
 #include "camera_ref.h"
 

@@ -4,7 +4,7 @@
 #define REF_BEAMS_REF_H
 
 #include <stdint.h>
-#include "beams/beam_field.h"
+#include "lab/beam_field_d.h"
 
 /* H along origin + t*dir (|dir| = 1) over [t0, t1], summed over n beams, relative accuracy
  * about `rel_tol`. Breakpoints at support and slab boundaries and closest approaches, so the

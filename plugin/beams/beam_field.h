@@ -1,4 +1,4 @@
-/* beam_field.h — the beam density field (issue 5) and its closed-form line integral.
+/* beam_field.h — the beam density field and its closed-form line integral.
  *
  * One beam: head M, unit direction D, length L, strengths a (head) and b (trail), softening
  * eps, support radius R:
@@ -11,8 +11,10 @@
  * each piece is an integral of 1/sqrt((s x + beta)^2 + Q^2), done by volfx_beam_segment_integral.
  * The softening is floored at VOLFX_BEAM_EPS_FLOOR * R so that eps = 0 with a ray exactly
  * through M or the axis gives a large finite H, not Inf/NaN (the reference uses the same floor).
- * docs/beams.md has the derivation; shaders/beams/beam_field.glsl is the float32 closed form the
- * effect runs, checked against the float64 references by the tests (tests/beams/beam_probe.h). */
+ * docs/beams-method.md has the derivation; shaders/beams/beam_field.glsl is the float32 closed form
+ * the effect runs, checked by the tests (tests/beams/beam_probe.h) against the lab's float64
+ * references (plugin/lab/beam_field_d.h: the C closed form and the density). This header holds
+ * what the effect needs at run time: the float64 beam, its validation, joints and bounds. */
 #ifndef VOLFX_BEAM_FIELD_H
 #define VOLFX_BEAM_FIELD_H
 
@@ -46,26 +48,7 @@ vfx_result volfx_beam_validate(const vfx_beam *in, volfx_beam_d *out, char *err,
  * VFX_ERR_INVALID_ARGUMENT with a message otherwise. */
 vfx_result volfx_beam_set_joints(volfx_beam_d *bm, const float *xyz, uint32_t count, char *err, size_t errlen);
 
-/* Integral over x in [x0, x1] of 1/sqrt((s x + beta)^2 + Q^2), s >= 0, Q > 0, without
- * cancellation (float64; the lab's beam_field_f.h has the float32 instance). */
-double volfx_beam_segment_integral_d(double x0, double x1, double s, double beta, double Q);
-/* The smooth support's piece: integral over x in [x0, x1] of (h^2 - y^2)^2 / sqrt(y^2 + Q^2),
- * y = s x + beta, for |y| <= h (values in units of R, h and Q of order 1 or less). */
-double volfx_beam_segment_integral_smooth_d(double x0, double x1, double s, double beta, double Q,
-                                            double h);
-
-/* H of one beam along the ray origin + t*dir (|dir| = 1), t in [t0, t1], float64 (the shader is
- * the float32 closed form; the lab's beam_field_f.h a C float32 instance for the benches). */
-double volfx_beam_integral_d(const volfx_beam_d *beam, const double origin[3], const double dir[3],
-                           double t0, double t1);
-
-/* The body's radius multiplier R(u) / radius at u (1 without a profile), float64. */
-double volfx_beam_profile_d(const volfx_beam_d *beam, double u);
-
 /* The largest support radius of any piece (head, orb, body at its widest): bounds for culling. */
 double volfx_beam_max_radius(const volfx_beam_d *beam);
-
-/* The density at a point (float64), for references and tests. */
-double volfx_beam_density_d(const volfx_beam_d *beam, const double p[3]);
 
 #endif

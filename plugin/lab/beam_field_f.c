@@ -1,6 +1,7 @@
-/* beam_field_f.c — the lab's float32 instance of the closed form (beam_field_impl.inc, the
- * float path the shader beams/beam_field.glsl mirrors), for the CPU benches (bench_beams). The
- * product runs the shader, which the tests check themselves (tests/beams/beam_probe.h). */
+/* beam_field_f.c — the lab's float32 instance of the C closed form (beam_field_impl.inc; its
+ * float path is the one the shader beams/beam_field.glsl mirrors), for the CPU benches
+ * (bench_beams). The product runs the shader, which the tests check themselves
+ * (tests/beams/beam_probe.h). */
 #include "beam_field_f.h"
 
 #include <math.h>
@@ -30,20 +31,9 @@ static float log1p_over_f(float z)
 #define R_EDGE_TERMS 12   /* (1/4)^12 = 6e-8 */
 #define R_GRAZING_M 0.25f /* the closed form loses at most ~60 ulps above it (3.7e-6 seen) */
 #define R_SERIES_TERMS 12 /* (1/4)^12 = 6e-8: under float epsilon */
-#include "beams/beam_field_impl.inc"
-#undef REAL
-#undef SFX
-#undef R_SQRT
-#undef R_COS
-#undef R_FLOOR
-#undef R_FMA
-#undef R_FABS
-#undef R_LOG1P_OVER
-#undef R_SERIES_TERMS
-#undef R_EDGE_TERMS
-#undef R_GRAZING_M
+#include "beam_field_impl.inc"
 
-#include "beams/beam_field_anat.h"
+#include "beam_field_anat.h"
 
 #define SFXF(n) n##_f
 

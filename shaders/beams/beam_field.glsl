@@ -1,5 +1,5 @@
 // beam_field.glsl — the closed-form beam integral, line for line the float path of
-// plugin/beams/beam_field_impl.inc (docs/beams.md has the derivation). Positions are relative
+// plugin/lab/beam_field_impl.inc (docs/beams.md has the derivation). Positions are relative
 // to the eye, so the ray origin is 0 and far beams keep their digits.
 
 const float VOLFX_BEAM_EPS_FLOOR = 1e-6;

@@ -65,7 +65,7 @@ static inline bool beam_probe_eval(vfx_context *ctx, const beam_probe_ray *rays,
         c[i].ab_eps[0] = (float)b->a, c[i].ab_eps[1] = (float)b->b, c[i].ab_eps[2] = (float)b->eps;
         c[i].ab_eps[3] = b->smooth ? 1.f : 0.f;
         c[i].an0[0] = (float)b->head_radius, c[i].an0[1] = (float)b->orb_radius, c[i].an0[2] = (float)b->orb_a;
-        if (b->joint_count < 2) { /* a polyline has no body profile (beam_field.c anatomy_d) */
+        if (b->joint_count < 2) { /* a polyline has no body profile (beam_field_anat.h anatomy_d) */
             c[i].an1[0] = (float)b->taper, c[i].an1[1] = (float)b->surge;
             c[i].an1[2] = (float)b->surge_inv_wl, c[i].an1[3] = (float)b->surge_phase;
         }

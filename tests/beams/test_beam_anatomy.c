@@ -24,7 +24,7 @@
 
 #include <cmocka.h>
 
-#include "beams/beam_field.h"
+#include "lab/beam_field_d.h"
 #include "beams_ref.h"
 #include "beam_probe.h"
 

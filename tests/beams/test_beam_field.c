@@ -2,7 +2,7 @@
  * (reference/beams_ref.c): a torture set of singular and near-singular rays plus seeded random
  * beams and rays. The float32 closed form is the shader's own, shaders/beams/beam_field.glsl run
  * on these rays by a compute probe (beam_probe.h) on the test's GL (llvmpipe in CI); the float64
- * one is plugin/beams/beam_field.c's.
+ * one is the lab's C closed form, plugin/lab/beam_field_d.c.
  *
  * Tolerances.
  *  - float32 closed form (GLSL): relative error <= 1e-6 + cond, where cond is the spread of the exact
@@ -25,7 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "beams/beam_field.h"
+#include "lab/beam_field_d.h"
 #include "beams_ref.h"
 #include "beam_probe.h"
 

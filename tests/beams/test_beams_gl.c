@@ -15,6 +15,7 @@
 #include "app.h"
 #include "volfx_lab.h"
 #include "beams_ref.h"
+#include "lab/beam_field_d.h"
 #include "debug.h"
 #include "depth_modes.h"
 #include "test_camera.h"

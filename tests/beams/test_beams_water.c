@@ -16,6 +16,7 @@
 
 #include "app.h"
 #include "beams_ref.h"
+#include "lab/beam_field_d.h"
 #include "beams/beams_impact.h"
 #include "debug.h"
 #include "test_camera.h"

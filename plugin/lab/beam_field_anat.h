@@ -1,6 +1,6 @@
-/* beam_field_anat.h — the anatomy as the closed form reads it, shared by the float64 instance
- * (beam_field.c) and the lab's float32 one (plugin/lab/beam_field_f.c). Include after an instance
- * of beam_field_impl.inc (POLY_ANATOMY calls its prim_piece). */
+/* beam_field_anat.h — the anatomy as the C closed form reads it, shared by the lab's float64
+ * instance (beam_field_d.c) and its float32 one (beam_field_f.c). Include after an instance of
+ * beam_field_impl.inc (POLY_ANATOMY calls its prim_piece). */
 #ifndef VOLFX_BEAM_FIELD_ANAT_H
 #define VOLFX_BEAM_FIELD_ANAT_H
 
