@@ -12,19 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pbf_cases.h"
 #include "sim/sph.h"
-
-static rt_sph *make(rt_sph_desc d)
-{
-    rt_sph *s = NULL;
-    char err[256];
-    d.solver = RT_SPH_SOLVER_PBF;
-    vfx_result r = rt_sph_create(&d, &s, err, sizeof err);
-    if (r)
-        fprintf(stderr, "create: %s\n", err);
-    assert_int_equal(r, VFX_OK);
-    return s;
-}
 
 static void check_state(rt_sph *s)
 {
@@ -41,16 +30,10 @@ static void check_state(rt_sph *s)
     }
 }
 
-static rt_sph_desc small_box(void)
-{
-    rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.1f, 0.2f, 0.06f}, .threads = 2};
-    return d;
-}
-
 static void test_pbf_params(void **state)
 {
     (void)state;
-    rt_sph *s = make(small_box());
+    rt_sph *s = pbf_make(pbf_small_box(2));
     const rt_sph_desc *p = rt_sph_params(s);
     assert_int_equal(p->solver, RT_SPH_SOLVER_PBF);
     assert_int_equal(p->pbf_iterations, 5);
@@ -58,7 +41,7 @@ static void test_pbf_params(void **state)
     assert_true(fabsf(p->pbf_relaxation - 0.5f) < 1e-9f);
     assert_true(fabsf(p->pbf_max_step - 1.f / 60.f) < 1e-9f);
     rt_sph_destroy(s);
-    rt_sph_desc bad = small_box();
+    rt_sph_desc bad = pbf_small_box(2);
     bad.solver = 7;
     rt_sph *t = NULL;
     char err[256];
@@ -85,7 +68,7 @@ static double pbf_one_step(uint32_t iters, bool chebyshev, float **ref, uint32_t
 {
     rt_sph_desc d = {.spacing = 0.01f, .domain_min = {-0.05f, -0.05f, -0.05f}, .domain_max = {0.05f, 0.4f, 0.05f},
                       .threads = 2, .flags = chebyshev ? 0u : RT_SPH_PBF_NO_CHEBYSHEV, .pbf_iterations = iters};
-    rt_sph *s = make(d);
+    rt_sph *s = pbf_make(d);
     enum { N = 10 };
     static float x[N * N * N], y[N * N * N], z[N * N * N];
     uint32_t n = 0;
@@ -155,12 +138,7 @@ static void test_pbf_chebyshev_converges(void **state)
 static void test_pbf_all_at_one_point(void **state)
 {
     (void)state;
-    rt_sph *s = make(small_box());
-    enum { N = 300 };
-    float x[N], y[N], z[N];
-    for (int i = 0; i < N; ++i)
-        x[i] = 0.05f, y[i] = 0.1f, z[i] = 0.03f;
-    assert_int_equal(rt_sph_add_particles(s, N, x, y, z, NULL, NULL, NULL, NULL, 0), VFX_OK);
+    rt_sph *s = pbf_case_one_point(2);
     rt_sph_report r;
     assert_int_equal(rt_sph_step(s, 0.f, &r, NULL, 0), VFX_OK);
     assert_true(r.max_density_error > 10.f);
@@ -182,12 +160,7 @@ static void test_pbf_all_at_one_point(void **state)
 static void test_pbf_speed_cap(void **state)
 {
     (void)state;
-    rt_sph_desc d = small_box();
-    d.velocity_limit = 1.f;
-    rt_sph *s = make(d);
-    float x[3] = {0.02f, 0.05f, 0.08f}, y[3] = {0.1f, 0.1f, 0.1f}, z[3] = {0.03f, 0.03f, 0.03f};
-    float vy[3] = {0.f, 0.f, -50.f};
-    assert_int_equal(rt_sph_add_particles(s, 3, x, y, z, NULL, vy, NULL, NULL, 0), VFX_OK);
+    rt_sph *s = pbf_case_speed_cap(2);
     rt_sph_report r;
     assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, NULL, 0), VFX_OK);
     check_state(s);
@@ -200,13 +173,7 @@ static void test_pbf_speed_cap(void **state)
 static void test_pbf_thin_wall(void **state)
 {
     (void)state;
-    rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.2f, 0.3f, 0.04f}, .threads = 2};
-    rt_sph *s = make(d);
-    rt_sph_collider wall = {.kind = RT_SPH_BOX, .center = {0.1f, 0.08f, 0.02f}, .half = {0.3f, 0.005f, 0.3f}};
-    /* wider than the domain: its nearest face is always the top or the bottom */
-    assert_int_equal(rt_sph_add_collider(s, &wall, NULL, NULL, 0), VFX_OK);
-    float lo[3] = {0.06f, 0.15f, 0}, hi[3] = {0.14f, 0.28f, 0.04f};
-    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
+    rt_sph *s = pbf_case_thin_wall(2);
     rt_sph_report r;
     for (int f = 0; f < 60; ++f) {
         assert_int_equal(rt_sph_step(s, 1.f / 60.f, &r, NULL, 0), VFX_OK);
@@ -228,7 +195,7 @@ static void test_pbf_threads_bitwise(void **state)
     for (int t = 0; t < 2; ++t) {
         rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.3f, 0.2f, 0.1f},
                           .threads = (uint32_t)(t + 1)};
-        s[t] = make(d);
+        s[t] = pbf_make(d);
         float lo[3] = {0, 0, 0}, hi[3] = {0.12f, 0.2f, 0.1f};
         assert_int_equal(rt_sph_add_block(s[t], lo, hi, NULL, NULL, 0), VFX_OK); /* 2,400: 3 chunks */
         rt_sph_report r;
@@ -260,7 +227,7 @@ static void test_pbf_stored_pairs_bitwise(void **state)
         for (int m = 0; m < 2; ++m) {
             rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.2f, 0.25f, 0.06f},
                               .threads = 2, .flags = m ? RT_SPH_PBF_RECOMPUTE : 0u};
-            s[m] = make(d);
+            s[m] = pbf_make(d);
             if (c == 0) {
                 rt_sph_collider p = {.kind = RT_SPH_BOX, .center = {0.14f, 0.05f, 0.03f}, .half = {0.005f, 0.05f, 0.03f},
                                       .motion_axis = {1, 0, 0}, .motion_amplitude = 0.03f, .motion_frequency = 2.f};
@@ -303,7 +270,7 @@ static void test_pbf_paddle_ramp(void **state)
     const double times[3] = {1.0 / 60.0, 0.25, 1.5};
     for (int m = 0; m < 2; ++m) {
         rt_sph_desc d = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {1.f, 0.5f, 0.2f}, .threads = 1};
-        rt_sph *s = make(d);
+        rt_sph *s = pbf_make(d);
         rt_sph_collider c = {.kind = RT_SPH_BOX, .center = {0.3f, 0.25f, 0.1f}, .half = {0.01f, 0.25f, 0.1f},
                               .motion_axis = {1, 0, 0}, .motion_amplitude = (float)A, .motion_frequency = (float)f,
                               .motion_ramp_s = m ? 0.f : (float)ramp};
@@ -328,7 +295,7 @@ static void test_pbf_paddle_ramp(void **state)
         rt_sph_destroy(s);
     }
     rt_sph_collider bad = {.kind = RT_SPH_BOX, .half = {1, 1, 1}, .motion_ramp_s = -1.f};
-    rt_sph *s = make(small_box());
+    rt_sph *s = pbf_make(pbf_small_box(2));
     assert_int_equal(rt_sph_add_collider(s, &bad, NULL, NULL, 0), VFX_ERR_INVALID_ARGUMENT);
     rt_sph_destroy(s);
 }
@@ -345,7 +312,7 @@ static void test_pbf_paddle_velocity_and_settle(void **state)
     (void)state;
     const double A = 0.1, f = 1.0, pi = 3.14159265358979323846;
     rt_sph_desc d = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {1.f, 0.5f, 0.2f}, .threads = 1};
-    rt_sph *s = make(d);
+    rt_sph *s = pbf_make(d);
     rt_sph_collider c = {.kind = RT_SPH_BOX, .center = {0.3f, 0.25f, 0.1f}, .half = {0.01f, 0.25f, 0.1f},
                           .motion_axis = {1, 0, 0}, .motion_amplitude = (float)A, .motion_frequency = (float)f,
                           .motion_ramp_s = 1.f};
@@ -378,7 +345,7 @@ static void test_pbf_paddle_velocity_and_settle(void **state)
     rt_sph *t[2];
     for (int k = 0; k < 2; ++k) {
         rt_sph_desc dd = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {0.6f, 0.4f, 0.3f}, .threads = 1};
-        t[k] = make(dd);
+        t[k] = pbf_make(dd);
         rt_sph_collider pc = {.kind = RT_SPH_BOX, .center = {0.15f, 0.2f, 0.15f}, .half = {0.01f, 0.2f, 0.15f},
                                .motion_axis = {1, 0, 0}, .motion_amplitude = k ? 0.f : 0.1f, .motion_frequency = 0.5f,
                                .motion_ramp_s = 2.f};
@@ -405,10 +372,7 @@ static void test_pbf_paddle_velocity_and_settle(void **state)
 static void test_pbf_closed_tank_energy(void **state)
 {
     (void)state;
-    rt_sph_desc d = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {0.6f, 0.4f, 0.3f}, .threads = 2};
-    rt_sph *s = make(d);
-    float lo[3] = {0, 0, 0}, hi[3] = {0.6f, 0.12f, 0.3f};
-    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
+    rt_sph *s = pbf_case_pool(2);
     rt_sph_report r;
     assert_int_equal(rt_sph_step(s, 0.f, &r, NULL, 0), VFX_OK);
     double e0 = r.kinetic_energy + r.potential_energy, prev = e0, vmax = 0;
@@ -441,10 +405,7 @@ static void test_pbf_settled_tank_at_rest(void **state)
     (void)state;
     float vmax[2] = {0.f, 0.f};
     for (int k = 0; k < 2; ++k) {
-        rt_sph_desc d = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {0.6f, 0.4f, 0.3f}, .threads = 2};
-        rt_sph *s = make(d);
-        float lo[3] = {0, 0, 0}, hi[3] = {0.6f, 0.12f, 0.3f};
-        assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
+        rt_sph *s = pbf_case_pool(2);
         if (k) {
             rt_sph_settle_desc sd = {.max_steps = 120};
             rt_sph_settle_report sr;
@@ -477,7 +438,7 @@ static void test_pbf_settled_tank_at_rest(void **state)
     assert_true(vmax[0] > 0.3f);
     assert_true(vmax[1] < 0.15f);
     /* bad arguments are refused by name */
-    rt_sph *s = make(small_box());
+    rt_sph *s = pbf_make(pbf_small_box(2));
     char err[256];
     rt_sph_settle_desc bad = {.damping = 1.5f};
     assert_int_equal(rt_sph_settle(s, &bad, NULL, err, sizeof err), VFX_ERR_INVALID_ARGUMENT);
@@ -510,10 +471,7 @@ static void test_pbf_resting_pool_every_dt(void **state)
     (void)state;
     const float hs[4] = {1e-5f, 1e-3f, 1.f / 60.f, 0.1f};
     for (int k = 0; k < 4; ++k) {
-        rt_sph_desc d = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {0.6f, 0.4f, 0.3f}, .threads = 2};
-        rt_sph *s = make(d);
-        float lo[3] = {0, 0, 0}, hi[3] = {0.6f, 0.12f, 0.3f};
-        assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
+        rt_sph *s = pbf_case_pool(2);
         rt_sph_settle_desc sd = {.max_steps = 120};
         rt_sph_settle_report sr;
         assert_int_equal(rt_sph_settle(s, &sd, &sr, NULL, 0), VFX_OK);
@@ -546,7 +504,7 @@ static void test_pbf_free_block_energy(void **state)
     for (int k = 0; k < 2; ++k) {
         rt_sph_desc d = {.spacing = 0.05f, .domain_min = {-1, -1, -1}, .domain_max = {1, 1, 1}, .threads = 2,
                           .flags = RT_SPH_NO_GRAVITY, .pbf_scorr_k = k ? 0.001f : 0.f};
-        rt_sph *s = make(d);
+        rt_sph *s = pbf_make(d);
         float lo[3] = {-0.3f, -0.3f, -0.3f}, hi[3] = {0.3f, 0.3f, 0.3f};
         assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
         rt_sph_columns c = rt_sph_get_columns(s);

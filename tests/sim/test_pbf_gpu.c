@@ -13,21 +13,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pbf_cases.h"
 #include "sim/sph.h"
 #include "sim/sph_gpu.h"
 #include "test_util.h"
-
-static rt_sph *make(rt_sph_desc d)
-{
-    rt_sph *s = NULL;
-    char err[256];
-    d.solver = RT_SPH_SOLVER_PBF;
-    vfx_result r = rt_sph_create(&d, &s, err, sizeof err);
-    if (r)
-        fprintf(stderr, "create: %s\n", err);
-    assert_int_equal(r, VFX_OK);
-    return s;
-}
 
 static rt_sph_gpu *make_gpu(rt_sph *s)
 {
@@ -81,12 +70,6 @@ static void check_state(rt_sph_gpu *g, const rt_sph *s)
     state_free(&st);
 }
 
-static rt_sph_desc small_box(void)
-{
-    rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.1f, 0.2f, 0.06f}, .threads = 1};
-    return d;
-}
-
 static int setup_gl(void **state)
 {
     *state = test_gl_or_skip();
@@ -104,12 +87,7 @@ static int teardown_gl(void **state)
 static void test_gpu_all_at_one_point(void **unused)
 {
     (void)unused;
-    rt_sph *s = make(small_box());
-    enum { N = 300 };
-    float x[N], y[N], z[N];
-    for (int i = 0; i < N; ++i)
-        x[i] = 0.05f, y[i] = 0.1f, z[i] = 0.03f;
-    assert_int_equal(rt_sph_add_particles(s, N, x, y, z, NULL, NULL, NULL, NULL, 0), VFX_OK);
+    rt_sph *s = pbf_case_one_point(1);
     rt_sph_gpu *g = make_gpu(s);
     rt_sph_report r;
     const rt_sph_desc *p = rt_sph_params(s);
@@ -132,12 +110,7 @@ static void test_gpu_all_at_one_point(void **unused)
 static void test_gpu_speed_cap(void **unused)
 {
     (void)unused;
-    rt_sph_desc d = small_box();
-    d.velocity_limit = 1.f;
-    rt_sph *s = make(d);
-    float x[3] = {0.02f, 0.05f, 0.08f}, y[3] = {0.1f, 0.1f, 0.1f}, z[3] = {0.03f, 0.03f, 0.03f};
-    float vy[3] = {0.f, 0.f, -50.f};
-    assert_int_equal(rt_sph_add_particles(s, 3, x, y, z, NULL, vy, NULL, NULL, 0), VFX_OK);
+    rt_sph *s = pbf_case_speed_cap(1);
     rt_sph_gpu *g = make_gpu(s);
     rt_sph_report r;
     assert_int_equal(rt_sph_gpu_step(g, 1.f / 60.f, &r, NULL, 0), VFX_OK);
@@ -152,12 +125,7 @@ static void test_gpu_speed_cap(void **unused)
 static void test_gpu_thin_wall(void **unused)
 {
     (void)unused;
-    rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.2f, 0.3f, 0.04f}, .threads = 1};
-    rt_sph *s = make(d);
-    rt_sph_collider wall = {.kind = RT_SPH_BOX, .center = {0.1f, 0.08f, 0.02f}, .half = {0.3f, 0.005f, 0.3f}};
-    assert_int_equal(rt_sph_add_collider(s, &wall, NULL, NULL, 0), VFX_OK);
-    float lo[3] = {0.06f, 0.15f, 0}, hi[3] = {0.14f, 0.28f, 0.04f};
-    assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
+    rt_sph *s = pbf_case_thin_wall(1);
     rt_sph_gpu *g = make_gpu(s);
     rt_sph_report r;
     for (int f = 0; f < 60; ++f) {
@@ -184,10 +152,7 @@ static void test_gpu_pool_at_rest(void **unused)
     (void)unused;
     float vmax[2] = {0.f, 0.f}, comp[2] = {0.f, 0.f};
     for (int k = 0; k < 2; ++k) {
-        rt_sph_desc d = {.spacing = 0.02f, .domain_min = {0, 0, 0}, .domain_max = {0.6f, 0.4f, 0.3f}, .threads = 1};
-        rt_sph *s = make(d);
-        float lo[3] = {0, 0, 0}, hi[3] = {0.6f, 0.12f, 0.3f};
-        assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
+        rt_sph *s = pbf_case_pool(1);
         rt_sph_gpu *g = k ? make_gpu(s) : NULL;
         rt_sph_settle_desc sd = {.max_steps = 120};
         rt_sph_settle_report sr;
@@ -264,7 +229,7 @@ static void test_gpu_dam_break_vs_cpu(void **unused)
     dam_stats st[3];
     for (int k = 0; k < 3; ++k) {
         rt_sph_desc d = {.spacing = 0.01f, .domain_min = {0, 0, 0}, .domain_max = {0.6f, 0.3f, 0.05f}, .threads = 1};
-        rt_sph *s = make(d);
+        rt_sph *s = pbf_make(d);
         float lo[3] = {0, 0, 0}, hi[3] = {0.1f, 0.2f, 0.05f};
         assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
         rt_sph_columns c = rt_sph_get_columns(s);
@@ -318,7 +283,7 @@ static void test_gpu_dam_break_martin_moyce(void **unused)
     float dx = (float)(a / res);
     rt_sph_desc d = {.spacing = dx, .domain_min = {0, 0, 0}, .domain_max = {(float)(10 * a), (float)(2.5 * a), 4 * dx},
                       .threads = 1, .max_substeps = 100000, .no_slip_faces = RT_SPH_FACE_Y_MIN | RT_SPH_FACE_X_MIN};
-    rt_sph *s = make(d);
+    rt_sph *s = pbf_make(d);
     float lo[3] = {0, 0, 0}, hi[3] = {(float)a, (float)(2 * a), 4 * dx};
     assert_int_equal(rt_sph_add_block(s, lo, hi, NULL, NULL, 0), VFX_OK);
     rt_sph_gpu *gp = make_gpu(s);
@@ -329,7 +294,7 @@ static void test_gpu_dam_break_martin_moyce(void **unused)
         assert_int_equal(rt_sph_gpu_step(gp, (float)(T_mm[k] / Ts - rt_sph_time(s)), &r, NULL, 0), VFX_OK);
         assert_false(r.cap_hit);
         state st = download(gp);
-        rt_sph *q = make(d); /* the positions, for the volume fraction on its grid */
+        rt_sph *q = pbf_make(d); /* the positions, for the volume fraction on its grid */
         assert_int_equal(rt_sph_add_particles(q, st.n, st.x, st.y, st.z, NULL, NULL, NULL, NULL, 0), VFX_OK);
         rt_sph_report qr;
         assert_int_equal(rt_sph_step(q, 0.f, &qr, NULL, 0), VFX_OK);
