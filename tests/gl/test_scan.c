@@ -14,7 +14,7 @@
 
 #include "debug.h"
 #include "gpu/scan.h"
-#include "test_util.h"
+#include "test_plugin.h"
 
 static vfx_context *g_ctx;
 static const vfx_plugin_api *g_api;
@@ -79,36 +79,11 @@ static void test_refuses_past_limit(void **state)
     assert_int_equal(glGetError(), GL_NO_ERROR);
 }
 
-static int setup(void **state)
-{
-    (void)state;
-    static test_log log;
-    static vfx_context_desc host;
-    host = (vfx_context_desc){.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = &log,
-                              .log = test_vfx_log_fn};
-    static vfx_plugin_api api;
-    api.type = VFX_TYPE_PLUGIN_API;
-    if (vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api) != VFX_OK || api.create(&host, &g_ctx) != VFX_OK)
-        return -1;
-    g_api = &api;
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    g_api->destroy(g_ctx);
-    return 0;
-}
-
 int main(void)
 {
-    rt_gl_context *gl = test_gl_or_skip();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_matches_cpu),
         cmocka_unit_test(test_refuses_past_limit),
     };
-    int rc = cmocka_run_group_tests(tests, setup, teardown);
-    rt_gl_context_destroy(gl);
-    return rc;
+    return test_plugin_run_group(tests, &g_ctx, &g_api);
 }

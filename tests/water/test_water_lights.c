@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "gpu/gpu.h"
-#include "test_util.h"
+#include "test_plugin.h"
 #include "water/water_lights.h"
 
 typedef struct probe_case {
@@ -273,36 +273,11 @@ static void test_on_the_line_is_finite(void **state)
     assert_float_equal(res[0][1], res[1][1], 1e-5 * res[1][1]);
 }
 
-static int setup(void **state)
-{
-    (void)state;
-    static test_log log;
-    static vfx_context_desc host;
-    host = (vfx_context_desc){.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = &log,
-                              .log = test_vfx_log_fn};
-    static vfx_plugin_api api;
-    api.type = VFX_TYPE_PLUGIN_API;
-    if (vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api) != VFX_OK || api.create(&host, &g_ctx) != VFX_OK)
-        return -1;
-    g_api = &api;
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    g_api->destroy(g_ctx);
-    return 0;
-}
-
 int main(void)
 {
-    rt_gl_context *gl = test_gl_or_skip();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_terms_match_quadrature),
         cmocka_unit_test(test_on_the_line_is_finite),
     };
-    int rc = cmocka_run_group_tests(tests, setup, teardown);
-    rt_gl_context_destroy(gl);
-    return rc;
+    return test_plugin_run_group(tests, &g_ctx, &g_api);
 }
