@@ -1,13 +1,20 @@
 #!/usr/bin/env python3
 """Embeds GLSL files into a C table so the plugin (and the host) ship no loose files.
 
-usage: embed.py OUT.c SYMBOL SHADER_ROOT FILE...
+usage: embed.py OUT.c SYMBOL SHADER_ROOT FILE... [--validate|--unchecked C_SOURCE...]
 Writes `const volfx_shader_table SYMBOL` (shaders/volfx_shaders.h). Each entry keeps its path
 relative to SHADER_ROOT; shader_text.c uses that path and the entry's index to turn the
-driver's "0:LINE" messages back into "file:line".
+driver's "0:LINE" messages back into "file:line". With --validate, every stage among the files is
+first checked by glslangValidator in the variants the C sources build it in (validate.py): a GLSL
+error fails the build as file:line and no table is written. --unchecked (no glslang installed)
+embeds the files as they are.
 """
 import os
 import sys
+
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import validate  # noqa: E402
 
 
 def c_string(text):
@@ -20,6 +27,12 @@ def c_string(text):
 
 def main():
     out_path, symbol, root, files = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
+    for mode in ('--validate', '--unchecked'):
+        if mode in files:
+            files, csrc = files[:files.index(mode)], files[files.index(mode) + 1:]
+            errors = validate.validate(root, csrc, files)[1] if mode == '--validate' else []
+            if errors:
+                sys.exit('\n'.join(errors))
     entries = []
     for f in sorted(files):
         rel = os.path.relpath(f, root).replace(os.sep, '/')
