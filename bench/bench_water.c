@@ -25,6 +25,7 @@
 #include "gfx/gl_context.h"
 #include "gfx/image.h"
 #include "debug.h"
+#include "volfx_lab.h"
 #include "profile/profiler.h"
 #include "camera_ref.h"
 #include "gfx/camera.h"

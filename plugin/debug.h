@@ -7,6 +7,5 @@
 #include "context.h"
 #include "effect.h"
 #include "gpu/gpu.h"
-#include "volfx_lab.h"
 
 #endif

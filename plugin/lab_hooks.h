@@ -5,10 +5,12 @@
 #ifndef VOLFX_LAB_HOOKS_H
 #define VOLFX_LAB_HOOKS_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "gpu/gl.h"
 #include "effect.h"
+#include "lab_types.h"
 
 struct volfx_water_core;    /* water/water_params.h */
 struct volfx_shader_table;  /* volfx_shaders.h */
@@ -26,6 +28,12 @@ typedef struct volfx_lab_water_input {
     uint64_t data_rev;               /* changes whenever the columns were uploaded again */
 } volfx_lab_water_input;
 
+/* What a vfx_lab_volume switches off in the volume's renderer (tetra/tet_render.h tet_options):
+ * early ray termination, the workers' shared ERT tables, dynamic load balancing. */
+typedef struct volfx_lab_volume_off {
+    bool ert, share, dlb;
+} volfx_lab_volume_off;
+
 struct volfx_lab_hooks {
     /* The lab's embedded GLSL (volfx_lab_shaders): the program cache (gpu/gpu.c) builds a path
      * the product's table lacks from it. */
@@ -40,6 +48,13 @@ struct volfx_lab_hooks {
                               const volfx_frame_targets *targets);
     /* Frees what water_march made in *state (NULL allowed). */
     void (*water_free)(vfx_context *ctx, void *state);
+    /* Publishes the stats of lab method `method` from the counter slots `c` of one frame (the
+     * water's fenced readback, WATER_COUNTERS words). */
+    void (*water_counters)(vfx_context *ctx, uint32_t method, const uint32_t *c);
+    /* Reads the vfx_lab_volume at `lab` (its type already matched) into *off: what it switches
+     * off in the volume's renderer; unknown bits fail with VFX_ERR_INVALID_ARGUMENT naming the
+     * field. */
+    vfx_result (*volume_struct)(vfx_context *ctx, const void *lab, volfx_lab_volume_off *off);
 };
 
 #endif

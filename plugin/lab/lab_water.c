@@ -60,6 +60,20 @@ vfx_result volfx_lab_water_march(vfx_context *ctx, void **state, uint32_t method
     return volfx_water_grid_render(ctx, s->grid, in, targets);
 }
 
+/* GRID counts samples and pixel classes in march.comp's slots (2-5) and its walk in 8 and 9
+ * (shaders/water/grid.comp); BRUTE counts nothing. */
+void volfx_lab_water_counters(vfx_context *ctx, uint32_t method, const uint32_t *c)
+{
+    if (method != VFX_WATER_METHOD_GRID)
+        return;
+    volfx_stat_set(ctx, "water.samples", c[2]);
+    volfx_stat_set(ctx, "water.pixels_found", c[3]);
+    volfx_stat_set(ctx, "water.pixels_sample_cap", c[4]);
+    volfx_stat_set(ctx, "water.pixels_left", c[5]);
+    volfx_stat_set(ctx, "water.grid_cells_visited", c[8]);
+    volfx_stat_set(ctx, "water.grid_sphere_tests", c[9]);
+}
+
 void volfx_lab_water_free(vfx_context *ctx, void *state)
 {
     lab_water_state *s = state;

@@ -13,5 +13,7 @@ vfx_result volfx_lab_water_march(vfx_context *ctx, void **state, uint32_t method
                                  const volfx_frame_targets *targets);
 /* lab_hooks.h water_free. */
 void volfx_lab_water_free(vfx_context *ctx, void *state);
+/* lab_hooks.h water_counters: GRID's stats (BRUTE has none). */
+void volfx_lab_water_counters(vfx_context *ctx, uint32_t method, const uint32_t *c);
 
 #endif

@@ -3,59 +3,25 @@
  * water's baselines (plugin/lab). NOT installed and not part of the ABI's promise: tests and
  * benches link the lab library, attach it to their context and chain these structs into a public
  * struct's `next` to reproduce the measurements in docs/ (docs/abi.md "Lab structs"). libvolfx
- * holds no lab code: without volfx_lab_attach a vfx_lab_water, or a lab method, is refused by
- * name (VFX_ERR_UNSUPPORTED). */
+ * holds no lab code: without volfx_lab_attach a lab struct (vfx_lab_water, vfx_lab_volume) or a
+ * lab method is refused by name (VFX_ERR_UNSUPPORTED). */
 #ifndef VOLFX_LAB_H
 #define VOLFX_LAB_H
 
 #include <volfx/volfx.h>
 
+/* The lab structs' type values (lab_types.h), and the water's VFX_WATER_NO_* disable bits and
+ * baseline methods (water/water_switches.h): both the product's own headers, which it reads
+ * without this one. The public features_off bits (VFX_WATER_NO_SPRAY, VFX_WATER_NO_SSR) share the
+ * water's bit space and may be given in vfx_lab_water.disable too. */
+#include "lab_types.h"
+#include "water/water_switches.h"
+
 /* Attaches the lab library to ctx (a context of the statically linked plugin, in the same
- * program): from now on ctx reads vfx_lab_water and draws the water's BRUTE and GRID methods.
- * VFX_ERR_INVALID_ARGUMENT for NULL. Lab library only (tests, benches): libvolfx has no such symbol. */
+ * program): from now on ctx reads vfx_lab_water and vfx_lab_volume and draws the water's BRUTE
+ * and GRID methods. VFX_ERR_INVALID_ARGUMENT for NULL. Lab library only (tests, benches):
+ * libvolfx has no such symbol. */
 vfx_result volfx_lab_attach(vfx_context *ctx);
-
-/* Type values of the lab structs, far from the public ones. */
-#define VFX_TYPE_LAB_WATER ((vfx_struct_type)0x4c414201)
-#define VFX_TYPE_LAB_BEAMS ((vfx_struct_type)0x4c414202)
-#define VFX_TYPE_LAB_VOLUME ((vfx_struct_type)0x4c414203)
-
-/* Bits of vfx_lab_water.disable: each switches one technique of the water off, for ablations
- * (docs/water.md). The public features_off bits (VFX_WATER_NO_SPRAY, VFX_WATER_NO_SSR) share
- * this bit space and may be given here too. */
-enum {
-    VFX_WATER_NO_BILLBOARD_INIT = 1u << 0, /* technique 1: start every ray at the near plane */
-    VFX_WATER_NO_SKIP = 1u << 1,           /* technique 2: fixed steps, no gap jumping */
-    VFX_WATER_NO_BLEND = 1u << 2,          /* technique 3: compute-shader sum instead of blending */
-    VFX_WATER_NO_PACK4 = 1u << 3,          /* technique 4: one sample per texel, not four */
-    VFX_WATER_NO_PYRAMID = 1u << 4,        /* technique 5: no min/max pyramid culling */
-    VFX_WATER_NO_REFINE = 1u << 5,         /* technique 6: linear interpolation only */
-    VFX_WATER_NO_SHADING = 1u << 6,        /* flat colour: for tests that compare coverage */
-    /* PAPER: leave the pixels that spent max_samples undecided (holes), as the seed does,
-     * instead of finishing them with TILE's march */
-    VFX_WATER_NO_FINISH = 1u << 7,
-    /* TILE: evaluate the field over the tile's whole list at every sample */
-    VFX_WATER_NO_LOCAL_LIST = 1u << 8,
-    /* TILE: plain steps, no bound-driven subdivision (features thinner than a step can be missed) */
-    VFX_WATER_NO_SUBDIVIDE = 1u << 9,
-    /* TILE: no screen tiles: every pixel reads every particle */
-    VFX_WATER_NO_TILES = 1u << 10,
-    /* shading: absorb over the view ray's thickness and look the host colour up at a fixed
-     * screen offset, instead of tracing the refracted ray through the water */
-    VFX_WATER_NO_REFRACT_TRACE = 1u << 11,
-    /* TILE: no temporal reuse (the previous frame's hits, reprojected, as proven starting points) */
-    VFX_WATER_NO_TEMPORAL = 1u << 12,
-    /* TILE: no reduced-resolution march (one ray per 2x2 block, the rest upsampled where the
-     * block agrees and marched where it does not) */
-    VFX_WATER_NO_HALF_RES = 1u << 13,
-    VFX_WATER_NO_DIFFUSE = VFX_WATER_NO_SPRAY,
-};
-/* Every bit of the water's disable space. */
-#define VFX_WATER_DISABLE_ALL ((1u << 16) - 1u)
-
-/* Baseline methods of the water (vfx_lab_water.method; the public ones may be given too). */
-#define VFX_WATER_METHOD_BRUTE 1u /* per-pixel march over all particles (compute) */
-#define VFX_WATER_METHOD_GRID 2u  /* per-pixel march over a uniform grid (compute) */
 
 /* Chained into vfx_water_params.next. */
 typedef struct vfx_lab_water {

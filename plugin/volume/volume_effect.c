@@ -17,7 +17,7 @@
 #include "gpu/pass.h"
 #include "effect.h"
 #include "param_ranges.h"
-#include "volfx_lab.h"
+#include "lab_hooks.h"
 #include "tet_render.h"
 
 /* std140 mirror of shaders/volume/distance.frag's own block (the camera comes from the frame
@@ -42,7 +42,7 @@ typedef struct volume_state {
     int up_slot;                /* buffer holding the last image */
     float *max_dist;            /* width*height ray distances to the nearest opaque surface */
     vfx_volume_view view;       /* the host's (next cleared) */
-    uint32_t lab_disable;       /* vfx_lab_volume.disable: VFX_VOLUME_NO_* */
+    volfx_lab_volume_off lab_off; /* what a vfx_lab_volume switched off (lab_hooks.h) */
     tet_mesh mesh;              /* points into the host's arrays (no copy) */
     uint64_t revision;
     float data_min, data_max;
@@ -211,6 +211,21 @@ static vfx_result check_transfer(vfx_context *ctx, const vfx_volume_view *v)
     return VFX_OK;
 }
 
+/* The lab's struct in the view's chain (ablation switches of the renderer): read by the lab
+ * library only; without one attached (libvolfx) it is refused by name. */
+static vfx_result read_lab(vfx_context *ctx, const void *chain, volfx_lab_volume_off *off)
+{
+    const void *lab = volfx_chain_find(chain, VFX_TYPE_LAB_VOLUME);
+    if (!lab)
+        return VFX_OK;
+    if (!ctx->lab)
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_STRUCT_TYPE,
+                          "volume[0]: a vfx_lab_volume (type 0x%x) is chained into vfx_volume_view: lab structs are "
+                          "read only with the lab library attached (volfx_lab_attach: tests and benches), not by "
+                          "libvolfx", (unsigned)VFX_TYPE_LAB_VOLUME);
+    return ctx->lab->volume_struct(ctx, lab, off);
+}
+
 static vfx_result volume_update(vfx_context *ctx, void *state, double time, float dt)
 {
     (void)time, (void)dt;
@@ -225,7 +240,9 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
     vfx_result r = fetch_view(ctx, &v);
     if (r != VFX_OK)
         return r;
-    const vfx_lab_volume *lab = volfx_chain_find(v.next, VFX_TYPE_LAB_VOLUME);
+    volfx_lab_volume_off lab_off = {0};
+    if ((r = read_lab(ctx, v.next, &lab_off)) != VFX_OK)
+        return r;
     v.next = NULL;
     const vfx_volume_view *v1 = &v;
     if (!v1->points || !v1->tets || !v1->scalar || v1->point_count == 0 || v1->tet_count == 0)
@@ -264,7 +281,7 @@ static vfx_result volume_update(vfx_context *ctx, void *state, double time, floa
         s->last_key = 0; /* new data: never reuse the old image, whatever the key says */
     }
     s->view = v;
-    s->lab_disable = lab ? lab->disable : 0;
+    s->lab_off = lab_off;
     memset(&s->mesh, 0, sizeof s->mesh);
     s->mesh.point_count = v1->point_count;
     s->mesh.tet_count = v1->tet_count;
@@ -409,9 +426,9 @@ static vfx_result volume_render(vfx_context *ctx, void *state, volfx_frame_targe
     make_tf(s, &tf);
     tet_options o;
     tet_options_default(&o);
-    o.ert = !(s->lab_disable & VFX_VOLUME_NO_ERT);
-    o.share = !(s->lab_disable & VFX_VOLUME_NO_SHARE);
-    o.dlb = !(s->lab_disable & VFX_VOLUME_NO_DLB);
+    o.ert = !s->lab_off.ert;
+    o.share = !s->lab_off.share;
+    o.dlb = !s->lab_off.dlb;
     if (v->ert_threshold > 0) o.ert_threshold = v->ert_threshold;
     if (v->tiles) o.tiles_d = (int)v->tiles;
     if (v->update_c) o.update_c = (int)v->update_c;

@@ -560,12 +560,9 @@ static void publish_counters(vfx_context *ctx, water_state *s)
 {
     const uint32_t *c = s->last;
     const int paper = s->last_method == VFX_WATER_METHOD_PAPER;
-    const int grid = s->last_method == VFX_WATER_METHOD_GRID;
     if (paper) {
         volfx_stat_set(ctx, "water.fragments_culled", c[0]);
         volfx_stat_set(ctx, "water.potential_fragments", c[1]);
-    }
-    if (paper || grid) { /* both marches count samples and pixel classes in the same slots */
         volfx_stat_set(ctx, "water.samples", c[2]);
         volfx_stat_set(ctx, "water.pixels_found", c[3]);
         volfx_stat_set(ctx, "water.pixels_sample_cap", c[4]);
@@ -617,10 +614,8 @@ static void publish_counters(vfx_context *ctx, water_state *s)
         volfx_stat_set(ctx, "water.aniso_stretched", c[24]);
         volfx_stat_set(ctx, "water.aniso_isotropic", c[25]);
     }
-    if (grid) {
-        volfx_stat_set(ctx, "water.grid_cells_visited", c[8]);
-        volfx_stat_set(ctx, "water.grid_sphere_tests", c[9]);
-    }
+    if (!paper && !tile && ctx->lab) /* a lab method's (GRID's) counters are the lab's */
+        ctx->lab->water_counters(ctx, s->last_method, c);
     volfx_stat_set(ctx, "water.normal_fragments_culled", c[6]);
     volfx_stat_set(ctx, "water.normal_fragments", c[7]);
     volfx_stat_set(ctx, "water.counters_age", (double)(s->frame_no - 1 - s->last_frame));

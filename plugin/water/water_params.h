@@ -6,7 +6,7 @@
 
 #include "effect.h"
 #include "water_aniso.h"
-#include "volfx_lab.h"
+#include "water_switches.h"
 
 /* The fields every method reads, resolved: the host's, with the lab's disable bits and method
  * override folded in. */

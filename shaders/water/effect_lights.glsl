@@ -1,5 +1,6 @@
 // effect_lights.glsl — the water lit by the plugin's own lights (the beams' get_lights: a line
-// light per beam segment, a point per head and impact; docs/water.md "Lit by the beams").
+// light per beam segment, a point per head and impact; docs/water-look.md "Beams in the water,
+// and the water lit by them").
 // Two terms per light, both in closed form:
 //
 //  - specular: the surface's reflection lobe D(l) = exp((r.l - 1) / s^2) / N(s), a spherical
@@ -31,7 +32,7 @@
 // cos(delta) < 1/2 are dropped: there D <= exp(-1 / (2 s^2)) of its peak (e^-50 at s = 0.1).
 // h is clamped below at the caller's h_min (a beam is a tube, not a line: its light does not grow
 // without bound at its axis). tests/water/test_water_lights.c holds both terms to a float64
-// quadrature over the segment through shaders/water/lights_probe.comp.
+// quadrature over the segment, through its probe shader in the lab's table.
 
 float water_erf(float x)
 {

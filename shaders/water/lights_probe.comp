@@ -1,6 +1,6 @@
-// lights_probe.comp — tests only (tests/water/test_water_lights.c): evaluates the water's
-// effect-light terms (water/effect_lights.glsl) for a list of cases, so the test holds the GLSL
-// itself to a float64 quadrature.
+// lights_probe.comp — tests only (tests/water/test_water_lights.c; the lab's shader table, never
+// libvolfx's): evaluates the water's effect-light terms (water/effect_lights.glsl) for a list of
+// cases, so the test holds the GLSL itself to a float64 quadrature.
 layout(local_size_x = 64) in;
 #include "water/effect_lights.glsl"
 struct ProbeCase {

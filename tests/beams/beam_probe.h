@@ -11,6 +11,7 @@
 
 #include "beams/beam_field.h"
 #include "debug.h"
+#include "volfx_lab.h"
 #include "test_util.h"
 
 /* One ray of a batch: the beam (straight, anatomy or polyline), float32 origin and unit direction. */

@@ -39,6 +39,7 @@ static int setup(void **state)
 {
     (void)state;
     g_app = test_app_with_camera(&g_cam, NULL);
+    assert_int_equal(volfx_lab_attach(g_app->ctx), VFX_OK); /* the renderer's lab switches */
     rt_scene_volume sv;
     memset(&sv, 0, sizeof sv);
     sv.generated = true;
@@ -319,6 +320,35 @@ static void write_grid_vtu(const char *path, int n, tet_mesh *m)
     fclose(f);
 }
 
+/* The product and its laboratory: a context as libvolfx makes it (no lab attached) refuses a
+ * chained vfx_lab_volume by name and draws on without it; with the lab attached the struct
+ * switches the renderer's early ray termination off (a new render, no cell skipped by it), and
+ * an unknown bit is refused naming the field. */
+static void test_lab_struct_needs_the_lab(void **state)
+{
+    (void)state;
+    vfx_volume_view *v = game_app_volume(g_app, g_vol);
+    vfx_lab_volume lab = {.type = VFX_TYPE_LAB_VOLUME, .disable = VFX_VOLUME_NO_ERT};
+    const volfx_lab_hooks *hooks = g_app->ctx->lab;
+    g_app->ctx->lab = NULL; /* as libvolfx.so, which has no volfx_lab_attach */
+    v->next = &lab;
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_UNSUPPORTED);
+    printf("without the lab: %s\n", g_app->api->last_error(g_app->ctx, NULL));
+    assert_true(test_last_error_is(g_app->api, g_app->ctx, VFX_LOG_ID_STRUCT_TYPE, "vfx_lab_volume"));
+    v->next = NULL; /* nothing chained: the product draws */
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
+    g_app->ctx->lab = hooks;
+    v->next = &lab;
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
+    assert_true(stat("volume.render_skipped") == 0 && stat("volume.cells_skipped_ert") == 0);
+    assert_true(stat("volume.cells_scanned") > 0);
+    lab.disable = 1u << 7;
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_INVALID_ARGUMENT);
+    assert_true(test_last_error_is(g_app->api, g_app->ctx, VFX_LOG_ID_PARAM_RANGE, "vfx_lab_volume.disable 0x80"));
+    v->next = NULL;
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_OK);
+}
+
 /* A user's .vtu in a scene file with a 64-point transfer function (a smooth map with a narrow
  * spike), loaded by the game's scene code, rendered by the plugin (ERT off: the reference has
  * none, and ERT may drop up to 1 - threshold of light by design), against the float64 ray
@@ -461,6 +491,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_bad_view_and_absence),
         cmocka_unit_test(test_skip_when_unchanged),
         cmocka_unit_test(test_view2_breakpoints),
+        cmocka_unit_test(test_lab_struct_needs_the_lab),
         cmocka_unit_test(test_file_volume_in_scene),
         cmocka_unit_test(test_showcase_animates), /* last: it leaves the scene's meshes */
     };

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "debug.h"
+#include "volfx_lab.h"
 #include "camera_ref.h"
 #include "test_util.h"
 #include "water/water_effect.h"

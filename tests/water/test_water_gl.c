@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "debug.h"
+#include "volfx_lab.h"
 #include "depth_modes.h"
 #include "camera_ref.h"
 #include "test_util.h"

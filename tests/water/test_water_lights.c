@@ -1,8 +1,8 @@
-/* The water lit by the plugin's own lights (shaders/water/effect_lights.glsl, docs/water.md
- * "Lit by the beams"): the GLSL terms themselves, evaluated on the GPU by
- * shaders/water/lights_probe.comp, against a float64 quadrature of the same light over its
- * segment (Gauss-Legendre over pieces of the segment's length, straight from the definition:
- * no angle substitution, no erf). */
+/* The water lit by the plugin's own lights (shaders/water/effect_lights.glsl, docs/water-look.md
+ * "Beams in the water, and the water lit by them"): the GLSL terms themselves, evaluated on the
+ * GPU by shaders/water/lights_probe.comp (the lab's shader table), against a float64 quadrature
+ * of the same light over its segment (Gauss-Legendre over pieces of the segment's length,
+ * straight from the definition: no angle substitution, no erf). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -16,6 +16,7 @@
 
 #include "gpu/gpu.h"
 #include "test_plugin.h"
+#include "volfx_lab.h"
 #include "water/water_lights.h"
 
 typedef struct probe_case {
@@ -161,6 +162,8 @@ static const vfx_plugin_api *g_api;
 /* Runs the probe over the cases; results (spec, fluence, irradiance, 0) per case. */
 static void run_probe(const probe_case *cases, uint32_t n, float (*res)[4])
 {
+    /* the probe is in the lab's shader table (never libvolfx's): attach the lab first */
+    assert_int_equal(volfx_lab_attach(g_ctx), VFX_OK);
     GLuint prog = volfx_gpu_compute(g_ctx, "water/lights_probe.comp", NULL);
     assert_int_not_equal(prog, 0);
     GLuint buf[2];

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "debug.h"
+#include "volfx_lab.h"
 #include "camera_ref.h"
 #include "test_util.h"
 #include "water_ref.h"
