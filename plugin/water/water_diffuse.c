@@ -58,7 +58,7 @@ vfx_result volfx_water_diffuse_params_check(vfx_context *ctx, const vfx_water_pa
          * [1, 6] the default scene's paddle waves (|v| up to 1.3 v_ref) made no particle in 400
          * frames; these show foam along the paddle's wave and at the walls at frame 90 (106
          * foam, 5 bubbles) without the grey sheet that [0.1, 1], [0.5, 3], [0.1, 0.6] laid over
-         * the whole pool (3,504 foam), docs/water.md */
+         * the whole pool (3,504 foam), docs/water-whitewater.md "Diffuse particles" */
         {"trapped_air", in->trapped_air, {1.5f, 6.0f}, out->ta},
         {"wave_crest", in->wave_crest, {0.2f, 1.0f}, out->wc},
         {"energy", in->energy, {0.3f, 2.0f}, out->ek},

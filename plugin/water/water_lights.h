@@ -1,5 +1,5 @@
-/* water_lights.h — the plugin's own lights on the water (docs/water.md "Lit by the beams"): the
- * beams' get_lights (a line light per segment, a point per head and impact) packed once a frame
+/* water_lights.h — the plugin's own lights on the water (docs/water-look.md "Beams in the water,
+ * and the water lit by them"): the beams' get_lights (a line light per segment, a point per head and impact) packed once a frame
  * into the uniform block WaterLights of shaders/water/effect_lights.glsl. A frame with no light
  * makes no buffer and builds the shading program without the light loop. */
 #ifndef VOLFX_WATER_LIGHTS_H

@@ -367,8 +367,9 @@ static vfx_result tile_dispatch(vfx_context *ctx, volfx_water_tile *t, const vol
     if (finish) /* the paper method's kernel: isotropic */
         prog = volfx_gpu_compute(ctx, "water/tile.comp", "#define MODE_FINISH\n");
     else if (in->kernels) /* stretched kernels overlap more: at a flat pool's surface ~16 supports
-                             against ~9 (docs/water.md); 16 slots sent 9,359 pixels of the 3,000-
-                             particle pool to the dense fallback and cost 1.8x the CPU of 32 */
+                             against ~9 (docs/water-method.md "Anisotropic kernels"); 16 slots sent
+                             9,359 pixels of the 3,000-particle pool to the dense fallback and cost
+                             1.8x the CPU of 32 */
         prog = volfx_gpu_compute(ctx, "water/tile.comp", half == 2 ? "#define MODE_MARCH\n#define ANISO\n#define LOCAL_K 32\n#define UPSAMPLE_PASS\n"
                                                                    : "#define MODE_MARCH\n#define ANISO\n#define LOCAL_K 32\n");
     else

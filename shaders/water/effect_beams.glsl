@@ -1,5 +1,5 @@
-// effect_beams.glsl — the beams seen in the water (docs/water.md "Beams in the water"). The beams'
-// prepare step (plugin/beams/beams_effect.c) split each pixel's ray at this water's surface: the
+// effect_beams.glsl — the beams seen in the water (docs/water-look.md "Beams in the water"). The
+// beams' prepare step (plugin/beams/beams_effect.c) split each pixel's ray at this water's surface: the
 // light in front of the surface (composited over the water afterwards: the water never sees it
 // at its own pixel) and the light behind it. The refracted ray sees the light behind the surface
 // where it leaves the water, like the host colour there (so it is absorbed like it); the

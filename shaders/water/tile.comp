@@ -22,7 +22,7 @@
 // around its centre c_i; along a ray |G (x - c)|^2 = a (t - tc)^2 + b2 with a = |G d|^2, so
 // every sphere test below is the same quadratic with a per-entry a (isotropic: a = 1). The
 // binning takes the ellipsoid's axis-aligned box and files it by its nearest possible entry.
-// Every loop is bounded by a constant or by a list length; see docs/water.md (method TILE).
+// Every loop is bounded by a constant or by a list length; see docs/water-method.md "Method TILE".
 #include "common/depth.glsl"
 #if defined(MODE_MARCH) || defined(MODE_FINISH) || defined(MODE_REPROJECT)
 layout(local_size_x = 8, local_size_y = 8) in;

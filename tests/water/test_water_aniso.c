@@ -643,7 +643,7 @@ static void stepper_free(stepper *st)
     glDeleteTextures(1, &st->col);
 }
 
-/* Preset medium's half rate (docs/water-method.md, "Half rate"): in a running simulation every other
+/* Preset medium's half rate (docs/water-method.md, *Half rate*): in a running simulation every other
  * upload moves only the centres and keeps the shapes of the upload before. A pool under a
  * travelling wave, drawn frame after frame by preset medium and by preset high (every upload),
  * both marched at full resolution (the lab's NO_HALF_RES, so the half rate is the only

@@ -179,7 +179,8 @@ typedef enum vfx_water_method {
     VFX_WATER_METHOD_DEFAULT = 0,   /* the recommended method: TILE */
     VFX_WATER_METHOD_TILE = 3,      /* ours (recommended): per-pixel march over screen-tile
                                        particle lists, no sample cap */
-    VFX_WATER_METHOD_PAPER = 4,     /* billboards + blended potentials, the published method (docs/water.md) */
+    VFX_WATER_METHOD_PAPER = 4,     /* billboards + blended potentials, the published method
+                                       (docs/water-paper.md) */
 } vfx_water_method;
 
 /* The kernel each particle adds to the field (vfx_water_params.kernel). */
