@@ -26,7 +26,11 @@ typedef struct volfx_pass_desc {
     const char *name;        /* "effect.pass": debug group and GPU timer ("<name>.gpu_ms"); required */
     /* A compute pass (dispatches only), or a timed group of steps that each apply their own
      * state with volfx_pass_apply: begin leaves the framebuffer, viewport, clears, blend and depth
-     * alone (a dispatch reads none of them), and every field below is ignored. */
+     * alone (a dispatch reads none of them), and every field below is ignored. What a dispatch
+     * does read, the pass sets itself after begin: its program, its storage, uniform, image and
+     * texture bindings (all inside the ranges gl_state.h saves and restores for the host; test
+     * gl/gl_state binds hostile values on more), the dispatch-indirect buffer (unbound again
+     * after), and the glMemoryBarrier its readers need after its writes. */
     bool compute;
     GLuint framebuffer;      /* 0 -> the default framebuffer */
     uint32_t width, height;  /* viewport; 0 -> the context's size */
