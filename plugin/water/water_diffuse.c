@@ -17,6 +17,17 @@
 /* a spray streak's half-width and a foam / bubble splat's radius, in units of h */
 #define SPRAY_RADIUS_H 0.12f
 #define FOAM_RADIUS_H 0.8f
+/* Steam at a beam's impact: puffs a second an impact, their lifetime (s), terminal rise speed
+ * (units of v_ref = sqrt(|g| h)) and drag (1/s: how fast buoyancy and drag bring a puff to that
+ * speed and damp its outward drift); a puff's radius at birth and at the end of its life (h).
+ * In the default scene (h 0.106 m, v_ref 1.02 m/s) a puff rises at up to 0.71 m/s, about 1.1 m
+ * over its life (a body height), and grows from 0.13 to 0.85 m across. */
+#define STEAM_RATE 150.0
+#define STEAM_LIFE_S 2.0f
+#define STEAM_RISE 0.7f
+#define STEAM_DRAG 4.0f
+#define STEAM_RADIUS0_H 0.6f
+#define STEAM_RADIUS1_H 4.0f
 
 struct volfx_water_diffuse {
     GLuint vel;           /* vec4 a fluid particle */
@@ -33,6 +44,7 @@ struct volfx_water_diffuse {
     GLuint layer, fbo;    /* RG16F foam thickness, bubbles */
     uint32_t layer_w, layer_h;
     bool stepped;         /* a step ran since the pool was made or cleared */
+    float steam_left;     /* seconds a steam puff may still live (0: none in the pool) */
 };
 
 vfx_result volfx_water_diffuse_params_check(vfx_context *ctx, const vfx_water_params *in,
@@ -145,6 +157,7 @@ void volfx_water_diffuse_clear(volfx_water_diffuse *d)
     if (d->stepped) /* nothing to forget otherwise: no GL call on frames without particles */
         header_zero(d);
     d->stepped = false;
+    d->steam_left = 0;
 }
 
 vfx_result volfx_water_diffuse_begin(vfx_context *ctx, volfx_water_diffuse *d, uint32_t total)
@@ -232,6 +245,7 @@ static vfx_result ensure_step_buffers(vfx_context *ctx, volfx_water_diffuse *d, 
         }
         d->pool_cap = cap;
         d->cur = 0;
+        d->steam_left = 0;
         header_zero(d);
     }
     const char *e = volfx_gpu_error_string();
@@ -271,20 +285,37 @@ static void step_uniforms(vfx_context *ctx, GLuint prog, const volfx_water_diffu
     glUniform1ui(volfx_gpu_uniform(ctx, prog, "u_seed"), (uint32_t)(in->frame * 2654435761u));
     glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_lo"), 1, in->lo);
     glUniform3fv(volfx_gpu_uniform(ctx, prog, "u_hi"), 1, in->hi);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_steam_life"), STEAM_LIFE_S);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_steam_rise"), STEAM_RISE);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_steam_drag"), STEAM_DRAG);
 }
 
 /* Drops each impact throws this step: impact_rate x dt, the fraction carried by a hash of the
  * frame (a rate below one a step still throws some), at most IMPACT_DROPS_MAX. */
 #define IMPACT_DROPS_MAX 256u
+static uint32_t per_step(double rate, float dt, uint64_t frame)
+{
+    double want = rate * dt;
+    uint32_t x = (uint32_t)(frame * 2654435761u);
+    x ^= x >> 15, x *= 2246822519u, x ^= x >> 13;
+    double n = floor(want + (double)(x >> 8) / 16777216.0);
+    return n > IMPACT_DROPS_MAX ? IMPACT_DROPS_MAX : (uint32_t)n;
+}
+
 static uint32_t impact_drops(const volfx_water_diffuse_input *in)
 {
     if (!in->impact_count || !(in->impact_rate > 0))
         return 0;
-    double want = (double)in->impact_rate * in->dt;
-    uint32_t x = (uint32_t)(in->frame * 2654435761u);
-    x ^= x >> 15, x *= 2246822519u, x ^= x >> 13;
-    double n = floor(want + (double)(x >> 8) / 16777216.0);
-    return n > IMPACT_DROPS_MAX ? IMPACT_DROPS_MAX : (uint32_t)n;
+    return per_step(in->impact_rate, in->dt, in->frame);
+}
+
+/* Steam puffs each impact makes this step: STEAM_RATE x dt (the fraction carried like the
+ * drops', by another hash); none with the steam off or no impact. */
+static uint32_t steam_puffs(const volfx_water_diffuse_input *in)
+{
+    if (!in->impact_count || !in->steam)
+        return 0;
+    return per_step(STEAM_RATE, in->dt, in->frame ^ 0x5bd1e995u);
 }
 
 vfx_result volfx_water_diffuse_step(vfx_context *ctx, volfx_water_diffuse *d, const volfx_water_diffuse_input *in)
@@ -316,8 +347,9 @@ vfx_result volfx_water_diffuse_step(vfx_context *ctx, volfx_water_diffuse *d, co
         glDispatchCompute(gx, gy, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     }
-    uint32_t per = in->dt > 0 ? impact_drops(in) : 0;
-    if (per) {
+    uint32_t per = in->dt > 0 ? impact_drops(in) : 0, puffs = in->dt > 0 ? steam_puffs(in) : 0;
+    d->steam_left = puffs ? STEAM_LIFE_S : (d->steam_left > in->dt ? d->steam_left - in->dt : 0);
+    if (per || puffs) {
         step_uniforms(ctx, emit, in);
         float imp[VOLFX_WATER_DIFFUSE_IMPACTS][8];
         memset(imp, 0, sizeof imp);
@@ -329,7 +361,8 @@ vfx_result volfx_water_diffuse_step(vfx_context *ctx, volfx_water_diffuse *d, co
         glUniform1ui(volfx_gpu_uniform(ctx, emit, "u_imp_n"), in->impact_count);
         glUniform1ui(volfx_gpu_uniform(ctx, emit, "u_imp_per"), per);
         glUniform1f(volfx_gpu_uniform(ctx, emit, "u_imp_speed"), in->impact_speed);
-        glDispatchCompute((in->impact_count * per + 63u) / 64u, 1, 1);
+        glUniform1ui(volfx_gpu_uniform(ctx, emit, "u_steam_per"), puffs);
+        glDispatchCompute((in->impact_count * (per + puffs) + 63u) / 64u, 1, 1);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     }
     step_uniforms(ctx, prep, in);
@@ -433,6 +466,27 @@ vfx_result volfx_water_diffuse_spray(vfx_context *ctx, volfx_water_diffuse *d, c
                                              .width = targets->width, .height = targets->height,
                                              .blend = VOLFX_BLEND_OVER_PREMUL});
     draw_uniforms(ctx, prog, d, dd, targets, SPRAY_RADIUS_H);
+    glDrawArraysIndirect(GL_TRIANGLE_STRIP, (const void *)(uintptr_t)(4 * sizeof(uint32_t)));
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+    volfx_pass_end(ctx);
+    return VFX_OK;
+}
+
+vfx_result volfx_water_diffuse_steam(vfx_context *ctx, volfx_water_diffuse *d, const volfx_water_diffuse_draw *dd,
+                                     const volfx_frame_targets *targets)
+{
+    if (!d->stepped || !(d->steam_left > 0))
+        return VFX_OK;
+    GLuint prog = volfx_gpu_program(ctx, "water/steam.vert", "water/steam.frag",
+                                    dd->lights ? "#define WATER_EFFECT_LIGHTS 1\n#define WATER_MAX_LIGHTS 32\n" : "");
+    if (!prog)
+        return VFX_ERR_GL;
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = "water.steam", .framebuffer = targets->framebuffer,
+                                             .width = targets->width, .height = targets->height,
+                                             .blend = VOLFX_BLEND_OVER_PREMUL});
+    draw_uniforms(ctx, prog, d, dd, targets, STEAM_RADIUS0_H);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_radius1"), STEAM_RADIUS1_H * dd->h);
+    glUniform1f(volfx_gpu_uniform(ctx, prog, "u_steam_life"), STEAM_LIFE_S);
     glDrawArraysIndirect(GL_TRIANGLE_STRIP, (const void *)(uintptr_t)(4 * sizeof(uint32_t)));
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
     volfx_pass_end(ctx);

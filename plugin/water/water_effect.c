@@ -598,6 +598,7 @@ static void publish_counters(vfx_context *ctx, water_state *s)
     volfx_stat_set(ctx, "water.diffuse_foam", c[28]);
     volfx_stat_set(ctx, "water.diffuse_bubbles", c[29]);
     volfx_stat_set(ctx, "water.diffuse_generated", c[30]);
+    volfx_stat_set(ctx, "water.diffuse_steam", c[31]);
     if (paper) {
         /* the cap pixels the finishing pass took (0 with VFX_WATER_NO_FINISH), and what is left
          * undecided: cap pixels not finished plus those the finishing march could not decide */
@@ -797,7 +798,8 @@ static vfx_result diffuse_frame(vfx_context *ctx, water_state *s, const volfx_fr
         float imp[VOLFX_WATER_DIFFUSE_IMPACTS][6];
         volfx_water_diffuse_input in = {s->cols, s->count, s->lo, s->hi, s->params.h, s->dt, &s->dp, &grid,
                                         s->counters, s->frame_no, imp, water_impacts(ctx, s, imp),
-                                        s->fp.impact_rate, s->fp.impact_speed};
+                                        s->fp.impact_rate, s->fp.impact_speed,
+                                        (s->look & WATER_LOOK_STEAM) != 0};
         if ((r = volfx_water_diffuse_step(ctx, s->diffuse, &in)))
             return r;
         if ((r = foam_update(ctx, s, targets)))
@@ -944,7 +946,7 @@ static vfx_result shade_pass(vfx_context *ctx, water_state *s, const volfx_frame
 }
 
 /* One view's frame: set-up, the surface, the diffuse particles, the beams' prepare step, the
- * shading, the spray over it, then the counters. */
+ * shading, the spray and the steam over it, then the counters. */
 static vfx_result render_view(vfx_context *ctx, water_state *s, volfx_frame_targets *targets)
 {
     const volfx_water_core *p = &s->params;
@@ -970,7 +972,8 @@ static vfx_result render_view(vfx_context *ctx, water_state *s, volfx_frame_targ
         volfx_water_diffuse_draw dd = {p->h, p->absorption, ctx->water_dist_tex, s->vao, WATER_SHUTTER_S, nlights > 0};
         if (nlights)
             glBindBufferBase(GL_UNIFORM_BUFFER, 7, s->effect_lights.buffer);
-        if ((r = volfx_water_diffuse_spray(ctx, s->diffuse, &dd, targets)))
+        if ((r = volfx_water_diffuse_spray(ctx, s->diffuse, &dd, targets)) ||
+            (r = volfx_water_diffuse_steam(ctx, s->diffuse, &dd, targets)))
             return r;
     }
     counters_frame_end(ctx, s, p->method);

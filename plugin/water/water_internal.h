@@ -19,7 +19,7 @@
 /* march.comp's 8 (PAPER and the gradient pass), GRID's cells visited and sphere tests,
  * tile.comp's 14 (TILE and the paper method's finishing pass), aniso.comp's 2, shade.frag's
  * SSR hits (26) and diffuse.comp's 4 (27-30: spray, foam, bubbles, generated) */
-#define WATER_COUNTERS 31
+#define WATER_COUNTERS 32
 /* seconds a spray streak spans (its motion blur): two frames at 60 Hz */
 #define WATER_SHUTTER_S (1.0f / 30.0f)
 /* Particles the effect takes at most: positions are 12 bytes each (12 GiB at the limit) and a

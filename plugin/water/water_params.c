@@ -21,10 +21,11 @@ typedef struct preset_def {
 } preset_def;
 
 static const preset_def PRESETS[] = {
-#define LOOK_ALL (WATER_LOOK_HOST_LIGHT | WATER_LOOK_GGX | WATER_LOOK_FX_LIGHTS | WATER_LOOK_FOAM_LAYER)
+#define LOOK_ALL (WATER_LOOK_HOST_LIGHT | WATER_LOOK_GGX | WATER_LOOK_FX_LIGHTS | WATER_LOOK_FOAM_LAYER | WATER_LOOK_STEAM)
     /* low keeps the cheap GGX lobe and drops the host-light reads (16 texel reads a water pixel),
-     * the loop over the plugin's lights (up to 32 a water pixel) and the foam layer (its pass and
-     * one texture read a water pixel: the foam particles are splatted one by one instead) */
+     * the loop over the plugin's lights (up to 32 a water pixel), the foam layer (its pass and
+     * one texture read a water pixel: the foam particles are splatted one by one instead) and the
+     * steam at a beam's impact (its puffs and their draw; the strike's spray stays) */
     [VFX_WATER_PRESET_LOW] = {"low", VFX_WATER_KERNEL_ISOTROPIC, 0, 6.0f, 2, WATER_LOOK_GGX | WATER_LOOK_ANISO_HALF_RATE},
     /* medium: the anisotropic shapes every other upload (high and ultra every upload) */
     [VFX_WATER_PRESET_MEDIUM] = {"medium", VFX_WATER_KERNEL_ANISOTROPIC, 0, 8.0f, 3, LOOK_ALL | WATER_LOOK_ANISO_HALF_RATE},

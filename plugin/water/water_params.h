@@ -41,6 +41,8 @@ typedef struct volfx_water_resolved {
 #define WATER_LOOK_FX_LIGHTS 16u
 /* the foam layer (water_foam.h); without it the diffuse splat's per-particle foam */
 #define WATER_LOOK_FOAM_LAYER 32u
+/* steam puffs at a beam's impact on the water (water_diffuse.h) */
+#define WATER_LOOK_STEAM 64u
 /* The default absorption, per unit of h: a pool 3 h deep takes 1 - e^-2 of the red light
  * behind it (tint's 1 - 0.15) and fills with the deep colour; a sheet h/4 thick keeps 84% (red) to 92% (blue). */
 #define WATER_ABSORPTION_H 0.8f

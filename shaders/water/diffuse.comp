@@ -15,14 +15,22 @@
 //                  each impact, u_imp_per drops each): a spray drop placed 0.6-1.2 h above the
 //                  surface within 0.75 h of the point, launched along the normal tilted outwards
 //                  (a crown) at 0.35-1 x u_imp_speed v_ref; appended to the pool like generated
-//                  particles (they count in the generated counter)
+//                  particles (they count in the generated counter); then, with u_steam_per,
+//                  that many steam puffs an impact (class 3): placed 0.15-0.5 h above the
+//                  point (against gravity) within 0.8 h of it across, rising at 0.25-0.5 x the steam's
+//                  terminal speed (buoyancy brings it up to speed) and drifting outwards, with
+//                  a lifetime of 0.75-1 x u_steam_life
 //   MODE_PREP      one invocation: the pool's count clamped to the cap, the advection's
 //                  indirect dispatch
 //   MODE_ADVECT    per diffuse particle: its fluid neighbours within h classify it (fewer than
 //                  spray_below: spray, more than bubble_above: bubble, else foam); spray falls
 //                  ballistically, foam moves with the fluid's velocity (kernel-weighted mean)
 //                  and ages, a bubble is pushed up by buoyancy and dragged to the fluid's
-//                  velocity; survivors are appended to the other half of the pool
+//                  velocity; survivors are appended to the other half of the pool. Steam
+//                  (class 3, only MODE_EMIT makes it) is never re-classified and visits no
+//                  neighbour: in air it relaxes at u_steam_drag a second towards rising at
+//                  u_steam_rise v_ref against gravity plus a swirl fixed in space (buoyancy
+//                  and drag), and ages; it is dropped at the end of its lifetime
 //   MODE_FINAL     one invocation: the draw's indirect arguments, the next frame's count, the
 //                  generated count into the counters
 // W(r) = 1 - r / h within h (the paper's weighting). Speeds are in units of v_ref = sqrt(|g| h).
@@ -37,8 +45,8 @@ layout(std430, binding = 0) readonly buffer PX { float px[]; };
 layout(std430, binding = 1) readonly buffer PY { float py[]; };
 layout(std430, binding = 2) readonly buffer PZ { float pz[]; };
 layout(std430, binding = 3) readonly buffer Vel { vec4 vel[]; };
-// the effect's counter buffer: slots 27-30 are this pass's
-layout(std430, binding = 4) buffer Counters { uint c_slots_[27]; uint c_spray, c_foam, c_bubble, c_generated; };
+// the effect's counter buffer: slots 27-31 are this pass's
+layout(std430, binding = 4) buffer Counters { uint c_slots_[27]; uint c_spray, c_foam, c_bubble, c_generated, c_steam; };
 layout(std430, binding = 5) readonly buffer Start { uint start[]; };
 // 0-2 the advection's dispatch, 3 the pool's count, 4-7 the draw's (4, instances, 0, 0),
 // 8 survivors, 9 generated this frame (asked for, kept or not)
@@ -46,7 +54,7 @@ layout(std430, binding = 6) buffer Header { uint hdr[16]; };
 layout(std430, binding = 7) readonly buffer Sorted { vec4 sorted[]; };
 layout(std430, binding = 8) buffer Normal { vec4 nrm[]; };
 layout(std430, binding = 9) buffer Pot { vec4 pot[]; };
-// 2 vec4 a particle: position and lifetime; velocity and class (0 spray, 1 foam, 2 bubble)
+// 2 vec4 a particle: position and lifetime; velocity and class (0 spray, 1 foam, 2 bubble, 3 steam)
 layout(std430, binding = 10) buffer PoolIn { vec4 pin[]; };
 layout(std430, binding = 11) buffer PoolOut { vec4 pout[]; };
 uniform uint u_count;       // fluid particles
@@ -63,6 +71,8 @@ uniform vec3 u_lo, u_hi;    // the fluid's box: a diffuse particle far outside i
 uniform vec4 u_imp[16];     // MODE_EMIT: per impact its point and unit normal (xyz)
 uniform uint u_imp_n, u_imp_per;
 uniform float u_imp_speed;
+uniform uint u_steam_per;   // MODE_EMIT: steam puffs an impact
+uniform float u_steam_life, u_steam_rise, u_steam_drag;
 
 #define MAX_CAND 4096u
 #define MAX_NEW 8u
@@ -135,8 +145,10 @@ void main()
     hdr[9] = 0u;
 #elif defined(MODE_EMIT)
     uint k = gl_GlobalInvocationID.x;
-    if (k >= u_imp_n * u_imp_per) return;
-    uint e = k / u_imp_per;
+    uint nspray = u_imp_n * u_imp_per;
+    if (k >= nspray + u_imp_n * u_steam_per) return;
+    bool steam = k >= nspray;
+    uint e = steam ? (k - nspray) / u_steam_per : k / u_imp_per;
     vec3 c = u_imp[2u * e].xyz, nrm = u_imp[2u * e + 1u].xyz;
     if (!finite3(c) || !(dot(nrm, nrm) > 0.5)) return;
     uint s = pcg(k ^ pcg(u_seed ^ 0x9e3779b9u));
@@ -144,6 +156,22 @@ void main()
     vec3 e1 = normalize(cross(nrm, ref)), e2 = cross(nrm, e1);
     float th = 6.2831853 * rnd(s), rr = sqrt(rnd(s));
     vec3 side = cos(th) * e1 + sin(th) * e2;
+    if (steam) {
+        // a puff just above the hit, rising against gravity and drifting outwards
+        vec3 up = -normalize(u_gravity);
+        float vt = u_steam_rise * u_vref;
+        side -= dot(side, up) * up;   // across gravity: a puff is never born below the hit
+        side = dot(side, side) > 1.0e-6 ? normalize(side) : vec3(0.0);
+        vec3 xs = c + up * u_h * (0.15 + 0.35 * rnd(s)) + side * (rr * 0.8 * u_h);
+        vec3 vs = up * vt * (0.25 + 0.25 * rnd(s)) + side * vt * (0.2 + 0.6 * rr);
+        float ls = u_steam_life * (0.75 + 0.25 * rnd(s));
+        atomicAdd(hdr[9], 1u);
+        uint as = atomicAdd(hdr[3], 1u);
+        if (as >= u_cap) return;
+        pin[2u * as] = vec4(xs, ls);
+        pin[2u * as + 1u] = vec4(vs, 3.0);
+        return;
+    }
     vec3 x = c + nrm * u_h * (0.6 + 0.6 * rnd(s)) + side * (rr * 0.75 * u_h);
     float sp = u_imp_speed * u_vref * (0.35 + 0.65 * rnd(s));
     vec3 v = sp * normalize(nrm + side * (0.3 + 0.9 * rr));
@@ -159,6 +187,26 @@ void main()
     vec4 a = pin[2u * i], b = pin[2u * i + 1u];
     vec3 x = a.xyz, v = b.xyz;
     float life = a.w;
+    if (uint(b.w) == 3u) {
+        // steam: buoyancy and drag relax it towards rising at the terminal speed, plus a swirl
+        // fixed in space (across the rise, 0.5 of it) that spreads the puffs; no neighbours
+        vec3 up = -normalize(u_gravity);
+        float vt = u_steam_rise * u_vref;
+        vec3 q = x / u_h;
+        vec3 sw = vec3(sin(1.7 * q.y + 2.1 * q.z), 0.0, cos(1.9 * q.y + 1.3 * q.x)) * 0.5 * vt;
+        sw -= dot(sw, up) * up;
+        v += min(u_steam_drag * u_dt, 1.0) * (vt * up + sw - v);
+        x += v * u_dt;
+        life -= u_dt;
+        float ms = 8.0 * u_h;
+        bool in_s = all(greaterThan(x, u_lo - vec3(ms))) && all(lessThan(x, u_hi + vec3(ms, 4.0 * ms, ms)));
+        if (!(life > 0.0) || !finite3(x) || !finite3(v) || !in_s) return;
+        uint ks = atomicAdd(hdr[8], 1u);
+        pout[2u * ks] = vec4(x, life);
+        pout[2u * ks + 1u] = vec4(v, 3.0);
+        atomicAdd(c_steam, 1u);
+        return;
+    }
     uint n = 0u;
     float K = 0.0;
     vec3 vf = vec3(0.0);

@@ -1,8 +1,8 @@
 // Diffuse particles' quads, one instance a pool entry (the indirect draw's count is the pool's).
 // SPLAT: foam and bubbles, a camera-facing quad of radius u_radius (bubbles half of it).
 // STREAK: spray, a camera-facing capsule of half-width u_radius from where the drop was
-// u_shutter seconds ago to where it is (motion blur). The other classes are sent outside the
-// clip volume, as is a quad around the eye.
+// u_shutter seconds ago to where it is (motion blur). The other classes (and steam, drawn by
+// steam.vert) are sent outside the clip volume, as is a quad around the eye.
 layout(std430, binding = 0) readonly buffer Pool { vec4 pool[]; };
 uniform mat4 u_view_proj;
 uniform vec3 u_eye;
@@ -21,7 +21,7 @@ void main()
     vec3 e = p - u_eye;
     float d = length(e);
 #if defined(SPLAT)
-    bool drawn = v_cls != 0u;
+    bool drawn = v_cls == 1u || v_cls == 2u;   // steam (3) has its own draw, steam.vert
 #else
     bool drawn = v_cls == 0u;
 #endif

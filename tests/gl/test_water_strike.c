@@ -4,7 +4,10 @@
  * particles near the hit move away from it, spray rises at the hit within a few frames (thrown by
  * the plugin where the impact falls on the water: water.foam.impacts) and the largest speed stays
  * bounded. The same scene with impact_strength 0 is the control: the beam and its light are the
- * same, the fluid is not pushed (the spray still rises); with water.foam.impacts off, none does. */
+ * same, the fluid is not pushed (the spray still rises); with water.foam.impacts off, none does.
+ * Steam (diffuse class 3) puffs up at the hit on the calm control: within a few frames, above the
+ * surface, rising (mean height and mean upward speed both grow: buoyancy, not the launch, lifts
+ * it), bounded in count; none with the impacts off or at the preset low. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -19,13 +22,15 @@
 #include "debug.h"
 #include "sim/sim_system.h"
 #include "test_util.h"
+#include "water/water_effect.h"
 
 #define STRENGTH 4.0
 #define RADIUS 0.2
+#define MAX_FRAMES 32
 
 /* A 1.2 x 0.6 x 1.2 m tank, 3,000 particles, a beam from above whose head is under the surface
  * at the centre. */
-static const char *scene_text(double strength, bool spray)
+static const char *scene_text(double strength, bool spray, const char *preset)
 {
     static char buf[4096];
     snprintf(buf, sizeof buf,
@@ -38,10 +43,10 @@ static const char *scene_text(double strength, bool spray)
              "  \"fluid\": {\"min\": [-0.58, 0.01, -0.58], \"max\": [0.58, 0.2, 0.58]},"
              "  \"particle_count\": 3000, \"gravity\": [0, -9.81, 0], \"dt\": 0.016666667, \"solver\": \"pbf\","
              "  \"settle_steps\": 60, \"impact_strength\": %g, \"impact_radius\": %g},"
-             "  \"quality\": {\"method\": \"tile\"}, \"foam\": {\"impacts\": \"%s\"}},"
+             "  \"quality\": {\"method\": \"tile\", \"preset\": \"%s\"}, \"foam\": {\"impacts\": \"%s\"}},"
              "\"beams\": [{\"head\": [0.0, 0.1, 0.0], \"dir\": [0.3, 1, 0.2], \"length\": 1.5, \"radius\": 0.08,"
              "  \"a\": 0.6, \"b\": 0.4, \"eps\": 0.02, \"color\": [0.7, 0.6, 1.0, 1]}]}",
-             strength, RADIUS, spray ? "on" : "off");
+             strength, RADIUS, preset, spray ? "on" : "off");
     return buf;
 }
 
@@ -52,7 +57,40 @@ typedef struct run_result {
     double away_mean;      /* mean speed away from the hit, the frame after the first push, of the
                             * particles then within RADIUS / 2 of it */
     float vmax;            /* largest sim.max_speed over the run */
+    int first_seen;        /* frame the host first got an impact event (pushed or not; -1: never) */
+    float hit_y;           /* that event's height (the surface at the hit) */
+    int first_steam;       /* frame steam puffs were first in the pool (-1: never) */
+    double steam_max;      /* most puffs in the pool at once */
+    double steam_stat_max; /* largest water.diffuse_steam over the run */
+    double steam_low;      /* lowest puff above hit_y over the run (after its first frame) */
+    double steam_y[MAX_FRAMES], steam_vy[MAX_FRAMES], steam_top[MAX_FRAMES]; /* mean height, mean
+                            * upward speed, highest puff per frame (NAN: no puff) */
 } run_result;
+
+/* The steam puffs of the pool after a frame: their count, mean height and upward speed, the
+ * highest and the lowest. */
+static uint32_t steam_of(game_app *app, double *y, double *vy, double *top, double *low)
+{
+    uint32_t alive = 0;
+    assert_int_equal(volfx_water_debug_diffuse(app->ctx, NULL, 0, NULL, 0, &alive), VFX_OK);
+    float *pool = malloc(((size_t)alive + 1) * 8 * sizeof *pool);
+    assert_int_equal(volfx_water_debug_diffuse(app->ctx, NULL, 0, pool, alive, &alive), VFX_OK);
+    uint32_t n = 0;
+    double sy = 0, svy = 0;
+    *top = -INFINITY, *low = INFINITY;
+    for (uint32_t i = 0; i < alive; ++i) {
+        const float *e = pool + 8 * (size_t)i;
+        if (e[7] != 3.0f)
+            continue;
+        n++, sy += e[1], svy += e[5];
+        *top = fmax(*top, e[1]);
+        *low = fmin(*low, e[1]);
+    }
+    free(pool);
+    *y = n ? sy / n : NAN;
+    *vy = n ? svy / n : NAN;
+    return n;
+}
 
 static double stat(game_app *app, const char *name)
 {
@@ -65,13 +103,14 @@ static double stat(game_app *app, const char *name)
     return 0;
 }
 
-static run_result run(double strength, bool spray, int frames)
+static run_result run(double strength, bool spray, const char *preset, int frames)
 {
+    assert_true(frames <= MAX_FRAMES);
     char path[] = "/tmp/volfx-strike-XXXXXX.json";
     int fd = mkstemps(path, 5);
     assert_true(fd >= 0);
     FILE *f = fdopen(fd, "w");
-    fputs(scene_text(strength, spray), f);
+    fputs(scene_text(strength, spray, preset), f);
     fclose(f);
     test_log log = {0};
     game_app_desc d = {.mode = RT_GL_HEADLESS, .width = 96, .height = 64, .logger = {test_log_fn, &log}};
@@ -84,7 +123,7 @@ static run_result run(double strength, bool spray, int frames)
         printf("load: %s\n", log.last);
     assert_int_equal(lr, VFX_OK);
     remove(path);
-    run_result res = {-1, -1, 0, 0, 0};
+    run_result res = {.first_event = -1, .first_spray = -1, .first_seen = -1, .first_steam = -1, .steam_low = INFINITY};
     float hit[3] = {0};
     uint32_t *near = NULL;
     for (int fr = 0; fr < frames; ++fr) {
@@ -127,6 +166,21 @@ static run_result run(double strength, bool spray, int frames)
         res.vmax = fmaxf(res.vmax, rt_sim_system_stats(demo.spawned.sim)->max_speed);
         if (res.first_event >= 0 && res.first_spray < 0 && spray > 0)
             res.first_spray = fr;
+        if (res.first_seen < 0 && app->impact_count > 0) {
+            res.first_seen = fr;
+            res.hit_y = app->impacts[0].position[1];
+        }
+        double low;
+        uint32_t puffs = steam_of(app, &res.steam_y[fr], &res.steam_vy[fr], &res.steam_top[fr], &low);
+        res.steam_max = fmax(res.steam_max, puffs);
+        res.steam_stat_max = fmax(res.steam_stat_max, stat(app, "water.diffuse_steam"));
+        if (puffs && res.first_steam < 0)
+            res.first_steam = fr;
+        else if (puffs)
+            res.steam_low = fmin(res.steam_low, low);
+        if (getenv("STRIKE_TRACE") && puffs)
+            printf("frame %d steam %u mean y %.4f top %.4f low %.4f mean vy %.4f\n", fr, puffs, res.steam_y[fr],
+                   res.steam_top[fr], low, res.steam_vy[fr]);
     }
     free(near);
     assert_int_equal(log.errors, 0);
@@ -138,7 +192,8 @@ static run_result run(double strength, bool spray, int frames)
 static void test_strike_splashes(void **state)
 {
     (void)state;
-    run_result ctl = run(0.0, true, 16), hit = run(STRENGTH, true, 16), dry = run(STRENGTH, false, 16);
+    run_result ctl = run(0.0, true, "medium", 16), hit = run(STRENGTH, true, "medium", 16),
+               dry = run(STRENGTH, false, "medium", 16);
     printf("control (impact_strength 0): spray from frame %d (at most %g), max speed %.3f m/s\n", ctl.first_spray,
            ctl.spray_max, ctl.vmax);
     printf("struck (impact_strength %g): event at frame %d, spray from frame %d (at most %g), max speed %.3f m/s\n",
@@ -158,10 +213,48 @@ static void test_strike_splashes(void **state)
     assert_true(hit.vmax <= STRENGTH + 4.0f);
 }
 
+/* Steam at the hit on calm water (impact_strength 0: no push, the pool stays still). */
+static void test_strike_steams(void **state)
+{
+    (void)state;
+    enum { FRAMES = 28 };
+    run_result calm = run(0.0, true, "medium", FRAMES);
+    run_result dry = run(0.0, false, "medium", 10), low = run(0.0, true, "low", 10);
+    int f0 = calm.first_steam, f1 = FRAMES - 1;
+    printf("calm: event at frame %d (surface y %.3f), steam from frame %d, at most %g puffs (stat %g)\n",
+           calm.first_seen, calm.hit_y, f0, calm.steam_max, calm.steam_stat_max);
+    printf("  frame %d: mean y %.4f, mean vy %.4f; frame %d: mean y %.4f top %.4f, mean vy %.4f; lowest %.4f\n",
+           f0 + 2, calm.steam_y[f0 + 2], calm.steam_vy[f0 + 2], f1, calm.steam_y[f1], calm.steam_top[f1],
+           calm.steam_vy[f1], calm.steam_low);
+    printf("impacts off: %g puffs; preset low: %g puffs\n", dry.steam_max, low.steam_max);
+    /* within a few frames of the first event (read back 1-3 frames late), seen by the stat too */
+    assert_true(calm.first_seen >= 0 && f0 >= 0 && f0 <= calm.first_seen + 3);
+    assert_true(calm.steam_stat_max > 0);
+    /* above the surface, and rising: every frame's mean height above the one 4 frames earlier
+     * (new puffs are born at the surface all along: the mean still climbs as the first ones
+     * rise), the highest puff more than 2 h (h 0.088 here) above the hit by the last frame
+     * (launched and left to drag alone, it would stop below 0.5 h + 0.5 v_t / k_d = 1.4 h, with
+     * v_t = 0.7 sqrt(|g| h) = 0.65 m/s and k_d = 4/s) */
+    assert_true(calm.steam_low > calm.hit_y);
+    for (int f = f0 + 6; f <= f1; f += 4)
+        assert_true(calm.steam_y[f] > calm.steam_y[f - 4]);
+    assert_true(calm.steam_top[f1] > calm.hit_y + 2.0 * 0.088);
+    /* buoyancy lifts it: puffs leave the surface slower than they end up rising (launched at a
+     * quarter to half of the terminal speed), so the mean upward speed grows; thrown, or
+     * falling, it would shrink */
+    assert_true(calm.steam_vy[f1] > 1.3 * calm.steam_vy[f0 + 2] && calm.steam_vy[f0 + 2] > 0);
+    /* bounded: at most 3 puffs a frame (150 a second x 1/60, rounded up) from the one impact */
+    assert_true(calm.steam_max <= 3.0 * (FRAMES - f0));
+    /* none without impacts (water.foam.impacts off), none at the preset low */
+    assert_true(dry.steam_max == 0 && dry.steam_stat_max == 0);
+    assert_true(low.first_seen >= 0 && low.steam_max == 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_strike_splashes),
+        cmocka_unit_test(test_strike_steams),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
