@@ -178,11 +178,6 @@ rt_component rt_world_lookup(const rt_world *w, const char *name)
     return RT_COMPONENT_NONE;
 }
 
-const rt_component_desc *rt_world_component_desc(const rt_world *w, rt_component c)
-{
-    return (w && c < w->comp_count) ? &w->comps[c].desc : NULL;
-}
-
 /* ------------------------------------------------------------------------ tables */
 
 static int table_comp_slot(const table *t, rt_component c)

@@ -80,8 +80,6 @@ const char *rt_world_last_error(const rt_world *world);
 vfx_result rt_world_register(rt_world *world, const rt_component_desc *desc, rt_component *out);
 /* Component id by name, or RT_COMPONENT_NONE. */
 rt_component rt_world_lookup(const rt_world *world, const char *name);
-/* Descriptor of a registered component, or NULL. */
-const rt_component_desc *rt_world_component_desc(const rt_world *world, rt_component c);
 
 /* Spawns `count` entities with the given components (zero-initialised) into one table;
  * ids written to out_ids when not NULL. count 0 is a no-op. */

@@ -345,12 +345,6 @@ vfx_result rt_scene_get_path(pctx *c, const cJSON *obj, const char *path, const 
 
 /* ------------------------------------------------------------------ transforms */
 
-void rt_scene_mat_identity(float m[16])
-{
-    mat4 id = GLM_MAT4_IDENTITY_INIT;
-    memcpy(m, id, sizeof id);
-}
-
 /* M = T * Rz * Ry * Rx * S, column-major, with cglm. */
 void rt_scene_mat_trs(const float t[3], const float rdeg[3], const float s[3], float m[16])
 {

@@ -71,7 +71,6 @@ vfx_result rt_scene_get_vec(pctx *c, const cJSON *obj, const char *path, const c
 bool rt_scene_is_zero3(const float *v);
 void rt_scene_join(char *out, const char *parent, const char *key);
 void rt_scene_join_index(char *out, const char *parent, int i);
-void rt_scene_mat_identity(float m[16]);
 void rt_scene_mat_trs(const float t[3], const float rdeg[3], const float s[3], float m[16]);
 vfx_result rt_scene_number_value(pctx *c, const cJSON *v, const char *path, range rg, double *out);
 vfx_result rt_scene_parse_transform(pctx *c, const cJSON *obj, const char *path, float model[16]);

@@ -75,4 +75,3 @@ bool rt_sim_gpu_view(const rt_sim_gpu *g, vfx_particle_view *out)
     return true;
 }
 
-rt_sph_gpu *rt_sim_gpu_solver(const rt_sim_gpu *g) { return g ? g->gpu : NULL; }

@@ -18,7 +18,5 @@ vfx_result rt_sim_gpu_attach(rt_sim_system *sys, rt_sim_gpu **out, char *err, si
 /* The state as one particle view of GL buffer columns (gpu_pos, gpu_vel; revision changes every
  * step); false before the first run made the GPU solver. */
 bool rt_sim_gpu_view(const rt_sim_gpu *g, vfx_particle_view *out);
-/* The GPU solver (NULL before the first run). */
-rt_sph_gpu *rt_sim_gpu_solver(const rt_sim_gpu *g);
 
 #endif

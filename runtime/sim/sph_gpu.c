@@ -470,7 +470,6 @@ vfx_result rt_sph_gpu_step(rt_sph_gpu *g, float frame_dt, rt_sph_report *rep, ch
     return VFX_OK;
 }
 
-uint32_t rt_sph_gpu_stats_age(const rt_sph_gpu *g) { return g ? (uint32_t)(g->frame - g->known_frame) : 0; }
 
 /* ---- velocity edits, settle, access ------------------------------------------------------------ */
 
@@ -507,49 +506,31 @@ void rt_sph_gpu_impulse(rt_sph_gpu *g, const float centre[3], const float dir[3]
     g->vmax_known += speed; /* an impulse adds at most speed to a particle's */
 }
 
+static vfx_result gpu_settle_step(void *g, float dt, rt_sph_report *rep, char *err, size_t errlen)
+{
+    return rt_sph_gpu_step(g, dt, rep, err, errlen);
+}
+
+static void gpu_settle_damp(void *solver, float factor, const rt_sph_report *rep)
+{
+    rt_sph_gpu *g = solver;
+    gpu_velocity_pass(g, 0, factor, NULL, NULL);
+    g->vmax_known = rep->max_speed * factor;
+}
+
 vfx_result rt_sph_gpu_settle(rt_sph_gpu *g, const rt_sph_settle_desc *desc, rt_sph_settle_report *rep, char *err,
                              size_t errlen)
 {
-    rt_sph_settle_desc d;
-    rt_sph_settle_report out = {0};
     if (rep)
-        *rep = out;
+        *rep = (rt_sph_settle_report){0};
     if (!g)
         return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_gpu_settle: NULL solver");
-    /* rt_sph_settle's checks, defaults and stopping rule */
-    vfx_result rr = rt_sph_settle_resolve(desc, &d, "rt_sph_gpu_settle", err, errlen);
-    if (rr != VFX_OK)
-        return rr;
-    rt_sph *s = g->s;
-    const double t_start = s->time, c0 = rt_sph_process_cpu_s();
+    /* rt_sph_settle's checks, defaults, steps and stopping rule; each step waits for its figures */
     const bool sync = g->sync;
     g->sync = true;
-    vfx_result r = VFX_OK;
-    for (uint32_t k = 0; k < d.max_steps && g->n; ++k) {
-        s->time = t_start - d.step_dt;
-        rt_sph_report sr;
-        if ((r = rt_sph_gpu_step(g, d.step_dt, &sr, err, errlen)))
-            break;
-        out.steps = k + 1;
-        out.max_speed_last = sr.max_speed;
-        out.compression = sr.mean_density_error;
-        if (k == 0)
-            out.max_speed_first = sr.max_speed;
-        const bool done = sr.max_speed < d.speed_tol || k + 1 == d.max_steps;
-        const float damp = done || d.quasi_static ? 0.f : d.damping;
-        gpu_velocity_pass(g, 0, damp, NULL, NULL);
-        g->vmax_known = sr.max_speed * damp;
-        if (d.progress && (k == 0 || (k + 1) % d.progress_every == 0 || done))
-            d.progress(d.user, k + 1, d.max_steps, sr.max_speed, sr.mean_density_error);
-        if (done)
-            break;
-    }
+    const rt_sph_settle_ops ops = {gpu_settle_step, gpu_settle_damp, g, &g->n};
+    vfx_result r = rt_sph_settle_run(g->s, "rt_sph_gpu_settle", desc, &ops, rep, err, errlen);
     g->sync = sync;
-    s->time = t_start;
-    rt_sph_update_colliders(s, t_start);
-    out.cpu_s = rt_sph_process_cpu_s() - c0;
-    if (rep)
-        *rep = out;
     return r;
 }
 

@@ -36,7 +36,7 @@ vfx_result rt_sph_gpu_create(rt_sph *sim, const rt_sph_gpu_desc *desc, rt_sph_gp
 void rt_sph_gpu_destroy(rt_sph_gpu *g);
 /* Advances by frame_dt as rt_sph_step does for PBF (the step count from the newest known max
  * speed). The report's state figures are this step's with sync_stats, else the newest finished
- * frame's (rt_sph_gpu_stats_age). VFX_ERR_NUMERIC when particles went non-finite (they are then
+ * frame's. VFX_ERR_NUMERIC when particles went non-finite (they are then
  * held at their predicted positions, at rest, as on the CPU). */
 vfx_result rt_sph_gpu_step(rt_sph_gpu *g, float frame_dt, rt_sph_report *rep, char *err, size_t errlen);
 /* rt_sph_settle on the GPU (the same defaults, damping and stopping rule; waits for each step). */
@@ -44,8 +44,6 @@ vfx_result rt_sph_gpu_settle(rt_sph_gpu *g, const rt_sph_settle_desc *desc, rt_s
                              size_t errlen);
 /* rt_sph_impulse on the GPU buffers (the count of particles changed is not known here). */
 void rt_sph_gpu_impulse(rt_sph_gpu *g, const float centre[3], const float dir[3], float radius, float speed);
-/* Frames between the newest figures in a report and the step that returned it (0 with sync_stats). */
-uint32_t rt_sph_gpu_stats_age(const rt_sph_gpu *g);
 /* The state as GL buffer columns for vfx_particle_view (positions and velocities, 16 bytes a
  * particle, in the solver's cell order); valid until the next step. */
 void rt_sph_gpu_columns(const rt_sph_gpu *g, vfx_gpu_column *pos, vfx_gpu_column *vel, uint32_t *count);

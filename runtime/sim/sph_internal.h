@@ -233,8 +233,6 @@ vfx_result rt_sph_pbf_step(rt_sph *s, float frame_dt, rt_sph_report *rep, char *
  * step does): the lattice's sum |grad C|^2, the mixing eps of a call of frame_dt, (H^2 - dq^2)^3
  * (the GPU solver's, sph_gpu.c) */
 void rt_sph_pbf_constants(rt_sph *s, float frame_dt, float *D0, float *eps, float *wdq);
-/* sph_pbf.c: the walls' density rho0 * (missing fraction) at p and its gradient / rho0 */
-void rt_sph_pbf_walls(const rt_sph *s, float px, float py, float pz, float *wall_rho, float g[3]);
 /* sph_pbf.c: moves p out of every collider and the domain box to the clamp margin (dx/4) */
 void rt_sph_pbf_clamp(const rt_sph *s, float p[3]);
 
@@ -254,11 +252,18 @@ bool rt_sph_pbf_may_reach_wall(const rt_sph *s, uint32_t i, const float p[3]);
 
 /* sph_emit.c: runs the emitters for dt (0 on the first substep); count added to *emitted */
 vfx_result rt_sph_emit(rt_sph *s, double dt, uint32_t *emitted, char *err, size_t errlen);
-/* rt_sph_settle's desc checked (refused naming `who`) and its zero fields given the defaults, for
- * the CPU and GPU settles alike. */
-vfx_result rt_sph_settle_resolve(const rt_sph_settle_desc *desc, rt_sph_settle_desc *out, const char *who,
-                                 char *err, size_t errlen);
-/* The process's CPU seconds (all threads), for the settle reports. */
-double rt_sph_process_cpu_s(void);
+/* sph_settle.c: one settle over either solver (rt_sph_settle, rt_sph_gpu_settle). step advances the
+ * solver by dt, then damp scales its velocities by factor (given the step's report); count is its
+ * particle count. */
+typedef struct rt_sph_settle_ops {
+    vfx_result (*step)(void *solver, float dt, rt_sph_report *rep, char *err, size_t errlen);
+    void (*damp)(void *solver, float factor, const rt_sph_report *rep);
+    void *solver;
+    const uint32_t *count;
+} rt_sph_settle_ops;
+/* rt_sph_settle's steps through ops: desc checked (refused naming `who`) and defaulted, s's clock
+ * held at its start time and its colliders put back there after; *rep written at the end. */
+vfx_result rt_sph_settle_run(rt_sph *s, const char *who, const rt_sph_settle_desc *desc, const rt_sph_settle_ops *ops,
+                             rt_sph_settle_report *rep, char *err, size_t errlen);
 
 #endif

@@ -1,24 +1,10 @@
 /* sph_kernels.c — the per-chunk passes: density (cell scan or Verlet walk), forces,
  * integration, displacement; the pair loops take four pairs at a time with SSE2. */
 #include "sim/sph_collide.h"
+#include "sim/sph_simd.h"
 #include "sim/sph_wall.h"
 
 #include <stdlib.h>
-
-#if defined(__SSE2__) && (defined(__GNUC__) || defined(__clang__))
-#include <emmintrin.h>
-/* SSE2 (every x86-64): the density walk and the force pair loop take four pairs at a time;
- * elsewhere the scalar loops below do the same sums */
-#define SPH_SSE 1
-static inline float sph_hsum(__m128 v)
-{
-    float l[4];
-    _mm_storeu_ps(l, v);
-    return (l[0] + l[1]) + (l[2] + l[3]);
-}
-#else
-#define SPH_SSE 0
-#endif
 
 
 /* Grows a per-chunk list buffer to hold `want` entries; false (and nb_oom set) when it cannot. */

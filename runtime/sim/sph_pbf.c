@@ -24,24 +24,12 @@
  * last step's pressures, and a fresh fluid starts from the hydrostatic rho0 |g| depth. Measured
  * unstable with 3 iterations (the carried pressure acts as an integral of the compression). */
 #include "sim/sph_collide.h"
+#include "sim/sph_simd.h"
 #include "sim/sph_wall.h"
 #include "core/error.h"
 
 #include <stdlib.h>
 #include <string.h>
-
-#if defined(__SSE2__) && (defined(__GNUC__) || defined(__clang__))
-#include <emmintrin.h>
-#define PBF_SSE 1
-static inline float pbf_hsum(__m128 v)
-{
-    float l[4];
-    _mm_storeu_ps(l, v);
-    return (l[0] + l[1]) + (l[2] + l[3]);
-}
-#else
-#define PBF_SSE 0
-#endif
 
 /* ---- parameters ---------------------------------------------------------------------------- */
 
@@ -101,12 +89,6 @@ static void pbf_walls(const rt_sph *s, float px, float py, float pz, float *wall
         float gr = others * s->wall_scale * (float)rt_sph_wall_density_gradient(w[k].d, s->H);
         g[0] -= gr * w[k].n[0], g[1] -= gr * w[k].n[1], g[2] -= gr * w[k].n[2];
     }
-}
-
-void rt_sph_pbf_walls(const rt_sph *s, float px, float py, float pz, float *wall_rho, float g[3])
-{
-    float ig;
-    pbf_walls(s, px, py, pz, wall_rho, g, &ig);
 }
 
 /* Moves p out of every collider and the domain box to the clamp margin (positions only). */
@@ -221,7 +203,7 @@ static void pbf_lambda_chunk(rt_sph *s, uint32_t chunk)
         const uint32_t nn = s->nb_count[i];
         float sw = H2 * H2 * H2, gx = 0.f, gy = 0.f, gz = 0.f, g2 = 0.f;
         uint32_t k = 0, coincident = 0;
-#if PBF_SSE
+#if SPH_SSE
         {
             const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), vpz = _mm_set1_ps(pz);
             const __m128 vH = _mm_set1_ps(H), vH2 = _mm_set1_ps(H2), veps = _mm_set1_ps(eps2);
@@ -248,8 +230,8 @@ static void pbf_lambda_chunk(rt_sph *s, uint32_t chunk)
                     _mm_storeu_ps(PE[2] + off + k, qz);
                 }
             }
-            sw += pbf_hsum(w4);
-            gx = -pbf_hsum(gx4), gy = -pbf_hsum(gy4), gz = -pbf_hsum(gz4), g2 = pbf_hsum(g24);
+            sw += sph_hsum(w4);
+            gx = -sph_hsum(gx4), gy = -sph_hsum(gy4), gz = -sph_hsum(gz4), g2 = sph_hsum(g24);
         }
 #endif
         const uint32_t coincident4 = coincident; /* of the stored pairs */
@@ -334,7 +316,7 @@ static void pbf_delta(rt_sph *s, uint32_t chunk, const pbf_delta_args *a)
         const uint32_t nn = s->nb_count[i];
         float sx = 0.f, sy = 0.f, sz = 0.f;
         uint32_t k = 0, coincident = 0;
-#if PBF_SSE
+#if SPH_SSE
         if (a->stored) {
             /* the same operations on the lambda pass's stored gradients q_ij d_ij (q masked to 0
              * for coincident pairs, counted there): bitwise the sums below, without the position
@@ -347,7 +329,7 @@ static void pbf_delta(rt_sph *s, uint32_t chunk, const pbf_delta_args *a)
                 __m128 coef = vli + lj;
                 sx4 += coef * _mm_loadu_ps(GX + k), sy4 += coef * _mm_loadu_ps(GY + k), sz4 += coef * _mm_loadu_ps(GZ + k);
             }
-            sx = pbf_hsum(sx4), sy = pbf_hsum(sy4), sz = pbf_hsum(sz4);
+            sx = sph_hsum(sx4), sy = sph_hsum(sy4), sz = sph_hsum(sz4);
             coincident = rt_sph_pbf_stored_coincident(s, i);
         } else {
             const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), vpz = _mm_set1_ps(pz);
@@ -371,7 +353,7 @@ static void pbf_delta(rt_sph *s, uint32_t chunk, const pbf_delta_args *a)
                 __m128 coef = vli + lj - vsk * w2 * w2; /* times G_ij / Vks, as the stored path */
                 sx4 += coef * (q * dx), sy4 += coef * (q * dy), sz4 += coef * (q * dz);
             }
-            sx = pbf_hsum(sx4), sy = pbf_hsum(sy4), sz = pbf_hsum(sz4);
+            sx = sph_hsum(sx4), sy = sph_hsum(sy4), sz = sph_hsum(sz4);
         }
 #endif
         for (; k < nn; ++k) {
@@ -523,7 +505,7 @@ static void pbf_visc_chunk(rt_sph *s, uint32_t chunk)
         const uint32_t nn = s->nb_count[i];
         float sw = H2 * H2 * H2, ux = 0.f, uy = 0.f, uz = 0.f, wx = 0.f, wy = 0.f, wz = 0.f;
         uint32_t k = 0;
-#if PBF_SSE
+#if SPH_SSE
         if (!vort) {
             const __m128 vpx = _mm_set1_ps(px), vpy = _mm_set1_ps(py), vpz = _mm_set1_ps(pz);
             const __m128 vvx = _mm_set1_ps(vxi), vvy = _mm_set1_ps(vyi), vvz = _mm_set1_ps(vzi);
@@ -541,7 +523,7 @@ static void pbf_visc_chunk(rt_sph *s, uint32_t chunk)
                 uy4 += (_mm_setr_ps(VY[j0], VY[j1], VY[j2], VY[j3]) - vvy) * w;
                 uz4 += (_mm_setr_ps(VZ[j0], VZ[j1], VZ[j2], VZ[j3]) - vvz) * w;
             }
-            sw += pbf_hsum(w4), ux = pbf_hsum(ux4), uy = pbf_hsum(uy4), uz = pbf_hsum(uz4);
+            sw += sph_hsum(w4), ux = sph_hsum(ux4), uy = sph_hsum(uy4), uz = sph_hsum(uz4);
         }
 #endif
         for (; k < nn; ++k) {

@@ -12,14 +12,16 @@
 
 #include <time.h>
 
-double rt_sph_process_cpu_s(void)
+/* The process's CPU seconds (all threads), for the settle reports. */
+static double process_cpu_s(void)
 {
     struct timespec t;
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-vfx_result rt_sph_settle_resolve(const rt_sph_settle_desc *desc, rt_sph_settle_desc *d, const char *who, char *err,
+/* The desc checked (refused naming `who`) and its zero fields given the defaults. */
+static vfx_result settle_resolve(const rt_sph_settle_desc *desc, rt_sph_settle_desc *d, const char *who, char *err,
                                  size_t errlen)
 {
     *d = desc ? *desc : (rt_sph_settle_desc){0};
@@ -37,27 +39,20 @@ vfx_result rt_sph_settle_resolve(const rt_sph_settle_desc *desc, rt_sph_settle_d
     return VFX_OK;
 }
 
-vfx_result rt_sph_settle(rt_sph *s, const rt_sph_settle_desc *desc, rt_sph_settle_report *rep, char *err,
-                         size_t errlen)
+vfx_result rt_sph_settle_run(rt_sph *s, const char *who, const rt_sph_settle_desc *desc, const rt_sph_settle_ops *ops,
+                             rt_sph_settle_report *rep, char *err, size_t errlen)
 {
     rt_sph_settle_desc d;
     rt_sph_settle_report out = {0};
-    if (rep)
-        *rep = out;
-    if (!s)
-        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_settle: NULL solver");
-    vfx_result rr = rt_sph_settle_resolve(desc, &d, "rt_sph_settle", err, errlen);
-    if (rr != VFX_OK)
-        return rr;
-    const double t_start = s->time, c0 = rt_sph_process_cpu_s();
-    const uint32_t nem = s->nem; /* the emitters wait for frame 0 */
-    s->nem = 0;
-    vfx_result r = VFX_OK;
-    for (uint32_t k = 0; k < d.max_steps && s->n; ++k) {
+    vfx_result r = settle_resolve(desc, &d, who, err, errlen);
+    if (r != VFX_OK)
+        return r;
+    const double t_start = s->time, c0 = process_cpu_s();
+    for (uint32_t k = 0; k < d.max_steps && *ops->count; ++k) {
         /* the step's constraints hold at s->time + dt: held at the start time */
         s->time = t_start - d.step_dt;
         rt_sph_report sr;
-        if ((r = rt_sph_step(s, d.step_dt, &sr, err, errlen)))
+        if ((r = ops->step(ops->solver, d.step_dt, &sr, err, errlen)))
             break;
         out.steps = k + 1;
         out.max_speed_last = sr.max_speed;
@@ -65,19 +60,44 @@ vfx_result rt_sph_settle(rt_sph *s, const rt_sph_settle_desc *desc, rt_sph_settl
         if (k == 0)
             out.max_speed_first = sr.max_speed;
         const bool done = sr.max_speed < d.speed_tol || k + 1 == d.max_steps;
-        const float damp = done || d.quasi_static ? 0.f : d.damping;
-        for (uint32_t i = 0; i < s->n; ++i)
-            s->vx[i] *= damp, s->vy[i] *= damp, s->vz[i] *= damp;
+        ops->damp(ops->solver, done || d.quasi_static ? 0.f : d.damping, &sr);
         if (d.progress && (k == 0 || (k + 1) % d.progress_every == 0 || done))
             d.progress(d.user, k + 1, d.max_steps, sr.max_speed, sr.mean_density_error);
         if (done)
             break;
     }
-    s->nem = nem;
     s->time = t_start;
     rt_sph_update_colliders(s, t_start);
-    out.cpu_s = rt_sph_process_cpu_s() - c0;
+    out.cpu_s = process_cpu_s() - c0;
     if (rep)
         *rep = out;
+    return r;
+}
+
+static vfx_result cpu_step(void *s, float dt, rt_sph_report *rep, char *err, size_t errlen)
+{
+    return rt_sph_step(s, dt, rep, err, errlen);
+}
+
+static void cpu_damp(void *solver, float factor, const rt_sph_report *rep)
+{
+    (void)rep;
+    rt_sph *s = solver;
+    for (uint32_t i = 0; i < s->n; ++i)
+        s->vx[i] *= factor, s->vy[i] *= factor, s->vz[i] *= factor;
+}
+
+vfx_result rt_sph_settle(rt_sph *s, const rt_sph_settle_desc *desc, rt_sph_settle_report *rep, char *err,
+                         size_t errlen)
+{
+    if (rep)
+        *rep = (rt_sph_settle_report){0};
+    if (!s)
+        return rt_errf(err, errlen, VFX_ERR_INVALID_ARGUMENT, "rt_sph_settle: NULL solver");
+    const uint32_t nem = s->nem; /* the emitters wait for frame 0 */
+    s->nem = 0;
+    const rt_sph_settle_ops ops = {cpu_step, cpu_damp, s, &s->n};
+    vfx_result r = rt_sph_settle_run(s, "rt_sph_settle", desc, &ops, rep, err, errlen);
+    s->nem = nem;
     return r;
 }
