@@ -12,7 +12,7 @@
 #include "beams/beam_field.h"
 #include "debug.h"
 #include "volfx_lab.h"
-#include "test_util.h"
+#include "test_plugin.h"
 
 /* One ray of a batch: the beam (straight, anatomy or polyline), float32 origin and unit direction. */
 typedef struct beam_probe_ray {
@@ -29,19 +29,9 @@ typedef struct beam_probe_case {
 /* A plugin context with the lab on the current GL context (the program cache, file:line errors). */
 static inline vfx_context *beam_probe_open(const vfx_plugin_api **api_out)
 {
-    static test_log log;
-    static vfx_context_desc host;
-    static vfx_plugin_api api;
-    host = (vfx_context_desc){.type = VFX_TYPE_CONTEXT_DESC, .gl_get_proc_address = test_gl_proc, .user = &log,
-                              .log = test_vfx_log_fn};
-    api.type = VFX_TYPE_PLUGIN_API;
-    vfx_context *ctx = NULL;
     /* the probe is a lab shader (volfx_lab_shaders): a context with the lab attached builds it */
-    if (vfx_plugin_entry(VFX_ABI_VERSION, NULL, &api) != VFX_OK || api.create(&host, &ctx) != VFX_OK ||
-        volfx_lab_attach(ctx) != VFX_OK)
-        return NULL;
-    *api_out = &api;
-    return ctx;
+    vfx_context *ctx = test_plugin_open(api_out);
+    return ctx && volfx_lab_attach(ctx) == VFX_OK ? ctx : NULL;
 }
 
 /* out[i] = the shader's H of rays[i]; false when the probe could not run (its error printed). */

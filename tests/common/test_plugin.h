@@ -1,6 +1,6 @@
 /* test_plugin.h — a libvolfx context for the tests that drive the plugin directly on the headless
  * GL context of test_gl_or_skip. Header-only: the GL tests that include test_util.h alone link no
- * plugin. Include after <cmocka.h>. */
+ * plugin. The group runner is there where <cmocka.h> is included before this header. */
 #ifndef VFX_TEST_PLUGIN_H
 #define VFX_TEST_PLUGIN_H
 
@@ -23,6 +23,7 @@ static inline vfx_context *test_plugin_open(const vfx_plugin_api **api_out)
     return ctx;
 }
 
+#ifdef cmocka_run_group_tests
 /* Runs a cmocka group with *ctx and *api open (test_plugin_open) on a headless GL context, exiting
  * 77 when there is none; destroys both after. Returns cmocka's result, or 1 when the plugin
  * could not be opened. */
@@ -39,5 +40,6 @@ static inline int test_plugin_run_group_(const char *name, const struct CMUnitTe
 }
 #define test_plugin_run_group(tests, ctx, api) \
     test_plugin_run_group_(#tests, tests, sizeof(tests) / sizeof((tests)[0]), ctx, api)
+#endif
 
 #endif
