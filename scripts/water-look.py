@@ -91,8 +91,11 @@ def zero_params_scene(scene):
         raise SystemExit(f'water-look: {scene}: no "water" object')
     for key in ('color', 'absorption', 'ior', 'diffuse'):
         water.pop(key, None)
-    # beside the scene: its relative paths (meshes, volumes) stay right; removed after the run
-    fd, path = tempfile.mkstemp(prefix='zero-', suffix='-' + os.path.basename(scene), dir=os.path.dirname(os.path.abspath(scene)))
+    # beside the scene, so its relative paths (meshes, volumes) stay right; a hidden name that
+    # .gitignore lists (.water-look-*.json), so `git add -A` never picks it up, and removed after
+    # the run
+    fd, path = tempfile.mkstemp(prefix='.water-look-zero-', suffix='-' + os.path.basename(scene),
+                                dir=os.path.dirname(os.path.abspath(scene)))
     with os.fdopen(fd, 'w') as f:
         json.dump(doc, f, indent=1)
     return path
