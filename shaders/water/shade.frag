@@ -306,12 +306,12 @@ void main()
     vec3 hor = u_has_env ? texture(u_env, sun_h).rgb : volfx_sky(sun_h, WATER_SUN);
     vec3 ambient = water_sky_ambient(zen, hor) + water_host_light();
     vec3 p = u_eye + t * dir;
-    vec3 light = ambient + WATER_SUN_E * max(WATER_SUN.y, 0.0) + water_fx_lights(p, vec3(0.0));
+    vec3 light = ambient + WATER_SUN_E * max(WATER_SUN.y, 0.0);
     vec3 body = water_body(behind, thickness, light);
     vec2 foam_bub = u_has_diffuse ? texelFetch(u_diffuse, pix, 0).rg : vec2(0.0);
-    vec3 white = water_white(ambient, p, vec3(0.0, 1.0, 0.0));
+    vec3 white = water_white(ambient, vec3(0.0, 1.0, 0.0));
     // bubbles: white specks behind the surface (already attenuated by the water in front)
-    body += water_white(ambient, p, vec3(0.0)) * (1.0 - exp(-BUBBLE_K * foam_bub.g)) * u_tint * 1.5;
+    body += water_white(ambient, vec3(0.0)) * (1.0 - exp(-BUBBLE_K * foam_bub.g)) * u_tint * 1.5;
     vec3 col = water_surface(body, sky, n, -dir);
     vec3 fx_irr = vec3(0.0);   // the plugin's lights' irradiance on the surface (the foam's too)
 #ifdef WATER_EFFECT_LIGHTS
@@ -336,7 +336,7 @@ void main()
     float foam_a = water_foam_cover(foam_d, p.xz, max(fw.x, fw.y)) * smoothstep(-0.2, 0.5, n.y);
     if (foam_a > 0.0) {
         // a Lambertian scatterer under the lights too: albedo 0.9 x their irradiance / pi
-        vec3 froth = water_white(ambient, p, n) + 0.9 * 0.3183099 * fx_irr;
+        vec3 froth = water_white(ambient, n) + 0.9 * 0.3183099 * fx_irr;
         col = mix(col, froth, foam_a);
     }
     o_color = vec4(u_hdr ? col : min(col, vec3(1.0)), 1.0);
