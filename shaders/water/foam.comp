@@ -10,9 +10,10 @@
 //                  x dt splatted bilinearly (mass and centre kept exactly), in fixed point
 //   MODE_STEP      per texel: the density last update at the point the velocity carried it
 //                  from (semi-Lagrangian, bilinear), plus the explicit 5-point diffusion there,
-//                  times exp(-dt / lifetime) (10 times faster where no water lies under the
-//                  texel), plus this update's deposit. The previous grid may differ (the water's
-//                  box grew): it is sampled at the world position, 0 outside it.
+//                  faded over dt by dd/dt = -(d + FOAM_THIN) / lifetime (10 times faster where no
+//                  water lies under the texel) and held at 0 or above, plus this update's
+//                  deposit. The previous grid may differ (the water's box grew): it is sampled at
+//                  the world position, 0 outside it.
 #if defined(MODE_STEP)
 layout(local_size_x = 8, local_size_y = 8) in;
 #else
@@ -44,6 +45,16 @@ uniform float u_dt, u_vref, u_decay, u_dry_decay, u_kdiff, u_deposit;
 #define VEL_SCALE 4096.0
 #define VEL_MAX 16.0
 #define D_SCALE 65536.0
+// The fade of thin foam. A raft of foam lasts (its bubbles shield each other while the films
+// drain), a sparse scatter of lone bubbles on open water bursts within a fraction of that: the
+// fade dd/dt = -(d + FOAM_THIN) / lifetime gives a density d a finite life, lifetime
+// ln(1 + d / FOAM_THIN) (d = 3: 2.6 lifetimes; d = 0.1: 0.3), instead of the pure exponential's
+// thin haze that lingers wherever the flow spread it. Under a steady source (a beam held on the
+// water, a breaking wave) the patch ends where the drifting foam has thinned to nothing: a bounded
+// patch, not a sheet over the pool (which a bright light turns white: 1 - e^-d of even d = 0.3
+// is a quarter of the surface's light from the foam). 0.3: cover 1 - e^-0.3 = 0.26 at the
+// floor, the thinnest foam that reads as a layer rather than specks.
+#define FOAM_THIN 0.3
 
 bool finite3(vec3 v) { return !(any(isnan(v)) || any(isinf(v))); }
 
@@ -105,7 +116,9 @@ void main()
     float lap = texture(u_prev, uv + vec2(u_prev_texel.x, 0.0)).r + texture(u_prev, uv - vec2(u_prev_texel.x, 0.0)).r
               + texture(u_prev, uv + vec2(0.0, u_prev_texel.y)).r + texture(u_prev, uv - vec2(0.0, u_prev_texel.y)).r
               - 4.0 * c;
-    float d = (c + u_kdiff * lap) * (wsum > 0.0 ? u_decay : u_dry_decay) + float(dep[at]) / D_SCALE;
+    float keep = wsum > 0.0 ? u_decay : u_dry_decay;
+    // the fade clamped before the deposit is added: this update's deposit is kept whole
+    float d = max((c + u_kdiff * lap) * keep - FOAM_THIN * (1.0 - keep), 0.0) + float(dep[at]) / D_SCALE;
     imageStore(u_next, t, vec4(max(d, 0.0)));
 #endif
 }

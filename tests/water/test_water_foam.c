@@ -3,6 +3,8 @@
  *  - fade and spread: a Gaussian blob on water at rest keeps the mass M0 exp(-t / lifetime)
  *    and its variance grows by 2 D t per axis (D = diffusion x h^2), as the heat equation's;
  *  - drift: on water flowing uniformly at v the blob's centre moves by v t (and fades the same);
+ *  - thin foam bursts: the fade dd/dt = -(d + FOAM_THIN) / lifetime ends a thin density in
+ *    finite time while a thick one lasts (the blobs above are far thicker than FOAM_THIN);
  *  - gathering: the foam particles of one update deposit deposit x dt x h^2 each, centred on
  *    them, and nothing lands a texel away from every one of them.
  * Plus the layer off (the preset low, or vfx_water_foam.layer off) runs no pass, and the ranges. */
@@ -87,8 +89,16 @@ static moments moments_of(const float *d, const volfx_water_foam_grid *g)
     return m;
 }
 
+/* The blobs' peak density: far above foam.comp's FOAM_THIN (0.3), the floor below which thin foam
+ * bursts, so that the fade of the blob's mass is the exponential's to < 1e-5 relative (the floor
+ * takes at most FOAM_THIN (1 - e^-dt/lifetime) a texel an update: 0.3 x 0.63 over the grid's
+ * ~6 m^2 in test_fade_and_spread, against a mass of 1e6 x 2 pi sigma^2 = 1.4e5). */
+#define BLOB_PEAK 1.0e6
+/* foam.comp's FOAM_THIN: the fade is dd/dt = -(d + FOAM_THIN) / lifetime, held at 0 */
+#define FOAM_THIN 0.3
+
 /* Runs a frame, wakes the layer, runs another (it makes its grid), then writes a Gaussian blob of standard
- * deviation sigma (world) at (bx, bz); returns the density buffer (the grid in *g). */
+ * deviation sigma (world) and peak BLOB_PEAK at (bx, bz); returns the density buffer (the grid in *g). */
 static float *start_blob(session *ss, volfx_water_foam_grid *g, float bx, float bz, float sigma)
 {
     session_frame(ss); /* the effect exists after its first update */
@@ -100,7 +110,7 @@ static float *start_blob(session *ss, volfx_water_foam_grid *g, float bx, float 
     for (uint32_t j = 0; j < g->nz; ++j)
         for (uint32_t i = 0; i < g->nx; ++i) {
             double x = g->x0 + (i + 0.5) * g->cell - bx, z = g->z0 + (j + 0.5) * g->cell - bz;
-            d[(size_t)j * g->nx + i] = (float)exp(-(x * x + z * z) / (2.0 * sigma * sigma));
+            d[(size_t)j * g->nx + i] = (float)(BLOB_PEAK * exp(-(x * x + z * z) / (2.0 * sigma * sigma)));
         }
     assert_int_equal(volfx_water_debug_foam_write(ss->ctx, d, n), VFX_OK);
     return d;
@@ -130,7 +140,8 @@ static void test_fade_and_spread(void **state)
     printf("  grid %u x %u, cell %.4f: mass %.6f -> %.6f (closed form %.6f, rel %.2e); variance x %.6f -> %.6f "
            "(+%.6f, closed form +%.6f), z +%.6f\n", g.nx, g.nz, g.cell, m0.mass, m.mass, want,
            fabs(m.mass / want - 1), m0.vx, m.vx, m.vx - m0.vx, dvar, m.vz - m0.vz);
-    /* the decay is exp(-dt / lifetime) each update, exactly; the 5-point diffusion keeps the mass
+    /* the decay is exp(-dt / lifetime) each update, exactly, but for the thin-foam floor (below
+     * 1e-5 relative at BLOB_PEAK); the 5-point diffusion keeps the mass
      * and adds 2 k cell^2 = 2 D dt to the variance each update, exactly, away from the edges (the
      * blob's tail at the grid's edge is below 1e-12 here). What is left is float32: 1e-4 relative
      * is 30 updates of a few ulps over some thousand texels with a wide margin. */
@@ -176,6 +187,54 @@ static void test_drift(void **state)
     assert_true(fabs(m.cx - m0.cx - ux * t) < 2e-4);
     assert_true(fabs(m.cz - m0.cz - uz * t) < 2e-4);
     assert_true(fabs(m.mass / want - 1) < 1e-4);
+    free(d);
+    session_close(&ss);
+    free_host(&h);
+}
+
+/* Thin foam bursts: on water at rest (diffusion at its least), half the grid at density 1 and half
+ * at 0.2; after 30 updates of 1/60 s with lifetime 0.5 s, each texel follows the discrete fade
+ * d_n + FOAM_THIN = (d_0 + FOAM_THIN) e^(-n dt / lifetime) held at 0: the thick half keeps
+ * 1.3 e^-1 - 0.3 = 0.178 (a pure exponential: 0.368), the thin half is gone (0.2 lasts
+ * 0.5 ln(1 + 0.2 / 0.3) = 0.26 s; a pure exponential keeps 0.074). */
+static void test_thin_foam_bursts(void **state)
+{
+    (void)state;
+    host h = make_slab(32, 0, 0);
+    const float life = 0.5f;
+    vfx_water_foam foam = {.type = VFX_TYPE_WATER_FOAM, .lifetime = life, .diffusion = 1e-6f};
+    h.params_next = &foam;
+    session ss;
+    session_open(&ss, &h);
+    session_frame(&ss);
+    assert_int_equal(volfx_water_debug_foam_write(ss.ctx, NULL, 0), VFX_OK);
+    session_frame(&ss);
+    volfx_water_foam_grid g;
+    assert_int_equal(volfx_water_debug_foam(ss.ctx, &g, NULL, 0), VFX_OK);
+    size_t n = (size_t)g.nx * g.nz;
+    float *d = calloc(n, sizeof *d);
+    for (uint32_t j = 0; j < g.nz; ++j)
+        for (uint32_t i = 0; i < g.nx; ++i)
+            d[(size_t)j * g.nx + i] = i < g.nx / 2 ? 1.0f : 0.2f;
+    assert_int_equal(volfx_water_debug_foam_write(ss.ctx, d, n), VFX_OK);
+    const int N = 30;
+    for (int k = 0; k < N; ++k)
+        session_frame(&ss);
+    assert_int_equal(volfx_water_debug_foam(ss.ctx, &g, d, n), VFX_OK);
+    /* the discrete fade of each update, in float64: (d + thin) e^-dt/life - thin, at 0 or above */
+    double thick = 1.0, thin = 0.2, keep = exp(-(double)DT / life);
+    for (int k = 0; k < N; ++k) {
+        thick = fmax((thick + FOAM_THIN) * keep - FOAM_THIN, 0.0);
+        thin = fmax((thin + FOAM_THIN) * keep - FOAM_THIN, 0.0);
+    }
+    /* texels a quarter of the grid from the step and from the edges: the diffusion's reach over
+     * 30 updates (k = 1e-6 h^2 dt / cell^2 an update) is nil there */
+    uint32_t j = g.nz / 2, ia = g.nx / 4, ib = 3 * g.nx / 4;
+    float a = d[(size_t)j * g.nx + ia], b = d[(size_t)j * g.nx + ib];
+    printf("  after %d updates: thick %.6f (closed form %.6f), thin %.6f (closed form %.6f)\n", N, a, thick, b, thin);
+    /* float32 over 30 updates of a multiply-add near 1: a few ulps each, 1e-5 with margin */
+    assert_true(fabs(a - thick) < 1e-5);
+    assert_true(thin == 0.0 && b == 0.0f);
     free(d);
     session_close(&ss);
     free_host(&h);
@@ -305,6 +364,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_fade_and_spread),
         cmocka_unit_test(test_drift),
+        cmocka_unit_test(test_thin_foam_bursts),
         cmocka_unit_test(test_gathers_where_deposited),
         cmocka_unit_test(test_off_and_ranges),
     };
