@@ -44,8 +44,8 @@ typedef struct beam_look {
 } beam_look;
 
 typedef struct beams_state {
-    GLuint prog_integrate[32]; /* [march | smooth << 1 | polyline << 2 | anatomy << 3 | water << 4]: code only
-                                * where needed */
+    GLuint prog_integrate[128]; /* [march | smooth << 1 | polyline << 2 | anatomy << 3 | water << 4 | dry << 5
+                                 * | mark << 6]: code only where needed */
     GLuint prog_composite, prog_down, prog_up;
     GLuint beam_buf, range_buf, list_buf, joint_buf;
     size_t beam_cap, range_cap, list_cap, joint_cap; /* bytes */
@@ -54,6 +54,7 @@ typedef struct beams_state {
     GLuint acc_tex, light_tex, acc_fbo;   /* H (RG32F: in front of the water, behind it) and light (RGBA16F) */
     GLuint behind_tex, split_fbo;         /* light behind the water (RGBA16F), and the 3-target framebuffer:
                                            * made the first frame with water */
+    GLuint split_stencil;                 /* its stencil: 1 where the pixel has water in front */
     bool prepared;                        /* the integrate pass ran this render (beams_prepare) */
     bool bloom;                           /* this render's bloom, and its levels */
     uint32_t levels;
@@ -127,6 +128,7 @@ static void beams_destroy(vfx_context *ctx, void *state)
     glDeleteFramebuffers(1, &s->acc_fbo);
     glDeleteTextures(1, &s->behind_tex);
     glDeleteFramebuffers(1, &s->split_fbo);
+    glDeleteRenderbuffers(1, &s->split_stencil);
     free_bloom(s);
     volfx_ubo_destroy(&s->ubo);
     volfx_beams_impact_destroy(ctx, s->impact);
@@ -205,7 +207,8 @@ static vfx_result beams_resize(vfx_context *ctx, void *state, uint32_t w, uint32
     glDeleteFramebuffers(1, &s->acc_fbo);
     glDeleteTextures(1, &s->behind_tex);
     glDeleteFramebuffers(1, &s->split_fbo);
-    s->behind_tex = s->split_fbo = 0;
+    glDeleteRenderbuffers(1, &s->split_stencil);
+    s->behind_tex = s->split_fbo = s->split_stencil = 0;
     free_bloom(s);
     s->acc_tex = make_target(GL_RG32F, w, h, false, "beams.H");
     s->light_tex = make_target(GL_RGBA16F, w, h, true, "beams.light");
@@ -518,21 +521,26 @@ static vfx_result bin_beams(vfx_context *ctx, beams_state *s, const volfx_frame_
     return VFX_OK;
 }
 
-/* The integrate program for this frame's beams: code only for what some beam needs. */
-static GLuint integrate_program(vfx_context *ctx, beams_state *s, bool march, bool water)
+/* The integrate program for this frame's beams: code only for what some beam needs. With water,
+ * `draw` picks the split draws' program (integrate_draws): 0 the pixels with water in front,
+ * DRAW_DRY the others, DRAW_MARK the stencil of the first. */
+enum { DRAW_WET, DRAW_DRY, DRAW_MARK };
+static GLuint integrate_program(vfx_context *ctx, beams_state *s, bool march, bool water, int draw)
 {
     bool any_smooth = false, any_poly = false, any_anat = false;
     for (uint32_t i = 0; i < s->count; ++i)
         any_smooth |= s->beams[i].smooth != 0, any_poly |= s->beams[i].joint_count >= 2,
             any_anat |= s->looks[i].anatomy;
     unsigned variant = (unsigned)march | (unsigned)any_smooth << 1 | (unsigned)any_poly << 2 | (unsigned)any_anat << 3
-                       | (unsigned)water << 4;
+                       | (unsigned)water << 4 | (unsigned)(water && draw == DRAW_DRY) << 5
+                       | (unsigned)(water && draw == DRAW_MARK) << 6;
     if (!s->prog_integrate[variant]) {
-        static const char *const names[5] = {"#define VOLFX_BEAMS_MARCH 1\n", "#define VOLFX_BEAMS_SMOOTH 1\n",
+        static const char *const names[7] = {"#define VOLFX_BEAMS_MARCH 1\n", "#define VOLFX_BEAMS_SMOOTH 1\n",
                                              "#define VOLFX_BEAMS_POLYLINE 1\n", "#define VOLFX_BEAMS_ANATOMY 1\n",
-                                             "#define VOLFX_BEAMS_WATER 1\n"};
-        char defs[200] = "";
-        for (unsigned k = 0; k < 5; ++k)
+                                             "#define VOLFX_BEAMS_WATER 1\n", "#define VOLFX_BEAMS_DRY 1\n",
+                                             "#define VOLFX_BEAMS_MARK 1\n"};
+        char defs[240] = "";
+        for (unsigned k = 0; k < 7; ++k)
             if (variant >> k & 1u)
                 strncat(defs, names[k], sizeof defs - strlen(defs) - 1);
         s->prog_integrate[variant] = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
@@ -565,7 +573,7 @@ static void bloom_passes(vfx_context *ctx, beams_state *s, uint32_t levels)
 }
 
 /* The 3-target framebuffer of a frame with water: H, the light in front of the water surface,
- * the light behind it (made the first frame with water, kept until a resize). */
+ * the light behind it, and a stencil (made the first frame with water, kept until a resize). */
 static vfx_result split_targets(vfx_context *ctx, beams_state *s)
 {
     if (s->split_fbo)
@@ -575,10 +583,46 @@ static vfx_result split_targets(vfx_context *ctx, beams_state *s)
     glNamedFramebufferTexture(s->split_fbo, GL_COLOR_ATTACHMENT0, s->acc_tex, 0);
     glNamedFramebufferTexture(s->split_fbo, GL_COLOR_ATTACHMENT1, s->light_tex, 0);
     glNamedFramebufferTexture(s->split_fbo, GL_COLOR_ATTACHMENT2, s->behind_tex, 0);
+    glCreateRenderbuffers(1, &s->split_stencil);
+    glNamedRenderbufferStorage(s->split_stencil, GL_STENCIL_INDEX8, (GLsizei)s->grid.width, (GLsizei)s->grid.height);
+    glNamedFramebufferRenderbuffer(s->split_fbo, GL_STENCIL_ATTACHMENT, GL_RENDERBUFFER, s->split_stencil);
     static const GLenum bufs[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
     glNamedFramebufferDrawBuffers(s->split_fbo, 3, bufs);
     return volfx_gpu_check_target(ctx, s->split_fbo, "beams: H, light and behind-the-water targets", s->grid.width,
                                   s->grid.height);
+}
+
+/* The integrate pass's draws into the bound framebuffer. Without water one. With water three:
+ * the stencil marks the pixels with water in front (the program's own test, so both draws agree
+ * with it exactly), then those pixels get the split program (two integrals a beam) and the others
+ * the dry one (one, nothing behind). In one program llvmpipe would run the second integral on
+ * every pixel: it runs both sides of an if, and a discard does not skip the rest, but its early
+ * stencil test skips a fragment group that fails it. Leaves the stencil test off (the baseline);
+ * the host's stencil state comes back with gl_state. */
+static void integrate_draws(vfx_context *ctx, beams_state *s, const GLuint prog[3], bool water)
+{
+    if (!water) {
+        glUseProgram(prog[0]);
+        volfx_gpu_fullscreen(ctx);
+        return;
+    }
+    glStencilMask(0xffu);
+    glClearNamedFramebufferiv(s->split_fbo, GL_STENCIL, 0, (const GLint[]){0});
+    glEnable(GL_STENCIL_TEST);
+    glStencilFunc(GL_ALWAYS, 1, 0xffu);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glUseProgram(prog[DRAW_MARK]);
+    volfx_gpu_fullscreen(ctx);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+    glStencilFunc(GL_EQUAL, 1, 0xffu);
+    glUseProgram(prog[DRAW_WET]);
+    volfx_gpu_fullscreen(ctx);
+    glStencilFunc(GL_EQUAL, 0, 0xffu);
+    glUseProgram(prog[DRAW_DRY]);
+    volfx_gpu_fullscreen(ctx);
+    glDisable(GL_STENCIL_TEST);
 }
 
 /* The first GL half of a frame, before the water's shading: uploads, the integrate (or march)
@@ -595,8 +639,10 @@ static vfx_result integrate_passes(vfx_context *ctx, beams_state *s, volfx_frame
         || (r = upload(ctx, s->joint_buf, &s->joint_cap, s->joint_xyz, s->joint_used * sizeof s->joint_xyz[0])))
         return r;
     bool march = s->march == VFX_BEAMS_METHOD_MARCH, water = t->water_dist != 0;
-    GLuint prog = integrate_program(ctx, s, march, water);
-    if (!prog)
+    GLuint prog[3] = {integrate_program(ctx, s, march, water, DRAW_WET),
+                      water ? integrate_program(ctx, s, march, water, DRAW_DRY) : 0,
+                      water ? integrate_program(ctx, s, march, water, DRAW_MARK) : 0};
+    if (!prog[0] || (water && (!prog[1] || !prog[2])))
         return VFX_ERR_GL;
     if (water && (r = split_targets(ctx, s)))
         return r;
@@ -623,14 +669,13 @@ static vfx_result integrate_passes(vfx_context *ctx, beams_state *s, volfx_frame
     volfx_pass_begin(ctx, &(volfx_pass_desc){.name = march ? "beams.march" : "beams.integrate",
                                              .framebuffer = water ? s->split_fbo : s->acc_fbo,
                                              .width = s->grid.width, .height = s->grid.height});
-    glUseProgram(prog);
     glBindTextureUnit(0, t->scene_depth);
     glBindTextureUnit(1, t->water_dist);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s->beam_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s->range_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s->list_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s->joint_buf);
-    volfx_gpu_fullscreen(ctx);
+    integrate_draws(ctx, s, prog, water);
     volfx_pass_end(ctx);
     if ((r = volfx_beams_impact_render(ctx, s->impact, t, s->light_tex, s->time, s->dt)))
         return r;

@@ -17,6 +17,12 @@ static const GLenum unpack_names[7] = {GL_UNPACK_ALIGNMENT, GL_UNPACK_ROW_LENGTH
                                        GL_UNPACK_SKIP_ROWS, GL_UNPACK_SKIP_PIXELS, GL_UNPACK_SKIP_IMAGES,
                                        GL_UNPACK_SWAP_BYTES};
 static const GLint store_defaults[7] = {4, 0, 0, 0, 0, 0, 0};
+/* volfx_gl_saved.stencil's order, front and back (the beams' integrate pass draws with a stencil) */
+static const GLenum stencil_names[2][7] = {
+    {GL_STENCIL_FUNC, GL_STENCIL_REF, GL_STENCIL_VALUE_MASK, GL_STENCIL_FAIL, GL_STENCIL_PASS_DEPTH_FAIL,
+     GL_STENCIL_PASS_DEPTH_PASS, GL_STENCIL_WRITEMASK},
+    {GL_STENCIL_BACK_FUNC, GL_STENCIL_BACK_REF, GL_STENCIL_BACK_VALUE_MASK, GL_STENCIL_BACK_FAIL,
+     GL_STENCIL_BACK_PASS_DEPTH_FAIL, GL_STENCIL_BACK_PASS_DEPTH_PASS, GL_STENCIL_BACK_WRITEMASK}};
 
 static GLint get_i(GLenum e)
 {
@@ -98,6 +104,8 @@ void volfx_gl_state_save(volfx_gl_saved *s, bool compat)
     for (int i = 0; i < 7; ++i) {
         s->pack[i] = get_i(pack_names[i]);
         s->unpack[i] = get_i(unpack_names[i]);
+        s->stencil[0][i] = get_i(stencil_names[0][i]);
+        s->stencil[1][i] = get_i(stencil_names[1][i]);
     }
     s->enables = 0;
     for (unsigned i = 0; i < sizeof enables / sizeof enables[0]; ++i)
@@ -173,6 +181,13 @@ void volfx_gl_state_restore(const volfx_gl_saved *s)
     for (int i = 0; i < 7; ++i) {
         glPixelStorei(pack_names[i], s->pack[i]);
         glPixelStorei(unpack_names[i], s->unpack[i]);
+    }
+    for (int f = 0; f < 2; ++f) {
+        const GLint *st = s->stencil[f];
+        GLenum face = f ? GL_BACK : GL_FRONT;
+        glStencilFuncSeparate(face, (GLenum)st[0], st[1], (GLuint)st[2]);
+        glStencilOpSeparate(face, (GLenum)st[3], (GLenum)st[4], (GLenum)st[5]);
+        glStencilMaskSeparate(face, (GLuint)st[6]);
     }
     for (unsigned i = 0; i < sizeof enables / sizeof enables[0]; ++i)
         if (s->enables & (1u << i))

@@ -40,6 +40,7 @@ typedef struct volfx_gl_saved {
     GLint draw_buffers; /* how many entries of blend[] are saved: min(GL_MAX_DRAW_BUFFERS, 8) */
     volfx_gl_blend_i blend[VOLFX_GL_DRAW_BUFFERS];
     GLint pack[7], unpack[7]; /* the pixel-store values of volfx_gl_pixel_store's order */
+    GLint stencil[2][7];      /* front, back: func, ref, value mask, fail, depth fail, depth pass, write mask */
     uint32_t enables;         /* bit i: the i-th capability of the enables table was on */
     bool compat;              /* a compatibility profile: GL_ALPHA_TEST is saved as well */
     bool alpha_test;

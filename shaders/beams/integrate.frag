@@ -297,6 +297,17 @@ void main()
     vec3 tint_b = vec3(0.0);
     vec4 behind = vec4(0.0);
     bool split = tw < tmax;
+    // With water the pass draws three times (beams_effect.c integrate_draws): VOLFX_BEAMS_MARK
+    // stencils the pixels with water in front (split), this program without VOLFX_BEAMS_DRY
+    // draws those, with it the others (no part behind: one integral a beam, not two)
+#ifdef VOLFX_BEAMS_MARK
+    if (!split)
+        discard;
+    o_acc = vec2(0.0);
+    o_light = vec4(0.0);
+    o_behind = vec4(0.0);
+    return;
+#endif
 #endif
     for (uint k = 0u; k < range.y; ++k) {
         Beam bm = beams[list[range.x + k]];
@@ -305,8 +316,12 @@ void main()
 #ifdef VOLFX_BEAMS_WATER
         // behind the surface: the light of the whole ray less the light in front, so that where
         // the water is clear the two add up to the beam's light without water (the ramp is not
-        // linear in H); a pixel without water in front has nothing behind
+        // linear in H); a pixel without water in front (the dry draw) has nothing behind
+#ifdef VOLFX_BEAMS_DRY
+        float hb = 0.0;
+#else
         float hb = split ? volfx_beam_h(bm, V, tw, tmax) : 0.0;
+#endif
         Hb += hb;
         if (bm.mode.y != 0u) {
             Hth += h, Hth_b += hb;
@@ -314,8 +329,10 @@ void main()
         } else {
             vec4 lf = h > 0.0 ? volfx_beam_light(bm, h, V) : vec4(0.0);
             light += lf;
+#ifndef VOLFX_BEAMS_DRY
             if (hb > 0.0)
                 behind += max(volfx_beam_light(bm, h + hb, V) - lf, vec4(0.0));
+#endif
         }
 #else
         if (bm.mode.y != 0u) {
@@ -328,8 +345,10 @@ void main()
     }
     light.rgb += volfx_thesis_light(Hth, tint);
 #ifdef VOLFX_BEAMS_WATER
+#ifndef VOLFX_BEAMS_DRY
     if (Hth_b > 0.0)
         behind.rgb += max(volfx_thesis_light(Hth + Hth_b, tint + tint_b) - volfx_thesis_light(Hth, tint), vec3(0.0));
+#endif
     o_acc = vec2(H, Hb);
     o_behind = min(behind, vec4(LIGHT_MAX));
 #else

@@ -125,6 +125,10 @@ static void take(snap *s)
     PUT(s, GL_DEPTH_FUNC); PUT(s, GL_DEPTH_WRITEMASK); PUT(s, GL_CULL_FACE_MODE); PUT(s, GL_FRONT_FACE);
     put_i_n(s, "polygon mode", GL_POLYGON_MODE, 1);
     PUT(s, GL_CLIP_ORIGIN); PUT(s, GL_CLIP_DEPTH_MODE); PUT(s, GL_STENCIL_WRITEMASK); PUT(s, GL_STENCIL_FUNC);
+    PUT(s, GL_STENCIL_REF); PUT(s, GL_STENCIL_VALUE_MASK); PUT(s, GL_STENCIL_FAIL);
+    PUT(s, GL_STENCIL_PASS_DEPTH_FAIL); PUT(s, GL_STENCIL_PASS_DEPTH_PASS); PUT(s, GL_STENCIL_BACK_WRITEMASK);
+    PUT(s, GL_STENCIL_BACK_FUNC); PUT(s, GL_STENCIL_BACK_REF); PUT(s, GL_STENCIL_BACK_VALUE_MASK);
+    PUT(s, GL_STENCIL_BACK_FAIL); PUT(s, GL_STENCIL_BACK_PASS_DEPTH_FAIL); PUT(s, GL_STENCIL_BACK_PASS_DEPTH_PASS);
     PUT(s, GL_LOGIC_OP_MODE);
     for (GLuint i = 0; i < 8; ++i) {
         static const struct { GLenum e; const char *n; } bl[] = {
@@ -288,6 +292,9 @@ static void hostile_apply(const hostile *h)
     glEnable(GL_STENCIL_TEST);
     glStencilFunc(GL_NEVER, 1, 0xff);
     glStencilMask(0x0f);
+    glStencilOpSeparate(GL_FRONT, GL_INCR, GL_DECR_WRAP, GL_INVERT); /* the beams' pass sets these */
+    glStencilFuncSeparate(GL_BACK, GL_GEQUAL, 3, 0x3c);
+    glStencilMaskSeparate(GL_BACK, 0x70);
     glEnable(GL_CULL_FACE);
     glCullFace(GL_FRONT_AND_BACK);
     glFrontFace(GL_CW);
@@ -351,6 +358,7 @@ static void gl_initial(void)
     glDisable(GL_STENCIL_TEST);
     glStencilFunc(GL_ALWAYS, 0, 0xff);
     glStencilMask(0xffffffffu);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
     glDisable(GL_CULL_FACE);
     glCullFace(GL_BACK);
     glFrontFace(GL_CCW);
