@@ -131,6 +131,10 @@ int bench_beams_gpu(int argc, char **argv)
         game_app *app;
         if (game_app_create(&d, &app))
             return 1;
+        if (volfx_lab_attach(app->ctx) != VFX_OK) { /* the march is the lab's */
+            game_app_destroy(app);
+            return 1;
+        }
         vfx_lab_beams lab_beams = {.type = VFX_TYPE_LAB_BEAMS}, *lab = &lab_beams; /* closed form or march */
         app->beams_next = lab;
         /* the host's camera and the float64 reference's: the same numbers */

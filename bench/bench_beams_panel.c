@@ -138,6 +138,10 @@ int bench_beams_panel(int argc, char **argv)
     game_app_desc d = {.mode = RT_GL_HEADLESS, .width = w, .height = h};
     if (game_app_create(&d, &app))
         return 1;
+    if (volfx_lab_attach(app->ctx) != VFX_OK) { /* the march is the lab's */
+        game_app_destroy(app);
+        return 1;
+    }
     game_demo demo;
     memset(&demo, 0, sizeof demo);
     if (game_demo_load(app, &demo, scene, VFX_EFFECT_BIT(VFX_EFFECT_WATER) | VFX_EFFECT_BIT(VFX_EFFECT_VOLUME))) {

@@ -55,6 +55,14 @@ struct volfx_lab_hooks {
      * off in the volume's renderer; unknown bits fail with VFX_ERR_INVALID_ARGUMENT naming the
      * field. */
     vfx_result (*volume_struct)(vfx_context *ctx, const void *lab, volfx_lab_volume_off *off);
+    /* Reads the vfx_lab_beams at `lab` (its type already matched) into *method: 0 for the
+     * product's closed form, else a lab method for beams_program; a value outside its range
+     * (lab_ranges.h) fails with VFX_ERR_INVALID_ARGUMENT naming the field. */
+    vfx_result (*beams_struct)(vfx_context *ctx, const void *lab, uint32_t *method);
+    /* The beams' integrate program of lab method `method` (nonzero, from beams_struct) in the
+     * product's variant `defines` (its VOLFX_BEAMS_* lines; NULL: none), the pass's name in
+     * *pass; 0 on failure (logged). The product binds and draws it as its own integrate pass. */
+    GLuint (*beams_program)(vfx_context *ctx, uint32_t method, const char *defines, const char **pass);
 };
 
 #endif

@@ -58,7 +58,11 @@ static vfx_result refuse(vfx_context *ctx, const char *what, const volfx_range *
 
 vfx_result volfx_range_check(vfx_context *ctx, const char *what, vfx_range_id id, double v)
 {
-    const volfx_range *r = &ROWS[id];
+    return volfx_range_check_row(ctx, what, &ROWS[id], v);
+}
+
+vfx_result volfx_range_check_row(vfx_context *ctx, const char *what, const volfx_range *r, double v)
+{
     return fits(r, v) ? VFX_OK : refuse(ctx, what, r, "", v);
 }
 
@@ -211,7 +215,7 @@ vfx_result volfx_beam_check_ranges(vfx_context *ctx, uint32_t i, const vfx_beam 
     return VFX_OK;
 }
 
-vfx_result volfx_beams_view_check_ranges(vfx_context *ctx, const vfx_beams_view *v, uint32_t march_samples)
+vfx_result volfx_beams_view_check_ranges(vfx_context *ctx, const vfx_beams_view *v)
 {
     vfx_result r;
     if ((r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_COUNT, v->count))
@@ -219,8 +223,7 @@ vfx_result volfx_beams_view_check_ranges(vfx_context *ctx, const vfx_beams_view 
         || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_BLOOM, v->bloom)))
         return r;
     if ((r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_C, v->saturate_c))
-        || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_FAR, v->far_distance))
-        || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_MARCH_SAMPLES, march_samples)))
+        || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_FAR, v->far_distance)))
         return r;
     if ((r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_BLOOM_STRENGTH, v->bloom_strength))
         || (r = volfx_range_check(ctx, "beams", VFX_RANGE_BEAMS_BLOOM_LEVELS, v->bloom_levels)))

@@ -27,6 +27,8 @@ char *volfx_range_text(const volfx_range *r, char *out, size_t n);
 /* VFX_OK when v fits the row (0 too where 0 is the default); else fails ctx with
  * VFX_ERR_INVALID_ARGUMENT "WHAT: FIELD V outside RANGE". NaN and Inf never fit. */
 vfx_result volfx_range_check(vfx_context *ctx, const char *what, vfx_range_id id, double v);
+/* The same against a row of another table (the lab's, plugin/lab/lab_ranges.h). */
+vfx_result volfx_range_check_row(vfx_context *ctx, const char *what, const volfx_range *row, double v);
 /* Every one of v[0..n) (all 0 allowed where 0 is the default). */
 vfx_result volfx_range_check_vec(vfx_context *ctx, const char *what, vfx_range_id id, const float *v, int n);
 
@@ -38,8 +40,8 @@ vfx_result volfx_water_diffuse_check_ranges(vfx_context *ctx, const vfx_water_pa
 vfx_result volfx_water_foam_check_ranges(vfx_context *ctx, const vfx_water_foam *f);
 /* Beam i. */
 vfx_result volfx_beam_check_ranges(vfx_context *ctx, uint32_t i, const vfx_beam *b);
-/* The beams view's own numbers (and the lab's march samples, lab may be NULL). */
-vfx_result volfx_beams_view_check_ranges(vfx_context *ctx, const vfx_beams_view *v, uint32_t march_samples);
+/* The beams view's own numbers. */
+vfx_result volfx_beams_view_check_ranges(vfx_context *ctx, const vfx_beams_view *v);
 /* The volume view's renderer options. */
 vfx_result volfx_volume_view_check_ranges(vfx_context *ctx, const vfx_volume_view *v);
 /* The frame view's numbers, each against its row alone (the frame gate checks the relations:

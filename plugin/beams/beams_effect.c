@@ -13,7 +13,7 @@
 #include "gpu/pass.h"
 #include "effect.h"
 #include "param_ranges.h"
-#include "volfx_lab.h"
+#include "lab_hooks.h"
 
 #define MAX_BEAMS (1u << 20)
 #define MAX_BLOOM_LEVELS 8
@@ -29,8 +29,8 @@ typedef struct beam_gpu {
 /* std140, mirrors BeamsFrame in shaders/beams/frame.glsl */
 typedef struct beams_block {
     float far, c;
-    int32_t tile_px, tiles_x, samples, has_water, smooth_saturation, bloom;
-    float bloom_gain, _pad[3];
+    int32_t tile_px, tiles_x, has_water, smooth_saturation, bloom;
+    float bloom_gain, _pad[2];
 } beams_block;
 
 /* The look of one beam, resolved from a version 2 beam or version 1 defaults. */
@@ -44,8 +44,8 @@ typedef struct beam_look {
 } beam_look;
 
 typedef struct beams_state {
-    GLuint prog_integrate[128]; /* [march | smooth << 1 | polyline << 2 | anatomy << 3 | water << 4 | dry << 5
-                                 * | mark << 6]: code only where needed */
+    GLuint prog_integrate[64]; /* [smooth | polyline << 1 | anatomy << 2 | water << 3 | dry << 4 | mark << 5]:
+                                * code only where needed */
     GLuint prog_composite, prog_down, prog_up;
     GLuint beam_buf, range_buf, list_buf, joint_buf;
     size_t beam_cap, range_cap, list_cap, joint_cap; /* bytes */
@@ -64,7 +64,7 @@ typedef struct beams_state {
     volfx_ubo ubo;
     volfx_beams_grid grid;                /* the target in pixels and tiles */
     vfx_beams_view view;                  /* the host's answer (next cleared) */
-    uint32_t march, march_samples;        /* vfx_lab_beams: the ray-marching baseline */
+    uint32_t lab_method;                  /* a lab method (lab_hooks.h beams_struct); 0: the closed form */
     double time;
     float dt;
     volfx_beams_impact *impact;           /* flares, sparks, glow, lights (beams_impact.h) */
@@ -307,18 +307,23 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
                           "beams: host beams failed (%d)", (int)r);
     if ((r = volfx_check_type(ctx, &v, VFX_TYPE_BEAMS_VIEW, "beams: host beams view (vfx_beams_view)")))
         return r;
-    const vfx_lab_beams *lab = volfx_chain_find(v.next, VFX_TYPE_LAB_BEAMS);
+    const void *lab = volfx_chain_find(v.next, VFX_TYPE_LAB_BEAMS);
     v.next = NULL;
     const vfx_beam *beams = v.beams;
     if (v.count > MAX_BEAMS || !beams)
         return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_BEAMS_COUNT,
                           "beams: %u beams (at most %u, non-NULL array)",
                           v.count, MAX_BEAMS);
-    if (lab && lab->method > VFX_BEAMS_METHOD_MARCH)
-        return volfx_fail(ctx, VFX_ERR_INVALID_ARGUMENT, VFX_LOG_ID_BEAMS_VIEW_FIELD,
-                          "beams: vfx_lab_beams.method %u unknown (0 closed form, 1 march)",
-                          lab->method);
-    if ((r = volfx_beams_view_check_ranges(ctx, &v, lab ? lab->march_samples : 0)))
+    /* the lab's struct (the ray-marching baseline): read by the lab library only */
+    uint32_t lab_method = 0;
+    if (lab && !ctx->lab)
+        return volfx_fail(ctx, VFX_ERR_UNSUPPORTED, VFX_LOG_ID_BEAMS_VIEW_FIELD,
+                          "beams: a vfx_lab_beams (type 0x%x) is chained into vfx_beams_view: lab structs are read "
+                          "only with the lab library attached (volfx_lab_attach: tests and benches), not by libvolfx",
+                          (unsigned)VFX_TYPE_LAB_BEAMS);
+    if (lab && (r = ctx->lab->beams_struct(ctx, lab, &lab_method)))
+        return r;
+    if ((r = volfx_beams_view_check_ranges(ctx, &v)))
         return r;
     if (!(v.saturate_c >= 0) || !isfinite(v.saturate_c) || !(v.far_distance >= 0)
         || !isfinite(v.far_distance))
@@ -385,8 +390,7 @@ static vfx_result beams_update(vfx_context *ctx, void *state, double time, float
     }
     s->count = n;
     s->view = v;
-    s->march = lab ? lab->method : 0;
-    s->march_samples = lab ? lab->march_samples : 0;
+    s->lab_method = lab_method;
     s->time = time;
     s->dt = dt;
     return VFX_OK;
@@ -521,31 +525,32 @@ static vfx_result bin_beams(vfx_context *ctx, beams_state *s, const volfx_frame_
     return VFX_OK;
 }
 
-/* The integrate program for this frame's beams: code only for what some beam needs. With water,
- * `draw` picks the split draws' program (integrate_draws): 0 the pixels with water in front,
- * DRAW_DRY the others, DRAW_MARK the stencil of the first. */
+/* The integrate program for this frame's beams: code only for what some beam needs; a lab
+ * method's from the lab (lab_hooks.h beams_program), in the same variant, *pass its pass name.
+ * With water, `draw` picks the split draws' program (integrate_draws): DRAW_WET the pixels with
+ * water in front, DRAW_DRY the others, DRAW_MARK the stencil of the first. */
 enum { DRAW_WET, DRAW_DRY, DRAW_MARK };
-static GLuint integrate_program(vfx_context *ctx, beams_state *s, bool march, bool water, int draw)
+static GLuint integrate_program(vfx_context *ctx, beams_state *s, bool water, int draw, const char **pass)
 {
     bool any_smooth = false, any_poly = false, any_anat = false;
     for (uint32_t i = 0; i < s->count; ++i)
         any_smooth |= s->beams[i].smooth != 0, any_poly |= s->beams[i].joint_count >= 2,
             any_anat |= s->looks[i].anatomy;
-    unsigned variant = (unsigned)march | (unsigned)any_smooth << 1 | (unsigned)any_poly << 2 | (unsigned)any_anat << 3
-                       | (unsigned)water << 4 | (unsigned)(water && draw == DRAW_DRY) << 5
-                       | (unsigned)(water && draw == DRAW_MARK) << 6;
-    if (!s->prog_integrate[variant]) {
-        static const char *const names[7] = {"#define VOLFX_BEAMS_MARCH 1\n", "#define VOLFX_BEAMS_SMOOTH 1\n",
-                                             "#define VOLFX_BEAMS_POLYLINE 1\n", "#define VOLFX_BEAMS_ANATOMY 1\n",
-                                             "#define VOLFX_BEAMS_WATER 1\n", "#define VOLFX_BEAMS_DRY 1\n",
-                                             "#define VOLFX_BEAMS_MARK 1\n"};
-        char defs[240] = "";
-        for (unsigned k = 0; k < 7; ++k)
-            if (variant >> k & 1u)
-                strncat(defs, names[k], sizeof defs - strlen(defs) - 1);
-        s->prog_integrate[variant] = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
-                                                       variant ? defs : NULL);
-    }
+    unsigned variant = (unsigned)any_smooth | (unsigned)any_poly << 1 | (unsigned)any_anat << 2 | (unsigned)water << 3
+                       | (unsigned)(water && draw == DRAW_DRY) << 4 | (unsigned)(water && draw == DRAW_MARK) << 5;
+    if (s->prog_integrate[variant] && !s->lab_method)
+        return s->prog_integrate[variant];
+    static const char *const names[6] = {"#define VOLFX_BEAMS_SMOOTH 1\n", "#define VOLFX_BEAMS_POLYLINE 1\n",
+                                         "#define VOLFX_BEAMS_ANATOMY 1\n", "#define VOLFX_BEAMS_WATER 1\n",
+                                         "#define VOLFX_BEAMS_DRY 1\n", "#define VOLFX_BEAMS_MARK 1\n"};
+    char defs[240] = "";
+    for (unsigned k = 0; k < 6; ++k)
+        if (variant >> k & 1u)
+            strncat(defs, names[k], sizeof defs - strlen(defs) - 1);
+    if (s->lab_method) /* set only with a lab attached (beams_update) */
+        return ctx->lab->beams_program(ctx, s->lab_method, variant ? defs : NULL, pass);
+    s->prog_integrate[variant] = volfx_gpu_program(ctx, "common/fullscreen.vert", "beams/integrate.frag",
+                                                   variant ? defs : NULL);
     return s->prog_integrate[variant];
 }
 
@@ -625,7 +630,7 @@ static void integrate_draws(vfx_context *ctx, beams_state *s, const GLuint prog[
     glDisable(GL_STENCIL_TEST);
 }
 
-/* The first GL half of a frame, before the water's shading: uploads, the integrate (or march)
+/* The first GL half of a frame, before the water's shading: uploads, the integrate (or the lab's)
  * pass into H and light (split at the water's surface when there is water: the light in front of
  * it and the light behind it), the impacts. The camera comes from the VolfxFrame block
  * (shaders/common/frame.glsl), bound by the frame gate. */
@@ -638,10 +643,11 @@ static vfx_result integrate_passes(vfx_context *ctx, beams_state *s, volfx_frame
         || (r = upload(ctx, s->list_buf, &s->list_cap, s->list, (size_t)s->pairs * sizeof(uint32_t)))
         || (r = upload(ctx, s->joint_buf, &s->joint_cap, s->joint_xyz, s->joint_used * sizeof s->joint_xyz[0])))
         return r;
-    bool march = s->march == VFX_BEAMS_METHOD_MARCH, water = t->water_dist != 0;
-    GLuint prog[3] = {integrate_program(ctx, s, march, water, DRAW_WET),
-                      water ? integrate_program(ctx, s, march, water, DRAW_DRY) : 0,
-                      water ? integrate_program(ctx, s, march, water, DRAW_MARK) : 0};
+    bool water = t->water_dist != 0;
+    const char *pass = NULL;
+    GLuint prog[3] = {integrate_program(ctx, s, water, DRAW_WET, &pass),
+                      water ? integrate_program(ctx, s, water, DRAW_DRY, &pass) : 0,
+                      water ? integrate_program(ctx, s, water, DRAW_MARK, &pass) : 0};
     if (!prog[0] || (water && (!prog[1] || !prog[2])))
         return VFX_ERR_GL;
     if (water && (r = split_targets(ctx, s)))
@@ -659,14 +665,13 @@ static vfx_result integrate_passes(vfx_context *ctx, beams_state *s, volfx_frame
     if (!(far > 0))
         far = 1e30f;
     beams_block blk = {.far = far, .c = c, .tile_px = VOLFX_BEAMS_TILE_PX, .tiles_x = (int32_t)s->grid.tiles_x,
-                       .samples = (int32_t)(s->march_samples ? s->march_samples : 32),
                        .has_water = water,
                        .smooth_saturation = s->view.saturation == VFX_SATURATE_SMOOTH,
                        .bloom = s->bloom, .bloom_gain = strength / (float)levels};
     volfx_ubo_update(&s->ubo, &blk, sizeof blk);
     volfx_ubo_bind(&s->ubo, 3);
 
-    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = march ? "beams.march" : "beams.integrate",
+    volfx_pass_begin(ctx, &(volfx_pass_desc){.name = s->lab_method ? pass : "beams.integrate",
                                              .framebuffer = water ? s->split_fbo : s->acc_fbo,
                                              .width = s->grid.width, .height = s->grid.height});
     glBindTextureUnit(0, t->scene_depth);

@@ -203,12 +203,14 @@ GLuint volfx_gpu_link_sources(vfx_context *ctx, int stage_count, const GLenum *s
     return link_sources(ctx, &volfx_plugin_shaders, stage_count, stages, sources, names);
 }
 
-/* The product's table, or for a path it lacks the lab's when a lab is attached (lab_hooks.h):
- * libvolfx embeds no lab shader. */
-static const volfx_shader_table *table_of(const vfx_context *ctx, const char *path)
+/* The product's table, or for a program with a stage it lacks the lab's when a lab is attached
+ * (lab_hooks.h; the lab's table holds the product's pieces its stages include): libvolfx embeds
+ * no lab shader. */
+static const volfx_shader_table *table_of(const vfx_context *ctx, int n, const char *const *paths)
 {
-    if (volfx_shader_index(&volfx_plugin_shaders, path) < 0 && ctx->lab && ctx->lab->shaders)
-        return ctx->lab->shaders;
+    for (int i = 0; i < n; ++i)
+        if (volfx_shader_index(&volfx_plugin_shaders, paths[i]) < 0 && ctx->lab && ctx->lab->shaders)
+            return ctx->lab->shaders;
     return &volfx_plugin_shaders;
 }
 
@@ -238,7 +240,7 @@ static GLuint get_program(vfx_context *ctx, int n, const GLenum *stages, const c
     char err[256];
     GLuint prog = 0;
     bool ok = true;
-    const volfx_shader_table *table = table_of(ctx, paths[0]);
+    const volfx_shader_table *table = table_of(ctx, n, paths);
     for (int i = 0; i < n && ok; ++i)
         if (!(bufs[i] = volfx_shader_expand(table, paths[i], defines, err, sizeof err))) {
             volfx_fail(ctx, VFX_ERR_GL, VFX_LOG_ID_SHADER_COMPILE, "%s", err);

@@ -3,8 +3,8 @@
  * water's baselines (plugin/lab). NOT installed and not part of the ABI's promise: tests and
  * benches link the lab library, attach it to their context and chain these structs into a public
  * struct's `next` to reproduce the measurements in docs/ (docs/abi.md "Lab structs"). libvolfx
- * holds no lab code: without volfx_lab_attach a lab struct (vfx_lab_water, vfx_lab_volume) or a
- * lab method is refused by name (VFX_ERR_UNSUPPORTED). */
+ * holds no lab code: without volfx_lab_attach a lab struct (vfx_lab_water, vfx_lab_beams,
+ * vfx_lab_volume) or a lab method is refused by name (VFX_ERR_UNSUPPORTED). */
 #ifndef VOLFX_LAB_H
 #define VOLFX_LAB_H
 
@@ -18,9 +18,9 @@
 #include "water/water_switches.h"
 
 /* Attaches the lab library to ctx (a context of the statically linked plugin, in the same
- * program): from now on ctx reads vfx_lab_water and vfx_lab_volume and draws the water's BRUTE
- * and GRID methods. VFX_ERR_INVALID_ARGUMENT for NULL. Lab library only (tests, benches):
- * libvolfx has no such symbol. */
+ * program): from now on ctx reads vfx_lab_water, vfx_lab_beams and vfx_lab_volume, draws the
+ * water's BRUTE and GRID methods and the beams' ray-marching baseline. VFX_ERR_INVALID_ARGUMENT
+ * for NULL. Lab library only (tests, benches): libvolfx has no such symbol. */
 vfx_result volfx_lab_attach(vfx_context *ctx);
 
 /* Chained into vfx_water_params.next. */
@@ -31,7 +31,8 @@ typedef struct vfx_lab_water {
     uint32_t method;       /* 0 -> vfx_water_params.method; else a vfx_water_method or BRUTE/GRID */
 } vfx_lab_water;
 
-/* Chained into vfx_beams_view.next: the ray-marching baseline instead of the closed form. */
+/* Chained into vfx_beams_view.next: the ray-marching baseline instead of the closed form (the
+ * lab's, lab_beams.c; march_samples' range is lab_ranges.h's). */
 #define VFX_BEAMS_METHOD_CLOSED_FORM 0u
 #define VFX_BEAMS_METHOD_MARCH 1u
 typedef struct vfx_lab_beams {

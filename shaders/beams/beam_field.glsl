@@ -338,24 +338,6 @@ float volfx_beam_integral_anat(vec3 M, vec3 D, float L, float R, float a, float 
 }
 #endif
 
-// the raw density (for the ray-marching baseline), P relative to the eye
-float volfx_beam_density(vec3 M, vec3 D, float L, float R, float a, float b, float eps_in, bool soft,
-                         vec3 P)
-{
-    float eps = max(eps_in, VOLFX_BEAM_EPS_FLOOR * R);
-    vec3 d = P - M;
-    float d2 = dot(d, d), u = dot(d, D), rho = 0.0;
-    float wh = soft ? (1.0 - d2 / (R * R)) * (1.0 - d2 / (R * R)) : 1.0;
-    if (d2 <= R * R)
-        rho += a * wh / sqrt(d2 + eps * eps);
-    vec3 q = u < 0.0 ? d : (u > L ? d - L * D : d - u * D);
-    float r2 = dot(q, q);
-    float wt = soft ? (1.0 - r2 / (R * R)) * (1.0 - r2 / (R * R)) : 1.0;
-    if (r2 <= R * R)
-        rho += b * wt / sqrt(r2 + eps * eps);
-    return rho;
-}
-
 // ---------------------------------------------------------------- bending beams (polylines)
 // beam_field_impl.inc polyline_integral, line for line: the nearest primitive (joint or segment
 // interior) per interval between switch points. The includer defines
@@ -563,24 +545,4 @@ float volfx_polyline_integral(uint first, int nj, float R, float a, float b, flo
     return H;
 }
 
-// the raw polyline density (ray-marching baseline)
-float volfx_polyline_density(uint first, int nj, float R, float a, float b, float eps_in, bool soft, vec3 P)
-{
-    float eps = max(eps_in, VOLFX_BEAM_EPS_FLOOR * R), rho = 0.0;
-    vec3 d0 = P - volfx_joint(first);
-    float d2 = dot(d0, d0), r2 = 1e30;
-    for (int k = 0; k + 1 < nj; ++k) {
-        vec3 A = volfx_joint(first + uint(k)), e = volfx_joint(first + uint(k + 1)) - A, w = P - A;
-        float ee = dot(e, e), u = ee > 0.0 ? clamp(dot(w, e) / ee, 0.0, 1.0) : 0.0;
-        vec3 q = w - u * e;
-        r2 = min(r2, dot(q, q));
-    }
-    float wh = soft ? (1.0 - d2 / (R * R)) * (1.0 - d2 / (R * R)) : 1.0;
-    float wt = soft ? (1.0 - r2 / (R * R)) * (1.0 - r2 / (R * R)) : 1.0;
-    if (d2 <= R * R)
-        rho += a * wh / sqrt(d2 + eps * eps);
-    if (r2 <= R * R)
-        rho += b * wt / sqrt(r2 + eps * eps);
-    return rho;
-}
 #endif

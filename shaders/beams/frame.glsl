@@ -6,7 +6,6 @@ layout(std140, binding = 3) uniform BeamsFrame {
     float u_c;                // saturate_c
     int u_tile_px;
     int u_tiles_x;
-    int u_samples;            // ray-marching baseline samples
     int u_has_water;
     int u_smooth_saturation;  // thesis ramp: 1 - exp(-H/c) instead of min(H/c, 1)
     int u_bloom;              // composite adds the bloom chain

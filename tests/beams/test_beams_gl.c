@@ -320,8 +320,14 @@ static void test_marching_baseline(void **state)
     float *closed = render_raw();
     double err[2];
     const uint32_t samples[2] = {8, 120};
-    vfx_lab_beams lab = {.type = VFX_TYPE_LAB_BEAMS}; /* the ray-marching baseline, chained by the test */
+    vfx_lab_beams lab = {.type = VFX_TYPE_LAB_BEAMS, .method = VFX_BEAMS_METHOD_MARCH}; /* chained by the test */
     g_app->beams_next = &lab;
+    /* the baseline is the lab's: libvolfx alone refuses the struct by name */
+    g_app->ctx->lab = NULL;
+    assert_int_equal(game_app_frame(g_app, 0.f), VFX_ERR_UNSUPPORTED);
+    assert_true(test_last_error_is(g_app->api, g_app->ctx, VFX_LOG_ID_BEAMS_VIEW_FIELD,
+                                   "beams: a vfx_lab_beams (type 0x4c414202) is chained into vfx_beams_view"));
+    assert_int_equal(volfx_lab_attach(g_app->ctx), VFX_OK);
     for (int k = 0; k < 2; ++k) {
         lab.method = VFX_BEAMS_METHOD_MARCH;
         lab.march_samples = samples[k];

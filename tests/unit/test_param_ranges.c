@@ -17,6 +17,8 @@
 
 #include "context.h"
 #include "param_ranges.h"
+#include "lab/lab_beams.h"
+#include "lab/lab_ranges.h"
 #include "lab/volfx_lab.h"
 #include "water/water_params.h"
 #include <float.h>
@@ -70,30 +72,45 @@ static void expect(vfx_context *c, vfx_result r, vfx_result want, const char *ne
         fail_msg("result %d (want %d), \"%s\" (want \"%s\")", r, want, c->last_error, needle ? needle : "");
 }
 
+/* Row i of the two tables: the ABI's (volfx_ranges.h), then the lab's (plugin/lab/lab_ranges.h,
+ * whose rows the lab checks its structs against). */
+#define ROW_COUNT (VFX_RANGE_COUNT + VOLFX_LAB_RANGE_COUNT)
+static const volfx_range *row_at(int i)
+{
+    return i < VFX_RANGE_COUNT ? volfx_range_row((vfx_range_id)i)
+                               : volfx_lab_range_row((volfx_lab_range_id)(i - VFX_RANGE_COUNT));
+}
+
+static vfx_result check_at(vfx_context *c, int i, double v)
+{
+    return i < VFX_RANGE_COUNT ? volfx_range_check(c, "t", (vfx_range_id)i, v)
+                               : volfx_lab_range_check(c, "t", (volfx_lab_range_id)(i - VFX_RANGE_COUNT), v);
+}
+
 static void test_every_row(void **state)
 {
     (void)state;
     vfx_context *c = fake_ctx();
-    for (int i = 0; i < VFX_RANGE_COUNT; ++i) {
-        const volfx_range *r = volfx_range_row((vfx_range_id)i);
+    for (int i = 0; i < ROW_COUNT; ++i) {
+        const volfx_range *r = row_at(i);
         const char *fld = strchr(r->field, '.') + 1;
         if (r->flags & (VFX_RANGE_ANY | VFX_RANGE_MASK))
             continue; /* test_struct_walk: every value fits / bits */
         double lo_in = r->flags & VFX_RANGE_LO_OPEN ? (r->lo == 0 ? 1e-6 : r->lo * 1.0001) : r->lo;
-        expect(c, volfx_range_check(c, "t", (vfx_range_id)i, lo_in), VFX_OK, NULL);
-        expect(c, volfx_range_check(c, "t", (vfx_range_id)i, r->hi), VFX_OK, NULL);
+        expect(c, check_at(c, i, lo_in), VFX_OK, NULL);
+        expect(c, check_at(c, i, r->hi), VFX_OK, NULL);
         double over = r->flags & VFX_RANGE_INT ? r->hi + 1 : r->hi * 1.001 + 1e-6;
-        expect(c, volfx_range_check(c, "t", (vfx_range_id)i, over), VFX_ERR_INVALID_ARGUMENT, fld);
+        expect(c, check_at(c, i, over), VFX_ERR_INVALID_ARGUMENT, fld);
         if (r->lo != 0 || (r->flags & VFX_RANGE_LO_OPEN) || !(r->flags & VFX_RANGE_INT)) {
             double under = r->flags & VFX_RANGE_LO_OPEN ? r->lo : r->lo - (r->flags & VFX_RANGE_INT ? 1 : fmax(1e-3, fabs(r->lo) * 1e-3));
             if (!(under == 0 && (r->flags & VFX_RANGE_ZERO)) && !(r->flags & VFX_RANGE_INT && under < 0))
-                expect(c, volfx_range_check(c, "t", (vfx_range_id)i, under), VFX_ERR_INVALID_ARGUMENT, fld);
+                expect(c, check_at(c, i, under), VFX_ERR_INVALID_ARGUMENT, fld);
         }
-        expect(c, volfx_range_check(c, "t", (vfx_range_id)i, NAN), VFX_ERR_INVALID_ARGUMENT, fld);
-        expect(c, volfx_range_check(c, "t", (vfx_range_id)i, INFINITY), VFX_ERR_INVALID_ARGUMENT, fld);
-        expect(c, volfx_range_check(c, "t", (vfx_range_id)i, -INFINITY), VFX_ERR_INVALID_ARGUMENT, fld);
+        expect(c, check_at(c, i, NAN), VFX_ERR_INVALID_ARGUMENT, fld);
+        expect(c, check_at(c, i, INFINITY), VFX_ERR_INVALID_ARGUMENT, fld);
+        expect(c, check_at(c, i, -INFINITY), VFX_ERR_INVALID_ARGUMENT, fld);
         int zero_in = (r->flags & VFX_RANGE_LO_OPEN ? 0 > r->lo : 0 >= r->lo) && 0 <= r->hi;
-        expect(c, volfx_range_check(c, "t", (vfx_range_id)i, 0),
+        expect(c, check_at(c, i, 0),
                (r->flags & VFX_RANGE_ZERO) || zero_in ? VFX_OK : VFX_ERR_INVALID_ARGUMENT, NULL);
     }
     free(c);
@@ -115,7 +132,8 @@ typedef struct fmap {
                                             (int)(sizeof(((s *)0)->m) / 4 / (TYPE_OF_(((s *)0)->m) >= T_F64 ? 2 : 1))},
 #define MA_(id, k, s, m) [VFX_RANGE_##id] = {k, #s "." #m, offsetof(s, m), TYPE_OF_(((s *)0)->m[0]), \
                                             (int)(sizeof(((s *)0)->m) / sizeof(((s *)0)->m[0]))},
-static const fmap MAP[VFX_RANGE_COUNT] = {
+#define LM_(id, k, s, m) [VFX_RANGE_COUNT + VOLFX_LAB_RANGE_##id] = {k, #s "." #m, offsetof(s, m), TYPE_OF_(((s *)0)->m), 1},
+static const fmap MAP[ROW_COUNT] = {
     M_(WATER_H, K_WATER, vfx_water_params, h) M_(WATER_THRESHOLD, K_WATER, vfx_water_params, threshold)
     M_(WATER_MAX_SAMPLES, K_WATER, vfx_water_params, max_samples) M_(WATER_STEP, K_WATER, vfx_water_params, step)
     M_(WATER_REFINE_ITERS, K_WATER, vfx_water_params, refine_iters)
@@ -156,7 +174,6 @@ static const fmap MAP[VFX_RANGE_COUNT] = {
     M_(BEAMS_COUNT, K_BEAMS_VIEW, vfx_beams_view, count) M_(BEAMS_SATURATION, K_BEAMS_VIEW, vfx_beams_view, saturation)
     M_(BEAMS_BLOOM, K_BEAMS_VIEW, vfx_beams_view, bloom) M_(BEAMS_JOINT_COUNT, K_BEAMS_VIEW, vfx_beams_view, joint_count)
     M_(BEAMS_C, K_BEAMS_VIEW, vfx_beams_view, saturate_c) M_(BEAMS_FAR, K_BEAMS_VIEW, vfx_beams_view, far_distance)
-    M_(BEAMS_MARCH_SAMPLES, K_LAB_BEAMS, vfx_lab_beams, march_samples)
     M_(BEAMS_BLOOM_STRENGTH, K_BEAMS_VIEW, vfx_beams_view, bloom_strength)
     M_(BEAMS_BLOOM_LEVELS, K_BEAMS_VIEW, vfx_beams_view, bloom_levels)
     M_(VOLUME_POINT_COUNT, K_VOLUME, vfx_volume_view, point_count) M_(VOLUME_TET_COUNT, K_VOLUME, vfx_volume_view, tet_count)
@@ -188,6 +205,7 @@ static const fmap MAP[VFX_RANGE_COUNT] = {
     M_(WATER_FOAM_DEPOSIT, K_WATER_FOAM, vfx_water_foam, deposit)
     M_(WATER_FOAM_IMPACT_RATE, K_WATER_FOAM, vfx_water_foam, impact_rate)
     M_(WATER_FOAM_IMPACT_SPEED, K_WATER_FOAM, vfx_water_foam, impact_speed)
+    LM_(BEAMS_MARCH_SAMPLES, K_LAB_BEAMS, vfx_lab_beams, march_samples)
 };
 
 /* One valid struct of each kind, a member set, and the check the plugin runs on it. */
@@ -222,6 +240,9 @@ static void baseline(int kind, any_struct *u)
     case K_WATER_FOAM:
         u->wf.type = VFX_TYPE_WATER_FOAM;
         break;
+    case K_LAB_BEAMS:
+        u->lb = (vfx_lab_beams){.type = VFX_TYPE_LAB_BEAMS, .method = VFX_BEAMS_METHOD_MARCH};
+        break;
     case K_VOLUME:
         for (int k = 0; k < 16; ++k)
             u->vv.model[k] = k % 5 == 0 ? 1.f : 0.f;
@@ -239,10 +260,10 @@ static vfx_result run_check(vfx_context *c, int kind, any_struct *u)
     switch (kind) {
     case K_WATER: return volfx_water_params_resolve(c, &u->w, &out);
     case K_BEAM: return volfx_beam_check_ranges(c, 0, &u->b);
-    case K_BEAMS_VIEW: return volfx_beams_view_check_ranges(c, &u->bv, 0);
+    case K_BEAMS_VIEW: return volfx_beams_view_check_ranges(c, &u->bv);
     case K_LAB_BEAMS: {
-        vfx_beams_view v = {.type = VFX_TYPE_BEAMS_VIEW};
-        return volfx_beams_view_check_ranges(c, &v, u->lb.march_samples);
+        uint32_t method; /* what the beams hand a chained vfx_lab_beams to */
+        return volfx_lab_beams_struct(c, &u->lb, &method);
     }
     case K_VOLUME: return volfx_volume_view_check_ranges(c, &u->vv);
     case K_FRAME: return volfx_frame_view_check_ranges(c, &u->fv);
@@ -282,8 +303,8 @@ static void test_struct_walk(void **state)
     (void)state;
     vfx_context *c = fake_ctx();
     int walked = 0;
-    for (int i = 0; i < VFX_RANGE_COUNT; ++i) {
-        const volfx_range *r = volfx_range_row((vfx_range_id)i);
+    for (int i = 0; i < ROW_COUNT; ++i) {
+        const volfx_range *r = row_at(i);
         const fmap *m = &MAP[i];
         if (m->kind == K_NONE)
             fail_msg("row %s has no entry in this test's MAP", r->field);
@@ -410,9 +431,15 @@ static void test_beam_abi_values(void **state)
     l.surge_amount = 4, l.surge_wavelength = 1e-6f, l.orb_radius = 0.2f, l.orb_strength = 1e6f, l.taper = 0.95f, l.core = 1;
     expect(c, volfx_beam_check_ranges(c, 3, &l), VFX_OK, NULL);
     vfx_beams_view v = {.type = VFX_TYPE_BEAMS_VIEW, .saturate_c = -1};
-    expect(c, volfx_beams_view_check_ranges(c, &v, 0), VFX_ERR_INVALID_ARGUMENT, "vfx_beams_view.saturate_c -1");
-    v.saturate_c = 0;
-    expect(c, volfx_beams_view_check_ranges(c, &v, 5000), VFX_ERR_INVALID_ARGUMENT, "vfx_lab_beams.march_samples 5000");
+    expect(c, volfx_beams_view_check_ranges(c, &v), VFX_ERR_INVALID_ARGUMENT, "vfx_beams_view.saturate_c -1");
+    vfx_lab_beams lb = {.type = VFX_TYPE_LAB_BEAMS, .method = VFX_BEAMS_METHOD_MARCH, .march_samples = 5000};
+    uint32_t method = 0;
+    expect(c, volfx_lab_beams_struct(c, &lb, &method), VFX_ERR_INVALID_ARGUMENT, "vfx_lab_beams.march_samples 5000");
+    lb.march_samples = 0;
+    expect(c, volfx_lab_beams_struct(c, &lb, &method), VFX_OK, NULL);
+    assert_int_equal(method, 32); /* the baseline's default samples */
+    lb.method = 2;
+    expect(c, volfx_lab_beams_struct(c, &lb, &method), VFX_ERR_INVALID_ARGUMENT, "vfx_lab_beams.method 2 unknown");
     free(c);
 }
 

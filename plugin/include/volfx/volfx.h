@@ -464,7 +464,7 @@ typedef struct vfx_volume_view {
     X(BEAM_FIELD, 37)         /* a vfx_beam field not finite, unknown (falloff, ramp) or degenerate */ \
     X(BEAM_JOINTS, 38)        /* a bending beam's joints refused (range in the view, count, values) */ \
     X(BEAMS_COUNT, 39)        /* more than 2^20 beams, or a count with a NULL array */ \
-    X(BEAMS_VIEW_FIELD, 40)   /* a vfx_beams_view or vfx_lab_beams value unknown (lab method) */ \
+    X(BEAMS_VIEW_FIELD, 40)   /* a vfx_beams_view value unknown, or a lab struct in its chain */ \
     X(BEAMS_TILE_PAIRS, 41)   /* the beams cover more beam-tile pairs than the binning holds */ \
     X(WATER_PARAM, 42)        /* a vfx_water_params value unknown (method, preset, bits...) or two at odds */ \
     X(WATER_PARTICLE_VALUE, 43) /* a particle's radius or kernel column value refused */ \

@@ -21,7 +21,10 @@
 #define VFX_RANGE_FLOAT_MAX 3.4028234663852886e38
 #define VFX_RANGE_DOUBLE_MAX 1.7976931348623157e308
 
-/* X(ID, ABI field, scene key or "-", lo, hi, flags, note): every vector component is checked. */
+/* X(ID, ABI field, scene key or "-", lo, hi, flags, note): every vector component is checked.
+ * A VFX_RANGE_<ID> is the row's place in this table, for use at compile time (no ABI call takes
+ * one): a row is added beside its struct's, so the numbers of the rows after it move between
+ * versions; name rows by their ID, never by number. */
 #define VFX_RANGE_TABLE(X) \
     X(WATER_H, "vfx_water_params.h", "water.h", 1e-12, 1e3, VFX_RANGE_ZERO, "0: 2 x the particles' spacing, refused below 1e-12 too (h^3 is a normal float32)") \
     X(WATER_THRESHOLD, "vfx_water_params.threshold", "water.threshold", 0, 1e3, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "") \
@@ -101,7 +104,6 @@
     X(BEAMS_JOINT_COUNT, "vfx_beams_view.joint_count", "-", 0, 0, VFX_RANGE_ANY, "the joints array's triples") \
     X(BEAMS_C, "vfx_beams_view.saturate_c", "beam_settings.c", 0, 1e6, VFX_RANGE_LO_OPEN | VFX_RANGE_ZERO, "") \
     X(BEAMS_FAR, "vfx_beams_view.far_distance", "beam_settings.far_distance", 0, 1e6, 0, "0: the camera's far plane") \
-    X(BEAMS_MARCH_SAMPLES, "vfx_lab_beams.march_samples", "-", 1, 4096, VFX_RANGE_INT | VFX_RANGE_ZERO, "") \
     X(BEAMS_BLOOM_STRENGTH, "vfx_beams_view.bloom_strength", "beam_settings.bloom_strength", 0, 1e6, 0, "0: 0.6") \
     X(BEAMS_BLOOM_LEVELS, "vfx_beams_view.bloom_levels", "beam_settings.bloom_levels", 1, 8, VFX_RANGE_INT | VFX_RANGE_ZERO, "") \
     X(VOLUME_POINT_COUNT, "vfx_volume_view.point_count", "-", 0, 0, VFX_RANGE_ANY, "the points array's; every tet index is checked against it") \
