@@ -130,26 +130,35 @@ static double stat(game_app *app, const char *name)
     return 0;
 }
 
-static run_result run(double strength, bool spray, const char *preset, int frames)
+/* Writes `text` to a temporary scene file named after `tmpl` (ending ".json"), opens the headless
+ * game on it (skips the test without GL) and removes the file; *log collects the game's log. */
+static game_app *open_scene(const char *tmpl, const char *text, test_log *log, game_demo *demo)
 {
-    assert_true(frames <= MAX_FRAMES);
-    char path[] = "/tmp/volfx-strike-XXXXXX.json";
+    char path[64];
+    snprintf(path, sizeof path, "%s", tmpl);
     int fd = mkstemps(path, 5);
     assert_true(fd >= 0);
     FILE *f = fdopen(fd, "w");
-    fputs(scene_text(strength, spray, preset), f);
+    fputs(text, f);
     fclose(f);
-    test_log log = {0};
-    game_app_desc d = {.mode = RT_GL_HEADLESS, .width = 96, .height = 64, .logger = {test_log_fn, &log}};
+    game_app_desc d = {.mode = RT_GL_HEADLESS, .width = 96, .height = 64, .logger = {test_log_fn, log}};
     game_app *app;
     if (game_app_create(&d, &app) != VFX_OK)
         exit(VFX_TEST_SKIP);
-    game_demo demo;
-    vfx_result lr = game_demo_load(app, &demo, path, 0);
+    vfx_result lr = game_demo_load(app, demo, path, 0);
     if (lr)
-        printf("load: %s\n", log.last);
+        printf("load: %s\n", log->last);
     assert_int_equal(lr, VFX_OK);
     remove(path);
+    return app;
+}
+
+static run_result run(double strength, bool spray, const char *preset, int frames)
+{
+    assert_true(frames <= MAX_FRAMES);
+    test_log log = {0};
+    game_demo demo;
+    game_app *app = open_scene("/tmp/volfx-strike-XXXXXX.json", scene_text(strength, spray, preset), &log, &demo);
     run_result res = {.first_event = -1, .first_spray = -1, .first_seen = -1, .first_steam = -1, .steam_low = INFINITY};
     float hit[3] = {0};
     uint32_t *near = NULL;
@@ -312,23 +321,9 @@ static void foam_of(game_app *app, foam_run *fr, int fr_no)
 
 static void run_foam(foam_run *res, const char *extra)
 {
-    char path[] = "/tmp/volfx-strike-foam-XXXXXX.json";
-    int fd = mkstemps(path, 5);
-    assert_true(fd >= 0);
-    FILE *f = fdopen(fd, "w");
-    fputs(scene_text_foam(STRENGTH, extra), f);
-    fclose(f);
     test_log log = {0};
-    game_app_desc d = {.mode = RT_GL_HEADLESS, .width = 96, .height = 64, .logger = {test_log_fn, &log}};
-    game_app *app;
-    if (game_app_create(&d, &app) != VFX_OK)
-        exit(VFX_TEST_SKIP);
     game_demo demo;
-    vfx_result lr = game_demo_load(app, &demo, path, 0);
-    if (lr)
-        printf("load: %s\n", log.last);
-    assert_int_equal(lr, VFX_OK);
-    remove(path);
+    game_app *app = open_scene("/tmp/volfx-strike-foam-XXXXXX.json", scene_text_foam(STRENGTH, extra), &log, &demo);
     memset(res, 0, sizeof *res);
     for (int fr = 0; fr < FOAM_FRAMES; ++fr) {
         game_demo_animate(app, &demo, 1.f / 60.f);
